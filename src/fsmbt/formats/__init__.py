@@ -1,0 +1,9 @@
+"""File formats: one module per format, each registering itself in ``registry``."""
+
+from fsmbt.formats.registry import (
+    Format, ReadContext, detect_format, dumps, formats, get_format, loads, read_model, register,
+    write_model,
+)
+
+__all__ = ["Format", "ReadContext", "detect_format", "dumps", "formats", "get_format", "loads",
+           "read_model", "register", "write_model"]

@@ -1,0 +1,198 @@
+"""One registry of file formats: each format module registers a reader and/or writer here.
+
+Reading goes through ``read_model`` (file) or ``loads`` (text); both check size and encoding
+before any parser sees the bytes, pick the format from ``--from``, the extension or the content,
+and raise ``InputError`` with the file name on any problem. Writing never overwrites a file unless
+asked to.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from fsmbt.model.errors import InputError, SourceLocation
+
+if TYPE_CHECKING:
+    from fsmbt.model import Model
+
+#: Inputs larger than this are refused before parsing (a model this big is not a model).
+MAX_INPUT_BYTES = 64 * 1024 * 1024
+
+Reader = Callable[[str, "ReadContext"], "Model"]
+Writer = Callable[["Model"], str]
+
+
+@dataclass
+class ReadContext:
+    """What a reader may need besides the text: the file (errors, relative includes)."""
+
+    path: Path | None = None
+    options: dict[str, object] = field(default_factory=dict)
+
+    @property
+    def display_name(self) -> str:
+        return str(self.path) if self.path is not None else "<input>"
+
+    def location(self, line: int | None = None, column: int | None = None) -> SourceLocation:
+        return SourceLocation(self.display_name, line, column)
+
+
+@dataclass(frozen=True)
+class Format:
+    """A file format: a name for ``--from/--to``, extensions, which models it holds."""
+
+    name: str
+    extensions: tuple[str, ...]
+    kinds: frozenset[str]  # subset of {"fsm", "bt"}
+    description: str
+    read: Reader | None = None
+    write: Writer | None = None
+    sniff: Callable[[str], bool] | None = None
+    priority: int = 50  # lower is tried first when sniffing content
+
+
+_FORMATS: dict[str, Format] = {}
+
+
+def register(fmt: Format) -> Format:
+    _FORMATS[fmt.name] = fmt
+    return fmt
+
+
+def formats() -> list[Format]:
+    _load_builtin_formats()
+    return sorted(_FORMATS.values(), key=lambda f: (f.priority, f.name))
+
+
+def get_format(name: str) -> Format:
+    _load_builtin_formats()
+    try:
+        return _FORMATS[name.lower()]
+    except KeyError:
+        known = ", ".join(sorted(_FORMATS))
+        raise InputError(f"unknown format '{name}' (known: {known})") from None
+
+
+def _load_builtin_formats() -> None:
+    """Import every format module once so each registers itself."""
+    import importlib
+    import pkgutil
+
+    import fsmbt.formats as package
+
+    for info in pkgutil.iter_modules(package.__path__):
+        if info.name not in ("registry",) and not info.name.startswith("_"):
+            importlib.import_module(f"fsmbt.formats.{info.name}")
+
+
+def format_for_path(path: Path, *, writing: bool = False, kind: str | None = None) -> Format | None:
+    """The format whose extension matches ``path`` (``None`` when no extension matches)."""
+    suffixes = "".join(path.suffixes).lower()
+    candidates = [
+        f for f in formats()
+        if any(suffixes.endswith(ext) for ext in f.extensions)
+        and (f.write if writing else f.read) is not None
+        and (kind is None or kind in f.kinds)
+    ]
+    if not candidates:
+        return None
+    candidates.sort(key=lambda f: -max(len(e) for e in f.extensions if suffixes.endswith(e)))
+    return candidates[0]
+
+
+def detect_format(text: str, path: Path | None = None) -> Format:
+    """Pick a reader: content sniffing first (extensions lie), then the extension."""
+    for fmt in formats():
+        if fmt.read is not None and fmt.sniff is not None and fmt.sniff(text):
+            return fmt
+    if path is not None:
+        by_ext = format_for_path(path)
+        if by_ext is not None:
+            return by_ext
+    raise InputError("cannot tell the format of this input; name it with --from "
+                     f"({', '.join(f.name for f in formats() if f.read)})",
+                     location=SourceLocation(str(path) if path else None))
+
+
+def decode(data: bytes, name: str) -> str:
+    """Bytes to text: UTF-8 (with or without BOM) or UTF-16 with BOM; binary is refused."""
+    location = SourceLocation(name)
+    if not data.strip():
+        raise InputError("empty input: no model in it", location=location)
+    if data.startswith((b"\xff\xfe", b"\xfe\xff")):
+        try:
+            return data.decode("utf-16")
+        except UnicodeDecodeError as exc:
+            raise InputError(f"invalid UTF-16 at byte {exc.start}", location=location) from None
+    if b"\x00" in data[:8192]:
+        raise InputError("binary data, not a text model", location=location)
+    try:
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        line = data[: exc.start].count(b"\n") + 1
+        raise InputError(
+            f"not valid UTF-8 at byte {exc.start} (line {line}); save the file as UTF-8",
+            location=location) from None
+
+
+def loads(text: str, fmt: str | None = None, *, path: Path | None = None,
+          options: dict[str, object] | None = None) -> Model:
+    """Parse a model from text (format by name, or detected)."""
+    chosen = get_format(fmt) if fmt else detect_format(text, path)
+    if chosen.read is None:
+        raise InputError(f"format '{chosen.name}' can be written but not read")
+    return chosen.read(text, ReadContext(path=path, options=dict(options or {})))
+
+
+def read_model(path: str | Path, fmt: str | None = None,
+               options: dict[str, object] | None = None) -> Model:
+    """Read one model file: size and encoding checks, then the format's reader."""
+    path = Path(path)
+    try:
+        size = path.stat().st_size
+        if size > MAX_INPUT_BYTES:
+            raise InputError(f"input is {size} bytes; the limit is {MAX_INPUT_BYTES}",
+                             location=SourceLocation(str(path)))
+        if path.is_dir():
+            raise InputError("is a directory, not a model file", location=SourceLocation(str(path)))
+        data = path.read_bytes()
+    except OSError as exc:
+        raise InputError(f"cannot read: {exc.strerror}", location=SourceLocation(str(path))) from None
+    return loads(decode(data, str(path)), fmt, path=path, options=options)
+
+
+def dumps(model: Model, fmt: str) -> str:
+    chosen = get_format(fmt)
+    kind = "bt" if not _is_fsm(model) else "fsm"
+    if chosen.write is None:
+        raise InputError(f"format '{chosen.name}' can be read but not written")
+    if kind not in chosen.kinds:
+        raise InputError(f"format '{chosen.name}' cannot hold a {kind.upper()}")
+    return chosen.write(model)
+
+
+def write_model(model: Model, path: str | Path, fmt: str | None = None, *,
+                overwrite: bool = False) -> Path:
+    """Write a model; refuses to replace an existing file unless ``overwrite``."""
+    path = Path(path)
+    kind = "fsm" if _is_fsm(model) else "bt"
+    chosen = get_format(fmt) if fmt else format_for_path(path, writing=True, kind=kind)
+    if chosen is None:
+        raise InputError(f"cannot tell the output format from '{path.name}'; use --to")
+    text = dumps(model, chosen.name)
+    if path.exists() and not overwrite:
+        raise InputError("exists; pass --force to overwrite it", location=SourceLocation(str(path)))
+    try:
+        path.write_text(text, encoding="utf-8")
+    except OSError as exc:
+        raise InputError(f"cannot write: {exc.strerror}", location=SourceLocation(str(path))) from None
+    return path
+
+
+def _is_fsm(model: object) -> bool:
+    from fsmbt.model.fsm import FSM
+
+    return isinstance(model, FSM)

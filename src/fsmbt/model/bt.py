@@ -1,0 +1,118 @@
+"""The behavior tree model (DESIGN §1), kept close to BehaviorTree.CPP v4's XML.
+
+A ``BTDocument`` is what one file (plus its includes) holds: several ``BehaviorTree`` s, the one to
+execute, and the ``TreeNodesModel`` declarations. Attributes and ports stay on the nodes in order,
+so reading and writing a file loses nothing.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+
+from fsmbt.model.bt_nodes import NodeKind, builtin_spec
+from fsmbt.model.errors import SourceLocation
+
+
+@dataclass
+class BTNode:
+    """One node. ``type`` is the v4 registration ID (``Sequence``, ``Inverter``, ``MoveTo``...).
+
+    ``attrs`` holds every XML attribute except ``name`` (ports included), in file order. For a
+    ``SubTree`` node the referenced tree is ``attrs["ID"]``. ``kind_declared`` is False when a
+    leaf's kind was not declared anywhere and was assumed (Action, the safe choice: it may
+    return RUNNING).
+    """
+
+    type: str
+    kind: NodeKind
+    name: str | None = None
+    attrs: dict[str, str] = field(default_factory=dict)
+    children: list[BTNode] = field(default_factory=list)
+    kind_declared: bool = True
+    location: SourceLocation | None = field(default=None, compare=False, repr=False)
+
+    @property
+    def label(self) -> str:
+        """What a person calls this node: its name, else its type."""
+        return self.name or self.type
+
+    @property
+    def is_leaf(self) -> bool:
+        return self.kind in (NodeKind.ACTION, NodeKind.CONDITION)
+
+    @property
+    def is_builtin(self) -> bool:
+        return builtin_spec(self.type) is not None
+
+    @property
+    def subtree_id(self) -> str | None:
+        return self.attrs.get("ID") if self.kind is NodeKind.SUBTREE else None
+
+    def walk(self) -> Iterator[BTNode]:
+        """Pre-order traversal without recursion (trees may be 100 000 deep)."""
+        stack: list[BTNode] = [self]
+        while stack:
+            node = stack.pop()
+            yield node
+            stack.extend(reversed(node.children))
+
+
+@dataclass
+class PortModel:
+    name: str
+    direction: str = "input"  # input | output | inout
+    default: str | None = None
+    description: str | None = None
+    type: str | None = None
+
+
+@dataclass
+class NodeModel:
+    """A ``<TreeNodesModel>`` entry: declares a custom node type's kind and ports (for Groot2)."""
+
+    type: str
+    kind: NodeKind
+    ports: list[PortModel] = field(default_factory=list)
+    attrs: dict[str, str] = field(default_factory=dict)
+
+
+@dataclass
+class BehaviorTree:
+    id: str
+    root: BTNode | None
+    attrs: dict[str, str] = field(default_factory=dict)
+    location: SourceLocation | None = field(default=None, compare=False, repr=False)
+
+
+@dataclass
+class BTDocument:
+    """Everything one BT file holds. ``main_tree`` is the tree to execute."""
+
+    trees: dict[str, BehaviorTree] = field(default_factory=dict)
+    main_tree: str | None = None
+    node_models: dict[str, NodeModel] = field(default_factory=dict)
+    format_version: str = "4"
+    includes: list[str] = field(default_factory=list)
+    attrs: dict[str, str] = field(default_factory=dict)
+
+    @classmethod
+    def single(cls, root: BTNode, tree_id: str = "MainTree") -> BTDocument:
+        """A document with one tree, the usual shape of a converter's output."""
+        return cls(trees={tree_id: BehaviorTree(tree_id, root)}, main_tree=tree_id)
+
+    @property
+    def main(self) -> BehaviorTree:
+        """The tree to execute: ``main_tree``, else the only / first tree."""
+        if self.main_tree is not None and self.main_tree in self.trees:
+            return self.trees[self.main_tree]
+        if not self.trees:
+            raise KeyError("the document holds no behavior tree")
+        return next(iter(self.trees.values()))
+
+    def nodes(self) -> Iterator[tuple[str, BTNode]]:
+        """Every node of every tree as ``(tree id, node)``."""
+        for tree in self.trees.values():
+            if tree.root is not None:
+                for node in tree.root.walk():
+                    yield tree.id, node

@@ -1,0 +1,139 @@
+"""The finite state machine model, flat or hierarchical (DESIGN §1).
+
+Semantics in one paragraph: the machine starts in ``initial`` (or, when ``initial_event`` is set,
+in the start pseudo-state ``start_name`` and moves to ``initial`` on that event). Entering a state
+runs its ``action`` (``None`` = runs nothing). An event with no transition from the current state
+is ignored. Deterministic: at most one target per (source, event). A final state accepts no event.
+
+Hierarchy: a state with one region is composite (a sub-FSM with its own initial and final
+states); with several regions it is parallel (orthogonal regions, all active at once). A
+transition whose ``event`` is ``None`` is a completion transition: from a composite state it fires
+when the sub-FSM reaches a final state (``exit`` names which one; ``None`` = any); from an atomic
+state it fires as soon as the state is entered. ``fsmbt.model.flatten`` gives the plain FSM every
+check works on.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+
+from fsmbt.model.errors import SourceLocation
+
+
+@dataclass
+class State:
+    """One state. ``action`` defaults to the state's name in every reader."""
+
+    name: str
+    action: str | None = None
+    final: bool = False
+    regions: list[FSM] = field(default_factory=list)
+    attrs: dict[str, str] = field(default_factory=dict)
+    location: SourceLocation | None = field(default=None, compare=False, repr=False)
+
+    @property
+    def is_composite(self) -> bool:
+        return len(self.regions) == 1
+
+    @property
+    def is_parallel(self) -> bool:
+        return len(self.regions) > 1
+
+    @property
+    def is_atomic(self) -> bool:
+        return not self.regions
+
+
+@dataclass
+class Transition:
+    """``source --event--> target``; ``event=None`` is a completion (eventless) transition."""
+
+    source: str
+    event: str | None
+    target: str
+    exit: str | None = None
+    attrs: dict[str, str] = field(default_factory=dict)
+    location: SourceLocation | None = field(default=None, compare=False, repr=False)
+
+
+@dataclass
+class FSM:
+    """A (possibly hierarchical) deterministic state machine; states keep insertion order."""
+
+    name: str = "fsm"
+    states: dict[str, State] = field(default_factory=dict)
+    transitions: list[Transition] = field(default_factory=list)
+    initial: str | None = None
+    start_name: str | None = None
+    initial_event: str | None = None
+    attrs: dict[str, str] = field(default_factory=dict)
+
+    # -- building -------------------------------------------------------------------------
+    def add_state(self, state: State | str, **kwargs: object) -> State:
+        """Add a state (a ``State`` or a name plus ``State`` fields); the first becomes initial."""
+        if isinstance(state, str):
+            kwargs.setdefault("action", state)
+            state = State(state, **kwargs)  # type: ignore[arg-type]
+        self.states[state.name] = state
+        if self.initial is None:
+            self.initial = state.name
+        return state
+
+    def add_transition(
+        self, source: str, event: str | None, target: str, **kwargs: object
+    ) -> Transition:
+        transition = Transition(source, event, target, **kwargs)  # type: ignore[arg-type]
+        self.transitions.append(transition)
+        return transition
+
+    # -- queries ----------------------------------------------------------------------------
+    @property
+    def is_hierarchical(self) -> bool:
+        return any(not s.is_atomic for s in self.states.values())
+
+    def events(self) -> list[str]:
+        """Events in order of first appearance (the initial event included)."""
+        seen: dict[str, None] = {}
+        if self.initial_event is not None:
+            seen[self.initial_event] = None
+        for t in self.transitions:
+            if t.event is not None:
+                seen.setdefault(t.event, None)
+        return list(seen)
+
+    def outgoing(self, source: str) -> list[Transition]:
+        return [t for t in self.transitions if t.source == source]
+
+    def transition_map(self) -> dict[str, dict[str | None, Transition]]:
+        """``{source: {event: transition}}``; the first transition wins on a conflict."""
+        table: dict[str, dict[str | None, Transition]] = {name: {} for name in self.states}
+        for t in self.transitions:
+            table.setdefault(t.source, {}).setdefault(t.event, t)
+        return table
+
+    def predecessors(self, target: str) -> list[str]:
+        """Distinct sources of transitions into ``target`` (the start pseudo-state included)."""
+        preds: dict[str, None] = {}
+        if target == self.initial and self.start_name is not None:
+            preds[self.start_name] = None
+        for t in self.transitions:
+            if t.target == target:
+                preds.setdefault(t.source, None)
+        return list(preds)
+
+    def successors(self, source: str) -> list[str]:
+        succ: dict[str, None] = {}
+        for t in self.transitions:
+            if t.source == source:
+                succ.setdefault(t.target, None)
+        return list(succ)
+
+    def walk(self, prefix: str = "") -> Iterator[tuple[str, FSM, State]]:
+        """Every state at every level as ``(path, owning machine, state)``, pre-order."""
+        for state in self.states.values():
+            path = f"{prefix}{state.name}"
+            yield path, self, state
+            for index, region in enumerate(state.regions):
+                sub = f"{path}/" if state.is_composite else f"{path}/{index}:"
+                yield from region.walk(sub)

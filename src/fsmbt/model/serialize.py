@@ -1,0 +1,230 @@
+"""fsmbt's own JSON form of every model (documented in docs/formats.md).
+
+The same plain dictionaries back the JSON and YAML formats and the LLM path's output schema, so
+there is one schema. ``"kind"`` says which model a dictionary holds: ``"fsm"`` (flat or
+hierarchical) or ``"bt"``.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from fsmbt.model.bt import BehaviorTree, BTDocument, BTNode, NodeModel, PortModel
+from fsmbt.model.bt_nodes import NodeKind
+from fsmbt.model.errors import InputError
+from fsmbt.model.fsm import FSM, State, Transition
+
+SCHEMA_VERSION = 1
+
+
+# -- FSM ----------------------------------------------------------------------------------------
+def fsm_to_dict(fsm: FSM) -> dict[str, Any]:
+    out: dict[str, Any] = {"kind": "fsm", "schema": SCHEMA_VERSION}
+    out.update(_machine_to_dict(fsm))
+    return out
+
+
+def _machine_to_dict(fsm: FSM) -> dict[str, Any]:
+    out: dict[str, Any] = {"name": fsm.name, "initial": fsm.initial}
+    if fsm.start_name is not None:
+        out["start"] = fsm.start_name
+    if fsm.initial_event is not None:
+        out["initial_event"] = fsm.initial_event
+    out["states"] = [_state_to_dict(s) for s in fsm.states.values()]
+    out["transitions"] = [_transition_to_dict(t) for t in fsm.transitions]
+    if fsm.attrs:
+        out["attrs"] = dict(fsm.attrs)
+    return out
+
+
+def _state_to_dict(state: State) -> dict[str, Any]:
+    out: dict[str, Any] = {"name": state.name, "action": state.action}
+    if state.final:
+        out["final"] = True
+    if state.regions:
+        out["regions"] = [_machine_to_dict(r) for r in state.regions]
+    if state.attrs:
+        out["attrs"] = dict(state.attrs)
+    return out
+
+
+def _transition_to_dict(t: Transition) -> dict[str, Any]:
+    out: dict[str, Any] = {"source": t.source, "event": t.event, "target": t.target}
+    if t.exit is not None:
+        out["exit"] = t.exit
+    if t.attrs:
+        out["attrs"] = dict(t.attrs)
+    return out
+
+
+def fsm_from_dict(data: dict[str, Any], *, where: str = "fsm") -> FSM:
+    _expect(isinstance(data, dict), where, "expected an object")
+    return _machine_from_dict(data, where)
+
+
+def _machine_from_dict(data: dict[str, Any], where: str) -> FSM:
+    fsm = FSM(name=str(data.get("name", "fsm")))
+    states = data.get("states", [])
+    _expect(isinstance(states, list), f"{where}.states", "expected a list")
+    for i, s in enumerate(states):
+        path = f"{where}.states[{i}]"
+        _expect(isinstance(s, dict) and isinstance(s.get("name"), str), path,
+                "a state needs a string 'name'")
+        if s["name"] in fsm.states:
+            raise InputError(f"duplicate state '{s['name']}'", element=path)
+        regions = [
+            _machine_from_dict(r, f"{path}.regions[{j}]")
+            for j, r in enumerate(_as_list(s.get("regions", []), f"{path}.regions"))
+        ]
+        fsm.add_state(State(
+            s["name"],
+            action=s.get("action", s["name"]),
+            final=bool(s.get("final", False)),
+            regions=regions,
+            attrs=_str_dict(s.get("attrs", {})),
+        ))
+    transitions = _as_list(data.get("transitions", []), f"{where}.transitions")
+    for i, t in enumerate(transitions):
+        path = f"{where}.transitions[{i}]"
+        _expect(isinstance(t, dict) and isinstance(t.get("source"), str)
+                and isinstance(t.get("target"), str), path,
+                "a transition needs string 'source' and 'target'")
+        event = t.get("event")
+        _expect(event is None or isinstance(event, str), path, "'event' must be a string or null")
+        fsm.add_transition(t["source"], event, t["target"], exit=t.get("exit"),
+                           attrs=_str_dict(t.get("attrs", {})))
+    if "initial" in data:
+        fsm.initial = data["initial"]
+    fsm.start_name = data.get("start")
+    fsm.initial_event = data.get("initial_event")
+    fsm.attrs = _str_dict(data.get("attrs", {}))
+    return fsm
+
+
+# -- BT -----------------------------------------------------------------------------------------
+def bt_to_dict(doc: BTDocument) -> dict[str, Any]:
+    out: dict[str, Any] = {
+        "kind": "bt",
+        "schema": SCHEMA_VERSION,
+        "format_version": doc.format_version,
+        "main_tree": doc.main_tree,
+        "trees": [
+            {"id": t.id, "root": node_to_dict(t.root) if t.root is not None else None,
+             **({"attrs": dict(t.attrs)} if t.attrs else {})}
+            for t in doc.trees.values()
+        ],
+    }
+    if doc.node_models:
+        out["node_models"] = [
+            {"type": m.type, "kind": m.kind.value,
+             "ports": [vars(p).copy() for p in m.ports],
+             **({"attrs": dict(m.attrs)} if m.attrs else {})}
+            for m in doc.node_models.values()
+        ]
+    if doc.includes:
+        out["includes"] = list(doc.includes)
+    if doc.attrs:
+        out["attrs"] = dict(doc.attrs)
+    return out
+
+
+def node_to_dict(root: BTNode) -> dict[str, Any]:
+    """Iterative, so 100 000-deep trees do not hit the recursion limit."""
+    def shallow(node: BTNode) -> dict[str, Any]:
+        d: dict[str, Any] = {"type": node.type, "kind": node.kind.value}
+        if node.name is not None:
+            d["name"] = node.name
+        if node.attrs:
+            d["attrs"] = dict(node.attrs)
+        if not node.kind_declared:
+            d["kind_declared"] = False
+        return d
+
+    top = shallow(root)
+    stack = [(root, top)]
+    while stack:
+        node, out = stack.pop()
+        if node.children:
+            kids = [shallow(c) for c in node.children]
+            out["children"] = kids
+            stack.extend(zip(node.children, kids))
+    return top
+
+
+def node_from_dict(data: dict[str, Any], where: str = "node") -> BTNode:
+    def shallow(d: Any, path: str) -> BTNode:
+        _expect(isinstance(d, dict) and isinstance(d.get("type"), str), path,
+                "a node needs a string 'type'")
+        try:
+            kind = NodeKind(d.get("kind", "Action"))
+        except ValueError:
+            raise InputError(f"unknown node kind {d.get('kind')!r}", element=path) from None
+        return BTNode(type=d["type"], kind=kind, name=d.get("name"),
+                      attrs=_str_dict(d.get("attrs", {})),
+                      kind_declared=bool(d.get("kind_declared", True)))
+
+    root = shallow(data, where)
+    stack = [(data, root, where)]
+    while stack:
+        d, node, path = stack.pop()
+        for i, c in enumerate(_as_list(d.get("children", []), f"{path}.children")):
+            child = shallow(c, f"{path}.children[{i}]")
+            node.children.append(child)
+            stack.append((c, child, f"{path}.children[{i}]"))
+    return root
+
+
+def bt_from_dict(data: dict[str, Any], *, where: str = "bt") -> BTDocument:
+    _expect(isinstance(data, dict), where, "expected an object")
+    doc = BTDocument(format_version=str(data.get("format_version", "4")),
+                     main_tree=data.get("main_tree"),
+                     includes=[str(i) for i in data.get("includes", [])],
+                     attrs=_str_dict(data.get("attrs", {})))
+    for i, t in enumerate(_as_list(data.get("trees", []), f"{where}.trees")):
+        path = f"{where}.trees[{i}]"
+        _expect(isinstance(t, dict) and isinstance(t.get("id"), str), path,
+                "a tree needs a string 'id'")
+        root = node_from_dict(t["root"], f"{path}.root") if t.get("root") is not None else None
+        doc.trees[t["id"]] = BehaviorTree(t["id"], root, attrs=_str_dict(t.get("attrs", {})))
+    for i, m in enumerate(_as_list(data.get("node_models", []), f"{where}.node_models")):
+        path = f"{where}.node_models[{i}]"
+        _expect(isinstance(m, dict) and isinstance(m.get("type"), str), path,
+                "a node model needs a string 'type'")
+        try:
+            kind = NodeKind(m.get("kind", "Action"))
+        except ValueError:
+            raise InputError(f"unknown node kind {m.get('kind')!r}", element=path) from None
+        ports = [PortModel(**p) for p in _as_list(m.get("ports", []), f"{path}.ports")]
+        doc.node_models[m["type"]] = NodeModel(m["type"], kind, ports, _str_dict(m.get("attrs", {})))
+    return doc
+
+
+# -- either -------------------------------------------------------------------------------------
+def model_to_dict(model: FSM | BTDocument) -> dict[str, Any]:
+    return fsm_to_dict(model) if isinstance(model, FSM) else bt_to_dict(model)
+
+
+def model_from_dict(data: Any, *, where: str = "model") -> FSM | BTDocument:
+    _expect(isinstance(data, dict), where, "expected a JSON/YAML object")
+    kind = data.get("kind")
+    if kind == "fsm":
+        return fsm_from_dict(data, where=where)
+    if kind == "bt":
+        return bt_from_dict(data, where=where)
+    raise InputError(f"'kind' must be \"fsm\" or \"bt\", not {kind!r}", element=where)
+
+
+def _expect(ok: bool, where: str, message: str) -> None:
+    if not ok:
+        raise InputError(message, element=where)
+
+
+def _as_list(value: Any, where: str) -> list[Any]:
+    _expect(isinstance(value, list), where, "expected a list")
+    return value
+
+
+def _str_dict(value: Any) -> dict[str, str]:
+    if not isinstance(value, dict):
+        return {}
+    return {str(k): str(v) for k, v in value.items()}

@@ -1,0 +1,1 @@
+"""Executable semantics: BT interpreter, FSM runner, LEBT protocol, explored machines."""

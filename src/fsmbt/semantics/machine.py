@@ -1,0 +1,100 @@
+"""The one shape every behaviour is explored in: a deterministic Mealy machine with a status.
+
+The checker (``fsmbt.verify``) and NuSMV's encoding compare two such machines fed the same
+inputs. What counts as an input and an output depends on the pair (DESIGN §2, §3):
+
+- FSM vs LEBT (macro steps): inputs are events; outputs are the actions run; status is
+  ``"final"`` when the FSM is in a final state / the LEBT has terminated, else ``"running"``.
+- BT vs FSM (leaf execution): inputs are leaf outcomes ``success``/``failure``/``running``;
+  outputs name the next leaf ticked, or the root's result; status is ``"SUCCESS"``/``"FAILURE"``
+  when the root has returned, else ``"running"``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Hashable, Sequence
+from typing import Protocol, TypeVar
+
+from fsmbt.model.flatten import flatten
+from fsmbt.model.fsm import FSM
+
+S = TypeVar("S", bound=Hashable)
+Outputs = tuple[str, ...]
+
+RUNNING = "running"
+FINAL = "final"
+
+
+class Machine(Protocol[S]):
+    """A deterministic machine the checker can explore breadth first."""
+
+    name: str
+
+    def start(self) -> tuple[S, Outputs]:
+        """The initial state and what is output on start (e.g. the initial state's action)."""
+        ...
+
+    def inputs(self, state: S) -> Sequence[str]:
+        """Inputs the environment may give in ``state`` (a condition leaf never says running)."""
+        ...
+
+    def step(self, state: S, symbol: str) -> tuple[S, Outputs]:
+        """The next state and the outputs of consuming ``symbol``."""
+        ...
+
+    def status(self, state: S) -> str:
+        """``"running"``, or the terminal status the environment can observe."""
+        ...
+
+    def describe(self, state: S) -> str:
+        """A short human-readable name for traces."""
+        ...
+
+
+class FSMMachine:
+    """The macro-step machine of an FSM (hierarchical ones flattened first).
+
+    A state is the flat state's name, or the start pseudo-state before the initial event.
+    An event without a transition is ignored (no output); a final state ignores every event.
+    Complexity: O(1) per step after an O(T) table build.
+    """
+
+    def __init__(self, fsm: FSM, *, alphabet: Sequence[str] | None = None) -> None:
+        self.fsm = flatten(fsm)
+        self.name = self.fsm.name
+        self.start_state = self.fsm.start_name or "__start__"
+        self.table = self.fsm.transition_map()
+        self.alphabet: tuple[str, ...] = tuple(alphabet if alphabet is not None else self.fsm.events())
+
+    def start(self) -> tuple[str, Outputs]:
+        assert self.fsm.initial is not None, "validated FSMs have an initial state"
+        if self.fsm.initial_event is not None:
+            return self.start_state, ()
+        return self.fsm.initial, self._entry(self.fsm.initial)
+
+    def inputs(self, state: str) -> Sequence[str]:
+        return self.alphabet
+
+    def step(self, state: str, symbol: str) -> tuple[str, Outputs]:
+        if state == self.start_state and state not in self.fsm.states:
+            if symbol == self.fsm.initial_event:
+                assert self.fsm.initial is not None
+                return self.fsm.initial, self._entry(self.fsm.initial)
+            return state, ()
+        if self.fsm.states[state].final:
+            return state, ()
+        transition = self.table.get(state, {}).get(symbol)
+        if transition is None:
+            return state, ()
+        return transition.target, self._entry(transition.target)
+
+    def status(self, state: str) -> str:
+        known = self.fsm.states.get(state)
+        return FINAL if known is not None and known.final else RUNNING
+
+    def describe(self, state: str) -> str:
+        return state
+
+    def _entry(self, name: str) -> Outputs:
+        action = self.fsm.states[name].action
+        return (action,) if action is not None else ()
