@@ -31,6 +31,12 @@ class ReadContext:
 
     path: Path | None = None
     options: dict[str, object] = field(default_factory=dict)
+    warnings: list[str] = field(default_factory=list)
+
+    def warn(self, message: str, line: int | None = None, element: str | None = None) -> None:
+        """Record a documented, non-fatal deviation (e.g. an ignored SCXML datamodel)."""
+        where = f"{self.location(line)}: " + (f"{element}: " if element else "")
+        self.warnings.append(f"{where}{message}")
 
     @property
     def display_name(self) -> str:

@@ -1,0 +1,5 @@
+import sys
+
+from fsmbt.cli import main
+
+sys.exit(main())

@@ -1,0 +1,122 @@
+"""How the two LEBT leaf types are written in a behavior tree (DESIGN §3), shared by the
+converter that writes them and the runtimes (interpreter, BehaviorTree.CPP, py_trees) that run
+them.
+
+- ``LebtGuard`` (a Condition): port ``target`` (the state it guards) and ``pairs``, the
+  (source, event) pairs that enter the target, as ``source/event`` items separated by ``;``.
+  An empty event (``Start/``) is the initialisation pair: it matches when no event is pending.
+  Returns FAILURE when (``state``, ``event``) on the blackboard is one of its pairs.
+- ``LebtState`` (a stateful Action): ports ``state``, ``action`` (empty = none), ``final``
+  (``true``/``false``) and ``exits``, the events that have a transition out of the state,
+  separated by ``;``.
+Names with ``;``, ``/`` or ``\\`` are escaped with a backslash.
+Blackboard keys: ``state`` (starts at the start pseudo-state) and ``event`` (empty = none).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+GUARD_TYPE = "LebtGuard"
+STATE_TYPE = "LebtState"
+BB_STATE = "state"
+BB_EVENT = "event"
+NO_EVENT = ""
+DEFAULT_START = "__start__"
+
+
+def escape(text: str) -> str:
+    return text.replace("\\", "\\\\").replace(";", "\\;").replace("/", "\\/")
+
+
+def split_escaped(text: str, separator: str) -> list[str]:
+    """Split on unescaped ``separator`` and unescape the parts."""
+    parts: list[str] = []
+    current: list[str] = []
+    chars = iter(text)
+    for ch in chars:
+        if ch == "\\":
+            current.append(next(chars, ""))
+        elif ch == separator:
+            parts.append("".join(current))
+            current = []
+        else:
+            current.append(ch)
+    parts.append("".join(current))
+    return parts
+
+
+@dataclass(frozen=True)
+class GuardSpec:
+    target: str
+    pairs: tuple[tuple[str, str], ...]  # (source state, event); event "" = initialisation
+
+    def to_attrs(self) -> dict[str, str]:
+        items = []
+        for source, event in self.pairs:
+            items.append(f"{_escape_item(source)}/{_escape_item(event)}")
+        return {"target": self.target, "pairs": ";".join(items)}
+
+    @classmethod
+    def from_attrs(cls, attrs: dict[str, str]) -> GuardSpec:
+        pairs = []
+        raw = attrs.get("pairs", "")
+        for item in _split_top(raw, ";") if raw else []:
+            source, event = _split_pair(item)
+            pairs.append((source, event))
+        return cls(attrs.get("target", ""), tuple(pairs))
+
+    def matches(self, state: str, event: str) -> bool:
+        return (state, event) in self.pairs
+
+
+@dataclass(frozen=True)
+class StateSpec:
+    state: str
+    action: str | None
+    final: bool
+    exits: tuple[str, ...]
+
+    def to_attrs(self) -> dict[str, str]:
+        return {
+            "state": self.state,
+            "action": self.action or "",
+            "final": "true" if self.final else "false",
+            "exits": ";".join(_escape_item(e) for e in self.exits),
+        }
+
+    @classmethod
+    def from_attrs(cls, attrs: dict[str, str]) -> StateSpec:
+        raw = attrs.get("exits", "")
+        exits = tuple(split_escaped(raw, ";")) if raw else ()
+        return cls(attrs.get("state", ""), attrs.get("action") or None,
+                   attrs.get("final", "false").lower() == "true", exits)
+
+
+def _escape_item(text: str) -> str:
+    return escape(text)
+
+
+def _split_top(text: str, separator: str) -> list[str]:
+    """Split on unescaped separator, keeping escapes (items are unescaped later)."""
+    parts, current, escaped = [], [], False
+    for ch in text:
+        if escaped:
+            current.append("\\" + ch)
+            escaped = False
+        elif ch == "\\":
+            escaped = True
+        elif ch == separator:
+            parts.append("".join(current))
+            current = []
+        else:
+            current.append(ch)
+    parts.append("".join(current))
+    return parts
+
+
+def _split_pair(item: str) -> tuple[str, str]:
+    pieces = _split_top(item, "/")
+    if len(pieces) != 2:
+        raise ValueError(f"malformed LEBT guard pair {item!r}")
+    return split_escaped(pieces[0], "\x00")[0], split_escaped(pieces[1], "\x00")[0]

@@ -1,0 +1,59 @@
+"""The verdict both engines (native, NuSMV) give: five named properties, each with a shortest
+counterexample when it fails (DESIGN §4, the paper's tables III and VIII)."""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, field
+from typing import Any
+
+REACHABILITY = "reachability"
+COMPLETENESS = "completeness"
+NO_ADDITIONAL_BEHAVIOR = "no_additional_behavior"
+DEADLOCK_ABSENCE = "deadlock_absence"
+TERMINATION_CONSISTENCY = "termination_consistency"
+PROPERTIES = (REACHABILITY, COMPLETENESS, NO_ADDITIONAL_BEHAVIOR, DEADLOCK_ABSENCE,
+              TERMINATION_CONSISTENCY)
+
+
+@dataclass
+class TraceStep:
+    """One step of a counterexample: the input given and what each model did."""
+
+    step: int
+    input: str | None  # None for the start
+    source_outputs: list[str]
+    result_outputs: list[str]
+    source_state: str
+    result_state: str
+    source_status: str
+    result_status: str
+
+
+@dataclass
+class PropertyResult:
+    name: str
+    holds: bool
+    detail: str = ""
+    counterexample: list[TraceStep] | None = None
+
+
+@dataclass
+class Report:
+    engine: str
+    source: str
+    result: str
+    mode: str  # "macro-step" (FSM vs BT) or "leaf-execution" (BT vs FSM) ...
+    properties: dict[str, PropertyResult] = field(default_factory=dict)
+    stats: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def equivalent(self) -> bool:
+        return all(p.holds for p in self.properties.values()) and len(self.properties) == len(PROPERTIES)
+
+    def verdicts(self) -> dict[str, bool]:
+        return {name: p.holds for name, p in self.properties.items()}
+
+    def to_dict(self) -> dict[str, Any]:
+        data = asdict(self)
+        data["equivalent"] = self.equivalent
+        return data
