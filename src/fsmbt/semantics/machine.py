@@ -50,6 +50,12 @@ class Machine(Protocol[S]):
         """A short human-readable name for traces."""
         ...
 
+    # Optional (the checker uses them when present):
+    # - ``active_inputs(state) -> Sequence[str]``: the inputs that may change the state, output
+    #   something or change the status; every other offered input must be a silent self-loop.
+    # - ``follows_environment: bool``: the machine takes whatever inputs the other machine
+    #   offers (its own ``inputs`` must list every input it can be given).
+
 
 class FSMMachine:
     """The macro-step machine of an FSM (hierarchical ones flattened first).
@@ -74,6 +80,16 @@ class FSMMachine:
 
     def inputs(self, state: str) -> Sequence[str]:
         return self.alphabet
+
+    def active_inputs(self, state: str) -> Sequence[str]:
+        """The inputs that may do anything in ``state``; every other offered input is a silent
+        self-loop. Optional in the protocol: lets the checker skip ignored events (O(T), not
+        O(states x events))."""
+        if state == self.start_state and state not in self.fsm.states:
+            return (self.fsm.initial_event,) if self.fsm.initial_event is not None else ()
+        if self.fsm.states[state].final:
+            return ()
+        return [event for event in self.table.get(state, {}) if event is not None]
 
     def step(self, state: str, symbol: str) -> tuple[str, Outputs]:
         if state == self.start_state and state not in self.fsm.states:

@@ -27,6 +27,7 @@ class TraceStep:
     result_state: str
     source_status: str
     result_status: str
+    note: str = ""  # what differs at this step (empty when both agree)
 
 
 @dataclass
