@@ -1,1 +1,43 @@
-"""render package."""
+"""Pictures of models through Graphviz: DOT source (testable without Graphviz) and SVG/PNG files.
+
+``model_to_dot`` gives the DOT source of either model; ``render_model`` writes the picture the
+output file's suffix names (``.svg``, ``.png``, ``.pdf``, or ``.dot`` for the source), never
+replacing an existing file unless ``overwrite``. Models with more than ``max_nodes`` states or
+nodes (default 5 000) are refused with a ``TooLargeError``.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from fsmbt.model.bt import BTDocument
+from fsmbt.model.fsm import FSM
+from fsmbt.render.bt_graph import bt_to_dot
+from fsmbt.render.dot import (
+    DEFAULT_MAX_NODES, OUTPUT_FORMATS, GraphvizError, TooLargeError, run_dot, write_picture,
+)
+from fsmbt.render.fsm_graph import fsm_to_dot
+
+
+def model_to_dot(model: FSM | BTDocument, *, expand_subtrees: bool = False,
+                 max_nodes: int = DEFAULT_MAX_NODES) -> str:
+    if isinstance(model, FSM):
+        return fsm_to_dot(model, max_nodes=max_nodes)
+    return bt_to_dot(model, expand_subtrees=expand_subtrees, max_nodes=max_nodes)
+
+
+def render_model(model: FSM | BTDocument, path: str | Path, *, overwrite: bool = False,
+                 expand_subtrees: bool = False, max_nodes: int = DEFAULT_MAX_NODES) -> Path:
+    """Draw ``model`` into ``path`` (format from the suffix) and return the path."""
+    from fsmbt.render.dot import output_format
+
+    output_format(Path(path))  # an unknown suffix fails before any work
+    if Path(path).exists() and not overwrite:
+        # checked again on write; failing here saves laying out a picture that cannot be kept
+        write_picture("", path, overwrite=False)
+    source = model_to_dot(model, expand_subtrees=expand_subtrees, max_nodes=max_nodes)
+    return write_picture(source, path, overwrite=overwrite)
+
+
+__all__ = ["model_to_dot", "fsm_to_dot", "bt_to_dot", "render_model", "run_dot", "write_picture",
+           "GraphvizError", "TooLargeError", "DEFAULT_MAX_NODES", "OUTPUT_FORMATS"]

@@ -1,0 +1,92 @@
+"""Running Graphviz: DOT source in, an SVG/PNG/PDF file out, never hanging, never clobbering.
+
+The ``graphviz`` package builds the DOT source; the picture comes from Debian's ``dot`` binary,
+called here with a wall-clock timeout (the package's own ``pipe`` has none). Label text from a
+model goes through ``label_text`` so a name never changes the DOT's meaning.
+"""
+
+from __future__ import annotations
+
+import shutil
+import subprocess
+from pathlib import Path
+
+from fsmbt.model.errors import FsmbtError, InputError, SourceLocation
+
+#: Pictures of more nodes than this are refused: dot's layout time grows quickly and nobody
+#: reads such a picture. ``--max-nodes`` raises it.
+DEFAULT_MAX_NODES = 5_000
+#: Seconds dot may run before it is stopped.
+DOT_TIMEOUT_S = 120.0
+#: Output formats by file suffix; ``.dot`` writes the source without running Graphviz.
+OUTPUT_FORMATS = {".svg": "svg", ".png": "png", ".pdf": "pdf", ".dot": "dot", ".gv": "dot"}
+FONT = "DejaVu Sans"
+
+
+class GraphvizError(FsmbtError):
+    """Graphviz is missing, failed or ran out of time."""
+
+
+class TooLargeError(InputError):
+    """The model has more nodes than a readable picture holds."""
+
+
+def label_text(*lines: str) -> str:
+    """Lines of model text as one DOT label: backslashes kept literal, lines centred."""
+    cleaned = [line.replace("\\", "\\\\").replace("\r", "").replace("\n", "\\n") for line in lines]
+    return "\\n".join(cleaned)
+
+
+def check_size(count: int, max_nodes: int, what: str) -> None:
+    if count > max_nodes:
+        raise TooLargeError(
+            f"too large to draw: {count} {what} (limit {max_nodes}); "
+            "a picture this big is unreadable and slow to lay out - raise the limit with "
+            "--max-nodes, or use `fsmbt info` for its structure")
+
+
+def output_format(path: Path) -> str:
+    suffix = path.suffix.lower()
+    try:
+        return OUTPUT_FORMATS[suffix]
+    except KeyError:
+        known = ", ".join(OUTPUT_FORMATS)
+        raise InputError(f"cannot draw into '{path.name}': use one of {known}",
+                         location=SourceLocation(str(path))) from None
+
+
+def dot_binary() -> str:
+    found = shutil.which("dot")
+    if found is None:
+        raise GraphvizError("Graphviz's `dot` is not installed (Debian: apt-get install graphviz; "
+                            "or run ./scripts/setup.sh)")
+    return found
+
+
+def run_dot(source: str, fmt: str, *, timeout: float = DOT_TIMEOUT_S) -> bytes:
+    """The picture bytes of ``source`` in ``fmt`` (svg, png, pdf)."""
+    try:
+        done = subprocess.run([dot_binary(), f"-T{fmt}"], input=source.encode("utf-8"),
+                              capture_output=True, timeout=timeout, check=False)
+    except subprocess.TimeoutExpired:
+        raise GraphvizError(f"Graphviz did not finish within {timeout:g} s") from None
+    if done.returncode != 0:
+        message = done.stderr.decode("utf-8", "replace").strip().splitlines()
+        raise GraphvizError(f"Graphviz failed: {message[-1] if message else done.returncode}")
+    return done.stdout
+
+
+def write_picture(source: str, path: str | Path, *, overwrite: bool = False,
+                  timeout: float = DOT_TIMEOUT_S) -> Path:
+    """Write ``source`` as the picture ``path`` names (by suffix); refuse to replace a file."""
+    path = Path(path)
+    fmt = output_format(path)
+    if path.exists() and not overwrite:
+        raise InputError("exists; pass --force to overwrite it", location=SourceLocation(str(path)))
+    data = source.encode("utf-8") if fmt == "dot" else run_dot(source, fmt, timeout=timeout)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_bytes(data)
+    except OSError as exc:
+        raise InputError(f"cannot write: {exc.strerror}", location=SourceLocation(str(path))) from None
+    return path

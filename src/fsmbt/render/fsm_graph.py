@@ -1,0 +1,193 @@
+"""An FSM (flat or hierarchical) as a Graphviz picture.
+
+Drawing rules: states are circles, final states double circles; the initial state gets an arrow
+from a point (labelled with the initial event when the model has a start pseudo-state);
+transitions are labelled with their events, parallel transitions between the same two states
+share one arrow. A composite state is a cluster holding its sub-machine (with its own initial
+point); a parallel state is a cluster with one dashed sub-cluster per region. Arrows into or out
+of a composite state end at its cluster's border (``compound=true`` with ``lhead``/``ltail``).
+Eventless transitions are labelled ``ε`` (from an atomic state) or ``done`` / ``done(x)`` (from a
+composite state when its sub-machine reaches a final state, ``x`` if only that one).
+
+Built without recursion: clusters are created in pre-order and attached to their parents in
+reverse order. Complexity O(S + T) for S states (every level) and T transitions.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import graphviz
+
+from fsmbt.model.fsm import FSM, State
+from fsmbt.model.stats import fsm_stats
+from fsmbt.render.dot import DEFAULT_MAX_NODES, FONT, TooLargeError, check_size, label_text
+
+#: Nested clusters beyond this depth make dot slow and the picture unreadable.
+MAX_NESTING = 60
+#: At most this many event names per arrow label line.
+EVENTS_PER_LINE = 3
+
+
+@dataclass
+class _Level:
+    """One machine being drawn: where its nodes go and how its state names map to node ids."""
+
+    machine: FSM
+    graph: graphviz.Digraph
+    ids: dict[str, str] = field(default_factory=dict)
+    anchors: dict[str, tuple[str, str]] = field(default_factory=dict)  # composite -> (node, cluster)
+
+
+def fsm_to_dot(fsm: FSM, *, max_nodes: int = DEFAULT_MAX_NODES) -> str:
+    """DOT source of the picture of ``fsm``; refuses more than ``max_nodes`` states."""
+    stats = fsm_stats(fsm)
+    check_size(stats.all_states, max_nodes, "states")
+    check_size(stats.all_transitions, 5 * max_nodes, "transitions")
+    if stats.nesting_depth > MAX_NESTING:
+        raise TooLargeError(f"too deeply nested to draw: {stats.nesting_depth} levels "
+                            f"(limit {MAX_NESTING})")
+
+    root = graphviz.Digraph(name=_safe_name(fsm.name))
+    root.attr(rankdir="LR", compound="true", fontname=FONT, nodesep="0.35", ranksep="0.5")
+    root.attr("node", fontname=FONT, fontsize="12")
+    root.attr("edge", fontname=FONT, fontsize="10", arrowsize="0.8")
+    counter = _Counter()
+    edges: list[tuple[str, str, dict[str, str]]] = []
+    clusters: list[tuple[graphviz.Digraph, graphviz.Digraph]] = []  # (cluster, parent), pre-order
+
+    top = _Level(fsm, root)
+    pending: list[_Level] = [top]
+    levels: list[_Level] = []
+    while pending:
+        level = pending.pop()
+        levels.append(level)
+        for state in level.machine.states.values():
+            if state.is_atomic:
+                node_id = counter.next("s")
+                level.ids[state.name] = node_id
+                level.graph.node(node_id, **_state_attrs(state))
+                continue
+            cluster = graphviz.Digraph(name=counter.next("cluster_"))
+            cluster.attr(label=label_text(_state_title(state)), style="rounded",
+                         color="gray30", fontname=FONT, fontsize="12", labeljust="l")
+            clusters.append((cluster, level.graph))
+            inner: list[_Level] = []
+            for index, region in enumerate(state.regions):
+                holder = cluster
+                if state.is_parallel:
+                    holder = graphviz.Digraph(name=counter.next("cluster_"))
+                    holder.attr(label=label_text(_region_title(region, index)), style="dashed",
+                                color="gray50", fontname=FONT, fontsize="10")
+                    clusters.append((holder, cluster))
+                inner.append(_Level(region, holder))
+            # Arrows to/from the composite state end at its cluster, through its first initial point.
+            level.anchors[state.name] = (_initial_point_id(inner[0], counter), cluster.name)
+            pending.extend(reversed(inner))
+
+    for level in levels:
+        _draw_initial(level, edges, is_top=level is top)
+        _draw_transitions(level, edges)
+
+    for cluster, parent in reversed(clusters):
+        parent.subgraph(cluster)
+    for tail, head, attrs in edges:
+        root.edge(tail, head, **attrs)
+    return root.source
+
+
+class _Counter:
+    def __init__(self) -> None:
+        self.value = 0
+
+    def next(self, prefix: str) -> str:
+        self.value += 1
+        return f"{prefix}{self.value}"
+
+
+def _safe_name(name: str) -> str:
+    return "".join(ch if ch.isalnum() or ch == "_" else "_" for ch in name) or "fsm"
+
+
+def _state_title(state: State) -> str:
+    if state.action is not None and state.action != state.name:
+        return f"{state.name} / {state.action}"
+    return state.name
+
+
+def _region_title(region: FSM, index: int) -> str:
+    return region.name if region.name and region.name != "fsm" else f"region {index + 1}"
+
+
+def _state_attrs(state: State) -> dict[str, str]:
+    lines = [state.name]
+    if state.action is not None and state.action != state.name:
+        lines.append(f"/ {state.action}")
+    attrs = {"label": label_text(*lines), "shape": "doublecircle" if state.final else "circle"}
+    if state.final:
+        attrs.update(style="filled", fillcolor="gray92")
+    return attrs
+
+
+def _initial_point_id(level: _Level, counter: _Counter) -> str:
+    point = level.ids.get("__initial_point__")
+    if point is None:
+        point = counter.next("init")
+        level.ids["__initial_point__"] = point
+        level.graph.node(point, label="", shape="point", width="0.12")
+    return point
+
+
+def _draw_initial(level: _Level, edges: list, *, is_top: bool) -> None:
+    """The arrow from a point into the level's initial state (a composite state's point is
+    its anchor and already exists)."""
+    fsm = level.machine
+    if fsm.initial is None or fsm.initial not in fsm.states:
+        return
+    point = level.ids.get("__initial_point__")
+    if point is None:
+        point = f"init_{level.graph.name or 'root'}"
+        level.ids["__initial_point__"] = point
+        extra = {"xlabel": label_text(fsm.start_name)} if is_top and fsm.start_name else {}
+        level.graph.node(point, label="", shape="point", width="0.12", **extra)
+    attrs: dict[str, str] = {}
+    if is_top and fsm.initial_event is not None:
+        attrs["label"] = label_text(fsm.initial_event)
+    head, head_attrs = _endpoint(level, fsm.initial, "lhead")
+    edges.append((point, head, {**attrs, **head_attrs}))
+
+
+def _draw_transitions(level: _Level, edges: list) -> None:
+    grouped: dict[tuple[str, str], list[str]] = {}
+    for t in level.machine.transitions:
+        if t.source not in level.machine.states or t.target not in level.machine.states:
+            continue  # a dangling transition is `validate`'s business; draw what exists
+        grouped.setdefault((t.source, t.target), []).append(_event_label(level, t))
+    for (source, target), labels in grouped.items():
+        tail, tail_attrs = _endpoint(level, source, "ltail")
+        head, head_attrs = _endpoint(level, target, "lhead")
+        attrs = {"label": _wrap(labels), **tail_attrs, **head_attrs}
+        if tail == head and tail_attrs and head_attrs:
+            attrs.pop("ltail")
+            attrs.pop("lhead")
+        edges.append((tail, head, attrs))
+
+
+def _endpoint(level: _Level, state: str, side: str) -> tuple[str, dict[str, str]]:
+    if state in level.anchors:
+        node, cluster = level.anchors[state]
+        return node, {side: cluster}
+    return level.ids[state], {}
+
+
+def _event_label(level: _Level, t) -> str:
+    if t.event is not None:
+        return t.event
+    if level.machine.states[t.source].is_atomic:
+        return "ε"
+    return f"done({t.exit})" if t.exit is not None else "done"
+
+
+def _wrap(labels: list[str]) -> str:
+    lines = [", ".join(labels[i:i + EVENTS_PER_LINE]) for i in range(0, len(labels), EVENTS_PER_LINE)]
+    return label_text(*lines)
