@@ -54,7 +54,8 @@ def main(argv: list[str] | None = None) -> int:
     _register_commands()
     debug = os.environ.get("FSMBT_DEBUG") == "1"
     try:
-        app(args=argv, standalone_mode=False)
+        # without standalone mode click returns a raised typer.Exit's code instead of exiting
+        code = app(args=argv, standalone_mode=False)
     except FsmbtError as exc:
         if debug:
             raise
@@ -80,7 +81,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"internal error: {type(exc).__name__}: {exc} (FSMBT_DEBUG=1 shows the traceback)",
               file=sys.stderr)
         return EXIT_INTERNAL
-    return EXIT_OK
+    return code if isinstance(code, int) else EXIT_OK
 
 
 if __name__ == "__main__":

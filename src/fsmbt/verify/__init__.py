@@ -1,1 +1,88 @@
-"""verify package."""
+"""Equivalence checking of a source model and its conversion (DESIGN §4, docs/verification.md).
+
+``verify(source, result)`` gives a ``Report``: the verdict and the five properties, each with a
+shortest counterexample when it fails. Two engines: ``native`` (explicit-state product, the
+default) and ``nusmv``; ``both`` runs the two and raises ``EngineDisagreement`` if any property
+verdict differs, since then one of them is wrong.
+"""
+
+from __future__ import annotations
+
+from fsmbt.model.bt import BTDocument
+from fsmbt.model.errors import InputError
+from fsmbt.model.fsm import FSM
+from fsmbt.verify.native import DEFAULT_MAX_STATES, Replay, check, replay
+from fsmbt.verify.pairing import FSMLeafMachine, machines_for
+from fsmbt.verify.report import PROPERTIES, PropertyResult, Report, TraceStep
+
+ENGINES = ("native", "nusmv", "both")
+
+
+class EngineDisagreement(RuntimeError):
+    """The native checker and NuSMV disagree on a property: a bug in one of them (exit 3)."""
+
+    def __init__(self, native: Report, nusmv: Report) -> None:
+        differing = [name for name in PROPERTIES
+                     if native.verdicts().get(name) != nusmv.verdicts().get(name)]
+        shown = ", ".join(f"{name} (native {_word(native.verdicts().get(name))}, "
+                          f"NuSMV {_word(nusmv.verdicts().get(name))})" for name in differing)
+        super().__init__(f"the engines disagree on {shown}")
+        self.native = native
+        self.nusmv = nusmv
+        self.differing = differing
+
+
+def verify(source: FSM | BTDocument, result: FSM | BTDocument, *, engine: str = "native",
+           loop: bool = False, max_states: int = DEFAULT_MAX_STATES) -> Report:
+    """Check that ``result`` behaves exactly like ``source`` (see ``fsmbt.verify.pairing``)."""
+    if engine not in ENGINES:
+        raise InputError(f"unknown verification engine '{engine}' (known: {', '.join(ENGINES)})")
+    if engine == "nusmv":
+        return _nusmv(source, result, loop)
+    source_machine, result_machine, mode = machines_for(source, result, loop=loop)
+    native = check(source_machine, result_machine, max_states=max_states, mode=mode)
+    native.source = _model_name(source, native.source)
+    native.result = _model_name(result, native.result)
+    if engine == "native":
+        return native
+    other = _nusmv(source, result, loop)
+    if native.verdicts() != other.verdicts():
+        raise EngineDisagreement(native, other)
+    native.engine = "native+nusmv"
+    native.stats["nusmv"] = dict(other.stats)
+    return native
+
+
+def _nusmv(source: FSM | BTDocument, result: FSM | BTDocument, loop: bool) -> Report:
+    try:
+        from fsmbt.verify import nusmv
+    except ImportError as exc:
+        raise InputError(f"the NuSMV engine is not available ({exc}); use --engine native") from None
+    checker = getattr(nusmv, "check", None)
+    if checker is None:
+        raise InputError("the NuSMV engine is not available (fsmbt.verify.nusmv has no check); "
+                         "use --engine native")
+    try:
+        return checker(source, result, loop=loop)
+    except FileNotFoundError as exc:
+        raise InputError(f"the NuSMV binary is not installed ({exc}); run scripts/setup.sh or "
+                         "use --engine native") from None
+
+
+def _model_name(model: FSM | BTDocument, fallback: str) -> str:
+    if isinstance(model, FSM):
+        return model.name
+    try:
+        return model.main.id
+    except KeyError:
+        return fallback
+
+
+def _word(verdict: bool | None) -> str:
+    return {True: "holds", False: "fails", None: "missing"}[verdict]
+
+
+__all__ = [
+    "verify", "check", "replay", "Replay", "Report", "PropertyResult", "TraceStep", "PROPERTIES",
+    "EngineDisagreement", "FSMLeafMachine", "machines_for", "ENGINES",
+]

@@ -1,0 +1,135 @@
+"""Which two machines represent a (source, result) pair of models (docs/verification.md).
+
+- FSM source, BT result (macro steps): the FSM's macro-step machine against the LEBT run under
+  the DESIGN §3 protocol; inputs are events (the FSM's, then any the LEBT's guards name).
+- BT source, FSM result (leaf execution): the BT's leaf-execution machine against the FSM read as
+  one (``FSMLeafMachine``): a state is the leaf about to be ticked, inputs are leaf outcomes.
+- FSM vs FSM: both macro-step machines over the union of their events.
+- BT vs BT: both leaf-execution machines.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+from fsmbt.model.bt import BTDocument
+from fsmbt.model.errors import InputError
+from fsmbt.model.fsm import FSM
+from fsmbt.semantics.lebt_spec import GUARD_TYPE, GuardSpec
+from fsmbt.semantics.machine import FINAL, RUNNING, FSMMachine, Machine, Outputs
+
+MACRO_STEP = "macro-step"
+LEAF_EXECUTION = "leaf-execution"
+LEAF_OUTCOMES = ("success", "failure", "running")
+ROOT_RESULTS = ("SUCCESS", "FAILURE")
+
+
+class FSMLeafMachine:
+    """An FSM (flattened if hierarchical) read as a BT's leaf-execution machine (DESIGN §2).
+
+    A state is the leaf about to be ticked: entering it outputs its action (the leaf's label).
+    An outcome with no transition leaves the FSM where it is, so the same leaf is ticked again
+    and its label is output again (a converter may omit ``running`` self-loops). A final state
+    whose action is ``SUCCESS``/``FAILURE`` is the root's result, with that status. With ``loop``
+    the root is ticked again after a result: any outcome from a final state re-enters the
+    initial state (the first leaf). The machine takes whatever outcomes the BT side offers.
+    """
+
+    follows_environment = True
+
+    def __init__(self, fsm: FSM, *, loop: bool = False) -> None:
+        self.inner = FSMMachine(fsm, alphabet=LEAF_OUTCOMES)
+        self.fsm = self.inner.fsm
+        self.name = self.fsm.name
+        self.loop = loop
+
+    def start(self) -> tuple[str, Outputs]:
+        state, outputs = self.inner.start()
+        if state == self.inner.start_state and state not in self.fsm.states:
+            # a leaf machine has no start event: the initial transition is taken at once
+            assert self.fsm.initial is not None
+            return self.fsm.initial, self.inner._entry(self.fsm.initial)
+        return state, outputs
+
+    def inputs(self, state: str) -> Sequence[str]:
+        if self.fsm.states[state].final and not self.loop:
+            return ()
+        return LEAF_OUTCOMES
+
+    def step(self, state: str, symbol: str) -> tuple[str, Outputs]:
+        if self.fsm.states[state].final:
+            if not self.loop:
+                return state, ()
+            assert self.fsm.initial is not None
+            return self.fsm.initial, self.inner._entry(self.fsm.initial)
+        target, outputs = self.inner.step(state, symbol)
+        if not outputs and target == state:
+            return state, self.inner._entry(state)
+        return target, outputs
+
+    def status(self, state: str) -> str:
+        known = self.fsm.states[state]
+        if not known.final:
+            return RUNNING
+        return known.action if known.action in ROOT_RESULTS else FINAL
+
+    def describe(self, state: str) -> str:
+        return state
+
+
+def lebt_guard_events(doc: BTDocument) -> list[str]:
+    """Events named by the LEBT guard leaves (so the checker also offers events that only the
+    result knows: reacting to one is additional behaviour)."""
+    seen: dict[str, None] = {}
+    for _tree, node in doc.nodes():
+        if node.type == GUARD_TYPE:
+            try:
+                spec = GuardSpec.from_attrs(node.attrs)
+            except ValueError as exc:
+                raise InputError(str(exc), location=node.location, element=node.label) from None
+            for _source, event in spec.pairs:
+                if event:
+                    seen.setdefault(event, None)
+    return list(seen)
+
+
+def machines_for(source: FSM | BTDocument, result: FSM | BTDocument, *,
+                 loop: bool = False) -> tuple[Machine, Machine, str]:
+    """The (source machine, result machine, mode) for a pair of models."""
+    if isinstance(source, FSM) and isinstance(result, FSM):
+        alphabet = _union(source.events(), result.events(), *_flat_events(source, result))
+        return (FSMMachine(source, alphabet=alphabet), FSMMachine(result, alphabet=alphabet),
+                MACRO_STEP)
+    if isinstance(source, FSM) and isinstance(result, BTDocument):
+        from fsmbt.semantics.lebt_runtime import LEBTMachine
+
+        source_machine = FSMMachine(source)
+        alphabet = _union(source_machine.alphabet, lebt_guard_events(result))
+        source_machine = FSMMachine(source, alphabet=alphabet)
+        return source_machine, LEBTMachine(result, alphabet), MACRO_STEP
+    if isinstance(source, BTDocument) and isinstance(result, FSM):
+        from fsmbt.semantics.leaf_machine import LeafMachine
+
+        return LeafMachine(source, loop=loop), FSMLeafMachine(result, loop=loop), LEAF_EXECUTION
+    if isinstance(source, BTDocument) and isinstance(result, BTDocument):
+        from fsmbt.semantics.leaf_machine import LeafMachine
+
+        return LeafMachine(source, loop=loop), LeafMachine(result, loop=loop), LEAF_EXECUTION
+    raise InputError(f"cannot compare a {type(source).__name__} with a {type(result).__name__}")
+
+
+def _flat_events(*fsms: FSM) -> list[list[str]]:
+    """Events of nested sub-machines too (a hierarchical FSM's top level does not list them)."""
+    out = []
+    for fsm in fsms:
+        for _path, machine, _state in fsm.walk():
+            out.append(machine.events())
+    return out
+
+
+def _union(*groups: Sequence[str]) -> list[str]:
+    seen: dict[str, None] = {}
+    for group in groups:
+        for item in group:
+            seen.setdefault(item, None)
+    return list(seen)

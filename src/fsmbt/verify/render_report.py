@@ -1,0 +1,84 @@
+"""A verification report for people: the verdict, the five properties, and for each failure its
+shortest counterexample as a table (step, input, what the source did, what the result did)."""
+
+from __future__ import annotations
+
+from rich.console import Console, Group, RenderableType
+from rich.table import Table
+from rich.text import Text
+
+from fsmbt.verify.report import PROPERTIES, PropertyResult, Report, TraceStep
+
+_TITLES = {
+    "reachability": "reachability",
+    "completeness": "completeness",
+    "no_additional_behavior": "no additional behaviour",
+    "deadlock_absence": "deadlock absence",
+    "termination_consistency": "termination consistency",
+}
+
+
+def render(report: Report) -> RenderableType:
+    """The whole report as one rich renderable."""
+    parts: list[RenderableType] = []
+    verdict = Text("EQUIVALENT", style="bold green") if report.equivalent else Text(
+        "NOT EQUIVALENT", style="bold red")
+    header = Text.assemble(verdict, f"  {report.source} -> {report.result}",
+                           f"  ({report.mode}, engine {report.engine})")
+    parts.append(header)
+    table = Table("property", "verdict", "detail", show_lines=False)
+    for name in PROPERTIES:
+        prop = report.properties.get(name)
+        if prop is None:
+            table.add_row(_TITLES[name], Text("MISSING", style="yellow"), "not checked")
+            continue
+        mark = Text("PASS", style="green") if prop.holds else Text("FAIL", style="bold red")
+        table.add_row(_TITLES[name], mark, Text(prop.detail))
+    parts.append(table)
+    for name in PROPERTIES:
+        prop = report.properties.get(name)
+        if prop is not None and not prop.holds and prop.counterexample:
+            parts.append(counterexample_table(prop))
+    stats = report.stats
+    if stats:
+        parts.append(Text(_stats_line(stats), style="dim"))
+    return Group(*parts)
+
+
+def counterexample_table(prop: PropertyResult) -> Table:
+    """The shortest counterexample of one failed property."""
+    table = Table("step", "input", "source did", "result did", "states", "note",
+                  title=f"{_TITLES.get(prop.name, prop.name)}: shortest counterexample "
+                        f"({len(prop.counterexample or []) - 1} inputs)", title_justify="left")
+    for step in prop.counterexample or []:
+        style = "red" if step.note else None
+        cells = [str(step.step), "(start)" if step.input is None else step.input,
+                 _did(step.source_outputs, step.source_status),
+                 _did(step.result_outputs, step.result_status),
+                 f"{step.source_state} / {step.result_state}", step.note]
+        table.add_row(*(Text(cell) for cell in cells), style=style)
+    return table
+
+
+def _did(outputs: list[str], status: str) -> str:
+    text = ", ".join(outputs) if outputs else "-"
+    return text if status == "running" else f"{text} [{status}]"
+
+
+def _stats_line(stats: dict) -> str:
+    keys = ("source_states", "result_states", "product_states", "product_edges", "seconds")
+    shown = [f"{k.replace('_', ' ')} {stats[k]}" for k in keys if k in stats]
+    return ", ".join(shown)
+
+
+def print_report(report: Report, console: Console | None = None) -> None:
+    (console or Console()).print(render(report))
+
+
+def trace_rows(trace: list[TraceStep]) -> list[dict[str, object]]:
+    """Plain rows of a counterexample (for JSON or other front ends)."""
+    return [
+        {"step": s.step, "input": s.input, "source": s.source_outputs, "result": s.result_outputs,
+         "note": s.note}
+        for s in trace
+    ]
