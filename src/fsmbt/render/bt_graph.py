@@ -20,7 +20,10 @@ import graphviz
 from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.bt_nodes import NodeKind, canonical_type
 from fsmbt.model.errors import InputError
-from fsmbt.render.dot import DEFAULT_MAX_NODES, FONT, TooLargeError, check_size, label_text
+from fsmbt.render.dot import (
+    DEFAULT_MAX_NODES, FONT, TooLargeError, attach_clusters, check_size, html_label,
+    label_text,
+)
 
 CONTROL_SYMBOLS: dict[str, str] = {
     "Sequence": "→",
@@ -125,8 +128,7 @@ class _Builder:
             stack.extend((child, node_id, holder, trees) for child in reversed(node.children))
 
     def finish(self) -> str:
-        for cluster, parent in reversed(self.clusters):
-            parent.subgraph(cluster)
+        attach_clusters(self.clusters, self.root)
         for tail, head, attrs in self.edges:
             self.root.edge(tail, head, **attrs)
         return self.root.source
@@ -135,36 +137,34 @@ class _Builder:
 def node_attrs(node: BTNode, *, recursive: bool = False) -> dict[str, str]:
     """Shape, style and label of one node."""
     type_name = canonical_type(node.type)
-    attrs = [f"{k}={_shorten(v)}" for k, v in node.attrs.items()
-             if not (node.kind is NodeKind.SUBTREE and k == "ID")][:MAX_ATTRS_SHOWN]
-    if len(node.attrs) > MAX_ATTRS_SHOWN + (node.kind is NodeKind.SUBTREE):
-        attrs.append("…")
-    named = node.name is not None and node.name != node.type
+    shown = [(k, v) for k, v in node.attrs.items()
+             if not (node.kind is NodeKind.SUBTREE and k == "ID")]
+    details = [f"{k}={_shorten(v)}" for k, v in shown[:MAX_ATTRS_SHOWN]]
+    if len(shown) > MAX_ATTRS_SHOWN:
+        details.append(f"… (+{len(shown) - MAX_ATTRS_SHOWN})")
+    name = [node.name] if node.name is not None and node.name != node.type else []
     if node.kind is NodeKind.CONTROL:
-        head = [CONTROL_SYMBOLS.get(type_name, type_name)]
-        if named:
-            head.append(node.name or "")
-        return {"label": label_text(*head, *attrs), "shape": "box", "style": "filled",
-                "fillcolor": "gray88", "fontsize": "13" if len(head[0]) <= 2 else "11"}
+        symbol = CONTROL_SYMBOLS.get(type_name, type_name)
+        return {"label": html_label([symbol, *name], details, head_size=16 if len(symbol) <= 2 else 12),
+                "shape": "box", "style": "filled", "fillcolor": "gray88"}
     if node.kind is NodeKind.DECORATOR:
-        head = [DECORATOR_SYMBOLS.get(type_name, type_name)]
-        if named:
-            head.append(node.name or "")
-        return {"label": label_text(*head, *attrs), "shape": "hexagon", "style": "filled",
-                "fillcolor": "lightcyan"}
+        symbol = DECORATOR_SYMBOLS.get(type_name, type_name)
+        return {"label": html_label([symbol, *name], details, head_size=16 if len(symbol) <= 2 else None),
+                "shape": "hexagon", "style": "filled", "fillcolor": "lightcyan"}
     if node.kind is NodeKind.SUBTREE:
         ref = node.subtree_id or "?"
-        head = [f"SubTree {ref}"] + ([node.name or ""] if named and node.name != ref else [])
+        head = [f"SubTree {ref}"] + [n for n in name if n != ref]
         if recursive:
-            head.append("(recursive, not expanded)")
-        return {"label": label_text(*head, *attrs), "shape": "tab", "style": "filled",
+            details.insert(0, "(recursive: not expanded)")
+        return {"label": html_label(head, details), "shape": "tab", "style": "filled",
                 "fillcolor": "lavender"}
-    head = [node.label] + ([f"({node.type})"] if named else [])
+    head = [node.label] + ([f"({node.type})"] if name else [])
     if node.kind is NodeKind.CONDITION:
-        return {"label": label_text(*head, *attrs), "shape": "ellipse", "style": "filled",
+        return {"label": html_label(head, details), "shape": "ellipse", "style": "filled",
                 "fillcolor": "honeydew"}
+    # An action whose kind nobody declared (assumed Action) gets a dashed border.
     style = "rounded,filled" if node.kind_declared else "rounded,filled,dashed"
-    return {"label": label_text(*head, *attrs), "shape": "box", "style": style,
+    return {"label": html_label(head, details), "shape": "box", "style": style,
             "fillcolor": "lightyellow"}
 
 

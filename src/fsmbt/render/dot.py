@@ -7,9 +7,12 @@ model goes through ``label_text`` so a name never changes the DOT's meaning.
 
 from __future__ import annotations
 
+import html
 import shutil
 import subprocess
 from pathlib import Path
+
+import graphviz
 
 from fsmbt.model.errors import FsmbtError, InputError, SourceLocation
 
@@ -32,9 +35,27 @@ class TooLargeError(InputError):
 
 
 def label_text(*lines: str) -> str:
-    """Lines of model text as one DOT label: backslashes kept literal, lines centred."""
+    """Lines of model text as one DOT label: backslashes kept literal, lines centred, never
+    mistaken for an HTML label (a name like ``<x>`` would be one)."""
     cleaned = [line.replace("\\", "\\\\").replace("\r", "").replace("\n", "\\n") for line in lines]
-    return "\\n".join(cleaned)
+    return graphviz.nohtml("\\n".join(cleaned))
+
+
+def html_label(head: list[str], details: list[str], *, head_size: int | None = None) -> str:
+    """An HTML-like label: ``head`` lines (the first at ``head_size`` points, bold when set),
+    then ``details`` in small grey type. Model text is escaped."""
+    parts: list[str] = []
+    for index, line in enumerate(head):
+        text = _html_escape(line)
+        if index == 0 and head_size is not None:
+            text = f'<FONT POINT-SIZE="{head_size}"><B>{text}</B></FONT>'
+        parts.append(text)
+    parts.extend(f'<FONT POINT-SIZE="9" COLOR="gray30">{_html_escape(d)}</FONT>' for d in details)
+    return "<" + "<BR/>".join(parts or [" "]) + ">"
+
+
+def _html_escape(text: str) -> str:
+    return html.escape(" ".join(text.split()), quote=True) or " "
 
 
 def check_size(count: int, max_nodes: int, what: str) -> None:
@@ -43,6 +64,22 @@ def check_size(count: int, max_nodes: int, what: str) -> None:
             f"too large to draw: {count} {what} (limit {max_nodes}); "
             "a picture this big is unreadable and slow to lay out - raise the limit with "
             "--max-nodes, or use `fsmbt info` for its structure")
+
+
+def attach_clusters(clusters: list[tuple[graphviz.Digraph, graphviz.Digraph]],
+                    root: graphviz.Digraph) -> None:
+    """Nest clusters listed in pre-order as ``(cluster, parent)``, keeping sibling order.
+
+    A cluster's DOT text is copied into its parent when attached, so children go in first:
+    walking the list backwards reaches every cluster after all of its descendants.
+    """
+    children: dict[int, list[graphviz.Digraph]] = {}
+    for cluster, parent in reversed(clusters):
+        for child in reversed(children.pop(id(cluster), [])):
+            cluster.subgraph(child)
+        children.setdefault(id(parent), []).append(cluster)
+    for child in reversed(children.pop(id(root), [])):
+        root.subgraph(child)
 
 
 def output_format(path: Path) -> str:

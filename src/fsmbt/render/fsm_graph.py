@@ -21,7 +21,9 @@ import graphviz
 
 from fsmbt.model.fsm import FSM, State
 from fsmbt.model.stats import fsm_stats
-from fsmbt.render.dot import DEFAULT_MAX_NODES, FONT, TooLargeError, check_size, label_text
+from fsmbt.render.dot import (
+    DEFAULT_MAX_NODES, FONT, TooLargeError, attach_clusters, check_size, label_text,
+)
 
 #: Nested clusters beyond this depth make dot slow and the picture unreadable.
 MAX_NESTING = 60
@@ -89,8 +91,7 @@ def fsm_to_dot(fsm: FSM, *, max_nodes: int = DEFAULT_MAX_NODES) -> str:
         _draw_initial(level, edges, is_top=level is top)
         _draw_transitions(level, edges)
 
-    for cluster, parent in reversed(clusters):
-        parent.subgraph(cluster)
+    attach_clusters(clusters, root)
     for tail, head, attrs in edges:
         root.edge(tail, head, **attrs)
     return root.source
@@ -166,10 +167,15 @@ def _draw_transitions(level: _Level, edges: list) -> None:
     for (source, target), labels in grouped.items():
         tail, tail_attrs = _endpoint(level, source, "ltail")
         head, head_attrs = _endpoint(level, target, "lhead")
-        attrs = {"label": _wrap(labels), **tail_attrs, **head_attrs}
+        attrs = {**tail_attrs, **head_attrs}
         if tail == head and tail_attrs and head_attrs:
-            attrs.pop("ltail")
-            attrs.pop("lhead")
+            attrs = {}
+        # dot places a mid-edge label on the unclipped spline, i.e. inside the cluster an arrow
+        # leaves; a head label stays next to the arrow's visible end.
+        key = "headlabel" if "ltail" in attrs else "label"
+        attrs[key] = _wrap(labels)
+        if key == "headlabel":
+            attrs.update(labeldistance="3", labelangle="-25")
         edges.append((tail, head, attrs))
 
 

@@ -1,0 +1,9 @@
+#!/usr/bin/env bash
+# Run the test suite (sets the machine up first when .venv is missing); arguments go to pytest.
+set -euo pipefail
+REPO_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+cd "$REPO_ROOT"
+if [ ! -x .venv/bin/pytest ]; then
+    bash scripts/setup.sh
+fi
+exec .venv/bin/pytest "$@"
