@@ -309,7 +309,7 @@ class _Product:
         self.pair_r: list[int] = []
         self.parent: list[int] = []
         self.parent_input: list[str | None] = []
-        self.agree_next: list[list[int]] = []
+        self.start_ok = False
         self.index: dict[int, int] = {}
         self.width = max(len(res.states), 1)
         self.edges = 0
@@ -335,7 +335,6 @@ class _Product:
         self.pair_r.append(r)
         self.parent.append(parent)
         self.parent_input.append(symbol)
-        self.agree_next.append([])
         return new_id
 
     def input_difference(self, s: int, r: int) -> tuple[list[str], list[str]]:
@@ -362,25 +361,27 @@ class _Product:
                 p, symbol, f"{where} the result does {_show(v2)}, the source {_show(v1)}"))
 
     def run(self) -> None:
+        """Breadth first over agreeing steps only: every pair explored is faithful."""
         src, res = self.src, self.res
         start = self.pair(0, 0, -1, None)
         if src.start_outputs != res.start_outputs:
             self.compare_outputs(start, None, src.start_outputs, res.start_outputs)
+        if src.status[0] != res.status[0]:
+            self.violate(TERMINATION_CONSISTENCY, _Violation(
+                start, None, f"at the start the source is {src.status[0]!r}, the result "
+                             f"{res.status[0]!r}"))
+        self.start_ok = src.start_outputs == res.start_outputs and src.status[0] == res.status[0]
+        if not self.start_ok:
+            return
         follows = res.follows_environment
         cursor = 0
         while cursor < len(self.pair_s):
             p = cursor
             cursor += 1
             s, r = self.pair_s[p], self.pair_r[p]
-            if src.status[s] != res.status[r]:
-                self.violate(TERMINATION_CONSISTENCY, _Violation(
-                    p, None, f"the source is {src.status[s]!r} while the result is "
-                             f"{res.status[r]!r}"))
             if src.is_dead(s) != res.is_dead(r):
                 self._deadlock(p, s, r)
-            if follows:
-                accepted = src.input_frozen[src.offered[s]]
-            else:
+            if not follows:
                 missing, extra = self.input_difference(s, r)
                 if missing:
                     self.violate(COMPLETENESS, _Violation(
@@ -390,24 +391,28 @@ class _Product:
                     self.violate(NO_ADDITIONAL_BEHAVIOR, _Violation(
                         p, extra[0], f"the result accepts input {extra[0]!r} that the source "
                                      f"refuses ({len(extra)} such inputs)"))
-                accepted = None
             s_row, r_row = src.edges[s], res.edges[r]
             symbols = list(s_row)
             symbols.extend(a for a in r_row if a not in s_row)
-            agree = self.agree_next[p]
             for symbol in symbols:
                 if not src.accepts(s, symbol):
                     continue
-                if accepted is None and not res.accepts(r, symbol):
+                if not follows and not res.accepts(r, symbol):
                     continue
                 s2, o1 = src.move(s, symbol)
                 r2, o2 = res.move(r, symbol)
                 self.edges += 1
-                q = self.pair(s2, r2, p, symbol)
+                agree = True
                 if o1 != o2:
                     self.compare_outputs(p, symbol, o1, o2)
-                elif src.status[s2] == res.status[r2]:
-                    agree.append(q)
+                    agree = False
+                if src.status[s2] != res.status[r2]:
+                    self.violate(TERMINATION_CONSISTENCY, _Violation(
+                        p, symbol, f"after input {symbol!r} the source is {src.status[s2]!r}, "
+                                   f"the result {res.status[r2]!r}"))
+                    agree = False
+                if agree:
+                    self.pair(s2, r2, p, symbol)
 
     def _deadlock(self, p: int, s: int, r: int) -> None:
         src, res = self.src, self.res
@@ -423,20 +428,9 @@ class _Product:
                      f"act) while the {live_side} can still act", extension))
 
     def faithful(self) -> list[bool]:
-        """Pairs reached on a path where both machines agreed at every step."""
-        seen = [False] * len(self.pair_s)
-        src, res = self.src, self.res
-        if src.start_outputs != res.start_outputs or src.status[0] != res.status[0]:
-            return seen
-        seen[0] = True
-        stack = [0]
-        while stack:
-            p = stack.pop()
-            for q in self.agree_next[p]:
-                if not seen[q]:
-                    seen[q] = True
-                    stack.append(q)
-        return seen
+        """Pairs reached on a path where both machines agreed at every step: all explored ones,
+        unless the two already differ at the start."""
+        return [self.start_ok] * len(self.pair_s)
 
     def path_to(self, p: int) -> list[str]:
         inputs: list[str] = []
@@ -499,8 +493,13 @@ def check(source: Machine, result: Machine, *, max_states: int = DEFAULT_MAX_STA
 
 def _reachability(src: _Explored, res: _Explored, product: _Product,
                   faithful: list[bool]) -> _Violation | None:
-    """Source states never reached faithfully (shortest source path), then result states in the
-    product never reached faithfully (shortest product path); the shorter counterexample wins."""
+    """Source states, and result states, reachable on their own but never in a faithful pair.
+
+    The counterexample is the shortest path to the first such state in that machine alone
+    (replayed on both, it must differ somewhere: had every step agreed, the pair would be
+    faithful); of the two sides the shorter wins. A ``follows_environment`` result's own
+    inputs are not the environment's, so only the source side counts for it.
+    """
     source_ok = [False] * len(src.states)
     result_ok = [False] * len(res.states)
     for p, ok in enumerate(faithful):
@@ -508,16 +507,8 @@ def _reachability(src: _Explored, res: _Explored, product: _Product,
             source_ok[product.pair_s[p]] = True
             result_ok[product.pair_r[p]] = True
     unmatched_source = [x for x, ok in enumerate(source_ok) if not ok]
-    unmatched_result: list[int] = []
-    first_pair = -1
-    seen: set[int] = set()
-    for p in range(len(product.pair_s)):
-        r = product.pair_r[p]
-        if not result_ok[r] and r not in seen:
-            seen.add(r)
-            unmatched_result.append(r)
-            if first_pair < 0:
-                first_pair = p
+    unmatched_result = [] if res.follows_environment else [
+        x for x, ok in enumerate(result_ok) if not ok]
     if not unmatched_source and not unmatched_result:
         return None
     parts = []
@@ -525,15 +516,15 @@ def _reachability(src: _Explored, res: _Explored, product: _Product,
         parts.append(f"{len(unmatched_source)} source state(s) never reached with matching "
                      f"behaviour: {_names(src, unmatched_source)}")
     if unmatched_result:
-        parts.append(f"{len(unmatched_result)} result state(s) reached only after a difference: "
-                     f"{_names(res, unmatched_result)}")
-    detail = "; ".join(parts)
-    source_path = src.path_to(unmatched_source[0]) if unmatched_source else None
-    result_path = product.path_to(first_pair) if unmatched_result else None
-    if source_path is not None and (result_path is None or len(source_path) <= len(result_path)):
-        # the source path is replayed from the start: anchor it at the product's start pair
-        return _Violation(0, None, detail, source_path)
-    return _Violation(first_pair, None, detail)
+        parts.append(f"{len(unmatched_result)} result state(s) reachable only through behaviour "
+                     f"the source does not have: {_names(res, unmatched_result)}")
+    paths = []
+    if unmatched_source:
+        paths.append(src.path_to(unmatched_source[0]))
+    if unmatched_result:
+        paths.append(res.path_to(unmatched_result[0]))
+    # replayed from the start: anchored at the product's start pair
+    return _Violation(0, None, "; ".join(parts), min(paths, key=len))
 
 
 def _names(machine: _Explored, ids: list[int], limit: int = 5) -> str:
