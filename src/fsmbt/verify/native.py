@@ -528,8 +528,13 @@ def _reachability(src: _Explored, res: _Explored, product: _Product,
 
 
 def _names(machine: _Explored, ids: list[int], limit: int = 5) -> str:
-    shown = [machine.machine.describe(machine.states[x]) for x in ids[:limit]]
-    return ", ".join(shown) + (", ..." if len(ids) > limit else "")
+    shown: dict[str, None] = {}
+    for x in ids:
+        shown.setdefault(machine.machine.describe(machine.states[x]), None)
+        if len(shown) > limit:
+            break
+    names = list(shown)
+    return ", ".join(names[:limit]) + (", ..." if len(names) > limit else "")
 
 
 def _passed_detail(name: str, src: _Explored, product: _Product) -> str:

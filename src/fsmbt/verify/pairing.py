@@ -21,7 +21,6 @@ from fsmbt.semantics.machine import FINAL, RUNNING, FSMMachine, Machine, Outputs
 MACRO_STEP = "macro-step"
 LEAF_EXECUTION = "leaf-execution"
 LEAF_OUTCOMES = ("success", "failure", "running")
-ROOT_RESULTS = ("SUCCESS", "FAILURE")
 
 
 class FSMLeafMachine:
@@ -30,9 +29,11 @@ class FSMLeafMachine:
     A state is the leaf about to be ticked: entering it outputs its action (the leaf's label).
     An outcome with no transition leaves the FSM where it is, so the same leaf is ticked again
     and its label is output again (a converter may omit ``running`` self-loops). A final state
-    whose action is ``SUCCESS``/``FAILURE`` is the root's result, with that status. With ``loop``
-    the root is ticked again after a result: any outcome from a final state re-enters the
-    initial state (the first leaf). The machine takes whatever outcomes the BT side offers.
+    is the root's result: its action (``SUCCESS``/``FAILURE``) is output and the status is
+    ``"final"``, as ``LeafMachine`` does. With ``loop`` the root is ticked again at once: entering
+    a final state outputs its action and then the initial state's, and the machine is back in
+    the initial state (``LeafMachine(loop=True)`` outputs ``(result, first leaf)`` likewise).
+    The machine takes whatever outcomes the BT side offers.
     """
 
     follows_environment = True
@@ -42,36 +43,34 @@ class FSMLeafMachine:
         self.fsm = self.inner.fsm
         self.name = self.fsm.name
         self.loop = loop
+        if self.fsm.initial is None:
+            raise InputError("the state machine has no initial state", element=self.name)
+        self.initial: str = self.fsm.initial
 
     def start(self) -> tuple[str, Outputs]:
-        state, outputs = self.inner.start()
-        if state == self.inner.start_state and state not in self.fsm.states:
-            # a leaf machine has no start event: the initial transition is taken at once
-            assert self.fsm.initial is not None
-            return self.fsm.initial, self.inner._entry(self.fsm.initial)
-        return state, outputs
+        # a leaf machine has no start event: the initial transition is taken at once
+        return self._enter(self.initial, ())
 
     def inputs(self, state: str) -> Sequence[str]:
-        if self.fsm.states[state].final and not self.loop:
+        if self.fsm.states[state].final:
             return ()
         return LEAF_OUTCOMES
 
     def step(self, state: str, symbol: str) -> tuple[str, Outputs]:
         if self.fsm.states[state].final:
-            if not self.loop:
-                return state, ()
-            assert self.fsm.initial is not None
-            return self.fsm.initial, self.inner._entry(self.fsm.initial)
-        target, outputs = self.inner.step(state, symbol)
-        if not outputs and target == state:
-            return state, self.inner._entry(state)
+            return state, ()
+        # no transition leaves ``target == state``: the same leaf is ticked again
+        target, _outputs = self.inner.step(state, symbol)
+        return self._enter(target, ())
+
+    def _enter(self, target: str, before: Outputs) -> tuple[str, Outputs]:
+        outputs = before + self.inner._entry(target)
+        if self.loop and self.fsm.states[target].final and target != self.initial:
+            return self.initial, outputs + self.inner._entry(self.initial)
         return target, outputs
 
     def status(self, state: str) -> str:
-        known = self.fsm.states[state]
-        if not known.final:
-            return RUNNING
-        return known.action if known.action in ROOT_RESULTS else FINAL
+        return FINAL if self.fsm.states[state].final else RUNNING
 
     def describe(self, state: str) -> str:
         return state

@@ -35,20 +35,25 @@ def render(report: Report) -> RenderableType:
         mark = Text("PASS", style="green") if prop.holds else Text("FAIL", style="bold red")
         table.add_row(_TITLES[name], mark, Text(prop.detail))
     parts.append(table)
+    groups: dict[tuple, list[PropertyResult]] = {}
     for name in PROPERTIES:
         prop = report.properties.get(name)
         if prop is not None and not prop.holds and prop.counterexample:
-            parts.append(counterexample_table(prop))
+            key = tuple(step.input for step in prop.counterexample)
+            groups.setdefault(key, []).append(prop)
+    for props in groups.values():  # properties failing on the same trace share one table
+        parts.append(counterexample_table(props[0], [p.name for p in props]))
     stats = report.stats
     if stats:
         parts.append(Text(_stats_line(stats), style="dim"))
     return Group(*parts)
 
 
-def counterexample_table(prop: PropertyResult) -> Table:
-    """The shortest counterexample of one failed property."""
+def counterexample_table(prop: PropertyResult, names: list[str] | None = None) -> Table:
+    """The shortest counterexample of one failed property (or several sharing it)."""
+    titles = ", ".join(_TITLES.get(n, n) for n in (names or [prop.name]))
     table = Table("step", "input", "source did", "result did", "states", "note",
-                  title=f"{_TITLES.get(prop.name, prop.name)}: shortest counterexample "
+                  title=f"{titles}: shortest counterexample "
                         f"({len(prop.counterexample or []) - 1} inputs)", title_justify="left")
     for step in prop.counterexample or []:
         style = "red" if step.note else None
