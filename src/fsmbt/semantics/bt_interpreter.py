@@ -1,0 +1,881 @@
+"""An interpreter of behavior trees that follows BehaviorTree.CPP v4 (4.8) tick rules exactly.
+
+Why a resumable, explicit-stack design: the leaf-execution machine (``leaf_machine``) must pause
+*inside* a tick, at the moment a leaf is ticked, and snapshot everything as a hashable value so
+the checker can explore states. So every node's ``tick()`` is written as a small state machine:
+a *frame* ``(node id, pc, locals...)`` on an explicit stack; ticking a child pushes a frame, a
+child's return pops it and resumes the parent at ``pc``. No Python recursion is used anywhere
+(trees may be 100 000 deep): compiling, ticking and halting all use explicit stacks.
+
+What is modelled, node by node, is exactly the v4 code (see docs/semantics.md for the rules):
+node statuses (``IDLE``/``RUNNING``/``SUCCESS``/``FAILURE``; ``SKIPPED`` is returned but never
+stored, as ``TreeNode::executeTick`` does), each node's memory (running index, skipped count,
+counters, Parallel's completed set...), ``halt()`` per node type, ``resetChildren()``, and the
+tree's wake-up signal used by ``Tree::tickOnce`` (SequenceWithMemory, Repeat,
+RetryUntilSuccessful and the Async controls emit it; ``tickOnce`` re-ticks the root at once while
+it is RUNNING and a wake-up is pending; ``tickExactlyOnce`` does not).
+
+Leaves: a Condition consults the environment on every tick; an Action is a
+``StatefulActionNode`` (it may return RUNNING): it consults the environment when its status is
+IDLE (``onStart``) or RUNNING (``onRunning``) and returns its old status, *without* consulting the
+environment, when ticked while still SUCCESS/FAILURE. ``AlwaysSuccess``, ``AlwaysFailure``,
+``Script``, ``SetBlackboard`` and ``UnsetBlackboard`` are internal: deterministic, never
+observed. Blackboard- and time-dependent nodes are rejected with ``UnsupportedError``.
+
+Complexity: compiling is O(N) for N nodes after SubTree expansion; one leaf-to-leaf advance is
+O(nodes touched); a snapshot is O(k log k + d) for k nodes with non-default status/memory and
+stack depth d.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Hashable
+from dataclasses import dataclass, field
+from typing import Any
+
+from fsmbt.model.bt import BTDocument, BTNode
+from fsmbt.model.bt_nodes import NodeKind, builtin_spec, canonical_type
+from fsmbt.model.errors import InputError, UnsupportedError
+
+# -- statuses --------------------------------------------------------------------------------
+IDLE, RUNNING, SUCCESS, FAILURE, SKIPPED = range(5)
+STATUS_NAMES = ("IDLE", "RUNNING", "SUCCESS", "FAILURE", "SKIPPED")
+#: Leaf outcomes as the environment / the leaf machine's inputs name them.
+OUTCOME_SUCCESS, OUTCOME_FAILURE, OUTCOME_RUNNING = "success", "failure", "running"
+OUTCOME_TO_STATUS = {OUTCOME_SUCCESS: SUCCESS, OUTCOME_FAILURE: FAILURE, OUTCOME_RUNNING: RUNNING}
+STATUS_TO_OUTCOME = {v: k for k, v in OUTCOME_TO_STATUS.items()}
+
+#: Upper bound on nodes after SubTree expansion (a SubTree used twice per level doubles).
+MAX_COMPILED_NODES = 2_000_000
+
+# -- supported node types ----------------------------------------------------------------------
+SEQUENCE_LIKE = {"Sequence": False, "AsyncSequence": True}
+FALLBACK_LIKE = {"Fallback": False, "AsyncFallback": True}
+CONTROLS = frozenset({
+    "Sequence", "AsyncSequence", "SequenceWithMemory", "ReactiveSequence",
+    "Fallback", "AsyncFallback", "ReactiveFallback",
+    "Parallel", "ParallelAll", "IfThenElse", "WhileDoElse",
+})
+DECORATORS = frozenset({
+    "Inverter", "ForceSuccess", "ForceFailure", "Repeat", "RetryUntilSuccessful",
+    "KeepRunningUntilFailure", "RunOnce", "SubTree",
+})
+#: Built-in leaves that always succeed / fail and take no input from the environment.
+INTERNAL_LEAVES = {
+    "AlwaysSuccess": SUCCESS, "AlwaysFailure": FAILURE, "Script": SUCCESS,
+    "SetBlackboard": SUCCESS, "UnsetBlackboard": SUCCESS,
+}
+#: Pre-condition attributes change control flow from the blackboard: rejected.
+PRECONDITION_ATTRS = ("_skipIf", "_failureIf", "_successIf", "_while")
+_REJECT_REASON = {
+    "Delay": "time-based node (needs a clock)", "Timeout": "time-based node (needs a clock)",
+    "Sleep": "time-based node (needs a clock)",
+    "ScriptCondition": "its result depends on the blackboard",
+    "WasEntryUpdated": "its result depends on the blackboard",
+    "Precondition": "its result depends on the blackboard",
+    "SkipUnlessUpdated": "its result depends on the blackboard",
+    "WaitValueUpdate": "its result depends on the blackboard",
+    "ManualSelector": "it asks a person which child to run",
+}
+
+
+class BTRuntimeError(InputError):
+    """The tree does something BehaviorTree.CPP would throw on (e.g. a child returns IDLE)."""
+
+
+class BTLivelock(BTRuntimeError):
+    """``tickOnce`` would re-tick the root forever without ticking an environment leaf (e.g.
+    ``Repeat num_cycles=-1`` over ``AlwaysSuccess``): the real engine hangs."""
+
+
+@dataclass(frozen=True)
+class CompiledNode:
+    """One node after SubTree expansion; ``id`` is its pre-order index."""
+
+    id: int
+    type: str
+    kind: NodeKind
+    children: tuple[int, ...]
+    label: str
+    parent: int | None
+    index: int  # position among the parent's children
+    source: BTNode = field(compare=False, repr=False)
+    params: tuple[Any, ...] = ()
+    internal_status: int | None = None  # for internal built-in leaves
+    tree: CompiledTree | None = field(default=None, compare=False, repr=False)
+
+    @property
+    def path(self) -> str:
+        """Child indices from the root joined by ``/`` (``""`` for the root); a SubTree node
+        has its tree's root as child 0. Computed on demand: O(depth)."""
+        assert self.tree is not None
+        return self.tree.path_of(self.id)
+
+    @property
+    def is_env_leaf(self) -> bool:
+        """A leaf whose outcome the environment decides (observable in traces)."""
+        return self.kind in (NodeKind.ACTION, NodeKind.CONDITION) and self.internal_status is None
+
+    @property
+    def is_condition(self) -> bool:
+        return self.kind is NodeKind.CONDITION
+
+
+def _where(node: BTNode) -> dict[str, Any]:
+    return {"location": node.location, "element": f"<{node.type}> '{node.label}'"}
+
+
+def _int_param(node: BTNode, port: str, default: int | None) -> int:
+    raw = node.attrs.get(port)
+    if raw is None:
+        if default is None:
+            raise InputError(f"missing port '{port}'", **_where(node))
+        return default
+    text = raw.strip()
+    if text.startswith("{") and text.endswith("}"):
+        raise UnsupportedError(f"port '{port}' reads the blackboard ({text})", **_where(node))
+    try:
+        return int(text)
+    except ValueError:
+        raise InputError(f"port '{port}' is not an integer: {raw!r}", **_where(node)) from None
+
+
+def _bool_param(node: BTNode, port: str, default: bool) -> bool:
+    raw = node.attrs.get(port)
+    if raw is None:
+        return default
+    text = raw.strip().lower()
+    if text in ("true", "1"):
+        return True
+    if text in ("false", "0"):
+        return False
+    if text.startswith("{"):
+        raise UnsupportedError(f"port '{port}' reads the blackboard ({raw})", **_where(node))
+    raise InputError(f"port '{port}' is not a boolean: {raw!r}", **_where(node))
+
+
+def _threshold(value: int, count: int) -> int:
+    """BehaviorTree.CPP's reading of a Parallel threshold: negative means "all but"."""
+    return max(count + value + 1, 0) if value < 0 else value
+
+
+class CompiledTree:
+    """A ``BTDocument``'s main tree with SubTrees expanded, validated against v4 rules."""
+
+    def __init__(self, doc: BTDocument) -> None:
+        self.doc = doc
+        self.nodes: list[CompiledNode] = []
+        self._paths: dict[int, str] = {}
+        self._compile()
+
+    # Compilation is iterative: a work stack of (BTNode, parent id, path, subtree chain).
+    def _compile(self) -> None:
+        tree = self.doc.main
+        if tree.root is None:
+            raise InputError("the main behavior tree is empty", location=tree.location,
+                             element=f"BehaviorTree '{tree.id}'")
+        children_of: dict[int, list[int]] = {}
+        raw: list[tuple[BTNode, str, int | None, int, tuple[Any, ...], int | None,
+                        NodeKind]] = []
+        stack: list[tuple[BTNode, int | None, int, tuple[str, ...]]] = [
+            (tree.root, None, 0, (tree.id,))]
+        while stack:
+            node, parent, position, chain = stack.pop()
+            nid = len(raw)
+            if nid >= MAX_COMPILED_NODES:
+                raise InputError(f"the tree has more than {MAX_COMPILED_NODES} nodes once "
+                                 "SubTrees are expanded", element=tree.id)
+            if parent is not None:
+                children_of[parent].append(nid)
+            children_of[nid] = []
+            ctype, kind, params, internal, kids = self._check(node, chain)
+            raw.append((node, ctype, parent, position, params, internal, kind))
+            if ctype == "SubTree":
+                target = node.attrs["ID"]
+                kids = [self.doc.trees[target].root]  # type: ignore[list-item]
+                chain = chain + (target,)
+            for index in range(len(kids) - 1, -1, -1):
+                stack.append((kids[index], nid, index, chain))
+        # pre-order ids: stack pushes reversed, so children ids were assigned in order
+        for nid, (node, ctype, parent, position, params, internal, kind) in enumerate(raw):
+            self.nodes.append(CompiledNode(
+                id=nid, type=ctype, kind=kind, children=tuple(children_of[nid]),
+                label=node.label, parent=parent, index=position, source=node, params=params,
+                internal_status=internal, tree=self))
+
+    def path_of(self, nid: int) -> str:
+        """See ``CompiledNode.path``; cached per node."""
+        cached = self._paths.get(nid)
+        if cached is None:
+            parts: list[str] = []
+            x: int | None = nid
+            while x is not None and x != 0:
+                node = self.nodes[x]
+                parts.append(str(node.index))
+                x = node.parent
+            cached = "/".join(reversed(parts))
+            self._paths[nid] = cached
+        return cached
+
+    def _check(self, node: BTNode, chain: tuple[str, ...]):
+        ctype = canonical_type(node.type)
+        kind = node.kind
+        for attr in PRECONDITION_ATTRS:
+            if attr in node.attrs:
+                raise UnsupportedError(
+                    f"pre-condition '{attr}' depends on the blackboard", **_where(node))
+        if ctype in _REJECT_REASON:
+            raise UnsupportedError(f"{ctype}: {_REJECT_REASON[ctype]}", **_where(node))
+        kids = list(node.children)
+        params: tuple[Any, ...] = ()
+        internal: int | None = None
+        if kind is NodeKind.SUBTREE or ctype == "SubTree":
+            kind = NodeKind.SUBTREE
+            ctype = "SubTree"
+            target = node.attrs.get("ID")
+            if not target or target not in self.doc.trees:
+                raise InputError(f"SubTree refers to unknown tree {target!r}", **_where(node))
+            if target in chain:
+                raise UnsupportedError(f"SubTree '{target}' includes itself (recursion)",
+                                       **_where(node))
+            if self.doc.trees[target].root is None:
+                raise InputError(f"SubTree '{target}' is empty", **_where(node))
+            return ctype, kind, params, internal, []
+        if kind in (NodeKind.ACTION, NodeKind.CONDITION):
+            if kids:
+                raise InputError("a leaf node has children", **_where(node))
+            if ctype in INTERNAL_LEAVES:
+                internal = INTERNAL_LEAVES[ctype]
+            elif builtin_spec(ctype) is not None:
+                raise UnsupportedError(f"built-in leaf {ctype} is not supported", **_where(node))
+            return ctype, kind, params, internal, kids
+        if kind is NodeKind.DECORATOR:
+            if ctype not in DECORATORS:
+                raise UnsupportedError(f"decorator type '{node.type}' is not supported "
+                                       "(custom or unknown semantics)", **_where(node))
+            if len(kids) != 1:
+                raise InputError(f"decorator {ctype} needs exactly one child, has {len(kids)}",
+                                 **_where(node))
+            if ctype == "Repeat":
+                params = (_int_param(node, "num_cycles", None),)
+            elif ctype == "RetryUntilSuccessful":
+                params = (_int_param(node, "num_attempts", None),)
+            elif ctype == "RunOnce":
+                params = (_bool_param(node, "then_skip", True),)
+            return ctype, kind, params, internal, kids
+        if kind is NodeKind.CONTROL:
+            if ctype not in CONTROLS:
+                raise UnsupportedError(f"control type '{node.type}' is not supported "
+                                       "(custom or unknown semantics)", **_where(node))
+            if not kids:
+                raise InputError(f"control node {ctype} has no children", **_where(node))
+            n = len(kids)
+            if ctype in ("IfThenElse", "WhileDoElse") and n not in (2, 3):
+                raise InputError(f"{ctype} needs 2 or 3 children, has {n}", **_where(node))
+            if ctype == "Parallel":
+                succ = _int_param(node, "success_count", -1)
+                fail = _int_param(node, "failure_count", 1)
+                if n < _threshold(succ, n) or n < _threshold(fail, n):
+                    raise InputError("Parallel threshold exceeds the number of children",
+                                     **_where(node))
+                params = (succ, fail)
+            elif ctype == "ParallelAll":
+                fail = _int_param(node, "max_failures", 1)
+                if n < _threshold(fail, n):
+                    raise InputError("ParallelAll max_failures exceeds the number of children",
+                                     **_where(node))
+                params = (_threshold(fail, n),)
+            return ctype, kind, params, internal, kids
+        raise UnsupportedError(f"node kind {kind} is not supported", **_where(node))
+
+    @property
+    def root(self) -> CompiledNode:
+        return self.nodes[0]
+
+
+# -- run-time configuration ------------------------------------------------------------------
+#: A snapshot: (statuses, memories, frames, wake-up pending). Hashable; equal snapshots behave
+#: the same for every future input.
+Snapshot = tuple[tuple[tuple[int, int], ...], tuple[tuple[int, tuple], ...],
+                 tuple[tuple, ...], bool]
+
+
+@dataclass(frozen=True)
+class LeafRequest:
+    """The interpreter is about to tick an environment leaf; ``prev`` is its status (IDLE =
+    first tick / ``onStart``, RUNNING = ``onRunning``)."""
+
+    node: CompiledNode
+    prev: int
+
+
+@dataclass(frozen=True)
+class TickDone:
+    """A ``tickOnce`` (or ``tickExactlyOnce``) call returned ``status``."""
+
+    status: int
+
+
+HaltHook = Callable[[CompiledNode], None]
+
+
+class _Work:
+    """The mutable working copy of a snapshot."""
+
+    __slots__ = ("st", "mem", "frames", "wake")
+
+    def __init__(self, snap: Snapshot) -> None:
+        self.st: dict[int, int] = dict(snap[0])
+        self.mem: dict[int, tuple] = dict(snap[1])
+        self.frames: list[tuple] = list(snap[2])
+        self.wake: bool = snap[3]
+
+    def snapshot(self) -> Snapshot:
+        return (tuple(sorted(self.st.items())), tuple(sorted(self.mem.items())),
+                tuple(self.frames), self.wake)
+
+
+_DEFAULT_MEM: dict[str, tuple] = {
+    "Sequence": (0, 0), "AsyncSequence": (0, 0), "SequenceWithMemory": (0, 0),
+    "Fallback": (0, 0), "AsyncFallback": (0, 0),
+    "Parallel": (frozenset(), 0, 0), "ParallelAll": (frozenset(), 0),
+    "IfThenElse": (0,), "Repeat": (0,), "RetryUntilSuccessful": (0,),
+    "RunOnce": (False, IDLE),
+}
+
+EMPTY_SNAPSHOT: Snapshot = ((), (), (), False)
+
+
+class BTInterpreter:
+    """Executes a compiled tree step by step. Stateless itself: every call takes and returns a
+    ``Snapshot``, so callers (the leaf machine, the LEBT runtime, a plain runner) share it."""
+
+    def __init__(self, tree: BTDocument | CompiledTree, *, exactly_once: bool = False) -> None:
+        self.tree = tree if isinstance(tree, CompiledTree) else CompiledTree(tree)
+        self.nodes = self.tree.nodes
+        self.exactly_once = exactly_once
+        self._tick = {
+            "Sequence": self._t_sequence, "AsyncSequence": self._t_sequence,
+            "SequenceWithMemory": self._t_sequence, "Fallback": self._t_sequence,
+            "AsyncFallback": self._t_sequence,
+            "ReactiveSequence": self._t_reactive, "ReactiveFallback": self._t_reactive,
+            "Parallel": self._t_parallel, "ParallelAll": self._t_parallel_all,
+            "IfThenElse": self._t_if_then_else, "WhileDoElse": self._t_while_do_else,
+            "Inverter": self._t_simple_decorator, "ForceSuccess": self._t_simple_decorator,
+            "ForceFailure": self._t_simple_decorator,
+            "KeepRunningUntilFailure": self._t_simple_decorator,
+            "Repeat": self._t_repeat, "RetryUntilSuccessful": self._t_retry,
+            "RunOnce": self._t_run_once, "SubTree": self._t_subtree,
+        }
+
+    # -- public driving API --------------------------------------------------------------
+    def initial(self) -> Snapshot:
+        return EMPTY_SNAPSHOT
+
+    def begin_tick(self, snap: Snapshot) -> Snapshot:
+        """Start one ``tickOnce``: push the root's frame (the snapshot must be between ticks)."""
+        if snap[2]:
+            raise ValueError("a tick is already in progress")
+        return (snap[0], snap[1], ((0, 0),), snap[3])
+
+    def advance(self, snap: Snapshot, outcome: int | None = None,
+                halt_hook: HaltHook | None = None) -> tuple[Snapshot, LeafRequest | TickDone]:
+        """Run until the next environment leaf must be ticked or the ``tickOnce`` returns.
+
+        ``outcome`` answers the ``LeafRequest`` the snapshot stopped at (``None`` right after
+        ``begin_tick``). ``halt_hook`` is called for every RUNNING action that gets halted.
+        """
+        w = _Work(snap)
+        result: int | None = None
+        seen_reticks: set[Snapshot] = set()
+        if outcome is not None:
+            nid = w.frames[-1][0]
+            node = self.nodes[nid]
+            if node.is_condition and outcome == RUNNING:
+                raise BTRuntimeError("a condition returned RUNNING", element=node.label)
+            if outcome not in (SUCCESS, FAILURE, RUNNING):
+                raise ValueError(f"invalid leaf outcome {outcome!r}")
+            w.frames.pop()
+            result = self._returned(w, nid, outcome)
+        elif not w.frames:
+            raise ValueError("no tick in progress: call begin_tick first")
+        while True:
+            if not w.frames:
+                assert result is not None
+                # Tree::tickRoot: re-tick at once while RUNNING and a wake-up is pending.
+                if result == RUNNING and w.wake and not self.exactly_once:
+                    w.wake = False
+                    key = w.snapshot()
+                    if key in seen_reticks:
+                        raise BTLivelock("the tree re-ticks its root forever without ticking "
+                                         "a leaf", element=self.nodes[0].label)
+                    seen_reticks.add(key)
+                    w.frames.append((0, 0))
+                    result = None
+                    continue
+                if result in (SUCCESS, FAILURE):
+                    w.st.pop(0, None)  # rootNode()->resetStatus()
+                return w.snapshot(), TickDone(result)
+            frame = w.frames[-1]
+            node = self.nodes[frame[0]]
+            if node.kind in (NodeKind.ACTION, NodeKind.CONDITION):
+                if node.internal_status is not None:
+                    w.frames.pop()
+                    result = self._returned(w, node.id, node.internal_status)
+                    continue
+                prev = w.st.get(node.id, IDLE)
+                if node.kind is NodeKind.ACTION and prev in (SUCCESS, FAILURE):
+                    # StatefulActionNode::tick returns its old status without a callback
+                    w.frames.pop()
+                    result = self._returned(w, node.id, prev)
+                    continue
+                return w.snapshot(), LeafRequest(node, prev)
+            action = self._tick[node.type](w, node, frame, result, halt_hook)
+            if action[0] == "call":
+                _, child, new_frame = action
+                w.frames[-1] = new_frame
+                w.frames.append((child, 0))
+                result = None
+            else:
+                w.frames.pop()
+                result = self._returned(w, node.id, action[1])
+
+    def leaf_request(self, snap: Snapshot) -> LeafRequest | None:
+        """The leaf a paused snapshot waits on, or ``None`` between ticks."""
+        if not snap[2]:
+            return None
+        nid = snap[2][-1][0]
+        return LeafRequest(self.nodes[nid], dict(snap[0]).get(nid, IDLE))
+
+    def halt_tree(self, snap: Snapshot, halt_hook: HaltHook | None = None) -> Snapshot:
+        """``Tree::haltTree``: halt the root (between ticks)."""
+        w = _Work(snap)
+        self._halt(w, 0, halt_hook)
+        return w.snapshot()
+
+    # -- helpers shared by node types -------------------------------------------------------
+    def _returned(self, w: _Work, nid: int, status: int) -> int:
+        """``executeTick``'s epilogue: store the status unless SKIPPED."""
+        if status == IDLE:
+            raise BTRuntimeError("a node returned IDLE", element=self.nodes[nid].label)
+        if status != SKIPPED:
+            w.st[nid] = status
+        return status
+
+    def _mem(self, w: _Work, node: CompiledNode) -> tuple:
+        return w.mem.get(node.id, _DEFAULT_MEM[node.type])
+
+    def _set_mem(self, w: _Work, node: CompiledNode, value: tuple) -> None:
+        if value == _DEFAULT_MEM[node.type]:
+            w.mem.pop(node.id, None)
+        else:
+            w.mem[node.id] = value
+
+    def _reset_child(self, w: _Work, child: int, hook: HaltHook | None) -> None:
+        """``ControlNode::haltChild`` / ``DecoratorNode::resetChild``."""
+        if w.st.get(child, IDLE) == RUNNING:
+            self._halt(w, child, hook)
+        w.st.pop(child, None)
+
+    def _reset_children(self, w: _Work, node: CompiledNode, hook: HaltHook | None,
+                        first: int = 0) -> None:
+        for child in node.children[first:]:
+            self._reset_child(w, child, hook)
+
+    def _halt(self, w: _Work, nid: int, hook: HaltHook | None) -> None:
+        """``haltNode()``: per-type ``halt()``, halting RUNNING descendants (explicit stack,
+        pre-order, as the recursive C++ does)."""
+        stack = [nid]
+        while stack:
+            x = self.nodes[stack.pop()]
+            t = x.type
+            if t in ("Sequence", "AsyncSequence", "Fallback", "AsyncFallback", "Parallel",
+                     "ParallelAll", "IfThenElse", "Repeat", "RetryUntilSuccessful"):
+                w.mem.pop(x.id, None)  # these halt() reset their memory
+            # SequenceWithMemory, RunOnce, Reactive*, WhileDoElse keep theirs
+            if x.kind is NodeKind.ACTION and x.internal_status is None and hook is not None \
+                    and w.st.get(x.id, IDLE) == RUNNING:
+                hook(x)
+            for child in reversed(x.children):
+                if w.st.get(child, IDLE) == RUNNING:
+                    stack.append(child)
+                else:
+                    w.st.pop(child, None)
+            w.st.pop(x.id, None)
+            # running children reset their own status when popped (after their halt)
+
+    # -- node types: each returns ("call", child, new_frame) or ("ret", status) ---------------
+    def _t_sequence(self, w, node, frame, result, hook):
+        """Sequence / Fallback / Async* / SequenceWithMemory (sequence_node.cpp & co)."""
+        t = node.type
+        is_fallback = t in FALLBACK_LIKE
+        asynch = SEQUENCE_LIKE.get(t, FALLBACK_LIKE.get(t, False))
+        with_memory = t == "SequenceWithMemory"
+        stop, go_on = (SUCCESS, FAILURE) if is_fallback else (FAILURE, SUCCESS)
+        idx, skipped = self._mem(w, node)
+        n = len(node.children)
+        if frame[1] == 0:
+            if w.st.get(node.id, IDLE) == IDLE:  # !isStatusActive(status())
+                skipped = 0
+            w.st[node.id] = RUNNING
+        else:
+            prev = frame[2]
+            if result == RUNNING:
+                self._set_mem(w, node, (idx, skipped))
+                return ("ret", RUNNING)
+            if result == stop:
+                if with_memory:
+                    self._reset_children(w, node, hook, first=idx)
+                else:
+                    self._reset_children(w, node, hook)
+                    idx = 0
+                self._set_mem(w, node, (idx, skipped))
+                return ("ret", stop)
+            if result == go_on:
+                idx += 1
+                if (asynch or with_memory) and prev == IDLE and idx < n:
+                    w.wake = True
+                    self._set_mem(w, node, (idx, skipped))
+                    return ("ret", RUNNING)
+            elif result == SKIPPED:
+                idx += 1
+                skipped += 1
+            else:
+                raise BTRuntimeError("a child returned IDLE", element=node.label)
+        if idx < n:
+            child = node.children[idx]
+            self._set_mem(w, node, (idx, skipped))
+            return ("call", child, (node.id, 1, w.st.get(child, IDLE)))
+        all_skipped = skipped == n
+        self._reset_children(w, node, hook)
+        self._set_mem(w, node, (0, 0))
+        return ("ret", SKIPPED if all_skipped else go_on)
+
+    def _t_reactive(self, w, node, frame, result, hook):
+        """ReactiveSequence / ReactiveFallback (reactive_sequence.cpp, reactive_fallback.cpp)."""
+        is_fallback = node.type == "ReactiveFallback"
+        stop, go_on = (SUCCESS, FAILURE) if is_fallback else (FAILURE, SUCCESS)
+        if frame[1] == 0:
+            w.st[node.id] = RUNNING
+            index, all_skipped = 0, True
+        else:
+            index, all_skipped = frame[2], frame[3]
+            all_skipped = all_skipped and result == SKIPPED
+            if result == RUNNING:
+                for i, child in enumerate(node.children):
+                    if i != index:
+                        self._reset_child(w, child, hook)
+                return ("ret", RUNNING)
+            if result == stop:
+                self._reset_children(w, node, hook)
+                return ("ret", stop)
+            if result == SKIPPED:
+                self._reset_child(w, node.children[index], hook)
+            elif result != go_on:
+                raise BTRuntimeError("a child returned IDLE", element=node.label)
+            index += 1
+        if index < len(node.children):
+            return ("call", node.children[index], (node.id, 1, index, all_skipped))
+        self._reset_children(w, node, hook)
+        return ("ret", SKIPPED if all_skipped else go_on)
+
+    def _t_parallel(self, w, node, frame, result, hook):
+        """Parallel with success_count / failure_count (parallel_node.cpp)."""
+        n = len(node.children)
+        succ_param, fail_param = node.params
+        need_s, need_f = _threshold(succ_param, n), _threshold(fail_param, n)
+        completed, sc, fc = self._mem(w, node)
+        if frame[1] == 0:
+            w.st[node.id] = RUNNING
+            i, skipped = 0, 0
+            checked = False
+        else:
+            i, skipped = frame[2], frame[3]
+            if result == SKIPPED:
+                skipped += 1
+            elif result == SUCCESS:
+                completed, sc = completed | {i}, sc + 1
+            elif result == FAILURE:
+                completed, fc = completed | {i}, fc + 1
+            elif result != RUNNING:
+                raise BTRuntimeError("a child returned IDLE", element=node.label)
+            checked = True  # the child at i was ticked: run the checks for i below
+        while i < n:
+            if not checked and i not in completed:
+                self._set_mem(w, node, (completed, sc, fc))
+                return ("call", node.children[i], (node.id, 1, i, skipped))
+            checked = False
+            if sc >= need_s or (succ_param < 0 and sc + skipped >= need_s):
+                self._set_mem(w, node, (frozenset(), 0, 0))
+                self._reset_children(w, node, hook)
+                return ("ret", SUCCESS)
+            if (n - fc) < need_s or fc == need_f:
+                self._set_mem(w, node, (frozenset(), 0, 0))
+                self._reset_children(w, node, hook)
+                return ("ret", FAILURE)
+            i += 1
+        self._set_mem(w, node, (completed, sc, fc))
+        return ("ret", SKIPPED if skipped == n else RUNNING)
+
+    def _t_parallel_all(self, w, node, frame, result, hook):
+        """ParallelAll with max_failures (parallel_all_node.cpp)."""
+        n = len(node.children)
+        (need_f,) = node.params
+        completed, fc = self._mem(w, node)
+        if frame[1] == 0:
+            w.st[node.id] = RUNNING
+            i, skipped = 0, 0
+        else:
+            i, skipped = frame[2], frame[3]
+            if result == SUCCESS:
+                completed = completed | {i}
+            elif result == FAILURE:
+                completed, fc = completed | {i}, fc + 1
+            elif result == SKIPPED:
+                skipped += 1
+            elif result != RUNNING:
+                raise BTRuntimeError("a child returned IDLE", element=node.label)
+            i += 1
+        while i < n and i in completed:
+            i += 1
+        if i < n:
+            self._set_mem(w, node, (completed, fc))
+            return ("call", node.children[i], (node.id, 1, i, skipped))
+        if skipped == n:
+            self._set_mem(w, node, (completed, fc))
+            return ("ret", SKIPPED)
+        if skipped + len(completed) >= n:
+            self._reset_children(w, node, hook)  # haltChildren()
+            status = FAILURE if fc >= need_f else SUCCESS
+            self._set_mem(w, node, (frozenset(), 0))
+            return ("ret", status)
+        self._set_mem(w, node, (completed, fc))
+        return ("ret", RUNNING)
+
+    def _t_if_then_else(self, w, node, frame, result, hook):
+        """IfThenElse (if_then_else_node.cpp): the condition is not re-evaluated while a branch
+        runs."""
+        (child_idx,) = self._mem(w, node)
+        n = len(node.children)
+        pc = frame[1]
+        if pc == 0:
+            w.st[node.id] = RUNNING
+            if child_idx == 0:
+                return ("call", node.children[0], (node.id, 1))
+        elif pc == 1:
+            if result == RUNNING:
+                return ("ret", RUNNING)
+            if result == SUCCESS:
+                child_idx = 1
+            elif result == FAILURE:
+                if n == 3:
+                    child_idx = 2
+                else:
+                    return ("ret", FAILURE)
+            else:
+                raise BTRuntimeError("IfThenElse: the condition was skipped (BehaviorTree.CPP "
+                                     "throws a logic_error)", element=node.label)
+            self._set_mem(w, node, (child_idx,))
+        else:  # pc == 2: the branch returned
+            if result == RUNNING:
+                return ("ret", RUNNING)
+            self._reset_children(w, node, hook)
+            self._set_mem(w, node, (0,))
+            return ("ret", result)
+        return ("call", node.children[child_idx], (node.id, 2))
+
+    def _t_while_do_else(self, w, node, frame, result, hook):
+        """WhileDoElse (while_do_else_node.cpp): the condition is re-evaluated every tick."""
+        n = len(node.children)
+        pc = frame[1]
+        if pc == 0:
+            w.st[node.id] = RUNNING
+            return ("call", node.children[0], (node.id, 1))
+        if pc == 1:
+            if result == RUNNING:
+                return ("ret", RUNNING)
+            if result == SUCCESS:
+                if n == 3:
+                    self._reset_child(w, node.children[2], hook)
+                return ("call", node.children[1], (node.id, 2))
+            if result == FAILURE:
+                if n == 3:
+                    self._reset_child(w, node.children[1], hook)
+                    return ("call", node.children[2], (node.id, 2))
+                status = FAILURE
+            else:
+                raise BTRuntimeError("WhileDoElse: the condition was skipped (the node would "
+                                     "return IDLE)", element=node.label)
+        else:
+            status = result
+        if status == RUNNING:
+            return ("ret", RUNNING)
+        self._reset_children(w, node, hook)
+        return ("ret", status)
+
+    def _t_simple_decorator(self, w, node, frame, result, hook):
+        """Inverter, ForceSuccess, ForceFailure, KeepRunningUntilFailure."""
+        child = node.children[0]
+        if frame[1] == 0:
+            w.st[node.id] = RUNNING
+            return ("call", child, (node.id, 1))
+        t = node.type
+        if t == "KeepRunningUntilFailure":
+            if result == FAILURE:
+                self._reset_child(w, child, hook)
+                return ("ret", FAILURE)
+            if result == SUCCESS:
+                self._reset_child(w, child, hook)
+                return ("ret", RUNNING)
+            return ("ret", RUNNING)  # RUNNING, or `return status()` (RUNNING) when skipped
+        if result in (RUNNING, SKIPPED):
+            return ("ret", result)
+        self._reset_child(w, child, hook)
+        if t == "Inverter":
+            return ("ret", FAILURE if result == SUCCESS else SUCCESS)
+        return ("ret", SUCCESS if t == "ForceSuccess" else FAILURE)
+
+    def _t_repeat(self, w, node, frame, result, hook):
+        """Repeat num_cycles (repeat_node.cpp); -1 repeats forever."""
+        (cycles,) = node.params
+        (count,) = self._mem(w, node)
+        child = node.children[0]
+        if frame[1] == 0:
+            w.st[node.id] = RUNNING
+            do_loop = count < cycles or cycles == -1
+        else:
+            prev = frame[2]
+            if result == SUCCESS:
+                count += 1
+                do_loop = count < cycles or cycles == -1
+                self._reset_child(w, child, hook)
+                if prev == IDLE and do_loop:
+                    w.wake = True
+                    self._set_mem(w, node, (count,))
+                    return ("ret", RUNNING)
+            elif result == FAILURE:
+                self._set_mem(w, node, (0,))
+                self._reset_child(w, child, hook)
+                return ("ret", FAILURE)
+            elif result == RUNNING:
+                return ("ret", RUNNING)
+            elif result == SKIPPED:
+                self._reset_child(w, child, hook)
+                return ("ret", SKIPPED)
+            else:
+                raise BTRuntimeError("a child returned IDLE", element=node.label)
+        if do_loop:
+            self._set_mem(w, node, (count,))
+            return ("call", child, (node.id, 1, w.st.get(child, IDLE)))
+        self._set_mem(w, node, (0,))
+        return ("ret", SUCCESS)
+
+    def _t_retry(self, w, node, frame, result, hook):
+        """RetryUntilSuccessful num_attempts (retry_node.cpp); -1 retries forever."""
+        (attempts,) = node.params
+        (count,) = self._mem(w, node)
+        child = node.children[0]
+        if frame[1] == 0:
+            w.st[node.id] = RUNNING
+            do_loop = count < attempts or attempts == -1
+        else:
+            prev = frame[2]
+            if result == SUCCESS:
+                self._set_mem(w, node, (0,))
+                self._reset_child(w, child, hook)
+                return ("ret", SUCCESS)
+            if result == FAILURE:
+                count += 1
+                do_loop = count < attempts or attempts == -1
+                self._reset_child(w, child, hook)
+                if prev == IDLE and do_loop:
+                    w.wake = True
+                    self._set_mem(w, node, (count,))
+                    return ("ret", RUNNING)
+            elif result == RUNNING:
+                return ("ret", RUNNING)
+            elif result == SKIPPED:
+                self._reset_child(w, child, hook)
+                return ("ret", SKIPPED)
+            else:
+                raise BTRuntimeError("a child returned IDLE", element=node.label)
+        if do_loop:
+            self._set_mem(w, node, (count,))
+            return ("call", child, (node.id, 1, w.st.get(child, IDLE)))
+        self._set_mem(w, node, (0,))
+        return ("ret", FAILURE)
+
+    def _t_run_once(self, w, node, frame, result, hook):
+        """RunOnce then_skip (run_once_node.h): memory survives halts."""
+        (then_skip,) = node.params
+        ticked, returned = self._mem(w, node)
+        if frame[1] == 0:
+            if ticked:
+                return ("ret", SKIPPED if then_skip else returned)
+            w.st[node.id] = RUNNING
+            return ("call", node.children[0], (node.id, 1))
+        if result in (SUCCESS, FAILURE):
+            self._set_mem(w, node, (True, result))
+            self._reset_child(w, node.children[0], hook)
+        return ("ret", result)
+
+    def _t_subtree(self, w, node, frame, result, hook):
+        """SubTree (subtree_node.cpp): a transparent decorator; port remapping is irrelevant."""
+        if frame[1] == 0:
+            if w.st.get(node.id, IDLE) == IDLE:
+                w.st[node.id] = RUNNING
+            return ("call", node.children[0], (node.id, 1))
+        if result in (SUCCESS, FAILURE):
+            self._reset_child(w, node.children[0], hook)
+        return ("ret", result)
+
+
+# -- a plain runner: the interpreter driven by an environment callback -------------------------
+Environment = Callable[[BTNode, str], str]
+
+
+@dataclass
+class TickRecord:
+    """One ``tick_once``: the leaves ticked (labels and paths, in order) and the root result."""
+
+    leaves: list[tuple[str, str, str]]  # (label, path, outcome)
+    result: str
+
+
+class BTRunner:
+    """Run a document tick by tick; each leaf asks ``env(node, path)`` for its outcome
+    (``"success"``/``"failure"``/``"running"``). Mirrors behaviortreepy's ``Tree``."""
+
+    def __init__(self, doc: BTDocument | CompiledTree, env: Environment, *,
+                 exactly_once: bool = False, halt_hook: HaltHook | None = None,
+                 max_leaf_ticks_per_tick: int = 1_000_000) -> None:
+        self.interp = BTInterpreter(doc, exactly_once=exactly_once)
+        self.env = env
+        self.halt_hook = halt_hook
+        self.snapshot: Snapshot = self.interp.initial()
+        self.max_leaf_ticks = max_leaf_ticks_per_tick
+
+    def tick_once(self) -> TickRecord:
+        snap = self.interp.begin_tick(self.snapshot)
+        snap, event = self.interp.advance(snap, None, self.halt_hook)
+        leaves: list[tuple[str, str, str]] = []
+        while isinstance(event, LeafRequest):
+            if len(leaves) >= self.max_leaf_ticks:
+                raise BTRuntimeError("a tick does not end (too many leaf ticks)")
+            node = event.node
+            outcome = self.env(node.source, node.path)
+            status = OUTCOME_TO_STATUS.get(outcome)
+            if status is None:
+                raise ValueError(f"environment returned {outcome!r} for {node.label}")
+            leaves.append((node.label, node.path, outcome))
+            snap, event = self.interp.advance(snap, status, self.halt_hook)
+        self.snapshot = snap
+        return TickRecord(leaves, STATUS_NAMES[event.status])
+
+    def halt(self) -> None:
+        self.snapshot = self.interp.halt_tree(self.snapshot, self.halt_hook)
+
+
+def snapshot_key(snap: Snapshot) -> Hashable:
+    """Snapshots are already hashable; this names the intent at call sites."""
+    return snap

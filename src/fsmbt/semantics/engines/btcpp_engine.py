@@ -1,0 +1,133 @@
+"""Run a ``BTDocument`` in BehaviorTree.CPP v4 through ``behaviortreepy``.
+
+The tree is written to v4 XML here (with lxml) from the *compiled* tree, so that every
+environment leaf has a unique name ``n<id>`` (its pre-order id in ``CompiledTree``) and every
+SubTree occurrence gets its own generated ``<BehaviorTree>`` (SubTree semantics are kept, leaf
+names stay unique). Leaves are registered once per kind:
+
+- ``FsmbtCondition``: a simple condition; each tick asks the environment.
+- ``FsmbtAction``: a stateful action; ``onStart`` and ``onRunning`` ask the environment (so an
+  action ticked while still SUCCESS/FAILURE returns that status without asking, as v4 does).
+- ``Script``/``SetBlackboard``/``UnsetBlackboard`` are written as ``AlwaysSuccess`` (same
+  control flow; the blackboard is not modelled).
+
+``BTCppRunner.tick_once()`` calls ``Tree.tick_once`` (v4 ``tickOnce``: re-ticks while a wake-up
+is pending) or ``tick_exactly_once`` and returns the same ``TickRecord`` as the interpreter.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import behaviortreepy as btpy
+from lxml import etree
+
+from fsmbt.model.bt import BTDocument
+from fsmbt.model.bt_nodes import NodeKind
+from fsmbt.semantics.bt_interpreter import (
+    OUTCOME_TO_STATUS, STATUS_NAMES, CompiledNode, CompiledTree, Environment, TickRecord,
+)
+
+ACTION_ID = "FsmbtAction"
+CONDITION_ID = "FsmbtCondition"
+
+_STATUS = {
+    "success": btpy.NodeStatus.SUCCESS, "failure": btpy.NodeStatus.FAILURE,
+    "running": btpy.NodeStatus.RUNNING,
+}
+_NAME_OF = {
+    btpy.NodeStatus.SUCCESS: "SUCCESS", btpy.NodeStatus.FAILURE: "FAILURE",
+    btpy.NodeStatus.RUNNING: "RUNNING", btpy.NodeStatus.SKIPPED: "SKIPPED",
+    btpy.NodeStatus.IDLE: "IDLE",
+}
+assert set(OUTCOME_TO_STATUS) == set(_STATUS) and "SKIPPED" in STATUS_NAMES
+
+#: How a leaf is written: (registration ID, extra attributes) for a compiled leaf.
+LeafWriter = Callable[[CompiledNode], tuple[str, dict[str, str]]]
+
+
+def leaf_name(node: CompiledNode) -> str:
+    return f"n{node.id}"
+
+
+def _default_leaf(node: CompiledNode) -> tuple[str, dict[str, str]]:
+    if node.internal_status is not None:
+        return ("AlwaysFailure" if node.type == "AlwaysFailure" else "AlwaysSuccess"), {}
+    return (CONDITION_ID if node.kind is NodeKind.CONDITION else ACTION_ID), {}
+
+
+def compiled_to_xml(tree: CompiledTree, leaf_writer: LeafWriter = _default_leaf) -> str:
+    """v4 XML of the compiled tree; SubTree occurrences become generated trees ``T<id>``."""
+    nodes = tree.nodes
+    root_el = etree.Element("root", BTCPP_format="4", main_tree_to_execute="MainTree")
+    work: list[tuple[int, etree._Element]] = []
+    main = etree.SubElement(root_el, "BehaviorTree", ID="MainTree")
+    work.append((0, main))
+    while work:
+        nid, parent_el = work.pop()
+        node = nodes[nid]
+        if node.kind in (NodeKind.ACTION, NodeKind.CONDITION):
+            tag, extra = leaf_writer(node)
+            etree.SubElement(parent_el, tag, name=leaf_name(node), **extra)
+            continue
+        if node.type == "SubTree":
+            sub_id = f"T{nid}"
+            etree.SubElement(parent_el, "SubTree", ID=sub_id, name=leaf_name(node))
+            sub_el = etree.SubElement(root_el, "BehaviorTree", ID=sub_id)
+            work.append((node.children[0], sub_el))
+            continue
+        attrs = {"name": leaf_name(node)}
+        if node.type == "Parallel":
+            attrs["success_count"], attrs["failure_count"] = map(str, node.params)
+        elif node.type == "ParallelAll":
+            attrs["max_failures"] = str(node.params[0])
+        elif node.type == "Repeat":
+            attrs["num_cycles"] = str(node.params[0])
+        elif node.type == "RetryUntilSuccessful":
+            attrs["num_attempts"] = str(node.params[0])
+        elif node.type == "RunOnce":
+            attrs["then_skip"] = "true" if node.params[0] else "false"
+        el = etree.SubElement(parent_el, node.type, **attrs)
+        for child in reversed(node.children):
+            work.append((child, el))
+    # children were pushed reversed but SubElement appends: rebuild order by sorting on ids
+    for el in root_el.iter():
+        kids = list(el)
+        if len(kids) > 1 and el.tag != "root":
+            kids.sort(key=lambda e: int(e.get("name", "n0")[1:]))
+            el[:] = kids
+    return etree.tostring(root_el, pretty_print=True, encoding="unicode")
+
+
+class BTCppRunner:
+    """A BehaviorTree.CPP tree whose leaves ask ``env(node, path)`` for their outcome."""
+
+    def __init__(self, doc: BTDocument | CompiledTree, env: Environment, *,
+                 exactly_once: bool = False) -> None:
+        self.tree = doc if isinstance(doc, CompiledTree) else CompiledTree(doc)
+        self.env = env
+        self.exactly_once = exactly_once
+        self._leaves: list[tuple[str, str, str]] = []
+        self.halted: list[str] = []
+        factory = btpy.BehaviorTreeFactory()
+        factory.register_simple_condition(CONDITION_ID, self._tick)
+        factory.register_simple_stateful_action(ACTION_ID, self._tick, self._tick, self._halt)
+        self.xml = compiled_to_xml(self.tree)
+        self.bt = factory.create_tree_from_text(self.xml)
+
+    def _node_of(self, bt_node: btpy.TreeNode) -> CompiledNode:
+        return self.tree.nodes[int(bt_node.name()[1:])]
+
+    def _tick(self, bt_node: btpy.TreeNode) -> btpy.NodeStatus:
+        node = self._node_of(bt_node)
+        outcome = self.env(node.source, node.path)
+        self._leaves.append((node.label, node.path, outcome))
+        return _STATUS[outcome]
+
+    def _halt(self, bt_node: btpy.TreeNode) -> None:
+        self.halted.append(self._node_of(bt_node).label)
+
+    def tick_once(self) -> TickRecord:
+        self._leaves = []
+        status = self.bt.tick_exactly_once() if self.exactly_once else self.bt.tick_once()
+        return TickRecord(self._leaves, _NAME_OF[status])

@@ -1,0 +1,207 @@
+"""The leaf-execution machine of a behavior tree (DESIGN §2), and bounded exploration.
+
+A state is the interpreter's full configuration at the moment it is about to tick an
+environment leaf (node statuses, node memories, the explicit call stack, the pending wake-up):
+a hashable ``Snapshot``. Inputs are that leaf's outcome (``success``/``failure``, and
+``running`` for actions). ``step`` resumes the interpreter with the outcome and runs until the
+next environment leaf is about to be ticked; outputs are what the environment observes on the
+way: the root's result when a tick ends with one (``"SUCCESS"``/``"FAILURE"``, or
+``"SKIPPED"`` when every child was skipped by RunOnce), then the label of the next leaf.
+
+- A tick whose root returns RUNNING (a running leaf, KeepRunningUntilFailure...) is not
+  observable: the next tick starts at once (that is also why ``tickOnce``'s immediate re-tick on
+  a wake-up and ``tickExactlyOnce`` give the same leaf machine).
+- ``loop=False``: a root result ends the run: the state becomes ``RootResult(result)``, status
+  ``"final"``, outputs ``(result,)``. ``loop=True``: the root is ticked again; the outputs are
+  ``(result, next leaf label)`` and the status stays ``"running"``.
+- If the tree would run forever without ticking any environment leaf (every leaf internal,
+  e.g. ``KeepRunningUntilFailure`` over ``AlwaysSuccess``), the state is
+  ``RootResult("LIVELOCK")`` with output ``("LIVELOCK",)``: the real engine hangs there.
+
+Complexity: ``step`` costs the nodes ticked between two leaves plus a snapshot
+(O(k log k + depth)); ``explore`` is O(S · I) steps for S reachable states and I ≤ 3 inputs.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from collections.abc import Hashable, Sequence
+from dataclasses import dataclass, field
+from typing import Generic, TypeVar
+
+import networkx as nx
+
+from fsmbt.model.bt import BTDocument, BTNode
+from fsmbt.model.errors import InputError
+from fsmbt.semantics.bt_interpreter import (
+    OUTCOME_FAILURE, OUTCOME_RUNNING, OUTCOME_SUCCESS, OUTCOME_TO_STATUS, RUNNING,
+    STATUS_NAMES, BTInterpreter, BTLivelock, CompiledNode, CompiledTree, LeafRequest, Snapshot,
+)
+from fsmbt.semantics.machine import FINAL, Machine, Outputs
+from fsmbt.semantics.machine import RUNNING as STATUS_RUNNING
+
+LIVELOCK = "LIVELOCK"
+CONDITION_INPUTS = (OUTCOME_SUCCESS, OUTCOME_FAILURE)
+ACTION_INPUTS = (OUTCOME_SUCCESS, OUTCOME_FAILURE, OUTCOME_RUNNING)
+
+
+def leaf_label(node: BTNode | CompiledNode) -> str:
+    """What a leaf is called in traces and in FSM state actions: its name, else its type.
+
+    The FSM→BT and BT→FSM converters use this same function, so labels match by construction.
+    """
+    if isinstance(node, CompiledNode):
+        return node.label
+    return node.name or node.type
+
+
+@dataclass(frozen=True)
+class RootResult:
+    """Terminal state: the root returned ``result`` (``loop=False``) or the tree livelocks."""
+
+    result: str
+
+
+LeafState = Snapshot | RootResult
+
+
+class LeafMachine:
+    """``Machine`` over leaf outcomes for a BT document (``fsmbt.semantics.machine``)."""
+
+    def __init__(self, doc: BTDocument | CompiledTree, loop: bool = False, *,
+                 name: str | None = None) -> None:
+        self.interp = BTInterpreter(doc)
+        self.tree = self.interp.tree
+        self.loop = loop
+        main = self.tree.doc.main
+        self.name = name or main.id
+
+    # -- Machine protocol --------------------------------------------------------------------
+    def start(self) -> tuple[LeafState, Outputs]:
+        outputs: list[str] = []
+        snap = self.interp.begin_tick(self.interp.initial())
+        state = self._run(snap, None, outputs)
+        return state, tuple(outputs)
+
+    def inputs(self, state: LeafState) -> Sequence[str]:
+        node = self.leaf(state)
+        if node is None:
+            return ()
+        return CONDITION_INPUTS if node.is_condition else ACTION_INPUTS
+
+    def step(self, state: LeafState, symbol: str) -> tuple[LeafState, Outputs]:
+        if isinstance(state, RootResult):
+            raise ValueError(f"the tree has returned {state.result}; no input is expected")
+        outcome = OUTCOME_TO_STATUS.get(symbol)
+        node = self.leaf(state)
+        if outcome is None or node is None or (node.is_condition and outcome == RUNNING):
+            raise ValueError(f"input {symbol!r} is not allowed in state {self.describe(state)}")
+        outputs: list[str] = []
+        new_state = self._run(state, outcome, outputs)
+        return new_state, tuple(outputs)
+
+    def status(self, state: LeafState) -> str:
+        return FINAL if isinstance(state, RootResult) else STATUS_RUNNING
+
+    def describe(self, state: LeafState) -> str:
+        if isinstance(state, RootResult):
+            return state.result
+        node = self.leaf(state)
+        assert node is not None
+        return f"{node.label}@{node.path or 'root'}"
+
+    # -- helpers -----------------------------------------------------------------------------
+    def leaf(self, state: LeafState) -> CompiledNode | None:
+        """The leaf the state is about to tick (``None`` for a terminal state)."""
+        if isinstance(state, RootResult):
+            return None
+        request = self.interp.leaf_request(state)
+        return request.node if request is not None else None
+
+    def _run(self, snap: Snapshot, outcome: int | None, outputs: list[str]) -> LeafState:
+        """Advance to the next leaf request, ticking the root again as the rules say."""
+        boundaries: set[Snapshot] = set()
+        while True:
+            try:
+                snap, event = self.interp.advance(snap, outcome)
+            except BTLivelock:
+                outputs.append(LIVELOCK)
+                return RootResult(LIVELOCK)
+            outcome = None
+            if isinstance(event, LeafRequest):
+                outputs.append(event.node.label)
+                return snap
+            if event.status != RUNNING:
+                result = STATUS_NAMES[event.status]
+                outputs.append(result)
+                if not self.loop:
+                    return RootResult(result)
+            if snap in boundaries:  # ticks repeat without any leaf: the engine would hang
+                outputs.append(LIVELOCK)
+                return RootResult(LIVELOCK)
+            boundaries.add(snap)
+            snap = self.interp.begin_tick(snap)
+
+
+# -- exploration -----------------------------------------------------------------------------
+S = TypeVar("S", bound=Hashable)
+
+
+class StateLimitError(InputError):
+    """Exploration stopped: the machine has more reachable states than allowed."""
+
+
+@dataclass
+class ExploredMachine(Generic[S]):
+    """Every reachable state of a machine, breadth first from the start."""
+
+    start: S
+    start_outputs: Outputs
+    states: list[S] = field(default_factory=list)
+    transitions: dict[S, dict[str, tuple[S, Outputs]]] = field(default_factory=dict)
+    statuses: dict[S, str] = field(default_factory=dict)
+    names: dict[S, str] = field(default_factory=dict)
+
+    def __len__(self) -> int:
+        return len(self.states)
+
+    def to_networkx(self) -> nx.MultiDiGraph:
+        """States as integers (BFS order) with ``status``/``name``; one edge per input, keyed
+        by the input, carrying ``outputs``."""
+        index = {s: i for i, s in enumerate(self.states)}
+        graph = nx.MultiDiGraph(start=index[self.start], start_outputs=self.start_outputs)
+        for s, i in index.items():
+            graph.add_node(i, status=self.statuses[s], name=self.names[s])
+        for s, moves in self.transitions.items():
+            for symbol, (target, outs) in moves.items():
+                graph.add_edge(index[s], index[target], key=symbol, outputs=outs)
+        return graph
+
+
+def explore(machine: Machine, max_states: int = 200_000) -> ExploredMachine:
+    """Breadth-first exploration of every reachable state of ``machine``.
+
+    Raises ``StateLimitError`` past ``max_states``. O(S · I) machine steps.
+    """
+    start, start_outputs = machine.start()
+    result: ExploredMachine = ExploredMachine(start, start_outputs)
+    seen = {start}
+    queue = deque([start])
+    while queue:
+        state = queue.popleft()
+        result.states.append(state)
+        result.statuses[state] = machine.status(state)
+        result.names[state] = machine.describe(state)
+        moves: dict[str, tuple] = {}
+        for symbol in machine.inputs(state):
+            target, outs = machine.step(state, symbol)
+            moves[symbol] = (target, outs)
+            if target not in seen:
+                if len(seen) >= max_states:
+                    raise StateLimitError(
+                        f"the machine has more than {max_states} reachable states",
+                        element=getattr(machine, "name", None))
+                seen.add(target)
+                queue.append(target)
+        result.transitions[state] = moves
+    return result
