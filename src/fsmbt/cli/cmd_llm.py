@@ -1,0 +1,160 @@
+"""``fsmbt llm ...``: the LLM path's own commands (docs/llm.md).
+
+- ``fsmbt llm convert INPUT``: convert with ``llm`` / ``nllm`` / ``hybrid``, taking any input a
+  person has (a file any reader knows, prose, a table, an unseen notation, a PNG/JPEG diagram),
+  with every ``--llm-*`` setting as a flag; writes the result only when verified equivalent.
+- ``fsmbt llm extract INPUT``: only the extraction, as fsmbt JSON.
+- ``fsmbt llm prompt INPUT``: print the exact messages a conversion would send (no LLM needed).
+- ``fsmbt llm tokens INPUT...``: prompt tokens per conversion, counted with tiktoken offline.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Optional
+
+import typer
+
+LLM_ENGINES = ("llm", "nllm", "hybrid")
+
+
+def _llm_options(base_url: str | None, model: str | None, timeout: float | None,
+                 regenerations: int | None, log: str | None) -> dict[str, object]:
+    return {"llm_base_url": base_url, "llm_model": model, "llm_timeout": timeout,
+            "max_regenerations": regenerations, "llm_log": log}
+
+
+def register(app: typer.Typer) -> None:
+    llm_app = typer.Typer(help="The LLM conversion path: convert, extract, show prompts, count tokens.",
+                          no_args_is_help=True)
+    app.add_typer(llm_app, name="llm")
+
+    base_url_opt = typer.Option(None, "--llm-base-url",
+                                help="Endpoint URL or provider (openai, deepseek, qwen, ollama, vllm).")
+    model_opt = typer.Option(None, "--llm-model", help="Model name at the endpoint.")
+    timeout_opt = typer.Option(None, "--llm-timeout", help="Seconds per request, retries included (180).")
+    regen_opt = typer.Option(None, "--max-regenerations", help="Feedback rounds after the first answer (3).")
+    log_opt = typer.Option(None, "--llm-log", help="JSONL log file ('off' disables).")
+
+    @llm_app.command("convert")
+    def convert_command(
+        input_path: Path = typer.Argument(..., help="The source: any model file, text, table or image."),
+        output: Optional[Path] = typer.Option(None, "-o", "--output", help="Write the result here."),
+        to_format: Optional[str] = typer.Option(None, "--to", help="Output format (default: from -o, else printed as btcpp/json)."),
+        from_format: Optional[str] = typer.Option(None, "--from", help="Input format; 'llm' forces LLM extraction."),
+        engine: str = typer.Option("llm", "--engine", help="llm, nllm or hybrid."),
+        ablate: Optional[str] = typer.Option(None, "--ablate", help="SCP modules to drop, comma-separated."),
+        verify_engine: str = typer.Option("native", "--verify-engine", help="native, nusmv or both."),
+        force: bool = typer.Option(False, "--force", help="Overwrite OUTPUT."),
+        llm_base_url: Optional[str] = base_url_opt,
+        llm_model: Optional[str] = model_opt,
+        llm_timeout: Optional[float] = timeout_opt,
+        max_regenerations: Optional[int] = regen_opt,
+        llm_log: Optional[str] = log_opt,
+    ) -> None:
+        """Convert INPUT with an LLM engine; the result is verified before it is written."""
+        from fsmbt.convert.engines import converter_for
+        from fsmbt.formats import dumps, write_model
+        from fsmbt.llm.engine import client_from_options
+        from fsmbt.llm.extract import needs_llm, read_input
+        from fsmbt.model.errors import InputError
+
+        if engine not in LLM_ENGINES:
+            raise InputError(f"fsmbt llm convert takes --engine {', '.join(LLM_ENGINES)}; "
+                             "for rules use fsmbt convert")
+        options = _llm_options(llm_base_url, llm_model, llm_timeout, max_regenerations, llm_log)
+        client = None
+        if engine != "hybrid" or needs_llm(input_path, from_format):
+            client = client_from_options(options)
+        loaded = read_input(input_path, from_format, client=client,
+                            max_regenerations=max_regenerations)
+        options.update(client=client, ablate=ablate, verify_engine=verify_engine,
+                       source_name=str(input_path), extracted_by_llm=loaded.extracted)
+        result = converter_for(engine, loaded.model)(loaded.model, **options)
+        if output is not None:
+            write_model(result.model, output, to_format, overwrite=force)
+        else:
+            from fsmbt.model.fsm import FSM
+
+            print(dumps(result.model, to_format or ("json" if isinstance(result.model, FSM) else "btcpp")),
+                  end="")
+        typer.echo(f"{engine}: verified equivalent; " + ", ".join(
+            f"{k}={v}" for k, v in result.stats.items() if k in (
+                "first_pass_success", "regenerations", "tokens_in", "tokens_out", "latency_s",
+                "extracted_by_llm", "verify_engine")), err=True)
+
+    @llm_app.command("extract")
+    def extract_command(
+        input_path: Path = typer.Argument(..., help="Text, table, unseen notation or PNG/JPEG diagram."),
+        output: Optional[Path] = typer.Option(None, "-o", "--output", help="Write the JSON here."),
+        kind: Optional[str] = typer.Option(None, "--kind", help="fsm or bt, when known."),
+        force: bool = typer.Option(False, "--force", help="Overwrite OUTPUT."),
+        llm_base_url: Optional[str] = base_url_opt,
+        llm_model: Optional[str] = model_opt,
+        llm_timeout: Optional[float] = timeout_opt,
+        max_regenerations: Optional[int] = regen_opt,
+        llm_log: Optional[str] = log_opt,
+    ) -> None:
+        """Let the LLM write the model in INPUT as fsmbt JSON (validated like any input)."""
+        from fsmbt.formats import dumps, write_model
+        from fsmbt.llm.engine import client_from_options
+        from fsmbt.llm.extract import read_input
+
+        client = client_from_options(_llm_options(llm_base_url, llm_model, llm_timeout,
+                                                  max_regenerations, llm_log))
+        loaded = read_input(input_path, "llm", client=client, kind=kind,
+                            max_regenerations=max_regenerations)
+        if output is not None:
+            write_model(loaded.model, output, "json", overwrite=force)
+        else:
+            print(dumps(loaded.model, "json"), end="")
+
+    @llm_app.command("prompt")
+    def prompt_command(
+        input_path: Path = typer.Argument(..., help="A model file (FSM or BT)."),
+        from_format: Optional[str] = typer.Option(None, "--from", help="Input format (default: detected)."),
+        nllm: bool = typer.Option(False, "--nllm", help="The baseline prompt: no SCP."),
+        ablate: Optional[str] = typer.Option(None, "--ablate", help="SCP modules to drop, comma-separated."),
+        as_json: bool = typer.Option(False, "--json", help="Print the messages as JSON."),
+    ) -> None:
+        """Print the messages a conversion of INPUT would send, and their token count."""
+        from fsmbt.formats import read_model
+        from fsmbt.llm.pipeline import direction_for
+        from fsmbt.llm.prompts import PromptOptions, conversion_messages
+        from fsmbt.llm.tokens import count_messages
+        from fsmbt.model.flatten import flatten
+        from fsmbt.model.fsm import FSM
+
+        model = read_model(input_path, from_format)
+        modules = frozenset(m.strip() for m in (ablate or "").split(",") if m.strip())
+        options = PromptOptions(direction_for(model), scp=not nllm, disabled_modules=modules)
+        messages = conversion_messages(flatten(model) if isinstance(model, FSM) else model, options)
+        if as_json:
+            print(json.dumps(messages, indent=2, ensure_ascii=False))
+        else:
+            for message in messages:
+                print(f"=== {message['role']} ===\n{message['content']}\n")
+        typer.echo(f"{options.label}: {count_messages(messages)} prompt tokens (cl100k_base)", err=True)
+
+    @llm_app.command("tokens")
+    def tokens_command(
+        inputs: list[Path] = typer.Argument(..., help="Model files (FSM or BT)."),
+        from_format: Optional[str] = typer.Option(None, "--from", help="Input format (default: detected)."),
+    ) -> None:
+        """Prompt tokens of the llm and nllm requests for each model (tiktoken cl100k_base)."""
+        from fsmbt.formats import read_model
+        from fsmbt.llm.tokens import count_messages
+        from fsmbt.llm.pipeline import direction_for
+        from fsmbt.llm.prompts import PromptOptions, conversion_messages
+        from fsmbt.model.flatten import flatten
+        from fsmbt.model.fsm import FSM
+
+        print("input\tdirection\tllm_prompt_tokens\tnllm_prompt_tokens")
+        for path in inputs:
+            model = read_model(path, from_format)
+            shown = flatten(model) if isinstance(model, FSM) else model
+            direction = direction_for(model)
+            counts = [count_messages(conversion_messages(shown, PromptOptions(direction, scp=scp)))
+                      for scp in (True, False)]
+            print(f"{path}\t{direction}\t{counts[0]}\t{counts[1]}")
