@@ -9,7 +9,10 @@ Rules (also in docs/semantics.md):
   region's initial sub-state.
 - Completion transitions (``event=None``) fire at once: from an atomic state on entry, from a
   composite state when its sub-FSM is in a final state (``exit`` = that state, or ``None``), from
-  a parallel state when every region is in a final state. A state left that way is transient.
+  a parallel state when every region is in a final state - a region whose active state is
+  composite counts when that state's sub-FSM is in a final state, a nested parallel one when all
+  its regions are (SCXML's rule for ``done.state.<parallel>``). A state left that way is
+  transient.
 - The flat state's action is the actions of its active atomic states joined with ``+`` in
   document order; a transient state is never observed, so its action is not either.
 - Only the reachable configurations are kept; a plain FSM without eventless transitions is
@@ -89,6 +92,17 @@ class _Flattener:
         """Is this configuration in a final state of ``machine``?"""
         return self.state(machine, config.state).final and not config.inner
 
+    def in_final(self, machine: FSM, config: _Config) -> bool:
+        """SCXML's "in a final state" for a parallel state's region: an atomic final state, a
+        composite state whose active sub-state is final, a parallel state whose every region is
+        in a final state (so a parallel of compound states completes as in SCXML)."""
+        state = self.state(machine, config.state)
+        if not config.inner:
+            return state.final
+        if state.is_composite:
+            return self.is_done(state.regions[0], config.inner[0])
+        return all(self.in_final(region, sub) for region, sub in zip(state.regions, config.inner))
+
     def settle(self, machine: FSM, config: _Config) -> _Config:
         """Fire completion transitions until none applies."""
         for _ in range(MAX_COMPLETION_CHAIN):
@@ -112,10 +126,12 @@ class _Flattener:
             return None
         if state.is_atomic:
             return candidates[0]
-        regions_done = [
-            self.is_done(region, sub) for region, sub in zip(state.regions, config.inner)
-        ]
-        if not all(regions_done):
+        if state.is_composite:
+            done = self.is_done(state.regions[0], config.inner[0])
+        else:
+            done = all(self.in_final(region, sub)
+                       for region, sub in zip(state.regions, config.inner))
+        if not done:
             return None
         exit_name = config.inner[0].state if state.is_composite else None
         for t in candidates:

@@ -1,0 +1,632 @@
+"""W3C SCXML <-> the (hierarchical) FSM model (docs/formats/scxml.md).
+
+What is mapped: ``<state>`` (atomic, or compound = a composite state with one sub-FSM),
+``<parallel>`` (one region per child), ``<final>``, the ``initial`` attribute and
+``<initial><transition target/></initial>`` (default: first child in document order),
+``<transition event target>`` with several event names (one transition per name), eventless
+transitions of atomic states (completion transitions), ``done.state.<id>`` transitions of a
+compound/parallel state (completion transitions). A transition that leaves its parent
+(``a1 -> b`` with ``a1`` inside ``a``) becomes a transition to a transient final state of
+``a1``'s sub-FSM plus completion transitions up to ``b``'s level (``Transition.exit`` names the
+transient state), which has SCXML's priority (inner transitions first) and is written back as
+the original transition.
+
+Refused with ``UnsupportedError`` (element, line, feature): ``cond``, ``<history>``, wildcard and
+prefix-matching event descriptors, targetless transitions, transitions with several targets,
+``type="internal"``, behaviour-changing executable content (``<raise>``, ``<send>``,
+``<assign>``, ``<script>``, ``<if>``, ``<foreach>``, ``<cancel>``, ``<invoke>``), XInclude,
+eventless transitions of compound states, transitions into a nested state that is not its
+parent's initial state, transitions leaving a ``<parallel>`` region. Warned (``ctx.warn``):
+``<log>``, ``<datamodel>``/``<data>``, ``<donedata>``, foreign-namespace elements, and a
+transition dropped by document-order conflict resolution.
+
+Everything is iterative over the element tree; complexity O(n + T·d) for n elements,
+T transitions and nesting depth d.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from lxml import etree
+
+from fsmbt.formats.registry import Format, ReadContext, register
+from fsmbt.formats.xml_safe import local_name, namespace, parse_xml, root_tag
+from fsmbt.model import Model
+from fsmbt.model.errors import InputError, SourceLocation, UnsupportedError
+from fsmbt.model.fsm import FSM, State, Transition
+
+SCXML_NS = "http://www.w3.org/2005/07/scxml"
+LEGACY_NS = "http://www.w3.org/2005/SCXML"
+XINCLUDE_NS = "http://www.w3.org/2001/XInclude"
+#: fsmbt's own attributes (what SCXML cannot say: a start pseudo-state, a non-default action,
+#: a model name that is not a unique id, the final state a completion transition waits for).
+FSMBT_NS = "https://fsmbt.dev/ns/scxml"
+F_NAME, F_ACTION, F_START, F_EXIT = (f"{{{FSMBT_NS}}}{n}" for n in ("name", "action", "start", "exit"))
+#: ``State.attrs`` mark of the transient final states that encode a transition leaving its parent.
+EXIT_MARK = f"{{{FSMBT_NS}}}exit-state"
+
+STATE_TAGS = frozenset({"state", "parallel", "final"})
+UNSUPPORTED_CONTENT = frozenset({"raise", "send", "assign", "script", "if", "elseif", "else",
+                                 "foreach", "cancel", "invoke"})
+WARNED_CONTENT = frozenset({"log"})
+_SCXML_KEYS = frozenset({"initial", "name", "version"})
+_STATE_KEYS = frozenset({"id", "initial", F_NAME, F_ACTION, F_START})
+_TRANSITION_KEYS = frozenset({"event", "target", F_EXIT})
+
+
+# -- reading -------------------------------------------------------------------------------------
+@dataclass
+class _Node:
+    """One state element and where it sits in the model."""
+
+    element: etree._Element
+    state: State
+    machine: FSM  # the machine that holds ``state``
+    parent: _Node | None  # the compound/parallel state that owns ``machine``
+
+
+@dataclass
+class _Reader:
+    ctx: ReadContext
+    ns: str | None = None
+    by_id: dict[str, _Node] = field(default_factory=dict)
+    order: list[_Node] = field(default_factory=list)
+    parent_of: dict[int, _Node | None] = field(default_factory=dict)  # id(machine) -> owner
+    synthetic_states: list[tuple[FSM, State]] = field(default_factory=list)
+    synthetic_transitions: list[tuple[FSM, Transition]] = field(default_factory=list)
+    descriptors: dict[str, int] = field(default_factory=dict)
+
+    def where(self, element: etree._Element) -> SourceLocation:
+        return self.ctx.location(element.sourceline)
+
+    def unsupported(self, element: etree._Element, feature: str) -> UnsupportedError:
+        return UnsupportedError(feature, location=self.where(element),
+                                element=f"<{local_name(element)}>")
+
+    def tag(self, element: etree._Element) -> str | None:
+        """The SCXML local name, or ``None`` for an element of another namespace."""
+        if namespace(element) == XINCLUDE_NS:
+            raise self.unsupported(element, "XInclude (include the fragment's content in the "
+                                            "file itself)")
+        return local_name(element) if namespace(element) == self.ns else None
+
+    def children(self, element: etree._Element) -> list[etree._Element]:
+        return [c for c in element if isinstance(c.tag, str)]
+
+    # structure ----------------------------------------------------------------------------------
+    def read(self, text: str) -> FSM:
+        root = parse_xml(text, self.ctx.display_name)
+        self.ns = namespace(root)
+        if self.ns == LEGACY_NS:
+            raise UnsupportedError("the obsolete 2005 SCXML working-draft syntax "
+                                   f"(namespace {LEGACY_NS}); SCXML 1.0 uses {SCXML_NS}",
+                                   location=self.where(root), element="<scxml>")
+        if local_name(root) != "scxml":
+            raise InputError(f"not an SCXML document: root element is <{local_name(root)}>, "
+                             "expected <scxml> (a fragment meant for XInclude?)",
+                             location=self.where(root))
+        if self.ns not in (SCXML_NS, None):
+            raise InputError(f"not an SCXML document: unknown namespace {self.ns}",
+                             location=self.where(root))
+        top = FSM(name=root.get("name", "fsm"),
+                  attrs={k: v for k, v in root.attrib.items() if k not in _SCXML_KEYS})
+        self.parent_of[id(top)] = None
+        self.build(root, top)
+        for node in self.order:
+            self.transitions(node)
+        self.check_prefix_matching()
+        for machine, state in self.synthetic_states:
+            machine.states[state.name] = state
+        for machine, transition in self.synthetic_transitions:
+            machine.transitions.append(transition)
+        self.start_pseudo_state(top)
+        return top
+
+    def build(self, root: etree._Element, top: FSM) -> None:
+        """Create every state and machine (explicit stack, document order), then initials."""
+        for child in self.children(root):
+            if self.tag(child) not in STATE_TAGS:
+                self.content(child, root)
+        initials: list[tuple[etree._Element, FSM]] = []
+        stack: list[tuple[str, etree._Element, FSM, _Node | None]] = [("children", root, top, None)]
+        while stack:
+            mode, element, machine, owner = stack.pop()
+            pending: list[tuple[str, etree._Element, FSM, _Node | None]] = []
+            if mode == "single":  # a parallel state's child: the only state of its region
+                node = self.state(element, machine, owner)
+                pending.extend(self.regions(node))
+                machine.initial = node.state.name
+            else:
+                for child in self.children(element):
+                    if self.tag(child) in STATE_TAGS:
+                        node = self.state(child, machine, owner)
+                        pending.extend(self.regions(node))
+                initials.append((element, machine))
+            stack.extend(reversed(pending))
+        for element, machine in reversed(initials):  # innermost first
+            self.set_initial(element, machine)
+
+    def state(self, element: etree._Element, machine: FSM, owner: _Node | None) -> _Node:
+        tag = self.tag(element) or ""
+        state_id = element.get("id") or f"_state{len(self.order) + 1}"
+        if state_id in self.by_id:
+            raise InputError(f"duplicate state id '{state_id}'", location=self.where(element),
+                             element=f"<{tag}>")
+        name = element.get(F_NAME, state_id)
+        if name in machine.states:
+            raise InputError(f"duplicate state name '{name}' in one machine",
+                             location=self.where(element), element=f"<{tag}>")
+        nested = []
+        for child in self.children(element):
+            if self.tag(child) in STATE_TAGS:
+                nested.append(child)
+            else:
+                self.content(child, element)
+        if tag == "final" and nested:
+            raise InputError("<final> cannot hold states", location=self.where(element),
+                             element="<final>")
+        action: str | None = name if not nested else None
+        if F_ACTION in element.attrib:
+            action = element.get(F_ACTION) or None
+        attrs = {k: v for k, v in element.attrib.items() if k not in _STATE_KEYS}
+        state = State(name, action=action, final=tag == "final", attrs=attrs,
+                      location=self.where(element))
+        machine.states[name] = state
+        node = _Node(element, state, machine, owner)
+        self.by_id[state_id] = node
+        self.order.append(node)
+        return node
+
+    def regions(self, node: _Node) -> list[tuple[str, etree._Element, FSM, _Node | None]]:
+        """The sub-machines of a compound (one) or parallel (one per child) state."""
+        element = node.element
+        nested = [c for c in self.children(element) if self.tag(c) in STATE_TAGS]
+        if not nested:
+            return []
+        if local_name(element) == "parallel":
+            out = []
+            for child in nested:
+                region = FSM(name=child.get(F_NAME, child.get("id") or "region"))
+                self.parent_of[id(region)] = node
+                node.state.regions.append(region)
+                out.append(("single", child, region, node))
+            return out
+        region = FSM(name=node.state.name)
+        self.parent_of[id(region)] = node
+        node.state.regions.append(region)
+        return [("children", element, region, node)]
+
+    def content(self, element: etree._Element, container: etree._Element) -> None:
+        """Non-state children of a state or of <scxml>: supported, warned or refused."""
+        tag = self.tag(element)
+        if tag is None:
+            self.ctx.warn(f"element of another namespace ignored: <{etree.QName(element).localname}>",
+                          line=element.sourceline)
+        elif tag in ("transition", "initial"):
+            return  # handled with the transitions / the initial state
+        elif tag in ("onentry", "onexit", "donedata"):
+            self.executable(element)
+        elif tag == "datamodel":
+            self.ctx.warn("<datamodel> ignored (no supported construct reads data)",
+                          line=element.sourceline, element="<datamodel>")
+        elif tag in UNSUPPORTED_CONTENT:
+            raise self.unsupported(element, f"<{tag}> (executable content and external "
+                                            "communication change behaviour)")
+        elif tag == "history":
+            raise self.unsupported(element, "<history> (the model has no history states)")
+        elif tag == "invoke":
+            raise self.unsupported(element, "<invoke> (external services)")
+        else:
+            raise InputError(f"unknown SCXML element <{tag}> in <{local_name(container)}>",
+                             location=self.where(element), element=f"<{tag}>")
+
+    def executable(self, block: etree._Element) -> None:
+        """A block of executable content: only ``<log>`` (warned) is harmless."""
+        for item in block.iter():
+            if item is block or not isinstance(item.tag, str):
+                continue
+            tag = self.tag(item)
+            if tag is None:
+                self.ctx.warn("element of another namespace ignored: "
+                              f"<{etree.QName(item).localname}>", line=item.sourceline)
+            elif tag in WARNED_CONTENT:
+                self.ctx.warn(f"<{tag}> ignored (no effect on the state machine)",
+                              line=item.sourceline, element=f"<{tag}>")
+            elif tag in ("param", "content") and local_name(block) == "donedata":
+                self.ctx.warn("<donedata> ignored", line=item.sourceline, element="<donedata>")
+            else:
+                raise self.unsupported(item, f"<{tag}> (executable content that changes "
+                                             "behaviour)")
+
+    def set_initial(self, container: etree._Element, machine: FSM) -> None:
+        """The machine's initial state: ``initial`` attribute, ``<initial>``, or first child."""
+        targets = container.get("initial")
+        where = container
+        for child in self.children(container):
+            if self.tag(child) == "initial":
+                transitions = [t for t in self.children(child) if self.tag(t) == "transition"]
+                if len(transitions) != 1:
+                    raise InputError("<initial> needs exactly one <transition>",
+                                     location=self.where(child), element="<initial>")
+                self.executable(transitions[0])
+                targets, where = transitions[0].get("target"), transitions[0]
+        if not machine.states:
+            return
+        if not targets:
+            machine.initial = next(iter(machine.states))
+            return
+        ids = targets.split()
+        chosen: set[str] = set()
+        for target_id in ids:
+            node = self.by_id.get(target_id)
+            if node is None:
+                raise InputError(f"initial state '{target_id}' does not exist",
+                                 location=self.where(where), element=f"<{local_name(where)}>")
+            chosen.add(self.entry_in(node, machine, where).state.name)
+        if len(chosen) != 1:
+            raise self.unsupported(where, "an initial configuration spanning several states "
+                                          "of one machine")
+        machine.initial = chosen.pop()
+
+    # transitions --------------------------------------------------------------------------------
+    def transitions(self, node: _Node) -> None:
+        seen: set[tuple[str | None, str | None]] = set()
+        for element in self.children(node.element):
+            if self.tag(element) != "transition":
+                continue
+            for transition in self.transition(node, element):
+                key = (transition.event, transition.exit)
+                if key in seen:
+                    self.ctx.warn(
+                        f"transition on {transition.event or 'completion'} from "
+                        f"'{node.state.name}' dropped: an earlier one in document order wins",
+                        line=element.sourceline, element="<transition>")
+                    continue
+                seen.add(key)
+                node.machine.transitions.append(transition)
+
+    def transition(self, node: _Node, element: etree._Element) -> list[Transition]:
+        if element.get("cond") is not None:
+            raise self.unsupported(element, "cond guards (the model has no data)")
+        if element.get("type", "external") != "external":
+            raise self.unsupported(element, f"type=\"{element.get('type')}\" transitions")
+        target_ids = (element.get("target") or "").split()
+        if not target_ids:
+            raise self.unsupported(element, "targetless transitions (they only run executable "
+                                            "content)")
+        if len(target_ids) > 1:
+            raise self.unsupported(element, "transitions with several targets")
+        self.executable(element)
+        target = self.by_id.get(target_ids[0])
+        if target is None:
+            raise InputError(f"transition to unknown state '{target_ids[0]}'",
+                             location=self.where(element), element="<transition>")
+        attrs = {k: v for k, v in element.attrib.items() if k not in _TRANSITION_KEYS}
+        exit_name = element.get(F_EXIT)
+        events = element.get("event")
+        location = self.where(element)
+        if events is None:
+            if not node.state.is_atomic:
+                raise self.unsupported(element, "eventless transitions of a compound state "
+                                                "(they fire at once, unlike completion)")
+            return [self.route(node, None, target, element, attrs, exit_name, location)]
+        out = []
+        names = events.split()
+        if not names:
+            raise InputError("empty event attribute", location=location, element="<transition>")
+        for name in names:
+            if name == "*" or name.endswith(".*") or name.endswith("."):
+                raise self.unsupported(element, f"wildcard event descriptor '{name}'")
+            event: str | None = name
+            if name.startswith("done.state."):
+                if node.state.is_atomic:
+                    raise self.unsupported(element, f"'{name}' on an atomic state (only compound "
+                                                    "and parallel states complete)")
+                if name != f"done.state.{node.element.get('id')}":
+                    raise self.unsupported(element, f"'{name}' on another state than the one "
+                                                    "that completes")
+                event = None
+            else:
+                self.descriptors.setdefault(name, element.sourceline or 0)
+            out.append(self.route(node, event, target, element, attrs, exit_name, location))
+        return out
+
+    def route(self, node: _Node, event: str | None, target: _Node, element: etree._Element,
+              attrs: dict[str, str], exit_name: str | None,
+              location: SourceLocation) -> Transition:
+        """The model transition for ``node --event--> target``, leaving parents if needed."""
+        ancestors = self.machine_chain(node.machine)
+        entered = None
+        for index, machine in enumerate(ancestors):
+            entered = self.entry_or_none(target, machine)
+            if entered is not None:
+                break
+        if entered is None:
+            raise InputError("transition target is not in this document's tree",
+                             location=location, element="<transition>")
+        if entered is not target:
+            entered = self.entry_in(target, entered.machine, element)
+        if index == 0:
+            return Transition(node.state.name, event, entered.state.name, exit_name,
+                              dict(attrs), location)
+        # Leave ``index`` levels: transient final states carry the transition out.
+        label = f"exit({node.state.name},{event or ''},{target.state.name})"
+        first = Transition(node.state.name, event, label, exit_name, dict(attrs), location)
+        source_machine = node.machine
+        for level in range(1, index + 1):
+            owner = self.parent_of[id(source_machine)]
+            assert owner is not None
+            if owner.state.is_parallel:
+                raise self.unsupported(element, "transitions that leave a <parallel> region")
+            self.synthetic_states.append(
+                (source_machine, State(label, action=None, final=True, attrs={EXIT_MARK: "true"})))
+            next_label = label if level < index else entered.state.name
+            self.synthetic_transitions.append(
+                (owner.machine, Transition(owner.state.name, None, next_label, label)))
+            source_machine = owner.machine
+        return first
+
+    def machine_chain(self, machine: FSM) -> list[FSM]:
+        chain = [machine]
+        owner = self.parent_of[id(machine)]
+        while owner is not None:
+            chain.append(owner.machine)
+            owner = self.parent_of[id(owner.machine)]
+        return chain
+
+    def entry_or_none(self, target: _Node, machine: FSM) -> _Node | None:
+        """The state of ``machine`` whose entry enters ``target``, if ``target`` is in it."""
+        node: _Node | None = target
+        while node is not None and node.machine is not machine:
+            node = self.parent_of[id(node.machine)]
+        return node
+
+    def entry_in(self, target: _Node, machine: FSM, element: etree._Element) -> _Node:
+        """As ``entry_or_none``, but the nested target must be what default entry reaches."""
+        node = target
+        while node.machine is not machine:
+            if node.machine.initial is not None and node.machine.initial != node.state.name:
+                raise self.unsupported(element, f"entering nested state '{target.state.name}' "
+                                                "that is not its parent's initial state")
+            owner = self.parent_of[id(node.machine)]
+            if owner is None:
+                raise InputError(f"state '{target.state.name}' is not inside this state",
+                                 location=self.where(element))
+            node = owner
+        return node
+
+    def check_prefix_matching(self) -> None:
+        names = sorted(self.descriptors)
+        for i, name in enumerate(names):
+            for other in names[i + 1:]:
+                if not other.startswith(name):
+                    break
+                if other.startswith(name + "."):
+                    raise UnsupportedError(
+                        f"event descriptor '{name}' also matches '{other}' (SCXML prefix "
+                        "matching)", location=self.ctx.location(self.descriptors[name]),
+                        element="<transition>")
+
+    def start_pseudo_state(self, top: FSM) -> None:
+        """A state written with ``fsmbt:start`` is the FSM's start pseudo-state again."""
+        for name, state in list(top.states.items()):
+            node = self.by_name_top(name, top)
+            if node is None or node.element.get(F_START) != "true":
+                continue
+            leaving = [t for t in top.transitions if t.source == name]
+            if len(leaving) != 1 or top.initial != name or leaving[0].event is None:
+                raise InputError("an fsmbt:start state needs to be the initial state with one "
+                                 "outgoing transition on an event", location=state.location)
+            del top.states[name]
+            top.transitions.remove(leaving[0])
+            top.start_name, top.initial_event = name, leaving[0].event
+            top.initial = leaving[0].target
+
+    def by_name_top(self, name: str, top: FSM) -> _Node | None:
+        for node in self.order:
+            if node.machine is top and node.state.name == name:
+                return node
+        return None
+
+
+def read_scxml(text: str, ctx: ReadContext) -> FSM:
+    return _Reader(ctx).read(text)
+
+
+# -- writing -------------------------------------------------------------------------------------
+@dataclass
+class _Writer:
+    """Writes the model back; transient exit states become the transitions they came from."""
+
+    top: FSM
+    owner: dict[int, tuple[FSM, State]] = field(default_factory=dict)  # id(region) -> owner
+    ids: dict[tuple[int, str], str] = field(default_factory=dict)
+    skip_states: set[tuple[int, str]] = field(default_factory=set)
+    skip_transitions: set[int] = field(default_factory=set)
+    rerouted: dict[int, tuple[FSM, str]] = field(default_factory=dict)  # id(t) -> real target
+
+    def prepare(self) -> None:
+        machines = [self.top]
+        for _path, machine, state in self.top.walk():
+            for region in state.regions:
+                self.owner[id(region)] = (machine, state)
+                machines.append(region)
+        for machine in machines:
+            for t in machine.transitions:
+                resolved = self.resolve(machine, t.target)
+                if resolved is not None:
+                    self.rerouted[id(t)] = resolved
+        used: dict[str, int] = {}
+        reserved = {self.top.start_name} if self.top.initial_event is not None else set()
+        for machine in machines:
+            for state in machine.states.values():
+                if (id(machine), state.name) not in self.skip_states:
+                    used[state.name] = used.get(state.name, 0) + 1
+        taken: set[str] = set(n for n in reserved if n)
+        for machine in machines:
+            owner = self.owner.get(id(machine))
+            for state in machine.states.values():
+                if (id(machine), state.name) in self.skip_states:
+                    continue
+                unique = state.name
+                if used[state.name] > 1 or unique in taken:
+                    prefix = self.ids[(id(owner[0]), owner[1].name)] if owner else "top"
+                    unique = f"{prefix}.{state.name}"
+                    while unique in taken:
+                        unique += "_"
+                taken.add(unique)
+                self.ids[(id(machine), state.name)] = unique
+
+    def resolve(self, machine: FSM, target: str) -> tuple[FSM, str] | None:
+        """Follow transient exit states up to the real target (``None`` if not one)."""
+        chain_states: list[tuple[int, str]] = []
+        chain_transitions: list[int] = []
+        while True:
+            state = machine.states.get(target)
+            if state is None or state.attrs.get(EXIT_MARK) != "true":
+                break
+            up = self.owner.get(id(machine))
+            if up is None:
+                return None
+            parent, composite = up
+            completion = [t for t in parent.transitions if t.source == composite.name
+                          and t.event is None and t.exit == target]
+            if len(completion) != 1 or not composite.is_composite:
+                return None
+            chain_states.append((id(machine), target))
+            chain_transitions.append(id(completion[0]))
+            machine, target = parent, completion[0].target
+        if not chain_states:
+            return None
+        self.skip_states.update(chain_states)
+        self.skip_transitions.update(chain_transitions)
+        return machine, target
+
+    def write(self) -> str:
+        fsm = self.top
+        self.prepare()
+        root = etree.Element(f"{{{SCXML_NS}}}scxml", nsmap={None: SCXML_NS, "fsmbt": FSMBT_NS})
+        root.set("version", "1.0")
+        if fsm.name != "fsm":
+            root.set("name", fsm.name)
+        start = None
+        if fsm.initial_event is not None:
+            start = fsm.start_name or "Start"
+            root.set("initial", start)
+        elif fsm.initial is not None:
+            root.set("initial", self.ids[(id(fsm), fsm.initial)])
+        for key, value in fsm.attrs.items():
+            root.set(key, value)
+        if start is not None and fsm.initial is not None:
+            element = etree.SubElement(root, _q("state"), id=start)
+            element.set(F_START, "true")
+            etree.SubElement(element, _q("transition"), event=fsm.initial_event or "",
+                             target=self.ids[(id(fsm), fsm.initial)])
+        stack: list[tuple[FSM, etree._Element]] = [(fsm, root)]
+        while stack:
+            machine, container = stack.pop()
+            if machine is not fsm and machine.initial_event is not None:
+                raise UnsupportedError("a sub-machine with a start pseudo-state and initial "
+                                       "event cannot be written as SCXML", element=machine.name)
+            pending = []
+            for state in machine.states.values():
+                if (id(machine), state.name) in self.skip_states:
+                    continue
+                element = self.state_element(container, machine, state)
+                pending.extend(self.region_elements(element, state))
+            stack.extend(reversed(pending))
+        text = etree.tostring(root, encoding="unicode", pretty_print=True)
+        return '<?xml version="1.0" encoding="UTF-8"?>\n' + text
+
+    def state_element(self, container: etree._Element, machine: FSM,
+                      state: State) -> etree._Element:
+        tag = ("final" if state.final and state.is_atomic
+               else "parallel" if _is_parallel(state) else "state")
+        state_id = self.ids[(id(machine), state.name)]
+        element = etree.SubElement(container, _q(tag), id=state_id)
+        if state_id != state.name:
+            element.set(F_NAME, state.name)
+        default_action = state.name if state.is_atomic else None
+        if state.action != default_action:
+            element.set(F_ACTION, state.action or "")
+        if tag == "state" and state.is_composite:
+            region = state.regions[0]
+            if region.initial is not None:
+                element.set("initial", self.ids[(id(region), region.initial)])
+        for key, value in state.attrs.items():
+            element.set(key, value)
+        for t in machine.transitions:
+            if t.source != state.name or id(t) in self.skip_transitions:
+                continue
+            self.transition_element(element, machine, state, state_id, t)
+        return element
+
+    def transition_element(self, element: etree._Element, machine: FSM, state: State,
+                           state_id: str, t: Transition) -> None:
+        out = etree.SubElement(element, _q("transition"))
+        if t.event is not None:
+            out.set("event", t.event)
+        elif not state.is_atomic:
+            out.set("event", f"done.state.{state_id}")
+        target_machine, target = self.rerouted.get(id(t), (machine, t.target))
+        key = (id(target_machine), target)
+        if key not in self.ids:
+            raise InputError(f"transition to unknown state '{target}'", element=state.name)
+        out.set("target", self.ids[key])
+        if t.exit is not None and id(t) not in self.skip_transitions:
+            out.set(F_EXIT, t.exit)
+        for k, v in t.attrs.items():
+            out.set(k, v)
+
+    def region_elements(self, element: etree._Element,
+                        state: State) -> list[tuple[FSM, etree._Element]]:
+        if not state.regions:
+            return []
+        if state.is_composite and not _is_parallel(state):
+            return [(state.regions[0], element)]
+        out = []
+        for region in state.regions:
+            if len(region.states) == 1 and region.initial in region.states:
+                out.append((region, element))
+            else:  # a region of several states needs a wrapper state in SCXML
+                wrapper = etree.SubElement(element, _q("state"), id=f"{state.name}.{region.name}")
+                if region.initial is not None:
+                    wrapper.set("initial", self.ids[(id(region), region.initial)])
+                out.append((region, wrapper))
+        return out
+
+
+def _is_parallel(state: State) -> bool:
+    """Several regions, or one region holding one state named like it (a one-child parallel)."""
+    if len(state.regions) > 1:
+        return True
+    if len(state.regions) == 1:
+        region = state.regions[0]
+        return (len(region.states) == 1 and region.name in region.states
+                and region.name != state.name)
+    return False
+
+
+def _q(tag: str) -> str:
+    return f"{{{SCXML_NS}}}{tag}"
+
+
+def write_scxml(model: Model) -> str:
+    if not isinstance(model, FSM):
+        raise InputError("SCXML holds a state machine, not a behavior tree")
+    try:
+        return _Writer(model).write()
+    except ValueError as exc:  # lxml: a name or value XML cannot hold
+        raise InputError(f"cannot write as SCXML: {exc}") from None
+
+
+def _sniff(text: str) -> bool:
+    return root_tag(text) == "scxml"
+
+
+register(Format(
+    "scxml", (".scxml",), frozenset({"fsm"}),
+    "W3C SCXML (states, compound and parallel states, final, initial, events)",
+    read_scxml, write_scxml, _sniff, priority=30,
+))
