@@ -1,0 +1,213 @@
+"""SCXML reader/writer: mapping, refusals with lines, warnings, round trip, SCION ground truth."""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+from pathlib import Path
+
+import pytest
+
+from fsmbt.formats import dumps, loads, read_model
+from fsmbt.formats.registry import ReadContext
+from fsmbt.formats.scxml import read_scxml
+from fsmbt.model import FSM, State
+from fsmbt.model.errors import InputError, UnsupportedError
+from fsmbt.semantics.machine import FSMMachine
+
+CORPUS = Path(os.environ.get("FSMBT_CORPUS", Path(__file__).resolve().parents[2] / ".." / "shared" / "corpus"))
+NS = 'xmlns="http://www.w3.org/2005/07/scxml"'
+
+
+def scxml(body: str, attrs: str = "") -> str:
+    return f'<scxml {NS} version="1.0" {attrs}>\n{body}\n</scxml>'
+
+
+def run(fsm: FSM, events: list[str]) -> list[str]:
+    machine = FSMMachine(fsm)
+    state, _ = machine.start()
+    seen = [state]
+    for event in events:
+        state, _ = machine.step(state, event)
+        seen.append(state)
+    return seen
+
+
+def test_compound_parallel_final_and_initials() -> None:
+    fsm = loads(scxml("""
+  <state id="off"><transition event="on" target="on"/></state>
+  <state id="on">
+    <initial><transition target="b"/></initial>
+    <state id="a"/>
+    <state id="b"><transition event="next" target="a"/></state>
+    <transition event="off" target="off"/>
+  </state>
+  <parallel id="p"><state id="x"/><state id="y"/></parallel>
+  <final id="end"/>""", 'initial="off"'), "scxml")
+    assert fsm.initial == "off"
+    on = fsm.states["on"]
+    assert on.is_composite and on.action is None and on.regions[0].initial == "b"
+    assert fsm.states["p"].is_parallel and len(fsm.states["p"].regions) == 2
+    assert fsm.states["end"].final and fsm.states["off"].action == "off"
+    assert run(fsm, ["on", "next", "off"]) == ["off", "on/b", "on/a", "off"]
+    assert loads(dumps(fsm, "scxml"), "scxml") == fsm
+
+
+def test_multi_event_and_eventless_and_done_state() -> None:
+    fsm = loads(scxml("""
+  <state id="s"><transition event="a b" target="t"/></state>
+  <state id="t"><transition target="c"/></state>
+  <state id="c">
+    <state id="c1"><transition event="fin" target="cf"/></state>
+    <final id="cf"/>
+    <transition event="done.state.c" target="s"/>
+  </state>"""), "scxml")
+    assert [(t.source, t.event, t.target) for t in fsm.transitions] == [
+        ("s", "a", "t"), ("s", "b", "t"), ("t", None, "c"), ("c", None, "s")]
+    assert run(fsm, ["b", "fin"]) == ["s", "c/c1", "s"]
+    assert loads(dumps(fsm, "scxml"), "scxml") == fsm
+
+
+def test_transition_leaving_nested_states_round_trips() -> None:
+    text = scxml("""
+  <state id="a"><state id="a1"><state id="x">
+    <transition event="go" target="b"/><transition event="again" target="a"/>
+  </state></state></state>
+  <state id="b"><transition event="back" target="a"/></state>""")
+    fsm = loads(text, "scxml")
+    assert run(fsm, ["go", "back", "again"]) == ["a/a1/x", "b", "a/a1/x", "a/a1/x"]
+    written = dumps(fsm, "scxml")
+    assert 'target="b"' in written and "exit" not in written  # the original transition again
+    assert loads(written, "scxml") == fsm
+
+
+def test_document_order_conflict_keeps_first_and_warns() -> None:
+    ctx = ReadContext()
+    fsm = read_scxml(scxml("""
+  <state id="s"><transition event="e" target="t1"/>
+  <transition event="e" target="t2"/></state><state id="t1"/><state id="t2"/>"""), ctx)
+    assert [t.target for t in fsm.transitions] == ["t1"]
+    assert any("dropped" in w and ":4:" in w for w in ctx.warnings)
+
+
+def test_harmless_content_is_warned_not_silent() -> None:
+    ctx = ReadContext()
+    read_scxml(scxml("""
+  <datamodel><data id="x" expr="1"/></datamodel>
+  <state id="s"><onentry><log expr="'hi'"/></onentry><transition event="e" target="s"/></state>"""),
+               ctx)
+    assert any("datamodel" in w for w in ctx.warnings)
+    assert any("<log>" in w for w in ctx.warnings)
+
+
+@pytest.mark.parametrize("body, feature", [
+    ('<state id="s"><transition event="e" cond="x" target="s"/></state>', "cond"),
+    ('<state id="s"><history id="h"/><state id="a"/></state>', "history"),
+    ('<state id="s"><transition event="*" target="s"/></state>', "wildcard"),
+    ('<state id="s"><transition event="a.*" target="s"/></state>', "wildcard"),
+    ('<state id="s"><transition event="a" target="s"/><transition event="a.b" target="s"/></state>',
+     "prefix"),
+    ('<state id="s"><transition event="e"/></state>', "targetless"),
+    ('<state id="s"><transition event="e" target="s"><raise event="x"/></transition></state>',
+     "raise"),
+    ('<state id="s"><onentry><send event="x"/></onentry></state>', "send"),
+    ('<state id="s"><onexit><assign location="x" expr="1"/></onexit></state>', "assign"),
+    ('<state id="s"><invoke src="x"/></state>', "invoke"),
+    ('<state id="s"><transition event="e" target="s t"/></state><state id="t"/>', "several targets"),
+    ('<state id="s"><transition event="e" type="internal" target="s"/></state>', "internal"),
+    ('<state id="s"><state id="a"/><state id="b"/></state><state id="t">'
+     '<transition event="e" target="b"/></state>', "not its parent's initial"),
+    ('<parallel id="p"><state id="a"><transition event="e" target="t"/></state><state id="b"/>'
+     '</parallel><state id="t"/>', "parallel"),
+    ('<state id="c"><state id="a"/><transition target="t"/></state><state id="t"/>', "eventless"),
+])
+def test_unsupported_features_name_line_and_feature(body: str, feature: str) -> None:
+    with pytest.raises(UnsupportedError, match=feature) as info:
+        loads(scxml(body), "scxml")
+    assert str(info.value).count("unsupported") == 1
+    assert info.value.location is not None and info.value.location.line == 2
+
+
+def test_xinclude_and_fragments_and_legacy_are_refused() -> None:
+    with pytest.raises(UnsupportedError, match="XInclude"):
+        loads(scxml('<state id="s"><xi:include xmlns:xi="http://www.w3.org/2001/XInclude" '
+                    'href="x.scxml"/></state>'), "scxml")
+    with pytest.raises(InputError, match="fragment"):
+        loads(f'<state {NS} id="s"/>', "scxml")
+    with pytest.raises(UnsupportedError, match="2005"):
+        loads('<scxml xmlns="http://www.w3.org/2005/SCXML"/>', "scxml")
+
+
+def test_bad_references_are_input_errors() -> None:
+    with pytest.raises(InputError, match="unknown state 'zz'"):
+        loads(scxml('<state id="s"><transition event="e" target="zz"/></state>'), "scxml")
+    with pytest.raises(InputError, match="duplicate state id"):
+        loads(scxml('<state id="s"/><state id="s"/>'), "scxml")
+
+
+def test_flat_fsm_with_start_pseudo_state_round_trips() -> None:
+    fsm = FSM(name="paper", start_name="Start", initial_event="go")
+    fsm.add_state("A")
+    fsm.add_state("B", action="beep", final=True)
+    fsm.add_transition("A", "e", "B")
+    again = loads(dumps(fsm, "scxml"), "scxml")
+    assert again == fsm
+
+
+def test_duplicate_names_in_sub_machines_get_unique_ids() -> None:
+    def unit(name: str) -> State:
+        region = FSM(name=name)
+        region.add_state("run")
+        region.add_state(State("SUCCESS", action=None, final=True))
+        region.add_transition("run", "ok", "SUCCESS")
+        return State(name, regions=[region])
+
+    fsm = FSM()
+    fsm.add_state(unit("u1"))
+    fsm.add_state(unit("u2"))
+    fsm.add_transition("u1", None, "u2")
+    text = dumps(fsm, "scxml")
+    assert 'id="u1.SUCCESS"' in text and 'fsmbt:name="SUCCESS"' in text
+    again = loads(text, "scxml")
+    assert again == fsm
+    assert run(again, ["ok"]) == ["u1/run", "u2/run"]
+
+
+def test_parallel_of_compound_states_completes() -> None:
+    fsm = loads(scxml("""
+  <parallel id="p"><transition event="done.state.p" target="end"/>
+    <state id="a"><state id="a1"><transition event="x" target="af"/></state><final id="af"/></state>
+    <state id="b"><state id="b1"><transition event="y" target="bf"/></state><final id="bf"/></state>
+  </parallel><final id="end"/>"""), "scxml")
+    assert run(fsm, ["x", "y"]) == ["p/[a/a1|b/b1]", "p/[a/af|b/b1]", "end"]
+
+
+# -- ground truth: the SCION test suite ------------------------------------------------------
+def _active_leaves(flat_name: str) -> set[str]:
+    """Atomic states of a flat configuration name (``p/[a/a1|b]`` -> {a1, b})."""
+    tokens = re.split(r"([/\[\]|])", flat_name)
+    return {tok for i, tok in enumerate(tokens)
+            if tok and tok not in "/[]|" and (tokens[i + 1] if i + 1 < len(tokens) else "") != "/"}
+
+
+def test_scion_expected_configurations() -> None:
+    folder = CORPUS / "fsm" / "scion_tests"
+    if not folder.exists():
+        pytest.skip("corpus not present")
+    checked, unsupported = [], []
+    for spec_path in sorted(folder.glob("*.json")):
+        try:
+            machine = FSMMachine(read_model(spec_path.with_suffix(".scxml")))
+        except UnsupportedError:
+            unsupported.append(spec_path.stem)
+            continue
+        spec = json.loads(spec_path.read_text())
+        state, _ = machine.start()
+        assert _active_leaves(state) == set(spec["initialConfiguration"]), spec_path.name
+        for step in spec["events"]:
+            state, _ = machine.step(state, step["event"]["name"])
+            assert _active_leaves(state) == set(step["nextConfiguration"]), (spec_path.name, step)
+        checked.append(spec_path.stem)
+    print(f"\nSCION: {len(checked)} checked, {len(unsupported)} unsupported: {unsupported}")
+    assert len(checked) >= 14
