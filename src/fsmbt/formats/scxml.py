@@ -447,11 +447,17 @@ class _Writer:
     rerouted: dict[int, tuple[FSM, str]] = field(default_factory=dict)  # id(t) -> real target
 
     def prepare(self) -> None:
-        machines = [self.top]
-        for _path, machine, state in self.top.walk():
-            for region in state.regions:
-                self.owner[id(region)] = (machine, state)
-                machines.append(region)
+        machines = [self.top]  # pre-order without recursion (FSM.walk recurses)
+        stack = [self.top]
+        while stack:
+            machine = stack.pop()
+            found = []
+            for state in machine.states.values():
+                for region in state.regions:
+                    self.owner[id(region)] = (machine, state)
+                    found.append(region)
+            machines.extend(found)
+            stack.extend(reversed(found))
         for machine in machines:
             for t in machine.transitions:
                 resolved = self.resolve(machine, t.target)
