@@ -186,3 +186,43 @@ def test_game_npc_bt_loads_and_ticks_in_behaviortree_cpp() -> None:
     status, ticked = _btcpp_run(etree.tostring(root, encoding="unicode"), *_declared(path))
     assert ticked[:2] == ["IsHealthLow", "CanSeeEnemy"]  # not hurt, no enemy: patrol
     assert ticked[2] == "MoveToWaypoint" and status.endswith(("SUCCESS", "RUNNING"))
+
+
+# -- the README and the docs describe what exists -----------------------------------------------
+ROOT = EXAMPLES.parent
+
+
+def _registered_commands() -> set[str]:
+    from fsmbt import cli
+
+    assert main(["--help"]) == 0  # registers every cmd_*.py module
+    return ({c.name for c in cli.app.registered_commands}
+            | {g.name for g in cli.app.registered_groups})
+
+
+def test_readme_marks_exactly_the_existing_commands_available(capsys: pytest.CaptureFixture) -> None:
+    rows = re.findall(r"^\| `fsmbt (\w+)[^|]*\|[^|]*\| (\w+) \|$",
+                      (ROOT / "README.md").read_text(encoding="utf-8"), flags=re.M)
+    available = {name for name, status in rows if status == "available"}
+    registered = _registered_commands()
+    capsys.readouterr()
+    assert available == registered, "README.md's command table is out of date"
+    assert {name for name, status in rows if status == "planned"}.isdisjoint(registered)
+
+
+def test_cli_doc_has_a_section_per_command(capsys: pytest.CaptureFixture) -> None:
+    text = (ROOT / "docs" / "cli.md").read_text(encoding="utf-8")
+    documented = set(re.findall(r"^## `fsmbt (\w+)`", text, flags=re.M))
+    registered = _registered_commands()
+    capsys.readouterr()
+    assert registered <= documented, f"docs/cli.md lacks {sorted(registered - documented)}"
+
+
+def test_docs_index_links_every_document_and_nothing_missing() -> None:
+    docs = ROOT / "docs"
+    index = (docs / "README.md").read_text(encoding="utf-8")
+    links = re.findall(r"\]\(([^)#]+)\)", index)
+    assert all((docs / link).resolve().exists() for link in links), links
+    linked = {(docs / link).resolve() for link in links}
+    unlisted = [p.name for p in docs.glob("*.md") if p.name != "README.md" and p.resolve() not in linked]
+    assert not unlisted, f"docs/README.md does not list {unlisted}"

@@ -26,8 +26,12 @@ def register(app: typer.Typer) -> None:
                                                   help="Input format (default: detected)."),
         as_json: bool = typer.Option(False, "--json", help="Print the figures as JSON."),
     ) -> None:
-        """Counts and structure: FSM states, transitions, events, entry and loop states;
-        BT nodes by type and kind, depth, breadth, leaves."""
+        """Structure at a glance: states, events, entry/loop states; BT nodes, depth, breadth.
+
+        FSM: states, transitions, events, initial and final states, the entry state and the
+        loop states of DESIGN §3, hierarchy. BT: nodes by kind and type, depth, breadth,
+        leaves, trees and SubTree references.
+        """
         stats = model_stats(read_model(model, from_format))
         if as_json:
             print(json.dumps({"file": str(model), **stats.to_dict()}, indent=2, ensure_ascii=False))
