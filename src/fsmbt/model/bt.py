@@ -14,7 +14,7 @@ from fsmbt.model.bt_nodes import NodeKind, builtin_spec
 from fsmbt.model.errors import SourceLocation
 
 
-@dataclass
+@dataclass(eq=False, repr=False)
 class BTNode:
     """One node. ``type`` is the v4 registration ID (``Sequence``, ``Inverter``, ``MoveTo``...).
 
@@ -48,6 +48,27 @@ class BTNode:
     @property
     def subtree_id(self) -> str | None:
         return self.attrs.get("ID") if self.kind is NodeKind.SUBTREE else None
+
+    def __eq__(self, other: object) -> bool:
+        """Structural equality (location ignored), iterative: trees may be 100 000 deep."""
+        if not isinstance(other, BTNode):
+            return NotImplemented
+        stack: list[tuple[BTNode, BTNode]] = [(self, other)]
+        while stack:
+            a, b = stack.pop()
+            if (a.type, a.kind, a.name, a.attrs, a.kind_declared, len(a.children)) != (
+                b.type, b.kind, b.name, b.attrs, b.kind_declared, len(b.children)
+            ):
+                return False
+            stack.extend(zip(a.children, b.children))
+        return True
+
+    __hash__ = None  # type: ignore[assignment]  # mutable, like the other model classes
+
+    def __repr__(self) -> str:
+        """Shallow on purpose: a deep tree's full repr would recurse and be unreadable."""
+        name = f" name={self.name!r}" if self.name else ""
+        return f"<BTNode {self.type}{name} kind={self.kind.value} children={len(self.children)}>"
 
     def walk(self) -> Iterator[BTNode]:
         """Pre-order traversal without recursion (trees may be 100 000 deep)."""

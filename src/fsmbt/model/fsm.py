@@ -130,10 +130,20 @@ class FSM:
         return list(succ)
 
     def walk(self, prefix: str = "") -> Iterator[tuple[str, FSM, State]]:
-        """Every state at every level as ``(path, owning machine, state)``, pre-order."""
-        for state in self.states.values():
-            path = f"{prefix}{state.name}"
-            yield path, self, state
-            for index, region in enumerate(state.regions):
+        """Every state at every level as ``(path, owning machine, state)``, pre-order.
+
+        Iterative, so deeply nested machines do not hit Python's recursion limit.
+        """
+        stack: list[tuple[str, FSM, Iterator[State]]] = [(prefix, self, iter(self.states.values()))]
+        while stack:
+            base, machine, states = stack[-1]
+            state = next(states, None)
+            if state is None:
+                stack.pop()
+                continue
+            path = f"{base}{state.name}"
+            yield path, machine, state
+            for index in reversed(range(len(state.regions))):
                 sub = f"{path}/" if state.is_composite else f"{path}/{index}:"
-                yield from region.walk(sub)
+                region = state.regions[index]
+                stack.append((sub, region, iter(region.states.values())))
