@@ -76,6 +76,66 @@ class FSMLeafMachine:
         return state
 
 
+class LEBTWithActiveInputs:
+    """``LEBTMachine`` plus a sound ``active_inputs``, so ignored events are not stepped.
+
+    Why it is sound: under the DESIGN §3 protocol an event's identity is read only by two tests,
+    made while it is pending: a guard's ``(state, event) in pairs`` and a running state leaf's
+    ``event in exits``. ``state`` cannot change while an event is pending (the only writer, a
+    state leaf's start, clears the event), and a leaf tested with ``event in exits`` was running
+    before the macro step began. So in LEBT state ``x`` every event outside
+    ``relevant(x)`` = {e : (x.state, e) in some guard} | exits of the leaves running in ``x``
+    gets the same answers everywhere and leads to the same next state and outputs. One such
+    event is stepped: if it is a silent self-loop, only ``relevant(x)`` is active; otherwise
+    (a broken tree) every event is. Cost per state: O(|relevant(x)| + running leaves).
+    """
+
+    def __init__(self, machine: Machine) -> None:
+        from fsmbt.semantics.bt_interpreter import RUNNING as NODE_RUNNING
+
+        self.machine = machine
+        self.name = machine.name
+        self.alphabet: tuple[str, ...] = tuple(machine.alphabet)  # type: ignore[attr-defined]
+        self._alphabet_set = frozenset(self.alphabet)
+        leaves = machine.runtime.leaves  # type: ignore[attr-defined]
+        self._by_source: dict[str, list[str]] = {}
+        for guard in leaves.guards.values():
+            for source, event in guard.pairs:
+                if event:
+                    self._by_source.setdefault(source, []).append(event)
+        self._exits = {nid: spec.exits for nid, spec in leaves.states.items()}
+        self._node_running = NODE_RUNNING
+
+    def start(self):  # type: ignore[no-untyped-def]
+        return self.machine.start()
+
+    def inputs(self, state) -> Sequence[str]:  # type: ignore[no-untyped-def]
+        return self.machine.inputs(state)
+
+    def step(self, state, symbol: str):  # type: ignore[no-untyped-def]
+        return self.machine.step(state, symbol)
+
+    def status(self, state) -> str:  # type: ignore[no-untyped-def]
+        return self.machine.status(state)
+
+    def describe(self, state) -> str:  # type: ignore[no-untyped-def]
+        return self.machine.describe(state)
+
+    def active_inputs(self, state) -> Sequence[str]:  # type: ignore[no-untyped-def]
+        relevant: dict[str, None] = dict.fromkeys(self._by_source.get(state.bb_state, ()))
+        for nid, node_status in state.snapshot[0]:
+            if node_status == self._node_running and nid in self._exits:
+                relevant.update(dict.fromkeys(self._exits[nid]))
+        active = [e for e in relevant if e in self._alphabet_set]
+        other = next((e for e in self.alphabet if e not in relevant), None)
+        if other is None:
+            return active
+        nxt, outputs = self.machine.step(state, other)
+        if nxt == state and not outputs:
+            return active
+        return self.alphabet
+
+
 def lebt_guard_events(doc: BTDocument) -> list[str]:
     """Events named by the LEBT guard leaves (so the checker also offers events that only the
     result knows: reacting to one is additional behaviour)."""
@@ -105,7 +165,7 @@ def machines_for(source: FSM | BTDocument, result: FSM | BTDocument, *,
         source_machine = FSMMachine(source)
         alphabet = _union(source_machine.alphabet, lebt_guard_events(result))
         source_machine = FSMMachine(source, alphabet=alphabet)
-        return source_machine, LEBTMachine(result, alphabet), MACRO_STEP
+        return source_machine, LEBTWithActiveInputs(LEBTMachine(result, alphabet)), MACRO_STEP
     if isinstance(source, BTDocument) and isinstance(result, FSM):
         from fsmbt.semantics.leaf_machine import LeafMachine
 
