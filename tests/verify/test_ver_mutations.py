@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 
 import pytest
 
+from fsmbt.convert.bt_to_hfsm import bt_to_hfsm
 from fsmbt.convert.lebt import fsm_to_lebt
 from fsmbt.generate.generator import random_bt, random_fsm
 from fsmbt.model import FSM, BTDocument, BTNode, NodeKind, State
@@ -244,6 +245,19 @@ def test_leaf_fsm_mutants_are_caught():
     tally = run_family(bt_pairs(), "result", "BT vs mutated leaf FSM")
     assert {"retarget_transition", "drop_transition", "change_action", "flip_final"} <= set(
         tally.by_operator)
+
+
+def converted_bt_pairs() -> list[tuple[BTDocument, FSM]]:
+    pairs = []
+    for seed in range(2):
+        doc = random_bt(f"conv:{seed}", depth=4, breadth=3, max_nodes=16)
+        pairs.append((doc, bt_to_hfsm(doc).model))
+    return pairs
+
+
+def test_converted_hfsm_pairs_mutated_on_either_side_are_caught():
+    run_family(converted_bt_pairs(), "source", "mutated BT vs converted HFSM")
+    run_family(converted_bt_pairs(), "result", "BT vs mutated converted HFSM")
 
 
 def test_the_hand_derived_leaf_fsm_matches_the_explored_one():
