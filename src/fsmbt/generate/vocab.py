@@ -60,7 +60,7 @@ _GAME = Vocabulary(
             "hungry", "fed", "noise", "timeout", "cornered", "safe", "ally_called", "ammo_empty",
             "reloaded", "dawn", "dusk"),
     actions=("Patrol", "Chase", "Attack", "Flee", "Forage", "Hide", "Search", "Heal", "Reload",
-             "Ambush", "Wander", "Eat", "Sleep", "Investigate", "Retreat", "Defend", "Follow",
+             "Ambush", "Wander", "Eat", "Roost", "Investigate", "Retreat", "Defend", "Follow",
              "Evade", "Loot", "Scout"),
     conditions=("EnemyVisible", "InRange", "HealthLow", "Hungry", "AmmoEmpty", "HeardNoise",
                 "IsSafe", "AllyNearby", "IsNight", "HasFood", "Cornered", "TargetDead"),

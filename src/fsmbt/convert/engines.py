@@ -1,0 +1,117 @@
+"""The conversion engines by name, and the result every engine returns.
+
+An engine is a pair of callables ``(fsm_to_bt, bt_to_fsm)``, each taking the source model and
+keyword options (``style``, ``loop``, ... as the engine understands them) and returning a
+``ConversionResult``. ``rules`` (the paper's algorithms done exactly, the default) registers
+itself here; the baselines (``bsd``, ``chds``) and the LLM path (``llm``, ``nllm``, ``hybrid``)
+plug in the same way with ``register_engine`` from their own modules, listed in
+``_PLUGIN_MODULES`` so that ``get_engine`` finds them without anyone editing this table.
+A direction an engine does not offer is ``None``.
+"""
+
+from __future__ import annotations
+
+import importlib
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+from fsmbt.model.bt import BTDocument
+from fsmbt.model.errors import InputError, UnsupportedError
+from fsmbt.model.fsm import FSM
+
+Model = FSM | BTDocument
+
+
+@dataclass
+class ConversionResult:
+    """A converted model with what a person wants to know about the conversion.
+
+    ``direction`` is ``"fsm->bt"`` or ``"bt->fsm"``; ``stats`` holds engine-specific figures
+    (LEBT: entry/loop state counts, nodes; BT->HFSM: ``k`` sub-FSMs, ``depth_before`` /
+    ``depth_after`` compression ...); ``warnings`` are documented, non-fatal deviations (e.g.
+    unreachable states dropped).
+    """
+
+    model: Model
+    engine: str
+    direction: str
+    stats: dict[str, Any] = field(default_factory=dict)
+    warnings: list[str] = field(default_factory=list)
+
+
+Converter = Callable[..., ConversionResult]
+
+
+@dataclass(frozen=True)
+class Engine:
+    name: str
+    fsm_to_bt: Converter | None
+    bt_to_fsm: Converter | None
+    description: str = ""
+
+
+_ENGINES: dict[str, Engine] = {}
+
+#: Modules that register further engines when imported (missing ones are skipped).
+_PLUGIN_MODULES = (
+    "fsmbt.convert.baselines",
+    "fsmbt.llm.engine",
+)
+
+
+def register_engine(name: str, fsm_to_bt: Converter | None, bt_to_fsm: Converter | None,
+                    description: str = "") -> Engine:
+    """Add (or replace) an engine under ``name``."""
+    engine = Engine(name, fsm_to_bt, bt_to_fsm, description)
+    _ENGINES[name] = engine
+    return engine
+
+
+def _register_rules() -> None:
+    """The default engine: LEBT for FSM -> BT, hierarchical conversion units for BT -> FSM."""
+    from fsmbt.convert.bt_to_hfsm import bt_to_hfsm
+    from fsmbt.convert.lebt import fsm_to_lebt
+
+    register_engine("rules", fsm_to_lebt, bt_to_hfsm,
+                    "the paper's algorithms done exactly (LEBT; depth compression + units)")
+
+
+def _load_plugins() -> None:
+    if "rules" not in _ENGINES:
+        _register_rules()
+    for module in _PLUGIN_MODULES:
+        try:
+            importlib.import_module(module)
+        except ModuleNotFoundError as exc:
+            if exc.name is None or not module.startswith(exc.name):
+                raise  # a real missing dependency inside the plugin, not an absent plugin
+
+
+def engines() -> dict[str, Engine]:
+    """Every registered engine by name."""
+    _load_plugins()
+    return dict(_ENGINES)
+
+
+def get_engine(name: str) -> Engine:
+    _load_plugins()
+    try:
+        return _ENGINES[name]
+    except KeyError:
+        known = ", ".join(sorted(_ENGINES))
+        raise InputError(f"unknown engine '{name}' (known: {known})") from None
+
+
+def converter_for(engine: str, model: Model) -> Converter:
+    """The callable converting ``model`` with ``engine`` (direction from the model's kind)."""
+    chosen = get_engine(engine)
+    if isinstance(model, FSM):
+        func, direction = chosen.fsm_to_bt, "FSM -> BT"
+    elif isinstance(model, BTDocument):
+        func, direction = chosen.bt_to_fsm, "BT -> FSM"
+    else:
+        raise InputError(f"cannot convert a {type(model).__name__}")
+    if func is None:
+        raise UnsupportedError(f"engine '{engine}' does not convert {direction}")
+    return func
