@@ -136,3 +136,24 @@ def test_fsm_to_bt_round_with_a_scripted_correct_lebt(tmp_path: Path) -> None:
         outcome = convert_with_llm(fsm, client)
     assert outcome.equivalent and outcome.record.regenerations == 1
     assert "must have exits='pull;exit'" in server.requests[1]["body"]["messages"][-1]["content"]
+
+
+@pytest.mark.parametrize("extended", [False, True])
+def test_the_structural_checks_accept_every_verified_rules_result(extended: bool) -> None:
+    """A correct answer must never be rejected before verification: the rules engine's results,
+    which the checker proves equivalent, pass both structural checks."""
+    from fsmbt.convert.engines import converter_for
+    from fsmbt.generate.generator import random_bt
+    from fsmbt.llm.structural import check_hfsm
+    from fsmbt.model.flatten import flatten
+    from fsmbt.verify import verify
+
+    for seed in range(8):
+        bt = random_bt(seed, 4, 3, "robot", extended=extended, max_nodes=30)
+        hfsm = converter_for("rules", bt)(bt).model
+        assert verify(bt, hfsm).equivalent
+        assert check_hfsm(bt, hfsm) == [], seed
+        fsm = random_fsm(seed, 8 + seed)
+        lebt = converter_for("rules", fsm)(fsm).model
+        assert verify(fsm, lebt).equivalent
+        assert check_lebt(flatten(fsm), lebt) == [], seed

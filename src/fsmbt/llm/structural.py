@@ -8,8 +8,9 @@ FSM -> BT (an LEBT): each reachable FSM state has exactly one ``LebtState`` with
 action, final flag and exits; every ``LebtGuard`` guards a known state with pairs that are real
 transitions (or the start); nodes are only Sequence, Fallback, LebtGuard, LebtState; no empty
 control node. BT -> FSM: every transition and initial state points at an existing state, events
-are leaf outcomes, at most one target per (state, event), and every leaf of the tree has exactly
-one state (counted per leaf name) and no state names a leaf the tree lacks.
+are leaf outcomes, at most one target per (state, event), no state names a leaf the tree lacks,
+and, in the paper's node set (Sequence, Fallback, custom leaves), every leaf has exactly one
+state (counted per leaf name).
 Complexity: linear in the size of both models.
 """
 
@@ -24,6 +25,7 @@ from fsmbt.semantics.lebt_spec import DEFAULT_START, GUARD_TYPE, STATE_TYPE, Gua
 LEBT_NODE_TYPES = frozenset({"Sequence", "Fallback", GUARD_TYPE, STATE_TYPE})
 LEAF_EVENTS = frozenset({"success", "failure", "running"})
 TERMINAL_STATES = frozenset({"SUCCESS", "FAILURE"})
+PAPER_CONTROLS = frozenset({"Sequence", "Fallback"})
 MAX_LISTED = 12  # problems listed per check; more are summarised (feedback stays short)
 
 
@@ -167,14 +169,28 @@ def check_hfsm(source: BTDocument, result: FSM) -> list[str]:
     for _, node in source.nodes():
         if node.is_leaf:
             leaves[node.label] += 1
+    exact = _one_state_per_leaf(source)
     for name in sorted(set(leaves) | set(actions)):
-        if leaves[name] != actions[name]:
-            if leaves[name] == 0:
-                problems.append(f"a state runs {name!r}, which is not a leaf of the tree")
-            else:
-                problems.append(f"leaf {name} occurs {leaves[name]} time(s) in the tree but has "
-                                f"{actions[name]} state(s)")
+        if leaves[name] == 0:
+            problems.append(f"a state runs {name!r}, which is not a leaf of the tree")
+        elif exact and leaves[name] != actions[name]:
+            problems.append(f"leaf {name} occurs {leaves[name]} time(s) in the tree but has "
+                            f"{actions[name]} state(s)")
     return _summarise(problems)
+
+
+def _one_state_per_leaf(source: BTDocument) -> bool:
+    """Whether each leaf must have exactly one state: only in the paper's node set (Sequence,
+    Fallback, custom Action/Condition leaves), where no node keeps memory or counters and every
+    leaf can be ticked. Elsewhere a leaf may need several states (memory, counters, Parallel)
+    or none (never ticked), which the verifier's reachability property judges instead."""
+    for _, node in source.nodes():
+        if node.is_leaf:
+            if node.is_builtin:
+                return False
+        elif node.type not in PAPER_CONTROLS:
+            return False
+    return True
 
 
 def _where(node: object) -> str:
