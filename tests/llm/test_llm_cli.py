@@ -126,3 +126,26 @@ def test_llm_convert_writes_only_a_verified_result(model_file: Path, tmp_path: P
     from fsmbt.verify import verify
 
     assert verify(model, read_model(out)).equivalent
+
+
+def test_hybrid_on_a_parsed_file_needs_no_endpoint(model_file: Path, tmp_path: Path) -> None:
+    out = tmp_path / "door_bt.xml"
+    assert main(["llm", "convert", str(model_file), "--engine", "hybrid", "-o", str(out)]) == 0
+    from fsmbt.formats.registry import read_model
+    from fsmbt.verify import verify
+
+    assert verify(read_model(model_file), read_model(out)).equivalent
+
+
+def test_hybrid_on_prose_asks_the_llm_only_to_extract(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+                                                      capsys: pytest.CaptureFixture[str]) -> None:
+    notes = tmp_path / "door.txt"
+    notes.write_text("A door is Closed until pushed open; pulling closes it again.\n", encoding="utf-8")
+    monkeypatch.setenv("FSMBT_LLM_API_KEY", "k")
+    with ScriptedServer([{"content": json.dumps(FSM_JSON)}]) as server:
+        code = main(["llm", "convert", str(notes), "--engine", "hybrid", "--llm-base-url",
+                     server.base_url, "--llm-model", "m"])
+    assert code == 0 and len(server.requests) == 1
+    assert "Extract the behavior model" in server.user_texts(0)
+    captured = capsys.readouterr()
+    assert "<LebtState" in captured.out and "extracted_by_llm=True" in captured.err
