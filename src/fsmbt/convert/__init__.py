@@ -1,1 +1,27 @@
-"""convert package."""
+"""Conversion between FSMs and BTs: ``convert(model)`` picks the direction from the model's kind.
+
+Engines are looked up by name (``fsmbt.convert.engines``): ``rules`` (default; LEBT for
+FSM -> BT, depth compression + conversion units for BT -> FSM), and whatever the baselines and the
+LLM path register (``bsd``, ``chds``, ``llm`` ...).
+"""
+
+from __future__ import annotations
+
+from fsmbt.convert.engines import (
+    ConversionResult, Engine, converter_for, engines, get_engine, register_engine,
+)
+from fsmbt.model.bt import BTDocument
+from fsmbt.model.fsm import FSM
+
+
+def convert(model: FSM | BTDocument, *, engine: str = "rules", style: str = "paper",
+            **options: object) -> ConversionResult:
+    """Convert an FSM into a BT or a BT into a (hierarchical) FSM with ``engine``.
+
+    ``style`` and further ``options`` (e.g. ``loop=True`` for BT -> FSM) go to the engine.
+    """
+    return converter_for(engine, model)(model, style=style, **options)
+
+
+__all__ = ["convert", "ConversionResult", "Engine", "engines", "get_engine", "register_engine",
+           "converter_for"]
