@@ -23,7 +23,6 @@ import os
 import statistics
 import sys
 from collections import defaultdict
-from pathlib import Path
 from urllib.parse import urlparse
 
 from fsmbt.generate.generator import random_bt, random_fsm
