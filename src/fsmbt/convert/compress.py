@@ -48,6 +48,8 @@ def inline_subtrees(doc: BTDocument) -> BTNode:
     Raises ``InputError`` naming the node for a missing tree and for a tree that (directly or
     not) includes itself. O(N) in the size of the expanded tree.
     """
+    if not doc.trees:
+        raise InputError("the document holds no behavior tree to convert (only node models?)")
     main = doc.main
     if main.root is None:
         raise InputError("the behavior tree is empty", element=main.id)
