@@ -40,11 +40,27 @@ def test_a_file_a_parser_reads_never_reaches_the_llm(tmp_path: Path) -> None:
 
 
 def test_prose_without_an_llm_is_a_clear_input_error(tmp_path: Path) -> None:
-    path = tmp_path / "turnstile.txt"
+    path = tmp_path / "turnstile.notes"
     path.write_text(PROSE, encoding="utf-8")
     assert needs_llm(path)
     with pytest.raises(InputError, match="no reader knows this input"):
         read_input(path, client=None)
+    # a reader guessed from the extension alone reports its error and points at the LLM path
+    named = tmp_path / "turnstile.txt"
+    named.write_text(PROSE, encoding="utf-8")
+    assert needs_llm(named)
+    with pytest.raises(InputError, match="an LLM can extract the model"):
+        read_input(named, client=None)
+
+
+def test_a_reader_chosen_by_content_has_the_last_word(tmp_path: Path) -> None:
+    path = tmp_path / "broken.json"
+    path.write_text('{"kind": "fsm", "states": [{"action": "x"}]}', encoding="utf-8")
+    assert not needs_llm(path)
+    with ScriptedServer([{"content": json.dumps(TURNSTILE)}]) as server:
+        with pytest.raises(InputError, match="a state needs a string 'name'"):
+            read_input(path, client=client_for(server, tmp_path))
+    assert server.requests == []
 
 
 def test_prose_is_extracted_and_read_as_json(tmp_path: Path) -> None:

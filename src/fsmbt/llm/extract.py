@@ -15,7 +15,15 @@ import json
 from dataclasses import dataclass
 from pathlib import Path
 
-from fsmbt.formats.registry import MAX_INPUT_BYTES, decode, detect_format, loads
+from fsmbt.formats.registry import (
+    MAX_INPUT_BYTES,
+    Format,
+    decode,
+    format_for_path,
+    formats,
+    get_format,
+    loads,
+)
 from fsmbt.llm.client import LLMClient, Message
 from fsmbt.llm.config import LLMUnavailableError
 from fsmbt.llm.log import EXTRACTED, INVALID_ANSWER, UNAVAILABLE, ConversionRecord, RoundRecord, append_record
@@ -51,15 +59,31 @@ def image_mime(data: bytes) -> str | None:
     return None
 
 
+def _parser_for(text: str, path: Path, fmt: str | None) -> tuple[Format | None, bool]:
+    """The reader for ``text`` and whether its verdict is final (``--from`` or content sniffed)
+    rather than a guess from the file name, which prose in a ``.txt`` file can trip."""
+    if fmt is not None:
+        return get_format(fmt), True
+    for candidate in formats():
+        if candidate.read is not None and candidate.sniff is not None and candidate.sniff(text):
+            return candidate, True
+    return format_for_path(path), False
+
+
 def needs_llm(path: str | Path, fmt: str | None = None) -> bool:
     """Whether ``read_input`` would call the LLM for this file (no LLM call is made here)."""
-    data = _read_bytes(Path(path))
-    if fmt is not None:
-        return fmt.lower() in LLM_FORMATS
-    if image_mime(data) is not None:
+    path = Path(path)
+    data = _read_bytes(path)
+    if (fmt is not None and fmt.lower() in LLM_FORMATS) or image_mime(data) is not None:
         return True
+    text = decode(data, str(path))
+    parser, final = _parser_for(text, path, fmt)
+    if parser is None:
+        return True
+    if final:
+        return False
     try:
-        detect_format(decode(data, str(path)), Path(path))
+        loads(text, parser.name, path=path)
     except InputError:
         return True
     return False
@@ -69,25 +93,31 @@ def read_input(path: str | Path, fmt: str | None = None, *, client: LLMClient | 
                kind: str | None = None, max_regenerations: int | None = None) -> InputOutcome:
     """Read ``path`` with a parser when one knows it; otherwise let the LLM extract it.
 
-    ``client`` is only needed (and only created by callers) when the LLM must be asked;
-    ``kind`` ("fsm"/"bt") tells the model what to expect when the caller knows it.
+    A reader chosen by ``--from`` or by the content has the last word (its errors are reported);
+    one guessed only from the extension that fails hands the text to the LLM when a ``client``
+    is given. ``kind`` ("fsm"/"bt") tells the model what to expect when the caller knows it.
     """
     path = Path(path)
     data = _read_bytes(path)
     mime = image_mime(data)
     if mime is None and (fmt is None or fmt.lower() not in LLM_FORMATS):
         text = decode(data, str(path))
-        try:
-            chosen = detect_format(text, path) if fmt is None else None
-        except InputError:
-            chosen = None
-            if client is None:
-                raise InputError("no reader knows this input; an LLM can extract the model from it "
-                                 "(--engine llm|nllm|hybrid, or fsmbt llm extract)",
-                                 location=SourceLocation(str(path))) from None
-        else:
-            fmt_name = fmt if fmt is not None else chosen.name  # type: ignore[union-attr]
-            return InputOutcome(loads(text, fmt_name, path=path), False)
+        parser, final = _parser_for(text, path, fmt)
+        if parser is not None:
+            try:
+                return InputOutcome(loads(text, parser.name, path=path), False)
+            except InputError as exc:
+                if final:
+                    raise
+                if client is None:
+                    raise InputError(f"{exc.message} (read as {parser.name} from the file name; if "
+                                     "it is prose or another notation, an LLM can extract the model: "
+                                     "--engine llm|nllm|hybrid, or fsmbt llm extract)",
+                                     location=exc.location, element=exc.element) from None
+        elif client is None:
+            raise InputError("no reader knows this input; an LLM can extract the model from it "
+                             "(--engine llm|nllm|hybrid, or fsmbt llm extract)",
+                             location=SourceLocation(str(path)))
     if client is None:
         raise InputError("this input needs an LLM to extract the model (configure one: "
                          "docs/llm.md)", location=SourceLocation(str(path)))
