@@ -145,16 +145,23 @@ def decode(data: bytes, name: str) -> str:
 
 
 def loads(text: str, fmt: str | None = None, *, path: Path | None = None,
-          options: dict[str, object] | None = None) -> Model:
-    """Parse a model from text (format by name, or detected)."""
+          options: dict[str, object] | None = None,
+          warnings: list[str] | None = None) -> Model:
+    """Parse a model from text (format by name, or detected); the reader's documented
+    warnings are appended to ``warnings`` when given."""
     chosen = get_format(fmt) if fmt else detect_format(text, path)
     if chosen.read is None:
         raise InputError(f"format '{chosen.name}' can be written but not read")
-    return chosen.read(text, ReadContext(path=path, options=dict(options or {})))
+    ctx = ReadContext(path=path, options=dict(options or {}))
+    model = chosen.read(text, ctx)
+    if warnings is not None:
+        warnings.extend(ctx.warnings)
+    return model
 
 
 def read_model(path: str | Path, fmt: str | None = None,
-               options: dict[str, object] | None = None) -> Model:
+               options: dict[str, object] | None = None, *,
+               warnings: list[str] | None = None) -> Model:
     """Read one model file: size and encoding checks, then the format's reader."""
     path = Path(path)
     try:
@@ -164,10 +171,16 @@ def read_model(path: str | Path, fmt: str | None = None,
                              location=SourceLocation(str(path)))
         if path.is_dir():
             raise InputError("is a directory, not a model file", location=SourceLocation(str(path)))
-        data = path.read_bytes()
+        if not path.is_file():  # a FIFO or a device (/dev/zero) could block or never end
+            raise InputError("is not a regular file", location=SourceLocation(str(path)))
+        with path.open("rb") as stream:  # bounded: the file may grow after stat()
+            data = stream.read(MAX_INPUT_BYTES + 1)
+        if len(data) > MAX_INPUT_BYTES:
+            raise InputError(f"input is larger than the limit of {MAX_INPUT_BYTES} bytes",
+                             location=SourceLocation(str(path)))
     except OSError as exc:
         raise InputError(f"cannot read: {exc.strerror}", location=SourceLocation(str(path))) from None
-    return loads(decode(data, str(path)), fmt, path=path, options=options)
+    return loads(decode(data, str(path)), fmt, path=path, options=options, warnings=warnings)
 
 
 def dumps(model: Model, fmt: str) -> str:
