@@ -134,6 +134,11 @@ def decode(data: bytes, name: str) -> str:
         except UnicodeDecodeError as exc:
             raise InputError(f"invalid UTF-16 at byte {exc.start}", location=location) from None
     if b"\x00" in data[:8192]:
+        head = data[:8192]
+        if len(head) >= 4 and (head[1::2].count(0) > 0.9 * len(head[1::2])
+                               or head[0::2].count(0) > 0.9 * len(head[0::2])):
+            raise InputError("looks like UTF-16 without a byte-order mark; save the file as "
+                             "UTF-8", location=location)
         raise InputError("binary data, not a text model", location=location)
     try:
         return data.decode("utf-8-sig")
