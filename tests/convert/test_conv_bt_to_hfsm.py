@@ -105,3 +105,11 @@ def test_missing_subtree_is_a_clear_error() -> None:
                                                     attrs={"ID": "Nowhere"})))
     with pytest.raises(InputError, match="Nowhere"):
         convert(doc)
+
+
+def test_leaf_label_matches_the_leaf_machine() -> None:
+    from fsmbt.convert.bt_to_hfsm import leaf_label
+    from fsmbt.semantics.leaf_machine import leaf_label as shared
+
+    for node in (_leaf("Grasp"), BTNode(type="Grasp", kind=NodeKind.ACTION, name="Grasp_2")):
+        assert leaf_label(node) == shared(node)
