@@ -161,6 +161,12 @@ def machines_for(source: FSM | BTDocument, result: FSM | BTDocument, *,
                 MACRO_STEP)
     if isinstance(source, FSM) and isinstance(result, BTDocument):
         from fsmbt.semantics.lebt_runtime import LEBTMachine
+        from fsmbt.semantics.state_variable_runtime import (
+            is_state_variable_bt, machines_for_state_variable,
+        )
+
+        if is_state_variable_bt(result):  # the baselines' state-variable leaves (BSD, CHDS)
+            return (*machines_for_state_variable(source, result), MACRO_STEP)
 
         source_machine = FSMMachine(source)
         alphabet = _union(source_machine.alphabet, lebt_guard_events(result))
