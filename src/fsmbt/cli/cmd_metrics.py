@@ -1,0 +1,80 @@
+"""``fsmbt metrics MODEL [OTHER]``: the paper's size figures of a model, and the edit distance
+between two models of the same kind (docs/metrics.md)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Optional
+
+import typer
+from rich.console import Console
+from rich.markup import escape
+from rich.table import Table
+
+from fsmbt.formats import read_model
+from fsmbt.metrics import elements, graph_edit_distance, tree_edit_distance
+from fsmbt.model.bt import BTDocument
+from fsmbt.model.errors import InputError
+from fsmbt.model.fsm import FSM
+
+
+def register(app: typer.Typer) -> None:
+    @app.command("metrics")
+    def metrics_command(
+        model: Path = typer.Argument(..., help="Model file (FSM or BT)."),
+        other: Optional[Path] = typer.Argument(
+            None, help="A second model of the same kind: adds the edit distance."),
+        from_format: Optional[str] = typer.Option(None, "--from",
+                                                  help="Input format (default: detected)."),
+        timeout: float = typer.Option(5.0, "--timeout", min=0.01,
+                                      help="Seconds for the FSM graph edit distance search."),
+        as_json: bool = typer.Option(False, "--json", help="Print the figures as JSON."),
+    ) -> None:
+        """Graphical and active elements, depth, node counts by type, sub-FSMs; with OTHER the
+        tree edit distance (BTs) or graph edit distance (FSMs, an upper bound when cut)."""
+        first = read_model(model, from_format)
+        figures = {"file": str(model), **elements(first).to_dict()}
+        report: dict[str, object] = {"model": figures}
+        if other is not None:
+            second = read_model(other, from_format)
+            report["other"] = {"file": str(other), **elements(second).to_dict()}
+            if isinstance(first, BTDocument) and isinstance(second, BTDocument):
+                report["distance"] = {"type": "tree edit distance",
+                                      **tree_edit_distance(first, second).to_dict()}
+            elif isinstance(first, FSM) and isinstance(second, FSM):
+                report["distance"] = {"type": "graph edit distance",
+                                      **graph_edit_distance(first, second,
+                                                            timeout=timeout).to_dict()}
+            else:
+                raise InputError("an edit distance needs two models of the same kind "
+                                 "(two FSMs or two BTs)", element=str(other))
+        if as_json:
+            print(json.dumps(report, indent=2, ensure_ascii=False))
+            return
+        _print(report)
+
+
+ROWS = ("kind", "graphical", "active", "depth", "nodes", "edges", "leaves", "states",
+        "transitions", "machines", "sub_fsms")
+
+
+def _print(report: dict) -> None:
+    table = Table(title="metrics", title_justify="left")
+    table.add_column("figure", style="bold")
+    columns = [report["model"]] + ([report["other"]] if "other" in report else [])
+    for column in columns:
+        table.add_column(escape(Path(column["file"]).name))
+    for row in ROWS:
+        values = [column.get(row) for column in columns]
+        if all(v in (0, None) for v in values) and row not in ("graphical", "active"):
+            continue
+        table.add_row(row, *(escape(str(v)) for v in values))
+    table.add_row("by type", *(escape(", ".join(f"{k}={v}" for k, v in c["by_type"].items()))
+                               for c in columns))
+    console = Console()
+    console.print(table)
+    distance = report.get("distance")
+    if distance:
+        console.print(f"{distance['type']}: {distance['value']:g} ({distance['kind']}, "
+                      f"{distance['method']}, {distance['seconds']:.3f} s)")
