@@ -1,0 +1,386 @@
+"""A behavior tree as an SMV module, written from the tree's structure (DESIGN §2, §4).
+
+The tick rules of BehaviorTree.CPP v4 are transition relations over per-node variables, one
+*micro-step* per node visit, exactly as the interpreter walks the tree (docs/nusmv.md):
+
+- ``cur`` is the node on top of the call stack (``TOP`` when the root has returned, ``DONE_*``
+  after the root's result with ``loop`` off); ``res`` is the status the child just returned to
+  ``cur`` (``NONE``: ``cur`` was just called); ``lidx`` is that child's index. The rest of the
+  stack is the path from the root to ``cur``, so it needs no variable.
+- ``st_n`` is node ``n``'s status (IDLE/RUNNING/SUCCESS/FAILURE), ``idx_n`` the running-child
+  index of Sequence/Fallback/SequenceWithMemory/Async*, ``prev_n`` their child's status when it
+  was called (the stack frame's local), ``wake`` the tree's wake-up signal (``tickOnce``).
+- Halting is a combinational closure: ``clr_n`` (status reset to IDLE) holds when ``n``'s parent
+  resets it now or the parent is being halted; ``hlt_n := clr_n & st_n = RUNNING`` (a RUNNING
+  node is halted, which resets its memory and clears its children).
+
+Leaf requests are where the environment answers: in a leaf-execution machine they are the
+stable states that take an input (success/failure/running); the LEBT encoding
+(``encode_lebt``) answers them from its blackboard instead. Supported node types are listed in
+``SUPPORTED``; anything else raises ``UnsupportedError`` (docs/nusmv.md says why).
+Size: O(N · d) SMV text for N nodes of depth d.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+from fsmbt.model.bt import BTDocument
+from fsmbt.model.bt_nodes import NodeKind
+from fsmbt.model.errors import UnsupportedError
+from fsmbt.semantics.bt_interpreter import CompiledNode, CompiledTree
+from fsmbt.verify.nusmv.smv import Symbols, any_of, case
+
+SEQ_LIKE = {  # type: (is_fallback, emits wake-up after a fresh child succeeds/fails)
+    "Sequence": (False, False), "AsyncSequence": (False, True),
+    "SequenceWithMemory": (False, True),
+    "Fallback": (True, False), "AsyncFallback": (True, True),
+}
+REACTIVE = {"ReactiveSequence": False, "ReactiveFallback": True}
+SIMPLE_DECORATORS = {"Inverter", "ForceSuccess", "ForceFailure", "KeepRunningUntilFailure"}
+SUPPORTED = set(SEQ_LIKE) | set(REACTIVE) | SIMPLE_DECORATORS | {"SubTree"}
+NOT_ENCODED = {
+    "Parallel": "several children run at once (completed-set memory)",
+    "ParallelAll": "several children run at once (completed-set memory)",
+    "IfThenElse": "not encoded yet", "WhileDoElse": "not encoded yet",
+    "Repeat": "its cycle counter is not encoded", "RetryUntilSuccessful":
+    "its attempt counter is not encoded", "RunOnce": "SKIPPED statuses are not encoded",
+}
+ST = {"IDLE": "I", "RUNNING": "R", "SUCCESS": "S", "FAILURE": "F"}
+STATUS_ENUM = "{I, R, S, F}"
+
+
+@dataclass
+class NodeInfo:
+    node: CompiledNode
+    env_leaf: bool
+    internal: str | None  # "S"/"F" for AlwaysSuccess & co
+
+
+class BTCore:
+    """The tick rules of one compiled tree as SMV (shared by the leaf and LEBT encodings).
+
+    ``rules`` collects ``(condition, value)`` pairs per variable in priority order; the caller
+    adds its own rules (leaf answers, what happens when the root returns) and emits the module.
+    """
+
+    def __init__(self, doc: BTDocument | CompiledTree, *, loop: bool) -> None:
+        self.tree = doc if isinstance(doc, CompiledTree) else CompiledTree(doc)
+        self.nodes = self.tree.nodes
+        self.loop = loop
+        self.info: list[NodeInfo] = []
+        has_internal = False
+        has_keep_running = False
+        for node in self.nodes:
+            if node.kind in (NodeKind.ACTION, NodeKind.CONDITION):
+                internal = None
+                if node.internal_status is not None:
+                    internal = "S" if node.internal_status == 2 else "F"
+                    has_internal = True
+                self.info.append(NodeInfo(node, internal is None, internal))
+                continue
+            if node.type not in SUPPORTED:
+                reason = NOT_ENCODED.get(node.type, "not encoded")
+                raise UnsupportedError(
+                    f"the NuSMV encoding does not support {node.type} ({reason}); use "
+                    "--engine native", location=node.source.location,
+                    element=f"<{node.type}> '{node.label}'")
+            has_keep_running |= node.type == "KeepRunningUntilFailure"
+            self.info.append(NodeInfo(node, False, None))
+        if has_internal and (loop or has_keep_running):
+            raise UnsupportedError(
+                "the NuSMV encoding does not model ticks that end without any leaf "
+                "(AlwaysSuccess/AlwaysFailure & co with loop or KeepRunningUntilFailure: the "
+                "engine could livelock); use --engine native", element=self.nodes[0].label)
+        self.max_children = max((len(n.children) for n in self.nodes), default=0)
+        self.rules: dict[str, list[tuple[str, str]]] = {}
+        self.var_types: dict[str, str] = {}
+        self.defines: list[tuple[str, str]] = []
+        self.init: dict[str, str] = {}
+
+    # -- naming ----------------------------------------------------------------------------
+    def n(self, nid: int) -> str:
+        return f"n{nid}"
+
+    def st(self, nid: int) -> str:
+        return f"st_{nid}"
+
+    def rule(self, var: str, cond: str, value: str) -> None:
+        self.rules.setdefault(var, []).append((cond, value))
+
+    def is_seq_like(self, nid: int) -> bool:
+        return self.nodes[nid].type in SEQ_LIKE
+
+    # -- declarations ----------------------------------------------------------------------
+    def declare(self, cur_extra: list[str], init_cur: str) -> None:
+        cur_values = [self.n(x.id) for x in self.nodes] + cur_extra
+        self.var_types["cur"] = "{" + ", ".join(cur_values) + "}"
+        self.var_types["res"] = "{NONE, R, S, F}"
+        self.var_types["lidx"] = f"0..{max(self.max_children - 1, 1)}"
+        self.var_types["wake"] = "boolean"
+        self.init.update(cur=init_cur, res="NONE", lidx="0", wake="FALSE")
+        for x in self.nodes:
+            self.var_types[self.st(x.id)] = STATUS_ENUM
+            self.init[self.st(x.id)] = "I"
+            if self.is_seq_like(x.id):
+                self.var_types[f"idx_{x.id}"] = f"0..{max(len(x.children) - 1, 1)}"
+                self.init[f"idx_{x.id}"] = "0"
+                self.var_types[f"prev_{x.id}"] = STATUS_ENUM
+                self.init[f"prev_{x.id}"] = "I"
+
+    def identity_vars(self) -> list[str]:
+        out = ["cur", "wake"]
+        for x in self.nodes:
+            out.append(self.st(x.id))
+            if self.is_seq_like(x.id):
+                out += [f"idx_{x.id}", f"prev_{x.id}"]
+        return out
+
+    # -- the rules -------------------------------------------------------------------------
+    def call(self, cond: str, child: int) -> None:
+        """``cur`` calls ``child``: it becomes the top of the stack with no result yet."""
+        self.rule("cur", cond, self.n(child))
+        self.rule("res", cond, "NONE")
+        self.rule("lidx", cond, "0")
+
+    def ret(self, cond: str, nid: int, status: str) -> None:
+        """``nid`` returns ``status`` (an SMV expression over R/S/F) to its parent or to TOP."""
+        node = self.nodes[nid]
+        self.rule(self.st(nid), cond, status)
+        self.rule("cur", cond, self.n(node.parent) if node.parent is not None else "TOP")
+        self.rule("res", cond, status)
+        self.rule("lidx", cond, str(node.index))
+        if self.is_seq_like(nid):
+            self.rule(f"prev_{nid}", cond, "I")
+
+    def build(self) -> None:
+        """Every node's tick rules, and the halt closure."""
+        resets: dict[int, list[str]] = {x.id: [] for x in self.nodes}  # child -> conditions
+        for info in self.info:
+            x = info.node
+            here = f"cur = {self.n(x.id)}"
+            called = f"{here} & res = NONE"
+            if info.internal is not None:
+                self.ret(called, x.id, info.internal)
+                continue
+            if info.env_leaf:
+                if x.kind is NodeKind.ACTION:  # StatefulActionNode: old status, no callback
+                    stale = f"{called} & ({self.st(x.id)} = S | {self.st(x.id)} = F)"
+                    self.ret(stale, x.id, f"case {self.st(x.id)} = S : S; TRUE : F; esac")
+                continue  # leaf requests: answered by the machine encoding
+            kids = list(x.children)
+            k = len(kids)
+            t = x.type
+            if t in SEQ_LIKE:
+                is_fb, wakes = SEQ_LIKE[t]
+                stop, go_on = ("S", "F") if is_fb else ("F", "S")
+                memory = t == "SequenceWithMemory"
+                idx = f"idx_{x.id}"
+                self.rule(self.st(x.id), called, "R")
+                for i, c in enumerate(kids):
+                    cond = f"{called} & {idx} = {i}"
+                    self.call(cond, c)
+                    self.rule(f"prev_{x.id}", cond, self.st(c))
+                back = f"{here} & res != NONE"
+                self.ret(f"{back} & res = R", x.id, "R")
+                stopped = f"{back} & res = {stop}"
+                if memory:
+                    for i, c in enumerate(kids):
+                        resets[c].append(f"{stopped} & {idx} <= {i}")
+                else:
+                    for c in kids:
+                        resets[c].append(stopped)
+                    self.rule(idx, stopped, "0")
+                self.ret(stopped, x.id, stop)
+                went = f"{back} & res = {go_on}"
+                for i in range(k):
+                    cond = f"{went} & {idx} = {i}"
+                    if i + 1 < k:
+                        if wakes:
+                            woke = f"{cond} & prev_{x.id} = I"
+                            self.rule("wake", woke, "TRUE")
+                            self.rule(idx, woke, str(i + 1))
+                            self.ret(woke, x.id, "R")
+                            cond = f"{cond} & prev_{x.id} != I"
+                        self.rule(idx, cond, str(i + 1))
+                        self.call(cond, kids[i + 1])
+                        self.rule(f"prev_{x.id}", cond, self.st(kids[i + 1]))
+                    else:
+                        for c in kids:
+                            resets[c].append(cond)
+                        self.rule(idx, cond, "0")
+                        self.ret(cond, x.id, go_on)
+            elif t in REACTIVE:
+                is_fb = REACTIVE[t]
+                stop, go_on = ("S", "F") if is_fb else ("F", "S")
+                self.rule(self.st(x.id), called, "R")
+                self.call(called, kids[0])
+                back = f"{here} & res != NONE"
+                running = f"{back} & res = R"
+                for i, c in enumerate(kids):
+                    resets[c].append(f"{running} & lidx != {i}")
+                self.ret(running, x.id, "R")
+                stopped = f"{back} & res = {stop}"
+                for c in kids:
+                    resets[c].append(stopped)
+                self.ret(stopped, x.id, stop)
+                for i in range(k):
+                    cond = f"{back} & res = {go_on} & lidx = {i}"
+                    if i + 1 < k:
+                        self.call(cond, kids[i + 1])
+                    else:
+                        for c in kids:
+                            resets[c].append(cond)
+                        self.ret(cond, x.id, go_on)
+            else:  # one child: simple decorators and SubTree
+                c = kids[0]
+                if t == "SubTree":
+                    self.rule(self.st(x.id), f"{called} & {self.st(x.id)} = I", "R")
+                else:
+                    self.rule(self.st(x.id), called, "R")
+                self.call(called, c)
+                back = f"{here} & res != NONE"
+                done = f"{back} & (res = S | res = F)"
+                if t == "KeepRunningUntilFailure":
+                    resets[c].append(done)
+                    self.ret(f"{back} & res = F", x.id, "F")
+                    self.ret(f"{back} & res != F", x.id, "R")
+                    continue
+                self.ret(f"{back} & res = R", x.id, "R")
+                resets[c].append(done)
+                mapped = {"Inverter": "case res = S : F; TRUE : S; esac",
+                          "ForceSuccess": "S", "ForceFailure": "F",
+                          "SubTree": "case res = S : S; TRUE : F; esac"}[t]
+                self.ret(done, x.id, mapped)
+        # halt closure (pre-order ids: a parent's defines come before its children's)
+        for x in self.nodes:
+            parent_halt = f"hlt_{x.parent}" if x.parent is not None else "FALSE"
+            self.defines.append((f"clr_{x.id}", any_of(resets[x.id] + [parent_halt])))
+            self.defines.append((f"hlt_{x.id}", f"(clr_{x.id} & {self.st(x.id)} = R)"))
+            # a halted node's memory is reset (Sequence/Fallback/Async*; not WithMemory)
+            if self.is_seq_like(x.id) and x.type != "SequenceWithMemory":
+                self.rules.setdefault(f"idx_{x.id}", []).insert(0, (f"hlt_{x.id}", "0"))
+            self.rules.setdefault(self.st(x.id), []).insert(0, (f"clr_{x.id}", "I"))
+
+    def leaf_request(self, nid: int) -> str:
+        """The condition: ``cur`` is env leaf ``nid`` asking the environment."""
+        x = self.nodes[nid]
+        cond = f"cur = {self.n(nid)} & res = NONE"
+        if x.kind is NodeKind.ACTION:
+            cond += f" & ({self.st(nid)} = I | {self.st(nid)} = R)"
+        return f"({cond})"
+
+    def env_leaves(self) -> list[CompiledNode]:
+        return [i.node for i in self.info if i.env_leaf]
+
+    def emit(self, module: str, params: str, extra_defines: list[tuple[str, str]]) -> str:
+        lines = [f"MODULE {module}({params})", "VAR"]
+        for var, typ in self.var_types.items():
+            lines.append(f"  {var} : {typ};")
+        lines.append("DEFINE")
+        for name, expr in self.defines + extra_defines:
+            lines.append(f"  {name} := {expr};")
+        lines.append("ASSIGN")
+        for var in self.var_types:
+            lines.append(f"  init({var}) := {self.init[var]};")
+            lines.append(f"  next({var}) := {case(self.rules.get(var, []), var)};")
+        # NuSMV reserves S, F (and X, G, U, ...) as temporal operators: status constants are
+        # written I/R/S/F/NONE above for readability and renamed to safe words here.
+        return _SAFE_STATUS.sub(lambda m: "z" + m.group(1), "\n".join(lines) + "\n")
+
+
+_SAFE_STATUS = re.compile(r"(?<![\w$#-])(I|R|S|F|NONE)(?![\w$#-])")
+
+
+def safe_text(text: str) -> str:
+    return _SAFE_STATUS.sub(lambda m: "z" + m.group(1), text)
+
+
+def status_value(smv_value: str) -> str:
+    """The readable status constant of a safe one (``zS`` -> ``S``)."""
+    return smv_value[1:] if smv_value.startswith("z") else smv_value
+
+
+def describe_bt(core: BTCore, values: dict[str, str]) -> str:
+    """A leaf-machine state as the native checker names it: ``label@path`` or the result."""
+    cur = values.get("cur", "")
+    if cur.startswith("n") and cur[1:].isdigit():
+        node = core.nodes[int(cur[1:])]
+        return f"{node.label}@{node.path or 'root'}"
+    return {"DONE_S": "SUCCESS", "DONE_F": "FAILURE"}.get(cur, cur)
+
+
+class LeafBTEncoder:
+    """The BT's leaf-execution machine (``fsmbt.semantics.leaf_machine.LeafMachine``)."""
+
+    def __init__(self, doc: BTDocument | CompiledTree, module: str, inputs: Symbols,
+                 outputs: Symbols, *, loop: bool) -> None:
+        self.core = BTCore(doc, loop=loop)
+        self.module = module
+        self.inputs = inputs
+        self.outputs = outputs
+        self.loop = loop
+        inputs.add_all(("success", "failure", "running"))
+        for leaf in self.core.env_leaves():
+            outputs.id(leaf.label)
+        outputs.add_all(("SUCCESS", "FAILURE"))
+
+    def encode(self):
+        from fsmbt.verify.nusmv.encode_fsm import NONE_OUT, Encoding
+
+        core = self.core
+        core.declare(["TOP", "DONE_S", "DONE_F"], core.n(0))
+        out_enum = self.outputs.enum([NONE_OUT])
+        core.var_types["bres"] = out_enum
+        core.init["bres"] = NONE_OUT
+        core.build()
+        ids = self.inputs
+        outcome = {"success": "S", "failure": "F", "running": "R"}
+        requests = []
+        for leaf in core.env_leaves():
+            req = core.leaf_request(leaf.id)
+            requests.append(req)
+            for name, status in outcome.items():
+                if name == "running" and leaf.kind is NodeKind.CONDITION:
+                    continue
+                core.ret(f"go & {req} & inp = {ids.id(name)}", leaf.id, status)
+        stable = any_of(requests + ["cur = DONE_S", "cur = DONE_F"])
+        # the root returned: re-tick on a wake-up, else the tick is over
+        top = "cur = TOP"
+        core.rule("wake", f"{top} & res = R & wake", "FALSE")
+        core.call(f"{top} & res = R", 0)
+        for status in ("S", "F"):
+            ended = f"{top} & res = {status}"
+            word = "SUCCESS" if status == "S" else "FAILURE"
+            core.rules.setdefault("bres", []).append((ended, self.outputs.id(word)))
+            if self.loop:
+                core.rules.setdefault(core.st(0), []).append((ended, "I"))
+                core.call(ended, 0)
+            else:
+                core.rule("cur", ended, f"DONE_{status}")
+                core.rule("res", ended, "NONE")
+                core.rule("lidx", ended, "0")
+                for var in core.var_types:  # RootResult: nothing else is remembered
+                    if var not in ("cur", "res", "lidx", "bres"):
+                        core.rules.setdefault(var, []).insert(0, (ended, core.init[var]))
+        core.rules.setdefault("bres", []).insert(0, ("go", NONE_OUT))
+        label_rows = [(req, self.outputs.id(leaf.label))
+                      for req, leaf in zip(requests, core.env_leaves())]
+        defines = [("stable", stable), ("final", "(cur = DONE_S | cur = DONE_F)"),
+                   ("o1", "bres"), ("o2", case(label_rows, NONE_OUT))]
+        condition_req = any_of(r for r, leaf in zip(requests, core.env_leaves())
+                               if leaf.kind is NodeKind.CONDITION)
+        for symbol, sid in sorted(ids.to_id.items()):
+            if symbol == "running":
+                value = f"(stable & !final & !{condition_req})"
+            elif symbol in outcome:
+                value = "(stable & !final)"
+            else:
+                value = "FALSE"
+            defines.append((f"offers_{sid}", value))
+        text = core.emit(self.module, "go, inp", defines)
+        ident = [(v, safe_text(core.var_types[v])) for v in core.identity_vars()]
+        return Encoding(self.module, text, ["o1", "o2"], list(outcome), ident,
+                        decode_state=lambda values: describe_bt(core, values),
+                        var_order=list(core.var_types))

@@ -1,0 +1,147 @@
+"""An FSM as an SMV module: the macro-step machine (FSM vs LEBT, FSM vs FSM) or the FSM read as
+a leaf-execution machine (BT vs FSM), with the same meaning as ``fsmbt.semantics.machine``'s
+``FSMMachine`` and ``fsmbt.verify.pairing``'s ``FSMLeafMachine`` (docs/verification.md).
+
+Module interface shared by every machine encoding (``MODULE name(go, inp)``): ``go`` says the
+environment gives input ``inp`` now; DEFINEs ``stable`` (waiting for input), ``final`` (status
+"final"), ``offers_<input>``; output slots ``o1..ok`` holding what the last step (or the start)
+output, ``o_none`` for an empty slot. An FSM takes one step per input, so it is always stable.
+Size: O(S + T) lines for S states and T transitions.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+from fsmbt.model.errors import InputError
+from fsmbt.model.flatten import flatten
+from fsmbt.model.fsm import FSM
+from fsmbt.verify.nusmv.smv import Symbols, any_of, case
+
+NONE_OUT = "out_none"
+LEAF_OUTCOMES = ("success", "failure", "running")
+
+
+@dataclass
+class Encoding:
+    """What the product needs to know about one machine's module."""
+
+    module: str
+    text: str
+    slots: list[str]
+    inputs: list[str]  # inputs the machine may be offered (names)
+    id_vars: list[tuple[str, str]]  # identity variables (name, SMV type) at stable points
+    follows: bool = False
+    decode_state: object = None  # callable(dict of var -> value) -> description
+    var_order: list[str] = field(default_factory=list)  # the module's variables, for the BDD order
+
+
+class FSMEncoder:
+    """Encodes a (flattened) FSM; ``leaf=True`` reads it as ``FSMLeafMachine`` does."""
+
+    def __init__(self, fsm: FSM, module: str, inputs: Symbols, outputs: Symbols, *,
+                 alphabet: Sequence[str], leaf: bool = False, loop: bool = False) -> None:
+        self.fsm = flatten(fsm)
+        if self.fsm.initial is None:
+            raise InputError("the state machine has no initial state", element=self.fsm.name)
+        self.module = module
+        self.inputs = inputs
+        self.outputs = outputs
+        self.alphabet = list(LEAF_OUTCOMES) if leaf else list(alphabet)
+        self.leaf = leaf
+        self.loop = loop
+        self.states = Symbols("q")
+        self.start_pseudo: str | None = None
+        if not leaf and self.fsm.initial_event is not None:
+            self.start_pseudo = self.fsm.start_name or "__start__"
+            if self.start_pseudo in self.fsm.states:
+                self.start_pseudo = None  # FSMMachine treats it as the real state then
+        if self.start_pseudo is not None:
+            self.states.id(self.start_pseudo)
+        self.states.add_all(self.fsm.states)
+        inputs.add_all(self.alphabet)
+
+    def _out(self, name: str) -> str:
+        action = self.fsm.states[name].action
+        return NONE_OUT if action is None else self.outputs.id(action)
+
+    def encode(self) -> Encoding:
+        fsm, q = self.fsm, self.states
+        table = fsm.transition_map()
+        lines = [f"MODULE {self.module}(go, inp)", "VAR",
+                 f"  q : {q.enum()};", f"  o1 : {{{NONE_OUT}}};"]
+        # o1/o2 are typed after every output value is known (placeholder replaced below)
+        next_q: list[tuple[str, str]] = []
+        next_o1: list[tuple[str, str]] = []
+        next_o2: list[tuple[str, str]] = []
+        initial = fsm.initial
+        assert initial is not None
+        if self.leaf:
+            for name, state in fsm.states.items():
+                if state.final:
+                    continue  # a final state takes no input (it offers none)
+                for symbol in self.alphabet:
+                    t = table.get(name, {}).get(symbol)
+                    target = t.target if t is not None else name
+                    guard = f"go & q = {q.id(name)} & inp = {self.inputs.id(symbol)}"
+                    o2 = NONE_OUT
+                    if self.loop and fsm.states[target].final and target != initial:
+                        o2 = self._out(initial)
+                        lands = initial
+                    else:
+                        lands = target
+                    next_q.append((guard, q.id(lands)))
+                    next_o1.append((guard, self._out(target)))
+                    next_o2.append((guard, o2))
+            start_q, start_o = initial, [self._out(initial), NONE_OUT]
+        else:
+            if self.start_pseudo is not None:
+                ev = fsm.initial_event or ""
+                guard = f"go & q = {q.id(self.start_pseudo)} & inp = {self.inputs.id(ev)}"
+                next_q.append((guard, q.id(initial)))
+                next_o1.append((guard, self._out(initial)))
+            for name, state in fsm.states.items():
+                if state.final:
+                    continue
+                for symbol, t in table.get(name, {}).items():
+                    if symbol is None or symbol not in self.alphabet:
+                        continue
+                    guard = f"go & q = {q.id(name)} & inp = {self.inputs.id(symbol)}"
+                    next_q.append((guard, q.id(t.target)))
+                    next_o1.append((guard, self._out(t.target)))
+            if self.start_pseudo is not None:
+                start_q, start_o = self.start_pseudo, [NONE_OUT]
+            else:
+                start_q, start_o = initial, [self._out(initial)]
+        slots = ["o1", "o2"] if self.leaf else ["o1"]
+        out_enum = self.outputs.enum([NONE_OUT])
+        lines[-1] = f"  o1 : {out_enum};"
+        if self.leaf:
+            lines.append(f"  o2 : {out_enum};")
+        finals = [q.id(n) for n, s in fsm.states.items() if s.final]
+        lines += ["DEFINE", "  stable := TRUE;",
+                  f"  final := {any_of(f'q = {f}' for f in finals)};"]
+        for symbol in sorted(set(self.inputs.to_id) | set(self.alphabet)):
+            offered = symbol in self.alphabet
+            value = ("!final" if self.leaf else "TRUE") if offered else "FALSE"
+            lines.append(f"  offers_{self.inputs.id(symbol)} := {value};")
+        lines += ["ASSIGN", f"  init(q) := {q.id(start_q)};",
+                  f"  next(q) := {case(next_q, 'q')};",
+                  f"  init(o1) := {start_o[0]};",
+                  f"  next(o1) := {case(next_o1 + [('go', NONE_OUT)], 'o1')};"]
+        if self.leaf:
+            lines += [f"  init(o2) := {start_o[1]};",
+                      f"  next(o2) := {case(next_o2 + [('go', NONE_OUT)], 'o2')};"]
+        names = q.to_name
+
+        def decode(values: dict[str, str]) -> str:
+            return names.get(values.get("q", ""), "?")
+
+        return Encoding(self.module, "\n".join(lines) + "\n", slots, list(self.alphabet),
+                        [("q", q.enum())], follows=self.leaf, decode_state=decode,
+                        var_order=["q", *slots])
+
+    def status_of(self, values: dict[str, str]) -> str:
+        name = self.states.to_name.get(values.get("q", ""))
+        return "final" if name in self.fsm.states and self.fsm.states[name].final else "running"

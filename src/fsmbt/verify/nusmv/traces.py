@@ -1,0 +1,107 @@
+"""NuSMV's answers as a ``Report``: one ``PropertyResult`` per property, and each
+counterexample decoded (through the symbol tables) into ``TraceStep`` s like the native ones:
+one step per input both machines took while attached, the start as step 0."""
+
+from __future__ import annotations
+
+from fsmbt.model.errors import UnsupportedError
+from fsmbt.verify.nusmv.encode_fsm import NONE_OUT
+from fsmbt.verify.nusmv.runner import SpecResult, TraceState
+from fsmbt.verify.report import PROPERTIES, PropertyResult, Report, TraceStep
+
+_DETAIL_OK = {
+    "reachability": "every state reachable alone is reached with matching behaviour (CTL)",
+    "completeness": "every source step is matched in the faithful product (CTL)",
+    "no_additional_behavior": "the result never does or accepts more than the source (CTL)",
+    "deadlock_absence": "no faithful pair where only one side is stuck (CTL)",
+    "termination_consistency": "statuses agree in every faithful pair (CTL)",
+}
+_DETAIL_FAIL = {
+    "reachability": "a state reachable alone is never reached with matching behaviour",
+    "completeness": "a source step is not matched by the result",
+    "no_additional_behavior": "the result does or accepts more than the source",
+    "deadlock_absence": "one side is stuck while the other can still act",
+    "termination_consistency": "the statuses differ after a step",
+}
+
+
+def _side(values: dict[str, str], prefix: str) -> dict[str, str]:
+    cut = len(prefix) + 1
+    return {k[cut:]: v for k, v in values.items() if k.startswith(prefix + ".")}
+
+
+def decode_trace(trace: list[TraceState], context) -> list[TraceStep]:
+    src, res, _src_enc, _res_enc, inputs, outputs, _mode, _order = context
+    steps: list[TraceStep] = []
+    last_tog: str | None = None
+    for state in trace:
+        v = state.values
+        if v.get("det") == "TRUE":
+            break
+        if v.get("both") != "TRUE":
+            continue
+        if last_tog is not None and v.get("tog") == last_tog:
+            continue  # an idle step: nothing happened
+        s_vals, r_vals = _side(v, "s"), _side(v, "r")
+        symbol = None if last_tog is None else inputs.name(v.get("last_in", ""))
+        last_tog = v.get("tog")
+
+        def outs(vals: dict[str, str], enc) -> list[str]:
+            return [outputs.name(vals[slot]) or vals[slot] for slot in enc.slots
+                    if vals.get(slot, NONE_OUT) != NONE_OUT]
+
+        steps.append(TraceStep(
+            len(steps), symbol, outs(s_vals, src), outs(r_vals, res),
+            src.decode_state(s_vals), res.decode_state(r_vals),
+            "final" if s_vals.get("final") == "TRUE" else "running",
+            "final" if r_vals.get("final") == "TRUE" else "running"))
+    return steps
+
+
+def build_report(names: list[str], results: list[SpecResult], context, source_model,
+                 result_model) -> Report:
+    src, res, src_enc, res_enc, inputs, outputs, mode, _order = context
+    report = Report(engine="nusmv", source=_name(source_model), result=_name(result_model),
+                    mode=mode)
+    for name, result in zip(names, results):
+        if name in PROPERTIES:
+            continue
+        if not result.holds:
+            raise UnsupportedError(res_enc.extra_message(name))
+    for name, result in zip(names, results):
+        if name not in PROPERTIES:
+            continue
+        if result.holds:
+            report.properties[name] = PropertyResult(name, True, _DETAIL_OK[name])
+            continue
+        trace = decode_trace(result.trace or [], context)
+        detail = _DETAIL_FAIL[name]
+        if name == "reachability" and result.trace:
+            detail += _unmatched(result.trace[0].values, context)
+        report.properties[name] = PropertyResult(name, False, detail, trace or None)
+    report.properties = {n: report.properties[n] for n in PROPERTIES if n in report.properties}
+    report.stats = {"source_smv_id_vars": len(src.id_vars), "result_smv_id_vars": len(res.id_vars)}
+    return report
+
+
+def _unmatched(values: dict[str, str], context) -> str:
+    """Name the state the reachability counterexample picked (the frozen copy's value)."""
+    src, res = context[0], context[1]
+    parts = []
+    s_target = {k[3:]: v for k, v in values.items() if k.startswith("ts_")}
+    r_target = {k[3:]: v for k, v in values.items() if k.startswith("tr_")}
+    if s_target:
+        parts.append(f"source {src.decode_state(s_target)}")
+    if r_target and not res.follows:
+        parts.append(f"result {res.decode_state(r_target)}")
+    return f" (candidates: {', '.join(parts)})" if parts else ""
+
+
+def _name(model) -> str:
+    name = getattr(model, "name", None)
+    if isinstance(name, str):
+        return name
+    try:
+        return model.main.id
+    except Exception:  # noqa: BLE001 - a name for the report only
+        return "model"
