@@ -339,3 +339,28 @@ def test_cli_refuses_unknown_picture_formats_and_large_models(
     err = capsys.readouterr().err
     assert "too large to draw: 21 nodes (limit 10)" in err
     assert not (tmp_path / "a.svg").exists() and not (tmp_path / "a.jpg").exists()
+
+
+def test_large_fsms_switch_to_a_fast_layout_without_clusters() -> None:
+    from fsmbt.render.fsm_graph import LAYERED_MAX_STATES
+
+    big = FSM(name="big")
+    n = LAYERED_MAX_STATES + 1
+    for i in range(n):
+        big.add_state(f"s{i}")
+    for i in range(n):
+        big.add_transition(f"s{i}", "next", f"s{(i + 1) % n}")
+    source = fsm_to_dot(big)
+    assert "layout=sfdp" in source and "rankdir" not in source
+    assert "layout" not in fsm_to_dot(paper_fsm())
+    hfsm = door_hfsm()
+    for i in range(n):  # the same hierarchy, now too big for the layered layout
+        hfsm.add_state(f"extra{i}")
+    dot = parse_dot(fsm_to_dot(hfsm))
+    assert not dot.clusters
+    labels = {dot.label(n): n for n in dot.nodes}
+    assert dot.nodes[labels["Operating"]]["shape"] == "box"
+    assert {"Operating/Closed", "Panel/Done"} <= set(labels)
+    entry = [(t, h) for t, h, a in dot.edges if a.get("style") == "dotted"]
+    assert (labels["Operating"], labels["Operating/Closed"]) in entry
+    assert sum(1 for t, _ in entry if t == labels["Panel"]) == 2  # one per parallel region

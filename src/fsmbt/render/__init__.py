@@ -14,7 +14,8 @@ from fsmbt.model.bt import BTDocument
 from fsmbt.model.fsm import FSM
 from fsmbt.render.bt_graph import bt_to_dot
 from fsmbt.render.dot import (
-    DEFAULT_MAX_NODES, OUTPUT_FORMATS, GraphvizError, TooLargeError, run_dot, write_picture,
+    DEFAULT_MAX_NODES, OUTPUT_FORMATS, GraphvizError, TooLargeError, check_output, run_dot,
+    write_picture,
 )
 from fsmbt.render.fsm_graph import fsm_to_dot
 
@@ -29,12 +30,7 @@ def model_to_dot(model: FSM | BTDocument, *, expand_subtrees: bool = False,
 def render_model(model: FSM | BTDocument, path: str | Path, *, overwrite: bool = False,
                  expand_subtrees: bool = False, max_nodes: int = DEFAULT_MAX_NODES) -> Path:
     """Draw ``model`` into ``path`` (format from the suffix) and return the path."""
-    from fsmbt.render.dot import output_format
-
-    output_format(Path(path))  # an unknown suffix fails before any work
-    if Path(path).exists() and not overwrite:
-        # checked again on write; failing here saves laying out a picture that cannot be kept
-        write_picture("", path, overwrite=False)
+    check_output(Path(path), overwrite=overwrite)  # fail before laying out a picture
     source = model_to_dot(model, expand_subtrees=expand_subtrees, max_nodes=max_nodes)
     return write_picture(source, path, overwrite=overwrite)
 

@@ -92,6 +92,14 @@ def output_format(path: Path) -> str:
                          location=SourceLocation(str(path))) from None
 
 
+def check_output(path: Path, *, overwrite: bool) -> str:
+    """The picture format ``path`` asks for; refuses an existing file unless ``overwrite``."""
+    fmt = output_format(path)
+    if path.exists() and not overwrite:
+        raise InputError("exists; pass --force to overwrite it", location=SourceLocation(str(path)))
+    return fmt
+
+
 def dot_binary() -> str:
     found = shutil.which("dot")
     if found is None:
@@ -117,9 +125,7 @@ def write_picture(source: str, path: str | Path, *, overwrite: bool = False,
                   timeout: float = DOT_TIMEOUT_S) -> Path:
     """Write ``source`` as the picture ``path`` names (by suffix); refuse to replace a file."""
     path = Path(path)
-    fmt = output_format(path)
-    if path.exists() and not overwrite:
-        raise InputError("exists; pass --force to overwrite it", location=SourceLocation(str(path)))
+    fmt = check_output(path, overwrite=overwrite)
     data = source.encode("utf-8") if fmt == "dot" else run_dot(source, fmt, timeout=timeout)
     try:
         path.parent.mkdir(parents=True, exist_ok=True)

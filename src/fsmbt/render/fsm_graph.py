@@ -9,6 +9,12 @@ of a composite state end at its cluster's border (``compound=true`` with ``lhead
 Eventless transitions are labelled ``ε`` (from an atomic state) or ``done`` / ``done(x)`` (from a
 composite state when its sub-machine reaches a final state, ``x`` if only that one).
 
+Large machines (more than ``LAYERED_MAX_STATES`` states or ``LAYERED_MAX_ARROWS`` arrows) are
+drawn differently, because dot's layered layout with edge labels needs minutes from about a
+hundred states with crossing transitions: the force-directed ``sfdp`` layout is used (seconds for
+thousands of states), without clusters: a composite state is a box joined to its sub-machine's
+initial state by a dotted arrow, and nested states are named by their path (``Operating/Closed``).
+
 Built without recursion: clusters are created in pre-order and attached to their parents in
 reverse order. Complexity O(S + T) for S states (every level) and T transitions.
 """
@@ -27,6 +33,9 @@ from fsmbt.render.dot import (
 
 #: Nested clusters beyond this depth make dot slow and the picture unreadable.
 MAX_NESTING = 60
+#: Beyond these sizes the layered ``dot`` layout is too slow; ``sfdp`` is used, without clusters.
+LAYERED_MAX_STATES = 60
+LAYERED_MAX_ARROWS = 150
 #: At most this many event names per arrow label line.
 EVENTS_PER_LINE = 3
 
@@ -39,6 +48,8 @@ class _Level:
     graph: graphviz.Digraph
     ids: dict[str, str] = field(default_factory=dict)
     anchors: dict[str, tuple[str, str]] = field(default_factory=dict)  # composite -> (node, cluster)
+    prefix: str = ""  # large pictures: nested states are named by their path
+    entry: str | None = None  # large pictures: the composite state's box, drawn instead of a point
 
 
 def fsm_to_dot(fsm: FSM, *, max_nodes: int = DEFAULT_MAX_NODES) -> str:
@@ -50,8 +61,14 @@ def fsm_to_dot(fsm: FSM, *, max_nodes: int = DEFAULT_MAX_NODES) -> str:
         raise TooLargeError(f"too deeply nested to draw: {stats.nesting_depth} levels "
                             f"(limit {MAX_NESTING})")
 
+    layered = (stats.all_states <= LAYERED_MAX_STATES
+               and stats.all_transitions <= LAYERED_MAX_ARROWS)
     root = graphviz.Digraph(name=_safe_name(fsm.name))
-    root.attr(rankdir="LR", compound="true", fontname=FONT, nodesep="0.35", ranksep="0.5")
+    if layered:
+        root.attr(rankdir="LR", compound="true", fontname=FONT, nodesep="0.35", ranksep="0.5")
+    else:
+        root.attr(layout="sfdp", overlap="prism", splines="false", outputorder="edgesfirst",
+                  fontname=FONT)
     root.attr("node", fontname=FONT, fontsize="12")
     root.attr("edge", fontname=FONT, fontsize="10", arrowsize="0.8")
     counter = _Counter()
@@ -65,16 +82,26 @@ def fsm_to_dot(fsm: FSM, *, max_nodes: int = DEFAULT_MAX_NODES) -> str:
         level = pending.pop()
         levels.append(level)
         for state in level.machine.states.values():
+            title = level.prefix + state.name
             if state.is_atomic:
                 node_id = counter.next("s")
                 level.ids[state.name] = node_id
-                level.graph.node(node_id, **_state_attrs(state))
+                level.graph.node(node_id, **_state_attrs(state, title, compact=not layered))
+                continue
+            if not layered:  # a box standing for the composite state, no cluster
+                node_id = counter.next("c")
+                level.graph.node(node_id, label=label_text(_state_title(state, title)),
+                                 shape="box", style="rounded,bold")
+                inner = [_Level(region, level.graph, prefix=f"{title}/", entry=node_id)
+                         for region in state.regions]
+                level.anchors[state.name] = (node_id, "")
+                pending.extend(reversed(inner))
                 continue
             cluster = graphviz.Digraph(name=counter.next("cluster_"))
-            cluster.attr(label=label_text(_state_title(state)), style="rounded",
+            cluster.attr(label=label_text(_state_title(state, state.name)), style="rounded",
                          color="gray30", fontname=FONT, fontsize="12", labeljust="l")
             clusters.append((cluster, level.graph))
-            inner: list[_Level] = []
+            inner = []
             for index, region in enumerate(state.regions):
                 holder = cluster
                 if state.is_parallel:
@@ -110,21 +137,25 @@ def _safe_name(name: str) -> str:
     return "".join(ch if ch.isalnum() or ch == "_" else "_" for ch in name) or "fsm"
 
 
-def _state_title(state: State) -> str:
+def _state_title(state: State, title: str) -> str:
     if state.action is not None and state.action != state.name:
-        return f"{state.name} / {state.action}"
-    return state.name
+        return f"{title} / {state.action}"
+    return title
 
 
 def _region_title(region: FSM, index: int) -> str:
     return region.name if region.name and region.name != "fsm" else f"region {index + 1}"
 
 
-def _state_attrs(state: State) -> dict[str, str]:
-    lines = [state.name]
+def _state_attrs(state: State, title: str, *, compact: bool = False) -> dict[str, str]:
+    """Circles (double for final states); ellipses in large pictures, where long path names
+    would make circles huge."""
+    lines = [title]
     if state.action is not None and state.action != state.name:
         lines.append(f"/ {state.action}")
     attrs = {"label": label_text(*lines), "shape": "doublecircle" if state.final else "circle"}
+    if compact:
+        attrs.update(shape="ellipse", peripheries="2" if state.final else "1")
     if state.final:
         attrs.update(style="filled", fillcolor="gray92")
     return attrs
@@ -145,6 +176,10 @@ def _draw_initial(level: _Level, edges: list, *, is_top: bool) -> None:
     fsm = level.machine
     if fsm.initial is None or fsm.initial not in fsm.states:
         return
+    head, head_attrs = _endpoint(level, fsm.initial, "lhead")
+    if level.entry is not None:  # large pictures: from the composite state's box
+        edges.append((level.entry, head, {"style": "dotted", "arrowhead": "empty"}))
+        return
     point = level.ids.get("__initial_point__")
     if point is None:
         point = f"init_{level.graph.name or 'root'}"
@@ -154,7 +189,6 @@ def _draw_initial(level: _Level, edges: list, *, is_top: bool) -> None:
     attrs: dict[str, str] = {}
     if is_top and fsm.initial_event is not None:
         attrs["label"] = label_text(fsm.initial_event)
-    head, head_attrs = _endpoint(level, fsm.initial, "lhead")
     edges.append((point, head, {**attrs, **head_attrs}))
 
 
@@ -182,7 +216,7 @@ def _draw_transitions(level: _Level, edges: list) -> None:
 def _endpoint(level: _Level, state: str, side: str) -> tuple[str, dict[str, str]]:
     if state in level.anchors:
         node, cluster = level.anchors[state]
-        return node, {side: cluster}
+        return node, ({side: cluster} if cluster else {})
     return level.ids[state], {}
 
 
