@@ -224,5 +224,7 @@ def test_docs_index_links_every_document_and_nothing_missing() -> None:
     links = re.findall(r"\]\(([^)#]+)\)", index)
     assert all((docs / link).resolve().exists() for link in links), links
     linked = {(docs / link).resolve() for link in links}
-    unlisted = [p.name for p in docs.glob("*.md") if p.name != "README.md" and p.resolve() not in linked]
+    documents = [*docs.glob("*.md"), *docs.glob("*/README.md")]  # sub-folders have an index
+    unlisted = [str(p.relative_to(docs)) for p in documents
+                if p != docs / "README.md" and p.resolve() not in linked]
     assert not unlisted, f"docs/README.md does not list {unlisted}"
