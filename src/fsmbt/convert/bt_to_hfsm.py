@@ -39,8 +39,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from fsmbt.convert.compress import compress, inline_subtrees
+from fsmbt.convert.compress import inline_and_compress
 from fsmbt.convert.engines import ConversionResult
+from fsmbt.convert.perf import without_gc_pauses
 from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.bt_nodes import NodeKind
 from fsmbt.model.errors import InputError
@@ -243,12 +244,13 @@ def explore_region(node: BTNode, *, loop: bool = False, top: bool = False) -> tu
     return fsm, ends
 
 
+@without_gc_pauses
 def bt_to_hfsm(doc: BTDocument, *, loop: bool = False, style: str = "paper",
                **_options: object) -> ConversionResult:
     """Convert a BT document into a hierarchical FSM whose flattening is the BT's
     leaf-execution machine (see the module docstring)."""
-    inlined = inline_subtrees(doc)
-    compression = compress(inlined)
+    prepared = inline_and_compress(doc)
+    compression = prepared.compression
     root = compression.root
     builder = _Builder(loop=loop)
     opaque_nodes = _opaque_roots(root)
@@ -275,7 +277,7 @@ def bt_to_hfsm(doc: BTDocument, *, loop: bool = False, style: str = "paper",
         "depth_before": compression.depth_before,
         "depth_after": compression.depth_after,
         "merged_nodes": compression.merged,
-        "leaves": sum(1 for n in root.walk() if n.is_leaf),
+        "leaves": prepared.leaves,
         "loop": loop,
     }
     return ConversionResult(hfsm, "rules", "bt->fsm", stats, builder.warnings)

@@ -69,11 +69,12 @@ def register_engine(name: str, fsm_to_bt: Converter | None, bt_to_fsm: Converter
 
 
 def _register_rules() -> None:
-    """The default engine: LEBT for FSM -> BT, hierarchical conversion units for BT -> FSM."""
+    """The default engine: LEBT for FSM -> BT (a SubTree per composite state of a hierarchical
+    FSM, option ``hierarchy``), hierarchical conversion units for BT -> FSM."""
     from fsmbt.convert.bt_to_hfsm import bt_to_hfsm
-    from fsmbt.convert.lebt import fsm_to_lebt
+    from fsmbt.convert.hfsm_to_bt import fsm_to_bt
 
-    register_engine("rules", fsm_to_lebt, bt_to_hfsm,
+    register_engine("rules", fsm_to_bt, bt_to_hfsm,
                     "the paper's algorithms done exactly (LEBT; depth compression + units)")
 
 

@@ -27,13 +27,14 @@ Complexity: O(S + T) time and memory for S states and T transitions (after flatt
 from __future__ import annotations
 
 from fsmbt.convert.engines import ConversionResult
+from fsmbt.convert.perf import without_gc_pauses
 from fsmbt.convert.structure import LebtStructure, analyse
 from fsmbt.model.bt import BTDocument, BTNode, NodeModel, PortModel
 from fsmbt.model.bt_nodes import NodeKind
 from fsmbt.model.errors import UnsupportedError
 from fsmbt.model.flatten import flatten, needs_flattening
 from fsmbt.model.fsm import FSM
-from fsmbt.semantics.lebt_spec import GUARD_TYPE, STATE_TYPE, GuardSpec, StateSpec
+from fsmbt.semantics.lebt_spec import GUARD_TYPE, STATE_TYPE, escape
 
 STYLES = ("paper",)
 ROOT_NAME = "LEBT"
@@ -56,52 +57,93 @@ def lebt_node_models() -> dict[str, NodeModel]:
     }
 
 
-def _guard(structure: LebtStructure, state: str) -> BTNode:
-    spec = GuardSpec(state, tuple(structure.guard_pairs[state]))
-    return BTNode(type=GUARD_TYPE, kind=NodeKind.CONDITION, name=f"Enter_{state}",
-                  attrs=spec.to_attrs())
+class _LeafWriter:
+    """Writes the guard and state leaves' ports exactly as ``GuardSpec.to_attrs`` /
+    ``StateSpec.to_attrs`` do, escaping each distinct name once (names repeat: a state is the
+    source of all its outgoing pairs, an event occurs on many transitions). Asserted equal to
+    the spec classes in the tests."""
 
+    def __init__(self, fsm: FSM, structure: LebtStructure) -> None:
+        self.fsm = fsm
+        self.structure = structure
+        self._escaped: dict[str, str] = {}
 
-def _state_leaf(fsm: FSM, structure: LebtStructure, state: str) -> BTNode:
-    model_state = fsm.states[state]
-    spec = StateSpec(state, model_state.action, model_state.final,
-                     tuple(structure.exits[state]))
-    return BTNode(type=STATE_TYPE, kind=NodeKind.ACTION, name=state, attrs=spec.to_attrs())
+    def esc(self, text: str) -> str:
+        known = self._escaped.get(text)
+        if known is None:
+            known = escape(text) if ("\\" in text or ";" in text or "/" in text) else text
+            self._escaped[text] = known
+        return known
 
+    def guard(self, state: str) -> BTNode:
+        esc = self.esc
+        pairs = ";".join(f"{esc(source)}/{esc(event)}"
+                         for source, event in self.structure.guard_pairs[state])
+        return BTNode(type=GUARD_TYPE, kind=NodeKind.CONDITION, name=f"Enter_{state}",
+                      attrs={"target": state, "pairs": pairs})
 
-def _selector(fsm: FSM, structure: LebtStructure, state: str) -> tuple[BTNode, BTNode | None]:
-    """``Fallback(guard, body)``; returns it and the body Sequence to fill (None = leaf body)."""
-    leaf = _state_leaf(fsm, structure, state)
-    selector = BTNode(type="Fallback", kind=NodeKind.CONTROL, name=f"{state}_selector")
-    selector.children.append(_guard(structure, state))
-    below = structure.children.get(state, [])
-    if not below:
-        selector.children.append(leaf)
-        return selector, None
-    shape = "chain" if len(below) == 1 else "branch"
-    body = BTNode(type="Sequence", kind=NodeKind.CONTROL, name=f"{state}_{shape}",
-                  children=[leaf])
-    selector.children.append(body)
-    return selector, body
+    def state_leaf(self, state: str) -> BTNode:
+        model_state = self.fsm.states[state]
+        esc = self.esc
+        attrs = {
+            "state": state,
+            "action": model_state.action or "",
+            "final": "true" if model_state.final else "false",
+            "exits": ";".join(esc(event) for event in self.structure.exits[state]),
+        }
+        return BTNode(type=STATE_TYPE, kind=NodeKind.ACTION, name=state, attrs=attrs)
+
+    def selector(self, state: str) -> tuple[BTNode, BTNode | None]:
+        """``Fallback(guard, body)``; returns it and the body Sequence to fill (None = leaf)."""
+        leaf = self.state_leaf(state)
+        below = self.structure.children[state]
+        if not below:
+            return BTNode(type="Fallback", kind=NodeKind.CONTROL, name=f"{state}_selector",
+                          children=[self.guard(state), leaf]), None
+        shape = "chain" if len(below) == 1 else "branch"
+        body = BTNode(type="Sequence", kind=NodeKind.CONTROL, name=f"{state}_{shape}",
+                      children=[leaf])
+        return BTNode(type="Fallback", kind=NodeKind.CONTROL, name=f"{state}_selector",
+                      children=[self.guard(state), body]), body
 
 
 def build_lebt(fsm: FSM, structure: LebtStructure) -> BTNode:
     """The LEBT root for a flat FSM and its recognised structure (iterative)."""
+    return _build(fsm, structure)[0]
+
+
+def _build(fsm: FSM, structure: LebtStructure) -> tuple[BTNode, int, int]:
+    """The LEBT root, its node count and depth (counted while building: no second walk).
+
+    A selector on level ``L`` holds its guard and body on ``L + 1``; a body Sequence holds the
+    state leaf and the child selectors on ``L + 2``. O(S + T).
+    """
+    writer = _LeafWriter(fsm, structure)
     root = BTNode(type="Sequence", kind=NodeKind.CONTROL, name=ROOT_NAME)
-    pending: list[tuple[str, BTNode]] = []
+    nodes, depth = 1, 1
+    pending: list[tuple[str, BTNode, int]] = []
     for state in structure.roots:
-        selector, body = _selector(fsm, structure, state)
+        selector, body = writer.selector(state)
         root.children.append(selector)
-        if body is not None:
-            pending.append((state, body))
+        if body is None:
+            nodes += 3
+            depth = max(depth, 3)
+        else:
+            nodes += 4
+            pending.append((state, body, 3))
     while pending:
-        state, body = pending.pop()
+        state, body, level = pending.pop()
+        depth = max(depth, level + 1)  # the state leaf below the body
         for child in structure.children[state]:
-            selector, child_body = _selector(fsm, structure, child)
+            selector, child_body = writer.selector(child)
             body.children.append(selector)
-            if child_body is not None:
-                pending.append((child, child_body))
-    return root
+            if child_body is None:
+                nodes += 3
+                depth = max(depth, level + 2)
+            else:
+                nodes += 4
+                pending.append((child, child_body, level + 2))
+    return root, nodes, depth
 
 
 def tree_depth(root: BTNode) -> int:
@@ -115,6 +157,7 @@ def tree_depth(root: BTNode) -> int:
     return deepest
 
 
+@without_gc_pauses
 def fsm_to_lebt(fsm: FSM, *, style: str = "paper", **_options: object) -> ConversionResult:
     """Convert an FSM (flat or hierarchical) into its LEBT document."""
     if style not in STYLES:
@@ -131,7 +174,7 @@ def fsm_to_lebt(fsm: FSM, *, style: str = "paper", **_options: object) -> Conver
         shown = ", ".join(structure.unreachable[:10])
         more = "" if len(structure.unreachable) <= 10 else f" (+{len(structure.unreachable) - 10})"
         warnings.append(f"dropped {len(structure.unreachable)} unreachable state(s): {shown}{more}")
-    root = build_lebt(flat, structure)
+    root, node_count, depth = _build(flat, structure)
     doc = BTDocument.single(root)
     doc.node_models.update(lebt_node_models())
     below = [len(children) for children in structure.children.values()]
@@ -145,7 +188,7 @@ def fsm_to_lebt(fsm: FSM, *, style: str = "paper", **_options: object) -> Conver
         "branches": sum(1 for count in below if count >= 2),
         "unreachable_dropped": len(structure.unreachable),
         "flattened": flat is not fsm,
-        "nodes": sum(1 for _ in root.walk()),
-        "depth": tree_depth(root),
+        "nodes": node_count,
+        "depth": depth,
     }
     return ConversionResult(doc, "rules", "fsm->bt", stats, warnings)

@@ -119,11 +119,16 @@ def analyse(fsm: FSM) -> LebtStructure:
     roots = [entry] + [name for name in loop_states if name != entry]
     root_set = set(roots)
     children: dict[str, list[str]] = {name: [] for name in reachable}
+    linked: set[str] = set()  # a non-root state has one predecessor: it is linked at most once
     for source in reachable:
+        below = children[source]
         for t in table.get(source, ()):
             target = t.target
-            if (target not in root_set and predecessors[target] == [source]
-                    and target not in children[source]):
-                children[source].append(target)
+            if target in root_set or target in linked:
+                continue
+            preds = predecessors[target]
+            if len(preds) == 1 and preds[0] == source:
+                linked.add(target)
+                below.append(target)
     return LebtStructure(start, entry, roots, loop_states, children, guard_pairs, exits,
                          predecessors, unreachable)
