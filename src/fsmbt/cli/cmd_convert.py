@@ -3,6 +3,11 @@
 The converted model goes to ``-o`` (never overwriting without ``--force``) or to stdout; the
 verdict and the conversion's figures go to stderr then, so stdout stays a clean model. Exit 0
 when equivalent (or ``--no-verify``), 1 when not, 2 on bad input.
+
+The LLM engines (``llm``, ``nllm``, ``hybrid``) read the input through
+``fsmbt.llm.extract.read_input``, so prose, unknown notations and diagrams reach the model's
+extraction step (``hybrid`` asks the LLM only when no parser reads the file);
+``--llm-base-url`` / ``--llm-model`` go to the engine as ``llm_base_url`` / ``llm_model``.
 """
 
 from __future__ import annotations
@@ -20,6 +25,24 @@ from fsmbt.model.fsm import FSM
 
 DEFAULT_FSM_FORMAT = "scxml"  # BT -> FSM: nested states survive
 DEFAULT_BT_FORMAT = "btcpp"   # FSM -> BT: BehaviorTree.CPP v4 XML with TreeNodesModel
+LLM_ENGINES = ("llm", "nllm", "hybrid")
+
+
+def _read_source(source: Path, source_format: str | None, engine: str,
+                 options: dict[str, object]):
+    """The source model; for the LLM engines through ``read_input`` (LLM extraction when no
+    parser reads it), recording the client and provenance in ``options`` for the engine."""
+    if engine not in LLM_ENGINES:
+        return read_model(source, source_format)
+    from fsmbt.llm.engine import client_from_options
+    from fsmbt.llm.extract import needs_llm, read_input
+
+    client = None
+    if engine != "hybrid" or needs_llm(source, source_format):
+        client = client_from_options(options)  # LLMConfigError (exit 2) when none is set up
+    loaded = read_input(source, source_format, client=client)
+    options.update(client=client, source_name=str(source), extracted_by_llm=loaded.extracted)
+    return loaded.model
 
 
 def register(app: typer.Typer) -> None:
@@ -38,13 +61,25 @@ def register(app: typer.Typer) -> None:
         no_verify: bool = typer.Option(False, "--no-verify", help="skip the equivalence check"),
         force: bool = typer.Option(False, "--force", help="overwrite an existing output file"),
         as_json: bool = typer.Option(False, "--json", help="print a JSON summary on stdout"),
+        hierarchy: str = typer.Option("subtrees", "--hierarchy", help="FSM->BT of a "
+                                      "hierarchical FSM: subtrees (one SubTree per composite "
+                                      "state) or flatten (one flat LEBT)"),
+        llm_base_url: str | None = typer.Option(None, "--llm-base-url", help="LLM engines: "
+                                                "endpoint URL or provider (openai, deepseek, "
+                                                "qwen, ollama, vllm)"),
+        llm_model: str | None = typer.Option(None, "--llm-model", help="LLM engines: model "
+                                             "name"),
     ) -> None:
         """Convert an FSM into a behavior tree or a behavior tree into a hierarchical FSM, and
         prove the result equivalent."""
-        model = read_model(source, source_format)
         options: dict[str, object] = {}
+        if engine in LLM_ENGINES:
+            options.update(llm_base_url=llm_base_url, llm_model=llm_model)
+        model = _read_source(source, source_format, engine, options)
         if loop:
             options["loop"] = True
+        if engine == "rules" and isinstance(model, FSM):
+            options["hierarchy"] = hierarchy
         result = convert(model, engine=engine, style=style, **options)
         kind = "fsm" if isinstance(result.model, FSM) else "bt"
         fmt = to
