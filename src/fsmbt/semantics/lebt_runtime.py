@@ -25,7 +25,7 @@ differential tests compare.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Protocol
 
@@ -121,6 +121,17 @@ class LebtLeaves:
         names = {s.state for s in states.values()}
         sources = {src for g in guards.values() for src, _ in g.pairs if src not in names}
         return sources.pop() if len(sources) == 1 else DEFAULT_START
+
+
+def drive_macro_step(tick: Callable[[], str], bb: LebtBlackboard, event: str) -> str:
+    """DESIGN §3's macro step around any engine's root tick; returns the last root result.
+    An event still pending after the second tick is dropped."""
+    bb.event = event
+    result = tick()
+    if result == "SUCCESS" and bb.event != NO_EVENT:
+        result = tick()
+    bb.event = NO_EVENT
+    return result
 
 
 # -- the runtime -------------------------------------------------------------------------------

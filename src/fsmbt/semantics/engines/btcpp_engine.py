@@ -27,6 +27,10 @@ from fsmbt.model.bt_nodes import NodeKind
 from fsmbt.semantics.bt_interpreter import (
     OUTCOME_TO_STATUS, STATUS_NAMES, CompiledNode, CompiledTree, Environment, TickRecord,
 )
+from fsmbt.semantics.lebt_runtime import (
+    LebtLeaves, drive_macro_step, guard_outcome, state_on_running, state_on_start,
+)
+from fsmbt.semantics.lebt_spec import BB_EVENT, BB_STATE, GUARD_TYPE, NO_EVENT, STATE_TYPE
 
 ACTION_ID = "FsmbtAction"
 CONDITION_ID = "FsmbtCondition"
@@ -131,3 +135,84 @@ class BTCppRunner:
         self._leaves = []
         status = self.bt.tick_exactly_once() if self.exactly_once else self.bt.tick_once()
         return TickRecord(self._leaves, _NAME_OF[status])
+
+
+# -- the LEBT protocol in BehaviorTree.CPP -----------------------------------------------------
+class _TreeBlackboard:
+    """``state``/``event`` kept in the BehaviorTree.CPP tree's root blackboard."""
+
+    def __init__(self, bb: btpy.Blackboard) -> None:
+        self._bb = bb
+
+    @property
+    def state(self) -> str:
+        return self._bb.get_string(BB_STATE)
+
+    @state.setter
+    def state(self, value: str) -> None:
+        self._bb.set_string(BB_STATE, value)
+
+    @property
+    def event(self) -> str:
+        return self._bb.get_string(BB_EVENT)
+
+    @event.setter
+    def event(self, value: str) -> None:
+        self._bb.set_string(BB_EVENT, value)
+
+
+class BTCppLebtRunner:
+    """An LEBT in BehaviorTree.CPP: ``LebtGuard`` is a simple condition, ``LebtState`` a
+    stateful action (``onStart`` enters the state, ``onRunning`` watches the event); the
+    blackboard is the tree's; leaves find their spec by their name ``n<id>``."""
+
+    def __init__(self, doc: BTDocument | CompiledTree, *, start: str | None = None) -> None:
+        self.tree = doc if isinstance(doc, CompiledTree) else CompiledTree(doc)
+        self.leaves = LebtLeaves.of(self.tree, start)
+        self.actions: list[str] = []
+        self.last_result: str | None = None
+        factory = btpy.BehaviorTreeFactory()
+        factory.register_simple_condition(GUARD_TYPE, self._guard)
+        factory.register_simple_stateful_action(STATE_TYPE, self._start, self._running,
+                                                lambda node: None)
+
+        def writer(node: CompiledNode) -> tuple[str, dict[str, str]]:
+            return (GUARD_TYPE if node.id in self.leaves.guards else STATE_TYPE), {}
+
+        self.xml = compiled_to_xml(self.tree, writer)
+        self.bt = factory.create_tree_from_text(self.xml)
+        self.bb = _TreeBlackboard(self.bt.root_blackboard())
+        self.bb.state = self.leaves.start
+        self.bb.event = NO_EVENT
+
+    def _id(self, bt_node: btpy.TreeNode) -> int:
+        return int(bt_node.name()[1:])
+
+    def _guard(self, bt_node: btpy.TreeNode) -> btpy.NodeStatus:
+        return _STATUS[guard_outcome(self.leaves.guards[self._id(bt_node)], self.bb)]
+
+    def _start(self, bt_node: btpy.TreeNode) -> btpy.NodeStatus:
+        spec = self.leaves.states[self._id(bt_node)]
+        return _STATUS[state_on_start(spec, self.bb, self.actions)]
+
+    def _running(self, bt_node: btpy.TreeNode) -> btpy.NodeStatus:
+        return _STATUS[state_on_running(self.leaves.states[self._id(bt_node)], self.bb)]
+
+    def _tick(self) -> str:
+        self.last_result = _NAME_OF[self.bt.tick_once()]
+        return self.last_result
+
+    def initial(self) -> tuple[str, ...]:
+        self.actions = []
+        if self.leaves.init_on_start:
+            self._tick()
+        return tuple(self.actions)
+
+    def macro_step(self, event: str) -> tuple[str, ...]:
+        self.actions = []
+        drive_macro_step(self._tick, self.bb, event)
+        return tuple(self.actions)
+
+    @property
+    def terminated(self) -> bool:
+        return self.last_result == "SUCCESS" and self.bb.state != self.leaves.start
