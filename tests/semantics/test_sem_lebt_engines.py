@@ -122,3 +122,52 @@ def test_sem_lebt_paper_example_walkthrough() -> None:
         state, out = machine.step(state, event)
         assert out == (action,)
     assert machine.status(state) == FINAL
+
+
+def _random_fsm(rng: random.Random, index: int) -> FSM:
+    """2–12 states, self-loops and shared targets, maybe an initial event and finals."""
+    n = rng.randint(2, 12)
+    names = [f"S{i}" for i in range(n)]
+    events = [f"e{i}" for i in range(rng.randint(1, 4))]
+    edges: list[tuple[str, str, str]] = []
+    for i in range(1, n):  # keep every state reachable
+        edges.append((names[rng.randrange(i)], "", names[i]))
+    for _ in range(rng.randint(0, 2 * n)):
+        edges.append((rng.choice(names), "", rng.choice(names)))
+    used: set[tuple[str, str]] = set()
+    labelled = []
+    for source, _, target in edges:
+        free = [e for e in events + [f"x{len(used)}"] if (source, e) not in used]
+        event = rng.choice(free)
+        used.add((source, event))
+        labelled.append((source, event, target))
+    finals = " ".join(s for s in names[1:] if rng.random() < 0.2
+                      and all(src != s for src, _, _ in labelled))
+    return _fsm(f"random{index}", labelled, finals, initial="S0",
+                initial_event="start" if rng.random() < 0.5 else None)
+
+
+def test_sem_converter_lebts_run_alike_in_every_runtime() -> None:
+    """LEBTs from the project's converter (``fsmbt.convert.lebt``) on 30 random FSMs: the
+    interpreter, BehaviorTree.CPP and py_trees agree with the FSM on random event sequences."""
+    from fsmbt.convert.lebt import fsm_to_lebt
+
+    rng = random.Random(2024)
+    for index in range(30):
+        fsm = _random_fsm(rng, index)
+        doc = fsm_to_lebt(fsm).model
+        reference = FSMMachine(fsm)
+        ours = LEBTMachine(doc, reference.alphabet)
+        for _ in range(5):
+            f_state, f_out = reference.start()
+            o_state, o_out = ours.start()
+            btcpp, pytrees = BTCppLebtRunner(doc), PyTreesLebtRunner(doc)
+            assert f_out == o_out == btcpp.initial() == pytrees.initial()
+            for _ in range(12):
+                event = rng.choice(reference.alphabet)
+                f_state, f_out = reference.step(f_state, event)
+                o_state, o_out = ours.step(o_state, event)
+                assert f_out == o_out == btcpp.macro_step(event) == pytrees.macro_step(event), \
+                    (fsm.name, event)
+                assert (reference.status(f_state) == FINAL) == (ours.status(o_state) == FINAL) \
+                    == btcpp.terminated == pytrees.terminated, (fsm.name, event)
