@@ -746,7 +746,8 @@ class BTInterpreter:
         else:
             prev = frame[2]
             if result == SUCCESS:
-                count += 1
+                # with -1 the count is never read: keep it 0 so states stay finite
+                count = count + 1 if cycles != -1 else 0
                 do_loop = count < cycles or cycles == -1
                 self._reset_child(w, child, hook)
                 if prev == IDLE and do_loop:
@@ -785,7 +786,7 @@ class BTInterpreter:
                 self._reset_child(w, child, hook)
                 return ("ret", SUCCESS)
             if result == FAILURE:
-                count += 1
+                count = count + 1 if attempts != -1 else 0  # unread with -1: keep finite
                 do_loop = count < attempts or attempts == -1
                 self._reset_child(w, child, hook)
                 if prev == IDLE and do_loop:
