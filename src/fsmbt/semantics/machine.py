@@ -6,8 +6,8 @@ inputs. What counts as an input and an output depends on the pair (DESIGN ยง2, ย
 - FSM vs LEBT (macro steps): inputs are events; outputs are the actions run; status is
   ``"final"`` when the FSM is in a final state / the LEBT has terminated, else ``"running"``.
 - BT vs FSM (leaf execution): inputs are leaf outcomes ``success``/``failure``/``running``;
-  outputs name the next leaf ticked, or the root's result; status is ``"SUCCESS"``/``"FAILURE"``
-  when the root has returned, else ``"running"``.
+  outputs name the next leaf ticked, or the root's result (``"SUCCESS"``/``"FAILURE"``); status
+  is ``"final"`` once the root has returned, else ``"running"``.
 """
 
 from __future__ import annotations
