@@ -47,7 +47,7 @@ def run_nusmv(model: str, expected_specs: int, *, order: str | None = None,
         if keep:
             with open(keep, "w", encoding="utf-8") as handle:
                 handle.write(model)
-        command = [str(binary), "-coi"]
+        command = [str(binary)]  # no -coi: traces must keep last_in/tog
         if order:
             order_path = os.path.join(tmp, "product.ord")
             with open(order_path, "w", encoding="utf-8") as handle:
