@@ -35,3 +35,15 @@ def test_second_build_is_a_cached_no_op(nusmv_binary, monkeypatch):
 def test_env_var_pointing_nowhere_is_not_silently_replaced(monkeypatch, tmp_path):
     monkeypatch.setenv(ENV_VAR, str(tmp_path / "no-such-NuSMV"))
     assert find_nusmv() is None
+
+
+def test_doctor_reports_nusmv_and_fails_when_missing(nusmv_binary, monkeypatch, tmp_path):
+    from fsmbt.cli import main
+
+    assert main(["doctor"]) in (0, 1)  # other tools may be missing on a machine
+    from fsmbt.cli.cmd_doctor import checks
+
+    assert next(c for c in checks() if c.name == "NuSMV").ok
+    monkeypatch.setenv(ENV_VAR, str(tmp_path / "missing"))
+    assert not next(c for c in checks() if c.name == "NuSMV").ok
+    assert main(["doctor"]) == 1
