@@ -35,6 +35,7 @@ Complexity: ``O((|S| + |R|) · k · c + |P| · k)`` time and ``O(|S| + |R| + |P|
 
 from __future__ import annotations
 
+import gc
 import time
 from collections.abc import Hashable, Sequence
 from dataclasses import dataclass, field
@@ -450,6 +451,16 @@ def check(source: Machine, result: Machine, *, max_states: int = DEFAULT_MAX_STA
           mode: str = "lockstep") -> Report:
     """Compare two deterministic machines; the five properties, each with a shortest
     counterexample when it fails (see the module docstring and docs/verification.md)."""
+    collecting = gc.isenabled()
+    gc.disable()  # millions of small, acyclic objects: the cyclic GC would rescan them all
+    try:
+        return _check(source, result, max_states, mode)
+    finally:
+        if collecting:
+            gc.enable()
+
+
+def _check(source: Machine, result: Machine, max_states: int, mode: str) -> Report:
     started = time.perf_counter()
     outputs = _Interner()
     src = _Explored(source, outputs, max_states, "source")
