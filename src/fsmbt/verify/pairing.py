@@ -187,8 +187,8 @@ def _flat_events(*fsms: FSM) -> list[list[str]]:
     """Events of nested sub-machines too (a hierarchical FSM's top level does not list them)."""
     out = []
     for fsm in fsms:
-        for _path, machine, _state in fsm.walk():
-            out.append(machine.events())
+        for _path, _machine, state in fsm.walk():
+            out.extend(region.events() for region in state.regions)  # each sub-machine once
     return out
 
 
