@@ -15,6 +15,7 @@ Blackboard keys: ``state`` (starts at the start pseudo-state) and ``event`` (emp
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 GUARD_TYPE = "LebtGuard"
@@ -46,25 +47,65 @@ def split_escaped(text: str, separator: str) -> list[str]:
     return parts
 
 
+def unescape(text: str) -> str:
+    """Drop the backslash escapes of ``escape``."""
+    out: list[str] = []
+    chars = iter(text)
+    for ch in chars:
+        out.append(next(chars, "") if ch == "\\" else ch)
+    return "".join(out)
+
+
+def encode_pairs(pairs: Sequence[tuple[str, str]]) -> str:
+    """``a/b`` items joined by ``;``, names escaped: the port form of guard pairs and of the
+    baselines' transition tables."""
+    return ";".join(f"{escape(a)}/{escape(b)}" for a, b in pairs)
+
+
+def decode_pairs(text: str) -> list[tuple[str, str]]:
+    """The inverse of ``encode_pairs``; raises ``ValueError`` on a malformed item."""
+    if not text:
+        return []
+    pairs = []
+    for item in _split_keeping_escapes(text, ";"):
+        pieces = _split_keeping_escapes(item, "/")
+        if len(pieces) != 2:
+            raise ValueError(f"malformed pair {item!r}: expected 'a/b'")
+        pairs.append((unescape(pieces[0]), unescape(pieces[1])))
+    return pairs
+
+
+def _split_keeping_escapes(text: str, separator: str) -> list[str]:
+    """Split on unescaped ``separator``; the parts keep their escapes."""
+    parts: list[str] = []
+    current: list[str] = []
+    escaped = False
+    for ch in text:
+        if escaped:
+            current.append("\\" + ch)
+            escaped = False
+        elif ch == "\\":
+            escaped = True
+        elif ch == separator:
+            parts.append("".join(current))
+            current = []
+        else:
+            current.append(ch)
+    parts.append("".join(current))
+    return parts
+
+
 @dataclass(frozen=True)
 class GuardSpec:
     target: str
     pairs: tuple[tuple[str, str], ...]  # (source state, event); event "" = initialisation
 
     def to_attrs(self) -> dict[str, str]:
-        items = []
-        for source, event in self.pairs:
-            items.append(f"{_escape_item(source)}/{_escape_item(event)}")
-        return {"target": self.target, "pairs": ";".join(items)}
+        return {"target": self.target, "pairs": encode_pairs(self.pairs)}
 
     @classmethod
     def from_attrs(cls, attrs: dict[str, str]) -> GuardSpec:
-        pairs = []
-        raw = attrs.get("pairs", "")
-        for item in _split_top(raw, ";") if raw else []:
-            source, event = _split_pair(item)
-            pairs.append((source, event))
-        return cls(attrs.get("target", ""), tuple(pairs))
+        return cls(attrs.get("target", ""), tuple(decode_pairs(attrs.get("pairs", ""))))
 
     def matches(self, state: str, event: str) -> bool:
         return (state, event) in self.pairs
@@ -82,7 +123,7 @@ class StateSpec:
             "state": self.state,
             "action": self.action or "",
             "final": "true" if self.final else "false",
-            "exits": ";".join(_escape_item(e) for e in self.exits),
+            "exits": ";".join(escape(e) for e in self.exits),
         }
 
     @classmethod
@@ -91,32 +132,3 @@ class StateSpec:
         exits = tuple(split_escaped(raw, ";")) if raw else ()
         return cls(attrs.get("state", ""), attrs.get("action") or None,
                    attrs.get("final", "false").lower() == "true", exits)
-
-
-def _escape_item(text: str) -> str:
-    return escape(text)
-
-
-def _split_top(text: str, separator: str) -> list[str]:
-    """Split on unescaped separator, keeping escapes (items are unescaped later)."""
-    parts, current, escaped = [], [], False
-    for ch in text:
-        if escaped:
-            current.append("\\" + ch)
-            escaped = False
-        elif ch == "\\":
-            escaped = True
-        elif ch == separator:
-            parts.append("".join(current))
-            current = []
-        else:
-            current.append(ch)
-    parts.append("".join(current))
-    return parts
-
-
-def _split_pair(item: str) -> tuple[str, str]:
-    pieces = _split_top(item, "/")
-    if len(pieces) != 2:
-        raise ValueError(f"malformed LEBT guard pair {item!r}")
-    return split_escaped(pieces[0], "\x00")[0], split_escaped(pieces[1], "\x00")[0]

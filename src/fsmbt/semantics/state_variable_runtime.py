@@ -47,7 +47,7 @@ from fsmbt.semantics.bt_interpreter import (
     OUTCOME_FAILURE, OUTCOME_RUNNING, OUTCOME_SUCCESS, OUTCOME_TO_STATUS, STATUS_NAMES,
     BTInterpreter, CompiledTree, LeafRequest, Snapshot,
 )
-from fsmbt.semantics.lebt_spec import escape, split_escaped
+from fsmbt.semantics.lebt_spec import NO_EVENT, decode_pairs, encode_pairs
 from fsmbt.semantics.machine import FINAL, RUNNING, FSMMachine, Outputs
 
 IS_STATE, ENTRY_ACTION, TRANSITION = "SvIsState", "SvEntryAction", "SvTransition"
@@ -55,44 +55,20 @@ GUARD, ASSIGN, MODE = "SvGuard", "SvAssign", "SvMode"
 CONDITION_TYPES = frozenset({IS_STATE, GUARD})
 ACTION_TYPES = frozenset({ENTRY_ACTION, TRANSITION, ASSIGN, MODE})
 SV_TYPES = CONDITION_TYPES | ACTION_TYPES
-NO_EVENT = ""
 MAX_TICKS_PER_STEP = 8
 
 
 def encode_transitions(pairs: Sequence[tuple[str, str]]) -> str:
     """``event/target`` items joined by ``;`` (names escaped as in ``lebt_spec``)."""
-    return ";".join(f"{escape(event)}/{escape(target)}" for event, target in pairs)
+    return encode_pairs(pairs)
 
 
 def decode_transitions(text: str) -> dict[str, str]:
     """The inverse of ``encode_transitions`` as ``{event: target}`` (the first item wins)."""
     table: dict[str, str] = {}
-    if not text:
-        return table
-    for item in _split_keep_escapes(text, ";"):
-        pieces = _split_keep_escapes(item, "/")
-        if len(pieces) != 2:
-            raise ValueError(f"malformed transition item {item!r}")
-        event, target = (split_escaped(p, "\x00")[0] for p in pieces)
+    for event, target in decode_pairs(text):
         table.setdefault(event, target)
     return table
-
-
-def _split_keep_escapes(text: str, separator: str) -> list[str]:
-    parts, current, escaped = [], [], False
-    for ch in text:
-        if escaped:
-            current.append("\\" + ch)
-            escaped = False
-        elif ch == "\\":
-            escaped = True
-        elif ch == separator:
-            parts.append("".join(current))
-            current = []
-        else:
-            current.append(ch)
-    parts.append("".join(current))
-    return parts
 
 
 @dataclass(frozen=True)
