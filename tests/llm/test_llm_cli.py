@@ -86,15 +86,13 @@ def test_slow_endpoint_fails_within_the_timeout_via_flag(model_file: Path, monke
         start = time.monotonic()
         code = main(["llm", "convert", str(model_file), "--llm-base-url", server.base_url,
                      "--llm-model", "m", "--llm-timeout", "0.5"])
-        assert time.monotonic() - start < 2.0
+        # The server answers after 5 s: ending well before that shows the 0.5 s timeout cut it
+        # (the margin absorbs start-up time on a loaded 2-core machine).
+        assert time.monotonic() - start < 4.0
     assert code == 2 and "failed after" in capsys.readouterr().err
 
 
 def test_rules_engine_needs_no_llm(model_file: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    from importlib.util import find_spec
-
-    if find_spec("fsmbt.cli.cmd_convert") is None:
-        pytest.skip("fsmbt convert is not there yet")
     assert main(["convert", str(model_file)]) == 0
 
 

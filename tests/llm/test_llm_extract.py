@@ -124,7 +124,6 @@ def test_jpeg_is_recognised_by_its_bytes_not_its_name(tmp_path: Path) -> None:
 
 
 def test_hybrid_lets_the_llm_extract_and_the_rules_convert(tmp_path: Path) -> None:
-    pytest.importorskip("fsmbt.semantics.lebt_runtime")
     from fsmbt.convert.engines import converter_for
     from fsmbt.model.bt import BTDocument
 
