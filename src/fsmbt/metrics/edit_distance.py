@@ -16,8 +16,10 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass
 
-import networkx as nx
-import zss
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    import networkx as nx
 
 from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.flatten import flatten
@@ -52,6 +54,8 @@ def tree_edit_distance(a: BTDocument | BTNode, b: BTDocument | BTNode) -> Distan
         other = rb if ra is None else ra
         value = float(sum(1 for _ in other.walk())) if other is not None else 0.0
     else:
+        import zss  # heavy (numpy); only `fsmbt metrics A B` needs it
+
         value = float(zss.simple_distance(ra, rb, lambda n: n.children, _label))
     return Distance(value, True, "zss (Zhang-Shasha)", time.perf_counter() - began)
 
@@ -59,6 +63,8 @@ def tree_edit_distance(a: BTDocument | BTNode, b: BTDocument | BTNode) -> Distan
 def fsm_graph(fsm: FSM) -> nx.DiGraph:
     """The flattened FSM as a labelled digraph (see the module docstring)."""
     flat = flatten(fsm)
+    import networkx as nx
+
     graph = nx.DiGraph()
     graph.add_node(START_NODE, label=("start",))
     for state in flat.states.values():
@@ -75,6 +81,8 @@ def fsm_graph(fsm: FSM) -> nx.DiGraph:
 
 def graph_edit_distance(a: FSM, b: FSM, *, timeout: float = 5.0) -> Distance:
     """Graph edit distance of two FSMs, exact when the search ends within ``timeout``."""
+    import networkx as nx
+
     ga, gb = fsm_graph(a), fsm_graph(b)
     began = time.perf_counter()
     best: float | None = None

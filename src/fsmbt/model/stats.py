@@ -21,8 +21,6 @@ from collections import Counter, deque
 from dataclasses import asdict, dataclass, field
 from typing import Any
 
-import networkx as nx
-
 from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.bt_nodes import NodeKind
 from fsmbt.model.fsm import FSM
@@ -223,6 +221,8 @@ def expanded_depth(doc: BTDocument) -> int | None:
     main_id = _main_id(doc)
     if main_id is None:
         return None
+    import networkx as nx  # imported here: it costs ~0.4 s at CLI start-up
+
     graph = nx.DiGraph()
     graph.add_nodes_from(doc.trees)
     for tree_id, node in doc.nodes():

@@ -27,9 +27,10 @@ from __future__ import annotations
 from collections import deque
 from collections.abc import Hashable, Sequence
 from dataclasses import dataclass, field
-from typing import Generic, TypeVar
+from typing import TYPE_CHECKING, Generic, TypeVar
 
-import networkx as nx
+if TYPE_CHECKING:
+    import networkx as nx
 
 from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.errors import InputError
@@ -168,6 +169,8 @@ class ExploredMachine(Generic[S]):
     def to_networkx(self) -> nx.MultiDiGraph:
         """States as integers (BFS order) with ``status``/``name``; one edge per input, keyed
         by the input, carrying ``outputs``."""
+        import networkx as nx  # only tests and reports need the graph object
+
         index = {s: i for i, s in enumerate(self.states)}
         graph = nx.MultiDiGraph(start=index[self.start], start_outputs=self.start_outputs)
         for s, i in index.items():
