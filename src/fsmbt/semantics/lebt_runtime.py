@@ -134,6 +134,38 @@ def drive_macro_step(tick: Callable[[], str], bb: LebtBlackboard, event: str) ->
     return result
 
 
+class EngineLebtRun:
+    """The macro-step driver shared by the real-engine adapters (BehaviorTree.CPP, py_trees):
+    a subclass sets ``leaves`` and ``bb`` and implements ``_tick`` (one root tick, returning
+    the root's status name); actions run by state leaves are collected in ``actions``."""
+
+    leaves: LebtLeaves
+    bb: LebtBlackboard
+
+    def __init__(self) -> None:
+        self.actions: list[str] = []
+        self.last_result: str | None = None
+
+    def _tick(self) -> str:
+        raise NotImplementedError
+
+    def initial(self) -> tuple[str, ...]:
+        """What runs before any event: the initial state's action when no initial event."""
+        self.actions = []
+        if self.leaves.init_on_start:
+            self._tick()
+        return tuple(self.actions)
+
+    def macro_step(self, event: str) -> tuple[str, ...]:
+        self.actions = []
+        drive_macro_step(self._tick, self.bb, event)
+        return tuple(self.actions)
+
+    @property
+    def terminated(self) -> bool:
+        return self.last_result == "SUCCESS" and self.bb.state != self.leaves.start
+
+
 # -- the runtime -------------------------------------------------------------------------------
 @dataclass(frozen=True)
 class LebtState:

@@ -28,7 +28,7 @@ from fsmbt.semantics.bt_interpreter import (
     OUTCOME_TO_STATUS, STATUS_NAMES, CompiledNode, CompiledTree, Environment, TickRecord,
 )
 from fsmbt.semantics.lebt_runtime import (
-    LebtLeaves, drive_macro_step, guard_outcome, state_on_running, state_on_start,
+    EngineLebtRun, LebtLeaves, guard_outcome, state_on_running, state_on_start,
 )
 from fsmbt.semantics.lebt_spec import BB_EVENT, BB_STATE, GUARD_TYPE, NO_EVENT, STATE_TYPE
 
@@ -161,16 +161,15 @@ class _TreeBlackboard:
         self._bb.set_string(BB_EVENT, value)
 
 
-class BTCppLebtRunner:
+class BTCppLebtRunner(EngineLebtRun):
     """An LEBT in BehaviorTree.CPP: ``LebtGuard`` is a simple condition, ``LebtState`` a
     stateful action (``onStart`` enters the state, ``onRunning`` watches the event); the
     blackboard is the tree's; leaves find their spec by their name ``n<id>``."""
 
     def __init__(self, doc: BTDocument | CompiledTree, *, start: str | None = None) -> None:
         self.tree = doc if isinstance(doc, CompiledTree) else CompiledTree(doc)
+        super().__init__()
         self.leaves = LebtLeaves.of(self.tree, start)
-        self.actions: list[str] = []
-        self.last_result: str | None = None
         factory = btpy.BehaviorTreeFactory()
         factory.register_simple_condition(GUARD_TYPE, self._guard)
         factory.register_simple_stateful_action(STATE_TYPE, self._start, self._running,
@@ -201,18 +200,3 @@ class BTCppLebtRunner:
     def _tick(self) -> str:
         self.last_result = _NAME_OF[self.bt.tick_once()]
         return self.last_result
-
-    def initial(self) -> tuple[str, ...]:
-        self.actions = []
-        if self.leaves.init_on_start:
-            self._tick()
-        return tuple(self.actions)
-
-    def macro_step(self, event: str) -> tuple[str, ...]:
-        self.actions = []
-        drive_macro_step(self._tick, self.bb, event)
-        return tuple(self.actions)
-
-    @property
-    def terminated(self) -> bool:
-        return self.last_result == "SUCCESS" and self.bb.state != self.leaves.start

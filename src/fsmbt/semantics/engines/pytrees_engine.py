@@ -26,7 +26,7 @@ from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import UnsupportedError
 from fsmbt.semantics.bt_interpreter import CompiledNode, CompiledTree, Environment, TickRecord
 from fsmbt.semantics.lebt_runtime import (
-    LebtLeaves, PlainBlackboard, drive_macro_step, guard_outcome, state_on_running,
+    EngineLebtRun, LebtLeaves, PlainBlackboard, guard_outcome, state_on_running,
     state_on_start,
 )
 
@@ -118,17 +118,16 @@ class PyTreesRunner:
         return TickRecord(self._leaves, _NAME[self.root.status])
 
 
-class PyTreesLebtRunner:
+class PyTreesLebtRunner(EngineLebtRun):
     """An LEBT in py_trees: guard and state leaves are ``EnvLeaf`` s running the shared leaf
     behaviours; the state leaf's first tick is the tick that called ``initialise()``; the
     blackboard is a plain object held by the runner."""
 
     def __init__(self, doc: BTDocument | CompiledTree, *, start: str | None = None) -> None:
         self.tree = doc if isinstance(doc, CompiledTree) else CompiledTree(doc)
+        super().__init__()
         self.leaves = LebtLeaves.of(self.tree, start)
         self.bb = PlainBlackboard(self.leaves.start)
-        self.actions: list[str] = []
-        self.last_result: str | None = None
         self.root = build(self.tree, self._make_leaf)
 
     def _make_leaf(self, node: CompiledNode) -> py_trees.behaviour.Behaviour:
@@ -147,18 +146,3 @@ class PyTreesLebtRunner:
         self.root.tick_once()
         self.last_result = _NAME[self.root.status]
         return self.last_result
-
-    def initial(self) -> tuple[str, ...]:
-        self.actions = []
-        if self.leaves.init_on_start:
-            self._tick()
-        return tuple(self.actions)
-
-    def macro_step(self, event: str) -> tuple[str, ...]:
-        self.actions = []
-        drive_macro_step(self._tick, self.bb, event)
-        return tuple(self.actions)
-
-    @property
-    def terminated(self) -> bool:
-        return self.last_result == "SUCCESS" and self.bb.state != self.leaves.start
