@@ -27,7 +27,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Protocol
+from typing import TYPE_CHECKING, Any, Protocol
 
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.bt_nodes import NodeKind
@@ -40,6 +40,9 @@ from fsmbt.semantics.lebt_spec import (
     DEFAULT_START, GUARD_TYPE, NO_EVENT, STATE_TYPE, GuardSpec, StateSpec,
 )
 from fsmbt.semantics.machine import FINAL, RUNNING, Outputs
+
+if TYPE_CHECKING:
+    from fsmbt.semantics.lebt_fast import FastLEBTRuntime
 
 
 class LebtBlackboard(Protocol):
@@ -230,25 +233,41 @@ class LEBTRuntime:
 
 
 class LEBTMachine:
-    """``Machine`` of an LEBT's macro steps: inputs are events, outputs the actions run."""
+    """``Machine`` of an LEBT's macro steps: inputs are events, outputs the actions run.
+
+    A tree of the strict LEBT grammar (``lebt_fast.strict_lebt_sels``) runs on
+    ``lebt_fast.FastLEBTRuntime`` (O(1) per macro step for a deterministic LEBT instead of the
+    interpreter's O(root-level guards)); any other tree, or ``generic=True``, on the BT
+    interpreter (``LEBTRuntime``). ``fast`` says which one was taken.
+    """
 
     def __init__(self, doc: BTDocument | CompiledTree, alphabet: Sequence[str], *,
-                 start: str | None = None, name: str | None = None) -> None:
-        self.runtime = LEBTRuntime(doc, start=start)
+                 start: str | None = None, name: str | None = None,
+                 generic: bool = False) -> None:
+        from fsmbt.semantics.lebt_fast import FastLEBTRuntime, strict_lebt_sels
+
+        tree = doc if isinstance(doc, CompiledTree) else CompiledTree(doc)
+        body_state = None if generic else strict_lebt_sels(tree)
+        self.runtime: LEBTRuntime | FastLEBTRuntime
+        if body_state is None:
+            self.runtime = LEBTRuntime(tree, start=start)
+        else:
+            self.runtime = FastLEBTRuntime(tree, body_state, LebtLeaves.of(tree, start))
+        self.fast = body_state is not None
         self.alphabet = tuple(alphabet)
         self.name = name or self.runtime.tree.doc.main.id
 
-    def start(self) -> tuple[LebtState, Outputs]:
+    def start(self) -> tuple[Any, Outputs]:
         return self.runtime.initial()
 
-    def inputs(self, state: LebtState) -> Sequence[str]:
+    def inputs(self, state: Any) -> Sequence[str]:
         return self.alphabet
 
-    def step(self, state: LebtState, symbol: str) -> tuple[LebtState, Outputs]:
+    def step(self, state: Any, symbol: str) -> tuple[Any, Outputs]:
         return self.runtime.macro_step(state, symbol)
 
-    def status(self, state: LebtState) -> str:
+    def status(self, state: Any) -> str:
         return FINAL if self.runtime.terminated(state) else RUNNING
 
-    def describe(self, state: LebtState) -> str:
+    def describe(self, state: Any) -> str:
         return state.bb_state
