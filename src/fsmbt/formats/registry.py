@@ -210,6 +210,7 @@ def write_model(model: Model, path: str | Path, fmt: str | None = None, *,
     if path.exists() and not overwrite:
         raise InputError("exists; pass --force to overwrite it", location=SourceLocation(str(path)))
     try:
+        path.parent.mkdir(parents=True, exist_ok=True)
         path.write_text(text, encoding="utf-8")
     except OSError as exc:
         raise InputError(f"cannot write: {exc.strerror}", location=SourceLocation(str(path))) from None
