@@ -59,10 +59,10 @@ def product(src: Encoding, res: Encoding, inputs: Symbols,
     alone_s = any_of(f"(inp_s = {i} & s.offers_{i})" for i in in_ids)
     alone_r = any_of(f"(inp_r = {i} & r.offers_{i})" for i in in_ids)
     lines = ["MODULE main", "IVAR", f"  inp_s : {in_enum};", f"  inp_r : {in_enum};",
-             "  ctl : {step, detach, idle};", "VAR",
+             "  ctl : {step, alone_s, alone_r, idle};", "VAR",
              "  s : " + src.module + "(go_s, inp_s);",
              "  r : " + res.module + "(go_r, inp_eff_r);",
-             "  det : boolean;", "  s_obs : boolean;", "  r_obs : boolean;",
+             "  mode : {att, sa, ra};", "  s_obs : boolean;", "  r_obs : boolean;",
              "  s_run : boolean;", "  r_run : boolean;", "  s_st0 : boolean;",
              "  r_st0 : boolean;", f"  last_in : {last_enum};", "  tog : boolean;",
              "FROZENVAR"]
@@ -71,23 +71,25 @@ def product(src: Encoding, res: Encoding, inputs: Symbols,
             lines.append(f"  {prefix}_{var} : {typ};")
     lines += [
         "DEFINE",
+        "  det := mode != att;",
         "  both := s.stable & r.stable;",
         f"  agree := both & {equal_outs} & (s.final <-> r.final);",
         "  faithful := !det & agree;",
         f"  attached_go := !det & faithful & ctl = step & {joint};",
-        f"  go_s := attached_go | (det & s.stable & {alone_s});",
-        f"  go_r := attached_go | (det & r.stable & {alone_r});",
+        f"  go_s := attached_go | (mode = sa & s.stable & {alone_s});",
+        f"  go_r := attached_go | (mode = ra & r.stable & {alone_r});",
         "  inp_eff_r := case det : inp_r; TRUE : inp_s; esac;",
         "  s_out := " + any_of(f"{x} != {NONE_OUT}" for x in s_slots) + ";",
         "  r_out := " + any_of(f"{x} != {NONE_OUT}" for x in r_slots) + ";",
         "ASSIGN",
-        "  init(det) := FALSE;",
-        "  next(det) := case !det & both & ctl = detach : TRUE; TRUE : det; esac;",
+        "  init(mode) := att;",
+        "  next(mode) := case !det & both & ctl = alone_s : sa; "
+        "!det & both & ctl = alone_r : ra; TRUE : mode; esac;",
     ]
     for side in ("s", "r"):
         lines += [
             f"  init({side}_obs) := FALSE;",
-            f"  next({side}_obs) := case !det : FALSE; "
+            f"  next({side}_obs) := case mode != {side}a : FALSE; "
             f"{side}.stable & {side}_run & ({side}_out | ({side}.final xor {side}_st0)) : TRUE; "
             f"TRUE : {side}_obs; esac;",
             f"  init({side}_run) := FALSE;",
@@ -104,14 +106,14 @@ def product(src: Encoding, res: Encoding, inputs: Symbols,
     specs: list[tuple[str, str, str]] = []
     offers_s_in_r = all_of(f"(s.offers_{i} -> r.offers_{i})" for i in in_ids)
     offers_r_in_s = all_of(f"(r.offers_{i} -> s.offers_{i})" for i in in_ids)
-    dead_s = "(!s.final & !(EX (det & EF s_obs)))"
-    dead_r = "(!r.final & !(EX (det & EF r_obs)))"
+    dead_s = "(!s.final & !(EX (mode = sa & EF s_obs)))"
+    dead_r = "(!r.final & !(EX (mode = ra & EF r_obs)))"
     specs.append((DEADLOCK_ABSENCE, "SPEC", f"AG (faithful -> ({dead_s} <-> {dead_r}))"))
     same_s = all_of(f"s.{v} = ts_{v}" for v, _ in src.id_vars)
     same_r = all_of(f"r.{v} = tr_{v}" for v, _ in res.id_vars)
-    reach = f"((EF (det & s.stable & {same_s})) -> (EF (faithful & {same_s})))"
+    reach = f"((EF (mode = sa & s.stable & {same_s})) -> (EF (faithful & {same_s})))"
     if not follows:
-        reach += f" & ((EF (det & r.stable & {same_r})) -> (EF (faithful & {same_r})))"
+        reach += f" & ((EF (mode = ra & r.stable & {same_r})) -> (EF (faithful & {same_r})))"
     specs.append((REACHABILITY, "SPEC", reach))
     # invariants are checked by forward reachability: much cheaper than AG in CTL
     compl = f"((!det & both) -> {subsequence(s_slots, r_slots, NONE_OUT)})"
@@ -133,7 +135,7 @@ def product(src: Encoding, res: Encoding, inputs: Symbols,
 def _order(src: Encoding, res: Encoding) -> str:
     """A BDD variable order: each identity variable next to its frozen copy (the reachability
     spec compares them), inputs first. Without it NuSMV is 20x slower on small models."""
-    order = ["inp_s", "inp_r", "ctl", "det", "tog", "last_in", "s_obs", "r_obs", "s_run",
+    order = ["inp_s", "inp_r", "ctl", "mode", "tog", "last_in", "s_obs", "r_obs", "s_run",
              "r_run", "s_st0", "r_st0"]
     for side, copy, enc in (("s", "ts", src), ("r", "tr", res)):
         ids = {v for v, _ in enc.id_vars}
