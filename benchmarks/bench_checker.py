@@ -1,6 +1,11 @@
 """How long the native checker takes, and how it grows (issue 3, item 7). Prints a table.
 
     .venv/bin/python benchmarks/bench_checker.py [--sizes 10,30,100,1000,10000] [--repeat 3]
+        [--generic]
+
+``fsm~lebt`` runs the LEBT on the fast strict-grammar runtime (``lebt_fast``) when the tree has
+that shape (the family's name then reads ``fsm~lebt*``); ``--generic`` forces the generic BT
+interpreter path, to compare.
 
 Families (each pair is equivalent, so the whole product is explored):
 - ``fsm~fsm``: a random FSM of N states (a chain plus N/2 random extra edges, every transition
@@ -25,7 +30,8 @@ from collections.abc import Callable
 
 from fsmbt.model import FSM, BTDocument, BTNode, NodeKind, State
 from fsmbt.verify.native import check
-from fsmbt.verify.pairing import machines_for
+from fsmbt.semantics.lebt_runtime import LEBTMachine
+from fsmbt.verify.pairing import LEBTWithActiveInputs, machines_for
 
 Pair = tuple[object, object]
 
@@ -110,7 +116,22 @@ def _alarm(_signum, _frame):  # type: ignore[no-untyped-def]
     raise _Timeout
 
 
-def measure(pair: Pair, repeat: int, limit_s: int) -> tuple[float, dict] | None:
+def machines(pair: Pair, generic: bool):  # type: ignore[no-untyped-def]
+    """The checker's machines for ``pair``; ``generic`` puts an LEBT on the interpreter path."""
+    source, result, _mode = machines_for(pair[0], pair[1])  # type: ignore[arg-type]
+    if isinstance(result, LEBTWithActiveInputs) and generic:
+        result = LEBTWithActiveInputs(LEBTMachine(pair[1], result.alphabet,  # type: ignore[arg-type]
+                                                  generic=True))
+    return source, result
+
+
+def uses_fast_lebt(pair: Pair) -> bool:
+    _source, result = machines(pair, False)
+    return isinstance(result, LEBTWithActiveInputs) and result.machine.fast  # type: ignore[attr-defined]
+
+
+def measure(pair: Pair, repeat: int, limit_s: int,
+            generic: bool = False) -> tuple[float, dict] | None:
     best = float("inf")
     stats: dict = {}
     signal.signal(signal.SIGALRM, _alarm)
@@ -118,7 +139,7 @@ def measure(pair: Pair, repeat: int, limit_s: int) -> tuple[float, dict] | None:
         for attempt in range(repeat):
             if attempt and best > 1.0:
                 break  # long runs are measured once
-            source, result, _mode = machines_for(pair[0], pair[1])  # type: ignore[arg-type]
+            source, result = machines(pair, generic)
             signal.alarm(limit_s)
             started = time.perf_counter()
             report = check(source, result)
@@ -140,6 +161,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--sizes", default="10,30,100,1000,10000")
     parser.add_argument("--repeat", type=int, default=3, help="best of R runs (runs under 1 s)")
     parser.add_argument("--limit", type=int, default=120, help="seconds per check before giving up")
+    parser.add_argument("--generic", action="store_true",
+                        help="run LEBTs on the generic BT interpreter, not the fast runtime")
+    parser.add_argument("--families", default="", help="comma-separated subset of the families")
     args = parser.parse_args(argv)
     sizes = [int(s) for s in args.sizes.split(",")]
     sys.setrecursionlimit(10_000)
@@ -148,11 +172,16 @@ def main(argv: list[str] | None = None) -> int:
               f"{'x size':>7}")
     print(header)
     print("-" * len(header))
+    wanted = set(filter(None, args.families.split(",")))
     for family, make in family_pairs().items():
+        if wanted and family not in wanted:
+            continue
         previous: tuple[float, int] | None = None
         for n in sizes:
             pair = make(n)
-            measured = measure(pair, args.repeat, args.limit)
+            if uses_fast_lebt(pair) and not args.generic:
+                family = family.rstrip("*") + "*"
+            measured = measure(pair, args.repeat, args.limit, args.generic)
             if measured is None:
                 print(f"{family:<9} {n:>6}  over {args.limit} s, stopped")
                 break
@@ -165,6 +194,8 @@ def main(argv: list[str] | None = None) -> int:
                   f"{stats['explore_seconds'] * 1000:>9.2f} {stats['product_seconds'] * 1000:>8.2f} "
                   f"{seconds / product * 1e6:>9.1f} {ratio_t:>7} {ratio_s:>7}", flush=True)
             previous = (seconds, product)
+    if not args.generic:
+        print("* LEBT on the fast strict-grammar runtime (lebt_fast); --generic for the interpreter")
     return 0
 
 

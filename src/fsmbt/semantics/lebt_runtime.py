@@ -20,7 +20,9 @@ event pending so the initial state's leaf runs; otherwise ``start()`` ticks noth
 The same leaf functions (``guard_outcome``, ``state_on_start``, ``state_on_running``) are
 registered in BehaviorTree.CPP and py_trees by ``fsmbt.semantics.engines``; only the control
 flow around them differs between the interpreter and the engines, which is what the
-differential tests compare.
+differential tests compare. ``LEBTMachine`` runs a tree of the strict LEBT grammar on
+``fsmbt.semantics.lebt_fast`` (same leaf behaviours and macro step, no interpreter) and any
+other tree on the interpreter (``LEBTRuntime``).
 """
 
 from __future__ import annotations
