@@ -18,8 +18,14 @@ way: the root's result when a tick ends with one (``"SUCCESS"``/``"FAILURE"``, o
   e.g. ``KeepRunningUntilFailure`` over ``AlwaysSuccess``), the state is
   ``RootResult("LIVELOCK")`` with output ``("LIVELOCK",)``: the real engine hangs there.
 
+Fast path: a tree of only plain ``Sequence``/``Fallback`` nodes, transparent SubTrees and
+environment leaves (``leaf_fast.is_plain_tree``) runs on ``leaf_fast.PlainLeafTable`` instead:
+a state is then the ``int`` id of the leaf about to be ticked, one step is O(1), and the outputs,
+statuses and inputs are the interpreter's (tests/semantics/test_sem_leaf_fast.py checks them in
+lockstep). ``generic=True`` forces the interpreter; ``fast`` says which path was taken.
+
 Complexity: ``step`` costs the nodes ticked between two leaves plus a snapshot
-(O(k log k + depth)); ``explore`` is O(S · I) steps for S reachable states and I ≤ 3 inputs.
+(O(k log k + depth)) on the interpreter, O(1) on the fast path; ``explore`` is O(S · I) steps for S reachable states and I ≤ 3 inputs.
 """
 
 from __future__ import annotations
@@ -38,6 +44,7 @@ from fsmbt.semantics.bt_interpreter import (
     OUTCOME_FAILURE, OUTCOME_RUNNING, OUTCOME_SUCCESS, OUTCOME_TO_STATUS, RUNNING,
     STATUS_NAMES, BTInterpreter, BTLivelock, CompiledNode, CompiledTree, LeafRequest, Snapshot,
 )
+from fsmbt.semantics.leaf_fast import ROOT_RESULT_NAMES, PlainLeafTable, is_plain_tree
 from fsmbt.semantics.machine import FINAL, Machine, Outputs
 from fsmbt.semantics.machine import RUNNING as STATUS_RUNNING
 
@@ -63,28 +70,36 @@ class RootResult:
     result: str
 
 
-LeafState = Snapshot | RootResult
+#: Interpreter snapshot, terminal result, or (fast path) the id of the leaf about to be ticked.
+LeafState = Snapshot | RootResult | int
 
 
 class LeafMachine:
     """``Machine`` over leaf outcomes for a BT document (``fsmbt.semantics.machine``)."""
 
     def __init__(self, doc: BTDocument | CompiledTree, loop: bool = False, *,
-                 name: str | None = None) -> None:
+                 name: str | None = None, generic: bool = False) -> None:
         self.interp = BTInterpreter(doc)
         self.tree = self.interp.tree
         self.loop = loop
         main = self.tree.doc.main
         self.name = name or main.id
+        self.fast = not generic and is_plain_tree(self.tree)
+        self.table = PlainLeafTable(self.tree) if self.fast else None
 
     # -- Machine protocol --------------------------------------------------------------------
     def start(self) -> tuple[LeafState, Outputs]:
+        if self.table is not None:
+            leaf = self.table.start_leaf
+            return leaf, (self.table.labels[leaf],)
         outputs: list[str] = []
         snap = self.interp.begin_tick(self.interp.initial())
         state = self._run(snap, None, outputs)
         return state, tuple(outputs)
 
     def inputs(self, state: LeafState) -> Sequence[str]:
+        if self.table is not None and type(state) is int:
+            return CONDITION_INPUTS if self.table.is_condition[state] else ACTION_INPUTS
         node = self.leaf(state)
         if node is None:
             return ()
@@ -93,6 +108,8 @@ class LeafMachine:
     def step(self, state: LeafState, symbol: str) -> tuple[LeafState, Outputs]:
         if isinstance(state, RootResult):
             raise ValueError(f"the tree has returned {state.result}; no input is expected")
+        if self.table is not None:
+            return self._fast_step(state, symbol)  # type: ignore[arg-type]
         outcome = OUTCOME_TO_STATUS.get(symbol)
         node = self.leaf(state)
         if outcome is None or node is None or (node.is_condition and outcome == RUNNING):
@@ -116,8 +133,26 @@ class LeafMachine:
         """The leaf the state is about to tick (``None`` for a terminal state)."""
         if isinstance(state, RootResult):
             return None
+        if self.table is not None:
+            return self.tree.nodes[state]  # type: ignore[index]
         request = self.interp.leaf_request(state)
         return request.node if request is not None else None
+
+    def _fast_step(self, leaf: int, symbol: str) -> tuple[LeafState, Outputs]:
+        """``step`` on the fast path: O(1) table look-ups, the same loop rules as ``_run``."""
+        table = self.table
+        assert table is not None
+        if symbol == OUTCOME_RUNNING and table.is_condition[leaf] or \
+                symbol not in OUTCOME_TO_STATUS:
+            raise ValueError(f"input {symbol!r} is not allowed in state {self.describe(leaf)}")
+        target = table.after(leaf, symbol)
+        if target >= 0:
+            return target, (table.labels[target],)
+        result = ROOT_RESULT_NAMES[target]
+        if not self.loop:
+            return RootResult(result), (result,)
+        first = table.start_leaf
+        return first, (result, table.labels[first])
 
     def _run(self, snap: Snapshot, outcome: int | None, outputs: list[str]) -> LeafState:
         """Advance to the next leaf request, ticking the root again as the rules say."""

@@ -1,0 +1,158 @@
+"""The fast leaf-execution machine (``leaf_fast``) against the interpreter path of ``LeafMachine``.
+
+Differential: for plain Sequence/Fallback trees both paths must give the same outputs, statuses
+and inputs on random outcome walks (lockstep, with and without ``loop``), and the native checker
+must give the same verdict against the converted HFSM and against mutated HFSMs.
+"""
+
+from __future__ import annotations
+
+import random
+
+import pytest
+
+from fsmbt.convert.bt_to_hfsm import bt_to_hfsm
+from fsmbt.generate import random_bt
+from fsmbt.model.bt import BTDocument, BTNode
+from fsmbt.model.bt_nodes import NodeKind
+from fsmbt.semantics.leaf_machine import LeafMachine, RootResult
+from fsmbt.semantics.random_trees import random_tree
+from fsmbt.verify import native
+from fsmbt.verify.mutations import mutants
+from fsmbt.verify.pairing import machines_for
+from fsmbt.verify.report import REACHABILITY
+
+PLAIN_SEEDS = range(200)
+PLAIN_TREE_SEEDS = range(150)  # random_trees: Sequence/Fallback + SubTree, tiny trees
+WALK_STEPS = 80
+
+
+def plain_random_tree(seed: int) -> BTDocument:
+    return random_tree(random.Random(seed), controls=("Sequence", "Fallback"),
+                       decorators=("SubTree",), leaves=("Action", "Condition"))
+
+
+def plain_documents() -> list[BTDocument]:
+    docs = [random_bt(seed=seed, extended=False) for seed in PLAIN_SEEDS]
+    docs += [plain_random_tree(seed) for seed in PLAIN_TREE_SEEDS]
+    return docs
+
+
+def lockstep(doc: BTDocument, loop: bool, rng: random.Random) -> None:
+    fast = LeafMachine(doc, loop=loop)
+    slow = LeafMachine(doc, loop=loop, generic=True)
+    assert fast.fast and not slow.fast
+    fast_state, fast_out = fast.start()
+    slow_state, slow_out = slow.start()
+    assert fast_out == slow_out
+    for _ in range(WALK_STEPS):
+        assert fast.status(fast_state) == slow.status(slow_state)
+        assert fast.describe(fast_state) == slow.describe(slow_state)
+        inputs = tuple(fast.inputs(fast_state))
+        assert inputs == tuple(slow.inputs(slow_state))
+        if not inputs:  # terminal: both are RootResult; start over
+            assert isinstance(fast_state, RootResult) and fast_state == slow_state
+            fast_state, fast_out = fast.start()
+            slow_state, slow_out = slow.start()
+            assert fast_out == slow_out
+            continue
+        symbol = rng.choice(inputs)
+        fast_state, fast_out = fast.step(fast_state, symbol)
+        slow_state, slow_out = slow.step(slow_state, symbol)
+        assert fast_out == slow_out, (symbol, fast_out, slow_out)
+
+
+@pytest.mark.parametrize("loop", [False, True])
+def test_fast_and_generic_agree_in_lockstep(loop: bool) -> None:
+    rng = random.Random(1234 + loop)
+    docs = plain_documents()
+    assert len(docs) >= 300
+    for doc in docs:
+        lockstep(doc, loop, rng)
+
+
+#: Reachability speaks about *states* ("every source state is reached faithfully"), and the
+#: interpreter path splits one leaf into several snapshots (a running leaf, or one reached after
+#: different siblings finished, differs in node statuses) where the fast path has one state per
+#: leaf: a mutant that breaks one way into a leaf fails it on the generic path only. The overall
+#: verdict is trace-level (same inputs, outputs and statuses after every input sequence), so it,
+#: and the other four properties with their counterexamples, must be identical.
+STATE_LEVEL = REACHABILITY
+
+
+def _summary(report) -> dict:
+    """The verdict and each trace-level property's truth with its counterexample's trace."""
+    out: dict = {"equivalent": report.equivalent}
+    for name, prop in report.properties.items():
+        if name == STATE_LEVEL:
+            continue
+        trace = None
+        if prop.counterexample is not None:
+            trace = [(s.input, tuple(s.source_outputs), tuple(s.result_outputs), s.source_status,
+                      s.result_status) for s in prop.counterexample]
+        out[name] = (prop.holds, trace)
+    return out
+
+
+def _verdicts(doc: BTDocument, result, loop: bool) -> tuple[dict, dict]:
+    source, target, mode = machines_for(doc, result, loop=loop)
+    assert isinstance(source, LeafMachine) and source.fast
+    generic = LeafMachine(doc, loop=loop, generic=True)
+    return (_summary(native.check(source, target, mode="lockstep")),
+            _summary(native.check(generic, target, mode="lockstep")))
+
+
+@pytest.mark.parametrize("loop", [False, True])
+def test_checker_verdict_same_on_both_paths(loop: bool) -> None:
+    rng = random.Random(99 + loop)
+    checked = mutated_failures = 0
+    for seed in range(40):
+        doc = random_bt(seed=seed, extended=False, max_nodes=30)
+        hfsm = bt_to_hfsm(doc, loop=loop).model
+        fast, generic = _verdicts(doc, hfsm, loop)
+        assert fast == generic
+        assert fast["equivalent"]  # the converter is correct
+        for mutant in mutants(hfsm, seed=rng.randrange(1000), per_operator=1):
+            fast, generic = _verdicts(doc, mutant.model, loop)
+            assert fast == generic, mutant.description
+            mutated_failures += not fast["equivalent"]
+            checked += 1
+    assert checked >= 40 and mutated_failures > 0  # the mutants do catch something
+
+
+def _leaf(name: str, kind: NodeKind = NodeKind.ACTION) -> BTNode:
+    return BTNode("Act", kind, name=name)
+
+
+@pytest.mark.parametrize("root", [
+    BTNode("ReactiveSequence", NodeKind.CONTROL, children=[_leaf("a"), _leaf("b")]),
+    BTNode("SequenceWithMemory", NodeKind.CONTROL, children=[_leaf("a"), _leaf("b")]),
+    BTNode("Sequence", NodeKind.CONTROL, children=[
+        BTNode("Inverter", NodeKind.DECORATOR, children=[_leaf("a")]), _leaf("b")]),
+    BTNode("Fallback", NodeKind.CONTROL, children=[
+        _leaf("a"), BTNode("AlwaysSuccess", NodeKind.ACTION)]),
+    BTNode("Parallel", NodeKind.CONTROL, children=[_leaf("a"), _leaf("b")]),
+], ids=["reactive", "with-memory", "decorator", "always-success", "parallel"])
+def test_trees_outside_the_class_take_the_generic_path(root: BTNode) -> None:
+    assert not LeafMachine(BTDocument.single(root)).fast
+
+
+def test_plain_trees_take_the_fast_path() -> None:
+    assert LeafMachine(BTDocument.single(_leaf("only"))).fast
+    assert all(LeafMachine(doc).fast for doc in plain_documents()[::25])
+
+
+def test_deep_tree_builds_without_recursion() -> None:
+    """100 000 nested Sequences (alternating with Fallbacks): O(N) tables, no recursion."""
+    depth = 100_000
+    node = _leaf("bottom")
+    for i in range(depth):
+        node = BTNode("Sequence" if i % 2 else "Fallback", NodeKind.CONTROL,
+                      children=[node, _leaf(f"x{i}", NodeKind.CONDITION)])
+    machine = LeafMachine(BTDocument.single(node))
+    assert machine.fast
+    state, outputs = machine.start()
+    assert outputs == ("bottom",)
+    # bottom fails: its Fallback parent (i = 0) goes on to x0
+    state, outputs = machine.step(state, "failure")
+    assert outputs == ("x0",)
