@@ -196,6 +196,7 @@ def main(argv: list[str] | None = None) -> int:
             previous = (seconds, product)
     if not args.generic:
         print("* LEBT on the fast strict-grammar runtime (lebt_fast); --generic for the interpreter")
+    print("bt~hfsm: plain Sequence/Fallback trees run on the fast leaf machine (leaf_fast)")
     return 0
 
 
