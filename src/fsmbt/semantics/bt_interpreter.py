@@ -737,62 +737,39 @@ class BTInterpreter:
 
     def _t_repeat(self, w, node, frame, result, hook):
         """Repeat num_cycles (repeat_node.cpp); -1 repeats forever."""
-        (cycles,) = node.params
-        (count,) = self._mem(w, node)
-        child = node.children[0]
-        if frame[1] == 0:
-            w.st[node.id] = RUNNING
-            do_loop = count < cycles or cycles == -1
-        else:
-            prev = frame[2]
-            if result == SUCCESS:
-                # with -1 the count is never read: keep it 0 so states stay finite
-                count = count + 1 if cycles != -1 else 0
-                do_loop = count < cycles or cycles == -1
-                self._reset_child(w, child, hook)
-                if prev == IDLE and do_loop:
-                    w.wake = True
-                    self._set_mem(w, node, (count,))
-                    return ("ret", RUNNING)
-            elif result == FAILURE:
-                self._set_mem(w, node, (0,))
-                self._reset_child(w, child, hook)
-                return ("ret", FAILURE)
-            elif result == RUNNING:
-                return ("ret", RUNNING)
-            elif result == SKIPPED:
-                self._reset_child(w, child, hook)
-                return ("ret", SKIPPED)
-            else:
-                raise BTRuntimeError("a child returned IDLE", element=node.label)
-        if do_loop:
-            self._set_mem(w, node, (count,))
-            return ("call", child, (node.id, 1, w.st.get(child, IDLE)))
-        self._set_mem(w, node, (0,))
-        return ("ret", SUCCESS)
+        return self._loop_decorator(w, node, frame, result, hook, again_on=SUCCESS)
 
     def _t_retry(self, w, node, frame, result, hook):
         """RetryUntilSuccessful num_attempts (retry_node.cpp); -1 retries forever."""
-        (attempts,) = node.params
+        return self._loop_decorator(w, node, frame, result, hook, again_on=FAILURE)
+
+    def _loop_decorator(self, w, node, frame, result, hook, *, again_on):
+        """Repeat and RetryUntilSuccessful are mirror images in BehaviorTree.CPP: the child is
+        ticked again while it returns ``again_on``, at most ``node.params[0]`` times (-1: no
+        bound); the other result ends the loop at once. A loop that goes on in the same tick
+        after a synchronous child asks for a wake-up and returns RUNNING, as v4 does."""
+        (limit,) = node.params
         (count,) = self._mem(w, node)
         child = node.children[0]
+        stop_on = FAILURE if again_on == SUCCESS else SUCCESS
         if frame[1] == 0:
             w.st[node.id] = RUNNING
-            do_loop = count < attempts or attempts == -1
+            do_loop = count < limit or limit == -1
         else:
             prev = frame[2]
-            if result == SUCCESS:
-                self._set_mem(w, node, (0,))
-                self._reset_child(w, child, hook)
-                return ("ret", SUCCESS)
-            if result == FAILURE:
-                count = count + 1 if attempts != -1 else 0  # unread with -1: keep finite
-                do_loop = count < attempts or attempts == -1
+            if result == again_on:
+                # with -1 the count is never read: keep it 0 so states stay finite
+                count = count + 1 if limit != -1 else 0
+                do_loop = count < limit or limit == -1
                 self._reset_child(w, child, hook)
                 if prev == IDLE and do_loop:
                     w.wake = True
                     self._set_mem(w, node, (count,))
                     return ("ret", RUNNING)
+            elif result == stop_on:
+                self._set_mem(w, node, (0,))
+                self._reset_child(w, child, hook)
+                return ("ret", stop_on)
             elif result == RUNNING:
                 return ("ret", RUNNING)
             elif result == SKIPPED:
@@ -804,7 +781,7 @@ class BTInterpreter:
             self._set_mem(w, node, (count,))
             return ("call", child, (node.id, 1, w.st.get(child, IDLE)))
         self._set_mem(w, node, (0,))
-        return ("ret", FAILURE)
+        return ("ret", again_on)
 
     def _t_run_once(self, w, node, frame, result, hook):
         """RunOnce then_skip (run_once_node.h): memory survives halts."""
