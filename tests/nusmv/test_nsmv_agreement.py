@@ -160,3 +160,19 @@ def test_engines_agree_on_all_five_properties(nusmv_binary):
     assert not disagreements, disagreements[:5]
     assert agreed >= PAIRS
     assert failing_verdicts > 0  # the mutants really exercise failing properties
+
+
+def test_engines_agree_on_the_robot_example_and_a_mutant(nusmv_binary):
+    """The paper's robot BT and its HFSM (about 8 s of NuSMV), plus one wrong HFSM: the two
+    engines give the same five verdicts on both. The A-J LEBT (about 50 s) stays behind
+    FSMBT_NUSMV_EXAMPLES=1."""
+    from fsmbt.convert.bt_to_hfsm import bt_to_hfsm
+    from fsmbt.formats.registry import read_model
+
+    doc = read_model(REPO / "examples" / "robot_bt.xml")
+    hfsm = bt_to_hfsm(doc).model
+    wrong = next(m.model for m in mutants(hfsm, per_operator=1) if m.operator == "retarget_transition")
+    for result, expected in ((hfsm, True), (wrong, False)):
+        smv, native = check(doc, result), verify(doc, result)
+        assert smv.verdicts() == native.verdicts()
+        assert native.equivalent is expected
