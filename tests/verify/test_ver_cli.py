@@ -11,20 +11,9 @@ import fsmbt.verify as verify_module
 from fsmbt.cli import main
 from fsmbt.convert.lebt import fsm_to_lebt
 from fsmbt.formats import write_model
-from fsmbt.model import FSM
 from fsmbt.verify.report import PROPERTIES
 
-PAPER_EDGES = ["AB", "AC", "AD", "AF", "BC", "BD", "CD", "DE", "EC", "ED", "EG", "GH", "FI", "IJ"]
-
-
-def paper_fsm() -> FSM:
-    fsm = FSM(name="paper")
-    for name in "ABCDEFGHIJ":
-        fsm.add_state(name, final=name in "HJ")
-    fsm.start_name, fsm.initial_event, fsm.initial = "Start", "eventStartA", "A"
-    for a, b in PAPER_EDGES:
-        fsm.add_transition(a, f"event{a}{b}", b)
-    return fsm
+from ver_models import PAPER_EDGES, paper_fsm  # noqa: E402 (sibling test module)
 
 
 @pytest.fixture()

@@ -24,31 +24,10 @@ from fsmbt.verify import replay, verify
 from fsmbt.verify.mutations import mutants
 from fsmbt.verify.pairing import machines_for
 
-PAPER_EDGES = ["AB", "AC", "AD", "AF", "BC", "BD", "CD", "DE", "EC", "ED", "EG", "GH", "FI", "IJ"]
+from ver_models import PAPER_EDGES, paper_fsm, renamed_copy  # noqa: E402 (sibling test module)
+
 PAPER_STRUCTURE = [("A", [("B", []), ("F", [("I", [("J", [])])])]), ("C", []),
                    ("D", [("E", [("G", [("H", [])])])])]
-
-
-def paper_fsm() -> FSM:
-    fsm = FSM(name="paper")
-    for name in "ABCDEFGHIJ":
-        fsm.add_state(name, final=name in "HJ")
-    fsm.start_name, fsm.initial_event, fsm.initial = "Start", "eventStartA", "A"
-    for a, b in PAPER_EDGES:
-        fsm.add_transition(a, f"event{a}{b}", b)
-    return fsm
-
-
-def renamed_copy(fsm: FSM) -> FSM:
-    """Same behaviour, other state names and declaration order."""
-    out = FSM(name=f"{fsm.name}_renamed", start_name="Init", initial_event=fsm.initial_event)
-    for name in reversed(list(fsm.states)):
-        s = fsm.states[name]
-        out.add_state(State(f"r_{name}", action=s.action, final=s.final))
-    out.initial = f"r_{fsm.initial}"
-    for t in reversed(fsm.transitions):
-        out.add_transition(f"r_{t.source}", t.event, f"r_{t.target}")
-    return out
 
 
 def leaf(name: str, kind: NodeKind = NodeKind.ACTION) -> BTNode:

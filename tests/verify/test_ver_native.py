@@ -13,7 +13,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from fsmbt.model import FSM, InputError, State, flatten
-from fsmbt.semantics.machine import FINAL, RUNNING, FSMMachine
+from fsmbt.semantics.machine import FINAL, RUNNING
 from fsmbt.verify import replay
 from fsmbt.verify.native import check
 from fsmbt.verify.pairing import machines_for
@@ -26,17 +26,7 @@ from fsmbt.verify.report import (
     TERMINATION_CONSISTENCY,
 )
 
-PAPER_EDGES = ["AB", "AC", "AD", "AF", "BC", "BD", "CD", "DE", "EC", "ED", "EG", "GH", "FI", "IJ"]
-
-
-def paper_fsm() -> FSM:
-    fsm = FSM(name="paper")
-    for name in "ABCDEFGHIJ":
-        fsm.add_state(name, final=name in "HJ")
-    fsm.start_name, fsm.initial_event, fsm.initial = "Start", "eventStartA", "A"
-    for a, b in PAPER_EDGES:
-        fsm.add_transition(a, f"event{a}{b}", b)
-    return fsm
+from ver_models import PAPER_EDGES, paper_fsm  # noqa: E402 (sibling test module)
 
 
 def pair(source: FSM, result: FSM):
