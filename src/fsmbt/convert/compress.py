@@ -48,12 +48,7 @@ def inline_subtrees(doc: BTDocument) -> BTNode:
     Raises ``InputError`` naming the node for a missing tree and for a tree that (directly or
     not) includes itself. O(N) in the size of the expanded tree.
     """
-    if not doc.trees:
-        raise InputError("the document holds no behavior tree to convert (only node models?)")
-    main = doc.main
-    if main.root is None:
-        raise InputError("the behavior tree is empty", element=main.id)
-    root, chain = _resolve(doc, main.root, (main.id,))
+    root, chain = _resolved_main_root(doc)
     top = _shallow_copy(root)
     # (original node, its copy, chain of tree ids that led here)
     stack: list[tuple[BTNode, BTNode, tuple[str, ...]]] = [(root, top, chain)]
@@ -65,6 +60,17 @@ def inline_subtrees(doc: BTDocument) -> BTNode:
             copy.children.append(child_copy)
             stack.append((source, child_copy, child_chain))
     return top
+
+
+def _resolved_main_root(doc: BTDocument) -> tuple[BTNode, tuple[str, ...]]:
+    """The main tree's root with SubTree references at the top resolved, and the chain of
+    tree ids that led there; the errors every converter entry point gives."""
+    if not doc.trees:
+        raise InputError("the document holds no behavior tree to convert (only node models?)")
+    main = doc.main
+    if main.root is None:
+        raise InputError("the behavior tree is empty", element=main.id)
+    return _resolve(doc, main.root, (main.id,))
 
 
 def _resolve(doc: BTDocument, node: BTNode, chain: tuple[str, ...]) -> tuple[BTNode, tuple[str, ...]]:
@@ -132,12 +138,7 @@ def inline_and_compress(doc: BTDocument) -> Prepared:
     level of every node is carried along (a ``SubTree`` reference takes no level, as in
     ``inline_subtrees``). O(N) time for N nodes of the expanded tree, explicit stacks only.
     """
-    if not doc.trees:
-        raise InputError("the document holds no behavior tree to convert (only node models?)")
-    main = doc.main
-    if main.root is None:
-        raise InputError("the behavior tree is empty", element=main.id)
-    root, chain = _resolve(doc, main.root, (main.id,))
+    root, chain = _resolved_main_root(doc)
     top = _shallow_copy(root)
     depth_before = depth_after = 1
     merged = 0

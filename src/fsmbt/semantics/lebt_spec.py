@@ -32,19 +32,7 @@ def escape(text: str) -> str:
 
 def split_escaped(text: str, separator: str) -> list[str]:
     """Split on unescaped ``separator`` and unescape the parts."""
-    parts: list[str] = []
-    current: list[str] = []
-    chars = iter(text)
-    for ch in chars:
-        if ch == "\\":
-            current.append(next(chars, ""))
-        elif ch == separator:
-            parts.append("".join(current))
-            current = []
-        else:
-            current.append(ch)
-    parts.append("".join(current))
-    return parts
+    return [unescape(part) for part in _split_keeping_escapes(text, separator)]
 
 
 def unescape(text: str) -> str:
