@@ -47,7 +47,7 @@ def run_nusmv(model: str, expected_specs: int, *, order: str | None = None,
         if keep:
             with open(keep, "w", encoding="utf-8") as handle:
                 handle.write(model)
-        # no -coi: traces must keep last_in/tog. -mono: one monolithic transition relation;
+        # -mono: one monolithic transition relation;
         # the partitioned (IWLS95) default is ~10x slower on these micro-step products.
         command = [str(binary), "-mono"]
         if order:
@@ -71,10 +71,12 @@ def run_nusmv(model: str, expected_specs: int, *, order: str | None = None,
 
 
 def parse_output(text: str) -> list[SpecResult]:
-    """Spec verdicts and counterexample traces from NuSMV's standard output."""
+    """Spec verdicts and counterexample traces from NuSMV's standard output. NuSMV prints only
+    the values that changed, for states and inputs alike: both are carried forward, so every
+    ``TraceState`` holds full valuations (inputs: those of the transition into the state)."""
     results: list[SpecResult] = []
     current: list[TraceState] | None = None
-    pending_inputs: dict[str, str] = {}
+    inputs: dict[str, str] = {}
     in_input = False
     for line in text.splitlines():
         match = _SPEC.match(line)
@@ -85,14 +87,13 @@ def parse_output(text: str) -> list[SpecResult]:
         if results and not results[-1].holds and line.startswith("Trace Type:"):
             current = []
             results[-1].trace = current
-            pending_inputs = {}
+            inputs = {}
             continue
         if current is None:
             continue
         if _STATE.match(line):
             base = dict(current[-1].values) if current else {}
-            current.append(TraceState(base, pending_inputs))
-            pending_inputs = {}
+            current.append(TraceState(base, dict(inputs) if current else {}))
             in_input = False
             continue
         if _INPUT.match(line):
@@ -104,7 +105,7 @@ def parse_output(text: str) -> list[SpecResult]:
         if assign:
             name, value = assign.groups()
             if in_input:
-                pending_inputs[name] = value
+                inputs[name] = value
             elif current:
                 current[-1].values[name] = value
     return results

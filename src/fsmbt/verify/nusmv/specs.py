@@ -47,7 +47,6 @@ def product(src: Encoding, res: Encoding, inputs: Symbols,
     """The ``main`` module and the specs, in the order ``spec_names`` lists them."""
     in_ids = list(inputs.to_id.values())
     in_enum = "{" + ", ".join(in_ids) + "}"
-    last_enum = "{" + ", ".join(["in_none"] + in_ids) + "}"
     follows = res.follows
     s_slots = [f"s.{x}" for x in src.slots]
     r_slots = [f"r.{x}" for x in res.slots]
@@ -64,7 +63,7 @@ def product(src: Encoding, res: Encoding, inputs: Symbols,
              "  r : " + res.module + "(go_r, inp_eff_r);",
              "  mode : {att, sa, ra};", "  s_obs : boolean;", "  r_obs : boolean;",
              "  s_run : boolean;", "  r_run : boolean;", "  s_st0 : boolean;",
-             "  r_st0 : boolean;", f"  last_in : {last_enum};", "  tog : boolean;",
+             "  r_st0 : boolean;",
              "FROZENVAR"]
     for prefix, enc in (("ts", src), ("tr", res)):
         for var, typ in enc.id_vars:
@@ -98,10 +97,6 @@ def product(src: Encoding, res: Encoding, inputs: Symbols,
             f"  init({side}_st0) := FALSE;",
             f"  next({side}_st0) := case go_{side} : {side}.final; TRUE : {side}_st0; esac;",
         ]
-    lines += ["  init(last_in) := in_none;",
-              "  next(last_in) := case attached_go : inp_s; TRUE : last_in; esac;",
-              "  init(tog) := FALSE;",
-              "  next(tog) := case attached_go : !tog; TRUE : tog; esac;"]
     # CTL specs first, invariants after: NuSMV checks (and prints) them in that order.
     specs: list[tuple[str, str, str]] = []
     offers_s_in_r = all_of(f"(s.offers_{i} -> r.offers_{i})" for i in in_ids)
@@ -135,7 +130,7 @@ def product(src: Encoding, res: Encoding, inputs: Symbols,
 def _order(src: Encoding, res: Encoding) -> str:
     """A BDD variable order: each identity variable next to its frozen copy (the reachability
     spec compares them), inputs first. Without it NuSMV is 20x slower on small models."""
-    order = ["inp_s", "inp_r", "ctl", "mode", "tog", "last_in", "s_obs", "r_obs", "s_run",
+    order = ["inp_s", "inp_r", "ctl", "mode", "s_obs", "r_obs", "s_run",
              "r_run", "s_st0", "r_st0"]
     for side, copy, enc in (("s", "ts", src), ("r", "tr", res)):
         ids = {v for v, _ in enc.id_vars}

@@ -30,31 +30,43 @@ def _side(values: dict[str, str], prefix: str) -> dict[str, str]:
     return {k[cut:]: v for k, v in values.items() if k.startswith(prefix + ".")}
 
 
+def _attached_go(before: dict[str, str], inputs: dict[str, str], follows: bool) -> bool:
+    """The product's ``attached_go`` on a transition (NuSMV does not print defines over both
+    state and input variables, so it is evaluated here from the state before and the input)."""
+    symbol = inputs.get("inp_s")
+    if before.get("faithful") != "TRUE" or inputs.get("ctl") != "step" or symbol is None:
+        return False
+    return before.get(f"s.offers_{symbol}") == "TRUE" and (
+        follows or before.get(f"r.offers_{symbol}") == "TRUE")
+
+
 def decode_trace(trace: list[TraceState], context) -> list[TraceStep]:
+    """One step per attached input: a transition taken with ``attached_go`` starts it, the
+    next state where both machines are stable ends it (a BT module needs micro-steps)."""
     src, res, _src_enc, _res_enc, inputs, outputs, _mode, _order = context
     steps: list[TraceStep] = []
-    last_tog: str | None = None
+    pending: str | None = None
+    before: dict[str, str] = {}
     for state in trace:
-        v = state.values
+        if _attached_go(before, state.inputs, res.follows):
+            pending = inputs.name(state.inputs["inp_s"]) or "?"
+        v = before = state.values
         if v.get("det") == "TRUE":
             break
-        if v.get("both") != "TRUE":
-            continue
-        if last_tog is not None and v.get("tog") == last_tog:
-            continue  # an idle step: nothing happened
+        if v.get("both") != "TRUE" or (steps and pending is None):
+            continue  # micro-steps, or an idle step: nothing happened
         s_vals, r_vals = _side(v, "s"), _side(v, "r")
-        symbol = None if last_tog is None else inputs.name(v.get("last_in", ""))
-        last_tog = v.get("tog")
 
         def outs(vals: dict[str, str], enc) -> list[str]:
             return [outputs.name(vals[slot]) or vals[slot] for slot in enc.slots
                     if vals.get(slot, NONE_OUT) != NONE_OUT]
 
         steps.append(TraceStep(
-            len(steps), symbol, outs(s_vals, src), outs(r_vals, res),
+            len(steps), pending if steps else None, outs(s_vals, src), outs(r_vals, res),
             src.decode_state(s_vals), res.decode_state(r_vals),
             "final" if s_vals.get("final") == "TRUE" else "running",
             "final" if r_vals.get("final") == "TRUE" else "running"))
+        pending = None
     return steps
 
 
