@@ -14,63 +14,16 @@ from dataclasses import dataclass, field
 
 import pytest
 
-from fsmbt.convert.bt_to_hfsm import bt_to_hfsm
-from fsmbt.convert.lebt import fsm_to_lebt
-from fsmbt.generate.generator import random_bt, random_fsm
-from fsmbt.model import FSM, BTDocument, BTNode, NodeKind, State
-from fsmbt.semantics.leaf_machine import LeafMachine
-from fsmbt.semantics.random_trees import lebt_from_structure
 from fsmbt.verify import replay, verify
 from fsmbt.verify.mutations import mutants
 from fsmbt.verify.pairing import machines_for
 
-from ver_models import PAPER_EDGES, paper_fsm, renamed_copy  # noqa: E402 (sibling test module)
-
-PAPER_STRUCTURE = [("A", [("B", []), ("F", [("I", [("J", [])])])]), ("C", []),
-                   ("D", [("E", [("G", [("H", [])])])])]
-
-
-def leaf(name: str, kind: NodeKind = NodeKind.ACTION) -> BTNode:
-    return BTNode("Act" if kind is NodeKind.ACTION else "Check", kind, name=name)
-
-
-def small_bt_and_leaf_fsm() -> tuple[BTDocument, FSM]:
-    """Sequence(c1?, Fallback(a1, a2)) and its leaf FSM, derived by hand."""
-    root = BTNode("Sequence", NodeKind.CONTROL, children=[
-        leaf("c1", NodeKind.CONDITION),
-        BTNode("Fallback", NodeKind.CONTROL, children=[leaf("a1"), leaf("a2")])])
-    fsm = FSM(name="leaf_fsm")
-    for name in ("c1", "a1", "a2"):
-        fsm.add_state(name)
-    fsm.add_state(State("S", action="SUCCESS", final=True))
-    fsm.add_state(State("F", action="FAILURE", final=True))
-    for a, e, b in [("c1", "success", "a1"), ("c1", "failure", "F"), ("a1", "success", "S"),
-                    ("a1", "failure", "a2"), ("a1", "running", "a1"), ("a2", "success", "S"),
-                    ("a2", "failure", "F"), ("a2", "running", "a2")]:
-        fsm.add_transition(a, e, b)
-    return BTDocument.single(root), fsm
-
-
-def leaf_fsm_by_exploration(doc: BTDocument) -> FSM:
-    """The BT's leaf-execution machine written out as an FSM (one state per machine state)."""
-    machine = LeafMachine(doc)
-    start, outputs = machine.start()
-    names: dict[object, str] = {}
-    fsm = FSM(name="explored")
-    queue = [(start, outputs)]
-    names[start] = "q0"
-    fsm.add_state(State("q0", action=outputs[-1], final=machine.status(start) != "running"))
-    while queue:
-        state, _ = queue.pop(0)
-        for symbol in machine.inputs(state):
-            nxt, outs = machine.step(state, symbol)
-            if nxt not in names:
-                names[nxt] = f"q{len(names)}"
-                fsm.add_state(State(names[nxt], action=outs[-1],
-                                    final=machine.status(nxt) != "running"))
-                queue.append((nxt, outs))
-            fsm.add_transition(names[state], symbol, names[nxt])
-    return fsm
+# the families live in a sibling module shared with the NuSMV agreement test (tests/nusmv)
+from mutation_families import (  # noqa: E402 (sibling test modules)
+    bt_pairs, converted_bt_pairs, fsm_pairs, leaf_fsm_by_exploration, lebt_pairs,
+    small_bt_and_leaf_fsm,
+)
+from ver_models import PAPER_EDGES, paper_fsm  # noqa: E402
 
 
 # -- independent random simulation ----------------------------------------------------------------
@@ -152,27 +105,11 @@ def run_family(pairs, mutate: str, family: str) -> Tally:
     return tally
 
 
-# -- the families ---------------------------------------------------------------------------------
-def fsm_pairs() -> list[tuple[FSM, FSM]]:
-    pairs = [(paper_fsm(), renamed_copy(paper_fsm()))]
-    for seed in range(4):
-        fsm = random_fsm(f"mut:{seed}", min_states=4, max_states=9)
-        pairs.append((fsm, renamed_copy(fsm)))
-    return pairs
-
-
+# -- the families (tests/verify/mutation_families.py) ----------------------------------------------
 def test_fsm_vs_fsm_mutants_are_caught():
     tally = run_family(fsm_pairs(), "result", "FSM vs FSM")
     assert {"retarget_transition", "drop_transition", "change_action", "flip_final"} <= set(
         tally.by_operator)
-
-
-def lebt_pairs() -> list[tuple[FSM, BTDocument]]:
-    pairs = [(paper_fsm(), lebt_from_structure(paper_fsm(), PAPER_STRUCTURE))]
-    for seed in range(3):
-        fsm = random_fsm(f"lebt:{seed}", min_states=4, max_states=8)
-        pairs.append((fsm, fsm_to_lebt(fsm).model))
-    return pairs
 
 
 def test_fsm_vs_lebt_mutants_are_caught():
@@ -206,14 +143,6 @@ def test_lebt_active_inputs_are_sound_and_change_no_verdict():
     assert checked > 0
 
 
-def bt_pairs() -> list[tuple[BTDocument, FSM]]:
-    pairs = [small_bt_and_leaf_fsm()]
-    for seed in range(4):
-        doc = random_bt(f"mutbt:{seed}", depth=3, breadth=3, max_nodes=14)
-        pairs.append((doc, leaf_fsm_by_exploration(doc)))
-    return pairs
-
-
 def test_bt_source_mutants_are_caught():
     tally = run_family(bt_pairs(), "source", "mutated BT vs leaf FSM")
     assert {"swap_children", "sequence_to_fallback", "invert_condition", "drop_leaf",
@@ -224,14 +153,6 @@ def test_leaf_fsm_mutants_are_caught():
     tally = run_family(bt_pairs(), "result", "BT vs mutated leaf FSM")
     assert {"retarget_transition", "drop_transition", "change_action", "flip_final"} <= set(
         tally.by_operator)
-
-
-def converted_bt_pairs() -> list[tuple[BTDocument, FSM]]:
-    pairs = []
-    for seed in range(2):
-        doc = random_bt(f"conv:{seed}", depth=4, breadth=3, max_nodes=16)
-        pairs.append((doc, bt_to_hfsm(doc).model))
-    return pairs
 
 
 def test_converted_hfsm_pairs_mutated_on_either_side_are_caught():
