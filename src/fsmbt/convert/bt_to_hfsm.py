@@ -44,7 +44,7 @@ from fsmbt.convert.engines import ConversionResult
 from fsmbt.convert.perf import without_gc_pauses
 from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.bt_nodes import NodeKind
-from fsmbt.model.errors import InputError
+from fsmbt.model.errors import InputError, UnsupportedError
 from fsmbt.model.fsm import FSM, State
 
 SUCCESS, FAILURE, RUNNING = "SUCCESS", "FAILURE", "RUNNING"
@@ -239,9 +239,33 @@ def explore_region(node: BTNode, *, loop: bool = False, top: bool = False) -> tu
     for state in explored.states:
         source = names[state]
         for symbol, (target, outputs) in explored.transitions[state].items():
-            fsm.add_transition(source, symbol, state_for(target, outputs))
+            if loop and top and len(outputs) == 2:
+                name = _looped_result(fsm, explored, target, outputs, ends, node)
+            else:
+                name = state_for(target, outputs)
+                if top and outputs != (fsm.states[name].action,):  # never drop an output
+                    raise UnsupportedError(f"cannot express the outputs {outputs} of one step "
+                                           "as one state's action", element=node.label)
+            fsm.add_transition(source, symbol, name)
     fsm.initial = names[explored.start]
     return fsm, ends
+
+
+def _looped_result(fsm: FSM, explored, target: object, outputs: tuple[str, ...],
+                   ends: set[str], node: BTNode) -> str:
+    """With ``loop`` a step can end the tick and start the next one: outputs ``(result,
+    first leaf)``. An FSM read as a leaf machine with ``loop`` says exactly that on entering a
+    final state named after the result (its action, then the initial state's), provided the
+    new tick is back in the start configuration; anything else cannot be expressed."""
+    result, leaf = outputs
+    start_action = fsm.states[fsm.initial].action if fsm.initial else None
+    if target != explored.start or result not in ("SUCCESS", "FAILURE") or leaf != start_action:
+        raise UnsupportedError(f"cannot express the outputs {outputs} of one step as one "
+                               "state's action", element=node.label)
+    if result not in fsm.states:
+        fsm.add_state(State(result, action=result, final=True))
+    ends.add(result)
+    return result
 
 
 @without_gc_pauses

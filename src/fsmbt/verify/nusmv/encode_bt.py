@@ -326,6 +326,15 @@ class LeafBTEncoder:
             outputs.id(leaf.label)
         outputs.add_all(("SUCCESS", "FAILURE"))
 
+    def _identity(self) -> list[str]:
+        """The variables that make up a state, as the native leaf machine keys it: for a plain
+        Sequence/Fallback tree (``leaf_fast``) only the leaf about to be ticked (``cur``; a
+        leaf ticked again after ``running`` is the same state there), else every variable
+        (the interpreter's snapshot)."""
+        from fsmbt.semantics.leaf_fast import is_plain_tree
+
+        return ["cur"] if is_plain_tree(self.core.tree) else self.core.identity_vars()
+
     def encode(self):
         from fsmbt.verify.nusmv.encode_fsm import NONE_OUT, Encoding
 
@@ -380,7 +389,7 @@ class LeafBTEncoder:
                 value = "FALSE"
             defines.append((f"offers_{sid}", value))
         text = core.emit(self.module, "go, inp", defines)
-        ident = [(v, safe_text(core.var_types[v])) for v in core.identity_vars()]
+        ident = [(v, safe_text(core.var_types[v])) for v in self._identity()]
         return Encoding(self.module, text, ["o1", "o2"], list(outcome), ident,
                         decode_state=lambda values: describe_bt(core, values),
                         var_order=list(core.var_types))

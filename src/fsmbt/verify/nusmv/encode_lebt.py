@@ -66,6 +66,23 @@ class LebtEncoder:
             return "ev_none"
         return self.events.to_id.get(event)  # an event outside the alphabet never occurs
 
+    def _running_leaf(self) -> tuple[str, str] | None:
+        """For a tree of the strict LEBT grammar, its state between macro steps as the native
+        fast path keys it: the running state leaf (``runl``), with ``bbs`` and ``lres``. Every
+        other status, index and frame local follows from that leaf's position there
+        (``fsmbt.semantics.lebt_fast``), so comparing these three compares the same states as
+        comparing all variables, with a frozen copy of 3 variables instead of ~3 per node
+        (the reachability spec's cost). ``None`` for any other tree: all variables count."""
+        from fsmbt.semantics.lebt_fast import strict_lebt_sels
+
+        if strict_lebt_sels(self.core.tree) is None:
+            return None
+        core = self.core
+        leaves = sorted(self.leaves.states)
+        rows = [(f"{core.st(nid)} = R", f"rl_{nid}") for nid in leaves]
+        return (case(rows, "rl_none"),
+                "{" + ", ".join(["rl_none"] + [f"rl_{nid}" for nid in leaves]) + "}")
+
     def encode(self) -> Encoding:
         core, k = self.core, self.slots
         init_cur = core.n(0) if self.leaves.init_on_start else "TOP"
@@ -138,9 +155,14 @@ class LebtEncoder:
         defines += [(f"o{j}", f"a{j}") for j in range(1, k + 1)]
         for symbol, sid in sorted(self.inputs.to_id.items()):
             defines.append((f"offers_{sid}", "TRUE" if symbol in self.alphabet else "FALSE"))
+        ident = [("bbs", extra_vars["bbs"]), ("lres", extra_vars["lres"])]
+        running = self._running_leaf()
+        if running is None:
+            ident += [(v, safe_text(core.var_types[v])) for v in core.identity_vars()]
+        else:
+            defines.append(("runl", running[0]))
+            ident.append(("runl", running[1]))
         text = core.emit(self.module, "go, inp", defines)
-        ident = [(v, safe_text(core.var_types[v])) for v in core.identity_vars()]
-        ident += [("bbs", extra_vars["bbs"]), ("lres", extra_vars["lres"])]
         names = self.states.to_name
         return Encoding(self.module, text, [f"o{j}" for j in range(1, k + 1)],
                         list(self.alphabet), ident,

@@ -33,11 +33,20 @@ class Symbols:
             self.id(name)
 
     def enum(self, extra: Sequence[str] = ()) -> str:
-        values = list(extra) + list(self.to_id.values())
-        return "{" + ", ".join(values) + "}"
+        """The SMV enumeration type; padded to two values when it would have one (NuSMV turns
+        a single-value variable into a constant, and then rejects its ``init``/``next``)."""
+        return enum_type(list(extra) + list(self.to_id.values()), f"{self.prefix}pad")
 
     def name(self, smv_id: str) -> str | None:
         return self.to_name.get(smv_id)
+
+
+def enum_type(values: Sequence[str], pad: str) -> str:
+    """``{v1, v2, ...}``, with ``pad`` added when fewer than two values (see ``Symbols.enum``)."""
+    values = list(values)
+    if len(values) < 2:
+        values.append(pad)
+    return "{" + ", ".join(values) + "}"
 
 
 def case(rows: Sequence[tuple[str, str]], default: str) -> str:

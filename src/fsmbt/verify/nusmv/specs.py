@@ -26,7 +26,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from fsmbt.verify.nusmv.encode_fsm import NONE_OUT, Encoding
-from fsmbt.verify.nusmv.smv import Symbols, all_of, any_of, subsequence
+from fsmbt.verify.nusmv.smv import Symbols, all_of, any_of, enum_type, subsequence
 from fsmbt.verify.report import (
     COMPLETENESS, DEADLOCK_ABSENCE, NO_ADDITIONAL_BEHAVIOR, REACHABILITY,
     TERMINATION_CONSISTENCY,
@@ -46,7 +46,7 @@ def product(src: Encoding, res: Encoding, inputs: Symbols,
             extra_specs: list[tuple[str, str]] | None = None) -> Product:
     """The ``main`` module and the specs, in the order ``spec_names`` lists them."""
     in_ids = list(inputs.to_id.values())
-    in_enum = "{" + ", ".join(in_ids) + "}"
+    in_enum = enum_type(in_ids, "in_pad")  # never offered: no machine defines offers_in_pad
     follows = res.follows
     s_slots = [f"s.{x}" for x in src.slots]
     r_slots = [f"r.{x}" for x in res.slots]
@@ -138,4 +138,5 @@ def _order(src: Encoding, res: Encoding) -> str:
             order.append(f"{side}.{var}")
             if var in ids:
                 order.append(f"{copy}_{var}")
+        order += [f"{copy}_{v}" for v, _ in enc.id_vars if v not in enc.var_order]  # DEFINEs
     return "\n".join(order) + "\n"
