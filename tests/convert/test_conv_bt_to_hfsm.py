@@ -113,3 +113,33 @@ def test_leaf_label_matches_the_leaf_machine() -> None:
 
     for node in (_leaf("Grasp"), BTNode(type="Grasp", kind=NodeKind.ACTION, name="Grasp_2")):
         assert leaf_label(node) == shared(node)
+
+
+@pytest.mark.parametrize("tree", [
+    lambda: _ctl("ReactiveFallback", _leaf("a", NodeKind.CONDITION),
+                 _ctl("Inverter", _leaf("b"), node_kind=NodeKind.DECORATOR), _leaf("c")),
+    lambda: _ctl("KeepRunningUntilFailure", _ctl("Sequence", _leaf("a", NodeKind.CONDITION),
+                                                 _leaf("b")), node_kind=NodeKind.DECORATOR),
+])
+def test_loop_conversion_of_explored_trees_keeps_the_root_result(tree) -> None:
+    """With loop, a step that ends the tick outputs (result, first leaf); the HFSM must say
+    both (a final state named after the result), not jump back to the start silently."""
+    from fsmbt.convert.bt_to_hfsm import bt_to_hfsm
+    from fsmbt.verify import verify
+
+    doc = BTDocument.single(tree())
+    hfsm = bt_to_hfsm(doc, loop=True).model
+    report = verify(doc, hfsm, loop=True)
+    assert report.equivalent, report.verdicts()
+
+
+def test_loop_step_that_cannot_be_one_state_is_refused() -> None:
+    """ReactiveSequence over a SequenceWithMemory: after a failure the next tick does not start
+    where the first one did, so (FAILURE, a) has no state to stand for it."""
+    from fsmbt.convert.bt_to_hfsm import bt_to_hfsm
+    from fsmbt.model.errors import UnsupportedError
+
+    doc = BTDocument.single(_ctl("ReactiveSequence", _leaf("a", NodeKind.CONDITION),
+                                 _ctl("SequenceWithMemory", _leaf("b"), _leaf("c"))))
+    with pytest.raises(UnsupportedError, match="cannot express the outputs"):
+        bt_to_hfsm(doc, loop=True)
