@@ -25,7 +25,7 @@ from fsmbt.semantics.lebt_runtime import LebtLeaves
 from fsmbt.semantics.lebt_spec import NO_EVENT
 from fsmbt.verify.nusmv.encode_bt import BTCore, safe_text
 from fsmbt.verify.nusmv.encode_fsm import NONE_OUT, Encoding
-from fsmbt.verify.nusmv.smv import Symbols, any_of, case
+from fsmbt.verify.nusmv.smv import Symbols, any_of, case, enum_type
 
 MAX_SLOTS = 6
 
@@ -80,8 +80,7 @@ class LebtEncoder:
         core = self.core
         leaves = sorted(self.leaves.states)
         rows = [(f"{core.st(nid)} = R", f"rl_{nid}") for nid in leaves]
-        return (case(rows, "rl_none"),
-                "{" + ", ".join(["rl_none"] + [f"rl_{nid}" for nid in leaves]) + "}")
+        return case(rows, "rl_none"), enum_type(["rl_none"] + [f"rl_{n}" for n in leaves], "rl_pad")
 
     def encode(self) -> Encoding:
         core, k = self.core, self.slots

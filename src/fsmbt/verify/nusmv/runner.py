@@ -47,8 +47,8 @@ def run_nusmv(model: str, expected_specs: int, *, order: str | None = None,
         if keep:
             with open(keep, "w", encoding="utf-8") as handle:
                 handle.write(model)
-        # -mono: one monolithic transition relation;
-        # the partitioned (IWLS95) default is ~10x slower on these micro-step products.
+        # -mono: one monolithic transition relation; the partitioned (IWLS95) default is ~10x
+        # slower on these micro-step products.
         command = [str(binary), "-mono"]
         if order:
             order_path = os.path.join(tmp, "product.ord")
