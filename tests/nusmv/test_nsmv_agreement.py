@@ -256,41 +256,29 @@ def _hand_built() -> list[BTDocument]:
     return docs
 
 
-def generated_pairs() -> Iterator[Pair]:
-    """Hand-built trees (both loop modes, with mutants) and ``PAIRS`` generated pairs."""
-    from fsmbt.convert.bt_to_hfsm import bt_to_hfsm
-    from fsmbt.convert.lebt import fsm_to_lebt
+def generated_pairs() -> Iterator[Pair | Rejected]:
+    """Hand-built trees (both loop modes, with mutants) and ``PAIRS`` generated pairs; a
+    conversion the rules engine refuses is counted as unsupported."""
     from fsmbt.generate.generator import random_fsm
 
-    def bt_pair(label: str, doc: BTDocument, loop: bool) -> Pair | None:
-        try:
-            return Pair(label, doc, bt_to_hfsm(doc, loop=loop).model, loop, conversion=True)
-        except FsmbtError:
-            return None
-
-    def fsm_pair(label: str, fsm: FSM) -> Pair | None:
-        try:
-            return Pair(label, fsm, fsm_to_lebt(fsm).model, conversion=True)
-        except FsmbtError:
-            return None
+    def with_mutants(item: Pair | Rejected | None, mutated: bool) -> Iterator[Pair | Rejected]:
+        if isinstance(item, Pair) and mutated:
+            yield from _with_mutants(item, bt_side=2, fsm_side=1)
+        elif item is not None:
+            yield item
 
     for i, doc in enumerate(_hand_built()):
         for loop in (False, True):
-            pair = bt_pair(f"hand{i}-loop{int(loop)}", doc, loop)
-            if pair:
-                yield from _with_mutants(pair, bt_side=2, fsm_side=1)
+            yield from with_mutants(_convert(f"hand{i}-loop{int(loop)}", doc, loop=loop), True)
     rng = random.Random(5)
     for made in range(PAIRS):
         if made % 2 == 0:
             fsm = random_fsm(rng.randrange(10**9), min_states=2, max_states=4)
-            pair = fsm_pair(f"gen-fsm{made}", fsm)
+            item = _convert(f"gen-fsm{made}", fsm)
         else:
             doc = _random_bt(rng, rng.randint(2, 4))
-            pair = bt_pair(f"gen-bt{made}", doc, rng.random() < 0.5)
-        if pair and made < MUTATED:
-            yield from _with_mutants(pair, bt_side=2, fsm_side=1)
-        elif pair:
-            yield pair
+            item = _convert(f"gen-bt{made}", doc, loop=rng.random() < 0.5)
+        yield from with_mutants(item, made < MUTATED)
 
 
 # -- examples and corpus -------------------------------------------------------------------------
