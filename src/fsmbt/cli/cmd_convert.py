@@ -1,13 +1,11 @@
 """``fsmbt convert``: convert a model (direction from its kind), verify the result, report.
 
-The converted model goes to ``-o`` (never overwriting without ``--force``) or to stdout; the
-verdict and the conversion's figures go to stderr then, so stdout stays a clean model. Exit 0
-when equivalent (or ``--no-verify``), 1 when not, 2 on bad input.
-
-The LLM engines (``llm``, ``nllm``, ``hybrid``) read the input through
-``fsmbt.llm.extract.read_input``, so prose, unknown notations and diagrams reach the model's
-extraction step (``hybrid`` asks the LLM only when no parser reads the file);
-``--llm-base-url`` / ``--llm-model`` go to the engine as ``llm_base_url`` / ``llm_model``.
+Option parsing and printing around ``fsmbt.api.convert_file``, which does the work. The
+destination is checked before anything else; the result goes to ``-o`` (never overwriting
+without ``--force``) or to stdout, and is written only when it is equivalent (or
+``--no-verify``), unless ``--keep-failed``. With stdout as the output the verdict and figures
+go to stderr, so stdout stays a clean model. Exit 0 when equivalent (or ``--no-verify``), 1 when
+not, 2 on bad input.
 """
 
 from __future__ import annotations
@@ -18,31 +16,8 @@ from pathlib import Path
 
 import typer
 
-from fsmbt.convert import convert
-from fsmbt.formats import dumps, read_model, write_model
-from fsmbt.formats.registry import format_for_path
-from fsmbt.model.fsm import FSM
-
-DEFAULT_FSM_FORMAT = "scxml"  # BT -> FSM: nested states survive
-DEFAULT_BT_FORMAT = "btcpp"   # FSM -> BT: BehaviorTree.CPP v4 XML with TreeNodesModel
-LLM_ENGINES = ("llm", "nllm", "hybrid")
-
-
-def _read_source(source: Path, source_format: str | None, engine: str,
-                 options: dict[str, object]):
-    """The source model; for the LLM engines through ``read_input`` (LLM extraction when no
-    parser reads it), recording the client and provenance in ``options`` for the engine."""
-    if engine not in LLM_ENGINES:
-        return read_model(source, source_format)
-    from fsmbt.llm.engine import client_from_options
-    from fsmbt.llm.extract import needs_llm, read_input
-
-    client = None
-    if engine != "hybrid" or needs_llm(source, source_format):
-        client = client_from_options(options)  # LLMConfigError (exit 2) when none is set up
-    loaded = read_input(source, source_format, client=client)
-    options.update(client=client, source_name=str(source), extracted_by_llm=loaded.extracted)
-    return loaded.model
+from fsmbt import api
+from fsmbt.verify.report import Report
 
 
 def register(app: typer.Typer) -> None:
@@ -60,6 +35,8 @@ def register(app: typer.Typer) -> None:
                                   "after it returns (checked in loop mode)"),
         no_verify: bool = typer.Option(False, "--no-verify", help="skip the equivalence check"),
         force: bool = typer.Option(False, "--force", help="overwrite an existing output file"),
+        keep_failed: bool = typer.Option(False, "--keep-failed", help="write the result even "
+                                         "when it is not equivalent (default: not written)"),
         as_json: bool = typer.Option(False, "--json", help="print a JSON summary on stdout"),
         hierarchy: str = typer.Option("subtrees", "--hierarchy", help="FSM->BT of a "
                                       "hierarchical FSM: subtrees (one SubTree per composite "
@@ -73,68 +50,41 @@ def register(app: typer.Typer) -> None:
         """Convert an FSM into a behavior tree or a behavior tree into a hierarchical FSM, and
         prove the result equivalent."""
         options: dict[str, object] = {}
-        if engine in LLM_ENGINES:
+        if engine in api.LLM_ENGINES:
             options.update(llm_base_url=llm_base_url, llm_model=llm_model)
-        model = _read_source(source, source_format, engine, options)
-        if loop:
-            options["loop"] = True
-        if engine == "rules" and isinstance(model, FSM):
-            options["hierarchy"] = hierarchy
-        result = convert(model, engine=engine, style=style, **options)
-        kind = "fsm" if isinstance(result.model, FSM) else "bt"
-        fmt = to
-        if fmt is None and output is not None:
-            guessed = format_for_path(output, writing=True, kind=kind)
-            fmt = guessed.name if guessed is not None else None
-        if fmt is None:
-            fmt = DEFAULT_FSM_FORMAT if kind == "fsm" else DEFAULT_BT_FORMAT
-        text: str | None = None
-        if output is not None:
-            write_model(result.model, output, fmt, overwrite=force)
-        else:
-            text = dumps(result.model, fmt)
-
-        report = None
-        if not no_verify:
-            from fsmbt.verify import verify
-
-            report = verify(model, result.model, loop=loop)
-        summary = {
-            "source": str(source),
-            "output": str(output) if output is not None else None,
-            "format": fmt,
-            "engine": result.engine,
-            "direction": result.direction,
-            "stats": result.stats,
-            "warnings": result.warnings,
-            "equivalent": report.equivalent if report is not None else None,
-            "properties": report.verdicts() if report is not None else None,
-        }
+        outcome = api.convert_file(
+            source, output, to=to, source_format=source_format, engine=engine, style=style,
+            loop=loop, hierarchy=hierarchy, verify=not no_verify, overwrite=force,
+            keep_not_equivalent=keep_failed, options=options)
+        summary = outcome.to_dict()
         if as_json:
-            if text is not None:
-                summary["model"] = text
+            if output is None:
+                summary["model"] = outcome.text
             print(json.dumps(summary, indent=2, default=str))
         else:
-            if text is not None:
-                sys.stdout.write(text)
-            _print_summary(summary, report, to_stderr=text is not None)
-        if report is not None and not report.equivalent:
+            if output is None:
+                sys.stdout.write(outcome.text)
+            _print_summary(outcome, to_stderr=output is None)
+        if outcome.equivalent is False:
             raise typer.Exit(1)
 
 
-def _print_summary(summary: dict, report, *, to_stderr: bool) -> None:
+def _print_summary(outcome: api.Outcome, *, to_stderr: bool) -> None:
     stream = sys.stderr if to_stderr else sys.stdout
-    for warning in summary["warnings"]:
+    for warning in outcome.warnings:
         print(f"warning: {warning}", file=stream)
-    figures = ", ".join(f"{k}={v}" for k, v in summary["stats"].items())
-    where = summary["output"] or "stdout"
-    print(f"converted {summary['direction']} with {summary['engine']} -> {where} "
-          f"({summary['format']}): {figures}", file=stream)
+    figures = ", ".join(f"{k}={v}" for k, v in outcome.conversion.stats.items())
+    where = str(outcome.output) if outcome.output is not None else "stdout"
+    print(f"converted {outcome.conversion.direction} with {outcome.conversion.engine} -> "
+          f"{where} ({outcome.output_format}): {figures}", file=stream)
+    report: Report | None = outcome.report
     if report is None:
         print("verification skipped (--no-verify)", file=stream)
         return
-    verdict = "EQUIVALENT" if report.equivalent else "NOT EQUIVALENT"
-    print(f"verdict: {verdict}", file=stream)
+    print(f"verdict: {outcome.verdict}", file=stream)
     for name, prop in report.properties.items():
         mark = "ok  " if prop.holds else "FAIL"
         print(f"  {mark} {name}: {prop.detail}", file=stream)
+    if outcome.output is not None and not outcome.written:
+        print(f"not written: {outcome.output} (the result is not equivalent; --keep-failed "
+              "writes it anyway)", file=stream)

@@ -11,7 +11,7 @@ from rich.console import Console
 from rich.markup import escape
 from rich.table import Table
 
-from fsmbt.formats import read_model
+from fsmbt import api
 from fsmbt.model.stats import BTStats, FSMStats, model_stats
 
 #: Lists longer than this are cut in the table (``--json`` always has them all).
@@ -32,7 +32,7 @@ def register(app: typer.Typer) -> None:
         loop states of DESIGN §3, hierarchy. BT: nodes by kind and type, depth, breadth,
         leaves, trees and SubTree references.
         """
-        stats = model_stats(read_model(model, from_format))
+        stats = model_stats(api.load(model, from_format).model)
         if as_json:
             print(json.dumps({"file": str(model), **stats.to_dict()}, indent=2, ensure_ascii=False))
             return

@@ -12,7 +12,7 @@ from rich.console import Console
 from rich.markup import escape
 from rich.table import Table
 
-from fsmbt.formats import read_model
+from fsmbt import api
 from fsmbt.metrics import elements, graph_edit_distance, tree_edit_distance
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import InputError
@@ -33,11 +33,11 @@ def register(app: typer.Typer) -> None:
     ) -> None:
         """Graphical and active elements, depth, node counts by type, sub-FSMs; with OTHER the
         tree edit distance (BTs) or graph edit distance (FSMs, an upper bound when cut)."""
-        first = read_model(model, from_format)
+        first = api.load(model, from_format).model
         figures = {"file": str(model), **elements(first).to_dict()}
         report: dict[str, object] = {"model": figures}
         if other is not None:
-            second = read_model(other, from_format)
+            second = api.load(other, from_format).model
             report["other"] = {"file": str(other), **elements(second).to_dict()}
             if isinstance(first, BTDocument) and isinstance(second, BTDocument):
                 report["distance"] = {"type": "tree edit distance",

@@ -8,7 +8,7 @@ from typing import Optional
 import typer
 
 from fsmbt.cli import EXIT_INTERNAL, fail
-from fsmbt.formats import read_model
+from fsmbt import api
 from fsmbt.render import DEFAULT_MAX_NODES, GraphvizError, render_model
 
 
@@ -28,7 +28,7 @@ def register(app: typer.Typer) -> None:
                                       help="Refuse models with more states/nodes than this."),
     ) -> None:
         """Draw MODEL: FSMs as state diagrams, behavior trees top-down with the usual symbols."""
-        loaded = read_model(model, from_format)
+        loaded = api.load(model, from_format).model
         try:
             written = render_model(loaded, output, overwrite=force,
                                    expand_subtrees=expand_subtrees, max_nodes=max_nodes)

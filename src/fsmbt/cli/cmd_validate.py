@@ -18,7 +18,7 @@ from rich.markup import escape
 from rich.table import Table
 
 from fsmbt.cli import EXIT_BAD_INPUT, EXIT_OK
-from fsmbt.formats import read_model
+from fsmbt import api
 from fsmbt.model.errors import SourceLocation
 from fsmbt.model.validate import Issue, validate
 
@@ -35,14 +35,13 @@ def register(app: typer.Typer) -> None:
         """Check a model: unknown nodes, wrong child counts, missing SubTrees, unknown or
         duplicate states, nondeterminism, empty models; warn about unreachable states,
         dead ends not marked final and parts fsmbt cannot model exactly."""
-        reader_warnings: list[str] = []
-        loaded = read_model(model, from_format, warnings=reader_warnings)
+        loaded = api.load(model, from_format)
         # reader warnings already start with their location; model issues get the file name
-        issues = [Issue("warning", w) for w in reader_warnings]
-        issues += [_with_file(i, model) for i in validate(loaded)]
+        issues = [Issue("warning", w) for w in loaded.warnings]
+        issues += [_with_file(i, model) for i in validate(loaded.model)]
         failing = [i for i in issues if i.severity == "error"] + (
             [i for i in issues if i.severity == "warning"] if strict else [])
-        kind = "fsm" if type(loaded).__name__ == "FSM" else "bt"
+        kind = loaded.kind
         if as_json:
             print(json.dumps({
                 "file": str(model), "kind": kind, "valid": not failing,

@@ -13,7 +13,9 @@ from typing import Optional
 import typer
 from rich.console import Console
 
-from fsmbt.formats import read_model
+from fsmbt import api
+from fsmbt.verify import EngineDisagreement
+from fsmbt.verify.render_report import print_report
 
 EXIT_EQUIVALENT = 0
 EXIT_NOT_EQUIVALENT = 1
@@ -38,13 +40,10 @@ def register(app: typer.Typer) -> None:
         """Check the five properties (reachability, completeness, no additional behaviour,
         deadlock absence, termination consistency); on failure, show the shortest input
         sequence that tells the two models apart."""
-        from fsmbt.verify import EngineDisagreement, verify
-        from fsmbt.verify.render_report import print_report
-
-        source_model = read_model(source, from_format)
-        result_model = read_model(converted, from_format2)
         try:
-            report = verify(source_model, result_model, engine=engine, loop=loop)
+            _, _, report = api.verify_files(source, converted, engine=engine, loop=loop,
+                                            source_format=from_format,
+                                            converted_format=from_format2)
         except EngineDisagreement as exc:
             print(f"error: ENGINES DISAGREE: {exc}; one of the checkers is wrong, please report "
                   "this with both files", file=sys.stderr)

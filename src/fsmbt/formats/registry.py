@@ -164,10 +164,12 @@ def loads(text: str, fmt: str | None = None, *, path: Path | None = None,
     return model
 
 
-def read_model(path: str | Path, fmt: str | None = None,
-               options: dict[str, object] | None = None, *,
-               warnings: list[str] | None = None) -> Model:
-    """Read one model file: size and encoding checks, then the format's reader."""
+def read_text(path: str | Path) -> str:
+    """The text of one model file: a regular file, within the size limit, decoded.
+
+    Raises:
+        InputError: a folder, a device or FIFO, a file over the limit, unreadable bytes.
+    """
     path = Path(path)
     try:
         size = path.stat().st_size
@@ -185,7 +187,15 @@ def read_model(path: str | Path, fmt: str | None = None,
                              location=SourceLocation(str(path)))
     except OSError as exc:
         raise InputError(f"cannot read: {exc.strerror}", location=SourceLocation(str(path))) from None
-    return loads(decode(data, str(path)), fmt, path=path, options=options, warnings=warnings)
+    return decode(data, str(path))
+
+
+def read_model(path: str | Path, fmt: str | None = None,
+               options: dict[str, object] | None = None, *,
+               warnings: list[str] | None = None) -> Model:
+    """Read one model file: size and encoding checks, then the format's reader."""
+    path = Path(path)
+    return loads(read_text(path), fmt, path=path, options=options, warnings=warnings)
 
 
 def dumps(model: Model, fmt: str) -> str:

@@ -1,0 +1,564 @@
+"""fsmbt's library API: the whole pipeline, read -> model -> convert -> verify -> write.
+
+Why one module: the command line, the batch runner, the evaluation, the web page and the
+simulations all do the same few things with a model, and each must do them the same way (the
+same reader, the same engine table, the same checker, the same refusal to overwrite). They call
+these functions and only parse options and print around them; none of them does this work again.
+
+The steps, each a thin public function over the package that owns it:
+
+- ``load`` / ``load_text``: a file or a text into a model (``fsmbt.formats``), with the reader's
+  warnings and the format it was read as. ``load_for_engine`` reads through the LLM extraction
+  step (``fsmbt.llm.extract``) when an LLM engine is asked for and no parser reads the input.
+- ``convert_model``: one engine's conversion (``fsmbt.convert``); the direction follows the
+  model's kind.
+- ``verify_models``: the five properties (``fsmbt.verify``), native, NuSMV or both.
+- ``check_destination`` / ``write``: where the result goes, checked *before* any work is done,
+  and written atomically (a temporary file in the same folder, then a rename), so an output is
+  never left half-written.
+- ``convert_file``: all of it for one input, returning one ``Outcome`` (both models, the
+  conversion, the report, timings, warnings, where the result was written).
+
+What happens to the output when the result is not equivalent (docs/cli.md, "convert"): the
+result is verified *before* it is written. An equivalent result (or one not verified, when
+verification was switched off) is written; a result that is not equivalent is not written, so a
+wrong model never lands where the user expects a proven one, unless ``keep_not_equivalent`` asks
+for it (then it is written, and the ``Outcome`` says it is not equivalent). Either way the
+result's text is in the ``Outcome``.
+
+Costs: reading is linear in the input; conversion and verification costs are stated in
+``fsmbt.convert`` and ``fsmbt.verify``; writing is linear in the output.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+import time
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from fsmbt.convert import ConversionResult, convert
+from fsmbt.formats import detect_format, dumps, get_format, loads
+from fsmbt.formats.registry import format_for_path, read_text
+from fsmbt.model.bt import BTDocument
+from fsmbt.model.errors import InputError, SourceLocation
+from fsmbt.model.fsm import FSM
+from fsmbt.verify import Report, verify
+from fsmbt.verify.native import DEFAULT_MAX_STATES
+
+Model = FSM | BTDocument
+
+#: The format a result is written in when neither a format nor a file extension names one.
+DEFAULT_FSM_FORMAT = "scxml"  # BT -> FSM: nested states survive
+DEFAULT_BT_FORMAT = "btcpp"  # FSM -> BT: BehaviorTree.CPP v4 XML with TreeNodesModel
+#: Engines that ask a language model (they read prose and pictures through LLM extraction).
+LLM_ENGINES = ("llm", "nllm", "hybrid")
+
+#: The verdict words every layer prints and stores.
+EQUIVALENT = "EQUIVALENT"
+NOT_EQUIVALENT = "NOT EQUIVALENT"
+NOT_VERIFIED = "NOT VERIFIED"
+
+#: ``on_stage`` is told each step's name as it starts: "read", "convert", "verify", "write".
+StageHook = Callable[[str], None]
+
+
+@dataclass
+class Loaded:
+    """A model read from a file or a text, with what the reader had to say about it.
+
+    Attributes:
+        model: the model (an ``FSM`` or a ``BTDocument``).
+        path: the file it came from, or ``None`` for a text.
+        format: the name of the format it was read as (``"btcpp"``, ``"scxml"``, ... or
+            ``"llm"`` when a language model extracted it).
+        warnings: the reader's documented, non-fatal deviations, each with its location.
+        extracted_by_llm: ``True`` when no parser read the input and the LLM wrote the model.
+    """
+
+    model: Model
+    path: Path | None
+    format: str
+    warnings: list[str] = field(default_factory=list)
+    extracted_by_llm: bool = False
+
+    @property
+    def kind(self) -> str:
+        """``"fsm"`` or ``"bt"``."""
+        return model_kind(self.model)
+
+
+@dataclass
+class Outcome:
+    """Everything one conversion produced, for any layer to print, store or show.
+
+    Attributes:
+        source: the loaded source model.
+        conversion: the engine's result (converted model, engine, direction, stats, warnings).
+        report: the verification report, or ``None`` when verification was skipped.
+        output_format: the format the result was serialised in.
+        text: the result serialised in ``output_format``.
+        output: where the result was written, or ``None`` (no path given, or not written).
+        written: whether ``output`` holds the result.
+        timings: seconds per step ("read", "convert", "verify", "write").
+    """
+
+    source: Loaded
+    conversion: ConversionResult
+    report: Report | None
+    output_format: str
+    text: str
+    output: Path | None = None
+    written: bool = False
+    timings: dict[str, float] = field(default_factory=dict)
+
+    @property
+    def result(self) -> Model:
+        """The converted model."""
+        return self.conversion.model
+
+    @property
+    def equivalent(self) -> bool | None:
+        """``True``/``False`` from the report; ``None`` when verification was skipped."""
+        return None if self.report is None else self.report.equivalent
+
+    @property
+    def verdict(self) -> str:
+        """``"EQUIVALENT"``, ``"NOT EQUIVALENT"`` or ``"NOT VERIFIED"``."""
+        return verdict_word(self.report)
+
+    @property
+    def warnings(self) -> list[str]:
+        """The reader's warnings, then the engine's."""
+        return [*self.source.warnings, *self.conversion.warnings]
+
+    def to_dict(self) -> dict[str, Any]:
+        """A JSON-ready summary (the models themselves are left out; ``text`` has the result).
+
+        Returns:
+            A dict with source, output, format, engine, direction, stats, warnings, verdict,
+            equivalent, properties (name -> holds), timings and written.
+        """
+        return {
+            "source": str(self.source.path) if self.source.path is not None else None,
+            "source_format": self.source.format,
+            "output": str(self.output) if self.output is not None else None,
+            "written": self.written,
+            "format": self.output_format,
+            "engine": self.conversion.engine,
+            "direction": self.conversion.direction,
+            "stats": self.conversion.stats,
+            "warnings": self.warnings,
+            "verdict": self.verdict,
+            "equivalent": self.equivalent,
+            "properties": self.report.verdicts() if self.report is not None else None,
+            "timings": {name: round(seconds, 6) for name, seconds in self.timings.items()},
+        }
+
+
+def model_kind(model: Model) -> str:
+    """``"fsm"`` for an FSM, ``"bt"`` for a behavior tree document."""
+    return "fsm" if isinstance(model, FSM) else "bt"
+
+
+def verdict_word(report: Report | None) -> str:
+    """The verdict of ``report`` in the words every layer uses.
+
+    Args:
+        report: a verification report, or ``None`` when verification was skipped.
+
+    Returns:
+        ``EQUIVALENT``, ``NOT EQUIVALENT`` or ``NOT VERIFIED``.
+    """
+    if report is None:
+        return NOT_VERIFIED
+    return EQUIVALENT if report.equivalent else NOT_EQUIVALENT
+
+
+class DestinationExists(InputError):
+    """The output file exists and replacing it was not asked for (the CLI names ``--force``)."""
+
+    def __init__(self, location: SourceLocation) -> None:
+        super().__init__("exists; it is not overwritten unless asked to", location=location)
+
+
+# -- read -------------------------------------------------------------------------------------
+
+
+def load(path: str | Path, fmt: str | None = None, *,
+         options: dict[str, object] | None = None) -> Loaded:
+    """Read one model file.
+
+    Args:
+        path: the file.
+        fmt: its format's name; detected from the content, then the extension, when ``None``.
+        options: reader options (e.g. ``node_models`` for BehaviorTree.CPP files).
+
+    Returns:
+        The ``Loaded`` model with the reader's warnings.
+
+    Raises:
+        InputError: the file cannot be read or is not a valid model (located).
+        UnsupportedError: the model uses something fsmbt cannot model exactly (located).
+    """
+    path = Path(path)
+    text = read_text(path)
+    chosen = get_format(fmt).name if fmt else detect_format(text, path).name
+    warnings: list[str] = []
+    model = loads(text, chosen, path=path, options=options, warnings=warnings)
+    return Loaded(model, path, chosen, warnings)
+
+
+def load_text(text: str, fmt: str | None = None, *, filename: str | None = None,
+              options: dict[str, object] | None = None) -> Loaded:
+    """Read one model from a text (a paste, an upload, an LLM answer).
+
+    Args:
+        text: the model's text.
+        fmt: its format's name; detected from the content (then ``filename``'s extension).
+        filename: a name used for format detection and in error locations only; it is never
+            opened, so relative includes are refused rather than read from the server's disk.
+        options: reader options.
+
+    Returns:
+        The ``Loaded`` model (``path`` is ``None``).
+
+    Raises:
+        InputError, UnsupportedError: as for ``load``.
+    """
+    name = Path(Path(filename).name) if filename else None
+    warnings: list[str] = []
+    chosen = fmt or detect_format(text, name).name
+    model = loads(text, chosen, options=options, warnings=warnings)
+    return Loaded(model, None, chosen, warnings)
+
+
+def load_for_engine(path: str | Path, engine: str, fmt: str | None = None, *,
+                    options: dict[str, object]) -> Loaded:
+    """Read the source of a conversion; for the LLM engines through LLM extraction.
+
+    The LLM engines (``llm``, ``nllm``, ``hybrid``) read prose, unknown notations and pictures
+    by asking the model to extract them (``hybrid`` asks only when no parser reads the file).
+    The client and the input's provenance are recorded in ``options`` for the engine.
+
+    Args:
+        path: the source file.
+        engine: the conversion engine that will run.
+        fmt: the source format, or ``None`` to detect it.
+        options: the engine options; updated in place for the LLM engines.
+
+    Returns:
+        The ``Loaded`` source.
+
+    Raises:
+        InputError, UnsupportedError: unreadable input; ``LLMConfigError`` when an LLM engine
+        has no endpoint configured.
+    """
+    if engine not in LLM_ENGINES:
+        return load(path, fmt, options=_reader_options(options))
+    from fsmbt.llm.engine import client_from_options
+    from fsmbt.llm.extract import needs_llm, read_input
+
+    path = Path(path)
+    client = None
+    if engine != "hybrid" or needs_llm(path, fmt):
+        client = client_from_options(options)
+    loaded = read_input(path, fmt, client=client)
+    options.update(client=client, source_name=str(path), extracted_by_llm=loaded.extracted)
+    name = "llm" if loaded.extracted else (fmt or "detected")
+    return Loaded(loaded.model, path, name, [], loaded.extracted)
+
+
+def _reader_options(options: dict[str, object]) -> dict[str, object] | None:
+    """The options a reader understands (``node_models``), out of the engine options."""
+    picked = {key: options[key] for key in ("node_models",) if key in options}
+    return picked or None
+
+
+# -- convert and verify ----------------------------------------------------------------------
+
+
+def convert_model(model: Model, engine: str = "rules", *, style: str = "paper",
+                  loop: bool = False, hierarchy: str | None = None,
+                  **options: object) -> ConversionResult:
+    """Convert an FSM into a BT, or a BT into a hierarchical FSM.
+
+    Args:
+        model: the source model; its kind decides the direction.
+        engine: the engine's name (``rules``, ``bsd``, ``chds``, ``llm``, ...).
+        style: the output structure style the engine offers (``paper`` by default).
+        loop: BT -> FSM: the root is ticked again after it returns.
+        hierarchy: FSM -> BT with ``rules``: ``subtrees`` (one SubTree per composite state) or
+            ``flatten``; ``None`` leaves the engine's default.
+        **options: further engine options.
+
+    Returns:
+        The engine's ``ConversionResult``.
+
+    Raises:
+        InputError: an unknown engine or an invalid model; UnsupportedError: the engine cannot
+        convert this model (the reason is named).
+    """
+    if loop:
+        options["loop"] = True
+    if hierarchy is not None and engine == "rules" and isinstance(model, FSM):
+        options["hierarchy"] = hierarchy
+    return convert(model, engine=engine, style=style, **options)
+
+
+def verify_models(source: Model, result: Model, engine: str = "native", *, loop: bool = False,
+                  max_states: int = DEFAULT_MAX_STATES) -> Report:
+    """Check that ``result`` behaves exactly like ``source`` (the five properties).
+
+    Args:
+        source: the source model.
+        result: the converted model.
+        engine: ``native``, ``nusmv`` or ``both`` (both must agree).
+        loop: the BT side's root is ticked again after it returns.
+        max_states: the native checker's state limit.
+
+    Returns:
+        The ``Report``: verdict, five properties, shortest counterexamples.
+
+    Raises:
+        EngineDisagreement: ``both`` and the engines disagree (a bug in one of them).
+        InputError, UnsupportedError: the pair cannot be compared.
+    """
+    return verify(source, result, engine=engine, loop=loop, max_states=max_states)
+
+
+# -- write -----------------------------------------------------------------------------------
+
+
+def check_destination(path: str | Path, *, overwrite: bool = False) -> Path:
+    """Refuse a destination that cannot take a result, before any work is done.
+
+    Args:
+        path: the file to be written.
+        overwrite: an existing file may be replaced.
+
+    Returns:
+        The path.
+
+    Raises:
+        InputError: the path is a folder, exists (without ``overwrite``), or its folder is a
+        file; the error names the path and says how to proceed.
+    """
+    path = Path(path)
+    where = SourceLocation(str(path))
+    if path.is_dir():
+        raise InputError("is a folder; name a file to write the result to", location=where)
+    if path.exists() and not overwrite:
+        raise DestinationExists(where)
+    for parent in path.parents:
+        if parent.exists():
+            if not parent.is_dir():
+                raise InputError(f"cannot write here: '{parent}' is a file, not a folder",
+                                 location=where)
+            if not os.access(parent, os.W_OK):
+                raise InputError(f"cannot write here: no permission to write in '{parent}'",
+                                 location=where)
+            break
+    return path
+
+
+def output_format_for(kind: str, *, to: str | None = None, output: Path | None = None) -> str:
+    """The format a result of ``kind`` is written in.
+
+    Args:
+        kind: ``"fsm"`` or ``"bt"``.
+        to: an explicit format name.
+        output: the output file, whose extension may name the format.
+
+    Returns:
+        ``to`` when given, else the format of ``output``'s extension, else ``scxml`` for an
+        FSM and ``btcpp`` for a BT.
+    """
+    if to is not None:
+        return get_format(to).name
+    if output is not None:
+        guessed = format_for_path(output, writing=True, kind=kind)
+        if guessed is not None:
+            return guessed.name
+    return DEFAULT_FSM_FORMAT if kind == "fsm" else DEFAULT_BT_FORMAT
+
+
+def write(model: Model, path: str | Path, fmt: str | None = None, *,
+          overwrite: bool = False) -> Path:
+    """Write a model to a file, atomically.
+
+    Args:
+        model: the model.
+        path: the file; its folder is created when missing.
+        fmt: the format; from ``path``'s extension (then the kind's default) when ``None``.
+        overwrite: an existing file may be replaced.
+
+    Returns:
+        The path written.
+
+    Raises:
+        InputError: the destination is refused (see ``check_destination``), the format cannot
+        hold the model, or the file system refuses the write.
+    """
+    path = check_destination(path, overwrite=overwrite)
+    chosen = output_format_for(model_kind(model), to=fmt, output=path)
+    return write_text(dumps(model, chosen), path, overwrite=overwrite)
+
+
+def write_text(text: str, path: str | Path, *, overwrite: bool = False) -> Path:
+    """Write a text atomically: a temporary file in the same folder, then a rename.
+
+    A reader never sees half a file, and a crash mid-write leaves the old file (or none).
+
+    Args:
+        text: what to write (UTF-8).
+        path: the destination.
+        overwrite: an existing file may be replaced.
+
+    Returns:
+        The path written.
+
+    Raises:
+        InputError: the destination is refused or the file system refuses the write.
+    """
+    path = check_destination(path, overwrite=overwrite)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp",
+                                             dir=path.parent)
+        try:
+            with os.fdopen(handle, "w", encoding="utf-8", newline="") as stream:
+                stream.write(text)
+                stream.flush()
+                os.fsync(stream.fileno())
+            if not overwrite and path.exists():  # appeared while we wrote: keep it
+                raise DestinationExists(SourceLocation(str(path)))
+            os.replace(temporary, path)
+        finally:
+            if os.path.exists(temporary):
+                os.unlink(temporary)
+    except OSError as exc:
+        raise InputError(f"cannot write: {exc.strerror}",
+                         location=SourceLocation(str(path))) from None
+    return path
+
+
+# -- the whole pipeline ----------------------------------------------------------------------
+
+
+@contextmanager
+def _timed(timings: dict[str, float], stage: str, on_stage: StageHook | None) -> Iterator[None]:
+    if on_stage is not None:
+        on_stage(stage)
+    started = time.perf_counter()
+    try:
+        yield
+    finally:
+        timings[stage] = time.perf_counter() - started
+
+
+def convert_file(source: str | Path, output: str | Path | None = None, *,
+                 to: str | None = None, source_format: str | None = None,
+                 engine: str = "rules", style: str = "paper", loop: bool = False,
+                 hierarchy: str = "subtrees", verify: bool = True,
+                 verify_engine: str = "native", max_states: int = DEFAULT_MAX_STATES,
+                 overwrite: bool = False, keep_not_equivalent: bool = False,
+                 options: dict[str, object] | None = None,
+                 on_stage: StageHook | None = None) -> Outcome:
+    """Read, convert, verify and write one model.
+
+    The destination is checked first, so a refused output costs no conversion. The result is
+    written only after verification, and only when it is equivalent (or not verified), unless
+    ``keep_not_equivalent``.
+
+    Args:
+        source: the source file.
+        output: where to write the result; ``None`` keeps it in ``Outcome.text`` only.
+        to: the output format (default: from ``output``'s extension, else ``btcpp`` for a BT,
+            ``scxml`` for an FSM).
+        source_format: the source's format (default: detected).
+        engine: the conversion engine.
+        style: the engine's output structure style.
+        loop: BT -> FSM: the root is ticked again after it returns (checked in loop mode).
+        hierarchy: FSM -> BT of a hierarchical FSM: ``subtrees`` or ``flatten``.
+        verify: run the equivalence check.
+        verify_engine: ``native``, ``nusmv`` or ``both``.
+        max_states: the native checker's state limit.
+        overwrite: an existing output file may be replaced.
+        keep_not_equivalent: write the result even when it is not equivalent.
+        options: further engine options (LLM endpoint and model, node models, ...).
+        on_stage: told each step's name as it starts (for progress displays).
+
+    Returns:
+        The ``Outcome``.
+
+    Raises:
+        InputError, UnsupportedError: bad input or a refused destination (located);
+        EngineDisagreement: ``verify_engine="both"`` and the engines disagree.
+    """
+    options = dict(options or {})
+    destination = Path(output) if output is not None else None
+    if destination is not None:
+        check_destination(destination, overwrite=overwrite)
+    timings: dict[str, float] = {}
+    with _timed(timings, "read", on_stage):
+        loaded = load_for_engine(source, engine, source_format, options=options)
+    with _timed(timings, "convert", on_stage):
+        conversion = convert_model(loaded.model, engine, style=style, loop=loop,
+                                   hierarchy=hierarchy, **options)
+    fmt = output_format_for(model_kind(conversion.model), to=to, output=destination)
+    text = dumps(conversion.model, fmt)
+    report: Report | None = None
+    if verify:
+        with _timed(timings, "verify", on_stage):
+            report = verify_models(loaded.model, conversion.model, verify_engine, loop=loop,
+                                   max_states=max_states)
+    outcome = Outcome(loaded, conversion, report, fmt, text, output=destination)
+    if destination is not None and (report is None or report.equivalent or keep_not_equivalent):
+        with _timed(timings, "write", on_stage):
+            write_text(text, destination, overwrite=overwrite)
+        outcome.written = True
+    outcome.timings = timings
+    return outcome
+
+
+def verify_files(source: str | Path, converted: str | Path, *, engine: str = "native",
+                 loop: bool = False, source_format: str | None = None,
+                 converted_format: str | None = None,
+                 max_states: int = DEFAULT_MAX_STATES,
+                 options: dict[str, object] | None = None) -> tuple[Loaded, Loaded, Report]:
+    """Read two model files and check that the second behaves exactly like the first.
+
+    Args:
+        source: the source model's file.
+        converted: the converted model's file.
+        engine: ``native``, ``nusmv`` or ``both``.
+        loop: the BT side's root is ticked again after it returns.
+        source_format: the first file's format (default: detected).
+        converted_format: the second file's format (default: detected).
+        max_states: the native checker's state limit.
+        options: reader options (e.g. ``node_models``).
+
+    Returns:
+        Both loaded models and the ``Report``.
+
+    Raises:
+        InputError, UnsupportedError: unreadable models or a pair that cannot be compared;
+        EngineDisagreement: ``both`` and the engines disagree.
+    """
+    first = load(source, source_format, options=options)
+    second = load(converted, converted_format, options=options)
+    report = verify_models(first.model, second.model, engine, loop=loop, max_states=max_states)
+    return first, second, report
+
+
+__all__ = [
+    "DEFAULT_BT_FORMAT", "DEFAULT_FSM_FORMAT", "EQUIVALENT", "LLM_ENGINES", "NOT_EQUIVALENT",
+    "NOT_VERIFIED", "DestinationExists", "Loaded", "Model", "Outcome", "check_destination", "convert_file",
+    "convert_model", "load", "load_for_engine", "load_text", "model_kind", "output_format_for",
+    "verdict_word", "verify_files", "verify_models", "write", "write_text",
+]
