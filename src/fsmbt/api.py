@@ -267,7 +267,9 @@ def load_for_engine(path: str | Path, engine: str, fmt: str | None = None, *,
     client = None
     if engine != "hybrid" or needs_llm(path, fmt):
         client = client_from_options(options)
-    loaded = read_input(path, fmt, client=client)
+    regenerations = options.get("max_regenerations")
+    loaded = read_input(path, fmt, client=client,
+                        max_regenerations=regenerations if isinstance(regenerations, int) else None)
     options.update(client=client, source_name=str(path), extracted_by_llm=loaded.extracted)
     name = "llm" if loaded.extracted else (fmt or "detected")
     return Loaded(loaded.model, path, name, [], loaded.extracted)

@@ -54,33 +54,26 @@ def register(app: typer.Typer) -> None:
         llm_log: Optional[str] = log_opt,
     ) -> None:
         """Convert INPUT with an LLM engine; the result is verified before it is written."""
-        from fsmbt.convert.engines import converter_for
-        from fsmbt.formats import dumps, write_model
-        from fsmbt.llm.engine import client_from_options
-        from fsmbt.llm.extract import needs_llm, read_input
+        from fsmbt import api
+        from fsmbt.formats import dumps
         from fsmbt.model.errors import InputError
 
         if engine not in LLM_ENGINES:
             raise InputError(f"fsmbt llm convert takes --engine {', '.join(LLM_ENGINES)}; "
                              "for rules use fsmbt convert")
         options = _llm_options(llm_base_url, llm_model, llm_timeout, max_regenerations, llm_log)
-        client = None
-        if engine != "hybrid" or needs_llm(input_path, from_format):
-            client = client_from_options(options)
-        loaded = read_input(input_path, from_format, client=client,
-                            max_regenerations=max_regenerations)
-        options.update(client=client, ablate=ablate, verify_engine=verify_engine,
-                       source_name=str(input_path), extracted_by_llm=loaded.extracted)
-        result = converter_for(engine, loaded.model)(loaded.model, **options)
-        if output is not None:
-            write_model(result.model, output, to_format, overwrite=force)
-        else:
-            from fsmbt.model.fsm import FSM
-
-            print(dumps(result.model, to_format or ("json" if isinstance(result.model, FSM) else "btcpp")),
-                  end="")
+        options.update(ablate=ablate, verify_engine=verify_engine)
+        # the engine verified its answer with verify_engine (it refuses one that is not
+        # equivalent); the pipeline's own check is the cheap native one
+        outcome = api.convert_file(input_path, output, to=to_format, source_format=from_format,
+                                   engine=engine, overwrite=force, options=options)
+        if output is None:  # printed FSMs default to fsmbt JSON here (what the LLM speaks)
+            text = outcome.text
+            if to_format is None and api.model_kind(outcome.result) == "fsm":
+                text = dumps(outcome.result, "json")
+            print(text, end="")
         typer.echo(f"{engine}: verified equivalent; " + ", ".join(
-            f"{k}={v}" for k, v in result.stats.items() if k in (
+            f"{k}={v}" for k, v in outcome.conversion.stats.items() if k in (
                 "first_pass_success", "regenerations", "tokens_in", "tokens_out", "latency_s",
                 "extracted_by_llm", "verify_engine")), err=True)
 
