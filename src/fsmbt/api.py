@@ -532,7 +532,8 @@ def verify_files(source: str | Path, converted: str | Path, *, engine: str = "na
                  loop: bool = False, source_format: str | None = None,
                  converted_format: str | None = None,
                  max_states: int = DEFAULT_MAX_STATES,
-                 options: dict[str, object] | None = None) -> tuple[Loaded, Loaded, Report]:
+                 options: dict[str, object] | None = None,
+                 on_stage: StageHook | None = None) -> tuple[Loaded, Loaded, Report]:
     """Read two model files and check that the second behaves exactly like the first.
 
     Args:
@@ -544,6 +545,7 @@ def verify_files(source: str | Path, converted: str | Path, *, engine: str = "na
         converted_format: the second file's format (default: detected).
         max_states: the native checker's state limit.
         options: reader options (e.g. ``node_models``).
+        on_stage: told each step's name as it starts ("read", "verify").
 
     Returns:
         Both loaded models and the ``Report``.
@@ -552,9 +554,13 @@ def verify_files(source: str | Path, converted: str | Path, *, engine: str = "na
         InputError, UnsupportedError: unreadable models or a pair that cannot be compared;
         EngineDisagreement: ``both`` and the engines disagree.
     """
-    first = load(source, source_format, options=options)
-    second = load(converted, converted_format, options=options)
-    report = verify_models(first.model, second.model, engine, loop=loop, max_states=max_states)
+    timings: dict[str, float] = {}
+    with _timed(timings, "read", on_stage):
+        first = load(source, source_format, options=options)
+        second = load(converted, converted_format, options=options)
+    with _timed(timings, "verify", on_stage):
+        report = verify_models(first.model, second.model, engine, loop=loop,
+                               max_states=max_states)
     return first, second, report
 
 

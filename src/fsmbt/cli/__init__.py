@@ -28,7 +28,15 @@ app = typer.Typer(
     no_args_is_help=True,
     add_completion=False,
     pretty_exceptions_enable=False,
+    # plain click help: paragraphs re-wrapped to the terminal, flags without a "<bool>" type,
+    # choices shown as <a|b>
+    rich_markup_mode=None,
 )
+
+
+def sub_app(help_text: str) -> typer.Typer:
+    """A command group (``fsmbt llm ...``) with the same help style as the main app."""
+    return typer.Typer(help=help_text, no_args_is_help=True, rich_markup_mode=None)
 
 
 @app.callback()
@@ -48,6 +56,15 @@ def fail(message: str, code: int = EXIT_BAD_INPUT) -> typer.Exit:
     """Print one line on stderr and return the ``typer.Exit`` to raise."""
     print(f"error: {message}", file=sys.stderr)
     return typer.Exit(code)
+
+
+def _silence_stdout() -> None:
+    """Point stdout at /dev/null so the interpreter's final flush cannot fail again."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+    except (OSError, ValueError):
+        pass
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -74,6 +91,10 @@ def main(argv: list[str] | None = None) -> int:
         return EXIT_BAD_INPUT
     except KeyboardInterrupt:
         return 130
+    except BrokenPipeError:
+        # the reader went away (``fsmbt llm prompt x | head``): what it wanted, it got
+        _silence_stdout()
+        return EXIT_OK
     except typer.Abort:
         return 130
     except Exception as exc:  # noqa: BLE001 - the last line of defence: never a traceback

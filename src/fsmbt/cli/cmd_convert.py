@@ -13,11 +13,17 @@ from __future__ import annotations
 import json
 import sys
 from pathlib import Path
+from typing import Literal
 
 import typer
 
 from fsmbt import api
+from fsmbt.llm.config import PROVIDERS
+from fsmbt.cli.progress import StageProgress, format_timings
 from fsmbt.verify.report import Report
+
+
+PROVIDER_NAMES = ", ".join(sorted(PROVIDERS))
 
 
 def register(app: typer.Typer) -> None:
@@ -38,12 +44,12 @@ def register(app: typer.Typer) -> None:
         keep_failed: bool = typer.Option(False, "--keep-failed", help="write the result even "
                                          "when it is not equivalent (default: not written)"),
         as_json: bool = typer.Option(False, "--json", help="print a JSON summary on stdout"),
-        hierarchy: str = typer.Option("subtrees", "--hierarchy", help="FSM->BT of a "
+        quiet: bool = typer.Option(False, "--quiet", "-q", help="no progress display on stderr"),
+        hierarchy: Literal["subtrees", "flatten"] = typer.Option("subtrees", "--hierarchy", help="FSM->BT of a "
                                       "hierarchical FSM: subtrees (one SubTree per composite "
                                       "state) or flatten (one flat LEBT)"),
         llm_base_url: str | None = typer.Option(None, "--llm-base-url", help="LLM engines: "
-                                                "endpoint URL or provider (openai, deepseek, "
-                                                "qwen, ollama, vllm)"),
+                                                f"endpoint URL or provider ({PROVIDER_NAMES})"),
         llm_model: str | None = typer.Option(None, "--llm-model", help="LLM engines: model "
                                              "name"),
     ) -> None:
@@ -52,10 +58,11 @@ def register(app: typer.Typer) -> None:
         options: dict[str, object] = {}
         if engine in api.LLM_ENGINES:
             options.update(llm_base_url=llm_base_url, llm_model=llm_model)
-        outcome = api.convert_file(
-            source, output, to=to, source_format=source_format, engine=engine, style=style,
-            loop=loop, hierarchy=hierarchy, verify=not no_verify, overwrite=force,
-            keep_not_equivalent=keep_failed, options=options)
+        with StageProgress(quiet=quiet, label=source.name) as progress:
+            outcome = api.convert_file(
+                source, output, to=to, source_format=source_format, engine=engine, style=style,
+                loop=loop, hierarchy=hierarchy, verify=not no_verify, overwrite=force,
+                keep_not_equivalent=keep_failed, options=options, on_stage=progress)
         summary = outcome.to_dict()
         if as_json:
             if output is None:
@@ -77,6 +84,7 @@ def _print_summary(outcome: api.Outcome, *, to_stderr: bool) -> None:
     where = str(outcome.output) if outcome.output is not None else "stdout"
     print(f"converted {outcome.conversion.direction} with {outcome.conversion.engine} -> "
           f"{where} ({outcome.output_format}): {figures}", file=stream)
+    print(f"time: {format_timings(outcome.timings)}", file=stream)
     report: Report | None = outcome.report
     if report is None:
         print("verification skipped (--no-verify)", file=stream)

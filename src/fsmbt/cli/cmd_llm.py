@@ -16,6 +16,9 @@ from typing import Optional
 
 import typer
 
+from fsmbt.cli import sub_app
+from fsmbt.llm.config import PROVIDERS
+
 LLM_ENGINES = ("llm", "nllm", "hybrid")
 
 
@@ -26,12 +29,11 @@ def _llm_options(base_url: str | None, model: str | None, timeout: float | None,
 
 
 def register(app: typer.Typer) -> None:
-    llm_app = typer.Typer(help="The LLM conversion path: convert, extract, show prompts, count tokens.",
-                          no_args_is_help=True)
+    llm_app = sub_app("The LLM conversion path: convert, extract, show prompts, count tokens.")
     app.add_typer(llm_app, name="llm")
 
-    base_url_opt = typer.Option(None, "--llm-base-url",
-                                help="Endpoint URL or provider (openai, deepseek, qwen, ollama, vllm).")
+    base_url_opt = typer.Option(None, "--llm-base-url", help="Endpoint URL or provider "
+                                f"({', '.join(sorted(PROVIDERS))}).")
     model_opt = typer.Option(None, "--llm-model", help="Model name at the endpoint.")
     timeout_opt = typer.Option(None, "--llm-timeout", help="Seconds per request, retries included (180).")
     regen_opt = typer.Option(None, "--max-regenerations", help="Feedback rounds after the first answer (3).")

@@ -14,6 +14,7 @@ import typer
 from rich.console import Console
 
 from fsmbt import api
+from fsmbt.cli.progress import StageProgress
 from fsmbt.verify import EngineDisagreement
 from fsmbt.verify.render_report import print_report
 
@@ -28,6 +29,7 @@ def register(app: typer.Typer) -> None:
         source: Path = typer.Argument(..., help="The source model (FSM or BT)."),
         converted: Path = typer.Argument(..., help="The converted model to check against it."),
         as_json: bool = typer.Option(False, "--json", help="Print the report as JSON."),
+        quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress display on stderr."),
         engine: str = typer.Option("native", "--engine",
                                    help="native, nusmv, or both (both must agree)."),
         loop: bool = typer.Option(False, "--loop",
@@ -41,9 +43,11 @@ def register(app: typer.Typer) -> None:
         deadlock absence, termination consistency); on failure, show the shortest input
         sequence that tells the two models apart."""
         try:
-            _, _, report = api.verify_files(source, converted, engine=engine, loop=loop,
-                                            source_format=from_format,
-                                            converted_format=from_format2)
+            with StageProgress(quiet=quiet or as_json, label=f"{source.name} ~ {converted.name}") as progress:
+                _, _, report = api.verify_files(source, converted, engine=engine, loop=loop,
+                                                source_format=from_format,
+                                                converted_format=from_format2,
+                                                on_stage=progress)
         except EngineDisagreement as exc:
             print(f"error: ENGINES DISAGREE: {exc}; one of the checkers is wrong, please report "
                   "this with both files", file=sys.stderr)

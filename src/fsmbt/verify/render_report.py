@@ -71,8 +71,14 @@ def _did(outputs: list[str], status: str) -> str:
 
 
 def _stats_line(stats: dict) -> str:
-    keys = ("source_states", "result_states", "product_states", "product_edges", "seconds")
+    keys = ("source_states", "result_states", "product_states", "product_edges")
     shown = [f"{k.replace('_', ' ')} {stats[k]}" for k in keys if k in stats]
+    nusmv = stats.get("nusmv")
+    if isinstance(nusmv, dict) and "seconds" in nusmv:  # --engine both: each engine's time
+        shown.append(f"native {float(stats.get('seconds', 0.0)):.3f} s")
+        shown.append(f"NuSMV {float(nusmv['seconds']):.3f} s")
+    elif "seconds" in stats:
+        shown.append(f"{stats['seconds']:.3f} s")
     return ", ".join(shown)
 
 
