@@ -95,6 +95,12 @@ def main(argv: list[str] | None = None) -> int:
         # the reader went away (``fsmbt llm prompt x | head``): what it wanted, it got
         _silence_stdout()
         return EXIT_OK
+    except SystemExit as exc:
+        # click turns a closed pipe into exit 1 after wrapping stdout; that is not a failure
+        if type(sys.stdout).__name__ == "PacifyFlushWrapper":
+            _silence_stdout()
+            return EXIT_OK
+        raise exc
     except typer.Abort:
         return 130
     except Exception as exc:  # noqa: BLE001 - the last line of defence: never a traceback

@@ -1,4 +1,8 @@
-"""``fsmbt generate``: write N seeded random models (same seed, same files)."""
+"""``fsmbt generate``: write N seeded random models (same seed, same files).
+
+Option parsing and printing around ``fsmbt.generate.generate_models`` (what model i of a run
+is) and ``fsmbt.api.write`` (atomic, never overwriting without ``--force``).
+"""
 
 from __future__ import annotations
 
@@ -6,14 +10,11 @@ from pathlib import Path
 
 import typer
 
-from fsmbt.formats import get_format, write_model
-from fsmbt.generate import SCENARIOS, random_bt, random_fsm
+from fsmbt import api
+from fsmbt.formats import get_format
+from fsmbt.generate import DatasetSpec, generate_models
+from fsmbt.generate.dataset import DEFAULT_MAX_NODES
 from fsmbt.model.errors import InputError
-
-
-def model_seed(seed: int, index: int) -> str:
-    """The seed of the ``index``-th model of a run: independent of N, so files are stable."""
-    return f"{seed}:{index}"
 
 
 def register(app: typer.Typer) -> None:
@@ -29,29 +30,25 @@ def register(app: typer.Typer) -> None:
         depth: int | None = typer.Option(None, "--depth", min=2, help="BT depth (default 2-10)"),
         breadth: int | None = typer.Option(None, "--breadth", min=1,
                                            help="BT breadth (default 2-10)"),
+        max_nodes: int = typer.Option(DEFAULT_MAX_NODES, "--max-nodes", min=1,
+                                      help="BT node budget, soft: past it no new control "
+                                      "node is opened, but open ones keep their breadth "
+                                      "and the spine keeps its --depth levels"),
         extended: bool = typer.Option(False, "--extended",
                                       help="BTs: add Reactive/WithMemory, Parallel, decorators"),
         force: bool = typer.Option(False, "--force", help="overwrite existing files"),
     ) -> None:
         """Write N random FSMs or BTs within the paper's limits, reproducibly from --seed."""
-        if kind not in ("fsm", "bt"):
-            raise InputError(f"--kind must be fsm or bt, not {kind!r}")
-        if scenario not in SCENARIOS:
-            raise InputError(f"--scenario must be one of {', '.join(SCENARIOS)}, not {scenario!r}")
         low, high = _size_range(states)
+        spec = DatasetSpec(kind, scenario, seed, low, high, depth, breadth, extended, max_nodes)
+        spec.check()
         chosen = get_format(fmt)
         if chosen.write is None or kind not in chosen.kinds:
             raise InputError(f"format '{chosen.name}' cannot write a {kind.upper()}")
-        output.mkdir(parents=True, exist_ok=True)
         extension = chosen.extensions[0] if chosen.extensions else ".txt"
-        for index in range(n):
-            model_rng = model_seed(seed, index)
-            if kind == "fsm":
-                model = random_fsm(model_rng, None, scenario, min_states=low, max_states=high)
-            else:
-                model = random_bt(model_rng, depth, breadth, scenario, extended=extended)
-            path = output / f"{kind}_{scenario}_{seed}_{index:04d}{extension}"
-            write_model(model, path, chosen.name, overwrite=force)
+        output.mkdir(parents=True, exist_ok=True)
+        for stem, model in generate_models(spec, n):
+            api.write(model, output / f"{stem}{extension}", chosen.name, overwrite=force)
         print(f"wrote {n} {kind.upper()}s ({scenario}, seed {seed}) to {output}")
 
 

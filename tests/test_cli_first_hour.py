@@ -1,0 +1,98 @@
+"""What a new user meets in the first hour, through the real CLI (issue 13's points).
+
+Each test runs ``fsmbt`` as a user would (``fsmbt.cli.main`` or a subprocess where a pipe or a
+terminal matters) and pins the behaviour that was wrong before.
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from fsmbt import api
+from fsmbt.cli import main
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+PAPER_FSM = EXAMPLES / "paper_fsm.xml"
+FSMBT = [sys.executable, "-m", "fsmbt.cli"]
+
+
+def test_output_is_checked_before_any_work(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+                                            capsys: pytest.CaptureFixture[str]) -> None:
+    existing = tmp_path / "mine.xml"
+    existing.write_text("keep me", encoding="utf-8")
+
+    def must_not_run(*args: object, **kwargs: object) -> None:
+        raise AssertionError("converted although the output is refused")
+
+    monkeypatch.setattr(api, "convert_model", must_not_run)
+    assert main(["convert", str(PAPER_FSM), "-o", str(existing)]) == 2
+    err = capsys.readouterr().err
+    assert "mine.xml" in err and "--force" in err and err.count("\n") == 1
+    assert existing.read_text(encoding="utf-8") == "keep me"
+    assert main(["convert", str(PAPER_FSM), "-o", str(tmp_path), "--force"]) == 2
+    assert "is a folder" in capsys.readouterr().err
+
+
+def test_convert_prints_each_step_time(tmp_path: Path,
+                                       capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["convert", str(PAPER_FSM), "-o", str(tmp_path / "bt.xml")]) == 0
+    out = capsys.readouterr().out
+    time_line = next(line for line in out.splitlines() if line.startswith("time:"))
+    for stage in ("read", "convert", "verify", "write"):
+        assert f"{stage} " in time_line
+
+
+def test_no_progress_display_when_stderr_is_not_a_terminal(tmp_path: Path) -> None:
+    proc = subprocess.run([*FSMBT, "convert", str(PAPER_FSM), "-o", str(tmp_path / "x.xml")],
+                          capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stderr == ""  # no spinner, no escape codes in a pipe
+
+
+def test_help_is_plain_and_lists_choices() -> None:
+    proc = subprocess.run([*FSMBT, "convert", "--help"], capture_output=True, text=True,
+                          timeout=60, env={"COLUMNS": "100", "PATH": "/usr/bin:/bin"})
+    assert proc.returncode == 0
+    assert "<bool>" not in proc.stdout
+    assert "<subtrees|flatten>" in proc.stdout
+    assert "vllm" in proc.stdout  # the provider list is the one the endpoint error uses
+
+
+def test_closed_pipe_exits_zero_without_a_message() -> None:
+    proc = subprocess.run(f"{sys.executable} -m fsmbt.cli llm prompt {PAPER_FSM} | head -1",
+                          shell=True, capture_output=True, text=True, timeout=60,
+                          executable="/bin/bash")
+    assert proc.stdout.startswith("=== system ===")
+    status = subprocess.run(
+        f"set -o pipefail; {sys.executable} -m fsmbt.cli llm prompt {PAPER_FSM} | head -1 "
+        ">/dev/null", shell=True, capture_output=True, text=True, timeout=60,
+        executable="/bin/bash")
+    assert status.returncode == 0, status.stderr
+    assert "Traceback" not in status.stderr and "Broken pipe" not in status.stderr
+
+
+def test_generate_node_budget_is_an_option(tmp_path: Path) -> None:
+    small, large = tmp_path / "small", tmp_path / "large"
+    common = ["generate", "--kind", "bt", "--n", "1", "--depth", "40", "--breadth", "40"]
+    assert main([*common, "-o", str(small)]) == 0
+    assert main([*common, "-o", str(large), "--max-nodes", "4000"]) == 0
+
+    def nodes(folder: Path) -> int:
+        model = api.load(next(folder.iterdir())).model
+        return sum(1 for _ in model.nodes())
+
+    assert nodes(large) > 1000 > nodes(small)
+    assert main([*common, "-o", str(small), "--max-nodes", "0"]) == 2
+
+
+def test_convert_json_summary_has_verdict_and_timings(tmp_path: Path,
+                                                      capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["convert", str(PAPER_FSM), "-o", str(tmp_path / "bt.xml"), "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["verdict"] == "EQUIVALENT" and data["written"] is True
+    assert set(data["timings"]) == {"read", "convert", "verify", "write"}
