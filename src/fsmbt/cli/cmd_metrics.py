@@ -13,10 +13,8 @@ from rich.markup import escape
 from rich.table import Table
 
 from fsmbt import api
-from fsmbt.metrics import elements, graph_edit_distance, tree_edit_distance
-from fsmbt.model.bt import BTDocument
+from fsmbt.metrics import edit_distance, elements
 from fsmbt.model.errors import InputError
-from fsmbt.model.fsm import FSM
 
 
 def register(app: typer.Typer) -> None:
@@ -39,16 +37,10 @@ def register(app: typer.Typer) -> None:
         if other is not None:
             second = api.load(other, from_format).model
             report["other"] = {"file": str(other), **elements(second).to_dict()}
-            if isinstance(first, BTDocument) and isinstance(second, BTDocument):
-                report["distance"] = {"type": "tree edit distance",
-                                      **tree_edit_distance(first, second).to_dict()}
-            elif isinstance(first, FSM) and isinstance(second, FSM):
-                report["distance"] = {"type": "graph edit distance",
-                                      **graph_edit_distance(first, second,
-                                                            timeout=timeout).to_dict()}
-            else:
-                raise InputError("an edit distance needs two models of the same kind "
-                                 "(two FSMs or two BTs)", element=str(other))
+            try:
+                report["distance"] = edit_distance(first, second, timeout=timeout)
+            except InputError as exc:
+                raise InputError(exc.message, element=str(other)) from None
         if as_json:
             print(json.dumps(report, indent=2, ensure_ascii=False))
             return
