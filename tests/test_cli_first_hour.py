@@ -96,3 +96,50 @@ def test_convert_json_summary_has_verdict_and_timings(tmp_path: Path,
     data = json.loads(capsys.readouterr().out)
     assert data["verdict"] == "EQUIVALENT" and data["written"] is True
     assert set(data["timings"]) == {"read", "convert", "verify", "write"}
+
+
+ROBOT_BT = EXAMPLES / "robot_bt.xml"
+
+
+@pytest.mark.parametrize("source, convert_to", [(PAPER_FSM, "bt.xml"), (ROBOT_BT, "hfsm.scxml")])
+def test_verify_verdict_does_not_depend_on_the_order(tmp_path: Path, source: Path,
+                                                     convert_to: str,
+                                                     capsys: pytest.CaptureFixture[str]) -> None:
+    converted = tmp_path / convert_to
+    assert main(["convert", str(source), "-o", str(converted)]) == 0
+    capsys.readouterr()
+    assert main(["verify", str(source), str(converted), "--json"]) == 0
+    given = json.loads(capsys.readouterr().out)
+    assert main(["verify", str(converted), str(source), "--json"]) == 0
+    swapped = json.loads(capsys.readouterr().out)
+    assert given["equivalent"] is swapped["equivalent"] is True
+    assert given["stats"]["swapped"] is False and swapped["stats"]["swapped"] is True
+    assert given["stats"]["pairing"] == swapped["stats"]["pairing"]
+    assert main(["verify", str(converted), str(source)]) == 0
+    assert "was read as the source" in capsys.readouterr().out
+
+
+def test_not_equivalent_in_both_orders(tmp_path: Path) -> None:
+    from fsmbt.verify.mutations import mutants
+
+    converted = api.convert_file(PAPER_FSM).result
+    wrong = next(m.model for m in mutants(converted, seed=1)
+                 if not api.verify_models(api.load(PAPER_FSM).model, m.model).equivalent)
+    path = tmp_path / "wrong.xml"
+    api.write(wrong, path)
+    assert main(["verify", str(PAPER_FSM), str(path)]) == 1
+    assert main(["verify", str(path), str(PAPER_FSM)]) == 1
+
+
+def test_a_pair_no_rule_compares_names_the_rules(tmp_path: Path,
+                                                 capsys: pytest.CaptureFixture[str]) -> None:
+    lebt = api.convert_file(PAPER_FSM).text
+    # an LEBT with one foreign action leaf: neither a loop-execution BT nor a plain BT's FSM
+    broken = lebt.replace("<LebtState", "<SomeRobotAction", 1)
+    path = tmp_path / "mixed.xml"
+    path.write_text(broken, encoding="utf-8")
+    code = main(["verify", str(PAPER_FSM), str(path)])
+    err = capsys.readouterr().err
+    assert code == 2
+    assert "pairing rule tried: FSM ~ loop-execution BT" in err
+    assert "BT ~ FSM (leaf execution)" in err and err.count("\n") == 1

@@ -45,10 +45,11 @@ from fsmbt.convert import ConversionResult, convert
 from fsmbt.formats import detect_format, dumps, get_format, loads
 from fsmbt.formats.registry import format_for_path, read_text
 from fsmbt.model.bt import BTDocument
-from fsmbt.model.errors import InputError, SourceLocation
+from fsmbt.model.errors import InputError, SourceLocation, UnsupportedError
 from fsmbt.model.fsm import FSM
 from fsmbt.verify import Report, verify
 from fsmbt.verify.native import DEFAULT_MAX_STATES
+from fsmbt.verify.orient import orient, rules_text
 
 Model = FSM | BTDocument
 
@@ -333,6 +334,36 @@ def verify_models(source: Model, result: Model, engine: str = "native", *, loop:
     return verify(source, result, engine=engine, loop=loop, max_states=max_states)
 
 
+def verify_either_order(first: Model, second: Model, engine: str = "native", *,
+                        loop: bool = False, max_states: int = DEFAULT_MAX_STATES) -> Report:
+    """Like ``verify_models``, for two models given in either order.
+
+    The pair is put in the order its pairing rule needs (``fsmbt.verify.orient``): an FSM and
+    its loop-execution BT by macro steps with the FSM as the source, a BT and its FSM by leaf
+    execution with the BT as the source. The verdict is the same for both orders; the report
+    names the rule in ``stats["pairing"]`` and, when the order was reversed, says so in
+    ``stats["swapped"]``.
+
+    Raises:
+        InputError: the pair cannot be compared by its rule; the message names the rule that
+        was tried and every rule there is.
+        EngineDisagreement: ``both`` and the engines disagree.
+    """
+    oriented = orient(first, second)
+    try:
+        report = verify(oriented.source, oriented.result, engine=engine, loop=loop,
+                        max_states=max_states)
+    except UnsupportedError:
+        raise
+    except InputError as exc:
+        raise InputError(f"{exc.message} (pairing rule tried: {oriented.rule}; the rules are: "
+                         f"{rules_text()})", location=exc.location,
+                         element=exc.element) from None
+    report.stats["pairing"] = oriented.rule
+    report.stats["swapped"] = oriented.swapped
+    return report
+
+
 # -- write -----------------------------------------------------------------------------------
 
 
@@ -548,7 +579,8 @@ def verify_files(source: str | Path, converted: str | Path, *, engine: str = "na
         on_stage: told each step's name as it starts ("read", "verify").
 
     Returns:
-        Both loaded models and the ``Report``.
+        Both loaded models (as given) and the ``Report``; the pair is compared in the order
+        its pairing rule needs, so the verdict does not depend on the argument order.
 
     Raises:
         InputError, UnsupportedError: unreadable models or a pair that cannot be compared;
@@ -559,8 +591,8 @@ def verify_files(source: str | Path, converted: str | Path, *, engine: str = "na
         first = load(source, source_format, options=options)
         second = load(converted, converted_format, options=options)
     with _timed(timings, "verify", on_stage):
-        report = verify_models(first.model, second.model, engine, loop=loop,
-                               max_states=max_states)
+        report = verify_either_order(first.model, second.model, engine, loop=loop,
+                                     max_states=max_states)
     return first, second, report
 
 
@@ -568,5 +600,5 @@ __all__ = [
     "DEFAULT_BT_FORMAT", "DEFAULT_FSM_FORMAT", "EQUIVALENT", "LLM_ENGINES", "NOT_EQUIVALENT",
     "NOT_VERIFIED", "DestinationExists", "Loaded", "Model", "Outcome", "check_destination", "convert_file",
     "convert_model", "load", "load_for_engine", "load_text", "model_kind", "output_format_for",
-    "verdict_word", "verify_files", "verify_models", "write", "write_text",
+    "verdict_word", "verify_either_order", "verify_files", "verify_models", "write", "write_text",
 ]

@@ -59,4 +59,8 @@ def register(app: typer.Typer) -> None:
             print(json.dumps(data, indent=2, ensure_ascii=False))
         else:
             print_report(report, Console())
+            if report.stats.get("swapped"):
+                print(f"note: {converted} was read as the source and {source} as its "
+                      f"conversion (pairing rule: {report.stats['pairing']}); the verdict does "
+                      "not depend on the order")
         raise typer.Exit(EXIT_EQUIVALENT if report.equivalent else EXIT_NOT_EQUIVALENT)

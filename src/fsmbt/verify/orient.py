@@ -1,0 +1,104 @@
+"""Which of two models is the source, so that a verdict never depends on the argument order.
+
+Why: a user checks a conversion as ``verify A B`` or ``verify B A``; equivalence is symmetric,
+but the machines the checker builds are not — an FSM is compared with its loop-execution BT by
+macro steps (the FSM is the source), and a BT with its hierarchical FSM by leaf execution (the
+BT is the source). So the pair is put in the one order a pairing rule exists for
+(docs/verification.md, "Pairing rules"):
+
+=========================================  ====================================================
+rule                                        when
+=========================================  ====================================================
+FSM ~ loop-execution BT (macro steps)       one side is an FSM, the other a BT whose leaves are
+                                            LebtGuard / LebtState
+FSM ~ state-variable BT (macro steps)       the BT's leaves are the baselines' Sv* leaves
+BT ~ FSM (leaf execution)                   any other BT against an FSM: the FSM is read as the
+                                            BT's leaf-execution machine
+FSM ~ FSM (macro steps)                     two FSMs, in the given order
+BT ~ BT (leaf execution)                    two BTs, in the given order
+=========================================  ====================================================
+
+When the order is changed, the report says so: what the five properties call "source" is then
+the second model. Cost: one pass over the BT's nodes.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from fsmbt.model.bt import BTDocument
+from fsmbt.model.fsm import FSM
+from fsmbt.semantics.lebt_spec import GUARD_TYPE, STATE_TYPE
+from fsmbt.semantics.state_variable_runtime import is_state_variable_bt
+
+Model = FSM | BTDocument
+
+LEBT_RULE = "FSM ~ loop-execution BT (macro steps)"
+STATE_VARIABLE_RULE = "FSM ~ state-variable BT (macro steps)"
+LEAF_EXECUTION_RULE = "BT ~ FSM (leaf execution)"
+FSM_FSM_RULE = "FSM ~ FSM (macro steps)"
+BT_BT_RULE = "BT ~ BT (leaf execution)"
+#: Every pairing rule, in the order they are tried (named in errors).
+PAIRING_RULES = (LEBT_RULE, STATE_VARIABLE_RULE, LEAF_EXECUTION_RULE, FSM_FSM_RULE, BT_BT_RULE)
+
+
+@dataclass(frozen=True)
+class Orientation:
+    """A pair in the order its pairing rule needs.
+
+    Attributes:
+        source: the model the five properties call the source.
+        result: the other model.
+        swapped: ``True`` when the given order was reversed.
+        rule: the pairing rule that applies (one of ``PAIRING_RULES``).
+    """
+
+    source: Model
+    result: Model
+    swapped: bool
+    rule: str
+
+
+def is_lebt(doc: BTDocument) -> bool:
+    """True when any leaf of ``doc`` is a loop-execution leaf (LebtGuard / LebtState)."""
+    return any(node.type in (GUARD_TYPE, STATE_TYPE) for _tree, node in doc.nodes())
+
+
+def fsm_side_rule(doc: BTDocument) -> str | None:
+    """The macro-step rule a BT is compared with an FSM by, or ``None`` (leaf execution)."""
+    if is_lebt(doc):
+        return LEBT_RULE
+    if is_state_variable_bt(doc):
+        return STATE_VARIABLE_RULE
+    return None
+
+
+def orient(first: Model, second: Model) -> Orientation:
+    """Put two models in the order a pairing rule exists for.
+
+    Args:
+        first: the model given first.
+        second: the model given second.
+
+    Returns:
+        The ``Orientation``: source, result, whether they were swapped, and the rule.
+    """
+    if isinstance(first, FSM) and isinstance(second, FSM):
+        return Orientation(first, second, False, FSM_FSM_RULE)
+    if isinstance(first, BTDocument) and isinstance(second, BTDocument):
+        return Orientation(first, second, False, BT_BT_RULE)
+    if isinstance(first, FSM) and isinstance(second, BTDocument):
+        rule = fsm_side_rule(second)
+        if rule is not None:
+            return Orientation(first, second, False, rule)
+        return Orientation(second, first, True, LEAF_EXECUTION_RULE)
+    assert isinstance(first, BTDocument) and isinstance(second, FSM)
+    rule = fsm_side_rule(first)
+    if rule is not None:
+        return Orientation(second, first, True, rule)
+    return Orientation(first, second, False, LEAF_EXECUTION_RULE)
+
+
+def rules_text() -> str:
+    """The pairing rules as one line, for error messages."""
+    return "; ".join(PAIRING_RULES)
