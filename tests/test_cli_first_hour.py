@@ -143,3 +143,48 @@ def test_a_pair_no_rule_compares_names_the_rules(tmp_path: Path,
     assert code == 2
     assert "pairing rule tried: FSM ~ loop-execution BT" in err
     assert "BT ~ FSM (leaf execution)" in err and err.count("\n") == 1
+
+
+CUSTOM_TREE = """<root BTCPP_format="4" main_tree_to_execute="Main">
+  <BehaviorTree ID="Main">
+    <MyPipeline name="pipe">
+      <Sequence>
+        <IsReady/>
+        <DoWork/>
+      </Sequence>
+    </MyPipeline>
+  </BehaviorTree>
+</root>
+"""
+
+
+def _models_file(path: Path, entries: str) -> Path:
+    path.write_text(f'<root BTCPP_format="4"><TreeNodesModel>{entries}</TreeNodesModel></root>',
+                    encoding="utf-8")
+    return path
+
+
+@pytest.mark.parametrize("command", ["validate", "info"])
+def test_node_models_files_declare_custom_nodes(tmp_path: Path, command: str,
+                                                capsys: pytest.CaptureFixture[str]) -> None:
+    tree = tmp_path / "tree.xml"
+    tree.write_text(CUSTOM_TREE, encoding="utf-8")
+    controls = _models_file(tmp_path / "controls.xml", '<Control ID="MyPipeline"/>')
+    leaves = _models_file(tmp_path / "leaves.xml",
+                          '<Condition ID="IsReady"/><Action ID="DoWork"/>')
+    if command == "validate":
+        assert main(["validate", str(tree)]) == 2
+        assert "MyPipeline" in capsys.readouterr().err
+    code = main([command, str(tree), "--node-models", str(controls), "--node-models",
+                 str(leaves), "--json"])
+    out = json.loads(capsys.readouterr().out)
+    assert code == 0
+    if command == "validate":
+        assert out["errors"] == 0  # the control is declared by the first file ...
+        messages = [issue["message"] for issue in out["issues"]]
+        assert not any("not declared" in m for m in messages)  # ... the leaves by the second
+        assert any("MyPipeline" in m and "no known semantics" in m for m in messages)
+    else:
+        assert out["conditions"] == 1 or out.get("by_kind", {}).get("Condition") == 1
+    assert main([command, str(tree), "--node-models", str(tmp_path / "missing.xml")]) == 2
+    assert "missing.xml" in capsys.readouterr().err

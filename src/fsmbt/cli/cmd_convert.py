@@ -19,6 +19,7 @@ import typer
 
 from fsmbt import api
 from fsmbt.llm.config import PROVIDERS
+from fsmbt.cli.options import node_models_option, reader_options
 from fsmbt.cli.progress import StageProgress, format_timings
 from fsmbt.verify.report import Report
 
@@ -45,6 +46,7 @@ def register(app: typer.Typer) -> None:
                                          "when it is not equivalent (default: not written)"),
         as_json: bool = typer.Option(False, "--json", help="print a JSON summary on stdout"),
         quiet: bool = typer.Option(False, "--quiet", "-q", help="no progress display on stderr"),
+        node_models: list[Path] = node_models_option(),
         hierarchy: Literal["subtrees", "flatten"] = typer.Option("subtrees", "--hierarchy", help="FSM->BT of a "
                                       "hierarchical FSM: subtrees (one SubTree per composite "
                                       "state) or flatten (one flat LEBT)"),
@@ -55,7 +57,7 @@ def register(app: typer.Typer) -> None:
     ) -> None:
         """Convert an FSM into a behavior tree or a behavior tree into a hierarchical FSM, and
         prove the result equivalent."""
-        options: dict[str, object] = {}
+        options: dict[str, object] = dict(reader_options(node_models) or {})
         if engine in api.LLM_ENGINES:
             options.update(llm_base_url=llm_base_url, llm_model=llm_model)
         with StageProgress(quiet=quiet, label=source.name) as progress:

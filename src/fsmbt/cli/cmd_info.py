@@ -12,6 +12,7 @@ from rich.markup import escape
 from rich.table import Table
 
 from fsmbt import api
+from fsmbt.cli.options import node_models_option, reader_options
 from fsmbt.model.stats import BTStats, FSMStats, model_stats
 
 #: Lists longer than this are cut in the table (``--json`` always has them all).
@@ -24,6 +25,7 @@ def register(app: typer.Typer) -> None:
         model: Path = typer.Argument(..., help="Model file (FSM or BT, any format fsmbt reads)."),
         from_format: Optional[str] = typer.Option(None, "--from",
                                                   help="Input format (default: detected)."),
+        node_models: list[Path] = node_models_option(),
         as_json: bool = typer.Option(False, "--json", help="Print the figures as JSON."),
     ) -> None:
         """Structure at a glance: states, events, entry/loop states; BT nodes, depth, breadth.
@@ -32,7 +34,7 @@ def register(app: typer.Typer) -> None:
         loop states of DESIGN §3, hierarchy. BT: nodes by kind and type, depth, breadth,
         leaves, trees and SubTree references.
         """
-        stats = model_stats(api.load(model, from_format).model)
+        stats = model_stats(api.load(model, from_format, options=reader_options(node_models)).model)
         if as_json:
             print(json.dumps({"file": str(model), **stats.to_dict()}, indent=2, ensure_ascii=False))
             return

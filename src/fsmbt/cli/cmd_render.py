@@ -9,6 +9,7 @@ import typer
 
 from fsmbt.cli import EXIT_INTERNAL, fail
 from fsmbt import api
+from fsmbt.cli.options import node_models_option, reader_options
 from fsmbt.render import DEFAULT_MAX_NODES, GraphvizError, render_model
 
 
@@ -20,6 +21,7 @@ def register(app: typer.Typer) -> None:
                                     help="Picture to write: .svg, .png, .pdf, or .dot (source)."),
         from_format: Optional[str] = typer.Option(None, "--from",
                                                   help="Input format (default: detected)."),
+        node_models: list[Path] = node_models_option(),
         force: bool = typer.Option(False, "--force", help="Overwrite OUTPUT if it exists."),
         expand_subtrees: bool = typer.Option(
             False, "--expand-subtrees",
@@ -28,7 +30,7 @@ def register(app: typer.Typer) -> None:
                                       help="Refuse models with more states/nodes than this."),
     ) -> None:
         """Draw MODEL: FSMs as state diagrams, behavior trees top-down with the usual symbols."""
-        loaded = api.load(model, from_format).model
+        loaded = api.load(model, from_format, options=reader_options(node_models)).model
         try:
             written = render_model(loaded, output, overwrite=force,
                                    expand_subtrees=expand_subtrees, max_nodes=max_nodes)

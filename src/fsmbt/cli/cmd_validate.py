@@ -19,6 +19,7 @@ from rich.table import Table
 
 from fsmbt.cli import EXIT_BAD_INPUT, EXIT_OK
 from fsmbt import api
+from fsmbt.cli.options import node_models_option, reader_options
 from fsmbt.model.errors import SourceLocation
 from fsmbt.model.validate import Issue, validate
 
@@ -29,13 +30,14 @@ def register(app: typer.Typer) -> None:
         model: Path = typer.Argument(..., help="Model file (FSM or BT, any format fsmbt reads)."),
         from_format: Optional[str] = typer.Option(None, "--from",
                                                   help="Input format (default: detected)."),
+        node_models: list[Path] = node_models_option(),
         as_json: bool = typer.Option(False, "--json", help="Print the issues as JSON."),
         strict: bool = typer.Option(False, "--strict", help="Treat warnings as errors."),
     ) -> None:
         """Check a model: unknown nodes, wrong child counts, missing SubTrees, unknown or
         duplicate states, nondeterminism, empty models; warn about unreachable states,
         dead ends not marked final and parts fsmbt cannot model exactly."""
-        loaded = api.load(model, from_format)
+        loaded = api.load(model, from_format, options=reader_options(node_models))
         # reader warnings already start with their location; model issues get the file name
         issues = [Issue("warning", w) for w in loaded.warnings]
         issues += [_with_file(i, model) for i in validate(loaded.model)]

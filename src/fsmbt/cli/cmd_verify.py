@@ -14,6 +14,7 @@ import typer
 from rich.console import Console
 
 from fsmbt import api
+from fsmbt.cli.options import node_models_option, reader_options
 from fsmbt.cli.progress import StageProgress
 from fsmbt.verify import EngineDisagreement
 from fsmbt.verify.render_report import print_report
@@ -30,6 +31,7 @@ def register(app: typer.Typer) -> None:
         converted: Path = typer.Argument(..., help="The converted model to check against it."),
         as_json: bool = typer.Option(False, "--json", help="Print the report as JSON."),
         quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress display on stderr."),
+        node_models: list[Path] = node_models_option(),
         engine: str = typer.Option("native", "--engine",
                                    help="native, nusmv, or both (both must agree)."),
         loop: bool = typer.Option(False, "--loop",
@@ -47,6 +49,7 @@ def register(app: typer.Typer) -> None:
                 _, _, report = api.verify_files(source, converted, engine=engine, loop=loop,
                                                 source_format=from_format,
                                                 converted_format=from_format2,
+                                                options=reader_options(node_models),
                                                 on_stage=progress)
         except EngineDisagreement as exc:
             print(f"error: ENGINES DISAGREE: {exc}; one of the checkers is wrong, please report "
