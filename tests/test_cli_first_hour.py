@@ -188,3 +188,20 @@ def test_node_models_files_declare_custom_nodes(tmp_path: Path, command: str,
         assert out["conditions"] == 1 or out.get("by_kind", {}).get("Condition") == 1
     assert main([command, str(tree), "--node-models", str(tmp_path / "missing.xml")]) == 2
     assert "missing.xml" in capsys.readouterr().err
+
+
+def test_bt_to_mermaid_writes_exits_and_reads_back_equivalent(tmp_path: Path,
+                                                              capsys: pytest.CaptureFixture[str]
+                                                              ) -> None:
+    out = tmp_path / "robot.mmd"
+    assert main(["convert", str(ROBOT_BT), "-o", str(out)]) == 0
+    text = out.read_text(encoding="utf-8")
+    assert '%% fsmbt-exit: "SUCCESS"' in text and '%% fsmbt-exit: "FAILURE"' in text
+    capsys.readouterr()
+    assert main(["verify", str(ROBOT_BT), str(out)]) == 0
+    # a directive must be followed by the transition it names
+    broken = text.replace('%% fsmbt-exit: "SUCCESS"\n', '%% fsmbt-exit: "SUCCESS"\n    X : y\n', 1)
+    bad = tmp_path / "bad.mmd"
+    bad.write_text(broken, encoding="utf-8")
+    assert main(["validate", str(bad)]) == 2
+    assert "fsmbt-exit directive on line" in capsys.readouterr().err

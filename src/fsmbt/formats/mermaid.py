@@ -19,7 +19,11 @@ What is read, line by line (one statement a line, Mermaid's usual form):
 
 Writer directives (comments Mermaid ignores, the reader honours): ``%% fsmbt-name: id = "name"``
 for a state name that is not a Mermaid identifier, ``%% fsmbt-no-action: id`` for a state
-without action, ``%% fsmbt-start: "Name"`` for the start pseudo-state's name.
+without action, ``%% fsmbt-start: "Name"`` for the start pseudo-state's name, and
+``%% fsmbt-exit: "X"`` before a completion transition that fires only when the composite state's
+sub-machine ends in its final state ``X`` (a BT -> FSM conversion leaves a unit by ``SUCCESS`` or
+``FAILURE``): the transition is drawn ``U --> T : X``, so a person reads "when U ends in X, go
+to T", and the directive tells fsmbt's reader that ``X`` is an exit, not an event.
 Parsing is O(lines); nesting is handled with an explicit stack.
 """
 
@@ -49,6 +53,7 @@ _IGNORED_KEYWORDS = ("direction", "classDef", "class", "style", "click", "accTit
 _DIRECTIVE_NAME = re.compile(r'^%%\s*fsmbt-name:\s*(\S+)\s*=\s*(".*")\s*$')
 _DIRECTIVE_NO_ACTION = re.compile(r"^%%\s*fsmbt-no-action:\s*(\S+)\s*$")
 _DIRECTIVE_START = re.compile(r'^%%\s*fsmbt-start:\s*(".*")\s*$')
+_DIRECTIVE_EXIT = re.compile(r'^%%\s*fsmbt-exit:\s*(".*")\s*$')
 _WRITABLE_ID = re.compile(r"^[A-Za-z_]\w*$")
 _KEYWORDS = frozenset({"state", "note", "end", "direction", "class", "classDef", "style",
                        "click", "as", "stateDiagram", "accTitle", "accDescr", "linkStyle"})
@@ -72,6 +77,7 @@ class _MermaidReader:
         self.names: dict[str, str] = {}  # Mermaid id -> fsmbt name (fsmbt-name directives)
         self.no_action: set[str] = set()
         self.pending_start: str | None = None
+        self.pending_exit: tuple[str, int] | None = None  # fsmbt-exit directive, its line
 
     # -- helpers ---------------------------------------------------------------------------
     def fail(self, message: str, line: int, unsupported: bool = False) -> InputError:
@@ -110,6 +116,9 @@ class _MermaidReader:
     # -- statements -------------------------------------------------------------------------
     def transition(self, source: str, target: str, label: str | None, line: int) -> None:
         event = label.strip() if label is not None and label.strip() else None
+        if self.pending_exit is not None:
+            self.exit_transition(source, target, event, line)
+            return
         if source == "[*]" and target == "[*]":
             raise self.fail("'[*] --> [*]' names no state", line)
         if source == "[*]":
@@ -132,6 +141,23 @@ class _MermaidReader:
         src = self.declare(source, line)
         dst = self.declare(target, line)
         self.level.machine.add_transition(src.name, event, dst.name,
+                                          location=self.ctx.location(line))
+
+    def exit_transition(self, source: str, target: str, label: str | None, line: int) -> None:
+        """The transition after an ``fsmbt-exit`` directive: a completion transition by exit."""
+        assert self.pending_exit is not None
+        exit_name, directive_line = self.pending_exit
+        self.pending_exit = None
+        if "[*]" in (source, target):
+            raise self.fail(f"the fsmbt-exit directive on line {directive_line} must precede a "
+                            "transition between two states", line)
+        if label is not None and label != exit_name:
+            raise self.fail(f"the transition's label '{label}' differs from the exit "
+                            f"'{exit_name}' named by the fsmbt-exit directive on line "
+                            f"{directive_line}", line)
+        src = self.declare(source, line)
+        dst = self.declare(target, line)
+        self.level.machine.add_transition(src.name, None, dst.name, exit=exit_name,
                                           location=self.ctx.location(line))
 
     def open_composite(self, mermaid_id: str, description: str | None, line: int) -> None:
@@ -174,7 +200,7 @@ class _MermaidReader:
             if not line:
                 continue
             if line.startswith("%%"):
-                self.directive(line)
+                self.directive(line, line_no)
                 continue
             if not seen_header:
                 if not _HEADER.match(line):
@@ -182,6 +208,9 @@ class _MermaidReader:
                                     f"found {line[:40]!r}", line_no)
                 seen_header = True
                 continue
+            if self.pending_exit is not None and not _TRANSITION.match(line):
+                raise self.fail(f"the fsmbt-exit directive on line {self.pending_exit[1]} must "
+                                "be followed by a transition", line_no)
             skip_until = self.statement(line, line_no)
         if not seen_header:
             raise self.fail("not a Mermaid state diagram: no 'stateDiagram-v2' line", 1)
@@ -214,8 +243,16 @@ class _MermaidReader:
                 self.top.name = title or self.top.name
         raise self.fail("front matter '---' is never closed", first + 1)
 
-    def directive(self, line: str) -> None:
-        if match := _DIRECTIVE_NAME.match(line):
+    def directive(self, line: str, line_no: int) -> None:
+        if match := _DIRECTIVE_EXIT.match(line):
+            if self.pending_exit is not None:
+                raise self.fail("two fsmbt-exit directives without a transition between them",
+                                line_no)
+            try:
+                self.pending_exit = (str(json.loads(match.group(1))), line_no)
+            except json.JSONDecodeError:
+                raise self.fail("the fsmbt-exit directive needs a quoted name", line_no) from None
+        elif match := _DIRECTIVE_NAME.match(line):
             self.names[match.group(1)] = json.loads(match.group(2))
         elif match := _DIRECTIVE_NO_ACTION.match(line):
             self.no_action.add(match.group(1))
@@ -339,12 +376,13 @@ def write_mermaid(model: Model) -> str:
             else:
                 tail.append(f"[*] --> {ids.of(machine, machine.initial)}")
         for t in machine.transitions:
-            if t.exit is not None:
-                raise UnsupportedError(f"completion transition '{t.source}' --> '{t.target}' "
-                                       f"names an exit state ('{t.exit}'); Mermaid cannot")
             if t.source not in machine.states or t.target not in machine.states:
                 raise InputError(f"transition {t.source} --> {t.target} names an unknown state")
-            label = f" : {t.event}" if t.event is not None else ""
+            if t.exit is not None:  # completion by exit state: drawn with the exit's name
+                tail.append(f"%% fsmbt-exit: {json.dumps(t.exit)}")
+                label = f" : {t.exit}"
+            else:
+                label = f" : {t.event}" if t.event is not None else ""
             tail.append(f"{ids.of(machine, t.source)} --> {ids.of(machine, t.target)}{label}")
         for state in machine.states.values():
             if state.final:
