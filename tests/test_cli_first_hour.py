@@ -205,3 +205,13 @@ def test_bt_to_mermaid_writes_exits_and_reads_back_equivalent(tmp_path: Path,
     bad.write_text(broken, encoding="utf-8")
     assert main(["validate", str(bad)]) == 2
     assert "fsmbt-exit directive on line" in capsys.readouterr().err
+
+
+def test_formats_lists_what_each_writer_cannot_hold(capsys: pytest.CaptureFixture[str]) -> None:
+    from fsmbt.formats import formats
+
+    assert main(["formats"]) == 0
+    out = capsys.readouterr().out
+    assert "cannot hold" in out
+    limited = {f.name: f.cannot_hold for f in formats() if f.cannot_hold}
+    assert "parallel states" in limited["mermaid"] and "composite" in limited["csv"]

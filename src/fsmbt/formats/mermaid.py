@@ -430,4 +430,5 @@ def _sniff(text: str) -> bool:
 
 register(Format("mermaid", (".mmd", ".mermaid"), frozenset({"fsm"}),
                 "Mermaid stateDiagram-v2 (flat and composite states)",
-                read_mermaid, write_mermaid, _sniff, priority=25))
+                read_mermaid, write_mermaid, _sniff, priority=25,
+                cannot_hold="parallel states"))

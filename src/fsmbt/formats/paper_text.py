@@ -202,4 +202,5 @@ def _sniff(text: str) -> bool:
 
 register(Format("paper-text", (".txt",), frozenset({"fsm"}),
                 "the paper's 'States / Transitions' text (hierarchy by indentation)",
-                read_paper_text, write_paper_text, _sniff, priority=60))
+                read_paper_text, write_paper_text, _sniff, priority=60,
+                cannot_hold="parallel states"))

@@ -58,6 +58,8 @@ class Format:
     write: Writer | None = None
     sniff: Callable[[str], bool] | None = None
     priority: int = 50  # lower is tried first when sniffing content
+    #: what its writer refuses, in a person's words ("" when it holds every model of its kinds)
+    cannot_hold: str = ""
 
 
 _FORMATS: dict[str, Format] = {}

@@ -210,4 +210,6 @@ def _sniff(text: str) -> bool:
 
 register(Format("csv", (".csv",), frozenset({"fsm"}),
                 "transition table, CSV (source,event,target[,action])",
-                read_csv, write_csv, _sniff, priority=40))
+                read_csv, write_csv, _sniff, priority=40,
+                cannot_hold="composite or parallel states, a start pseudo-state, final states "
+                "with transitions, states without an action"))

@@ -81,4 +81,6 @@ def _sniff(text: str) -> bool:
 
 register(Format("md", (".md", ".markdown"), frozenset({"fsm"}),
                 "transition table, Markdown pipe table (source | event | target [| action])",
-                read_md, write_md, _sniff, priority=41))
+                read_md, write_md, _sniff, priority=41,
+                cannot_hold="composite or parallel states, a start pseudo-state, final states "
+                "with transitions, states without an action"))
