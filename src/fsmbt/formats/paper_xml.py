@@ -186,5 +186,4 @@ register(Format(
     "paper-xml", (".fsm.xml",), frozenset({"fsm"}),
     "the reference paper's FSM XML (<FSM>, <States>, <Transitions>)",
     read_paper_xml, write_paper_xml, _sniff, priority=30,
-,
     cannot_hold="composite or parallel states (flatten first)"))
