@@ -276,9 +276,13 @@ def load_for_engine(path: str | Path, engine: str, fmt: str | None = None, *,
     return Loaded(loaded.model, path, name, [], loaded.extracted)
 
 
+#: Options meant for the readers, not the engines (they travel in the same ``options`` dict).
+READER_OPTIONS = ("node_models",)
+
+
 def _reader_options(options: dict[str, object]) -> dict[str, object] | None:
     """The options a reader understands (``node_models``), out of the engine options."""
-    picked = {key: options[key] for key in ("node_models",) if key in options}
+    picked = {key: options[key] for key in READER_OPTIONS if key in options}
     return picked or None
 
 
@@ -502,7 +506,7 @@ def convert_file(source: str | Path, output: str | Path | None = None, *,
                  overwrite: bool = False, keep_not_equivalent: bool = False,
                  options: dict[str, object] | None = None,
                  on_stage: StageHook | None = None) -> Outcome:
-    """Read, convert, verify and write one model.
+    """Read, convert, verify and write one model file.
 
     The destination is checked first, so a refused output costs no conversion. The result is
     written only after verification, and only when it is equivalent (or not verified), unless
@@ -534,15 +538,52 @@ def convert_file(source: str | Path, output: str | Path | None = None, *,
         EngineDisagreement: ``verify_engine="both"`` and the engines disagree.
     """
     options = dict(options or {})
+    if output is not None:
+        check_destination(output, overwrite=overwrite)
+    timings: dict[str, float] = {}
+    with _timed(timings, "read", on_stage):
+        loaded = load_for_engine(source, engine, source_format, options=options)
+    outcome = convert_loaded(loaded, output, to=to, engine=engine, style=style, loop=loop,
+                             hierarchy=hierarchy, verify=verify, verify_engine=verify_engine,
+                             max_states=max_states, overwrite=overwrite,
+                             keep_not_equivalent=keep_not_equivalent, options=options,
+                             on_stage=on_stage)
+    outcome.timings = {**timings, **outcome.timings}
+    return outcome
+
+
+def convert_loaded(loaded: Loaded, output: str | Path | None = None, *,
+                   to: str | None = None, engine: str = "rules", style: str = "paper",
+                   loop: bool = False, hierarchy: str = "subtrees", verify: bool = True,
+                   verify_engine: str = "native", max_states: int = DEFAULT_MAX_STATES,
+                   overwrite: bool = False, keep_not_equivalent: bool = False,
+                   options: dict[str, object] | None = None,
+                   on_stage: StageHook | None = None) -> Outcome:
+    """Convert, verify and (optionally) write a model already read (a file, a text, an upload).
+
+    The same steps and rules as ``convert_file`` after reading; a text from ``load_text`` goes
+    through here, so the web page and the batch runner convert exactly as the CLI does.
+
+    Args:
+        loaded: the source, from ``load``, ``load_text`` or ``load_for_engine``.
+        output, to, engine, style, loop, hierarchy, verify, verify_engine, max_states,
+        overwrite, keep_not_equivalent, options, on_stage: as for ``convert_file``.
+
+    Returns:
+        The ``Outcome`` (``timings`` without "read").
+
+    Raises:
+        As ``convert_file``.
+    """
+    options = dict(options or {})
     destination = Path(output) if output is not None else None
     if destination is not None:
         check_destination(destination, overwrite=overwrite)
     timings: dict[str, float] = {}
-    with _timed(timings, "read", on_stage):
-        loaded = load_for_engine(source, engine, source_format, options=options)
     with _timed(timings, "convert", on_stage):
+        engine_options = {k: v for k, v in options.items() if k not in READER_OPTIONS}
         conversion = convert_model(loaded.model, engine, style=style, loop=loop,
-                                   hierarchy=hierarchy, **options)
+                                   hierarchy=hierarchy, **engine_options)
     fmt = output_format_for(model_kind(conversion.model), to=to, output=destination)
     text = dumps(conversion.model, fmt)
     report: Report | None = None
@@ -598,7 +639,7 @@ def verify_files(source: str | Path, converted: str | Path, *, engine: str = "na
 
 __all__ = [
     "DEFAULT_BT_FORMAT", "DEFAULT_FSM_FORMAT", "EQUIVALENT", "LLM_ENGINES", "NOT_EQUIVALENT",
-    "NOT_VERIFIED", "DestinationExists", "Loaded", "Model", "Outcome", "check_destination", "convert_file",
+    "NOT_VERIFIED", "DestinationExists", "Loaded", "Model", "Outcome", "check_destination", "convert_file", "convert_loaded",
     "convert_model", "load", "load_for_engine", "load_text", "model_kind", "output_format_for",
     "verdict_word", "verify_either_order", "verify_files", "verify_models", "write", "write_text",
 ]
