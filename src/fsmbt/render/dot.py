@@ -13,6 +13,7 @@ import subprocess
 from pathlib import Path
 
 import graphviz
+from graphviz import quoting
 
 from fsmbt.model.errors import FsmbtError, InputError, SourceLocation
 
@@ -66,20 +67,48 @@ def check_size(count: int, max_nodes: int, what: str) -> None:
             "--max-nodes, or use `fsmbt info` for its structure")
 
 
-def attach_clusters(clusters: list[tuple[graphviz.Digraph, graphviz.Digraph]],
-                    root: graphviz.Digraph) -> None:
-    """Nest clusters listed in pre-order as ``(cluster, parent)``, keeping sibling order.
+def dot_id(text: str) -> str:
+    """A model name as a DOT node id for the ``graphviz`` package: never read as an HTML id
+    (``<b>``), and a trailing backslash (which would escape the closing quote) padded with a
+    space."""
+    trailing = len(text) - len(text.rstrip("\\"))
+    return graphviz.nohtml(text + " " if trailing % 2 else text)
 
-    A cluster's DOT text is copied into its parent when attached, so children go in first:
-    walking the list backwards reaches every cluster after all of its descendants.
+
+def edge_line(tail: str, head: str, attrs: dict[str, str]) -> str:
+    """One edge statement. ``graphviz.Digraph.edge`` reads ``a:b`` as node ``a``, port ``b``;
+    model names may hold colons, so ends are quoted as plain ids here."""
+    rest = dict(attrs)
+    listed = quoting.attr_list(rest.pop("label", None), kwargs=rest)  # as Digraph.edge lists them
+    return f"\t{quoting.quote(tail)} -> {quoting.quote(head)}{listed}\n"
+
+
+def assemble(root: graphviz.Digraph, clusters: list[tuple[graphviz.Digraph, graphviz.Digraph]],
+             edges: list[str]) -> str:
+    """The DOT source of ``root`` with ``clusters`` nested inside it and ``edges`` after them.
+
+    ``clusters`` lists ``(cluster, parent)`` in pre-order. The source is written out in one
+    pre-order walk with an explicit stack (``graphviz.Digraph.subgraph`` copies a cluster's text
+    into its parent, quadratic in the nesting depth), each cluster's own statements first, then
+    its sub-clusters, then its closing brace. O(total lines).
     """
     children: dict[int, list[graphviz.Digraph]] = {}
-    for cluster, parent in reversed(clusters):
-        for child in reversed(children.pop(id(cluster), [])):
-            cluster.subgraph(child)
+    for cluster, parent in clusters:
         children.setdefault(id(parent), []).append(cluster)
-    for child in reversed(children.pop(id(root), [])):
-        root.subgraph(child)
+    out: list[str] = []
+    stack: list[tuple[graphviz.Digraph, str, bool]] = [(root, "", False)]
+    while stack:
+        graph, pad, closing = stack.pop()
+        if closing:
+            if graph is root:
+                out.extend(edges)
+            out.append(f"{pad}}}\n")
+            continue
+        lines = list(graph.__iter__(subgraph=graph is not root))
+        out.extend(f"{pad}{line}" if pad else line for line in lines[:-1])  # all but its "}"
+        stack.append((graph, pad, True))
+        stack.extend((child, pad + "\t", False) for child in reversed(children.get(id(graph), [])))
+    return "".join(out)
 
 
 def output_format(path: Path) -> str:
