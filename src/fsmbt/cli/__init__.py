@@ -14,6 +14,7 @@ import sys
 
 import typer
 
+from fsmbt.cli.hints import cli_message
 from fsmbt.model.errors import FsmbtError
 
 EXIT_OK = 0
@@ -59,7 +60,7 @@ def main(argv: list[str] | None = None) -> int:
     except FsmbtError as exc:
         if debug:
             raise
-        print(f"error: {exc}", file=sys.stderr)
+        print(f"error: {cli_message(exc)}", file=sys.stderr)
         return EXIT_BAD_INPUT
     except typer.Exit as exc:
         return int(exc.exit_code)

@@ -22,7 +22,7 @@ import graphviz
 
 from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.bt_nodes import NodeKind, canonical_type
-from fsmbt.model.errors import InputError
+from fsmbt.model.errors import Hint, InputError
 from fsmbt.render.dot import (
     DEFAULT_MAX_NODES, FONT, TooLargeError, assemble, check_size, edge_line, html_label,
     label_text,
@@ -122,8 +122,8 @@ class _Builder:
             self.count += 1
             if self.max_nodes is not None and self.count > self.max_nodes:
                 raise TooLargeError(f"too large to draw: more than {self.max_nodes} nodes "
-                                    f"(limit {self.max_nodes}); raise it with --max-nodes, or "
-                                    "draw without --expand-subtrees")
+                                    f"(limit {self.max_nodes})",
+                                    hints=(Hint.MAX_NODES, Hint.NO_EXPANSION))
             node_id = self.next_id("n")
             holder.node(node_id, **node_attrs(node, recursive=node.subtree_id in trees))
             if parent_id is not None:

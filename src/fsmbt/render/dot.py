@@ -15,10 +15,10 @@ from pathlib import Path
 import graphviz
 from graphviz import quoting
 
-from fsmbt.model.errors import FsmbtError, InputError, SourceLocation
+from fsmbt.model.errors import FsmbtError, Hint, InputError, SourceLocation
 
 #: Pictures of more nodes than this are refused: dot's layout time grows quickly and nobody
-#: reads such a picture. ``--max-nodes`` raises it.
+#: reads such a picture. Callers raise it with ``max_nodes``.
 DEFAULT_MAX_NODES = 5_000
 #: Seconds dot may run before it is stopped.
 DOT_TIMEOUT_S = 120.0
@@ -63,8 +63,8 @@ def check_size(count: int, max_nodes: int, what: str) -> None:
     if count > max_nodes:
         raise TooLargeError(
             f"too large to draw: {count} {what} (limit {max_nodes}); "
-            "a picture this big is unreadable and slow to lay out - raise the limit with "
-            "--max-nodes, or use `fsmbt info` for its structure")
+            "a picture this big is unreadable and slow to lay out",
+            hints=(Hint.MAX_NODES, Hint.STATISTICS))
 
 
 def dot_id(text: str) -> str:
@@ -125,7 +125,7 @@ def check_output(path: Path, *, overwrite: bool) -> str:
     """The picture format ``path`` asks for; refuses an existing file unless ``overwrite``."""
     fmt = output_format(path)
     if path.exists() and not overwrite:
-        raise InputError("exists; pass --force to overwrite it", location=SourceLocation(str(path)))
+        raise InputError("exists", location=SourceLocation(str(path)), hints=(Hint.OVERWRITE,))
     return fmt
 
 
