@@ -193,7 +193,7 @@ def sub_machine_events(*fsms: FSM) -> list[list[str]]:
     Returns:
         One event list per sub-machine (region), in walk order; flat machines add none.
     """
-    out = []
+    out: list[list[str]] = []
     for fsm in fsms:
         for _path, _machine, state in fsm.walk():
             out.extend(region.events() for region in state.regions)  # each sub-machine once
