@@ -45,7 +45,7 @@ from fsmbt.convert import ConversionResult, convert
 from fsmbt.formats import detect_format, dumps, get_format, loads
 from fsmbt.formats.registry import format_for_path, read_text
 from fsmbt.model.bt import BTDocument
-from fsmbt.model.errors import InputError, SourceLocation, UnsupportedError
+from fsmbt.model.errors import Hint, InputError, SourceLocation, UnsupportedError
 from fsmbt.model.fsm import FSM
 from fsmbt.verify import Report, verify
 from fsmbt.verify.native import DEFAULT_MAX_STATES
@@ -184,7 +184,8 @@ class DestinationExists(InputError):
     """The output file exists and replacing it was not asked for (the CLI names ``--force``)."""
 
     def __init__(self, location: SourceLocation) -> None:
-        super().__init__("exists; it is not overwritten unless asked to", location=location)
+        super().__init__("exists", location=location,
+                         hints=(Hint.OVERWRITE,))
 
 
 # -- read -------------------------------------------------------------------------------------

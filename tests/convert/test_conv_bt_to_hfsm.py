@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import pytest
-from conv_helpers import check, paper_robot_bt
 
 from fsmbt.convert import convert
 from fsmbt.convert.compress import compress
@@ -11,6 +10,7 @@ from fsmbt.model.bt import BehaviorTree, BTDocument, BTNode
 from fsmbt.model.bt_nodes import NodeKind
 from fsmbt.model.errors import InputError
 from fsmbt.model.flatten import flatten
+from support.conv_helpers import check, paper_robot_bt
 
 
 def _leaf(name: str, kind: NodeKind = NodeKind.ACTION) -> BTNode:

@@ -4,15 +4,12 @@ prose goes through the LLM's extraction step (scripted local server: plumbing on
 from __future__ import annotations
 
 import json
-import sys
 from pathlib import Path
 
 import pytest
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "llm"))
-from scripted_server import ScriptedServer  # noqa: E402
-
-from fsmbt.cli import main  # noqa: E402
+from fsmbt.cli import main
+from support.scripted_server import ScriptedServer
 
 FSM_JSON = {"kind": "fsm", "name": "door", "initial": "Closed",
             "states": [{"name": "Closed", "action": "close"}, {"name": "Open", "action": "open"}],

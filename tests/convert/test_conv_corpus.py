@@ -8,11 +8,11 @@ from collections import Counter
 from pathlib import Path
 
 import pytest
-from conv_helpers import check
 
 from fsmbt.convert import convert
 from fsmbt.formats import read_model
 from fsmbt.model.errors import InputError
+from support.conv_helpers import check
 
 CORPUS = Path(os.environ.get("FSMBT_CORPUS", Path(__file__).resolve().parents[3] / "shared" / "corpus"))
 MAX_CHECK_STATES = 200_000

@@ -6,15 +6,14 @@ from __future__ import annotations
 
 import gc
 
-from conv_helpers import paper_aj_fsm
-
 from fsmbt.convert import convert
 from fsmbt.convert.compress import compress, inline_and_compress, inline_subtrees, tree_depth
 from fsmbt.convert.perf import gc_paused
 from fsmbt.generate import random_bt, random_fsm
-from fsmbt.model.bt import BTDocument, BehaviorTree, BTNode
+from fsmbt.model.bt import BehaviorTree, BTDocument, BTNode
 from fsmbt.model.bt_nodes import NodeKind
 from fsmbt.semantics.lebt_spec import GUARD_TYPE, STATE_TYPE, GuardSpec, StateSpec
+from support.conv_helpers import paper_aj_fsm
 
 
 def _with_subtrees(seed: int) -> BTDocument:

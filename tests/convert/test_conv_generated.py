@@ -4,10 +4,10 @@ each conversion must be proven equivalent by the checker (100% is the only accep
 from __future__ import annotations
 
 import pytest
-from conv_helpers import check
 
 from fsmbt.convert import convert
 from fsmbt.generate import random_bt, random_fsm
+from support.conv_helpers import check
 
 SCENARIOS = ("basic", "robot", "game")
 FSM_SMALL, FSM_LARGE, BT_PAPER, BT_EXTENDED = 300, 100, 350, 250

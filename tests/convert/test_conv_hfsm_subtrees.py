@@ -8,14 +8,14 @@ import os
 from pathlib import Path
 
 import pytest
-from conv_hfsm_gen import random_hfsm
-from conv_helpers import check
 
 from fsmbt.convert import convert
 from fsmbt.convert.hfsm_to_bt import fsm_to_subtree_bt
 from fsmbt.formats import read_model
 from fsmbt.model.errors import InputError
 from fsmbt.model.fsm import FSM
+from support.conv_helpers import check
+from support.conv_hfsm_gen import random_hfsm
 
 REPO = Path(__file__).resolve().parents[2]
 CORPUS = Path(os.environ.get("FSMBT_CORPUS", REPO.parent / "shared" / "corpus"))

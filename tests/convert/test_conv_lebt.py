@@ -3,13 +3,13 @@
 from __future__ import annotations
 
 import pytest
-from conv_helpers import check, paper_aj_fsm
 
 from fsmbt.convert import convert
 from fsmbt.model.bt import BTNode
 from fsmbt.model.errors import UnsupportedError
 from fsmbt.model.fsm import FSM
 from fsmbt.semantics.lebt_spec import GUARD_TYPE, STATE_TYPE, GuardSpec, StateSpec
+from support.conv_helpers import check, paper_aj_fsm
 
 
 def _subtree_state(selector: BTNode) -> str:
@@ -116,11 +116,10 @@ def test_compact_style_is_refused() -> None:
 
 
 def test_cli_convert_verifies_writes_and_refuses_overwrite(tmp_path) -> None:
-    from conv_helpers import paper_robot_bt
-
     from fsmbt.cli import main
     from fsmbt.formats import loads, write_model
     from fsmbt.model.serialize import model_to_dict
+    from support.conv_helpers import paper_robot_bt
 
     source = tmp_path / "aj.json"
     write_model(paper_aj_fsm(), source)

@@ -8,9 +8,9 @@ import time
 from pathlib import Path
 
 import pytest
-from scripted_server import ScriptedServer, closed_port
 
 from fsmbt.cli import main
+from support.scripted_server import ScriptedServer, closed_port
 
 FSM_JSON = {"kind": "fsm", "name": "door", "initial": "Closed",
             "states": [{"name": "Closed", "action": "close"}, {"name": "Open", "action": "open"}],

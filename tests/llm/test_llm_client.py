@@ -7,7 +7,6 @@ from dataclasses import replace
 from pathlib import Path
 
 import pytest
-from scripted_server import ScriptedServer, closed_port
 
 from fsmbt.llm.client import LLMClient
 from fsmbt.llm.config import (
@@ -17,6 +16,7 @@ from fsmbt.llm.config import (
     LLMUnavailableError,
     resolve_settings,
 )
+from support.scripted_server import ScriptedServer, closed_port
 
 
 def settings_for(url: str, **changes: object) -> LLMSettings:

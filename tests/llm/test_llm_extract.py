@@ -8,13 +8,13 @@ import json
 from pathlib import Path
 
 import pytest
-from scripted_server import ScriptedServer
 
 from fsmbt.llm.client import LLMClient
 from fsmbt.llm.config import LLMSettings
 from fsmbt.llm.extract import LLMExtractionError, needs_llm, read_input
 from fsmbt.model.errors import InputError
 from fsmbt.model.fsm import FSM
+from support.scripted_server import ScriptedServer
 
 TURNSTILE = {"kind": "fsm", "name": "turnstile", "initial": "Locked",
              "states": [{"name": "Locked", "action": "lock"}, {"name": "Unlocked", "action": "unlock"}],

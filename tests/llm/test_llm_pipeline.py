@@ -11,7 +11,6 @@ from dataclasses import replace
 from pathlib import Path
 
 import pytest
-from scripted_server import ScriptedServer
 
 from fsmbt.formats.registry import loads
 from fsmbt.llm.client import LLMClient
@@ -20,6 +19,7 @@ from fsmbt.llm.engine import LLMConversionError, _run
 from fsmbt.llm.log import read_records
 from fsmbt.llm.pipeline import convert_with_llm
 from fsmbt.model.bt import BTDocument
+from support.scripted_server import ScriptedServer
 
 BT_XML = """<root BTCPP_format="4"><BehaviorTree ID="Main"><Sequence>
 <Condition ID="IsReady" name="IsReady"/><Action ID="Work" name="Work"/></Sequence></BehaviorTree>

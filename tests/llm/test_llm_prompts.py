@@ -5,7 +5,6 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from scripted_server import ScriptedServer
 
 from fsmbt.formats.registry import dumps
 from fsmbt.generate.generator import random_fsm
@@ -26,6 +25,7 @@ from fsmbt.llm.structural import check_lebt
 from fsmbt.llm.tokens import count_messages, count_text, encoding
 from fsmbt.model.errors import InputError
 from fsmbt.model.fsm import FSM
+from support.scripted_server import ScriptedServer
 
 PAPER_BUDGET = 1000  # the paper's upper figure for prompt tokens per conversion
 

@@ -15,7 +15,7 @@ from hypothesis import strategies as st
 
 from fsmbt.semantics.bt_interpreter import BTLivelock, BTRunner, BTRuntimeError
 from fsmbt.semantics.engines.btcpp_engine import BTCppRunner
-from fsmbt.semantics.random_trees import ALL_NODE_TYPES, OutcomeScript, random_tree
+from support.random_trees import ALL_NODE_TYPES, OutcomeScript, random_tree
 
 TICKS = 8
 SEEDS = st.integers(min_value=0, max_value=2**31 - 1)

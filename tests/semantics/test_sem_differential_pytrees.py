@@ -18,8 +18,11 @@ from fsmbt.model.bt_nodes import NodeKind
 from fsmbt.model.errors import UnsupportedError
 from fsmbt.semantics.bt_interpreter import BTRunner
 from fsmbt.semantics.engines.pytrees_engine import PyTreesRunner
-from fsmbt.semantics.random_trees import (
-    PYTREES_CONTROLS, PYTREES_DECORATORS, OutcomeScript, random_tree,
+from support.random_trees import (
+    PYTREES_CONTROLS,
+    PYTREES_DECORATORS,
+    OutcomeScript,
+    random_tree,
 )
 
 TICKS = 8

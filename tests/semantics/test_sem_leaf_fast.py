@@ -16,11 +16,11 @@ from fsmbt.generate import random_bt
 from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.bt_nodes import NodeKind
 from fsmbt.semantics.leaf_machine import LeafMachine, RootResult
-from fsmbt.semantics.random_trees import random_tree
 from fsmbt.verify import native
 from fsmbt.verify.mutations import mutants
 from fsmbt.verify.pairing import machines_for
 from fsmbt.verify.report import REACHABILITY
+from support.random_trees import random_tree
 
 PLAIN_SEEDS = range(200)
 PLAIN_TREE_SEEDS = range(150)  # random_trees: Sequence/Fallback + SubTree, tiny trees

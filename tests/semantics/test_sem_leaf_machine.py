@@ -14,10 +14,15 @@ from fsmbt.model.bt_nodes import NodeKind
 from fsmbt.semantics.bt_interpreter import BTRuntimeError
 from fsmbt.semantics.engines.btcpp_engine import BTCppRunner
 from fsmbt.semantics.leaf_machine import (
-    LIVELOCK, LeafMachine, RootResult, StateLimitError, explore, leaf_label,
+    LIVELOCK,
+    LeafMachine,
+    RootResult,
+    StateLimitError,
+    explore,
+    leaf_label,
 )
 from fsmbt.semantics.machine import FINAL, RUNNING
-from fsmbt.semantics.random_trees import random_tree
+from support.random_trees import random_tree
 
 
 def act(name: str) -> BTNode:

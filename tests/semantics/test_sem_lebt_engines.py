@@ -18,7 +18,7 @@ from fsmbt.semantics.engines.btcpp_engine import BTCppLebtRunner
 from fsmbt.semantics.engines.pytrees_engine import PyTreesLebtRunner
 from fsmbt.semantics.lebt_runtime import LEBTMachine
 from fsmbt.semantics.machine import FINAL, FSMMachine
-from fsmbt.semantics.random_trees import Structure, lebt_from_structure
+from support.random_trees import Structure, lebt_from_structure
 
 SEQUENCES = 40
 LENGTH = 14

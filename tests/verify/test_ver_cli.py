@@ -12,8 +12,7 @@ from fsmbt.cli import main
 from fsmbt.convert.lebt import fsm_to_lebt
 from fsmbt.formats import write_model
 from fsmbt.verify.report import PROPERTIES
-
-from ver_models import PAPER_EDGES, paper_fsm  # noqa: E402 (sibling test module)
+from support.ver_models import PAPER_EDGES, paper_fsm
 
 
 @pytest.fixture()

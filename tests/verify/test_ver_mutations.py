@@ -18,12 +18,16 @@ from fsmbt.verify import replay, verify
 from fsmbt.verify.mutations import mutants
 from fsmbt.verify.pairing import machines_for
 
-# the families live in a sibling module shared with the NuSMV agreement test (tests/nusmv)
-from mutation_families import (  # noqa: E402 (sibling test modules)
-    bt_pairs, converted_bt_pairs, fsm_pairs, leaf_fsm_by_exploration, lebt_pairs,
+# the families live in tests/support, shared with the NuSMV agreement test (tests/verify/nusmv)
+from support.mutation_families import (
+    bt_pairs,
+    converted_bt_pairs,
+    fsm_pairs,
+    leaf_fsm_by_exploration,
+    lebt_pairs,
     small_bt_and_leaf_fsm,
 )
-from ver_models import PAPER_EDGES, paper_fsm  # noqa: E402
+from support.ver_models import PAPER_EDGES, paper_fsm
 
 
 # -- independent random simulation ----------------------------------------------------------------
@@ -105,7 +109,7 @@ def run_family(pairs, mutate: str, family: str) -> Tally:
     return tally
 
 
-# -- the families (tests/verify/mutation_families.py) ----------------------------------------------
+# -- the families (tests/support/mutation_families.py) ----------------------------------------------
 def test_fsm_vs_fsm_mutants_are_caught():
     tally = run_family(fsm_pairs(), "result", "FSM vs FSM")
     assert {"retarget_transition", "drop_transition", "change_action", "flip_final"} <= set(

@@ -25,8 +25,7 @@ from fsmbt.verify.report import (
     REACHABILITY,
     TERMINATION_CONSISTENCY,
 )
-
-from ver_models import PAPER_EDGES, paper_fsm  # noqa: E402 (sibling test module)
+from support.ver_models import PAPER_EDGES, paper_fsm
 
 
 def pair(source: FSM, result: FSM):

@@ -14,7 +14,7 @@ import sys
 
 import typer
 
-from fsmbt.api import DestinationExists
+from fsmbt.cli.hints import cli_message
 from fsmbt.model.errors import FsmbtError
 
 EXIT_OK = 0
@@ -74,13 +74,10 @@ def main(argv: list[str] | None = None) -> int:
     try:
         # without standalone mode click returns a raised typer.Exit's code instead of exiting
         code = app(args=argv, standalone_mode=False)
-    except DestinationExists as exc:
-        print(f"error: {exc}; pass --force to replace it", file=sys.stderr)
-        return EXIT_BAD_INPUT
     except FsmbtError as exc:
         if debug:
             raise
-        print(f"error: {exc}", file=sys.stderr)
+        print(f"error: {cli_message(exc)}", file=sys.stderr)
         return EXIT_BAD_INPUT
     except typer.Exit as exc:
         return int(exc.exit_code)

@@ -40,7 +40,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from fsmbt.convert.engines import ConversionResult
-from fsmbt.convert.lebt import ROOT_NAME, _LeafWriter, fsm_to_lebt, lebt_node_models
+from fsmbt.convert.lebt import ROOT_NAME, LebtLeafWriter, fsm_to_lebt, lebt_node_models
 from fsmbt.convert.perf import without_gc_pauses
 from fsmbt.convert.structure import analyse
 from fsmbt.model.bt import BehaviorTree, BTDocument, BTNode
@@ -148,7 +148,7 @@ def fsm_to_subtree_bt(fsm: FSM, *, style: str = "paper", **options: object) -> C
         warnings.append(f"parallel state(s) {', '.join(parallel[:5])}: their regions are one "
                         "SubTree over the product of the regions (no tree per region)")
 
-    writer = _LeafWriter(flat, structure)
+    writer = LebtLeafWriter(flat, structure)
     # per level: predecessor nodes of each node, and where each flat pair's target lies
     guard_pairs: dict[str, list[tuple[str, str]]] = {}
     preds: dict[str, dict[str, None]] = {}

@@ -57,11 +57,14 @@ def lebt_node_models() -> dict[str, NodeModel]:
     }
 
 
-class _LeafWriter:
+class LebtLeafWriter:
     """Writes the guard and state leaves' ports exactly as ``GuardSpec.to_attrs`` /
     ``StateSpec.to_attrs`` do, escaping each distinct name once (names repeat: a state is the
     source of all its outgoing pairs, an event occurs on many transitions). Asserted equal to
-    the spec classes in the tests."""
+    the spec classes in the tests.
+
+    Public because both LEBT builders use it: ``fsm_to_lebt`` here and the hierarchical
+    ``fsmbt.convert.hfsm_to_bt`` (one writer per flat machine and its ``LebtStructure``)."""
 
     def __init__(self, fsm: FSM, structure: LebtStructure) -> None:
         self.fsm = fsm
@@ -118,7 +121,7 @@ def _build(fsm: FSM, structure: LebtStructure) -> tuple[BTNode, int, int]:
     A selector on level ``L`` holds its guard and body on ``L + 1``; a body Sequence holds the
     state leaf and the child selectors on ``L + 2``. O(S + T).
     """
-    writer = _LeafWriter(fsm, structure)
+    writer = LebtLeafWriter(fsm, structure)
     root = BTNode(type="Sequence", kind=NodeKind.CONTROL, name=ROOT_NAME)
     nodes, depth = 1, 1
     pending: list[tuple[str, BTNode, int]] = []

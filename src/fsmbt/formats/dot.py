@@ -1,12 +1,13 @@
 """Graphviz DOT: write FSMs (flat or hierarchical) and BTs; read simple state digraphs.
 
-Written FSMs: every state a node (``doublecircle`` when final), the initial arrow from a
-``point``-shaped start node (``__start__``, or the start pseudo-state's name, its edge labelled
-with the initial event), transitions as edges labelled with their event, composite states as
-``cluster_`` subgraphs with their own start point. A state whose action differs from its name
-carries an ``action`` attribute (Graphviz ignores unknown attributes) and shows it in its label.
-Written BTs: a top-down tree per behavior tree (→ Sequence, ? Fallback, ⇉ Parallel; conditions
-as ellipses, actions as rounded boxes, decorators as hexagons, SubTree as 3-D boxes).
+Writing goes through the one DOT writer, ``fsmbt.render`` (``fsm_to_dot(..., exchange=True)``,
+``bt_to_dot``), so ``fsmbt convert --to dot`` and ``fsmbt render x.dot`` draw with the same
+shapes, symbols and clusters. Written FSMs: every state a node whose id is its name (a path
+inside composite states; ``doublecircle`` when final, an ``action`` attribute when its action
+differs from its name), the initial arrow from a ``point``-shaped start node (``__start__``, or
+the start pseudo-state's name, its edge labelled with the initial event), one edge per
+transition labelled with its event, composite states as ``cluster_`` subgraphs with their own
+start point. Written BTs: the picture's top-down tree per behavior tree (write-only).
 
 Read (docs/formats/dot.md) is the simple subset hand-written state digraphs use, parsed by a
 small tokenizer here (no pydot): ``[strict] digraph [name] { ... }`` with node statements,
@@ -27,12 +28,10 @@ from dataclasses import dataclass
 
 from fsmbt.formats.registry import Format, ReadContext, register
 from fsmbt.model import Model
-from fsmbt.model.bt import BTDocument, BTNode
-from fsmbt.model.bt_nodes import NodeKind
 from fsmbt.model.errors import InputError, UnsupportedError
 from fsmbt.model.fsm import FSM, State
-
-START_NODE = "__start__"
+from fsmbt.render.bt_graph import bt_to_dot
+from fsmbt.render.fsm_graph import START_NODE, fsm_to_dot
 
 
 # -- tokenizer ------------------------------------------------------------------------------
@@ -269,145 +268,22 @@ def read_dot(text: str, ctx: ReadContext) -> Model:
 
 
 # -- writer ---------------------------------------------------------------------------------
-def quote(text: str) -> str:
-    """A DOT double-quoted string (``"`` escaped; a trailing backslash cannot end it)."""
-    body = text.replace('"', '\\"')
-    if body.endswith("\\") and not body.endswith('\\"'):
-        body += " "
-    return f'"{body}"'
-
-
-def _label(text: str) -> str:
-    """A label: backslash sequences (\\n, \\N) would be interpreted, so backslashes double."""
-    return quote(text.replace("\\", "\\\\"))
-
-
-def write_fsm_dot(fsm: FSM) -> str:
-    lines = [f"digraph {quote(fsm.name)} {{", "    rankdir=LR;", "    compound=true;",
-             "    node [shape=circle, fontname=\"Helvetica\"];",
-             "    edge [fontname=\"Helvetica\", fontsize=10];"]
-    # explicit stack of (machine, path prefix, indent); composite states become clusters
-    stack: list[tuple[FSM, str, int, str | None]] = [(fsm, "", 1, None)]
-    body: list[str] = []
-    edges: list[str] = []
-    while stack:
-        machine, prefix, depth, closing = stack.pop()
-        pad = "    " * depth
-        if closing is not None:
-            body.append(closing)
-            continue
-        start_id = f"{prefix}{machine.start_name or START_NODE}"
-        anchor = {name: f"{prefix}{name}" for name in machine.states}
-        cluster = {name: f"cluster_{prefix}{name}" for name, s in machine.states.items()
-                   if s.regions}
-        if machine.initial is not None:
-            body.append(f"{pad}{quote(start_id)} [shape=point, width=0.15, label=\"\"];")
-            start_attrs = f" [label={_label(machine.initial_event)}]" if machine.initial_event else ""
-            target = anchor.get(machine.initial, f"{prefix}{machine.initial}")
-            extra = ""
-            if machine.initial in cluster:
-                target = f"{prefix}{machine.initial}/{machine.states[machine.initial].regions[0].start_name or START_NODE}"
-                extra = f" [lhead={quote(cluster[machine.initial])}]"
-            edges.append(f"    {quote(start_id)} -> {quote(target)}{start_attrs}{extra}")
-        for state in machine.states.values():
-            node_id = anchor[state.name]
-            if state.regions:
-                continue
-            attrs = []
-            if state.final:
-                attrs.append("shape=doublecircle")
-            shown = state.name if state.action in (state.name, None) else f"{state.name}\n/ {state.action}"
-            if state.action != state.name:
-                attrs.append(f"action={quote(state.action or '')}")
-            attrs.append(f"label={quote(shown)}")
-            body.append(f"{pad}{quote(node_id)} [{', '.join(attrs)}];")
-        for t in machine.transitions:
-            source, target = anchor.get(t.source, prefix + t.source), anchor.get(t.target, prefix + t.target)
-            extra = []
-            if t.source in cluster:
-                inner = machine.states[t.source].regions[0]
-                source = f"{prefix}{t.source}/{inner.start_name or START_NODE}"
-                extra.append(f"ltail={quote(cluster[t.source])}")
-            if t.target in cluster:
-                inner = machine.states[t.target].regions[0]
-                target = f"{prefix}{t.target}/{inner.start_name or START_NODE}"
-                extra.append(f"lhead={quote(cluster[t.target])}")
-            if t.event is not None:
-                extra.insert(0, f"label={_label(t.event)}")
-            suffix = f" [{', '.join(extra)}]" if extra else ""
-            edges.append(f"    {quote(source)} -> {quote(target)}{suffix}")
-        for state in reversed([s for s in machine.states.values() if s.regions]):
-            inner_prefix = f"{prefix}{state.name}/"
-            stack.append((machine, prefix, depth, f"{pad}}}"))
-            for index, region in reversed(list(enumerate(state.regions))):
-                region_prefix = inner_prefix if len(state.regions) == 1 else f"{inner_prefix}{index}:"
-                stack.append((region, region_prefix, depth + 1, None))
-            title = state.name + (" (parallel)" if state.is_parallel else "")
-            stack.append((machine, prefix, depth,
-                          f"{pad}subgraph {quote(cluster[state.name])} {{\n{pad}    "
-                          f"label={_label(title)}; style=rounded;"))
-    return "\n".join(lines + body + edges + ["}"]) + "\n"
-
-
-_SYMBOLS = {
-    "Sequence": "→", "SequenceWithMemory": "→*", "ReactiveSequence": "R→", "AsyncSequence": "→",
-    "Fallback": "?", "ReactiveFallback": "R?", "AsyncFallback": "?",
-    "Parallel": "⇉", "ParallelAll": "⇉",
-}
-_SHAPES = {
-    NodeKind.CONTROL: 'shape=box, style="filled", fillcolor="#dddddd"',
-    NodeKind.DECORATOR: 'shape=hexagon, style="filled", fillcolor="#f3e6c4"',
-    NodeKind.CONDITION: 'shape=ellipse, style="filled", fillcolor="#d5ecd4"',
-    NodeKind.ACTION: 'shape=box, style="rounded,filled", fillcolor="#d4e4f7"',
-    NodeKind.SUBTREE: 'shape=box3d, style="filled", fillcolor="#eeeeee"',
-}
-
-
-def _bt_label(node: BTNode) -> str:
-    symbol = _SYMBOLS.get(node.type)
-    if node.kind is NodeKind.SUBTREE:
-        head = f"SubTree {node.subtree_id or '?'}"
-        return head if node.name in (None, node.subtree_id) else f"{head}\n{node.name}"
-    if symbol is not None:
-        return symbol if node.name in (None, node.type) else f"{symbol}\n{node.name}"
-    if node.name and node.name != node.type:
-        return f"{node.name}\n({node.type})"
-    return node.type
-
-
-def write_bt_dot(doc: BTDocument) -> str:
-    lines = ["digraph \"bt\" {", "    rankdir=TB;", "    ordering=out;",
-             "    node [fontname=\"Helvetica\"];"]
-    counter = 0
-    several = len(doc.trees) > 1
-    for tree in doc.trees.values():
-        pad = "        " if several else "    "
-        if several:
-            main = " (main)" if tree.id == doc.main.id else ""
-            lines.append(f"    subgraph {quote('cluster_' + tree.id)} {{")
-            lines.append(f"        label={_label(tree.id + main)}; style=rounded;")
-        if tree.root is None:
-            lines.append(f"{pad}{quote(f'n{counter}')} [label={_label(tree.id + ' (empty)')}];")
-            counter += 1
-        else:
-            stack: list[tuple[BTNode, str | None]] = [(tree.root, None)]
-            while stack:  # iterative pre-order: trees may be 100 000 deep
-                node, parent = stack.pop()
-                node_id = f"n{counter}"
-                counter += 1
-                lines.append(f"{pad}{node_id} [label={_label(_bt_label(node))}, "
-                             f"{_SHAPES[node.kind]}];")
-                if parent is not None:
-                    lines.append(f"{pad}{parent} -> {node_id};")
-                stack.extend((child, node_id) for child in reversed(node.children))
-        if several:
-            lines.append("    }")
-    lines.append("}")
-    return "\n".join(lines) + "\n"
-
-
 def write_dot(model: Model) -> str:
-    return write_fsm_dot(model) if isinstance(model, FSM) else write_bt_dot(model)
+    """The DOT file of ``model``, written by the one DOT writer (``fsmbt.render``).
+
+    FSMs use its exchange mode (state names as node ids, one edge per transition, exact event
+    labels) so that ``read_dot`` reads a flat FSM back exactly; BTs are the picture's DOT
+    (write-only). No size limit applies, unlike ``fsmbt render``.
+
+    Args:
+        model: an FSM or a BT document.
+
+    Returns:
+        The DOT source text.
+    """
+    if isinstance(model, FSM):
+        return fsm_to_dot(model, max_nodes=None, exchange=True)
+    return bt_to_dot(model, max_nodes=None)
 
 
 def _sniff(text: str) -> bool:

@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from fsmbt.model.errors import InputError, SourceLocation
+from fsmbt.model.errors import Hint, InputError, SourceLocation
 
 if TYPE_CHECKING:
     from fsmbt.model import Model
@@ -120,9 +120,10 @@ def detect_format(text: str, path: Path | None = None) -> Format:
         by_ext = format_for_path(path)
         if by_ext is not None:
             return by_ext
-    raise InputError("cannot tell the format of this input; name it with --from "
-                     f"({', '.join(f.name for f in formats() if f.read)})",
-                     location=SourceLocation(str(path) if path else None))
+    raise InputError("cannot tell the format of this input "
+                     f"(known: {', '.join(f.name for f in formats() if f.read)})",
+                     location=SourceLocation(str(path) if path else None),
+                     hints=(Hint.INPUT_FORMAT,))
 
 
 def decode(data: bytes, name: str) -> str:
@@ -217,10 +218,11 @@ def write_model(model: Model, path: str | Path, fmt: str | None = None, *,
     kind = "fsm" if _is_fsm(model) else "bt"
     chosen = get_format(fmt) if fmt else format_for_path(path, writing=True, kind=kind)
     if chosen is None:
-        raise InputError(f"cannot tell the output format from '{path.name}'; use --to")
+        raise InputError(f"cannot tell the output format from '{path.name}'",
+                         hints=(Hint.OUTPUT_FORMAT,))
     text = dumps(model, chosen.name)
     if path.exists() and not overwrite:
-        raise InputError("exists; pass --force to overwrite it", location=SourceLocation(str(path)))
+        raise InputError("exists", location=SourceLocation(str(path)), hints=(Hint.OVERWRITE,))
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
         path.write_text(text, encoding="utf-8")

@@ -44,7 +44,7 @@ class _Refused(Exception):
 
 
 try:  # libyaml's parser when PyYAML was built with it (the pinned wheels are)
-    from yaml._yaml import CParser as _Parser
+    from yaml.cyaml import CParser as _Parser  # PyYAML's public name for libyaml's parser
 except ImportError:  # pragma: no cover - pure-Python fallback
     _Parser = yaml.parser.Parser  # type: ignore[assignment,misc]
 

@@ -19,7 +19,7 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
-from fsmbt.model.errors import InputError
+from fsmbt.model.errors import Hint, InputError
 
 
 class LLMConfigError(InputError):
@@ -144,13 +144,14 @@ def resolve_settings(
     raw_url = pick(base_url, "FSMBT_LLM_BASE_URL", "base_url") or pick(None, None, "provider")
     if not raw_url:
         raise LLMConfigError(
-            "no LLM endpoint configured: set --llm-base-url or FSMBT_LLM_BASE_URL (a URL or one of "
-            f"{', '.join(sorted(PROVIDERS))}), or base_url in fsmbt.toml [llm]; "
-            "the rules engine (--engine rules) needs none")
+            "no LLM endpoint configured (the rules engine needs none): set FSMBT_LLM_BASE_URL "
+            f"(a URL or one of {', '.join(sorted(PROVIDERS))}) or base_url in fsmbt.toml [llm]",
+            hints=(Hint.LLM_BASE_URL, Hint.RULES_ENGINE))
     url, provider = resolve_base_url(str(raw_url))
     chosen_model = pick(model, "FSMBT_LLM_MODEL", "model") or (provider.default_model if provider else None)
     if not chosen_model:
-        raise LLMConfigError(f"no LLM model configured for {url}: set --llm-model or FSMBT_LLM_MODEL")
+        raise LLMConfigError(f"no LLM model configured for {url}: set FSMBT_LLM_MODEL",
+                             hints=(Hint.LLM_MODEL,))
     key = pick(api_key, "FSMBT_LLM_API_KEY", "api_key") or env.get("OPENAI_API_KEY")
     if not key:
         if provider is not None and not provider.needs_key:

@@ -27,7 +27,7 @@ from fsmbt.llm.client import LLMClient
 from fsmbt.llm.config import resolve_settings
 from fsmbt.llm.pipeline import LLMOutcome, convert_with_llm, default_verifier
 from fsmbt.model.bt import BTDocument
-from fsmbt.model.errors import FsmbtError, UnsupportedError
+from fsmbt.model.errors import FsmbtError, Hint, UnsupportedError
 from fsmbt.model.fsm import FSM
 
 Model = FSM | BTDocument
@@ -49,7 +49,8 @@ def client_from_options(options: dict[str, Any]) -> LLMClient:
 
 def _refuse_loop(engine: str, options: dict[str, Any]) -> None:
     if options.get("loop"):
-        raise UnsupportedError(f"engine '{engine}' converts without the loop option; use --engine rules")
+        raise UnsupportedError(f"engine '{engine}' converts without the loop option",
+                               hints=(Hint.RULES_ENGINE,))
 
 
 def _run(engine: str, model: Model, scp: bool, options: dict[str, Any]) -> ConversionResult:

@@ -30,7 +30,7 @@ from fsmbt.llm.log import EXTRACTED, INVALID_ANSWER, UNAVAILABLE, ConversionReco
 from fsmbt.llm.parsing import AnswerError, extract_json
 from fsmbt.llm.prompts import DEFAULT_VERSION, extraction_messages, feedback_message
 from fsmbt.model.bt import BTDocument
-from fsmbt.model.errors import FsmbtError, InputError, SourceLocation
+from fsmbt.model.errors import FsmbtError, Hint, InputError, SourceLocation
 from fsmbt.model.fsm import FSM
 
 Model = FSM | BTDocument
@@ -111,13 +111,12 @@ def read_input(path: str | Path, fmt: str | None = None, *, client: LLMClient | 
                     raise
                 if client is None:
                     raise InputError(f"{exc.message} (read as {parser.name} from the file name; if "
-                                     "it is prose or another notation, an LLM can extract the model: "
-                                     "--engine llm|nllm|hybrid, or fsmbt llm extract)",
-                                     location=exc.location, element=exc.element) from None
+                                     "it is prose or another notation, an LLM can extract the "
+                                     "model)", location=exc.location, element=exc.element,
+                                     hints=(*exc.hints, Hint.LLM_ENGINE)) from None
         elif client is None:
-            raise InputError("no reader knows this input; an LLM can extract the model from it "
-                             "(--engine llm|nllm|hybrid, or fsmbt llm extract)",
-                             location=SourceLocation(str(path)))
+            raise InputError("no reader knows this input; an LLM can extract the model from it",
+                             location=SourceLocation(str(path)), hints=(Hint.LLM_ENGINE,))
     if client is None:
         raise InputError("this input needs an LLM to extract the model (configure one: "
                          "docs/llm.md)", location=SourceLocation(str(path)))

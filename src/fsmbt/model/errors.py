@@ -2,11 +2,50 @@
 
 The CLI turns any ``FsmbtError`` into one line on stderr and exit code 2 (bad input); nothing
 else in the library should let a raw exception reach the user.
+
+An error may carry ``hints``: ways past it, named in the library's terms (``Hint``), never as a
+command-line flag. ``str(error)`` words them with ``HINT_TEXT``; a front end words them its own
+way through ``FsmbtError.text(wording)`` (the CLI's wording, with its flags, is
+``fsmbt.cli.hints``).
 """
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
+from enum import Enum
+
+
+class Hint(str, Enum):
+    """A way past an error: the choice a caller of the library can change."""
+
+    INPUT_FORMAT = "input_format"  # name the input's format instead of detecting it
+    OUTPUT_FORMAT = "output_format"  # name the output's format
+    OVERWRITE = "overwrite"  # allow replacing an existing file
+    NATIVE_VERIFIER = "native_verifier"  # verify with the native checker
+    RULES_ENGINE = "rules_engine"  # convert with the rules engine
+    LLM_ENGINE = "llm_engine"  # let an LLM engine extract the model from the input
+    MAX_NODES = "max_nodes"  # raise a picture's node limit
+    STATISTICS = "statistics"  # read a model's structure from its statistics instead
+    NO_EXPANSION = "no_expansion"  # draw without expanding SubTree references
+    LLM_BASE_URL = "llm_base_url"  # give the LLM endpoint
+    LLM_MODEL = "llm_model"  # give the LLM model name
+
+
+#: Each hint in the library's own words (``str(error)``).
+HINT_TEXT: Mapping[Hint, str] = {
+    Hint.INPUT_FORMAT: "name its format (fmt=...)",
+    Hint.OUTPUT_FORMAT: "name the output format (fmt=...)",
+    Hint.OVERWRITE: "pass overwrite=True to replace it",
+    Hint.NATIVE_VERIFIER: "verify with engine='native'",
+    Hint.RULES_ENGINE: "convert with engine='rules'",
+    Hint.LLM_ENGINE: "convert with engine='llm', 'nllm' or 'hybrid', which extract the model",
+    Hint.MAX_NODES: "raise max_nodes",
+    Hint.STATISTICS: "read its structure from fsmbt.model.stats",
+    Hint.NO_EXPANSION: "draw with expand_subtrees=False",
+    Hint.LLM_BASE_URL: "pass base_url=...",
+    Hint.LLM_MODEL: "pass model=...",
+}
 
 
 @dataclass(frozen=True)
@@ -35,16 +74,31 @@ class FsmbtError(Exception):
         *,
         location: SourceLocation | None = None,
         element: str | None = None,
+        hints: tuple[Hint, ...] = (),
     ) -> None:
         super().__init__(message)
         self.message = message
         self.location = location
         self.element = element
+        self.hints = hints
 
-    def __str__(self) -> str:
+    def text(self, wording: Mapping[Hint, str] = HINT_TEXT) -> str:
+        """The one-line report: location, element, message, then the hints in ``wording``.
+
+        Args:
+            wording: the words for each hint (a hint missing from it falls back to
+                ``HINT_TEXT``).
+
+        Returns:
+            ``file:line:column: element: message; hint or hint``.
+        """
         prefix = f"{self.location}: " if self.location is not None else ""
         where = f"{self.element}: " if self.element else ""
-        return f"{prefix}{where}{self.message}"
+        advice = " or ".join(wording.get(h, HINT_TEXT[h]) for h in self.hints)
+        return f"{prefix}{where}{self.message}" + (f"; {advice}" if advice else "")
+
+    def __str__(self) -> str:
+        return self.text()
 
 
 class InputError(FsmbtError):

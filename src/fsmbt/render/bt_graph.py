@@ -11,6 +11,9 @@ Every tree of the document is drawn, each in a cluster when there are several. W
 ``expand_subtrees`` only the main tree is drawn and each SubTree reference gets the tree it names
 below it, in a dashed cluster (a recursive reference is not expanded again). Built with an
 explicit stack; complexity O(N) for N drawn nodes, refused beyond ``max_nodes``.
+
+This is also the DOT file format's BT writer (``fsmbt convert --to dot``, through
+``fsmbt.formats.dot``, with no size limit); BT DOT is write-only (docs/formats/dot.md).
 """
 
 from __future__ import annotations
@@ -19,9 +22,9 @@ import graphviz
 
 from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.bt_nodes import NodeKind, canonical_type
-from fsmbt.model.errors import InputError
+from fsmbt.model.errors import Hint, InputError
 from fsmbt.render.dot import (
-    DEFAULT_MAX_NODES, FONT, TooLargeError, attach_clusters, check_size, html_label,
+    DEFAULT_MAX_NODES, FONT, TooLargeError, assemble, check_size, edge_line, html_label,
     label_text,
 )
 
@@ -54,11 +57,20 @@ MAX_ATTRS_SHOWN = 4
 
 
 def bt_to_dot(doc: BTDocument, *, expand_subtrees: bool = False,
-              max_nodes: int = DEFAULT_MAX_NODES) -> str:
-    """DOT source of the picture of ``doc``; refuses more than ``max_nodes`` nodes."""
+              max_nodes: int | None = DEFAULT_MAX_NODES) -> str:
+    """DOT source of the picture of ``doc``.
+
+    Args:
+        doc: the behavior tree document.
+        expand_subtrees: draw the main tree only, each SubTree reference with its tree below it.
+        max_nodes: refuse (``TooLargeError``) more drawn nodes than this; ``None``: no limit.
+
+    Returns:
+        The DOT source text.
+    """
     if not doc.trees:
         raise InputError("the document holds no behavior tree")
-    if not expand_subtrees:
+    if not expand_subtrees and max_nodes is not None:
         check_size(sum(1 for _ in doc.nodes()), max_nodes, "nodes")
     root = graphviz.Digraph(name="bt")
     root.attr(rankdir="TB", ordering="out", fontname=FONT, nodesep="0.25", ranksep="0.45")
@@ -83,7 +95,7 @@ def bt_to_dot(doc: BTDocument, *, expand_subtrees: bool = False,
 
 
 class _Builder:
-    def __init__(self, doc: BTDocument, root: graphviz.Digraph, max_nodes: int,
+    def __init__(self, doc: BTDocument, root: graphviz.Digraph, max_nodes: int | None,
                  expanding: bool) -> None:
         self.doc = doc
         self.expanding = expanding
@@ -108,10 +120,10 @@ class _Builder:
         while stack:
             node, parent_id, holder, trees = stack.pop()
             self.count += 1
-            if self.count > self.max_nodes:
+            if self.max_nodes is not None and self.count > self.max_nodes:
                 raise TooLargeError(f"too large to draw: more than {self.max_nodes} nodes "
-                                    f"(limit {self.max_nodes}); raise it with --max-nodes, or "
-                                    "draw without --expand-subtrees")
+                                    f"(limit {self.max_nodes})",
+                                    hints=(Hint.MAX_NODES, Hint.NO_EXPANSION))
             node_id = self.next_id("n")
             holder.node(node_id, **node_attrs(node, recursive=node.subtree_id in trees))
             if parent_id is not None:
@@ -128,10 +140,8 @@ class _Builder:
             stack.extend((child, node_id, holder, trees) for child in reversed(node.children))
 
     def finish(self) -> str:
-        attach_clusters(self.clusters, self.root)
-        for tail, head, attrs in self.edges:
-            self.root.edge(tail, head, **attrs)
-        return self.root.source
+        return assemble(self.root, self.clusters,
+                        [edge_line(tail, head, attrs) for tail, head, attrs in self.edges])
 
 
 def node_attrs(node: BTNode, *, recursive: bool = False) -> dict[str, str]:

@@ -13,11 +13,12 @@ import subprocess
 from pathlib import Path
 
 import graphviz
+from graphviz import quoting
 
-from fsmbt.model.errors import FsmbtError, InputError, SourceLocation
+from fsmbt.model.errors import FsmbtError, Hint, InputError, SourceLocation
 
 #: Pictures of more nodes than this are refused: dot's layout time grows quickly and nobody
-#: reads such a picture. ``--max-nodes`` raises it.
+#: reads such a picture. Callers raise it with ``max_nodes``.
 DEFAULT_MAX_NODES = 5_000
 #: Seconds dot may run before it is stopped.
 DOT_TIMEOUT_S = 120.0
@@ -62,24 +63,52 @@ def check_size(count: int, max_nodes: int, what: str) -> None:
     if count > max_nodes:
         raise TooLargeError(
             f"too large to draw: {count} {what} (limit {max_nodes}); "
-            "a picture this big is unreadable and slow to lay out - raise the limit with "
-            "--max-nodes, or use `fsmbt info` for its structure")
+            "a picture this big is unreadable and slow to lay out",
+            hints=(Hint.MAX_NODES, Hint.STATISTICS))
 
 
-def attach_clusters(clusters: list[tuple[graphviz.Digraph, graphviz.Digraph]],
-                    root: graphviz.Digraph) -> None:
-    """Nest clusters listed in pre-order as ``(cluster, parent)``, keeping sibling order.
+def dot_id(text: str) -> str:
+    """A model name as a DOT node id for the ``graphviz`` package: never read as an HTML id
+    (``<b>``), and a trailing backslash (which would escape the closing quote) padded with a
+    space."""
+    trailing = len(text) - len(text.rstrip("\\"))
+    return graphviz.nohtml(text + " " if trailing % 2 else text)
 
-    A cluster's DOT text is copied into its parent when attached, so children go in first:
-    walking the list backwards reaches every cluster after all of its descendants.
+
+def edge_line(tail: str, head: str, attrs: dict[str, str]) -> str:
+    """One edge statement. ``graphviz.Digraph.edge`` reads ``a:b`` as node ``a``, port ``b``;
+    model names may hold colons, so ends are quoted as plain ids here."""
+    rest = dict(attrs)
+    listed = quoting.attr_list(rest.pop("label", None), kwargs=rest)  # as Digraph.edge lists them
+    return f"\t{quoting.quote(tail)} -> {quoting.quote(head)}{listed}\n"
+
+
+def assemble(root: graphviz.Digraph, clusters: list[tuple[graphviz.Digraph, graphviz.Digraph]],
+             edges: list[str]) -> str:
+    """The DOT source of ``root`` with ``clusters`` nested inside it and ``edges`` after them.
+
+    ``clusters`` lists ``(cluster, parent)`` in pre-order. The source is written out in one
+    pre-order walk with an explicit stack (``graphviz.Digraph.subgraph`` copies a cluster's text
+    into its parent, quadratic in the nesting depth), each cluster's own statements first, then
+    its sub-clusters, then its closing brace. O(total lines).
     """
     children: dict[int, list[graphviz.Digraph]] = {}
-    for cluster, parent in reversed(clusters):
-        for child in reversed(children.pop(id(cluster), [])):
-            cluster.subgraph(child)
+    for cluster, parent in clusters:
         children.setdefault(id(parent), []).append(cluster)
-    for child in reversed(children.pop(id(root), [])):
-        root.subgraph(child)
+    out: list[str] = []
+    stack: list[tuple[graphviz.Digraph, str, bool]] = [(root, "", False)]
+    while stack:
+        graph, pad, closing = stack.pop()
+        if closing:
+            if graph is root:
+                out.extend(edges)
+            out.append(f"{pad}}}\n")
+            continue
+        lines = list(graph.__iter__(subgraph=graph is not root))
+        out.extend(f"{pad}{line}" if pad else line for line in lines[:-1])  # all but its "}"
+        stack.append((graph, pad, True))
+        stack.extend((child, pad + "\t", False) for child in reversed(children.get(id(graph), [])))
+    return "".join(out)
 
 
 def output_format(path: Path) -> str:
@@ -96,7 +125,7 @@ def check_output(path: Path, *, overwrite: bool) -> str:
     """The picture format ``path`` asks for; refuses an existing file unless ``overwrite``."""
     fmt = output_format(path)
     if path.exists() and not overwrite:
-        raise InputError("exists; pass --force to overwrite it", location=SourceLocation(str(path)))
+        raise InputError("exists", location=SourceLocation(str(path)), hints=(Hint.OVERWRITE,))
     return fmt
 
 

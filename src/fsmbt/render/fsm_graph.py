@@ -15,8 +15,17 @@ hundred states with crossing transitions: the force-directed ``sfdp`` layout is 
 thousands of states), without clusters: a composite state is a box joined to its sub-machine's
 initial state by a dotted arrow, and nested states are named by their path (``Operating/Closed``).
 
-Built without recursion: clusters are created in pre-order and attached to their parents in
-reverse order. Complexity O(S + T) for S states (every level) and T transitions.
+The same builder writes the DOT *file format* (``fsmbt convert --to dot``, registered by
+``fsmbt.formats.dot``) with ``exchange=True``: node ids are the state names (``Parent/child``
+paths inside composite states, ``Parent/0:child`` in parallel regions), each carrying an
+``action`` attribute when its action differs from its name; every transition is its own edge
+labelled with its exact event (eventless: no label); the initial point is named after the start
+pseudo-state (else ``__start__``); the layered layout is always used and no size limit applies.
+That is what ``fsmbt.formats.dot``'s reader reads back (docs/formats/dot.md). Pictures also
+carry the ``action`` attribute (Graphviz ignores attributes it does not know).
+
+Built without recursion: clusters are created in pre-order and written out by one pre-order
+walk (``render.dot.assemble``). Complexity O(S + T) for S states (every level) and T transitions.
 """
 
 from __future__ import annotations
@@ -28,8 +37,12 @@ import graphviz
 from fsmbt.model.fsm import FSM, State
 from fsmbt.model.stats import fsm_stats
 from fsmbt.render.dot import (
-    DEFAULT_MAX_NODES, FONT, TooLargeError, attach_clusters, check_size, label_text,
+    DEFAULT_MAX_NODES, FONT, TooLargeError, assemble, check_size, dot_id, edge_line, label_text,
 )
+
+#: The initial point's id in exchange DOT when the model names no start pseudo-state; the
+#: reader (``fsmbt.formats.dot``) takes a node of this name as the start marker.
+START_NODE = "__start__"
 
 #: Nested clusters beyond this depth make dot slow and the picture unreadable.
 MAX_NESTING = 60
@@ -50,20 +63,34 @@ class _Level:
     anchors: dict[str, tuple[str, str]] = field(default_factory=dict)  # composite -> (node, cluster)
     prefix: str = ""  # large pictures: nested states are named by their path
     entry: str | None = None  # large pictures: the composite state's box, drawn instead of a point
+    path: str = ""  # exchange DOT: the node-id prefix of this level's states
 
 
-def fsm_to_dot(fsm: FSM, *, max_nodes: int = DEFAULT_MAX_NODES) -> str:
-    """DOT source of the picture of ``fsm``; refuses more than ``max_nodes`` states."""
+def fsm_to_dot(fsm: FSM, *, max_nodes: int | None = DEFAULT_MAX_NODES,
+               exchange: bool = False) -> str:
+    """DOT source of ``fsm``.
+
+    Args:
+        fsm: the machine (flat or hierarchical).
+        max_nodes: refuse (``TooLargeError``) more states than this (and more than five times
+            as many transitions), and nesting deeper than ``MAX_NESTING``; ``None``: no limit.
+        exchange: write the DOT file format that ``fsmbt.formats.dot`` reads back (see the
+            module docstring) instead of the picture's DOT.
+
+    Returns:
+        The DOT source text.
+    """
     stats = fsm_stats(fsm)
-    check_size(stats.all_states, max_nodes, "states")
-    check_size(stats.all_transitions, 5 * max_nodes, "transitions")
-    if stats.nesting_depth > MAX_NESTING:
-        raise TooLargeError(f"too deeply nested to draw: {stats.nesting_depth} levels "
-                            f"(limit {MAX_NESTING})")
+    if max_nodes is not None:
+        check_size(stats.all_states, max_nodes, "states")
+        check_size(stats.all_transitions, 5 * max_nodes, "transitions")
+        if stats.nesting_depth > MAX_NESTING:
+            raise TooLargeError(f"too deeply nested to draw: {stats.nesting_depth} levels "
+                                f"(limit {MAX_NESTING})")
 
-    layered = (stats.all_states <= LAYERED_MAX_STATES
-               and stats.all_transitions <= LAYERED_MAX_ARROWS)
-    root = graphviz.Digraph(name=_safe_name(fsm.name))
+    layered = exchange or (stats.all_states <= LAYERED_MAX_STATES
+                           and stats.all_transitions <= LAYERED_MAX_ARROWS)
+    root = graphviz.Digraph(name=dot_id(fsm.name) if exchange else _safe_name(fsm.name))
     if layered:
         root.attr(rankdir="LR", compound="true", fontname=FONT, nodesep="0.35", ranksep="0.5")
     else:
@@ -71,7 +98,7 @@ def fsm_to_dot(fsm: FSM, *, max_nodes: int = DEFAULT_MAX_NODES) -> str:
                   fontname=FONT)
     root.attr("node", fontname=FONT, fontsize="12")
     root.attr("edge", fontname=FONT, fontsize="10", arrowsize="0.8")
-    counter = _Counter()
+    counter = _Counter(exchange)
     edges: list[tuple[str, str, dict[str, str]]] = []
     clusters: list[tuple[graphviz.Digraph, graphviz.Digraph]] = []  # (cluster, parent), pre-order
 
@@ -84,7 +111,7 @@ def fsm_to_dot(fsm: FSM, *, max_nodes: int = DEFAULT_MAX_NODES) -> str:
         for state in level.machine.states.values():
             title = level.prefix + state.name
             if state.is_atomic:
-                node_id = counter.next("s")
+                node_id = counter.state_id(level, state.name)
                 level.ids[state.name] = node_id
                 level.graph.node(node_id, **_state_attrs(state, title, compact=not layered))
                 continue
@@ -104,33 +131,45 @@ def fsm_to_dot(fsm: FSM, *, max_nodes: int = DEFAULT_MAX_NODES) -> str:
             inner = []
             for index, region in enumerate(state.regions):
                 holder = cluster
+                path = f"{level.path}{state.name}/"
                 if state.is_parallel:
                     holder = graphviz.Digraph(name=counter.next("cluster_"))
                     holder.attr(label=label_text(_region_title(region, index)), style="dashed",
                                 color="gray50", fontname=FONT, fontsize="10")
                     clusters.append((holder, cluster))
-                inner.append(_Level(region, holder))
+                    path = f"{path}{index}:"
+                inner.append(_Level(region, holder, path=path))
             # Arrows to/from the composite state end at its cluster, through its first initial point.
             level.anchors[state.name] = (_initial_point_id(inner[0], counter), cluster.name)
             pending.extend(reversed(inner))
 
     for level in levels:
-        _draw_initial(level, edges, is_top=level is top)
-        _draw_transitions(level, edges)
+        _draw_initial(level, edges, counter, is_top=level is top)
+        _draw_transitions(level, edges, exact=exchange)
 
-    attach_clusters(clusters, root)
-    for tail, head, attrs in edges:
-        root.edge(tail, head, **attrs)
-    return root.source
+    return assemble(root, clusters, [edge_line(tail, head, attrs) for tail, head, attrs in edges])
 
 
 class _Counter:
-    def __init__(self) -> None:
+    """Node ids: serial numbers in pictures, state-name paths in exchange DOT."""
+
+    def __init__(self, exchange: bool = False) -> None:
         self.value = 0
+        self.exchange = exchange
 
     def next(self, prefix: str) -> str:
         self.value += 1
         return f"{prefix}{self.value}"
+
+    def state_id(self, level: _Level, name: str) -> str:
+        return dot_id(level.path + name) if self.exchange else self.next("s")
+
+    def point_id(self, level: _Level, *, is_top: bool) -> str:
+        """The id of ``level``'s initial point (exchange DOT: named after the start
+        pseudo-state, which the reader takes back as ``start_name``)."""
+        if self.exchange:
+            return dot_id(level.path + (level.machine.start_name or START_NODE))
+        return self.next("init") if not is_top else f"init_{level.graph.name or 'root'}"
 
 
 def _safe_name(name: str) -> str:
@@ -154,6 +193,8 @@ def _state_attrs(state: State, title: str, *, compact: bool = False) -> dict[str
     if state.action is not None and state.action != state.name:
         lines.append(f"/ {state.action}")
     attrs = {"label": label_text(*lines), "shape": "doublecircle" if state.final else "circle"}
+    if state.action != state.name:  # read back by fsmbt.formats.dot; Graphviz ignores it
+        attrs["action"] = dot_id(state.action or "")
     if compact:
         attrs.update(shape="ellipse", peripheries="2" if state.final else "1")
     if state.final:
@@ -164,13 +205,13 @@ def _state_attrs(state: State, title: str, *, compact: bool = False) -> dict[str
 def _initial_point_id(level: _Level, counter: _Counter) -> str:
     point = level.ids.get("__initial_point__")
     if point is None:
-        point = counter.next("init")
+        point = counter.point_id(level, is_top=False)
         level.ids["__initial_point__"] = point
         level.graph.node(point, label="", shape="point", width="0.12")
     return point
 
 
-def _draw_initial(level: _Level, edges: list, *, is_top: bool) -> None:
+def _draw_initial(level: _Level, edges: list, counter: _Counter, *, is_top: bool) -> None:
     """The arrow from a point into the level's initial state (a composite state's point is
     its anchor and already exists)."""
     fsm = level.machine
@@ -182,35 +223,52 @@ def _draw_initial(level: _Level, edges: list, *, is_top: bool) -> None:
         return
     point = level.ids.get("__initial_point__")
     if point is None:
-        point = f"init_{level.graph.name or 'root'}"
+        point = counter.point_id(level, is_top=True)
         level.ids["__initial_point__"] = point
         extra = {"xlabel": label_text(fsm.start_name)} if is_top and fsm.start_name else {}
         level.graph.node(point, label="", shape="point", width="0.12", **extra)
     attrs: dict[str, str] = {}
     if is_top and fsm.initial_event is not None:
-        attrs["label"] = label_text(fsm.initial_event)
+        attrs["label"] = (_exact_label(fsm.initial_event) if counter.exchange
+                          else label_text(fsm.initial_event))
     edges.append((point, head, {**attrs, **head_attrs}))
 
 
-def _draw_transitions(level: _Level, edges: list) -> None:
-    grouped: dict[tuple[str, str], list[str]] = {}
-    for t in level.machine.transitions:
+def _draw_transitions(level: _Level, edges: list, *, exact: bool = False) -> None:
+    """Pictures: one arrow per (source, target) pair listing its events; ``exact`` (exchange
+    DOT): one edge per transition labelled with its event as written, eventless unlabelled."""
+    grouped: dict[tuple[str, ...], list[str]] = {}
+    for index, t in enumerate(level.machine.transitions):
         if t.source not in level.machine.states or t.target not in level.machine.states:
             continue  # a dangling transition is `validate`'s business; draw what exists
-        grouped.setdefault((t.source, t.target), []).append(_event_label(level, t))
-    for (source, target), labels in grouped.items():
+        if exact:
+            grouped[(t.source, t.target, str(index))] = [] if t.event is None else [t.event]
+        else:
+            grouped.setdefault((t.source, t.target), []).append(_event_label(level, t))
+    for (source, target, *_), labels in grouped.items():
         tail, tail_attrs = _endpoint(level, source, "ltail")
         head, head_attrs = _endpoint(level, target, "lhead")
         attrs = {**tail_attrs, **head_attrs}
         if tail == head and tail_attrs and head_attrs:
             attrs = {}
+        if exact:
+            if labels:
+                attrs["label"] = _exact_label(labels[0])
+            edges.append((tail, head, attrs))
+            continue
         # dot places a mid-edge label on the unclipped spline, i.e. inside the cluster an arrow
         # leaves; a head label stays next to the arrow's visible end.
-        key = "headlabel" if "ltail" in attrs else "label"
-        attrs[key] = _wrap(labels)
-        if key == "headlabel":
+        label_key = "headlabel" if "ltail" in attrs else "label"
+        attrs[label_key] = _wrap(labels)
+        if label_key == "headlabel":
             attrs.update(labeldistance="3", labelangle="-25")
         edges.append((tail, head, attrs))
+
+
+def _exact_label(text: str) -> str:
+    """An event as an exchange-DOT label: the text as written (line breaks kept), backslashes
+    doubled so DOT escapes (``\\n``, ``\\N``) stay text."""
+    return graphviz.nohtml(text.replace("\\", "\\\\"))
 
 
 def _endpoint(level: _Level, state: str, side: str) -> tuple[str, dict[str, str]]:

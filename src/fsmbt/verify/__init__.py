@@ -9,7 +9,7 @@ verdict differs, since then one of them is wrong.
 from __future__ import annotations
 
 from fsmbt.model.bt import BTDocument
-from fsmbt.model.errors import InputError
+from fsmbt.model.errors import Hint, InputError
 from fsmbt.model.fsm import FSM
 from fsmbt.verify.native import DEFAULT_MAX_STATES, Replay, check, replay
 from fsmbt.verify.pairing import FSMLeafMachine, machines_for
@@ -57,16 +57,17 @@ def _nusmv(source: FSM | BTDocument, result: FSM | BTDocument, loop: bool) -> Re
     try:
         from fsmbt.verify import nusmv
     except ImportError as exc:
-        raise InputError(f"the NuSMV engine is not available ({exc}); use --engine native") from None
+        raise InputError(f"the NuSMV engine is not available ({exc})",
+                         hints=(Hint.NATIVE_VERIFIER,)) from None
     checker = getattr(nusmv, "check", None)
     if checker is None:
-        raise InputError("the NuSMV engine is not available (fsmbt.verify.nusmv has no check); "
-                         "use --engine native")
+        raise InputError("the NuSMV engine is not available (fsmbt.verify.nusmv has no check)",
+                         hints=(Hint.NATIVE_VERIFIER,))
     try:
         return checker(source, result, loop=loop)
     except FileNotFoundError as exc:
-        raise InputError(f"the NuSMV binary is not installed ({exc}); run scripts/setup.sh or "
-                         "use --engine native") from None
+        raise InputError(f"the NuSMV binary is not installed ({exc}); scripts/setup.sh builds it",
+                         hints=(Hint.NATIVE_VERIFIER,)) from None
 
 
 def _model_name(model: FSM | BTDocument, fallback: str) -> str:

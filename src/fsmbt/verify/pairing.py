@@ -156,7 +156,7 @@ def machines_for(source: FSM | BTDocument, result: FSM | BTDocument, *,
                  loop: bool = False) -> tuple[Machine, Machine, str]:
     """The (source machine, result machine, mode) for a pair of models."""
     if isinstance(source, FSM) and isinstance(result, FSM):
-        alphabet = _union(source.events(), result.events(), *_flat_events(source, result))
+        alphabet = _union(source.events(), result.events(), *sub_machine_events(source, result))
         return (FSMMachine(source, alphabet=alphabet), FSMMachine(result, alphabet=alphabet),
                 MACRO_STEP)
     if isinstance(source, FSM) and isinstance(result, BTDocument):
@@ -183,9 +183,17 @@ def machines_for(source: FSM | BTDocument, result: FSM | BTDocument, *,
     raise InputError(f"cannot compare a {type(source).__name__} with a {type(result).__name__}")
 
 
-def _flat_events(*fsms: FSM) -> list[list[str]]:
-    """Events of nested sub-machines too (a hierarchical FSM's top level does not list them)."""
-    out = []
+def sub_machine_events(*fsms: FSM) -> list[list[str]]:
+    """The events of every nested sub-machine of ``fsms`` (a hierarchical FSM's top level does
+    not list them), so both verifiers (native here, ``fsmbt.verify.nusmv``) step one alphabet.
+
+    Args:
+        fsms: the machines, flat or hierarchical.
+
+    Returns:
+        One event list per sub-machine (region), in walk order; flat machines add none.
+    """
+    out: list[list[str]] = []
     for fsm in fsms:
         for _path, _machine, state in fsm.walk():
             out.extend(region.events() for region in state.regions)  # each sub-machine once

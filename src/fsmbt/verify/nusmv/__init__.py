@@ -36,11 +36,11 @@ def _union(*groups) -> list[str]:
 def encode(source: FSM | BTDocument, result: FSM | BTDocument, *, loop: bool = False):
     """The two machine encoders, the shared symbol tables and the mode for a pair of models
     (the same pairing as ``fsmbt.verify.pairing.machines_for``)."""
-    from fsmbt.verify.pairing import _flat_events, lebt_guard_events
+    from fsmbt.verify.pairing import lebt_guard_events, sub_machine_events
 
     inputs, outputs = Symbols("in_"), Symbols("out_")
     if isinstance(source, FSM) and isinstance(result, FSM):
-        alphabet = _union(source.events(), result.events(), *_flat_events(source, result))
+        alphabet = _union(source.events(), result.events(), *sub_machine_events(source, result))
         return (FSMEncoder(source, "source", inputs, outputs, alphabet=alphabet),
                 FSMEncoder(result, "result", inputs, outputs, alphabet=alphabet),
                 inputs, outputs, MACRO_STEP)

@@ -59,7 +59,7 @@ class LebtEncoder:
 
     def extra_message(self, name: str) -> str:
         return (f"the NuSMV encoding bounds the actions of one macro step at {self.slots}; this "
-                "LEBT runs more in one step; use --engine native")
+                "LEBT runs more in one step")
 
     def _ev(self, event: str) -> str | None:
         if event == NO_EVENT:

@@ -4,7 +4,7 @@ one step per input both machines took while attached, the start as step 0."""
 
 from __future__ import annotations
 
-from fsmbt.model.errors import UnsupportedError
+from fsmbt.model.errors import Hint, UnsupportedError
 from fsmbt.verify.nusmv.encode_fsm import NONE_OUT
 from fsmbt.verify.nusmv.runner import SpecResult, TraceState
 from fsmbt.verify.report import PROPERTIES, PropertyResult, Report, TraceStep
@@ -79,7 +79,7 @@ def build_report(names: list[str], results: list[SpecResult], context, source_mo
         if name in PROPERTIES:
             continue
         if not result.holds:
-            raise UnsupportedError(res_enc.extra_message(name))
+            raise UnsupportedError(res_enc.extra_message(name), hints=(Hint.NATIVE_VERIFIER,))
     for name, result in zip(names, results):
         if name not in PROPERTIES:
             continue

@@ -1,5 +1,5 @@
 """The mutation suite's families of equivalent pairs, shared by the checker's mutation tests
-(test_ver_mutations.py) and the NuSMV/native agreement test (tests/nusmv), so both mutate
+(test_ver_mutations.py) and the NuSMV/native agreement test (tests/verify/nusmv), so both mutate
 exactly the same pairs.
 
 Each family is a list of equivalent ``(source, result)`` pairs; ``FAMILIES`` names the side
@@ -15,10 +15,9 @@ from fsmbt.convert.lebt import fsm_to_lebt
 from fsmbt.generate.generator import random_bt, random_fsm
 from fsmbt.model import FSM, BTDocument, BTNode, NodeKind, State
 from fsmbt.semantics.leaf_machine import LeafMachine
-from fsmbt.semantics.random_trees import lebt_from_structure
 from fsmbt.verify.mutations import Mutant, mutants
-
-from ver_models import paper_fsm, renamed_copy  # noqa: E402 (sibling test module)
+from support.random_trees import lebt_from_structure
+from support.ver_models import paper_fsm, renamed_copy
 
 PAPER_STRUCTURE = [("A", [("B", []), ("F", [("I", [("J", [])])])]), ("C", []),
                    ("D", [("E", [("G", [("H", [])])])])]

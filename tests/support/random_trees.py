@@ -15,11 +15,16 @@ import random
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
-from fsmbt.model.bt import BTDocument, BehaviorTree, BTNode
+from fsmbt.model.bt import BehaviorTree, BTDocument, BTNode
 from fsmbt.model.bt_nodes import NodeKind
 from fsmbt.model.fsm import FSM
 from fsmbt.semantics.lebt_spec import (
-    DEFAULT_START, GUARD_TYPE, NO_EVENT, STATE_TYPE, GuardSpec, StateSpec,
+    DEFAULT_START,
+    GUARD_TYPE,
+    NO_EVENT,
+    STATE_TYPE,
+    GuardSpec,
+    StateSpec,
 )
 
 ALL_CONTROLS = ("Sequence", "ReactiveSequence", "SequenceWithMemory", "Fallback",

@@ -1,22 +1,15 @@
 """Session fixture: a NuSMV binary, built by scripts/build_nusmv.sh when missing.
 
-tests/verify is put on ``sys.path`` so the agreement test imports the mutation suite's families
-(``mutation_families``) instead of copying them; pytest's default import mode adds only each
-test file's own directory."""
+The agreement test imports the mutation suite's families from ``support.mutation_families``
+(tests/support, importable through ``pythonpath`` in pyproject.toml) instead of copying them."""
 
 from __future__ import annotations
 
 import subprocess
-import sys
-from pathlib import Path
 
 import pytest
 
 from fsmbt.verify.nusmv.binary import BUILD_SCRIPT, find_nusmv
-
-VERIFY_TESTS = str(Path(__file__).resolve().parents[1] / "verify")
-if VERIFY_TESTS not in sys.path:
-    sys.path.append(VERIFY_TESTS)
 
 
 @pytest.fixture(scope="session")

@@ -42,7 +42,7 @@ from fsmbt.verify.mutations import mutants
 from fsmbt.verify.nusmv import check
 from fsmbt.verify.nusmv.runner import NuSMVError
 
-REPO = Path(__file__).resolve().parents[2]
+REPO = Path(__file__).resolve().parents[3]
 CORPUS = Path(os.environ.get("FSMBT_CORPUS", REPO.parent / "shared" / "corpus"))
 PAIRS = int(os.environ.get("FSMBT_NUSMV_PAIRS", "300"))
 TIMEOUT_S = 600  # a hang guard, not a speed target: workers share 2 cores with pytest-xdist
@@ -330,7 +330,7 @@ def corpus_pairs(notes: Counter[str]) -> Iterator[Pair | Rejected]:
 # -- the mutation suite --------------------------------------------------------------------------
 def mutation_suite_pairs() -> Iterator[Pair]:
     """The unmutated pairs of each family once, and every mutant of every family."""
-    from mutation_families import FAMILIES, family_mutants  # tests/verify, see conftest.py
+    from support.mutation_families import FAMILIES, family_mutants  # tests/support
 
     seen: set[str] = set()
     for family, make_pairs, side in FAMILIES:
@@ -366,7 +366,7 @@ def test_agreement_corpus(nusmv_binary):
 
 
 def test_agreement_mutation_suite(nusmv_binary):
-    from mutation_families import FAMILIES
+    from support.mutation_families import FAMILIES
 
     group = run_group("mutation suite", mutation_suite_pairs())
     assert_agreement(group)

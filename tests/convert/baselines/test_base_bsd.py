@@ -9,17 +9,22 @@ from pathlib import Path
 
 import pytest
 
-from base_helpers import (
-    convert, generated_bts, generated_fsms, leaf, ctrl, not_equivalent_seeds,
-    plain_under_reactive,
-)
 from fsmbt.formats import read_model
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import UnsupportedError
 from fsmbt.semantics import state_variable_runtime as sv
 from fsmbt.verify import replay, verify
+from support.base_helpers import (
+    convert,
+    ctrl,
+    generated_bts,
+    generated_fsms,
+    leaf,
+    not_equivalent_seeds,
+    plain_under_reactive,
+)
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = Path(__file__).resolve().parents[3]
 EXAMPLES = ROOT / "examples"
 
 

@@ -16,7 +16,7 @@ from fsmbt.model import FSM, BehaviorTree, BTDocument, BTNode, NodeKind, State
 from fsmbt.render import TooLargeError, bt_to_dot, fsm_to_dot, render_model
 from fsmbt.render.bt_graph import CONTROL_SYMBOLS
 
-EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 needs_dot = pytest.mark.skipif(shutil.which("dot") is None, reason="Graphviz dot not installed")
 
 

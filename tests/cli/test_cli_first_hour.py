@@ -16,7 +16,7 @@ import pytest
 from fsmbt import api
 from fsmbt.cli import main
 
-EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 PAPER_FSM = EXAMPLES / "paper_fsm.xml"
 FSMBT = [sys.executable, "-m", "fsmbt.cli"]
 

@@ -5,16 +5,21 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from base_helpers import (
-    convert, ctrl, generated_bts, generated_fsms, leaf, not_equivalent_seeds,
-    plain_under_reactive,
-)
 from fsmbt.formats import read_model
 from fsmbt.model.bt import BTDocument
 from fsmbt.semantics import state_variable_runtime as sv
 from fsmbt.verify import verify
+from support.base_helpers import (
+    convert,
+    ctrl,
+    generated_bts,
+    generated_fsms,
+    leaf,
+    not_equivalent_seeds,
+    plain_under_reactive,
+)
 
-EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
+EXAMPLES = Path(__file__).resolve().parents[3] / "examples"
 
 
 def test_chds_generated_fsms_all_equivalent():

@@ -18,7 +18,7 @@ from fsmbt.formats import read_model
 from fsmbt.formats.registry import format_for_path, formats
 from fsmbt.model import FSM, BTDocument, BTNode, NodeKind
 
-EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 MODEL_FILES = sorted(p for p in EXAMPLES.iterdir() if p.is_file() and p.name != "README.md")
 
 

@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 
 from fsmbt.formats import loads
-from fsmbt.model import BTDocument, BTNode, FSM, InputError, NodeKind, NodeModel, State
+from fsmbt.model import FSM, BTDocument, BTNode, InputError, NodeKind, NodeModel, State
 from fsmbt.model.validate import check, validate
 
 

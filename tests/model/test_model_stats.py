@@ -15,7 +15,7 @@ from fsmbt.formats import read_model
 from fsmbt.model import FSM, BehaviorTree, BTDocument, BTNode, NodeKind, State
 from fsmbt.model.stats import bt_stats, expanded_depth, fsm_stats
 
-EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 
 
 def info_json(path: Path, capsys: pytest.CaptureFixture) -> dict:
