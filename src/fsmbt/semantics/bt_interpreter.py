@@ -31,52 +31,38 @@ from __future__ import annotations
 
 from collections.abc import Callable, Hashable
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Final
 
 from fsmbt.model.bt import BTDocument, BTNode
-from fsmbt.model.bt_nodes import NodeKind, builtin_spec, canonical_type
 from fsmbt.model.errors import InputError, UnsupportedError
+from fsmbt.model.kinds import NodeKind
+from fsmbt.semantics.nodes import canonical_type, node_semantics, runtime_tables
+from fsmbt.semantics.status import LeafOutcome, NodeStatus
 
-# -- statuses --------------------------------------------------------------------------------
-IDLE, RUNNING, SUCCESS, FAILURE, SKIPPED = range(5)
-STATUS_NAMES = ("IDLE", "RUNNING", "SUCCESS", "FAILURE", "SKIPPED")
-#: Leaf outcomes as the environment / the leaf machine's inputs name them.
-OUTCOME_SUCCESS, OUTCOME_FAILURE, OUTCOME_RUNNING = "success", "failure", "running"
-OUTCOME_TO_STATUS = {OUTCOME_SUCCESS: SUCCESS, OUTCOME_FAILURE: FAILURE, OUTCOME_RUNNING: RUNNING}
-STATUS_TO_OUTCOME = {v: k for k, v in OUTCOME_TO_STATUS.items()}
+# -- statuses (fsmbt.semantics.status; docs/semantics.md "Statuses") ---------------------------
+# Plain-int aliases of NodeStatus for the hot loops: snapshots hold them, and an int hashes
+# three times faster than an IntEnum member (equal values, equal hashes).
+IDLE: Final[int] = NodeStatus.IDLE.value
+RUNNING: Final[int] = NodeStatus.RUNNING.value
+SUCCESS: Final[int] = NodeStatus.SUCCESS.value
+FAILURE: Final[int] = NodeStatus.FAILURE.value
+SKIPPED: Final[int] = NodeStatus.SKIPPED.value
+STATUS_NAMES: tuple[str, ...] = tuple(status.name for status in NodeStatus)
+#: Leaf outcomes as the environment / the leaf machine's inputs name them (plain ``str``).
+OUTCOME_SUCCESS: Final[str] = LeafOutcome.SUCCESS.value
+OUTCOME_FAILURE: Final[str] = LeafOutcome.FAILURE.value
+OUTCOME_RUNNING: Final[str] = LeafOutcome.RUNNING.value
+OUTCOME_TO_STATUS: dict[str, int] = {o.value: o.status.value for o in LeafOutcome}
+STATUS_TO_OUTCOME: dict[int, str] = {v: k for k, v in OUTCOME_TO_STATUS.items()}
 
 #: Upper bound on nodes after SubTree expansion (a SubTree used twice per level doubles).
 MAX_COMPILED_NODES = 2_000_000
 
-# -- supported node types ----------------------------------------------------------------------
-SEQUENCE_LIKE = {"Sequence": False, "AsyncSequence": True}
-FALLBACK_LIKE = {"Fallback": False, "AsyncFallback": True}
-CONTROLS = frozenset({
-    "Sequence", "AsyncSequence", "SequenceWithMemory", "ReactiveSequence",
-    "Fallback", "AsyncFallback", "ReactiveFallback",
-    "Parallel", "ParallelAll", "IfThenElse", "WhileDoElse",
-})
-DECORATORS = frozenset({
-    "Inverter", "ForceSuccess", "ForceFailure", "Repeat", "RetryUntilSuccessful",
-    "KeepRunningUntilFailure", "RunOnce", "SubTree",
-})
-#: Built-in leaves that always succeed / fail and take no input from the environment.
-INTERNAL_LEAVES = {
-    "AlwaysSuccess": SUCCESS, "AlwaysFailure": FAILURE, "Script": SUCCESS,
-    "SetBlackboard": SUCCESS, "UnsetBlackboard": SUCCESS,
-}
+# -- supported node types: the node registry (fsmbt.semantics.nodes) ----------------------------
+# Which kinds are ticked and by which rule, their default memory, which are refused and why:
+# ``runtime_tables()``, read when a tree is compiled and when an interpreter is built.
 #: Pre-condition attributes change control flow from the blackboard: rejected.
 PRECONDITION_ATTRS = ("_skipIf", "_failureIf", "_successIf", "_while")
-_REJECT_REASON = {
-    "Delay": "time-based node (needs a clock)", "Timeout": "time-based node (needs a clock)",
-    "Sleep": "time-based node (needs a clock)",
-    "ScriptCondition": "its result depends on the blackboard",
-    "WasEntryUpdated": "its result depends on the blackboard",
-    "Precondition": "its result depends on the blackboard",
-    "SkipUnlessUpdated": "its result depends on the blackboard",
-    "WaitValueUpdate": "its result depends on the blackboard",
-    "ManualSelector": "it asks a person which child to run",
-}
 
 
 class BTRuntimeError(InputError):
@@ -217,15 +203,18 @@ class CompiledTree:
             self._paths[nid] = cached
         return cached
 
-    def _check(self, node: BTNode, chain: tuple[str, ...]):
+    def _check(self, node: BTNode, chain: tuple[str, ...]
+               ) -> tuple[str, NodeKind, tuple[Any, ...], int | None, list[BTNode]]:
+        tables = runtime_tables()
         ctype = canonical_type(node.type)
         kind = node.kind
         for attr in PRECONDITION_ATTRS:
             if attr in node.attrs:
                 raise UnsupportedError(
                     f"pre-condition '{attr}' depends on the blackboard", **_where(node))
-        if ctype in _REJECT_REASON:
-            raise UnsupportedError(f"{ctype}: {_REJECT_REASON[ctype]}", **_where(node))
+        reason = tables.rejected.get(ctype)
+        if reason is not None:
+            raise UnsupportedError(f"{ctype}: {reason}", **_where(node))
         kids = list(node.children)
         params: tuple[Any, ...] = ()
         internal: int | None = None
@@ -244,13 +233,13 @@ class CompiledTree:
         if kind in (NodeKind.ACTION, NodeKind.CONDITION):
             if kids:
                 raise InputError("a leaf node has children", **_where(node))
-            if ctype in INTERNAL_LEAVES:
-                internal = INTERNAL_LEAVES[ctype]
-            elif builtin_spec(ctype) is not None:
+            if ctype in tables.internal_leaves:
+                internal = tables.internal_leaves[ctype]
+            elif node_semantics(ctype) is not None:
                 raise UnsupportedError(f"built-in leaf {ctype} is not supported", **_where(node))
             return ctype, kind, params, internal, kids
         if kind is NodeKind.DECORATOR:
-            if ctype not in DECORATORS:
+            if ctype not in tables.decorators:
                 raise UnsupportedError(f"decorator type '{node.type}' is not supported "
                                        "(custom or unknown semantics)", **_where(node))
             if len(kids) != 1:
@@ -264,14 +253,16 @@ class CompiledTree:
                 params = (_bool_param(node, "then_skip", True),)
             return ctype, kind, params, internal, kids
         if kind is NodeKind.CONTROL:
-            if ctype not in CONTROLS:
+            if ctype not in tables.controls:
                 raise UnsupportedError(f"control type '{node.type}' is not supported "
                                        "(custom or unknown semantics)", **_where(node))
             if not kids:
                 raise InputError(f"control node {ctype} has no children", **_where(node))
             n = len(kids)
-            if ctype in ("IfThenElse", "WhileDoElse") and n not in (2, 3):
-                raise InputError(f"{ctype} needs 2 or 3 children, has {n}", **_where(node))
+            counts = node_semantics(ctype).child_counts  # type: ignore[union-attr]
+            if counts is not None and n not in counts:
+                allowed = " or ".join(str(c) for c in counts)
+                raise InputError(f"{ctype} needs {allowed} children, has {n}", **_where(node))
             if ctype == "Parallel":
                 succ = _int_param(node, "success_count", -1)
                 fail = _int_param(node, "failure_count", 1)
@@ -317,6 +308,12 @@ class TickDone:
 
 
 HaltHook = Callable[[CompiledNode], None]
+#: A frame on the interpreter's stack: (node id, pc, locals...).
+Frame = tuple[Any, ...]
+#: What a tick rule does next: ("call", child id, new frame) or ("ret", status).
+TickAction = tuple[Any, ...]
+#: A node kind's tick rule (``BTInterpreter._t_<handler>``).
+TickRule = Callable[["_Work", CompiledNode, Frame, "int | None", "HaltHook | None"], TickAction]
 
 
 class _Work:
@@ -335,14 +332,6 @@ class _Work:
                 tuple(self.frames), self.wake)
 
 
-_DEFAULT_MEM: dict[str, tuple] = {
-    "Sequence": (0, 0), "AsyncSequence": (0, 0), "SequenceWithMemory": (0, 0),
-    "Fallback": (0, 0), "AsyncFallback": (0, 0),
-    "Parallel": (frozenset(), 0, 0), "ParallelAll": (frozenset(), 0),
-    "IfThenElse": (0,), "Repeat": (0,), "RetryUntilSuccessful": (0,),
-    "RunOnce": (False, IDLE),
-}
-
 EMPTY_SNAPSHOT: Snapshot = ((), (), (), False)
 
 
@@ -354,19 +343,15 @@ class BTInterpreter:
         self.tree = tree if isinstance(tree, CompiledTree) else CompiledTree(tree)
         self.nodes = self.tree.nodes
         self.exactly_once = exactly_once
-        self._tick = {
-            "Sequence": self._t_sequence, "AsyncSequence": self._t_sequence,
-            "SequenceWithMemory": self._t_sequence, "Fallback": self._t_sequence,
-            "AsyncFallback": self._t_sequence,
-            "ReactiveSequence": self._t_reactive, "ReactiveFallback": self._t_reactive,
-            "Parallel": self._t_parallel, "ParallelAll": self._t_parallel_all,
-            "IfThenElse": self._t_if_then_else, "WhileDoElse": self._t_while_do_else,
-            "Inverter": self._t_simple_decorator, "ForceSuccess": self._t_simple_decorator,
-            "ForceFailure": self._t_simple_decorator,
-            "KeepRunningUntilFailure": self._t_simple_decorator,
-            "Repeat": self._t_repeat, "RetryUntilSuccessful": self._t_retry,
-            "RunOnce": self._t_run_once, "SubTree": self._t_subtree,
-        }
+        # Dispatch data from the node registry (docs/semantics.md "Node registry").
+        tables = runtime_tables()
+        self._tick: dict[str, TickRule] = {
+            kind: getattr(self, f"_t_{handler}") for kind, handler in tables.handlers.items()}
+        self._default_mem = tables.default_memory
+        self._halt_resets = tables.halt_resets_memory
+        self._seq_flags = tables.sequence_flags
+        self._reactive_fallbacks = tables.reactive_fallbacks
+        self._result_maps = tables.result_maps
 
     # -- public driving API --------------------------------------------------------------
     def initial(self) -> Snapshot:
@@ -463,10 +448,10 @@ class BTInterpreter:
         return status
 
     def _mem(self, w: _Work, node: CompiledNode) -> tuple:
-        return w.mem.get(node.id, _DEFAULT_MEM[node.type])
+        return w.mem.get(node.id, self._default_mem[node.type])
 
     def _set_mem(self, w: _Work, node: CompiledNode, value: tuple) -> None:
-        if value == _DEFAULT_MEM[node.type]:
+        if value == self._default_mem[node.type]:
             w.mem.pop(node.id, None)
         else:
             w.mem[node.id] = value
@@ -489,10 +474,9 @@ class BTInterpreter:
         while stack:
             x = self.nodes[stack.pop()]
             t = x.type
-            if t in ("Sequence", "AsyncSequence", "Fallback", "AsyncFallback", "Parallel",
-                     "ParallelAll", "IfThenElse", "Repeat", "RetryUntilSuccessful"):
+            if t in self._halt_resets:
                 w.mem.pop(x.id, None)  # these halt() reset their memory
-            # SequenceWithMemory, RunOnce, Reactive*, WhileDoElse keep theirs
+            # the others (SequenceWithMemory, RunOnce...) keep theirs: NodeSemantics.halt
             if x.kind is NodeKind.ACTION and x.internal_status is None and hook is not None \
                     and w.st.get(x.id, IDLE) == RUNNING:
                 hook(x)
@@ -507,10 +491,7 @@ class BTInterpreter:
     # -- node types: each returns ("call", child, new_frame) or ("ret", status) ---------------
     def _t_sequence(self, w, node, frame, result, hook):
         """Sequence / Fallback / Async* / SequenceWithMemory (sequence_node.cpp & co)."""
-        t = node.type
-        is_fallback = t in FALLBACK_LIKE
-        asynch = SEQUENCE_LIKE.get(t, FALLBACK_LIKE.get(t, False))
-        with_memory = t == "SequenceWithMemory"
+        is_fallback, asynch, with_memory = self._seq_flags[node.type]
         stop, go_on = (SUCCESS, FAILURE) if is_fallback else (FAILURE, SUCCESS)
         idx, skipped = self._mem(w, node)
         n = len(node.children)
@@ -553,7 +534,7 @@ class BTInterpreter:
 
     def _t_reactive(self, w, node, frame, result, hook):
         """ReactiveSequence / ReactiveFallback (reactive_sequence.cpp, reactive_fallback.cpp)."""
-        is_fallback = node.type == "ReactiveFallback"
+        is_fallback = node.type in self._reactive_fallbacks
         stop, go_on = (SUCCESS, FAILURE) if is_fallback else (FAILURE, SUCCESS)
         if frame[1] == 0:
             w.st[node.id] = RUNNING
@@ -719,8 +700,8 @@ class BTInterpreter:
         if frame[1] == 0:
             w.st[node.id] = RUNNING
             return ("call", child, (node.id, 1))
-        t = node.type
-        if t == "KeepRunningUntilFailure":
+        mapped = self._result_maps.get(node.type)
+        if mapped is None:  # KeepRunningUntilFailure
             if result == FAILURE:
                 self._reset_child(w, child, hook)
                 return ("ret", FAILURE)
@@ -731,9 +712,7 @@ class BTInterpreter:
         if result in (RUNNING, SKIPPED):
             return ("ret", result)
         self._reset_child(w, child, hook)
-        if t == "Inverter":
-            return ("ret", FAILURE if result == SUCCESS else SUCCESS)
-        return ("ret", SUCCESS if t == "ForceSuccess" else FAILURE)
+        return ("ret", mapped[0] if result == SUCCESS else mapped[1])
 
     def _t_repeat(self, w, node, frame, result, hook):
         """Repeat num_cycles (repeat_node.cpp); -1 repeats forever."""
