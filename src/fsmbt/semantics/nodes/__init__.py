@@ -16,6 +16,7 @@ cached read.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TypeVar
 
 from fsmbt.model.kinds import NodeKind
 from fsmbt.model.nodes import (
@@ -103,6 +104,34 @@ def _build(nodes: tuple[NodeSemantics, ...]) -> RuntimeTables:
     )
 
 
+T = TypeVar("T")
+
+
+def rewired(decorator: str, success: T, failure: T) -> tuple[T, T]:
+    """Where a status-mapping decorator's child's SUCCESS and FAILURE lead, given where the
+    decorator's own SUCCESS and FAILURE lead (its ``result_map``); the converters wire
+    Inverter, ForceSuccess and ForceFailure with it.
+
+    Args:
+        decorator: a type in ``RESULT_MAP_DECORATORS``.
+        success: the target of the decorator's SUCCESS.
+        failure: the target of the decorator's FAILURE.
+
+    Returns:
+        The targets of the child's SUCCESS and FAILURE.
+
+    Raises:
+        ValueError: ``decorator`` is not a status-mapping decorator.
+    """
+    spec = node_semantics(decorator)
+    if spec is None or spec.result_map is None:
+        raise ValueError(f"{decorator!r} is not a status-mapping decorator")
+    on_success, on_failure = spec.result_map
+    succeeded = NodeStatus.SUCCESS.name
+    return (success if on_success == succeeded else failure,
+            success if on_failure == succeeded else failure)
+
+
 _CACHE: list[tuple[int, RuntimeTables]] = []
 
 
@@ -119,5 +148,5 @@ __all__ = [
     "MERGEABLE_CONTROLS", "NUSMV_ENCODED", "PLAIN_CONTROLS", "REACTIVE_CONTROLS",
     "RESULT_MAP_DECORATORS", "SEQUENCE_TYPES", "TIME_BASED", "Family", "NodeSemantics",
     "RuntimeTables", "aliases", "all_nodes", "canonical_type", "internal_status", "kinds_where",
-    "node_semantics", "register", "registered", "runtime_tables", "unregister",
+    "node_semantics", "register", "registered", "rewired", "runtime_tables", "unregister",
 ]
