@@ -259,7 +259,8 @@ class CompiledTree:
             if not kids:
                 raise InputError(f"control node {ctype} has no children", **_where(node))
             n = len(kids)
-            counts = node_semantics(ctype).child_counts  # type: ignore[union-attr]
+            spec = node_semantics(ctype)
+            counts = spec.child_counts if spec is not None else None
             if counts is not None and n not in counts:
                 allowed = " or ".join(str(c) for c in counts)
                 raise InputError(f"{ctype} needs {allowed} children, has {n}", **_where(node))
@@ -287,8 +288,8 @@ class CompiledTree:
 # -- run-time configuration ------------------------------------------------------------------
 #: A snapshot: (statuses, memories, frames, wake-up pending). Hashable; equal snapshots behave
 #: the same for every future input.
-Snapshot = tuple[tuple[tuple[int, int], ...], tuple[tuple[int, tuple], ...],
-                 tuple[tuple, ...], bool]
+Snapshot = tuple[tuple[tuple[int, int], ...], tuple[tuple[int, tuple[Any, ...]], ...],
+                 tuple[tuple[Any, ...], ...], bool]
 
 
 @dataclass(frozen=True)
@@ -323,8 +324,8 @@ class _Work:
 
     def __init__(self, snap: Snapshot) -> None:
         self.st: dict[int, int] = dict(snap[0])
-        self.mem: dict[int, tuple] = dict(snap[1])
-        self.frames: list[tuple] = list(snap[2])
+        self.mem: dict[int, tuple[Any, ...]] = dict(snap[1])
+        self.frames: list[tuple[Any, ...]] = list(snap[2])
         self.wake: bool = snap[3]
 
     def snapshot(self) -> Snapshot:
@@ -447,10 +448,10 @@ class BTInterpreter:
             w.st[nid] = status
         return status
 
-    def _mem(self, w: _Work, node: CompiledNode) -> tuple:
+    def _mem(self, w: _Work, node: CompiledNode) -> tuple[Any, ...]:
         return w.mem.get(node.id, self._default_mem[node.type])
 
-    def _set_mem(self, w: _Work, node: CompiledNode, value: tuple) -> None:
+    def _set_mem(self, w: _Work, node: CompiledNode, value: tuple[Any, ...]) -> None:
         if value == self._default_mem[node.type]:
             w.mem.pop(node.id, None)
         else:
@@ -489,7 +490,8 @@ class BTInterpreter:
             # running children reset their own status when popped (after their halt)
 
     # -- node types: each returns ("call", child, new_frame) or ("ret", status) ---------------
-    def _t_sequence(self, w, node, frame, result, hook):
+    def _t_sequence(self, w: _Work, node: CompiledNode, frame: Frame, result: int | None,
+                    hook: HaltHook | None) -> TickAction:
         """Sequence / Fallback / Async* / SequenceWithMemory (sequence_node.cpp & co)."""
         is_fallback, asynch, with_memory = self._seq_flags[node.type]
         stop, go_on = (SUCCESS, FAILURE) if is_fallback else (FAILURE, SUCCESS)
@@ -532,7 +534,8 @@ class BTInterpreter:
         self._set_mem(w, node, (0, 0))
         return ("ret", SKIPPED if all_skipped else go_on)
 
-    def _t_reactive(self, w, node, frame, result, hook):
+    def _t_reactive(self, w: _Work, node: CompiledNode, frame: Frame, result: int | None,
+                    hook: HaltHook | None) -> TickAction:
         """ReactiveSequence / ReactiveFallback (reactive_sequence.cpp, reactive_fallback.cpp)."""
         is_fallback = node.type in self._reactive_fallbacks
         stop, go_on = (SUCCESS, FAILURE) if is_fallback else (FAILURE, SUCCESS)
@@ -560,7 +563,8 @@ class BTInterpreter:
         self._reset_children(w, node, hook)
         return ("ret", SKIPPED if all_skipped else go_on)
 
-    def _t_parallel(self, w, node, frame, result, hook):
+    def _t_parallel(self, w: _Work, node: CompiledNode, frame: Frame, result: int | None,
+                    hook: HaltHook | None) -> TickAction:
         """Parallel with success_count / failure_count (parallel_node.cpp)."""
         n = len(node.children)
         succ_param, fail_param = node.params
@@ -598,7 +602,8 @@ class BTInterpreter:
         self._set_mem(w, node, (completed, sc, fc))
         return ("ret", SKIPPED if skipped == n else RUNNING)
 
-    def _t_parallel_all(self, w, node, frame, result, hook):
+    def _t_parallel_all(self, w: _Work, node: CompiledNode, frame: Frame, result: int | None,
+                        hook: HaltHook | None) -> TickAction:
         """ParallelAll with max_failures (parallel_all_node.cpp)."""
         n = len(node.children)
         (need_f,) = node.params
@@ -633,7 +638,8 @@ class BTInterpreter:
         self._set_mem(w, node, (completed, fc))
         return ("ret", RUNNING)
 
-    def _t_if_then_else(self, w, node, frame, result, hook):
+    def _t_if_then_else(self, w: _Work, node: CompiledNode, frame: Frame, result: int | None,
+                        hook: HaltHook | None) -> TickAction:
         """IfThenElse (if_then_else_node.cpp): the condition is not re-evaluated while a branch
         runs."""
         (child_idx,) = self._mem(w, node)
@@ -665,7 +671,8 @@ class BTInterpreter:
             return ("ret", result)
         return ("call", node.children[child_idx], (node.id, 2))
 
-    def _t_while_do_else(self, w, node, frame, result, hook):
+    def _t_while_do_else(self, w: _Work, node: CompiledNode, frame: Frame, result: int | None,
+                         hook: HaltHook | None) -> TickAction:
         """WhileDoElse (while_do_else_node.cpp): the condition is re-evaluated every tick."""
         n = len(node.children)
         pc = frame[1]
@@ -688,13 +695,15 @@ class BTInterpreter:
                 raise BTRuntimeError("WhileDoElse: the condition was skipped (the node would "
                                      "return IDLE)", element=node.label)
         else:
+            assert result is not None  # pc == 2: the branch returned
             status = result
         if status == RUNNING:
             return ("ret", RUNNING)
         self._reset_children(w, node, hook)
         return ("ret", status)
 
-    def _t_simple_decorator(self, w, node, frame, result, hook):
+    def _t_simple_decorator(self, w: _Work, node: CompiledNode, frame: Frame, result: int | None,
+                            hook: HaltHook | None) -> TickAction:
         """Inverter, ForceSuccess, ForceFailure, KeepRunningUntilFailure."""
         child = node.children[0]
         if frame[1] == 0:
@@ -714,15 +723,18 @@ class BTInterpreter:
         self._reset_child(w, child, hook)
         return ("ret", mapped[0] if result == SUCCESS else mapped[1])
 
-    def _t_repeat(self, w, node, frame, result, hook):
+    def _t_repeat(self, w: _Work, node: CompiledNode, frame: Frame, result: int | None,
+                  hook: HaltHook | None) -> TickAction:
         """Repeat num_cycles (repeat_node.cpp); -1 repeats forever."""
         return self._loop_decorator(w, node, frame, result, hook, again_on=SUCCESS)
 
-    def _t_retry(self, w, node, frame, result, hook):
+    def _t_retry(self, w: _Work, node: CompiledNode, frame: Frame, result: int | None,
+                 hook: HaltHook | None) -> TickAction:
         """RetryUntilSuccessful num_attempts (retry_node.cpp); -1 retries forever."""
         return self._loop_decorator(w, node, frame, result, hook, again_on=FAILURE)
 
-    def _loop_decorator(self, w, node, frame, result, hook, *, again_on):
+    def _loop_decorator(self, w: _Work, node: CompiledNode, frame: Frame, result: int | None,
+                        hook: HaltHook | None, *, again_on: int) -> TickAction:
         """Repeat and RetryUntilSuccessful are mirror images in BehaviorTree.CPP: the child is
         ticked again while it returns ``again_on``, at most ``node.params[0]`` times (-1: no
         bound); the other result ends the loop at once. A loop that goes on in the same tick
@@ -762,7 +774,8 @@ class BTInterpreter:
         self._set_mem(w, node, (0,))
         return ("ret", again_on)
 
-    def _t_run_once(self, w, node, frame, result, hook):
+    def _t_run_once(self, w: _Work, node: CompiledNode, frame: Frame, result: int | None,
+                    hook: HaltHook | None) -> TickAction:
         """RunOnce then_skip (run_once_node.h): memory survives halts."""
         (then_skip,) = node.params
         ticked, returned = self._mem(w, node)
@@ -776,7 +789,8 @@ class BTInterpreter:
             self._reset_child(w, node.children[0], hook)
         return ("ret", result)
 
-    def _t_subtree(self, w, node, frame, result, hook):
+    def _t_subtree(self, w: _Work, node: CompiledNode, frame: Frame, result: int | None,
+                   hook: HaltHook | None) -> TickAction:
         """SubTree (subtree_node.cpp): a transparent decorator; port remapping is irrelevant."""
         if frame[1] == 0:
             if w.st.get(node.id, IDLE) == IDLE:

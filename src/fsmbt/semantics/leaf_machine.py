@@ -33,7 +33,7 @@ from __future__ import annotations
 from collections import deque
 from collections.abc import Hashable, Sequence
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Final, Generic, TypeVar
+from typing import TYPE_CHECKING, Any, Final, Generic, TypeVar, cast
 
 if TYPE_CHECKING:
     import networkx as nx
@@ -124,7 +124,7 @@ class LeafMachine:
         if outcome is None or node is None or (node.is_condition and outcome == _NODE_RUNNING):
             raise ValueError(f"input {symbol!r} is not allowed in state {self.describe(state)}")
         outputs: list[str] = []
-        new_state = self._run(state, outcome, outputs)
+        new_state = self._run(cast(Snapshot, state), outcome, outputs)
         return new_state, tuple(outputs)
 
     def status(self, state: LeafState) -> str:
@@ -144,7 +144,7 @@ class LeafMachine:
             return None
         if self.table is not None:
             return self.tree.nodes[state]  # type: ignore[index]
-        request = self.interp.leaf_request(state)
+        request = self.interp.leaf_request(cast(Snapshot, state))
         return request.node if request is not None else None
 
     def _fast_step(self, leaf: int, symbol: str) -> tuple[LeafState, Outputs]:
@@ -210,13 +210,13 @@ class ExploredMachine(Generic[S]):
     def __len__(self) -> int:
         return len(self.states)
 
-    def to_networkx(self) -> nx.MultiDiGraph:
+    def to_networkx(self) -> nx.MultiDiGraph[int]:
         """States as integers (BFS order) with ``status``/``name``; one edge per input, keyed
         by the input, carrying ``outputs``."""
         import networkx as nx  # only tests and reports need the graph object
 
         index = {s: i for i, s in enumerate(self.states)}
-        graph = nx.MultiDiGraph(start=index[self.start], start_outputs=self.start_outputs)
+        graph: nx.MultiDiGraph[int] = nx.MultiDiGraph(start=index[self.start], start_outputs=self.start_outputs)
         for s, i in index.items():
             graph.add_node(i, status=self.statuses[s], name=self.names[s])
         for s, moves in self.transitions.items():
@@ -225,13 +225,13 @@ class ExploredMachine(Generic[S]):
         return graph
 
 
-def explore(machine: Machine, max_states: int = 200_000) -> ExploredMachine:
+def explore(machine: Machine[Any], max_states: int = 200_000) -> ExploredMachine[Any]:
     """Breadth-first exploration of every reachable state of ``machine``.
 
     Raises ``StateLimitError`` past ``max_states``. O(S · I) machine steps.
     """
     start, start_outputs = machine.start()
-    result: ExploredMachine = ExploredMachine(start, start_outputs)
+    result: ExploredMachine[Any] = ExploredMachine(start, start_outputs)
     seen = {start}
     queue = deque([start])
     while queue:
@@ -239,7 +239,7 @@ def explore(machine: Machine, max_states: int = 200_000) -> ExploredMachine:
         result.states.append(state)
         result.statuses[state] = machine.status(state)
         result.names[state] = machine.describe(state)
-        moves: dict[str, tuple] = {}
+        moves: dict[str, tuple[Any, Outputs]] = {}
         for symbol in machine.inputs(state):
             target, outs = machine.step(state, symbol)
             moves[symbol] = (target, outs)
