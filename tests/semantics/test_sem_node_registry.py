@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import dataclasses
 import re
+from collections.abc import Callable
 from pathlib import Path
 
 import pytest
@@ -30,7 +31,7 @@ from fsmbt.semantics.status import LeafOutcome, MachineStatus, NodeStatus, RootR
 from fsmbt.verify.nusmv import encode_bt
 
 
-def _names(pred) -> frozenset[str]:  # type: ignore[no-untyped-def]
+def _names(pred: Callable[[nodes.NodeSemantics], object]) -> frozenset[str]:
     return frozenset(n.name for n in nodes.all_nodes() if pred(n))
 
 
@@ -45,17 +46,25 @@ def test_sem_registry_every_consumer_set_is_the_registry_set() -> None:
     assert structural.PAPER_CONTROLS is nodes.PLAIN_CONTROLS
     assert bt_to_hfsm.PLAIN_CONTROLS is nodes.PLAIN_CONTROLS
     assert compress.MERGEABLE_CONTROLS == _names(lambda n: n.mergeable) == plain
-    assert baseline_common.REACTIVE_CONTROLS == _names(lambda n: n.reactive) == {
-        "ReactiveSequence", "ReactiveFallback"}
-    assert bt_to_hfsm.RESULT_MAP_DECORATORS == _names(lambda n: n.result_map is not None) == {
-        "Inverter", "ForceSuccess", "ForceFailure"}
+    assert (
+        baseline_common.REACTIVE_CONTROLS
+        == _names(lambda n: n.reactive)
+        == {"ReactiveSequence", "ReactiveFallback"}
+    )
+    assert (
+        bt_to_hfsm.RESULT_MAP_DECORATORS
+        == _names(lambda n: n.result_map is not None)
+        == {"Inverter", "ForceSuccess", "ForceFailure"}
+    )
     assert encode_bt.SUPPORTED == _names(lambda n: n.nusmv is not None)
     assert set(encode_bt.NOT_ENCODED) == _names(lambda n: n.nusmv_refusal is not None)
     assert not set(encode_bt.SUPPORTED) & set(encode_bt.NOT_ENCODED)
     assert set(bt_nodes.BUILTIN_NODES) == _names(lambda n: True)
-    assert bt_nodes.V3_ALIASES == {"SequenceStar": "SequenceWithMemory",
-                                   "RetryUntilSuccesful": "RetryUntilSuccessful",
-                                   "SubTreePlus": "SubTree"}
+    assert bt_nodes.V3_ALIASES == {
+        "SequenceStar": "SequenceWithMemory",
+        "RetryUntilSuccesful": "RetryUntilSuccessful",
+        "SubTreePlus": "SubTree",
+    }
 
 
 def test_sem_registry_entries_are_consistent() -> None:
@@ -79,8 +88,14 @@ def test_sem_registry_entries_are_consistent() -> None:
 
 
 def test_sem_registry_refused_kinds_keep_their_reasons() -> None:
-    doc = BTDocument.single(BTNode("Delay", NodeKind.DECORATOR, attrs={"delay_msec": "5"},
-                                   children=[BTNode("A", NodeKind.ACTION)]))
+    doc = BTDocument.single(
+        BTNode(
+            "Delay",
+            NodeKind.DECORATOR,
+            attrs={"delay_msec": "5"},
+            children=[BTNode("A", NodeKind.ACTION)],
+        )
+    )
     with pytest.raises(UnsupportedError, match="time-based node"):
         bt_interpreter.CompiledTree(doc)
 
@@ -89,8 +104,9 @@ def test_sem_registry_rejects_a_duplicate_name() -> None:
     with pytest.raises(ValueError, match="already registered"):
         nodes.register(dataclasses.replace(model_nodes.controls.SEQUENCE))
     with pytest.raises(ValueError, match="already registered"):
-        nodes.register(dataclasses.replace(model_nodes.controls.FALLBACK, name="X",
-                                           aliases=("SequenceStar",)))
+        nodes.register(
+            dataclasses.replace(model_nodes.controls.FALLBACK, name="X", aliases=("SequenceStar",))
+        )
 
 
 MY_XML = """<root BTCPP_format="4" main_tree_to_execute="Main">
@@ -106,15 +122,21 @@ MY_XML = """<root BTCPP_format="4" main_tree_to_execute="Main">
 def _run(doc: BTDocument, plan: dict[str, list[str]], ticks: int) -> list[tuple[list[str], str]]:
     remaining = {k: list(v) for k, v in plan.items()}
     runner = BTRunner(doc, lambda node, path: remaining[node.label].pop(0))
-    return [([leaf[0] for leaf in r.leaves], r.result) for r in
-            (runner.tick_once() for _ in range(ticks))]
+    return [
+        ([leaf[0] for leaf in r.leaves], r.result)
+        for r in (runner.tick_once() for _ in range(ticks))
+    ]
 
 
 def test_sem_registry_a_registered_kind_is_read_validated_and_ticked() -> None:
     """One entry is all a new kind needs: the reader knows it is a control, validate knows its
     semantics, the interpreter ticks it by the rule the entry names."""
-    mine = dataclasses.replace(model_nodes.controls.SEQUENCE, name="MySequence", aliases=(),
-                               tick="a Sequence under another name (test)")
+    mine = dataclasses.replace(
+        model_nodes.controls.SEQUENCE,
+        name="MySequence",
+        aliases=(),
+        tick="a Sequence under another name (test)",
+    )
     plan = {"a": ["success", "success"], "b": ["running", "failure", "success"]}
     with nodes.registered(mine):
         doc = read_btcpp(MY_XML.format(kind="MySequence"), ReadContext())
@@ -124,13 +146,15 @@ def test_sem_registry_a_registered_kind_is_read_validated_and_ticked() -> None:
         assert "MySequence" in nodes.runtime_tables().controls
         ours = _run(doc, plan, 3)
     reference = _run(read_btcpp(MY_XML.format(kind="Sequence"), ReadContext()), plan, 3)
-    assert ours == reference == [(["a", "b"], "RUNNING"), (["b"], "FAILURE"),
-                                 (["a", "b"], "SUCCESS")]
+    assert (
+        ours == reference == [(["a", "b"], "RUNNING"), (["b"], "FAILURE"), (["a", "b"], "SUCCESS")]
+    )
     # unregistered again: an unknown control, refused by the interpreter
     assert nodes.node_semantics("MySequence") is None
     assert "MySequence" not in nodes.runtime_tables().controls
-    stray = BTDocument.single(BTNode("MySequence", NodeKind.CONTROL,
-                                     children=[BTNode("A", NodeKind.ACTION)]))
+    stray = BTDocument.single(
+        BTNode("MySequence", NodeKind.CONTROL, children=[BTNode("A", NodeKind.ACTION)])
+    )
     with pytest.raises(UnsupportedError, match="custom or unknown semantics"):
         bt_interpreter.CompiledTree(stray)
 
@@ -146,8 +170,13 @@ def test_sem_registry_rewired_follows_the_result_map() -> None:
 def test_sem_statuses_keep_their_old_values() -> None:
     assert [int(s) for s in NodeStatus] == [0, 1, 2, 3, 4]
     assert bt_interpreter.STATUS_NAMES == ("IDLE", "RUNNING", "SUCCESS", "FAILURE", "SKIPPED")
-    assert (bt_interpreter.IDLE, bt_interpreter.RUNNING, bt_interpreter.SUCCESS,
-            bt_interpreter.FAILURE, bt_interpreter.SKIPPED) == tuple(NodeStatus)
+    assert (
+        bt_interpreter.IDLE,
+        bt_interpreter.RUNNING,
+        bt_interpreter.SUCCESS,
+        bt_interpreter.FAILURE,
+        bt_interpreter.SKIPPED,
+    ) == tuple(NodeStatus)
     assert bt_interpreter.OUTCOME_TO_STATUS == {"success": 2, "failure": 3, "running": 1}
     assert [o.value for o in LeafOutcome] == ["success", "failure", "running"]
     assert [m.value for m in MachineStatus] == ["running", "final"]

@@ -30,7 +30,8 @@ _BUILTINS = all_nodes()
 INTERPRETED_CONTROLS = kinds_where(lambda n: n.kind is NodeKind.CONTROL and n.handler is not None)
 #: Decorator kinds the interpreter ticks.
 INTERPRETED_DECORATORS = kinds_where(
-    lambda n: n.kind is NodeKind.DECORATOR and n.handler is not None)
+    lambda n: n.kind is NodeKind.DECORATOR and n.handler is not None
+)
 #: The plain (non-reactive, memoryless, synchronous) Sequence and Fallback: the paper's
 #: controls, the unit controls of BT -> HFSM, the fast leaf table's class.
 PLAIN_CONTROLS = kinds_where(lambda n: n.is_plain)
@@ -50,9 +51,28 @@ BLACKBOARD_BASED = kinds_where(lambda n: n.blackboard_based)
 NUSMV_ENCODED = kinds_where(lambda n: n.nusmv is not None)
 
 __all__ = [
-    "BLACKBOARD_BASED", "FALLBACK_TYPES", "INTERPRETED_CONTROLS", "INTERPRETED_DECORATORS",
-    "MERGEABLE_CONTROLS", "NUSMV_ENCODED", "PLAIN_CONTROLS", "REACTIVE_CONTROLS",
-    "RESULT_MAP_DECORATORS", "SEQUENCE_TYPES", "TIME_BASED", "Family", "NodeSemantics",
-    "aliases", "all_nodes", "canonical_type", "controls", "decorators", "kinds_where", "leaves",
-    "node_semantics", "register", "registered", "unregister",
+    "BLACKBOARD_BASED",
+    "FALLBACK_TYPES",
+    "INTERPRETED_CONTROLS",
+    "INTERPRETED_DECORATORS",
+    "MERGEABLE_CONTROLS",
+    "NUSMV_ENCODED",
+    "PLAIN_CONTROLS",
+    "REACTIVE_CONTROLS",
+    "RESULT_MAP_DECORATORS",
+    "SEQUENCE_TYPES",
+    "TIME_BASED",
+    "Family",
+    "NodeSemantics",
+    "aliases",
+    "all_nodes",
+    "canonical_type",
+    "controls",
+    "decorators",
+    "kinds_where",
+    "leaves",
+    "node_semantics",
+    "register",
+    "registered",
+    "unregister",
 ]

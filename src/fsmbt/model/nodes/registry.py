@@ -36,21 +36,21 @@ from fsmbt.model.kinds import NodeKind
 class Family(str, Enum):
     """What a node does, the grouping of docs/semantics.md and BehaviorTree.CPP's sources."""
 
-    SEQUENCE = "sequence"        # ticks children in order, stops at the first failure
-    FALLBACK = "fallback"        # ticks children in order, stops at the first success
-    PARALLEL = "parallel"        # ticks every child each tick, thresholds decide
+    SEQUENCE = "sequence"  # ticks children in order, stops at the first failure
+    FALLBACK = "fallback"  # ticks children in order, stops at the first success
+    PARALLEL = "parallel"  # ticks every child each tick, thresholds decide
     CONDITIONAL = "conditional"  # IfThenElse / WhileDoElse: child 0 picks a branch
-    SWITCH = "switch"            # a blackboard value picks the child
-    MANUAL = "manual"            # a person picks the child
-    STATUS_MAP = "status_map"    # one child, its result rewritten (Inverter, Force*, ...)
-    LOOP = "loop"                # one child, ticked again while a result repeats (Repeat, Retry)
-    ONCE = "once"                # RunOnce
-    GATE = "gate"                # blackboard pre-conditions / entry updates
+    SWITCH = "switch"  # a blackboard value picks the child
+    MANUAL = "manual"  # a person picks the child
+    STATUS_MAP = "status_map"  # one child, its result rewritten (Inverter, Force*, ...)
+    LOOP = "loop"  # one child, ticked again while a result repeats (Repeat, Retry)
+    ONCE = "once"  # RunOnce
+    GATE = "gate"  # blackboard pre-conditions / entry updates
     BLACKBOARD_LOOP = "blackboard_loop"  # LoopInt & co: a blackboard queue
-    TIMER = "timer"              # Delay, Timeout, Sleep
+    TIMER = "timer"  # Delay, Timeout, Sleep
     INTERNAL_LEAF = "internal_leaf"  # AlwaysSuccess & co: a fixed result, no environment
     BLACKBOARD_LEAF = "blackboard_leaf"  # ScriptCondition, WasEntryUpdated
-    SUBTREE = "subtree"          # a reference to another tree
+    SUBTREE = "subtree"  # a reference to another tree
 
 
 @dataclass(frozen=True)
@@ -131,8 +131,12 @@ class NodeSemantics:
     @property
     def is_plain(self) -> bool:
         """A plain ``Sequence``/``Fallback``: not reactive, no memory, not asynchronous."""
-        return (self.family in (Family.SEQUENCE, Family.FALLBACK) and not self.reactive
-                and not self.with_memory and not self.asynchronous)
+        return (
+            self.family in (Family.SEQUENCE, Family.FALLBACK)
+            and not self.reactive
+            and not self.with_memory
+            and not self.asynchronous
+        )
 
     def allows_children(self, count: int) -> bool:
         """Whether a node of this kind may have ``count`` children in a file."""
@@ -220,13 +224,23 @@ def aliases() -> dict[str, str]:
     return dict(_ALIASES)
 
 
-def kinds_where(predicate: Callable[[NodeSemantics], bool],
-                nodes: Iterable[NodeSemantics] | None = None) -> frozenset[str]:
+def kinds_where(
+    predicate: Callable[[NodeSemantics], bool], nodes: Iterable[NodeSemantics] | None = None
+) -> frozenset[str]:
     """The names of the registered kinds (or of ``nodes``) that satisfy ``predicate``."""
     return frozenset(n.name for n in (all_nodes() if nodes is None else nodes) if predicate(n))
 
 
 __all__ = [
-    "Family", "NodeSemantics", "aliases", "all_nodes", "canonical_type", "kinds_where",
-    "node_semantics", "register", "registered", "unregister", "version",
+    "Family",
+    "NodeSemantics",
+    "aliases",
+    "all_nodes",
+    "canonical_type",
+    "kinds_where",
+    "node_semantics",
+    "register",
+    "registered",
+    "unregister",
+    "version",
 ]

@@ -84,23 +84,30 @@ def internal_status(node: NodeSemantics) -> NodeStatus | None:
 
 def _build(nodes: tuple[NodeSemantics, ...]) -> RuntimeTables:
     handlers = {n.name: n.handler for n in nodes if n.handler is not None}
-    internal = {n.name: int(NodeStatus[n.internal_result])
-                for n in nodes if n.internal_result is not None}
+    internal = {
+        n.name: int(NodeStatus[n.internal_result]) for n in nodes if n.internal_result is not None
+    }
     return RuntimeTables(
         handlers=handlers,
-        controls=kinds_where(lambda n: n.kind is NodeKind.CONTROL and n.handler is not None,
-                             nodes),
-        decorators=kinds_where(lambda n: n.kind is NodeKind.DECORATOR and n.handler is not None,
-                               nodes),
+        controls=kinds_where(lambda n: n.kind is NodeKind.CONTROL and n.handler is not None, nodes),
+        decorators=kinds_where(
+            lambda n: n.kind is NodeKind.DECORATOR and n.handler is not None, nodes
+        ),
         internal_leaves=internal,
         rejected={n.name: n.rejection for n in nodes if n.rejection is not None},
         default_memory={n.name: n.default_memory for n in nodes if n.default_memory is not None},
         halt_resets_memory=kinds_where(lambda n: n.halt_resets_memory, nodes),
-        sequence_flags={n.name: (n.is_fallback, n.asynchronous, n.with_memory)
-                        for n in nodes if n.handler == "sequence"},
+        sequence_flags={
+            n.name: (n.is_fallback, n.asynchronous, n.with_memory)
+            for n in nodes
+            if n.handler == "sequence"
+        },
         reactive_fallbacks=kinds_where(lambda n: n.reactive and n.is_fallback, nodes),
-        result_maps={n.name: (int(NodeStatus[n.result_map[0]]), int(NodeStatus[n.result_map[1]]))
-                     for n in nodes if n.result_map is not None},
+        result_maps={
+            n.name: (int(NodeStatus[n.result_map[0]]), int(NodeStatus[n.result_map[1]]))
+            for n in nodes
+            if n.result_map is not None
+        },
     )
 
 
@@ -128,8 +135,10 @@ def rewired(decorator: str, success: T, failure: T) -> tuple[T, T]:
         raise ValueError(f"{decorator!r} is not a status-mapping decorator")
     on_success, on_failure = spec.result_map
     succeeded = NodeStatus.SUCCESS.name
-    return (success if on_success == succeeded else failure,
-            success if on_failure == succeeded else failure)
+    return (
+        success if on_success == succeeded else failure,
+        success if on_failure == succeeded else failure,
+    )
 
 
 _CACHE: list[tuple[int, RuntimeTables]] = []
@@ -144,9 +153,29 @@ def runtime_tables() -> RuntimeTables:
 
 
 __all__ = [
-    "BLACKBOARD_BASED", "FALLBACK_TYPES", "INTERPRETED_CONTROLS", "INTERPRETED_DECORATORS",
-    "MERGEABLE_CONTROLS", "NUSMV_ENCODED", "PLAIN_CONTROLS", "REACTIVE_CONTROLS",
-    "RESULT_MAP_DECORATORS", "SEQUENCE_TYPES", "TIME_BASED", "Family", "NodeSemantics",
-    "RuntimeTables", "aliases", "all_nodes", "canonical_type", "internal_status", "kinds_where",
-    "node_semantics", "register", "registered", "rewired", "runtime_tables", "unregister",
+    "BLACKBOARD_BASED",
+    "FALLBACK_TYPES",
+    "INTERPRETED_CONTROLS",
+    "INTERPRETED_DECORATORS",
+    "MERGEABLE_CONTROLS",
+    "NUSMV_ENCODED",
+    "PLAIN_CONTROLS",
+    "REACTIVE_CONTROLS",
+    "RESULT_MAP_DECORATORS",
+    "SEQUENCE_TYPES",
+    "TIME_BASED",
+    "Family",
+    "NodeSemantics",
+    "RuntimeTables",
+    "aliases",
+    "all_nodes",
+    "canonical_type",
+    "internal_status",
+    "kinds_where",
+    "node_semantics",
+    "register",
+    "registered",
+    "rewired",
+    "runtime_tables",
+    "unregister",
 ]
