@@ -7,6 +7,11 @@ a *frame* ``(node id, pc, locals...)`` on an explicit stack; ticking a child pus
 child's return pops it and resumes the parent at ``pc``. No Python recursion is used anywhere
 (trees may be 100 000 deep): compiling, ticking and halting all use explicit stacks.
 
+Which node kinds exist, which tick rule (``_t_<handler>``) runs each, their memory at rest,
+which ``halt()`` forgets it and which kinds are refused and why come from the node registry
+(``fsmbt.semantics.nodes.runtime_tables()``, docs/semantics.md "Node registry"); statuses are
+``fsmbt.semantics.status.NodeStatus`` values (plain-int aliases below, for the hot loops).
+
 What is modelled, node by node, is exactly the v4 code (see docs/semantics.md for the rules):
 node statuses (``IDLE``/``RUNNING``/``SUCCESS``/``FAILURE``; ``SKIPPED`` is returned but never
 stored, as ``TreeNode::executeTick`` does), each node's memory (running index, skipped count,
