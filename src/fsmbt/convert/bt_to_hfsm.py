@@ -46,11 +46,19 @@ from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.bt_nodes import NodeKind
 from fsmbt.model.errors import InputError, UnsupportedError
 from fsmbt.model.fsm import FSM, State
+from fsmbt.semantics.nodes import (
+    PLAIN_CONTROLS,
+    RESULT_MAP_DECORATORS,
+    SEQUENCE_TYPES,
+    rewired,
+)
+from fsmbt.semantics.status import LeafOutcome, NodeStatus, RootResult
 
-SUCCESS, FAILURE, RUNNING = "SUCCESS", "FAILURE", "RUNNING"
-EV_SUCCESS, EV_FAILURE, EV_RUNNING = "success", "failure", "running"
-UNIT_CONTROLS = frozenset({"Sequence", "Fallback"})
-TRANSPARENT_DECORATORS = frozenset({"Inverter", "ForceSuccess", "ForceFailure"})
+#: Exit-state names (``RootResult``) and leaf-outcome events (``LeafOutcome``), as plain str.
+SUCCESS, FAILURE = RootResult.SUCCESS.value, RootResult.FAILURE.value
+RUNNING = NodeStatus.RUNNING.name
+EV_SUCCESS, EV_FAILURE, EV_RUNNING = (
+    LeafOutcome.SUCCESS.value, LeafOutcome.FAILURE.value, LeafOutcome.RUNNING.value)
 ROOT_RESULTS = (SUCCESS, FAILURE)
 
 
@@ -70,9 +78,9 @@ class _Cont:
 
 def _is_structural(node: BTNode) -> bool:
     if node.kind is NodeKind.CONTROL:
-        return node.type in UNIT_CONTROLS and not node.attrs
+        return node.type in PLAIN_CONTROLS and not node.attrs
     if node.kind is NodeKind.DECORATOR:
-        return node.type in TRANSPARENT_DECORATORS and not node.attrs
+        return node.type in RESULT_MAP_DECORATORS and not node.attrs
     if node.is_leaf:
         return not node.is_builtin and not any(k.startswith("_") for k in node.attrs)
     return False
@@ -147,12 +155,7 @@ class _Builder:
         """The entry state of ``node`` wired to ``cont`` (recursion depth <= 3 levels; chains
         of transparent decorators are unrolled in a loop)."""
         while node.kind is NodeKind.DECORATOR and id(node) not in opaque:
-            if node.type == "Inverter":
-                cont = _Cont(cont.failure, cont.success)
-            elif node.type == "ForceSuccess":
-                cont = _Cont(cont.success, cont.success)
-            else:  # ForceFailure
-                cont = _Cont(cont.failure, cont.failure)
+            cont = _Cont(*rewired(node.type, cont.success, cont.failure))
             node = node.children[0]
         if id(node) in opaque:
             return self._explored_state(node, cont, machine)
@@ -173,9 +176,10 @@ class _Builder:
             work.append((node, sub))
             return name
         # a unit control node (level 0) or a child control node (level 1): wire its children
-        entry = cont.success if node.type == "Sequence" else cont.failure
+        is_sequence = node.type in SEQUENCE_TYPES
+        entry = cont.success if is_sequence else cont.failure
         for child in reversed(node.children):
-            if node.type == "Sequence":
+            if is_sequence:
                 child_cont = _Cont(entry, cont.failure)
             else:
                 child_cont = _Cont(cont.success, entry)
@@ -259,7 +263,7 @@ def _looped_result(fsm: FSM, explored, target: object, outputs: tuple[str, ...],
     new tick is back in the start configuration; anything else cannot be expressed."""
     result, leaf = outputs
     start_action = fsm.states[fsm.initial].action if fsm.initial else None
-    if target != explored.start or result not in ("SUCCESS", "FAILURE") or leaf != start_action:
+    if target != explored.start or result not in ROOT_RESULTS or leaf != start_action:
         raise UnsupportedError(f"cannot express the outputs {outputs} of one step as one "
                                "state's action", element=node.label)
     if result not in fsm.states:

@@ -1,6 +1,7 @@
-"""Preparing a BT for BT -> HFSM: SubTree inlining and depth compression (DESIGN §2, step 1).
+"""Preparing a BT for BT -> HFSM: SubTree inlining and depth compression (docs/conversion.md, step 1).
 
-Depth compression merges a child control node into its parent when both have the same type:
+Depth compression merges a child control node into its parent when both have the same type
+and the node registry marks that type ``mergeable`` (``MERGEABLE_CONTROLS``):
 ``Sequence(a, Sequence(b, c), d) = Sequence(a, b, c, d)``, the same for ``Fallback``. Only the
 plain (BehaviorTree.CPP v4, non-reactive, memoryless-across-ticks) ``Sequence`` and ``Fallback``
 are merged: for them the nested and the flat form tick the same leaves in the same order, resume
@@ -20,8 +21,7 @@ from dataclasses import dataclass
 from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.bt_nodes import NodeKind
 from fsmbt.model.errors import InputError
-
-MERGEABLE = frozenset({"Sequence", "Fallback"})
+from fsmbt.semantics.nodes import MERGEABLE_CONTROLS
 
 
 def tree_depth(root: BTNode) -> int:
@@ -97,7 +97,7 @@ class Compression:
 
 
 def _mergeable(parent: BTNode, child: BTNode) -> bool:
-    return (child.type == parent.type and parent.type in MERGEABLE
+    return (child.type == parent.type and parent.type in MERGEABLE_CONTROLS
             and child.kind is NodeKind.CONTROL and not child.attrs)
 
 

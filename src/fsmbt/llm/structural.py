@@ -21,11 +21,14 @@ from collections import Counter, deque
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.fsm import FSM
 from fsmbt.semantics.lebt_spec import DEFAULT_START, GUARD_TYPE, STATE_TYPE, GuardSpec, StateSpec
+from fsmbt.semantics.nodes import PLAIN_CONTROLS
+from fsmbt.semantics.status import LeafOutcome, RootResult
 
-LEBT_NODE_TYPES = frozenset({"Sequence", "Fallback", GUARD_TYPE, STATE_TYPE})
-LEAF_EVENTS = frozenset({"success", "failure", "running"})
-TERMINAL_STATES = frozenset({"SUCCESS", "FAILURE"})
-PAPER_CONTROLS = frozenset({"Sequence", "Fallback"})
+#: The paper's controls: the plain Sequence and Fallback of the node registry.
+PAPER_CONTROLS = PLAIN_CONTROLS
+LEBT_NODE_TYPES = PAPER_CONTROLS | {GUARD_TYPE, STATE_TYPE}
+LEAF_EVENTS = frozenset(outcome.value for outcome in LeafOutcome)
+TERMINAL_STATES = frozenset(result.value for result in RootResult)
 MAX_LISTED = 12  # problems listed per check; more are summarised (feedback stays short)
 
 
@@ -70,7 +73,7 @@ def check_lebt(source: FSM, result: BTDocument) -> list[str]:
         if node.type not in LEBT_NODE_TYPES:
             problems.append(f"{where}: node type {node.type} is not allowed (use Sequence, Fallback, "
                             f"{GUARD_TYPE}, {STATE_TYPE})")
-        elif node.type in ("Sequence", "Fallback") and not node.children:
+        elif node.type in PAPER_CONTROLS and not node.children:
             problems.append(f"{where}: empty {node.type}")
         elif node.type == STATE_TYPE:
             spec = StateSpec.from_attrs(node.attrs)

@@ -1,83 +1,37 @@
 """The node types of BehaviorTree.CPP v4 that fsmbt knows, and the names older inputs use.
 
-Everything is mapped to BehaviorTree.CPP v4 meaning (DESIGN §1, trap (a)): the reactive
-"Sequence" of Colledanchise & Ögren is ``ReactiveSequence`` here, their "Sequence*" is the plain
-``Sequence``; BehaviorTree.CPP v3's ``SequenceStar`` is v4's ``SequenceWithMemory``.
+A thin view of the node registry (``fsmbt.model.nodes``, docs/semantics.md "Node registry"):
+nothing here is declared, everything is read from the registry's entries.
+
+Everything is mapped to BehaviorTree.CPP v4 meaning (docs/semantics.md, "Which Sequence"): the
+reactive "Sequence" of Colledanchise & Ögren is ``ReactiveSequence`` here, their "Sequence*" is
+the plain ``Sequence``; BehaviorTree.CPP v3's ``SequenceStar`` is v4's ``SequenceWithMemory``.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from enum import Enum
+from fsmbt.model.kinds import NodeKind
+from fsmbt.model.nodes import FALLBACK_TYPES, SEQUENCE_TYPES, aliases, all_nodes, node_semantics
+from fsmbt.model.nodes import canonical_type as canonical_type
+from fsmbt.model.nodes.registry import NodeSemantics
 
+#: A built-in node type (the registry entry; ``.type``, ``.kind``, ``.children``,
+#: ``.time_based`` as before).
+NodeSpec = NodeSemantics
 
-class NodeKind(str, Enum):
-    """What a node is, which decides how many children it has and what it may return."""
-
-    CONTROL = "Control"
-    DECORATOR = "Decorator"
-    ACTION = "Action"
-    CONDITION = "Condition"
-    SUBTREE = "SubTree"
-
-
-@dataclass(frozen=True)
-class NodeSpec:
-    """A built-in node type: its kind and how many children it takes (``None`` = one or more)."""
-
-    type: str
-    kind: NodeKind
-    children: int | None
-    time_based: bool = False
-
-
-def _specs() -> dict[str, NodeSpec]:
-    control_many = [
-        "Sequence", "ReactiveSequence", "SequenceWithMemory", "AsyncSequence",
-        "Fallback", "ReactiveFallback", "AsyncFallback",
-        "Parallel", "ParallelAll", "ManualSelector",
-    ]
-    specs = {name: NodeSpec(name, NodeKind.CONTROL, None) for name in control_many}
-    specs["IfThenElse"] = NodeSpec("IfThenElse", NodeKind.CONTROL, None)  # 2 or 3 children
-    specs["WhileDoElse"] = NodeSpec("WhileDoElse", NodeKind.CONTROL, None)  # 2 or 3 children
-    for n in range(2, 7):
-        specs[f"Switch{n}"] = NodeSpec(f"Switch{n}", NodeKind.CONTROL, n + 1)
-    decorators = [
-        "Inverter", "ForceSuccess", "ForceFailure", "Repeat", "RetryUntilSuccessful",
-        "KeepRunningUntilFailure", "RunOnce", "Precondition", "SkipUnlessUpdated",
-        "WaitValueUpdate", "LoopInt", "LoopBool", "LoopDouble", "LoopString",
-    ]
-    for name in decorators:
-        specs[name] = NodeSpec(name, NodeKind.DECORATOR, 1)
-    for name in ("Delay", "Timeout"):
-        specs[name] = NodeSpec(name, NodeKind.DECORATOR, 1, time_based=True)
-    for name in ("AlwaysSuccess", "AlwaysFailure", "Script", "SetBlackboard", "UnsetBlackboard"):
-        specs[name] = NodeSpec(name, NodeKind.ACTION, 0)
-    specs["Sleep"] = NodeSpec("Sleep", NodeKind.ACTION, 0, time_based=True)
-    for name in ("ScriptCondition", "WasEntryUpdated"):
-        specs[name] = NodeSpec(name, NodeKind.CONDITION, 0)
-    specs["SubTree"] = NodeSpec("SubTree", NodeKind.SUBTREE, 0)
-    return specs
-
-
-BUILTIN_NODES: dict[str, NodeSpec] = _specs()
+#: The built-in node types by name (a snapshot of the registry at import).
+BUILTIN_NODES: dict[str, NodeSpec] = {node.name: node for node in all_nodes()}
 
 #: BehaviorTree.CPP v3 (and misspelt) names and their v4 equivalents.
-V3_ALIASES: dict[str, str] = {
-    "SequenceStar": "SequenceWithMemory",
-    "RetryUntilSuccesful": "RetryUntilSuccessful",
-    "SubTreePlus": "SubTree",
-}
-
-#: Control node types whose children are merged by depth compression when nested in themselves.
-SEQUENCE_TYPES = frozenset({"Sequence", "ReactiveSequence", "SequenceWithMemory"})
-FALLBACK_TYPES = frozenset({"Fallback", "ReactiveFallback"})
-
-
-def canonical_type(type_name: str) -> str:
-    """The v4 name of a node type (v3 aliases mapped, everything else unchanged)."""
-    return V3_ALIASES.get(type_name, type_name)
+V3_ALIASES: dict[str, str] = aliases()
 
 
 def builtin_spec(type_name: str) -> NodeSpec | None:
-    return BUILTIN_NODES.get(canonical_type(type_name))
+    """The registry entry of a type name (aliases accepted), ``None`` for custom types."""
+    return node_semantics(type_name)
+
+
+__all__ = [
+    "BUILTIN_NODES", "FALLBACK_TYPES", "SEQUENCE_TYPES", "V3_ALIASES", "NodeKind", "NodeSpec",
+    "builtin_spec", "canonical_type",
+]

@@ -266,8 +266,10 @@ class _BtValidator:
             elif spec is not None and spec.children is not None and count != spec.children:
                 self.add("error", f"'{node.type}' needs exactly {spec.children} children, has "
                          f"{count}", node, where())
-            elif node.type in ("IfThenElse", "WhileDoElse") and count not in (2, 3):
-                self.add("error", f"'{node.type}' needs 2 or 3 children, has {count}", node, where())
+            elif spec is not None and not spec.allows_children(count):
+                allowed = " or ".join(str(c) for c in spec.child_counts or ())
+                self.add("error", f"'{node.type}' needs {allowed} children, has {count}", node,
+                         where())
         elif node.kind is NodeKind.DECORATOR:
             if count != 1:
                 self.add("error", f"decorator '{node.type}' needs exactly one child, has {count}",

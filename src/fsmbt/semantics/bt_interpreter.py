@@ -7,6 +7,11 @@ a *frame* ``(node id, pc, locals...)`` on an explicit stack; ticking a child pus
 child's return pops it and resumes the parent at ``pc``. No Python recursion is used anywhere
 (trees may be 100 000 deep): compiling, ticking and halting all use explicit stacks.
 
+Which node kinds exist, which tick rule (``_t_<handler>``) runs each, their memory at rest,
+which ``halt()`` forgets it and which kinds are refused and why come from the node registry
+(``fsmbt.semantics.nodes.runtime_tables()``, docs/semantics.md "Node registry"); statuses are
+``fsmbt.semantics.status.NodeStatus`` values (plain-int aliases below, for the hot loops).
+
 What is modelled, node by node, is exactly the v4 code (see docs/semantics.md for the rules):
 node statuses (``IDLE``/``RUNNING``/``SUCCESS``/``FAILURE``; ``SKIPPED`` is returned but never
 stored, as ``TreeNode::executeTick`` does), each node's memory (running index, skipped count,
@@ -31,52 +36,38 @@ from __future__ import annotations
 
 from collections.abc import Callable, Hashable
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Final
 
 from fsmbt.model.bt import BTDocument, BTNode
-from fsmbt.model.bt_nodes import NodeKind, builtin_spec, canonical_type
 from fsmbt.model.errors import InputError, UnsupportedError
+from fsmbt.model.kinds import NodeKind
+from fsmbt.semantics.nodes import canonical_type, node_semantics, runtime_tables
+from fsmbt.semantics.status import LeafOutcome, NodeStatus
 
-# -- statuses --------------------------------------------------------------------------------
-IDLE, RUNNING, SUCCESS, FAILURE, SKIPPED = range(5)
-STATUS_NAMES = ("IDLE", "RUNNING", "SUCCESS", "FAILURE", "SKIPPED")
-#: Leaf outcomes as the environment / the leaf machine's inputs name them.
-OUTCOME_SUCCESS, OUTCOME_FAILURE, OUTCOME_RUNNING = "success", "failure", "running"
-OUTCOME_TO_STATUS = {OUTCOME_SUCCESS: SUCCESS, OUTCOME_FAILURE: FAILURE, OUTCOME_RUNNING: RUNNING}
-STATUS_TO_OUTCOME = {v: k for k, v in OUTCOME_TO_STATUS.items()}
+# -- statuses (fsmbt.semantics.status; docs/semantics.md "Statuses") ---------------------------
+# Plain-int aliases of NodeStatus for the hot loops: snapshots hold them, and an int hashes
+# three times faster than an IntEnum member (equal values, equal hashes).
+IDLE: Final[int] = NodeStatus.IDLE.value
+RUNNING: Final[int] = NodeStatus.RUNNING.value
+SUCCESS: Final[int] = NodeStatus.SUCCESS.value
+FAILURE: Final[int] = NodeStatus.FAILURE.value
+SKIPPED: Final[int] = NodeStatus.SKIPPED.value
+STATUS_NAMES: tuple[str, ...] = tuple(status.name for status in NodeStatus)
+#: Leaf outcomes as the environment / the leaf machine's inputs name them (plain ``str``).
+OUTCOME_SUCCESS: Final[str] = LeafOutcome.SUCCESS.value
+OUTCOME_FAILURE: Final[str] = LeafOutcome.FAILURE.value
+OUTCOME_RUNNING: Final[str] = LeafOutcome.RUNNING.value
+OUTCOME_TO_STATUS: dict[str, int] = {o.value: o.status.value for o in LeafOutcome}
+STATUS_TO_OUTCOME: dict[int, str] = {v: k for k, v in OUTCOME_TO_STATUS.items()}
 
 #: Upper bound on nodes after SubTree expansion (a SubTree used twice per level doubles).
 MAX_COMPILED_NODES = 2_000_000
 
-# -- supported node types ----------------------------------------------------------------------
-SEQUENCE_LIKE = {"Sequence": False, "AsyncSequence": True}
-FALLBACK_LIKE = {"Fallback": False, "AsyncFallback": True}
-CONTROLS = frozenset({
-    "Sequence", "AsyncSequence", "SequenceWithMemory", "ReactiveSequence",
-    "Fallback", "AsyncFallback", "ReactiveFallback",
-    "Parallel", "ParallelAll", "IfThenElse", "WhileDoElse",
-})
-DECORATORS = frozenset({
-    "Inverter", "ForceSuccess", "ForceFailure", "Repeat", "RetryUntilSuccessful",
-    "KeepRunningUntilFailure", "RunOnce", "SubTree",
-})
-#: Built-in leaves that always succeed / fail and take no input from the environment.
-INTERNAL_LEAVES = {
-    "AlwaysSuccess": SUCCESS, "AlwaysFailure": FAILURE, "Script": SUCCESS,
-    "SetBlackboard": SUCCESS, "UnsetBlackboard": SUCCESS,
-}
+# -- supported node types: the node registry (fsmbt.semantics.nodes) ----------------------------
+# Which kinds are ticked and by which rule, their default memory, which are refused and why:
+# ``runtime_tables()``, read when a tree is compiled and when an interpreter is built.
 #: Pre-condition attributes change control flow from the blackboard: rejected.
 PRECONDITION_ATTRS = ("_skipIf", "_failureIf", "_successIf", "_while")
-_REJECT_REASON = {
-    "Delay": "time-based node (needs a clock)", "Timeout": "time-based node (needs a clock)",
-    "Sleep": "time-based node (needs a clock)",
-    "ScriptCondition": "its result depends on the blackboard",
-    "WasEntryUpdated": "its result depends on the blackboard",
-    "Precondition": "its result depends on the blackboard",
-    "SkipUnlessUpdated": "its result depends on the blackboard",
-    "WaitValueUpdate": "its result depends on the blackboard",
-    "ManualSelector": "it asks a person which child to run",
-}
 
 
 class BTRuntimeError(InputError):
@@ -217,15 +208,18 @@ class CompiledTree:
             self._paths[nid] = cached
         return cached
 
-    def _check(self, node: BTNode, chain: tuple[str, ...]):
+    def _check(self, node: BTNode, chain: tuple[str, ...]
+               ) -> tuple[str, NodeKind, tuple[Any, ...], int | None, list[BTNode]]:
+        tables = runtime_tables()
         ctype = canonical_type(node.type)
         kind = node.kind
         for attr in PRECONDITION_ATTRS:
             if attr in node.attrs:
                 raise UnsupportedError(
                     f"pre-condition '{attr}' depends on the blackboard", **_where(node))
-        if ctype in _REJECT_REASON:
-            raise UnsupportedError(f"{ctype}: {_REJECT_REASON[ctype]}", **_where(node))
+        reason = tables.rejected.get(ctype)
+        if reason is not None:
+            raise UnsupportedError(f"{ctype}: {reason}", **_where(node))
         kids = list(node.children)
         params: tuple[Any, ...] = ()
         internal: int | None = None
@@ -244,13 +238,13 @@ class CompiledTree:
         if kind in (NodeKind.ACTION, NodeKind.CONDITION):
             if kids:
                 raise InputError("a leaf node has children", **_where(node))
-            if ctype in INTERNAL_LEAVES:
-                internal = INTERNAL_LEAVES[ctype]
-            elif builtin_spec(ctype) is not None:
+            if ctype in tables.internal_leaves:
+                internal = tables.internal_leaves[ctype]
+            elif node_semantics(ctype) is not None:
                 raise UnsupportedError(f"built-in leaf {ctype} is not supported", **_where(node))
             return ctype, kind, params, internal, kids
         if kind is NodeKind.DECORATOR:
-            if ctype not in DECORATORS:
+            if ctype not in tables.decorators:
                 raise UnsupportedError(f"decorator type '{node.type}' is not supported "
                                        "(custom or unknown semantics)", **_where(node))
             if len(kids) != 1:
@@ -264,14 +258,17 @@ class CompiledTree:
                 params = (_bool_param(node, "then_skip", True),)
             return ctype, kind, params, internal, kids
         if kind is NodeKind.CONTROL:
-            if ctype not in CONTROLS:
+            if ctype not in tables.controls:
                 raise UnsupportedError(f"control type '{node.type}' is not supported "
                                        "(custom or unknown semantics)", **_where(node))
             if not kids:
                 raise InputError(f"control node {ctype} has no children", **_where(node))
             n = len(kids)
-            if ctype in ("IfThenElse", "WhileDoElse") and n not in (2, 3):
-                raise InputError(f"{ctype} needs 2 or 3 children, has {n}", **_where(node))
+            spec = node_semantics(ctype)
+            counts = spec.child_counts if spec is not None else None
+            if counts is not None and n not in counts:
+                allowed = " or ".join(str(c) for c in counts)
+                raise InputError(f"{ctype} needs {allowed} children, has {n}", **_where(node))
             if ctype == "Parallel":
                 succ = _int_param(node, "success_count", -1)
                 fail = _int_param(node, "failure_count", 1)
@@ -296,8 +293,8 @@ class CompiledTree:
 # -- run-time configuration ------------------------------------------------------------------
 #: A snapshot: (statuses, memories, frames, wake-up pending). Hashable; equal snapshots behave
 #: the same for every future input.
-Snapshot = tuple[tuple[tuple[int, int], ...], tuple[tuple[int, tuple], ...],
-                 tuple[tuple, ...], bool]
+Snapshot = tuple[tuple[tuple[int, int], ...], tuple[tuple[int, tuple[Any, ...]], ...],
+                 tuple[tuple[Any, ...], ...], bool]
 
 
 @dataclass(frozen=True)
@@ -317,6 +314,12 @@ class TickDone:
 
 
 HaltHook = Callable[[CompiledNode], None]
+#: A frame on the interpreter's stack: (node id, pc, locals...).
+Frame = tuple[Any, ...]
+#: What a tick rule does next: ("call", child id, new frame) or ("ret", status).
+TickAction = tuple[Any, ...]
+#: A node kind's tick rule (``BTInterpreter._t_<handler>``).
+TickRule = Callable[["_Work", CompiledNode, Frame, "int | None", "HaltHook | None"], TickAction]
 
 
 class _Work:
@@ -326,22 +329,14 @@ class _Work:
 
     def __init__(self, snap: Snapshot) -> None:
         self.st: dict[int, int] = dict(snap[0])
-        self.mem: dict[int, tuple] = dict(snap[1])
-        self.frames: list[tuple] = list(snap[2])
+        self.mem: dict[int, tuple[Any, ...]] = dict(snap[1])
+        self.frames: list[tuple[Any, ...]] = list(snap[2])
         self.wake: bool = snap[3]
 
     def snapshot(self) -> Snapshot:
         return (tuple(sorted(self.st.items())), tuple(sorted(self.mem.items())),
                 tuple(self.frames), self.wake)
 
-
-_DEFAULT_MEM: dict[str, tuple] = {
-    "Sequence": (0, 0), "AsyncSequence": (0, 0), "SequenceWithMemory": (0, 0),
-    "Fallback": (0, 0), "AsyncFallback": (0, 0),
-    "Parallel": (frozenset(), 0, 0), "ParallelAll": (frozenset(), 0),
-    "IfThenElse": (0,), "Repeat": (0,), "RetryUntilSuccessful": (0,),
-    "RunOnce": (False, IDLE),
-}
 
 EMPTY_SNAPSHOT: Snapshot = ((), (), (), False)
 
@@ -354,19 +349,15 @@ class BTInterpreter:
         self.tree = tree if isinstance(tree, CompiledTree) else CompiledTree(tree)
         self.nodes = self.tree.nodes
         self.exactly_once = exactly_once
-        self._tick = {
-            "Sequence": self._t_sequence, "AsyncSequence": self._t_sequence,
-            "SequenceWithMemory": self._t_sequence, "Fallback": self._t_sequence,
-            "AsyncFallback": self._t_sequence,
-            "ReactiveSequence": self._t_reactive, "ReactiveFallback": self._t_reactive,
-            "Parallel": self._t_parallel, "ParallelAll": self._t_parallel_all,
-            "IfThenElse": self._t_if_then_else, "WhileDoElse": self._t_while_do_else,
-            "Inverter": self._t_simple_decorator, "ForceSuccess": self._t_simple_decorator,
-            "ForceFailure": self._t_simple_decorator,
-            "KeepRunningUntilFailure": self._t_simple_decorator,
-            "Repeat": self._t_repeat, "RetryUntilSuccessful": self._t_retry,
-            "RunOnce": self._t_run_once, "SubTree": self._t_subtree,
-        }
+        # Dispatch data from the node registry (docs/semantics.md "Node registry").
+        tables = runtime_tables()
+        self._tick: dict[str, TickRule] = {
+            kind: getattr(self, f"_t_{handler}") for kind, handler in tables.handlers.items()}
+        self._default_mem = tables.default_memory
+        self._halt_resets = tables.halt_resets_memory
+        self._seq_flags = tables.sequence_flags
+        self._reactive_fallbacks = tables.reactive_fallbacks
+        self._result_maps = tables.result_maps
 
     # -- public driving API --------------------------------------------------------------
     def initial(self) -> Snapshot:
@@ -462,11 +453,11 @@ class BTInterpreter:
             w.st[nid] = status
         return status
 
-    def _mem(self, w: _Work, node: CompiledNode) -> tuple:
-        return w.mem.get(node.id, _DEFAULT_MEM[node.type])
+    def _mem(self, w: _Work, node: CompiledNode) -> tuple[Any, ...]:
+        return w.mem.get(node.id, self._default_mem[node.type])
 
-    def _set_mem(self, w: _Work, node: CompiledNode, value: tuple) -> None:
-        if value == _DEFAULT_MEM[node.type]:
+    def _set_mem(self, w: _Work, node: CompiledNode, value: tuple[Any, ...]) -> None:
+        if value == self._default_mem[node.type]:
             w.mem.pop(node.id, None)
         else:
             w.mem[node.id] = value
@@ -489,10 +480,9 @@ class BTInterpreter:
         while stack:
             x = self.nodes[stack.pop()]
             t = x.type
-            if t in ("Sequence", "AsyncSequence", "Fallback", "AsyncFallback", "Parallel",
-                     "ParallelAll", "IfThenElse", "Repeat", "RetryUntilSuccessful"):
+            if t in self._halt_resets:
                 w.mem.pop(x.id, None)  # these halt() reset their memory
-            # SequenceWithMemory, RunOnce, Reactive*, WhileDoElse keep theirs
+            # the others (SequenceWithMemory, RunOnce...) keep theirs: NodeSemantics.halt
             if x.kind is NodeKind.ACTION and x.internal_status is None and hook is not None \
                     and w.st.get(x.id, IDLE) == RUNNING:
                 hook(x)
@@ -505,12 +495,10 @@ class BTInterpreter:
             # running children reset their own status when popped (after their halt)
 
     # -- node types: each returns ("call", child, new_frame) or ("ret", status) ---------------
-    def _t_sequence(self, w, node, frame, result, hook):
+    def _t_sequence(self, w: _Work, node: CompiledNode, frame: Frame, result: int | None,
+                    hook: HaltHook | None) -> TickAction:
         """Sequence / Fallback / Async* / SequenceWithMemory (sequence_node.cpp & co)."""
-        t = node.type
-        is_fallback = t in FALLBACK_LIKE
-        asynch = SEQUENCE_LIKE.get(t, FALLBACK_LIKE.get(t, False))
-        with_memory = t == "SequenceWithMemory"
+        is_fallback, asynch, with_memory = self._seq_flags[node.type]
         stop, go_on = (SUCCESS, FAILURE) if is_fallback else (FAILURE, SUCCESS)
         idx, skipped = self._mem(w, node)
         n = len(node.children)
@@ -551,9 +539,10 @@ class BTInterpreter:
         self._set_mem(w, node, (0, 0))
         return ("ret", SKIPPED if all_skipped else go_on)
 
-    def _t_reactive(self, w, node, frame, result, hook):
+    def _t_reactive(self, w: _Work, node: CompiledNode, frame: Frame, result: int | None,
+                    hook: HaltHook | None) -> TickAction:
         """ReactiveSequence / ReactiveFallback (reactive_sequence.cpp, reactive_fallback.cpp)."""
-        is_fallback = node.type == "ReactiveFallback"
+        is_fallback = node.type in self._reactive_fallbacks
         stop, go_on = (SUCCESS, FAILURE) if is_fallback else (FAILURE, SUCCESS)
         if frame[1] == 0:
             w.st[node.id] = RUNNING
@@ -579,7 +568,8 @@ class BTInterpreter:
         self._reset_children(w, node, hook)
         return ("ret", SKIPPED if all_skipped else go_on)
 
-    def _t_parallel(self, w, node, frame, result, hook):
+    def _t_parallel(self, w: _Work, node: CompiledNode, frame: Frame, result: int | None,
+                    hook: HaltHook | None) -> TickAction:
         """Parallel with success_count / failure_count (parallel_node.cpp)."""
         n = len(node.children)
         succ_param, fail_param = node.params
@@ -617,7 +607,8 @@ class BTInterpreter:
         self._set_mem(w, node, (completed, sc, fc))
         return ("ret", SKIPPED if skipped == n else RUNNING)
 
-    def _t_parallel_all(self, w, node, frame, result, hook):
+    def _t_parallel_all(self, w: _Work, node: CompiledNode, frame: Frame, result: int | None,
+                        hook: HaltHook | None) -> TickAction:
         """ParallelAll with max_failures (parallel_all_node.cpp)."""
         n = len(node.children)
         (need_f,) = node.params
@@ -652,7 +643,8 @@ class BTInterpreter:
         self._set_mem(w, node, (completed, fc))
         return ("ret", RUNNING)
 
-    def _t_if_then_else(self, w, node, frame, result, hook):
+    def _t_if_then_else(self, w: _Work, node: CompiledNode, frame: Frame, result: int | None,
+                        hook: HaltHook | None) -> TickAction:
         """IfThenElse (if_then_else_node.cpp): the condition is not re-evaluated while a branch
         runs."""
         (child_idx,) = self._mem(w, node)
@@ -684,7 +676,8 @@ class BTInterpreter:
             return ("ret", result)
         return ("call", node.children[child_idx], (node.id, 2))
 
-    def _t_while_do_else(self, w, node, frame, result, hook):
+    def _t_while_do_else(self, w: _Work, node: CompiledNode, frame: Frame, result: int | None,
+                         hook: HaltHook | None) -> TickAction:
         """WhileDoElse (while_do_else_node.cpp): the condition is re-evaluated every tick."""
         n = len(node.children)
         pc = frame[1]
@@ -707,20 +700,22 @@ class BTInterpreter:
                 raise BTRuntimeError("WhileDoElse: the condition was skipped (the node would "
                                      "return IDLE)", element=node.label)
         else:
+            assert result is not None  # pc == 2: the branch returned
             status = result
         if status == RUNNING:
             return ("ret", RUNNING)
         self._reset_children(w, node, hook)
         return ("ret", status)
 
-    def _t_simple_decorator(self, w, node, frame, result, hook):
+    def _t_simple_decorator(self, w: _Work, node: CompiledNode, frame: Frame, result: int | None,
+                            hook: HaltHook | None) -> TickAction:
         """Inverter, ForceSuccess, ForceFailure, KeepRunningUntilFailure."""
         child = node.children[0]
         if frame[1] == 0:
             w.st[node.id] = RUNNING
             return ("call", child, (node.id, 1))
-        t = node.type
-        if t == "KeepRunningUntilFailure":
+        mapped = self._result_maps.get(node.type)
+        if mapped is None:  # KeepRunningUntilFailure
             if result == FAILURE:
                 self._reset_child(w, child, hook)
                 return ("ret", FAILURE)
@@ -731,19 +726,20 @@ class BTInterpreter:
         if result in (RUNNING, SKIPPED):
             return ("ret", result)
         self._reset_child(w, child, hook)
-        if t == "Inverter":
-            return ("ret", FAILURE if result == SUCCESS else SUCCESS)
-        return ("ret", SUCCESS if t == "ForceSuccess" else FAILURE)
+        return ("ret", mapped[0] if result == SUCCESS else mapped[1])
 
-    def _t_repeat(self, w, node, frame, result, hook):
+    def _t_repeat(self, w: _Work, node: CompiledNode, frame: Frame, result: int | None,
+                  hook: HaltHook | None) -> TickAction:
         """Repeat num_cycles (repeat_node.cpp); -1 repeats forever."""
         return self._loop_decorator(w, node, frame, result, hook, again_on=SUCCESS)
 
-    def _t_retry(self, w, node, frame, result, hook):
+    def _t_retry(self, w: _Work, node: CompiledNode, frame: Frame, result: int | None,
+                 hook: HaltHook | None) -> TickAction:
         """RetryUntilSuccessful num_attempts (retry_node.cpp); -1 retries forever."""
         return self._loop_decorator(w, node, frame, result, hook, again_on=FAILURE)
 
-    def _loop_decorator(self, w, node, frame, result, hook, *, again_on):
+    def _loop_decorator(self, w: _Work, node: CompiledNode, frame: Frame, result: int | None,
+                        hook: HaltHook | None, *, again_on: int) -> TickAction:
         """Repeat and RetryUntilSuccessful are mirror images in BehaviorTree.CPP: the child is
         ticked again while it returns ``again_on``, at most ``node.params[0]`` times (-1: no
         bound); the other result ends the loop at once. A loop that goes on in the same tick
@@ -783,7 +779,8 @@ class BTInterpreter:
         self._set_mem(w, node, (0,))
         return ("ret", again_on)
 
-    def _t_run_once(self, w, node, frame, result, hook):
+    def _t_run_once(self, w: _Work, node: CompiledNode, frame: Frame, result: int | None,
+                    hook: HaltHook | None) -> TickAction:
         """RunOnce then_skip (run_once_node.h): memory survives halts."""
         (then_skip,) = node.params
         ticked, returned = self._mem(w, node)
@@ -797,7 +794,8 @@ class BTInterpreter:
             self._reset_child(w, node.children[0], hook)
         return ("ret", result)
 
-    def _t_subtree(self, w, node, frame, result, hook):
+    def _t_subtree(self, w: _Work, node: CompiledNode, frame: Frame, result: int | None,
+                   hook: HaltHook | None) -> TickAction:
         """SubTree (subtree_node.cpp): a transparent decorator; port remapping is irrelevant."""
         if frame[1] == 0:
             if w.st.get(node.id, IDLE) == IDLE:

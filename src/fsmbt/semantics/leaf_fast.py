@@ -26,16 +26,21 @@ is O(1). States are the plain ``int`` id of the leaf about to be ticked (cheap t
 
 from __future__ import annotations
 
-from fsmbt.model.bt_nodes import NodeKind
-from fsmbt.semantics.bt_interpreter import (
-    OUTCOME_FAILURE, OUTCOME_RUNNING, OUTCOME_SUCCESS, CompiledTree,
-)
+from typing import Final
+
+from fsmbt.model.kinds import NodeKind
+from fsmbt.semantics.bt_interpreter import CompiledTree
+from fsmbt.semantics.nodes import FALLBACK_TYPES, PLAIN_CONTROLS
+from fsmbt.semantics.status import LeafOutcome, RootResult
 
 ROOT = 0  # the compiled root's id (ids are pre-order indices)
-PLAIN_CONTROLS = frozenset({"Sequence", "Fallback"})
 #: Negative targets in the exit tables: the root returned this result.
 ROOT_SUCCESS, ROOT_FAILURE = -1, -2
-ROOT_RESULT_NAMES = {ROOT_SUCCESS: "SUCCESS", ROOT_FAILURE: "FAILURE"}
+ROOT_RESULT_NAMES: dict[int, str] = {ROOT_SUCCESS: RootResult.SUCCESS.value,
+                                     ROOT_FAILURE: RootResult.FAILURE.value}
+_SUCCESS: Final[str] = LeafOutcome.SUCCESS.value
+_FAILURE: Final[str] = LeafOutcome.FAILURE.value
+_RUNNING: Final[str] = LeafOutcome.RUNNING.value
 
 
 def is_plain_tree(tree: CompiledTree) -> bool:
@@ -76,11 +81,11 @@ class PlainLeafTable:
                 continue
             parent_success, parent_failure = on_success[node.id], on_failure[node.id]
             last = len(kids) - 1
-            if node.type == "Sequence":
+            if node.kind is NodeKind.CONTROL and node.type not in FALLBACK_TYPES:  # Sequence
                 for i, kid in enumerate(kids):
                     on_success[kid] = first_leaf[kids[i + 1]] if i < last else parent_success
                     on_failure[kid] = parent_failure
-            elif node.type == "Fallback":
+            elif node.kind is NodeKind.CONTROL:  # Fallback
                 for i, kid in enumerate(kids):
                     on_success[kid] = parent_success
                     on_failure[kid] = first_leaf[kids[i + 1]] if i < last else parent_failure
@@ -97,10 +102,10 @@ class PlainLeafTable:
     def after(self, leaf: int, outcome: str) -> int:
         """Where ``outcome`` of ``leaf`` leads: the same leaf on ``running``, else the next leaf
         or a negative root result. O(1)."""
-        if outcome == OUTCOME_SUCCESS:
+        if outcome == _SUCCESS:
             return self.on_success[leaf]
-        if outcome == OUTCOME_FAILURE:
+        if outcome == _FAILURE:
             return self.on_failure[leaf]
-        if outcome == OUTCOME_RUNNING:
+        if outcome == _RUNNING:
             return leaf
         raise ValueError(f"unknown outcome {outcome!r}")

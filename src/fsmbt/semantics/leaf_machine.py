@@ -33,7 +33,7 @@ from __future__ import annotations
 from collections import deque
 from collections.abc import Hashable, Sequence
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Generic, TypeVar
+from typing import TYPE_CHECKING, Any, Final, Generic, TypeVar, cast
 
 if TYPE_CHECKING:
     import networkx as nx
@@ -41,16 +41,25 @@ if TYPE_CHECKING:
 from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.errors import InputError
 from fsmbt.semantics.bt_interpreter import (
-    OUTCOME_FAILURE, OUTCOME_RUNNING, OUTCOME_SUCCESS, OUTCOME_TO_STATUS, RUNNING,
-    STATUS_NAMES, BTInterpreter, BTLivelock, CompiledNode, CompiledTree, LeafRequest, Snapshot,
+    OUTCOME_TO_STATUS,
+    BTInterpreter,
+    BTLivelock,
+    CompiledNode,
+    CompiledTree,
+    LeafRequest,
+    Snapshot,
 )
 from fsmbt.semantics.leaf_fast import ROOT_RESULT_NAMES, PlainLeafTable, is_plain_tree
 from fsmbt.semantics.machine import FINAL, Machine, Outputs
 from fsmbt.semantics.machine import RUNNING as STATUS_RUNNING
+from fsmbt.semantics.status import LeafOutcome, NodeStatus
 
 LIVELOCK = "LIVELOCK"
-CONDITION_INPUTS = (OUTCOME_SUCCESS, OUTCOME_FAILURE)
-ACTION_INPUTS = (OUTCOME_SUCCESS, OUTCOME_FAILURE, OUTCOME_RUNNING)
+#: The leaf outcomes a condition / an action may be given (``LeafOutcome`` values, plain str).
+CONDITION_INPUTS: tuple[str, ...] = (LeafOutcome.SUCCESS.value, LeafOutcome.FAILURE.value)
+ACTION_INPUTS: tuple[str, ...] = CONDITION_INPUTS + (LeafOutcome.RUNNING.value,)
+_NODE_RUNNING: Final[int] = NodeStatus.RUNNING.value  # hot-loop alias
+_OUTCOME_RUNNING: Final[str] = LeafOutcome.RUNNING.value
 
 
 def leaf_label(node: BTNode | CompiledNode) -> str:
@@ -112,10 +121,10 @@ class LeafMachine:
             return self._fast_step(state, symbol)  # type: ignore[arg-type]
         outcome = OUTCOME_TO_STATUS.get(symbol)
         node = self.leaf(state)
-        if outcome is None or node is None or (node.is_condition and outcome == RUNNING):
+        if outcome is None or node is None or (node.is_condition and outcome == _NODE_RUNNING):
             raise ValueError(f"input {symbol!r} is not allowed in state {self.describe(state)}")
         outputs: list[str] = []
-        new_state = self._run(state, outcome, outputs)
+        new_state = self._run(cast(Snapshot, state), outcome, outputs)
         return new_state, tuple(outputs)
 
     def status(self, state: LeafState) -> str:
@@ -135,14 +144,14 @@ class LeafMachine:
             return None
         if self.table is not None:
             return self.tree.nodes[state]  # type: ignore[index]
-        request = self.interp.leaf_request(state)
+        request = self.interp.leaf_request(cast(Snapshot, state))
         return request.node if request is not None else None
 
     def _fast_step(self, leaf: int, symbol: str) -> tuple[LeafState, Outputs]:
         """``step`` on the fast path: O(1) table look-ups, the same loop rules as ``_run``."""
         table = self.table
         assert table is not None
-        if symbol == OUTCOME_RUNNING and table.is_condition[leaf] or \
+        if symbol == _OUTCOME_RUNNING and table.is_condition[leaf] or \
                 symbol not in OUTCOME_TO_STATUS:
             raise ValueError(f"input {symbol!r} is not allowed in state {self.describe(leaf)}")
         target = table.after(leaf, symbol)
@@ -167,8 +176,8 @@ class LeafMachine:
             if isinstance(event, LeafRequest):
                 outputs.append(event.node.label)
                 return snap
-            if event.status != RUNNING:
-                result = STATUS_NAMES[event.status]
+            if event.status != _NODE_RUNNING:
+                result = NodeStatus(event.status).name
                 outputs.append(result)
                 if not self.loop:
                     return RootResult(result)
@@ -201,13 +210,13 @@ class ExploredMachine(Generic[S]):
     def __len__(self) -> int:
         return len(self.states)
 
-    def to_networkx(self) -> nx.MultiDiGraph:
+    def to_networkx(self) -> nx.MultiDiGraph[int]:
         """States as integers (BFS order) with ``status``/``name``; one edge per input, keyed
         by the input, carrying ``outputs``."""
         import networkx as nx  # only tests and reports need the graph object
 
         index = {s: i for i, s in enumerate(self.states)}
-        graph = nx.MultiDiGraph(start=index[self.start], start_outputs=self.start_outputs)
+        graph: nx.MultiDiGraph[int] = nx.MultiDiGraph(start=index[self.start], start_outputs=self.start_outputs)
         for s, i in index.items():
             graph.add_node(i, status=self.statuses[s], name=self.names[s])
         for s, moves in self.transitions.items():
@@ -216,13 +225,13 @@ class ExploredMachine(Generic[S]):
         return graph
 
 
-def explore(machine: Machine, max_states: int = 200_000) -> ExploredMachine:
+def explore(machine: Machine[Any], max_states: int = 200_000) -> ExploredMachine[Any]:
     """Breadth-first exploration of every reachable state of ``machine``.
 
     Raises ``StateLimitError`` past ``max_states``. O(S · I) machine steps.
     """
     start, start_outputs = machine.start()
-    result: ExploredMachine = ExploredMachine(start, start_outputs)
+    result: ExploredMachine[Any] = ExploredMachine(start, start_outputs)
     seen = {start}
     queue = deque([start])
     while queue:
@@ -230,7 +239,7 @@ def explore(machine: Machine, max_states: int = 200_000) -> ExploredMachine:
         result.states.append(state)
         result.statuses[state] = machine.status(state)
         result.names[state] = machine.describe(state)
-        moves: dict[str, tuple] = {}
+        moves: dict[str, tuple[Any, Outputs]] = {}
         for symbol in machine.inputs(state):
             target, outs = machine.step(state, symbol)
             moves[symbol] = (target, outs)

@@ -1,7 +1,8 @@
 """The one shape every behaviour is explored in: a deterministic Mealy machine with a status.
 
 The checker (``fsmbt.verify``) and NuSMV's encoding compare two such machines fed the same
-inputs. What counts as an input and an output depends on the pair (DESIGN §2, §3):
+inputs. What counts as an input and an output depends on the pair (docs/semantics.md,
+"Statuses" names the values):
 
 - FSM vs LEBT (macro steps): inputs are events; outputs are the actions run; status is
   ``"final"`` when the FSM is in a final state / the LEBT has terminated, else ``"running"``.
@@ -13,16 +14,18 @@ inputs. What counts as an input and an output depends on the pair (DESIGN §2, �
 from __future__ import annotations
 
 from collections.abc import Hashable, Sequence
-from typing import Protocol, TypeVar
+from typing import Final, Protocol, TypeVar
 
 from fsmbt.model.flatten import flatten, needs_flattening
 from fsmbt.model.fsm import FSM
+from fsmbt.semantics.status import MachineStatus
 
 S = TypeVar("S", bound=Hashable)
 Outputs = tuple[str, ...]
 
-RUNNING = "running"
-FINAL = "final"
+#: ``MachineStatus`` values as plain ``str`` (the checker compares them in its hot loops).
+RUNNING: Final[str] = MachineStatus.RUNNING.value
+FINAL: Final[str] = MachineStatus.FINAL.value
 
 
 class Machine(Protocol[S]):

@@ -25,6 +25,7 @@ from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.bt_nodes import NodeKind
 from fsmbt.model.fsm import FSM
 from fsmbt.semantics.lebt_spec import GUARD_TYPE, STATE_TYPE, GuardSpec, StateSpec
+from fsmbt.semantics.nodes import PLAIN_CONTROLS
 
 Model = FSM | BTDocument
 
@@ -76,7 +77,7 @@ def _bt_candidates(doc: BTDocument) -> Iterator[tuple[str, str, Callable[[list[B
                     kids = ns[i].children
                     kids[a], kids[a + 1] = kids[a + 1], kids[a]
                 yield "swap_children", f"children {a} and {a + 1} of {label} swapped", swap
-        if node.type in ("Sequence", "Fallback"):
+        if node.type in PLAIN_CONTROLS:  # the paper's two controls swap into each other
             other = "Fallback" if node.type == "Sequence" else "Sequence"
             def turn(ns: list[BTNode], i: int = i, other: str = other) -> None:
                 ns[i].type = other

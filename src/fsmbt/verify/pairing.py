@@ -17,10 +17,11 @@ from fsmbt.model.errors import InputError
 from fsmbt.model.fsm import FSM
 from fsmbt.semantics.lebt_spec import GUARD_TYPE, GuardSpec
 from fsmbt.semantics.machine import FINAL, RUNNING, FSMMachine, Machine, Outputs
+from fsmbt.semantics.status import LeafOutcome, NodeStatus
 
 MACRO_STEP = "macro-step"
 LEAF_EXECUTION = "leaf-execution"
-LEAF_OUTCOMES = ("success", "failure", "running")
+LEAF_OUTCOMES = tuple(outcome.value for outcome in LeafOutcome)
 
 
 class FSMLeafMachine:
@@ -91,8 +92,6 @@ class LEBTWithActiveInputs:
     """
 
     def __init__(self, machine: Machine) -> None:
-        from fsmbt.semantics.bt_interpreter import RUNNING as NODE_RUNNING
-
         self.machine = machine
         self.name = machine.name
         self.alphabet: tuple[str, ...] = tuple(machine.alphabet)  # type: ignore[attr-defined]
@@ -104,7 +103,7 @@ class LEBTWithActiveInputs:
                 if event:
                     self._by_source.setdefault(source, []).append(event)
         self._exits = {nid: spec.exits for nid, spec in leaves.states.items()}
-        self._node_running = NODE_RUNNING
+        self._node_running = NodeStatus.RUNNING.value
 
     def start(self):  # type: ignore[no-untyped-def]
         return self.machine.start()
@@ -162,7 +161,8 @@ def machines_for(source: FSM | BTDocument, result: FSM | BTDocument, *,
     if isinstance(source, FSM) and isinstance(result, BTDocument):
         from fsmbt.semantics.lebt_runtime import LEBTMachine
         from fsmbt.semantics.state_variable_runtime import (
-            is_state_variable_bt, machines_for_state_variable,
+            is_state_variable_bt,
+            machines_for_state_variable,
         )
 
         if is_state_variable_bt(result):  # the baselines' state-variable leaves (BSD, CHDS)

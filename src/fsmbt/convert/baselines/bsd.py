@@ -25,8 +25,19 @@ Complexity: O(S + T) for FSM -> BT; O(N) for BT -> FSM (explicit stacks, no recu
 from __future__ import annotations
 
 from fsmbt.convert.baselines.common import (
-    EV_FAILURE, EV_RUNNING, EV_SUCCESS, FAILURE, REACTIVE_CONTROLS, SUCCESS, Cont,
-    check_baseline_node, control, exits_of, leaf_node, prepare_fsm, sv_node_models,
+    EV_FAILURE,
+    EV_RUNNING,
+    EV_SUCCESS,
+    FAILURE,
+    REACTIVE_CONTROLS,
+    SUCCESS,
+    Cont,
+    check_baseline_node,
+    control,
+    exits_of,
+    leaf_node,
+    prepare_fsm,
+    sv_node_models,
 )
 from fsmbt.convert.engines import ConversionResult, register_engine
 from fsmbt.model.bt import BTDocument, BTNode
@@ -34,6 +45,7 @@ from fsmbt.model.bt_nodes import NodeKind
 from fsmbt.model.fsm import FSM, State
 from fsmbt.semantics import state_variable_runtime as sv
 from fsmbt.semantics.leaf_machine import leaf_label
+from fsmbt.semantics.nodes import SEQUENCE_TYPES, rewired
 
 ENGINE = "bsd"
 
@@ -93,11 +105,7 @@ def _leaf_names(root: BTNode) -> tuple[dict[int, str], dict[int, BTNode]]:
 
 def rewire(node: BTNode, cont: Cont) -> Cont:
     """The continuation a transparent decorator passes to its child."""
-    if node.type == "Inverter":
-        return Cont(cont.failure, cont.success)
-    if node.type == "ForceSuccess":
-        return Cont(cont.success, cont.success)
-    return Cont(cont.failure, cont.failure)
+    return Cont(*rewired(node.type, cont.success, cont.failure))
 
 
 def bt_to_bsd_fsm(doc: BTDocument, *, loop: bool = False, **_options: object) -> ConversionResult:
@@ -128,7 +136,7 @@ def bt_to_bsd_fsm(doc: BTDocument, *, loop: bool = False, **_options: object) ->
             continue
         if node.type in REACTIVE_CONTROLS and restart is None:
             restart = names[id(leftmost[id(node)])]
-        is_sequence = node.type.endswith("Sequence")
+        is_sequence = node.type in SEQUENCE_TYPES
         kids = node.children
         for index, child in enumerate(kids):
             after = names[id(leftmost[id(kids[index + 1])])] if index + 1 < len(kids) else None

@@ -30,8 +30,19 @@ from __future__ import annotations
 
 from fsmbt.convert.baselines.bsd import rewire
 from fsmbt.convert.baselines.common import (
-    EV_FAILURE, EV_RUNNING, EV_SUCCESS, FAILURE, REACTIVE_CONTROLS, SUCCESS, Cont,
-    check_baseline_node, control, exits_of, leaf_node, prepare_fsm, sv_node_models,
+    EV_FAILURE,
+    EV_RUNNING,
+    EV_SUCCESS,
+    FAILURE,
+    REACTIVE_CONTROLS,
+    SUCCESS,
+    Cont,
+    check_baseline_node,
+    control,
+    exits_of,
+    leaf_node,
+    prepare_fsm,
+    sv_node_models,
 )
 from fsmbt.convert.engines import ConversionResult, register_engine
 from fsmbt.model.bt import BTDocument, BTNode
@@ -39,9 +50,11 @@ from fsmbt.model.bt_nodes import NodeKind
 from fsmbt.model.fsm import FSM, State
 from fsmbt.semantics import state_variable_runtime as sv
 from fsmbt.semantics.leaf_machine import leaf_label
+from fsmbt.semantics.nodes import SEQUENCE_TYPES
+from fsmbt.semantics.status import NodeStatus
 
 ENGINE = "chds"
-RESTART = "RUNNING"
+RESTART = NodeStatus.RUNNING.name  # the end state a reactive restart leaves through
 
 
 # -- FSM -> BT ---------------------------------------------------------------------------------
@@ -142,7 +155,7 @@ def _fill(builder: _Builder, node: BTNode, machine: FSM,
           work: list[tuple[BTNode, FSM]]) -> str:
     """Wire a control node's children into its own sub-FSM ``machine``; returns its entry."""
     owner = builder.owner[id(node)]
-    is_sequence = node.type.endswith("Sequence")
+    is_sequence = node.type in SEQUENCE_TYPES
     # running: restart here when this node is the outermost reactive one; leave through the
     # RUNNING end when an outer reactive node owns the restart; else re-tick the leaf
     restart_here = owner == id(node)

@@ -12,12 +12,17 @@ from fsmbt.model.errors import InputError, UnsupportedError
 from fsmbt.model.flatten import flatten, needs_flattening
 from fsmbt.model.fsm import FSM
 from fsmbt.semantics import state_variable_runtime as sv
+from fsmbt.semantics.nodes import (
+    PLAIN_CONTROLS,
+    REACTIVE_CONTROLS,
+    RESULT_MAP_DECORATORS,
+)
+from fsmbt.semantics.status import LeafOutcome, RootResult
 
-SUCCESS, FAILURE = "SUCCESS", "FAILURE"
-EV_SUCCESS, EV_FAILURE, EV_RUNNING = "success", "failure", "running"
-PLAIN_CONTROLS = frozenset({"Sequence", "Fallback"})
-REACTIVE_CONTROLS = frozenset({"ReactiveSequence", "ReactiveFallback"})
-TRANSPARENT_DECORATORS = frozenset({"Inverter", "ForceSuccess", "ForceFailure"})
+#: End-state names (``RootResult``) and leaf-outcome events (``LeafOutcome``), as plain str.
+SUCCESS, FAILURE = RootResult.SUCCESS.value, RootResult.FAILURE.value
+EV_SUCCESS, EV_FAILURE, EV_RUNNING = (
+    LeafOutcome.SUCCESS.value, LeafOutcome.FAILURE.value, LeafOutcome.RUNNING.value)
 
 
 def sv_node_models(types: tuple[str, ...]) -> dict[str, NodeModel]:
@@ -106,7 +111,7 @@ def check_baseline_node(node: BTNode) -> None:
             raise InputError(f"{node.type} has no children", location=node.location,
                              element=node.label)
         return
-    if node.kind is NodeKind.DECORATOR and node.type in TRANSPARENT_DECORATORS:
+    if node.kind is NodeKind.DECORATOR and node.type in RESULT_MAP_DECORATORS:
         return
     raise UnsupportedError(
         f"{node.type}: the classical baselines map Sequence, Fallback, their Reactive "

@@ -1,4 +1,4 @@
-"""A behavior tree as an SMV module, written from the tree's structure (DESIGN §2, §4).
+"""A behavior tree as an SMV module, written from the tree's structure (docs/nusmv.md).
 
 The tick rules of BehaviorTree.CPP v4 are transition relations over per-node variables, one
 *micro-step* per node visit, exactly as the interpreter walks the tree (docs/nusmv.md):
@@ -14,10 +14,12 @@ The tick rules of BehaviorTree.CPP v4 are transition relations over per-node var
   resets it now or the parent is being halted; ``hlt_n := clr_n & st_n = RUNNING`` (a RUNNING
   node is halted, which resets its memory and clears its children).
 
-Leaf requests are where the environment answers: in a leaf-execution machine they are the
+Which kinds are encoded and by which rule is the node registry's ``nusmv`` field, and why a
+kind is refused its ``nusmv_refusal`` (``fsmbt.semantics.nodes``, docs/semantics.md "Node
+registry"). Leaf requests are where the environment answers: in a leaf-execution machine they are the
 stable states that take an input (success/failure/running); the LEBT encoding
 (``encode_lebt``) answers them from its blackboard instead. Supported node types are listed in
-``SUPPORTED``; anything else raises ``UnsupportedError`` (docs/nusmv.md says why).
+``SUPPORTED`` (derived from the registry); anything else raises ``UnsupportedError`` (docs/nusmv.md says why).
 Size: O(N · d) SMV text for N nodes of depth d.
 """
 
@@ -30,24 +32,23 @@ from fsmbt.model.bt import BTDocument
 from fsmbt.model.bt_nodes import NodeKind
 from fsmbt.model.errors import UnsupportedError
 from fsmbt.semantics.bt_interpreter import CompiledNode, CompiledTree
+from fsmbt.semantics.nodes import NUSMV_ENCODED, all_nodes, node_semantics
+from fsmbt.semantics.status import LeafOutcome, NodeStatus, RootResult
 from fsmbt.verify.nusmv.smv import Symbols, any_of, case
 
-SEQ_LIKE = {  # type: (is_fallback, emits wake-up after a fresh child succeeds/fails)
-    "Sequence": (False, False), "AsyncSequence": (False, True),
-    "SequenceWithMemory": (False, True),
-    "Fallback": (True, False), "AsyncFallback": (True, True),
-}
-REACTIVE = {"ReactiveSequence": False, "ReactiveFallback": True}
-SIMPLE_DECORATORS = {"Inverter", "ForceSuccess", "ForceFailure", "KeepRunningUntilFailure"}
-SUPPORTED = set(SEQ_LIKE) | set(REACTIVE) | SIMPLE_DECORATORS | {"SubTree"}
-NOT_ENCODED = {
-    "Parallel": "several children run at once (completed-set memory)",
-    "ParallelAll": "several children run at once (completed-set memory)",
-    "IfThenElse": "not encoded yet", "WhileDoElse": "not encoded yet",
-    "Repeat": "its cycle counter is not encoded", "RetryUntilSuccessful":
-    "its attempt counter is not encoded", "RunOnce": "SKIPPED statuses are not encoded",
-}
-ST = {"IDLE": "I", "RUNNING": "R", "SUCCESS": "S", "FAILURE": "F"}
+# The encoding rules by node kind, from the registry's ``nusmv`` field.
+#: type -> (is_fallback, emits wake-up after a fresh child succeeds/fails, with memory)
+SEQ_LIKE = {n.name: (n.is_fallback, n.wakes_up, n.with_memory)
+            for n in all_nodes() if n.nusmv == "sequence"}
+#: type -> is_fallback
+REACTIVE = {n.name: n.is_fallback for n in all_nodes() if n.nusmv == "reactive"}
+SIMPLE_DECORATORS = frozenset(n.name for n in all_nodes() if n.nusmv == "simple_decorator")
+SUPPORTED = NUSMV_ENCODED
+#: type -> why the encoding refuses it
+NOT_ENCODED = {n.name: n.nusmv_refusal for n in all_nodes() if n.nusmv_refusal is not None}
+#: The SMV constants of the four stored statuses (``NodeStatus`` names' initials).
+ST = {s.name: s.name[0] for s in NodeStatus if s is not NodeStatus.SKIPPED}
+_S, _F = ST[NodeStatus.SUCCESS.name], ST[NodeStatus.FAILURE.name]
 STATUS_ENUM = "{I, R, S, F}"
 
 
@@ -76,7 +77,7 @@ class BTCore:
             if node.kind in (NodeKind.ACTION, NodeKind.CONDITION):
                 internal = None
                 if node.internal_status is not None:
-                    internal = "S" if node.internal_status == 2 else "F"
+                    internal = _S if node.internal_status == NodeStatus.SUCCESS else _F
                     has_internal = True
                 self.info.append(NodeInfo(node, internal is None, internal))
                 continue
@@ -86,7 +87,10 @@ class BTCore:
                     f"the NuSMV encoding does not support {node.type} ({reason}); use "
                     "--engine native", location=node.source.location,
                     element=f"<{node.type}> '{node.label}'")
-            has_keep_running |= node.type == "KeepRunningUntilFailure"
+            spec = node_semantics(node.type)
+            # a simple decorator without a result map (KeepRunningUntilFailure) can tick forever
+            has_keep_running |= (node.type in SIMPLE_DECORATORS and spec is not None
+                                 and spec.result_map is None)
             self.info.append(NodeInfo(node, False, None))
         if has_internal and (loop or has_keep_running):
             raise UnsupportedError(
@@ -173,9 +177,8 @@ class BTCore:
             k = len(kids)
             t = x.type
             if t in SEQ_LIKE:
-                is_fb, wakes = SEQ_LIKE[t]
+                is_fb, wakes, memory = SEQ_LIKE[t]
                 stop, go_on = ("S", "F") if is_fb else ("F", "S")
-                memory = t == "SequenceWithMemory"
                 idx = f"idx_{x.id}"
                 self.rule(self.st(x.id), called, "R")
                 for i, c in enumerate(kids):
@@ -235,23 +238,28 @@ class BTCore:
                         self.ret(cond, x.id, go_on)
             else:  # one child: simple decorators and SubTree
                 c = kids[0]
-                if t == "SubTree":
+                spec = node_semantics(t)
+                assert spec is not None
+                result_map = spec.result_map
+                if spec.kind is NodeKind.SUBTREE:
                     self.rule(self.st(x.id), f"{called} & {self.st(x.id)} = I", "R")
                 else:
                     self.rule(self.st(x.id), called, "R")
                 self.call(called, c)
                 back = f"{here} & res != NONE"
                 done = f"{back} & (res = S | res = F)"
-                if t == "KeepRunningUntilFailure":
+                if result_map is None and spec.kind is not NodeKind.SUBTREE:
+                    # KeepRunningUntilFailure
                     resets[c].append(done)
                     self.ret(f"{back} & res = F", x.id, "F")
                     self.ret(f"{back} & res != F", x.id, "R")
                     continue
                 self.ret(f"{back} & res = R", x.id, "R")
                 resets[c].append(done)
-                mapped = {"Inverter": "case res = S : F; TRUE : S; esac",
-                          "ForceSuccess": "S", "ForceFailure": "F",
-                          "SubTree": "case res = S : S; TRUE : F; esac"}[t]
+                # the child's S / F as the node returns them (a SubTree passes them on)
+                on_s, on_f = ((ST[result_map[0]], ST[result_map[1]]) if result_map is not None
+                              else (_S, _F))
+                mapped = on_s if on_s == on_f else f"case res = S : {on_s}; TRUE : {on_f}; esac"
                 self.ret(done, x.id, mapped)
         # halt closure (pre-order ids: a parent's defines come before its children's)
         for x in self.nodes:
@@ -259,7 +267,7 @@ class BTCore:
             self.defines.append((f"clr_{x.id}", any_of(resets[x.id] + [parent_halt])))
             self.defines.append((f"hlt_{x.id}", f"(clr_{x.id} & {self.st(x.id)} = R)"))
             # a halted node's memory is reset (Sequence/Fallback/Async*; not WithMemory)
-            if self.is_seq_like(x.id) and x.type != "SequenceWithMemory":
+            if self.is_seq_like(x.id) and not SEQ_LIKE[x.type][2]:
                 self.rules.setdefault(f"idx_{x.id}", []).insert(0, (f"hlt_{x.id}", "0"))
             self.rules.setdefault(self.st(x.id), []).insert(0, (f"clr_{x.id}", "I"))
 
@@ -308,7 +316,7 @@ def describe_bt(core: BTCore, values: dict[str, str]) -> str:
     if cur.startswith("n") and cur[1:].isdigit():
         node = core.nodes[int(cur[1:])]
         return f"{node.label}@{node.path or 'root'}"
-    return {"DONE_S": "SUCCESS", "DONE_F": "FAILURE"}.get(cur, cur)
+    return {"DONE_S": RootResult.SUCCESS.value, "DONE_F": RootResult.FAILURE.value}.get(cur, cur)
 
 
 class LeafBTEncoder:
@@ -321,10 +329,10 @@ class LeafBTEncoder:
         self.inputs = inputs
         self.outputs = outputs
         self.loop = loop
-        inputs.add_all(("success", "failure", "running"))
+        inputs.add_all(tuple(o.value for o in LeafOutcome))
         for leaf in self.core.env_leaves():
             outputs.id(leaf.label)
-        outputs.add_all(("SUCCESS", "FAILURE"))
+        outputs.add_all(tuple(r.value for r in RootResult))
 
     def _identity(self) -> list[str]:
         """The variables that make up a state, as the native leaf machine keys it: for a plain
@@ -345,13 +353,13 @@ class LeafBTEncoder:
         core.init["bres"] = NONE_OUT
         core.build()
         ids = self.inputs
-        outcome = {"success": "S", "failure": "F", "running": "R"}
+        outcome = {o.value: ST[o.status.name] for o in LeafOutcome}
         requests = []
         for leaf in core.env_leaves():
             req = core.leaf_request(leaf.id)
             requests.append(req)
             for name, status in outcome.items():
-                if name == "running" and leaf.kind is NodeKind.CONDITION:
+                if name == LeafOutcome.RUNNING and leaf.kind is NodeKind.CONDITION:
                     continue
                 core.ret(f"go & {req} & inp = {ids.id(name)}", leaf.id, status)
         stable = any_of(requests + ["cur = DONE_S", "cur = DONE_F"])
@@ -361,7 +369,7 @@ class LeafBTEncoder:
         core.call(f"{top} & res = R", 0)
         for status in ("S", "F"):
             ended = f"{top} & res = {status}"
-            word = "SUCCESS" if status == "S" else "FAILURE"
+            word = (RootResult.SUCCESS if status == _S else RootResult.FAILURE).value
             core.rules.setdefault("bres", []).append((ended, self.outputs.id(word)))
             if self.loop:
                 core.rules.setdefault(core.st(0), []).append((ended, "I"))
@@ -381,7 +389,7 @@ class LeafBTEncoder:
         condition_req = any_of(r for r, leaf in zip(requests, core.env_leaves())
                                if leaf.kind is NodeKind.CONDITION)
         for symbol, sid in sorted(ids.to_id.items()):
-            if symbol == "running":
+            if symbol == LeafOutcome.RUNNING:
                 value = f"(stable & !final & !{condition_req})"
             elif symbol in outcome:
                 value = "(stable & !final)"

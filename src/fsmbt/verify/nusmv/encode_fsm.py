@@ -17,10 +17,11 @@ from dataclasses import dataclass, field
 from fsmbt.model.errors import InputError
 from fsmbt.model.flatten import flatten
 from fsmbt.model.fsm import FSM
+from fsmbt.semantics.status import LeafOutcome, MachineStatus
 from fsmbt.verify.nusmv.smv import Symbols, any_of, case
 
 NONE_OUT = "out_none"
-LEAF_OUTCOMES = ("success", "failure", "running")
+LEAF_OUTCOMES = tuple(outcome.value for outcome in LeafOutcome)
 
 
 @dataclass
@@ -144,4 +145,5 @@ class FSMEncoder:
 
     def status_of(self, values: dict[str, str]) -> str:
         name = self.states.to_name.get(values.get("q", ""))
-        return "final" if name in self.fsm.states and self.fsm.states[name].final else "running"
+        final = name in self.fsm.states and self.fsm.states[name].final
+        return (MachineStatus.FINAL if final else MachineStatus.RUNNING).value

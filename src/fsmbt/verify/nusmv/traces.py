@@ -5,6 +5,7 @@ one step per input both machines took while attached, the start as step 0."""
 from __future__ import annotations
 
 from fsmbt.model.errors import Hint, UnsupportedError
+from fsmbt.semantics.status import MachineStatus
 from fsmbt.verify.nusmv.encode_fsm import NONE_OUT
 from fsmbt.verify.nusmv.runner import SpecResult, TraceState
 from fsmbt.verify.report import PROPERTIES, PropertyResult, Report, TraceStep
@@ -64,8 +65,7 @@ def decode_trace(trace: list[TraceState], context) -> list[TraceStep]:
         steps.append(TraceStep(
             len(steps), pending if steps else None, outs(s_vals, src), outs(r_vals, res),
             src.decode_state(s_vals), res.decode_state(r_vals),
-            "final" if s_vals.get("final") == "TRUE" else "running",
-            "final" if r_vals.get("final") == "TRUE" else "running"))
+            _status(s_vals), _status(r_vals)))
         pending = None
     return steps
 
@@ -117,3 +117,9 @@ def _name(model) -> str:
         return model.main.id
     except Exception:  # noqa: BLE001 - a name for the report only
         return "model"
+
+
+def _status(values: dict[str, str]) -> str:
+    """The machine status of a trace state (its ``final`` define), as the native checker says."""
+    final = values.get("final") == "TRUE"
+    return (MachineStatus.FINAL if final else MachineStatus.RUNNING).value

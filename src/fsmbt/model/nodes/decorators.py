@@ -1,0 +1,214 @@
+"""Decorator nodes (BehaviorTree.CPP ``src/decorators``): one entry per kind, one child each.
+
+The rules are summaries; docs/semantics.md ("Decorators") is the reference.
+"""
+
+from __future__ import annotations
+
+from fsmbt.model.kinds import NodeKind
+from fsmbt.model.nodes.registry import Family, NodeSemantics, register
+
+_D = NodeKind.DECORATOR
+_BLACKBOARD = "its result depends on the blackboard"
+_CLOCK = "time-based node (needs a clock)"
+_RESET = "halts the child if running; keeps no memory"
+
+INVERTER = register(
+    NodeSemantics(
+        "Inverter",
+        _D,
+        Family.STATUS_MAP,
+        1,
+        tick="ticks the child; SUCCESS becomes FAILURE and FAILURE becomes SUCCESS; RUNNING and "
+        "SKIPPED pass through",
+        halt=_RESET,
+        result_map=("FAILURE", "SUCCESS"),
+        handler="simple_decorator",
+        nusmv="simple_decorator",
+        source="inverter_node.cpp",
+    )
+)
+FORCE_SUCCESS = register(
+    NodeSemantics(
+        "ForceSuccess",
+        _D,
+        Family.STATUS_MAP,
+        1,
+        tick="ticks the child; SUCCESS and FAILURE become SUCCESS; RUNNING and SKIPPED pass through",
+        halt=_RESET,
+        result_map=("SUCCESS", "SUCCESS"),
+        handler="simple_decorator",
+        nusmv="simple_decorator",
+        source="force_success_node.h",
+    )
+)
+FORCE_FAILURE = register(
+    NodeSemantics(
+        "ForceFailure",
+        _D,
+        Family.STATUS_MAP,
+        1,
+        tick="ticks the child; SUCCESS and FAILURE become FAILURE; RUNNING and SKIPPED pass through",
+        halt=_RESET,
+        result_map=("FAILURE", "FAILURE"),
+        handler="simple_decorator",
+        nusmv="simple_decorator",
+        source="force_failure_node.h",
+    )
+)
+KEEP_RUNNING_UNTIL_FAILURE = register(
+    NodeSemantics(
+        "KeepRunningUntilFailure",
+        _D,
+        Family.STATUS_MAP,
+        1,
+        tick="ticks the child; FAILURE ends it with FAILURE, SUCCESS resets the child and returns "
+        "RUNNING (the child is ticked afresh next tick)",
+        halt=_RESET,
+        handler="simple_decorator",
+        nusmv="simple_decorator",
+        source="keep_running_until_failure_node.h",
+    )
+)
+REPEAT = register(
+    NodeSemantics(
+        "Repeat",
+        _D,
+        Family.LOOP,
+        1,
+        tick="ticks the child again after each SUCCESS, num_cycles times (-1: forever); FAILURE "
+        "ends it; after a synchronous success it asks for a wake-up and returns RUNNING",
+        halt="forgets the cycle count, halts the child",
+        memory=("repeat_count",),
+        default_memory=(0,),
+        halt_resets_memory=True,
+        wakes_up=True,
+        handler="repeat",
+        nusmv_refusal="its cycle counter is not encoded",
+        ports=("num_cycles",),
+        source="repeat_node.cpp",
+    )
+)
+RETRY_UNTIL_SUCCESSFUL = register(
+    NodeSemantics(
+        "RetryUntilSuccessful",
+        _D,
+        Family.LOOP,
+        1,
+        tick="ticks the child again after each FAILURE, num_attempts times (-1: forever); SUCCESS "
+        "ends it; after a synchronous failure it asks for a wake-up and returns RUNNING",
+        halt="forgets the attempt count, halts the child",
+        memory=("try_count",),
+        default_memory=(0,),
+        halt_resets_memory=True,
+        wakes_up=True,
+        handler="retry",
+        nusmv_refusal="its attempt counter is not encoded",
+        ports=("num_attempts",),
+        aliases=("RetryUntilSuccesful",),
+        source="retry_node.cpp",
+    )
+)
+RUN_ONCE = register(
+    NodeSemantics(
+        "RunOnce",
+        _D,
+        Family.ONCE,
+        1,
+        tick="ticks the child until it completes once; afterwards returns SKIPPED (then_skip=true) "
+        "or the remembered result without ticking it",
+        halt="halts the child; keeps the memory (the node stays 'already run')",
+        memory=("already_ticked", "returned_status"),
+        default_memory=(False, 0),
+        handler="run_once",
+        nusmv_refusal="SKIPPED statuses are not encoded",
+        ports=("then_skip",),
+        source="run_once_node.h",
+    )
+)
+PRECONDITION = register(
+    NodeSemantics(
+        "Precondition",
+        _D,
+        Family.GATE,
+        1,
+        tick="evaluates a script on the blackboard to decide whether the child runs",
+        blackboard_based=True,
+        rejection=_BLACKBOARD,
+        nusmv_refusal=_BLACKBOARD,
+        ports=("if", "else"),
+        source="script_precondition.h",
+    )
+)
+SKIP_UNLESS_UPDATED = register(
+    NodeSemantics(
+        "SkipUnlessUpdated",
+        _D,
+        Family.GATE,
+        1,
+        tick="ticks the child only if a blackboard entry changed since the last tick",
+        blackboard_based=True,
+        rejection=_BLACKBOARD,
+        nusmv_refusal=_BLACKBOARD,
+        ports=("entry",),
+        source="updated_decorator.cpp",
+    )
+)
+WAIT_VALUE_UPDATE = register(
+    NodeSemantics(
+        "WaitValueUpdate",
+        _D,
+        Family.GATE,
+        1,
+        tick="returns RUNNING until a blackboard entry changes, then ticks the child",
+        blackboard_based=True,
+        rejection=_BLACKBOARD,
+        nusmv_refusal=_BLACKBOARD,
+        ports=("entry",),
+        source="updated_decorator.cpp",
+    )
+)
+LOOPS = tuple(
+    register(
+        NodeSemantics(
+            f"Loop{value}",
+            _D,
+            Family.BLACKBOARD_LOOP,
+            1,
+            tick=f"pops {value.lower()} values from a blackboard queue and ticks the child once per value",
+            blackboard_based=True,
+            nusmv_refusal="its loop reads a blackboard queue",
+            ports=("queue", "value", "if_empty"),
+            source="loop_node.h",
+        )
+    )
+    for value in ("Int", "Bool", "Double", "String")
+)
+DELAY = register(
+    NodeSemantics(
+        "Delay",
+        _D,
+        Family.TIMER,
+        1,
+        tick="returns RUNNING for delay_msec milliseconds, then ticks the child",
+        time_based=True,
+        rejection=_CLOCK,
+        nusmv_refusal=_CLOCK,
+        ports=("delay_msec",),
+        source="delay_node.cpp",
+    )
+)
+TIMEOUT = register(
+    NodeSemantics(
+        "Timeout",
+        _D,
+        Family.TIMER,
+        1,
+        tick="ticks the child; halts it and returns FAILURE after msec milliseconds",
+        time_based=True,
+        rejection=_CLOCK,
+        nusmv_refusal=_CLOCK,
+        ports=("msec",),
+        source="timeout_node.h",
+    )
+)
