@@ -341,6 +341,16 @@ class _Work:
 EMPTY_SNAPSHOT: Snapshot = ((), (), (), False)
 
 
+def snapshot_statuses(snapshot: Snapshot) -> tuple[tuple[int, int], ...]:
+    """The ``(node id, status)`` pairs of the nodes whose status is not IDLE, in id order.
+
+    Why a function and not a named tuple: snapshots are made once per explored state, and a
+    plain tuple is the cheapest hashable value; readers outside this module use this accessor
+    instead of indexing the tuple.
+    """
+    return snapshot[0]
+
+
 class BTInterpreter:
     """Executes a compiled tree step by step. Stateless itself: every call takes and returns a
     ``Snapshot``, so callers (the leaf machine, the LEBT runtime, a plain runner) share it."""

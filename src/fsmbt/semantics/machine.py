@@ -80,7 +80,7 @@ class FSMMachine:
         assert self.fsm.initial is not None, "validated FSMs have an initial state"
         if self.fsm.initial_event is not None:
             return self.start_state, ()
-        return self.fsm.initial, self._entry(self.fsm.initial)
+        return self.fsm.initial, self.entry_outputs(self.fsm.initial)
 
     def inputs(self, state: str) -> Sequence[str]:
         return self.alphabet
@@ -99,14 +99,14 @@ class FSMMachine:
         if state == self.start_state and state not in self.fsm.states:
             if symbol == self.fsm.initial_event:
                 assert self.fsm.initial is not None
-                return self.fsm.initial, self._entry(self.fsm.initial)
+                return self.fsm.initial, self.entry_outputs(self.fsm.initial)
             return state, ()
         if self.fsm.states[state].final:
             return state, ()
         transition = self.table.get(state, {}).get(symbol)
         if transition is None:
             return state, ()
-        return transition.target, self._entry(transition.target)
+        return transition.target, self.entry_outputs(transition.target)
 
     def status(self, state: str) -> str:
         known = self.fsm.states.get(state)
@@ -115,6 +115,7 @@ class FSMMachine:
     def describe(self, state: str) -> str:
         return state
 
-    def _entry(self, name: str) -> Outputs:
+    def entry_outputs(self, name: str) -> Outputs:
+        """What entering the flat state ``name`` outputs: its action, if it has one."""
         action = self.fsm.states[name].action
         return (action,) if action is not None else ()

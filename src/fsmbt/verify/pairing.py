@@ -15,6 +15,7 @@ from collections.abc import Sequence
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import InputError
 from fsmbt.model.fsm import FSM
+from fsmbt.semantics.bt_interpreter import snapshot_statuses
 from fsmbt.semantics.lebt_spec import GUARD_TYPE, GuardSpec
 from fsmbt.semantics.machine import FINAL, RUNNING, FSMMachine, Machine, Outputs
 from fsmbt.semantics.status import LeafOutcome, NodeStatus
@@ -65,9 +66,9 @@ class FSMLeafMachine:
         return self._enter(target, ())
 
     def _enter(self, target: str, before: Outputs) -> tuple[str, Outputs]:
-        outputs = before + self.inner._entry(target)
+        outputs = before + self.inner.entry_outputs(target)
         if self.loop and self.fsm.states[target].final and target != self.initial:
-            return self.initial, outputs + self.inner._entry(self.initial)
+            return self.initial, outputs + self.inner.entry_outputs(self.initial)
         return target, outputs
 
     def status(self, state: str) -> str:
@@ -122,7 +123,7 @@ class LEBTWithActiveInputs:
 
     def active_inputs(self, state) -> Sequence[str]:  # type: ignore[no-untyped-def]
         relevant: dict[str, None] = dict.fromkeys(self._by_source.get(state.bb_state, ()))
-        for nid, node_status in state.snapshot[0]:
+        for nid, node_status in snapshot_statuses(state.snapshot):
             if node_status == self._node_running and nid in self._exits:
                 relevant.update(dict.fromkeys(self._exits[nid]))
         active = [e for e in relevant if e in self._alphabet_set]

@@ -30,7 +30,7 @@ from dataclasses import dataclass
 
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.bt_nodes import NodeKind
-from fsmbt.model.errors import UnsupportedError
+from fsmbt.model.errors import Hint, UnsupportedError
 from fsmbt.semantics.bt_interpreter import CompiledNode, CompiledTree
 from fsmbt.semantics.nodes import NUSMV_ENCODED, all_nodes, node_semantics
 from fsmbt.semantics.status import LeafOutcome, NodeStatus, RootResult
@@ -84,9 +84,9 @@ class BTCore:
             if node.type not in SUPPORTED:
                 reason = NOT_ENCODED.get(node.type, "not encoded")
                 raise UnsupportedError(
-                    f"the NuSMV encoding does not support {node.type} ({reason}); use "
-                    "--engine native", location=node.source.location,
-                    element=f"<{node.type}> '{node.label}'")
+                    f"the NuSMV encoding does not support {node.type} ({reason})",
+                    location=node.source.location, element=f"<{node.type}> '{node.label}'",
+                    hints=(Hint.NATIVE_VERIFIER,))
             spec = node_semantics(node.type)
             # a simple decorator without a result map (KeepRunningUntilFailure) can tick forever
             has_keep_running |= (node.type in SIMPLE_DECORATORS and spec is not None
@@ -96,7 +96,8 @@ class BTCore:
             raise UnsupportedError(
                 "the NuSMV encoding does not model ticks that end without any leaf "
                 "(AlwaysSuccess/AlwaysFailure & co with loop or KeepRunningUntilFailure: the "
-                "engine could livelock); use --engine native", element=self.nodes[0].label)
+                "engine could livelock)", element=self.nodes[0].label,
+                hints=(Hint.NATIVE_VERIFIER,))
         self.max_children = max((len(n.children) for n in self.nodes), default=0)
         self.rules: dict[str, list[tuple[str, str]]] = {}
         self.var_types: dict[str, str] = {}
