@@ -6,7 +6,19 @@ else in the library should let a raw exception reach the user.
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
+
+_LINE_BREAKS = re.compile(r"\s*[\r\n\v\f\x1c-\x1e\x85\u2028\u2029]+\s*")
+
+
+def one_line(text: str) -> str:
+    """``text`` with every line break (and the blanks around it) replaced by one space.
+
+    Messages quote pieces of the input (a token, a parser's complaint); the CLI promises a
+    one-line cause, so no quoted newline may split it.
+    """
+    return _LINE_BREAKS.sub(" ", text).strip()
 
 
 @dataclass(frozen=True)
@@ -36,10 +48,11 @@ class FsmbtError(Exception):
         location: SourceLocation | None = None,
         element: str | None = None,
     ) -> None:
+        message = one_line(message)
         super().__init__(message)
         self.message = message
         self.location = location
-        self.element = element
+        self.element = one_line(element) if element else element
 
     def __str__(self) -> str:
         prefix = f"{self.location}: " if self.location is not None else ""
