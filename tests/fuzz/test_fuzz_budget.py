@@ -15,10 +15,9 @@ import sys
 from pathlib import Path
 
 import pytest
+from fuzz_harness_loader import ROOT, SCRIPT
 
 from fsmbt.formats import formats
-
-from fuzz_harness_loader import ROOT, SCRIPT
 
 ITERATIONS = 2_000
 SEED = 18

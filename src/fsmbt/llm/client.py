@@ -169,6 +169,9 @@ class LLMClient:
             except openai.OpenAIError as exc:  # malformed responses and the like
                 last_problem = f"an unusable response: {_short(str(exc))}"
                 delay = None
+            except ValueError as exc:  # a body that is not JSON (truncated, another format)
+                last_problem = f"an unusable response (not JSON: {_short(str(exc))})"
+                delay = None
             else:
                 try:
                     completion = self._completion(response, messages, self._clock() - start,
@@ -196,6 +199,8 @@ class LLMClient:
 
     def _completion(self, response: Any, messages: list[Message], latency: float,
                     attempts: int) -> Completion:
+        if not hasattr(response, "choices"):  # e.g. an HTML error page the SDK passed on as text
+            raise TypeError(f"got {_short(repr(response), 80)}")
         choices = getattr(response, "choices", None) or []
         text = ""
         if choices and getattr(choices[0], "message", None) is not None:
