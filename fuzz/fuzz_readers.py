@@ -201,7 +201,8 @@ def run_reader(reader: str, args: argparse.Namespace) -> ReaderResult:
             "--hard-timeout", str(args.hard_timeout),
             "--memory-mb", str(args.memory_mb), "--max-len", str(args.max_len),
             "--regressions", str(args.regressions), "--status", str(status_file),
-            "--artifacts", str(artifacts), "--dict", str(dictionary), str(corpus), str(seeds),
+            "--artifacts", str(artifacts), "--dict", str(dictionary),
+            *(["--value-profile"] if args.value_profile else []), str(corpus), str(seeds),
         ]
         env = dict(os.environ, PYTHONPATH=str(ROOT / "src") + os.pathsep
                    + os.environ.get("PYTHONPATH", ""))
@@ -425,6 +426,7 @@ def worker_main(args: argparse.Namespace) -> int:
                    f"-timeout={args.hard_timeout}", f"-rss_limit_mb={args.memory_mb}",
                    f"-max_len={args.max_len}", f"-artifact_prefix={args.artifacts}/",
                    "-print_final_stats=1", *([f"-dict={args.dict}"] if args.dict else []),
+                   *(["-use_value_profile=1"] if args.value_profile else []),
                    *args.dirs], one_input)
     atheris.Fuzz()
     return 0
@@ -448,6 +450,9 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     parser.add_argument("--regressions", default=str(DEFAULT_REGRESSIONS),
                         help="where finding inputs are saved")
     parser.add_argument("--json", help="also write the figures to this JSON file")
+    parser.add_argument("--value-profile", action="store_true",
+                        help="libFuzzer -use_value_profile=1 (guides mutations by comparison "
+                        "operands; slower, finds magic values)")
     parser.add_argument("--verbose", action="store_true")
     parser.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
     parser.add_argument("--status", help=argparse.SUPPRESS)
