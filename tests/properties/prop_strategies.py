@@ -22,7 +22,7 @@ from fsmbt.model.fsm import FSM, State
 # the random-tree helpers move to tests/support/random_trees.py; this is the one line to change
 from fsmbt.semantics.random_trees import ALL_CONTROLS, ALL_DECORATORS, bt_documents
 
-EXAMPLES = int(os.environ.get("FSMBT_PROPERTY_EXAMPLES", "60"))
+EXAMPLES = int(os.environ.get("FSMBT_PROPERTY_EXAMPLES", "100"))
 
 #: The CI profile: seeded, bounded, no deadline (the checker's time varies with the machine).
 BUDGET = settings(max_examples=EXAMPLES, derandomize=True, database=None, deadline=None,
@@ -82,9 +82,39 @@ def drawn_bts() -> st.SearchStrategy:
     return bt_documents(controls=ALL_CONTROLS, decorators=ALL_DECORATORS, max_nodes=10)
 
 
-def fsms() -> st.SearchStrategy[FSM]:
-    return st.one_of(generated_fsms(), drawn_fsms())
+
 
 
 def bts() -> st.SearchStrategy:
     return st.one_of(generated_bts(), drawn_bts())
+
+
+@st.composite
+def drawn_hfsms(draw: st.DrawFn) -> FSM:
+    """A hierarchical FSM: a drawn flat machine whose first non-final state becomes composite,
+    holding a drawn sub-machine (names made distinct); when the sub-machine has a final state,
+    the composite state gets a completion (eventless) transition."""
+    top = draw(drawn_fsms())
+    inner = draw(drawn_fsms())
+    inner.start_name = inner.initial_event = None
+    candidates = [s for s in top.states.values() if not s.final]
+    if not candidates:
+        return top
+    host = candidates[0]
+    renamed = FSM(name=host.name)  # a region is named after its state (every reader does so)
+    for state in inner.states.values():
+        renamed.add_state(State(f"{host.name}.{state.name}", action=state.action,
+                                final=state.final))
+    for t in inner.transitions:
+        renamed.add_transition(f"{host.name}.{t.source}", t.event, f"{host.name}.{t.target}")
+    renamed.initial = f"{host.name}.{inner.initial}"
+    host.regions = [renamed]
+    host.action = None
+    if any(s.final for s in renamed.states.values()):
+        top.add_transition(host.name, None, draw(st.sampled_from(sorted(top.states))))
+    return top
+
+
+def fsms() -> st.SearchStrategy[FSM]:
+    """Flat (generated, drawn) and hierarchical (drawn) FSMs."""
+    return st.one_of(generated_fsms(), drawn_fsms(), drawn_hfsms())

@@ -38,11 +38,28 @@ def kind_of(model: FSM | BTDocument) -> str:
 
 
 def held(model: FSM | BTDocument, fmt: str) -> FSM | BTDocument:
-    """The part of ``model`` that ``fmt`` holds (models compare states as a mapping, so the
-    order of states never matters)."""
-    if fmt in TABLES and isinstance(model, FSM):
-        return dataclasses.replace(model, name="fsm")
-    return model
+    """The part of ``model`` that ``fmt`` holds. Models compare states as a mapping (their order
+    never matters); transitions are compared grouped by source state, keeping their order within
+    a source (it is their priority) - writers that list transitions under their state (SCXML)
+    change only the order between sources, which means nothing."""
+    if not isinstance(model, FSM):
+        return model
+    copy = copy_fsm(model)
+    if fmt in TABLES:
+        copy.name = "fsm"
+    stack = [copy]
+    while stack:
+        machine = stack.pop()
+        machine.transitions = sorted(machine.transitions, key=lambda t: t.source)
+        for state in machine.states.values():
+            stack.extend(state.regions)
+    return copy
+
+
+def copy_fsm(model: FSM) -> FSM:
+    import copy
+
+    return copy.deepcopy(model)
 
 
 def without_added_declarations(back: FSM | BTDocument,
