@@ -85,6 +85,15 @@ class ReaderResult:
     findings: list[str] = field(default_factory=list)  # saved input files (new or known)
 
 
+def import_plugins(modules: list[str]) -> None:
+    """Import modules that register further formats (``--import``; e.g. a test's planted
+    reader); they become readers like any other."""
+    import importlib
+
+    for name in modules:
+        importlib.import_module(name)
+
+
 def reader_names() -> list[str]:
     """Every format of the registry that can read: one entry each."""
     from fsmbt.formats import formats
@@ -202,7 +211,8 @@ def run_reader(reader: str, args: argparse.Namespace) -> ReaderResult:
             "--memory-mb", str(args.memory_mb), "--max-len", str(args.max_len),
             "--regressions", str(args.regressions), "--status", str(status_file),
             "--artifacts", str(artifacts), "--dict", str(dictionary),
-            *(["--value-profile"] if args.value_profile else []), str(corpus), str(seeds),
+            *(["--value-profile"] if args.value_profile else []),
+            *[f"--import={name}" for name in args.imports], str(corpus), str(seeds),
         ]
         env = dict(os.environ, PYTHONPATH=str(ROOT / "src") + os.pathsep
                    + os.environ.get("PYTHONPATH", ""))
@@ -302,6 +312,7 @@ def print_table(results: list[ReaderResult]) -> str:
 
 
 def parent_main(args: argparse.Namespace) -> int:
+    import_plugins(args.imports)
     names = reader_names()
     chosen = names if args.reader == "all" else [args.reader]
     for name in chosen:
@@ -383,6 +394,7 @@ def worker_main(args: argparse.Namespace) -> int:
         from fsmbt.formats import registry
 
         registry.formats()  # imports (and so instruments) every format module
+        import_plugins(args.imports)
         import fsmbt.model.bt  # noqa: F401
         import fsmbt.model.fsm  # noqa: F401
 
@@ -453,6 +465,8 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     parser.add_argument("--value-profile", action="store_true",
                         help="libFuzzer -use_value_profile=1 (guides mutations by comparison "
                         "operands; slower, finds magic values)")
+    parser.add_argument("--import", dest="imports", action="append", default=[],
+                        metavar="MODULE", help="import a module that registers more formats")
     parser.add_argument("--verbose", action="store_true")
     parser.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
     parser.add_argument("--status", help=argparse.SUPPRESS)
