@@ -249,7 +249,7 @@ def _node_kind(value: Any, where: str) -> NodeKind:
 def _opt_str(value: Any, where: str) -> str | None:
     """A string or null field: anything else is refused (numbers are not names)."""
     _expect(value is None or isinstance(value, str), where, "expected a string or null")
-    return value
+    return None if value is None else str(value)
 
 
 def _expect(ok: bool, where: str, message: str) -> None:
