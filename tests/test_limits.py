@@ -166,3 +166,17 @@ def test_limits_module_imports_nothing_from_fsmbt() -> None:
                 for n in ([node.module or ""] if isinstance(node, ast.ImportFrom)
                           else [a.name for a in node.names])]
     assert not [n for n in imported if n.startswith("fsmbt")], imported
+
+
+def test_include_root_option_widens_the_confinement(tmp_path: Path) -> None:
+    (tmp_path / "common.xml").write_text(
+        '<root BTCPP_format="4"><BehaviorTree ID="S"><AlwaysSuccess/></BehaviorTree></root>',
+        encoding="utf-8")
+    (tmp_path / "sub").mkdir()
+    child = tmp_path / "sub" / "child.xml"
+    child.write_text('<root BTCPP_format="4" main_tree_to_execute="C"><include path="../common.xml"/>'
+                     '<BehaviorTree ID="C"><SubTree ID="S"/></BehaviorTree></root>',
+                     encoding="utf-8")
+    with pytest.raises(InputError, match="outside the folder of the file read"):
+        read_model(child)
+    assert set(read_model(child, options={"include_root": str(tmp_path)}).trees) == {"C", "S"}

@@ -97,13 +97,16 @@ class _Loader:
             raise InputError("<include> needs the including file's path to resolve "
                              f"'{target}' (read the file, not text)", location=where, element="include")
         resolved = (path.parent / target).resolve()
-        # includes are confined to the folder of the file the user gave (docs/security.md):
-        # "../x.xml" from a subfolder is fine, "/etc/passwd" or a symlink out of it is not
-        top_folder = (chain[0] if chain else path.resolve()).parent
+        # includes are confined to the folder of the file the user gave, or to the folder the
+        # caller names with the option include_root (docs/security.md): "../x.xml" from a
+        # subfolder is fine, "/etc/passwd" or a symlink out of the folder is not
+        root_option = self.ctx.options.get("include_root")
+        top_folder = (Path(str(root_option)).resolve() if root_option
+                      else (chain[0] if chain else path.resolve()).parent)
         if not resolved.is_relative_to(top_folder):
             raise InputError(f"include '{target}' resolves to {resolved}, outside the folder of "
-                             f"the file read ({top_folder}); refused", location=where,
-                             element="include")
+                             f"the file read ({top_folder}); refused (allow a wider folder "
+                             "with the include_root option)", location=where, element="include")
         if resolved in chain:
             cycle = " -> ".join(str(p) for p in (*chain, resolved))
             raise InputError(f"include cycle: {cycle}", location=where, element="include")

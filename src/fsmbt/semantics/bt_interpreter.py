@@ -33,6 +33,7 @@ from collections.abc import Callable, Hashable
 from dataclasses import dataclass, field
 from typing import Any
 
+from fsmbt.limits import Limits
 from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.bt_nodes import NodeKind, builtin_spec, canonical_type
 from fsmbt.model.errors import InputError, UnsupportedError
@@ -45,8 +46,9 @@ OUTCOME_SUCCESS, OUTCOME_FAILURE, OUTCOME_RUNNING = "success", "failure", "runni
 OUTCOME_TO_STATUS = {OUTCOME_SUCCESS: SUCCESS, OUTCOME_FAILURE: FAILURE, OUTCOME_RUNNING: RUNNING}
 STATUS_TO_OUTCOME = {v: k for k, v in OUTCOME_TO_STATUS.items()}
 
-#: Upper bound on nodes after SubTree expansion (a SubTree used twice per level doubles).
-MAX_COMPILED_NODES = 2_000_000
+#: Upper bound on nodes after SubTree expansion (a SubTree used twice per level doubles); the
+#: default lives in ``fsmbt.limits`` (``max_nodes``).
+MAX_COMPILED_NODES = Limits.max_nodes
 
 # -- supported node types ----------------------------------------------------------------------
 SEQUENCE_LIKE = {"Sequence": False, "AsyncSequence": True}
