@@ -9,7 +9,8 @@
    (``fsmbt.verify.replay``) to a real difference on both models. Whether a mutation changes
    behaviour is decided independently of the checker, by random simulation of both models;
    a mutant the simulation cannot tell apart is still checked: if the checker calls it not
-   equivalent, its counterexamples must replay too.
+   equivalent, its counterexamples must replay too. A mutant that is no longer a valid model
+   (an eventless cycle, say) must be refused with a one-line ``InputError``; it is counted.
 
 Counts (examples, refusals, mutants caught) are printed (``pytest -s``).
 """
@@ -25,7 +26,7 @@ from prop_strategies import BUDGET, bts, fsms
 
 from fsmbt.convert import convert
 from fsmbt.model.bt import BTDocument
-from fsmbt.model.errors import UnsupportedError
+from fsmbt.model.errors import InputError, UnsupportedError
 from fsmbt.model.fsm import FSM
 from fsmbt.verify import replay, verify
 from fsmbt.verify.mutations import mutants
@@ -96,7 +97,12 @@ def simulation_differs(source: Model, result: Model, seed: int, runs: int = 120,
 
 
 def judge_mutant(source: Model, result: Model, seed: int, tally: Counter[str]) -> None:
-    report = verify(source, result)
+    try:
+        report = verify(source, result)
+    except InputError as exc:  # the mutation made the model invalid (e.g. an eventless cycle)
+        assert "\n" not in str(exc) and exc.message
+        tally["mutant refused as invalid"] += 1
+        return
     differs = simulation_differs(source, result, seed)
     if not report.equivalent:
         src, res, _mode = machines_for(source, result)
