@@ -10,7 +10,8 @@ import pytest
 
 from fsmbt.formats import dumps, loads, read_model
 from fsmbt.formats.btcpp import ASSUMED_MARK
-from fsmbt.formats.xml_safe import MAX_DEPTH, parse_xml, root_tag
+from fsmbt.formats.xml_safe import parse_xml, root_tag
+from fsmbt.limits import current as current_limits
 from fsmbt.model import BTDocument, BTNode, NodeKind
 from fsmbt.model.errors import InputError, UnsupportedError
 
@@ -196,7 +197,7 @@ def test_deep_documents_read_and_deeper_ones_fail_fast() -> None:
     again = roundtrip(doc)
     assert [_shallow(n) for _, n in again.nodes()] == [_shallow(n) for _, n in doc.nodes()]
     start = time.monotonic()
-    with pytest.raises(InputError, match=f"deeper than {MAX_DEPTH}"):
+    with pytest.raises(InputError, match=f"deeper than {current_limits().max_xml_depth}"):
         parse_xml("<a>" * 100_000 + "</a>" * 100_000, "deep.xml")
     assert time.monotonic() - start < 2
 

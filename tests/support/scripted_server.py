@@ -7,11 +7,19 @@ client sent. It checks plumbing only; nothing it returns says anything about a r
 A step is a dict: ``{"content": "..."}`` (a normal answer), ``{"status": 429, "headers":
 {...}}`` (an HTTP error), ``{"delay": 2.0, ...}`` (wait first), ``{"usage": False}`` (no usage
 block). When the script runs out, the last step repeats.
+
+Fault steps (for the fault-injection tests): ``{"raw": "..."}`` sends that body as-is with
+status 200 (``"content_type"`` to change its type: another format, or truncated JSON);
+``{"trickle": 0.05, "chunk": 1}`` sends the body ``chunk`` bytes at a time, ``trickle`` seconds
+apart; ``{"reset_after": 100}`` sends the first 100 bytes of the body and then resets the
+connection (TCP RST).
 """
 
 from __future__ import annotations
 
 import json
+import socket
+import struct
 import threading
 import time
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
@@ -50,6 +58,11 @@ class ScriptedServer:
                 if not self.path.endswith("/chat/completions"):
                     self._send(404, {"error": {"message": f"no route {self.path}"}})
                     return
+                if "raw" in step:
+                    raw_body = step["raw"]
+                    self._send_bytes(200, raw_body.encode() if isinstance(raw_body, str) else raw_body,
+                                     step, step.get("content_type", "application/json"))
+                    return
                 status = int(step.get("status", 200))
                 if status != 200:
                     self._send(status, {"error": {"message": step.get("message", f"scripted {status}"),
@@ -66,7 +79,42 @@ class ScriptedServer:
                     reply["usage"] = {"prompt_tokens": 100 + len(server.requests),
                                       "completion_tokens": max(1, len(content) // 4),
                                       "total_tokens": 0}
-                self._send(200, reply)
+                self._send_bytes(200, json.dumps(reply).encode(), step, "application/json")
+
+            def _send_bytes(self, status: int, data: bytes, step: dict[str, Any],
+                            content_type: str) -> None:
+                try:
+                    self.send_response(status)
+                    self.send_header("Content-Type", content_type)
+                    self.send_header("Content-Length", str(len(data)))
+                    self.end_headers()
+                    if "reset_after" in step:
+                        self.wfile.write(data[: int(step["reset_after"])])
+                        self.wfile.flush()
+                        # SO_LINGER 0: close() sends a TCP RST instead of a clean FIN
+                        self.connection.setsockopt(socket.SOL_SOCKET, socket.SO_LINGER,
+                                                   struct.pack("ii", 1, 0))
+                        self.connection.close()
+                        self.close_connection = True
+                        return
+                    if "trickle" in step:
+                        chunk = int(step.get("chunk", 1))
+                        for start in range(0, len(data), chunk):
+                            if server._stop.is_set():
+                                return
+                            self.wfile.write(data[start:start + chunk])
+                            self.wfile.flush()
+                            time.sleep(float(step["trickle"]))
+                        return
+                    self.wfile.write(data)
+                except (BrokenPipeError, ConnectionResetError, OSError):
+                    pass  # the client gave up (a guard or timeout test)
+
+            def finish(self) -> None:
+                try:
+                    super().finish()
+                except OSError:
+                    pass  # the connection was reset on purpose
 
             def _send(self, status: int, payload: dict[str, Any],
                       headers: dict[str, str] | None = None) -> None:

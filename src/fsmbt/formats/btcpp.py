@@ -23,7 +23,8 @@ from pathlib import Path
 
 from lxml import etree
 
-from fsmbt.formats.registry import Format, ReadContext, register
+from fsmbt import limits
+from fsmbt.formats.registry import Format, ReadContext, decode, read_bounded, register
 from fsmbt.formats.xml_safe import parse_xml, root_tag
 from fsmbt.model import Model
 from fsmbt.model.bt import BehaviorTree, BTDocument, BTNode, NodeModel, PortModel
@@ -46,7 +47,6 @@ PORT_ELEMENT = {"input": "input_port", "output": "output_port", "inout": "inout_
 ASSUMED_MARK = "_fsmbt_assumed"
 #: ``NodeModel.attrs`` key holding a model entry's non-port children (Groot2 metadata) as XML.
 EXTRA_XML_KEY = "_fsmbt_extra_xml"
-MAX_INCLUDE_DEPTH = 64
 #: Deeper trees are written without indentation (indentation alone would be O(depth²) bytes).
 PRETTY_MAX_DEPTH = 200
 _XML_NAME = re.compile(r"^[A-Za-z_][\w.-]*$")
@@ -97,34 +97,45 @@ class _Loader:
             raise InputError("<include> needs the including file's path to resolve "
                              f"'{target}' (read the file, not text)", location=where, element="include")
         resolved = (path.parent / target).resolve()
+        # includes are confined to the folder of the file the user gave, or to the folder the
+        # caller names with the option include_root (docs/security.md): "../x.xml" from a
+        # subfolder is fine, "/etc/passwd" or a symlink out of the folder is not
+        root_option = self.ctx.options.get("include_root")
+        top_folder = (Path(str(root_option)).resolve() if root_option
+                      else (chain[0] if chain else path.resolve()).parent)
+        if not resolved.is_relative_to(top_folder):
+            raise InputError(f"include '{target}' resolves to {resolved}, outside the folder of "
+                             f"the file read ({top_folder}); refused (allow a wider folder "
+                             "with the include_root option)", location=where, element="include")
         if resolved in chain:
             cycle = " -> ".join(str(p) for p in (*chain, resolved))
             raise InputError(f"include cycle: {cycle}", location=where, element="include")
-        if len(chain) >= MAX_INCLUDE_DEPTH:
-            raise InputError(f"includes nested deeper than {MAX_INCLUDE_DEPTH} files",
+        max_include_depth = limits.current().max_include_depth
+        if len(chain) >= max_include_depth:
+            raise InputError(limits.exceeded(f"an include chain of {len(chain) + 1} files",
+                                             "max_include_depth", max_include_depth),
                              location=where, element="include")
         if resolved in self.loaded:
             return  # included twice (diamond): BehaviorTree.CPP registers it once
         self.loaded.add(resolved)
         try:
-            text = resolved.read_bytes()
+            if not resolved.is_file():  # a FIFO or a device could block or never end
+                raise InputError(f"included '{target}' is not a regular file", location=where,
+                                 element="include")
+            text = read_bounded(resolved)
         except OSError as exc:
             raise InputError(f"cannot read included file '{target}' ({resolved}): {exc.strerror}",
                              location=where, element="include") from None
-        from fsmbt.formats.registry import decode
-
         self.load(decode(text, str(resolved)), resolved, (*chain, resolved))
 
     def load_external_models(self) -> None:
         paths = self.ctx.options.get("node_models") or []
         if isinstance(paths, (str, Path)):
             paths = [paths]
-        from fsmbt.formats.registry import decode
-
         for item in paths:  # type: ignore[union-attr]
             model_path = Path(str(item))
             try:
-                data = model_path.read_bytes()
+                data = read_bounded(model_path)
             except OSError as exc:
                 raise InputError(f"cannot read node model file: {exc.strerror}",
                                  location=SourceLocation(str(model_path))) from None

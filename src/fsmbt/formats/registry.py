@@ -13,13 +13,11 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from fsmbt import limits
 from fsmbt.model.errors import Hint, InputError, SourceLocation
 
 if TYPE_CHECKING:
     from fsmbt.model import Model
-
-#: Inputs larger than this are refused before parsing (a model this big is not a model).
-MAX_INPUT_BYTES = 64 * 1024 * 1024
 
 Reader = Callable[[str, "ReadContext"], "Model"]
 Writer = Callable[["Model"], str]
@@ -157,14 +155,80 @@ def loads(text: str, fmt: str | None = None, *, path: Path | None = None,
           warnings: list[str] | None = None) -> Model:
     """Parse a model from text (format by name, or detected); the reader's documented
     warnings are appended to ``warnings`` when given."""
+    _check_text_size(text, path)
     chosen = get_format(fmt) if fmt else detect_format(text, path)
     if chosen.read is None:
         raise InputError(f"format '{chosen.name}' can be written but not read")
     ctx = ReadContext(path=path, options=dict(options or {}))
-    model = chosen.read(text, ctx)
+    try:
+        model = chosen.read(text, ctx)
+    except InputError as exc:  # every error names the input, even where a reader did not
+        if exc.location is None:
+            exc.location = ctx.location()
+        raise
+    check_model_size(model, ctx.location())
     if warnings is not None:
         warnings.extend(ctx.warnings)
     return model
+
+
+def _check_text_size(text: str, path: Path | None) -> None:
+    limit = limits.current().max_input_bytes
+    if len(text) > limit or (len(text) * 4 > limit and len(text.encode("utf-8", "replace")) > limit):
+        raise InputError(limits.exceeded(f"the input's {len(text.encode('utf-8', 'replace'))} "
+                                         "bytes", "max_input_bytes", limit),
+                         location=SourceLocation(str(path) if path else None))
+
+
+def check_model_size(model: Model, location: SourceLocation) -> None:
+    """Refuse a model with more states (FSM, all levels) or nodes (BT, all trees) than the
+    limits allow (``FSMBT_MAX_STATES`` / ``FSMBT_MAX_NODES``). Explicit stacks; O(size)."""
+    from fsmbt.model.fsm import FSM
+
+    bounds = limits.current()
+    count = 0
+    if isinstance(model, FSM):
+        machines = [model]
+        while machines:
+            machine = machines.pop()
+            count += len(machine.states)
+            if count > bounds.max_states:
+                raise InputError(limits.exceeded(f"the machine's {count}+ states", "max_states",
+                                                 bounds.max_states),
+                                 location=location)
+            for state in machine.states.values():
+                machines.extend(state.regions)
+        return
+    nodes = [tree.root for tree in model.trees.values() if tree.root is not None]
+    while nodes:
+        node = nodes.pop()
+        count += 1
+        if count > bounds.max_nodes:
+            raise InputError(limits.exceeded(f"the document's {count}+ nodes", "max_nodes",
+                                             bounds.max_nodes),
+                             location=location)
+        nodes.extend(node.children)
+
+
+def read_bounded(path: Path) -> bytes:
+    """A regular file's bytes, refused past ``max_input_bytes`` (checked before and while
+    reading: the file may grow after ``stat``). Raises ``InputError`` (located) or ``OSError``."""
+    limit = limits.current().max_input_bytes
+    location = SourceLocation(str(path))
+    size = path.stat().st_size
+    if size > limit:
+        raise InputError(limits.exceeded(f"the file's {size} bytes", "max_input_bytes", limit),
+                         location=location)
+    if path.is_dir():
+        raise InputError("is a directory, not a model file", location=location)
+    if not path.is_file():  # a FIFO or a device (/dev/zero) could block or never end
+        raise InputError("is not a regular file", location=location)
+    with path.open("rb") as stream:
+        data = stream.read(limit + 1)
+    if len(data) > limit:
+        raise InputError(limits.exceeded(f"the file's {len(data)}+ bytes", "max_input_bytes",
+                                         limit), location=location)
+    return data
 
 
 def read_text(path: str | Path) -> str:
@@ -175,19 +239,7 @@ def read_text(path: str | Path) -> str:
     """
     path = Path(path)
     try:
-        size = path.stat().st_size
-        if size > MAX_INPUT_BYTES:
-            raise InputError(f"input is {size} bytes; the limit is {MAX_INPUT_BYTES}",
-                             location=SourceLocation(str(path)))
-        if path.is_dir():
-            raise InputError("is a directory, not a model file", location=SourceLocation(str(path)))
-        if not path.is_file():  # a FIFO or a device (/dev/zero) could block or never end
-            raise InputError("is not a regular file", location=SourceLocation(str(path)))
-        with path.open("rb") as stream:  # bounded: the file may grow after stat()
-            data = stream.read(MAX_INPUT_BYTES + 1)
-        if len(data) > MAX_INPUT_BYTES:
-            raise InputError(f"input is larger than the limit of {MAX_INPUT_BYTES} bytes",
-                             location=SourceLocation(str(path)))
+        data = read_bounded(path)
     except OSError as exc:
         raise InputError(f"cannot read: {exc.strerror}", location=SourceLocation(str(path))) from None
     return decode(data, str(path))

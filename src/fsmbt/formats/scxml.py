@@ -26,6 +26,8 @@ T transitions and nesting depth d.
 
 from __future__ import annotations
 
+import re
+
 from dataclasses import dataclass, field
 
 from lxml import etree
@@ -475,10 +477,10 @@ class _Writer:
             for state in machine.states.values():
                 if (id(machine), state.name) in self.skip_states:
                     continue
-                unique = state.name
+                unique = _id_token(state.name)  # the real name goes to fsmbt:name
                 if used[state.name] > 1 or unique in taken:
                     prefix = self.ids[(id(owner[0]), owner[1].name)] if owner else "top"
-                    unique = f"{prefix}.{state.name}"
+                    unique = f"{prefix}.{_id_token(state.name)}"
                     while unique in taken:
                         unique += "_"
                 taken.add(unique)
@@ -601,6 +603,12 @@ class _Writer:
                     wrapper.set("initial", self.ids[(id(region), region.initial)])
                 out.append((region, wrapper))
         return out
+
+
+def _id_token(name: str) -> str:
+    """A state name as an SCXML id: ``initial`` and ``target`` are space-separated id lists,
+    so blanks become ``_`` (the writer then records the real name in ``fsmbt:name``)."""
+    return re.sub(r"\s+", "_", name) or "_"
 
 
 def _is_parallel(state: State) -> bool:

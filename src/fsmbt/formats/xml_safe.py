@@ -7,8 +7,9 @@ surface. Every XML reader in fsmbt goes through :func:`parse_xml`, which
   before any parser sees the text, and parses with ``resolve_entities=False``,
   ``no_network=True``, ``load_dtd=False`` (nothing is fetched, nothing is expanded);
 - turns malformed XML into one ``InputError`` naming file, line, column and lxml's cause;
-- allows element nesting up to :data:`MAX_DEPTH` levels (generated behavior trees are deep) and
-  refuses deeper documents at once with a clear message - never a ``RecursionError`` or a hang.
+- allows element nesting up to ``limits.current().max_xml_depth`` levels (``fsmbt.limits``,
+  ``FSMBT_MAX_XML_DEPTH``; generated behavior trees are deep) and refuses deeper documents at
+  once with a clear message - never a ``RecursionError`` or a hang.
 
 libxml2 (under lxml) stops at 2 048 levels even with ``huge_tree``; documents deeper than that
 are parsed by the standard library's expat (C, not recursive) feeding lxml's ``TreeBuilder``, so
@@ -23,10 +24,9 @@ import xml.parsers.expat as expat
 
 from lxml import etree
 
+from fsmbt import limits
 from fsmbt.model.errors import InputError, SourceLocation
 
-#: Deepest element nesting accepted (the root element is level 1).
-MAX_DEPTH = 10_000
 #: libxml2's own limit with ``huge_tree=True``; deeper documents go through expat.
 _LIBXML_MAX_DEPTH = 2048
 
@@ -74,15 +74,37 @@ def parse_xml(text: str, source: str | None = None) -> etree._Element:
         resolve_entities=False, no_network=True, load_dtd=False, huge_tree=True,
         remove_comments=True, remove_pis=True, encoding="utf-8",
     )
+    max_depth = limits.current().max_xml_depth
     try:
-        return etree.fromstring(data, parser)
+        root = etree.fromstring(data, parser)
     except etree.XMLSyntaxError as exc:
         if "Excessive depth" in str(exc):
-            return _parse_deep(data, source)
+            return _parse_deep(data, source, max_depth)
         line, column = exc.position if exc.position else (exc.lineno, None)
         cause = re.sub(r",\s*line \d+, column \d+\s*$", "", exc.msg or str(exc))
         raise InputError(f"malformed XML: {cause}",
                          location=SourceLocation(source, line, column)) from None
+    except ValueError as exc:  # lxml refuses some text before parsing (e.g. an XML declaration)
+        raise InputError(f"malformed XML: {exc}", location=SourceLocation(source)) from None
+    if max_depth < _LIBXML_MAX_DEPTH:
+        _check_depth(root, source, max_depth)
+    return root
+
+
+def _check_depth(root: etree._Element, source: str | None, max_depth: int) -> None:
+    """Refuse a parsed tree deeper than ``max_depth`` (explicit stack; O(elements))."""
+    stack = [(root, 1)]
+    while stack:
+        element, depth = stack.pop()
+        if depth > max_depth:
+            raise InputError(_too_deep(max_depth),
+                             location=SourceLocation(source, element.sourceline))
+        stack.extend((child, depth + 1) for child in element)
+
+
+def _too_deep(max_depth: int) -> str:
+    return limits.exceeded(f"XML nested deeper than {max_depth} levels", "max_xml_depth",
+                           max_depth)
 
 
 def _refuse_entity_declarations(text: str, source: str | None) -> None:
@@ -99,7 +121,7 @@ class _TooDeep(Exception):
     pass
 
 
-def _parse_deep(data: bytes, source: str | None) -> etree._Element:
+def _parse_deep(data: bytes, source: str | None, max_depth: int) -> etree._Element:
     """expat -> lxml ``TreeBuilder`` for documents deeper than libxml2 allows."""
     builder = etree.TreeBuilder()
     parser = expat.ParserCreate(encoding="UTF-8", namespace_separator=" ")
@@ -113,7 +135,7 @@ def _parse_deep(data: bytes, source: str | None) -> etree._Element:
     def start(name: str, attrs: dict[str, str]) -> None:
         nonlocal depth
         depth += 1
-        if depth > MAX_DEPTH:
+        if depth > max_depth:
             raise _TooDeep
         element = builder.start(clark(name), {clark(k): v for k, v in attrs.items()})
         element.sourceline = parser.CurrentLineNumber
@@ -135,8 +157,7 @@ def _parse_deep(data: bytes, source: str | None) -> etree._Element:
         parser.Parse(data, True)
     except _TooDeep:
         raise InputError(
-            f"XML nested deeper than {MAX_DEPTH} levels; refused (limit: "
-            "fsmbt.formats.xml_safe.MAX_DEPTH)",
+            _too_deep(max_depth),
             location=SourceLocation(source, parser.CurrentLineNumber,
                                     parser.CurrentColumnNumber + 1)) from None
     except expat.ExpatError as exc:

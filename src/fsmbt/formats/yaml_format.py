@@ -8,7 +8,7 @@ Two hazards of YAML are closed here, because PyYAML's ``safe_load`` leaves both 
 - deep nesting: PyYAML's composer recurses once per nesting level (``RecursionError`` near
   depth 300) and libyaml's scanner is quadratic in flow depth (100 000 levels: minutes).
   ``_GuardedLoader`` composes with an explicit stack and stops at ``MAX_YAML_DEPTH`` levels
-  while the parser is still reading lazily, so a 100 000-deep document is refused in
+  (``fsmbt.limits``; ``FSMBT_MAX_YAML_DEPTH``) while the parser is still reading lazily, so a 100 000-deep document is refused in
   milliseconds. Cost: O(n) time in the number of nodes below the bound.
 """
 
@@ -18,21 +18,24 @@ from typing import Any
 
 import yaml
 from yaml.events import (
-    AliasEvent, MappingEndEvent, MappingStartEvent, ScalarEvent, SequenceEndEvent,
+    AliasEvent,
+    MappingEndEvent,
+    MappingStartEvent,
+    ScalarEvent,
+    SequenceEndEvent,
     SequenceStartEvent,
 )
 from yaml.nodes import MappingNode, Node, ScalarNode, SequenceNode
 
+from fsmbt import limits
 from fsmbt.formats.registry import Format, ReadContext, register
 from fsmbt.model import Model
 from fsmbt.model.errors import InputError
 from fsmbt.model.serialize import model_from_dict, model_to_dict
 
-
-#: Deepest nesting accepted (YAML levels; a BT level is two: node mapping + children list).
-#: libyaml's scanner is quadratic in flow nesting depth (4 000 levels take ~0.3 s), so the guard
-#: stops at this depth while the parser is still lazily reading, before the cost grows.
-MAX_YAML_DEPTH = 3000
+# The deepest nesting accepted is ``limits.current().max_yaml_depth`` (YAML levels; a BT level is
+# two: node mapping + children list). libyaml's scanner is quadratic in flow nesting depth (4 000
+# levels take ~0.3 s), so the guard stops while the parser is still lazily reading.
 
 
 class _Refused(Exception):
@@ -80,6 +83,7 @@ class _GuardedLoader(_Parser, yaml.constructor.SafeConstructor, yaml.resolver.Re
 
     def _compose_tree(self) -> Node:
         stack: list[list[Any]] = []  # [collection node, pending mapping key or None]
+        max_depth = limits.current().max_yaml_depth
         while True:
             event = self.get_event()
             mark = event.start_mark
@@ -94,8 +98,9 @@ class _GuardedLoader(_Parser, yaml.constructor.SafeConstructor, yaml.resolver.Re
                     tag = self.resolve(ScalarNode, event.value, event.implicit)
                 node = ScalarNode(tag, event.value, mark, event.end_mark, style=event.style)
             elif isinstance(event, (SequenceStartEvent, MappingStartEvent)):
-                if len(stack) >= MAX_YAML_DEPTH:
-                    raise _Refused(f"YAML nested deeper than {MAX_YAML_DEPTH} levels",
+                if len(stack) >= max_depth:
+                    raise _Refused(limits.exceeded(f"YAML nested deeper than {max_depth} levels",
+                                                   "max_yaml_depth", max_depth),
                                    mark.line + 1, mark.column + 1)
                 kind = SequenceNode if isinstance(event, SequenceStartEvent) else MappingNode
                 tag = event.tag

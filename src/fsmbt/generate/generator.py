@@ -222,7 +222,7 @@ class _BTBuilder:
             elif self.count >= self.max_nodes:
                 n_children = 2
             else:
-                n_children = self.rng.randint(2, self.breadth)
+                n_children = self.rng.randint(min(2, self.breadth), self.breadth)
             if node.type == "Parallel":  # keeps the product of running children small
                 n_children = min(n_children, 3)
             spine_index = self.rng.randrange(n_children) if spine else -1

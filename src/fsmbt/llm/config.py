@@ -27,7 +27,19 @@ class LLMConfigError(InputError):
 
 
 class LLMUnavailableError(InputError):
-    """The endpoint could not be reached or kept failing (CLI exit 2, one line)."""
+    """The endpoint could not be reached or kept failing (CLI exit 2, one line).
+
+    ``failures`` holds the cause of each failed attempt (for the log); ``outcome`` is set by the
+    pipeline to what the conversion had produced before the endpoint failed (nothing is lost).
+    """
+
+    failures: list[str]
+    outcome: object | None
+
+    def __init__(self, message: str, **kwargs: object) -> None:
+        super().__init__(message, **kwargs)  # type: ignore[arg-type]
+        self.failures = []
+        self.outcome = None
 
 
 @dataclass(frozen=True)

@@ -16,17 +16,24 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from fsmbt.formats.registry import (
-    MAX_INPUT_BYTES,
     Format,
     decode,
     format_for_path,
     formats,
     get_format,
     loads,
+    read_bounded,
 )
 from fsmbt.llm.client import LLMClient, Message
 from fsmbt.llm.config import LLMUnavailableError
-from fsmbt.llm.log import EXTRACTED, INVALID_ANSWER, UNAVAILABLE, ConversionRecord, RoundRecord, append_record
+from fsmbt.llm.log import (
+    EXTRACTED,
+    INVALID_ANSWER,
+    UNAVAILABLE,
+    ConversionRecord,
+    RoundRecord,
+    append_record,
+)
 from fsmbt.llm.parsing import AnswerError, extract_json
 from fsmbt.llm.prompts import DEFAULT_VERSION, extraction_messages, feedback_message
 from fsmbt.model.bt import BTDocument
@@ -203,10 +210,6 @@ def _validate(model: Model) -> None:
 
 def _read_bytes(path: Path) -> bytes:
     try:
-        if path.stat().st_size > MAX_INPUT_BYTES:
-            raise InputError(f"input is larger than {MAX_INPUT_BYTES} bytes", location=SourceLocation(str(path)))
-        if path.is_dir():
-            raise InputError("is a directory, not a model file", location=SourceLocation(str(path)))
-        return path.read_bytes()
+        return read_bounded(path)
     except OSError as exc:
         raise InputError(f"cannot read: {exc.strerror}", location=SourceLocation(str(path))) from None

@@ -27,7 +27,8 @@ UNAVAILABLE = "endpoint_unavailable"
 @dataclass
 class RoundRecord:
     """One request/answer round. ``stage`` is where the answer stopped: parse, structure,
-    verify, or ok."""
+    verify, ok, or unavailable (the endpoint failed every attempt of this round).
+    ``failures`` says why each failed attempt failed (cut-off, reset, timeout, HTTP status)."""
 
     round: int
     stage: str
@@ -36,6 +37,7 @@ class RoundRecord:
     tokens_out: int
     latency_s: float
     attempts: int
+    failures: list[str] = field(default_factory=list)  # cause of each failed attempt, in order
 
 
 @dataclass

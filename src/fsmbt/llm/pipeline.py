@@ -108,7 +108,7 @@ def convert_with_llm(
                 result, report = candidate, candidate_report
             record.add_round(RoundRecord(round_no, stage, problems, completion.tokens_in,
                                          completion.tokens_out, round(completion.latency_s, 4),
-                                         completion.attempts))
+                                         completion.attempts, list(completion.failures)))
             if stage == "ok":
                 break
             conversation = prompt + [
@@ -116,9 +116,14 @@ def convert_with_llm(
                 feedback_message(problems, counterexample, OUTPUT_FORMAT[direction]),
             ]
     except LLMUnavailableError as exc:
+        # the round that could not be completed is recorded with each attempt's cause; the
+        # rounds before it and their best result stay in the record and on the exception
+        record.add_round(RoundRecord(len(record.rounds), "unavailable", [str(exc)], 0, 0, 0.0,
+                                     len(exc.failures), list(exc.failures)))
         record.verdict = UNAVAILABLE
         record.extra["error"] = str(exc)
         append_record(settings.log_path, record)
+        exc.outcome = LLMOutcome(result, report, record)
         raise
     if report is not None:
         record.verdict = EQUIVALENT if report.equivalent else NOT_EQUIVALENT

@@ -11,6 +11,7 @@ way through ``FsmbtError.text(wording)`` (the CLI's wording, with its flags, is
 
 from __future__ import annotations
 
+import re
 from collections.abc import Mapping
 from dataclasses import dataclass
 from enum import Enum
@@ -47,6 +48,17 @@ HINT_TEXT: Mapping[Hint, str] = {
     Hint.LLM_MODEL: "pass model=...",
 }
 
+_LINE_BREAKS = re.compile(r"\s*[\r\n\v\f\x1c-\x1e\x85\u2028\u2029]+\s*")
+
+
+def one_line(text: str) -> str:
+    """``text`` with every line break (and the blanks around it) replaced by one space.
+
+    Messages quote pieces of the input (a token, a parser's complaint); the CLI promises a
+    one-line cause, so no quoted newline may split it.
+    """
+    return _LINE_BREAKS.sub(" ", text).strip()
+
 
 @dataclass(frozen=True)
 class SourceLocation:
@@ -76,10 +88,11 @@ class FsmbtError(Exception):
         element: str | None = None,
         hints: tuple[Hint, ...] = (),
     ) -> None:
+        message = one_line(message)
         super().__init__(message)
         self.message = message
         self.location = location
-        self.element = element
+        self.element = one_line(element) if element else element
         self.hints = hints
 
     def text(self, wording: Mapping[Hint, str] = HINT_TEXT) -> str:

@@ -63,22 +63,35 @@ def fsm_from_dict(data: dict[str, Any], *, where: str = "fsm") -> FSM:
 
 
 def _machine_from_dict(data: dict[str, Any], where: str) -> FSM:
-    fsm = FSM(name=str(data.get("name", "fsm")))
-    states = data.get("states", [])
-    _expect(isinstance(states, list), f"{where}.states", "expected a list")
-    for i, s in enumerate(states):
+    """Build a machine and its regions with an explicit stack (regions nest without bound in
+    user data; no recursion). Every field's type is checked: a wrong type is an ``InputError``
+    naming the field's path."""
+    top = FSM(name="fsm")
+    stack: list[tuple[Any, str, FSM]] = [(data, where, top)]
+    while stack:
+        item, path, fsm = stack.pop()
+        _expect(isinstance(item, dict), path, "expected an object")
+        _fill_machine(item, path, fsm, stack)
+    return top
+
+
+def _fill_machine(data: dict[str, Any], where: str, fsm: FSM,
+                  stack: list[tuple[Any, str, FSM]]) -> None:
+    fsm.name = str(data.get("name", "fsm"))
+    for i, s in enumerate(_as_list(data.get("states", []), f"{where}.states")):
         path = f"{where}.states[{i}]"
         _expect(isinstance(s, dict) and isinstance(s.get("name"), str), path,
                 "a state needs a string 'name'")
         if s["name"] in fsm.states:
             raise InputError(f"duplicate state '{s['name']}'", element=path)
-        regions = [
-            _machine_from_dict(r, f"{path}.regions[{j}]")
-            for j, r in enumerate(_as_list(s.get("regions", []), f"{path}.regions"))
-        ]
+        regions: list[FSM] = []
+        for j, r in enumerate(_as_list(s.get("regions", []), f"{path}.regions")):
+            region = FSM(name="region")
+            regions.append(region)
+            stack.append((r, f"{path}.regions[{j}]", region))
         fsm.add_state(State(
             s["name"],
-            action=s.get("action", s["name"]),
+            action=_opt_str(s.get("action", s["name"]), f"{path}.action"),
             final=bool(s.get("final", False)),
             regions=regions,
             attrs=_str_dict(s.get("attrs", {})),
@@ -91,14 +104,14 @@ def _machine_from_dict(data: dict[str, Any], where: str) -> FSM:
                 "a transition needs string 'source' and 'target'")
         event = t.get("event")
         _expect(event is None or isinstance(event, str), path, "'event' must be a string or null")
-        fsm.add_transition(t["source"], event, t["target"], exit=t.get("exit"),
+        fsm.add_transition(t["source"], event, t["target"],
+                           exit=_opt_str(t.get("exit"), f"{path}.exit"),
                            attrs=_str_dict(t.get("attrs", {})))
     if "initial" in data:
-        fsm.initial = data["initial"]
-    fsm.start_name = data.get("start")
-    fsm.initial_event = data.get("initial_event")
+        fsm.initial = _opt_str(data["initial"], f"{where}.initial")
+    fsm.start_name = _opt_str(data.get("start"), f"{where}.start")
+    fsm.initial_event = _opt_str(data.get("initial_event"), f"{where}.initial_event")
     fsm.attrs = _str_dict(data.get("attrs", {}))
-    return fsm
 
 
 # -- BT -----------------------------------------------------------------------------------------
@@ -155,11 +168,8 @@ def node_from_dict(data: dict[str, Any], where: str = "node") -> BTNode:
     def shallow(d: Any, path: str) -> BTNode:
         _expect(isinstance(d, dict) and isinstance(d.get("type"), str), path,
                 "a node needs a string 'type'")
-        try:
-            kind = NodeKind(d.get("kind", "Action"))
-        except ValueError:
-            raise InputError(f"unknown node kind {d.get('kind')!r}", element=path) from None
-        return BTNode(type=d["type"], kind=kind, name=d.get("name"),
+        kind = _node_kind(d.get("kind", "Action"), path)
+        return BTNode(type=d["type"], kind=kind, name=_opt_str(d.get("name"), f"{path}.name"),
                       attrs=_str_dict(d.get("attrs", {})),
                       kind_declared=bool(d.get("kind_declared", True)))
 
@@ -177,8 +187,9 @@ def node_from_dict(data: dict[str, Any], where: str = "node") -> BTNode:
 def bt_from_dict(data: dict[str, Any], *, where: str = "bt") -> BTDocument:
     _expect(isinstance(data, dict), where, "expected an object")
     doc = BTDocument(format_version=str(data.get("format_version", "4")),
-                     main_tree=data.get("main_tree"),
-                     includes=[str(i) for i in data.get("includes", [])],
+                     main_tree=_opt_str(data.get("main_tree"), f"{where}.main_tree"),
+                     includes=[str(i) for i in _as_list(data.get("includes", []),
+                                                        f"{where}.includes")],
                      attrs=_str_dict(data.get("attrs", {})))
     for i, t in enumerate(_as_list(data.get("trees", []), f"{where}.trees")):
         path = f"{where}.trees[{i}]"
@@ -190,11 +201,9 @@ def bt_from_dict(data: dict[str, Any], *, where: str = "bt") -> BTDocument:
         path = f"{where}.node_models[{i}]"
         _expect(isinstance(m, dict) and isinstance(m.get("type"), str), path,
                 "a node model needs a string 'type'")
-        try:
-            kind = NodeKind(m.get("kind", "Action"))
-        except ValueError:
-            raise InputError(f"unknown node kind {m.get('kind')!r}", element=path) from None
-        ports = [PortModel(**p) for p in _as_list(m.get("ports", []), f"{path}.ports")]
+        kind = _node_kind(m.get("kind", "Action"), path)
+        ports = [_port_from_dict(p, f"{path}.ports[{j}]")
+                 for j, p in enumerate(_as_list(m.get("ports", []), f"{path}.ports"))]
         doc.node_models[m["type"]] = NodeModel(m["type"], kind, ports, _str_dict(m.get("attrs", {})))
     return doc
 
@@ -212,6 +221,35 @@ def model_from_dict(data: Any, *, where: str = "model") -> FSM | BTDocument:
     if kind == "bt":
         return bt_from_dict(data, where=where)
     raise InputError(f"'kind' must be \"fsm\" or \"bt\", not {kind!r}", element=where)
+
+
+_PORT_FIELDS = ("name", "direction", "default", "description", "type")
+
+
+def _port_from_dict(data: Any, where: str) -> PortModel:
+    _expect(isinstance(data, dict) and isinstance(data.get("name"), str), where,
+            "a port needs a string 'name'")
+    unknown = sorted(str(k) for k in data if k not in _PORT_FIELDS)
+    _expect(not unknown, where, f"unknown port field(s) {', '.join(unknown)} "
+            f"(known: {', '.join(_PORT_FIELDS)})")
+    return PortModel(name=data["name"],
+                     direction=str(data.get("direction", "input")),
+                     default=_opt_str(data.get("default"), f"{where}.default"),
+                     description=_opt_str(data.get("description"), f"{where}.description"),
+                     type=_opt_str(data.get("type"), f"{where}.type"))
+
+
+def _node_kind(value: Any, where: str) -> NodeKind:
+    try:
+        return NodeKind(value)
+    except (ValueError, TypeError):
+        raise InputError(f"unknown node kind {str(value)[:60]!r}", element=where) from None
+
+
+def _opt_str(value: Any, where: str) -> str | None:
+    """A string or null field: anything else is refused (numbers are not names)."""
+    _expect(value is None or isinstance(value, str), where, "expected a string or null")
+    return None if value is None else str(value)
 
 
 def _expect(ok: bool, where: str, message: str) -> None:

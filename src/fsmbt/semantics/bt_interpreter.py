@@ -38,6 +38,7 @@ from collections.abc import Callable, Hashable
 from dataclasses import dataclass, field
 from typing import Any, Final
 
+from fsmbt.limits import Limits
 from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.errors import InputError, UnsupportedError
 from fsmbt.model.kinds import NodeKind
@@ -60,8 +61,9 @@ OUTCOME_RUNNING: Final[str] = LeafOutcome.RUNNING.value
 OUTCOME_TO_STATUS: dict[str, int] = {o.value: o.status.value for o in LeafOutcome}
 STATUS_TO_OUTCOME: dict[int, str] = {v: k for k, v in OUTCOME_TO_STATUS.items()}
 
-#: Upper bound on nodes after SubTree expansion (a SubTree used twice per level doubles).
-MAX_COMPILED_NODES = 2_000_000
+#: Upper bound on nodes after SubTree expansion (a SubTree used twice per level doubles); the
+#: default lives in ``fsmbt.limits`` (``max_nodes``).
+MAX_COMPILED_NODES = Limits.max_nodes
 
 # -- supported node types: the node registry (fsmbt.semantics.nodes) ----------------------------
 # Which kinds are ticked and by which rule, their default memory, which are refused and why:

@@ -40,6 +40,7 @@ import time
 from collections.abc import Hashable, Sequence
 from dataclasses import dataclass, field
 
+from fsmbt.limits import Limits
 from fsmbt.model.errors import InputError
 from fsmbt.semantics.machine import RUNNING, Machine
 from fsmbt.verify.report import (
@@ -54,8 +55,9 @@ from fsmbt.verify.report import (
     TraceStep,
 )
 
-#: Largest number of states (per machine, and of the product) explored before giving up.
-DEFAULT_MAX_STATES = 2_000_000
+#: Largest number of states (per machine, and of the product) explored before giving up
+#: (the default lives in ``fsmbt.limits``: ``checker_max_states``).
+DEFAULT_MAX_STATES = Limits.checker_max_states
 _NO_OUTPUT: tuple[str, ...] = ()
 
 

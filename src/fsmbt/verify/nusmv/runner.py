@@ -9,9 +9,10 @@ import subprocess
 import tempfile
 from dataclasses import dataclass, field
 
+from fsmbt.limits import Limits
 from fsmbt.verify.nusmv.binary import require_nusmv
 
-DEFAULT_TIMEOUT_S = 300.0
+DEFAULT_TIMEOUT_S = Limits.nusmv_max_seconds  # the default lives in fsmbt.limits
 _SPEC = re.compile(r"^-- (?:specification|invariant) (.*) is (true|false)\s*$")
 _STATE = re.compile(r"^\s*-> State: \d+\.\d+ <-")
 _INPUT = re.compile(r"^\s*-> Input: \d+\.\d+ <-")
