@@ -1,0 +1,3 @@
+from fsmbt.model import Model
+def write_smach(model: Model) -> str:
+    raise NotImplementedError
