@@ -121,6 +121,7 @@ class Analysis:
     behaviours: dict[str, Container | None]  # FlexBE Behavior class -> container create() returns
     imports: dict[str, str]  # local name -> dotted module path it was imported from
     warnings: list[tuple[int | None, str]] = field(default_factory=list)
+    extension: dict[str, object] = field(default_factory=dict)  # ``__fsmbt__`` (written by fsmbt)
 
 
 @dataclass(frozen=True)
@@ -166,7 +167,24 @@ class Analyzer:
     def run(self) -> Analysis:
         self.collect_definitions()
         self.walk(self.tree.body, _Ctx(ChainMap(), (), None, None, None, None))
-        return Analysis(self.containers, self.behaviours, self.imports, self.warnings)
+        return Analysis(self.containers, self.behaviours, self.imports, self.warnings,
+                        self.extension())
+
+    def extension(self) -> dict[str, object]:
+        """The module-level ``__fsmbt__ = {...}`` literal the SMACH writer adds, if any."""
+        for stmt in self.tree.body:
+            if (isinstance(stmt, ast.Assign) and len(stmt.targets) == 1
+                    and isinstance(stmt.targets[0], ast.Name)
+                    and stmt.targets[0].id == "__fsmbt__"):
+                try:
+                    value = literal(stmt.value)
+                except NotStatic:
+                    value = None
+                if isinstance(value, dict) and value.get("version") == 1:
+                    return {str(k): v for k, v in value.items()}
+                self.warnings.append((stmt.lineno, "__fsmbt__ is not a version-1 literal dict "
+                                                   "written by fsmbt; ignored"))
+        return {}
 
     def collect_definitions(self) -> None:
         """Imports, state classes with their outcomes, ``@cb_interface`` callbacks."""

@@ -82,6 +82,7 @@ class _Work:
     label: str
     source: _Source
     chain: tuple[str, ...]  # behaviour files on the way here (cycle check)
+    path: str = ""  # label path from the file's top container ("" = top, "A/B")
 
 
 @dataclass
@@ -101,7 +102,7 @@ class Builder:
 
     def build(self, root: Container, name: str) -> FSM:
         top = FSM(name=name)
-        stack = [_Work(root, top, name, self.main, ())]
+        stack = [_Work(root, top, name, self.main, (), "")]
         while stack:
             work = stack.pop()
             if work.container.blocker is not None:
@@ -122,22 +123,29 @@ class Builder:
         label = name or child.label
         where = self.loc(work.source, child.line)
         state = child.state
+        sub_path = f"{work.path}/{label}" if work.path else label
         if isinstance(state, StateRef):
-            return (State(label, action=state.cls, attrs={A_CLASS: state.cls}, location=where),
+            actions = work.source.analysis.extension.get("actions")
+            action: str | None = state.cls
+            if isinstance(actions, dict) and state.cls in actions:
+                mapped = actions[state.cls]
+                action = mapped if isinstance(mapped, str) else None
+            attrs = {A_CLASS: "CBState"} if state.callback else {}
+            return (State(label, action=action, attrs=attrs, location=where),
                     state.outcomes, None)
         if isinstance(state, Container):
             region = FSM(name=label)
             composite = State(label, action=None, regions=[region], location=where)
             self.owners[id(region)] = composite
             return composite, list(state.outcomes), _Work(state, region, label, work.source,
-                                                          work.chain)
+                                                          work.chain, sub_path)
         root, source = self.embedded(work, state, child)
         region = FSM(name=label)
         composite = State(label, action=None, regions=[region], location=where,
                           attrs={A_BEHAVIOUR: state.cls})
         self.owners[id(region)] = composite
         chain = (*work.chain, str(source.path))
-        return composite, list(root.outcomes), _Work(root, region, label, source, chain)
+        return composite, list(root.outcomes), _Work(root, region, label, source, chain, "")
 
     def embedded(self, work: _Work, ref: Embedded, child: Child) -> tuple[Container, _Source]:
         here = work.source
@@ -222,9 +230,12 @@ class Builder:
             outcomes_of[child.label] = outcomes
             if sub is not None:
                 pending.append(sub)
+        finals = work.source.analysis.extension.get("final_actions")
+        final_actions = finals.get(work.path, {}) if isinstance(finals, dict) else {}
         for outcome in container.outcomes:
-            fsm.states[outcome] = State(outcome, action=None, final=True,
-                                        location=self.loc(work.source, container.line))
+            action = final_actions.get(outcome) if isinstance(final_actions, dict) else None
+            fsm.states[outcome] = State(outcome, action=action if isinstance(action, str) else None,
+                                        final=True, location=self.loc(work.source, container.line))
         initial = container.initial or children[0].label
         if initial not in labels:
             raise InputError(f"set_initial_state names '{initial}', not a state of "
@@ -545,5 +556,12 @@ def build_fsm(text: str, ctx: ReadContext, choose_root: Callable[[Analysis, Read
     for line, message in analysis.warnings:
         builder.warn(main, line, message)
     root, name = choose_root(analysis, ctx)
+    extension = analysis.extension
+    if isinstance(extension.get("name"), str):
+        name = str(extension["name"])
     fsm = builder.build(root, name)
+    start = extension.get("start")
+    if isinstance(start, dict) and isinstance(start.get("name"), str) and isinstance(
+            start.get("event"), str):
+        fsm.start_name, fsm.initial_event = start["name"], start["event"]
     return fsm
