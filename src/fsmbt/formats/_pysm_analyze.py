@@ -550,8 +550,11 @@ class Analyzer:
         if node is None:
             return
         value = self.static(node, ctx, "the ConcurrencyContainer conditions")
-        items = value.items() if isinstance(value, dict) else value
-        if not isinstance(items, (list, tuple)) and not isinstance(value, dict):
+        if isinstance(value, dict):
+            items: list[object] = list(value.items())
+        elif isinstance(value, (list, tuple)):
+            items = list(value)
+        else:
             raise self.invalid(node, "ConcurrencyContainer conditions must be a list of "
                                      "(outcome, [(state, outcome), ...])")
         for item in items:
@@ -823,7 +826,8 @@ def _static_count(node: ast.expr, lookup) -> int | None:  # type: ignore[no-unty
         if not 1 <= len(bounds) <= 3 or not all(isinstance(b, int) and not isinstance(b, bool)
                                                 for b in bounds):
             return None
-        return len(range(*bounds))  # type: ignore[arg-type]
+        ints = [b for b in bounds if isinstance(b, int)]
+        return len(range(*ints))
     try:
         value = literal(node, lookup)
     except NotStatic:

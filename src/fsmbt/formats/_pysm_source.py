@@ -110,7 +110,8 @@ def _literal_children(node: ast.AST, lookup: Callable[[str], object] | None) -> 
     if isinstance(node, ast.Dict):
         if any(k is None for k in node.keys):
             raise NotStatic(node, "a dict built with ** unpacking")
-        return [k for k in node.keys if k is not None] + list(node.values)
+        keys: list[ast.AST] = [k for k in node.keys if k is not None]
+        return keys + list(node.values)
     if isinstance(node, ast.UnaryOp) and isinstance(node.op, (ast.USub, ast.UAdd)):
         return [node.operand]
     return []
@@ -134,9 +135,9 @@ def _literal_value(node: ast.AST, results: dict[int, object],
             out[k] = results[id(value)]
         return out
     if isinstance(node, ast.UnaryOp) and isinstance(node.op, (ast.USub, ast.UAdd)):
-        value = results[id(node.operand)]
-        if isinstance(value, (int, float)) and not isinstance(value, bool):
-            return -value if isinstance(node.op, ast.USub) else value
+        number = results[id(node.operand)]
+        if isinstance(number, (int, float)) and not isinstance(number, bool):
+            return -number if isinstance(node.op, ast.USub) else number
         raise NotStatic(node)
     if isinstance(node, ast.Name):
         if lookup is not None:

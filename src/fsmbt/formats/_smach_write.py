@@ -221,10 +221,10 @@ class _Writer:
                 if "autonomy" in t.attrs and not any("autonomy" in x for x in self.losses):
                     self.losses.append("FlexBE autonomy levels of transitions have no place in "
                                        "SMACH; dropped")
-                extra = {k for k in t.attrs if k != "autonomy"}
-                if extra:
+                dropped = sorted(k for k in t.attrs if k != "autonomy")
+                if dropped:
                     self.losses.append(f"transition {t.source} -> {t.target}: attributes "
-                                       f"{', '.join(sorted(extra))} have no place in SMACH; "
+                                       f"{', '.join(dropped)} have no place in SMACH; "
                                        "dropped")
             acting = [s.name for s in machine.states.values() if s.final and s.action is not None]
             if acting:
