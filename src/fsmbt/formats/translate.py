@@ -99,7 +99,12 @@ def translate(model: Model, to: str, *, flatten: bool = False,
     if target.read is None:
         losses.append(f"{target.name} cannot be read back, so what it loses is not checked")
         return result
-    back = loads(text, target.name)
+    try:
+        back = loads(text, target.name)
+    except InputError as exc:
+        losses.append(f"fsmbt cannot read this {target.name} back ({exc.message}), so what it "
+                      "loses is not checked")
+        return result
     _check_meaning(model, back, target.name)
     result.verified = True
     if own_losses is None:
