@@ -7,6 +7,9 @@ the construct is about behaviour (Concurrence outcome maps, Iterator unrolling).
 
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
 import textwrap
 from pathlib import Path
 
@@ -464,3 +467,39 @@ def test_deeply_nested_with_blocks_are_refused_cleanly() -> None:
     lines.append("    " * 300 + "pass")
     with pytest.raises(InputError):
         read("\n".join(lines) + "\n")
+
+
+# -- the same through the real CLI ----------------------------------------------------------------
+def _cli(*args: str) -> subprocess.CompletedProcess[str]:
+    root = Path(__file__).resolve().parents[2]
+    env = dict(os.environ, PYTHONPATH=str(root / "src"))
+    return subprocess.run([sys.executable, "-m", "fsmbt.cli", *args], capture_output=True,
+                          text=True, timeout=120, env=env, check=False)
+
+
+def test_cli_converts_a_smach_file_without_running_it(tmp_path: Path) -> None:
+    marker = tmp_path / "EXECUTED"
+    source = tmp_path / "robot.py"
+    source.write_text(smach("""
+        sm = smach.StateMachine(outcomes=['done'])
+        with sm:
+            smach.StateMachine.add('FOO', Foo(), {'outcome1': 'BAR', 'outcome2': 'done'})
+            smach.StateMachine.add('BAR', Bar(), {'outcome1': 'FOO'})
+    """, head=HEAD + f"open({str(marker)!r}, 'w')\n"), encoding="utf-8")
+    out = tmp_path / "robot_bt.xml"
+    done = _cli("convert", str(source), "-o", str(out))
+    assert done.returncode == 0, done.stderr
+    assert "verdict: EQUIVALENT" in done.stdout + done.stderr
+    assert out.exists() and not marker.exists()
+
+
+@pytest.mark.parametrize("kind", ["deep expression", "syntax error"])
+def test_cli_reports_hostile_python_in_one_line(tmp_path: Path, kind: str) -> None:
+    source = tmp_path / "bad.py"
+    body = "x = " + "-" * 100_000 + "1\n" if kind == "deep expression" else "def (:\n"
+    source.write_text("import smach\n" + body, encoding="utf-8")
+    done = _cli("convert", str(source), "-o", str(tmp_path / "out.xml"))
+    assert done.returncode == 2
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: ") and str(source) in lines[0]
+    assert "Traceback" not in done.stderr

@@ -107,6 +107,7 @@ class Container:
     exhausted_outcome: str = "exhausted"
     contained_line: int | None = None
     blocker: UnsupportedError | None = None  # raised only if this container is read
+    labels: set[str] = field(default_factory=set)
 
     @property
     def name(self) -> str:
@@ -658,7 +659,7 @@ class Analyzer:
             label = label_value
         else:
             label = label_node.value
-        if any(c.label == label for c in container.children):
+        if label in container.labels:
             raise self.invalid(call, f"state label '{label}' is already used in this container "
                                      "(SMACH raises InvalidStateError)")
         state = self.state(args["state"], ctx, label)
@@ -690,6 +691,7 @@ class Analyzer:
                                              f"(as '{label}'); SMACH shares one instance")
             state.parent = container
         container.children.append(child)
+        container.labels.add(label)
         return state
 
     def set_contained(self, container: Container, call: ast.Call, ctx: _Ctx) -> object:
@@ -768,7 +770,7 @@ class Analyzer:
                     elif outcomes is not None:
                         outcomes = list(dict.fromkeys([*outcomes, *extra]))
         display = callback if original == "CBState" and callback else original
-        return StateRef(display, outcomes, call.lineno, source_text(self.text, call), callback)
+        return StateRef(display, outcomes, call.lineno, callback=callback)
 
     def callback_interface(self, node: ast.expr) -> list[str] | None:
         if isinstance(node, ast.Call) and last_name(node.func) in ("CBInterface", "cb_interface"):

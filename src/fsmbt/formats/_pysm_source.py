@@ -174,8 +174,29 @@ def last_name(node: ast.AST) -> str | None:
     return None
 
 
+_LINES_CACHE: dict[int, tuple[str, list[bytes]]] = {}
+
+
 def source_text(text: str, node: ast.AST, limit: int = 200) -> str:
-    """The source of ``node`` on one line, shortened to ``limit`` characters."""
-    segment = ast.get_source_segment(text, node) or ""
-    segment = " ".join(segment.split())
+    """The source of ``node`` on one line, shortened to ``limit`` characters.
+
+    The text's lines are split once per text (``ast.get_source_segment`` splits the whole
+    text on every call, which made reading quadratic)."""
+    cached = _LINES_CACHE.get(id(text))
+    if cached is None or cached[0] is not text:
+        _LINES_CACHE.clear()
+        cached = (text, [line.encode("utf-8") for line in text.splitlines(keepends=True)])
+        _LINES_CACHE[id(text)] = cached
+    lines = cached[1]
+    start, end = getattr(node, "lineno", None), getattr(node, "end_lineno", None)
+    first, last = getattr(node, "col_offset", None), getattr(node, "end_col_offset", None)
+    if None in (start, end, first, last) or not 1 <= start <= end <= len(lines):  # type: ignore[operator]
+        return ""
+    assert start is not None and end is not None and first is not None and last is not None
+    if start == end:
+        chunk = lines[start - 1][first:last]
+    else:
+        chunk = b"".join([lines[start - 1][first:], *lines[start:end - 1],
+                          lines[end - 1][:last]])
+    segment = " ".join(chunk.decode("utf-8", "replace").split())
     return segment if len(segment) <= limit else segment[: limit - 3] + "..."
