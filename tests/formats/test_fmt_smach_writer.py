@@ -228,3 +228,20 @@ def test_written_module_builds_a_consistent_smach_machine(source: str,
     labels = {label for c in containers for label in c.states}
     back = loads(text, "smach")
     assert labels == {state.name for _path, _machine, state in back.walk() if not state.final}
+
+
+def test_an_initial_state_that_is_not_the_first_is_set_after_the_with_block() -> None:
+    fsm = FSM(name="late_start")
+    fsm.add_state("A")
+    fsm.add_state("B")
+    fsm.add_state("End", final=True)
+    fsm.initial = "B"
+    fsm.add_transition("A", "go", "End")
+    fsm.add_transition("B", "go", "A")
+    text = write_smach(fsm)
+    lines = text.splitlines()
+    with_line = next(i for i, line in enumerate(lines) if line.strip() == "with sm_0:")
+    initial_line = next(i for i, line in enumerate(lines) if "set_initial_state(['B'])" in line)
+    assert initial_line > with_line and not lines[initial_line].startswith(" " * 8)
+    back = loads(text, "smach")
+    assert back.initial == "B" and differences_between(fsm, back) == []

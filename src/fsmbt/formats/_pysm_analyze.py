@@ -188,8 +188,9 @@ class Analyzer:
         return {}
 
     def collect_definitions(self) -> None:
-        """Imports, state classes with their outcomes, ``@cb_interface`` callbacks."""
-        for node in ast.walk(self.tree):
+        """Imports, state classes with their outcomes, ``@cb_interface`` callbacks (a walk over
+        statements only: definitions and imports are statements, expressions need no visit)."""
+        for node in _statements(self.tree):
             if isinstance(node, ast.ImportFrom) and node.module:
                 for alias in node.names:
                     local = alias.asname or alias.name
@@ -796,6 +797,24 @@ _CONSTRUCTOR_PARAMS: dict[str, tuple[str, ...]] = {
     "PriorityContainer": ("outcomes", "input_keys", "output_keys"),
     "ConcurrencyContainer": ("conditions", "outcomes", "input_keys", "output_keys"),
 }
+
+
+def _statements(tree: ast.Module) -> list[ast.stmt]:
+    """Every statement at every block level, in no particular order (explicit stack)."""
+    out: list[ast.stmt] = []
+    stack: list[list[ast.stmt]] = [tree.body]
+    while stack:
+        for stmt in stack.pop():
+            out.append(stmt)
+            for name in ("body", "orelse", "finalbody"):
+                block = getattr(stmt, name, None)
+                if isinstance(block, list):
+                    stack.append(block)
+            for handler in getattr(stmt, "handlers", []) or []:
+                stack.append(handler.body)
+            for case in getattr(stmt, "cases", []) or []:
+                stack.append(case.body)
+    return out
 
 
 def _target_key(node: ast.expr) -> str | None:

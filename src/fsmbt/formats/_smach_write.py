@@ -40,7 +40,7 @@ from dataclasses import dataclass, field
 from fsmbt.model import Model
 from fsmbt.model.errors import InputError, UnsupportedError
 from fsmbt.model.flatten import flatten
-from fsmbt.model.fsm import FSM, State
+from fsmbt.model.fsm import FSM, State, Transition
 
 #: ``State.attrs`` the SMACH reader sets on a composite read from a container.
 A_CONTAINER = "smach.container"
@@ -135,7 +135,7 @@ def _push_down(top: FSM) -> None:
                 continue
             region = state.regions[0]
             moved = [t for t in machine.transitions if t.source == state.name and t.event is not None]
-            for index, t in enumerate(moved):
+            for t in moved:
                 exit_name = _unique(f"on {t.event}", region.states)
                 region.states[exit_name] = State(exit_name, action=None, final=True)
                 handled = {s.source for s in region.transitions if s.event == t.event}
@@ -145,7 +145,6 @@ def _push_down(top: FSM) -> None:
                     region.add_transition(inner.name, t.event, exit_name)
                 t.event = None
                 t.exit = exit_name
-                del index
 
 
 def _unique(name: str, taken: dict[str, State] | set[str]) -> str:
@@ -178,6 +177,7 @@ class _Writer:
         self.final_actions: dict[str, dict[str, str | None]] = {}
         self.lines: list[str] = []
         self.counter = 0
+        self.outgoing: dict[int, dict[str, list[Transition]]] = {}
 
     def run(self) -> Written:
         self.prepare()
@@ -186,6 +186,10 @@ class _Writer:
         return Written("\n".join([*header, *body]) + "\n", self.losses)
 
     def prepare(self) -> None:
+        top_attrs = {k for k in self.fsm.attrs if k not in _READER_ATTRS}
+        if top_attrs:
+            self.losses.append(f"model attributes {', '.join(sorted(top_attrs))} have no place "
+                               "in SMACH; dropped")
         for path, machine, _owner in _machines(self.fsm):
             for state in list(machine.states.values()):
                 where = f"'{path}/{state.name}'" if path else f"'{state.name}'"
@@ -204,6 +208,9 @@ class _Writer:
                     self.losses.append(f"composite state {where} has action '{state.action}', "
                                        "which no semantics runs (docs/semantics.md §6); dropped")
                     state.action = None
+                if state.attrs.get("class") == "CBState":
+                    self.losses.append(f"state {where} was a CBState calling "
+                                       f"'{state.action}'; written as a stub state class")
                 extra = {k: v for k, v in state.attrs.items() if k not in _READER_ATTRS}
                 if extra:
                     self.losses.append(f"state {where}: attributes {', '.join(extra)} have no "
@@ -302,8 +309,9 @@ class _Writer:
         # frames: (machine, path, var, indent, remaining states, pending add line after sub)
         first_var = self.new_container(top, top_path, indent, lines)
         stack: list[tuple[FSM, str, str, int, list[State], list[str] | None]] = [
-            (top, top_path, first_var, indent + 1, [s for s in top.states.values()
-                                                     if not s.final], None)]
+            (top, top_path, first_var, indent + 1, [s for s in reversed(top.states.values())
+                                                     if not s.final],
+             self.initial_line(top, first_var, indent))]
         while stack:
             machine, path, var, level, remaining, after = stack[-1]
             if not remaining:
@@ -311,7 +319,7 @@ class _Writer:
                 if after is not None:
                     lines.extend(after)
                 continue
-            state = remaining.pop(0)
+            state = remaining.pop()  # the lists are reversed: pop() takes the next state
             pad = "    " * level
             transitions = self.transitions_of(machine, state)
             if state.is_composite:
@@ -324,10 +332,12 @@ class _Writer:
                                  f"transitions={_py(transitions)})")
                     continue
                 sub_var = self.new_container(region, sub_path, level, lines)
-                after_lines = [f"{pad}smach.StateMachine.add({_py(state.name)}, {sub_var}, "
+                after_lines = [*self.initial_line(region, sub_var, level),
+                               f"{pad}smach.StateMachine.add({_py(state.name)}, {sub_var}, "
                                f"transitions={_py(transitions)})"]
                 stack.append((region, sub_path, sub_var, level + 1,
-                              [s for s in region.states.values() if not s.final], after_lines))
+                              [s for s in reversed(region.states.values()) if not s.final],
+                              after_lines))
                 continue
             cls = self.state_class(state.action, tuple(transitions))
             lines.append(f"{pad}smach.StateMachine.add({_py(state.name)}, {cls}(), "
@@ -347,19 +357,25 @@ class _Writer:
         self.counter += 1
         pad = "    " * level
         lines.append(f"{pad}{var} = smach.StateMachine(outcomes={_py([s.name for s in finals])})")
-        initial = machine.initial
-        ordered = [s for s in machine.states.values() if not s.final]
-        if ordered and ordered[0].name != initial:
-            lines.append(f"{pad}{var}.set_initial_state([{_py(initial)}])")
         lines.append(f"{pad}with {var}:")
         return var
 
+    def initial_line(self, machine: FSM, var: str, level: int) -> list[str]:
+        """``set_initial_state`` after the ``with`` block, when the first state is not it."""
+        ordered = [s for s in machine.states.values() if not s.final]
+        if ordered and ordered[0].name != machine.initial:
+            return [f"{'    ' * level}{var}.set_initial_state([{_py(machine.initial)}])"]
+        return []
+
     def transitions_of(self, machine: FSM, state: State) -> dict[str, str]:
         out: dict[str, str] = {}
-        finals = {s.name for s in machine.states.values() if s.final}
-        for t in machine.transitions:
-            if t.source != state.name:
-                continue
+        index = self.outgoing.get(id(machine))
+        if index is None:
+            index = {}
+            for t in machine.transitions:
+                index.setdefault(t.source, []).append(t)
+            self.outgoing[id(machine)] = index
+        for t in index.get(state.name, []):
             if state.is_atomic:
                 key = t.event
             else:
@@ -378,7 +394,6 @@ class _Writer:
                     raise UnsupportedError(
                         f"composite state '{state.name}': its final state '{inner.name}' has no "
                         "completion transition; SMACH needs every container outcome mapped")
-        del finals
         return out
 
     # -- concurrence --------------------------------------------------------------------------
