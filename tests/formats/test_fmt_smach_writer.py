@@ -245,3 +245,20 @@ def test_an_initial_state_that_is_not_the_first_is_set_after_the_with_block() ->
     assert initial_line > with_line and not lines[initial_line].startswith(" " * 8)
     back = loads(text, "smach")
     assert back.initial == "B" and differences_between(fsm, back) == []
+
+
+def test_states_sharing_an_action_but_not_their_events_get_one_class_each() -> None:
+    fsm = FSM(name="shared")
+    for name in ("A", "B", "C"):
+        fsm.add_state(name, action="Move")
+    fsm.add_state("End", final=True)
+    fsm.add_transition("A", "x", "B")
+    fsm.add_transition("B", "y", "C")
+    fsm.add_transition("C", "z", "End")
+    fsm.add_transition("A", "w", "End")
+    text = write_smach(fsm)
+    for cls in ("class Move(", "class Move_2(", "class Move_3("):
+        assert text.count(cls) == 1
+    back = loads(text, "smach")
+    assert {s.action for s in back.states.values() if not s.final} == {"Move"}
+    assert differences_between(fsm, back) == []

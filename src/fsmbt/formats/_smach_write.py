@@ -249,8 +249,9 @@ class _Writer:
         key = (action, outcomes)
         if key not in self.classes:
             base = _identifier(action) if action is not None else "NoAction"
-            taken = set(self.class_actions)
-            name = base if base not in taken else _unique(base, taken).replace(" #", "_")
+            name, index = base, 2
+            while name in self.class_actions:  # a dict: O(1) per probe
+                name, index = f"{base}_{index}", index + 1
             self.classes[key] = name
             self.class_actions[name] = action
             self.class_order.append((name, outcomes, action))
