@@ -28,7 +28,7 @@ from fsmbt.verify import verify
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 FSM_EXAMPLES = ["paper_fsm.xml", "paper_fsm.json", "guard_npc.csv", "turnstile.mmd",
-                "door_hfsm.scxml"]
+                "door_hfsm.scxml", "delivery_smach.py"]
 
 
 def round_trip(model: FSM) -> FSM:

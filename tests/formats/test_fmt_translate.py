@@ -7,6 +7,7 @@ Each output is read back here independently and compared with the source model.
 
 from __future__ import annotations
 
+import json
 import os
 import subprocess
 import sys
@@ -125,6 +126,24 @@ def test_flexbe_to_json(tmp_path: Path) -> None:
     assert "warning:" in done.stderr and "declares outcome 'failed'" in done.stderr  # reader's
     model, back = read_model(source), read_model(out)
     assert isinstance(back, FSM) and differences_between(model, back) == []
+
+
+def test_reader_option_picks_another_machine(tmp_path: Path) -> None:
+    source = tmp_path / "two.py"
+    source.write_text(SMACH_SOURCE + """
+    other = smach.StateMachine(outcomes=['end'])
+    with other:
+        smach.StateMachine.add('SOLO', Foo(), {'outcome1': 'end', 'outcome2': 'end'})
+""", encoding="utf-8")
+    first = cli("translate", str(source), "--to", "json")
+    assert first.returncode == 0 and "not read: 'other'" in first.stderr
+    assert list(loads(first.stdout, "json").states) == ["FOO", "BAR", "outcome4"]
+    chosen = cli("translate", str(source), "--to", "json", "-O", "machine=other", "--json")
+    assert chosen.returncode == 0, chosen.stderr
+    summary = json.loads(chosen.stdout)
+    assert summary["verified_equivalent"] is True and summary["from"] == "smach"
+    assert list(loads(summary["model"], "json").states) == ["SOLO", "end"]
+    assert cli("translate", str(source), "--to", "json", "-O", "machine").returncode == 2
 
 
 def test_stdout_needs_a_target_format(tmp_path: Path) -> None:

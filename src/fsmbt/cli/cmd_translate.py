@@ -1,6 +1,7 @@
 """``fsmbt translate``: the same model in another format, with every loss named.
 
-``fsmbt translate IN -o OUT [--to FMT] [--from FMT] [--force] [--flatten]``: reads IN, writes
+``fsmbt translate IN -o OUT [--to FMT] [--from FMT] [--force] [--flatten] [-O KEY=VALUE]``:
+reads IN (``-O`` passes reader options, e.g. ``machine=NAME`` for SMACH), writes
 OUT in FMT (default: from OUT's extension; stdout when there is no ``-o``, then ``--to`` is
 needed). The reader's warnings and one ``warning:`` line per thing the target cannot hold go
 to stderr; a loss that changes the model's behaviour is an error (exit 2) and nothing is
@@ -33,13 +34,23 @@ def register(app: typer.Typer) -> None:
         flatten: bool = typer.Option(False, "--flatten", help="write a hierarchical FSM as its "
                                      "flat machine (named as a loss)"),
         as_json: bool = typer.Option(False, "--json", help="print a JSON summary on stdout"),
+        option: list[str] = typer.Option([], "--option", "-O", help="a reader option "
+                                         "KEY=VALUE, e.g. machine=sm_top (SMACH: which "
+                                         "top-level container), behaviour=MySM (FlexBE)"),
     ) -> None:
         """Write the same model in another format; name whatever the target cannot hold."""
         if output is None and to is None:
             print("error: name the target format with --to (or give -o FILE)", file=sys.stderr)
             raise typer.Exit(2)
+        options: dict[str, object] = {}
+        for item in option:
+            key, sep, value = item.partition("=")
+            if not sep or not key:
+                print(f"error: --option takes KEY=VALUE, not {item!r}", file=sys.stderr)
+                raise typer.Exit(2)
+            options[key.strip()] = value.strip()
         result = translate_file(source, to, output, source_format=source_format,
-                                flatten=flatten, overwrite=force)
+                                flatten=flatten, overwrite=force, options=options)
         summary = {
             "source": str(source), "from": result.source_format, "to": result.target_format,
             "output": str(output) if output is not None else None,
