@@ -205,6 +205,32 @@ def test_concurrence_last_matching_outcome_map_entry_wins() -> None:
     assert ("FOO=outcome2,BAR", "BAR.outcome1", "y", None) in edges(model)
 
 
+def test_concurrence_of_a_container_child_runs_it_alongside_the_leaf() -> None:
+    model, _ = read(smach("""
+        cc = smach.Concurrence(outcomes=['ok', 'ko'], default_outcome='ko',
+                               outcome_map={'ok': {'SUB': 'fine', 'BAR': 'outcome1'}})
+        with cc:
+            sub = smach.StateMachine(outcomes=['fine', 'bad'])
+            with sub:
+                smach.StateMachine.add('F', Foo(), {'outcome1': 'G', 'outcome2': 'bad'})
+                smach.StateMachine.add('G', Bar(), {'outcome1': 'fine'})
+            smach.Concurrence.add('SUB', sub)
+            smach.Concurrence.add('BAR', Bar())
+    """))
+    assert model.states[model.initial].action == "Foo+Bar"
+    # SUB's F and BAR share 'outcome1': every child event is qualified by its child
+    runner = Runner(model)
+    assert runner.step("SUB.outcome1") == ["Bar"]  # SUB moves on to G (class Bar)
+    assert runner.step("BAR.outcome1") == []  # BAR is done, nothing starts
+    assert runner.step("SUB.outcome1") == [] and runner.status == "final"
+    ending = {t.target for t in model.transitions if model.states[t.target].final}
+    assert ending == {"ok", "ko"}
+    runner = Runner(model)
+    runner.step("SUB.outcome2")  # SUB ends 'bad'
+    runner.step("BAR.outcome1")
+    assert runner.status == "final" and runner.state == "ko"
+
+
 def test_iterator_with_static_items_is_unrolled() -> None:
     model, warnings = read(smach("""
         sm = smach.StateMachine(outcomes=['succeeded', 'aborted'])
@@ -338,14 +364,11 @@ UNSUPPORTED = {
         with cc:
             smach.Concurrence.add('B', Bar())
     """, "child_termination_cb"),
-    "concurrence of containers": ("""
+    "concurrence child of unknown outcomes": ("""
         cc = smach.Concurrence(outcomes=['a'], default_outcome='a')
         with cc:
-            sub = smach.StateMachine(outcomes=['x'])
-            with sub:
-                smach.StateMachine.add('B', Bar(), {'outcome1': 'x'})
-            smach.Concurrence.add('SUB', sub)
-    """, "itself a container"),
+            smach.Concurrence.add('EXT', ImportedState())
+    """, "outcomes of Concurrence child 'EXT'"),
 }
 
 

@@ -16,13 +16,15 @@ Mapping rules:
 - ``Sequence`` links each state's connector outcome to the next added state unless mapped;
   ``add_auto`` links its connector outcomes to the next added state (overriding, as SMACH's
   code does).
-- ``Concurrence`` / ``ConcurrencyContainer`` of leaf states is a composite state whose inner
-  machine is the product of its children: a state per combination of finished children and
-  their outcomes, one event per child outcome (qualified ``LABEL.outcome`` when two children
-  share an outcome name, so each child's outcome stays an independent input). SMACH: when all
-  children are done, the last matching entry of ``outcome_map`` (else ``default_outcome``)
-  ends it; FlexBE: after each child outcome the first satisfied condition ends it (children
-  not finished are stopped). Entering it runs every child's action (``A+B``).
+- ``Concurrence`` / ``ConcurrencyContainer`` is a composite state whose inner machine is the
+  product of its children (a leaf child is its state plus one final state per outcome; a
+  container child its flattened machine): a state per combination of child positions, one
+  event per child event (qualified ``LABEL.event`` when two children share an event name, so
+  each child's input stays independent). SMACH: when all children are done, the last matching
+  entry of ``outcome_map`` (else ``default_outcome``) ends it; FlexBE: after each child step
+  the first satisfied condition ends it (children not finished are stopped). Entering it runs
+  every child's first action (``A+B``); a later product state runs only what the child that
+  moved starts (product states are split by that action).
 - ``Iterator`` with a static item list (literal list/tuple, ``range`` of integers, at most
   ``MAX_UNROLLED_ITEMS``) is unrolled, one copy of the contained state per item; with items
   computed at run time, the number of items is an environment choice after each loop outcome
@@ -54,9 +56,14 @@ from fsmbt.formats._pysm_analyze import (
 from fsmbt.formats._pysm_source import parse_source
 from fsmbt.formats.registry import MAX_INPUT_BYTES, ReadContext, decode
 from fsmbt.model.errors import InputError, SourceLocation, UnsupportedError
+from fsmbt.model.flatten import flatten
 from fsmbt.model.fsm import FSM, State
 
 MAX_PRODUCT_STATES = 20_000
+#: Where a concurrence child is: ``(False, flat state)`` while it runs, ``(True, outcome)`` done.
+Position = tuple[bool, str]
+#: A product state: every child's position, and the action that entering it runs.
+Key = tuple[tuple[Position, ...], str | None]
 #: ``State.attrs`` keys the SMACH writer reads back (docs/formats/smach.md).
 A_CLASS = "class"
 A_CONTAINER = "smach.container"
@@ -83,6 +90,8 @@ class _Work:
     source: _Source
     chain: tuple[str, ...]  # behaviour files on the way here (cycle check)
     path: str = ""  # label path from the file's top container ("" = top, "A/B")
+    phase: int = 0  # concurrences: 0 = build the container children first, 1 = the product
+    child_machines: dict[str, FSM] = field(default_factory=dict)
 
 
 @dataclass
@@ -109,6 +118,13 @@ class Builder:
                 raise work.container.blocker
             kind = work.container.kind
             if kind in ("concurrence", "flexbe-concurrency"):
+                if work.phase == 0:
+                    pending = self.concurrence_children(work)
+                    if pending:
+                        work.phase = 1
+                        stack.append(work)
+                        stack.extend(pending)
+                        continue
                 self.concurrence(work)
             elif kind == "iterator":
                 stack.extend(self.iterator(work))
@@ -305,88 +321,123 @@ class Builder:
                 fsm.add_transition(child.label, outcome, target, attrs=attrs, location=where)
 
     # -- concurrence --------------------------------------------------------------------------
+    def concurrence_children(self, work: _Work) -> list[_Work]:
+        """Phase 0 of a concurrence: the machines of its container children, built first."""
+        pending: list[_Work] = []
+        for child in work.container.children:
+            if not isinstance(child.state, StateRef):
+                state, _, sub = self.child_state(work, child)
+                work.child_machines[child.label] = state.regions[0]
+                if sub is not None:
+                    pending.append(sub)
+        return pending
+
+    def child_machine(self, work: _Work, child: Child, what: str, smach: bool) -> FSM:
+        """A child as a flat machine whose final states are its outcomes."""
+        container = work.container
+        if not isinstance(child.state, StateRef):
+            flat = flatten(work.child_machines[child.label])
+            if flat.initial is None or flat.start_name is not None:
+                raise UnsupportedError(f"{what} child '{child.label}' has no plain initial state",
+                                       location=self.loc(work.source, child.line))
+            return flat
+        known = child.state.outcomes
+        if not smach and child.transitions:
+            known = list(dict.fromkeys([*(known or []), *child.transitions]))
+        if known is None:
+            from_map = [m[child.label] for _, m in container.outcome_map if child.label in m]
+            if not from_map:
+                raise UnsupportedError(
+                    f"outcomes of {what} child '{child.label}' (class {child.state.cls}) are "
+                    "unknown: its class is not in the file and no outcome map names it",
+                    location=self.loc(work.source, child.line))
+            known = list(dict.fromkeys(from_map))
+            self.warn(work.source, child.line, f"outcomes of '{child.label}' (class "
+                      f"{child.state.cls}, defined elsewhere) read from the outcome map: "
+                      f"{', '.join(known)}")
+        leaf = FSM(name=child.label)
+        leaf.add_state(State(child.label, action=child.state.cls))
+        for outcome in known:
+            leaf.add_state(State(outcome, action=None, final=True))
+            leaf.add_transition(child.label, outcome, outcome)
+        return leaf
+
     def concurrence(self, work: _Work) -> None:
+        """Phase 1: the product of the children's machines (see the module docstring)."""
         container, fsm = work.container, work.machine
         smach = container.kind == "concurrence"
         what = "Concurrence" if smach else "ConcurrencyContainer"
+        where = self.loc(work.source, container.line)
         if not container.children:
-            raise InputError(f"{what} '{container.name}' has no states",
-                             location=self.loc(work.source, container.line))
+            raise InputError(f"{what} '{container.name}' has no states", location=where)
         labels = [c.label for c in container.children]
-        refs: list[StateRef] = []
-        outcomes: list[list[str]] = []
-        for child in container.children:
-            if not isinstance(child.state, StateRef):
-                raise UnsupportedError(
-                    f"{what} child '{child.label}' is itself a container or behaviour; fsmbt "
-                    "reads concurrent leaf states only", location=self.loc(work.source,
-                                                                           child.line))
-            refs.append(child.state)
-            known = child.state.outcomes
-            if not smach and child.transitions:
-                known = list(dict.fromkeys([*(known or []), *child.transitions]))
-            if known is None:
-                from_map = [m[child.label] for _, m in container.outcome_map if child.label in m]
-                if not from_map:
-                    raise UnsupportedError(
-                        f"outcomes of {what} child '{child.label}' (class "
-                        f"{child.state.cls}) are unknown: its class is not in the file and no "
-                        "outcome map names it", location=self.loc(work.source, child.line))
-                known = list(dict.fromkeys(from_map))
-                self.warn(work.source, child.line, f"outcomes of '{child.label}' (class "
-                          f"{child.state.cls}, defined elsewhere) read from the outcome map: "
-                          f"{', '.join(known)}")
-            outcomes.append(known)
+        machines = [self.child_machine(work, c, what, smach) for c in container.children]
+        leaves = all(isinstance(c.state, StateRef) for c in container.children)
+        outcomes = [[s.name for s in m.states.values() if s.final] for m in machines]
         self.check_outcome_map(work, what, labels, outcomes)
         for outcome in container.outcomes:
-            fsm.states[outcome] = State(outcome, action=None, final=True,
-                                        location=self.loc(work.source, container.line))
-        shared = _shares_outcomes(outcomes)
-        events = [[f"{label}.{o}" if shared else o for o in outs]
-                  for label, outs in zip(labels, outcomes)]
-        start: tuple[str | None, ...] = tuple(None for _ in labels)
-        names: dict[tuple[str | None, ...], str] = {}
-        queue: deque[tuple[str | None, ...]] = deque()
+            fsm.states[outcome] = State(outcome, action=None, final=True, location=where)
+        shared = _shares_outcomes([m.events() for m in machines])
+        tables = [m.transition_map() for m in machines]
+        start_positions = tuple((False, str(m.initial)) for m in machines)
+        start_action = "+".join(a for a in (m.states[str(m.initial)].action for m in machines)
+                                if a is not None) or None
+        names: dict[Key, str] = {}
+        queue: deque[Key] = deque()
 
-        def visit(combo: tuple[str | None, ...]) -> str:
-            if combo not in names:
+        def part(label: str, position: Position, machine: FSM) -> str:
+            done, name = position
+            if done:
+                return f"{label}={name}"
+            return label if name == machine.initial and name == label else f"{label}:{name}"
+
+        def visit(key: Key) -> str:
+            if key not in names:
                 if len(names) >= MAX_PRODUCT_STATES:
                     raise UnsupportedError(f"{what} '{container.name}' has more than "
-                                           f"{MAX_PRODUCT_STATES} combinations of child "
-                                           "outcomes", location=self.loc(work.source,
-                                                                         container.line))
-                name = ",".join(lab if o is None else f"{lab}={o}" for lab, o in zip(labels, combo))
+                                           f"{MAX_PRODUCT_STATES} combinations of child states",
+                                           location=where)
+                positions, action = key
+                name = ",".join(part(lab, pos, m) for lab, pos, m in zip(labels, positions,
+                                                                           machines))
+                if key[0] != start_positions and action is not None:
+                    name = f"{name} ({action})"
                 if name in fsm.states:
                     raise UnsupportedError(f"{what} '{container.name}': state name '{name}' "
-                                           "clashes with an outcome",
-                                           location=self.loc(work.source, container.line))
-                names[combo] = name
-                action = "+".join(r.cls for r in refs) if combo == start else None
-                fsm.states[name] = State(name, action=action,
-                                         location=self.loc(work.source, container.line))
-                queue.append(combo)
-            return names[combo]
+                                           "clashes with an outcome", location=where)
+                names[key] = name
+                fsm.states[name] = State(name, action=action, location=where)
+                queue.append(key)
+            return names[key]
 
-        fsm.initial = visit(start)
+        fsm.initial = visit((start_positions, start_action))
         stuck: list[str] = []
         reached: set[str] = set()
         while queue:
-            combo = queue.popleft()
-            source = names[combo]
-            for index, outs in enumerate(outcomes):
-                if combo[index] is not None:
+            key = queue.popleft()
+            positions = key[0]
+            source = names[key]
+            for index, (done, current) in enumerate(positions):
+                if done:
                     continue
-                for outcome, event in zip(outs, events[index]):
-                    after = combo[:index] + (outcome,) + combo[index + 1:]
-                    decided = self.decide(container, smach, labels, after)
+                for event, transition in tables[index].get(current, {}).items():
+                    if event is None:
+                        continue
+                    target_state = machines[index].states[transition.target]
+                    moved: Position = (target_state.final, transition.target)
+                    after = positions[:index] + (moved,) + positions[index + 1:]
+                    combo = tuple(name if is_done else None for is_done, name in after)
+                    qualified = f"{labels[index]}.{event}" if shared else event
+                    decided = self.decide(container, smach, labels, combo)
                     if decided is not None:
                         reached.add(decided)
-                        fsm.add_transition(source, event, decided)
-                    else:
-                        target = visit(after)
-                        fsm.add_transition(source, event, target)
-                        if all(o is not None for o in after):
-                            stuck.append(target)
+                        fsm.add_transition(source, qualified, decided)
+                        continue
+                    action = None if target_state.final else target_state.action
+                    target = visit((after, action))
+                    fsm.add_transition(source, qualified, target)
+                    if all(is_done for is_done, _ in after):
+                        stuck.append(target)
         for name in dict.fromkeys(stuck):
             self.warn(work.source, container.line,
                       f"{what} '{container.name}': when its children end as '{name}' no "
@@ -396,6 +447,9 @@ class Builder:
                 self.warn(work.source, container.line,
                           f"{what} '{container.name}' declares outcome '{outcome}' that no "
                           "combination of child outcomes gives")
+        refs = [c.state for c in container.children if isinstance(c.state, StateRef)]
+        if not leaves:
+            return
         owner = self.owner_state(work)
         attrs = owner.attrs if owner is not None else fsm.attrs
         attrs.update({
