@@ -178,3 +178,26 @@ def test_behaviours_embedding_each_other_are_refused(tmp_path: Path) -> None:
 def test_create_that_returns_nothing_readable_is_an_error() -> None:
     with pytest.raises(InputError, match="create"):
         loads(behaviour("return make_machine()\n"), "flexbe")
+
+
+def test_priority_container_inside_a_concurrency_container_is_named() -> None:
+    warnings: list[str] = []
+    model = loads(behaviour("""
+        _sm = OperatableStateMachine(outcomes=['finished'])
+        _cc = ConcurrencyContainer(outcomes=['finished'],
+                                   conditions=[('finished', [('P', 'finished'), ('W', 'done')])])
+        with _cc:
+            _p = PriorityContainer(outcomes=['finished'])
+            with _p:
+                OperatableStateMachine.add('Log', LogState(text='x'),
+                                           transitions={'done': 'finished'})
+            OperatableStateMachine.add('P', _p, transitions={'finished': 'finished'})
+            OperatableStateMachine.add('W', WaitState(wait_time=1.0),
+                                       transitions={'done': 'finished'})
+        with _sm:
+            OperatableStateMachine.add('Both', _cc, transitions={'finished': 'finished'})
+        return _sm
+    """), "flexbe", warnings=warnings)
+    assert any("PriorityContainer 'P' inside a concurrency container" in w for w in warnings)
+    out, status = outputs(model, ["P.done", "W.done"])
+    assert status == "final"

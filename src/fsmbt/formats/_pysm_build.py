@@ -325,6 +325,11 @@ class Builder:
         """Phase 0 of a concurrence: the machines of its container children, built first."""
         pending: list[_Work] = []
         for child in work.container.children:
+            if isinstance(child.state, Container) and child.state.kind == "priority":
+                self.warn(work.source, child.line,
+                          f"PriorityContainer '{child.label}' inside a concurrency container: "
+                          "FlexBE pauses its siblings while it runs; read without that "
+                          "priority (siblings may return meanwhile)")
             if not isinstance(child.state, StateRef):
                 state, _, sub = self.child_state(work, child)
                 work.child_machines[child.label] = state.regions[0]
