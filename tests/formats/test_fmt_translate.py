@@ -171,3 +171,15 @@ def test_a_loss_that_changes_behaviour_is_refused(monkeypatch: pytest.MonkeyPatc
     model = read_model(EXAMPLES / "paper_fsm.xml")
     with pytest.raises(UnsupportedError, match="changes the model's behaviour"):
         translate(model, "lossy-for-test")
+
+
+@needs_corpus
+def test_labels_that_are_not_scxml_ids_are_renamed_and_named(tmp_path: Path) -> None:
+    source = CORPUS / "fsm" / "flexbe_turtlesim_demo" / "flexbe_turtlesim_demo_sm.py"
+    out = tmp_path / "demo.scxml"
+    done = cli("translate", str(source), "-o", str(out))
+    assert done.returncode == 0, done.stderr
+    assert "'Finished Eight-pattern' -> 'Finished_Eight-pattern'" in done.stderr
+    text = out.read_text(encoding="utf-8")
+    assert 'id="Finished Eight-pattern"' not in text and 'id="Finished_Eight-pattern"' in text
+    assert verify(read_model(source), read_model(out)).equivalent

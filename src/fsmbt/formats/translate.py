@@ -20,7 +20,9 @@ exploration of docs/verification.md).
 
 from __future__ import annotations
 
+import copy
 import json
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -83,6 +85,14 @@ def translate(model: Model, to: str, *, flatten: bool = False,
         written = flatten_fsm(model)
         losses.append(f"hierarchy flattened: {len(written.states)} flat states replace the "
                       "composite and parallel states")
+    if target.name == "scxml" and isinstance(written, FSM):
+        written, renamed = scxml_safe_names(written)
+        if renamed:
+            shown = ", ".join(f"'{a}' -> '{b}'" for a, b in list(renamed.items())[:5])
+            more = f" and {len(renamed) - 5} more" if len(renamed) > 5 else ""
+            losses.append(f"{len(renamed)} state name(s) are not SCXML ids (an id is an XML "
+                          f"NCName; a space would split a transition's target): renamed "
+                          f"{shown}{more}")
     try:
         text = target.write(written)
     except UnsupportedError as exc:
@@ -174,6 +184,57 @@ def _writer_losses(target: str, model: Model) -> list[str] | None:
 
         return smach_losses(model)
     return None
+
+
+_NCNAME = re.compile(r"[A-Za-z_][A-Za-z0-9_.\-]*\Z")
+
+
+def scxml_safe_names(fsm: FSM) -> tuple[FSM, dict[str, str]]:
+    """A copy of ``fsm`` whose state names are valid SCXML ids, and the renames made.
+
+    A name that is not an XML NCName gets its other characters replaced by ``_`` (a leading
+    ``_`` when it starts with a digit or ``.``/``-``), numbered when that clashes; transitions,
+    exits, initial states and the start pseudo-state follow. Iterative over the machines.
+    """
+    copy_ = copy.deepcopy(fsm)
+    taken = {state.name for _p, _m, state in copy_.walk()}
+    if copy_.start_name is not None:
+        taken.add(copy_.start_name)
+    renamed: dict[str, str] = {}
+
+    def safe(name: str) -> str:
+        if _NCNAME.match(name):
+            return name
+        if name in renamed:
+            return renamed[name]
+        base = re.sub(r"[^A-Za-z0-9_.\-]", "_", name)
+        if not re.match(r"[A-Za-z_]", base):
+            base = f"_{base}"
+        candidate, index = base, 2
+        while candidate in taken:
+            candidate, index = f"{base}_{index}", index + 1
+        taken.add(candidate)
+        renamed[name] = candidate
+        return candidate
+
+    machines = [copy_, *(region for _p, _m, state in copy_.walk() for region in state.regions)]
+    for machine in machines:
+        if not any(not _NCNAME.match(n) for n in machine.states) and machine.initial is not None \
+                and _NCNAME.match(machine.initial) and not any(
+                    t.exit is not None and not _NCNAME.match(t.exit) for t in machine.transitions):
+            continue
+        machine.states = {safe(name): state for name, state in machine.states.items()}
+        for new_name, state in machine.states.items():
+            state.name = new_name
+        if machine.initial is not None:
+            machine.initial = safe(machine.initial)
+        for t in machine.transitions:
+            t.source, t.target = safe(t.source), safe(t.target)
+            if t.exit is not None:
+                t.exit = safe(t.exit)
+    if copy_.start_name is not None:
+        copy_.start_name = safe(copy_.start_name)
+    return copy_, renamed
 
 
 def _format_losses(target: str, model: Model) -> list[str]:
