@@ -170,7 +170,10 @@ def test_a_loss_that_changes_behaviour_is_refused(monkeypatch: pytest.MonkeyPatc
         lambda text, ctx: loads(text, "json"), drop_last_transition))
     model = read_model(EXAMPLES / "paper_fsm.xml")
     with pytest.raises(UnsupportedError, match="changes the model's behaviour"):
-        translate(model, "lossy-for-test")
+        translate(model, "lossy-for-test", check=verify)
+    unchecked = translate(model, "lossy-for-test")  # no checker: structure only, named
+    assert not unchecked.verified
+    assert any("transitions" in loss and "is lost" in loss for loss in unchecked.losses)
 
 
 @needs_corpus

@@ -49,8 +49,10 @@ def register(app: typer.Typer) -> None:
                 print(f"error: --option takes KEY=VALUE, not {item!r}", file=sys.stderr)
                 raise typer.Exit(2)
             options[key.strip()] = value.strip()
+        from fsmbt.verify import verify
+
         result = translate_file(source, to, output, source_format=source_format,
-                                flatten=flatten, overwrite=force, options=options)
+                                flatten=flatten, overwrite=force, options=options, check=verify)
         summary = {
             "source": str(source), "from": result.source_format, "to": result.target_format,
             "output": str(output) if output is not None else None,

@@ -224,7 +224,7 @@ class _Writer:
                     raise UnsupportedError(
                         f"state '{t.source}' has an eventless transition to '{t.target}': a "
                         "SMACH state always returns an outcome; flatten the model first "
-                        "(fsmbt convert --hierarchy flatten) or remove the transient state")
+                        "(fsmbt translate --flatten) or remove the transient state")
                 if "autonomy" in t.attrs and not any("autonomy" in x for x in self.losses):
                     self.losses.append("FlexBE autonomy levels of transitions have no place in "
                                        "SMACH; dropped")
