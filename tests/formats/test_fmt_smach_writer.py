@@ -262,3 +262,18 @@ def test_states_sharing_an_action_but_not_their_events_get_one_class_each() -> N
     back = loads(text, "smach")
     assert {s.action for s in back.states.values() if not s.final} == {"Move"}
     assert differences_between(fsm, back) == []
+
+
+def test_a_transient_state_is_refused_but_translate_flatten_writes_it() -> None:
+    from fsmbt.formats.translate import translate
+
+    fsm = FSM(name="transient")
+    fsm.add_state("A")
+    fsm.add_state("Pass")
+    fsm.add_state("B", final=True)
+    fsm.add_transition("A", "go", "Pass")
+    fsm.add_transition("Pass", None, "B")
+    with pytest.raises(UnsupportedError, match="--flatten"):
+        translate(fsm, "smach", check=verify)
+    result = translate(fsm, "smach", flatten=True, check=verify)
+    assert result.verified and any(loss.startswith("flattened:") for loss in result.losses)

@@ -40,6 +40,7 @@ from fsmbt.formats.registry import (
 from fsmbt.model import Model
 from fsmbt.model.errors import InputError, SourceLocation, UnsupportedError
 from fsmbt.model.flatten import flatten as flatten_fsm
+from fsmbt.model.flatten import needs_flattening
 from fsmbt.model.fsm import FSM
 from fsmbt.model.serialize import model_to_dict
 
@@ -91,10 +92,10 @@ def translate(model: Model, to: str, *, flatten: bool = False,
         raise InputError(f"format '{target.name}' cannot hold a {kind.upper()}")
     losses: list[str] = []
     written = model
-    if flatten and isinstance(model, FSM) and model.is_hierarchical:
+    if flatten and isinstance(model, FSM) and needs_flattening(model):
         written = flatten_fsm(model)
-        losses.append(f"hierarchy flattened: {len(written.states)} flat states replace the "
-                      "composite and parallel states")
+        losses.append(f"flattened: {len(written.states)} flat states replace the composite, "
+                      "parallel and transient states")
     if target.name == "scxml" and isinstance(written, FSM):
         written, renamed = scxml_safe_names(written)
         if renamed:
@@ -107,7 +108,7 @@ def translate(model: Model, to: str, *, flatten: bool = False,
         text = target.write(written)
     except UnsupportedError as exc:
         hint = ""
-        if isinstance(written, FSM) and written.is_hierarchical:
+        if isinstance(written, FSM) and needs_flattening(written):
             hint = " (--flatten writes the flat machine instead, naming that as a loss)"
         reason = exc.message.removeprefix("unsupported: ")
         raise UnsupportedError(f"{target.name} cannot hold this model: {reason}{hint}",
