@@ -55,7 +55,6 @@ class StateRef:
     cls: str
     outcomes: list[str] | None
     line: int
-    text: str = ""
     callback: str | None = None
 
 
