@@ -1,0 +1,346 @@
+"""The same model in another format, with every loss named (docs/cli.md, ``fsmbt translate``).
+
+Rules:
+- The model is written with the target format's writer. A writer that refuses the model
+  (``UnsupportedError``: e.g. Mermaid and a completion transition naming its exit state) stops
+  the translation; for a hierarchical FSM, ``flatten=True`` writes the flat machine instead,
+  which is itself named as a loss.
+- What the target cannot hold is listed, never dropped silently: the writer's own list where it
+  keeps one (SMACH: ``smach_losses``), else every difference between the model and the model
+  read back from the written text (states, transitions, attributes, nodes, the BT format
+  version ...), ignoring only the order of FSM states and transitions, which no format keeps
+  the same way and no semantics reads.
+- A loss that changes meaning is an error, not a warning: when the target has a reader, the
+  model read back is checked against the source with the checker the caller passes
+  (``fsmbt.verify.verify``; this module sits below verify in the package layers and does not
+  import it); not equivalent -> ``UnsupportedError`` naming the failed properties, and nothing
+  is written.
+
+Costs: one write, one read and one equivalence check of the model (the check is the product
+exploration of docs/verification.md).
+"""
+
+from __future__ import annotations
+
+import copy
+import json
+import re
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from fsmbt.formats.registry import (
+    ReadContext,
+    format_for_path,
+    get_format,
+    loads,
+    read_model,
+)
+from fsmbt.model import Model
+from fsmbt.model.errors import InputError, SourceLocation, UnsupportedError
+from fsmbt.model.flatten import flatten as flatten_fsm
+from fsmbt.model.flatten import needs_flattening
+from fsmbt.model.fsm import FSM
+from fsmbt.model.serialize import model_to_dict
+
+#: More generic differences than this are summarised in one line.
+MAX_DIFFERENCE_LINES = 25
+
+
+@dataclass
+class Translation:
+    """The written text and what the reader and the target format reported."""
+
+    text: str
+    source_format: str | None
+    target_format: str
+    losses: list[str] = field(default_factory=list)  # what the target cannot hold
+    warnings: list[str] = field(default_factory=list)  # the reader's warnings about the input
+    verified: bool = False  # the model read back was checked equivalent
+
+
+#: Checks two models equivalent: ``fsmbt.verify.verify`` (passed in by the caller: formats sit
+#: below verify in the package layers, so this module does not import it).
+Checker = Callable[[Model, Model], Any]
+
+
+def translate(model: Model, to: str, *, flatten: bool = False,
+              source_format: str | None = None, check: Checker | None = None) -> Translation:
+    """Write ``model`` in format ``to`` and name everything the format cannot hold.
+
+    Args:
+        model: the model read from the source.
+        to: the target format's name (``fsmbt formats`` lists them).
+        flatten: write a hierarchical FSM as its flat machine (a named loss).
+        source_format: the source format's name, for the report.
+        check: the equivalence checker (``fsmbt.verify.verify``); without it the model read
+            back is compared structurally only and ``verified`` stays False.
+
+    Returns:
+        The translation (text, losses, whether the read-back was verified equivalent).
+
+    Raises:
+        InputError / UnsupportedError: the target cannot hold the model, or what it loses
+        changes the model's behaviour.
+    """
+    target = get_format(to)
+    kind = "fsm" if isinstance(model, FSM) else "bt"
+    if target.write is None:
+        raise InputError(f"format '{target.name}' can be read but not written")
+    if kind not in target.kinds:
+        raise InputError(f"format '{target.name}' cannot hold a {kind.upper()}")
+    losses: list[str] = []
+    written = model
+    if flatten and isinstance(model, FSM) and needs_flattening(model):
+        written = flatten_fsm(model)
+        losses.append(f"flattened: {len(written.states)} flat states replace the composite, "
+                      "parallel and transient states")
+    if target.name == "scxml" and isinstance(written, FSM):
+        written, renamed = scxml_safe_names(written)
+        if renamed:
+            shown = ", ".join(f"'{a}' -> '{b}'" for a, b in list(renamed.items())[:5])
+            more = f" and {len(renamed) - 5} more" if len(renamed) > 5 else ""
+            losses.append(f"{len(renamed)} state name(s) are not SCXML ids (an id is an XML "
+                          f"NCName; a space would split a transition's target): renamed "
+                          f"{shown}{more}")
+    try:
+        text = target.write(written)
+    except UnsupportedError as exc:
+        hint = ""
+        if isinstance(written, FSM) and needs_flattening(written):
+            hint = " (--flatten writes the flat machine instead, naming that as a loss)"
+        reason = exc.message.removeprefix("unsupported: ")
+        raise UnsupportedError(f"{target.name} cannot hold this model: {reason}{hint}",
+                               location=exc.location, element=exc.element) from None
+    own_losses = _writer_losses(target.name, written)
+    losses.extend(own_losses or [])
+    losses.extend(_format_losses(target.name, written))
+    result = Translation(text, source_format, target.name, losses)
+    if target.read is None:
+        losses.append(f"{target.name} cannot be read back, so what it loses is not checked")
+        return result
+    try:
+        back = loads(text, target.name)
+    except InputError as exc:
+        losses.append(f"fsmbt cannot read this {target.name} back ({exc.message}), so what it "
+                      "loses is not checked")
+        return result
+    if check is not None:
+        _check_meaning(model, back, target.name, check)
+        result.verified = True
+    if own_losses is None:
+        losses.extend(differences_between(written, back))
+    return result
+
+
+def translate_file(source: str | Path, to: str | None = None, output: str | Path | None = None,
+                   *, source_format: str | None = None, flatten: bool = False,
+                   overwrite: bool = False, options: dict[str, object] | None = None,
+                   check: Checker | None = None) -> Translation:
+    """Read ``source``, translate it, write ``output`` (never replacing it unless asked).
+
+    Args:
+        source: the input file.
+        to: the target format (default: from ``output``'s extension).
+        output: where to write (``None``: only return the text).
+        source_format: the input format (default: detected).
+        flatten: see ``translate``.
+        overwrite: replace an existing ``output``.
+        options: reader options (``ReadContext.options``).
+        check: see ``translate``.
+
+    Returns:
+        The translation; ``warnings`` holds the reader's warnings.
+    """
+    warnings: list[str] = []
+    model = read_model(source, source_format, options, warnings=warnings)
+    kind = "fsm" if isinstance(model, FSM) else "bt"
+    target = to
+    if target is None and output is not None:
+        guessed = format_for_path(Path(output), writing=True, kind=kind)
+        target = guessed.name if guessed is not None else None
+    if target is None:
+        raise InputError("cannot tell the target format; name it with --to"
+                         + (f" (from '{Path(output).name}')" if output is not None else ""))
+    chosen_source = source_format or _detected(source)
+    result = translate(model, target, flatten=flatten, source_format=chosen_source, check=check)
+    result.warnings = warnings
+    if output is not None:
+        path = Path(output)
+        if path.exists() and not overwrite:
+            raise InputError("exists; pass --force to overwrite it",
+                             location=SourceLocation(str(path)))
+        try:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            path.write_text(result.text, encoding="utf-8")
+        except OSError as exc:
+            raise InputError(f"cannot write: {exc.strerror}",
+                             location=SourceLocation(str(path))) from None
+    return result
+
+
+def _detected(source: str | Path) -> str | None:
+    from fsmbt.formats.registry import decode, detect_format
+
+    path = Path(source)
+    try:
+        return detect_format(decode(path.read_bytes()[:1 << 20], str(path)), path).name
+    except (InputError, OSError):
+        return None
+
+
+def _writer_losses(target: str, model: Model) -> list[str] | None:
+    """The writer's own list of losses, for writers that keep one (else ``None``)."""
+    if target == "smach" and isinstance(model, FSM):
+        from fsmbt.formats._smach_write import smach_losses
+
+        return smach_losses(model)
+    return None
+
+
+_NCNAME = re.compile(r"[A-Za-z_][A-Za-z0-9_.\-]*\Z")
+
+
+def scxml_safe_names(fsm: FSM) -> tuple[FSM, dict[str, str]]:
+    """A copy of ``fsm`` whose state names are valid SCXML ids, and the renames made.
+
+    A name that is not an XML NCName gets its other characters replaced by ``_`` (a leading
+    ``_`` when it starts with a digit or ``.``/``-``), numbered when that clashes; transitions,
+    exits, initial states and the start pseudo-state follow. Iterative over the machines.
+    """
+    copy_ = copy.deepcopy(fsm)
+    taken = {state.name for _p, _m, state in copy_.walk()}
+    if copy_.start_name is not None:
+        taken.add(copy_.start_name)
+    renamed: dict[str, str] = {}
+
+    def safe(name: str) -> str:
+        if _NCNAME.match(name):
+            return name
+        if name in renamed:
+            return renamed[name]
+        base = re.sub(r"[^A-Za-z0-9_.\-]", "_", name)
+        if not re.match(r"[A-Za-z_]", base):
+            base = f"_{base}"
+        candidate, index = base, 2
+        while candidate in taken:
+            candidate, index = f"{base}_{index}", index + 1
+        taken.add(candidate)
+        renamed[name] = candidate
+        return candidate
+
+    machines = [copy_, *(region for _p, _m, state in copy_.walk() for region in state.regions)]
+    for machine in machines:
+        if not any(not _NCNAME.match(n) for n in machine.states) and machine.initial is not None \
+                and _NCNAME.match(machine.initial) and not any(
+                    t.exit is not None and not _NCNAME.match(t.exit) for t in machine.transitions):
+            continue
+        machine.states = {safe(name): state for name, state in machine.states.items()}
+        for new_name, state in machine.states.items():
+            state.name = new_name
+        if machine.initial is not None:
+            machine.initial = safe(machine.initial)
+        for t in machine.transitions:
+            t.source, t.target = safe(t.source), safe(t.target)
+            if t.exit is not None:
+                t.exit = safe(t.exit)
+    if copy_.start_name is not None:
+        copy_.start_name = safe(copy_.start_name)
+    return copy_, renamed
+
+
+def _format_losses(target: str, model: Model) -> list[str]:
+    """What the target keeps only in fsmbt's own extension, so other engines lose it."""
+    if target != "scxml" or not isinstance(model, FSM):
+        return []
+    out: list[str] = []
+    for path, _machine, state in model.walk():
+        if not state.is_composite:
+            continue
+        owner = _machine
+        exits = [t.exit for t in owner.transitions
+                 if t.source == state.name and t.event is None and t.exit is not None]
+        if len(set(exits)) > 1:
+            out.append(f"composite '{path}' ends differently by final state "
+                       f"({', '.join(dict.fromkeys(exits))}); SCXML's done.state.{state.name} "
+                       "does not say which, so this is kept in the fsmbt:exit attribute only "
+                       "(other SCXML engines take the first matching transition)")
+    return out
+
+
+def _check_meaning(model: Model, back: Model, target: str, verify: Checker) -> None:
+    if isinstance(model, FSM) != isinstance(back, FSM):
+        raise InputError(f"{target} read back a different kind of model")
+    report = verify(model, back)
+    if not report.equivalent:
+        failed = [name for name, prop in report.properties.items() if not prop.holds]
+        details = "; ".join(f"{name}: {report.properties[name].detail}" for name in failed)
+        raise UnsupportedError(f"translating to {target} changes the model's behaviour "
+                               f"({details}); nothing written")
+
+
+# -- generic differences ------------------------------------------------------------------------
+def differences_between(before: Model, after: Model) -> list[str]:
+    """Every difference between two models, one line each (order of FSM states and
+    transitions ignored), iteratively over their JSON form."""
+    old = _normalised(model_to_dict(before))
+    new = _normalised(model_to_dict(after))
+    lines: list[str] = []
+    stack: list[tuple[str, Any, Any]] = [("", old, new)]
+    while stack:
+        path, a, b = stack.pop()
+        if isinstance(a, dict) and isinstance(b, dict):
+            for key in sorted(set(a) | set(b), key=str, reverse=True):
+                sub = f"{path}.{key}" if path else str(key)
+                if key not in b:
+                    lines.append(f"{sub}: {_short(a[key])} is lost")
+                elif key not in a:
+                    lines.append(f"{sub}: {_short(b[key])} added")
+                elif a[key] != b[key]:
+                    stack.append((sub, a[key], b[key]))
+        elif isinstance(a, list) and isinstance(b, list) and len(a) == len(b):
+            for index in reversed(range(len(a))):
+                if a[index] != b[index]:
+                    stack.append((f"{path}[{index}]", a[index], b[index]))
+        else:
+            lines.append(f"{path or 'model'}: {_short(a)} becomes {_short(b)}")
+    lines.sort()
+    if len(lines) > MAX_DIFFERENCE_LINES:
+        extra = len(lines) - MAX_DIFFERENCE_LINES
+        lines = [*lines[:MAX_DIFFERENCE_LINES], f"... and {extra} more differences"]
+    return lines
+
+
+def _normalised(data: Any) -> Any:
+    """FSM ``states`` keyed by name and ``transitions`` as a sorted set (explicit stack)."""
+    root = {"": data}
+    stack: list[Any] = [root]
+    while stack:
+        node = stack.pop()
+        items = node.items() if isinstance(node, dict) else enumerate(node)
+        for key, value in list(items):
+            if isinstance(value, dict) and "states" in value and isinstance(value["states"], list):
+                value["states"] = {s.get("name"): s for s in value["states"]
+                                   if isinstance(s, dict)}
+                if isinstance(value.get("transitions"), list):
+                    value["transitions"] = {_transition_key(t): t.get("attrs", {})
+                                            for t in value["transitions"] if isinstance(t, dict)}
+            if isinstance(value, (dict, list)):
+                stack.append(value)
+            node[key] = value
+    return root[""]
+
+
+def _transition_key(t: dict[str, Any]) -> str:
+    exit_name = f" (exit {t['exit']})" if t.get("exit") is not None else ""
+    event = t.get("event")
+    return f"{t.get('source')} --{event if event is not None else ''}--> {t.get('target')}{exit_name}"
+
+
+def _short(value: Any) -> str:
+    text = json.dumps(value, sort_keys=True, default=str)
+    return text if len(text) <= 80 else text[:77] + "..."
+
+
+__all__ = ["Translation", "translate", "translate_file", "differences_between", "ReadContext"]

@@ -1,0 +1,188 @@
+"""``fsmbt translate`` through the real CLI (a subprocess, as a user runs it) for each example
+pair of issue 12 - SMACH -> SCXML, BehaviorTree.CPP v3 -> v4, SCXML -> Mermaid, FlexBE -> JSON -
+and the library's refusal of a loss that changes behaviour.
+
+Each output is read back here independently and compared with the source model.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from fsmbt.formats import Format, loads, read_model
+from fsmbt.formats.json_format import write_json
+from fsmbt.formats.translate import differences_between, translate
+from fsmbt.model.bt import BTDocument
+from fsmbt.model.errors import UnsupportedError
+from fsmbt.model.fsm import FSM
+from fsmbt.verify import verify
+
+ROOT = Path(__file__).resolve().parents[2]
+EXAMPLES = ROOT / "examples"
+CORPUS = Path(os.environ.get("FSMBT_CORPUS", ROOT / ".." / "shared" / "corpus"))
+needs_corpus = pytest.mark.skipif(not (CORPUS / "fsm").exists(), reason="corpus not present")
+
+
+def cli(*args: str) -> subprocess.CompletedProcess[str]:
+    env = dict(os.environ, PYTHONPATH=str(ROOT / "src"))
+    return subprocess.run([sys.executable, "-m", "fsmbt.cli", *args], capture_output=True,
+                          text=True, timeout=120, env=env, check=False)
+
+
+SMACH_SOURCE = """\
+import smach
+
+class Foo(smach.State):
+    def __init__(self):
+        smach.State.__init__(self, outcomes=['outcome1', 'outcome2'])
+
+def main():
+    sm = smach.StateMachine(outcomes=['outcome4'])
+    with sm:
+        smach.StateMachine.add('FOO', Foo(), transitions={'outcome1': 'BAR',
+                                                          'outcome2': 'outcome4'})
+        sub = smach.StateMachine(outcomes=['back'])
+        with sub:
+            smach.StateMachine.add('INNER', Foo(), {'outcome1': 'back', 'outcome2': 'back'})
+        smach.StateMachine.add('BAR', sub, transitions={'back': 'FOO'})
+"""
+
+
+def test_smach_to_scxml(tmp_path: Path) -> None:
+    source = tmp_path / "machine.py"
+    source.write_text(SMACH_SOURCE, encoding="utf-8")
+    out = tmp_path / "machine.scxml"
+    done = cli("translate", str(source), "-o", str(out))
+    assert done.returncode == 0, done.stderr
+    assert "(smach) ->" in done.stderr and "(scxml)" in done.stderr
+    assert "verified equivalent" in done.stderr
+    model, back = read_model(source), read_model(out)
+    assert differences_between(model, back) == []
+    again = cli("translate", str(source), "-o", str(out))
+    assert again.returncode == 2 and "--force" in again.stderr  # never overwritten silently
+    assert cli("translate", str(source), "-o", str(out), "--force").returncode == 0
+
+
+@needs_corpus
+def test_smach_concurrence_to_scxml_names_what_scxml_cannot_say(tmp_path: Path) -> None:
+    out = tmp_path / "c.scxml"
+    done = cli("translate", str(CORPUS / "fsm" / "smach_tutorials" / "concurrence2.py"),
+               "-o", str(out))
+    assert done.returncode == 0, done.stderr
+    assert "warning: scxml: composite 'CON' ends differently by final state" in done.stderr
+    assert verify(read_model(CORPUS / "fsm" / "smach_tutorials" / "concurrence2.py"),
+                  read_model(out)).equivalent
+
+
+@needs_corpus
+def test_btcpp_v3_to_v4(tmp_path: Path) -> None:
+    source = CORPUS / "bt" / "bt_in_action" / "julienbayle_stardust_r1_bt.xml"
+    assert "BTCPP_format" not in source.read_text(encoding="utf-8")
+    out = tmp_path / "v4.xml"
+    done = cli("translate", str(source), "-o", str(out), "--to", "btcpp")
+    assert done.returncode == 0, done.stderr
+    assert 'format_version: "3" becomes "4"' in done.stderr  # the change is named
+    text = out.read_text(encoding="utf-8")
+    assert 'BTCPP_format="4"' in text and "SequenceStar" not in text
+    before, after = read_model(source), read_model(out)
+    assert isinstance(before, BTDocument) and isinstance(after, BTDocument)
+    assert verify(before, after).equivalent
+
+
+def test_scxml_to_mermaid(tmp_path: Path) -> None:
+    out = tmp_path / "door.mmd"
+    done = cli("translate", str(EXAMPLES / "door_hfsm.scxml"), "-o", str(out))
+    assert done.returncode == 0, done.stderr
+    assert "\nstateDiagram-v2\n" in out.read_text(encoding="utf-8")
+    assert differences_between(read_model(EXAMPLES / "door_hfsm.scxml"), read_model(out)) == []
+
+
+def test_a_refusing_target_is_an_error_and_flatten_is_offered(tmp_path: Path) -> None:
+    source = tmp_path / "machine.py"
+    source.write_text(SMACH_SOURCE, encoding="utf-8")
+    out = tmp_path / "m.mmd"
+    done = cli("translate", str(source), "-o", str(out))
+    assert done.returncode == 2 and "--flatten" in done.stderr and not out.exists()
+    assert "Traceback" not in done.stderr
+    flat = cli("translate", str(source), "-o", str(out), "--flatten")
+    assert flat.returncode == 0, flat.stderr
+    assert "warning: mermaid: flattened:" in flat.stderr
+    assert verify(read_model(source), read_model(out)).equivalent
+
+
+@needs_corpus
+def test_flexbe_to_json(tmp_path: Path) -> None:
+    source = CORPUS / "fsm" / "flexbe_turtlesim_demo" / "flexbe_turtlesim_demo_sm.py"
+    out = tmp_path / "demo.json"
+    done = cli("translate", str(source), "-o", str(out))
+    assert done.returncode == 0, done.stderr
+    assert "(flexbe) ->" in done.stderr
+    assert "warning:" in done.stderr and "declares outcome 'failed'" in done.stderr  # reader's
+    model, back = read_model(source), read_model(out)
+    assert isinstance(back, FSM) and differences_between(model, back) == []
+
+
+def test_reader_option_picks_another_machine(tmp_path: Path) -> None:
+    source = tmp_path / "two.py"
+    source.write_text(SMACH_SOURCE + """
+    other = smach.StateMachine(outcomes=['end'])
+    with other:
+        smach.StateMachine.add('SOLO', Foo(), {'outcome1': 'end', 'outcome2': 'end'})
+""", encoding="utf-8")
+    first = cli("translate", str(source), "--to", "json")
+    assert first.returncode == 0 and "not read: 'other'" in first.stderr
+    assert list(loads(first.stdout, "json").states) == ["FOO", "BAR", "outcome4"]
+    chosen = cli("translate", str(source), "--to", "json", "-O", "machine=other", "--json")
+    assert chosen.returncode == 0, chosen.stderr
+    summary = json.loads(chosen.stdout)
+    assert summary["verified_equivalent"] is True and summary["from"] == "smach"
+    assert list(loads(summary["model"], "json").states) == ["SOLO", "end"]
+    assert cli("translate", str(source), "--to", "json", "-O", "machine").returncode == 2
+
+
+def test_stdout_needs_a_target_format(tmp_path: Path) -> None:
+    source = tmp_path / "machine.py"
+    source.write_text(SMACH_SOURCE, encoding="utf-8")
+    assert cli("translate", str(source)).returncode == 2
+    done = cli("translate", str(source), "--to", "json")
+    assert done.returncode == 0 and loads(done.stdout, "json") == read_model(source)
+
+
+def test_a_loss_that_changes_behaviour_is_refused(monkeypatch: pytest.MonkeyPatch) -> None:
+    def drop_last_transition(model: FSM) -> str:  # a target that silently loses an edge
+        assert isinstance(model, FSM)
+        cut = FSM(name=model.name, states=dict(model.states), transitions=model.transitions[:-1],
+                  initial=model.initial, start_name=model.start_name,
+                  initial_event=model.initial_event)
+        return write_json(cut)
+
+    from fsmbt.formats import registry
+
+    registry.formats()  # the built-in formats first, then the test's (removed afterwards)
+    monkeypatch.setitem(registry._FORMATS, "lossy-for-test", Format(
+        "lossy-for-test", (".lossy",), frozenset({"fsm"}), "test only",
+        lambda text, ctx: loads(text, "json"), drop_last_transition))
+    model = read_model(EXAMPLES / "paper_fsm.xml")
+    with pytest.raises(UnsupportedError, match="changes the model's behaviour"):
+        translate(model, "lossy-for-test", check=verify)
+    unchecked = translate(model, "lossy-for-test")  # no checker: structure only, named
+    assert not unchecked.verified
+    assert any("transitions" in loss and "is lost" in loss for loss in unchecked.losses)
+
+
+@needs_corpus
+def test_labels_that_are_not_scxml_ids_are_renamed_and_named(tmp_path: Path) -> None:
+    source = CORPUS / "fsm" / "flexbe_turtlesim_demo" / "flexbe_turtlesim_demo_sm.py"
+    out = tmp_path / "demo.scxml"
+    done = cli("translate", str(source), "-o", str(out))
+    assert done.returncode == 0, done.stderr
+    assert "'Finished Eight-pattern' -> 'Finished_Eight-pattern'" in done.stderr
+    text = out.read_text(encoding="utf-8")
+    assert 'id="Finished Eight-pattern"' not in text and 'id="Finished_Eight-pattern"' in text
+    assert verify(read_model(source), read_model(out)).equivalent
