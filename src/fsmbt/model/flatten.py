@@ -29,7 +29,7 @@ from collections import deque
 from dataclasses import dataclass
 
 from fsmbt.model.errors import InputError
-from fsmbt.model.fsm import FSM, State
+from fsmbt.model.fsm import FSM, State, Transition
 
 #: Separator between a composite state's name and its active sub-state in flat names.
 PATH_SEPARATOR = "/"
@@ -55,13 +55,13 @@ class _Flattener:
     def __init__(self, fsm: FSM, max_configurations: int) -> None:
         self.fsm = fsm
         self.max_configurations = max_configurations
-        self._tables: dict[int, dict[str, dict[str | None, list]]] = {}
+        self._tables: dict[int, dict[str, dict[str | None, list[Transition]]]] = {}
 
     # -- structure helpers --------------------------------------------------------------------
-    def table(self, machine: FSM) -> dict[str, dict[str | None, list]]:
+    def table(self, machine: FSM) -> dict[str, dict[str | None, list[Transition]]]:
         key = id(machine)
         if key not in self._tables:
-            table: dict[str, dict[str | None, list]] = {}
+            table: dict[str, dict[str | None, list[Transition]]] = {}
             for t in machine.transitions:
                 table.setdefault(t.source, {}).setdefault(t.event, []).append(t)
             self._tables[key] = table
@@ -119,7 +119,7 @@ class _Flattener:
         inner = tuple(self.enter(region, region.initial or "") for region in state.regions)
         return _Config(name, inner)
 
-    def completion(self, machine: FSM, config: _Config):
+    def completion(self, machine: FSM, config: _Config) -> Transition | None:
         state = self.state(machine, config.state)
         candidates = self.table(machine).get(config.state, {}).get(None, [])
         if not candidates:

@@ -220,7 +220,8 @@ def _expect(ok: bool, where: str, message: str) -> None:
 
 
 def _as_list(value: Any, where: str) -> list[Any]:
-    _expect(isinstance(value, list), where, "expected a list")
+    if not isinstance(value, list):
+        raise InputError("expected a list", element=where)
     return value
 
 

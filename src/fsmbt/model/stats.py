@@ -223,7 +223,7 @@ def expanded_depth(doc: BTDocument) -> int | None:
         return None
     import networkx as nx  # imported here: it costs ~0.4 s at CLI start-up
 
-    graph = nx.DiGraph()
+    graph: nx.DiGraph[str] = nx.DiGraph()
     graph.add_nodes_from(doc.trees)
     for tree_id, node in doc.nodes():
         ref = node.subtree_id

@@ -63,7 +63,8 @@ def _nusmv(source: FSM | BTDocument, result: FSM | BTDocument, loop: bool) -> Re
         raise InputError("the NuSMV engine is not available (fsmbt.verify.nusmv has no check); "
                          "use --engine native")
     try:
-        return checker(source, result, loop=loop)
+        report: Report = checker(source, result, loop=loop)
+        return report
     except FileNotFoundError as exc:
         raise InputError(f"the NuSMV binary is not installed ({exc}); run scripts/setup.sh or "
                          "use --engine native") from None

@@ -39,6 +39,7 @@ import gc
 import time
 from collections.abc import Hashable, Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 from fsmbt.model.errors import InputError
 from fsmbt.semantics.machine import RUNNING, Machine
@@ -67,7 +68,7 @@ class _Explored:
     offered inputs that are not explored are silent self-loops (see ``active_inputs``).
     """
 
-    def __init__(self, machine: Machine, outputs: _Interner, max_states: int, role: str) -> None:
+    def __init__(self, machine: Machine[Any], outputs: _Interner, max_states: int, role: str) -> None:
         self.machine = machine
         self.role = role
         self.outputs = outputs
@@ -247,7 +248,7 @@ class Replay:
         return bool(self.differences)
 
 
-def replay(source: Machine, result: Machine, inputs: Sequence[str]) -> Replay:
+def replay(source: Machine[Any], result: Machine[Any], inputs: Sequence[str]) -> Replay:
     """Run ``inputs`` on both machines from their start and record what each did.
 
     A step differs when the outputs or the statuses differ, or one side refuses the input (it is
@@ -447,7 +448,7 @@ def _show(outputs: tuple[str, ...]) -> str:
 
 
 # -- the checker ----------------------------------------------------------------------------------
-def check(source: Machine, result: Machine, *, max_states: int = DEFAULT_MAX_STATES,
+def check(source: Machine[Any], result: Machine[Any], *, max_states: int = DEFAULT_MAX_STATES,
           mode: str = "lockstep") -> Report:
     """Compare two deterministic machines; the five properties, each with a shortest
     counterexample when it fails (see the module docstring and docs/verification.md)."""
@@ -460,7 +461,7 @@ def check(source: Machine, result: Machine, *, max_states: int = DEFAULT_MAX_STA
             gc.enable()
 
 
-def _check(source: Machine, result: Machine, max_states: int, mode: str) -> Report:
+def _check(source: Machine[Any], result: Machine[Any], max_states: int, mode: str) -> Report:
     started = time.perf_counter()
     outputs = _Interner()
     src = _Explored(source, outputs, max_states, "source")

@@ -11,6 +11,7 @@
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import Any
 
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import InputError
@@ -90,7 +91,7 @@ class LEBTWithActiveInputs:
     (a broken tree) every event is. Cost per state: O(|relevant(x)| + running leaves).
     """
 
-    def __init__(self, machine: Machine) -> None:
+    def __init__(self, machine: Machine[Any]) -> None:
         from fsmbt.semantics.bt_interpreter import RUNNING as NODE_RUNNING
 
         self.machine = machine
@@ -153,7 +154,7 @@ def lebt_guard_events(doc: BTDocument) -> list[str]:
 
 
 def machines_for(source: FSM | BTDocument, result: FSM | BTDocument, *,
-                 loop: bool = False) -> tuple[Machine, Machine, str]:
+                 loop: bool = False) -> tuple[Machine[Any], Machine[Any], str]:
     """The (source machine, result machine, mode) for a pair of models."""
     if isinstance(source, FSM) and isinstance(result, FSM):
         alphabet = _union(source.events(), result.events(), *_flat_events(source, result))
@@ -162,7 +163,8 @@ def machines_for(source: FSM | BTDocument, result: FSM | BTDocument, *,
     if isinstance(source, FSM) and isinstance(result, BTDocument):
         from fsmbt.semantics.lebt_runtime import LEBTMachine
         from fsmbt.semantics.state_variable_runtime import (
-            is_state_variable_bt, machines_for_state_variable,
+            is_state_variable_bt,
+            machines_for_state_variable,
         )
 
         if is_state_variable_bt(result):  # the baselines' state-variable leaves (BSD, CHDS)
@@ -185,7 +187,7 @@ def machines_for(source: FSM | BTDocument, result: FSM | BTDocument, *,
 
 def _flat_events(*fsms: FSM) -> list[list[str]]:
     """Events of nested sub-machines too (a hierarchical FSM's top level does not list them)."""
-    out = []
+    out: list[list[str]] = []
     for fsm in fsms:
         for _path, _machine, state in fsm.walk():
             out.extend(region.events() for region in state.regions)  # each sub-machine once

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.bt_nodes import NodeKind
@@ -32,7 +33,10 @@ from fsmbt.model.errors import UnsupportedError
 from fsmbt.semantics.bt_interpreter import CompiledNode, CompiledTree
 from fsmbt.verify.nusmv.smv import Symbols, any_of, case
 
-SEQ_LIKE = {  # type: (is_fallback, emits wake-up after a fresh child succeeds/fails)
+if TYPE_CHECKING:
+    from fsmbt.verify.nusmv.encode_fsm import Encoding
+
+SEQ_LIKE = {  # kind: (is_fallback, emits wake-up after a fresh child succeeds/fails)
     "Sequence": (False, False), "AsyncSequence": (False, True),
     "SequenceWithMemory": (False, True),
     "Fallback": (True, False), "AsyncFallback": (True, True),
@@ -335,7 +339,7 @@ class LeafBTEncoder:
 
         return ["cur"] if is_plain_tree(self.core.tree) else self.core.identity_vars()
 
-    def encode(self):
+    def encode(self) -> Encoding:
         from fsmbt.verify.nusmv.encode_fsm import NONE_OUT, Encoding
 
         core = self.core
