@@ -92,7 +92,8 @@ def _classify(fsm: FSM, flat: FSM) -> tuple[dict[str, _Cluster], dict[str, str |
                 break  # an atomic state at this level (or a name flatten made up: keep it here)
             path = prefix + head
             if path not in clusters:
-                parent_cluster = clusters.get(parent) if parent is not None else None
+                parent_cluster: _Cluster | None = (
+                    clusters.get(parent) if parent is not None else None)
                 clusters[path] = _Cluster(path, parent, state.is_parallel,
                                           depth=0 if parent_cluster is None
                                           else parent_cluster.depth + 1)

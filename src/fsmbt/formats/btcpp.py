@@ -18,6 +18,7 @@ Complexity: O(n) in the number of elements.
 from __future__ import annotations
 
 import re
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -73,7 +74,7 @@ class _Loader:
         name = str(path) if path is not None else self.ctx.display_name
         root = parse_xml(text, name)
         if root.tag != "root":
-            raise InputError(f"not a BehaviorTree.CPP file: root element is <{root.tag}>, "
+            raise InputError(f"not a BehaviorTree.CPP file: root element is <{str(root.tag)}>, "
                              "expected <root>", location=SourceLocation(name, root.sourceline))
         version = root.get("BTCPP_format", "3")
         if version not in ("3", "4"):
@@ -116,12 +117,16 @@ class _Loader:
         self.load(decode(text, str(resolved)), resolved, (*chain, resolved))
 
     def load_external_models(self) -> None:
-        paths = self.ctx.options.get("node_models") or []
-        if isinstance(paths, (str, Path)):
-            paths = [paths]
+        option = self.ctx.options.get("node_models") or []
+        if isinstance(option, (str, Path)):
+            paths: list[object] = [option]
+        elif isinstance(option, Iterable):
+            paths = list(option)
+        else:
+            raise InputError("the node_models option must be a path or a list of paths")
         from fsmbt.formats.registry import decode
 
-        for item in paths:  # type: ignore[union-attr]
+        for item in paths:
             model_path = Path(str(item))
             try:
                 data = model_path.read_bytes()
@@ -147,7 +152,7 @@ class _Loader:
                         if model.attrs.get(ASSUMED_MARK) != "true":
                             self.declared.setdefault(model.type, model)
                 elif child.tag not in ("BehaviorTree", "include"):
-                    raise UnsupportedError(f"unknown element <{child.tag}> under <root>",
+                    raise UnsupportedError(f"unknown element <{str(child.tag)}> under <root>",
                                            location=SourceLocation(f.path, child.sourceline),
                                            element=str(child.tag))
         doc.node_models = dict(self.declared)
@@ -248,6 +253,7 @@ class _Loader:
         for key in attrs:
             seen.setdefault(key, None)
         model = self.declared.get(type_name) or self.external.get(type_name)
+        kind: NodeKind
         if model is not None and model.kind is not NodeKind.SUBTREE:
             kind = model.kind
         elif explicit is not None:
@@ -270,13 +276,13 @@ def _read_models(element: etree._Element, source: str) -> list[NodeModel]:
         where = SourceLocation(source, entry.sourceline)
         kind = EXPLICIT_TAGS.get(str(entry.tag))
         if kind is None:
-            raise InputError(f"unknown <TreeNodesModel> entry <{entry.tag}> (expected Action, "
+            raise InputError(f"unknown <TreeNodesModel> entry <{str(entry.tag)}> (expected Action, "
                              "Condition, Control, Decorator or SubTree)", location=where,
                              element=str(entry.tag))
         attrs = dict(entry.attrib)
         type_id = attrs.pop("ID", None)
         if not type_id:
-            raise InputError(f"<{entry.tag}> in <TreeNodesModel> without ID", location=where,
+            raise InputError(f"<{str(entry.tag)}> in <TreeNodesModel> without ID", location=where,
                              element=str(entry.tag))
         ports: list[PortModel] = []
         extra: list[str] = []
@@ -287,7 +293,7 @@ def _read_models(element: etree._Element, source: str) -> list[NodeModel]:
                 continue
             port_name = child.get("name")
             if not port_name:
-                raise InputError(f"<{child.tag}> without name", element=str(child.tag),
+                raise InputError(f"<{str(child.tag)}> without name", element=str(child.tag),
                                  location=SourceLocation(source, child.sourceline))
             text = (child.text or "").strip() or child.get("description")
             ports.append(PortModel(port_name, direction, child.get("default"), text,

@@ -323,18 +323,18 @@ def write_fsm_dot(fsm: FSM) -> str:
             body.append(f"{pad}{quote(node_id)} [{', '.join(attrs)}];")
         for t in machine.transitions:
             source, target = anchor.get(t.source, prefix + t.source), anchor.get(t.target, prefix + t.target)
-            extra = []
+            edge_attrs: list[str] = []
             if t.source in cluster:
                 inner = machine.states[t.source].regions[0]
                 source = f"{prefix}{t.source}/{inner.start_name or START_NODE}"
-                extra.append(f"ltail={quote(cluster[t.source])}")
+                edge_attrs.append(f"ltail={quote(cluster[t.source])}")
             if t.target in cluster:
                 inner = machine.states[t.target].regions[0]
                 target = f"{prefix}{t.target}/{inner.start_name or START_NODE}"
-                extra.append(f"lhead={quote(cluster[t.target])}")
+                edge_attrs.append(f"lhead={quote(cluster[t.target])}")
             if t.event is not None:
-                extra.insert(0, f"label={_label(t.event)}")
-            suffix = f" [{', '.join(extra)}]" if extra else ""
+                edge_attrs.insert(0, f"label={_label(t.event)}")
+            suffix = f" [{', '.join(edge_attrs)}]" if edge_attrs else ""
             edges.append(f"    {quote(source)} -> {quote(target)}{suffix}")
         for state in reversed([s for s in machine.states.values() if s.regions]):
             inner_prefix = f"{prefix}{state.name}/"

@@ -317,8 +317,8 @@ def write_mermaid(model: Model) -> str:
         if item == "line":
             body.append(f"{pad}{payload}")
             continue
+        assert isinstance(payload, FSM)
         machine = payload
-        assert isinstance(machine, FSM)
         head: list[str] = []
         tail: list[str] = []
         for state in machine.states.values():

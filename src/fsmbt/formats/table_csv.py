@@ -163,7 +163,7 @@ def rows_from_fsm(model: Model, table: str) -> tuple[list[str], list[list[str]]]
     for t in ordered:
         row = [t.source, t.event or "", t.target]
         if with_action:
-            target_action = fsm.states[t.target].action
+            target_action = fsm.states[t.target].action or ""  # never None: checked above
             row.append(target_action if target_action != t.target else "")
         rows.append(row)
     return header, rows
