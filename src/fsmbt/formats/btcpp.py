@@ -1,6 +1,6 @@
 """BehaviorTree.CPP XML: read v4 and v3 files, write v4 (docs/formats/btcpp.md).
 
-Reading maps everything to BehaviorTree.CPP v4 meaning (DESIGN §1): v3 names through
+Reading maps everything to BehaviorTree.CPP v4 meaning (docs/semantics.md, 'Names'): v3 names through
 ``V3_ALIASES``, both the compact style (``<Sequence>``, ``<MyAction/>``) and Groot's explicit style
 (``<Action ID="MyAction"/>``). ``<include path=...>`` files are merged into one document; the
 writer writes that document inline, so a written file is self-contained and never includes.

@@ -6,7 +6,7 @@
       <Transitions><Transition from="Start" to="A" event="eventSA"/> ... </Transitions>
     </FSM>
 
-Mapping rules (DESIGN §1):
+Mapping rules (docs/semantics.md, 'Models'; docs/formats/paper-xml.md):
 - ``InitialState`` (a ``name`` attribute or its text) naming a start pseudo-state - a name not
   listed in ``<States>`` (or listed with ``type="start"``/``"initial"``) with exactly one outgoing
   transition - gives ``start_name`` = that name, ``initial`` = the transition's target and

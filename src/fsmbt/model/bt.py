@@ -1,4 +1,4 @@
-"""The behavior tree model (DESIGN §1), kept close to BehaviorTree.CPP v4's XML.
+"""The behavior tree model (docs/semantics.md, 'Models'), kept close to BehaviorTree.CPP v4's XML.
 
 A ``BTDocument`` is what one file (plus its includes) holds: several ``BehaviorTree`` s, the one to
 execute, and the ``TreeNodesModel`` declarations. Attributes and ports stay on the nodes in order,

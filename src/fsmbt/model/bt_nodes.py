@@ -1,6 +1,6 @@
 """The node types of BehaviorTree.CPP v4 that fsmbt knows, and the names older inputs use.
 
-Everything is mapped to BehaviorTree.CPP v4 meaning (DESIGN §1, trap (a)): the reactive
+Everything is mapped to BehaviorTree.CPP v4 meaning (docs/semantics.md, 'Names'): the reactive
 "Sequence" of Colledanchise & Ögren is ``ReactiveSequence`` here, their "Sequence*" is the plain
 ``Sequence``; BehaviorTree.CPP v3's ``SequenceStar`` is v4's ``SequenceWithMemory``.
 """

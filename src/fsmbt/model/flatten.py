@@ -1,4 +1,4 @@
-"""Flattening a hierarchical FSM into the plain FSM every check works on (DESIGN §1).
+"""Flattening a hierarchical FSM into the plain FSM every check works on (docs/semantics.md, 'Models').
 
 Rules (also in docs/semantics.md):
 - A configuration is the active atomic state at each level: ``C/x`` for state ``x`` inside

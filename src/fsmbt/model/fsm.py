@@ -1,4 +1,4 @@
-"""The finite state machine model, flat or hierarchical (DESIGN §1).
+"""The finite state machine model, flat or hierarchical (docs/semantics.md, 'Models').
 
 Semantics in one paragraph: the machine starts in ``initial`` (or, when ``initial_event`` is set,
 in the start pseudo-state ``start_name`` and moves to ``initial`` on that event). Entering a state

@@ -1,6 +1,6 @@
 """Structural statistics of a model: what ``fsmbt info`` shows and the size metrics build on.
 
-FSM (DESIGN §3): the *entry state* is the target of the initial transition (``fsm.initial``);
+FSM (docs/conversion.md, 'FSM -> BT: the loop-execution BT'): the *entry state* is the target of the initial transition (``fsm.initial``);
 a *loop state* has in-degree >= 2, where in-degree counts distinct predecessor states and the
 start pseudo-state's edge into the entry state (an FSM without a named start pseudo-state still
 has that edge: it is how the machine gets into its initial state). These are computed on the
@@ -58,7 +58,7 @@ def in_degrees(fsm: FSM) -> dict[str, int]:
     """Distinct predecessors of each top-level state, plus the start edge of the initial state.
 
     Two transitions from the same source into the same target (different events) count once:
-    the LEBT merges them into one guard either way (DESIGN §3).
+    the LEBT merges them into one guard either way (docs/conversion.md, 'FSM -> BT').
     """
     preds: dict[str, set[str]] = {name: set() for name in fsm.states}
     for t in fsm.transitions:

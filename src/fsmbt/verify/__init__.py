@@ -1,4 +1,4 @@
-"""Equivalence checking of a source model and its conversion (DESIGN §4, docs/verification.md).
+"""Equivalence checking of a source model and its conversion (docs/verification.md).
 
 ``verify(source, result)`` gives a ``Report``: the verdict and the five properties, each with a
 shortest counterexample when it fails. Two engines: ``native`` (explicit-state product, the

@@ -3,8 +3,8 @@
 Both machines (``fsmbt.semantics.machine.Machine``) are fed the same inputs from their start. The
 product ``P`` holds every pair ``(s, r)`` reachable that way, whether or not the two agreed on the
 way (so every property is a plain invariant of ``P``, independent of the others and of search
-order, and the NuSMV engine can state it the same way). The five properties of DESIGN §4, defined
-exactly in docs/verification.md:
+order, and the NuSMV engine can state it the same way). The five properties, defined exactly in
+docs/verification.md, 'The product and the five properties':
 
 - completeness: on every product edge the source's outputs are a subsequence of the result's,
   and every input the source offers, the result accepts;

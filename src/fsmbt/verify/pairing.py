@@ -1,7 +1,7 @@
 """Which two machines represent a (source, result) pair of models (docs/verification.md).
 
 - FSM source, BT result (macro steps): the FSM's macro-step machine against the LEBT run under
-  the DESIGN §3 protocol; inputs are events (the FSM's, then any the LEBT's guards name).
+  the LEBT protocol (docs/semantics.md); inputs are events (the FSM's, then any the LEBT's guards name).
 - BT source, FSM result (leaf execution): the BT's leaf-execution machine against the FSM read as
   one (``FSMLeafMachine``): a state is the leaf about to be ticked, inputs are leaf outcomes.
 - FSM vs FSM: both macro-step machines over the union of their events.
@@ -25,7 +25,8 @@ LEAF_OUTCOMES = ("success", "failure", "running")
 
 
 class FSMLeafMachine:
-    """An FSM (flattened if hierarchical) read as a BT's leaf-execution machine (DESIGN §2).
+    """An FSM (flattened if hierarchical) read as a BT's leaf-execution machine (docs/semantics.md,
+    'The leaf-execution machine').
 
     A state is the leaf about to be ticked: entering it outputs its action (the leaf's label).
     An outcome with no transition leaves the FSM where it is, so the same leaf is ticked again
@@ -80,7 +81,7 @@ class FSMLeafMachine:
 class LEBTWithActiveInputs:
     """``LEBTMachine`` plus a sound ``active_inputs``, so ignored events are not stepped.
 
-    Why it is sound: under the DESIGN §3 protocol an event's identity is read only by two tests,
+    Why it is sound: under the LEBT protocol (docs/semantics.md) an event's identity is read only by two tests,
     made while it is pending: a guard's ``(state, event) in pairs`` and a running state leaf's
     ``event in exits``. ``state`` cannot change while an event is pending (the only writer, a
     state leaf's start, clears the event), and a leaf tested with ``event in exits`` was running

@@ -1,5 +1,6 @@
 """The verdict both engines (native, NuSMV) give: five named properties, each with a shortest
-counterexample when it fails (DESIGN §4, the paper's tables III and VIII)."""
+counterexample when it fails (docs/verification.md, 'The product and the five properties';
+the paper's tables III and VIII)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""NuSMV as the second, independent verification engine (DESIGN §4, docs/nusmv.md).
+"""NuSMV as the second, independent verification engine (docs/verification.md, docs/nusmv.md).
 
 ``check(source, result, loop=False)`` encodes both models as SMV modules from their structure
 (the BT's tick rules as transition relations, never the native interpreter's explored graph),

@@ -1,4 +1,4 @@
-"""A behavior tree as an SMV module, written from the tree's structure (DESIGN §2, §4).
+"""A behavior tree as an SMV module, written from the tree's structure (docs/semantics.md, 'The leaf-execution machine'; docs/nusmv.md).
 
 The tick rules of BehaviorTree.CPP v4 are transition relations over per-node variables, one
 *micro-step* per node visit, exactly as the interpreter walks the tree (docs/nusmv.md):

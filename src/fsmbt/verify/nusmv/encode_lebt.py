@@ -1,4 +1,4 @@
-"""A loop-execution BT (DESIGN §3) as an SMV module: the tree's tick rules (``BTCore``) with the
+"""A loop-execution BT (docs/semantics.md, 'The LEBT protocol') as an SMV module: the tree's tick rules (``BTCore``) with the
 LEBT leaves answered from a blackboard held in SMV variables, and the macro-step protocol of
 ``fsmbt.semantics.lebt_runtime`` as transitions:
 
