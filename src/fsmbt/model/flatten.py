@@ -229,11 +229,33 @@ def _all_events(fsm: FSM) -> list[str]:
 
 
 def needs_flattening(fsm: FSM) -> bool:
+    """Whether ``fsm`` differs from its flattening.
+
+    Args:
+        fsm: A machine.
+
+    Returns:
+        True when it has a composite or parallel state, or a completion transition.
+    """
     return fsm.is_hierarchical or any(t.event is None for t in fsm.transitions)
 
 
 def flatten(fsm: FSM, *, max_configurations: int = 1_000_000) -> FSM:
-    """The plain FSM with the same macro-step behaviour as ``fsm`` (see module docstring)."""
+    """The plain FSM with the same macro-step behaviour as ``fsm`` (see module docstring).
+
+    Args:
+        fsm: A flat or hierarchical machine; it is not modified.
+        max_configurations: Bound on the reachable configurations kept.
+
+    Returns:
+        A new flat FSM whose states are the reachable configurations (a copy of ``fsm`` when
+        it needs no flattening).
+
+    Raises:
+        InputError: A transition to an unknown state, a composite state without initial
+            state, a cycle of completion transitions, no initial state, or more than
+            ``max_configurations`` configurations.
+    """
     if not needs_flattening(fsm):
         return copy.deepcopy(fsm)
     return _Flattener(fsm, max_configurations).run()
