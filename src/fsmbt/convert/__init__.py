@@ -8,7 +8,12 @@ LLM path register (``bsd``, ``chds``, ``llm`` ...).
 from __future__ import annotations
 
 from fsmbt.convert.engines import (
-    ConversionResult, Engine, converter_for, engines, get_engine, register_engine,
+    ConversionResult,
+    Engine,
+    converter_for,
+    engines,
+    get_engine,
+    register_engine,
 )
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.fsm import FSM

@@ -338,7 +338,7 @@ class _Reader:
         """The model transition for ``node --event--> target``, leaving parents if needed."""
         ancestors = self.machine_chain(node.machine)
         entered = None
-        for index, machine in enumerate(ancestors):
+        for index, machine in enumerate(ancestors):  # noqa: B007 - index is read after the loop
             entered = self.entry_or_none(target, machine)
             if entered is not None:
                 break

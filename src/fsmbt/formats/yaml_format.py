@@ -18,7 +18,11 @@ from typing import Any
 
 import yaml
 from yaml.events import (
-    AliasEvent, MappingEndEvent, MappingStartEvent, ScalarEvent, SequenceEndEvent,
+    AliasEvent,
+    MappingEndEvent,
+    MappingStartEvent,
+    ScalarEvent,
+    SequenceEndEvent,
     SequenceStartEvent,
 )
 from yaml.nodes import MappingNode, Node, ScalarNode, SequenceNode
@@ -27,7 +31,6 @@ from fsmbt.formats.registry import Format, ReadContext, register
 from fsmbt.model import Model
 from fsmbt.model.errors import InputError
 from fsmbt.model.serialize import model_from_dict, model_to_dict
-
 
 #: Deepest nesting accepted (YAML levels; a BT level is two: node mapping + children list).
 #: libyaml's scanner is quadratic in flow nesting depth (4 000 levels take ~0.3 s), so the guard

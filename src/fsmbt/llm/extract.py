@@ -26,7 +26,14 @@ from fsmbt.formats.registry import (
 )
 from fsmbt.llm.client import LLMClient, Message
 from fsmbt.llm.config import LLMUnavailableError
-from fsmbt.llm.log import EXTRACTED, INVALID_ANSWER, UNAVAILABLE, ConversionRecord, RoundRecord, append_record
+from fsmbt.llm.log import (
+    EXTRACTED,
+    INVALID_ANSWER,
+    UNAVAILABLE,
+    ConversionRecord,
+    RoundRecord,
+    append_record,
+)
 from fsmbt.llm.parsing import AnswerError, extract_json
 from fsmbt.llm.prompts import DEFAULT_VERSION, extraction_messages, feedback_message
 from fsmbt.model.bt import BTDocument

@@ -21,7 +21,12 @@ from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.bt_nodes import NodeKind, canonical_type
 from fsmbt.model.errors import InputError
 from fsmbt.render.dot import (
-    DEFAULT_MAX_NODES, FONT, TooLargeError, attach_clusters, check_size, html_label,
+    DEFAULT_MAX_NODES,
+    FONT,
+    TooLargeError,
+    attach_clusters,
+    check_size,
+    html_label,
     label_text,
 )
 

@@ -28,7 +28,12 @@ import graphviz
 from fsmbt.model.fsm import FSM, State
 from fsmbt.model.stats import fsm_stats
 from fsmbt.render.dot import (
-    DEFAULT_MAX_NODES, FONT, TooLargeError, attach_clusters, check_size, label_text,
+    DEFAULT_MAX_NODES,
+    FONT,
+    TooLargeError,
+    attach_clusters,
+    check_size,
+    label_text,
 )
 
 #: Nested clusters beyond this depth make dot slow and the picture unreadable.
