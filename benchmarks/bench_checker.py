@@ -29,8 +29,8 @@ import time
 from collections.abc import Callable
 
 from fsmbt.model import FSM, BTDocument, BTNode, NodeKind, State
-from fsmbt.verify.native import check
 from fsmbt.semantics.lebt_runtime import LEBTMachine
+from fsmbt.verify.native import check
 from fsmbt.verify.pairing import LEBTWithActiveInputs, machines_for
 
 Pair = tuple[object, object]

@@ -53,7 +53,7 @@ def main() -> None:
     rows = []
     for n in sizes:
         fsm = random_fsm(n, n, "basic", extra_edges=n // 2)
-        seconds = best_of(lambda: fsm_to_lebt(fsm), 50 if n <= 1000 else 3 if n <= 10_000 else 2)
+        seconds = best_of(lambda fsm=fsm: fsm_to_lebt(fsm), 50 if n <= 1000 else 3 if n <= 10_000 else 2)
         rows.append(("FSM->BT random", f"{n} states", seconds))
     chain_n = 10_000 if quick else 100_000
     chain = random_fsm(1, chain_n, "basic", shape="chain", extra_edges=0)
@@ -62,7 +62,7 @@ def main() -> None:
     for n in ([100, 1_000, 10_000] if quick else [100, 1_000, 10_000, 100_000]):
         doc = random_bt(n, 40, 10, "basic", max_nodes=n)
         nodes = sum(1 for _ in doc.main.root.walk())
-        seconds = best_of(lambda: bt_to_hfsm(doc), 20 if n <= 1000 else 3 if n <= 10_000 else 2)
+        seconds = best_of(lambda doc=doc: bt_to_hfsm(doc), 20 if n <= 1000 else 3 if n <= 10_000 else 2)
         rows.append(("BT->HFSM random", f"{nodes} nodes", seconds))
     deep = deep_bt(chain_n // 2)
     nodes = sum(1 for _ in deep.main.root.walk())

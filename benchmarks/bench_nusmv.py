@@ -64,9 +64,9 @@ def measure(pairs, timeout: float) -> tuple[list[float], list[float], int, int, 
     and the reason when NuSMV's encoding rejects the pair."""
     native_t, smv_t, agree, timeouts = [], [], 0, 0
     for source, result in pairs:
-        t_native, native = timed(lambda: verify(source, result))
+        t_native, native = timed(lambda source=source, result=result: verify(source, result))
         try:
-            t_smv, smv = timed(lambda: check(source, result, timeout=timeout))
+            t_smv, smv = timed(lambda source=source, result=result: check(source, result, timeout=timeout))
         except UnsupportedError as exc:
             return native_t, smv_t, agree, timeouts, str(exc).split("unsupported: ")[-1][:60]
         except NuSMVError:

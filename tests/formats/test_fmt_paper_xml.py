@@ -53,7 +53,7 @@ def test_initial_state_naming_a_real_state_and_text_form() -> None:
                 "</States><Transitions><Transition from='B' to='A' event='e'/></Transitions></FSM>",
                 "paper-xml")
     assert (fsm.initial, fsm.start_name, fsm.initial_event) == ("B", None, None)
-    # no state is marked final: a state with no way out is final (DESIGN §1)
+    # no state is marked final: a state with no way out is final (docs/semantics.md, 'Models')
     assert fsm.states["A"].final and not fsm.states["B"].final
     assert loads(dumps(fsm, "paper-xml"), "paper-xml") == fsm
 

@@ -4,13 +4,14 @@ content sniffing picks the right reader, and the documented rules hold."""
 from __future__ import annotations
 
 import random
-import subprocess
 import shutil
+import subprocess
+from pathlib import Path
 
 import pytest
 
 from fsmbt.formats import detect_format, dumps, loads
-from fsmbt.model import BTDocument, BTNode, FSM, InputError, NodeKind, State, UnsupportedError
+from fsmbt.model import FSM, BTDocument, BTNode, InputError, NodeKind, State, UnsupportedError
 from fsmbt.model.serialize import model_to_dict
 
 TABLE = "source,event,target,action\nA,go,B,doB\nB,back,A,\nB,stop,C,\n"

@@ -50,7 +50,7 @@ def test_paper_fsm_figures(name: str, capsys: pytest.CaptureFixture) -> None:
     assert set(data["events"]) == {event for _s, event, _t in facts["edges"]}
     assert data["start"] == facts["start"] and data["initial_event"] == "eventSA"
     assert data["entry_state"] == facts["entry"] == "A"
-    assert data["loop_states"] == facts["loops"] == ["C", "D"]  # DESIGN §3 on the paper's FSM
+    assert data["loop_states"] == facts["loops"] == ["C", "D"]  # docs/conversion.md, 'FSM -> BT', on the paper's FSM
     assert data["finals"] == facts["finals"] == ["H", "J"]
     assert data["unreachable"] == []
     assert data["in_degree"]["C"] == 3 and data["in_degree"]["D"] == 4  # C: A,B,E; D: A,B,C,E

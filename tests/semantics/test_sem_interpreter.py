@@ -52,7 +52,7 @@ def both(root: BTNode, ticks: int, exactly_once: bool = False, **plans: str):
 
 
 def test_sem_tick_once_reticks_on_wake_up_but_exactly_once_does_not() -> None:
-    """DESIGN §1 trap (b): SequenceWithMemory emits a wake-up after a synchronous success."""
+    """docs/semantics.md, 'Tick granularity': SequenceWithMemory emits a wake-up after a synchronous success."""
     tree = ctl("ReactiveSequence", cond("c"), ctl("SequenceWithMemory", act("a"), act("b")))
     plans = {"c": "success " * 6, "a": "success", "b": "running success"}
     assert both(tree, 2, **plans) == [(["c", "a", "c", "b"], "RUNNING"), (["c", "b"], "SUCCESS")]

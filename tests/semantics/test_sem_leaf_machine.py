@@ -1,4 +1,4 @@
-"""The leaf-execution machine (DESIGN §2): exploration, loop mode, and agreement with the
+"""The leaf-execution machine (docs/semantics.md, 'The leaf-execution machine'): exploration, loop mode, and agreement with the
 real engine: random walks through the machine replayed in BehaviorTree.CPP."""
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""The LEBT protocol (DESIGN §3) in four runtimes against the FSM, on hand-built LEBTs.
+"""The LEBT protocol (docs/semantics.md, 'The LEBT protocol') in four runtimes against the FSM, on hand-built LEBTs.
 
 For each FSM (the paper's A–J example among them) the LEBT is built by hand from a nesting of
 selector subtrees; random event sequences are fed to the FSM's macro-step machine, our

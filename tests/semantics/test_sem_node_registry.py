@@ -196,6 +196,8 @@ def test_sem_no_module_restates_a_node_set() -> None:
         rel = path.relative_to(src).as_posix()
         if rel.startswith("model/nodes/") or rel.startswith("semantics/engines/"):
             continue  # the registry itself; engine adapters map kinds to another library's
+        if rel.startswith("formats/_pysm_"):
+            continue  # SMACH's own container classes (its Sequence is not a BT node kind)
         for number, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1):
             if _SET_LITERAL.search(line):
                 offenders.append(f"{rel}:{number}: {line.strip()}")

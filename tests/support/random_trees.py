@@ -5,7 +5,7 @@
 - ``bt_documents(...)``: the same as a hypothesis strategy (draws a seed).
 - ``OutcomeScript``: a deterministic environment: per leaf path, a cycle of outcomes.
 - ``lebt_from_structure(fsm, structure)``: an LEBT built from a hand-written nesting of states
-  (DESIGN §3); guard pairs and state leaves are filled in from the FSM, the shape is the
+  (docs/conversion.md, 'FSM -> BT'); guard pairs and state leaves are filled in from the FSM, the shape is the
   caller's. Used to test the runtime independently of the real converter.
 """
 
@@ -164,7 +164,7 @@ Structure = tuple[str, list["Structure"]]
 
 def lebt_from_structure(fsm: FSM, structure: Sequence[Structure]) -> BTDocument:
     """Root ``Sequence`` of ``Fallback(guard, body)`` per top-level entry; body = the state
-    leaf alone, or ``Sequence(state leaf, selector subtrees...)`` (DESIGN §3).
+    leaf alone, or ``Sequence(state leaf, selector subtrees...)`` (docs/conversion.md, 'FSM -> BT').
 
     Guard pairs are every transition into the state, plus the start pair for the initial state
     (``(start, initial_event)``, or ``(start, "")`` without an initial event).

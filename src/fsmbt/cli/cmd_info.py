@@ -31,7 +31,7 @@ def register(app: typer.Typer) -> None:
         """Structure at a glance: states, events, entry/loop states; BT nodes, depth, breadth.
 
         FSM: states, transitions, events, initial and final states, the entry state and the
-        loop states of DESIGN §3, hierarchy. BT: nodes by kind and type, depth, breadth,
+        loop states of the LEBT structure (docs/conversion.md), hierarchy. BT: nodes by kind and type, depth, breadth,
         leaves, trees and SubTree references.
         """
         stats = model_stats(api.load(model, from_format, options=reader_options(node_models)).model)

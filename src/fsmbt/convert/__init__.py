@@ -8,7 +8,12 @@ LLM path register (``bsd``, ``chds``, ``llm`` ...).
 from __future__ import annotations
 
 from fsmbt.convert.engines import (
-    ConversionResult, Engine, converter_for, engines, get_engine, register_engine,
+    ConversionResult,
+    Engine,
+    converter_for,
+    engines,
+    get_engine,
+    register_engine,
 )
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.fsm import FSM
@@ -18,7 +23,19 @@ def convert(model: FSM | BTDocument, *, engine: str = "rules", style: str = "pap
             **options: object) -> ConversionResult:
     """Convert an FSM into a BT or a BT into a (hierarchical) FSM with ``engine``.
 
-    ``style`` and further ``options`` (e.g. ``loop=True`` for BT -> FSM) go to the engine.
+    Args:
+        model: The source model; its kind picks the direction.
+        engine: A registered engine name (``rules``, ``bsd``, ``chds``, ``llm``, ...).
+        style: The engine's output style (``paper`` for the rules engine).
+        **options: Passed to the engine (e.g. ``loop=True`` for BT -> FSM,
+            ``hierarchy="flatten"`` for FSM -> BT).
+
+    Returns:
+        The converted model with the engine's name, the direction, figures and warnings.
+
+    Raises:
+        InputError: Unknown engine, or one that does not convert this kind of model.
+        UnsupportedError: The model uses something the engine cannot convert (located).
     """
     return converter_for(engine, model)(model, style=style, **options)
 

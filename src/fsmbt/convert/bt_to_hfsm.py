@@ -1,4 +1,4 @@
-"""BT -> hierarchical FSM, the paper's way (DESIGN §2), done exactly.
+"""BT -> hierarchical FSM, the paper's way (docs/conversion.md, 'BT -> FSM: depth compression and conversion units'), done exactly.
 
 Steps:
 1. inline ``SubTree`` references and compress depth (``compress``): same-type Sequence/Fallback

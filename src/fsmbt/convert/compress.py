@@ -1,4 +1,4 @@
-"""Preparing a BT for BT -> HFSM: SubTree inlining and depth compression (docs/conversion.md, step 1).
+"""Preparing a BT for BT -> HFSM: SubTree inlining and depth compression (docs/conversion.md, 'BT -> FSM: depth compression and conversion units', steps 1-2).
 
 Depth compression merges a child control node into its parent when both have the same type
 and the node registry marks that type ``mergeable`` (``MERGEABLE_CONTROLS``):

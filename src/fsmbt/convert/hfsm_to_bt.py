@@ -1,8 +1,8 @@
 """Hierarchical FSM -> BT with one ``<BehaviorTree>`` per composite state (the paper's future work).
 
-The behaviour is the flattened FSM's (DESIGN §1: every check works on the flattening), so the
+The behaviour is the flattened FSM's (docs/semantics.md, 'Models': every check works on the flattening), so the
 guards and state leaves speak flat names (``Door/Open/ajar``) and the macro-step protocol of
-DESIGN §3 is unchanged; only the *shape* of the tree follows the hierarchy:
+docs/semantics.md, 'The LEBT protocol', is unchanged; only the *shape* of the tree follows the hierarchy:
 
 - a *cluster* is a composite state with the flat states inside it; each cluster gets its own
   tree (id = its path, ``Door/Open``), referenced from its parent level by a ``<SubTree>`` node;
@@ -92,7 +92,8 @@ def _classify(fsm: FSM, flat: FSM) -> tuple[dict[str, _Cluster], dict[str, str |
                 break  # an atomic state at this level (or a name flatten made up: keep it here)
             path = prefix + head
             if path not in clusters:
-                parent_cluster = clusters.get(parent) if parent is not None else None
+                parent_cluster: _Cluster | None = (
+                    clusters.get(parent) if parent is not None else None)
                 clusters[path] = _Cluster(path, parent, state.is_parallel,
                                           depth=0 if parent_cluster is None
                                           else parent_cluster.depth + 1)

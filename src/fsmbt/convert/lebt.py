@@ -1,4 +1,4 @@
-"""FSM -> BT: the loop-execution behavior tree (LEBT) of the paper, built exactly (DESIGN §3).
+"""FSM -> BT: the loop-execution behavior tree (LEBT) of the paper, built exactly (docs/conversion.md, 'FSM -> BT: the loop-execution BT').
 
 Steps (``docs/conversion.md`` has the worked A-J example):
 1. flatten a hierarchical FSM (``model.flatten``; its states are named ``Composite/inner``);

@@ -1,4 +1,4 @@
-"""LEBT structure recognition (DESIGN §3): entry, loop and ordinary states; chain and branch links.
+"""LEBT structure recognition (docs/conversion.md, 'FSM -> BT: the loop-execution BT'): entry, loop and ordinary states; chain and branch links.
 
 Definitions, on the part of the FSM that can run (see ``analyse``):
 - the entry state is the target of the initial transition (the FSM's initial state);

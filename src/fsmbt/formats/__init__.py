@@ -1,7 +1,15 @@
 """File formats: one module per format, each registering itself in ``registry``."""
 
 from fsmbt.formats.registry import (
-    Format, ReadContext, detect_format, dumps, formats, get_format, loads, read_model, register,
+    Format,
+    ReadContext,
+    detect_format,
+    dumps,
+    formats,
+    get_format,
+    loads,
+    read_model,
+    register,
     write_model,
 )
 

@@ -54,7 +54,8 @@ from fsmbt.formats._pysm_analyze import (
     analyze,
 )
 from fsmbt.formats._pysm_source import parse_source
-from fsmbt.formats.registry import MAX_INPUT_BYTES, ReadContext, decode
+from fsmbt import limits
+from fsmbt.formats.registry import ReadContext, decode, read_bounded
 from fsmbt.model.errors import InputError, SourceLocation, UnsupportedError
 from fsmbt.model.flatten import flatten
 from fsmbt.model.fsm import FSM, State
@@ -184,7 +185,7 @@ class Builder:
             marker = f"class {ref.cls}("
             for path in sorted(folder.glob("*.py")):
                 try:
-                    if path.stat().st_size <= MAX_INPUT_BYTES and marker in path.read_text(
+                    if path.stat().st_size <= limits.current().max_input_bytes and marker in path.read_text(
                             encoding="utf-8", errors="replace"):
                         candidates.append(path)
                         break
@@ -212,7 +213,7 @@ class Builder:
         if path in self.loaded:
             return self.loaded[path]
         try:
-            data = path.read_bytes()[: MAX_INPUT_BYTES + 1]
+            data = read_bounded(path)
         except OSError as exc:
             raise InputError(f"cannot read: {exc.strerror}", location=SourceLocation(str(path))) \
                 from None

@@ -1,6 +1,6 @@
 """BehaviorTree.CPP XML: read v4 and v3 files, write v4 (docs/formats/btcpp.md).
 
-Reading maps everything to BehaviorTree.CPP v4 meaning (DESIGN §1): v3 names through
+Reading maps everything to BehaviorTree.CPP v4 meaning (docs/semantics.md, 'Names'): v3 names through
 ``V3_ALIASES``, both the compact style (``<Sequence>``, ``<MyAction/>``) and Groot's explicit style
 (``<Action ID="MyAction"/>``). ``<include path=...>`` files are merged into one document; the
 writer writes that document inline, so a written file is self-contained and never includes.
@@ -18,6 +18,7 @@ Complexity: O(n) in the number of elements.
 from __future__ import annotations
 
 import re
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -73,7 +74,7 @@ class _Loader:
         name = str(path) if path is not None else self.ctx.display_name
         root = parse_xml(text, name)
         if root.tag != "root":
-            raise InputError(f"not a BehaviorTree.CPP file: root element is <{root.tag}>, "
+            raise InputError(f"not a BehaviorTree.CPP file: root element is <{str(root.tag)}>, "
                              "expected <root>", location=SourceLocation(name, root.sourceline))
         version = root.get("BTCPP_format", "3")
         if version not in ("3", "4"):
@@ -129,10 +130,14 @@ class _Loader:
         self.load(decode(text, str(resolved)), resolved, (*chain, resolved))
 
     def load_external_models(self) -> None:
-        paths = self.ctx.options.get("node_models") or []
-        if isinstance(paths, (str, Path)):
-            paths = [paths]
-        for item in paths:  # type: ignore[union-attr]
+        option = self.ctx.options.get("node_models") or []
+        if isinstance(option, (str, Path)):
+            paths: list[object] = [option]
+        elif isinstance(option, Iterable):
+            paths = list(option)
+        else:
+            raise InputError("the node_models option must be a path or a list of paths")
+        for item in paths:
             model_path = Path(str(item))
             try:
                 data = read_bounded(model_path)
@@ -158,7 +163,7 @@ class _Loader:
                         if model.attrs.get(ASSUMED_MARK) != "true":
                             self.declared.setdefault(model.type, model)
                 elif child.tag not in ("BehaviorTree", "include"):
-                    raise UnsupportedError(f"unknown element <{child.tag}> under <root>",
+                    raise UnsupportedError(f"unknown element <{str(child.tag)}> under <root>",
                                            location=SourceLocation(f.path, child.sourceline),
                                            element=str(child.tag))
         doc.node_models = dict(self.declared)
@@ -259,6 +264,7 @@ class _Loader:
         for key in attrs:
             seen.setdefault(key, None)
         model = self.declared.get(type_name) or self.external.get(type_name)
+        kind: NodeKind
         if model is not None and model.kind is not NodeKind.SUBTREE:
             kind = model.kind
         elif explicit is not None:
@@ -281,13 +287,13 @@ def _read_models(element: etree._Element, source: str) -> list[NodeModel]:
         where = SourceLocation(source, entry.sourceline)
         kind = EXPLICIT_TAGS.get(str(entry.tag))
         if kind is None:
-            raise InputError(f"unknown <TreeNodesModel> entry <{entry.tag}> (expected Action, "
+            raise InputError(f"unknown <TreeNodesModel> entry <{str(entry.tag)}> (expected Action, "
                              "Condition, Control, Decorator or SubTree)", location=where,
                              element=str(entry.tag))
         attrs = dict(entry.attrib)
         type_id = attrs.pop("ID", None)
         if not type_id:
-            raise InputError(f"<{entry.tag}> in <TreeNodesModel> without ID", location=where,
+            raise InputError(f"<{str(entry.tag)}> in <TreeNodesModel> without ID", location=where,
                              element=str(entry.tag))
         ports: list[PortModel] = []
         extra: list[str] = []
@@ -298,7 +304,7 @@ def _read_models(element: etree._Element, source: str) -> list[NodeModel]:
                 continue
             port_name = child.get("name")
             if not port_name:
-                raise InputError(f"<{child.tag}> without name", element=str(child.tag),
+                raise InputError(f"<{str(child.tag)}> without name", element=str(child.tag),
                                  location=SourceLocation(source, child.sourceline))
             text = (child.text or "").strip() or child.get("description")
             ports.append(PortModel(port_name, direction, child.get("default"), text,

@@ -226,7 +226,7 @@ class _MermaidReader:
 
     def skip_front_matter(self, lines: list[str]) -> int:
         """Skip a leading ``---`` block; its ``title:`` names the machine."""
-        first = next((i for i, l in enumerate(lines) if l.strip()), None)
+        first = next((i for i, text in enumerate(lines) if text.strip()), None)
         if first is None or lines[first].strip() != "---":
             return 0
         for i in range(first + 1, len(lines)):
@@ -354,8 +354,8 @@ def write_mermaid(model: Model) -> str:
         if item == "line":
             body.append(f"{pad}{payload}")
             continue
+        assert isinstance(payload, FSM)
         machine = payload
-        assert isinstance(machine, FSM)
         head: list[str] = []
         tail: list[str] = []
         for state in machine.states.values():

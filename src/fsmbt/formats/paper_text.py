@@ -181,8 +181,8 @@ def read_paper_text(text: str, ctx: ReadContext) -> Model:
                              location=where)
     if fsm is None:
         raise InputError("empty paper-text input", location=ctx.location())
-    for _path, owner, state in [("", fsm, None), *fsm.walk()]:
-        machines = [owner] if state is None else list(state.regions)
+    for _path, owner, parent in [("", fsm, None), *fsm.walk()]:
+        machines = [owner] if parent is None else list(parent.regions)
         for m in machines:
             for t in m.transitions:
                 for end in (t.source, t.target):

@@ -6,7 +6,7 @@
       <Transitions><Transition from="Start" to="A" event="eventSA"/> ... </Transitions>
     </FSM>
 
-Mapping rules (DESIGN §1):
+Mapping rules (docs/semantics.md, 'Models'; docs/formats/paper-xml.md):
 - ``InitialState`` (a ``name`` attribute or its text) naming a start pseudo-state - a name not
   listed in ``<States>`` (or listed with ``type="start"``/``"initial"``) with exactly one outgoing
   transition - gives ``start_name`` = that name, ``initial`` = the transition's target and
@@ -39,7 +39,7 @@ _FSM_KEYS = frozenset({"name", "finals"})
 def read_paper_xml(text: str, ctx: ReadContext) -> FSM:
     root = parse_xml(text, ctx.display_name)
     if root.tag != "FSM":
-        raise InputError(f"not the paper's FSM XML: root element is <{root.tag}>, expected <FSM>",
+        raise InputError(f"not the paper's FSM XML: root element is <{str(root.tag)}>, expected <FSM>",
                          location=ctx.location(root.sourceline))
     fsm = FSM(name=root.get("name", "fsm"),
               attrs={k: v for k, v in root.attrib.items() if k not in _FSM_KEYS})
@@ -73,7 +73,7 @@ def read_paper_xml(text: str, ctx: ReadContext) -> FSM:
                 fsm.add_transition(source, event, target, attrs=attrs,
                                    location=ctx.location(element.sourceline))
         else:
-            raise InputError(f"unexpected element <{section.tag}> in <FSM> (expected "
+            raise InputError(f"unexpected element <{str(section.tag)}> in <FSM> (expected "
                              "InitialState, States, Transitions)",
                              location=ctx.location(section.sourceline), element=str(section.tag))
     _set_initial(fsm, initial_name, initial_line, pseudo_listed, ctx)
@@ -132,7 +132,7 @@ def _children(section: etree._Element, tag: str, ctx: ReadContext) -> list[etree
     children = _elements(section)
     for child in children:
         if child.tag != tag:
-            raise InputError(f"unexpected <{child.tag}> in <{section.tag}> (expected <{tag}>)",
+            raise InputError(f"unexpected <{str(child.tag)}> in <{str(section.tag)}> (expected <{tag}>)",
                              location=ctx.location(child.sourceline), element=str(child.tag))
     return children
 

@@ -25,28 +25,61 @@ Writer = Callable[["Model"], str]
 
 @dataclass
 class ReadContext:
-    """What a reader may need besides the text: the file (errors, relative includes)."""
+    """What a reader may need besides the text.
+
+    Attributes:
+        path: The file read, for error locations and relative includes (``None``: a string).
+        options: Reader options (e.g. ``node_models`` for BehaviorTree.CPP).
+        warnings: Documented, non-fatal deviations the reader recorded, located.
+    """
 
     path: Path | None = None
     options: dict[str, object] = field(default_factory=dict)
     warnings: list[str] = field(default_factory=list)
 
     def warn(self, message: str, line: int | None = None, element: str | None = None) -> None:
-        """Record a documented, non-fatal deviation (e.g. an ignored SCXML datamodel)."""
+        """Record a documented, non-fatal deviation (e.g. an ignored SCXML datamodel).
+
+        Args:
+            message: What was ignored or changed, and why.
+            line: The line it is on, when known.
+            element: The element or node it concerns, when known.
+        """
         where = f"{self.location(line)}: " + (f"{element}: " if element else "")
         self.warnings.append(f"{where}{message}")
 
     @property
     def display_name(self) -> str:
+        """The file name errors show (``<input>`` for text with no file)."""
         return str(self.path) if self.path is not None else "<input>"
 
     def location(self, line: int | None = None, column: int | None = None) -> SourceLocation:
+        """A location in the input being read.
+
+        Args:
+            line: 1-based line, when known.
+            column: 1-based column, when known.
+
+        Returns:
+            The location, naming :attr:`display_name`.
+        """
         return SourceLocation(self.display_name, line, column)
 
 
 @dataclass(frozen=True)
 class Format:
-    """A file format: a name for ``--from/--to``, extensions, which models it holds."""
+    """A file format: its name, extensions, which models it holds, its reader and writer.
+
+    Attributes:
+        name: The name users give it (lower case, e.g. ``"btcpp"``).
+        extensions: File name endings that select it (``".xml"``, ``".bt.json"``).
+        kinds: Which models it holds, a subset of ``{"fsm", "bt"}``.
+        description: One line for format listings.
+        read: Text to model, or ``None`` for a write-only format.
+        write: Model to text, or ``None`` for a read-only format.
+        sniff: Whether a text looks like this format (content detection).
+        priority: Order of sniffing; lower is tried first.
+    """
 
     name: str
     extensions: tuple[str, ...]
@@ -64,16 +97,40 @@ _FORMATS: dict[str, Format] = {}
 
 
 def register(fmt: Format) -> Format:
+    """Add a format to the registry (a format module calls this on import).
+
+    Args:
+        fmt: The format; a later registration under the same name replaces it.
+
+    Returns:
+        ``fmt``, so a module can write ``FORMAT = register(Format(...))``.
+    """
     _FORMATS[fmt.name] = fmt
     return fmt
 
 
 def formats() -> list[Format]:
+    """Every registered format, built-in ones loaded first.
+
+    Returns:
+        The formats in sniffing order (priority, then name).
+    """
     _load_builtin_formats()
     return sorted(_FORMATS.values(), key=lambda f: (f.priority, f.name))
 
 
 def get_format(name: str) -> Format:
+    """The format of a given name.
+
+    Args:
+        name: A format name, any case.
+
+    Returns:
+        The registered format.
+
+    Raises:
+        InputError: No format has that name (the message lists the known ones).
+    """
     _load_builtin_formats()
     try:
         return _FORMATS[name.lower()]
@@ -95,7 +152,16 @@ def _load_builtin_formats() -> None:
 
 
 def format_for_path(path: Path, *, writing: bool = False, kind: str | None = None) -> Format | None:
-    """The format whose extension matches ``path`` (``None`` when no extension matches)."""
+    """The format a file name selects by its extension.
+
+    Args:
+        path: The file name; the longest matching extension wins (``.bt.json`` over ``.json``).
+        writing: Only formats that can write (else: that can read).
+        kind: Only formats that hold this kind of model (``"fsm"`` or ``"bt"``).
+
+    Returns:
+        The format, or ``None`` when no extension matches.
+    """
     suffixes = "".join(path.suffixes).lower()
     candidates = [
         f for f in formats()
@@ -110,7 +176,18 @@ def format_for_path(path: Path, *, writing: bool = False, kind: str | None = Non
 
 
 def detect_format(text: str, path: Path | None = None) -> Format:
-    """Pick a reader: content sniffing first (extensions lie), then the extension."""
+    """Pick a reader: content sniffing first (extensions lie), then the extension.
+
+    Args:
+        text: The input text.
+        path: The file it came from, for the extension and the error location.
+
+    Returns:
+        The format to read ``text`` with.
+
+    Raises:
+        InputError: Neither the content nor the extension tells the format.
+    """
     for fmt in formats():
         if fmt.read is not None and fmt.sniff is not None and fmt.sniff(text):
             return fmt
@@ -125,7 +202,19 @@ def detect_format(text: str, path: Path | None = None) -> Format:
 
 
 def decode(data: bytes, name: str) -> str:
-    """Bytes to text: UTF-8 (with or without BOM) or UTF-16 with BOM; binary is refused."""
+    """Bytes to text: UTF-8 (with or without BOM) or UTF-16 with BOM; binary is refused.
+
+    Args:
+        data: The raw input.
+        name: The input's name, for error locations.
+
+    Returns:
+        The decoded text.
+
+    Raises:
+        InputError: Empty input, binary data, UTF-16 without a byte-order mark, or invalid
+            UTF-8/UTF-16 (the message gives the byte offset and line).
+    """
     location = SourceLocation(name)
     if not data.strip():
         raise InputError("empty input: no model in it", location=location)
@@ -153,8 +242,23 @@ def decode(data: bytes, name: str) -> str:
 def loads(text: str, fmt: str | None = None, *, path: Path | None = None,
           options: dict[str, object] | None = None,
           warnings: list[str] | None = None) -> Model:
-    """Parse a model from text (format by name, or detected); the reader's documented
-    warnings are appended to ``warnings`` when given."""
+    """Parse a model from text.
+
+    Args:
+        text: The model's text.
+        fmt: A format name; ``None`` detects it (see :func:`detect_format`).
+        path: The file the text came from (error locations, relative includes).
+        options: Reader options.
+        warnings: When given, the reader's documented warnings are appended to it.
+
+    Returns:
+        The model (``FSM`` or ``BTDocument``).
+
+    Raises:
+        InputError: Unknown or write-only format, text over the size limit, or text the
+            reader refuses (located).
+        UnsupportedError: A construct the format allows but fsmbt cannot model (located).
+    """
     _check_text_size(text, path)
     chosen = get_format(fmt) if fmt else detect_format(text, path)
     if chosen.read is None:
@@ -248,12 +352,40 @@ def read_text(path: str | Path) -> str:
 def read_model(path: str | Path, fmt: str | None = None,
                options: dict[str, object] | None = None, *,
                warnings: list[str] | None = None) -> Model:
-    """Read one model file: size and encoding checks, then the format's reader."""
+    """Read one model file: size and encoding checks, then the format's reader.
+
+    Args:
+        path: The file; a regular file within ``limits.current().max_input_bytes``.
+        fmt: A format name; ``None`` detects it from the content, then the extension.
+        options: Reader options.
+        warnings: When given, the reader's documented warnings are appended to it.
+
+    Returns:
+        The model (``FSM`` or ``BTDocument``).
+
+    Raises:
+        InputError: The file cannot be read, is too large, not a regular file, not text, or
+            the reader refuses it (located).
+        UnsupportedError: A construct fsmbt cannot model (located).
+    """
     path = Path(path)
     return loads(read_text(path), fmt, path=path, options=options, warnings=warnings)
 
 
 def dumps(model: Model, fmt: str) -> str:
+    """A model as text in a format.
+
+    Args:
+        model: An ``FSM`` or a ``BTDocument``.
+        fmt: The format name.
+
+    Returns:
+        The text the format's writer produces.
+
+    Raises:
+        InputError: Unknown or read-only format, or one that cannot hold this kind of model.
+        UnsupportedError: The model uses something the format cannot express.
+    """
     chosen = get_format(fmt)
     kind = "bt" if not _is_fsm(model) else "fsm"
     if chosen.write is None:
@@ -265,7 +397,22 @@ def dumps(model: Model, fmt: str) -> str:
 
 def write_model(model: Model, path: str | Path, fmt: str | None = None, *,
                 overwrite: bool = False) -> Path:
-    """Write a model; refuses to replace an existing file unless ``overwrite``."""
+    """Write a model to a file; never replaces an existing file unless ``overwrite``.
+
+    Args:
+        model: An ``FSM`` or a ``BTDocument``.
+        path: The file to write; missing parent directories are created.
+        fmt: A format name; ``None`` takes it from the extension.
+        overwrite: Replace ``path`` if it exists.
+
+    Returns:
+        The path written.
+
+    Raises:
+        InputError: No format for the name, the file exists and ``overwrite`` is false, or
+            the file cannot be written (located).
+        UnsupportedError: The model uses something the format cannot express.
+    """
     path = Path(path)
     kind = "fsm" if _is_fsm(model) else "bt"
     chosen = get_format(fmt) if fmt else format_for_path(path, writing=True, kind=kind)

@@ -187,7 +187,7 @@ class _Reader:
         if not nested:
             return []
         if local_name(element) == "parallel":
-            out = []
+            out: list[tuple[str, etree._Element, FSM, _Node | None]] = []
             for child in nested:
                 region = FSM(name=child.get(F_NAME, child.get("id") or "region"))
                 self.parent_of[id(region)] = node
@@ -340,7 +340,7 @@ class _Reader:
         """The model transition for ``node --event--> target``, leaving parents if needed."""
         ancestors = self.machine_chain(node.machine)
         entered = None
-        for index, machine in enumerate(ancestors):
+        for index, machine in enumerate(ancestors):  # noqa: B007 - index is read after the loop
             entered = self.entry_or_none(target, machine)
             if entered is not None:
                 break

@@ -1,8 +1,8 @@
 """Transition tables in CSV (the paper's "table" input); the row logic is shared with Markdown.
 
 A table has a header row naming the columns ``source, event, target`` and optionally
-``action`` (any order, any case, surrounding spaces ignored). Meaning (DESIGN §1,
-docs/formats/tables.md):
+``action`` (any order, any case, surrounding spaces ignored). Meaning (docs/semantics.md,
+'Models'; docs/formats/tables.md):
 
 - no initial-state column: the first row's source is the initial state, unless
   ``ReadContext.options["initial"]`` names another;
@@ -163,7 +163,7 @@ def rows_from_fsm(model: Model, table: str) -> tuple[list[str], list[list[str]]]
     for t in ordered:
         row = [t.source, t.event or "", t.target]
         if with_action:
-            target_action = fsm.states[t.target].action
+            target_action = fsm.states[t.target].action or ""  # never None: checked above
             row.append(target_action if target_action != t.target else "")
         rows.append(row)
     return header, rows

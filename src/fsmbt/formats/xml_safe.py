@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import re
 import xml.parsers.expat as expat
+from typing import Any
 
 from lxml import etree
 
@@ -137,7 +138,9 @@ def _parse_deep(data: bytes, source: str | None, max_depth: int) -> etree._Eleme
         depth += 1
         if depth > max_depth:
             raise _TooDeep
-        element = builder.start(clark(name), {clark(k): v for k, v in attrs.items()})
+        # lxml's TreeBuilder.start returns the new element (types-lxml declares None)
+        element: Any = builder.start(  # type: ignore[func-returns-value]
+            clark(name), {clark(k): v for k, v in attrs.items()})
         element.sourceline = parser.CurrentLineNumber
 
     def end(name: str) -> None:

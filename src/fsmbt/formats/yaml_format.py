@@ -59,9 +59,10 @@ class _GuardedLoader(_Parser, yaml.constructor.SafeConstructor, yaml.resolver.Re
 
     def __init__(self, stream: str) -> None:
         if _Parser is yaml.parser.Parser:  # pragma: no cover - needs its reader and scanner
-            yaml.reader.Reader.__init__(self, stream)
-            yaml.scanner.Scanner.__init__(self)
-            yaml.parser.Parser.__init__(self)
+            # the stubs type these mixin initialisers' self as their own class
+            yaml.reader.Reader.__init__(self, stream)  # type: ignore[arg-type]
+            yaml.scanner.Scanner.__init__(self)  # type: ignore[arg-type]
+            yaml.parser.Parser.__init__(self)  # type: ignore[arg-type]
         else:
             _Parser.__init__(self, stream)
         yaml.constructor.SafeConstructor.__init__(self)
@@ -75,7 +76,9 @@ class _GuardedLoader(_Parser, yaml.constructor.SafeConstructor, yaml.resolver.Re
             document = self._compose_tree()
             self.get_event()  # document end
         if not self.check_event(yaml.events.StreamEndEvent):
-            mark = self.peek_event().start_mark
+            following = self.peek_event()
+            assert following is not None  # check_event saw an event
+            mark = following.start_mark
             raise _Refused("expected one YAML document, found several", mark.line + 1,
                            mark.column + 1)
         self.get_event()
@@ -86,6 +89,8 @@ class _GuardedLoader(_Parser, yaml.constructor.SafeConstructor, yaml.resolver.Re
         max_depth = limits.current().max_yaml_depth
         while True:
             event = self.get_event()
+            if event is None:
+                raise _Refused("unexpected end of the YAML stream", 1, 1)
             mark = event.start_mark
             if isinstance(event, AliasEvent):
                 raise _Refused("YAML aliases (*name) are not allowed in fsmbt models (they can "
@@ -129,7 +134,8 @@ class _GuardedLoader(_Parser, yaml.constructor.SafeConstructor, yaml.resolver.Re
 def load_yaml(text: str, ctx: ReadContext) -> Any:
     """Plain data from YAML text (one document), with fsmbt's guards; errors name the line."""
     try:
-        return yaml.load(text, Loader=_GuardedLoader)  # noqa: S506 - safe constructor only
+        # safe constructor only; the stubs list PyYAML's own loader classes
+        return yaml.load(text, Loader=_GuardedLoader)  # type: ignore[arg-type]  # noqa: S506
     except _Refused as exc:
         raise InputError(exc.message, location=ctx.location(exc.line, exc.column)) from None
     except yaml.MarkedYAMLError as exc:

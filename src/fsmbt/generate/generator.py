@@ -154,6 +154,8 @@ class _BTBuilder:
     # node factories -------------------------------------------------------------------------
     def control(self, *, parallel: bool = True) -> BTNode:
         self.count += 1
+        kinds: tuple[str, ...]
+        weights: tuple[float, ...]
         if self.extended:
             kinds, weights = EXTENDED_CONTROLS, _EXTENDED_WEIGHTS
             if not parallel:

@@ -24,13 +24,16 @@ from __future__ import annotations
 import time
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any, cast
 
 import httpx2
 import openai
 
 from fsmbt import limits
 from fsmbt.llm.config import LLMSettings, LLMUnavailableError
+
+if TYPE_CHECKING:
+    from openai.types.chat import ChatCompletionMessageParam
 
 Message = dict[str, Any]
 MAX_RETRY_AFTER_S = 60.0
@@ -140,9 +143,11 @@ class LLMClient:
                                     attempts - 1, failures)
             try:
                 response = self._client.chat.completions.create(
-                    model=s.model, messages=messages, temperature=s.temperature, top_p=s.top_p,
+                    model=s.model,
+                    messages=cast("list[ChatCompletionMessageParam]", messages),
+                    temperature=s.temperature, top_p=s.top_p,
                     seed=s.seed, timeout=remaining,
-                    **({"max_tokens": s.max_output_tokens} if s.max_output_tokens else {}),
+                    max_tokens=s.max_output_tokens if s.max_output_tokens else openai.omit,
                 )
             except openai.APITimeoutError:
                 last_problem = "request timed out"

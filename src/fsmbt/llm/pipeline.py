@@ -29,7 +29,13 @@ from fsmbt.llm.log import (
     append_record,
 )
 from fsmbt.llm.parsing import AnswerError, parse_bt_answer, parse_fsm_answer
-from fsmbt.llm.prompts import BT_TO_FSM, FSM_TO_BT, PromptOptions, conversion_messages, feedback_message
+from fsmbt.llm.prompts import (
+    BT_TO_FSM,
+    FSM_TO_BT,
+    PromptOptions,
+    conversion_messages,
+    feedback_message,
+)
 from fsmbt.llm.structural import check_hfsm, check_lebt
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import FsmbtError

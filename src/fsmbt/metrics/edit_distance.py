@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
-
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
@@ -65,7 +64,7 @@ def fsm_graph(fsm: FSM) -> nx.DiGraph:
     flat = flatten(fsm)
     import networkx as nx
 
-    graph = nx.DiGraph()
+    graph: nx.DiGraph[str] = nx.DiGraph()
     graph.add_node(START_NODE, label=("start",))
     for state in flat.states.values():
         graph.add_node(state.name, label=("state", state.action, state.final))

@@ -1,4 +1,4 @@
-"""The behavior tree model (DESIGN §1), kept close to BehaviorTree.CPP v4's XML.
+"""The behavior tree model (docs/semantics.md, 'Models'), kept close to BehaviorTree.CPP v4's XML.
 
 A ``BTDocument`` is what one file (plus its includes) holds: several ``BehaviorTree`` s, the one to
 execute, and the ``TreeNodesModel`` declarations. Attributes and ports stay on the nodes in order,
@@ -22,6 +22,15 @@ class BTNode:
     ``SubTree`` node the referenced tree is ``attrs["ID"]``. ``kind_declared`` is False when a
     leaf's kind was not declared anywhere and was assumed (Action, the safe choice: it may
     return RUNNING).
+
+    Attributes:
+        type: The node type (registration ID).
+        kind: Its family: control, decorator, action, condition or subtree.
+        name: The instance name, when the file gives one.
+        attrs: The other XML attributes (ports), in file order.
+        children: The child nodes, in order.
+        kind_declared: False when a leaf's kind was assumed (see above).
+        location: Where the node was read (not compared).
     """
 
     type: str
@@ -39,14 +48,17 @@ class BTNode:
 
     @property
     def is_leaf(self) -> bool:
+        """Whether the node is an Action or a Condition."""
         return self.kind in (NodeKind.ACTION, NodeKind.CONDITION)
 
     @property
     def is_builtin(self) -> bool:
+        """Whether the type is one of BehaviorTree.CPP v4's built-in nodes."""
         return builtin_spec(self.type) is not None
 
     @property
     def subtree_id(self) -> str | None:
+        """The referenced tree's ID for a ``SubTree`` node, else ``None``."""
         return self.attrs.get("ID") if self.kind is NodeKind.SUBTREE else None
 
     def __eq__(self, other: object) -> bool:
@@ -71,7 +83,12 @@ class BTNode:
         return f"<BTNode {self.type}{name} kind={self.kind.value} children={len(self.children)}>"
 
     def walk(self) -> Iterator[BTNode]:
-        """Pre-order traversal without recursion (trees may be 100 000 deep)."""
+        """Pre-order traversal without recursion (trees may be 100 000 deep).
+
+        Returns:
+            An iterator over this node and its descendants, parents before children,
+            children in order.
+        """
         stack: list[BTNode] = [self]
         while stack:
             node = stack.pop()
@@ -81,6 +98,16 @@ class BTNode:
 
 @dataclass
 class PortModel:
+    """A port of a declared node type (``<input_port>``, ``<output_port>``, ``<inout_port>``).
+
+    Attributes:
+        name: The port's name.
+        direction: ``input``, ``output`` or ``inout``.
+        default: The default value, when declared.
+        description: The port's description text, when given.
+        type: The declared value type, when given.
+    """
+
     name: str
     direction: str = "input"  # input | output | inout
     default: str | None = None
@@ -90,7 +117,14 @@ class PortModel:
 
 @dataclass
 class NodeModel:
-    """A ``<TreeNodesModel>`` entry: declares a custom node type's kind and ports (for Groot2)."""
+    """A ``<TreeNodesModel>`` entry: declares a custom node type's kind and ports (for Groot2).
+
+    Attributes:
+        type: The node type it declares.
+        kind: The declared family (action, condition, control, decorator, subtree).
+        ports: The declared ports.
+        attrs: The entry's other attributes.
+    """
 
     type: str
     kind: NodeKind
@@ -100,6 +134,15 @@ class NodeModel:
 
 @dataclass
 class BehaviorTree:
+    """One ``<BehaviorTree ID=...>`` of a document.
+
+    Attributes:
+        id: The tree's ID (``SubTree`` nodes refer to it).
+        root: Its root node (``None`` for an empty tree).
+        attrs: The element's other attributes.
+        location: Where the tree was read (not compared).
+    """
+
     id: str
     root: BTNode | None
     attrs: dict[str, str] = field(default_factory=dict)
@@ -108,7 +151,16 @@ class BehaviorTree:
 
 @dataclass
 class BTDocument:
-    """Everything one BT file holds. ``main_tree`` is the tree to execute."""
+    """Everything one BT file holds. ``main_tree`` is the tree to execute.
+
+    Attributes:
+        trees: The trees by ID, in file order.
+        main_tree: The ID of the tree to execute (``None``: the only or first tree).
+        node_models: Declared node types by type name.
+        format_version: BehaviorTree.CPP's ``BTCPP_format`` (``"3"`` or ``"4"``).
+        includes: The ``<include path=...>`` files merged in.
+        attrs: The root element's other attributes.
+    """
 
     trees: dict[str, BehaviorTree] = field(default_factory=dict)
     main_tree: str | None = None
@@ -119,12 +171,24 @@ class BTDocument:
 
     @classmethod
     def single(cls, root: BTNode, tree_id: str = "MainTree") -> BTDocument:
-        """A document with one tree, the usual shape of a converter's output."""
+        """A document with one tree, the usual shape of a converter's output.
+
+        Args:
+            root: The tree's root node.
+            tree_id: The tree's ID, also the main tree.
+
+        Returns:
+            The document.
+        """
         return cls(trees={tree_id: BehaviorTree(tree_id, root)}, main_tree=tree_id)
 
     @property
     def main(self) -> BehaviorTree:
-        """The tree to execute: ``main_tree``, else the only / first tree."""
+        """The tree to execute: ``main_tree``, else the only / first tree.
+
+        Raises:
+            KeyError: The document holds no tree.
+        """
         if self.main_tree is not None and self.main_tree in self.trees:
             return self.trees[self.main_tree]
         if not self.trees:
@@ -132,7 +196,11 @@ class BTDocument:
         return next(iter(self.trees.values()))
 
     def nodes(self) -> Iterator[tuple[str, BTNode]]:
-        """Every node of every tree as ``(tree id, node)``."""
+        """Every node of every tree.
+
+        Returns:
+            An iterator of ``(tree id, node)``, trees in order, each tree pre-order.
+        """
         for tree in self.trees.values():
             if tree.root is not None:
                 for node in tree.root.walk():

@@ -3,9 +3,9 @@
 A thin view of the node registry (``fsmbt.model.nodes``, docs/semantics.md "Node registry"):
 nothing here is declared, everything is read from the registry's entries.
 
-Everything is mapped to BehaviorTree.CPP v4 meaning (docs/semantics.md, "Which Sequence"): the
-reactive "Sequence" of Colledanchise & Ögren is ``ReactiveSequence`` here, their "Sequence*" is
-the plain ``Sequence``; BehaviorTree.CPP v3's ``SequenceStar`` is v4's ``SequenceWithMemory``.
+Everything is mapped to BehaviorTree.CPP v4 meaning (docs/semantics.md, 'Names'): the reactive
+"Sequence" of Colledanchise & Ögren is ``ReactiveSequence`` here, their "Sequence*" is the plain
+``Sequence``; BehaviorTree.CPP v3's ``SequenceStar`` is v4's ``SequenceWithMemory``.
 """
 
 from __future__ import annotations

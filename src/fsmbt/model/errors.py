@@ -62,7 +62,13 @@ def one_line(text: str) -> str:
 
 @dataclass(frozen=True)
 class SourceLocation:
-    """Where something came from: file, and line/column where the format has them."""
+    """Where something came from: file, and line/column where the format has them.
+
+    Attributes:
+        file: The file name (``None``: text with no file, shown as ``<input>``).
+        line: 1-based line, when the format has lines.
+        column: 1-based column, when known.
+    """
 
     file: str | None = None
     line: int | None = None
@@ -78,7 +84,15 @@ class SourceLocation:
 
 
 class FsmbtError(Exception):
-    """Base class of every error fsmbt reports to a user."""
+    """Base class of every error fsmbt reports to a user.
+
+    Shown as ``file:line:col: element: message``, each part only when known.
+
+    Args:
+        message: The cause, in words a user can act on.
+        location: Where in the input.
+        element: The state, node or element concerned.
+    """
 
     def __init__(
         self,

@@ -1,4 +1,4 @@
-"""Flattening a hierarchical FSM into the plain FSM every check works on (DESIGN §1).
+"""Flattening a hierarchical FSM into the plain FSM every check works on (docs/semantics.md, 'Models').
 
 Rules (also in docs/semantics.md):
 - A configuration is the active atomic state at each level: ``C/x`` for state ``x`` inside
@@ -29,7 +29,7 @@ from collections import deque
 from dataclasses import dataclass
 
 from fsmbt.model.errors import InputError
-from fsmbt.model.fsm import FSM, State
+from fsmbt.model.fsm import FSM, State, Transition
 
 #: Separator between a composite state's name and its active sub-state in flat names.
 PATH_SEPARATOR = "/"
@@ -55,13 +55,13 @@ class _Flattener:
     def __init__(self, fsm: FSM, max_configurations: int) -> None:
         self.fsm = fsm
         self.max_configurations = max_configurations
-        self._tables: dict[int, dict[str, dict[str | None, list]]] = {}
+        self._tables: dict[int, dict[str, dict[str | None, list[Transition]]]] = {}
 
     # -- structure helpers --------------------------------------------------------------------
-    def table(self, machine: FSM) -> dict[str, dict[str | None, list]]:
+    def table(self, machine: FSM) -> dict[str, dict[str | None, list[Transition]]]:
         key = id(machine)
         if key not in self._tables:
-            table: dict[str, dict[str | None, list]] = {}
+            table: dict[str, dict[str | None, list[Transition]]] = {}
             for t in machine.transitions:
                 table.setdefault(t.source, {}).setdefault(t.event, []).append(t)
             self._tables[key] = table
@@ -119,7 +119,7 @@ class _Flattener:
         inner = tuple(self.enter(region, region.initial or "") for region in state.regions)
         return _Config(name, inner)
 
-    def completion(self, machine: FSM, config: _Config):
+    def completion(self, machine: FSM, config: _Config) -> Transition | None:
         state = self.state(machine, config.state)
         candidates = self.table(machine).get(config.state, {}).get(None, [])
         if not candidates:
@@ -229,11 +229,33 @@ def _all_events(fsm: FSM) -> list[str]:
 
 
 def needs_flattening(fsm: FSM) -> bool:
+    """Whether ``fsm`` differs from its flattening.
+
+    Args:
+        fsm: A machine.
+
+    Returns:
+        True when it has a composite or parallel state, or a completion transition.
+    """
     return fsm.is_hierarchical or any(t.event is None for t in fsm.transitions)
 
 
 def flatten(fsm: FSM, *, max_configurations: int = 1_000_000) -> FSM:
-    """The plain FSM with the same macro-step behaviour as ``fsm`` (see module docstring)."""
+    """The plain FSM with the same macro-step behaviour as ``fsm`` (see module docstring).
+
+    Args:
+        fsm: A flat or hierarchical machine; it is not modified.
+        max_configurations: Bound on the reachable configurations kept.
+
+    Returns:
+        A new flat FSM whose states are the reachable configurations (a copy of ``fsm`` when
+        it needs no flattening).
+
+    Raises:
+        InputError: A transition to an unknown state, a composite state without initial
+            state, a cycle of completion transitions, no initial state, or more than
+            ``max_configurations`` configurations.
+    """
     if not needs_flattening(fsm):
         return copy.deepcopy(fsm)
     return _Flattener(fsm, max_configurations).run()

@@ -1,4 +1,4 @@
-"""The finite state machine model, flat or hierarchical (DESIGN §1).
+"""The finite state machine model, flat or hierarchical (docs/semantics.md, 'Models').
 
 Semantics in one paragraph: the machine starts in ``initial`` (or, when ``initial_event`` is set,
 in the start pseudo-state ``start_name`` and moves to ``initial`` on that event). Entering a state
@@ -23,7 +23,17 @@ from fsmbt.model.errors import SourceLocation
 
 @dataclass
 class State:
-    """One state. ``action`` defaults to the state's name in every reader."""
+    """One state of an FSM, possibly composite (one region) or parallel (several).
+
+    Attributes:
+        name: Unique within its machine.
+        action: The action label run on entry (every reader defaults it to ``name``;
+            ``None``: no action).
+        final: Whether the machine is done in this state.
+        regions: Sub-machines: none (atomic), one (composite) or several (parallel).
+        attrs: Format-specific attributes kept for round trips.
+        location: Where the state was read (not compared).
+    """
 
     name: str
     action: str | None = None
@@ -34,20 +44,33 @@ class State:
 
     @property
     def is_composite(self) -> bool:
+        """Whether the state holds exactly one sub-machine."""
         return len(self.regions) == 1
 
     @property
     def is_parallel(self) -> bool:
+        """Whether the state holds several concurrent regions."""
         return len(self.regions) > 1
 
     @property
     def is_atomic(self) -> bool:
+        """Whether the state holds no sub-machine."""
         return not self.regions
 
 
 @dataclass
 class Transition:
-    """``source --event--> target``; ``event=None`` is a completion (eventless) transition."""
+    """``source --event--> target``; ``event=None`` is a completion (eventless) transition.
+
+    Attributes:
+        source: The source state's name (in the same machine).
+        event: The triggering event, or ``None`` for a completion transition.
+        target: The target state's name (in the same machine).
+        exit: For a completion transition out of a composite state: the sub-machine's final
+            state it waits for (``None``: any).
+        attrs: Format-specific attributes kept for round trips.
+        location: Where the transition was read (not compared).
+    """
 
     source: str
     event: str | None
@@ -59,7 +82,17 @@ class Transition:
 
 @dataclass
 class FSM:
-    """A (possibly hierarchical) deterministic state machine; states keep insertion order."""
+    """A (possibly hierarchical) deterministic state machine; states keep insertion order.
+
+    Attributes:
+        name: The machine's name.
+        states: The states by name, in declaration order.
+        transitions: The transitions, in declaration order.
+        initial: The initial state's name (the target of the initial transition).
+        start_name: The start pseudo-state's name, when the file gives one.
+        initial_event: The event that leaves the start pseudo-state (``None``: none needed).
+        attrs: Format-specific attributes kept for round trips.
+    """
 
     name: str = "fsm"
     states: dict[str, State] = field(default_factory=dict)
@@ -71,7 +104,15 @@ class FSM:
 
     # -- building -------------------------------------------------------------------------
     def add_state(self, state: State | str, **kwargs: object) -> State:
-        """Add a state (a ``State`` or a name plus ``State`` fields); the first becomes initial."""
+        """Add a state; the first one added becomes the initial state.
+
+        Args:
+            state: A ``State``, or a name (its action defaults to the name).
+            **kwargs: ``State`` fields when ``state`` is a name.
+
+        Returns:
+            The state added (replacing any state of the same name).
+        """
         if isinstance(state, str):
             kwargs.setdefault("action", state)
             state = State(state, **kwargs)  # type: ignore[arg-type]
@@ -83,6 +124,17 @@ class FSM:
     def add_transition(
         self, source: str, event: str | None, target: str, **kwargs: object
     ) -> Transition:
+        """Add a transition.
+
+        Args:
+            source: The source state's name.
+            event: The event, or ``None`` for a completion transition.
+            target: The target state's name.
+            **kwargs: Further ``Transition`` fields (``exit``, ``attrs``, ``location``).
+
+        Returns:
+            The transition added.
+        """
         transition = Transition(source, event, target, **kwargs)  # type: ignore[arg-type]
         self.transitions.append(transition)
         return transition
@@ -90,10 +142,15 @@ class FSM:
     # -- queries ----------------------------------------------------------------------------
     @property
     def is_hierarchical(self) -> bool:
+        """Whether some top-level state is composite or parallel."""
         return any(not s.is_atomic for s in self.states.values())
 
     def events(self) -> list[str]:
-        """Events in order of first appearance (the initial event included)."""
+        """The events this machine's transitions name (not its sub-machines').
+
+        Returns:
+            The events in order of first appearance, the initial event first.
+        """
         seen: dict[str, None] = {}
         if self.initial_event is not None:
             seen[self.initial_event] = None
@@ -103,17 +160,38 @@ class FSM:
         return list(seen)
 
     def outgoing(self, source: str) -> list[Transition]:
+        """The transitions out of a state.
+
+        Args:
+            source: A state's name.
+
+        Returns:
+            Its outgoing transitions, in declaration order.
+        """
         return [t for t in self.transitions if t.source == source]
 
     def transition_map(self) -> dict[str, dict[str | None, Transition]]:
-        """``{source: {event: transition}}``; the first transition wins on a conflict."""
+        """The transitions indexed by source and event.
+
+        Returns:
+            ``{source: {event: transition}}`` with an entry for every state; the first
+            transition wins on a conflict (``validate`` reports conflicts).
+        """
         table: dict[str, dict[str | None, Transition]] = {name: {} for name in self.states}
         for t in self.transitions:
             table.setdefault(t.source, {}).setdefault(t.event, t)
         return table
 
     def predecessors(self, target: str) -> list[str]:
-        """Distinct sources of transitions into ``target`` (the start pseudo-state included)."""
+        """The distinct sources of transitions into a state.
+
+        Args:
+            target: A state's name.
+
+        Returns:
+            The source names in order of first appearance; the start pseudo-state is included
+            when ``target`` is the initial state.
+        """
         preds: dict[str, None] = {}
         if target == self.initial and self.start_name is not None:
             preds[self.start_name] = None
@@ -123,6 +201,14 @@ class FSM:
         return list(preds)
 
     def successors(self, source: str) -> list[str]:
+        """The distinct targets of transitions out of a state.
+
+        Args:
+            source: A state's name.
+
+        Returns:
+            The target names in order of first appearance.
+        """
         succ: dict[str, None] = {}
         for t in self.transitions:
             if t.source == source:
@@ -130,9 +216,17 @@ class FSM:
         return list(succ)
 
     def walk(self, prefix: str = "") -> Iterator[tuple[str, FSM, State]]:
-        """Every state at every level as ``(path, owning machine, state)``, pre-order.
+        """Every state at every level, pre-order.
 
         Iterative, so deeply nested machines do not hit Python's recursion limit.
+
+        Args:
+            prefix: Prepended to every path.
+
+        Returns:
+            An iterator of ``(path, owning machine, state)``; a path joins the names of the
+            enclosing states and the state with ``/`` (inside a parallel state, the region's
+            index is added: ``P/0:x``).
         """
         stack: list[tuple[str, FSM, Iterator[State]]] = [(prefix, self, iter(self.states.values()))]
         while stack:

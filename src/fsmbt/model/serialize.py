@@ -19,6 +19,14 @@ SCHEMA_VERSION = 1
 
 # -- FSM ----------------------------------------------------------------------------------------
 def fsm_to_dict(fsm: FSM) -> dict[str, Any]:
+    """An FSM as fsmbt's JSON/YAML schema (docs/formats/README.md).
+
+    Args:
+        fsm: A flat or hierarchical machine.
+
+    Returns:
+        Plain data with ``kind: "fsm"`` and the schema version.
+    """
     out: dict[str, Any] = {"kind": "fsm", "schema": SCHEMA_VERSION}
     out.update(_machine_to_dict(fsm))
     return out
@@ -58,6 +66,18 @@ def _transition_to_dict(t: Transition) -> dict[str, Any]:
 
 
 def fsm_from_dict(data: dict[str, Any], *, where: str = "fsm") -> FSM:
+    """An FSM from fsmbt's JSON/YAML schema.
+
+    Args:
+        data: Plain data as :func:`fsm_to_dict` writes it.
+        where: The path of ``data`` in the document, for error messages.
+
+    Returns:
+        The machine.
+
+    Raises:
+        InputError: A missing or mistyped field, named by its path in the data.
+    """
     _expect(isinstance(data, dict), where, "expected an object")
     return _machine_from_dict(data, where)
 
@@ -116,6 +136,14 @@ def _fill_machine(data: dict[str, Any], where: str, fsm: FSM,
 
 # -- BT -----------------------------------------------------------------------------------------
 def bt_to_dict(doc: BTDocument) -> dict[str, Any]:
+    """A BT document as fsmbt's JSON/YAML schema (docs/formats/README.md).
+
+    Args:
+        doc: The document.
+
+    Returns:
+        Plain data with ``kind: "bt"`` and the schema version.
+    """
     out: dict[str, Any] = {
         "kind": "bt",
         "schema": SCHEMA_VERSION,
@@ -142,7 +170,15 @@ def bt_to_dict(doc: BTDocument) -> dict[str, Any]:
 
 
 def node_to_dict(root: BTNode) -> dict[str, Any]:
-    """Iterative, so 100 000-deep trees do not hit the recursion limit."""
+    """A node and its subtree as plain data; iterative, so 100 000-deep trees do not hit the
+    recursion limit.
+
+    Args:
+        root: The subtree's root.
+
+    Returns:
+        Nested dicts, children under ``"children"``.
+    """
     def shallow(node: BTNode) -> dict[str, Any]:
         d: dict[str, Any] = {"type": node.type, "kind": node.kind.value}
         if node.name is not None:
@@ -165,6 +201,18 @@ def node_to_dict(root: BTNode) -> dict[str, Any]:
 
 
 def node_from_dict(data: dict[str, Any], where: str = "node") -> BTNode:
+    """A node and its subtree from plain data, without recursion.
+
+    Args:
+        data: Nested dicts as :func:`node_to_dict` writes them.
+        where: The path of ``data`` in the document, for error messages.
+
+    Returns:
+        The subtree's root.
+
+    Raises:
+        InputError: A missing or mistyped field, named by its path in the data.
+    """
     def shallow(d: Any, path: str) -> BTNode:
         _expect(isinstance(d, dict) and isinstance(d.get("type"), str), path,
                 "a node needs a string 'type'")
@@ -185,6 +233,18 @@ def node_from_dict(data: dict[str, Any], where: str = "node") -> BTNode:
 
 
 def bt_from_dict(data: dict[str, Any], *, where: str = "bt") -> BTDocument:
+    """A BT document from fsmbt's JSON/YAML schema.
+
+    Args:
+        data: Plain data as :func:`bt_to_dict` writes it.
+        where: The path of ``data`` in the document, for error messages.
+
+    Returns:
+        The document.
+
+    Raises:
+        InputError: A missing or mistyped field, named by its path in the data.
+    """
     _expect(isinstance(data, dict), where, "expected an object")
     doc = BTDocument(format_version=str(data.get("format_version", "4")),
                      main_tree=_opt_str(data.get("main_tree"), f"{where}.main_tree"),
@@ -210,10 +270,31 @@ def bt_from_dict(data: dict[str, Any], *, where: str = "bt") -> BTDocument:
 
 # -- either -------------------------------------------------------------------------------------
 def model_to_dict(model: FSM | BTDocument) -> dict[str, Any]:
+    """Either kind of model as fsmbt's JSON/YAML schema.
+
+    Args:
+        model: An ``FSM`` or a ``BTDocument``.
+
+    Returns:
+        Plain data whose ``kind`` says which.
+    """
     return fsm_to_dict(model) if isinstance(model, FSM) else bt_to_dict(model)
 
 
 def model_from_dict(data: Any, *, where: str = "model") -> FSM | BTDocument:
+    """Either kind of model from fsmbt's JSON/YAML schema, by its ``kind`` field.
+
+    Args:
+        data: Plain data as :func:`model_to_dict` writes it.
+        where: The path of ``data`` in the document, for error messages.
+
+    Returns:
+        The ``FSM`` or ``BTDocument``.
+
+    Raises:
+        InputError: Not a mapping, an unknown ``kind``, or a missing or mistyped field
+            (named by its path in the data).
+    """
     _expect(isinstance(data, dict), where, "expected a JSON/YAML object")
     kind = data.get("kind")
     if kind == "fsm":
@@ -258,7 +339,8 @@ def _expect(ok: bool, where: str, message: str) -> None:
 
 
 def _as_list(value: Any, where: str) -> list[Any]:
-    _expect(isinstance(value, list), where, "expected a list")
+    if not isinstance(value, list):
+        raise InputError("expected a list", element=where)
     return value
 
 

@@ -1,6 +1,6 @@
 """Structural statistics of a model: what ``fsmbt info`` shows and the size metrics build on.
 
-FSM (DESIGN §3): the *entry state* is the target of the initial transition (``fsm.initial``);
+FSM (docs/conversion.md, 'FSM -> BT: the loop-execution BT'): the *entry state* is the target of the initial transition (``fsm.initial``);
 a *loop state* has in-degree >= 2, where in-degree counts distinct predecessor states and the
 start pseudo-state's edge into the entry state (an FSM without a named start pseudo-state still
 has that edge: it is how the machine gets into its initial state). These are computed on the
@@ -51,6 +51,11 @@ class FSMStats:
     in_degree: dict[str, int] = field(default_factory=dict)
 
     def to_dict(self) -> dict[str, Any]:
+        """The figures as plain data (for ``--json``).
+
+        Returns:
+            Every field, plus ``kind: "fsm"``.
+        """
         return {"kind": "fsm", **asdict(self)}
 
 
@@ -58,7 +63,13 @@ def in_degrees(fsm: FSM) -> dict[str, int]:
     """Distinct predecessors of each top-level state, plus the start edge of the initial state.
 
     Two transitions from the same source into the same target (different events) count once:
-    the LEBT merges them into one guard either way (DESIGN §3).
+    the LEBT merges them into one guard either way (docs/conversion.md, 'FSM -> BT').
+
+    Args:
+        fsm: A machine (only its top level is counted).
+
+    Returns:
+        The in-degree of every top-level state, by name.
     """
     preds: dict[str, set[str]] = {name: set() for name in fsm.states}
     for t in fsm.transitions:
@@ -71,6 +82,15 @@ def in_degrees(fsm: FSM) -> dict[str, int]:
 
 
 def fsm_stats(fsm: FSM) -> FSMStats:
+    """Counts and named states of an FSM (what ``fsmbt info`` prints).
+
+    Args:
+        fsm: A flat or hierarchical machine.
+
+    Returns:
+        Its figures: sizes at the top level and at every level, initial, final, entry, loop
+        and unreachable states, nesting depth and in-degrees.
+    """
     degrees = in_degrees(fsm)
     all_states = all_transitions = composites = parallels = 0
     depth = 0
@@ -131,6 +151,9 @@ def _unreachable(fsm: FSM) -> list[str]:
 # -- BT ---------------------------------------------------------------------------------------
 @dataclass
 class TreeStats:
+    """The shape of one tree: node count, depth (levels), breadth (widest level), the most
+    children of one node, and leaves."""
+
     id: str
     nodes: int
     depth: int
@@ -141,6 +164,9 @@ class TreeStats:
 
 @dataclass
 class BTStats:
+    """Counts of one BT document: nodes by kind and type, leaves, SubTree references, and the
+    main tree's shape with and without references followed."""
+
     main_tree: str | None
     trees: int
     nodes: int  # every tree, SubTree references not expanded
@@ -157,11 +183,24 @@ class BTStats:
     per_tree: list[TreeStats] = field(default_factory=list)
 
     def to_dict(self) -> dict[str, Any]:
+        """The figures as plain data (for ``--json``).
+
+        Returns:
+            Every field (``per_tree`` as a list of dicts), plus ``kind: "bt"``.
+        """
         return {"kind": "bt", **asdict(self)}
 
 
 def tree_shape(root: BTNode | None, tree_id: str = "tree") -> TreeStats:
-    """Nodes, depth (levels), breadth (widest level), widest node and leaves of one tree."""
+    """Nodes, depth (levels), breadth (widest level), widest node and leaves of one tree.
+
+    Args:
+        root: The tree's root (``None``: an empty tree).
+        tree_id: The ID reported.
+
+    Returns:
+        The shape, measured without recursion.
+    """
     if root is None:
         return TreeStats(tree_id, 0, 0, 0, 0, 0)
     width: Counter[int] = Counter()
@@ -178,6 +217,14 @@ def tree_shape(root: BTNode | None, tree_id: str = "tree") -> TreeStats:
 
 
 def bt_stats(doc: BTDocument) -> BTStats:
+    """Counts of a BT document (what ``fsmbt info`` prints).
+
+    Args:
+        doc: The document.
+
+    Returns:
+        Its figures, with one ``TreeStats`` per tree.
+    """
     by_kind: Counter[str] = Counter()
     by_type: Counter[str] = Counter()
     for _tree_id, node in doc.nodes():
@@ -217,13 +264,19 @@ def expanded_depth(doc: BTDocument) -> int | None:
     A SubTree node counts as one level above its tree's root (it is a node BehaviorTree.CPP
     ticks). ``None`` when references are cyclic or dangling. O(N) over all trees: trees are
     measured once each, in reverse topological order of the reference graph.
+
+    Args:
+        doc: The document.
+
+    Returns:
+        The depth in levels, or ``None`` (no main tree, cyclic or dangling references).
     """
     main_id = _main_id(doc)
     if main_id is None:
         return None
     import networkx as nx  # imported here: it costs ~0.4 s at CLI start-up
 
-    graph = nx.DiGraph()
+    graph: nx.DiGraph[str] = nx.DiGraph()
     graph.add_nodes_from(doc.trees)
     for tree_id, node in doc.nodes():
         ref = node.subtree_id
@@ -250,4 +303,12 @@ def expanded_depth(doc: BTDocument) -> int | None:
 
 
 def model_stats(model: FSM | BTDocument) -> FSMStats | BTStats:
+    """The figures of either kind of model.
+
+    Args:
+        model: An ``FSM`` or a ``BTDocument``.
+
+    Returns:
+        ``FSMStats`` for an FSM, ``BTStats`` for a BT document.
+    """
     return fsm_stats(model) if isinstance(model, FSM) else bt_stats(model)

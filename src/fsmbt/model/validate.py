@@ -2,7 +2,7 @@
 
 ``validate(model)`` lists every problem as an ``Issue``; ``check(model)`` raises ``InputError``
 when there is an error (the message lists them all). Errors are models fsmbt cannot give a
-meaning to (DESIGN §1); warnings are legal models that are probably not what the author meant,
+meaning to (docs/semantics.md, 'Models'); warnings are legal models that are probably not what the author meant,
 or whose parts fsmbt cannot model exactly. The rules, with their reasons, are in
 docs/semantics.md and below at each check.
 

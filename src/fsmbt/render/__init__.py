@@ -14,7 +14,12 @@ from fsmbt.model.bt import BTDocument
 from fsmbt.model.fsm import FSM
 from fsmbt.render.bt_graph import bt_to_dot
 from fsmbt.render.dot import (
-    DEFAULT_MAX_NODES, OUTPUT_FORMATS, GraphvizError, TooLargeError, check_output, run_dot,
+    DEFAULT_MAX_NODES,
+    OUTPUT_FORMATS,
+    GraphvizError,
+    TooLargeError,
+    check_output,
+    run_dot,
     write_picture,
 )
 from fsmbt.render.fsm_graph import fsm_to_dot

@@ -1,4 +1,4 @@
-"""The leaf-execution machine of a behavior tree (DESIGN §2), and bounded exploration.
+"""The leaf-execution machine of a behavior tree (docs/semantics.md, 'The leaf-execution machine'), and bounded exploration.
 
 A state is the interpreter's full configuration at the moment it is about to tick an
 environment leaf (node statuses, node memories, the explicit call stack, the pending wake-up):

@@ -1,4 +1,4 @@
-"""The LEBT runtime protocol of DESIGN §3 as a library: leaf behaviours, macro steps, a Machine.
+"""The LEBT protocol (docs/semantics.md, 'The LEBT protocol') as a library: leaf behaviours, macro steps, a Machine.
 
 The two leaf types (written as ``fsmbt.semantics.lebt_spec`` says) behave like this, against a
 blackboard with ``state`` and ``event`` (``""`` = no event pending):
@@ -129,7 +129,7 @@ class LebtLeaves:
 
 
 def drive_macro_step(tick: Callable[[], str], bb: LebtBlackboard, event: str) -> str:
-    """DESIGN §3's macro step around any engine's root tick; returns the last root result.
+    """The LEBT macro step (docs/semantics.md, 'The LEBT protocol') around any engine's root tick; returns the last root result.
     An event still pending after the second tick is dropped."""
     bb.event = event
     result = tick()

@@ -1,4 +1,4 @@
-"""How the two LEBT leaf types are written in a behavior tree (DESIGN §3), shared by the
+"""How the two LEBT leaf types are written in a behavior tree (docs/semantics.md, 'The LEBT protocol'), shared by the
 converter that writes them and the runtimes (interpreter, BehaviorTree.CPP, py_trees) that run
 them.
 

@@ -1,8 +1,8 @@
 """The one shape every behaviour is explored in: a deterministic Mealy machine with a status.
 
 The checker (``fsmbt.verify``) and NuSMV's encoding compare two such machines fed the same
-inputs. What counts as an input and an output depends on the pair (docs/semantics.md,
-"Statuses" names the values):
+inputs. What counts as an input and an output depends on the pair (docs/verification.md,
+"Both models become machines"; docs/semantics.md, "Statuses" names the values):
 
 - FSM vs LEBT (macro steps): inputs are events; outputs are the actions run; status is
   ``"final"`` when the FSM is in a final state / the LEBT has terminated, else ``"running"``.

@@ -24,7 +24,7 @@ Start: ``state`` is the ``state`` port of the one leaf marked ``initial="true"``
 state, or the start pseudo-state when the FSM has an initial event); ``entered`` is false; the
 root is ticked until quiescent (below), which runs the initial state's action.
 
-One macro step (the analogue of DESIGN §3 for a state variable): set ``event``; tick the root;
+One macro step (the analogue of docs/semantics.md, 'The LEBT protocol', for a state variable): set ``event``; tick the root;
 while that tick fired a transition (a leaf wrote ``state``, self-loops included, so the new
 state's subtree must run; its entry action sets ``entered`` on that next tick), tick again, at most ``MAX_TICKS_PER_STEP`` times in all (more is a livelock, reported
 as an ``InputError``); then drop the event if it is still pending (no transition took it: the

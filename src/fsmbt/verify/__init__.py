@@ -1,4 +1,4 @@
-"""Equivalence checking of a source model and its conversion (DESIGN §4, docs/verification.md).
+"""Equivalence checking of a source model and its conversion (docs/verification.md).
 
 ``verify(source, result)`` gives a ``Report``: the verdict and the five properties, each with a
 shortest counterexample when it fails. Two engines: ``native`` (explicit-state product, the
@@ -34,7 +34,26 @@ class EngineDisagreement(RuntimeError):
 
 def verify(source: FSM | BTDocument, result: FSM | BTDocument, *, engine: str = "native",
            loop: bool = False, max_states: int = DEFAULT_MAX_STATES) -> Report:
-    """Check that ``result`` behaves exactly like ``source`` (see ``fsmbt.verify.pairing``)."""
+    """Check that ``result`` behaves exactly like ``source`` (see ``fsmbt.verify.pairing``).
+
+    Args:
+        source: The model that was converted.
+        result: Its conversion.
+        engine: ``native`` (explicit-state product), ``nusmv``, or ``both`` (must agree).
+        loop: BT source: the root is ticked again after it finishes (leaf-execution mode).
+        max_states: Bound on the states the native checker explores per machine.
+
+    Returns:
+        The report: the verdict and the five properties, each with a shortest
+        counterexample when it fails.
+
+    Raises:
+        InputError: Unknown engine, a pair of models that cannot be compared, NuSMV
+            missing when it is asked for, or a machine with more than ``max_states``
+            reachable states.
+        UnsupportedError: A construct the chosen engine does not model (located).
+        EngineDisagreement: With ``both``, the engines differ on some property.
+    """
     if engine not in ENGINES:
         raise InputError(f"unknown verification engine '{engine}' (known: {', '.join(ENGINES)})")
     if engine == "nusmv":
@@ -64,7 +83,8 @@ def _nusmv(source: FSM | BTDocument, result: FSM | BTDocument, loop: bool) -> Re
         raise InputError("the NuSMV engine is not available (fsmbt.verify.nusmv has no check)",
                          hints=(Hint.NATIVE_VERIFIER,))
     try:
-        return checker(source, result, loop=loop)
+        report: Report = checker(source, result, loop=loop)
+        return report
     except FileNotFoundError as exc:
         raise InputError(f"the NuSMV binary is not installed ({exc}); scripts/setup.sh builds it",
                          hints=(Hint.NATIVE_VERIFIER,)) from None

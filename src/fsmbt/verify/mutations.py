@@ -20,6 +20,7 @@ import copy
 import random
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
+from typing import Any
 
 from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.bt_nodes import NodeKind
@@ -110,8 +111,8 @@ def _bt_candidates(doc: BTDocument) -> Iterator[tuple[str, str, Callable[[list[B
                 ns[i].name = f"{ns[i].label}_mutated"
             yield "change_action", f"leaf {label} renamed", relabel
         if node.type == GUARD_TYPE:
-            spec = GuardSpec.from_attrs(node.attrs)
-            for k, pair in enumerate(spec.pairs):
+            guard = GuardSpec.from_attrs(node.attrs)
+            for k, pair in enumerate(guard.pairs):
                 def drop_pair(ns: list[BTNode], i: int = i, k: int = k) -> None:
                     old = GuardSpec.from_attrs(ns[i].attrs)
                     pairs = old.pairs[:k] + old.pairs[k + 1:]
@@ -142,6 +143,8 @@ def mutants(model: Model, *, seed: int = 0, per_operator: int | None = 4) -> lis
     """Single mutants of ``model``: at most ``per_operator`` per operator (``None`` = all),
     sampled with ``seed``; the original is never modified."""
     rng = random.Random(seed)
+    # each apply takes the FSM copy or the BT copy's node list, as its enumerator built it
+    candidates: list[tuple[str, str, Callable[[Any], None]]]
     if isinstance(model, FSM):
         candidates = list(_fsm_candidates(model))
     else:
@@ -159,9 +162,9 @@ def mutants(model: Model, *, seed: int = 0, per_operator: int | None = 4) -> lis
         operator, description, apply = candidates[index]
         copied = copy.deepcopy(model)
         if isinstance(copied, FSM):
-            apply(copied)  # type: ignore[arg-type]
+            apply(copied)
         else:
-            apply([node for _tree, node in copied.nodes()])  # type: ignore[arg-type]
+            apply([node for _tree, node in copied.nodes()])
         out.append(Mutant(operator, description, copied))
     return out
 

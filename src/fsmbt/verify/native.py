@@ -3,8 +3,8 @@
 Both machines (``fsmbt.semantics.machine.Machine``) are fed the same inputs from their start. The
 product ``P`` holds every pair ``(s, r)`` reachable that way, whether or not the two agreed on the
 way (so every property is a plain invariant of ``P``, independent of the others and of search
-order, and the NuSMV engine can state it the same way). The five properties of DESIGN §4, defined
-exactly in docs/verification.md:
+order, and the NuSMV engine can state it the same way). The five properties, defined exactly in
+docs/verification.md, 'The product and the five properties':
 
 - completeness: on every product edge the source's outputs are a subsequence of the result's,
   and every input the source offers, the result accepts;
@@ -39,6 +39,7 @@ import gc
 import time
 from collections.abc import Hashable, Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 from fsmbt.limits import Limits
 from fsmbt.model.errors import InputError
@@ -69,7 +70,7 @@ class _Explored:
     offered inputs that are not explored are silent self-loops (see ``active_inputs``).
     """
 
-    def __init__(self, machine: Machine, outputs: _Interner, max_states: int, role: str) -> None:
+    def __init__(self, machine: Machine[Any], outputs: _Interner, max_states: int, role: str) -> None:
         self.machine = machine
         self.role = role
         self.outputs = outputs
@@ -249,7 +250,7 @@ class Replay:
         return bool(self.differences)
 
 
-def replay(source: Machine, result: Machine, inputs: Sequence[str]) -> Replay:
+def replay(source: Machine[Any], result: Machine[Any], inputs: Sequence[str]) -> Replay:
     """Run ``inputs`` on both machines from their start and record what each did.
 
     A step differs when the outputs or the statuses differ, or one side refuses the input (it is
@@ -449,7 +450,7 @@ def _show(outputs: tuple[str, ...]) -> str:
 
 
 # -- the checker ----------------------------------------------------------------------------------
-def check(source: Machine, result: Machine, *, max_states: int = DEFAULT_MAX_STATES,
+def check(source: Machine[Any], result: Machine[Any], *, max_states: int = DEFAULT_MAX_STATES,
           mode: str = "lockstep") -> Report:
     """Compare two deterministic machines; the five properties, each with a shortest
     counterexample when it fails (see the module docstring and docs/verification.md)."""
@@ -462,7 +463,7 @@ def check(source: Machine, result: Machine, *, max_states: int = DEFAULT_MAX_STA
             gc.enable()
 
 
-def _check(source: Machine, result: Machine, max_states: int, mode: str) -> Report:
+def _check(source: Machine[Any], result: Machine[Any], max_states: int, mode: str) -> Report:
     started = time.perf_counter()
     outputs = _Interner()
     src = _Explored(source, outputs, max_states, "source")

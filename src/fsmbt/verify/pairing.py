@@ -1,7 +1,7 @@
 """Which two machines represent a (source, result) pair of models (docs/verification.md).
 
 - FSM source, BT result (macro steps): the FSM's macro-step machine against the LEBT run under
-  the DESIGN §3 protocol; inputs are events (the FSM's, then any the LEBT's guards name).
+  the LEBT protocol (docs/semantics.md); inputs are events (the FSM's, then any the LEBT's guards name).
 - BT source, FSM result (leaf execution): the BT's leaf-execution machine against the FSM read as
   one (``FSMLeafMachine``): a state is the leaf about to be ticked, inputs are leaf outcomes.
 - FSM vs FSM: both macro-step machines over the union of their events.
@@ -11,6 +11,7 @@
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import Any
 
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import InputError
@@ -26,7 +27,8 @@ LEAF_OUTCOMES = tuple(outcome.value for outcome in LeafOutcome)
 
 
 class FSMLeafMachine:
-    """An FSM (flattened if hierarchical) read as a BT's leaf-execution machine (DESIGN §2).
+    """An FSM (flattened if hierarchical) read as a BT's leaf-execution machine (docs/semantics.md,
+    'The leaf-execution machine').
 
     A state is the leaf about to be ticked: entering it outputs its action (the leaf's label).
     An outcome with no transition leaves the FSM where it is, so the same leaf is ticked again
@@ -81,7 +83,7 @@ class FSMLeafMachine:
 class LEBTWithActiveInputs:
     """``LEBTMachine`` plus a sound ``active_inputs``, so ignored events are not stepped.
 
-    Why it is sound: under the DESIGN §3 protocol an event's identity is read only by two tests,
+    Why it is sound: under the LEBT protocol (docs/semantics.md) an event's identity is read only by two tests,
     made while it is pending: a guard's ``(state, event) in pairs`` and a running state leaf's
     ``event in exits``. ``state`` cannot change while an event is pending (the only writer, a
     state leaf's start, clears the event), and a leaf tested with ``event in exits`` was running
@@ -92,7 +94,7 @@ class LEBTWithActiveInputs:
     (a broken tree) every event is. Cost per state: O(|relevant(x)| + running leaves).
     """
 
-    def __init__(self, machine: Machine) -> None:
+    def __init__(self, machine: Machine[Any]) -> None:
         self.machine = machine
         self.name = machine.name
         self.alphabet: tuple[str, ...] = tuple(machine.alphabet)  # type: ignore[attr-defined]
@@ -153,7 +155,7 @@ def lebt_guard_events(doc: BTDocument) -> list[str]:
 
 
 def machines_for(source: FSM | BTDocument, result: FSM | BTDocument, *,
-                 loop: bool = False) -> tuple[Machine, Machine, str]:
+                 loop: bool = False) -> tuple[Machine[Any], Machine[Any], str]:
     """The (source machine, result machine, mode) for a pair of models."""
     if isinstance(source, FSM) and isinstance(result, FSM):
         alphabet = _union(source.events(), result.events(), *sub_machine_events(source, result))

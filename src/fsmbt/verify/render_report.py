@@ -35,7 +35,7 @@ def render(report: Report) -> RenderableType:
         mark = Text("PASS", style="green") if prop.holds else Text("FAIL", style="bold red")
         table.add_row(_TITLES[name], mark, Text(prop.detail))
     parts.append(table)
-    groups: dict[tuple, list[PropertyResult]] = {}
+    groups: dict[tuple[str | None, ...], list[PropertyResult]] = {}
     for name in PROPERTIES:
         prop = report.properties.get(name)
         if prop is not None and not prop.holds and prop.counterexample:
@@ -70,7 +70,7 @@ def _did(outputs: list[str], status: str) -> str:
     return text if status == "running" else f"{text} [{status}]"
 
 
-def _stats_line(stats: dict) -> str:
+def _stats_line(stats: dict[str, object]) -> str:
     keys = ("source_states", "result_states", "product_states", "product_edges")
     shown = [f"{k.replace('_', ' ')} {stats[k]}" for k in keys if k in stats]
     nusmv = stats.get("nusmv")

@@ -1,5 +1,6 @@
 """The verdict both engines (native, NuSMV) give: five named properties, each with a shortest
-counterexample when it fails (DESIGN §4, the paper's tables III and VIII)."""
+counterexample when it fails (docs/verification.md, 'The product and the five properties';
+the paper's tables III and VIII)."""
 
 from __future__ import annotations
 
@@ -32,6 +33,15 @@ class TraceStep:
 
 @dataclass
 class PropertyResult:
+    """The outcome of one property.
+
+    Attributes:
+        name: One of :data:`PROPERTIES`.
+        holds: Whether the property holds.
+        detail: One line: what was checked, or what failed.
+        counterexample: A shortest trace showing the failure (``None`` when it holds).
+    """
+
     name: str
     holds: bool
     detail: str = ""
@@ -40,6 +50,18 @@ class PropertyResult:
 
 @dataclass
 class Report:
+    """The verdict of one verification, as both engines give it.
+
+    Attributes:
+        engine: ``native``, ``nusmv`` or ``native+nusmv``.
+        source: The source model's name.
+        result: The converted model's name.
+        mode: ``macro-step`` (events in, actions out) or ``leaf-execution`` (leaf outcomes in,
+            leaf labels and root results out); see docs/verification.md.
+        properties: The five properties by name, in :data:`PROPERTIES` order.
+        stats: Figures of the run (states, edges, seconds, ...).
+    """
+
     engine: str
     source: str
     result: str
@@ -49,12 +71,23 @@ class Report:
 
     @property
     def equivalent(self) -> bool:
+        """Whether all five properties were checked and hold."""
         return all(p.holds for p in self.properties.values()) and len(self.properties) == len(PROPERTIES)
 
     def verdicts(self) -> dict[str, bool]:
+        """Each checked property's name and whether it holds.
+
+        Returns:
+            A dict from property name to verdict.
+        """
         return {name: p.holds for name, p in self.properties.items()}
 
     def to_dict(self) -> dict[str, Any]:
+        """The report as plain data (for ``--json``), with ``equivalent`` added.
+
+        Returns:
+            Nested dicts and lists of strings, numbers and booleans.
+        """
         data = asdict(self)
         data["equivalent"] = self.equivalent
         return data

@@ -2,7 +2,7 @@
 "FSMs vs BTs"), both directions. Choices the publications leave open: docs/baselines.md.
 
 FSM -> BT: the FSM's current state lives in a blackboard variable. The root is a selector
-(``ReactiveFallback``: the book's Fallback is reactive, DESIGN §1 trap (a)) with, per reachable
+(``ReactiveFallback``: the book's Fallback is reactive, docs/semantics.md, 'Names') with, per reachable
 state ``s``, one guarded subtree ``ReactiveSequence(SvIsState(s), SvEntryAction(s),
 SvTransition(s))``: 4 nodes and 4 edges per state, plus the root: 8M+1 graphical elements. The
 transition leaf holds all of ``s``'s outgoing transitions and sets the state variable. An FSM

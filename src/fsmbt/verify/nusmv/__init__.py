@@ -1,4 +1,4 @@
-"""NuSMV as the second, independent verification engine (DESIGN §4, docs/nusmv.md).
+"""NuSMV as the second, independent verification engine (docs/verification.md, docs/nusmv.md).
 
 ``check(source, result, loop=False)`` encodes both models as SMV modules from their structure
 (the BT's tick rules as transition relations, never the native interpreter's explored graph),
@@ -9,6 +9,8 @@ builds the product and the five properties as CTL specs, runs NuSMV once and ret
 from __future__ import annotations
 
 import time
+from collections.abc import Iterable
+from typing import TYPE_CHECKING, TypeAlias
 
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import InputError
@@ -19,13 +21,19 @@ from fsmbt.verify.nusmv.encode_fsm import FSMEncoder
 from fsmbt.verify.nusmv.runner import NuSMVError, run_nusmv
 from fsmbt.verify.nusmv.smv import Symbols
 from fsmbt.verify.nusmv.specs import product
-from fsmbt.verify.nusmv.traces import build_report
+from fsmbt.verify.nusmv.traces import Context, Encoder, build_report
+from fsmbt.verify.report import Report
+
+if TYPE_CHECKING:
+    from fsmbt.verify.nusmv.encode_lebt import LebtEncoder  # noqa: F401 - in Encoder
+
+Encoders: TypeAlias = tuple[Encoder, Encoder, Symbols, Symbols, str]
 
 MACRO_STEP = "macro-step"
 LEAF_EXECUTION = "leaf-execution"
 
 
-def _union(*groups) -> list[str]:
+def _union(*groups: Iterable[str]) -> list[str]:
     seen: dict[str, None] = {}
     for group in groups:
         for item in group:
@@ -33,7 +41,8 @@ def _union(*groups) -> list[str]:
     return list(seen)
 
 
-def encode(source: FSM | BTDocument, result: FSM | BTDocument, *, loop: bool = False):
+def encode(source: FSM | BTDocument, result: FSM | BTDocument, *, loop: bool = False
+           ) -> Encoders:
     """The two machine encoders, the shared symbol tables and the mode for a pair of models
     (the same pairing as ``fsmbt.verify.pairing.machines_for``)."""
     from fsmbt.verify.pairing import lebt_guard_events, sub_machine_events
@@ -63,11 +72,12 @@ def encode(source: FSM | BTDocument, result: FSM | BTDocument, *, loop: bool = F
     raise InputError(f"cannot compare a {type(source).__name__} with a {type(result).__name__}")
 
 
-def build_model(source: FSM | BTDocument, result: FSM | BTDocument, *, loop: bool = False):
+def build_model(source: FSM | BTDocument, result: FSM | BTDocument, *, loop: bool = False
+                ) -> tuple[str, list[str], Context]:
     """The SMV text of the product, the spec names and what is needed to decode traces."""
     src_enc, res_enc, inputs, outputs, mode = encode(source, result, loop=loop)
     src, res = src_enc.encode(), res_enc.encode()
-    extra = getattr(res_enc, "extra_specs", lambda: [])()
+    extra: list[tuple[str, str]] = getattr(res_enc, "extra_specs", lambda: [])()
     prod = product(src, res, inputs, extra)
     text = src.text + "\n" + res.text + "\n" + prod.text
     return text, prod.spec_names, (src, res, src_enc, res_enc, inputs, outputs, mode,
@@ -75,7 +85,7 @@ def build_model(source: FSM | BTDocument, result: FSM | BTDocument, *, loop: boo
 
 
 def check(source_model: FSM | BTDocument, result_model: FSM | BTDocument, *,
-          loop: bool = False, timeout: float = 300.0) -> "Report":  # noqa: F821
+          loop: bool = False, timeout: float = 300.0) -> Report:
     """Verify ``result_model`` against ``source_model`` with NuSMV; see the module docstring.
 
     Raises ``UnsupportedError`` for BT node types the encoding does not model (docs/nusmv.md)

@@ -1,4 +1,5 @@
-"""A behavior tree as an SMV module, written from the tree's structure (docs/nusmv.md).
+"""A behavior tree as an SMV module, written from the tree's structure (docs/semantics.md,
+"The leaf-execution machine"; docs/nusmv.md).
 
 The tick rules of BehaviorTree.CPP v4 are transition relations over per-node variables, one
 *micro-step* per node visit, exactly as the interpreter walks the tree (docs/nusmv.md):
@@ -27,6 +28,7 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.bt_nodes import NodeKind
@@ -35,6 +37,9 @@ from fsmbt.semantics.bt_interpreter import CompiledNode, CompiledTree
 from fsmbt.semantics.nodes import NUSMV_ENCODED, all_nodes, node_semantics
 from fsmbt.semantics.status import LeafOutcome, NodeStatus, RootResult
 from fsmbt.verify.nusmv.smv import Symbols, any_of, case
+
+if TYPE_CHECKING:
+    from fsmbt.verify.nusmv.encode_fsm import Encoding
 
 # The encoding rules by node kind, from the registry's ``nusmv`` field.
 #: type -> (is_fallback, emits wake-up after a fresh child succeeds/fails, with memory)
@@ -344,7 +349,7 @@ class LeafBTEncoder:
 
         return ["cur"] if is_plain_tree(self.core.tree) else self.core.identity_vars()
 
-    def encode(self):
+    def encode(self) -> Encoding:
         from fsmbt.verify.nusmv.encode_fsm import NONE_OUT, Encoding
 
         core = self.core

@@ -11,7 +11,7 @@ Size: O(S + T) lines for S states and T transitions.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 from fsmbt.model.errors import InputError
@@ -34,7 +34,8 @@ class Encoding:
     inputs: list[str]  # inputs the machine may be offered (names)
     id_vars: list[tuple[str, str]]  # identity variables (name, SMV type) at stable points
     follows: bool = False
-    decode_state: object = None  # callable(dict of var -> value) -> description
+    # the state's description from its variables' values (dict of var -> value)
+    decode_state: Callable[[dict[str, str]], str] = str
     var_order: list[str] = field(default_factory=list)  # the module's variables, for the BDD order
 
 
@@ -105,10 +106,10 @@ class FSMEncoder:
             for name, state in fsm.states.items():
                 if state.final:
                     continue
-                for symbol, t in table.get(name, {}).items():
-                    if symbol is None or symbol not in self.alphabet:
+                for label, t in table.get(name, {}).items():
+                    if label is None or label not in self.alphabet:
                         continue
-                    guard = f"go & q = {q.id(name)} & inp = {self.inputs.id(symbol)}"
+                    guard = f"go & q = {q.id(name)} & inp = {self.inputs.id(label)}"
                     next_q.append((guard, q.id(t.target)))
                     next_o1.append((guard, self._out(t.target)))
             if self.start_pseudo is not None:

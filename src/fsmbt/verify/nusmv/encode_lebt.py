@@ -1,4 +1,4 @@
-"""A loop-execution BT (DESIGN §3) as an SMV module: the tree's tick rules (``BTCore``) with the
+"""A loop-execution BT (docs/semantics.md, 'The LEBT protocol') as an SMV module: the tree's tick rules (``BTCore``) with the
 LEBT leaves answered from a blackboard held in SMV variables, and the macro-step protocol of
 ``fsmbt.semantics.lebt_runtime`` as transitions:
 
@@ -45,7 +45,7 @@ class LebtEncoder:
         self.events = Symbols("ev")
         self.events.add_all(self.alphabet)
         for guard in self.leaves.guards.values():
-            for source, event in guard.pairs:
+            for source, _event in guard.pairs:
                 self.states.id(source)
         for spec in self.leaves.states.values():
             self.states.id(spec.state)
@@ -155,12 +155,12 @@ class LebtEncoder:
         for symbol, sid in sorted(self.inputs.to_id.items()):
             defines.append((f"offers_{sid}", "TRUE" if symbol in self.alphabet else "FALSE"))
         ident = [("bbs", extra_vars["bbs"]), ("lres", extra_vars["lres"])]
-        running = self._running_leaf()
-        if running is None:
+        runl = self._running_leaf()
+        if runl is None:
             ident += [(v, safe_text(core.var_types[v])) for v in core.identity_vars()]
         else:
-            defines.append(("runl", running[0]))
-            ident.append(("runl", running[1]))
+            defines.append(("runl", runl[0]))
+            ident.append(("runl", runl[1]))
         text = core.emit(self.module, "go, inp", defines)
         names = self.states.to_name
         return Encoding(self.module, text, [f"o{j}" for j in range(1, k + 1)],

@@ -28,7 +28,10 @@ from dataclasses import dataclass
 from fsmbt.verify.nusmv.encode_fsm import NONE_OUT, Encoding
 from fsmbt.verify.nusmv.smv import Symbols, all_of, any_of, enum_type, subsequence
 from fsmbt.verify.report import (
-    COMPLETENESS, DEADLOCK_ABSENCE, NO_ADDITIONAL_BEHAVIOR, REACHABILITY,
+    COMPLETENESS,
+    DEADLOCK_ABSENCE,
+    NO_ADDITIONAL_BEHAVIOR,
+    REACHABILITY,
     TERMINATION_CONSISTENCY,
 )
 

@@ -4,11 +4,25 @@ one step per input both machines took while attached, the start as step 0."""
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING, TypeAlias
+
+from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import Hint, UnsupportedError
+from fsmbt.model.fsm import FSM
 from fsmbt.semantics.status import MachineStatus
-from fsmbt.verify.nusmv.encode_fsm import NONE_OUT
+from fsmbt.verify.nusmv.encode_bt import LeafBTEncoder
+from fsmbt.verify.nusmv.encode_fsm import NONE_OUT, Encoding, FSMEncoder
 from fsmbt.verify.nusmv.runner import SpecResult, TraceState
+from fsmbt.verify.nusmv.smv import Symbols
 from fsmbt.verify.report import PROPERTIES, PropertyResult, Report, TraceStep
+
+if TYPE_CHECKING:
+    from fsmbt.verify.nusmv.encode_lebt import LebtEncoder
+
+Encoder: TypeAlias = "FSMEncoder | LeafBTEncoder | LebtEncoder"
+# What decoding needs: both encodings, both encoders, the input and output symbol tables, the
+# mode ("macro-step" or "leaf-execution") and the BDD variable order.
+Context: TypeAlias = tuple[Encoding, Encoding, Encoder, Encoder, Symbols, Symbols, str, str]
 
 _DETAIL_OK = {
     "reachability": "every state reachable alone is reached with matching behaviour (CTL)",
@@ -41,7 +55,7 @@ def _attached_go(before: dict[str, str], inputs: dict[str, str], follows: bool) 
         follows or before.get(f"r.offers_{symbol}") == "TRUE")
 
 
-def decode_trace(trace: list[TraceState], context) -> list[TraceStep]:
+def decode_trace(trace: list[TraceState], context: Context) -> list[TraceStep]:
     """One step per attached input: a transition taken with ``attached_go`` starts it, the
     next state where both machines are stable ends it (a BT module needs micro-steps)."""
     src, res, _src_enc, _res_enc, inputs, outputs, _mode, _order = context
@@ -58,7 +72,7 @@ def decode_trace(trace: list[TraceState], context) -> list[TraceStep]:
             continue  # micro-steps, or an idle step: nothing happened
         s_vals, r_vals = _side(v, "s"), _side(v, "r")
 
-        def outs(vals: dict[str, str], enc) -> list[str]:
+        def outs(vals: dict[str, str], enc: Encoding) -> list[str]:
             return [outputs.name(vals[slot]) or vals[slot] for slot in enc.slots
                     if vals.get(slot, NONE_OUT) != NONE_OUT]
 
@@ -70,8 +84,8 @@ def decode_trace(trace: list[TraceState], context) -> list[TraceStep]:
     return steps
 
 
-def build_report(names: list[str], results: list[SpecResult], context, source_model,
-                 result_model) -> Report:
+def build_report(names: list[str], results: list[SpecResult], context: Context,
+                 source_model: FSM | BTDocument, result_model: FSM | BTDocument) -> Report:
     src, res, src_enc, res_enc, inputs, outputs, mode, _order = context
     report = Report(engine="nusmv", source=_name(source_model), result=_name(result_model),
                     mode=mode)
@@ -79,7 +93,11 @@ def build_report(names: list[str], results: list[SpecResult], context, source_mo
         if name in PROPERTIES:
             continue
         if not result.holds:
-            raise UnsupportedError(res_enc.extra_message(name), hints=(Hint.NATIVE_VERIFIER,))
+            from fsmbt.verify.nusmv.encode_lebt import LebtEncoder  # only LEBT adds specs
+
+            if isinstance(res_enc, LebtEncoder):
+                raise UnsupportedError(res_enc.extra_message(name), hints=(Hint.NATIVE_VERIFIER,))
+            raise UnsupportedError(f"the NuSMV check {name!r} failed")
     for name, result in zip(names, results):
         if name not in PROPERTIES:
             continue
@@ -96,7 +114,7 @@ def build_report(names: list[str], results: list[SpecResult], context, source_mo
     return report
 
 
-def _unmatched(values: dict[str, str], context) -> str:
+def _unmatched(values: dict[str, str], context: Context) -> str:
     """Name the state the reachability counterexample picked (the frozen copy's value)."""
     src, res = context[0], context[1]
     parts = []
@@ -109,10 +127,9 @@ def _unmatched(values: dict[str, str], context) -> str:
     return f" (candidates: {', '.join(parts)})" if parts else ""
 
 
-def _name(model) -> str:
-    name = getattr(model, "name", None)
-    if isinstance(name, str):
-        return name
+def _name(model: FSM | BTDocument) -> str:
+    if isinstance(model, FSM):
+        return model.name
     try:
         return model.main.id
     except Exception:  # noqa: BLE001 - a name for the report only
