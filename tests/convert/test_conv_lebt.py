@@ -9,7 +9,7 @@ from fsmbt.convert import convert
 from fsmbt.model.bt import BTNode
 from fsmbt.model.errors import UnsupportedError
 from fsmbt.model.fsm import FSM
-from fsmbt.semantics.lebt_spec import GUARD_TYPE, STATE_TYPE, GuardSpec, StateSpec
+from fsmbt.semantics.lebt.spec import GUARD_TYPE, STATE_TYPE, GuardSpec, StateSpec
 
 
 def _subtree_state(selector: BTNode) -> str:

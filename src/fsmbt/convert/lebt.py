@@ -34,7 +34,7 @@ from fsmbt.model.bt_nodes import NodeKind
 from fsmbt.model.errors import UnsupportedError
 from fsmbt.model.flatten import flatten, needs_flattening
 from fsmbt.model.fsm import FSM
-from fsmbt.semantics.lebt_spec import GUARD_TYPE, STATE_TYPE, escape
+from fsmbt.semantics.lebt.spec import GUARD_TYPE, STATE_TYPE, escape
 
 STYLES = ("paper",)
 ROOT_NAME = "LEBT"

@@ -47,7 +47,7 @@ from fsmbt.semantics.bt_interpreter import (
     OUTCOME_FAILURE, OUTCOME_RUNNING, OUTCOME_SUCCESS, OUTCOME_TO_STATUS, STATUS_NAMES,
     BTInterpreter, CompiledTree, LeafRequest, Snapshot,
 )
-from fsmbt.semantics.lebt_spec import NO_EVENT, decode_pairs, encode_pairs
+from fsmbt.semantics.lebt.spec import NO_EVENT, decode_pairs, encode_pairs
 from fsmbt.semantics.machine import FINAL, RUNNING, FSMMachine, Outputs
 
 IS_STATE, ENTRY_ACTION, TRANSITION = "SvIsState", "SvEntryAction", "SvTransition"
@@ -59,7 +59,7 @@ MAX_TICKS_PER_STEP = 8
 
 
 def encode_transitions(pairs: Sequence[tuple[str, str]]) -> str:
-    """``event/target`` items joined by ``;`` (names escaped as in ``lebt_spec``)."""
+    """``event/target`` items joined by ``;`` (names escaped as in ``fsmbt.semantics.lebt.spec``)."""
     return encode_pairs(pairs)
 
 

@@ -24,7 +24,7 @@ from dataclasses import dataclass
 from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.bt_nodes import NodeKind
 from fsmbt.model.fsm import FSM
-from fsmbt.semantics.lebt_spec import GUARD_TYPE, STATE_TYPE, GuardSpec, StateSpec
+from fsmbt.semantics.lebt.spec import GUARD_TYPE, STATE_TYPE, GuardSpec, StateSpec
 
 Model = FSM | BTDocument
 

@@ -24,27 +24,25 @@ from lxml import etree
 
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.bt_nodes import NodeKind
-from fsmbt.semantics.bt_interpreter import (
-    OUTCOME_TO_STATUS, STATUS_NAMES, CompiledNode, CompiledTree, Environment, TickRecord,
+from fsmbt.semantics.bt_interpreter import CompiledNode, CompiledTree, Environment, TickRecord
+from fsmbt.semantics.lebt.driver import EngineLebtRun
+from fsmbt.semantics.lebt.leaves import (
+    LebtLeaves,
+    guard_outcome,
+    state_on_running,
+    state_on_start,
 )
-from fsmbt.semantics.lebt_runtime import (
-    EngineLebtRun, LebtLeaves, guard_outcome, state_on_running, state_on_start,
-)
-from fsmbt.semantics.lebt_spec import BB_EVENT, BB_STATE, GUARD_TYPE, NO_EVENT, STATE_TYPE
+from fsmbt.semantics.lebt.spec import BB_EVENT, BB_STATE, GUARD_TYPE, NO_EVENT, STATE_TYPE
+from fsmbt.semantics.status import LeafOutcome, NodeStatus
 
 ACTION_ID = "FsmbtAction"
 CONDITION_ID = "FsmbtCondition"
 
-_STATUS = {
-    "success": btpy.NodeStatus.SUCCESS, "failure": btpy.NodeStatus.FAILURE,
-    "running": btpy.NodeStatus.RUNNING,
-}
-_NAME_OF = {
-    btpy.NodeStatus.SUCCESS: "SUCCESS", btpy.NodeStatus.FAILURE: "FAILURE",
-    btpy.NodeStatus.RUNNING: "RUNNING", btpy.NodeStatus.SKIPPED: "SKIPPED",
-    btpy.NodeStatus.IDLE: "IDLE",
-}
-assert set(OUTCOME_TO_STATUS) == set(_STATUS) and "SKIPPED" in STATUS_NAMES
+#: A leaf outcome (``LeafOutcome`` or its string) as the engine's status.
+_STATUS = {outcome: getattr(btpy.NodeStatus, outcome.status.name) for outcome in LeafOutcome}
+#: The engine's status as ours, and by name (the interpreter's ``TickRecord`` spelling).
+_NODE_STATUS = {getattr(btpy.NodeStatus, status.name): status for status in NodeStatus}
+_NAME_OF = {engine: status.name for engine, status in _NODE_STATUS.items()}
 
 #: How a leaf is written: (registration ID, extra attributes) for a compiled leaf.
 LeafWriter = Callable[[CompiledNode], tuple[str, dict[str, str]]]
@@ -137,7 +135,7 @@ class BTCppRunner:
         return TickRecord(self._leaves, _NAME_OF[status])
 
 
-# -- the LEBT protocol in BehaviorTree.CPP -----------------------------------------------------
+# -- the LEBT protocol in BehaviorTree.CPP (tick function for fsmbt.semantics.lebt.driver) ----
 class _TreeBlackboard:
     """``state``/``event`` kept in the BehaviorTree.CPP tree's root blackboard."""
 
@@ -197,6 +195,6 @@ class BTCppLebtRunner(EngineLebtRun):
     def _running(self, bt_node: btpy.TreeNode) -> btpy.NodeStatus:
         return _STATUS[state_on_running(self.leaves.states[self._id(bt_node)], self.bb)]
 
-    def _tick(self) -> str:
-        self.last_result = _NAME_OF[self.bt.tick_once()]
-        return self.last_result
+    def _tick_engine(self) -> NodeStatus:
+        """One ``tickOnce`` of the engine's tree."""
+        return _NODE_STATUS[self.bt.tick_once()]
