@@ -26,8 +26,8 @@ Complexity: O(S + T) time and memory for S states and T transitions (after flatt
 
 from __future__ import annotations
 
-from fsmbt.convert.engines import ConversionResult
 from fsmbt.convert.perf import without_gc_pauses
+from fsmbt.convert.result import ConversionResult
 from fsmbt.convert.structure import LebtStructure, analyse
 from fsmbt.model.bt import BTDocument, BTNode, NodeModel, PortModel
 from fsmbt.model.bt_nodes import NodeKind

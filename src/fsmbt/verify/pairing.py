@@ -15,6 +15,7 @@ from collections.abc import Sequence
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import InputError
 from fsmbt.model.fsm import FSM
+from fsmbt.semantics.lebt.machine import LEBTMachine
 from fsmbt.semantics.lebt.spec import GUARD_TYPE, GuardSpec
 from fsmbt.semantics.machine import FINAL, RUNNING, FSMMachine, Machine, Outputs
 
@@ -157,7 +158,6 @@ def machines_for(source: FSM | BTDocument, result: FSM | BTDocument, *,
         return (FSMMachine(source, alphabet=alphabet), FSMMachine(result, alphabet=alphabet),
                 MACRO_STEP)
     if isinstance(source, FSM) and isinstance(result, BTDocument):
-        from fsmbt.semantics.lebt.machine import LEBTMachine
         from fsmbt.semantics.state_variable_runtime import (
             is_state_variable_bt, machines_for_state_variable,
         )

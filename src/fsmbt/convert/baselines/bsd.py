@@ -28,7 +28,8 @@ from fsmbt.convert.baselines.common import (
     EV_FAILURE, EV_RUNNING, EV_SUCCESS, FAILURE, REACTIVE_CONTROLS, SUCCESS, Cont,
     check_baseline_node, control, exits_of, leaf_node, prepare_fsm, sv_node_models,
 )
-from fsmbt.convert.engines import ConversionResult, register_engine
+from fsmbt.convert.engines import register_engine
+from fsmbt.convert.result import ConversionResult
 from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.bt_nodes import NodeKind
 from fsmbt.model.fsm import FSM, State

@@ -21,6 +21,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 from fsmbt.model.bt import BTDocument
+from fsmbt.semantics.lebt.fast import strict_lebt_sels
 from fsmbt.semantics.lebt.leaves import LebtLeaves
 from fsmbt.semantics.lebt.spec import NO_EVENT
 from fsmbt.verify.nusmv.encode_bt import BTCore, safe_text
@@ -73,8 +74,6 @@ class LebtEncoder:
         (``fsmbt.semantics.lebt.fast``), so comparing these three compares the same states as
         comparing all variables, with a frozen copy of 3 variables instead of ~3 per node
         (the reachability spec's cost). ``None`` for any other tree: all variables count."""
-        from fsmbt.semantics.lebt.fast import strict_lebt_sels
-
         if strict_lebt_sels(self.core.tree) is None:
             return None
         core = self.core
