@@ -18,8 +18,9 @@ is pending) or ``tick_exactly_once`` and returns the same ``TickRecord`` as the 
 from __future__ import annotations
 
 from collections.abc import Callable
+from typing import Any
 
-import behaviortreepy as btpy
+import behaviortreepy as btpy  # type: ignore[import-untyped]  # no stubs shipped
 from lxml import etree
 
 from fsmbt.model.bt import BTDocument
@@ -39,7 +40,7 @@ ACTION_ID = "FsmbtAction"
 CONDITION_ID = "FsmbtCondition"
 
 #: A leaf outcome (``LeafOutcome`` or its string) as the engine's status.
-_STATUS = {outcome: getattr(btpy.NodeStatus, outcome.status.name) for outcome in LeafOutcome}
+_STATUS: dict[str, Any] = {outcome: getattr(btpy.NodeStatus, outcome.status.name) for outcome in LeafOutcome}
 #: The engine's status as ours, and by name (the interpreter's ``TickRecord`` spelling).
 _NODE_STATUS = {getattr(btpy.NodeStatus, status.name): status for status in NodeStatus}
 _NAME_OF = {engine: status.name for engine, status in _NODE_STATUS.items()}
@@ -70,7 +71,9 @@ def compiled_to_xml(tree: CompiledTree, leaf_writer: LeafWriter = _default_leaf)
         node = nodes[nid]
         if node.kind in (NodeKind.ACTION, NodeKind.CONDITION):
             tag, extra = leaf_writer(node)
-            etree.SubElement(parent_el, tag, name=leaf_name(node), **extra)
+            leaf_attrs = {"name": leaf_name(node)}
+            leaf_attrs.update(extra)
+            etree.SubElement(parent_el, tag, attrib=leaf_attrs)
             continue
         if node.type == "SubTree":
             sub_id = f"T{nid}"
@@ -89,7 +92,7 @@ def compiled_to_xml(tree: CompiledTree, leaf_writer: LeafWriter = _default_leaf)
             attrs["num_attempts"] = str(node.params[0])
         elif node.type == "RunOnce":
             attrs["then_skip"] = "true" if node.params[0] else "false"
-        el = etree.SubElement(parent_el, node.type, **attrs)
+        el = etree.SubElement(parent_el, node.type, attrib=attrs)
         for child in reversed(node.children):
             work.append((child, el))
     # children were pushed reversed but SubElement appends: rebuild order by sorting on ids
@@ -144,7 +147,8 @@ class _TreeBlackboard:
 
     @property
     def state(self) -> str:
-        return self._bb.get_string(BB_STATE)
+        value: str = self._bb.get_string(BB_STATE)
+        return value
 
     @state.setter
     def state(self, value: str) -> None:
@@ -152,7 +156,8 @@ class _TreeBlackboard:
 
     @property
     def event(self) -> str:
-        return self._bb.get_string(BB_EVENT)
+        value: str = self._bb.get_string(BB_EVENT)
+        return value
 
     @event.setter
     def event(self, value: str) -> None:

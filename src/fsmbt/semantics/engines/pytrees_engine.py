@@ -40,7 +40,7 @@ SUPPORTED_TYPES = frozenset({
     "ForceSuccess", "ForceFailure", "SubTree", "AlwaysSuccess", "AlwaysFailure",
 })
 #: A leaf outcome (``LeafOutcome`` or its string) as py_trees' status.
-_STATUS = {LeafOutcome.SUCCESS: Status.SUCCESS, LeafOutcome.FAILURE: Status.FAILURE,
+_STATUS: dict[str, Status] = {LeafOutcome.SUCCESS: Status.SUCCESS, LeafOutcome.FAILURE: Status.FAILURE,
            LeafOutcome.RUNNING: Status.RUNNING}
 #: py_trees' status as ours (INVALID = never ticked or halted = IDLE), and by name.
 _NODE_STATUS = {Status.SUCCESS: NodeStatus.SUCCESS, Status.FAILURE: NodeStatus.FAILURE,

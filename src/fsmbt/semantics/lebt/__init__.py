@@ -1,6 +1,6 @@
 """The LEBT runtime: how a loop-execution BT (the rules engine's FSM -> BT result) runs.
 
-docs/semantics.md ("The LEBT runtime protocol") states the rules; each module has one job:
+docs/semantics.md §5 ("The LEBT protocol") states the rules; each module has one job:
 
 - ``spec``: how the two leaves ``LebtGuard``/``LebtState`` are written (ports, pair codec,
   blackboard keys); imported by the converter, the checkers and the LLM path.

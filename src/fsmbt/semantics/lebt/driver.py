@@ -1,6 +1,6 @@
 """The LEBT macro step, written once, over a tick function that each runtime plugs in.
 
-Rules (docs/semantics.md, "The LEBT runtime protocol"):
+Rules (docs/semantics.md §5, "The LEBT protocol"):
 
 - one macro step = post the event (``event`` on the blackboard), tick the root; if the root
   returned SUCCESS with the event still pending, tick once more (the second-tick rule: the

@@ -2,7 +2,7 @@
 
 Why: the generic interpreter ticks past every root-level guard in each macro step, so checking
 an n-state FSM against its LEBT costs O(n^2) (1 000 states: ~100 s). For trees of the strict
-LEBT grammar (docs/semantics.md, "The LEBT runtime protocol") ::
+LEBT grammar (docs/semantics.md §5, "The LEBT protocol") ::
 
     Root := Sequence(Sel+)      Sel := Fallback(Guard, Body)      Body := State | Sequence(State, Sel*)
 

@@ -1,6 +1,6 @@
 """The behaviour of the two LEBT leaves, and the parsed leaves of a compiled tree.
 
-Rules (docs/semantics.md, "The LEBT runtime protocol"), against a blackboard with ``state`` and
+Rules (docs/semantics.md §5, "The LEBT protocol"), against a blackboard with ``state`` and
 ``event`` (``""`` = no event pending):
 
 - guard (``LebtGuard``, a condition): FAILURE when (``state``, ``event``) is one of its pairs —

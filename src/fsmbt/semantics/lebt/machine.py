@@ -3,7 +3,7 @@
 A tree of the strict LEBT grammar (``fsmbt.semantics.lebt.fast.strict_lebt_sels``) runs on
 ``FastLEBTRuntime`` (O(1) per macro step for a deterministic LEBT); any other tree, or
 ``generic=True``, on the interpreter (``LEBTRuntime``, O(root-level guards) per step). Both are
-``MacroStepDriver`` s (docs/semantics.md, "The LEBT runtime protocol"), so they take the same
+``MacroStepDriver`` s (docs/semantics.md §5, "The LEBT protocol"), so they take the same
 steps; ``fast`` says which one was chosen. Choosing costs one O(N) pass over the tree.
 """
 
