@@ -52,8 +52,8 @@ def driver(script: list[tuple[NodeStatus, bool, str | None]], *, init: bool = Fa
         return MacroStepDriver(leaves, tick, 0, ScriptState), tick
     persistent = blackboard
 
-    def same_blackboard(state: str) -> LebtBlackboard:
-        persistent.state = state
+    def same_blackboard(state: str, event: str) -> LebtBlackboard:
+        persistent.state, persistent.event = state, event
         return persistent
     return MacroStepDriver(leaves, tick, 0, ScriptState, same_blackboard), tick
 

@@ -58,7 +58,7 @@ class MacroStepDriver(Generic[M, S]):
         tick: the runtime's tick function.
         idle: the memory before the first tick.
         make_state: the runtime's state type (a ``NamedTuple`` of three fields).
-        blackboard: gives the blackboard a step runs on, holding ``state``; a fresh
+        blackboard: gives the blackboard a step runs on, from (``state``, ``event``); a fresh
             ``PlainBlackboard`` by default, the engine's own for a real engine.
     """
 
@@ -68,7 +68,7 @@ class MacroStepDriver(Generic[M, S]):
         tick: TickFunction[M],
         idle: M,
         make_state: StateFactory[M, S],
-        blackboard: Callable[[str], LebtBlackboard] = PlainBlackboard,
+        blackboard: Callable[[str, str], LebtBlackboard] = PlainBlackboard,
     ) -> None:
         self.leaves = leaves
         self._tick = tick
@@ -85,8 +85,7 @@ class MacroStepDriver(Generic[M, S]):
         start = self.leaves.start
         if not self.leaves.init_on_start:
             return self._make_state(self._idle, start, None), ()
-        bb = self._blackboard(start)
-        bb.event = NO_EVENT
+        bb = self._blackboard(start, NO_EVENT)
         actions: list[str] = []
         memory, result = self._tick(self._idle, bb, actions)
         return self._make_state(memory, bb.state, result), tuple(actions)
@@ -102,8 +101,7 @@ class MacroStepDriver(Generic[M, S]):
             The next state and the actions run during the step, in order.
         """
         memory, bb_state, _last = state
-        bb = self._blackboard(bb_state)
-        bb.event = event
+        bb = self._blackboard(bb_state, event)
         actions: list[str] = []
         tick = self._tick
         memory, result = tick(memory, bb, actions)
@@ -156,8 +154,9 @@ class EngineLebtRun:
         self.last_result = self._tick_engine()
         return None, self.last_result
 
-    def _engine_blackboard(self, state: str) -> LebtBlackboard:
+    def _engine_blackboard(self, state: str, event: str) -> LebtBlackboard:
         self.bb.state = state
+        self.bb.event = event
         return self.bb
 
     @cached_property

@@ -31,6 +31,9 @@ from fsmbt.semantics.status import LeafOutcome, NodeStatus
 
 _IDLE = NodeStatus.IDLE
 _RUNNING = NodeStatus.RUNNING
+#: lookups instead of ``outcome.status`` / ``NodeStatus(i)`` calls: this is the inner loop
+_STATUS_OF_OUTCOME = {outcome: outcome.status for outcome in LeafOutcome}
+_NODE_STATUS = tuple(NodeStatus)
 
 
 class InterpretedLebtState(NamedTuple):
@@ -56,8 +59,8 @@ class InterpretedTick:
         snap, event = interp.advance(snap)
         while isinstance(event, LeafRequest):
             outcome = self.leaf_outcome(event, bb, actions)
-            snap, event = interp.advance(snap, outcome.status)
-        return snap, NodeStatus(event.status)
+            snap, event = interp.advance(snap, _STATUS_OF_OUTCOME[outcome])
+        return snap, _NODE_STATUS[event.status]
 
     def leaf_outcome(
         self, request: LeafRequest, bb: LebtBlackboard, actions: list[str]
