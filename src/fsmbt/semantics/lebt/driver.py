@@ -40,14 +40,14 @@ from fsmbt.semantics.machine import Outputs
 from fsmbt.semantics.status import NodeStatus
 
 M = TypeVar("M")
-S = TypeVar("S", bound="tuple[Any, str, NodeStatus | None]")
+S = TypeVar("S", bound=tuple[Any, str, NodeStatus | None])
 
 #: One root tick: (memory before, blackboard, actions run so far) -> (memory after, root status).
 TickFunction = Callable[[M, LebtBlackboard, list[str]], tuple[M, NodeStatus]]
 #: Builds a runtime's state from (memory, ``state`` on the blackboard, last root status).
-StateFactory = Callable[[M, str, "NodeStatus | None"], S]
+StateFactory = Callable[[M, str, NodeStatus | None], S]
 
-_SUCCESS = NodeStatus.SUCCESS
+_SUCCESS = NodeStatus.SUCCESS  # tick functions return NodeStatus members: compared with `is`
 
 
 class MacroStepDriver(Generic[M, S]):
@@ -105,7 +105,7 @@ class MacroStepDriver(Generic[M, S]):
         actions: list[str] = []
         tick = self._tick
         memory, result = tick(memory, bb, actions)
-        if result == _SUCCESS and bb.event != NO_EVENT:
+        if result is _SUCCESS and bb.event != NO_EVENT:
             memory, result = tick(memory, bb, actions)
         bb.event = NO_EVENT  # an event still pending is dropped
         return self._make_state(memory, bb.state, result), tuple(actions)
@@ -115,7 +115,7 @@ class MacroStepDriver(Generic[M, S]):
         pseudo-state is left (an initial event not seen yet) a SUCCESS only says that no guard
         fired, so it does not count (docs/semantics.md)."""
         _memory, bb_state, last = state
-        return last == _SUCCESS and bb_state != self.leaves.start
+        return last is _SUCCESS and bb_state != self.leaves.start
 
 
 class EngineLebtState(NamedTuple):

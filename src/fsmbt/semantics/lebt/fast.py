@@ -156,7 +156,7 @@ class StrictTick:
                 return sel
         return None
 
-    def __call__(
+    def tick(
         self, running: int | None, bb: LebtBlackboard, actions: list[str]
     ) -> tuple[int | None, NodeStatus]:
         """One root tick: the running leaf afterwards and the root's status."""
@@ -192,8 +192,8 @@ class FastLEBTRuntime(MacroStepDriver["int | None", FastLebtState]):
 
     def __init__(self, tree: CompiledTree, body_state: dict[int, int], leaves: LebtLeaves) -> None:
         self.tree = tree
-        self.tick = StrictTick(tree, body_state, leaves)
-        super().__init__(leaves, self.tick, None, FastLebtState)
+        self.ticker = StrictTick(tree, body_state, leaves)
+        super().__init__(leaves, self.ticker.tick, None, FastLebtState)
 
     def running_leaves(self, state: FastLebtState) -> Iterator[int]:
         """The compiled id of the state leaf RUNNING in ``state`` (none or one).

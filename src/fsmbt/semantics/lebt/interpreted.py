@@ -51,7 +51,7 @@ class InterpretedTick:
         self.interp = interp
         self.leaves = leaves
 
-    def __call__(
+    def tick(
         self, snap: Snapshot, bb: LebtBlackboard, actions: list[str]
     ) -> tuple[Snapshot, NodeStatus]:
         interp = self.interp
@@ -98,8 +98,8 @@ class LEBTRuntime(MacroStepDriver[Snapshot, InterpretedLebtState]):
         self.interp = BTInterpreter(doc)
         self.tree = self.interp.tree
         leaves = LebtLeaves.of(self.tree, start)
-        self.tick = InterpretedTick(self.interp, leaves)
-        super().__init__(leaves, self.tick, self.interp.initial(), InterpretedLebtState)
+        self.ticker = InterpretedTick(self.interp, leaves)
+        super().__init__(leaves, self.ticker.tick, self.interp.initial(), InterpretedLebtState)
 
     def running_leaves(self, state: InterpretedLebtState) -> Iterator[int]:
         """The compiled ids of the state leaves RUNNING in ``state``.
