@@ -3,7 +3,7 @@
     .venv/bin/python benchmarks/bench_checker.py [--sizes 10,30,100,1000,10000] [--repeat 3]
         [--generic]
 
-``fsm~lebt`` runs the LEBT on the fast strict-grammar runtime (``lebt_fast``) when the tree has
+``fsm~lebt`` runs the LEBT on the fast strict-grammar runtime (``fsmbt.semantics.lebt.fast``) when the tree has
 that shape (the family's name then reads ``fsm~lebt*``); ``--generic`` forces the generic BT
 interpreter path, to compare.
 
@@ -29,7 +29,7 @@ import time
 from collections.abc import Callable
 
 from fsmbt.model import FSM, BTDocument, BTNode, NodeKind, State
-from fsmbt.semantics.lebt_runtime import LEBTMachine
+from fsmbt.semantics.lebt.machine import LEBTMachine
 from fsmbt.verify.native import check
 from fsmbt.verify.pairing import LEBTWithActiveInputs, machines_for
 
@@ -195,7 +195,7 @@ def main(argv: list[str] | None = None) -> int:
                   f"{seconds / product * 1e6:>9.1f} {ratio_t:>7} {ratio_s:>7}", flush=True)
             previous = (seconds, product)
     if not args.generic:
-        print("* LEBT on the fast strict-grammar runtime (lebt_fast); --generic for the interpreter")
+        print("* LEBT on the fast strict-grammar runtime (semantics/lebt/fast.py); --generic for the interpreter")
     print("bt~hfsm: plain Sequence/Fallback trees run on the fast leaf machine (leaf_fast)")
     return 0
 

@@ -1,6 +1,6 @@
 """The converters' fast paths give exactly what the straightforward definitions give: the
 one-pass inlining + compression vs ``compress(inline_subtrees(...))``, the leaf writer vs the
-``lebt_spec`` classes, and the figures counted while building vs walking the result."""
+``fsmbt.semantics.lebt.spec`` classes, and the figures counted while building vs walking the result."""
 
 from __future__ import annotations
 
@@ -12,7 +12,7 @@ from fsmbt.convert.perf import gc_paused
 from fsmbt.generate import random_bt, random_fsm
 from fsmbt.model.bt import BehaviorTree, BTDocument, BTNode
 from fsmbt.model.bt_nodes import NodeKind
-from fsmbt.semantics.lebt_spec import GUARD_TYPE, STATE_TYPE, GuardSpec, StateSpec
+from fsmbt.semantics.lebt.spec import GUARD_TYPE, STATE_TYPE, GuardSpec, StateSpec
 from support.conv_helpers import paper_aj_fsm
 
 

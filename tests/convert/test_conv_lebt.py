@@ -8,7 +8,7 @@ from fsmbt.convert import convert
 from fsmbt.model.bt import BTNode
 from fsmbt.model.errors import UnsupportedError
 from fsmbt.model.fsm import FSM
-from fsmbt.semantics.lebt_spec import GUARD_TYPE, STATE_TYPE, GuardSpec, StateSpec
+from fsmbt.semantics.lebt.spec import GUARD_TYPE, STATE_TYPE, GuardSpec, StateSpec
 from support.conv_helpers import check, paper_aj_fsm
 
 

@@ -16,7 +16,7 @@ import pytest
 from fsmbt.model.fsm import FSM
 from fsmbt.semantics.engines.btcpp_engine import BTCppLebtRunner
 from fsmbt.semantics.engines.pytrees_engine import PyTreesLebtRunner
-from fsmbt.semantics.lebt_runtime import LEBTMachine
+from fsmbt.semantics.lebt.machine import LEBTMachine
 from fsmbt.semantics.machine import FINAL, FSMMachine
 from support.random_trees import Structure, lebt_from_structure
 

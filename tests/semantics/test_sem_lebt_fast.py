@@ -1,4 +1,4 @@
-"""The fast LEBT runtime (``lebt_fast``) against the generic interpreter path (``LEBTRuntime``).
+"""The fast LEBT runtime (``fsmbt.semantics.lebt.fast``) against the generic interpreter path (``LEBTRuntime``).
 
 Both paths of ``LEBTMachine`` run the same trees on the same random event sequences; outputs,
 statuses, blackboard ``state``, last root result and the running state leaf must agree at every
@@ -17,14 +17,16 @@ import pytest
 from fsmbt.convert.lebt import fsm_to_lebt
 from fsmbt.generate.generator import random_fsm
 from fsmbt.model import FSM, BTDocument, BTNode, NodeKind
-from fsmbt.semantics.bt_interpreter import RUNNING as NODE_RUNNING, CompiledTree
-from fsmbt.semantics.lebt_fast import strict_lebt_sels
-from fsmbt.semantics.lebt_runtime import LEBTMachine
-from fsmbt.semantics.lebt_spec import STATE_TYPE
+from fsmbt.semantics.bt_interpreter import CompiledTree
+from fsmbt.semantics.lebt.fast import strict_lebt_sels
+from fsmbt.semantics.lebt.machine import LEBTMachine
+from fsmbt.semantics.lebt.spec import STATE_TYPE
+from fsmbt.semantics.status import NodeStatus
 from fsmbt.verify.mutations import mutants
 from fsmbt.verify.native import check
 from fsmbt.verify.pairing import LEBTWithActiveInputs, machines_for
 
+NODE_RUNNING = NodeStatus.RUNNING
 UNKNOWN_EVENT = "no_such_event"
 #: operators whose every mutant leaves the strict grammar / stays inside it
 SHAPE_BREAKING = {"sequence_to_fallback", "fallback_to_sequence", "invert_condition", "drop_leaf"}

@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 from fsmbt.model.bt import BehaviorTree, BTDocument, BTNode
 from fsmbt.model.bt_nodes import NodeKind
 from fsmbt.model.fsm import FSM
-from fsmbt.semantics.lebt_spec import (
+from fsmbt.semantics.lebt.spec import (
     DEFAULT_START,
     GUARD_TYPE,
     NO_EVENT,

@@ -126,7 +126,7 @@ def test_fsm_vs_lebt_mutants_are_caught():
 def test_lebt_active_inputs_are_sound_and_change_no_verdict():
     """Events left out by ``LEBTWithActiveInputs.active_inputs`` really are silent self-loops,
     and checking against the bare ``LEBTMachine`` (every event stepped) gives the same verdicts."""
-    from fsmbt.semantics.lebt_runtime import LEBTMachine
+    from fsmbt.semantics.lebt.machine import LEBTMachine
     from fsmbt.verify.native import check
 
     checked = 0

@@ -7,14 +7,8 @@ LLM path register (``bsd``, ``chds``, ``llm`` ...).
 
 from __future__ import annotations
 
-from fsmbt.convert.engines import (
-    ConversionResult,
-    Engine,
-    converter_for,
-    engines,
-    get_engine,
-    register_engine,
-)
+from fsmbt.convert.engines import Engine, converter_for, engines, get_engine, register_engine
+from fsmbt.convert.result import ConversionResult
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.fsm import FSM
 

@@ -40,8 +40,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from fsmbt.convert.compress import inline_and_compress
-from fsmbt.convert.engines import ConversionResult
 from fsmbt.convert.perf import without_gc_pauses
+from fsmbt.convert.result import ConversionResult
 from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.bt_nodes import NodeKind
 from fsmbt.model.errors import InputError, UnsupportedError

@@ -1,9 +1,9 @@
-"""The conversion engines by name, and the result every engine returns.
+"""The conversion engines by name (each returns a ``fsmbt.convert.result.ConversionResult``).
 
 An engine is a pair of callables ``(fsm_to_bt, bt_to_fsm)``, each taking the source model and
 keyword options (``style``, ``loop``, ... as the engine understands them) and returning a
-``ConversionResult``. ``rules`` (the paper's algorithms done exactly, the default) registers
-itself here; the baselines (``bsd``, ``chds``) and the LLM path (``llm``, ``nllm``, ``hybrid``)
+``ConversionResult``. ``rules`` (the paper's algorithms done exactly, the default) is
+registered here from the converters this module imports; the baselines (``bsd``, ``chds``) and the LLM path (``llm``, ``nllm``, ``hybrid``)
 plug in the same way with ``register_engine`` from their own modules, listed in
 ``_PLUGIN_MODULES`` so that ``get_engine`` finds them without anyone editing this table.
 A direction an engine does not offer is ``None``.
@@ -12,35 +12,14 @@ A direction an engine does not offer is ``None``.
 from __future__ import annotations
 
 import importlib
-from collections.abc import Callable
-from dataclasses import dataclass, field
-from typing import Any
+from dataclasses import dataclass
 
+from fsmbt.convert.bt_to_hfsm import bt_to_hfsm
+from fsmbt.convert.hfsm_to_bt import fsm_to_bt
+from fsmbt.convert.result import Converter, Model
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import InputError, UnsupportedError
 from fsmbt.model.fsm import FSM
-
-Model = FSM | BTDocument
-
-
-@dataclass
-class ConversionResult:
-    """A converted model with what a person wants to know about the conversion.
-
-    ``direction`` is ``"fsm->bt"`` or ``"bt->fsm"``; ``stats`` holds engine-specific figures
-    (LEBT: entry/loop state counts, nodes; BT->HFSM: ``k`` sub-FSMs, ``depth_before`` /
-    ``depth_after`` compression ...); ``warnings`` are documented, non-fatal deviations (e.g.
-    unreachable states dropped).
-    """
-
-    model: Model
-    engine: str
-    direction: str
-    stats: dict[str, Any] = field(default_factory=dict)
-    warnings: list[str] = field(default_factory=list)
-
-
-Converter = Callable[..., ConversionResult]
 
 
 @dataclass(frozen=True)
@@ -53,7 +32,10 @@ class Engine:
 
 _ENGINES: dict[str, Engine] = {}
 
-#: Modules that register further engines when imported (missing ones are skipped).
+#: Modules that register further engines when imported (missing ones are skipped). They are
+#: plugins: each imports ``register_engine`` from here and registers itself, so this table does
+#: not import them statically (that would be a cycle); they are loaded on the first look-up, which
+#: also keeps the LLM engine's heavier imports out of every start-up that never asks for it.
 _PLUGIN_MODULES = (
     "fsmbt.convert.baselines",
     "fsmbt.llm.engine",
@@ -71,9 +53,6 @@ def register_engine(name: str, fsm_to_bt: Converter | None, bt_to_fsm: Converter
 def _register_rules() -> None:
     """The default engine: LEBT for FSM -> BT (a SubTree per composite state of a hierarchical
     FSM, option ``hierarchy``), hierarchical conversion units for BT -> FSM."""
-    from fsmbt.convert.bt_to_hfsm import bt_to_hfsm
-    from fsmbt.convert.hfsm_to_bt import fsm_to_bt
-
     register_engine("rules", fsm_to_bt, bt_to_hfsm,
                     "the paper's algorithms done exactly (LEBT; depth compression + units)")
 

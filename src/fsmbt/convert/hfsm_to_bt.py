@@ -39,9 +39,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from fsmbt.convert.engines import ConversionResult
 from fsmbt.convert.lebt import ROOT_NAME, LebtLeafWriter, fsm_to_lebt, lebt_node_models
 from fsmbt.convert.perf import without_gc_pauses
+from fsmbt.convert.result import ConversionResult
 from fsmbt.convert.structure import analyse
 from fsmbt.model.bt import BehaviorTree, BTDocument, BTNode
 from fsmbt.model.bt_nodes import NodeKind

@@ -26,15 +26,15 @@ Complexity: O(S + T) time and memory for S states and T transitions (after flatt
 
 from __future__ import annotations
 
-from fsmbt.convert.engines import ConversionResult
 from fsmbt.convert.perf import without_gc_pauses
+from fsmbt.convert.result import ConversionResult
 from fsmbt.convert.structure import LebtStructure, analyse
 from fsmbt.model.bt import BTDocument, BTNode, NodeModel, PortModel
 from fsmbt.model.bt_nodes import NodeKind
 from fsmbt.model.errors import UnsupportedError
 from fsmbt.model.flatten import flatten, needs_flattening
 from fsmbt.model.fsm import FSM
-from fsmbt.semantics.lebt_spec import GUARD_TYPE, STATE_TYPE, escape
+from fsmbt.semantics.lebt.spec import GUARD_TYPE, STATE_TYPE, escape
 
 STYLES = ("paper",)
 ROOT_NAME = "LEBT"

@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 
 from fsmbt.model.errors import InputError, UnsupportedError
 from fsmbt.model.fsm import FSM, Transition
-from fsmbt.semantics.lebt_spec import DEFAULT_START, NO_EVENT
+from fsmbt.semantics.lebt.spec import DEFAULT_START, NO_EVENT
 
 
 @dataclass

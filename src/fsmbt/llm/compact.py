@@ -12,7 +12,7 @@ from __future__ import annotations
 from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.bt_nodes import NodeKind
 from fsmbt.model.fsm import FSM
-from fsmbt.semantics.lebt_spec import DEFAULT_START
+from fsmbt.semantics.lebt.spec import DEFAULT_START
 
 #: Attributes that change a node's behavior and so stay in the outline.
 BEHAVIOR_ATTRS = ("num_cycles", "num_attempts", "success_count", "failure_count", "max_failures",

@@ -22,7 +22,8 @@ from __future__ import annotations
 from collections.abc import Iterable
 from typing import Any
 
-from fsmbt.convert.engines import ConversionResult, converter_for, register_engine
+from fsmbt.convert.engines import converter_for, register_engine
+from fsmbt.convert.result import ConversionResult
 from fsmbt.llm.client import LLMClient
 from fsmbt.llm.config import resolve_settings
 from fsmbt.llm.pipeline import LLMOutcome, convert_with_llm, default_verifier

@@ -16,7 +16,7 @@ from fsmbt.model.bt_nodes import NodeKind
 from fsmbt.model.errors import FsmbtError
 from fsmbt.model.fsm import FSM
 from fsmbt.model.serialize import model_from_dict
-from fsmbt.semantics.lebt_spec import GUARD_TYPE, STATE_TYPE
+from fsmbt.semantics.lebt.spec import GUARD_TYPE, STATE_TYPE
 
 _FENCE = re.compile(r"```[ \t]*([A-Za-z0-9_+-]*)[^\n]*\n(.*?)```", re.S)
 #: The BT.CPP XML reader's registry name.

@@ -20,7 +20,7 @@ from collections import Counter, deque
 
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.fsm import FSM
-from fsmbt.semantics.lebt_spec import DEFAULT_START, GUARD_TYPE, STATE_TYPE, GuardSpec, StateSpec
+from fsmbt.semantics.lebt.spec import DEFAULT_START, GUARD_TYPE, STATE_TYPE, GuardSpec, StateSpec
 from fsmbt.semantics.nodes import PLAIN_CONTROLS
 from fsmbt.semantics.status import LeafOutcome, RootResult
 

@@ -24,7 +24,8 @@ Start: ``state`` is the ``state`` port of the one leaf marked ``initial="true"``
 state, or the start pseudo-state when the FSM has an initial event); ``entered`` is false; the
 root is ticked until quiescent (below), which runs the initial state's action.
 
-One macro step (the analogue of docs/semantics.md, 'The LEBT protocol', for a state variable): set ``event``; tick the root;
+One macro step (the analogue of the LEBT macro step, docs/semantics.md §5, for a state
+variable): set ``event``; tick the root;
 while that tick fired a transition (a leaf wrote ``state``, self-loops included, so the new
 state's subtree must run; its entry action sets ``entered`` on that next tick), tick again, at most ``MAX_TICKS_PER_STEP`` times in all (more is a livelock, reported
 as an ``InputError``); then drop the event if it is still pending (no transition took it: the
@@ -43,12 +44,10 @@ from fsmbt.model.bt import BTDocument
 from fsmbt.model.bt_nodes import NodeKind
 from fsmbt.model.errors import InputError
 from fsmbt.model.fsm import FSM
-from fsmbt.semantics.bt_interpreter import (
-    OUTCOME_FAILURE, OUTCOME_RUNNING, OUTCOME_SUCCESS, OUTCOME_TO_STATUS, STATUS_NAMES,
-    BTInterpreter, CompiledTree, LeafRequest, Snapshot,
-)
-from fsmbt.semantics.lebt_spec import NO_EVENT, decode_pairs, encode_pairs
+from fsmbt.semantics.bt_interpreter import BTInterpreter, CompiledTree, LeafRequest, Snapshot
+from fsmbt.semantics.lebt.spec import NO_EVENT, decode_pairs, encode_pairs
 from fsmbt.semantics.machine import FINAL, RUNNING, FSMMachine, Outputs
+from fsmbt.semantics.status import LeafOutcome, NodeStatus
 
 IS_STATE, ENTRY_ACTION, TRANSITION = "SvIsState", "SvEntryAction", "SvTransition"
 GUARD, ASSIGN, MODE = "SvGuard", "SvAssign", "SvMode"
@@ -59,7 +58,7 @@ MAX_TICKS_PER_STEP = 8
 
 
 def encode_transitions(pairs: Sequence[tuple[str, str]]) -> str:
-    """``event/target`` items joined by ``;`` (names escaped as in ``lebt_spec``)."""
+    """``event/target`` items joined by ``;`` (names escaped as in ``fsmbt.semantics.lebt.spec``)."""
     return encode_pairs(pairs)
 
 
@@ -119,34 +118,34 @@ def _parse_leaf(node) -> SvLeaf:  # type: ignore[no-untyped-def]
         initial=attrs.get("initial", "false").lower() == "true")
 
 
-def leaf_outcome(leaf: SvLeaf, bb: SvBlackboard, actions: list[str]) -> str:
+def leaf_outcome(leaf: SvLeaf, bb: SvBlackboard, actions: list[str]) -> LeafOutcome:
     """What one leaf returns (and does to the blackboard); see the module docstring."""
     kind = leaf.type
     if kind == IS_STATE:
-        return OUTCOME_SUCCESS if bb.state == leaf.state else OUTCOME_FAILURE
+        return LeafOutcome.SUCCESS if bb.state == leaf.state else LeafOutcome.FAILURE
     if kind == GUARD:
         matches = bb.event != NO_EVENT and (bb.state, bb.event) == (leaf.state, leaf.event)
-        return OUTCOME_SUCCESS if matches else OUTCOME_FAILURE
+        return LeafOutcome.SUCCESS if matches else LeafOutcome.FAILURE
     if kind in (ENTRY_ACTION, MODE):
         if not bb.entered:
             if leaf.action is not None:
                 actions.append(leaf.action)
             bb.entered = True
         if kind == ENTRY_ACTION or leaf.final:
-            return OUTCOME_SUCCESS
-        return OUTCOME_RUNNING
+            return LeafOutcome.SUCCESS
+        return LeafOutcome.RUNNING
     if kind == ASSIGN:
         _switch(bb, leaf.target)
-        return OUTCOME_SUCCESS
+        return LeafOutcome.SUCCESS
     # TRANSITION
     if leaf.final:
-        return OUTCOME_SUCCESS
+        return LeafOutcome.SUCCESS
     if bb.event != NO_EVENT and bb.state == leaf.state:
         target = dict(leaf.transitions).get(bb.event)
         if target is not None:
             _switch(bb, target)
-            return OUTCOME_SUCCESS
-    return OUTCOME_RUNNING
+            return LeafOutcome.SUCCESS
+    return LeafOutcome.RUNNING
 
 
 def _switch(bb: SvBlackboard, target: str) -> None:
@@ -163,7 +162,7 @@ class SvState:
     snapshot: Snapshot
     bb_state: str
     entered: bool
-    last_result: str | None
+    last_result: NodeStatus | None
 
 
 class StateVariableMachine:
@@ -232,7 +231,7 @@ class StateVariableMachine:
         return self._settle(state, symbol)
 
     def status(self, state: SvState) -> str:
-        done = state.last_result == "SUCCESS"
+        done = state.last_result == NodeStatus.SUCCESS
         if self.pseudo_start and state.bb_state == self.initial_state:
             done = False
         return FINAL if done else RUNNING
@@ -256,13 +255,14 @@ class StateVariableMachine:
                              "(livelock)", element=self.name)
         return SvState(snap, bb.state, bb.entered, result), tuple(actions)
 
-    def _tick(self, snap: Snapshot, bb: SvBlackboard, actions: list[str]) -> tuple[Snapshot, str]:
+    def _tick(self, snap: Snapshot, bb: SvBlackboard,
+              actions: list[str]) -> tuple[Snapshot, NodeStatus]:
         snap = self.interp.begin_tick(snap)
         snap, request = self.interp.advance(snap)
         while isinstance(request, LeafRequest):
             outcome = leaf_outcome(self.leaves[request.node.id], bb, actions)
-            snap, request = self.interp.advance(snap, OUTCOME_TO_STATUS[outcome])
-        return snap, STATUS_NAMES[request.status]
+            snap, request = self.interp.advance(snap, outcome.status)
+        return snap, NodeStatus(request.status)
 
 
 def machines_for_state_variable(source: FSM, result: BTDocument) -> tuple[FSMMachine,

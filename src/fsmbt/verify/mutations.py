@@ -25,7 +25,7 @@ from typing import Any
 from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.bt_nodes import NodeKind
 from fsmbt.model.fsm import FSM
-from fsmbt.semantics.lebt_spec import GUARD_TYPE, STATE_TYPE, GuardSpec, StateSpec
+from fsmbt.semantics.lebt.spec import GUARD_TYPE, STATE_TYPE, GuardSpec, StateSpec
 from fsmbt.semantics.nodes import PLAIN_CONTROLS
 
 Model = FSM | BTDocument

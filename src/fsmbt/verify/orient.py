@@ -28,7 +28,7 @@ from dataclasses import dataclass
 
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.fsm import FSM
-from fsmbt.semantics.lebt_spec import GUARD_TYPE, STATE_TYPE
+from fsmbt.semantics.lebt.spec import GUARD_TYPE, STATE_TYPE
 from fsmbt.semantics.state_variable_runtime import is_state_variable_bt
 
 Model = FSM | BTDocument

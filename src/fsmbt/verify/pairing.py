@@ -16,8 +16,8 @@ from typing import Any
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import InputError
 from fsmbt.model.fsm import FSM
-from fsmbt.semantics.bt_interpreter import snapshot_statuses
-from fsmbt.semantics.lebt_spec import GUARD_TYPE, GuardSpec
+from fsmbt.semantics.lebt.machine import LEBTMachine
+from fsmbt.semantics.lebt.spec import GUARD_TYPE, GuardSpec
 from fsmbt.semantics.machine import FINAL, RUNNING, FSMMachine, Machine, Outputs
 from fsmbt.semantics.status import LeafOutcome, NodeStatus
 
@@ -106,7 +106,7 @@ class LEBTWithActiveInputs:
                 if event:
                     self._by_source.setdefault(source, []).append(event)
         self._exits = {nid: spec.exits for nid, spec in leaves.states.items()}
-        self._node_running = NodeStatus.RUNNING.value
+        self._running_leaves = machine.running_leaves  # type: ignore[attr-defined]
 
     def start(self):  # type: ignore[no-untyped-def]
         return self.machine.start()
@@ -125,9 +125,8 @@ class LEBTWithActiveInputs:
 
     def active_inputs(self, state) -> Sequence[str]:  # type: ignore[no-untyped-def]
         relevant: dict[str, None] = dict.fromkeys(self._by_source.get(state.bb_state, ()))
-        for nid, node_status in snapshot_statuses(state.snapshot):
-            if node_status == self._node_running and nid in self._exits:
-                relevant.update(dict.fromkeys(self._exits[nid]))
+        for nid in self._running_leaves(state):
+            relevant.update(dict.fromkeys(self._exits[nid]))
         active = [e for e in relevant if e in self._alphabet_set]
         other = next((e for e in self.alphabet if e not in relevant), None)
         if other is None:
@@ -162,7 +161,6 @@ def machines_for(source: FSM | BTDocument, result: FSM | BTDocument, *,
         return (FSMMachine(source, alphabet=alphabet), FSMMachine(result, alphabet=alphabet),
                 MACRO_STEP)
     if isinstance(source, FSM) and isinstance(result, BTDocument):
-        from fsmbt.semantics.lebt_runtime import LEBTMachine
         from fsmbt.semantics.state_variable_runtime import (
             is_state_variable_bt,
             machines_for_state_variable,

@@ -44,7 +44,8 @@ from fsmbt.convert.baselines.common import (
     prepare_fsm,
     sv_node_models,
 )
-from fsmbt.convert.engines import ConversionResult, register_engine
+from fsmbt.convert.engines import register_engine
+from fsmbt.convert.result import ConversionResult
 from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.bt_nodes import NodeKind
 from fsmbt.model.fsm import FSM, State

@@ -18,33 +18,32 @@ is pending) or ``tick_exactly_once`` and returns the same ``TickRecord`` as the 
 from __future__ import annotations
 
 from collections.abc import Callable
+from typing import Any
 
-import behaviortreepy as btpy
+import behaviortreepy as btpy  # type: ignore[import-untyped]  # no stubs shipped
 from lxml import etree
 
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.bt_nodes import NodeKind
-from fsmbt.semantics.bt_interpreter import (
-    OUTCOME_TO_STATUS, STATUS_NAMES, CompiledNode, CompiledTree, Environment, TickRecord,
+from fsmbt.semantics.bt_interpreter import CompiledNode, CompiledTree, Environment, TickRecord
+from fsmbt.semantics.lebt.driver import EngineLebtRun
+from fsmbt.semantics.lebt.leaves import (
+    LebtLeaves,
+    guard_outcome,
+    state_on_running,
+    state_on_start,
 )
-from fsmbt.semantics.lebt_runtime import (
-    EngineLebtRun, LebtLeaves, guard_outcome, state_on_running, state_on_start,
-)
-from fsmbt.semantics.lebt_spec import BB_EVENT, BB_STATE, GUARD_TYPE, NO_EVENT, STATE_TYPE
+from fsmbt.semantics.lebt.spec import BB_EVENT, BB_STATE, GUARD_TYPE, NO_EVENT, STATE_TYPE
+from fsmbt.semantics.status import LeafOutcome, NodeStatus
 
 ACTION_ID = "FsmbtAction"
 CONDITION_ID = "FsmbtCondition"
 
-_STATUS = {
-    "success": btpy.NodeStatus.SUCCESS, "failure": btpy.NodeStatus.FAILURE,
-    "running": btpy.NodeStatus.RUNNING,
-}
-_NAME_OF = {
-    btpy.NodeStatus.SUCCESS: "SUCCESS", btpy.NodeStatus.FAILURE: "FAILURE",
-    btpy.NodeStatus.RUNNING: "RUNNING", btpy.NodeStatus.SKIPPED: "SKIPPED",
-    btpy.NodeStatus.IDLE: "IDLE",
-}
-assert set(OUTCOME_TO_STATUS) == set(_STATUS) and "SKIPPED" in STATUS_NAMES
+#: A leaf outcome (``LeafOutcome`` or its string) as the engine's status.
+_STATUS: dict[str, Any] = {outcome: getattr(btpy.NodeStatus, outcome.status.name) for outcome in LeafOutcome}
+#: The engine's status as ours, and by name (the interpreter's ``TickRecord`` spelling).
+_NODE_STATUS = {getattr(btpy.NodeStatus, status.name): status for status in NodeStatus}
+_NAME_OF = {engine: status.name for engine, status in _NODE_STATUS.items()}
 
 #: How a leaf is written: (registration ID, extra attributes) for a compiled leaf.
 LeafWriter = Callable[[CompiledNode], tuple[str, dict[str, str]]]
@@ -72,7 +71,9 @@ def compiled_to_xml(tree: CompiledTree, leaf_writer: LeafWriter = _default_leaf)
         node = nodes[nid]
         if node.kind in (NodeKind.ACTION, NodeKind.CONDITION):
             tag, extra = leaf_writer(node)
-            etree.SubElement(parent_el, tag, name=leaf_name(node), **extra)
+            leaf_attrs = {"name": leaf_name(node)}
+            leaf_attrs.update(extra)
+            etree.SubElement(parent_el, tag, attrib=leaf_attrs)
             continue
         if node.type == "SubTree":
             sub_id = f"T{nid}"
@@ -91,7 +92,7 @@ def compiled_to_xml(tree: CompiledTree, leaf_writer: LeafWriter = _default_leaf)
             attrs["num_attempts"] = str(node.params[0])
         elif node.type == "RunOnce":
             attrs["then_skip"] = "true" if node.params[0] else "false"
-        el = etree.SubElement(parent_el, node.type, **attrs)
+        el = etree.SubElement(parent_el, node.type, attrib=attrs)
         for child in reversed(node.children):
             work.append((child, el))
     # children were pushed reversed but SubElement appends: rebuild order by sorting on ids
@@ -137,7 +138,7 @@ class BTCppRunner:
         return TickRecord(self._leaves, _NAME_OF[status])
 
 
-# -- the LEBT protocol in BehaviorTree.CPP -----------------------------------------------------
+# -- the LEBT protocol in BehaviorTree.CPP (tick function for fsmbt.semantics.lebt.driver) ----
 class _TreeBlackboard:
     """``state``/``event`` kept in the BehaviorTree.CPP tree's root blackboard."""
 
@@ -146,7 +147,8 @@ class _TreeBlackboard:
 
     @property
     def state(self) -> str:
-        return self._bb.get_string(BB_STATE)
+        value: str = self._bb.get_string(BB_STATE)
+        return value
 
     @state.setter
     def state(self, value: str) -> None:
@@ -154,7 +156,8 @@ class _TreeBlackboard:
 
     @property
     def event(self) -> str:
-        return self._bb.get_string(BB_EVENT)
+        value: str = self._bb.get_string(BB_EVENT)
+        return value
 
     @event.setter
     def event(self, value: str) -> None:
@@ -197,6 +200,6 @@ class BTCppLebtRunner(EngineLebtRun):
     def _running(self, bt_node: btpy.TreeNode) -> btpy.NodeStatus:
         return _STATUS[state_on_running(self.leaves.states[self._id(bt_node)], self.bb)]
 
-    def _tick(self) -> str:
-        self.last_result = _NAME_OF[self.bt.tick_once()]
-        return self.last_result
+    def _tick_engine(self) -> NodeStatus:
+        """One ``tickOnce`` of the engine's tree."""
+        return _NODE_STATUS[self.bt.tick_once()]

@@ -25,18 +25,27 @@ from py_trees.common import Status
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import UnsupportedError
 from fsmbt.semantics.bt_interpreter import CompiledNode, CompiledTree, Environment, TickRecord
-from fsmbt.semantics.lebt_runtime import (
-    EngineLebtRun, LebtLeaves, PlainBlackboard, guard_outcome, state_on_running,
+from fsmbt.semantics.lebt.driver import EngineLebtRun
+from fsmbt.semantics.lebt.leaves import (
+    LebtLeaves,
+    PlainBlackboard,
+    guard_outcome,
+    state_on_running,
     state_on_start,
 )
+from fsmbt.semantics.status import LeafOutcome, NodeStatus
 
 SUPPORTED_TYPES = frozenset({
     "Sequence", "ReactiveSequence", "Fallback", "ReactiveFallback", "Inverter",
     "ForceSuccess", "ForceFailure", "SubTree", "AlwaysSuccess", "AlwaysFailure",
 })
-_STATUS = {"success": Status.SUCCESS, "failure": Status.FAILURE, "running": Status.RUNNING}
-_NAME = {Status.SUCCESS: "SUCCESS", Status.FAILURE: "FAILURE", Status.RUNNING: "RUNNING",
-         Status.INVALID: "IDLE"}
+#: A leaf outcome (``LeafOutcome`` or its string) as py_trees' status.
+_STATUS: dict[str, Status] = {LeafOutcome.SUCCESS: Status.SUCCESS, LeafOutcome.FAILURE: Status.FAILURE,
+           LeafOutcome.RUNNING: Status.RUNNING}
+#: py_trees' status as ours (INVALID = never ticked or halted = IDLE), and by name.
+_NODE_STATUS = {Status.SUCCESS: NodeStatus.SUCCESS, Status.FAILURE: NodeStatus.FAILURE,
+                Status.RUNNING: NodeStatus.RUNNING, Status.INVALID: NodeStatus.IDLE}
+_NAME = {engine: status.name for engine, status in _NODE_STATUS.items()}
 
 #: Builds the py_trees leaf for an environment leaf of the compiled tree.
 LeafFactory = Callable[[CompiledNode], py_trees.behaviour.Behaviour]
@@ -142,7 +151,7 @@ class PyTreesLebtRunner(EngineLebtRun):
             return state_on_running(spec, self.bb)
         return EnvLeaf(f"n{node.id}", state_leaf)
 
-    def _tick(self) -> str:
+    def _tick_engine(self) -> NodeStatus:
+        """One py_trees tick of the root."""
         self.root.tick_once()
-        self.last_result = _NAME[self.root.status]
-        return self.last_result
+        return _NODE_STATUS[self.root.status]

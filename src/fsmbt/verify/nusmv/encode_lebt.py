@@ -1,6 +1,6 @@
 """A loop-execution BT (docs/semantics.md, 'The LEBT protocol') as an SMV module: the tree's tick rules (``BTCore``) with the
 LEBT leaves answered from a blackboard held in SMV variables, and the macro-step protocol of
-``fsmbt.semantics.lebt_runtime`` as transitions:
+``fsmbt.semantics.lebt`` (leaves and macro step) as transitions:
 
 - ``bbs`` (blackboard ``state``, starts at the start pseudo-state), ``bbe`` (``event``,
   ``ev_none`` when none is pending), ``lres`` (the last tick's root result), ``tick2`` (the
@@ -21,8 +21,9 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 from fsmbt.model.bt import BTDocument
-from fsmbt.semantics.lebt_runtime import LebtLeaves
-from fsmbt.semantics.lebt_spec import NO_EVENT
+from fsmbt.semantics.lebt.fast import strict_lebt_sels
+from fsmbt.semantics.lebt.leaves import LebtLeaves
+from fsmbt.semantics.lebt.spec import NO_EVENT
 from fsmbt.verify.nusmv.encode_bt import BTCore, safe_text
 from fsmbt.verify.nusmv.encode_fsm import NONE_OUT, Encoding
 from fsmbt.verify.nusmv.smv import Symbols, any_of, case, enum_type
@@ -70,11 +71,9 @@ class LebtEncoder:
         """For a tree of the strict LEBT grammar, its state between macro steps as the native
         fast path keys it: the running state leaf (``runl``), with ``bbs`` and ``lres``. Every
         other status, index and frame local follows from that leaf's position there
-        (``fsmbt.semantics.lebt_fast``), so comparing these three compares the same states as
+        (``fsmbt.semantics.lebt.fast``), so comparing these three compares the same states as
         comparing all variables, with a frozen copy of 3 variables instead of ~3 per node
         (the reachability spec's cost). ``None`` for any other tree: all variables count."""
-        from fsmbt.semantics.lebt_fast import strict_lebt_sels
-
         if strict_lebt_sels(self.core.tree) is None:
             return None
         core = self.core

@@ -1,6 +1,6 @@
-"""How the two LEBT leaf types are written in a behavior tree (docs/semantics.md, 'The LEBT protocol'), shared by the
-converter that writes them and the runtimes (interpreter, BehaviorTree.CPP, py_trees) that run
-them.
+"""How the two LEBT leaf types are written in a behavior tree (docs/semantics.md, "The LEBT
+runtime protocol"), shared by the converter that writes them, the checkers that read them and
+the runtimes (interpreter, fast path, BehaviorTree.CPP, py_trees) that run them.
 
 - ``LebtGuard`` (a Condition): port ``target`` (the state it guards) and ``pairs``, the
   (source, event) pairs that enter the target, as ``source/event`` items separated by ``;``.
@@ -11,6 +11,9 @@ them.
   separated by ``;``.
 Names with ``;``, ``/`` or ``\\`` are escaped with a backslash.
 Blackboard keys: ``state`` (starts at the start pseudo-state) and ``event`` (empty = none).
+
+Costs: ``encode_pairs``/``decode_pairs``/``split_escaped`` are O(length of the text), one pass
+each, no recursion.
 """
 
 from __future__ import annotations
@@ -27,6 +30,7 @@ DEFAULT_START = "__start__"
 
 
 def escape(text: str) -> str:
+    """Backslash-escape ``\\``, ``;`` and ``/`` so a name survives ``encode_pairs``."""
     return text.replace("\\", "\\\\").replace(";", "\\;").replace("/", "\\/")
 
 
@@ -118,5 +122,9 @@ class StateSpec:
     def from_attrs(cls, attrs: dict[str, str]) -> StateSpec:
         raw = attrs.get("exits", "")
         exits = tuple(split_escaped(raw, ";")) if raw else ()
-        return cls(attrs.get("state", ""), attrs.get("action") or None,
-                   attrs.get("final", "false").lower() == "true", exits)
+        return cls(
+            attrs.get("state", ""),
+            attrs.get("action") or None,
+            attrs.get("final", "false").lower() == "true",
+            exits,
+        )

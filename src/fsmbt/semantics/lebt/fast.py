@@ -2,7 +2,7 @@
 
 Why: the generic interpreter ticks past every root-level guard in each macro step, so checking
 an n-state FSM against its LEBT costs O(n^2) (1 000 states: ~100 s). For trees of the strict
-LEBT grammar (docs/conversion.md, 'FSM -> BT: the loop-execution BT') ::
+LEBT grammar (docs/semantics.md §5, "The LEBT protocol") ::
 
     Root := Sequence(Sel+)      Sel := Fallback(Guard, Body)      Body := State | Sequence(State, Sel*)
 
@@ -12,7 +12,7 @@ ever returns FAILURE, so nothing is ever halted and the whole run-time memory be
 is the running state leaf (or none): the indices of BehaviorTree.CPP's non-reactive
 Sequence/Fallback ancestors and the SUCCESS/FAILURE statuses before it follow from its position.
 A tick then is (derived from ``sequence_node.cpp``/``fallback_node.cpp`` and the leaf
-behaviours of ``lebt_runtime``):
+behaviours of ``fsmbt.semantics.lebt.leaves``):
 
 - running leaf ``X``: ``state_on_running(X)``; RUNNING ends the tick; SUCCESS continues
   "after X";
@@ -28,23 +28,29 @@ pre-order, and an O(1) test "the Sel's parent Sequence is an ancestor of ``Y`` (
 interval) and the Sel comes after ``Y``". One tick costs O(c log c + k) for c Sels sharing the
 pair and k leaves started (one per final state passed); a deterministic LEBT has c <= 1.
 Building the index is O(N + P) for N nodes and P guard pairs.
+
+That tick is ``StrictTick``; macro step, start and termination are
+``fsmbt.semantics.lebt.driver.MacroStepDriver``'s, the same as the interpreted runtime's.
 """
 
 from __future__ import annotations
 
 from bisect import bisect_right
+from collections.abc import Iterator
 from typing import NamedTuple
 
 from fsmbt.model.bt_nodes import NodeKind
-from fsmbt.semantics.bt_interpreter import (
-    OUTCOME_RUNNING, RUNNING as NODE_RUNNING, CompiledTree, Snapshot,
-)
-from fsmbt.semantics.lebt_runtime import LebtLeaves, PlainBlackboard, state_on_start
-from fsmbt.semantics.lebt_spec import GUARD_TYPE, NO_EVENT, STATE_TYPE
-from fsmbt.semantics.machine import Outputs
+from fsmbt.semantics.bt_interpreter import CompiledTree, Snapshot
+from fsmbt.semantics.lebt.driver import MacroStepDriver
+from fsmbt.semantics.lebt.leaves import LebtBlackboard, LebtLeaves, state_on_start
+from fsmbt.semantics.lebt.spec import GUARD_TYPE, NO_EVENT, STATE_TYPE
+from fsmbt.semantics.status import LeafOutcome, NodeStatus
 
 ROOT = 0  # the compiled root's id (ids are pre-order indices)
 _IDLE_SNAPSHOT: Snapshot = ((), (), (), False)
+_RUNNING = NodeStatus.RUNNING
+_SUCCESS = NodeStatus.SUCCESS
+_LEAF_RUNNING = LeafOutcome.RUNNING
 
 
 class FastLebtState(NamedTuple):
@@ -52,15 +58,14 @@ class FastLebtState(NamedTuple):
 
     running: int | None  # compiled id of the running LebtState leaf, None when nothing runs
     bb_state: str
-    last_result: str | None  # "SUCCESS"/"RUNNING" of the last tick; None before any
+    last_result: NodeStatus | None  # the root's status after the last tick; None before any
 
     @property
     def snapshot(self) -> Snapshot:
-        """The interpreter-shaped view callers read (``LEBTWithActiveInputs`` looks for the
-        RUNNING leaves in ``snapshot[0]``); only the running leaf is listed."""
+        """The interpreter-shaped view of the memory: only the running leaf is listed."""
         if self.running is None:
             return _IDLE_SNAPSHOT
-        return (((self.running, NODE_RUNNING),), (), (), False)
+        return (((self.running, int(_RUNNING)),), (), (), False)
 
 
 def strict_lebt_sels(tree: CompiledTree) -> dict[int, int] | None:
@@ -91,8 +96,11 @@ def strict_lebt_sels(tree: CompiledTree) -> dict[int, int] | None:
             body_state[sel] = body
             continue
         kids = nodes[body].children
-        if not (is_(body, NodeKind.CONTROL, "Sequence") and kids
-                and is_(kids[0], NodeKind.ACTION, STATE_TYPE)):
+        if not (
+            is_(body, NodeKind.CONTROL, "Sequence")
+            and kids
+            and is_(kids[0], NodeKind.ACTION, STATE_TYPE)
+        ):
             return None
         body_state[sel] = kids[0]
         visited += 1
@@ -100,16 +108,18 @@ def strict_lebt_sels(tree: CompiledTree) -> dict[int, int] | None:
     return body_state if visited == len(nodes) else None
 
 
-class FastLEBTRuntime:
-    """``LEBTRuntime``'s interface (``initial``, ``macro_step``, ``terminated``, ``tree``,
-    ``leaves``) for a strict-shape LEBT (``body_state`` from ``strict_lebt_sels``), ticked
-    directly; leaf behaviours, macro step, start and termination are ``lebt_runtime``'s, so the
-    two runtimes are interchangeable."""
+class StrictTick:
+    """The tick function of the fast path: one root tick of a strict-grammar LEBT, computed
+    from the running leaf alone (module docstring), with an index of guard pairs.
 
-    def __init__(self, tree: CompiledTree, body_state: dict[int, int],
-                 leaves: LebtLeaves) -> None:
+    Args:
+        tree: the compiled tree.
+        body_state: ``strict_lebt_sels(tree)``.
+        leaves: the tree's parsed leaves.
+    """
+
+    def __init__(self, tree: CompiledTree, body_state: dict[int, int], leaves: LebtLeaves) -> None:
         nodes = tree.nodes
-        self.tree = tree
         self.leaves = leaves
         self.body_state = body_state
         self.parent: dict[int, int] = {sel: nodes[sel].parent for sel in body_state}  # type: ignore[misc]
@@ -126,7 +136,8 @@ class FastLEBTRuntime:
             for pair in leaves.guards[guard].pairs:
                 index.setdefault(pair, set()).add(sel)
         self.index: dict[tuple[str, str], list[int]] = {
-            pair: sorted(sels) for pair, sels in index.items()}
+            pair: sorted(sels) for pair, sels in index.items()
+        }
 
     def _next_sel(self, after: int | None, state: str, event: str) -> int | None:
         """The first Sel (pre-order) tried after ``after`` (None: a fresh tick) whose guard
@@ -145,44 +156,53 @@ class FastLEBTRuntime:
                 return sel
         return None
 
-    def tick(self, running: int | None, bb: PlainBlackboard,
-             actions: list[str]) -> tuple[int | None, str]:
-        """One root tick: the running leaf afterwards and the root's status name."""
+    def tick(
+        self, running: int | None, bb: LebtBlackboard, actions: list[str]
+    ) -> tuple[int | None, NodeStatus]:
+        """One root tick: the running leaf afterwards and the root's status."""
         if running is not None:
             if bb.event == NO_EVENT:
-                return running, "RUNNING"
+                return running, _RUNNING
             if bb.event not in self.exits[running]:
                 bb.event = NO_EVENT
-                return running, "RUNNING"
+                return running, _RUNNING
         after = running
         states = self.leaves.states
         while True:
             sel = self._next_sel(after, bb.state, bb.event)
             if sel is None:
-                return None, "SUCCESS"
+                return None, _SUCCESS
             leaf = self.body_state[sel]
-            if state_on_start(states[leaf], bb, actions) == OUTCOME_RUNNING:
-                return leaf, "RUNNING"
+            if state_on_start(states[leaf], bb, actions) is _LEAF_RUNNING:
+                return leaf, _RUNNING
             after = leaf
 
-    def initial(self) -> tuple[FastLebtState, Outputs]:
-        state = FastLebtState(None, self.leaves.start, None)
-        if not self.leaves.init_on_start:
-            return state, ()
-        bb = PlainBlackboard(state.bb_state)
-        actions: list[str] = []
-        running, result = self.tick(None, bb, actions)
-        return FastLebtState(running, bb.state, result), tuple(actions)
 
-    def macro_step(self, state: FastLebtState, event: str) -> tuple[FastLebtState, Outputs]:
-        """``drive_macro_step``: set ``event``, tick; tick again on SUCCESS with it pending."""
-        bb = PlainBlackboard(state.bb_state, event)
-        actions: list[str] = []
-        running, result = self.tick(state.running, bb, actions)
-        if result == "SUCCESS" and bb.event != NO_EVENT:
-            running, result = self.tick(running, bb, actions)
-        return FastLebtState(running, bb.state, result), tuple(actions)
+class FastLEBTRuntime(MacroStepDriver["int | None", FastLebtState]):
+    """``LEBTRuntime``'s interface (``initial``, ``macro_step``, ``terminated``,
+    ``running_leaves``, ``tree``, ``leaves``) for a strict-shape LEBT (``body_state`` from
+    ``strict_lebt_sels``): the same driver over ``StrictTick``, so the two runtimes are
+    interchangeable.
 
-    def terminated(self, state: FastLebtState) -> bool:
-        """As ``LEBTRuntime.terminated``: root SUCCESS once the start pseudo-state is left."""
-        return state.last_result == "SUCCESS" and state.bb_state != self.leaves.start
+    Args:
+        tree: the compiled tree.
+        body_state: ``strict_lebt_sels(tree)``.
+        leaves: the tree's parsed leaves.
+    """
+
+    def __init__(self, tree: CompiledTree, body_state: dict[int, int], leaves: LebtLeaves) -> None:
+        self.tree = tree
+        self.ticker = StrictTick(tree, body_state, leaves)
+        super().__init__(leaves, self.ticker.tick, None, FastLebtState)
+
+    def running_leaves(self, state: FastLebtState) -> Iterator[int]:
+        """The compiled id of the state leaf RUNNING in ``state`` (none or one).
+
+        Args:
+            state: a state of this runtime.
+
+        Returns:
+            The ids.
+        """
+        if state.running is not None:
+            yield state.running
