@@ -312,3 +312,27 @@ def test_writer_refuses_events_scxml_would_read_otherwise(events: tuple[str, ...
         fsm.add_transition("s", event, "s")
     with pytest.raises(UnsupportedError, match="SCXML"):
         dumps(fsm, "scxml")
+
+
+def test_parallel_region_of_several_states_round_trips_through_its_wrapper() -> None:
+    def region(name: str) -> FSM:
+        machine = FSM(name=name)
+        machine.add_state(f"{name}1")
+        machine.add_state(State(f"{name}2", final=True))
+        machine.add_transition(f"{name}1", "go", f"{name}2")
+        return machine
+
+    fsm = FSM()
+    fsm.add_state(State("p", action=None, regions=[region("r"), region("s")]))
+    fsm.add_state("out")
+    fsm.add_transition("p", None, "out")
+    text = dumps(fsm, "scxml")
+    assert text.count('fsmbt:region="true"') == 2
+    again = loads(text, "scxml")
+    assert again == fsm
+    assert run(again, ["go"]) == ["p/[r1|s1]", "out"]
+    with pytest.raises(InputError, match="holds states only"):
+        loads(text.replace('<state id="r1">', '<transition event="z" target="out"/>'
+                                               '<state id="r1">'), "scxml")
+    with pytest.raises(InputError, match="only meaningful"):
+        loads(scxml('<state id="s" fsmbt:region="true"/>', FSMBT), "scxml")

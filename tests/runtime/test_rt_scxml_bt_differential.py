@@ -18,18 +18,20 @@ from __future__ import annotations
 
 import os
 import random
+import sys
 from collections import Counter
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import pytest
-from scxml_oracle import Engine, Mismatch, replay
+from scxml_oracle import PARALLEL_STOPS, Engine, Mismatch, Replay, replay
 
 from fsmbt.convert.bt_to_hfsm import bt_to_hfsm
 from fsmbt.formats import dumps, read_model
 from fsmbt.generate import random_bt
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import FsmbtError, UnsupportedError
+from fsmbt.model.fsm import FSM
 from fsmbt.semantics.machine import FSMMachine
 
 REPO = Path(__file__).resolve().parents[2]
@@ -38,6 +40,7 @@ GENERATED = int(os.environ.get("FSMBT_SCXML_BTS", "300"))
 SEQUENCES = int(os.environ.get("FSMBT_SCXML_SEQUENCES", "5"))
 LENGTH = int(os.environ.get("FSMBT_SCXML_LENGTH", "30"))
 SEED = int(os.environ.get("FSMBT_SCXML_SEED", "11"))
+HFSMS = int(os.environ.get("FSMBT_SCXML_HFSMS", "100"))
 
 
 @dataclass
@@ -48,11 +51,32 @@ class Tally:
     events: int = 0
     refused: Counter[str] = field(default_factory=Counter)
     mismatches: list[str] = field(default_factory=list)
+    departures: Counter[str] = field(default_factory=Counter)
+
+    def add(self, label: str, result: Replay) -> None:
+        self.sequences += 1
+        self.events += result.sent
+        if result.mismatch is not None:
+            self.mismatches.append(f"{label}: {result.mismatch}")
+        if result.departure is not None:
+            self.departures[result.departure] += 1
 
     def report(self) -> str:
         return (f"\n[{self.group}] {self.models} models, {self.sequences} sequences, "
-                f"{self.events} leaf outcomes, {len(self.mismatches)} mismatches; not converted: "
+                f"{self.events} events, {len(self.mismatches)} mismatches, "
+                f"{sum(self.departures.values())} sequences ended by a documented engine "
+                f"departure {dict(self.departures)}; not converted/written: "
                 f"{sum(self.refused.values())} {dict(self.refused.most_common(4))}")
+
+
+def random_hfsm(seed: int, *, parallel: bool) -> FSM:
+    """tests/convert's seeded HFSM generator (imported, not copied)."""
+    convert_tests = str(REPO / "tests" / "convert")
+    if convert_tests not in sys.path:
+        sys.path.append(convert_tests)
+    from conv_hfsm_gen import random_hfsm as make
+
+    return make(seed, parallel=parallel)
 
 
 def check_tree(tally: Tally, label: str, doc: BTDocument, rng: random.Random,
@@ -60,19 +84,16 @@ def check_tree(tally: Tally, label: str, doc: BTDocument, rng: random.Random,
     try:
         hfsm = bt_to_hfsm(doc).model
     except FsmbtError as exc:
-        tally.refused[type(exc).__name__ + ": " + str(exc)[:60]] += 1
+        tally.refused[f"{type(exc).__name__}: {getattr(exc, 'message', str(exc))[:60]}"] += 1
         return
     text = dumps(hfsm, "scxml")
     Engine(text)  # loads in the engine at all (raises otherwise)
     machine = FSMMachine(hfsm)
     tally.models += 1
     for _ in range(sequences):
-        sent, mismatch = replay(text, hfsm, rng, length=LENGTH, machine=machine,
-                                alphabet=("success", "failure", "running"))
-        tally.sequences += 1
-        tally.events += sent
-        if mismatch is not None:
-            tally.mismatches.append(f"{label}: {mismatch}")
+        result = replay(text, hfsm, rng, length=LENGTH, machine=machine,
+                        alphabet=("success", "failure", "running"))
+        tally.add(label, result)
 
 
 def test_reported_bug_robot_pick_failure_is_not_delivery() -> None:
@@ -133,7 +154,25 @@ def test_generated_bts() -> None:
     refused = sum(tally.refused.values())
     assert all(k.startswith(UnsupportedError.__name__) for k in tally.refused), tally.refused
     assert tally.models + refused == GENERATED and tally.models >= 0.9 * GENERATED
+    assert not tally.mismatches and not tally.departures, tally.mismatches[:5]
+
+
+def test_generated_hfsms_written_by_fsmbt() -> None:
+    """Beyond BT->FSM: seeded hierarchical FSMs (nested composites, completion transitions,
+    events shared between levels, parallel states whose regions fsmbt wraps) written by fsmbt
+    run in the engine as fsmbt's flattening says."""
+    tally = Tally("generated hfsm")
+    rng = random.Random(SEED)
+    for index in range(HFSMS):
+        hfsm = random_hfsm(SEED * 1000 + index, parallel=index % 2 == 1)
+        text = dumps(hfsm, "scxml")
+        machine = FSMMachine(hfsm)
+        tally.models += 1
+        for _ in range(SEQUENCES):
+            tally.add(f"hfsm{index}", replay(text, hfsm, rng, length=LENGTH, machine=machine))
+    print(tally.report())
     assert not tally.mismatches, tally.mismatches[:5]
+    assert set(tally.departures) <= {PARALLEL_STOPS}
 
 
 def test_mismatch_is_reported_on_a_wrong_model() -> None:
@@ -152,8 +191,8 @@ def test_mismatch_is_reported_on_a_wrong_model() -> None:
     found: list[Mismatch] = []
     rng = random.Random(SEED)
     for _ in range(40):
-        _sent, mismatch = replay(text, hfsm, rng, length=LENGTH,
-                                 alphabet=("success", "failure", "running"))
-        if mismatch is not None:
-            found.append(mismatch)
+        result = replay(text, hfsm, rng, length=LENGTH,
+                        alphabet=("success", "failure", "running"))
+        if result.mismatch is not None:
+            found.append(result.mismatch)
     assert found

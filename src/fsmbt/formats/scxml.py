@@ -43,7 +43,8 @@ XINCLUDE_NS = "http://www.w3.org/2001/XInclude"
 #: fsmbt's own attributes (what SCXML cannot say: a start pseudo-state, a non-default action,
 #: a model name that is not a unique id, the final state a completion transition waits for).
 FSMBT_NS = "https://fsmbt.dev/ns/scxml"
-F_NAME, F_ACTION, F_START, F_EXIT = (f"{{{FSMBT_NS}}}{n}" for n in ("name", "action", "start", "exit"))
+F_NAME, F_ACTION, F_START, F_EXIT, F_REGION = (
+    f"{{{FSMBT_NS}}}{n}" for n in ("name", "action", "start", "exit", "region"))
 #: ``State.attrs`` mark of the transient final states that encode a transition leaving its parent.
 EXIT_MARK = f"{{{FSMBT_NS}}}exit-state"
 
@@ -52,7 +53,7 @@ UNSUPPORTED_CONTENT = frozenset({"raise", "send", "assign", "script", "if", "els
                                  "foreach", "cancel", "invoke"})
 WARNED_CONTENT = frozenset({"log"})
 _SCXML_KEYS = frozenset({"initial", "name", "version"})
-_STATE_KEYS = frozenset({"id", "initial", F_NAME, F_ACTION, F_START})
+_STATE_KEYS = frozenset({"id", "initial", F_NAME, F_ACTION, F_START, F_REGION})
 _TRANSITION_KEYS = frozenset({"event", "target", "cond", F_EXIT})
 #: The one guard read: ``In('id')`` / ``In("id")`` (W3C's predicate, in every data model).
 _IN_FINAL = re.compile(r"""\s*In\(\s*(['"])(?P<id>[^'"]+)\1\s*\)\s*""")
@@ -80,6 +81,7 @@ class _Reader:
     synthetic_transitions: list[tuple[FSM, Transition]] = field(default_factory=list)
     descriptors: dict[str, int] = field(default_factory=dict)
     done_transitions: list[tuple[_Node, etree._Element, bool]] = field(default_factory=list)
+    wrapper_ids: set[str] = field(default_factory=set)
 
     def where(self, element: etree._Element) -> SourceLocation:
         return self.ctx.location(element.sourceline)
@@ -154,7 +156,10 @@ class _Reader:
     def state(self, element: etree._Element, machine: FSM, owner: _Node | None) -> _Node:
         tag = self.tag(element) or ""
         state_id = element.get("id") or f"_state{len(self.order) + 1}"
-        if state_id in self.by_id:
+        if element.get(F_REGION) is not None:  # a wrapper never gets here (``regions``)
+            raise InputError('fsmbt:region="true" is only meaningful on a <state> child of '
+                             "<parallel>", location=self.where(element), element=f"<{tag}>")
+        if state_id in self.by_id or state_id in self.wrapper_ids:
             raise InputError(f"duplicate state id '{state_id}'", location=self.where(element),
                              element=f"<{tag}>")
         name = element.get(F_NAME, state_id)
@@ -194,12 +199,35 @@ class _Reader:
                 region = FSM(name=child.get(F_NAME, child.get("id") or "region"))
                 self.parent_of[id(region)] = node
                 node.state.regions.append(region)
-                out.append(("single", child, region, node))
+                if child.get(F_REGION) == "true":
+                    self.region_wrapper(child)
+                    out.append(("children", child, region, node))
+                else:
+                    out.append(("single", child, region, node))
             return out
         region = FSM(name=node.state.name)
         self.parent_of[id(region)] = node
         node.state.regions.append(region)
         return [("children", element, region, node)]
+
+    def region_wrapper(self, element: etree._Element) -> None:
+        """A ``<state fsmbt:region="true">`` child of a ``<parallel>`` is the wrapper fsmbt
+        writes around a region of several states: the region itself, not a state of it (a
+        compound state with the same W3C meaning). It may hold states only."""
+        if local_name(element) != "state":
+            raise InputError("fsmbt:region is only meaningful on a <state>",
+                             location=self.where(element), element=f"<{local_name(element)}>")
+        for child in self.children(element):
+            if self.tag(child) not in STATE_TAGS and self.tag(child) != "initial":
+                raise InputError(f"a region wrapper (fsmbt:region) holds states only, not "
+                                 f"<{local_name(child)}>", location=self.where(child),
+                                 element=f"<{local_name(child)}>")
+        wrapper_id = element.get("id")
+        if wrapper_id is not None:
+            if wrapper_id in self.by_id or wrapper_id in self.wrapper_ids:
+                raise InputError(f"duplicate state id '{wrapper_id}'",
+                                 location=self.where(element), element="<state>")
+            self.wrapper_ids.add(wrapper_id)
 
     def content(self, element: etree._Element, container: etree._Element) -> None:
         """Non-state children of a state or of <scxml>: supported, warned or refused."""
@@ -710,6 +738,9 @@ class _Writer:
                 wrapper_id = self.allocate(region.name, element.get("id") or state.name,
                                            composite=True, shared=True)
                 wrapper = etree.SubElement(element, _q("state"), id=wrapper_id)
+                wrapper.set(F_REGION, "true")
+                if wrapper_id != region.name:
+                    wrapper.set(F_NAME, region.name)
                 if region.initial is not None:
                     wrapper.set("initial", self.ids[(id(region), region.initial)])
                 out.append((region, wrapper))
