@@ -11,8 +11,15 @@ compound/parallel state (completion transitions). A transition that leaves its p
 transient state), which has SCXML's priority (inner transitions first) and is written back as
 the original transition.
 
-Refused with ``UnsupportedError`` (element, line, feature): ``cond``, ``<history>``, wildcard and
-prefix-matching event descriptors, targetless transitions, transitions with several targets,
+Completion transitions of one composite state are told apart by the standard guard
+``cond="In('F')"`` naming the ``<final>`` child they wait for (``Transition.exit``); the writer
+writes it, the reader reads it and still reads the legacy annotation ``fsmbt:exit`` of older
+files (warned: a W3C engine ignores it). ``fsmbt:`` attributes are annotations only: ids are
+chosen so that no ``done.state.<id>`` descriptor prefix-matches another state's completion
+event, and events SCXML would read otherwise are refused (docs/formats/scxml.md).
+
+Refused with ``UnsupportedError`` (element, line, feature): ``cond`` other than that guard,
+``<history>``, wildcard and prefix-matching event descriptors (``done.state`` ones included), targetless transitions, transitions with several targets,
 ``type="internal"``, behaviour-changing executable content (``<raise>``, ``<send>``,
 ``<assign>``, ``<script>``, ``<if>``, ``<foreach>``, ``<cancel>``, ``<invoke>``), XInclude,
 eventless transitions of compound states, transitions into a nested state that is not its
