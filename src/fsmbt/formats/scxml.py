@@ -201,7 +201,7 @@ class _Reader:
         if not nested:
             return []
         if local_name(element) == "parallel":
-            out = []
+            out: list[tuple[str, etree._Element, FSM, _Node | None]] = []
             for child in nested:
                 region = FSM(name=child.get(F_NAME, child.get("id") or "region"))
                 self.parent_of[id(region)] = node
