@@ -8,6 +8,7 @@ three columns must agree (docs/runtime-python.md).
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 
 from fsmbt.convert.engines import converter_for
@@ -31,17 +32,17 @@ def main() -> None:
         state, outputs = machine.step(state, event)
         expected.append(outputs)
 
+    log: list[str] = []  # the actions run in one macro step
+
+    def action(name: str) -> Callable[[], None]:
+        def run() -> None:  # your robot's code goes here
+            log.append(name)
+            print(f"   running action {name}")
+        return run
+
+    actions = {name: action(name) for name in "ABCDEFGHIJ"}
     for engine in ENGINES:
         print(f"== {engine}")
-        log: list[str] = []
-
-        def action(name: str):
-            def run() -> None:
-                log.append(name)
-                print(f"   running action {name}")
-            return run
-
-        actions = {name: action(name) for name in "ABCDEFGHIJ"}
         runner = load_tree(tree_xml, actions, engine=engine)
         runner.start()
         for event, fsm_outputs in zip(EVENTS, expected):
