@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import os
 import random
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -276,3 +277,27 @@ def test_example_script_runs() -> None:
     assert done.returncode == 0, done.stderr
     assert done.stdout.strip().endswith("both engines ran the FSM's actions")
     assert done.stdout.count("running action H") == 2
+
+
+def test_the_docs_snippet_runs_as_written(tmp_path: Path) -> None:
+    """docs/runtime-python.md's shell line and Python block, run as written (the examples
+    path made absolute, the files written in a scratch folder), print what the page shows."""
+    page = (REPO / "docs" / "runtime-python.md").read_text(encoding="utf-8")
+    blocks = re.findall(r"```(\w*)\n(.*?)```", page, flags=re.S)
+    shell = next(body for lang, body in blocks if lang == "sh").strip()
+    python = next(body for lang, body in blocks if lang == "python")
+    shown = next(body for lang, body in blocks if lang == "" and "motor off" in body)
+    env = {**os.environ, "PYTHONPATH": str(REPO / "src")}
+    args = shell.replace("examples/", f"{REPO / 'examples'}/").split()
+    assert args[0] == "fsmbt"
+    done = subprocess.run([sys.executable, "-m", "fsmbt.cli", *args[1:]], cwd=tmp_path,
+                          capture_output=True, text=True, timeout=120, check=False, env=env)
+    assert done.returncode == 0, done.stderr
+    (tmp_path / "snippet.py").write_text(python, encoding="utf-8")
+    for engine in ENGINES:
+        script = python.replace('engine="py_trees")', f'engine="{engine}")')
+        (tmp_path / "snippet.py").write_text(script, encoding="utf-8")
+        done = subprocess.run([sys.executable, "snippet.py"], cwd=tmp_path, capture_output=True,
+                              text=True, timeout=120, check=False, env=env)
+        assert done.returncode == 0, done.stderr
+        assert done.stdout == shown, (engine, done.stdout)
