@@ -336,3 +336,17 @@ def test_parallel_region_of_several_states_round_trips_through_its_wrapper() -> 
                                                '<state id="r1">'), "scxml")
     with pytest.raises(InputError, match="only meaningful"):
         loads(scxml('<state id="s" fsmbt:region="true"/>', FSMBT), "scxml")
+
+
+def test_in_guard_quotes_an_id_holding_a_quote() -> None:
+    region = FSM(name="u")
+    region.add_state("w")
+    region.add_state(State("it's done", action=None, final=True))
+    region.add_transition("w", "ok", "it's done")
+    fsm = FSM()
+    fsm.add_state(State("u", action=None, regions=[region]))
+    fsm.add_state("t")
+    fsm.add_transition("u", None, "t", exit="it's done")
+    text = dumps(fsm, "scxml")
+    assert "cond=\"In(&quot;it's done&quot;)\"" in text
+    assert loads(text, "scxml") == fsm

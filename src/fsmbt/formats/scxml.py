@@ -63,7 +63,7 @@ _SCXML_KEYS = frozenset({"initial", "name", "version"})
 _STATE_KEYS = frozenset({"id", "initial", F_NAME, F_ACTION, F_START, F_REGION})
 _TRANSITION_KEYS = frozenset({"event", "target", "cond", F_EXIT})
 #: The one guard read: ``In('id')`` / ``In("id")`` (W3C's predicate, in every data model).
-_IN_FINAL = re.compile(r"""\s*In\(\s*(['"])(?P<id>[^'"]+)\1\s*\)\s*""")
+_IN_FINAL = re.compile(r"""\s*In\(\s*(?:'(?P<single>[^']+)'|"(?P<double>[^"]+)")\s*\)\s*""")
 
 
 # -- reading -------------------------------------------------------------------------------------
@@ -385,7 +385,7 @@ class _Reader:
             raise self.unsupported(element, "cond guards (the model has no data; the only guard "
                                             "read is In('F') on a compound state's own "
                                             "done.state event, F one of its <final> children)")
-        final = self.by_id.get(match.group("id"))
+        final = self.by_id.get(match.group("single") or match.group("double"))
         if final is None or local_name(final.element) != "final" \
                 or final.element.getparent() is not node.element:
             raise self.unsupported(element, f"cond=\"{cond}\": In() must name a <final> child "
@@ -710,7 +710,7 @@ class _Writer:
         elif not state.is_atomic:
             out.set("event", f"done.state.{state_id}")
             if t.exit is not None:
-                out.set("cond", f"In('{self.final_id(state, t.exit)}')")
+                out.set("cond", _in_predicate(self.final_id(state, t.exit), state.name))
         target_machine, target = self.rerouted.get(id(t), (machine, t.target))
         key = (id(target_machine), target)
         if key not in self.ids:
@@ -752,6 +752,16 @@ class _Writer:
                     wrapper.set("initial", self.ids[(id(region), region.initial)])
                 out.append((region, wrapper))
         return out
+
+
+def _in_predicate(state_id: str, source: str) -> str:
+    """W3C's ``In('id')`` (``In("id")`` when the id holds a single quote)."""
+    if "'" not in state_id:
+        return f"In('{state_id}')"
+    if '"' not in state_id:
+        return f'In("{state_id}")'
+    raise UnsupportedError(f"the state id {state_id!r} holds both quote characters and cannot "
+                           "be named in a cond guard", element=source)
 
 
 def _event_descriptor(event: str, source: str) -> str:
