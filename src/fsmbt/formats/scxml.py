@@ -599,8 +599,10 @@ class _Writer:
 
         The id of a compound/parallel state (it raises ``done.state.<id>``) is never a
         dot-prefix of another one's, nor has one as a dot-prefix: SCXML's event matching takes
-        ``done.state.a`` for ``done.state.a.b`` too. Such ids get ``_`` for ``.``.
+        ``done.state.a`` for ``done.state.a.b`` too. Such ids get ``_`` for ``.``; whitespace
+        becomes ``_`` (the model name is kept in ``fsmbt:name``).
         """
+        name = re.sub(r"\s+", "_", name)  # an id is one token (targets are lists of ids)
         unique = f"{prefix}.{name}" if shared or name in self.taken else name
         while unique in self.taken or (composite and self.dot_related(unique)):
             unique = unique.replace(".", "_") if composite and "." in unique else unique + "_"
