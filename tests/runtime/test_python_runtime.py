@@ -221,6 +221,9 @@ def test_bad_sources_and_engines_are_clear_errors(tmp_path: Path) -> None:
         load_tree(broken, DOOR_ACTIONS)
     with pytest.raises(InputError):
         load_tree(tmp_path / "missing.xml", DOOR_ACTIONS)
+    tree_file = tmp_path / "door_bt.xml"
+    tree_file.write_text(door_tree(), encoding="utf-8")
+    assert load_tree(str(tree_file), DOOR_ACTIONS).used_actions == frozenset(DOOR_ACTIONS)
 
 
 def test_call_order_errors_and_action_exceptions() -> None:

@@ -139,7 +139,8 @@ def load_tree(source: Path | str, actions: Mapping[str, Action], *, engine: str 
     """Load a converted tree and bind the user's actions.
 
     Args:
-        source: a ``Path`` to the BehaviorTree.CPP XML file, or the XML text itself.
+        source: the BehaviorTree.CPP XML text (a string starting with ``<``), or the path of
+            the file (a ``Path``, or any other string).
         actions: action name -> callable without arguments.
         engine: ``"py_trees"`` or ``"btcpp"``.
         allow_unused: accept callables whose name no state of the tree uses.
@@ -148,7 +149,8 @@ def load_tree(source: Path | str, actions: Mapping[str, Action], *, engine: str 
     Raises:
         InputError: unreadable file, not a behavior tree, or one of ``TreeRunner``'s checks.
     """
-    model = read_model(source) if isinstance(source, Path) else loads(source, "btcpp")
+    is_text = isinstance(source, str) and source.lstrip("\ufeff \t\r\n").startswith("<")
+    model = loads(source, "btcpp") if is_text else read_model(Path(source))
     if not isinstance(model, BTDocument):
         raise InputError("not a behavior tree: the runtime runs converted trees "
                          "(fsmbt convert model -o tree.xml)")
