@@ -149,8 +149,10 @@ def load_tree(source: Path | str, actions: Mapping[str, Action], *, engine: str 
     Raises:
         InputError: unreadable file, not a behavior tree, or one of ``TreeRunner``'s checks.
     """
-    is_text = isinstance(source, str) and source.lstrip("\ufeff \t\r\n").startswith("<")
-    model = loads(source, "btcpp") if is_text else read_model(Path(source))
+    if isinstance(source, str) and source.lstrip("\ufeff \t\r\n").startswith("<"):
+        model = loads(source, "btcpp")
+    else:
+        model = read_model(Path(source))
     if not isinstance(model, BTDocument):
         raise InputError("not a behavior tree: the runtime runs converted trees "
                          "(fsmbt convert model -o tree.xml)")
