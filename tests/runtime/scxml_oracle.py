@@ -19,12 +19,14 @@ builds it in O(states + transitions)), O(depth) per configuration name.
 from __future__ import annotations
 
 import contextlib
+import functools
 import io
 import random
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 from lxml import etree
+from statemachine import StateChart
 from statemachine.io.loader import load
 
 from fsmbt.model.fsm import FSM
@@ -112,13 +114,21 @@ class Document:
         return "".join(out)
 
 
+@functools.lru_cache(maxsize=8)
+def _compiled(text: str) -> tuple[Document, type[StateChart]]:
+    """The document's tree and the engine's class (built once per text: the sequences of one
+    model share it, each gets a fresh instance)."""
+    with contextlib.redirect_stdout(io.StringIO()):
+        return Document.parse(text), load(text, format="scxml")
+
+
 class Engine:
     """One python-statemachine instance of an SCXML document."""
 
     def __init__(self, text: str) -> None:
-        self.doc = Document.parse(text)
+        self.doc, chart = _compiled(text)
         with contextlib.redirect_stdout(io.StringIO()):  # the engine prints <log> content
-            self.machine = load(text, format="scxml")()
+            self.machine = chart()
 
     def send(self, event: str) -> None:
         with contextlib.redirect_stdout(io.StringIO()):
