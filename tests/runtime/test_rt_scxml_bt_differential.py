@@ -8,7 +8,7 @@ conversion proved), the same leaf active, the same termination and the same fina
 Groups (one test each): the examples (``examples/*_bt.xml``), every corpus BT that converts
 (``FSMBT_CORPUS``, default ``<repo>/../shared/corpus``) and ``FSMBT_SCXML_BTS`` generated BTs
 (default 300; paper controls and, every other one, the extended node set whose regions are
-explored). ``FSMBT_SCXML_SEQUENCES`` sequences per model (default 5 for generated trees, 4x for
+explored; every fourth converted with ``loop=True``). ``FSMBT_SCXML_SEQUENCES`` sequences per model (default 5 for generated trees, 4x for
 the examples and the corpus) of up to ``FSMBT_SCXML_LENGTH`` outcomes (default 30). Counts are
 printed (``pytest -s``). The full run used for the report: ``FSMBT_SCXML_BTS=1000
 FSMBT_SCXML_SEQUENCES=20``.
@@ -80,9 +80,9 @@ def random_hfsm(seed: int, *, parallel: bool) -> FSM:
 
 
 def check_tree(tally: Tally, label: str, doc: BTDocument, rng: random.Random,
-               sequences: int) -> None:
+               sequences: int, *, loop: bool = False) -> None:
     try:
-        hfsm = bt_to_hfsm(doc).model
+        hfsm = bt_to_hfsm(doc, loop=loop).model
     except FsmbtError as exc:
         tally.refused[f"{type(exc).__name__}: {getattr(exc, 'message', str(exc))[:60]}"] += 1
         return
@@ -149,7 +149,7 @@ def test_generated_bts() -> None:
     for index in range(GENERATED):
         doc = random_bt(seed=SEED * 100_000 + index, depth=rng.randint(2, 5),
                         breadth=rng.randint(2, 4), extended=index % 2 == 1, max_nodes=40)
-        check_tree(tally, f"gen{index}", doc, rng, SEQUENCES)
+        check_tree(tally, f"gen{index}", doc, rng, SEQUENCES, loop=index % 4 == 3)
     print(tally.report())
     refused = sum(tally.refused.values())
     assert all(k.startswith(UnsupportedError.__name__) for k in tally.refused), tally.refused
