@@ -28,7 +28,8 @@ Rules:
 - ``write_files`` writes a runnable example (a converted tree and a script) into a folder.
 
 Costs: loading is O(n) in the tree's nodes plus the engine's own build; a macro step costs one
-or two root ticks, i.e. O(depth of the state's leaf) in both engines. User code is never
+or two root ticks, each O(root-level selectors + depth of the active state's leaf) in both
+engines (the root Sequence asks every root-level guard before the running branch). User code is never
 imported or executed by fsmbt itself: only the callables you pass are called.
 """
 
