@@ -19,7 +19,10 @@ from fsmbt.formats.registry import format_for_path, formats
 from fsmbt.model import FSM, BTDocument, BTNode, NodeKind
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
-MODEL_FILES = sorted(p for p in EXAMPLES.iterdir() if p.is_file() and p.name != "README.md")
+#: runnable example programs (not models): run_*.py
+SCRIPTS = sorted(p for p in EXAMPLES.iterdir() if p.suffix == ".py" and p.name.startswith("run_"))
+MODEL_FILES = sorted(p for p in EXAMPLES.iterdir()
+                     if p.is_file() and p.name != "README.md" and p not in SCRIPTS)
 
 
 def _readable(path: Path) -> bool:
@@ -37,7 +40,7 @@ def _need_reader(path: Path) -> None:
 def test_examples_readme_lists_exactly_the_example_files() -> None:
     readme = (EXAMPLES / "README.md").read_text(encoding="utf-8")
     mentioned = set(re.findall(r"`([\w.-]+\.\w+)`", readme))
-    assert mentioned == {p.name for p in MODEL_FILES}
+    assert mentioned == {p.name for p in MODEL_FILES + SCRIPTS}
 
 
 @pytest.mark.parametrize("path", MODEL_FILES, ids=lambda p: p.name)

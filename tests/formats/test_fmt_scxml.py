@@ -211,3 +211,142 @@ def test_scion_expected_configurations() -> None:
         checked.append(spec_path.stem)
     print(f"\nSCION: {len(checked)} checked, {len(unsupported)} unsupported: {unsupported}")
     assert len(checked) >= 14
+
+
+# -- completion transitions told apart by a standard guard (issue 11) ---------------------------
+UNIT = """
+  <state id="u" initial="work">
+    <state id="work"><transition event="ok" target="u.S"/><transition event="ko" target="u.F"/></state>
+    <final id="u.S" fsmbt:name="S"/><final id="u.F" fsmbt:name="F"/>
+    <transition event="done.state.u" {guard_s} target="won"/>
+    <transition event="done.state.u" {guard_f} target="lost"/>
+  </state>
+  <final id="won"/><final id="lost"/>"""
+FSMBT = 'xmlns:fsmbt="https://fsmbt.dev/ns/scxml"'
+
+
+def test_in_guard_on_done_state_is_the_exit_and_round_trips() -> None:
+    fsm = loads(scxml(UNIT.format(guard_s="cond=\"In('u.S')\"", guard_f='cond="In( \'u.F\' )"'),
+                      FSMBT), "scxml")
+    assert [(t.event, t.exit, t.target) for t in fsm.transitions] == [
+        (None, "S", "won"), (None, "F", "lost")]
+    assert run(fsm, ["ko"]) == ["u/work", "lost"]
+    text = dumps(fsm, "scxml")
+    assert "fsmbt:exit" not in text and "cond=\"In('F')\"" in text
+    assert loads(text, "scxml") == fsm
+
+
+def test_legacy_fsmbt_exit_is_still_read_and_warned() -> None:
+    ctx = ReadContext()
+    legacy = read_scxml(scxml(UNIT.format(guard_s='fsmbt:exit="S"', guard_f='fsmbt:exit="F"'),
+                              FSMBT), ctx)
+    guarded = loads(scxml(UNIT.format(guard_s="cond=\"In('u.S')\"", guard_f="cond=\"In('u.F')\""),
+                          FSMBT), "scxml")
+    assert legacy == guarded
+    assert sum("fsmbt:exit" in w and "W3C" in w for w in ctx.warnings) == 2
+
+
+@pytest.mark.parametrize("guard_s, guard_f, error, message", [
+    ("cond=\"In('u.S')\" fsmbt:exit=\"F\"", "", InputError, "contradicts"),
+    ("cond=\"In('work')\"", "", UnsupportedError, "<final> child of 'u'"),
+    ("cond=\"In('won')\"", "", UnsupportedError, "<final> child of 'u'"),
+    ("cond=\"In('u.S') or true\"", "", UnsupportedError, "cond guards"),
+])
+def test_bad_guards_are_refused_with_line(guard_s: str, guard_f: str, error: type,
+                                          message: str) -> None:
+    with pytest.raises(error, match=message) as info:
+        loads(scxml(UNIT.format(guard_s=guard_s, guard_f=guard_f), FSMBT), "scxml")
+    assert info.value.location is not None and info.value.location.line == 6
+
+
+def test_in_guard_elsewhere_is_refused() -> None:
+    with pytest.raises(UnsupportedError, match="cond guards"):
+        loads(scxml('<state id="s"><transition event="e" cond="In(\'s\')" target="s"/></state>'),
+              "scxml")
+
+
+@pytest.mark.parametrize("body, message", [
+    # done.state.a also matches done.state.a.b: a W3C engine leaves 'a' when 'a.b' completes
+    ('<state id="a"><state id="a.b"><state id="x"><transition event="e" target="f"/></state>'
+     '<final id="f"/></state><transition event="done.state.a" target="t"/></state>'
+     '<state id="t"/>', "also matches the completion event of 'a.b'"),
+    # the descriptor 'done' matches every done.state.<id> event
+    ('<state id="s"><transition event="done" target="t"/><state id="c"><state id="x">'
+     '<transition event="e" target="f"/></state><final id="f"/></state></state><state id="t"/>',
+     "'done' also matches every done.state"),
+])
+def test_done_event_prefix_matching_is_refused(body: str, message: str) -> None:
+    with pytest.raises(UnsupportedError, match=message):
+        loads(scxml(body), "scxml")
+
+
+def test_writer_never_makes_compound_ids_dot_prefixes_of_each_other() -> None:
+    def unit(name: str, inner: State | None = None) -> State:
+        region = FSM(name=name)
+        if inner is not None:
+            region.add_state(inner)
+            region.add_state(State("SUCCESS", action=None, final=True))
+            region.add_transition(inner.name, None, "SUCCESS", exit="SUCCESS")
+        else:
+            region.add_state("run")
+            region.add_state(State("SUCCESS", action=None, final=True))
+            region.add_transition("run", "ok", "SUCCESS")
+        return State(name, action=None, regions=[region])
+
+    fsm = FSM()
+    fsm.add_state(unit("Sequence", unit("Sequence", unit("Sequence"))))
+    fsm.add_state(State("SUCCESS", action=None, final=True))
+    fsm.add_transition("Sequence", None, "SUCCESS", exit="SUCCESS")
+    text = dumps(fsm, "scxml")
+    ids = re.findall(r'<(?:state|parallel) id="([^"]+)"', text)
+    assert len(ids) == 4  # three compound states and 'run'
+    assert not any(a != b and b.startswith(a + ".") for a in ids for b in ids), ids
+    assert loads(text, "scxml") == fsm
+
+
+@pytest.mark.parametrize("events", [("a", "a.b"), ("done",), ("x y",), ("*",)])
+def test_writer_refuses_events_scxml_would_read_otherwise(events: tuple[str, ...]) -> None:
+    fsm = FSM()
+    fsm.add_state("s")
+    for event in events:
+        fsm.add_transition("s", event, "s")
+    with pytest.raises(UnsupportedError, match="SCXML"):
+        dumps(fsm, "scxml")
+
+
+def test_parallel_region_of_several_states_round_trips_through_its_wrapper() -> None:
+    def region(name: str) -> FSM:
+        machine = FSM(name=name)
+        machine.add_state(f"{name}1")
+        machine.add_state(State(f"{name}2", final=True))
+        machine.add_transition(f"{name}1", "go", f"{name}2")
+        return machine
+
+    fsm = FSM()
+    fsm.add_state(State("p", action=None, regions=[region("r"), region("s")]))
+    fsm.add_state("out")
+    fsm.add_transition("p", None, "out")
+    text = dumps(fsm, "scxml")
+    assert text.count('fsmbt:region="true"') == 2
+    again = loads(text, "scxml")
+    assert again == fsm
+    assert run(again, ["go"]) == ["p/[r1|s1]", "out"]
+    with pytest.raises(InputError, match="holds states only"):
+        loads(text.replace('<state id="r1">', '<transition event="z" target="out"/>'
+                                               '<state id="r1">'), "scxml")
+    with pytest.raises(InputError, match="only meaningful"):
+        loads(scxml('<state id="s" fsmbt:region="true"/>', FSMBT), "scxml")
+
+
+def test_in_guard_quotes_an_id_holding_a_quote() -> None:
+    region = FSM(name="u")
+    region.add_state("w")
+    region.add_state(State("it's done", action=None, final=True))
+    region.add_transition("w", "ok", "it's done")
+    fsm = FSM()
+    fsm.add_state(State("u", action=None, regions=[region]))
+    fsm.add_state("t")
+    fsm.add_transition("u", None, "t", exit="it's done")
+    text = dumps(fsm, "scxml")
+    assert "cond=\"In(&quot;it's_done&quot;)\"" in text and 'fsmbt:name="it\'s done"' in text
+    assert loads(text, "scxml") == fsm

@@ -197,8 +197,12 @@ class _Builder:
             raise _NeedsWholeTree(", ".join(sorted(unexpected)))
         name = self._unique(machine, node.name or node.type)
         machine.add_state(State(name, action=None, regions=[sub]))
-        machine.add_transition(name, None, cont.success, exit=SUCCESS)
-        machine.add_transition(name, None, cont.failure, exit=FAILURE)
+        # only the ends the region reaches: a completion transition waiting for a final state
+        # the sub-machine does not have never fires (and SCXML cannot name that state)
+        if SUCCESS in ends:
+            machine.add_transition(name, None, cont.success, exit=SUCCESS)
+        if FAILURE in ends:
+            machine.add_transition(name, None, cont.failure, exit=FAILURE)
         return name
 
 

@@ -11,8 +11,15 @@ compound/parallel state (completion transitions). A transition that leaves its p
 transient state), which has SCXML's priority (inner transitions first) and is written back as
 the original transition.
 
-Refused with ``UnsupportedError`` (element, line, feature): ``cond``, ``<history>``, wildcard and
-prefix-matching event descriptors, targetless transitions, transitions with several targets,
+Completion transitions of one composite state are told apart by the standard guard
+``cond="In('F')"`` naming the ``<final>`` child they wait for (``Transition.exit``); the writer
+writes it, the reader reads it and still reads the legacy annotation ``fsmbt:exit`` of older
+files (warned: a W3C engine ignores it). ``fsmbt:`` attributes are annotations only: ids are
+chosen so that no ``done.state.<id>`` descriptor prefix-matches another state's completion
+event, and events SCXML would read otherwise are refused (docs/formats/scxml.md).
+
+Refused with ``UnsupportedError`` (element, line, feature): ``cond`` other than that guard,
+``<history>``, wildcard and prefix-matching event descriptors (``done.state`` ones included), targetless transitions, transitions with several targets,
 ``type="internal"``, behaviour-changing executable content (``<raise>``, ``<send>``,
 ``<assign>``, ``<script>``, ``<if>``, ``<foreach>``, ``<cancel>``, ``<invoke>``), XInclude,
 eventless transitions of compound states, transitions into a nested state that is not its
@@ -44,7 +51,8 @@ XINCLUDE_NS = "http://www.w3.org/2001/XInclude"
 #: fsmbt's own attributes (what SCXML cannot say: a start pseudo-state, a non-default action,
 #: a model name that is not a unique id, the final state a completion transition waits for).
 FSMBT_NS = "https://fsmbt.dev/ns/scxml"
-F_NAME, F_ACTION, F_START, F_EXIT = (f"{{{FSMBT_NS}}}{n}" for n in ("name", "action", "start", "exit"))
+F_NAME, F_ACTION, F_START, F_EXIT, F_REGION = (
+    f"{{{FSMBT_NS}}}{n}" for n in ("name", "action", "start", "exit", "region"))
 #: ``State.attrs`` mark of the transient final states that encode a transition leaving its parent.
 EXIT_MARK = f"{{{FSMBT_NS}}}exit-state"
 
@@ -53,8 +61,10 @@ UNSUPPORTED_CONTENT = frozenset({"raise", "send", "assign", "script", "if", "els
                                  "foreach", "cancel", "invoke"})
 WARNED_CONTENT = frozenset({"log"})
 _SCXML_KEYS = frozenset({"initial", "name", "version"})
-_STATE_KEYS = frozenset({"id", "initial", F_NAME, F_ACTION, F_START})
-_TRANSITION_KEYS = frozenset({"event", "target", F_EXIT})
+_STATE_KEYS = frozenset({"id", "initial", F_NAME, F_ACTION, F_START, F_REGION})
+_TRANSITION_KEYS = frozenset({"event", "target", "cond", F_EXIT})
+#: The one guard read: ``In('id')`` / ``In("id")`` (W3C's predicate, in every data model).
+_IN_FINAL = re.compile(r"""\s*In\(\s*(?:'(?P<single>[^']+)'|"(?P<double>[^"]+)")\s*\)\s*""")
 
 
 # -- reading -------------------------------------------------------------------------------------
@@ -78,6 +88,8 @@ class _Reader:
     synthetic_states: list[tuple[FSM, State]] = field(default_factory=list)
     synthetic_transitions: list[tuple[FSM, Transition]] = field(default_factory=list)
     descriptors: dict[str, int] = field(default_factory=dict)
+    done_transitions: list[tuple[_Node, etree._Element, bool]] = field(default_factory=list)
+    wrapper_ids: set[str] = field(default_factory=set)
 
     def where(self, element: etree._Element) -> SourceLocation:
         return self.ctx.location(element.sourceline)
@@ -152,7 +164,10 @@ class _Reader:
     def state(self, element: etree._Element, machine: FSM, owner: _Node | None) -> _Node:
         tag = self.tag(element) or ""
         state_id = element.get("id") or f"_state{len(self.order) + 1}"
-        if state_id in self.by_id:
+        if element.get(F_REGION) is not None:  # a wrapper never gets here (``regions``)
+            raise InputError('fsmbt:region="true" is only meaningful on a <state> child of '
+                             "<parallel>", location=self.where(element), element=f"<{tag}>")
+        if state_id in self.by_id or state_id in self.wrapper_ids:
             raise InputError(f"duplicate state id '{state_id}'", location=self.where(element),
                              element=f"<{tag}>")
         name = element.get(F_NAME, state_id)
@@ -192,12 +207,35 @@ class _Reader:
                 region = FSM(name=child.get(F_NAME, child.get("id") or "region"))
                 self.parent_of[id(region)] = node
                 node.state.regions.append(region)
-                out.append(("single", child, region, node))
+                if child.get(F_REGION) == "true":
+                    self.region_wrapper(child)
+                    out.append(("children", child, region, node))
+                else:
+                    out.append(("single", child, region, node))
             return out
         region = FSM(name=node.state.name)
         self.parent_of[id(region)] = node
         node.state.regions.append(region)
         return [("children", element, region, node)]
+
+    def region_wrapper(self, element: etree._Element) -> None:
+        """A ``<state fsmbt:region="true">`` child of a ``<parallel>`` is the wrapper fsmbt
+        writes around a region of several states: the region itself, not a state of it (a
+        compound state with the same W3C meaning). It may hold states only."""
+        if local_name(element) != "state":
+            raise InputError("fsmbt:region is only meaningful on a <state>",
+                             location=self.where(element), element=f"<{local_name(element)}>")
+        for child in self.children(element):
+            if self.tag(child) not in STATE_TAGS and self.tag(child) != "initial":
+                raise InputError(f"a region wrapper (fsmbt:region) holds states only, not "
+                                 f"<{local_name(child)}>", location=self.where(child),
+                                 element=f"<{local_name(child)}>")
+        wrapper_id = element.get("id")
+        if wrapper_id is not None:
+            if wrapper_id in self.by_id or wrapper_id in self.wrapper_ids:
+                raise InputError(f"duplicate state id '{wrapper_id}'",
+                                 location=self.where(element), element="<state>")
+            self.wrapper_ids.add(wrapper_id)
 
     def content(self, element: etree._Element, container: etree._Element) -> None:
         """Non-state children of a state or of <scxml>: supported, warned or refused."""
@@ -289,8 +327,7 @@ class _Reader:
                 node.machine.transitions.append(transition)
 
     def transition(self, node: _Node, element: etree._Element) -> list[Transition]:
-        if element.get("cond") is not None:
-            raise self.unsupported(element, "cond guards (the model has no data)")
+        cond_exit = self.completion_guard(node, element)
         if element.get("type", "external") != "external":
             raise self.unsupported(element, f"type=\"{element.get('type')}\" transitions")
         target_ids = (element.get("target") or "").split()
@@ -305,7 +342,7 @@ class _Reader:
             raise InputError(f"transition to unknown state '{target_ids[0]}'",
                              location=self.where(element), element="<transition>")
         attrs = {k: v for k, v in element.attrib.items() if k not in _TRANSITION_KEYS}
-        exit_name = element.get(F_EXIT)
+        exit_name = self.exit_of(node, element, cond_exit)
         events = element.get("event")
         location = self.where(element)
         if events is None:
@@ -329,10 +366,50 @@ class _Reader:
                     raise self.unsupported(element, f"'{name}' on another state than the one "
                                                     "that completes")
                 event = None
+                self.done_transitions.append((node, element, exit_name is not None))
             else:
                 self.descriptors.setdefault(name, element.sourceline or 0)
             out.append(self.route(node, event, target, element, attrs, exit_name, location))
         return out
+
+    def completion_guard(self, node: _Node, element: etree._Element) -> str | None:
+        """The final state named by ``cond="In('F')"`` on a ``done.state.X`` transition of
+        compound ``X`` (``F`` a ``<final>`` child of ``X``): the completion transition waits for
+        ``F``. Any other ``cond`` is refused (the model has no data)."""
+        cond = element.get("cond")
+        if cond is None:
+            return None
+        match = _IN_FINAL.fullmatch(cond)
+        events = (element.get("event") or "").split()
+        own_done = f"done.state.{node.element.get('id')}"
+        if match is None or events != [own_done] or local_name(node.element) != "state":
+            raise self.unsupported(element, "cond guards (the model has no data; the only guard "
+                                            "read is In('F') on a compound state's own "
+                                            "done.state event, F one of its <final> children)")
+        final = self.by_id.get(match.group("single") or match.group("double"))
+        if final is None or local_name(final.element) != "final" \
+                or final.element.getparent() is not node.element:
+            raise self.unsupported(element, f"cond=\"{cond}\": In() must name a <final> child "
+                                            f"of '{node.element.get('id')}'")
+        return final.state.name
+
+    def exit_of(self, node: _Node, element: etree._Element, cond_exit: str | None) -> str | None:
+        """The final state a completion transition waits for: the ``In()`` guard (standard
+        meaning), else the legacy annotation ``fsmbt:exit`` (files written before the guard;
+        warned, since a W3C engine ignores it). Both present: they must agree."""
+        legacy = element.get(F_EXIT)
+        if legacy is None or cond_exit is not None:
+            if legacy is not None and legacy != cond_exit:
+                raise InputError(f"fsmbt:exit=\"{legacy}\" contradicts cond=\""
+                                 f"{element.get('cond')}\" (the guard is the meaning)",
+                                 location=self.where(element), element="<transition>")
+            return cond_exit
+        self.ctx.warn(f"fsmbt:exit=\"{legacy}\" without a cond=\"In(...)\" guard (a file "
+                      "written by an older fsmbt): read as fsmbt meant it, but a W3C engine "
+                      "takes the first done.state transition in document order; write the "
+                      "file again to get the guard", line=element.sourceline,
+                      element="<transition>")
+        return legacy
 
     def route(self, node: _Node, event: str | None, target: _Node, element: etree._Element,
               attrs: dict[str, str], exit_name: str | None,
@@ -399,6 +476,13 @@ class _Reader:
         return node
 
     def check_prefix_matching(self) -> None:
+        for name, line in self.descriptors.items():
+            if name in ("done", "done.state"):
+                raise UnsupportedError(f"event descriptor '{name}' also matches every "
+                                       "done.state.<id> completion event (SCXML prefix "
+                                       "matching)", location=self.ctx.location(line),
+                                       element="<transition>")
+        self.check_done_prefixes()
         names = sorted(self.descriptors)
         for i, name in enumerate(names):
             for other in names[i + 1:]:
@@ -409,6 +493,32 @@ class _Reader:
                         f"event descriptor '{name}' also matches '{other}' (SCXML prefix "
                         "matching)", location=self.ctx.location(self.descriptors[name]),
                         element="<transition>")
+
+    def check_done_prefixes(self) -> None:
+        """``done.state.a`` also matches ``done.state.a.b`` (SCXML prefix matching): refuse a
+        completion transition of ``a`` that a W3C engine could take on the completion of another
+        compound/parallel state ``a.b``, unless its ``In()`` guard rules that out (``a.b``
+        inside compound ``a``, whose guard names a final child of ``a``: not active then)."""
+        composite_ids = {state_id for state_id, node in self.by_id.items()
+                         if not node.state.is_atomic}
+        for node, element, guarded in self.done_transitions:
+            own = node.element.get("id") or ""
+            for other in composite_ids:
+                if not other.startswith(own + "."):
+                    continue
+                if guarded and self.is_inside(self.by_id[other], node):
+                    continue
+                raise self.unsupported(element, f"'done.state.{own}' also matches the "
+                                                f"completion event of '{other}' (SCXML prefix "
+                                                "matching)")
+
+    def is_inside(self, inner: _Node, outer: _Node) -> bool:
+        owner = self.parent_of[id(inner.machine)]
+        while owner is not None:
+            if owner is outer:
+                return True
+            owner = self.parent_of[id(owner.machine)]
+        return False
 
     def start_pseudo_state(self, top: FSM) -> None:
         """A state written with ``fsmbt:start`` is the FSM's start pseudo-state again."""
@@ -447,6 +557,9 @@ class _Writer:
     skip_states: set[tuple[int, str]] = field(default_factory=set)
     skip_transitions: set[int] = field(default_factory=set)
     rerouted: dict[int, tuple[FSM, str]] = field(default_factory=dict)  # id(t) -> real target
+    taken: set[str] = field(default_factory=set)
+    composite_ids: set[str] = field(default_factory=set)
+    composite_prefixes: set[str] = field(default_factory=set)  # proper dot-prefixes of those
 
     def prepare(self) -> None:
         machines = [self.top]  # pre-order without recursion (FSM.walk recurses)
@@ -471,20 +584,42 @@ class _Writer:
             for state in machine.states.values():
                 if (id(machine), state.name) not in self.skip_states:
                     used[state.name] = used.get(state.name, 0) + 1
-        taken: set[str] = set(n for n in reserved if n)
+        self.taken.update(n for n in reserved if n)
         for machine in machines:
             owner = self.owner.get(id(machine))
             for state in machine.states.values():
                 if (id(machine), state.name) in self.skip_states:
                     continue
-                unique = _id_token(state.name)  # the real name goes to fsmbt:name
-                if used[state.name] > 1 or unique in taken:
-                    prefix = self.ids[(id(owner[0]), owner[1].name)] if owner else "top"
-                    unique = f"{prefix}.{_id_token(state.name)}"
-                    while unique in taken:
-                        unique += "_"
-                taken.add(unique)
-                self.ids[(id(machine), state.name)] = unique
+                prefix = self.ids[(id(owner[0]), owner[1].name)] if owner else "top"
+                self.ids[(id(machine), state.name)] = self.allocate(
+                    state.name, prefix, composite=not state.is_atomic,
+                    shared=used[state.name] > 1)
+
+    def allocate(self, name: str, prefix: str, *, composite: bool, shared: bool) -> str:
+        """A unique id for ``name`` (``<prefix>.<name>`` when the name repeats or is taken).
+
+        The id of a compound/parallel state (it raises ``done.state.<id>``) is never a
+        dot-prefix of another one's, nor has one as a dot-prefix: SCXML's event matching takes
+        ``done.state.a`` for ``done.state.a.b`` too. Such ids get ``_`` for ``.``; whitespace
+        becomes ``_`` (the model name is kept in ``fsmbt:name``).
+        """
+        name = re.sub(r"\s+", "_", name)  # an id is one token (targets are lists of ids)
+        unique = f"{prefix}.{name}" if shared or name in self.taken else name
+        while unique in self.taken or (composite and self.dot_related(unique)):
+            unique = unique.replace(".", "_") if composite and "." in unique else unique + "_"
+        self.taken.add(unique)
+        if composite:
+            self.composite_ids.add(unique)
+            parts = unique.split(".")
+            self.composite_prefixes.update(".".join(parts[:n]) for n in range(1, len(parts)))
+        return unique
+
+    def dot_related(self, candidate: str) -> bool:
+        """Is ``candidate`` a dot-prefix of a compound state's id, or the reverse?"""
+        if candidate in self.composite_prefixes:
+            return True
+        parts = candidate.split(".")
+        return any(".".join(parts[:n]) in self.composite_ids for n in range(1, len(parts)))
 
     def resolve(self, machine: FSM, target: str) -> tuple[FSM, str] | None:
         """Follow transient exit states up to the real target (``None`` if not one)."""
@@ -529,7 +664,7 @@ class _Writer:
         if start is not None and fsm.initial is not None:
             element = etree.SubElement(root, _q("state"), id=start)
             element.set(F_START, "true")
-            etree.SubElement(element, _q("transition"), event=fsm.initial_event or "",
+            etree.SubElement(element, _q("transition"), event=_event_descriptor(fsm.initial_event or "", start),
                              target=self.ids[(id(fsm), fsm.initial)])
         stack: list[tuple[FSM, etree._Element]] = [(fsm, root)]
         while stack:
@@ -574,18 +709,30 @@ class _Writer:
                            state_id: str, t: Transition) -> None:
         out = etree.SubElement(element, _q("transition"))
         if t.event is not None:
-            out.set("event", t.event)
+            out.set("event", _event_descriptor(t.event, state.name))
         elif not state.is_atomic:
             out.set("event", f"done.state.{state_id}")
+            if t.exit is not None:
+                out.set("cond", _in_predicate(self.final_id(state, t.exit), state.name))
         target_machine, target = self.rerouted.get(id(t), (machine, t.target))
         key = (id(target_machine), target)
         if key not in self.ids:
             raise InputError(f"transition to unknown state '{target}'", element=state.name)
         out.set("target", self.ids[key])
-        if t.exit is not None and id(t) not in self.skip_transitions:
-            out.set(F_EXIT, t.exit)
         for k, v in t.attrs.items():
             out.set(k, v)
+
+    def final_id(self, state: State, exit_name: str) -> str:
+        """The id of the final state a completion transition of ``state`` waits for."""
+        region = state.regions[0]
+        final = region.states.get(exit_name)
+        if not state.is_composite or final is None or not final.final or not final.is_atomic:
+            where = "a parallel state" if state.is_parallel else f"'{state.name}'"
+            raise UnsupportedError(f"a completion transition of {where} waiting for "
+                                   f"'{exit_name}', which is not a final state of its "
+                                   "sub-machine, cannot be written as SCXML (it never fires)",
+                                   element=state.name)
+        return self.ids[(id(region), exit_name)]
 
     def region_elements(self, element: etree._Element,
                         state: State) -> list[tuple[FSM, etree._Element]]:
@@ -598,19 +745,59 @@ class _Writer:
             if len(region.states) == 1 and region.initial in region.states:
                 out.append((region, element))
             else:  # a region of several states needs a wrapper state in SCXML
-                wrapper = etree.SubElement(element, _q("state"), id=f"{state.name}.{region.name}")
+                wrapper_id = self.allocate(region.name, element.get("id") or state.name,
+                                           composite=True, shared=True)
+                wrapper = etree.SubElement(element, _q("state"), id=wrapper_id)
+                wrapper.set(F_REGION, "true")
+                if wrapper_id != region.name:
+                    wrapper.set(F_NAME, region.name)
                 if region.initial is not None:
                     wrapper.set("initial", self.ids[(id(region), region.initial)])
                 out.append((region, wrapper))
         return out
 
 
-def _id_token(name: str) -> str:
-    """A state name as an SCXML id: ``initial`` and ``target`` are space-separated id lists,
-    so blanks become ``_`` (the writer then records the real name in ``fsmbt:name``)."""
-    return re.sub(r"\s+", "_", name) or "_"
+def _in_predicate(state_id: str, source: str) -> str:
+    """W3C's ``In('id')`` (``In("id")`` when the id holds a single quote)."""
+    if "'" not in state_id:
+        return f"In('{state_id}')"
+    if '"' not in state_id:
+        return f'In("{state_id}")'
+    raise UnsupportedError(f"the state id {state_id!r} holds both quote characters and cannot "
+                           "be named in a cond guard", element=source)
 
 
+def _event_descriptor(event: str, source: str) -> str:
+    """The event as an SCXML descriptor; names SCXML would read as something else are refused
+    (see also ``_check_event_prefixes``)."""
+    if not event or any(c.isspace() for c in event) or event == "*" or event.endswith(".*") \
+            or event.endswith(".") or event in ("done", "done.state") \
+            or event.startswith("done.state."):
+        raise UnsupportedError(f"event '{event}' cannot be an SCXML event name (whitespace, a "
+                               "wildcard, or a done.state event)", element=source)
+    return event
+
+
+def _check_event_prefixes(fsm: FSM) -> None:
+    """SCXML's descriptor ``a`` also matches event ``a.b``: such an alphabet cannot be written."""
+    names: set[str] = set()
+    stack = [fsm]
+    while stack:
+        machine = stack.pop()
+        names.update(t.event for t in machine.transitions if t.event is not None)
+        if machine.initial_event is not None:
+            names.add(machine.initial_event)
+        for state in machine.states.values():
+            stack.extend(state.regions)
+    ordered = sorted(names)
+    for i, name in enumerate(ordered):
+        for other in ordered[i + 1:]:
+            if not other.startswith(name):
+                break
+            if other.startswith(name + "."):
+                raise UnsupportedError(f"events '{name}' and '{other}' cannot both be written as "
+                                       f"SCXML: the descriptor '{name}' also matches '{other}' "
+                                       "(SCXML prefix matching)")
 def _is_parallel(state: State) -> bool:
     """Several regions, or one region holding one state named like it (a one-child parallel)."""
     if len(state.regions) > 1:
@@ -629,6 +816,7 @@ def _q(tag: str) -> str:
 def write_scxml(model: Model) -> str:
     if not isinstance(model, FSM):
         raise InputError("SCXML holds a state machine, not a behavior tree")
+    _check_event_prefixes(model)
     try:
         return _Writer(model).write()
     except ValueError as exc:  # lxml: a name or value XML cannot hold

@@ -96,7 +96,18 @@ def translate(model: Model, to: str, *, flatten: bool = False,
         written = flatten_fsm(model)
         losses.append(f"flattened: {len(written.states)} flat states replace the composite, "
                       "parallel and transient states")
+    checked = model  # what the read-back must equal in behaviour (events renamed, if any)
     if target.name == "scxml" and isinstance(written, FSM):
+        events = scxml_event_renames(written)
+        if events:
+            written = rename_events(written, events)
+            if isinstance(model, FSM):
+                checked = rename_events(model, events)
+            shown = ", ".join(f"'{a}' -> '{b}'" for a, b in list(events.items())[:5])
+            more = f" and {len(events) - 5} more" if len(events) > 5 else ""
+            losses.append(f"{len(events)} event name(s) mean something else to an SCXML engine "
+                          "(done.state prefixes, wildcards, blanks, or one event a dot-prefix of "
+                          f"another): renamed {shown}{more}; send the new names to the engine")
         written, renamed = scxml_safe_names(written)
         if renamed:
             shown = ", ".join(f"'{a}' -> '{b}'" for a, b in list(renamed.items())[:5])
@@ -115,7 +126,6 @@ def translate(model: Model, to: str, *, flatten: bool = False,
                                location=exc.location, element=exc.element) from None
     own_losses = _writer_losses(target.name, written)
     losses.extend(own_losses or [])
-    losses.extend(_format_losses(target.name, written))
     result = Translation(text, source_format, target.name, losses)
     if target.read is None:
         losses.append(f"{target.name} cannot be read back, so what it loses is not checked")
@@ -127,7 +137,7 @@ def translate(model: Model, to: str, *, flatten: bool = False,
                       "loses is not checked")
         return result
     if check is not None:
-        _check_meaning(model, back, target.name, check)
+        _check_meaning(checked, back, target.name, check)
         result.verified = True
     if own_losses is None:
         losses.extend(differences_between(written, back))
@@ -202,6 +212,64 @@ def _writer_losses(target: str, model: Model) -> list[str] | None:
 _NCNAME = re.compile(r"[A-Za-z_][A-Za-z0-9_.\-]*\Z")
 
 
+def _all_events(fsm: FSM) -> list[str]:
+    """Every event of ``fsm`` and its sub-machines, in walk order, once each."""
+    seen: dict[str, None] = {}
+    machines = [fsm, *(region for _p, _m, state in fsm.walk() for region in state.regions)]
+    for machine in machines:
+        if machine.initial_event is not None:
+            seen.setdefault(machine.initial_event, None)
+        for t in machine.transitions:
+            if t.event is not None:
+                seen.setdefault(t.event, None)
+    return list(seen)
+
+
+def scxml_event_renames(fsm: FSM) -> dict[str, str]:
+    """The events an SCXML engine would read differently, each with a safe new name.
+
+    An SCXML event descriptor matches by dot-prefix (``a`` also matches ``a.b``, ``done`` every
+    ``done.state.X``), ``*`` is a wildcard and blanks separate descriptors; such names get their
+    blanks, ``*`` and (where they make a prefix) dots replaced by ``_``, and a ``done`` name an
+    ``ev_`` prefix, numbered when that clashes.
+    """
+    events = _all_events(fsm)
+    taken = set(events)
+    prefixes = {e for e in events if any(o.startswith(e + ".") for o in events if o != e)}
+    renames: dict[str, str] = {}
+    for event in events:
+        related = event in prefixes or any(event.startswith(p + ".") for p in prefixes)
+        bad = (not event or any(c.isspace() for c in event) or "*" in event
+               or event.endswith(".") or event == "done" or event.startswith("done."))
+        if not (bad or related):
+            continue
+        base = re.sub(r"[\s*]+", "_", event)
+        if related:
+            base = base.replace(".", "_")
+        base = base.rstrip(".") or "_"
+        if base == "done" or base.startswith("done.") or base.startswith("done_"):
+            base = f"ev_{base}"
+        candidate, index = base, 2
+        while candidate in taken:
+            candidate, index = f"{base}_{index}", index + 1
+        taken.add(candidate)
+        renames[event] = candidate
+    return renames
+
+
+def rename_events(fsm: FSM, renames: dict[str, str]) -> FSM:
+    """A copy of ``fsm`` with its events renamed (every level)."""
+    copy_ = copy.deepcopy(fsm)
+    machines = [copy_, *(region for _p, _m, state in copy_.walk() for region in state.regions)]
+    for machine in machines:
+        if machine.initial_event is not None:
+            machine.initial_event = renames.get(machine.initial_event, machine.initial_event)
+        for t in machine.transitions:
+            if t.event is not None:
+                t.event = renames.get(t.event, t.event)
+    return copy_
+
+
 def scxml_safe_names(fsm: FSM) -> tuple[FSM, dict[str, str]]:
     """A copy of ``fsm`` whose state names are valid SCXML ids, and the renames made.
 
@@ -248,25 +316,6 @@ def scxml_safe_names(fsm: FSM) -> tuple[FSM, dict[str, str]]:
     if copy_.start_name is not None:
         copy_.start_name = safe(copy_.start_name)
     return copy_, renamed
-
-
-def _format_losses(target: str, model: Model) -> list[str]:
-    """What the target keeps only in fsmbt's own extension, so other engines lose it."""
-    if target != "scxml" or not isinstance(model, FSM):
-        return []
-    out: list[str] = []
-    for path, _machine, state in model.walk():
-        if not state.is_composite:
-            continue
-        owner = _machine
-        exits = [t.exit for t in owner.transitions
-                 if t.source == state.name and t.event is None and t.exit is not None]
-        if len(set(exits)) > 1:
-            out.append(f"composite '{path}' ends differently by final state "
-                       f"({', '.join(dict.fromkeys(exits))}); SCXML's done.state.{state.name} "
-                       "does not say which, so this is kept in the fsmbt:exit attribute only "
-                       "(other SCXML engines take the first matching transition)")
-    return out
 
 
 def _check_meaning(model: Model, back: Model, target: str, verify: Checker) -> None:

@@ -1,0 +1,1 @@
+"""Run converted models with the user's own code: the Python runtime of LEBTs (python_runtime)."""

@@ -1,0 +1,310 @@
+"""Run a converted behavior tree (an LEBT) with your own actions, on py_trees or BehaviorTree.CPP.
+
+fsmbt's FSM -> BT conversion writes a BehaviorTree.CPP v4 tree whose leaves are ``LebtGuard``
+and ``LebtState`` (docs/semantics.md, "loop-execution BT"). This module runs such a tree in a
+real engine and calls *your* code when a state is entered:
+
+    runner = load_tree(Path("door_bt.xml"), {"Open": open_door, "Closed": stop_motor})
+    runner.start()            # the initial state's action runs (FSMs without initial event)
+    runner.post("open_cmd")   # one macro step; returns the action names run, in order
+    runner.state, runner.terminated
+
+Rules:
+
+- Engines: ``"py_trees"`` (py_trees 2.6) and ``"btcpp"`` (BehaviorTree.CPP 4.8.2 through
+  ``behaviortreepy``); both run the same leaf behaviours (``fsmbt.semantics.lebt.leaves``) and
+  the macro step of docs/semantics.md: post the event, tick, tick once more when the root
+  succeeded with the event still pending, drop an event no state takes.
+- An action is a callable taking no argument, looked up by the action name the ``LebtState``
+  leaf carries (its ``action`` port; by default the FSM state's name). It runs once per entry
+  into the state, as the FSM's entry action does, in entry order, after the engine's ticks of
+  that macro step (the tree's control flow never depends on an action). An exception raised
+  by an action propagates to the caller of ``start``/``post``.
+- Checked when loading, never at tick time (``InputError`` naming the place): the file is a
+  v4 tree fsmbt can read; every node is ``LebtGuard``, ``LebtState``, ``SubTree`` or the
+  control nodes the LEBT uses (``Sequence``, ``Fallback``) - any other node is named with its
+  line; every action name the tree uses has a callable, and (unless ``allow_unused=True``) every
+  callable names an action of the tree (a typo is caught, not ignored).
+- ``write_files`` writes a runnable example (a converted tree and a script) into a folder.
+
+Costs: loading is O(n) in the tree's nodes plus the engine's own build; a macro step costs one
+or two root ticks, each O(root-level selectors + depth of the active state's leaf) in both
+engines (the root Sequence asks every root-level guard before the running branch). User code is never
+imported or executed by fsmbt itself: only the callables you pass are called.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from pathlib import Path
+
+from fsmbt.formats import loads, read_model
+from fsmbt.model.bt import BTDocument, BTNode
+from fsmbt.model.bt_nodes import NodeKind
+from fsmbt.model.errors import InputError
+from fsmbt.semantics.bt_interpreter import CompiledTree
+from fsmbt.semantics.lebt.driver import EngineLebtRun
+from fsmbt.semantics.lebt.spec import GUARD_TYPE, STATE_TYPE
+
+#: The engines a tree can run on.
+ENGINES = ("py_trees", "btcpp")
+#: The non-leaf nodes an LEBT is built from (fsmbt.convert.lebt, hfsm_to_bt).
+LEBT_CONTROLS = frozenset({"Sequence", "Fallback"})
+LEBT_LEAVES = frozenset({GUARD_TYPE, STATE_TYPE})
+
+Action = Callable[[], object]
+
+__all__ = ["ENGINES", "TreeRunner", "load_tree", "write_files"]
+
+
+class TreeRunner:
+    """A loaded LEBT on one engine, with the user's actions (build it with ``load_tree``)."""
+
+    def __init__(self, doc: BTDocument, actions: Mapping[str, Action], *,
+                 engine: str = "py_trees", allow_unused: bool = False) -> None:
+        """Check ``doc`` and ``actions`` and build the engine's tree (not started).
+
+        Args:
+            doc: the converted tree, as fsmbt read it.
+            actions: action name -> callable without arguments.
+            engine: ``"py_trees"`` or ``"btcpp"``.
+            allow_unused: accept callables whose name no state of the tree uses.
+        Raises:
+            InputError: a node the LEBT does not use (with its line), an action without
+                callable, a callable without action, an unknown engine.
+        """
+        if engine not in ENGINES:
+            raise InputError(f"unknown engine '{engine}' (known: {', '.join(ENGINES)})")
+        check_lebt_nodes(doc)
+        tree = CompiledTree(doc)
+        self.engine = engine
+        self._run = _engine_runner(engine, tree)
+        self.used_actions = _check_actions(self._run, actions, allow_unused=allow_unused)
+        self._actions = dict(actions)
+        self._started = False
+
+    @property
+    def state(self) -> str:
+        """The FSM state the tree is in (the start pseudo-state before the initial event)."""
+        return self._run.bb.state
+
+    @property
+    def start_state(self) -> str:
+        """The start pseudo-state's name."""
+        return self._run.leaves.start
+
+    @property
+    def terminated(self) -> bool:
+        """The tree has reached a final state of the FSM (the root returned SUCCESS)."""
+        return self._run.terminated
+
+    @property
+    def started(self) -> bool:
+        return self._started
+
+    def start(self) -> tuple[str, ...]:
+        """Start the tree: with no initial event the initial state is entered (one tick).
+
+        Returns:
+            The action names run (the initial state's, or none).
+        Raises:
+            RuntimeError: when called twice.
+        """
+        if self._started:
+            raise RuntimeError("the tree is already started")
+        self._started = True
+        return self._call(self._run.initial())
+
+    def post(self, event: str) -> tuple[str, ...]:
+        """One macro step: post ``event`` and tick (twice when the rule says so).
+
+        Args:
+            event: the event name (an event no state takes is dropped).
+        Returns:
+            The action names run, in entry order (empty when the event was ignored).
+        Raises:
+            RuntimeError: before ``start``.
+        """
+        if not self._started:
+            raise RuntimeError("call start() before posting events")
+        return self._call(self._run.macro_step(event))
+
+    def _call(self, names: tuple[str, ...]) -> tuple[str, ...]:
+        for name in names:
+            self._actions[name]()
+        return names
+
+
+def load_tree(source: Path | str, actions: Mapping[str, Action], *, engine: str = "py_trees",
+              allow_unused: bool = False) -> TreeRunner:
+    """Load a converted tree and bind the user's actions.
+
+    Args:
+        source: the BehaviorTree.CPP XML text (a string starting with ``<``), or the path of
+            the file (a ``Path``, or any other string).
+        actions: action name -> callable without arguments.
+        engine: ``"py_trees"`` or ``"btcpp"``.
+        allow_unused: accept callables whose name no state of the tree uses.
+    Returns:
+        A ``TreeRunner``, not started.
+    Raises:
+        InputError: unreadable file, not a behavior tree, or one of ``TreeRunner``'s checks.
+    """
+    if isinstance(source, str) and source.lstrip("\ufeff \t\r\n").startswith("<"):
+        model = loads(source, "btcpp")
+    else:
+        model = read_model(Path(source))
+    if not isinstance(model, BTDocument):
+        raise InputError("not a behavior tree: the runtime runs converted trees "
+                         "(fsmbt convert model -o tree.xml)")
+    return TreeRunner(model, actions, engine=engine, allow_unused=allow_unused)
+
+
+def check_lebt_nodes(doc: BTDocument) -> None:
+    """Refuse any node an LEBT does not have, naming it and its line.
+
+    Raises:
+        InputError: the first such node in document order.
+    """
+    for tree in doc.trees.values():
+        stack: list[BTNode] = [tree.root] if tree.root is not None else []
+        while stack:
+            node = stack.pop()
+            allowed = (node.type in LEBT_LEAVES if node.is_leaf
+                       else node.kind is NodeKind.SUBTREE or node.type in LEBT_CONTROLS)
+            if not allowed:
+                raise InputError(
+                    f"<{node.type}> is not a node of a converted tree (loop-execution BT: "
+                    f"leaves {GUARD_TYPE} and {STATE_TYPE}, controls "
+                    f"{', '.join(sorted(LEBT_CONTROLS))}, SubTree)",
+                    location=node.location, element=f"<{node.type}> '{node.label}'")
+            stack.extend(reversed(node.children))
+
+
+def _engine_runner(engine: str, tree: CompiledTree) -> EngineLebtRun:
+    """The engine adapter of fsmbt's differential tests, on the compiled tree."""
+    if engine == "btcpp":
+        from fsmbt.semantics.engines.btcpp_engine import BTCppLebtRunner
+
+        return BTCppLebtRunner(tree)
+    from fsmbt.semantics.engines.pytrees_engine import PyTreesLebtRunner
+
+    return PyTreesLebtRunner(tree)
+
+
+def _check_actions(run: EngineLebtRun, actions: Mapping[str, Action], *,
+                   allow_unused: bool) -> frozenset[str]:
+    """Every action of the tree has a callable (and every callable an action)."""
+    used: dict[str, str] = {}  # action -> a state that runs it
+    for spec in run.leaves.states.values():
+        if spec.action is not None:
+            used.setdefault(spec.action, spec.state)
+    missing = [name for name in used if name not in actions]
+    if missing:
+        shown = ", ".join(f"'{name}' (state '{used[name]}')" for name in missing)
+        raise InputError(f"no callable for the action(s) {shown}; pass one per action name "
+                         f"(the tree's actions: {', '.join(sorted(used))})")
+    not_callable = [name for name, action in actions.items() if not callable(action)]
+    if not_callable:
+        raise InputError(f"the action(s) {', '.join(map(repr, not_callable))} are not callable")
+    unused = [name for name in actions if name not in used]
+    if unused and not allow_unused:
+        raise InputError(f"no state of the tree runs the action(s) "
+                         f"{', '.join(map(repr, unused))} (a typo? pass allow_unused=True to "
+                         f"accept them); the tree's actions: {', '.join(sorted(used))}")
+    return frozenset(used)
+
+
+# -- the example folder -------------------------------------------------------------------------
+EXAMPLE_TREE = "lebt_tree.xml"
+EXAMPLE_SCRIPT = "run_lebt.py"
+
+
+def write_files(directory: Path, *, overwrite: bool) -> list[Path]:
+    """Write a self-contained runnable example: a converted tree and a script that runs it.
+
+    The tree is the LEBT of a small door controller (converted by fsmbt here, so it is always
+    what this fsmbt writes); the script binds one printing callable per action and runs a few
+    events on both engines (``python run_lebt.py`` in the folder, with fsmbt installed).
+
+    Args:
+        directory: the folder (created when missing).
+        overwrite: replace files that exist; without it an existing file is an error.
+    Returns:
+        The paths written.
+    Raises:
+        InputError: a file exists and ``overwrite`` is False, or the folder is a file.
+    """
+    if directory.exists() and not directory.is_dir():
+        raise InputError(f"{directory} exists and is not a folder")
+    paths = [directory / EXAMPLE_TREE, directory / EXAMPLE_SCRIPT]
+    existing = [p for p in paths if p.exists()]
+    if existing and not overwrite:
+        raise InputError(f"{', '.join(map(str, existing))} already exist(s); nothing written "
+                         "(overwrite=True / --force replaces them)")
+    directory.mkdir(parents=True, exist_ok=True)
+    paths[0].write_text(_example_tree(), encoding="utf-8")
+    paths[1].write_text(_EXAMPLE_SCRIPT_TEXT, encoding="utf-8")
+    return paths
+
+
+_EXAMPLE_FSM = """\
+<?xml version="1.0" encoding="UTF-8"?>
+<scxml xmlns="http://www.w3.org/2005/07/scxml" version="1.0" name="door" initial="Closed">
+  <state id="Closed"><transition event="open_cmd" target="Opening"/></state>
+  <state id="Opening"><transition event="fully_open" target="Open"/>
+    <transition event="fault" target="Stopped"/></state>
+  <state id="Open"><transition event="close_cmd" target="Closing"/></state>
+  <state id="Closing"><transition event="fully_closed" target="Closed"/>
+    <transition event="obstacle" target="Opening"/></state>
+  <final id="Stopped"/>
+</scxml>
+"""
+
+
+def _example_tree() -> str:
+    """The example FSM converted as ``fsmbt convert`` does (the rules engine)."""
+    from fsmbt.convert.engines import converter_for
+    from fsmbt.formats import dumps
+
+    fsm = loads(_EXAMPLE_FSM, "scxml")
+    return dumps(converter_for("rules", fsm)(fsm).model, "btcpp")
+
+
+_EXAMPLE_SCRIPT_TEXT = '''\
+"""Run the converted tree lebt_tree.xml with your own actions, on py_trees and BehaviorTree.CPP.
+
+Written by fsmbt (fsmbt.runtime.python_runtime.write_files). Run: python run_lebt.py
+Replace the callables in ACTIONS with your robot's code; docs: docs/runtime-python.md.
+"""
+
+from pathlib import Path
+
+from fsmbt.runtime.python_runtime import ENGINES, load_tree
+
+TREE = Path(__file__).with_name("lebt_tree.xml")
+EVENTS = ["open_cmd", "fully_open", "close_cmd", "obstacle", "fully_open", "close_cmd",
+          "fully_closed", "open_cmd", "fault"]
+
+
+def say(text):
+    return lambda: print(f"    action: {text}")
+
+
+ACTIONS = {
+    "Closed": say("door closed, motor off"),
+    "Opening": say("motor forward"),
+    "Open": say("door open, motor off"),
+    "Closing": say("motor backward"),
+    "Stopped": say("fault: motor off, door stopped"),
+}
+
+for engine in ENGINES:
+    print(f"engine {engine}")
+    runner = load_tree(TREE, ACTIONS, engine=engine)
+    runner.start()
+    for event in EVENTS:
+        print(f"  event {event}")
+        runner.post(event)
+        print(f"    state {runner.state}, terminated {runner.terminated}")
+'''

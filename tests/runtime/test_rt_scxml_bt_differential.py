@@ -1,0 +1,195 @@
+"""Every SCXML that BT->FSM writes runs in python-statemachine as fsmbt proved it (issue 11, 5a).
+
+The BT is converted by the rules engine (``bt_to_hfsm``), the HFSM written as SCXML, the text
+loaded in python-statemachine 3.2.2 and driven with seeded random leaf outcomes; after each
+outcome the engine's configuration must be fsmbt's (``FSMMachine`` over the flattened HFSM the
+conversion proved), the same leaf active, the same termination and the same final state.
+
+Groups (one test each): the examples (``examples/*_bt.xml``), every corpus BT that converts
+(``FSMBT_CORPUS``, default ``<repo>/../shared/corpus``) and ``FSMBT_SCXML_BTS`` generated BTs
+(default 300; paper controls and, every other one, the extended node set whose regions are
+explored; every fourth converted with ``loop=True``). ``FSMBT_SCXML_SEQUENCES`` sequences per model (default 5 for generated trees, 4x for
+the examples and the corpus) of up to ``FSMBT_SCXML_LENGTH`` outcomes (default 30). Counts are
+printed (``pytest -s``). The full run used for the report: ``FSMBT_SCXML_BTS=1000
+FSMBT_SCXML_SEQUENCES=20``.
+"""
+
+from __future__ import annotations
+
+import os
+import random
+import sys
+from collections import Counter
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import pytest
+from scxml_oracle import PARALLEL_STOPS, Engine, Mismatch, Replay, replay
+
+from fsmbt.convert.bt_to_hfsm import bt_to_hfsm
+from fsmbt.formats import dumps, read_model
+from fsmbt.generate import random_bt
+from fsmbt.model.bt import BTDocument
+from fsmbt.model.errors import FsmbtError, UnsupportedError
+from fsmbt.model.fsm import FSM
+from fsmbt.semantics.machine import FSMMachine
+
+REPO = Path(__file__).resolve().parents[2]
+CORPUS = Path(os.environ.get("FSMBT_CORPUS", REPO.parent / "shared" / "corpus"))
+GENERATED = int(os.environ.get("FSMBT_SCXML_BTS", "300"))
+SEQUENCES = int(os.environ.get("FSMBT_SCXML_SEQUENCES", "5"))
+LENGTH = int(os.environ.get("FSMBT_SCXML_LENGTH", "30"))
+SEED = int(os.environ.get("FSMBT_SCXML_SEED", "11"))
+HFSMS = int(os.environ.get("FSMBT_SCXML_HFSMS", "100"))
+
+
+@dataclass
+class Tally:
+    group: str
+    models: int = 0
+    sequences: int = 0
+    events: int = 0
+    refused: Counter[str] = field(default_factory=Counter)
+    mismatches: list[str] = field(default_factory=list)
+    departures: Counter[str] = field(default_factory=Counter)
+
+    def add(self, label: str, result: Replay) -> None:
+        self.sequences += 1
+        self.events += result.sent
+        if result.mismatch is not None:
+            self.mismatches.append(f"{label}: {result.mismatch}")
+        if result.departure is not None:
+            self.departures[result.departure] += 1
+
+    def report(self) -> str:
+        return (f"\n[{self.group}] {self.models} models, {self.sequences} sequences, "
+                f"{self.events} events, {len(self.mismatches)} mismatches, "
+                f"{sum(self.departures.values())} sequences ended by a documented engine "
+                f"departure {dict(self.departures)}; not converted/written: "
+                f"{sum(self.refused.values())} {dict(self.refused.most_common(4))}")
+
+
+def random_hfsm(seed: int, *, parallel: bool) -> FSM:
+    """tests/convert's seeded HFSM generator (imported, not copied)."""
+    from support.conv_hfsm_gen import random_hfsm as make
+
+    return make(seed, parallel=parallel)
+
+
+def check_tree(tally: Tally, label: str, doc: BTDocument, rng: random.Random,
+               sequences: int, *, loop: bool = False) -> None:
+    try:
+        hfsm = bt_to_hfsm(doc, loop=loop).model
+    except FsmbtError as exc:
+        tally.refused[f"{type(exc).__name__}: {getattr(exc, 'message', str(exc))[:60]}"] += 1
+        return
+    text = dumps(hfsm, "scxml")
+    Engine(text)  # loads in the engine at all (raises otherwise)
+    machine = FSMMachine(hfsm)
+    tally.models += 1
+    for _ in range(sequences):
+        result = replay(text, hfsm, rng, length=LENGTH, machine=machine,
+                        alphabet=("success", "failure", "running"))
+        tally.add(label, result)
+
+
+def test_reported_bug_robot_pick_failure_is_not_delivery() -> None:
+    """Issue 11's report: after MovetoCube2 fails the engine must leave the pick unit by its
+    FAILURE end (the BT fails), not go on to RobotatDelivery as if the pick had succeeded."""
+    doc = read_model(REPO / "examples" / "robot_bt.xml")
+    hfsm = bt_to_hfsm(doc).model
+    text = dumps(hfsm, "scxml")
+    engine = Engine(text)
+    machine = FSMMachine(hfsm)
+    state, _ = machine.start()
+    for outcome in ("success", "failure", "failure", "failure", "failure"):
+        engine.send(outcome)
+        state, _ = machine.step(state, outcome)
+        assert engine.configuration() == state
+    assert "RobotatDelivery" not in engine.configuration()
+    assert engine.terminated and engine.configuration() == "FAILURE" == state
+
+
+def test_examples() -> None:
+    tally = Tally("examples")
+    rng = random.Random(SEED)
+    paths = sorted((REPO / "examples").glob("*_bt.xml"))
+    assert paths
+    for path in paths:
+        check_tree(tally, path.name, read_model(path), rng, 4 * SEQUENCES)
+    print(tally.report())
+    assert tally.models == len(paths) and not tally.mismatches, tally.mismatches[:5]
+
+
+def test_corpus_bts() -> None:
+    folder = CORPUS / "bt"
+    if not folder.exists():
+        pytest.skip(f"corpus not found at {CORPUS} (set FSMBT_CORPUS)")
+    tally = Tally("corpus bt")
+    rng = random.Random(SEED)
+    unreadable = 0
+    for path in sorted(folder.rglob("*.xml")):
+        try:
+            doc = read_model(path)
+        except FsmbtError:
+            unreadable += 1
+            continue
+        if isinstance(doc, BTDocument):
+            check_tree(tally, str(path.relative_to(CORPUS)), doc, rng, 4 * SEQUENCES)
+    print(tally.report() + f"; unreadable {unreadable}")
+    assert tally.models >= 10 and not tally.mismatches, tally.mismatches[:5]
+
+
+def test_generated_bts() -> None:
+    tally = Tally("generated bt")
+    rng = random.Random(SEED)
+    for index in range(GENERATED):
+        doc = random_bt(seed=SEED * 100_000 + index, depth=rng.randint(2, 5),
+                        breadth=rng.randint(2, 4), extended=index % 2 == 1, max_nodes=40)
+        check_tree(tally, f"gen{index}", doc, rng, SEQUENCES, loop=index % 4 == 3)
+    print(tally.report())
+    refused = sum(tally.refused.values())
+    assert all(k.startswith(UnsupportedError.__name__) for k in tally.refused), tally.refused
+    assert tally.models + refused == GENERATED and tally.models >= 0.9 * GENERATED
+    assert not tally.mismatches and not tally.departures, tally.mismatches[:5]
+
+
+def test_generated_hfsms_written_by_fsmbt() -> None:
+    """Beyond BT->FSM: seeded hierarchical FSMs (nested composites, completion transitions,
+    events shared between levels, parallel states whose regions fsmbt wraps) written by fsmbt
+    run in the engine as fsmbt's flattening says."""
+    tally = Tally("generated hfsm")
+    rng = random.Random(SEED)
+    for index in range(HFSMS):
+        hfsm = random_hfsm(SEED * 1000 + index, parallel=index % 2 == 1)
+        text = dumps(hfsm, "scxml")
+        machine = FSMMachine(hfsm)
+        tally.models += 1
+        for _ in range(SEQUENCES):
+            tally.add(f"hfsm{index}", replay(text, hfsm, rng, length=LENGTH, machine=machine))
+    print(tally.report())
+    assert not tally.mismatches, tally.mismatches[:5]
+    assert set(tally.departures) <= {PARALLEL_STOPS}
+
+
+def test_mismatch_is_reported_on_a_wrong_model() -> None:
+    """The oracle can fail: the robot SCXML against an HFSM whose pick unit's completion
+    transitions are swapped disagrees with the engine (so zero mismatches above means
+    something)."""
+    doc = read_model(REPO / "examples" / "robot_bt.xml")
+    hfsm = bt_to_hfsm(doc).model
+    text = dumps(hfsm, "scxml")
+    for machine_fsm in [hfsm, *(s.regions[0] for s in hfsm.states.values() if s.regions)]:
+        for t in machine_fsm.transitions:
+            if t.exit == "SUCCESS":
+                t.exit = "FAILURE"
+            elif t.exit == "FAILURE":
+                t.exit = "SUCCESS"
+    found: list[Mismatch] = []
+    rng = random.Random(SEED)
+    for _ in range(40):
+        result = replay(text, hfsm, rng, length=LENGTH,
+                        alphabet=("success", "failure", "running"))
+        if result.mismatch is not None:
+            found.append(result.mismatch)
+    assert found

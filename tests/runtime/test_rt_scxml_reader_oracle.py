@@ -1,0 +1,195 @@
+"""python-statemachine as an independent oracle for fsmbt's SCXML reader (issue 11, 5b).
+
+For every corpus SCXML file (``FSMBT_CORPUS``/fsm, default ``<repo>/../shared/corpus``; the
+``_malformed`` and ``_legacy_draft`` folders excluded) that both fsmbt and python-statemachine
+3.2.2 read, ``FSMBT_SCXML_READER_SEQUENCES`` (default 20) seeded random event sequences of up to
+``FSMBT_SCXML_LENGTH`` events (default 20) must give the same configuration after every event
+in the engine and in ``FSMMachine`` over fsmbt's model of the file. Then hand-written documents
+probe the corners of the supported subset where a reader is most easily wrong (parallel
+regions, prefix-free event matching, completion of nested and parallel states, transitions
+leaving several levels, document order). Counts are printed (``pytest -s``).
+
+Departures of the engine from the W3C algorithm found on the way are documented in
+docs/formats/scxml.md ("python-statemachine as oracle") and named by a test here.
+"""
+
+from __future__ import annotations
+
+import os
+import random
+from pathlib import Path
+
+import pytest
+from scxml_oracle import Engine, replay
+
+from fsmbt.formats import loads, read_model
+from fsmbt.model.errors import FsmbtError
+from fsmbt.model.fsm import FSM
+from fsmbt.semantics.machine import FSMMachine
+
+REPO = Path(__file__).resolve().parents[2]
+CORPUS = Path(os.environ.get("FSMBT_CORPUS", REPO.parent / "shared" / "corpus"))
+SEQUENCES = int(os.environ.get("FSMBT_SCXML_READER_SEQUENCES", "20"))
+LENGTH = int(os.environ.get("FSMBT_SCXML_LENGTH", "20"))
+SEED = int(os.environ.get("FSMBT_SCXML_SEED", "11"))
+NS = 'xmlns="http://www.w3.org/2005/07/scxml"'
+
+
+def corpus_scxml() -> list[Path]:
+    folder = CORPUS / "fsm"
+    return sorted(p for p in folder.rglob("*.scxml")
+                  if "_malformed" not in p.parts and "_legacy_draft" not in p.parts)
+
+
+def compare(text: str, model: FSM, seed: int, sequences: int) -> tuple[int, list[str]]:
+    rng = random.Random(seed)
+    machine = FSMMachine(model)
+    events = 0
+    mismatches = []
+    for _ in range(sequences):
+        result = replay(text, model, rng, length=LENGTH, machine=machine)
+        events += result.sent
+        if result.mismatch is not None:
+            mismatches.append(str(result.mismatch))
+        if result.departure is not None:
+            mismatches.append(f"undocumented here: {result.departure}")
+    return events, mismatches
+
+
+def test_corpus_files_both_read_agree() -> None:
+    paths = corpus_scxml() if (CORPUS / "fsm").exists() else []
+    if not paths:
+        pytest.skip(f"corpus not found at {CORPUS} (set FSMBT_CORPUS)")
+    compared, fsmbt_refuses, engine_refuses, events = [], [], [], 0
+    disagreements: dict[str, list[str]] = {}
+    for index, path in enumerate(paths):
+        label = str(path.relative_to(CORPUS))
+        try:
+            model = read_model(path)
+        except FsmbtError:
+            fsmbt_refuses.append(label)
+            continue
+        text = path.read_text()
+        try:
+            Engine(text)
+        except Exception as exc:  # the engine's own refusal, whatever its type
+            engine_refuses.append(f"{label}: {type(exc).__name__}")
+            continue
+        sent, mismatches = compare(text, model, SEED + index, SEQUENCES)
+        events += sent
+        compared.append(label)
+        if mismatches:
+            disagreements[label] = mismatches[:2]
+    print(f"\n[corpus scxml] {len(paths)} files: {len(compared)} read by both and compared "
+          f"({len(compared) * SEQUENCES} sequences, {events} events), "
+          f"{len(compared) - len(disagreements)} agree, {len(disagreements)} disagree; "
+          f"refused by fsmbt {len(fsmbt_refuses)}, by the engine (fsmbt reads them) "
+          f"{len(engine_refuses)} {engine_refuses}")
+    assert len(compared) >= 15
+    assert not disagreements, disagreements
+
+
+# -- probes: the corners of the subset ---------------------------------------------------------
+PROBES = {
+    "parallel regions both move, parent transition on the same event loses": """
+  <parallel id="p">
+    <state id="r1"><state id="a1"><transition event="e" target="a2"/></state><state id="a2"/></state>
+    <state id="r2"><state id="b1"><transition event="f" target="b2"/></state><state id="b2"/></state>
+    <transition event="e" target="out"/><transition event="g" target="out"/>
+  </parallel>
+  <state id="out"><transition event="back" target="p"/></state>""",
+    "completion of a compound whose initial state is final at once": """
+  <state id="s"><transition event="go" target="c"/></state>
+  <state id="c"><final id="cf"/><transition event="done.state.c" target="t"/></state>
+  <state id="t"><transition event="again" target="s"/></state>""",
+    "eventless chain into a nested compound": """
+  <state id="s"><transition target="c"/></state>
+  <state id="c"><state id="c1"><transition target="c2"/></state>
+    <state id="c2"><transition event="x" target="cf"/></state><final id="cf"/>
+    <transition event="done.state.c" target="end"/></state>
+  <final id="end"/>""",
+    "an event on a compound whose sub-machine sits in a final state": """
+  <state id="c"><state id="c1"><transition event="x" target="cf"/></state><final id="cf"/>
+    <transition event="y" target="d"/></state>
+  <state id="d"><transition event="y" target="c"/></state>""",
+    "self-transition of a compound restarts it": """
+  <state id="c"><state id="c1"><transition event="x" target="c2"/></state><state id="c2"/>
+    <transition event="r" target="c"/></state>""",
+    "transition leaving two levels, and the same event on each level": """
+  <state id="a"><state id="a1"><state id="x"><transition event="go" target="b"/>
+    <transition event="in" target="y"/></state><state id="y"><transition event="go" target="a"/>
+    </state><transition event="up" target="b"/></state>
+    <transition event="go" target="a"/><transition event="up" target="a"/></state>
+  <state id="b"><transition event="back" target="a"/></state>""",
+    "parallel of compound states completes, nested in a compound": """
+  <state id="top" initial="p"><parallel id="p">
+    <state id="r1"><state id="a1"><transition event="x" target="af"/></state><final id="af"/></state>
+    <state id="r2"><state id="b1"><transition event="y" target="bf"/></state><final id="bf"/></state>
+    <transition event="done.state.p" target="tf"/></parallel>
+    <final id="tf"/><transition event="done.state.top" target="end"/></state>
+  <final id="end"/>""",
+    "document order between transitions on one event": """
+  <state id="s"><transition event="e" target="t"/><transition event="e" target="u"/></state>
+  <state id="t"><transition event="e" target="s"/></state><state id="u"/>""",
+    "guarded completion transitions (fsmbt's own encoding)": """
+  <state id="u"><state id="w"><transition event="ok" target="uS"/>
+    <transition event="ko" target="uF"/></state><final id="uS"/><final id="uF"/>
+    <transition event="done.state.u" cond="In('uS')" target="won"/>
+    <transition event="done.state.u" cond="In('uF')" target="lost"/></state>
+  <state id="won"><transition event="again" target="u"/></state><final id="lost"/>""",
+    "dotted ids and events that are not prefixes of each other": """
+  <state id="a.b"><transition event="x.y" target="a.c"/></state>
+  <state id="a.c"><transition event="x.z" target="a.b"/></state>""",
+}
+
+
+@pytest.mark.parametrize("case", sorted(PROBES))
+def test_probe_agrees(case: str) -> None:
+    text = f'<scxml {NS} version="1.0">{PROBES[case]}\n</scxml>'
+    model = loads(text, "scxml")
+    _events, mismatches = compare(text, model, SEED, 60)
+    assert not mismatches, mismatches[:3]
+
+
+# -- departures of the engine from the W3C algorithm -----------------------------------------------
+@pytest.mark.parametrize("body, w3c, engine", [
+    # W3C 3.3: no initial attribute -> the first child state in document order (here <parallel>)
+    ('<state id="top"><parallel id="p"><state id="a"/><state id="b"/></parallel>'
+     '<state id="t"/></state>', "top/p/[a|b]", "top/t"),
+    # ... and here the <final>
+    ('<state id="c"><final id="f"/><state id="s"/></state>', "c/f", "c/s"),
+])
+def test_departure_default_initial_of_compound_ignores_document_order(body: str, w3c: str,
+                                                                      engine: str) -> None:
+    """python-statemachine 3.2.2 collects a compound state's children by tag (<state>, then
+    <final>, then <parallel>), so without ``initial`` it starts in the first <state> child, not
+    the first child in document order as W3C says. fsmbt keeps W3C's rule; the files fsmbt
+    writes always carry ``initial`` on compound states, so they do not meet the case."""
+    text = f'<scxml {NS} version="1.0">{body}</scxml>'
+    fsmbt_state, _ = FSMMachine(loads(text, "scxml")).start()
+    assert fsmbt_state == w3c
+    assert Engine(text).configuration() == engine  # the departure, as of 3.2.2
+
+
+def test_departure_engine_stops_when_a_top_level_parallel_completes() -> None:
+    """python-statemachine 3.2.2 stops (``is_terminated``) once every region of a top-level
+    <parallel> rests in a final state; W3C stops only on entering a top-level <final>: the
+    parallel raises ``done.state.p`` and the machine runs on, so ``p``'s own transitions still
+    fire. fsmbt keeps W3C's rule (``FSMMachine`` is still running and takes ``e``)."""
+    text = f"""<scxml {NS} version="1.0">
+  <parallel id="p"><transition event="e" target="out"/>
+    <state id="a"><state id="a1"><transition event="x" target="af"/></state><final id="af"/></state>
+    <state id="b"><state id="b1"><transition event="y" target="bf"/></state><final id="bf"/></state>
+  </parallel><state id="out"/></scxml>"""
+    machine = FSMMachine(loads(text, "scxml"))
+    engine = Engine(text)
+    state, _ = machine.start()
+    for event in ("x", "y"):
+        state, _ = machine.step(state, event)
+        engine.send(event)
+    assert engine.configuration() == state == "p/[a/af|b/bf]"
+    assert machine.status(state) == "running" and engine.terminated  # the departure
+    assert engine.top_parallel_completed()
+    state, _ = machine.step(state, "e")
+    engine.send("e")
+    assert state == "out" and engine.configuration() == "p/[a/af|b/bf]"
