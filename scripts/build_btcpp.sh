@@ -5,8 +5,8 @@
 # BehaviorTree.CPP 4.8.2 tree in its folder BehaviorTree.CPP/ (the same engine the Python tests
 # run through behaviortreepy). The library is configured without its tests, examples, command-line
 # tools, ZeroMQ/Groot2 publisher and SQLite logger (none is needed to load and tick a tree) and
-# (shared: the static build does not install its vendored tinyxml2, so consumers could not link it)
-# installed, as a shared library, into a cache OUTSIDE the checkout, keyed by version:
+# installed, as a shared library, into a cache OUTSIDE the checkout, keyed by version (shared: the
+# static build does not install its vendored tinyxml2, so nothing could link against it):
 #
 #     ${FSMBT_CACHE:-${XDG_CACHE_HOME:-$HOME/.cache}/fsmbt}/btcpp-4.8.2/
 #         include/ lib/ lib/cmake/behaviortree_cpp/   the installed library (CMake package)

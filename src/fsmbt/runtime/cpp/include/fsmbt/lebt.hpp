@@ -427,7 +427,13 @@ public:
     }
     catch(const std::exception& exc)
     {
-      throw LebtError(std::string("cannot load the behavior tree: ") + exc.what());
+      std::string text = std::string("cannot load the behavior tree: ") + exc.what();
+      if(text.find("XML_ELEMENT_DEPTH_EXCEEDED") != std::string::npos)
+      {
+        text += " (BehaviorTree.CPP's XML parser, tinyxml2, nests at most 500 elements: an LEBT "
+                "whose chain of states is longer than about 245 cannot be loaded)";
+      }
+      throw LebtError(text);
     }
     collectLeaves(xml_text);
     start_ = options.start ? *options.start : inferStart();

@@ -1,0 +1,198 @@
+"""Runtime cost of the BT form: time per macro step of a converted LEBT in C++ (BehaviorTree.CPP
+4.8.2 through fsmbt/lebt.hpp), in py_trees, and of the same FSM as a plain C++ transition table.
+
+    PYTHONPATH=src python benchmarks/bench_runtime.py [--sizes 10,100,1000,10000] [--steps 20000]
+
+For each size and shape (``random``: ``random_fsm(shape="tree")``, random parents, shallow trees;
+``chain``: ``random_fsm(shape="chain", extra_edges=0)``, each state below the previous one, so
+the running leaf sits deepest), the FSM is converted (rules engine), written as BehaviorTree.CPP XML, and driven by
+one random walk of macro steps (70 % events the current state handles, 30 % any event of the
+alphabet); every final state gets a ``restart`` transition to the initial state first, so the
+walk never stops (a chain becomes a ring). The C++ figures are timed inside the driver
+(``--bench``: only the ``post()`` calls), the table runner is the driver's ``--table`` mode (one
+hash look-up per step, no tree); py_trees is timed around ``PyTreesLebtRunner.macro_step``.
+``leaf ticks/step`` is counted by the C++ leaves: a step costs O(depth of the running leaf) node
+ticks (BehaviorTree.CPP resumes each Sequence at its running child, but every tick walks down
+from the root), which the chain rows and the extra depth series show.
+
+Limits met and printed, not hidden: BehaviorTree.CPP parses XML with tinyxml2, which refuses
+documents nested deeper than 500 elements, so a chain LEBT (two XML levels per state) beyond ~245
+states cannot be loaded in C++; py_trees ticks recursively, so very deep trees exceed Python's
+recursion limit. Sizes py_trees would take too long for are capped (``--pytrees-max-states``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import random
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+from fsmbt.convert import convert
+from fsmbt.formats import dumps, loads
+from fsmbt.generate import random_fsm
+from fsmbt.model.fsm import FSM
+from fsmbt.runtime.cpp import CppRuntimeError, DriverSession, find_driver, status
+from fsmbt.semantics.engines.pytrees_engine import PyTreesLebtRunner
+from fsmbt.semantics.machine import FINAL, FSMMachine
+
+#: shape -> random_fsm arguments: shallow random trees, and a pure chain (no extra edge)
+SHAPES: dict[str, dict[str, object]] = {"random": {"shape": "tree"},
+                                        "chain": {"shape": "chain", "extra_edges": 0}}
+
+
+def living(fsm: FSM) -> FSM:
+    """The machine with every final state given a ``restart`` transition back to the initial
+    state (and no longer final), so one long walk never stops: a chain becomes a ring whose
+    running leaf goes deeper step by step, and no runtime is rebuilt in the timed walk."""
+    assert fsm.initial is not None
+    for name, state in fsm.states.items():
+        if state.final:
+            state.final = False
+            fsm.add_transition(name, "restart", fsm.initial)
+    return fsm
+
+
+def walk(fsm: FSM, steps: int, seed: str) -> list[list[str]]:
+    """Random-walk event sequences (a new sequence after a final state), ``steps`` events."""
+    machine = FSMMachine(fsm)
+    rng = random.Random(seed)
+    alphabet = list(machine.alphabet) + ["__unknown__"]
+    sequences: list[list[str]] = [[]]
+    state, _ = machine.start()
+    for _ in range(steps):
+        active = list(machine.active_inputs(state))
+        event = rng.choice(active) if active and rng.random() < 0.7 else rng.choice(alphabet)
+        sequences[-1].append(event)
+        state, _ = machine.step(state, event)
+        if machine.status(state) == FINAL:
+            sequences.append([])
+            state, _ = machine.start()
+    return [s for s in sequences if s]
+
+
+def pytrees_ns_per_step(doc, sequences: list[list[str]], budget: float) -> tuple[float, int]:
+    """ns per macro step in py_trees over the sequences (stops after ``budget`` seconds)."""
+    spent, steps = 0.0, 0
+    for events in sequences:
+        runner = PyTreesLebtRunner(doc)
+        runner.initial()
+        started = time.perf_counter()
+        for event in events:
+            runner.macro_step(event)
+        spent += time.perf_counter() - started
+        steps += len(events)
+        if spent > budget:
+            break
+    return spent * 1e9 / max(steps, 1), steps
+
+
+def measure(shape: str, n: int, args: argparse.Namespace, tmp: Path) -> dict[str, object]:
+    fsm = living(random_fsm(f"bench-runtime-{shape}-{n}", n, start_event=False,
+                            **SHAPES[shape]))  # type: ignore[arg-type]
+    started = time.perf_counter()
+    result = convert(fsm)
+    convert_s = time.perf_counter() - started
+    text = dumps(result.model, "btcpp")
+    tree = tmp / f"{shape}-{n}.xml"
+    tree.write_text(text, encoding="utf-8")
+    sequences = walk(fsm, args.steps, f"{shape}-{n}")
+    row: dict[str, object] = {"shape": shape, "states": n, "nodes": result.stats["nodes"],
+                              "depth": result.stats["depth"], "convert_s": convert_s}
+    driver = find_driver()
+    if driver is None:
+        row["cpp"] = row["table"] = f"driver not built ({status().problem})"
+    else:
+        try:
+            bt = DriverSession(tree, driver=driver, timeout=600).bench(sequences, args.repeat)
+            row["cpp"] = bt["ns_per_step"]
+            row["leaf_ticks"] = bt["leaf_ticks"] / max(bt["steps"], 1)
+        except CppRuntimeError as exc:
+            row["cpp"] = "cannot load: " + str(exc).split(": ", 2)[-1][:90]
+        table = DriverSession(tree, driver=driver, table=True, timeout=600)
+        try:
+            row["table"] = table.bench(sequences, args.repeat)["ns_per_step"]
+        except CppRuntimeError as exc:  # the table is read off the same loaded tree
+            row["table"] = "cannot load: " + str(exc).split(": ", 2)[-1][:60]
+    if n > args.pytrees_max_states:
+        row["pytrees"] = f"capped (> {args.pytrees_max_states} states)"
+    else:
+        doc = loads(text, "btcpp")
+        try:
+            ns, steps = pytrees_ns_per_step(doc, sequences, args.pytrees_budget)
+            row["pytrees"] = ns
+            row["pytrees_steps"] = steps
+        except RecursionError:
+            row["pytrees"] = "RecursionError (py_trees ticks recursively)"
+    return row
+
+
+def fmt(value: object, scale: float = 1.0, unit: str = "") -> str:
+    if isinstance(value, float | int):
+        return f"{value / scale:,.1f}{unit}"
+    return str(value) if value is not None else "-"
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--sizes", default="10,100,1000,10000")
+    parser.add_argument("--steps", type=int, default=20_000, help="macro steps per model")
+    parser.add_argument("--repeat", type=int, default=5, help="C++ replays of the walk")
+    parser.add_argument("--pytrees-max-states", type=int, default=10_000)
+    parser.add_argument("--pytrees-budget", type=float, default=20.0,
+                        help="seconds of py_trees stepping per model (then it stops early)")
+    parser.add_argument("--depth-series", default="10,25,50,100,200,240",
+                        help="chain sizes for the O(depth) series (loadable in C++)")
+    args = parser.parse_args()
+    sys.setrecursionlimit(max(sys.getrecursionlimit(), 10_000))
+    if find_driver() is None:
+        print(f"note: C++ driver not built ({status().problem}); run scripts/build_btcpp.sh")
+    sizes = [int(s) for s in args.sizes.split(",") if s]
+    rows = []
+    with tempfile.TemporaryDirectory() as tmp_name:
+        tmp = Path(tmp_name)
+        for shape in SHAPES:
+            for n in sizes:
+                rows.append(measure(shape, n, args, tmp))
+                print(f"  measured {shape} {n}", file=sys.stderr, flush=True)
+        header = (f"{'shape':7} {'states':>6} {'nodes':>6} {'depth':>6} {'C++ BT ns/step':>15} "
+                  f"{'C++ table ns/step':>17} {'BT/table':>9} {'leaf ticks/step':>15} "
+                  f"{'py_trees us/step':>17} {'py_trees/C++':>12}")
+        print("\nRuntime cost per macro step (BehaviorTree.CPP 4.8.2 via fsmbt/lebt.hpp; py_trees "
+              f"2.6; plain C++ table); {args.steps} steps per model\n")
+        print(header)
+        print("-" * len(header))
+        for row in rows:
+            cpp, table, py = row.get("cpp"), row.get("table"), row.get("pytrees")
+            ratio = fmt(cpp / table, unit="x") if isinstance(cpp, float) and isinstance(
+                table, float) and table else "-"
+            py_ratio = fmt(py / cpp, unit="x") if isinstance(py, float) and isinstance(
+                cpp, float) else "-"
+            if isinstance(cpp, str):
+                print(f"{row['shape']:7} {row['states']:>6} {row['nodes']:>6} {row['depth']:>6} "
+                      f"{cpp}")
+                print(f"{'':29} C++ table {fmt(table)} ns/step; py_trees "
+                      f"{fmt(py, 1e3)} us/step")
+                continue
+            print(f"{row['shape']:7} {row['states']:>6} {row['nodes']:>6} {row['depth']:>6} "
+                  f"{fmt(cpp):>15} {fmt(table):>17} {ratio:>9} {fmt(row.get('leaf_ticks')):>15} "
+                  f"{fmt(py, 1e3):>17} {py_ratio:>12}")
+        print("\nO(depth) series: chains loadable in BehaviorTree.CPP (tinyxml2 nests <= 500)\n")
+        series_header = (f"{'states':>6} {'depth':>6} {'C++ BT ns/step':>15} "
+                         f"{'leaf ticks/step':>15} {'ns per leaf tick':>16}")
+        print(series_header)
+        print("-" * len(series_header))
+        for n in [int(s) for s in args.depth_series.split(",") if s]:
+            row = measure("chain", n, argparse.Namespace(**{**vars(args), "pytrees_max_states": 0}),
+                          tmp)
+            cpp, ticks = row.get("cpp"), row.get("leaf_ticks")
+            per_tick = fmt(cpp / ticks) if isinstance(cpp, float) and isinstance(
+                ticks, float) and ticks else "-"
+            print(f"{n:>6} {row['depth']:>6} {fmt(cpp):>15} {fmt(ticks):>15} {per_tick:>16}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
