@@ -18,7 +18,10 @@ from the root), which the chain rows and the extra depth series show.
 Limits met and printed, not hidden: BehaviorTree.CPP parses XML with tinyxml2, which refuses
 documents nested deeper than 500 elements, so a chain LEBT (two XML levels per state) beyond ~245
 states cannot be loaded in C++; py_trees ticks recursively, so very deep trees exceed Python's
-recursion limit. Sizes py_trees would take too long for are capped (``--pytrees-max-states``).
+recursion limit, and every node it ticks is yielded up through all its ancestors' generators, so
+one tick costs O(depth^2) there. Trees deeper than ``--pytrees-max-depth`` (2 100: the 1 000-state
+chain runs, the 10 000-state one does not) are not run in py_trees; py_trees stops after
+``--pytrees-budget`` seconds per model (the steps measured are printed).
 """
 
 from __future__ import annotations
@@ -79,13 +82,13 @@ def pytrees_ns_per_step(doc, sequences: list[list[str]], budget: float) -> tuple
     for events in sequences:
         runner = PyTreesLebtRunner(doc)
         runner.initial()
-        started = time.perf_counter()
         for event in events:
+            started = time.perf_counter()
             runner.macro_step(event)
-        spent += time.perf_counter() - started
-        steps += len(events)
-        if spent > budget:
-            break
+            spent += time.perf_counter() - started
+            steps += 1
+            if spent > budget:
+                return spent * 1e9 / steps, steps
     return spent * 1e9 / max(steps, 1), steps
 
 
@@ -109,6 +112,8 @@ def measure(shape: str, n: int, args: argparse.Namespace, tmp: Path) -> dict[str
             bt = DriverSession(tree, driver=driver, timeout=600).bench(sequences, args.repeat)
             row["cpp"] = bt["ns_per_step"]
             row["leaf_ticks"] = bt["leaf_ticks"] / max(bt["steps"], 1)
+            once = DriverSession(tree, driver=driver, tick="once", timeout=1200)
+            row["cpp_once"] = once.bench(sequences, 1)["ns_per_step"]
         except CppRuntimeError as exc:
             row["cpp"] = "cannot load: " + str(exc).split(": ", 2)[-1][:90]
         table = DriverSession(tree, driver=driver, table=True, timeout=600)
@@ -118,6 +123,8 @@ def measure(shape: str, n: int, args: argparse.Namespace, tmp: Path) -> dict[str
             row["table"] = "cannot load: " + str(exc).split(": ", 2)[-1][:60]
     if n > args.pytrees_max_states:
         row["pytrees"] = f"capped (> {args.pytrees_max_states} states)"
+    elif int(result.stats["depth"]) > args.pytrees_max_depth:
+        row["pytrees"] = f"capped (depth > {args.pytrees_max_depth})"
     else:
         doc = loads(text, "btcpp")
         try:
@@ -141,6 +148,8 @@ def main() -> int:
     parser.add_argument("--steps", type=int, default=20_000, help="macro steps per model")
     parser.add_argument("--repeat", type=int, default=5, help="C++ replays of the walk")
     parser.add_argument("--pytrees-max-states", type=int, default=10_000)
+    parser.add_argument("--pytrees-max-depth", type=int, default=2_100,
+                        help="deeper trees are not run in py_trees (recursive ticks)")
     parser.add_argument("--pytrees-budget", type=float, default=20.0,
                         help="seconds of py_trees stepping per model (then it stops early)")
     parser.add_argument("--depth-series", default="10,25,50,100,200,240",
@@ -159,7 +168,8 @@ def main() -> int:
                 print(f"  measured {shape} {n}", file=sys.stderr, flush=True)
         header = (f"{'shape':7} {'states':>6} {'nodes':>6} {'depth':>6} {'C++ BT ns/step':>15} "
                   f"{'C++ table ns/step':>17} {'BT/table':>9} {'leaf ticks/step':>15} "
-                  f"{'py_trees us/step':>17} {'py_trees/C++':>12}")
+                  f"{'py_trees us/step':>17} {'(steps)':>8} {'py_trees/C++':>12} "
+                  f"{'tickOnce ns/step':>17}")
         print("\nRuntime cost per macro step (BehaviorTree.CPP 4.8.2 via fsmbt/lebt.hpp; py_trees "
               f"2.6; plain C++ table); {args.steps} steps per model\n")
         print(header)
@@ -173,12 +183,16 @@ def main() -> int:
             if isinstance(cpp, str):
                 print(f"{row['shape']:7} {row['states']:>6} {row['nodes']:>6} {row['depth']:>6} "
                       f"{cpp}")
-                print(f"{'':29} C++ table {fmt(table)} ns/step; py_trees "
+                print(f"{'':29} C++ table: {fmt(table)}; py_trees "
                       f"{fmt(py, 1e3)} us/step")
                 continue
             print(f"{row['shape']:7} {row['states']:>6} {row['nodes']:>6} {row['depth']:>6} "
                   f"{fmt(cpp):>15} {fmt(table):>17} {ratio:>9} {fmt(row.get('leaf_ticks')):>15} "
-                  f"{fmt(py, 1e3):>17} {py_ratio:>12}")
+                  f"{fmt(py, 1e3):>17} {row.get('pytrees_steps', '-'):>8} {py_ratio:>12} "
+                  f"{fmt(row.get('cpp_once')):>17}")
+        print("\nC++ BT = fsmbt/lebt.hpp's default (tickExactlyOnce: no node of an LEBT emits a "
+              "wake-up); tickOnce = the same tree ticked\nwith BehaviorTree.CPP's tickOnce(), "
+              "whose wake-up check is a futex system call per RUNNING tick (same results).")
         print("\nO(depth) series: chains loadable in BehaviorTree.CPP (tinyxml2 nests <= 500)\n")
         series_header = (f"{'states':>6} {'depth':>6} {'C++ BT ns/step':>15} "
                          f"{'leaf ticks/step':>15} {'ns per leaf tick':>16}")

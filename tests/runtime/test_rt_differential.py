@@ -1,7 +1,9 @@
 """Differential test of the LEBT runtimes (issue 11): the FSM's own macro-step runner
 (``FSMMachine``), the C++ runtime (``fsmbt/lebt.hpp`` in BehaviorTree.CPP 4.8.2, through the
 driver), behaviortreepy (BehaviorTree.CPP through Python) and py_trees on the same event
-sequences - plus the driver's plain transition table (the benchmark's baseline).
+sequences - plus the C++ runtime forced to ``tickOnce`` (its default ticks exactly once when no
+node can emit a wake-up, docs/runtime.md) and the driver's plain transition table (the
+benchmark's baseline).
 
 Models: every example in examples/ that is an FSM, every corpus model (``FSMBT_CORPUS``) that is
 an FSM converting to a BT, 200 generated FSMs (``fsmbt.generate.random_fsm``) and 150 generated
@@ -57,8 +59,9 @@ class Tally:
 
     def report(self, group: str) -> str:
         return (f"\n[runtime differential] {group}: {self.models} models, {self.sequences} "
-                f"sequences, {self.steps} macro steps compared in 5 runtimes (FSM, C++ "
-                f"BehaviorTree.CPP, C++ table, behaviortreepy, py_trees); C++ driver time "
+                f"sequences, {self.steps} macro steps compared in 6 runs (FSM, C++ "
+                f"BehaviorTree.CPP (auto tick, tickOnce), C++ table, behaviortreepy, py_trees); "
+                f"C++ driver time (auto tick) "
                 f"{self.cpp_seconds:.2f} s; refused by the converter: {len(self.refused)}; "
                 f"differences: {len(self.differences)}")
 
@@ -109,9 +112,12 @@ def _compare(label: str, fsm: FSM, tmp: Path, driver: Path, tally: Tally) -> Non
     started = time.perf_counter()
     cpp = DriverSession(tree_file, driver=driver).run(sequences)
     tally.cpp_seconds += time.perf_counter() - started
+    literal = DriverSession(tree_file, driver=driver, tick="once").run(sequences)
     table = DriverSession(tree_file, driver=driver, table=True).run(sequences)
     observed = {
         "C++ BehaviorTree.CPP": [[(s.actions, s.terminated) for s in run] for run in cpp],
+        "C++ BehaviorTree.CPP tickOnce": [[(s.actions, s.terminated) for s in run]
+                                          for run in literal],
         "C++ table": [[(s.actions, s.terminated) for s in run] for run in table],
         "behaviortreepy": _engine_runs(lambda: BTCppLebtRunner(doc), sequences),
         "py_trees": _engine_runs(lambda: PyTreesLebtRunner(doc), sequences),

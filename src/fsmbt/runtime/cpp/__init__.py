@@ -180,8 +180,10 @@ class DriverSession:
     """One driver process per tree file, fed every event sequence at once."""
 
     def __init__(self, tree_file: Path, *, driver: Path | None = None, table: bool = False,
-                 start: str | None = None, timeout: float = 120.0) -> None:
+                 start: str | None = None, tick: str | None = None,
+                 timeout: float = 120.0) -> None:
         self.tree_file = tree_file
+        self.tick = tick  # "once", "exactly-once", "auto" (the driver's default) or None
         self.driver = driver or require_driver()
         self.table = table
         self.start = start
@@ -193,6 +195,8 @@ class DriverSession:
             command.append("--table")
         if self.start is not None:
             command += ["--start", self.start]
+        if self.tick is not None:
+            command += ["--tick", self.tick]
         return command + list(extra)
 
     def run(self, sequences: Sequence[Sequence[str]]) -> list[list[DriverStep]]:

@@ -2,6 +2,7 @@
 // fsmbt/lebt.hpp, reading events from stdin and printing what each macro step did.
 //
 //   fsmbt_lebt_driver TREE.xml [--start NAME] [--register A,B,...] [--table] [--bench R]
+//                              [--tick once|exactly-once|auto]
 //   fsmbt_lebt_driver --version
 //
 // Input (stdin): one event name per line (a trailing '\r' is dropped; empty lines are skipped).
@@ -19,6 +20,7 @@
 //   --register LIST  register callbacks only for these comma-separated action names (each one
 //                    records its call); without it every action gets a recording fallback. An
 //                    action of the tree missing from LIST is a load-time error.
+//   --tick MODE      how the root is ticked (fsmbt::lebt::TickMode; default auto)
 //   --table          run the same FSM as a plain transition table read off the tree's guards and
 //                    states (no behavior tree ticks): the baseline of benchmarks/bench_runtime.py
 //   --bench R        read all of stdin first, replay it R times without printing steps, then print
@@ -196,13 +198,14 @@ struct Arguments
   std::optional<std::vector<std::string>> registered;
   bool table = false;
   long bench = 0;
+  fsmbt::lebt::TickMode tick = fsmbt::lebt::TickMode::Auto;
 };
 
 [[noreturn]] void usage(const std::string& problem)
 {
   std::fprintf(stderr,
                "error: %s\nusage: fsmbt_lebt_driver TREE.xml [--start NAME] [--register A,B] "
-               "[--table] [--bench R] | --version\n",
+               "[--table] [--bench R] [--tick once|exactly-once|auto] | --version\n",
                problem.c_str());
   std::exit(2);
 }
@@ -236,6 +239,26 @@ Arguments parse(int argc, char** argv)
         }
       }
       args.registered = names;
+    }
+    else if(arg == "--tick")
+    {
+      const std::string mode = value();
+      if(mode == "once")
+      {
+        args.tick = fsmbt::lebt::TickMode::Once;
+      }
+      else if(mode == "exactly-once")
+      {
+        args.tick = fsmbt::lebt::TickMode::ExactlyOnce;
+      }
+      else if(mode == "auto")
+      {
+        args.tick = fsmbt::lebt::TickMode::Auto;
+      }
+      else
+      {
+        usage("--tick takes once, exactly-once or auto");
+      }
     }
     else if(arg == "--table")
     {
@@ -409,6 +432,7 @@ int main(int argc, char** argv)
     }
     fsmbt::lebt::Options options;
     options.start = args.start;
+    options.tick = args.tick;
     fsmbt::lebt::LebtRunner runner =
         fsmbt::lebt::LebtRunner::fromFile(args.tree, std::move(actions), options);
     if(args.table)

@@ -18,6 +18,13 @@
 //    dropped and the leaf stays RUNNING; RUNNING when no event is pending.
 //  - macro step (LebtRunner::post): set `event`, tickOnce(); if the root returned SUCCESS with
 //    the event still pending, tick once more; then drop any event still pending.
+//  - tickOnce() vs tickExactlyOnce(): they differ only when a node emitted a wake-up signal
+//    (docs/semantics.md section 3). When every node of the tree is one that never does
+//    (Sequence, Fallback, SubTree, the LEBT leaves, ...: kNeverWakeUp) the runner calls
+//    tickExactlyOnce(), which gives the same result and skips tickOnce()'s wake-up check - a
+//    condition_variable wait with a zero timeout, one futex system call per RUNNING tick, which
+//    costs microseconds and, on a busy machine, a reschedule (benchmarks/bench_runtime.py
+//    measures both). Options::tick forces one or the other.
 //  - start (LebtRunner::start): when a guard holds the pair (start, "") the root is ticked once
 //    with no event so the initial state's action runs; otherwise nothing is ticked.
 //  - start pseudo-state: the one guard source that is not a state, else "__start__" (or
@@ -396,9 +403,32 @@ struct StepResult
   std::string state;                 ///< the current state after the step
 };
 
+/// Node types that never emit a wake-up signal in BehaviorTree.CPP 4.8 (checked in its
+/// sources: the asynchronous controls, Repeat, Retry, Delay, Timeout, Sleep and threaded actions
+/// do): for a tree made of these only, tickOnce() and tickExactlyOnce() are the same.
+inline const std::unordered_set<std::string>& neverWakeUp()
+{
+  static const std::unordered_set<std::string> types = {
+    kGuardType,  kStateType,      "Sequence",      "Fallback",     "ReactiveSequence",
+    "ReactiveFallback", "SubTree", "Inverter",     "ForceSuccess", "ForceFailure",
+    "AlwaysSuccess", "AlwaysFailure"
+  };
+  return types;
+}
+
+/// How LebtRunner ticks the root.
+enum class TickMode
+{
+  Auto,         ///< tickExactlyOnce() when every node is in neverWakeUp(), else tickOnce()
+  Once,         ///< always tickOnce() (docs/semantics.md's macro step, literally)
+  ExactlyOnce,  ///< always tickExactlyOnce()
+};
+
 /// Options of LebtRunner.
 struct Options
 {
+  TickMode tick = TickMode::Auto;
+
   /// The start pseudo-state; default: the one guard source that is not a state, else
   /// "__start__" (docs/semantics.md section 5).
   std::optional<std::string> start;
@@ -448,6 +478,8 @@ public:
       }
     }
     context_->state = start_;
+    exactly_once_ = options.tick == TickMode::ExactlyOnce ||
+                    (options.tick == TickMode::Auto && never_wakes_up_);
   }
 
   /// Load the tree from an XML file (LebtError when it cannot be read).
@@ -525,6 +557,8 @@ public:
 
   const std::string& state() const { return context_->state; }
   const std::string& startState() const { return start_; }
+  /// True when the root is ticked with tickExactlyOnce() (see TickMode).
+  bool ticksExactlyOnce() const { return exactly_once_; }
   /// The status of the last root tick (IDLE before any).
   BT::NodeStatus lastRootStatus() const { return last_; }
   BT::Tree& tree() { return tree_; }
@@ -552,7 +586,7 @@ public:
 private:
   BT::NodeStatus tick()
   {
-    last_ = tree_.tickOnce();
+    last_ = exactly_once_ ? tree_.tickExactlyOnce() : tree_.tickOnce();
     return last_;
   }
 
@@ -581,6 +615,7 @@ private:
       {
         const BT::NodeType type = node->type();
         const std::string& id = node->registrationName();
+        never_wakes_up_ = never_wakes_up_ && neverWakeUp().count(id) != 0;
         if((type == BT::NodeType::ACTION || type == BT::NodeType::CONDITION) &&
            id != kGuardType && id != kStateType && id != "AlwaysSuccess" &&
            id != "AlwaysFailure")
@@ -659,6 +694,8 @@ private:
   std::vector<const LebtState*> state_leaves_;
   std::string start_;
   bool init_on_start_ = false;
+  bool never_wakes_up_ = true;
+  bool exactly_once_ = false;
   bool started_ = false;
   BT::NodeStatus last_ = BT::NodeStatus::IDLE;
 };
