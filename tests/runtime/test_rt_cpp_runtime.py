@@ -208,6 +208,12 @@ def test_cmake_example_builds_and_runs_the_door(driver: Path, tmp_path: Path) ->
                               capture_output=True, text=True, timeout=900)
     assert compiled.returncode == 0, compiled.stdout[-2000:] + compiled.stderr[-2000:]
     tree = _door_tree(tmp_path)
+    snippet, printed = _documented_example()
+    documented_args = snippet.strip().splitlines()[-1].split()[2:]  # after binary and tree
+    run = subprocess.run([str(build / "lebt_example"), str(tree), *documented_args],
+                         capture_output=True, text=True, timeout=60)
+    assert run.returncode == 0, run.stderr
+    assert run.stdout == printed  # docs/runtime.md shows what it prints
     run = subprocess.run([str(build / "lebt_example"), str(tree), "open_cmd", "fully_open",
                           "fire_alarm", "shutdown"], capture_output=True, text=True, timeout=60)
     assert run.returncode == 0, run.stderr
@@ -227,6 +233,31 @@ def test_cmake_example_builds_and_runs_the_door(driver: Path, tmp_path: Path) ->
     refused = subprocess.run([str(build / "lebt_example"), str(other)], capture_output=True,
                              text=True, timeout=60)
     assert refused.returncode == 1 and "'do_A' (state A)" in refused.stderr
+
+
+def _documented_example() -> tuple[str, str]:
+    """docs/runtime.md's example: the shell snippet and the text it says is printed."""
+    import re
+
+    doc = (REPO / "docs" / "runtime.md").read_text(encoding="utf-8")
+    section = doc.split("## The example, run as written", 1)[1]
+    blocks = re.findall(r"```(\w+)\n(.*?)```", section, re.S)
+    snippet = next(body for lang, body in blocks if lang == "sh")
+    printed = next(body for lang, body in blocks if lang == "text")
+    return snippet, printed
+
+
+def test_docs_show_the_shipped_example_files() -> None:
+    import re
+
+    doc = (REPO / "docs" / "runtime.md").read_text(encoding="utf-8")
+    blocks = dict((lang, body) for lang, body in re.findall(r"```(\w+)\n(.*?)```", doc, re.S)
+                  if lang in ("cpp", "cmake"))
+    assert blocks["cpp"] == (cpp_runtime.EXAMPLE_DIR / "main.cpp").read_text(encoding="utf-8")
+    assert blocks["cmake"] == (cpp_runtime.EXAMPLE_DIR / "CMakeLists.txt").read_text(
+        encoding="utf-8")
+    snippet, _ = _documented_example()
+    assert "fsmbt runtime cpp out/lebt_example" in snippet
 
 
 # -- cache lookup, doctor, the build script without a compiler ----------------------------------

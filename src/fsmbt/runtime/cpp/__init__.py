@@ -241,7 +241,8 @@ class DriverSession:
     def _call(self, lines: list[str], extra: Sequence[str] = ()) -> str:
         try:
             proc = subprocess.run(self._command(extra), input="\n".join(lines) + "\n",
-                                  capture_output=True, text=True, timeout=self.timeout)
+                                  capture_output=True, text=True, encoding="utf-8",
+                                  timeout=self.timeout)
         except subprocess.TimeoutExpired:
             raise CppRuntimeError(f"driver timed out after {self.timeout} s on "
                                   f"{self.tree_file}") from None
