@@ -101,15 +101,18 @@ def measure(shape: str, n: int, args: argparse.Namespace, tmp: Path) -> dict[str
     text = dumps(result.model, "btcpp")
     tree = tmp / f"{shape}-{n}.xml"
     tree.write_text(text, encoding="utf-8")
-    sequences = walk(fsm, args.steps, f"{shape}-{n}")
+    steps = max(1_000, min(args.steps, args.step_budget // n))
+    repeat = args.repeat if n < 1_000 else 1
+    sequences = walk(fsm, steps, f"{shape}-{n}")
     row: dict[str, object] = {"shape": shape, "states": n, "nodes": result.stats["nodes"],
-                              "depth": result.stats["depth"], "convert_s": convert_s}
+                              "depth": result.stats["depth"], "convert_s": convert_s,
+                              "roots": result.stats["root_subtrees"], "steps": steps * repeat}
     driver = find_driver()
     if driver is None:
         row["cpp"] = row["table"] = f"driver not built ({status().problem})"
     else:
         try:
-            bt = DriverSession(tree, driver=driver, timeout=600).bench(sequences, args.repeat)
+            bt = DriverSession(tree, driver=driver, timeout=1200).bench(sequences, repeat)
             row["cpp"] = bt["ns_per_step"]
             row["leaf_ticks"] = bt["leaf_ticks"] / max(bt["steps"], 1)
             once = DriverSession(tree, driver=driver, tick="once", timeout=1200)
@@ -118,7 +121,7 @@ def measure(shape: str, n: int, args: argparse.Namespace, tmp: Path) -> dict[str
             row["cpp"] = "cannot load: " + str(exc).split(": ", 2)[-1][:90]
         table = DriverSession(tree, driver=driver, table=True, timeout=600)
         try:
-            row["table"] = table.bench(sequences, args.repeat)["ns_per_step"]
+            row["table"] = table.bench(sequences, repeat)["ns_per_step"]
         except CppRuntimeError as exc:  # the table is read off the same loaded tree
             row["table"] = "cannot load: " + str(exc).split(": ", 2)[-1][:60]
     if n > args.pytrees_max_states:
@@ -146,6 +149,8 @@ def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--sizes", default="10,100,1000,10000")
     parser.add_argument("--steps", type=int, default=20_000, help="macro steps per model")
+    parser.add_argument("--step-budget", type=int, default=2_000_000,
+                        help="at most this / states steps per model (at least 1 000)")
     parser.add_argument("--repeat", type=int, default=5, help="C++ replays of the walk")
     parser.add_argument("--pytrees-max-states", type=int, default=10_000)
     parser.add_argument("--pytrees-max-depth", type=int, default=2_100,
@@ -166,12 +171,14 @@ def main() -> int:
             for n in sizes:
                 rows.append(measure(shape, n, args, tmp))
                 print(f"  measured {shape} {n}", file=sys.stderr, flush=True)
-        header = (f"{'shape':7} {'states':>6} {'nodes':>6} {'depth':>6} {'C++ BT ns/step':>15} "
+        header = (f"{'shape':7} {'states':>6} {'nodes':>6} {'depth':>6} {'roots':>6} "
+                  f"{'steps':>6} {'C++ BT ns/step':>15} "
                   f"{'C++ table ns/step':>17} {'BT/table':>9} {'leaf ticks/step':>15} "
                   f"{'py_trees us/step':>17} {'(steps)':>8} {'py_trees/C++':>12} "
                   f"{'tickOnce ns/step':>17}")
         print("\nRuntime cost per macro step (BehaviorTree.CPP 4.8.2 via fsmbt/lebt.hpp; py_trees "
-              f"2.6; plain C++ table); {args.steps} steps per model\n")
+              "2.6; plain C++ table); steps = macro steps timed in C++ (py_trees: its own "
+              "column)\n")
         print(header)
         print("-" * len(header))
         for row in rows:
@@ -182,15 +189,19 @@ def main() -> int:
                 cpp, float) else "-"
             if isinstance(cpp, str):
                 print(f"{row['shape']:7} {row['states']:>6} {row['nodes']:>6} {row['depth']:>6} "
-                      f"{cpp}")
-                print(f"{'':29} C++ table: {fmt(table)}; py_trees "
+                      f"{row['roots']:>6} {row['steps']:>6} {cpp}")
+                print(f"{'':43} C++ table: {fmt(table)}; py_trees "
                       f"{fmt(py, 1e3)} us/step")
                 continue
             print(f"{row['shape']:7} {row['states']:>6} {row['nodes']:>6} {row['depth']:>6} "
-                  f"{fmt(cpp):>15} {fmt(table):>17} {ratio:>9} {fmt(row.get('leaf_ticks')):>15} "
+                  f"{row['roots']:>6} {row['steps']:>6} {fmt(cpp):>15} {fmt(table):>17} {ratio:>9} {fmt(row.get('leaf_ticks')):>15} "
                   f"{fmt(py, 1e3):>17} {row.get('pytrees_steps', '-'):>8} {py_ratio:>12} "
                   f"{fmt(row.get('cpp_once')):>17}")
-        print("\nC++ BT = fsmbt/lebt.hpp's default (tickExactlyOnce: no node of an LEBT emits a "
+        print("\nroots = selectors of the root Sequence (the entry state and every state entered "
+              "from two or more states):\nan event that leaves the running subtree towards one "
+              "of them makes the second tick scan the root Sequence,\nso a step costs "
+              "O(depth + roots) node ticks; the table is O(1).")
+        print("C++ BT = fsmbt/lebt.hpp's default (tickExactlyOnce: no node of an LEBT emits a "
               "wake-up); tickOnce = the same tree ticked\nwith BehaviorTree.CPP's tickOnce(), "
               "whose wake-up check is a futex system call per RUNNING tick (same results).")
         print("\nO(depth) series: chains loadable in BehaviorTree.CPP (tinyxml2 nests <= 500)\n")
