@@ -322,3 +322,27 @@ def test_nusmv_cache_is_per_machine_and_keyed_by_version(tmp_path: Path, monkeyp
     listed = binary.candidates()
     assert listed.index(binary.cached_binary()) < listed.index(binary.LEGACY_BINARY)
     assert listed[-1] == binary.LEGACY_BINARY  # the old per-checkout place, last
+
+
+def test_nusmv_build_script_reuses_the_old_checkout_binary(tmp_path: Path) -> None:
+    """A NuSMV the old script built in <repo>/.cache is copied into the machine cache (no
+    rebuild); the next run finds it there."""
+    repo = tmp_path / "repo"
+    (repo / "scripts").mkdir(parents=True)
+    shutil.copy2(REPO / "scripts" / "build_nusmv.sh", repo / "scripts" / "build_nusmv.sh")
+    legacy = repo / ".cache" / "nusmv" / "bin" / "NuSMV"
+    legacy.parent.mkdir(parents=True)
+    legacy.write_text("#!/bin/sh\necho 'usage: NuSMV -dcx ...'\n", encoding="utf-8")
+    legacy.chmod(0o755)
+    env = {**os.environ, "FSMBT_CACHE": str(tmp_path / "cache")}
+    env.pop("FSMBT_NUSMV_PREFIX", None)
+    first = subprocess.run([str(repo / "scripts" / "build_nusmv.sh")], capture_output=True,
+                           text=True, timeout=60, env=env)
+    assert first.returncode == 0, first.stderr
+    cached = tmp_path / "cache" / "nusmv-2.5.4" / "bin" / "NuSMV"
+    assert "copied from the old per-checkout cache" in first.stdout
+    assert cached.read_bytes() == legacy.read_bytes()
+    legacy.unlink()
+    second = subprocess.run([str(repo / "scripts" / "build_nusmv.sh")], capture_output=True,
+                            text=True, timeout=60, env=env)
+    assert second.returncode == 0 and f"already built: {cached}" in second.stdout
