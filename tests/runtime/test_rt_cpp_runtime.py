@@ -105,6 +105,23 @@ def test_builtin_leaf_that_is_not_lebt_is_refused_with_its_line(driver: Path,
     assert "not an LEBT leaf" in proc.stderr
 
 
+def test_refused_leaf_line_is_the_named_element(driver: Path, tmp_path: Path) -> None:
+    leaf = ('<Sequence name="s">\n  <SleepLonger/>\n  <Sleep name="first" msec="1"/>\n'
+            '  <Sleep name="nap" msec="1"/>\n</Sequence>')
+    path = tmp_path / "two_sleeps.xml"
+    path.write_text(MINIMAL.replace("{leaf}", leaf).replace(
+        '<LebtGuard name="Enter_B" target="B" pairs="A/go"/>', ""), encoding="utf-8")
+    proc = _driver_call(driver, path)
+    assert proc.returncode == 1
+    # BehaviorTree.CPP refuses the unknown <SleepLonger> first, with the line tinyxml2 gives
+    # (for a first child, the line its preceding whitespace starts on)
+    assert "Error at line 10: -> Node not recognized: SleepLonger" in proc.stderr
+    path.write_text(path.read_text(encoding="utf-8").replace("  <SleepLonger/>\n", ""),
+                    encoding="utf-8")
+    proc = _driver_call(driver, path)
+    assert "<Sleep name=\"first\">" in proc.stderr and "line 11" in proc.stderr, proc.stderr
+
+
 def test_missing_action_callback_is_a_load_error(driver: Path, tmp_path: Path) -> None:
     tree = _tree(tmp_path)
     proc = _driver_call(driver, tree, "--register", "do_A", stdin="go\n")

@@ -55,6 +55,7 @@
 #include <behaviortree_cpp/condition_node.h>
 
 #include <algorithm>
+#include <cstddef>
 #include <cstdint>
 #include <fstream>
 #include <functional>
@@ -595,15 +596,38 @@ private:
     return StepResult{ context_->actions_run, terminated(), context_->state };
   }
 
-  /// 1-based line of the first occurrence of `needle` in `text` (0 when absent).
-  static int lineOf(const std::string& text, const std::string& needle)
+  /// 1-based line of the element `<tag ...>` in `text` (0 when not found): the first one whose
+  /// attributes hold name="`name`", else the first `<tag` at all.
+  static int lineOf(const std::string& text, const std::string& tag, const std::string& name)
   {
-    const std::size_t at = text.find(needle);
-    if(at == std::string::npos)
+    const std::string open = "<" + tag;
+    const std::string named = "name=\"" + name + "\"";
+    std::size_t first = std::string::npos;
+    for(std::size_t at = text.find(open); at != std::string::npos; at = text.find(open, at + 1))
+    {
+      const std::size_t after = at + open.size();
+      if(after < text.size() && std::string(" \t\r\n/>").find(text[after]) == std::string::npos)
+      {
+        continue;  // a longer tag name (<SleepLong> for <Sleep>)
+      }
+      if(first == std::string::npos)
+      {
+        first = at;
+      }
+      const std::size_t end = text.find('>', after);
+      if(text.substr(after, end == std::string::npos ? std::string::npos : end - after)
+             .find(named) != std::string::npos)
+      {
+        first = at;
+        break;
+      }
+    }
+    if(first == std::string::npos)
     {
       return 0;
     }
-    return 1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<long>(at), '\n'));
+    return 1 + static_cast<int>(std::count(text.begin(),
+                                           text.begin() + static_cast<std::ptrdiff_t>(first), '\n'));
   }
 
   void collectLeaves(const std::string& xml_text)
@@ -620,7 +644,7 @@ private:
            id != kGuardType && id != kStateType && id != "AlwaysSuccess" &&
            id != "AlwaysFailure")
         {
-          const int line = lineOf(xml_text, "<" + id);
+          const int line = lineOf(xml_text, id, node->name());
           throw LebtError("leaf <" + id + " name=\"" + node->name() + "\"> (" +
                           node->fullPath() + (line > 0 ? ", line " + std::to_string(line) : "") +
                           ") is not an LEBT leaf: this runtime runs only LebtGuard and "
