@@ -76,20 +76,23 @@ def walk(fsm: FSM, steps: int, seed: str) -> list[list[str]]:
     return [s for s in sequences if s]
 
 
-def pytrees_ns_per_step(doc, sequences: list[list[str]], budget: float) -> tuple[float, int]:
-    """ns per macro step in py_trees over the sequences (stops after ``budget`` seconds)."""
-    spent, steps = 0.0, 0
+def pytrees_ns_per_step(doc, sequences: list[list[str]],
+                        budget: float) -> tuple[float, float, int]:
+    """(CPU ns, wall ns) per macro step in py_trees over the sequences, and the steps measured
+    (stops after ``budget`` wall seconds)."""
+    spent, cpu, steps = 0.0, 0.0, 0
     for events in sequences:
         runner = PyTreesLebtRunner(doc)
         runner.initial()
         for event in events:
-            started = time.perf_counter()
+            started, cpu_started = time.perf_counter(), time.process_time()
             runner.macro_step(event)
+            cpu += time.process_time() - cpu_started
             spent += time.perf_counter() - started
             steps += 1
             if spent > budget:
-                return spent * 1e9 / steps, steps
-    return spent * 1e9 / max(steps, 1), steps
+                return cpu * 1e9 / steps, spent * 1e9 / steps, steps
+    return cpu * 1e9 / max(steps, 1), spent * 1e9 / max(steps, 1), steps
 
 
 def measure(shape: str, n: int, args: argparse.Namespace, tmp: Path) -> dict[str, object]:
@@ -113,15 +116,17 @@ def measure(shape: str, n: int, args: argparse.Namespace, tmp: Path) -> dict[str
     else:
         try:
             bt = DriverSession(tree, driver=driver, timeout=1200).bench(sequences, repeat)
-            row["cpp"] = bt["ns_per_step"]
+            row["cpp"] = bt["cpu_ns_per_step"]
+            row["cpp_wall"] = bt["ns_per_step"]
             row["leaf_ticks"] = bt["leaf_ticks"] / max(bt["steps"], 1)
-            once = DriverSession(tree, driver=driver, tick="once", timeout=1200)
-            row["cpp_once"] = once.bench(sequences, 1)["ns_per_step"]
+            once = DriverSession(tree, driver=driver, tick="once", timeout=1200).bench(
+                sequences, 1)
+            row["cpp_once"], row["cpp_once_wall"] = once["cpu_ns_per_step"], once["ns_per_step"]
         except CppRuntimeError as exc:
             row["cpp"] = "cannot load: " + str(exc).split(": ", 2)[-1][:90]
         table = DriverSession(tree, driver=driver, table=True, timeout=600)
         try:
-            row["table"] = table.bench(sequences, repeat)["ns_per_step"]
+            row["table"] = table.bench(sequences, repeat)["cpu_ns_per_step"]
         except CppRuntimeError as exc:  # the table is read off the same loaded tree
             row["table"] = "cannot load: " + str(exc).split(": ", 2)[-1][:60]
     if n > args.pytrees_max_states:
@@ -131,9 +136,10 @@ def measure(shape: str, n: int, args: argparse.Namespace, tmp: Path) -> dict[str
     else:
         doc = loads(text, "btcpp")
         try:
-            ns, steps = pytrees_ns_per_step(doc, sequences, args.pytrees_budget)
+            ns, wall, py_steps = pytrees_ns_per_step(doc, sequences, args.pytrees_budget)
             row["pytrees"] = ns
-            row["pytrees_steps"] = steps
+            row["pytrees_wall"] = wall
+            row["pytrees_steps"] = py_steps
         except RecursionError:
             row["pytrees"] = "RecursionError (py_trees ticks recursively)"
     return row
@@ -171,14 +177,15 @@ def main() -> int:
             for n in sizes:
                 rows.append(measure(shape, n, args, tmp))
                 print(f"  measured {shape} {n}", file=sys.stderr, flush=True)
-        header = (f"{'shape':7} {'states':>6} {'nodes':>6} {'depth':>6} {'roots':>6} "
-                  f"{'steps':>6} {'C++ BT ns/step':>15} "
-                  f"{'C++ table ns/step':>17} {'BT/table':>9} {'leaf ticks/step':>15} "
-                  f"{'py_trees us/step':>17} {'(steps)':>8} {'py_trees/C++':>12} "
-                  f"{'tickOnce ns/step':>17}")
-        print("\nRuntime cost per macro step (BehaviorTree.CPP 4.8.2 via fsmbt/lebt.hpp; py_trees "
-              "2.6; plain C++ table); steps = macro steps timed in C++ (py_trees: its own "
-              "column)\n")
+        header = (f"{'shape':7} {'states':>6} {'nodes':>6} {'depth':>5} {'roots':>5} "
+                  f"{'steps':>6} {'C++ BT':>10} {'table':>6} {'BT/table':>9} {'ticks':>7} "
+                  f"{'py_trees':>11} {'(steps)':>7} {'py/C++':>7} {'tickOnce':>10} "
+                  f"{'| wall:':>7} {'C++ BT':>10} {'tickOnce':>10} {'py_trees':>11}")
+        print("\nRuntime cost per macro step, ns of CPU time (process CPU clock; wall-clock "
+              "columns on the right: this machine is\nshared, wall time includes waiting for a "
+              "core). BehaviorTree.CPP 4.8.2 via fsmbt/lebt.hpp, py_trees 2.6, plain C++ table.\n"
+              "steps = macro steps timed in C++; ticks = LEBT leaf ticks per step; (steps) = "
+              "py_trees steps timed.\n")
         print(header)
         print("-" * len(header))
         for row in rows:
@@ -187,16 +194,18 @@ def main() -> int:
                 table, float) and table else "-"
             py_ratio = fmt(py / cpp, unit="x") if isinstance(py, float) and isinstance(
                 cpp, float) else "-"
+            lead = (f"{row['shape']:7} {row['states']:>6} {row['nodes']:>6} {row['depth']:>5} "
+                    f"{row['roots']:>5} {row['steps']:>6}")
             if isinstance(cpp, str):
-                print(f"{row['shape']:7} {row['states']:>6} {row['nodes']:>6} {row['depth']:>6} "
-                      f"{row['roots']:>6} {row['steps']:>6} {cpp}")
-                print(f"{'':43} C++ table: {fmt(table)}; py_trees "
-                      f"{fmt(py, 1e3)} us/step")
+                print(f"{lead} {cpp}")
+                print(f"{'':42} table: {fmt(table)}; py_trees {fmt(py)} ns/step CPU "
+                      f"({row.get('pytrees_steps', '-')} steps), wall {fmt(row.get('pytrees_wall'))}")
                 continue
-            print(f"{row['shape']:7} {row['states']:>6} {row['nodes']:>6} {row['depth']:>6} "
-                  f"{row['roots']:>6} {row['steps']:>6} {fmt(cpp):>15} {fmt(table):>17} {ratio:>9} {fmt(row.get('leaf_ticks')):>15} "
-                  f"{fmt(py, 1e3):>17} {row.get('pytrees_steps', '-'):>8} {py_ratio:>12} "
-                  f"{fmt(row.get('cpp_once')):>17}")
+            print(f"{lead} {fmt(cpp):>10} {fmt(table):>6} {ratio:>9} "
+                  f"{fmt(row.get('leaf_ticks')):>7} {fmt(py):>11} "
+                  f"{row.get('pytrees_steps', '-'):>7} {py_ratio:>7} {fmt(row.get('cpp_once')):>10} "
+                  f"{'|':>7} {fmt(row.get('cpp_wall')):>10} {fmt(row.get('cpp_once_wall')):>10} "
+                  f"{fmt(row.get('pytrees_wall')):>11}")
         print("\nroots = selectors of the root Sequence (the entry state and every state entered "
               "from two or more states):\nan event that leaves the running subtree towards one "
               "of them makes the second tick scan the root Sequence,\nso a step costs "
@@ -205,17 +214,17 @@ def main() -> int:
               "wake-up); tickOnce = the same tree ticked\nwith BehaviorTree.CPP's tickOnce(), "
               "whose wake-up check is a futex system call per RUNNING tick (same results).")
         print("\nO(depth) series: chains loadable in BehaviorTree.CPP (tinyxml2 nests <= 500)\n")
-        series_header = (f"{'states':>6} {'depth':>6} {'C++ BT ns/step':>15} "
-                         f"{'leaf ticks/step':>15} {'ns per leaf tick':>16}")
+        series_header = (f"{'states':>6} {'depth':>6} {'C++ BT CPU ns/step':>19} "
+                         f"{'leaf ticks/step':>15} {'ns per level':>13}")
         print(series_header)
         print("-" * len(series_header))
         for n in [int(s) for s in args.depth_series.split(",") if s]:
             row = measure("chain", n, argparse.Namespace(**{**vars(args), "pytrees_max_states": 0}),
                           tmp)
             cpp, ticks = row.get("cpp"), row.get("leaf_ticks")
-            per_tick = fmt(cpp / ticks) if isinstance(cpp, float) and isinstance(
-                ticks, float) and ticks else "-"
-            print(f"{n:>6} {row['depth']:>6} {fmt(cpp):>15} {fmt(ticks):>15} {per_tick:>16}")
+            depth = int(str(row["depth"]))
+            per_level = fmt(cpp / depth) if isinstance(cpp, float) and depth else "-"
+            print(f"{n:>6} {row['depth']:>6} {fmt(cpp):>19} {fmt(ticks):>15} {per_level:>13}")
     return 0
 
 

@@ -24,11 +24,13 @@
 //   --table          run the same FSM as a plain transition table read off the tree's guards and
 //                    states (no behavior tree ticks): the baseline of benchmarks/bench_runtime.py
 //   --bench R        read all of stdin first, replay it R times without printing steps, then print
-//                    one JSON object: {"mode","steps","seconds","ns_per_step","leaf_ticks"}
+//                    one JSON object: {"mode","steps","seconds","ns_per_step","cpu_seconds",
+//                    "cpu_ns_per_step","leaf_ticks","actions"} (wall clock and process CPU time)
 #include <fsmbt/lebt.hpp>
 
 #include <chrono>
 #include <cstdio>
+#include <ctime>
 #include <iostream>
 #include <sstream>
 #include <string>
@@ -354,6 +356,12 @@ void bench(Runner& runner, fsmbt::lebt::LebtRunner* lebt, const std::vector<std:
 {
   using Clock = std::chrono::steady_clock;
   Clock::duration spent{};
+  double cpu_spent = 0.0;  // process CPU time: what the steps cost without waiting for a core
+  auto cpu_now = []() {
+    timespec ts{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return static_cast<double>(ts.tv_sec) + static_cast<double>(ts.tv_nsec) * 1e-9;
+  };
   std::size_t sink = 0;  // keeps the results observable
   const std::uint64_t ticks_before = lebt != nullptr && mode[0] == 'b' ? lebt->leafTicks() : 0;
   for(long r = 0; r < repeat; ++r)
@@ -382,10 +390,12 @@ void bench(Runner& runner, fsmbt::lebt::LebtRunner* lebt, const std::vector<std:
         ++end;
       }
       const auto t0 = Clock::now();
+      const double c0 = cpu_now();
       for(; i < end; ++i)
       {
         sink += runner.post(lines[i]).actions.size();
       }
+      cpu_spent += cpu_now() - c0;
       spent += Clock::now() - t0;
     }
   }
@@ -398,9 +408,11 @@ void bench(Runner& runner, fsmbt::lebt::LebtRunner* lebt, const std::vector<std:
   const double seconds = std::chrono::duration<double>(spent).count();
   const std::uint64_t ticks =
       (lebt != nullptr && mode[0] == 'b' ? lebt->leafTicks() : 0) - ticks_before;
+  const double per = steps ? 1e9 / static_cast<double>(steps) : 0.0;
   std::printf("{\"mode\":\"%s\",\"steps\":%ld,\"seconds\":%.9f,\"ns_per_step\":%.1f,"
-              "\"leaf_ticks\":%llu,\"actions\":%zu}\n",
-              mode, steps, seconds, steps ? seconds * 1e9 / static_cast<double>(steps) : 0.0,
+              "\"cpu_seconds\":%.9f,\"cpu_ns_per_step\":%.1f,\"leaf_ticks\":%llu,"
+              "\"actions\":%zu}\n",
+              mode, steps, seconds, seconds * per, cpu_spent, cpu_spent * per,
               static_cast<unsigned long long>(ticks), sink);
 }
 
