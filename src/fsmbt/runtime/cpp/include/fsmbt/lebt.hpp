@@ -37,10 +37,11 @@
 // is a blackboard reference or malformed, and an action name with no registered callback - all
 // raised by the LebtRunner constructor, never at tick time.
 //
-// Cost: a guard tick is two hash look-ups; a state tick is one look-up; a macro step ticks the
-// root's Sequence from its running child down to the running leaf (BehaviorTree.CPP resumes a
-// Sequence at its running child), so one step costs O(depth of the running leaf) node ticks, plus
-// a scan of the root's selectors when the event leaves the running subtree.
+// Cost: a guard tick is two hash look-ups, a state tick one. A macro step ticks from the root
+// down to the running leaf (BehaviorTree.CPP resumes each Sequence at its running child, but every
+// tick walks the path), and when the event leaves the running subtree for a selector of the root
+// Sequence the second tick scans the root's selectors guard by guard: O(depth + root selectors)
+// node ticks per step (benchmarks/bench_runtime.py: ~46 ns of CPU per level; docs/runtime.md).
 //
 // Usage:
 //   fsmbt::lebt::ActionRegistry actions;
