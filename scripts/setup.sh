@@ -6,8 +6,12 @@
 #   3. the project and its pinned dependencies: pip install -e '.[test]' (pins live in
 #      pyproject.toml); skipped when pyproject.toml has not changed since the last install
 #   4. NuSMV, built from source by scripts/build_nusmv.sh when that script is present
+#   5. the C++ runtime: BehaviorTree.CPP 4.8.2 and the LEBT driver, built by scripts/build_btcpp.sh
+#      into the machine's cache (once per machine); a machine without cmake/g++ gets one line
+#      saying what is missing and the rest of the setup still succeeds
 #
-# Environment: PYTHON=/path/to/python3.11 picks the interpreter; FSMBT_SKIP_NUSMV=1 skips step 4.
+# Environment: PYTHON=/path/to/python3.11 picks the interpreter; FSMBT_SKIP_NUSMV=1 skips step 4;
+# FSMBT_SKIP_BTCPP=1 skips step 5; FSMBT_CACHE moves the build cache of steps 4 and 5.
 set -euo pipefail
 
 REPO_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -96,6 +100,20 @@ if [ "${FSMBT_SKIP_NUSMV:-0}" = "1" ]; then
 elif [ -x scripts/build_nusmv.sh ]; then
     say "NuSMV: scripts/build_nusmv.sh"
     PYTHON="$VENV/bin/python" scripts/build_nusmv.sh
+fi
+
+# -- 5. the C++ runtime (BehaviorTree.CPP + LEBT driver) -----------------------------------------
+if [ "${FSMBT_SKIP_BTCPP:-0}" = "1" ]; then
+    say "C++ runtime: skipped (FSMBT_SKIP_BTCPP=1)"
+elif [ -x scripts/build_btcpp.sh ]; then
+    say "C++ runtime: scripts/build_btcpp.sh"
+    status=0
+    PYTHON="$VENV/bin/python" scripts/build_btcpp.sh || status=$?
+    if [ "$status" = "2" ]; then
+        say "C++ runtime: not built (see the line above); everything else works"
+    elif [ "$status" != "0" ]; then
+        die "scripts/build_btcpp.sh failed"
+    fi
 fi
 
 say "ready: $VENV/bin/fsmbt"

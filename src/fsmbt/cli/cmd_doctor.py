@@ -1,8 +1,10 @@
 """``fsmbt doctor``: what fsmbt's optional engines and tools need, found or not.
 
 Checks NuSMV (the second verification engine; path and version), Graphviz ``dot`` (pictures),
-behaviortreepy (BehaviorTree.CPP, the differential tests) and py_trees. Exit 0 when all are
-found, 1 otherwise; each missing one says how to get it.
+behaviortreepy (BehaviorTree.CPP, the differential tests), py_trees, and the C++ runtime built
+by ``scripts/build_btcpp.sh`` (BehaviorTree.CPP's install prefix in the cache, the LEBT driver
+built from the current sources or not). Exit 0 when all are found, 1 otherwise; each missing one
+says how to get it.
 """
 
 from __future__ import annotations
@@ -62,15 +64,30 @@ def _module(label: str, module: str, dist: str) -> Check:
     return Check(label, True, f"{dist} {ver}")
 
 
+def _cpp_runtime() -> list[Check]:
+    from fsmbt.runtime.cpp import BTCPP_VERSION, library_prefix, status
+
+    found = status()
+    hint = "run scripts/build_btcpp.sh (needs cmake and g++)"
+    library = (Check(f"BehaviorTree.CPP {BTCPP_VERSION} (C++)", True, f"built at {found.library}")
+               if found.library else
+               Check(f"BehaviorTree.CPP {BTCPP_VERSION} (C++)", False,
+                     f"not built at {library_prefix()}", hint))
+    driver = (Check("C++ LEBT driver", True, f"built at {found.driver}") if found.driver else
+              Check("C++ LEBT driver", False, found.problem, hint))
+    return [library, driver]
+
+
 def checks() -> list[Check]:
     return [_nusmv(), _dot(), _module("behaviortreepy", "behaviortreepy", "behaviortreepy"),
-            _module("py_trees", "py_trees", "py_trees")]
+            _module("py_trees", "py_trees", "py_trees"), *_cpp_runtime()]
 
 
 def register(app: typer.Typer) -> None:
     @app.command("doctor")
     def doctor_command() -> None:
-        """Report the external tools fsmbt uses (NuSMV, Graphviz, behaviortreepy, py_trees)."""
+        """Report the external tools fsmbt uses (NuSMV, Graphviz, behaviortreepy, py_trees, the
+        C++ runtime)."""
         results = checks()
         table = Table("tool", "status", "detail")
         for c in results:

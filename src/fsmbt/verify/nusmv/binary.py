@@ -1,6 +1,8 @@
-"""Finding the NuSMV binary: ``FSMBT_NUSMV``, then ``PATH``, then the project's build cache.
+"""Finding the NuSMV binary: ``FSMBT_NUSMV``, then ``PATH``, then the machine's build cache.
 
-The build cache is where ``scripts/build_nusmv.sh`` puts it (``<repo>/.cache/nusmv/bin/NuSMV``).
+The build cache is where ``scripts/build_nusmv.sh`` puts it, once per machine and keyed by
+version: ``${FSMBT_CACHE:-${XDG_CACHE_HOME:-~/.cache}/fsmbt}/nusmv-2.5.4/bin/NuSMV``; the old
+per-checkout place ``<repo>/.cache/nusmv/bin/NuSMV`` is still looked at last.
 """
 
 from __future__ import annotations
@@ -17,7 +19,22 @@ from fsmbt.model.errors import FsmbtError
 ENV_VAR = "FSMBT_NUSMV"
 _REPO_ROOT = Path(__file__).resolve().parents[4]
 BUILD_SCRIPT = _REPO_ROOT / "scripts" / "build_nusmv.sh"
-CACHED_BINARY = _REPO_ROOT / ".cache" / "nusmv" / "bin" / "NuSMV"
+NUSMV_VERSION = "2.5.4"
+LEGACY_BINARY = _REPO_ROOT / ".cache" / "nusmv" / "bin" / "NuSMV"
+
+
+def cache_root() -> Path:
+    """``$FSMBT_CACHE``, else ``$XDG_CACHE_HOME/fsmbt``, else ``~/.cache/fsmbt``."""
+    explicit = os.environ.get("FSMBT_CACHE")
+    if explicit:
+        return Path(explicit)
+    xdg = os.environ.get("XDG_CACHE_HOME")
+    return (Path(xdg) if xdg else Path.home() / ".cache") / "fsmbt"
+
+
+def cached_binary() -> Path:
+    """Where ``scripts/build_nusmv.sh`` installs NuSMV on this machine."""
+    return cache_root() / f"nusmv-{NUSMV_VERSION}" / "bin" / "NuSMV"
 
 
 class NuSMVNotFound(FsmbtError):
@@ -33,7 +50,8 @@ def candidates() -> list[Path]:
     on_path = shutil.which("NuSMV") or shutil.which("nusmv")
     if on_path:
         found.append(Path(on_path))
-    found.append(CACHED_BINARY)
+    found.append(cached_binary())
+    found.append(LEGACY_BINARY)
     return found
 
 
@@ -54,7 +72,7 @@ def require_nusmv() -> Path:
     if path is None:
         env = os.environ.get(ENV_VAR)
         hint = (f"{ENV_VAR}={env} is not an executable file" if env else
-                f"not on PATH and not built at {CACHED_BINARY}")
+                f"not on PATH and not built at {cached_binary()}")
         raise NuSMVNotFound(f"NuSMV not found ({hint}); run {BUILD_SCRIPT} or set {ENV_VAR}")
     return path
 

@@ -1,0 +1,478 @@
+// fsmbt_lebt_driver: run an LEBT written by `fsmbt convert` in BehaviorTree.CPP v4 through
+// fsmbt/lebt.hpp, reading events from stdin and printing what each macro step did.
+//
+//   fsmbt_lebt_driver TREE.xml [--start NAME] [--register A,B,...] [--table] [--bench R]
+//                              [--tick once|exactly-once|auto]
+//   fsmbt_lebt_driver --version
+//
+// Input (stdin): one event name per line (a trailing '\r' is dropped; empty lines are skipped).
+// The line `%reset` puts the run back to before its start (the tree is halted) and starts again,
+// so one process can replay many event sequences.
+//
+// Output (stdout): one JSON object per line - the start, then one per event:
+//   {"step":0,"event":null,"actions":["A"],"terminated":false,"state":"A"}
+//   {"step":1,"event":"go","actions":["B"],"terminated":true,"state":"B"}
+// `step` counts events since the last start. Errors go to stderr as one line
+// `error: ...` with exit status 1 (load errors: unknown leaf with its line, missing callbacks).
+//
+// Options:
+//   --start NAME     the start pseudo-state (default: inferred, docs/semantics.md section 5)
+//   --register LIST  register callbacks only for these comma-separated action names (each one
+//                    records its call); without it every action gets a recording fallback. An
+//                    action of the tree missing from LIST is a load-time error.
+//   --tick MODE      how the root is ticked (fsmbt::lebt::TickMode; default auto)
+//   --table          run the same FSM as a plain transition table read off the tree's guards and
+//                    states (no behavior tree ticks): the baseline of benchmarks/bench_runtime.py
+//   --bench R        read all of stdin first, replay it R times without printing steps, then print
+//                    one JSON object: {"mode","steps","seconds","ns_per_step","cpu_seconds",
+//                    "cpu_ns_per_step","leaf_ticks","actions"} (wall clock and process CPU time)
+#include <fsmbt/lebt.hpp>
+
+#include <chrono>
+#include <cstdio>
+#include <ctime>
+#include <iostream>
+#include <sstream>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+namespace {
+
+constexpr const char* kReset = "%reset";
+
+std::string jsonString(const std::string& text)
+{
+  std::string out = "\"";
+  for(unsigned char ch : text)
+  {
+    switch(ch)
+    {
+      case '"': out += "\\\""; break;
+      case '\\': out += "\\\\"; break;
+      case '\n': out += "\\n"; break;
+      case '\r': out += "\\r"; break;
+      case '\t': out += "\\t"; break;
+      default:
+        if(ch < 0x20)
+        {
+          char buffer[8];
+          std::snprintf(buffer, sizeof buffer, "\\u%04x", ch);
+          out += buffer;
+        }
+        else
+        {
+          out.push_back(static_cast<char>(ch));
+        }
+    }
+  }
+  return out + "\"";
+}
+
+void printStep(long step, const std::string* event, const fsmbt::lebt::StepResult& result)
+{
+  std::string line = "{\"step\":" + std::to_string(step) +
+                     ",\"event\":" + (event ? jsonString(*event) : std::string("null")) +
+                     ",\"actions\":[";
+  for(std::size_t i = 0; i < result.actions.size(); ++i)
+  {
+    line += (i ? "," : "") + jsonString(result.actions[i]);
+  }
+  line += std::string("],\"terminated\":") + (result.terminated ? "true" : "false") +
+          ",\"state\":" + jsonString(result.state) + "}\n";
+  std::fputs(line.c_str(), stdout);
+}
+
+/// The FSM the LEBT encodes, as a plain table: state index -> (event -> target index). Built
+/// from the loaded runner's leaves: each atomic state's own guard (target = a state) holds the
+/// (source, event) pairs entering it; cluster guards (target = a composite path) are skipped.
+class TableRunner
+{
+public:
+  explicit TableRunner(const fsmbt::lebt::LebtRunner& lebt) : start_(lebt.startState())
+  {
+    for(const fsmbt::lebt::LebtState* leaf : lebt.states())
+    {
+      if(ids_.count(leaf->stateName()) == 0)
+      {
+        ids_[leaf->stateName()] = static_cast<int>(names_.size());
+        names_.push_back(leaf->stateName());
+        actions_.push_back(leaf->actionName());
+        finals_.push_back(leaf->isFinal());
+      }
+    }
+    table_.resize(names_.size());
+    for(const fsmbt::lebt::LebtGuard* guard : lebt.guards())
+    {
+      auto target = ids_.find(guard->target());
+      if(target == ids_.end())
+      {
+        continue;  // a composite state's guard: its pairs reappear at the atomic targets
+      }
+      for(const auto& [source, event] : guard->pairs())
+      {
+        if(source == start_)
+        {
+          (event.empty() ? init_target_ : start_events_[event]) = target->second;
+          continue;
+        }
+        auto from = ids_.find(source);
+        if(from == ids_.end())
+        {
+          throw fsmbt::lebt::LebtError("guard pair " + source + "/" + event +
+                                       " leaves an unknown state");
+        }
+        auto [it, inserted] = table_[from->second].emplace(event, target->second);
+        if(!inserted && it->second != target->second)
+        {
+          throw fsmbt::lebt::LebtError("two targets for " + source + "/" + event);
+        }
+      }
+    }
+  }
+
+  fsmbt::lebt::StepResult start()
+  {
+    current_ = -1;
+    actions_run_.clear();
+    if(init_target_ >= 0)
+    {
+      enter(init_target_);
+    }
+    return result();
+  }
+
+  fsmbt::lebt::StepResult post(const std::string& event)
+  {
+    actions_run_.clear();
+    if(current_ < 0)
+    {
+      auto it = start_events_.find(event);
+      if(it != start_events_.end())
+      {
+        enter(it->second);
+      }
+    }
+    else if(!finals_[current_])
+    {
+      const auto& row = table_[current_];
+      auto it = row.find(event);
+      if(it != row.end())
+      {
+        enter(it->second);
+      }
+    }
+    return result();
+  }
+
+private:
+  void enter(int target)
+  {
+    current_ = target;
+    if(!actions_[target].empty())
+    {
+      actions_run_.push_back(actions_[target]);
+    }
+  }
+
+  fsmbt::lebt::StepResult result() const
+  {
+    const bool final = current_ >= 0 && finals_[current_];
+    return { actions_run_, final, current_ < 0 ? start_ : names_[current_] };
+  }
+
+  std::string start_;
+  std::unordered_map<std::string, int> ids_;
+  std::vector<std::string> names_;
+  std::vector<std::string> actions_;
+  std::vector<bool> finals_;
+  std::vector<std::unordered_map<std::string, int>> table_;
+  std::unordered_map<std::string, int> start_events_;
+  int init_target_ = -1;
+  int current_ = -1;
+  std::vector<std::string> actions_run_;
+};
+
+struct Arguments
+{
+  std::string tree;
+  std::optional<std::string> start;
+  std::optional<std::vector<std::string>> registered;
+  bool table = false;
+  long bench = 0;
+  fsmbt::lebt::TickMode tick = fsmbt::lebt::TickMode::Auto;
+};
+
+[[noreturn]] void usage(const std::string& problem)
+{
+  std::fprintf(stderr,
+               "error: %s\nusage: fsmbt_lebt_driver TREE.xml [--start NAME] [--register A,B] "
+               "[--table] [--bench R] [--tick once|exactly-once|auto] | --version\n",
+               problem.c_str());
+  std::exit(2);
+}
+
+Arguments parse(int argc, char** argv)
+{
+  Arguments args;
+  for(int i = 1; i < argc; ++i)
+  {
+    const std::string arg = argv[i];
+    auto value = [&]() -> std::string {
+      if(i + 1 >= argc)
+      {
+        usage(arg + " needs a value");
+      }
+      return argv[++i];
+    };
+    if(arg == "--start")
+    {
+      args.start = value();
+    }
+    else if(arg == "--register")
+    {
+      std::vector<std::string> names;
+      std::stringstream list(value());
+      for(std::string name; std::getline(list, name, ',');)
+      {
+        if(!name.empty())
+        {
+          names.push_back(name);
+        }
+      }
+      args.registered = names;
+    }
+    else if(arg == "--tick")
+    {
+      const std::string mode = value();
+      if(mode == "once")
+      {
+        args.tick = fsmbt::lebt::TickMode::Once;
+      }
+      else if(mode == "exactly-once")
+      {
+        args.tick = fsmbt::lebt::TickMode::ExactlyOnce;
+      }
+      else if(mode == "auto")
+      {
+        args.tick = fsmbt::lebt::TickMode::Auto;
+      }
+      else
+      {
+        usage("--tick takes once, exactly-once or auto");
+      }
+    }
+    else if(arg == "--table")
+    {
+      args.table = true;
+    }
+    else if(arg == "--bench")
+    {
+      try
+      {
+        args.bench = std::stol(value());
+      }
+      catch(const std::exception&)
+      {
+        usage("--bench needs a number of repetitions");
+      }
+      if(args.bench < 1)
+      {
+        usage("--bench needs a number of repetitions >= 1");
+      }
+    }
+    else if(!arg.empty() && arg[0] == '-')
+    {
+      usage("unknown option " + arg);
+    }
+    else if(args.tree.empty())
+    {
+      args.tree = arg;
+    }
+    else
+    {
+      usage("one tree file only");
+    }
+  }
+  if(args.tree.empty())
+  {
+    usage("no tree file given");
+  }
+  return args;
+}
+
+std::vector<std::string> readLines()
+{
+  std::vector<std::string> lines;
+  for(std::string line; std::getline(std::cin, line);)
+  {
+    if(!line.empty() && line.back() == '\r')
+    {
+      line.pop_back();
+    }
+    if(!line.empty())
+    {
+      lines.push_back(line);
+    }
+  }
+  return lines;
+}
+
+/// Run `lines` through `runner` (LebtRunner or TableRunner), printing every step.
+template <typename Runner>
+void interactive(Runner& runner, fsmbt::lebt::LebtRunner* lebt)
+{
+  long step = 0;
+  printStep(step, nullptr, runner.start());
+  for(std::string line; std::getline(std::cin, line);)
+  {
+    if(!line.empty() && line.back() == '\r')
+    {
+      line.pop_back();
+    }
+    if(line.empty())
+    {
+      continue;
+    }
+    if(line == kReset)
+    {
+      if(lebt != nullptr)
+      {
+        lebt->reset();
+      }
+      step = 0;
+      printStep(step, nullptr, runner.start());
+      continue;
+    }
+    printStep(++step, &line, runner.post(line));
+  }
+  std::fflush(stdout);
+}
+
+/// Replay `lines` `repeat` times; only the post() calls are timed.
+template <typename Runner>
+void bench(Runner& runner, fsmbt::lebt::LebtRunner* lebt, const std::vector<std::string>& lines,
+           long repeat, const char* mode)
+{
+  using Clock = std::chrono::steady_clock;
+  Clock::duration spent{};
+  double cpu_spent = 0.0;  // process CPU time: what the steps cost without waiting for a core
+  auto cpu_now = []() {
+    timespec ts{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return static_cast<double>(ts.tv_sec) + static_cast<double>(ts.tv_nsec) * 1e-9;
+  };
+  std::size_t sink = 0;  // keeps the results observable
+  const std::uint64_t ticks_before = lebt != nullptr && mode[0] == 'b' ? lebt->leafTicks() : 0;
+  for(long r = 0; r < repeat; ++r)
+  {
+    if(lebt != nullptr)
+    {
+      lebt->reset();
+    }
+    runner.start();
+    std::size_t i = 0;
+    while(i < lines.size())
+    {
+      if(lines[i] == kReset)
+      {
+        if(lebt != nullptr)
+        {
+          lebt->reset();
+        }
+        runner.start();
+        ++i;
+        continue;
+      }
+      std::size_t end = i;
+      while(end < lines.size() && lines[end] != kReset)
+      {
+        ++end;
+      }
+      const auto t0 = Clock::now();
+      const double c0 = cpu_now();
+      for(; i < end; ++i)
+      {
+        sink += runner.post(lines[i]).actions.size();
+      }
+      cpu_spent += cpu_now() - c0;
+      spent += Clock::now() - t0;
+    }
+  }
+  long steps = 0;
+  for(const std::string& line : lines)
+  {
+    steps += line != kReset;
+  }
+  steps *= repeat;
+  const double seconds = std::chrono::duration<double>(spent).count();
+  const std::uint64_t ticks =
+      (lebt != nullptr && mode[0] == 'b' ? lebt->leafTicks() : 0) - ticks_before;
+  const double per = steps ? 1e9 / static_cast<double>(steps) : 0.0;
+  std::printf("{\"mode\":\"%s\",\"steps\":%ld,\"seconds\":%.9f,\"ns_per_step\":%.1f,"
+              "\"cpu_seconds\":%.9f,\"cpu_ns_per_step\":%.1f,\"leaf_ticks\":%llu,"
+              "\"actions\":%zu}\n",
+              mode, steps, seconds, seconds * per, cpu_spent, cpu_spent * per,
+              static_cast<unsigned long long>(ticks), sink);
+}
+
+}  // namespace
+
+int main(int argc, char** argv)
+{
+  std::ios::sync_with_stdio(false);
+  if(argc == 2 && std::string(argv[1]) == "--version")
+  {
+    std::printf("%s on BehaviorTree.CPP %s\n", fsmbt::lebt::kRuntimeVersion,
+                BT::LibraryVersionString());
+    return 0;
+  }
+  const Arguments args = parse(argc, argv);
+  try
+  {
+    fsmbt::lebt::ActionRegistry actions;
+    if(args.registered)
+    {
+      for(const std::string& name : *args.registered)
+      {
+        actions.add(name, [](const std::string&) {});
+      }
+    }
+    else
+    {
+      actions.addFallback([](const std::string&) {});
+    }
+    fsmbt::lebt::Options options;
+    options.start = args.start;
+    options.tick = args.tick;
+    fsmbt::lebt::LebtRunner runner =
+        fsmbt::lebt::LebtRunner::fromFile(args.tree, std::move(actions), options);
+    if(args.table)
+    {
+      TableRunner table(runner);
+      if(args.bench > 0)
+      {
+        bench(table, nullptr, readLines(), args.bench, "table");
+      }
+      else
+      {
+        interactive(table, nullptr);
+      }
+    }
+    else if(args.bench > 0)
+    {
+      bench(runner, &runner, readLines(), args.bench, "bt");
+    }
+    else
+    {
+      interactive(runner, &runner);
+    }
+  }
+  catch(const std::exception& exc)
+  {
+    std::fflush(stdout);
+    std::fprintf(stderr, "error: %s\n", exc.what());
+    return 1;
+  }
+  return 0;
+}

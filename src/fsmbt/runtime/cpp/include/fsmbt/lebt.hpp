@@ -1,0 +1,729 @@
+// fsmbt LEBT runtime for BehaviorTree.CPP v4 (header-only; C++17).
+//
+// Runs the loop-execution behavior trees (LEBT) that `fsmbt convert` writes from a state
+// machine: their leaves are `LebtGuard` and `LebtState`, their meaning is fsmbt's
+// docs/semantics.md section 5 ("The LEBT protocol"), and this file follows it literally:
+//
+//  - blackboard: `state` (starts at the start pseudo-state) and `event` ("" = none). Both live in
+//    a `fsmbt::lebt::Context` owned by the runner and shared by every leaf of the tree, SubTrees
+//    included, so a hierarchical conversion (one <BehaviorTree> per composite state, <SubTree>
+//    references, no port remapping) runs unchanged.
+//  - LebtGuard (a Condition; ports `target`, `pairs`): FAILURE when (state, event) is one of its
+//    `source/event` pairs (the transition fires), else SUCCESS. `Start/` (empty event) is the
+//    initialisation pair.
+//  - LebtState (a stateful Action; ports `state`, `action`, `final`, `exits`): onStart runs the
+//    state's action (the user's callback registered under the action's name; once per entry),
+//    sets `state`, clears `event`, returns RUNNING (SUCCESS when final). onRunning: SUCCESS when
+//    the pending event has a transition out of the state (the event is kept), else the event is
+//    dropped and the leaf stays RUNNING; RUNNING when no event is pending.
+//  - macro step (LebtRunner::post): set `event`, tickOnce(); if the root returned SUCCESS with
+//    the event still pending, tick once more; then drop any event still pending.
+//  - tickOnce() vs tickExactlyOnce(): they differ only when a node emitted a wake-up signal
+//    (docs/semantics.md section 3). When every node of the tree is one that never does
+//    (Sequence, Fallback, SubTree, the LEBT leaves, ...: kNeverWakeUp) the runner calls
+//    tickExactlyOnce(), which gives the same result and skips tickOnce()'s wake-up check - a
+//    condition_variable wait with a zero timeout, one futex system call per RUNNING tick, which
+//    costs microseconds and, on a busy machine, a reschedule (benchmarks/bench_runtime.py
+//    measures both). Options::tick forces one or the other.
+//  - start (LebtRunner::start): when a guard holds the pair (start, "") the root is ticked once
+//    with no event so the initial state's action runs; otherwise nothing is ticked.
+//  - start pseudo-state: the one guard source that is not a state, else "__start__" (or
+//    Options::start).
+//  - terminated: the last root result is SUCCESS and `state` is no longer the start
+//    pseudo-state.
+//
+// Load-time errors (fsmbt::lebt::LebtError, derived from std::runtime_error): a leaf the runtime
+// does not define (BehaviorTree.CPP's "Error at line N: -> Node not recognized: X"), a port that
+// is a blackboard reference or malformed, and an action name with no registered callback - all
+// raised by the LebtRunner constructor, never at tick time.
+//
+// Cost: a guard tick is two hash look-ups, a state tick one. A macro step ticks from the root
+// down to the running leaf (BehaviorTree.CPP resumes each Sequence at its running child, but every
+// tick walks the path), and when the event leaves the running subtree for a selector of the root
+// Sequence the second tick scans the root's selectors guard by guard: O(depth + root selectors)
+// node ticks per step (benchmarks/bench_runtime.py: ~46 ns of CPU per level; docs/runtime.md).
+//
+// Usage:
+//   fsmbt::lebt::ActionRegistry actions;
+//   actions.add("Open", [](const std::string& state) { /* drive the motor */ });
+//   fsmbt::lebt::LebtRunner runner = fsmbt::lebt::LebtRunner::fromFile("door.xml", actions);
+//   runner.start();
+//   fsmbt::lebt::StepResult r = runner.post("open_cmd");   // r.actions, r.terminated
+#pragma once
+
+#include <behaviortree_cpp/action_node.h>
+#include <behaviortree_cpp/bt_factory.h>
+#include <behaviortree_cpp/condition_node.h>
+
+#include <algorithm>
+#include <cstddef>
+#include <cstdint>
+#include <fstream>
+#include <functional>
+#include <map>
+#include <memory>
+#include <optional>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <unordered_map>
+#include <unordered_set>
+#include <utility>
+#include <vector>
+
+namespace fsmbt {
+namespace lebt {
+
+inline constexpr const char* kGuardType = "LebtGuard";
+inline constexpr const char* kStateType = "LebtState";
+inline constexpr const char* kDefaultStart = "__start__";
+inline constexpr const char* kRuntimeVersion = "fsmbt-lebt 1.0";
+
+/// Every load-time problem of an LEBT: unknown leaves, bad ports, missing action callbacks.
+class LebtError : public std::runtime_error
+{
+public:
+  using std::runtime_error::runtime_error;
+};
+
+// -- the escaping of fsmbt.semantics.lebt_spec: names with ';', '/' or '\' carry a backslash --
+namespace detail {
+
+/// Split `text` on unescaped `sep`; the parts keep their escapes.
+inline std::vector<std::string> splitKeepingEscapes(std::string_view text, char sep)
+{
+  std::vector<std::string> parts;
+  std::string current;
+  bool escaped = false;
+  for(char ch : text)
+  {
+    if(escaped)
+    {
+      current.push_back('\\');
+      current.push_back(ch);
+      escaped = false;
+    }
+    else if(ch == '\\')
+    {
+      escaped = true;
+    }
+    else if(ch == sep)
+    {
+      parts.push_back(std::move(current));
+      current.clear();
+    }
+    else
+    {
+      current.push_back(ch);
+    }
+  }
+  parts.push_back(std::move(current));
+  return parts;
+}
+
+/// Drop the backslash escapes (a trailing lone backslash is dropped, as lebt_spec does).
+inline std::string unescape(std::string_view text)
+{
+  std::string out;
+  out.reserve(text.size());
+  for(std::size_t i = 0; i < text.size(); ++i)
+  {
+    if(text[i] == '\\')
+    {
+      if(i + 1 < text.size())
+      {
+        out.push_back(text[++i]);
+      }
+    }
+    else
+    {
+      out.push_back(text[i]);
+    }
+  }
+  return out;
+}
+
+/// The literal value of an input port as written in the XML ("" when absent). A blackboard
+/// reference ("{key}") is refused: an LEBT's ports are constants fixed by the converter.
+inline std::string literalPort(const BT::NodeConfig& config, const std::string& node_name,
+                               const char* type, const std::string& port)
+{
+  auto it = config.input_ports.find(port);
+  if(it == config.input_ports.end())
+  {
+    return {};
+  }
+  if(BT::TreeNode::isBlackboardPointer(it->second))
+  {
+    throw LebtError(std::string("<") + type + " name=\"" + node_name + "\"> (" + config.path +
+                    "): port '" + port + "' is a blackboard reference '" + it->second +
+                    "'; an LEBT leaf needs the literal value fsmbt wrote");
+  }
+  return it->second;
+}
+
+}  // namespace detail
+
+/// The (source, event) pairs of a guard's `pairs` port; throws std::invalid_argument on an item
+/// that is not `a/b`.
+inline std::vector<std::pair<std::string, std::string>> decodePairs(std::string_view text)
+{
+  std::vector<std::pair<std::string, std::string>> pairs;
+  if(text.empty())
+  {
+    return pairs;
+  }
+  for(const std::string& item : detail::splitKeepingEscapes(text, ';'))
+  {
+    std::vector<std::string> pieces = detail::splitKeepingEscapes(item, '/');
+    if(pieces.size() != 2)
+    {
+      throw std::invalid_argument("malformed pair '" + item + "': expected 'a/b'");
+    }
+    pairs.emplace_back(detail::unescape(pieces[0]), detail::unescape(pieces[1]));
+  }
+  return pairs;
+}
+
+/// The events of a state's `exits` port.
+inline std::vector<std::string> decodeExits(std::string_view text)
+{
+  std::vector<std::string> exits;
+  if(text.empty())
+  {
+    return exits;
+  }
+  for(const std::string& part : detail::splitKeepingEscapes(text, ';'))
+  {
+    exits.push_back(detail::unescape(part));
+  }
+  return exits;
+}
+
+/// User code run when a state is entered: receives the (flat) name of the state entered.
+using ActionCallback = std::function<void(const std::string& state)>;
+
+/// The user's actions, by the action name the tree's `LebtState` leaves carry.
+class ActionRegistry
+{
+public:
+  /// Register `callback` for `action` (replaces an earlier registration of the same name).
+  ActionRegistry& add(const std::string& action, ActionCallback callback)
+  {
+    callbacks_[action] = std::move(callback);
+    return *this;
+  }
+
+  /// Run `callback` for every action that has no callback of its own (a logger, a test
+  /// recorder). Without it, an unregistered action is a load-time error.
+  ActionRegistry& addFallback(ActionCallback callback)
+  {
+    fallback_ = std::move(callback);
+    return *this;
+  }
+
+  /// The callback that runs for `action`, or nullptr.
+  const ActionCallback* find(const std::string& action) const
+  {
+    auto it = callbacks_.find(action);
+    if(it != callbacks_.end())
+    {
+      return &it->second;
+    }
+    return fallback_ ? &fallback_ : nullptr;
+  }
+
+private:
+  std::unordered_map<std::string, ActionCallback> callbacks_;
+  ActionCallback fallback_;
+};
+
+/// What the leaves share (docs/semantics.md section 5's blackboard) and what a step reports.
+struct Context
+{
+  std::string state;                     ///< the current flat state (or the start pseudo-state)
+  std::string event;                     ///< the pending event, "" = none
+  std::vector<std::string> actions_run;  ///< action names run since the step began, in order
+  const ActionRegistry* registry = nullptr;
+  std::uint64_t leaf_ticks = 0;          ///< LEBT leaf ticks so far (a cost counter)
+};
+
+/// `LebtGuard`: FAILURE when (state, event) is one of its pairs, else SUCCESS.
+class LebtGuard : public BT::ConditionNode
+{
+public:
+  LebtGuard(const std::string& name, const BT::NodeConfig& config, Context* context)
+    : BT::ConditionNode(name, config), context_(context)
+  {
+    target_ = detail::literalPort(config, name, kGuardType, "target");
+    const std::string raw = detail::literalPort(config, name, kGuardType, "pairs");
+    try
+    {
+      for(auto& [source, event] : decodePairs(raw))
+      {
+        sources_by_event_[event].insert(source);
+        pairs_.emplace_back(std::move(source), std::move(event));
+      }
+    }
+    catch(const std::invalid_argument& exc)
+    {
+      throw LebtError(std::string("<LebtGuard name=\"") + name + "\"> (" + config.path +
+                      "): " + exc.what());
+    }
+  }
+
+  static BT::PortsList providedPorts()
+  {
+    return { BT::InputPort<std::string>("target", "the state this guard enters"),
+             BT::InputPort<std::string>("pairs", "source/event pairs entering the target") };
+  }
+
+  /// True when the guard's transition fires for (state, event).
+  bool matches(const std::string& state, const std::string& event) const
+  {
+    auto it = sources_by_event_.find(event);
+    return it != sources_by_event_.end() && it->second.count(state) != 0;
+  }
+
+  const std::string& target() const { return target_; }
+  const std::vector<std::pair<std::string, std::string>>& pairs() const { return pairs_; }
+
+protected:
+  BT::NodeStatus tick() override
+  {
+    ++context_->leaf_ticks;
+    return matches(context_->state, context_->event) ? BT::NodeStatus::FAILURE :
+                                                       BT::NodeStatus::SUCCESS;
+  }
+
+private:
+  Context* context_;
+  std::string target_;
+  std::vector<std::pair<std::string, std::string>> pairs_;
+  std::unordered_map<std::string, std::unordered_set<std::string>> sources_by_event_;
+};
+
+/// `LebtState`: enters its state on the first tick, then watches the pending event.
+class LebtState : public BT::StatefulActionNode
+{
+public:
+  LebtState(const std::string& name, const BT::NodeConfig& config, Context* context)
+    : BT::StatefulActionNode(name, config), context_(context)
+  {
+    state_ = detail::literalPort(config, name, kStateType, "state");
+    action_ = detail::literalPort(config, name, kStateType, "action");
+    const std::string final_text = detail::literalPort(config, name, kStateType, "final");
+    if(final_text == "true" || final_text == "True" || final_text == "TRUE")
+    {
+      final_ = true;
+    }
+    else if(!final_text.empty() && final_text != "false" && final_text != "False" &&
+            final_text != "FALSE")
+    {
+      throw LebtError(std::string("<LebtState name=\"") + name + "\"> (" + config.path +
+                      "): port 'final' is '" + final_text + "', expected true or false");
+    }
+    for(std::string& exit : decodeExits(detail::literalPort(config, name, kStateType, "exits")))
+    {
+      exits_.insert(std::move(exit));
+    }
+  }
+
+  static BT::PortsList providedPorts()
+  {
+    return { BT::InputPort<std::string>("state", "the FSM state"),
+             BT::InputPort<std::string>("action", "the state's action (empty = none)"),
+             BT::InputPort<std::string>("final", "true when the state is final"),
+             BT::InputPort<std::string>("exits", "events leaving the state, ';'-separated") };
+  }
+
+  const std::string& stateName() const { return state_; }
+  const std::string& actionName() const { return action_; }
+  bool isFinal() const { return final_; }
+
+  /// Bind the user's callback (done by LebtRunner at load time; nullptr = no action).
+  void bind(const ActionCallback* callback) { callback_ = callback; }
+
+protected:
+  BT::NodeStatus onStart() override
+  {
+    ++context_->leaf_ticks;
+    if(!action_.empty())
+    {
+      context_->actions_run.push_back(action_);
+      if(callback_ != nullptr)
+      {
+        (*callback_)(state_);
+      }
+    }
+    context_->state = state_;
+    context_->event.clear();
+    return final_ ? BT::NodeStatus::SUCCESS : BT::NodeStatus::RUNNING;
+  }
+
+  BT::NodeStatus onRunning() override
+  {
+    ++context_->leaf_ticks;
+    if(!context_->event.empty())
+    {
+      if(exits_.count(context_->event) != 0)
+      {
+        return BT::NodeStatus::SUCCESS;
+      }
+      context_->event.clear();
+    }
+    return BT::NodeStatus::RUNNING;
+  }
+
+  void onHalted() override {}
+
+private:
+  Context* context_;
+  std::string state_;
+  std::string action_;
+  bool final_ = false;
+  std::unordered_set<std::string> exits_;
+  const ActionCallback* callback_ = nullptr;
+};
+
+/// Register `LebtGuard` and `LebtState` in `factory`; their leaves share `context`, which must
+/// outlive every tree the factory creates. LebtRunner calls this; call it yourself to mix LEBT
+/// leaves with your own nodes in one factory.
+inline void registerLebtNodes(BT::BehaviorTreeFactory& factory, Context& context)
+{
+  factory.registerNodeType<LebtGuard>(kGuardType, &context);
+  factory.registerNodeType<LebtState>(kStateType, &context);
+}
+
+/// What one macro step (or the start) did.
+struct StepResult
+{
+  std::vector<std::string> actions;  ///< action names run, in order (entries only)
+  bool terminated = false;           ///< the FSM reached a final state
+  std::string state;                 ///< the current state after the step
+};
+
+/// Node types that never emit a wake-up signal in BehaviorTree.CPP 4.8 (checked in its
+/// sources: the asynchronous controls, Repeat, Retry, Delay, Timeout, Sleep and threaded actions
+/// do): for a tree made of these only, tickOnce() and tickExactlyOnce() are the same.
+inline const std::unordered_set<std::string>& neverWakeUp()
+{
+  static const std::unordered_set<std::string> types = {
+    kGuardType,  kStateType,      "Sequence",      "Fallback",     "ReactiveSequence",
+    "ReactiveFallback", "SubTree", "Inverter",     "ForceSuccess", "ForceFailure",
+    "AlwaysSuccess", "AlwaysFailure"
+  };
+  return types;
+}
+
+/// How LebtRunner ticks the root.
+enum class TickMode
+{
+  Auto,         ///< tickExactlyOnce() when every node is in neverWakeUp(), else tickOnce()
+  Once,         ///< always tickOnce() (docs/semantics.md's macro step, literally)
+  ExactlyOnce,  ///< always tickExactlyOnce()
+};
+
+/// Options of LebtRunner.
+struct Options
+{
+  TickMode tick = TickMode::Auto;
+
+  /// The start pseudo-state; default: the one guard source that is not a state, else
+  /// "__start__" (docs/semantics.md section 5).
+  std::optional<std::string> start;
+};
+
+/// Loads an LEBT and runs it macro step by macro step (docs/semantics.md section 5).
+class LebtRunner
+{
+public:
+  /// Load the tree from XML text. Throws LebtError on an unknown leaf (naming it and its line),
+  /// a malformed LEBT port, or an action without a callback in `actions`.
+  LebtRunner(const std::string& xml_text, ActionRegistry actions, Options options = {})
+    : registry_(std::make_unique<ActionRegistry>(std::move(actions)))
+    , context_(std::make_unique<Context>())
+    , factory_(std::make_unique<BT::BehaviorTreeFactory>())
+  {
+    context_->registry = registry_.get();
+    registerLebtNodes(*factory_, *context_);
+    try
+    {
+      tree_ = factory_->createTreeFromText(xml_text);
+    }
+    catch(const LebtError&)
+    {
+      throw;
+    }
+    catch(const std::exception& exc)
+    {
+      std::string text = std::string("cannot load the behavior tree: ") + exc.what();
+      if(text.find("XML_ELEMENT_DEPTH_EXCEEDED") != std::string::npos)
+      {
+        text += " (BehaviorTree.CPP's XML parser, tinyxml2, nests at most 500 elements: an LEBT "
+                "whose chain of states is longer than about 245 cannot be loaded)";
+      }
+      throw LebtError(text);
+    }
+    collectLeaves(xml_text);
+    start_ = options.start ? *options.start : inferStart();
+    for(const LebtGuard* guard : guards_)
+    {
+      for(const auto& [source, event] : guard->pairs())
+      {
+        if(source == start_ && event.empty())
+        {
+          init_on_start_ = true;
+        }
+      }
+    }
+    context_->state = start_;
+    exactly_once_ = options.tick == TickMode::ExactlyOnce ||
+                    (options.tick == TickMode::Auto && never_wakes_up_);
+  }
+
+  /// Load the tree from an XML file (LebtError when it cannot be read).
+  static LebtRunner fromFile(const std::string& path, ActionRegistry actions,
+                             Options options = {})
+  {
+    std::ifstream in(path, std::ios::binary);
+    if(!in)
+    {
+      throw LebtError("cannot read the behavior tree file '" + path + "'");
+    }
+    std::ostringstream text;
+    text << in.rdbuf();
+    return LebtRunner(text.str(), std::move(actions), std::move(options));
+  }
+
+  LebtRunner(LebtRunner&&) = default;
+  LebtRunner& operator=(LebtRunner&&) = default;
+
+  /// Before any event: ticks once with no event when the FSM has no initial event (its initial
+  /// state's action runs), else nothing. Call once after loading and after reset().
+  StepResult start()
+  {
+    if(started_)
+    {
+      throw LebtError("LebtRunner::start() called twice without reset()");
+    }
+    started_ = true;
+    context_->actions_run.clear();
+    if(init_on_start_)
+    {
+      tick();
+    }
+    return result();
+  }
+
+  /// One macro step for `event` (docs/semantics.md section 5).
+  StepResult post(const std::string& event)
+  {
+    if(!started_)
+    {
+      throw LebtError("LebtRunner::post() before start()");
+    }
+    if(event.empty())
+    {
+      throw LebtError("LebtRunner::post(): an event name cannot be empty");
+    }
+    context_->actions_run.clear();
+    context_->event = event;
+    BT::NodeStatus status = tick();
+    if(status == BT::NodeStatus::SUCCESS && !context_->event.empty())
+    {
+      tick();
+    }
+    context_->event.clear();
+    return result();
+  }
+
+  /// Back to before start(): the tree is halted, `state` is the start pseudo-state again.
+  void reset()
+  {
+    tree_.haltTree();
+    context_->state = start_;
+    context_->event.clear();
+    context_->actions_run.clear();
+    last_ = BT::NodeStatus::IDLE;
+    started_ = false;
+  }
+
+  /// Root SUCCESS and the start pseudo-state left: the FSM is in a final state.
+  bool terminated() const
+  {
+    return last_ == BT::NodeStatus::SUCCESS && context_->state != start_;
+  }
+
+  const std::string& state() const { return context_->state; }
+  const std::string& startState() const { return start_; }
+  /// True when the root is ticked with tickExactlyOnce() (see TickMode).
+  bool ticksExactlyOnce() const { return exactly_once_; }
+  /// The status of the last root tick (IDLE before any).
+  BT::NodeStatus lastRootStatus() const { return last_; }
+  BT::Tree& tree() { return tree_; }
+  /// LEBT leaf ticks since loading (guards and states; a cost counter for benchmarks).
+  std::uint64_t leafTicks() const { return context_->leaf_ticks; }
+
+  /// Every LebtGuard / LebtState of the tree (SubTree instances included).
+  const std::vector<const LebtGuard*>& guards() const { return guards_; }
+  const std::vector<const LebtState*>& states() const { return state_leaves_; }
+
+  /// The distinct non-empty action names the tree's states run.
+  std::vector<std::string> actionNames() const
+  {
+    std::set<std::string> names;
+    for(const LebtState* leaf : state_leaves_)
+    {
+      if(!leaf->actionName().empty())
+      {
+        names.insert(leaf->actionName());
+      }
+    }
+    return { names.begin(), names.end() };
+  }
+
+private:
+  BT::NodeStatus tick()
+  {
+    last_ = exactly_once_ ? tree_.tickExactlyOnce() : tree_.tickOnce();
+    return last_;
+  }
+
+  StepResult result() const
+  {
+    return StepResult{ context_->actions_run, terminated(), context_->state };
+  }
+
+  /// 1-based line of the element `<tag ...>` in `text` (0 when not found): the first one whose
+  /// attributes hold name="`name`", else the first `<tag` at all.
+  static int lineOf(const std::string& text, const std::string& tag, const std::string& name)
+  {
+    const std::string open = "<" + tag;
+    const std::string named = "name=\"" + name + "\"";
+    std::size_t first = std::string::npos;
+    for(std::size_t at = text.find(open); at != std::string::npos; at = text.find(open, at + 1))
+    {
+      const std::size_t after = at + open.size();
+      if(after < text.size() && std::string(" \t\r\n/>").find(text[after]) == std::string::npos)
+      {
+        continue;  // a longer tag name (<SleepLong> for <Sleep>)
+      }
+      if(first == std::string::npos)
+      {
+        first = at;
+      }
+      const std::size_t end = text.find('>', after);
+      if(text.substr(after, end == std::string::npos ? std::string::npos : end - after)
+             .find(named) != std::string::npos)
+      {
+        first = at;
+        break;
+      }
+    }
+    if(first == std::string::npos)
+    {
+      return 0;
+    }
+    return 1 + static_cast<int>(std::count(text.begin(),
+                                           text.begin() + static_cast<std::ptrdiff_t>(first), '\n'));
+  }
+
+  void collectLeaves(const std::string& xml_text)
+  {
+    std::map<std::string, std::vector<std::string>> missing;  // action -> states
+    for(const auto& subtree : tree_.subtrees)
+    {
+      for(const BT::TreeNode::Ptr& node : subtree->nodes)
+      {
+        const BT::NodeType type = node->type();
+        const std::string& id = node->registrationName();
+        never_wakes_up_ = never_wakes_up_ && neverWakeUp().count(id) != 0;
+        if((type == BT::NodeType::ACTION || type == BT::NodeType::CONDITION) &&
+           id != kGuardType && id != kStateType && id != "AlwaysSuccess" &&
+           id != "AlwaysFailure")
+        {
+          const int line = lineOf(xml_text, id, node->name());
+          throw LebtError("leaf <" + id + " name=\"" + node->name() + "\"> (" +
+                          node->fullPath() + (line > 0 ? ", line " + std::to_string(line) : "") +
+                          ") is not an LEBT leaf: this runtime runs only LebtGuard and "
+                          "LebtState leaves");
+        }
+        if(auto* guard = dynamic_cast<LebtGuard*>(node.get()))
+        {
+          guards_.push_back(guard);
+        }
+        else if(auto* leaf = dynamic_cast<LebtState*>(node.get()))
+        {
+          state_leaves_.push_back(leaf);
+          if(leaf->actionName().empty())
+          {
+            continue;
+          }
+          const ActionCallback* callback = registry_->find(leaf->actionName());
+          if(callback == nullptr)
+          {
+            missing[leaf->actionName()].push_back(leaf->stateName());
+          }
+          leaf->bind(callback);
+        }
+      }
+    }
+    if(!missing.empty())
+    {
+      std::string text = "no callback registered for action(s): ";
+      bool first = true;
+      for(const auto& [action, states] : missing)
+      {
+        text += (first ? "'" : ", '") + action + "' (state " + states.front() +
+                (states.size() > 1 ? " and " + std::to_string(states.size() - 1) + " more" : "") +
+                ")";
+        first = false;
+      }
+      throw LebtError(text + "; register each with ActionRegistry::add (or addFallback)");
+    }
+    if(state_leaves_.empty())
+    {
+      throw LebtError("the tree has no LebtState leaf: it is not an LEBT written by fsmbt");
+    }
+  }
+
+  std::string inferStart() const
+  {
+    std::unordered_set<std::string> names;
+    for(const LebtState* leaf : state_leaves_)
+    {
+      names.insert(leaf->stateName());
+    }
+    std::set<std::string> sources;
+    for(const LebtGuard* guard : guards_)
+    {
+      for(const auto& pair : guard->pairs())
+      {
+        if(names.count(pair.first) == 0)
+        {
+          sources.insert(pair.first);
+        }
+      }
+    }
+    return sources.size() == 1 ? *sources.begin() : std::string(kDefaultStart);
+  }
+
+  std::unique_ptr<ActionRegistry> registry_;
+  std::unique_ptr<Context> context_;
+  std::unique_ptr<BT::BehaviorTreeFactory> factory_;
+  BT::Tree tree_;
+  std::vector<const LebtGuard*> guards_;
+  std::vector<const LebtState*> state_leaves_;
+  std::string start_;
+  bool init_on_start_ = false;
+  bool never_wakes_up_ = true;
+  bool exactly_once_ = false;
+  bool started_ = false;
+  BT::NodeStatus last_ = BT::NodeStatus::IDLE;
+};
+
+}  // namespace lebt
+}  // namespace fsmbt
