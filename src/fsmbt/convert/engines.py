@@ -57,10 +57,13 @@ def _register_rules() -> None:
                     "the paper's algorithms done exactly (LEBT; depth compression + units)")
 
 
-def _load_plugins() -> None:
+def _load_plugins(until: str | None = None) -> None:
+    """Import the plug-in modules in order (all of them, or until ``until`` is registered)."""
     if "rules" not in _ENGINES:
         _register_rules()
     for module in _PLUGIN_MODULES:
+        if until is not None and until in _ENGINES:
+            return
         try:
             importlib.import_module(module)
         except ModuleNotFoundError as exc:
@@ -75,7 +78,19 @@ def engines() -> dict[str, Engine]:
 
 
 def get_engine(name: str) -> Engine:
-    _load_plugins()
+    """The engine registered under ``name``.
+
+    The plug-in modules (baselines, LLM engines) are imported only when ``name`` is not
+    registered yet: ``rules`` needs none of them, and the LLM engine's client library alone
+    costs about half a second to import.
+
+    Raises:
+        InputError: no engine has that name (the known ones are listed).
+    """
+    if "rules" not in _ENGINES:
+        _register_rules()
+    if name not in _ENGINES:
+        _load_plugins(until=name)
     try:
         return _ENGINES[name]
     except KeyError:

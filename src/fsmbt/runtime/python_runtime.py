@@ -263,12 +263,10 @@ _EXAMPLE_FSM = """\
 
 
 def _example_tree() -> str:
-    """The example FSM converted as ``fsmbt convert`` does (the rules engine)."""
-    from fsmbt.convert.engines import converter_for
-    from fsmbt.formats import dumps
+    """The example FSM converted as ``fsmbt convert`` does (the library pipeline, rules)."""
+    from fsmbt import api
 
-    fsm = loads(_EXAMPLE_FSM, "scxml")
-    return dumps(converter_for("rules", fsm)(fsm).model, "btcpp")
+    return api.convert_loaded(api.load_text(_EXAMPLE_FSM, "scxml"), to="btcpp").text
 
 
 _EXAMPLE_SCRIPT_TEXT = '''\
