@@ -47,7 +47,7 @@ class _Refused(Exception):
 
 
 try:  # libyaml's parser when PyYAML was built with it (the pinned wheels are)
-    from yaml.cyaml import CParser as _Parser  # PyYAML's public name for libyaml's parser
+    from yaml.cyaml import CParser as _Parser  # type: ignore[attr-defined]  # public, unstubbed
 except ImportError:  # pragma: no cover - pure-Python fallback
     _Parser = yaml.parser.Parser  # type: ignore[assignment,misc]
 

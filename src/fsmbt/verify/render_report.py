@@ -75,7 +75,8 @@ def _stats_line(stats: dict[str, object]) -> str:
     shown = [f"{k.replace('_', ' ')} {stats[k]}" for k in keys if k in stats]
     nusmv = stats.get("nusmv")
     if isinstance(nusmv, dict) and "seconds" in nusmv:  # --engine both: each engine's time
-        shown.append(f"native {float(stats.get('seconds', 0.0)):.3f} s")
+        native_seconds = stats.get("seconds", 0.0)
+        shown.append(f"native {float(native_seconds) if isinstance(native_seconds, (int, float)) else 0.0:.3f} s")
         shown.append(f"NuSMV {float(nusmv['seconds']):.3f} s")
     elif "seconds" in stats:
         shown.append(f"{stats['seconds']:.3f} s")

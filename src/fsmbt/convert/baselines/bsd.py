@@ -57,7 +57,7 @@ def fsm_to_bsd(fsm: FSM, **_options: object) -> ConversionResult:
     flat, reachable, warnings = prepare_fsm(fsm)
     root = control("ReactiveFallback", "BSD", [])
     start = flat.start_name or "__start__"
-    if flat.initial_event is not None:
+    if flat.initial_event is not None and flat.initial is not None:
         root.children.append(control("ReactiveSequence", f"{start}_subtree", [
             leaf_node(sv.IS_STATE, f"Is_{start}", state=start, initial="true"),
             leaf_node(sv.TRANSITION, f"{start}_transitions", state=start,

@@ -65,7 +65,7 @@ def fsm_to_chds(fsm: FSM, **_options: object) -> ConversionResult:
     root = control("ReactiveFallback", "CHDS", [])
     switches: list[BTNode] = []
     start = flat.start_name or "__start__"
-    if flat.initial_event is not None:
+    if flat.initial_event is not None and flat.initial is not None:
         switches.append(_switch(start, flat.initial_event, flat.initial, initial=True))
     for name in reachable:
         for event, target in exits_of(flat, name):

@@ -12,6 +12,7 @@ from fsmbt.model.errors import InputError, UnsupportedError
 from fsmbt.model.flatten import flatten, needs_flattening
 from fsmbt.model.fsm import FSM
 from fsmbt.semantics import state_variable_runtime as sv
+from fsmbt.semantics.lebt.spec import NO_EVENT
 from fsmbt.semantics.nodes import (
     PLAIN_CONTROLS,
     REACTIVE_CONTROLS,
@@ -60,7 +61,7 @@ def prepare_fsm(fsm: FSM) -> tuple[FSM, list[str], list[str]]:
         for event, t in table.get(name, {}).items():
             if event is None:
                 raise InputError("eventless transition in a flat FSM", element=name)
-            if event == sv.NO_EVENT:
+            if event == NO_EVENT:
                 raise UnsupportedError("an empty event name cannot be told from 'no event'",
                                        element=name)
             if t.target not in flat.states:

@@ -20,7 +20,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
-import behaviortreepy as btpy  # type: ignore[import-untyped]  # no stubs shipped
+import behaviortreepy as btpy  # no stubs shipped (ignore_missing_imports in pyproject)
 from lxml import etree
 
 from fsmbt.model.bt import BTDocument

@@ -147,4 +147,5 @@ class FSMEncoder:
     def status_of(self, values: dict[str, str]) -> str:
         name = self.states.to_name.get(values.get("q", ""))
         final = name in self.fsm.states and self.fsm.states[name].final
-        return (MachineStatus.FINAL if final else MachineStatus.RUNNING).value
+        status: MachineStatus = MachineStatus.FINAL if final else MachineStatus.RUNNING
+        return str(status.value)

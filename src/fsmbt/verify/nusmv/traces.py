@@ -139,4 +139,5 @@ def _name(model: FSM | BTDocument) -> str:
 def _status(values: dict[str, str]) -> str:
     """The machine status of a trace state (its ``final`` define), as the native checker says."""
     final = values.get("final") == "TRUE"
-    return (MachineStatus.FINAL if final else MachineStatus.RUNNING).value
+    status: MachineStatus = MachineStatus.FINAL if final else MachineStatus.RUNNING
+    return str(status.value)
