@@ -114,17 +114,13 @@ def register(app: typer.Typer) -> None:
         as_json: bool = typer.Option(False, "--json", help="Print the messages as JSON."),
     ) -> None:
         """Print the messages a conversion of INPUT would send, and their token count."""
-        from fsmbt.formats import read_model
-        from fsmbt.llm.pipeline import direction_for
-        from fsmbt.llm.prompts import PromptOptions, conversion_messages
+        from fsmbt import api
+        from fsmbt.llm.prompts import messages_for
         from fsmbt.llm.tokens import count_messages
-        from fsmbt.model.flatten import flatten
-        from fsmbt.model.fsm import FSM
 
-        model = read_model(input_path, from_format)
+        model = api.load(input_path, from_format).model
         modules = frozenset(m.strip() for m in (ablate or "").split(",") if m.strip())
-        options = PromptOptions(direction_for(model), scp=not nllm, disabled_modules=modules)
-        messages = conversion_messages(flatten(model) if isinstance(model, FSM) else model, options)
+        options, messages = messages_for(model, scp=not nllm, disabled_modules=modules)
         if as_json:
             print(json.dumps(messages, indent=2, ensure_ascii=False))
         else:
@@ -138,18 +134,13 @@ def register(app: typer.Typer) -> None:
         from_format: Optional[str] = typer.Option(None, "--from", help="Input format (default: detected)."),
     ) -> None:
         """Prompt tokens of the llm and nllm requests for each model (tiktoken cl100k_base)."""
-        from fsmbt.formats import read_model
+        from fsmbt import api
+        from fsmbt.llm.prompts import messages_for
         from fsmbt.llm.tokens import count_messages
-        from fsmbt.llm.pipeline import direction_for
-        from fsmbt.llm.prompts import PromptOptions, conversion_messages
-        from fsmbt.model.flatten import flatten
-        from fsmbt.model.fsm import FSM
 
         print("input\tdirection\tllm_prompt_tokens\tnllm_prompt_tokens")
         for path in inputs:
-            model = read_model(path, from_format)
-            shown = flatten(model) if isinstance(model, FSM) else model
-            direction = direction_for(model)
-            counts = [count_messages(conversion_messages(shown, PromptOptions(direction, scp=scp)))
-                      for scp in (True, False)]
-            print(f"{path}\t{direction}\t{counts[0]}\t{counts[1]}")
+            model = api.load(path, from_format).model
+            prompts = [messages_for(model, scp=scp) for scp in (True, False)]
+            counts = [count_messages(messages) for _options, messages in prompts]
+            print(f"{path}\t{prompts[0][0].direction}\t{counts[0]}\t{counts[1]}")

@@ -125,6 +125,28 @@ def conversion_messages(model: FSM | BTDocument, options: PromptOptions) -> list
             {"role": "user", "content": "\n\n".join(user_parts)}]
 
 
+def messages_for(model: FSM | BTDocument, *, scp: bool = True,
+                 disabled_modules: frozenset[str] = frozenset()) -> tuple[PromptOptions, list[Message]]:
+    """The exact messages a conversion of ``model`` sends (what ``fsmbt llm prompt`` shows).
+
+    An FSM is shown flat (hierarchy flattened first), as the conversion engines send it.
+
+    Args:
+        model: the source model; its kind gives the direction.
+        scp: the structured prompt (``llm``); ``False`` is the baseline prompt (``nllm``).
+        disabled_modules: SCP modules dropped for an ablation.
+
+    Returns:
+        The prompt options used and the messages.
+    """
+    from fsmbt.model.flatten import flatten
+
+    direction = FSM_TO_BT if isinstance(model, FSM) else BT_TO_FSM
+    options = PromptOptions(direction, scp=scp, disabled_modules=disabled_modules)
+    shown = flatten(model) if isinstance(model, FSM) else model
+    return options, conversion_messages(shown, options)
+
+
 def feedback_message(problems: list[str], counterexample: str | None, output_format: str,
                      version: int = DEFAULT_VERSION) -> Message:
     """The user message that sends the concrete errors (and a counterexample) back."""
