@@ -29,6 +29,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
+from fsmbt.cache import cache_root
 from fsmbt.model.errors import FsmbtError
 
 BTCPP_VERSION = "4.8.2"
@@ -60,15 +61,6 @@ def build_script() -> Path | None:
     """``scripts/build_btcpp.sh`` of the checkout, or ``None`` for an installed package."""
     root = _repo_root()
     return None if root is None else root / "scripts" / "build_btcpp.sh"
-
-
-def cache_root() -> Path:
-    """``$FSMBT_CACHE``, else ``$XDG_CACHE_HOME/fsmbt``, else ``~/.cache/fsmbt``."""
-    explicit = os.environ.get("FSMBT_CACHE")
-    if explicit:
-        return Path(explicit)
-    xdg = os.environ.get("XDG_CACHE_HOME")
-    return (Path(xdg) if xdg else Path.home() / ".cache") / "fsmbt"
 
 
 def library_prefix() -> Path:

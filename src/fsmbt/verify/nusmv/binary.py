@@ -14,6 +14,7 @@ import subprocess
 from functools import lru_cache
 from pathlib import Path
 
+from fsmbt.cache import cache_root
 from fsmbt.model.errors import FsmbtError
 
 ENV_VAR = "FSMBT_NUSMV"
@@ -21,15 +22,6 @@ _REPO_ROOT = Path(__file__).resolve().parents[4]
 BUILD_SCRIPT = _REPO_ROOT / "scripts" / "build_nusmv.sh"
 NUSMV_VERSION = "2.5.4"
 LEGACY_BINARY = _REPO_ROOT / ".cache" / "nusmv" / "bin" / "NuSMV"
-
-
-def cache_root() -> Path:
-    """``$FSMBT_CACHE``, else ``$XDG_CACHE_HOME/fsmbt``, else ``~/.cache/fsmbt``."""
-    explicit = os.environ.get("FSMBT_CACHE")
-    if explicit:
-        return Path(explicit)
-    xdg = os.environ.get("XDG_CACHE_HOME")
-    return (Path(xdg) if xdg else Path.home() / ".cache") / "fsmbt"
 
 
 def cached_binary() -> Path:

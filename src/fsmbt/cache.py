@@ -1,0 +1,21 @@
+"""Where fsmbt keeps what it builds once per machine (NuSMV, BehaviorTree.CPP, the C++ driver).
+
+Why outside the checkout: a clean checkout (CI, a fresh clone) must not rebuild a 4-minute
+NuSMV or a 7-minute BehaviorTree.CPP; each build lands in a folder keyed by its version under
+this root, and the build scripts (scripts/build_nusmv.sh, scripts/build_btcpp.sh) use the same
+rule.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+
+def cache_root() -> Path:
+    """``$FSMBT_CACHE``, else ``$XDG_CACHE_HOME/fsmbt``, else ``~/.cache/fsmbt``."""
+    explicit = os.environ.get("FSMBT_CACHE")
+    if explicit:
+        return Path(explicit)
+    xdg = os.environ.get("XDG_CACHE_HOME")
+    return (Path(xdg) if xdg else Path.home() / ".cache") / "fsmbt"
