@@ -21,7 +21,7 @@ import multiprocessing
 import os
 import signal
 from collections.abc import Callable
-from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures import Future, ProcessPoolExecutor
 from concurrent.futures.process import BrokenProcessPool
 from typing import Any
 
@@ -42,6 +42,11 @@ class WorkerCrashed(Exception):
 def _initialise(seconds: float) -> None:
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # the server handles Ctrl-C
     limits.use(limits.current().with_changes(checker_max_seconds=seconds))
+
+
+def _warm() -> None:
+    """Import what the calls need, so the first request's time limit counts work only."""
+    import fsmbt.web.service  # noqa: F401
 
 
 def _call(function: Callable[[Any], Any], argument: Any) -> tuple[str, Any]:
@@ -71,12 +76,15 @@ class Workers:
     def __init__(self, count: int, seconds: float) -> None:
         self.count = max(1, count)
         self.seconds = seconds
-        self._pool = self._new_pool()
+        self._pool, self._warming = self._new_pool()
 
-    def _new_pool(self) -> ProcessPoolExecutor:
-        return ProcessPoolExecutor(max_workers=self.count,
+    def _new_pool(self) -> tuple[ProcessPoolExecutor, list[Future[None]]]:
+        """A pool whose processes are started and have imported the service (one warm-up
+        call per process, submitted at once)."""
+        pool = ProcessPoolExecutor(max_workers=self.count,
                                    mp_context=multiprocessing.get_context("spawn"),
                                    initializer=_initialise, initargs=(self.seconds,))
+        return pool, [pool.submit(_warm) for _ in range(self.count)]
 
     async def run(self, function: Callable[[Any], Any], argument: Any) -> tuple[str, Any]:
         """Run ``function(argument)`` in a worker.
@@ -91,6 +99,8 @@ class Workers:
         pool = self._pool
         loop = asyncio.get_running_loop()
         try:
+            # start-up is not the request's time: wait for the processes to be ready first
+            await asyncio.gather(*(asyncio.wrap_future(f) for f in self._warming))
             future = loop.run_in_executor(pool, _call, function, argument)
             status, value = await asyncio.wait_for(future, timeout=self.seconds)
         except TimeoutError:
@@ -107,7 +117,7 @@ class Workers:
     def _replace(self, pool: ProcessPoolExecutor) -> None:
         if pool is not self._pool:
             return  # another request already replaced it
-        self._pool = self._new_pool()
+        self._pool, self._warming = self._new_pool()
         processes = list(getattr(pool, "_processes", {}).values())
         pool.shutdown(wait=False, cancel_futures=True)
         for process in processes:

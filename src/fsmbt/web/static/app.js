@@ -156,8 +156,10 @@ function mountSvg(box, svgText, error) {
 
 function role(root, name) { return root.querySelector(`[data-role="${name}"]`); }
 
+// [key, label, the model kind it applies to (both when absent)]
 const METRIC_ROWS = [["graphical", "graphical elements"], ["active", "active elements"], ["depth", "depth"],
-  ["states", "states"], ["transitions", "transitions"], ["sub_fsms", "sub-FSMs"], ["nodes", "nodes"], ["leaves", "leaves"]];
+  ["states", "states", "fsm"], ["transitions", "transitions", "fsm"], ["sub_fsms", "sub-FSMs", "fsm"],
+  ["nodes", "nodes", "bt"], ["leaves", "leaves", "bt"]];
 
 function fillTables(root, data, leftMetrics, rightMetrics) {
   const props = role(root, "properties");
@@ -167,11 +169,11 @@ function fillTables(root, data, leftMetrics, rightMetrics) {
     props.append(row);
   }
   const metrics = role(root, "metrics");
-  for (const [key, label] of METRIC_ROWS) {
-    const a = leftMetrics[key], b = rightMetrics[key];
-    if (!a && !b) continue;
+  const cell = (m, key, kind) => (kind && m.kind !== kind ? "—" : String(m[key] ?? ""));
+  for (const [key, label, kind] of METRIC_ROWS) {
+    if (kind && leftMetrics.kind !== kind && rightMetrics.kind !== kind) continue;
     const row = el("tr", { "data-metric": key });
-    row.append(el("td", {}, label), el("td", {}, String(a ?? "")), el("td", {}, String(b ?? "")));
+    row.append(el("td", {}, label), el("td", {}, cell(leftMetrics, key, kind)), el("td", {}, cell(rightMetrics, key, kind)));
     metrics.append(row);
   }
   const warnings = role(root, "warnings");
