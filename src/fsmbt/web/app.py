@@ -37,7 +37,7 @@ from fsmbt.model.errors import FsmbtError
 from fsmbt.web import service
 from fsmbt.web.schemas import ConvertRequest, ExportRequest, ModelText, VerifyRequest
 from fsmbt.web.settings import WebSettings
-from fsmbt.web.workers import WorkerCrashed, Workers, WorkTimeout
+from fsmbt.web.workers import Busy, WorkerCrashed, Workers, WorkTimeout
 
 LOG = logging.getLogger("fsmbt.web")
 HERE = Path(__file__).parent
@@ -156,6 +156,9 @@ def create_app(settings: WebSettings | None = None) -> FastAPI:
             raise ApiError(503, f"took longer than {settings.timeout_s:g} s, the page's limit; "
                                 "the model is too large for the page: use the command line "
                                 "(fsmbt convert / fsmbt verify)") from None
+        except Busy:
+            raise ApiError(503, "the server is busy (too many requests waiting); try again "
+                                "shortly") from None
         except WorkerCrashed:
             raise ApiError(500, "internal error (logged on the server)") from None
         if status == "error":

@@ -2,7 +2,10 @@
 
 Why processes: a conversion is CPU-bound Python; in a thread it would hold the interpreter and a
 too-large model could not be stopped. A ``ProcessPoolExecutor`` of ``workers`` processes runs
-the ``fsmbt.web.service`` functions; each call has a wall-time limit. Past it the request gets a
+the ``fsmbt.web.service`` functions. Calls wait (in the server's event loop, costing nothing) for
+a free process, at most ``max_waiting`` of them (beyond: 503 "busy" at once), and each call's
+wall-time limit starts when a process takes it, so a burst of requests queues instead of
+timing out. Past the limit the request gets a
 clear 503 answer with a hint to use the CLI, and the pool is replaced (its processes killed), so
 the worker is free for the next request instead of grinding on. Each worker also installs the
 checker's own time bound (``fsmbt.limits``, ``checker_max_seconds``) at the same value, so the
@@ -29,10 +32,16 @@ from fsmbt import limits
 from fsmbt.model.errors import FsmbtError, one_line
 
 LOG = logging.getLogger("fsmbt.web")
+#: Calls that may wait for a free worker before new ones are refused (503, "busy").
+DEFAULT_MAX_WAITING = 1000
 
 
 class WorkTimeout(Exception):
     """A call took longer than the per-request limit."""
+
+
+class Busy(Exception):
+    """Too many calls are already waiting for a worker."""
 
 
 class WorkerCrashed(Exception):
@@ -70,13 +79,18 @@ class Workers:
 
     Args:
         count: how many processes.
-        seconds: the wall-time limit of one call.
+        seconds: the wall-time limit of one call, counted from when a process takes it (a call
+            waits for a free process first, so queueing under load is not charged to it).
+        max_waiting: calls allowed to wait for a process; beyond, ``Busy`` at once.
     """
 
-    def __init__(self, count: int, seconds: float) -> None:
+    def __init__(self, count: int, seconds: float, max_waiting: int = DEFAULT_MAX_WAITING) -> None:
         self.count = max(1, count)
         self.seconds = seconds
+        self.max_waiting = max_waiting
         self._pool, self._warming = self._new_pool()
+        self._slots: asyncio.Semaphore | None = None  # made in the server's loop
+        self._waiting = 0
 
     def _new_pool(self) -> tuple[ProcessPoolExecutor, list[Future[None]]]:
         """A pool whose processes are started and have imported the service (one warm-up
@@ -94,8 +108,24 @@ class Workers:
 
         Raises:
             WorkTimeout: past the time limit (the pool has been replaced).
+            Busy: ``max_waiting`` calls are already waiting.
             WorkerCrashed: the function raised something other than an ``FsmbtError``.
         """
+        if self._slots is None:
+            self._slots = asyncio.Semaphore(self.count)
+        if self._waiting >= self.max_waiting:
+            raise Busy()
+        self._waiting += 1
+        try:
+            await self._slots.acquire()
+        finally:
+            self._waiting -= 1
+        try:
+            return await self._run_now(function, argument)
+        finally:
+            self._slots.release()
+
+    async def _run_now(self, function: Callable[[Any], Any], argument: Any) -> tuple[str, Any]:
         pool = self._pool
         loop = asyncio.get_running_loop()
         try:
