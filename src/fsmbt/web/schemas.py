@@ -13,23 +13,23 @@ class ModelText(BaseModel):
     """One model as text."""
 
     text: str = Field(description="the model's text (multipart: the uploaded `file`)")
-    filename: str | None = Field(None, description="a file name, for format detection only")
-    format: str | None = Field(None, description="the format's name; detected when omitted")
+    filename: str | None = Field(default=None, description="a file name, for format detection only")
+    format: str | None = Field(default=None, description="the format's name; detected when omitted")
 
 
 class Options(BaseModel):
     """Conversion options."""
 
-    loop: bool = Field(False, description="BT -> FSM: the root is ticked again after it returns")
-    hierarchy: str = Field("subtrees", description="FSM -> BT: `subtrees` or `flatten`")
+    loop: bool = Field(default=False, description="BT -> FSM: the root is ticked again after it returns")
+    hierarchy: str = Field(default="subtrees", description="FSM -> BT: `subtrees` or `flatten`")
 
 
 class ConvertRequest(ModelText):
     """A conversion."""
 
-    engine: str = Field("rules", description="rules, bsd, chds (LLM engines when configured)")
-    options: Options = Field(default_factory=Options)
-    to: str | None = Field(None, description="the result's format (default: btcpp / scxml)")
+    engine: str = Field(default="rules", description="rules, bsd, chds (LLM engines when configured)")
+    options: Options = Options()
+    to: str | None = Field(default=None, description="the result's format (default: btcpp / scxml)")
 
 
 class VerifyRequest(BaseModel):
@@ -37,11 +37,11 @@ class VerifyRequest(BaseModel):
 
     first: ModelText
     second: ModelText
-    options: Options = Field(default_factory=Options)
+    options: Options = Options()
 
 
 class ExportRequest(ModelText):
     """A model to download in another format."""
 
     to: str = Field(description="a format name from /api/formats (svg and png: pictures)")
-    name: str | None = Field(None, description="the download's file name stem")
+    name: str | None = Field(default=None, description="the download's file name stem")
