@@ -145,3 +145,16 @@ def test_a_malformed_file_shows_its_line_number(page, tmp_path, screenshots):
     page.wait_for_selector("#convert-error strong")
     assert f"line {expected}" in page.inner_text("#convert-error")
     page.screenshot(path=str(screenshots / "06-malformed-file.png"), full_page=True)
+
+
+def test_the_page_opens_on_an_example_named_in_the_address(page, server_url):
+    page.goto(f"{server_url}/?example=door_hfsm.scxml")
+    page.wait_for_selector("body[data-ready='1']")
+    page.wait_for_selector("#issues li")
+    assert page.input_value("#source-text") == (REPO / "examples" / "door_hfsm.scxml").read_text(
+        encoding="utf-8")
+    assert page.input_value("#example") == "door_hfsm.scxml"
+    page.click("#convert")
+    page.wait_for_selector("#convert-results-verdict")
+    assert page.inner_text("#convert-results-verdict").startswith("EQUIVALENT")
+    assert page.locator('[data-metric="sub_fsms"]').count() == 1

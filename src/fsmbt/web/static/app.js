@@ -399,6 +399,15 @@ document.addEventListener("DOMContentLoaded", async () => {
   setupVerify();
   $("convert").addEventListener("click", convert);
   $("verify").addEventListener("click", verify);
-  try { await loadChoices(); } catch (err) { showError($("convert-error"), err); }
+  try {
+    await loadChoices();
+    // ?example=NAME opens the page on that example (README: one command to start on one)
+    const wanted = new URLSearchParams(location.search).get("example");
+    if (wanted) {
+      const data = await api(`/api/examples/${encodeURIComponent(wanted)}`);
+      $("example").value = wanted;
+      setSource(data.text, data.name);
+    }
+  } catch (err) { showError($("convert-error"), err); }
   document.body.dataset.ready = "1";
 });
