@@ -27,8 +27,15 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 from support.web_server import REPO, running_server  # noqa: E402
 
 #: The examples sent (each converted and verified by the server, both pictures drawn).
-EXAMPLES = ("paper_fsm.xml", "robot_bt.xml", "door_hfsm.scxml", "game_npc_bt.xml",
-            "turnstile.mmd", "guard_npc.csv", "paper_fsm.json")
+EXAMPLES = (
+    "paper_fsm.xml",
+    "robot_bt.xml",
+    "door_hfsm.scxml",
+    "game_npc_bt.xml",
+    "turnstile.mmd",
+    "guard_npc.csv",
+    "paper_fsm.json",
+)
 
 
 def percentile(values: list[float], fraction: float) -> float:
@@ -37,10 +44,13 @@ def percentile(values: list[float], fraction: float) -> float:
     return ordered[index]
 
 
-async def load(url: str, requests: int, concurrency: int, deadline: float,
-               timeout: float) -> dict[str, object]:
-    bodies = [{"text": (REPO / "examples" / name).read_text(encoding="utf-8"), "filename": name}
-              for name in EXAMPLES]
+async def load(
+    url: str, requests: int, concurrency: int, deadline: float, timeout: float
+) -> dict[str, object]:
+    bodies = [
+        {"text": (REPO / "examples" / name).read_text(encoding="utf-8"), "filename": name}
+        for name in EXAMPLES
+    ]
     latencies: list[float] = []
     errors: list[str] = []
     gate = asyncio.Semaphore(concurrency)
@@ -55,7 +65,9 @@ async def load(url: str, requests: int, concurrency: int, deadline: float,
                     answer = await client.post("/api/convert", json=body)
                     ok = answer.status_code == 200 and "verdict" in answer.json()
                     if not ok:
-                        errors.append(f"{body['filename']}: {answer.status_code} {answer.text[:120]}")
+                        errors.append(
+                            f"{body['filename']}: {answer.status_code} {answer.text[:120]}"
+                        )
                 except httpx.HTTPError as exc:
                     errors.append(f"{body['filename']}: {type(exc).__name__}")
                 latencies.append(time.perf_counter() - started)
@@ -66,8 +78,13 @@ async def load(url: str, requests: int, concurrency: int, deadline: float,
         except TimeoutError:
             errors.append(f"the run passed its deadline of {deadline:g} s")
         elapsed = time.perf_counter() - started
-    return {"requests": requests, "done": len(latencies), "errors": errors, "elapsed": elapsed,
-            "latencies": latencies}
+    return {
+        "requests": requests,
+        "done": len(latencies),
+        "errors": errors,
+        "elapsed": elapsed,
+        "latencies": latencies,
+    }
 
 
 def report(result: dict[str, object], concurrency: int) -> int:
@@ -75,14 +92,18 @@ def report(result: dict[str, object], concurrency: int) -> int:
     errors = result["errors"]
     assert isinstance(latencies, list) and isinstance(errors, list)
     elapsed = float(result["elapsed"])  # type: ignore[arg-type]
-    print(f"requests: {result['requests']} (concurrency {concurrency}), answered: "
-          f"{result['done']}, errors: {len(errors)}")
+    print(
+        f"requests: {result['requests']} (concurrency {concurrency}), answered: "
+        f"{result['done']}, errors: {len(errors)}"
+    )
     if latencies:
         print(f"elapsed: {elapsed:.2f} s, throughput: {len(latencies) / elapsed:.1f} req/s")
-        print(f"latency p50: {percentile(latencies, 0.5) * 1000:.0f} ms, "
-              f"p95: {percentile(latencies, 0.95) * 1000:.0f} ms, "
-              f"max: {max(latencies) * 1000:.0f} ms, mean: "
-              f"{statistics.fmean(latencies) * 1000:.0f} ms")
+        print(
+            f"latency p50: {percentile(latencies, 0.5) * 1000:.0f} ms, "
+            f"p95: {percentile(latencies, 0.95) * 1000:.0f} ms, "
+            f"max: {max(latencies) * 1000:.0f} ms, mean: "
+            f"{statistics.fmean(latencies) * 1000:.0f} ms"
+        )
     for line in errors[:10]:
         print(f"  error: {line}")
     return 1 if errors else 0
@@ -99,8 +120,9 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
 
     def run(url: str) -> int:
-        result = asyncio.run(load(url, args.requests, args.concurrency, args.deadline,
-                                  args.timeout))
+        result = asyncio.run(
+            load(url, args.requests, args.concurrency, args.deadline, args.timeout)
+        )
         return report(result, args.concurrency)
 
     if args.url:

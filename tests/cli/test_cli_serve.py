@@ -18,8 +18,13 @@ def test_loopback_addresses():
 
 def _serve(*args: str) -> subprocess.Popen[str]:
     env = dict(os.environ, PYTHONPATH=str(REPO / "src"))
-    return subprocess.Popen([sys.executable, "-m", "fsmbt.cli", "serve", *args], env=env,
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    return subprocess.Popen(
+        [sys.executable, "-m", "fsmbt.cli", "serve", *args],
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
 
 
 def test_a_non_loopback_address_prints_a_warning():
@@ -34,10 +39,23 @@ def test_a_non_loopback_address_prints_a_warning():
 
 
 def test_loopback_has_no_warning_and_a_missing_reports_folder_is_refused():
-    done = subprocess.run([sys.executable, "-m", "fsmbt.cli", "serve", "--reports",
-                           "/nonexistent/reports", "--port", str(free_port())],
-                          env=dict(os.environ, PYTHONPATH=str(REPO / "src")),
-                          capture_output=True, text=True, timeout=60, check=False)
+    done = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "fsmbt.cli",
+            "serve",
+            "--reports",
+            "/nonexistent/reports",
+            "--port",
+            str(free_port()),
+        ],
+        env=dict(os.environ, PYTHONPATH=str(REPO / "src")),
+        capture_output=True,
+        text=True,
+        timeout=60,
+        check=False,
+    )
     assert done.returncode == 2
     assert "--reports /nonexistent/reports: not a folder" in done.stderr
     assert "Traceback" not in done.stderr

@@ -20,8 +20,9 @@ def _ids(svg: str) -> set[str]:
     return set(re.findall(r'<g id="([^"]+)"', svg))
 
 
-@pytest.mark.parametrize("name", ["paper_fsm.xml", "door_hfsm.scxml", "robot_bt.xml",
-                                  "game_npc_bt.xml"])
+@pytest.mark.parametrize(
+    "name", ["paper_fsm.xml", "door_hfsm.scxml", "robot_bt.xml", "game_npc_bt.xml"]
+)
 def test_every_state_and_node_has_its_anchor(name):
     loaded = api.load(EXAMPLES / name)
     ids = _ids(svg_text(loaded.model, expand_subtrees=True))
@@ -35,7 +36,8 @@ def test_every_state_and_node_has_its_anchor(name):
     else:  # the interpreter's paths (docs/semantics.md) are exactly the drawn ones
         tree = CompiledTree(loaded.model)
         assert {f"n@{node.path or 'root'}" for node in tree.nodes} == {
-            i for i in ids if i.startswith("n@")}
+            i for i in ids if i.startswith("n@")
+        }
 
 
 def test_anchors_are_off_by_default():
@@ -59,9 +61,13 @@ def test_every_trace_state_of_a_mutant_maps_to_drawn_elements(name):
         other = result if original is source.model else source.model
         for mutant in mutants(original, per_operator=1)[:4]:
             report = api.verify_either_order(other, mutant.model)
-            first, second = (mutant.model, other) if report.stats["swapped"] else (other, mutant.model)
-            drawn = {id(first): _ids(svg_text(first, expand_subtrees=True)),
-                     id(second): _ids(svg_text(second, expand_subtrees=True))}
+            first, second = (
+                (mutant.model, other) if report.stats["swapped"] else (other, mutant.model)
+            )
+            drawn = {
+                id(first): _ids(svg_text(first, expand_subtrees=True)),
+                id(second): _ids(svg_text(second, expand_subtrees=True)),
+            }
             for prop in report.properties.values():
                 for step in prop.counterexample or []:
                     for model, state in ((first, step.source_state), (second, step.result_state)):
@@ -78,7 +84,8 @@ def test_leaf_execution_state_names_the_leaf_at_its_path():
     for node in tree.nodes:
         if not node.children and node.is_env_leaf:
             assert trace_anchors(doc, f"{node.label}@{node.path or 'root'}") == [
-                f"n@{node.path or 'root'}"]
+                f"n@{node.path or 'root'}"
+            ]
     assert trace_anchors(doc, "SUCCESS") == ["n@root"]
 
 

@@ -29,14 +29,30 @@ def running_server(*args: str, ready_seconds: float = 60.0) -> Iterator[str]:
     env = dict(os.environ)
     env["PYTHONPATH"] = os.pathsep.join([str(REPO / "src"), env.get("PYTHONPATH", "")])
     process = subprocess.Popen(
-        [sys.executable, "-m", "fsmbt.cli", "serve", "--host", "127.0.0.1", "--port", str(port),
-         *args], env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        [
+            sys.executable,
+            "-m",
+            "fsmbt.cli",
+            "serve",
+            "--host",
+            "127.0.0.1",
+            "--port",
+            str(port),
+            *args,
+        ],
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     url = f"http://127.0.0.1:{port}"
     try:
         deadline = time.monotonic() + ready_seconds
         while True:
             if process.poll() is not None:
-                raise RuntimeError(f"fsmbt serve exited: {process.stderr.read() if process.stderr else ''}")
+                raise RuntimeError(
+                    f"fsmbt serve exited: {process.stderr.read() if process.stderr else ''}"
+                )
             try:
                 with urllib.request.urlopen(f"{url}/api/formats", timeout=2):
                     break

@@ -13,8 +13,14 @@ import pytest
 from support.web_server import REPO, running_server
 
 CHROMIUM = os.environ.get("FSMBT_CHROMIUM", "/usr/bin/chromium")
-CHROMIUM_ARGS = ["--no-sandbox", "--disable-gpu", "--disable-background-networking",
-                 "--disable-component-update", "--no-first-run", "--disable-sync"]
+CHROMIUM_ARGS = [
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--no-first-run",
+    "--disable-sync",
+]
 #: Where the browser tests write their screenshots (docs/web.md lists the names).
 SCREENSHOTS = Path(os.environ.get("FSMBT_SCREENSHOTS", REPO / "build" / "web-screenshots"))
 

@@ -58,8 +58,12 @@ def test_convert_json_answer_has_every_part(client):
     data = answer.json()
     assert data["verdict"] == "EQUIVALENT" and data["direction"] == "fsm->bt"
     assert [p["name"] for p in data["properties"]] == [
-        "reachability", "completeness", "no_additional_behavior", "deadlock_absence",
-        "termination_consistency"]
+        "reachability",
+        "completeness",
+        "no_additional_behavior",
+        "deadlock_absence",
+        "termination_consistency",
+    ]
     assert data["counterexample"] is None
     result = api.load_text(data["result"]["text"], data["result"]["format"])
     assert api.verify_models(api.load_text(PAPER).model, result.model).equivalent
@@ -70,8 +74,11 @@ def test_convert_json_answer_has_every_part(client):
 
 
 def test_convert_multipart_upload_with_options(client):
-    answer = client.post("/api/convert", files={"file": ("robot_bt.xml", ROBOT)},
-                         data={"engine": "rules", "loop": "true"})
+    answer = client.post(
+        "/api/convert",
+        files={"file": ("robot_bt.xml", ROBOT)},
+        data={"engine": "rules", "loop": "true"},
+    )
     assert answer.status_code == 200, answer.text
     data = answer.json()
     assert data["direction"] == "bt->fsm" and data["result"]["format"] == "scxml"
@@ -93,10 +100,13 @@ def test_llm_engine_is_refused_without_an_endpoint(client, monkeypatch):
 
 def test_verify_a_pair_gives_a_located_counterexample(client):
     source = api.load_text(PAPER)
-    mutant = next(m for m in mutants(source.model, per_operator=1)
-                  if m.operator == "drop_transition")
-    data = client.post("/api/verify", json={
-        "first": {"text": PAPER}, "second": {"text": api.dumps(mutant.model, "scxml")}}).json()
+    mutant = next(
+        m for m in mutants(source.model, per_operator=1) if m.operator == "drop_transition"
+    )
+    data = client.post(
+        "/api/verify",
+        json={"first": {"text": PAPER}, "second": {"text": api.dumps(mutant.model, "scxml")}},
+    ).json()
     assert data["verdict"] == "NOT EQUIVALENT"
     steps = data["counterexample"]["steps"]
     report = api.verify_either_order(source.model, mutant.model)
@@ -110,9 +120,15 @@ def test_verify_a_pair_gives_a_located_counterexample(client):
 def test_export_every_download_reads_back(client):
     data = client.post("/api/convert", json={"text": PAPER}).json()
     for fmt in data["downloads"]:
-        answer = client.post("/api/export", json={"text": data["result"]["text"],
-                                                  "format": data["result"]["format"], "to": fmt,
-                                                  "name": "../../etc/paper"})
+        answer = client.post(
+            "/api/export",
+            json={
+                "text": data["result"]["text"],
+                "format": data["result"]["format"],
+                "to": fmt,
+                "name": "../../etc/paper",
+            },
+        )
         assert answer.status_code == 200, (fmt, answer.text)
         disposition = answer.headers["content-disposition"]
         assert "/" not in disposition.split("filename=")[1]
@@ -141,8 +157,10 @@ def test_runtime_zip_when_the_runtime_is_installed(client):
 
 
 def test_inspect_lists_validation_issues_with_locations(client):
-    broken = PAPER.replace('<Transition from="A" to="B" event="eventAB"/>',
-                           '<Transition from="A" to="Nowhere" event="eventAB"/>')
+    broken = PAPER.replace(
+        '<Transition from="A" to="B" event="eventAB"/>',
+        '<Transition from="A" to="Nowhere" event="eventAB"/>',
+    )
     assert broken != PAPER
     answer = client.post("/api/inspect", json={"text": broken})
     body = answer.json()

@@ -19,7 +19,8 @@ def _highlighted_texts(page, box: str) -> list[str]:
     """The label text of every highlighted element in one picture."""
     return page.eval_on_selector_all(
         f"#{box} .hl",
-        "nodes => nodes.map(n => [...n.querySelectorAll('text')].map(t => t.textContent).join(' '))")
+        "nodes => nodes.map(n => [...n.querySelectorAll('text')].map(t => t.textContent).join(' '))",
+    )
 
 
 def test_convert_the_paper_fsm_shows_equivalent_and_both_pictures(page, screenshots):
@@ -115,7 +116,11 @@ def test_verify_a_mutated_pair_and_step_the_counterexample(page, tmp_path, scree
         else:
             assert page.locator('#svg-first [id="n@root"].hl').count() == 1
         outputs = page.inner_text('#verify-results [data-role="right-out"]')
-        assert ", ".join(step.source_outputs) in outputs if step.source_outputs else "nothing" in outputs
+        assert (
+            ", ".join(step.source_outputs) in outputs
+            if step.source_outputs
+            else "nothing" in outputs
+        )
     assert page.is_disabled('#verify-results [data-role="next"]')
     last = trace[-1]
     assert last.note  # the last step is where they differ
@@ -152,7 +157,8 @@ def test_the_page_opens_on_an_example_named_in_the_address(page, server_url):
     page.wait_for_selector("body[data-ready='1']")
     page.wait_for_selector("#issues li")
     assert page.input_value("#source-text") == (REPO / "examples" / "door_hfsm.scxml").read_text(
-        encoding="utf-8")
+        encoding="utf-8"
+    )
     assert page.input_value("#example") == "door_hfsm.scxml"
     page.click("#convert")
     page.wait_for_selector("#convert-results-verdict")

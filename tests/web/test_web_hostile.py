@@ -3,6 +3,8 @@ the server keeps answering afterwards."""
 
 from __future__ import annotations
 
+import json
+
 import pytest
 from fastapi.testclient import TestClient
 
@@ -19,8 +21,9 @@ BOMB = """<?xml version="1.0"?>
 
 @pytest.fixture(scope="module")
 def client():
-    with TestClient(create_app(WebSettings.default(workers=1, max_body_bytes=64 * 1024,
-                                                   timeout_s=20))) as test_client:
+    with TestClient(
+        create_app(WebSettings.default(workers=1, max_body_bytes=64 * 1024, timeout_s=20))
+    ) as test_client:
         yield test_client
 
 
@@ -40,8 +43,11 @@ def test_oversize_body_declared_or_streamed(client):
         for _ in range(40):
             yield b"a" * 4096
 
-    _refused(client.post("/api/convert", content=chunks(),
-                         headers={"content-type": "application/json"}), 413, "larger than")
+    _refused(
+        client.post("/api/convert", content=chunks(), headers={"content-type": "application/json"}),
+        413,
+        "larger than",
+    )
 
 
 def test_xml_bomb(client):
@@ -49,26 +55,41 @@ def test_xml_bomb(client):
 
 
 def test_deep_nesting_in_the_model_and_in_the_body(client):
-    deep_xml = ('<root BTCPP_format="4"><BehaviorTree ID="M">' + "<Inverter>" * 12_000
-                + '<Action ID="a"/>' + "</Inverter>" * 12_000 + "</BehaviorTree></root>")
+    deep_xml = (
+        '<root BTCPP_format="4"><BehaviorTree ID="M">'
+        + "<Inverter>" * 12_000
+        + '<Action ID="a"/>'
+        + "</Inverter>" * 12_000
+        + "</BehaviorTree></root>"
+    )
     settings = WebSettings.default(workers=1, max_body_bytes=4 * 1024 * 1024)
     with TestClient(create_app(settings)) as big:
         _refused(big.post("/api/convert", json={"text": deep_xml}), 400, "deep")
     deep_json = "[" * 30_000 + "]" * 30_000
-    _refused(client.post("/api/convert", content=deep_json,
-                         headers={"content-type": "application/json"}), 400, "nested too deeply")
+    _refused(
+        client.post(
+            "/api/convert", content=deep_json, headers={"content-type": "application/json"}
+        ),
+        400,
+        "nested too deeply",
+    )
 
 
 def test_wrong_content_type(client):
-    _refused(client.post("/api/convert", content=PAPER,
-                         headers={"content-type": "application/xml"}), 415, "content type")
-    _refused(client.post("/api/verify", content=b"x", headers={"content-type": "text/plain"}),
-             415)
+    _refused(
+        client.post("/api/convert", content=PAPER, headers={"content-type": "application/xml"}),
+        415,
+        "content type",
+    )
+    _refused(client.post("/api/verify", content=b"x", headers={"content-type": "text/plain"}), 415)
 
 
 def test_path_like_names(client):
-    _refused(client.post("/api/convert", json={"text": PAPER, "filename": "../../etc/passwd"}),
-             400, "not a path")
+    _refused(
+        client.post("/api/convert", json={"text": PAPER, "filename": "../../etc/passwd"}),
+        400,
+        "not a path",
+    )
     _refused(client.post("/api/convert", files={"file": ("/etc/passwd", PAPER)}), 400)
     _refused(client.get("/api/examples/..%2Fpyproject.toml"), 404)
     _refused(client.get("/api/examples/%2Fetc%2Fpasswd"), 404)
@@ -78,14 +99,21 @@ def test_path_like_names(client):
 def test_bad_fields(client):
     _refused(client.post("/api/convert", json={"text": 5}), 400, "must be a string")
     _refused(client.post("/api/convert", json=[1]), 400, "object")
-    _refused(client.post("/api/convert", content=b"{not json",
-                         headers={"content-type": "application/json"}), 400, "not valid JSON")
+    _refused(
+        client.post(
+            "/api/convert", content=b"{not json", headers={"content-type": "application/json"}
+        ),
+        400,
+        "not valid JSON",
+    )
     _refused(client.post("/api/convert", json={"text": ""}), 400, "empty")
     _refused(client.post("/api/convert", json={"text": PAPER, "format": "nope"}), 400)
-    _refused(client.post("/api/convert", json={"text": PAPER, "engine": "rm -rf"}), 400,
-             "not offered")
-    _refused(client.post("/api/convert", files={"file": ("x.xml", b"\xff\xfe\x00bad")}), 400,
-             "UTF-8")
+    _refused(
+        client.post("/api/convert", json={"text": PAPER, "engine": "rm -rf"}), 400, "not offered"
+    )
+    _refused(
+        client.post("/api/convert", files={"file": ("x.xml", b"\xff\xfe\x00bad")}), 400, "UTF-8"
+    )
     _refused(client.post("/api/verify", json={"first": {"text": PAPER}}), 400, "two models")
 
 
@@ -104,3 +132,15 @@ def test_time_limit_answers_and_frees_the_worker():
 
 def test_server_still_answers_after_the_hostile_ones(client):
     assert client.post("/api/convert", json={"text": PAPER}).json()["verdict"] == "EQUIVALENT"
+
+
+def test_names_from_the_model_cannot_inject_markup_into_the_page(client):
+    hostile = '<img src=x onerror="alert(1)">'
+    text = (REPO / "examples" / "paper_fsm.json").read_text(encoding="utf-8")
+    text = text.replace('"B"', json.dumps(hostile))
+    answer = client.post("/api/convert", json={"text": text})
+    assert answer.status_code == 200, answer.text
+    data = answer.json()
+    assert data["verdict"] == "EQUIVALENT"
+    for picture in data["svg"].values():
+        assert "<img" not in picture and "&lt;img" in picture

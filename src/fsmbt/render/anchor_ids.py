@@ -145,7 +145,8 @@ def _bt_walk(doc: BTDocument) -> list[tuple[BTNode, str, str, str]]:
         return []
     out: list[tuple[BTNode, str, str, str]] = []
     stack: list[tuple[BTNode, str, str, str, tuple[str, ...]]] = [
-        (main.root, "", main.id, "", (main.id,))]
+        (main.root, "", main.id, "", (main.id,))
+    ]
     while stack:
         node, path, tree, local, chain = stack.pop()
         out.append((node, path, tree, local))
@@ -155,8 +156,15 @@ def _bt_walk(doc: BTDocument) -> list[tuple[BTNode, str, str, str]]:
             if sub is not None:
                 stack.append((sub, child_path(path, 0), ref, "", (*chain, ref)))
         for index in range(len(node.children) - 1, -1, -1):
-            stack.append((node.children[index], child_path(path, index), tree,
-                          child_path(local, index), chain))
+            stack.append(
+                (
+                    node.children[index],
+                    child_path(path, index),
+                    tree,
+                    child_path(local, index),
+                    chain,
+                )
+            )
     return out
 
 

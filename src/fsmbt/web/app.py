@@ -90,12 +90,24 @@ class BodyLimit:
             await self._refuse(send)
 
     async def _refuse(self, send: Send) -> None:
-        body = json.dumps({"error": f"request body larger than {self.limit} bytes (the server's "
-                                    "limit); convert large models with the command line "
-                                    "(fsmbt convert)", "where": None}).encode()
-        await send({"type": "http.response.start", "status": 413,
-                    "headers": [(b"content-type", b"application/json"),
-                                (b"content-length", str(len(body)).encode())]})
+        body = json.dumps(
+            {
+                "error": f"request body larger than {self.limit} bytes (the server's "
+                "limit); convert large models with the command line "
+                "(fsmbt convert)",
+                "where": None,
+            }
+        ).encode()
+        await send(
+            {
+                "type": "http.response.start",
+                "status": 413,
+                "headers": [
+                    (b"content-type", b"application/json"),
+                    (b"content-length", str(len(body)).encode()),
+                ],
+            }
+        )
         await send({"type": "http.response.body", "body": body})
 
 
@@ -121,9 +133,13 @@ def create_app(settings: WebSettings | None = None) -> FastAPI:
         yield
         state.pop("workers").close()
 
-    app = FastAPI(title="fsmbt", version="0.1.0", lifespan=lifespan,
-                  description="Convert behavior models between FSMs and behavior trees and "
-                              "prove the result equivalent (docs/web.md).")
+    app = FastAPI(
+        title="fsmbt",
+        version="0.1.0",
+        lifespan=lifespan,
+        description="Convert behavior models between FSMs and behavior trees and "
+        "prove the result equivalent (docs/web.md).",
+    )
     app.add_middleware(BodyLimit, limit=settings.max_body_bytes)
     app.mount("/static", StaticFiles(directory=HERE / "static"), name="static")
     templates = Jinja2Templates(directory=str(HERE / "templates"))
@@ -140,25 +156,32 @@ def create_app(settings: WebSettings | None = None) -> FastAPI:
     async def validation_error(_: Request, exc: RequestValidationError) -> JSONResponse:
         first = exc.errors()[0] if exc.errors() else {}
         where = ".".join(str(p) for p in first.get("loc", ()))
-        return JSONResponse({"error": f"bad request: {first.get('msg', 'invalid')}",
-                             "where": where or None}, status_code=422)
+        return JSONResponse(
+            {"error": f"bad request: {first.get('msg', 'invalid')}", "where": where or None},
+            status_code=422,
+        )
 
     @app.exception_handler(Exception)
     async def any_error(_: Request, exc: Exception) -> JSONResponse:
         LOG.exception("unexpected error")
-        return JSONResponse({"error": "internal error (logged on the server)", "where": None},
-                            status_code=500)
+        return JSONResponse(
+            {"error": "internal error (logged on the server)", "where": None}, status_code=500
+        )
 
     async def work(function: Any, argument: Any) -> Any:
         try:
             status, value = await state["workers"].run(function, argument)
         except WorkTimeout:
-            raise ApiError(503, f"took longer than {settings.timeout_s:g} s, the page's limit; "
-                                "the model is too large for the page: use the command line "
-                                "(fsmbt convert / fsmbt verify)") from None
+            raise ApiError(
+                503,
+                f"took longer than {settings.timeout_s:g} s, the page's limit; "
+                "the model is too large for the page: use the command line "
+                "(fsmbt convert / fsmbt verify)",
+            ) from None
         except Busy:
-            raise ApiError(503, "the server is busy (too many requests waiting); try again "
-                                "shortly") from None
+            raise ApiError(
+                503, "the server is busy (too many requests waiting); try again shortly"
+            ) from None
         except WorkerCrashed:
             raise ApiError(500, "internal error (logged on the server)") from None
         if status == "error":
@@ -168,8 +191,9 @@ def create_app(settings: WebSettings | None = None) -> FastAPI:
     # -- page ---------------------------------------------------------------------------------
     @app.get("/", response_class=HTMLResponse, include_in_schema=False)
     async def page(request: Request) -> Response:
-        return templates.TemplateResponse(request, "index.html", {
-            "reports": settings.reports_dir is not None})
+        return templates.TemplateResponse(
+            request, "index.html", {"reports": settings.reports_dir is not None}
+        )
 
     # -- reference data -----------------------------------------------------------------------
     @app.get("/api/formats", summary="Every format fsmbt reads or writes")
@@ -178,8 +202,11 @@ def create_app(settings: WebSettings | None = None) -> FastAPI:
 
     @app.get("/api/engines", summary="The conversion engines this server offers")
     async def get_engines() -> dict[str, Any]:
-        return {"engines": list(service.PLAIN_ENGINES) + _llm_engines(),
-                "hierarchies": list(service.HIERARCHIES), "runtimes": service.runtime_kinds()}
+        return {
+            "engines": list(service.PLAIN_ENGINES) + _llm_engines(),
+            "hierarchies": list(service.HIERARCHIES),
+            "runtimes": service.runtime_kinds(),
+        }
 
     @app.get("/api/examples", summary="The example models (by name)")
     async def get_examples() -> list[dict[str, str]]:
@@ -194,44 +221,61 @@ def create_app(settings: WebSettings | None = None) -> FastAPI:
         return {"name": name, "format": listing[name], "text": text}
 
     # -- the pipeline -------------------------------------------------------------------------
-    @app.post("/api/inspect", summary="Read and validate one model",
-              openapi_extra=_body_doc(ModelText))
+    @app.post(
+        "/api/inspect", summary="Read and validate one model", openapi_extra=_body_doc(ModelText)
+    )
     async def inspect(request: Request) -> Any:
         body = await _model_body(request)
         return await work(service.inspect, body)
 
-    @app.post("/api/convert", summary="Convert a model, verify the result, draw both",
-              openapi_extra=_body_doc(ConvertRequest))
+    @app.post(
+        "/api/convert",
+        summary="Convert a model, verify the result, draw both",
+        openapi_extra=_body_doc(ConvertRequest),
+    )
     async def convert(request: Request) -> Any:
         body = await _model_body(request)
         engine = str(body.get("engine") or "rules")
         if engine not in service.PLAIN_ENGINES and engine not in _llm_engines():
             known = ", ".join([*service.PLAIN_ENGINES, *_llm_engines()])
-            raise ApiError(400, f"engine '{engine}' is not offered here (offered: {known})",
-                           "engine")
+            raise ApiError(
+                400, f"engine '{engine}' is not offered here (offered: {known})", "engine"
+            )
         return await work(service.convert, body)
 
-    @app.post("/api/verify", summary="Check two models against each other",
-              openapi_extra=_body_doc(VerifyRequest))
+    @app.post(
+        "/api/verify",
+        summary="Check two models against each other",
+        openapi_extra=_body_doc(VerifyRequest),
+    )
     async def verify(request: Request) -> Any:
         body = await _pair_body(request)
         return await work(service.verify, body)
 
-    @app.post("/api/export", summary="A model in another format (download)",
-              openapi_extra=_body_doc(ExportRequest))
+    @app.post(
+        "/api/export",
+        summary="A model in another format (download)",
+        openapi_extra=_body_doc(ExportRequest),
+    )
     async def export(request: Request) -> Response:
         body = await _model_body(request)
         data, name, media = await work(service.export, body)
-        return Response(data, media_type=media,
-                        headers={"content-disposition": f'attachment; filename="{name}"'})
+        return Response(
+            data,
+            media_type=media,
+            headers={"content-disposition": f'attachment; filename="{name}"'},
+        )
 
     @app.get("/api/runtime/{kind}", summary="The runtime files (zip) for converted trees")
     async def runtime(kind: str) -> Response:
         if kind not in ("cpp", "python"):
             raise ApiError(404, f"no runtime '{kind}' (cpp or python)", "kind")
         data, name = await work(service.runtime_zip, kind)
-        return Response(data, media_type="application/zip",
-                        headers={"content-disposition": f'attachment; filename="{name}"'})
+        return Response(
+            data,
+            media_type="application/zip",
+            headers={"content-disposition": f'attachment; filename="{name}"'},
+        )
 
     # -- reports (read-only) ------------------------------------------------------------------
     @app.get("/api/reports", summary="Evaluation reports and batch stores under --reports")
@@ -246,8 +290,11 @@ def create_app(settings: WebSettings | None = None) -> FastAPI:
             if (folder / "results.sqlite").is_file():
                 found["batches"].append(_relative(folder / "results.sqlite", root))
             if depth < MAX_REPORT_DEPTH:
-                stack.extend((child, depth + 1) for child in sorted(folder.iterdir(), reverse=True)
-                             if child.is_dir() and not child.is_symlink())
+                stack.extend(
+                    (child, depth + 1)
+                    for child in sorted(folder.iterdir(), reverse=True)
+                    if child.is_dir() and not child.is_symlink()
+                )
         return found
 
     @app.get("/reports/{path:path}", include_in_schema=False)
@@ -270,11 +317,25 @@ def create_app(settings: WebSettings | None = None) -> FastAPI:
 def _body_doc(model: Any) -> dict[str, Any]:
     """OpenAPI text for a body read by hand (JSON, or the same fields as multipart)."""
     schema = model.model_json_schema()
-    return {"requestBody": {"required": True, "content": {
-        "application/json": {"schema": schema},
-        "multipart/form-data": {"schema": {"type": "object", "properties": {
-            "file": {"type": "string", "format": "binary"},
-            **{k: v for k, v in schema.get("properties", {}).items() if k != "text"}}}}}}}
+    return {
+        "requestBody": {
+            "required": True,
+            "content": {
+                "application/json": {"schema": schema},
+                "multipart/form-data": {
+                    "schema": {
+                        "type": "object",
+                        "properties": {
+                            "file": {"type": "string", "format": "binary"},
+                            **{
+                                k: v for k, v in schema.get("properties", {}).items() if k != "text"
+                            },
+                        },
+                    }
+                },
+            },
+        }
+    }
 
 
 def _llm_engines() -> list[str]:
@@ -321,8 +382,9 @@ def _decode_upload(data: bytes, field: str) -> str:
     try:
         return data.decode("utf-8-sig")
     except UnicodeDecodeError as exc:
-        raise ApiError(400, f"the uploaded file is not UTF-8 text (byte {exc.start})",
-                       field) from None
+        raise ApiError(
+            400, f"the uploaded file is not UTF-8 text (byte {exc.start})", field
+        ) from None
 
 
 async def _form(request: Request) -> Any:
@@ -359,8 +421,11 @@ async def _model_body(request: Request) -> dict[str, Any]:
             if "hierarchy" in body:
                 options["hierarchy"] = body.pop("hierarchy")
     else:
-        raise ApiError(415, f"unsupported content type '{kind or 'none'}': send "
-                            "application/json or multipart/form-data")
+        raise ApiError(
+            415,
+            f"unsupported content type '{kind or 'none'}': send "
+            "application/json or multipart/form-data",
+        )
     _check_fields(body)
     return body
 
@@ -377,12 +442,17 @@ async def _pair_body(request: Request) -> dict[str, Any]:
             upload = form.get(side)
             if upload is None or isinstance(upload, str):
                 raise ApiError(400, f"missing the '{side}' file", side)
-            body[side] = {"text": _decode_upload(await upload.read(), side),
-                          "filename": upload.filename or "",
-                          "format": form.get(f"{side}_format") or None}
+            body[side] = {
+                "text": _decode_upload(await upload.read(), side),
+                "filename": upload.filename or "",
+                "format": form.get(f"{side}_format") or None,
+            }
     else:
-        raise ApiError(415, f"unsupported content type '{kind or 'none'}': send "
-                            "application/json or multipart/form-data")
+        raise ApiError(
+            415,
+            f"unsupported content type '{kind or 'none'}': send "
+            "application/json or multipart/form-data",
+        )
     for side in ("first", "second"):
         if isinstance(body.get(side), dict):
             _check_fields(body[side], prefix=f"{side}.")
@@ -397,8 +467,11 @@ def _check_fields(body: dict[str, Any], prefix: str = "") -> None:
             raise ApiError(400, f"'{prefix}{key}' must be a string", prefix + key)
     name = body.get("filename")
     if name and ("/" in name or "\\" in name or name in (".", "..") or "\x00" in name):
-        raise ApiError(400, "'filename' must be a file name, not a path (the server reads no "
-                            "files; send the text)", prefix + "filename")
+        raise ApiError(
+            400,
+            "'filename' must be a file name, not a path (the server reads no files; send the text)",
+            prefix + "filename",
+        )
     options = body.get("options")
     if options is not None and not isinstance(options, dict):
         raise ApiError(400, f"'{prefix}options' must be an object", prefix + "options")
@@ -434,15 +507,22 @@ def _read_store(path: Path) -> dict[str, Any]:
     except sqlite3.Error as exc:
         raise ApiError(400, f"cannot open the batch store: {exc}") from None
     try:
-        names = [row[0] for row in connection.execute(
-            "SELECT name FROM sqlite_master WHERE type='table' ORDER BY name")]
+        names = [
+            row[0]
+            for row in connection.execute(
+                "SELECT name FROM sqlite_master WHERE type='table' ORDER BY name"
+            )
+        ]
         tables = {}
         for name in names:
-            cursor = connection.execute(f'SELECT * FROM "{name.replace(chr(34), "")}" LIMIT ?',
-                                        (MAX_BATCH_ROWS,))
+            cursor = connection.execute(
+                f'SELECT * FROM "{name.replace(chr(34), "")}" LIMIT ?', (MAX_BATCH_ROWS,)
+            )
             columns = [c[0] for c in cursor.description or ()]
-            tables[name] = {"columns": columns,
-                            "rows": [[_cell(v) for v in row] for row in cursor.fetchall()]}
+            tables[name] = {
+                "columns": columns,
+                "rows": [[_cell(v) for v in row] for row in cursor.fetchall()],
+            }
         return {"store": path.name, "tables": tables}
     except sqlite3.Error as exc:
         raise ApiError(400, f"cannot read the batch store: {exc}") from None

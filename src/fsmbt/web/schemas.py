@@ -20,14 +20,18 @@ class ModelText(BaseModel):
 class Options(BaseModel):
     """Conversion options."""
 
-    loop: bool = Field(default=False, description="BT -> FSM: the root is ticked again after it returns")
+    loop: bool = Field(
+        default=False, description="BT -> FSM: the root is ticked again after it returns"
+    )
     hierarchy: str = Field(default="subtrees", description="FSM -> BT: `subtrees` or `flatten`")
 
 
 class ConvertRequest(ModelText):
     """A conversion."""
 
-    engine: str = Field(default="rules", description="rules, bsd, chds (LLM engines when configured)")
+    engine: str = Field(
+        default="rules", description="rules, bsd, chds (LLM engines when configured)"
+    )
     options: Options = Options()
     to: str | None = Field(default=None, description="the result's format (default: btcpp / scxml)")
 

@@ -40,10 +40,21 @@ HIERARCHIES = ("subtrees", "flatten")
 #: Download formats besides the registry's writers: pictures through Graphviz.
 PICTURE_FORMATS = ("svg", "png")
 #: The file name ending of each download format.
-SUFFIXES = {"btcpp": ".xml", "scxml": ".scxml", "json": ".json", "yaml": ".yaml",
-            "mermaid": ".mmd", "dot": ".dot", "svg": ".svg", "png": ".png",
-            "paper-xml": ".fsm.xml", "smach": ".py", "csv": ".csv", "md": ".md",
-            "paper-text": ".txt"}
+SUFFIXES = {
+    "btcpp": ".xml",
+    "scxml": ".scxml",
+    "json": ".json",
+    "yaml": ".yaml",
+    "mermaid": ".mmd",
+    "dot": ".dot",
+    "svg": ".svg",
+    "png": ".png",
+    "paper-xml": ".fsm.xml",
+    "smach": ".py",
+    "csv": ".csv",
+    "md": ".md",
+    "paper-text": ".txt",
+}
 
 #: The hints in the page's words (the form's controls), as the CLI words them as flags.
 WEB_WORDING = {
@@ -73,8 +84,12 @@ def error_body(error: FsmbtError) -> dict[str, Any]:
     loc = error.location
     where = None
     if loc is not None or error.element:
-        where = {"file": loc.file if loc else None, "line": loc.line if loc else None,
-                 "column": loc.column if loc else None, "element": error.element}
+        where = {
+            "file": loc.file if loc else None,
+            "line": loc.line if loc else None,
+            "column": loc.column if loc else None,
+            "element": error.element,
+        }
     return {"error": error.text(WEB_WORDING), "where": where}
 
 
@@ -84,19 +99,36 @@ def format_list() -> list[dict[str, Any]]:
     Returns:
         ``[{"name", "description", "extensions", "kinds", "read", "write"}]``.
     """
-    listed = [{"name": f.name, "description": f.description, "extensions": list(f.extensions),
-               "kinds": sorted(f.kinds), "read": f.read is not None, "write": f.write is not None}
-              for f in formats()]
-    listed += [{"name": name, "description": f"{name.upper()} picture (Graphviz)",
-                "extensions": [f".{name}"], "kinds": ["bt", "fsm"], "read": False,
-                "write": True} for name in PICTURE_FORMATS]
+    listed = [
+        {
+            "name": f.name,
+            "description": f.description,
+            "extensions": list(f.extensions),
+            "kinds": sorted(f.kinds),
+            "read": f.read is not None,
+            "write": f.write is not None,
+        }
+        for f in formats()
+    ]
+    listed += [
+        {
+            "name": name,
+            "description": f"{name.upper()} picture (Graphviz)",
+            "extensions": [f".{name}"],
+            "kinds": ["bt", "fsm"],
+            "read": False,
+            "write": True,
+        }
+        for name in PICTURE_FORMATS
+    ]
     return listed
 
 
 def download_formats(kind: str) -> list[str]:
     """The formats a model of ``kind`` can be downloaded in (writers, then pictures)."""
-    return [f.name for f in formats() if f.write is not None and kind in f.kinds
-            and f.name != "smach"] + list(PICTURE_FORMATS)
+    return [f.name for f in formats() if f.write is not None and kind in f.kinds] + list(
+        PICTURE_FORMATS
+    )
 
 
 #: The runtimes offered for download and the modules that write their files.
@@ -159,8 +191,9 @@ def _steps(report: Report, source: api.Model, result: api.Model) -> dict[str, An
 
 
 def _properties(report: Report) -> list[dict[str, Any]]:
-    return [{"name": p.name, "holds": p.holds, "detail": p.detail}
-            for p in report.properties.values()]
+    return [
+        {"name": p.name, "holds": p.holds, "detail": p.detail} for p in report.properties.values()
+    ]
 
 
 def inspect(model: dict[str, Any]) -> dict[str, Any]:
@@ -176,8 +209,13 @@ def inspect(model: dict[str, Any]) -> dict[str, Any]:
         FsmbtError: the text cannot be read (located).
     """
     loaded = _load(model)
-    return {"format": loaded.format, "kind": loaded.kind, "issues": _issues(loaded),
-            "warnings": loaded.warnings, "metrics": _metrics(loaded.model)}
+    return {
+        "format": loaded.format,
+        "kind": loaded.kind,
+        "issues": _issues(loaded),
+        "warnings": loaded.warnings,
+        "metrics": _metrics(loaded.model),
+    }
 
 
 def convert(request: dict[str, Any]) -> dict[str, Any]:
@@ -201,10 +239,13 @@ def convert(request: dict[str, Any]) -> dict[str, Any]:
     loop = bool(options.get("loop", False))
     hierarchy = str(options.get("hierarchy") or "subtrees")
     if hierarchy not in HIERARCHIES:
-        raise InputError(f"unknown hierarchy option '{hierarchy}' (one of: {', '.join(HIERARCHIES)})")
+        raise InputError(
+            f"unknown hierarchy option '{hierarchy}' (one of: {', '.join(HIERARCHIES)})"
+        )
     to = request.get("to") or None
-    outcome = api.convert_loaded(loaded, to=to, engine=str(request.get("engine") or "rules"),
-                                 loop=loop, hierarchy=hierarchy)
+    outcome = api.convert_loaded(
+        loaded, to=to, engine=str(request.get("engine") or "rules"), loop=loop, hierarchy=hierarchy
+    )
     report = outcome.report
     pictures = {"source": _picture(loaded.model), "result": _picture(outcome.result)}
     kind = api.model_kind(outcome.result)
@@ -222,8 +263,10 @@ def convert(request: dict[str, Any]) -> dict[str, Any]:
         "issues": _issues(loaded),
         "metrics": {"source": _metrics(loaded.model), "result": _metrics(outcome.result)},
         "svg": {"source": pictures["source"]["svg"], "result": pictures["result"]["svg"]},
-        "svg_errors": {"source": pictures["source"]["error"],
-                       "result": pictures["result"]["error"]},
+        "svg_errors": {
+            "source": pictures["source"]["error"],
+            "result": pictures["result"]["error"],
+        },
         "downloads": download_formats(kind),
         "runtimes": runtime_kinds() if kind == "bt" else [],
         "timings": {k: round(v, 6) for k, v in outcome.timings.items()},
@@ -267,8 +310,7 @@ def verify(request: dict[str, Any]) -> dict[str, Any]:
         "formats": {"first": first.format, "second": second.format},
         "metrics": {"first": _metrics(first.model), "second": _metrics(second.model)},
         "svg": {"first": pictures["first"]["svg"], "second": pictures["second"]["svg"]},
-        "svg_errors": {"first": pictures["first"]["error"],
-                       "second": pictures["second"]["error"]},
+        "svg_errors": {"first": pictures["first"]["error"], "second": pictures["second"]["error"]},
         "warnings": [*first.warnings, *second.warnings],
     }
 

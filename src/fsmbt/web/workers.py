@@ -68,8 +68,11 @@ def _call(function: Callable[[Any], Any], argument: Any) -> tuple[str, Any]:
     except RecursionError:
         return "error", {"error": "the model is nested too deeply to handle", "where": None}
     except MemoryError:
-        return "error", {"error": "the model needs more memory than the server allows; "
-                                  "use the command line (fsmbt convert)", "where": None}
+        return "error", {
+            "error": "the model needs more memory than the server allows; "
+            "use the command line (fsmbt convert)",
+            "where": None,
+        }
     except Exception as exc:  # a bug: keep the cause for the log, not the browser
         return "crash", f"{type(exc).__name__}: {one_line(str(exc))}"[:500]
 
@@ -95,9 +98,12 @@ class Workers:
     def _new_pool(self) -> tuple[ProcessPoolExecutor, list[Future[None]]]:
         """A pool whose processes are started and have imported the service (one warm-up
         call per process, submitted at once)."""
-        pool = ProcessPoolExecutor(max_workers=self.count,
-                                   mp_context=multiprocessing.get_context("spawn"),
-                                   initializer=_initialise, initargs=(self.seconds,))
+        pool = ProcessPoolExecutor(
+            max_workers=self.count,
+            mp_context=multiprocessing.get_context("spawn"),
+            initializer=_initialise,
+            initargs=(self.seconds,),
+        )
         return pool, [pool.submit(_warm) for _ in range(self.count)]
 
     async def run(self, function: Callable[[Any], Any], argument: Any) -> tuple[str, Any]:
