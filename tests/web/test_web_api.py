@@ -190,3 +190,33 @@ def test_openapi_documents_the_api(client):
     body = paths["/api/convert"]["post"]["requestBody"]["content"]
     assert {"application/json", "multipart/form-data"} <= set(body)
     assert json.dumps(body).count("engine") >= 1
+
+
+def test_llm_engines_are_offered_only_with_a_server_endpoint(client, monkeypatch, tmp_path):
+    for name in (
+        "FSMBT_LLM_BASE_URL",
+        "FSMBT_LLM_MODEL",
+        "FSMBT_LLM_API_KEY",
+        "OPENAI_API_KEY",
+        "FSMBT_LLM_CONFIG",
+    ):
+        monkeypatch.delenv(name, raising=False)
+    monkeypatch.chdir(tmp_path)  # no fsmbt.toml here
+    monkeypatch.setenv("XDG_CONFIG_HOME", str(tmp_path))
+    assert "llm" not in client.get("/api/engines").json()["engines"]
+    monkeypatch.setenv("FSMBT_LLM_BASE_URL", "http://127.0.0.1:9/v1")
+    monkeypatch.setenv("FSMBT_LLM_MODEL", "some-model")
+    monkeypatch.setenv("FSMBT_LLM_API_KEY", "none")
+    assert {"llm", "nllm", "hybrid"} <= set(client.get("/api/engines").json()["engines"])
+
+
+def test_verify_multipart_upload_of_two_files(client):
+    converted = client.post("/api/convert", json={"text": PAPER}).json()["result"]["text"]
+    answer = client.post(
+        "/api/verify",
+        files={"first": ("paper_bt.xml", converted), "second": ("paper_fsm.xml", PAPER)},
+    )
+    assert answer.status_code == 200, answer.text
+    data = answer.json()
+    assert data["verdict"] == "EQUIVALENT" and data["source_side"] == "second"
+    assert data["counterexample"] is None
