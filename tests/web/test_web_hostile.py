@@ -51,7 +51,7 @@ def test_oversize_body_declared_or_streamed(client):
 
 
 def test_xml_bomb(client):
-    _refused(client.post("/api/convert", json={"text": BOMB}), 400)
+    _refused(client.post("/api/convert", json={"text": BOMB}), 400, "entities")
 
 
 def test_deep_nesting_in_the_model_and_in_the_body(client):
