@@ -220,3 +220,22 @@ def test_verify_multipart_upload_of_two_files(client):
     data = answer.json()
     assert data["verdict"] == "EQUIVALENT" and data["source_side"] == "second"
     assert data["counterexample"] is None
+
+
+def test_errors_name_the_uploaded_file_and_the_line_as_the_cli_does(client, tmp_path):
+    broken = PAPER.replace('<State name="C" type="normal"/>', '<State name="C" type="normal"')
+    assert broken != PAPER
+    path = tmp_path / "broken.xml"
+    path.write_text(broken, encoding="utf-8")
+    from fsmbt.cli.hints import cli_message
+    from fsmbt.model.errors import InputError
+
+    with pytest.raises(InputError) as caught:
+        api.load(path)
+    expected = cli_message(caught.value).replace(str(path), "broken.xml")
+    answer = client.post("/api/convert", files={"file": ("broken.xml", broken)})
+    assert answer.status_code == 400
+    body = answer.json()
+    assert body["error"] == expected
+    assert body["where"]["file"] == "broken.xml"
+    assert body["where"]["line"] == caught.value.location.line

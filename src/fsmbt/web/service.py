@@ -20,7 +20,7 @@ import importlib.util
 import io
 import tempfile
 import zipfile
-from dataclasses import asdict
+from dataclasses import asdict, replace
 from pathlib import Path
 from typing import Any
 
@@ -153,9 +153,17 @@ def _load(model: dict[str, Any]) -> api.Loaded:
     if not isinstance(text, str) or not text.strip():
         raise InputError("the model is empty: paste a model, upload a file or pick an example")
     fmt = model.get("format") or None
-    if fmt is not None:
-        fmt = get_format(str(fmt)).name
-    return api.load_text(text, fmt, filename=model.get("filename") or None)
+    filename = model.get("filename") or None
+    try:
+        if fmt is not None:
+            fmt = get_format(str(fmt)).name
+        return api.load_text(text, fmt, filename=filename)
+    except FsmbtError as exc:
+        # a text has no file; name the upload in the location, as the CLI names its file
+        loc = exc.location
+        if filename and loc is not None and loc.file in (None, "<input>"):
+            exc.location = replace(loc, file=filename)
+        raise
 
 
 def _issues(loaded: api.Loaded) -> list[dict[str, object]]:
