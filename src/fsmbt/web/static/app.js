@@ -249,7 +249,8 @@ function fillDownloads(root, data) {
   const stem = (sourceName || "model").replace(/\.[^.]*$/, "") + "_converted";
   const box = role(root, "downloads");
   for (const fmt of data.downloads) {
-    const button = el("button", { type: "button", "data-format": fmt, class: "download" }, fmt);
+    const label = { btcpp: "BT.CPP XML", scxml: "SCXML", json: "JSON", yaml: "YAML", mermaid: "Mermaid", dot: "DOT", svg: "SVG", png: "PNG", "paper-xml": "paper XML", "paper-text": "paper text", csv: "CSV", md: "Markdown", smach: "SMACH (Python)" }[fmt] || fmt;
+    const button = el("button", { type: "button", "data-format": fmt, class: "download", title: `the result as ${fmt}` }, label);
     button.addEventListener("click", async () => {
       try {
         const blob = await api("/api/export", { text: data.result.text, format: data.result.format, to: fmt, name: stem });
