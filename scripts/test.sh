@@ -7,4 +7,8 @@ cd "$REPO_ROOT"
 if [ ! -x .venv/bin/pytest ]; then
     bash scripts/setup.sh
 fi
+# the web page's browser tests (tests/web) drive Debian's chromium; install it when missing
+if [ -z "${FSMBT_SKIP_BROWSER:-}" ] && [ ! -x "${FSMBT_CHROMIUM:-/usr/bin/chromium}" ]; then
+    bash scripts/install_browser.sh
+fi
 exec .venv/bin/pytest -n auto "$@"

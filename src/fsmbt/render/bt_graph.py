@@ -23,8 +23,15 @@ import graphviz
 from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.bt_nodes import NodeKind, canonical_type
 from fsmbt.model.errors import Hint, InputError
+from fsmbt.render.anchor_ids import child_path, node_anchor
 from fsmbt.render.dot import (
-    DEFAULT_MAX_NODES, FONT, TooLargeError, assemble, check_size, edge_line, html_label,
+    DEFAULT_MAX_NODES,
+    FONT,
+    TooLargeError,
+    assemble,
+    check_size,
+    edge_line,
+    html_label,
     label_text,
 )
 
@@ -57,13 +64,16 @@ MAX_ATTRS_SHOWN = 4
 
 
 def bt_to_dot(doc: BTDocument, *, expand_subtrees: bool = False,
-              max_nodes: int | None = DEFAULT_MAX_NODES) -> str:
+              max_nodes: int | None = DEFAULT_MAX_NODES, anchors: bool = False) -> str:
     """DOT source of the picture of ``doc``.
 
     Args:
         doc: the behavior tree document.
         expand_subtrees: draw the main tree only, each SubTree reference with its tree below it.
         max_nodes: refuse (``TooLargeError``) more drawn nodes than this; ``None``: no limit.
+        anchors: give every node an SVG id from its place (``fsmbt.render.anchor_ids``): the
+            child-index path from the main root with ``expand_subtrees`` (the interpreter's
+            path, docs/semantics.md), else the tree's id and the path inside that tree.
 
     Returns:
         The DOT source text.
@@ -76,7 +86,7 @@ def bt_to_dot(doc: BTDocument, *, expand_subtrees: bool = False,
     root.attr(rankdir="TB", ordering="out", fontname=FONT, nodesep="0.25", ranksep="0.45")
     root.attr("node", fontname=FONT, fontsize="11", height="0.4")
     root.attr("edge", arrowsize="0.6", color="gray25")
-    builder = _Builder(doc, root, max_nodes, expand_subtrees)
+    builder = _Builder(doc, root, max_nodes, expand_subtrees, anchors)
     if expand_subtrees:
         main = doc.main
         builder.draw_tree(main.root, root, parent=None, path=(main.id,))
@@ -96,8 +106,9 @@ def bt_to_dot(doc: BTDocument, *, expand_subtrees: bool = False,
 
 class _Builder:
     def __init__(self, doc: BTDocument, root: graphviz.Digraph, max_nodes: int | None,
-                 expanding: bool) -> None:
+                 expanding: bool, anchors: bool = False) -> None:
         self.doc = doc
+        self.anchors = anchors
         self.expanding = expanding
         self.root = root
         self.max_nodes = max_nodes
@@ -115,17 +126,20 @@ class _Builder:
         if top is None:
             graph.node(self.next_id("n"), label="(empty tree)", shape="plaintext")
             return
-        stack: list[tuple[BTNode, str | None, graphviz.Digraph, tuple[str, ...]]] = [
-            (top, parent, graph, path)]
+        stack: list[tuple[BTNode, str | None, graphviz.Digraph, tuple[str, ...], str]] = [
+            (top, parent, graph, path, "")]
         while stack:
-            node, parent_id, holder, trees = stack.pop()
+            node, parent_id, holder, trees, where = stack.pop()
             self.count += 1
             if self.max_nodes is not None and self.count > self.max_nodes:
                 raise TooLargeError(f"too large to draw: more than {self.max_nodes} nodes "
                                     f"(limit {self.max_nodes})",
                                     hints=(Hint.MAX_NODES, Hint.NO_EXPANSION))
             node_id = self.next_id("n")
-            holder.node(node_id, **node_attrs(node, recursive=node.subtree_id in trees))
+            attrs = node_attrs(node, recursive=node.subtree_id in trees)
+            if self.anchors:
+                attrs["id"] = node_anchor(where, None if self.expanding else trees[0])
+            holder.node(node_id, **attrs)
             if parent_id is not None:
                 self.edges.append((parent_id, node_id, {}))
             ref = node.subtree_id
@@ -136,8 +150,9 @@ class _Builder:
                 self.clusters.append((cluster, holder))
                 sub_root = self.doc.trees[ref].root
                 if sub_root is not None:
-                    stack.append((sub_root, node_id, cluster, (*trees, ref)))
-            stack.extend((child, node_id, holder, trees) for child in reversed(node.children))
+                    stack.append((sub_root, node_id, cluster, (*trees, ref), child_path(where, 0)))
+            stack.extend((child, node_id, holder, trees, child_path(where, index))
+                         for index, child in reversed(list(enumerate(node.children))))
 
     def finish(self) -> str:
         return assemble(self.root, self.clusters,

@@ -36,8 +36,16 @@ import graphviz
 
 from fsmbt.model.fsm import FSM, State
 from fsmbt.model.stats import fsm_stats
+from fsmbt.render.anchor_ids import START_ANCHOR, state_anchor
 from fsmbt.render.dot import (
-    DEFAULT_MAX_NODES, FONT, TooLargeError, assemble, check_size, dot_id, edge_line, label_text,
+    DEFAULT_MAX_NODES,
+    FONT,
+    TooLargeError,
+    assemble,
+    check_size,
+    dot_id,
+    edge_line,
+    label_text,
 )
 
 #: The initial point's id in exchange DOT when the model names no start pseudo-state; the
@@ -64,10 +72,11 @@ class _Level:
     prefix: str = ""  # large pictures: nested states are named by their path
     entry: str | None = None  # large pictures: the composite state's box, drawn instead of a point
     path: str = ""  # exchange DOT: the node-id prefix of this level's states
+    anchor: str = ""  # anchors: the composite-state path of this level ("Parent/"), no regions
 
 
 def fsm_to_dot(fsm: FSM, *, max_nodes: int | None = DEFAULT_MAX_NODES,
-               exchange: bool = False) -> str:
+               exchange: bool = False, anchors: bool = False) -> str:
     """DOT source of ``fsm``.
 
     Args:
@@ -76,6 +85,8 @@ def fsm_to_dot(fsm: FSM, *, max_nodes: int | None = DEFAULT_MAX_NODES,
             as many transitions), and nesting deeper than ``MAX_NESTING``; ``None``: no limit.
         exchange: write the DOT file format that ``fsmbt.formats.dot`` reads back (see the
             module docstring) instead of the picture's DOT.
+        anchors: give every state an SVG id from its name (``fsmbt.render.anchors``): atomic
+            and composite states ``s@Parent/child``, the top initial point ``start@``.
 
     Returns:
         The DOT source text.
@@ -113,13 +124,18 @@ def fsm_to_dot(fsm: FSM, *, max_nodes: int | None = DEFAULT_MAX_NODES,
             if state.is_atomic:
                 node_id = counter.state_id(level, state.name)
                 level.ids[state.name] = node_id
-                level.graph.node(node_id, **_state_attrs(state, title, compact=not layered))
+                attrs = _state_attrs(state, title, compact=not layered)
+                if anchors:
+                    attrs["id"] = state_anchor(level.anchor + state.name)
+                level.graph.node(node_id, **attrs)
                 continue
             if not layered:  # a box standing for the composite state, no cluster
                 node_id = counter.next("c")
+                extra = {"id": state_anchor(level.anchor + state.name)} if anchors else {}
                 level.graph.node(node_id, label=label_text(_state_title(state, title)),
-                                 shape="box", style="rounded,bold")
-                inner = [_Level(region, level.graph, prefix=f"{title}/", entry=node_id)
+                                 shape="box", style="rounded,bold", **extra)
+                inner = [_Level(region, level.graph, prefix=f"{title}/", entry=node_id,
+                                anchor=f"{level.anchor}{state.name}/")
                          for region in state.regions]
                 level.anchors[state.name] = (node_id, "")
                 pending.extend(reversed(inner))
@@ -127,6 +143,8 @@ def fsm_to_dot(fsm: FSM, *, max_nodes: int | None = DEFAULT_MAX_NODES,
             cluster = graphviz.Digraph(name=counter.next("cluster_"))
             cluster.attr(label=label_text(_state_title(state, state.name)), style="rounded",
                          color="gray30", fontname=FONT, fontsize="12", labeljust="l")
+            if anchors:
+                cluster.attr(id=state_anchor(level.anchor + state.name))
             clusters.append((cluster, level.graph))
             inner = []
             for index, region in enumerate(state.regions):
@@ -138,13 +156,14 @@ def fsm_to_dot(fsm: FSM, *, max_nodes: int | None = DEFAULT_MAX_NODES,
                                 color="gray50", fontname=FONT, fontsize="10")
                     clusters.append((holder, cluster))
                     path = f"{path}{index}:"
-                inner.append(_Level(region, holder, path=path))
+                inner.append(_Level(region, holder, path=path,
+                                    anchor=f"{level.anchor}{state.name}/"))
             # Arrows to/from the composite state end at its cluster, through its first initial point.
             level.anchors[state.name] = (_initial_point_id(inner[0], counter), cluster.name)
             pending.extend(reversed(inner))
 
     for level in levels:
-        _draw_initial(level, edges, counter, is_top=level is top)
+        _draw_initial(level, edges, counter, is_top=level is top, anchors=anchors)
         _draw_transitions(level, edges, exact=exchange)
 
     return assemble(root, clusters, [edge_line(tail, head, attrs) for tail, head, attrs in edges])
@@ -211,7 +230,8 @@ def _initial_point_id(level: _Level, counter: _Counter) -> str:
     return point
 
 
-def _draw_initial(level: _Level, edges: list, counter: _Counter, *, is_top: bool) -> None:
+def _draw_initial(level: _Level, edges: list, counter: _Counter, *, is_top: bool,
+                  anchors: bool = False) -> None:
     """The arrow from a point into the level's initial state (a composite state's point is
     its anchor and already exists)."""
     fsm = level.machine
@@ -226,6 +246,8 @@ def _draw_initial(level: _Level, edges: list, counter: _Counter, *, is_top: bool
         point = counter.point_id(level, is_top=True)
         level.ids["__initial_point__"] = point
         extra = {"xlabel": label_text(fsm.start_name)} if is_top and fsm.start_name else {}
+        if is_top and anchors:
+            extra["id"] = START_ANCHOR
         level.graph.node(point, label="", shape="point", width="0.12", **extra)
     attrs: dict[str, str] = {}
     if is_top and fsm.initial_event is not None:

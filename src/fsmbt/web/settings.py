@@ -1,0 +1,54 @@
+"""The web server's settings: limits, folders, workers (docs/web.md, 'Limits').
+
+Defaults are safe for a page on a developer's machine: 2 MB request bodies, 30 s per
+conversion or verification, two worker processes, the repository's ``examples/`` folder, no
+report folder. Nothing here comes from a request.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import fsmbt
+
+#: Largest request body accepted (bytes).
+DEFAULT_MAX_BODY_BYTES = 2 * 1024 * 1024
+#: Wall seconds one conversion or verification may take in a worker.
+DEFAULT_TIMEOUT_S = 30.0
+#: Worker processes.
+DEFAULT_WORKERS = 2
+
+
+def default_examples_dir() -> Path | None:
+    """The ``examples/`` folder of the checkout fsmbt is installed from (``pip install -e .``),
+    or ``None`` when there is none (an installed wheel)."""
+    candidate = Path(fsmbt.__file__).resolve().parents[2] / "examples"
+    return candidate if candidate.is_dir() else None
+
+
+@dataclass(frozen=True)
+class WebSettings:
+    """What ``create_app`` needs.
+
+    Attributes:
+        max_body_bytes: requests with a larger body are refused with 413.
+        timeout_s: the wall-time limit of one conversion or verification.
+        workers: worker processes.
+        examples_dir: the folder whose model files the page offers as examples (``None``: none).
+        reports_dir: the folder of evaluation reports and batch stores browsed read-only
+            (``None``: browsing is off).
+    """
+
+    max_body_bytes: int = DEFAULT_MAX_BODY_BYTES
+    timeout_s: float = DEFAULT_TIMEOUT_S
+    workers: int = DEFAULT_WORKERS
+    examples_dir: Path | None = None
+    reports_dir: Path | None = None
+
+    @classmethod
+    def default(cls, **changes: object) -> WebSettings:
+        """The defaults, with the checkout's examples folder and ``changes`` applied."""
+        values: dict[str, object] = {"examples_dir": default_examples_dir()}
+        values.update(changes)
+        return cls(**values)  # type: ignore[arg-type]
