@@ -56,6 +56,14 @@ from fsmbt.verify.report import (
 
 #: Largest number of states (per machine, and of the product) explored before giving up.
 DEFAULT_MAX_STATES = 2_000_000
+
+
+class StateLimitError(InputError):
+    """A machine or the product has more reachable states than ``max_states`` allows.
+
+    An ``InputError`` (callers that only know that class still see bad input); the batch
+    runner tells it apart to record the model as over the state limit, not as malformed.
+    """
 _NO_OUTPUT: tuple[str, ...] = ()
 
 
@@ -97,7 +105,7 @@ class _Explored:
         if found is not None:
             return found
         if len(self.states) >= self.max_states:
-            raise InputError(
+            raise StateLimitError(
                 f"the {self.role} machine has more than {self.max_states} reachable states; "
                 "raise max_states or check the model for an unbounded counter",
                 element=getattr(self.machine, "name", self.role))
@@ -328,7 +336,7 @@ class _Product:
         if found is not None:
             return found
         if len(self.pair_s) >= self.max_states:
-            raise InputError(f"the product has more than {self.max_states} states; "
+            raise StateLimitError(f"the product has more than {self.max_states} states; "
                              "raise max_states")
         new_id = len(self.pair_s)
         self.index[key] = new_id
