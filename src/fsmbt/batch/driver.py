@@ -24,7 +24,7 @@ from pathlib import Path
 from typing import Any, Literal
 
 from fsmbt import api
-from fsmbt.batch.jobs import LIMIT_OPTIONS, Job
+from fsmbt.batch.jobs import LIMIT_OPTIONS, Job, public_options
 from fsmbt.batch.result import LIMIT, REFUSED, TIMEOUT, JobResult
 from fsmbt.batch.store import ResultStore
 from fsmbt.model.errors import InputError, SourceLocation
@@ -68,7 +68,7 @@ def refused_destination(job: Job) -> JobResult:
     error = api.DestinationExists(SourceLocation(str(job.output)))
     return JobResult(job.key, job.input, REFUSED, error_class="DestinationExists",
                      error_message=" ".join(str(error).split()), engine=job.engine,
-                     verify_engine=job.verify_engine, options=dict(job.options), retry=True)
+                     verify_engine=job.verify_engine, options=public_options(job.options), retry=True)
 
 
 def _prepare(store: ResultStore | None, job: Job) -> Job | JobResult:

@@ -18,7 +18,8 @@ Rules (docs/batch.md, "Inputs and outputs"):
 - ``Job.key`` is a content hash of the input and a hash of what decides the result (engine,
   verifier, options, output name); it is what the store remembers. The per-model limits
   (``timeout_s``, ``max_states``) are not part of it, so a second run with larger limits
-  re-runs exactly the rows that hit the old ones (``fsmbt.batch.driver``).
+  re-runs exactly the rows that hit the old ones (``fsmbt.batch.driver``); nor are the LLM
+  endpoint's address and request timeout (``ENDPOINT_OPTIONS``): the model's name is.
 
 Costs: ``make_jobs`` reads every input once (hashing, at most ``MAX_INPUT_BYTES`` + 1 bytes
 each) and sniffs its first ``SNIFF_BYTES``; nothing is parsed except the small ``kind`` probe
@@ -44,6 +45,12 @@ from fsmbt.model.errors import InputError
 
 #: Options that bound the work on one model; not part of a job's key (see the module text).
 LIMIT_OPTIONS = ("timeout_s", "max_states")
+#: Options that say how to reach an LLM, not which model answers; not part of a job's key.
+#: (``llm_model`` is.) The same model at another address, or with another request timeout,
+#: resumes the same rows.
+ENDPOINT_OPTIONS = ("llm_base_url", "llm_timeout", "llm_log", "llm_api_key")
+#: Options never written to the store (secrets).
+SECRET_OPTIONS = ("llm_api_key",)
 #: Extensions of prose formats: in a folder they are taken only when the content is claimed.
 PROSE_EXTENSIONS = (".md", ".markdown", ".txt")
 #: How much of a file the content sniffers see when a folder is walked.
@@ -93,6 +100,11 @@ class Job:
         return {name: self.options[name] for name in LIMIT_OPTIONS if name in self.options}
 
 
+def public_options(options: dict[str, Any]) -> dict[str, Any]:
+    """``options`` without the secrets (what the store may keep)."""
+    return {k: v for k, v in options.items() if k not in SECRET_OPTIONS}
+
+
 def content_hash(path: str | Path) -> str:
     """SHA-256 of a file's first ``MAX_INPUT_BYTES`` + 1 bytes and its size, in hex.
 
@@ -138,7 +150,8 @@ def job_key(input_path: str, output: str | None, engine: str, verify_engine: str
     """
     settings = {
         "engine": engine, "verify": verify_engine,
-        "options": {k: v for k, v in sorted(options.items()) if k not in LIMIT_OPTIONS},
+        "options": {k: v for k, v in sorted(options.items())
+                    if k not in LIMIT_OPTIONS and k not in ENDPOINT_OPTIONS},
         "output": Path(output).name if output is not None else Path(input_path).name,
     }
     encoded = json.dumps(settings, sort_keys=True, default=str).encode()

@@ -29,7 +29,7 @@ from collections.abc import Callable, Iterable
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
 
-from fsmbt.batch.jobs import Job
+from fsmbt.batch.jobs import Job, public_options
 from fsmbt.batch.result import ERROR, TIMEOUT, JobResult
 from fsmbt.batch.worker import run_job
 
@@ -47,7 +47,7 @@ def worker_died(job: Job, attempts: int) -> JobResult:
     return JobResult(job.key, job.input, ERROR, error_class="WorkerDied",
                      error_message=f"{job.input}: the worker process died {attempts} time(s) "
                      "while converting this input", engine=job.engine,
-                     verify_engine=job.verify_engine, options=dict(job.options),
+                     verify_engine=job.verify_engine, options=public_options(job.options),
                      attempts=attempts, retry=True)
 
 
@@ -56,7 +56,7 @@ def overran(job: Job, seconds: float) -> JobResult:
     return JobResult(job.key, job.input, TIMEOUT, error_class="JobTimeout",
                      error_message=f"{job.input}: no result after {seconds:.0f} s; the worker "
                      "was stopped", timings={"total": seconds}, engine=job.engine,
-                     verify_engine=job.verify_engine, options=dict(job.options))
+                     verify_engine=job.verify_engine, options=public_options(job.options))
 
 
 def _hard_deadline(job: Job) -> float | None:

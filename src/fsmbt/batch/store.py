@@ -25,7 +25,7 @@ from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
 
-from fsmbt.batch.jobs import Job
+from fsmbt.batch.jobs import Job, public_options
 from fsmbt.batch.result import STATUSES, JobResult
 
 SCHEMA_VERSION = 1
@@ -101,7 +101,7 @@ class ResultStore:
                     "INSERT INTO results (key, input, state, output, engine, verify_engine, "
                     "options) VALUES (?, ?, 'pending', ?, ?, ?, ?) ON CONFLICT(key) DO NOTHING",
                     (job.key, job.input, job.output, job.engine, job.verify_engine,
-                     json.dumps(job.options, sort_keys=True, default=str)))
+                     json.dumps(public_options(job.options), sort_keys=True, default=str)))
 
     def _transaction(self) -> _Transaction:
         return _Transaction(self._db)

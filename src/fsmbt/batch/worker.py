@@ -35,7 +35,7 @@ from types import FrameType
 from typing import Any
 
 from fsmbt import api
-from fsmbt.batch.jobs import Job
+from fsmbt.batch.jobs import Job, public_options
 from fsmbt.batch.ratelimit import MinuteRateLimit, RateLimitedClient
 from fsmbt.batch.result import (
     BAD_INPUT,
@@ -169,7 +169,7 @@ def run_job(job: Job) -> JobResult:
     started = time.perf_counter()
     timings: dict[str, float] = {}
     result = JobResult(job.key, job.input, ERROR, engine=job.engine,
-                       verify_engine=job.verify_engine, options=dict(job.options))
+                       verify_engine=job.verify_engine, options=public_options(job.options))
     options = {k: v for k, v in job.options.items()}
     try:
         with time_limit(job.options.get("timeout_s")):
