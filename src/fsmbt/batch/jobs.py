@@ -271,9 +271,9 @@ def expand_inputs(inputs: Sequence[str | Path], *, skip: Path | None = None) -> 
                     found.skipped.append(child)
         elif glob.has_magic(text):
             matches = sorted(glob.glob(text, recursive=True))
-            files = [Path(m) for m in matches if not Path(m).is_dir()]
-            for match in files:
-                add(match)
+            for match in matches:
+                if not Path(match).is_dir():
+                    add(Path(match))
             for match in matches:
                 if Path(match).is_dir():
                     for child in _walk(Path(match), skip_resolved):

@@ -114,7 +114,7 @@ class LocalExecutor:
         pool = self._pool()
         try:
             while queue or out:
-                batch = []
+                batch: list[tuple[Job, int]] = []
                 while queue and len(out) + len(batch) < limit:
                     batch.append(queue.popleft())
                 if batch:

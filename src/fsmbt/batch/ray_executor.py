@@ -44,7 +44,7 @@ def _import_ray() -> Any:
     try:
         import ray
     except ImportError:  # pragma: no cover - ray is a dependency; a broken install says so
-        raise InputError("the Ray executor needs the 'ray' package (pip install ray)") from None
+        raise InputError("the Ray executor needs the 'ray' package (pip install 'fsmbt[ray]')") from None
     return ray
 
 
