@@ -31,7 +31,7 @@ from concurrent.futures.process import BrokenProcessPool
 
 from fsmbt.batch.jobs import Job, public_options
 from fsmbt.batch.result import ERROR, TIMEOUT, JobResult
-from fsmbt.batch.worker import run_job
+from fsmbt.batch.worker import run_job, warm_up
 
 #: Seconds a job may run past twice its time limit before the watchdog kills its worker.
 WATCHDOG_GRACE_S = 30.0
@@ -84,7 +84,8 @@ class LocalExecutor:
 
     def _pool(self) -> ProcessPoolExecutor:
         return ProcessPoolExecutor(max_workers=self.workers, mp_context=self._context,
-                                   max_tasks_per_child=self.max_tasks_per_child)
+                                   max_tasks_per_child=self.max_tasks_per_child,
+                                   initializer=warm_up)
 
     def _pool_pids(self) -> list[int]:
         pids = [p.pid for p in multiprocessing.active_children()

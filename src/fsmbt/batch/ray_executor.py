@@ -28,7 +28,7 @@ from typing import Any
 from fsmbt.batch.jobs import Job
 from fsmbt.batch.local import Claim, Deliver, worker_died
 from fsmbt.batch.result import JobResult
-from fsmbt.batch.worker import run_job
+from fsmbt.batch.worker import run_job, warm_up
 from fsmbt.model.errors import InputError
 
 #: Jobs per Ray task.
@@ -37,6 +37,7 @@ DEFAULT_CHUNK = 8
 
 def run_chunk(jobs: list[Job]) -> list[JobResult]:
     """Run jobs one after another in this worker (the body of the Ray task)."""
+    warm_up()
     return [run_job(job) for job in jobs]
 
 
