@@ -55,7 +55,9 @@ def test_an_existing_output_is_kept_without_force(tmp_path: Path,
     mine.write_text("keep me", encoding="utf-8")
     args = ["batch", str(EXAMPLES / "robot_bt.xml"), "-o", str(out), "--quiet"]
     assert main(args) == 2
-    assert "refused" in capsys.readouterr().out and mine.read_text(encoding="utf-8") == "keep me"
+    table = capsys.readouterr().out
+    assert "refused" in table and "--force" in table
+    assert mine.read_text(encoding="utf-8") == "keep me"
     assert main([*args, "--force"]) == 0
     assert api.load(mine).kind == "fsm"
 

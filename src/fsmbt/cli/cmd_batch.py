@@ -40,9 +40,10 @@ from fsmbt.batch.result import (
     REFUSED,
     TIMEOUT,
 )
+from fsmbt.cli.hints import CLI_WORDING
 from fsmbt.cli.options import node_models_option, reader_options
 from fsmbt.llm.config import PROVIDERS
-from fsmbt.model.errors import InputError, SourceLocation
+from fsmbt.model.errors import HINT_TEXT, InputError, SourceLocation
 
 PROVIDER_NAMES = ", ".join(sorted(PROVIDERS))
 #: How many refused / failed inputs the final table lists before "... and N more".
@@ -114,6 +115,14 @@ class BatchProgress:
             self._progress.stop()
 
 
+def cli_reason(result: JobResult) -> str:
+    """A row's reason with the library's hints worded as this CLI's flags (``cli/hints.py``)."""
+    text = result.reason
+    for hint, words in HINT_TEXT.items():
+        text = text.replace(words, CLI_WORDING[hint])
+    return text
+
+
 def print_table(results: list[JobResult], summary: dict[str, Any]) -> None:
     """The final table on stdout: counts, refused and failed inputs, the slowest inputs."""
     from rich.console import Console
@@ -138,7 +147,7 @@ def print_table(results: list[JobResult], summary: dict[str, Any]) -> None:
         table.add_column("status")
         table.add_column("reason", overflow="fold")
         for row in rows[:LISTED]:
-            table.add_row(row.input, row.status.replace("_", " "), row.reason)
+            table.add_row(row.input, row.status.replace("_", " "), cli_reason(row))
         console.print(table)
         if len(rows) > LISTED:
             console.print(f"... and {len(rows) - LISTED} more ({title}); --json lists all")
