@@ -81,3 +81,22 @@ def test_an_existing_output_is_a_refused_row_and_force_replaces_it(tmp_path: Pat
         assert [r.key for r in again] == [jobs[0].key] and again[0].status == "equivalent"
         source = api.load(jobs[0].input).model
         assert api.verify_either_order(source, api.load(taken).model).equivalent
+
+
+def test_a_claimed_job_replaces_its_own_output_and_stale_temporaries(tmp_path: Path) -> None:
+    """The driver died after the worker wrote (or half-wrote) and before the row was stored."""
+    write_models(tmp_path / "in", 1, nested=False)
+    out = tmp_path / "out"
+    [job] = make_jobs([tmp_path / "in"], out)
+    output = Path(job.output or "")
+    output.parent.mkdir(parents=True)
+    output.write_text("left by the killed run", encoding="utf-8")
+    stale = output.parent / f".{output.name}.abc123.tmp"
+    stale.write_text("half a fi", encoding="utf-8")
+    with ResultStore(out) as store:
+        store.claim([job])  # what the killed run had committed
+        [result] = run_jobs([job], store=store)
+        assert result.status == "equivalent" and len(store.results()) == 1
+    assert not stale.exists()
+    source = api.load(job.input).model
+    assert api.verify_either_order(source, api.load(output).model).equivalent

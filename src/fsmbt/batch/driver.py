@@ -9,6 +9,8 @@ Rules (docs/batch.md, "Resume"):
   ``refused`` (``DestinationExists``) and nothing runs. Otherwise the job is claimed in the
   store and runs allowed to replace its output, which from then on can only be its own work
   (an earlier attempt, a worker that died, a driver that was killed after the write).
+- A claimed job whose earlier attempt was interrupted mid-write has its stale temporary file
+  removed before it runs again.
 - Each result is stored the moment it reaches the driver, then handed to ``on_result``.
 - LLM engines run on at most ``llm_concurrency`` workers (requests at once) and under the
   per-minute limit of ``fsmbt.batch.ratelimit``.
@@ -20,6 +22,7 @@ from __future__ import annotations
 
 import dataclasses
 from collections.abc import Callable, Sequence
+from glob import escape as glob_escape
 from pathlib import Path
 from typing import Any, Literal
 
@@ -71,12 +74,36 @@ def refused_destination(job: Job) -> JobResult:
                      verify_engine=job.verify_engine, options=public_options(job.options), retry=True)
 
 
+def remove_stale_temporaries(output: Path) -> int:
+    """Delete the temporary files an interrupted atomic write of ``output`` left behind.
+
+    ``fsmbt.api.write_text`` writes ``.<name>.<random>.tmp`` beside the output and renames it;
+    a worker killed between the two leaves it. Only called for a job this batch claimed.
+
+    Returns:
+        How many files were removed.
+    """
+    removed = 0
+    try:
+        for stale in output.parent.glob(f".{glob_escape(output.name)}.*.tmp"):
+            try:
+                stale.unlink()
+                removed += 1
+            except OSError:
+                continue
+    except OSError:
+        return removed
+    return removed
+
+
 def _prepare(store: ResultStore | None, job: Job) -> Job | JobResult:
     """The job as it runs (allowed to replace its own output), or the refusal row."""
     if job.output is None or job.overwrite:
         return job
     output = Path(job.output)
     ours = store is not None and store.pending_output(job.key)
+    if ours:
+        remove_stale_temporaries(output)
     if output.exists() and not ours:
         if output.is_dir():
             return dataclasses.replace(job)  # the worker's row names the problem

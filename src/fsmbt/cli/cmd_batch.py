@@ -123,6 +123,16 @@ def cli_reason(result: JobResult) -> str:
     return text
 
 
+def shown_path(path: str | None) -> str:
+    """``path`` relative to the current folder when it lies inside it (shorter tables)."""
+    if path is None:
+        return ""
+    try:
+        return str(Path(path).resolve().relative_to(Path.cwd()))
+    except (ValueError, OSError):
+        return path
+
+
 def print_table(results: list[JobResult], summary: dict[str, Any]) -> None:
     """The final table on stdout: counts, refused and failed inputs, the slowest inputs."""
     from rich.console import Console
@@ -147,7 +157,7 @@ def print_table(results: list[JobResult], summary: dict[str, Any]) -> None:
         table.add_column("status")
         table.add_column("reason", overflow="fold")
         for row in rows[:LISTED]:
-            table.add_row(row.input, row.status.replace("_", " "), cli_reason(row))
+            table.add_row(shown_path(row.input), row.status.replace("_", " "), cli_reason(row))
         console.print(table)
         if len(rows) > LISTED:
             console.print(f"... and {len(rows) - LISTED} more ({title}); --json lists all")
@@ -158,7 +168,7 @@ def print_table(results: list[JobResult], summary: dict[str, Any]) -> None:
         slow.add_column("seconds", justify="right")
         slow.add_column("status")
         for row in timed[:SLOWEST]:
-            slow.add_row(row.input, f"{row.seconds:.3f}", row.status.replace("_", " "))
+            slow.add_row(shown_path(row.input), f"{row.seconds:.3f}", row.status.replace("_", " "))
         console.print(slow)
     console.print(f"store: {summary['store']} ({summary['bytes']} bytes)")
 
