@@ -91,3 +91,28 @@ def test_the_corpus_malformed_files_are_rows_not_a_crash(
     assert {r["status"] for r in rows} == {"bad_input"}
     assert all(Path(r["input"]).name in r["error_message"] for r in rows)
     assert "Traceback" not in captured.err
+
+
+def test_the_progress_bar_counts_per_status_on_a_terminal(monkeypatch: pytest.MonkeyPatch,
+                                                          capsys: pytest.CaptureFixture[str]) -> None:
+    from fsmbt.batch import JobResult
+    from fsmbt.cli.cmd_batch import BatchProgress
+
+    monkeypatch.setattr("sys.stderr.isatty", lambda: True)
+    with BatchProgress(3, quiet=False) as progress:
+        assert progress.enabled
+        for status in ("equivalent", "bad_input", "equivalent"):
+            progress(JobResult("k", "x", status))
+        assert progress._describe() == "equivalent 2, bad input 1"
+    with BatchProgress(3, quiet=True) as quiet:
+        assert not quiet.enabled
+
+
+@pytest.mark.slow
+def test_the_ray_executor_from_the_command_line(tmp_path: Path,
+                                                capsys: pytest.CaptureFixture[str]) -> None:
+    out = tmp_path / "out"
+    assert main(["batch", str(EXAMPLES), "-o", str(out), "--executor", "ray", "-j", "2",
+                 "--chunk-size", "2", "--quiet", "--json"]) == 0
+    rows = json.loads(capsys.readouterr().out)["results"]
+    assert len(rows) == 7 and {r["status"] for r in rows} == {"equivalent"}
