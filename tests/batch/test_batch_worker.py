@@ -113,3 +113,15 @@ def test_no_verify_is_a_not_verified_row(tmp_path: Path) -> None:
                          verify_engine="none"))
     assert result.status == "not_verified" and result.properties == {}
     assert Path(result.output or "").exists()
+
+
+@pytest.mark.nusmv
+def test_both_verifiers_in_a_batch_row(tmp_path: Path) -> None:
+    from fsmbt.verify.nusmv.binary import find_nusmv
+
+    if find_nusmv() is None:
+        pytest.skip("NuSMV is not available (FSMBT_NUSMV, PATH or .cache/nusmv)")
+    result = run_job(Job(str(EXAMPLES / "paper_fsm.xml"), str(tmp_path / "p.xml"),
+                         verify_engine="both"))
+    assert result.status == "equivalent", result.error_message
+    assert result.verify_engine == "both" and all(result.properties.values())
