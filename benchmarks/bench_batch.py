@@ -45,6 +45,9 @@ from fsmbt.batch import ResultStore, make_jobs, run_jobs
 from fsmbt.generate import DatasetSpec, generate_models
 
 MB = 1024 * 1024
+#: Every this many results, a progress line goes to ``progress-<executor>-<workers>-<folder>.txt``
+#: in the scratch folder (figures of a run that is stopped before its end).
+PROGRESS_EVERY = 5000
 
 
 def build_folder(folder: Path, n: int) -> None:
@@ -103,10 +106,24 @@ def run_one(folder: Path, workers: int, executor: str, scratch: Path) -> dict[st
     if out.exists():
         shutil.rmtree(out)
     started = time.perf_counter()
-    with MemorySampler() as memory:
+    progress_file = scratch / f"progress-{executor}-{workers}-{folder.name}.txt"
+    with MemorySampler() as memory, progress_file.open("w", encoding="utf-8") as progress:
         jobs = make_jobs([folder], out)
+        done = [0]
+
+        def report(_result: object) -> None:
+            done[0] += 1
+            if done[0] % PROGRESS_EVERY == 0 or done[0] == len(jobs):
+                elapsed = time.perf_counter() - started
+                progress.write(f"{done[0]} of {len(jobs)} in {elapsed:.1f} s: "
+                               f"{done[0] / elapsed:.1f} models/s, driver "
+                               f"{driver_peak_mb():.0f} MB, worker {memory.worker_peak / MB:.0f}"
+                               f" MB, all {memory.total_peak / MB:.0f} MB\n")
+                progress.flush()
+
         with ResultStore(out) as store:
-            run_jobs(jobs, store=store, executor=executor, workers=workers, collect=False)
+            run_jobs(jobs, store=store, executor=executor, workers=workers, collect=False,
+                     on_result=report)
             statuses = Counter({k: v for k, v in store.summary()["statuses"].items() if v})
         store_bytes = ResultStore(out).size_bytes()
     seconds = time.perf_counter() - started

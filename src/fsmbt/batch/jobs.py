@@ -229,7 +229,7 @@ class Expanded:
     """The input files a list of arguments names, and what was left out.
 
     Attributes:
-        files: (file, the folder or parent it is mirrored relative to) in order, no repeats.
+        files: the input files in order, each once.
         skipped: files met in folders that no reader claims.
         missing: arguments that name nothing (a path or glob that matches no file).
     """
