@@ -2,7 +2,7 @@
 
 It listens on 127.0.0.1 on a free port, answers ``POST .../chat/completions`` with the next
 scripted step and records every request (headers and JSON body) so tests can assert what the
-client sent. It checks plumbing only; nothing it returns says anything about a real model.
+client sent (and when: ``time``, ``time.monotonic()`` on arrival). It checks plumbing only; nothing it returns says anything about a real model.
 
 A step is a dict: ``{"content": "..."}`` (a normal answer), ``{"status": 429, "headers":
 {...}}`` (an HTTP error), ``{"delay": 2.0, ...}`` (wait first), ``{"usage": False}`` (no usage
@@ -47,7 +47,7 @@ class ScriptedServer:
                     body = None
                 with server._lock:
                     server.requests.append({"path": self.path, "headers": dict(self.headers),
-                                            "body": body})
+                                            "body": body, "time": time.monotonic()})
                     index = min(len(server.requests) - 1, len(server.steps) - 1)
                     step = server.steps[index]
                 deadline = time.monotonic() + float(step.get("delay", 0))

@@ -59,6 +59,14 @@ from fsmbt.verify.report import (
 #: Largest number of states (per machine, and of the product) explored before giving up
 #: (the default lives in ``fsmbt.limits``: ``checker_max_states``).
 DEFAULT_MAX_STATES = Limits.checker_max_states
+
+
+class StateLimitError(InputError):
+    """A machine or the product has more reachable states than ``max_states`` allows.
+
+    An ``InputError`` (callers that only know that class still see bad input); the batch
+    runner tells it apart to record the model as over the state limit, not as malformed.
+    """
 _NO_OUTPUT: tuple[str, ...] = ()
 
 
@@ -100,7 +108,7 @@ class _Explored:
         if found is not None:
             return found
         if len(self.states) >= self.max_states:
-            raise InputError(
+            raise StateLimitError(
                 f"the {self.role} machine has more than {self.max_states} reachable states; "
                 "raise max_states or check the model for an unbounded counter",
                 element=getattr(self.machine, "name", self.role))
@@ -331,7 +339,7 @@ class _Product:
         if found is not None:
             return found
         if len(self.pair_s) >= self.max_states:
-            raise InputError(f"the product has more than {self.max_states} states; "
+            raise StateLimitError(f"the product has more than {self.max_states} states; "
                              "raise max_states")
         new_id = len(self.pair_s)
         self.index[key] = new_id
