@@ -11,6 +11,7 @@ edit distances of the add-behaviour ``cases``, input representations, cost) -> `
 
 from __future__ import annotations
 
+import json
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -48,6 +49,19 @@ class EvaluationSettings:
         return QUICK_COUNT if self.quick else FULL_COUNT
 
 
+#: One JSON line per invocation in the report folder: a killed and resumed run shows each part.
+RUNS_FILE = "runs.jsonl"
+
+
+def _log_invocation(path: Path, settings: EvaluationSettings, summary: dict[str, Any]) -> None:
+    line = {"command": settings.command, "finished_at": time.strftime("%Y-%m-%d %H:%M:%S UTC",
+                                                                      time.gmtime()),
+            **{k: summary[k] for k in ("before", "ran", "after", "jobs")},
+            "seconds": round(summary["run_seconds"], 1)}
+    with open(path, "a", encoding="utf-8") as stream:
+        stream.write(json.dumps(line) + "\n")
+
+
 def evaluate(settings: EvaluationSettings, *, report: bool = True,
              progress: bool = True) -> dict[str, Any]:
     """Build the dataset, run and verify every method, write the report.
@@ -78,6 +92,7 @@ def evaluate(settings: EvaluationSettings, *, report: bool = True,
                          progress=progress)
     summary: dict[str, Any] = {"models": len(entries), "jobs": len(planned), **counts,
                                "run_seconds": time.perf_counter() - started}
+    _log_invocation(out / RUNS_FILE, settings, summary)
     if report:
         from fsmbt.evaluate.report import write_report
 

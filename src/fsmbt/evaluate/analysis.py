@@ -12,7 +12,7 @@ from __future__ import annotations
 import statistics
 from collections import defaultdict
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 from fsmbt import api
 from fsmbt.evaluate.dataset import Entry
@@ -63,14 +63,15 @@ def accuracy(table_rows: list[dict[str, Any]], methods: list[str]) -> list[dict[
             produced = [r for r in chosen if r["status"] in ("equivalent", "not_equivalent")]
             good = sum(r["status"] == "equivalent" for r in produced)
             low, high = wilson(good, len(produced))
-            out.append({"method": method, "group": group, "attempted": len(chosen),
+            row: dict[str, Any] = {"method": method, "group": group, "attempted": len(chosen),
                         "produced": len(produced), "equivalent": good,
                         "accuracy": good / len(produced) if produced else None,
                         "wilson_low": low, "wilson_high": high,
                         "refused": sum(r["status"] == "refused" for r in chosen),
                         "bad_input": sum(r["status"] == "bad_input" for r in chosen),
                         "error": sum(r["status"] in ("error", "limit", "timeout")
-                                     for r in chosen)})
+                                     for r in chosen)}
+            out.append(row)
     return out
 
 
@@ -161,13 +162,13 @@ def cost(table_rows: list[dict[str, Any]], methods: list[str]) -> list[dict[str,
             continue
         convert = sorted(r["timings"].get("convert", 0.0) for r in chosen)
         verify = sorted(r["timings"].get("verify", 0.0) for r in chosen)
-        out.append({"method": method, "n": len(chosen),
+        out.append(cast(dict[str, Any], {"method": method, "n": len(chosen),
                     "convert_median_s": statistics.median(convert),
                     "convert_p95_s": convert[int(0.95 * (len(convert) - 1))],
                     "convert_max_s": convert[-1],
                     "verify_median_s": statistics.median(verify),
                     "verify_p95_s": verify[int(0.95 * (len(verify) - 1))],
-                    "tokens": NOT_RUN})
+                    "tokens": NOT_RUN}))
     return out
 
 

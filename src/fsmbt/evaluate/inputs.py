@@ -17,12 +17,15 @@ from fsmbt import api
 from fsmbt.evaluate.plan import NOT_RUN, RULE_ENGINES
 from fsmbt.formats import dumps
 from fsmbt.llm.extract import needs_llm
+from fsmbt.model.fsm import FSM
 
 
 def write_representations(examples: Path, outdir: Path) -> list[tuple[str, Path]]:
     """Write the five representations of the predator FSM; return (name, file)."""
     outdir.mkdir(parents=True, exist_ok=True)
     model = api.load(examples / "predator_fsm.csv").model
+    if not isinstance(model, FSM):
+        raise ValueError("examples/predator_fsm.csv must hold an FSM")
     files = [("text file (paper text)", outdir / "predator.txt", dumps(model, "paper-text")),
              ("table (CSV)", outdir / "predator.csv", dumps(model, "csv")),
              ("table (Markdown)", outdir / "predator.md", dumps(model, "md"))]
@@ -51,17 +54,20 @@ def table(examples: Path, outdir: Path, llm_methods: list[str]) -> list[dict[str
         llm_needed = needs_llm(path)
         for method in (*RULE_ENGINES, *llm_methods):
             cell: dict[str, Any] = {"representation": name, "file": path.name, "method": method}
-            if llm_needed or method not in RULE_ENGINES:
+            if llm_needed:
                 cell.update(reader="LLM extraction (fsmbt.llm.extract.read_input)",
-                            text=NOT_RUN if method in RULE_ENGINES or not llm_methods
-                            else NOT_RUN)
+                            text=NOT_RUN)
+                out.append(cell)
+                continue
+            if method not in RULE_ENGINES:  # a parser reads it; the LLM converts it
+                cell.update(reader=f"{api.load(path).format} reader", text=NOT_RUN)
                 out.append(cell)
                 continue
             try:
                 outcome = api.convert_file(path, engine=method)
-                cell.update(reader=outcome.source.format, engine=method,
-                            verdict=outcome.verdict, text=f"{outcome.source.format} reader, "
-                            f"{method}, {outcome.verdict}")
+                cell.update(reader=f"{outcome.source.format} reader", engine=method,
+                            verdict=outcome.verdict,
+                            text=f"converted by {method}, native check: {outcome.verdict}")
             except Exception as exc:  # noqa: BLE001 - a cell that fails says why
                 cell.update(reader="?", text=f"error: {type(exc).__name__}: {exc}")
             out.append(cell)

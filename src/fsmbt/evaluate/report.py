@@ -164,6 +164,9 @@ def write_report(settings: Any, entries: list[Entry], planned: list[Planned],
            "models": len(entries), "jobs": len(planned), "rows_stored": len(table_rows),
            "run_seconds": round(summary.get("run_seconds", 0.0), 1),
            "written_at": time.strftime("%Y-%m-%d %H:%M:%S UTC", time.gmtime())}
+    runs_file = out / "runs.jsonl"
+    run["invocations"] = ([json.loads(line) for line in runs_file.read_text().splitlines()
+                           if line.strip()] if runs_file.exists() else [])
     (out / "tables.json").write_text(json.dumps(tables, indent=1, default=str) + "\n")
     (out / "run.json").write_text(json.dumps(run, indent=1) + "\n")
     (out / "rows.json").write_text(json.dumps(table_rows, default=str) + "\n")
@@ -192,6 +195,11 @@ def _markdown(run: dict[str, Any], entries: list[Entry], acc: list[dict[str, Any
              f"`{run['batch_runner']}`; {run['models']} models, {run['jobs']} jobs, "
              f"{run['rows_stored']} rows stored; run {run['run_seconds']} s.", "",
              "Versions: " + ", ".join(f"{k} {v}" for k, v in run["versions"].items()), "",
+             "Invocations of this report folder (a killed run resumes; rows are stored once "
+             "per key):", "",
+             _md_table(["finished", "stored before", "ran", "stored after", "jobs", "seconds"],
+                       [[i["finished_at"], i["before"], i["ran"], i["after"], i["jobs"],
+                         i["seconds"]] for i in run["invocations"]]), "",
              f"LLM methods (llm, nllm, SCP ablations): {run['llm_models']}.", ""]
     sources: dict[str, int] = {}
     for e in entries:

@@ -9,7 +9,12 @@ contract (local processes only). ``BATCH_SOURCE`` says which one ran; the report
 from __future__ import annotations
 
 try:
-    from fsmbt.batch import Job, JobResult, ResultStore, run_jobs
+    from fsmbt.batch import (  # type: ignore[import-untyped, unused-ignore]
+        Job,
+        JobResult,
+        ResultStore,
+        run_jobs,
+    )
 
     BATCH_SOURCE = "fsmbt.batch"
 except ImportError:  # the batch runner is not merged yet
