@@ -9,6 +9,7 @@ number; a second run resumes and runs nothing again.
 from __future__ import annotations
 
 import json
+import sqlite3
 from pathlib import Path
 
 import pytest
@@ -16,6 +17,7 @@ import pytest
 from fsmbt.cli import main
 from fsmbt.evaluate import EvaluationSettings, evaluate
 from fsmbt.evaluate.analysis import FORMULA_BAND
+from fsmbt.evaluate.dataset import build
 from fsmbt.evaluate.plan import NOT_RUN
 from fsmbt.evaluate.stats import fit_slope, wilson
 
@@ -80,6 +82,36 @@ def test_resume_runs_nothing_again(report: Path) -> None:
                  "--workers", "1", "--no-report", "--quiet", "--examples", str(EXAMPLES),
                  "--corpus", str(report / "no-corpus")])
     assert code == 0
+    last = json.loads((report / "runs.jsonl").read_text().splitlines()[-1])
+    assert last["ran"] == 0 and last["before"] == last["after"] == last["jobs"]
+
+
+def test_resume_after_lost_rows_runs_exactly_those(tmp_path: Path) -> None:
+    settings = EvaluationSettings(output=tmp_path, count=2, nusmv_sample=0, workers=2,
+                                  corpus=None, examples=None)
+    first = evaluate(settings, report=False, progress=False)
+    assert first["before"] == 0 and first["ran"] == first["after"] == first["jobs"] == 36
+    # a run killed mid-way: the rows it had not stored yet are missing
+    with sqlite3.connect(tmp_path / "results.sqlite") as db:
+        db.execute("DELETE FROM results WHERE rowid % 3 = 0")
+        left = db.execute("SELECT COUNT(*) FROM results").fetchone()[0]
+    second = evaluate(settings, report=False, progress=False)
+    assert second["before"] == left and second["ran"] == 36 - left and second["after"] == 36
+    with sqlite3.connect(tmp_path / "results.sqlite") as db:
+        assert db.execute("SELECT COUNT(*), COUNT(DISTINCT key) FROM results").fetchone() == (36,
+                                                                                             36)
+
+
+def test_dataset_is_reproducible(tmp_path: Path) -> None:
+    one = build(tmp_path / "a", seed=5, count=4, examples=None, corpus=None)
+    two = build(tmp_path / "b", seed=5, count=4, examples=None, corpus=None)
+    other = build(tmp_path / "c", seed=6, count=4, examples=None, corpus=None)
+    assert [e.sha256 for e in one] == [e.sha256 for e in two]
+    assert [e.sha256 for e in one] != [e.sha256 for e in other]
+    shapes = [e.shape for e in one if e.kind == "fsm"]
+    assert shapes[:3] == ["chain", "tree", "loop"]
+    assert all(2 <= e.size["states"] <= 30 for e in one if e.kind == "fsm")
+    assert all(2 <= e.size["depth"] <= 10 for e in one if e.kind == "bt")
 
 
 def test_wilson_and_fit() -> None:
