@@ -27,21 +27,31 @@ EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 @pytest.fixture(scope="module")
 def report(tmp_path_factory: pytest.TempPathFactory) -> Path:
     out = tmp_path_factory.mktemp("evaluation")
-    settings = EvaluationSettings(output=out, quick=True, count=3, nusmv_sample=0, workers=1,
-                                  corpus=None, examples=EXAMPLES)
+    settings = EvaluationSettings(
+        output=out, quick=True, count=3, nusmv_sample=0, workers=1, corpus=None, examples=EXAMPLES
+    )
     evaluate(settings, progress=False)
     return out
 
 
 def test_report_folder_shape(report: Path) -> None:
-    for name in ("report.md", "report.html", "rows.csv", "rows.json", "tables.json",
-                 "run.json", "results.sqlite", "dataset/manifest.json", "dataset/manifest.csv"):
+    for name in (
+        "report.md",
+        "report.html",
+        "rows.csv",
+        "rows.json",
+        "tables.json",
+        "run.json",
+        "results.sqlite",
+        "dataset/manifest.json",
+        "dataset/manifest.csv",
+    ):
         assert (report / name).is_file(), name
     for plot in ("accuracy", "elements", "time"):
         assert (report / "plots" / f"{plot}.png").stat().st_size > 1000
         assert (report / "plots" / f"{plot}.svg").read_text().lstrip().startswith("<?xml")
     page = (report / "report.html").read_text()
-    assert page.count("<svg") == 3 and "src=\"http" not in page
+    assert page.count("<svg") == 3 and 'src="http' not in page
     run = json.loads((report / "run.json").read_text())
     assert run["command"] and run["versions"]["matplotlib"]
 
@@ -49,8 +59,7 @@ def test_report_folder_shape(report: Path) -> None:
 def test_rules_and_baselines_fully_verified(report: Path) -> None:
     tables = json.loads((report / "tables.json").read_text())
     for row in tables["accuracy"]:
-        if row["method"] in ("rules", "bsd", "chds") and row["group"] in ("basic", "robot",
-                                                                            "game"):
+        if row["method"] in ("rules", "bsd", "chds") and row["group"] in ("basic", "robot", "game"):
             assert row["produced"] == 6 and row["equivalent"] == 6, row
         if row["method"].startswith(("llm", "nllm")):
             assert row == {"method": row["method"], "group": row["group"], "text": NOT_RUN}
@@ -60,8 +69,10 @@ def test_elements_within_band_of_formulas(report: Path) -> None:
     rows = json.loads((report / "rows.json").read_text())
     generated_fsm = {r["model"] for r in rows if r["source"] == "generated" and r["kind"] == "fsm"}
     assert len(generated_fsm) == 9
-    formulas = {(f["direction"], f["method"]): f
-                for f in json.loads((report / "tables.json").read_text())["formulas"]}
+    formulas = {
+        (f["direction"], f["method"]): f
+        for f in json.loads((report / "tables.json").read_text())["formulas"]
+    }
     assert formulas[("fsm->bt", "bsd")]["max_abs_deviation_from_ours"] <= FORMULA_BAND
     assert formulas[("fsm->bt", "rules")]["within_band"] >= 0.9
     assert formulas[("fsm->bt", "chds")]["max_abs_deviation_from_ours"] <= FORMULA_BAND
@@ -78,17 +89,35 @@ def test_consistency_and_manifest(report: Path) -> None:
 
 
 def test_resume_runs_nothing_again(report: Path) -> None:
-    code = main(["evaluate", "-o", str(report), "--quick", "--count", "3", "--nusmv", "0",
-                 "--workers", "1", "--no-report", "--quiet", "--examples", str(EXAMPLES),
-                 "--corpus", str(report / "no-corpus")])
+    code = main(
+        [
+            "evaluate",
+            "-o",
+            str(report),
+            "--quick",
+            "--count",
+            "3",
+            "--nusmv",
+            "0",
+            "--workers",
+            "1",
+            "--no-report",
+            "--quiet",
+            "--examples",
+            str(EXAMPLES),
+            "--corpus",
+            str(report / "no-corpus"),
+        ]
+    )
     assert code == 0
     last = json.loads((report / "runs.jsonl").read_text().splitlines()[-1])
     assert last["ran"] == 0 and last["before"] == last["after"] == last["jobs"]
 
 
 def test_resume_after_lost_rows_runs_exactly_those(tmp_path: Path) -> None:
-    settings = EvaluationSettings(output=tmp_path, count=2, nusmv_sample=0, workers=2,
-                                  corpus=None, examples=None)
+    settings = EvaluationSettings(
+        output=tmp_path, count=2, nusmv_sample=0, workers=2, corpus=None, examples=None
+    )
     first = evaluate(settings, report=False, progress=False)
     assert first["before"] == 0 and first["ran"] == first["after"] == first["jobs"] == 36
     # a run killed mid-way: the rows it had not stored yet are missing
@@ -98,8 +127,10 @@ def test_resume_after_lost_rows_runs_exactly_those(tmp_path: Path) -> None:
     second = evaluate(settings, report=False, progress=False)
     assert second["before"] == left and second["ran"] == 36 - left and second["after"] == 36
     with sqlite3.connect(tmp_path / "results.sqlite") as db:
-        assert db.execute("SELECT COUNT(*), COUNT(DISTINCT key) FROM results").fetchone() == (36,
-                                                                                             36)
+        assert db.execute("SELECT COUNT(*), COUNT(DISTINCT key) FROM results").fetchone() == (
+            36,
+            36,
+        )
 
 
 def test_dataset_is_reproducible(tmp_path: Path) -> None:

@@ -54,16 +54,19 @@ RUNS_FILE = "runs.jsonl"
 
 
 def _log_invocation(path: Path, settings: EvaluationSettings, summary: dict[str, Any]) -> None:
-    line = {"command": settings.command, "finished_at": time.strftime("%Y-%m-%d %H:%M:%S UTC",
-                                                                      time.gmtime()),
-            **{k: summary[k] for k in ("before", "ran", "after", "jobs")},
-            "seconds": round(summary["run_seconds"], 1)}
+    line = {
+        "command": settings.command,
+        "finished_at": time.strftime("%Y-%m-%d %H:%M:%S UTC", time.gmtime()),
+        **{k: summary[k] for k in ("before", "ran", "after", "jobs")},
+        "seconds": round(summary["run_seconds"], 1),
+    }
     with open(path, "a", encoding="utf-8") as stream:
         stream.write(json.dumps(line) + "\n")
 
 
-def evaluate(settings: EvaluationSettings, *, report: bool = True,
-             progress: bool = True) -> dict[str, Any]:
+def evaluate(
+    settings: EvaluationSettings, *, report: bool = True, progress: bool = True
+) -> dict[str, Any]:
     """Build the dataset, run and verify every method, write the report.
 
     Args:
@@ -81,23 +84,37 @@ def evaluate(settings: EvaluationSettings, *, report: bool = True,
     out = settings.output
     out.mkdir(parents=True, exist_ok=True)
     corpus = settings.corpus if settings.corpus is not None and settings.corpus.is_dir() else None
-    entries = dataset.build(out / "dataset", seed=settings.seed, count=settings.per_kind,
-                            examples=settings.examples, corpus=corpus,
-                            corpus_limit=QUICK_CORPUS if settings.quick else None)
+    entries = dataset.build(
+        out / "dataset",
+        seed=settings.seed,
+        count=settings.per_kind,
+        examples=settings.examples,
+        corpus=corpus,
+        corpus_limit=QUICK_CORPUS if settings.quick else None,
+    )
     llm_models, _reason = plan.endpoint_models(settings.llm_models)
-    planned = plan.plan(entries, out, seed=settings.seed, nusmv_sample=settings.nusmv_sample,
-                        llm_models=llm_models)
-    counts = execute.run(planned, out / execute.STORE_FILE, workers=settings.workers,
-                         executor=settings.executor, ray_address=settings.ray_address,
-                         progress=progress)
-    summary: dict[str, Any] = {"models": len(entries), "jobs": len(planned), **counts,
-                               "run_seconds": time.perf_counter() - started}
+    planned = plan.plan(
+        entries, out, seed=settings.seed, nusmv_sample=settings.nusmv_sample, llm_models=llm_models
+    )
+    counts = execute.run(
+        planned,
+        out / execute.STORE_FILE,
+        workers=settings.workers,
+        executor=settings.executor,
+        ray_address=settings.ray_address,
+        progress=progress,
+    )
+    summary: dict[str, Any] = {
+        "models": len(entries),
+        "jobs": len(planned),
+        **counts,
+        "run_seconds": time.perf_counter() - started,
+    }
     _log_invocation(out / RUNS_FILE, settings, summary)
     if report:
         from fsmbt.evaluate.report import write_report
 
-        summary["report"] = str(write_report(settings, entries, planned, llm_models,
-                                             summary))
+        summary["report"] = str(write_report(settings, entries, planned, llm_models, summary))
     summary["seconds"] = time.perf_counter() - started
     return summary
 

@@ -51,8 +51,16 @@ class Job:
 
     def __post_init__(self) -> None:
         if not self.key:
-            settings = json.dumps([self.input, self.output, self.engine, self.verify_engine,
-                                   sorted(self.options.items())], default=str)
+            settings = json.dumps(
+                [
+                    self.input,
+                    self.output,
+                    self.engine,
+                    self.verify_engine,
+                    sorted(self.options.items()),
+                ],
+                default=str,
+            )
             object.__setattr__(self, "key", hashlib.sha256(settings.encode()).hexdigest()[:32])
 
     def __hash__(self) -> int:
@@ -81,46 +89,74 @@ class JobResult:
         return asdict(self)
 
 
-def make_jobs(inputs: Sequence[str | Path], outdir: Path, *, engine: str = "rules",
-              verify_engine: str = "native", options: dict[str, Any] | None = None,
-              to: str | None = None) -> list[Job]:
+def make_jobs(
+    inputs: Sequence[str | Path],
+    outdir: Path,
+    *,
+    engine: str = "rules",
+    verify_engine: str = "native",
+    options: dict[str, Any] | None = None,
+    to: str | None = None,
+) -> list[Job]:
     """One job per input file, outputs named after the inputs under ``outdir``."""
     job_options = dict(options or {})
     if to is not None:
         job_options["to"] = to
-    return [Job(str(path), str(Path(outdir) / f"{Path(path).name}.out"), engine, verify_engine,
-                dict(job_options)) for path in inputs]
+    return [
+        Job(
+            str(path),
+            str(Path(outdir) / f"{Path(path).name}.out"),
+            engine,
+            verify_engine,
+            dict(job_options),
+        )
+        for path in inputs
+    ]
 
 
 def run_job(job: Job) -> JobResult:
     """Convert and verify one input with ``fsmbt.api.convert_file``; problems become rows."""
     started = time.perf_counter()
-    result = JobResult(job.key, job.input, ERROR, engine=job.engine,
-                       verify_engine=job.verify_engine)
+    result = JobResult(
+        job.key, job.input, ERROR, engine=job.engine, verify_engine=job.verify_engine
+    )
     options = dict(job.options)
     try:
         outcome = api.convert_file(
-            job.input, job.output, to=options.pop("to", None),
-            source_format=options.pop("source_format", None), engine=job.engine,
+            job.input,
+            job.output,
+            to=options.pop("to", None),
+            source_format=options.pop("source_format", None),
+            engine=job.engine,
             loop=bool(options.pop("loop", False)),
             verify=job.verify_engine != "none",
             verify_engine=job.verify_engine if job.verify_engine != "none" else "native",
             max_states=int(options.pop("max_states", DEFAULT_MAX_STATES)),
-            overwrite=job.overwrite, keep_not_equivalent=bool(options.pop("keep_not_equivalent", False)),
-            options=options)
+            overwrite=job.overwrite,
+            keep_not_equivalent=bool(options.pop("keep_not_equivalent", False)),
+            options=options,
+        )
     except Exception as error:  # noqa: BLE001 - every problem of a model is a row
         name = type(error).__name__
-        result.status = (REFUSED if isinstance(error, UnsupportedError) else
-                         LIMIT if name == "StateLimitError" else
-                         BAD_INPUT if isinstance(error, InputError | RecursionError) else ERROR)
+        result.status = (
+            REFUSED
+            if isinstance(error, UnsupportedError)
+            else LIMIT
+            if name == "StateLimitError"
+            else BAD_INPUT
+            if isinstance(error, InputError | RecursionError)
+            else ERROR
+        )
         result.error_class = name
         result.error_message = " ".join(str(error).split()) or name
         result.timings = {"total": time.perf_counter() - started}
         return result
     result.timings = {**outcome.timings, "total": time.perf_counter() - started}
-    result.stats = {"conversion": outcome.conversion.stats,
-                    "direction": outcome.conversion.direction,
-                    "source_format": outcome.source.format}
+    result.stats = {
+        "conversion": outcome.conversion.stats,
+        "direction": outcome.conversion.direction,
+        "source_format": outcome.source.format,
+    }
     result.verdict = outcome.verdict
     if outcome.report is None:
         result.status = NOT_VERIFIED
@@ -140,26 +176,32 @@ class ResultStore:
         self.path.parent.mkdir(parents=True, exist_ok=True)
         self._db = sqlite3.connect(str(self.path))
         self._db.execute("PRAGMA journal_mode=WAL")
-        self._db.execute("CREATE TABLE IF NOT EXISTS results (key TEXT PRIMARY KEY, "
-                         "status TEXT, row TEXT)")
+        self._db.execute(
+            "CREATE TABLE IF NOT EXISTS results (key TEXT PRIMARY KEY, status TEXT, row TEXT)"
+        )
         self._db.commit()
 
     def put(self, result: JobResult) -> None:
         """Store (or replace) the row of ``result.key``."""
         with self._db:
-            self._db.execute("INSERT OR REPLACE INTO results VALUES (?, ?, ?)",
-                             (result.key, result.status, json.dumps(result.to_row())))
+            self._db.execute(
+                "INSERT OR REPLACE INTO results VALUES (?, ?, ?)",
+                (result.key, result.status, json.dumps(result.to_row())),
+            )
 
     def done(self, key: str) -> bool:
         """Whether a row for ``key`` is stored."""
-        return self._db.execute("SELECT 1 FROM results WHERE key = ?", (key,)).fetchone() \
-            is not None
+        return (
+            self._db.execute("SELECT 1 FROM results WHERE key = ?", (key,)).fetchone() is not None
+        )
 
     def results(self) -> list[JobResult]:
         """Every stored row."""
         names = set(JobResult.__dataclass_fields__)
-        return [JobResult(**{k: v for k, v in json.loads(text).items() if k in names})
-                for (text,) in self._db.execute("SELECT row FROM results ORDER BY rowid")]
+        return [
+            JobResult(**{k: v for k, v in json.loads(text).items() if k in names})
+            for (text,) in self._db.execute("SELECT row FROM results ORDER BY rowid")
+        ]
 
     def summary(self) -> dict[str, Any]:
         """Rows per status and the total."""
@@ -171,9 +213,11 @@ class ResultStore:
         self._db.close()
 
 
-_WARM_UP = ('{"kind": "fsm", "name": "warm_up", "initial": "A", "states": [{"name": "A", '
-            '"action": "a"}, {"name": "B", "action": "b"}], "transitions": [{"source": "A", '
-            '"event": "e", "target": "B"}, {"source": "B", "event": "f", "target": "A"}]}')
+_WARM_UP = (
+    '{"kind": "fsm", "name": "warm_up", "initial": "A", "states": [{"name": "A", '
+    '"action": "a"}, {"name": "B", "action": "b"}], "transitions": [{"source": "A", '
+    '"event": "e", "target": "B"}, {"source": "B", "event": "f", "target": "A"}]}'
+)
 
 
 def warm_up() -> None:
@@ -184,13 +228,21 @@ def warm_up() -> None:
         api.convert_loaded(api.load_text(outcome.text, outcome.output_format), engine=engine)
 
 
-def run_jobs(jobs: Sequence[Job], *, store: ResultStore | None = None,
-             executor: str = "local", workers: int = 1, ray_address: str | None = None,
-             on_result: Callable[[JobResult], None] | None = None) -> list[JobResult]:
+def run_jobs(
+    jobs: Sequence[Job],
+    *,
+    store: ResultStore | None = None,
+    executor: str = "local",
+    workers: int = 1,
+    ray_address: str | None = None,
+    on_result: Callable[[JobResult], None] | None = None,
+) -> list[JobResult]:
     """Run the jobs whose key is not in ``store``; store each result as it arrives."""
     if executor != "local":
-        raise InputError(f"the executor {executor!r} needs fsmbt.batch (issue 14); "
-                         "this stand-in runs local processes only")
+        raise InputError(
+            f"the executor {executor!r} needs fsmbt.batch (issue 14); "
+            "this stand-in runs local processes only"
+        )
     todo = [job for job in jobs if store is None or not store.done(job.key)]
     collected: list[JobResult] = []
 

@@ -33,47 +33,105 @@ GAME_BASE = """<Fallback>
 
 #: (scenario, case, the text replaced, its replacement) applied to the base tree's XML.
 CASES: tuple[tuple[str, str, str, str], ...] = (
-    ("robot", "Tuck Arm subtree",
-     "      <Fallback>\n        <RobotAtInspection/>",
-     "      <Fallback><ArmTucked/><TuckArm/></Fallback>\n"
-     "      <Fallback>\n        <RobotAtInspection/>"),
-    ("robot", "Safe-Move-To behaviour", "<MovetoDelivery/>",
-     "<Sequence><PathClear/><MovetoDelivery/></Sequence>"),
-    ("robot", "Dock subtree",
-     "<Fallback>\n        <RobotAtInspection/>\n        <Dock/>\n      </Fallback>",
-     "<Fallback><RobotDocked/><Sequence><Fallback><RobotAtInspection/><MovetoInspection/>"
-     "</Fallback><AlignWithDock/><Dock/></Sequence></Fallback>"),
-    ("game", "Fire subtree", "  <Patrol/>",
-     "  <Sequence><EnemyFar/><HasAmmo/><Aim/><Fire/></Sequence>\n  <Patrol/>"),
-    ("game", "Gliding behaviour", "  <Patrol/>",
-     "  <Sequence><Fallback><OnGround/><Glide/></Fallback><Patrol/></Sequence>"),
-    ("game", "Loading subtree", "  <Patrol/>",
-     "  <Sequence><AmmoEmpty/><Fallback><AtAmmoCrate/><MoveToAmmoCrate/></Fallback>"
-     "<LoadAmmo/></Sequence>\n  <Patrol/>"),
+    (
+        "robot",
+        "Tuck Arm subtree",
+        "      <Fallback>\n        <RobotAtInspection/>",
+        "      <Fallback><ArmTucked/><TuckArm/></Fallback>\n"
+        "      <Fallback>\n        <RobotAtInspection/>",
+    ),
+    (
+        "robot",
+        "Safe-Move-To behaviour",
+        "<MovetoDelivery/>",
+        "<Sequence><PathClear/><MovetoDelivery/></Sequence>",
+    ),
+    (
+        "robot",
+        "Dock subtree",
+        "<Fallback>\n        <RobotAtInspection/>\n        <Dock/>\n      </Fallback>",
+        "<Fallback><RobotDocked/><Sequence><Fallback><RobotAtInspection/><MovetoInspection/>"
+        "</Fallback><AlignWithDock/><Dock/></Sequence></Fallback>",
+    ),
+    (
+        "game",
+        "Fire subtree",
+        "  <Patrol/>",
+        "  <Sequence><EnemyFar/><HasAmmo/><Aim/><Fire/></Sequence>\n  <Patrol/>",
+    ),
+    (
+        "game",
+        "Gliding behaviour",
+        "  <Patrol/>",
+        "  <Sequence><Fallback><OnGround/><Glide/></Fallback><Patrol/></Sequence>",
+    ),
+    (
+        "game",
+        "Loading subtree",
+        "  <Patrol/>",
+        "  <Sequence><AmmoEmpty/><Fallback><AtAmmoCrate/><MoveToAmmoCrate/></Fallback>"
+        "<LoadAmmo/></Sequence>\n  <Patrol/>",
+    ),
 )
-CONDITIONS = {"BatteryBelow", "Cube2inDelivery", "CubeinHand", "RobotatCube2", "RobotatDelivery",
-              "RobotAtInspection", "ArmTucked", "PathClear", "RobotDocked", "EnemyVisible",
-              "EnemyInRange", "HealthLow", "EnemyFar", "HasAmmo", "OnGround", "AmmoEmpty",
-              "AtAmmoCrate"}
-ACTIONS = {"Recharge", "MovetoCube2", "Pickcube2", "MovetoDelivery", "PlaceCube2", "Dock",
-           "TuckArm", "MovetoInspection", "AlignWithDock", "MoveToEnemy", "Attack", "Retreat",
-           "Patrol", "Aim", "Fire", "Glide", "MoveToAmmoCrate", "LoadAmmo"}
+CONDITIONS = {
+    "BatteryBelow",
+    "Cube2inDelivery",
+    "CubeinHand",
+    "RobotatCube2",
+    "RobotatDelivery",
+    "RobotAtInspection",
+    "ArmTucked",
+    "PathClear",
+    "RobotDocked",
+    "EnemyVisible",
+    "EnemyInRange",
+    "HealthLow",
+    "EnemyFar",
+    "HasAmmo",
+    "OnGround",
+    "AmmoEmpty",
+    "AtAmmoCrate",
+}
+ACTIONS = {
+    "Recharge",
+    "MovetoCube2",
+    "Pickcube2",
+    "MovetoDelivery",
+    "PlaceCube2",
+    "Dock",
+    "TuckArm",
+    "MovetoInspection",
+    "AlignWithDock",
+    "MoveToEnemy",
+    "Attack",
+    "Retreat",
+    "Patrol",
+    "Aim",
+    "Fire",
+    "Glide",
+    "MoveToAmmoCrate",
+    "LoadAmmo",
+}
 METHODS = ("rules", "bsd", "chds")
 
 
 def _document(tree: str, name: str) -> str:
     models = "".join(f'<Condition ID="{c}"/>' for c in sorted(CONDITIONS))
     models += "".join(f'<Action ID="{a}"/>' for a in sorted(ACTIONS))
-    return (f'<?xml version="1.0" encoding="UTF-8"?>\n<root BTCPP_format="4" '
-            f'main_tree_to_execute="{name}">\n<BehaviorTree ID="{name}">\n{tree}\n'
-            f"</BehaviorTree>\n<TreeNodesModel>{models}</TreeNodesModel>\n</root>\n")
+    return (
+        f'<?xml version="1.0" encoding="UTF-8"?>\n<root BTCPP_format="4" '
+        f'main_tree_to_execute="{name}">\n<BehaviorTree ID="{name}">\n{tree}\n'
+        f"</BehaviorTree>\n<TreeNodesModel>{models}</TreeNodesModel>\n</root>\n"
+    )
 
 
 def robot_tree(examples: Path) -> str:
     """The ``<BehaviorTree>`` body of the robot example."""
     text = (examples / "robot_bt.xml").read_text(encoding="utf-8")
-    start = text.index("<BehaviorTree ID=\"RobotMission\">") + len("<BehaviorTree ID=\"RobotMission\">\n")
-    return text[start:text.index("  </BehaviorTree>")].rstrip("\n")
+    start = text.index('<BehaviorTree ID="RobotMission">') + len(
+        '<BehaviorTree ID="RobotMission">\n'
+    )
+    return text[start : text.index("  </BehaviorTree>")].rstrip("\n")
 
 
 @dataclass
@@ -110,8 +168,11 @@ def build_cases(examples: Path, outdir: Path) -> list[tuple[str, str, Path, Path
         base_path = outdir / f"{scenario}_base.xml"
         extended_path = outdir / f"{scenario}_{slug}.xml"
         api.write_text(_document(body, f"{scenario.title()}Base"), base_path, overwrite=True)
-        api.write_text(_document(body.replace(old, new, 1), f"{scenario.title()}Base"),
-                       extended_path, overwrite=True)
+        api.write_text(
+            _document(body.replace(old, new, 1), f"{scenario.title()}Base"),
+            extended_path,
+            overwrite=True,
+        )
         written.append((scenario, case, base_path, extended_path))
     return written
 
@@ -137,15 +198,39 @@ def measure(examples: Path, outdir: Path, *, timeout: float) -> list[CaseResult]
             try:
                 base_fsm = api.convert_model(base, method).model
                 extended_fsm = api.convert_model(extended, method).model
-                verdicts = [api.verify_models(base, base_fsm).equivalent,
-                            api.verify_models(extended, extended_fsm).equivalent]
+                verdicts = [
+                    api.verify_models(base, base_fsm).equivalent,
+                    api.verify_models(extended, extended_fsm).equivalent,
+                ]
                 distance = edit_distance(base_fsm, extended_fsm, timeout=timeout)
-                results.append(CaseResult(
-                    scenario, case, method, bt_edit, float(distance["value"]),
-                    bool(distance["exact"]), elements(extended_fsm).sub_fsms,
-                    elements(base_fsm).graphical, elements(extended_fsm).graphical,
-                    api.EQUIVALENT if all(verdicts) else api.NOT_EQUIVALENT))
+                results.append(
+                    CaseResult(
+                        scenario,
+                        case,
+                        method,
+                        bt_edit,
+                        float(distance["value"]),
+                        bool(distance["exact"]),
+                        elements(extended_fsm).sub_fsms,
+                        elements(base_fsm).graphical,
+                        elements(extended_fsm).graphical,
+                        api.EQUIVALENT if all(verdicts) else api.NOT_EQUIVALENT,
+                    )
+                )
             except Exception as exc:  # noqa: BLE001 - a failed case is a row, named
-                results.append(CaseResult(scenario, case, method, bt_edit, None, False, 0, 0,
-                                          0, "error", f"{type(exc).__name__}: {exc}"))
+                results.append(
+                    CaseResult(
+                        scenario,
+                        case,
+                        method,
+                        bt_edit,
+                        None,
+                        False,
+                        0,
+                        0,
+                        0,
+                        "error",
+                        f"{type(exc).__name__}: {exc}",
+                    )
+                )
     return results

@@ -40,8 +40,13 @@ from fsmbt.model.errors import FsmbtError
 FSM_STRUCTURES = ("chain", "tree", "loop")
 #: Files of the corpus that are models (SCION ``.json`` traces and notes are not).
 CORPUS_EXTENSIONS = (".xml", ".scxml", ".py")
-EXAMPLE_SCENARIOS = {"robot_bt": "robot", "game_npc_bt": "game", "guard_npc": "game",
-                     "predator_fsm": "game", "delivery_smach": "robot"}
+EXAMPLE_SCENARIOS = {
+    "robot_bt": "robot",
+    "game_npc_bt": "game",
+    "guard_npc": "game",
+    "predator_fsm": "game",
+    "delivery_smach": "robot",
+}
 #: What a full run generates per scenario and kind (the paper's 200).
 FULL_COUNT = 200
 
@@ -111,8 +116,7 @@ def generated(outdir: Path, seed: int, count: int) -> list[Entry]:
     """
     entries = []
     for scenario in SCENARIOS:
-        specs = {shape: DatasetSpec("fsm", scenario, seed, shape=shape)
-                 for shape in FSM_STRUCTURES}
+        specs = {shape: DatasetSpec("fsm", scenario, seed, shape=shape) for shape in FSM_STRUCTURES}
         for index in range(count):
             shape = FSM_STRUCTURES[index % len(FSM_STRUCTURES)]
             spec = specs[shape]
@@ -129,8 +133,17 @@ def _generated_entry(outdir: Path, spec: DatasetSpec, index: int, shape: str | N
     stem = spec.file_stem(index)
     path = outdir / "models" / spec.scenario / f"{stem}.json"
     _write_if_changed(path, dumps(model, "json"))
-    return Entry(stem, spec.scenario, spec.kind, "generated", str(path), sha256_of(path),
-                 seed=f"{spec.seed}:{index}", shape=shape, size=size_of(model))
+    return Entry(
+        stem,
+        spec.scenario,
+        spec.kind,
+        "generated",
+        str(path),
+        sha256_of(path),
+        seed=f"{spec.seed}:{index}",
+        shape=shape,
+        size=size_of(model),
+    )
 
 
 def real_entry(path: Path, source: str, scenario: str, ident: str) -> Entry:
@@ -160,8 +173,11 @@ def example_files(examples: Path) -> list[Path]:
 
 def corpus_files(corpus: Path, limit: int | None = None) -> list[Path]:
     """Every model file of the corpus (sorted; the first ``limit`` when given)."""
-    files = sorted(p for p in corpus.rglob("*") if p.is_file() and p.suffix in CORPUS_EXTENSIONS
-                   and "LICENSES" not in p.parts)
+    files = sorted(
+        p
+        for p in corpus.rglob("*")
+        if p.is_file() and p.suffix in CORPUS_EXTENSIONS and "LICENSES" not in p.parts
+    )
     return files[:limit] if limit is not None else files
 
 
@@ -171,13 +187,17 @@ def real(examples: Path | None, corpus: Path | None, corpus_limit: int | None) -
     if examples is not None and examples.is_dir():
         for path in example_files(examples):
             stem = path.name.split(".")[0]
-            entries.append(real_entry(path, "example", EXAMPLE_SCENARIOS.get(stem, "basic"),
-                                      f"example_{path.name}"))
+            entries.append(
+                real_entry(
+                    path, "example", EXAMPLE_SCENARIOS.get(stem, "basic"), f"example_{path.name}"
+                )
+            )
     if corpus is not None and corpus.is_dir():
         for path in corpus_files(corpus, corpus_limit):
             relative = path.relative_to(corpus).as_posix()
-            entries.append(real_entry(path, "corpus", "corpus",
-                                      "corpus_" + relative.replace("/", "__")))
+            entries.append(
+                real_entry(path, "corpus", "corpus", "corpus_" + relative.replace("/", "__"))
+            )
     return entries
 
 
@@ -185,8 +205,10 @@ def write_manifest(outdir: Path, entries: Iterable[Entry], settings: dict[str, A
     """Write ``manifest.json`` (settings + entries) and ``manifest.csv``; return the JSON path."""
     entries = list(entries)
     outdir.mkdir(parents=True, exist_ok=True)
-    _write_if_changed(outdir / "manifest.json", json.dumps(
-        {"settings": settings, "models": [asdict(e) for e in entries]}, indent=1) + "\n")
+    _write_if_changed(
+        outdir / "manifest.json",
+        json.dumps({"settings": settings, "models": [asdict(e) for e in entries]}, indent=1) + "\n",
+    )
     with open(outdir / "manifest.csv.tmp", "w", newline="", encoding="utf-8") as stream:
         writer = csv.DictWriter(stream, fieldnames=list(entries[0].to_row()) if entries else [])
         writer.writeheader()
@@ -196,8 +218,15 @@ def write_manifest(outdir: Path, entries: Iterable[Entry], settings: dict[str, A
     return outdir / "manifest.json"
 
 
-def build(outdir: Path, *, seed: int, count: int, examples: Path | None, corpus: Path | None,
-          corpus_limit: int | None = None) -> list[Entry]:
+def build(
+    outdir: Path,
+    *,
+    seed: int,
+    count: int,
+    examples: Path | None,
+    corpus: Path | None,
+    corpus_limit: int | None = None,
+) -> list[Entry]:
     """Build the whole dataset and its manifest.
 
     Args:
@@ -212,8 +241,15 @@ def build(outdir: Path, *, seed: int, count: int, examples: Path | None, corpus:
         Every entry, generated first.
     """
     entries = generated(outdir, seed, count) + real(examples, corpus, corpus_limit)
-    write_manifest(outdir, entries, {"seed": seed, "count_per_scenario_and_kind": count,
-                                     "examples": str(examples) if examples else None,
-                                     "corpus": str(corpus) if corpus else None,
-                                     "corpus_limit": corpus_limit})
+    write_manifest(
+        outdir,
+        entries,
+        {
+            "seed": seed,
+            "count_per_scenario_and_kind": count,
+            "examples": str(examples) if examples else None,
+            "corpus": str(corpus) if corpus else None,
+            "corpus_limit": corpus_limit,
+        },
+    )
     return entries

@@ -37,8 +37,15 @@ def _label(planned: Planned) -> str:
     return planned.method if planned.verifier == "native" else f"{planned.method}+nusmv"
 
 
-def run(planned: Sequence[Planned], store_path: Path, *, workers: int, executor: str = "local",
-        ray_address: str | None = None, progress: bool = True) -> dict[str, int]:
+def run(
+    planned: Sequence[Planned],
+    store_path: Path,
+    *,
+    workers: int,
+    executor: str = "local",
+    ray_address: str | None = None,
+    progress: bool = True,
+) -> dict[str, int]:
     """Run what the store does not hold yet.
 
     Args:
@@ -62,9 +69,15 @@ def run(planned: Sequence[Planned], store_path: Path, *, workers: int, executor:
         bars: Progress | None = None
         tasks: dict[str, TaskID] = {}
         if progress and sys.stderr.isatty() and todo:
-            bars = Progress(TextColumn("{task.description:>24}"), BarColumn(),
-                            MofNCompleteColumn(), TimeElapsedColumn(), TextColumn("ETA"),
-                            TimeRemainingColumn(), console=Console(stderr=True))
+            bars = Progress(
+                TextColumn("{task.description:>24}"),
+                BarColumn(),
+                MofNCompleteColumn(),
+                TimeElapsedColumn(),
+                TextColumn("ETA"),
+                TimeRemainingColumn(),
+                console=Console(stderr=True),
+            )
             for label, total in totals.items():
                 tasks[label] = bars.add_task(label, total=total, completed=done[label])
             bars.start()
@@ -77,8 +90,14 @@ def run(planned: Sequence[Planned], store_path: Path, *, workers: int, executor:
                 bars.advance(tasks[label_of[result.key]])
 
         try:
-            run_jobs(todo, store=store, executor=executor, workers=workers,
-                     ray_address=ray_address, on_result=on_result)
+            run_jobs(
+                todo,
+                store=store,
+                executor=executor,
+                workers=workers,
+                ray_address=ray_address,
+                on_result=on_result,
+            )
         finally:
             if bars is not None:
                 bars.stop()

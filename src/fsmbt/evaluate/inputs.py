@@ -26,9 +26,11 @@ def write_representations(examples: Path, outdir: Path) -> list[tuple[str, Path]
     model = api.load(examples / "predator_fsm.csv").model
     if not isinstance(model, FSM):
         raise ValueError("examples/predator_fsm.csv must hold an FSM")
-    files = [("text file (paper text)", outdir / "predator.txt", dumps(model, "paper-text")),
-             ("table (CSV)", outdir / "predator.csv", dumps(model, "csv")),
-             ("table (Markdown)", outdir / "predator.md", dumps(model, "md"))]
+    files = [
+        ("text file (paper text)", outdir / "predator.txt", dumps(model, "paper-text")),
+        ("table (CSV)", outdir / "predator.csv", dumps(model, "csv")),
+        ("table (Markdown)", outdir / "predator.md", dumps(model, "md")),
+    ]
     for _name, path, text in files:
         api.write_text(text, path, overwrite=True)
     picked = [(name, path) for name, path, _text in files]
@@ -41,8 +43,9 @@ def write_representations(examples: Path, outdir: Path) -> list[tuple[str, Path]
     picked.append(("image (PNG)", image))
     unseen = outdir / "predator.fsmnote"
     lines = [f"{t.source} ={t.event}=> {t.target}" for t in model.transitions]
-    api.write_text("predator machine, starts in Patrol\n" + "\n".join(lines) + "\n", unseen,
-                   overwrite=True)
+    api.write_text(
+        "predator machine, starts in Patrol\n" + "\n".join(lines) + "\n", unseen, overwrite=True
+    )
     picked.append(("unseen encoding", unseen))
     return picked
 
@@ -55,8 +58,7 @@ def table(examples: Path, outdir: Path, llm_methods: list[str]) -> list[dict[str
         for method in (*RULE_ENGINES, *llm_methods):
             cell: dict[str, Any] = {"representation": name, "file": path.name, "method": method}
             if llm_needed:
-                cell.update(reader="LLM extraction (fsmbt.llm.extract.read_input)",
-                            text=NOT_RUN)
+                cell.update(reader="LLM extraction (fsmbt.llm.extract.read_input)", text=NOT_RUN)
                 out.append(cell)
                 continue
             if method not in RULE_ENGINES:  # a parser reads it; the LLM converts it
@@ -65,9 +67,12 @@ def table(examples: Path, outdir: Path, llm_methods: list[str]) -> list[dict[str
                 continue
             try:
                 outcome = api.convert_file(path, engine=method)
-                cell.update(reader=f"{outcome.source.format} reader", engine=method,
-                            verdict=outcome.verdict,
-                            text=f"converted by {method}, native check: {outcome.verdict}")
+                cell.update(
+                    reader=f"{outcome.source.format} reader",
+                    engine=method,
+                    verdict=outcome.verdict,
+                    text=f"converted by {method}, native check: {outcome.verdict}",
+                )
             except Exception as exc:  # noqa: BLE001 - a cell that fails says why
                 cell.update(reader="?", text=f"error: {type(exc).__name__}: {exc}")
             out.append(cell)

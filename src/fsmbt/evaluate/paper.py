@@ -25,11 +25,19 @@ PAPER_NUMBERS: tuple[tuple[str, str, str], ...] = (
 
 #: The paper's coefficient of M for each (direction, method), for the fitted-slope table.
 PAPER_SLOPES: dict[tuple[str, str], float] = {
-    ("bt->fsm", "rules"): 4.0, ("bt->fsm", "bsd"): 36.0, ("bt->fsm", "chds"): 36.0,
-    ("fsm->bt", "rules"): 7.0, ("fsm->bt", "bsd"): 8.0, ("fsm->bt", "chds"): 8.0,
+    ("bt->fsm", "rules"): 4.0,
+    ("bt->fsm", "bsd"): 36.0,
+    ("bt->fsm", "chds"): 36.0,
+    ("fsm->bt", "rules"): 7.0,
+    ("fsm->bt", "bsd"): 8.0,
+    ("fsm->bt", "chds"): 8.0,
 }
 #: The paper's formula text per (direction, method).
 PAPER_FORMULAS: dict[tuple[str, str], str] = {
-    ("bt->fsm", "rules"): "4M+2k+1", ("bt->fsm", "bsd"): "≈36M", ("bt->fsm", "chds"): "≈36M",
-    ("fsm->bt", "rules"): "7M−1", ("fsm->bt", "bsd"): "8M+1", ("fsm->bt", "chds"): "8M+1+6k",
+    ("bt->fsm", "rules"): "4M+2k+1",
+    ("bt->fsm", "bsd"): "≈36M",
+    ("bt->fsm", "chds"): "≈36M",
+    ("fsm->bt", "rules"): "7M−1",
+    ("fsm->bt", "bsd"): "8M+1",
+    ("fsm->bt", "chds"): "8M+1+6k",
 }

@@ -73,14 +73,20 @@ def llm_method_names(models: list[str]) -> list[str]:
     return names
 
 
-def _job(entry: Entry, outdir: Path, method: str, engine: str, verifier: str,
-         options: dict[str, Any]) -> Planned:
+def _job(
+    entry: Entry, outdir: Path, method: str, engine: str, verifier: str, options: dict[str, Any]
+) -> Planned:
     folder = method if verifier == "native" else f"{method}-{verifier}"
     output = outdir / "outputs" / folder / f"{entry.id}.json"
-    job = Job(input=entry.path, output=str(output), engine=engine, verify_engine=verifier,
-              options={"to": "json", "keep_not_equivalent": True, "max_states": MAX_STATES,
-                       **options},
-              overwrite=True, key=f"{entry.id}|{method}|{verifier}|{entry.sha256[:16]}")
+    job = Job(
+        input=entry.path,
+        output=str(output),
+        engine=engine,
+        verify_engine=verifier,
+        options={"to": "json", "keep_not_equivalent": True, "max_states": MAX_STATES, **options},
+        overwrite=True,
+        key=f"{entry.id}|{method}|{verifier}|{entry.sha256[:16]}",
+    )
     return Planned(job, entry.id, method, verifier)
 
 
@@ -96,8 +102,9 @@ def _small(entry: Entry) -> bool:
     return entry.size.get("nodes", 0) <= NUSMV_MAX_NODES
 
 
-def plan(entries: list[Entry], outdir: Path, *, seed: int, nusmv_sample: int,
-         llm_models: list[str]) -> list[Planned]:
+def plan(
+    entries: list[Entry], outdir: Path, *, seed: int, nusmv_sample: int, llm_models: list[str]
+) -> list[Planned]:
     """Every job of the run, rule engines first (so the LLM's long jobs come last).
 
     Args:
@@ -111,19 +118,29 @@ def plan(entries: list[Entry], outdir: Path, *, seed: int, nusmv_sample: int,
         The planned jobs.
     """
     readable = [e for e in entries if e.readable]
-    planned = [_job(e, outdir, engine, engine, "native", {})
-               for engine in RULE_ENGINES for e in entries]
+    planned = [
+        _job(e, outdir, engine, engine, "native", {}) for engine in RULE_ENGINES for e in entries
+    ]
     pool = [e for e in readable if e.source == "generated" and _small(e)]
     sample = random.Random(f"nusmv:{seed}").sample(pool, min(nusmv_sample, len(pool)))
-    planned += [_job(e, outdir, engine, engine, "both", {})
-                for engine in RULE_ENGINES for e in sample]
+    planned += [
+        _job(e, outdir, engine, engine, "both", {}) for engine in RULE_ENGINES for e in sample
+    ]
     for model in llm_models:
         llm = {"llm_model": model}
         for e in readable:
             planned.append(_job(e, outdir, f"llm[{model}]", "llm", "native", llm))
             planned.append(_job(e, outdir, f"nllm[{model}]", "nllm", "native", llm))
-            direction_modules = (ABLATIONS[:2] if e.kind == "fsm" else ABLATIONS[2:])
+            direction_modules = ABLATIONS[:2] if e.kind == "fsm" else ABLATIONS[2:]
             for module in direction_modules:
-                planned.append(_job(e, outdir, f"llm-no-{module}[{model}]", "llm", "native",
-                                    {**llm, "ablate": [module]}))
+                planned.append(
+                    _job(
+                        e,
+                        outdir,
+                        f"llm-no-{module}[{model}]",
+                        "llm",
+                        "native",
+                        {**llm, "ablate": [module]},
+                    )
+                )
     return planned
