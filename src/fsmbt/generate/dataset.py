@@ -13,7 +13,7 @@ from __future__ import annotations
 from collections.abc import Iterator
 from dataclasses import dataclass
 
-from fsmbt.generate.generator import random_bt, random_fsm
+from fsmbt.generate.generator import FSM_SHAPES, random_bt, random_fsm
 from fsmbt.generate.vocab import SCENARIOS
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import InputError
@@ -42,6 +42,8 @@ class DatasetSpec:
         depth, breadth: BT shape; ``None`` draws each in [2, 10].
         extended: BTs also use Reactive/WithMemory controls, Parallel and decorators.
         max_nodes: BT node budget (soft: the spine of exactly ``depth`` levels is kept).
+        shape: FSM structure (``mixed``, ``chain``, ``tree`` = branches, ``loop``; see
+            ``random_fsm``); a run of one shape has the shape in its file stems.
     """
 
     kind: str
@@ -53,6 +55,7 @@ class DatasetSpec:
     breadth: int | None = None
     extended: bool = False
     max_nodes: int = DEFAULT_MAX_NODES
+    shape: str = "mixed"
 
     def check(self) -> None:
         """Raise ``InputError`` naming the first setting that is out of range."""
@@ -64,6 +67,9 @@ class DatasetSpec:
         if not 1 <= self.min_states <= self.max_states:
             raise InputError("the state range must satisfy 1 <= MIN <= MAX, not "
                              f"{self.min_states}-{self.max_states}")
+        if self.shape not in FSM_SHAPES:
+            raise InputError(f"the FSM shape must be one of {', '.join(FSM_SHAPES)}, "
+                             f"not {self.shape!r}")
         if self.max_nodes < 1:
             raise InputError(f"the node budget must be at least 1, not {self.max_nodes}")
 
@@ -71,13 +77,15 @@ class DatasetSpec:
         """The ``index``-th model of this run."""
         rng = model_seed(self.seed, index)
         if self.kind == "fsm":
-            return random_fsm(rng, None, self.scenario, min_states=self.min_states,
-                              max_states=self.max_states)
+            return random_fsm(rng, None, self.scenario, shape=self.shape,
+                              min_states=self.min_states, max_states=self.max_states)
         return random_bt(rng, self.depth, self.breadth, self.scenario, extended=self.extended,
                          max_nodes=self.max_nodes)
 
     def file_stem(self, index: int) -> str:
         """The file name (without extension) of the ``index``-th model."""
+        if self.kind == "fsm" and self.shape != "mixed":
+            return f"{self.kind}_{self.scenario}_{self.shape}_{self.seed}_{index:04d}"
         return f"{self.kind}_{self.scenario}_{self.seed}_{index:04d}"
 
 

@@ -1,0 +1,259 @@
+"""The report's tables, computed from the stored rows, the manifest and the result files.
+
+Every number here is measured on this run: accuracy = verified-equivalent results / results
+produced (refused and unreadable inputs are counted apart, never as successes), with Wilson
+95 % intervals (``stats.wilson``); elements are counted on the result files read back
+(``fsmbt.metrics.elements``); a method that did not run is the text ``NOT_RUN``.
+Cost: O(rows), plus reading every result file once.
+"""
+
+from __future__ import annotations
+
+import statistics
+from collections import defaultdict
+from pathlib import Path
+from typing import Any, cast
+
+from fsmbt import api
+from fsmbt.evaluate.dataset import Entry
+from fsmbt.evaluate.paper import PAPER_FORMULAS, PAPER_SLOPES
+from fsmbt.evaluate.plan import NOT_RUN, RULE_ENGINES, Planned
+from fsmbt.evaluate.stats import fit_slope, wilson
+from fsmbt.metrics import elements
+from fsmbt.metrics.formulas import bsd, chds, hfsm, lebt
+from fsmbt.verify import PROPERTIES
+
+GROUPS = ("basic", "robot", "game", "example", "corpus")
+#: Measured elements must lie within this relative band of our exact formulas (the test checks).
+FORMULA_BAND = 0.25
+
+
+def rows(planned: list[Planned], results: list[Any], entries: list[Entry]) -> list[dict[str, Any]]:
+    """One flat row per stored result, joined with its job and its model's manifest entry."""
+    by_key = {p.job.key: p for p in planned}
+    by_id = {e.id: e for e in entries}
+    joined = []
+    for result in results:
+        p = by_key.get(result.key)
+        if p is None:
+            continue
+        entry = by_id[p.entry_id]
+        joined.append(
+            {
+                "key": result.key,
+                "model": entry.id,
+                "scenario": entry.scenario,
+                "group": entry.scenario if entry.source == "generated" else entry.source,
+                "kind": entry.kind,
+                "source": entry.source,
+                "method": p.method,
+                "verifier": p.verifier,
+                "status": result.status,
+                "verdict": result.verdict,
+                "properties": dict(result.properties or {}),
+                "error_class": result.error_class,
+                "error_message": result.error_message,
+                "timings": dict(result.timings or {}),
+                "output": result.output,
+                "stats": dict(result.stats or {}),
+                "size": dict(entry.size),
+            }
+        )
+    return joined
+
+
+def accuracy(table_rows: list[dict[str, Any]], methods: list[str]) -> list[dict[str, Any]]:
+    """Per method and group: produced, equivalent, share with its Wilson interval, refused."""
+    out = []
+    for method in methods:
+        for group in (*GROUPS, "all"):
+            chosen = [
+                r
+                for r in table_rows
+                if r["method"] == method
+                and r["verifier"] == "native"
+                and (group == "all" or r["group"] == group)
+            ]
+            if method not in RULE_ENGINES and not chosen:
+                out.append({"method": method, "group": group, "text": NOT_RUN})
+                continue
+            produced = [r for r in chosen if r["status"] in ("equivalent", "not_equivalent")]
+            good = sum(r["status"] == "equivalent" for r in produced)
+            low, high = wilson(good, len(produced))
+            row: dict[str, Any] = {
+                "method": method,
+                "group": group,
+                "attempted": len(chosen),
+                "produced": len(produced),
+                "equivalent": good,
+                "accuracy": good / len(produced) if produced else None,
+                "wilson_low": low,
+                "wilson_high": high,
+                "refused": sum(r["status"] == "refused" for r in chosen),
+                "bad_input": sum(r["status"] == "bad_input" for r in chosen),
+                "error": sum(r["status"] in ("error", "limit", "timeout") for r in chosen),
+            }
+            out.append(row)
+    return out
+
+
+def consistency(
+    table_rows: list[dict[str, Any]], methods: list[str], models: tuple[str, ...]
+) -> list[dict[str, Any]]:
+    """The five properties per method on the named models (Tables III and VIII)."""
+    out = []
+    for model in models:
+        for method in methods:
+            found = [
+                r
+                for r in table_rows
+                if r["model"] == model and r["method"] == method and r["verifier"] == "native"
+            ]
+            if not found:
+                out.append({"model": model, "method": method, "text": NOT_RUN})
+                continue
+            row = found[0]
+            out.append(
+                {
+                    "model": model,
+                    "method": method,
+                    "status": row["status"],
+                    **{name: row["properties"].get(name) for name in PROPERTIES},
+                }
+            )
+    return out
+
+
+def _prediction(direction: str, method: str, m: int, k: int, t: int) -> int:
+    if direction == "fsm->bt":
+        return {"rules": lebt(m), "bsd": bsd(m), "chds": chds(m, t)}[method]
+    return hfsm(m, k) if method != "bsd" else hfsm(m, 0)
+
+
+def element_rows(table_rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """Graphical and active elements of every produced rule-engine result, with M and k."""
+    out = []
+    for r in table_rows:
+        if r["method"] not in RULE_ENGINES or r["verifier"] != "native" or not r["output"]:
+            continue
+        if r["status"] not in ("equivalent", "not_equivalent") or not Path(r["output"]).exists():
+            continue
+        result = elements(api.load(r["output"], "json").model)
+        conversion = r["stats"].get("conversion", {})
+        if r["kind"] == "fsm":
+            direction = "fsm->bt"
+            m = int(conversion.get("states", r["size"].get("states", 0)))
+            t = int(conversion.get("switches", conversion.get("transitions", 0)))
+        else:
+            direction = "bt->fsm"
+            m = int(r["size"].get("leaves", 0))
+            t = 0
+        k = result.sub_fsms
+        out.append(
+            {
+                "model": r["model"],
+                "group": r["group"],
+                "method": r["method"],
+                "direction": direction,
+                "M": m,
+                "k": k,
+                "graphical": result.graphical,
+                "active": result.active,
+                "ours": _prediction(direction, r["method"], m, k, t),
+                "seconds": r["timings"].get("convert", 0.0),
+                "source_graphical": r["size"].get("graphical", 0),
+            }
+        )
+    return out
+
+
+def formula_table(measured: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """Per direction and method: the fitted slope of graphical elements in M (with its
+    standard error) next to the paper's coefficient, and the deviation from our formula."""
+    groups: dict[tuple[str, str], list[dict[str, Any]]] = defaultdict(list)
+    for row in measured:
+        groups[(row["direction"], row["method"])].append(row)
+    out = []
+    for (direction, method), chosen in sorted(groups.items()):
+        x = [float(r["M"]) for r in chosen]
+        slope, error, intercept = fit_slope(x, [float(r["graphical"]) for r in chosen])
+        active_slope, active_error, _ = fit_slope(x, [float(r["active"]) for r in chosen])
+        deviations = [(r["graphical"] - r["ours"]) / r["ours"] for r in chosen if r["ours"]]
+        out.append(
+            {
+                "direction": direction,
+                "method": method,
+                "n": len(chosen),
+                "paper_formula": PAPER_FORMULAS[(direction, method)],
+                "paper_slope": PAPER_SLOPES[(direction, method)],
+                "fitted_slope": slope,
+                "slope_error": error,
+                "intercept": intercept,
+                "active_slope": active_slope,
+                "active_slope_error": active_error,
+                "mean_deviation_from_ours": statistics.fmean(deviations) if deviations else None,
+                "max_abs_deviation_from_ours": max(abs(d) for d in deviations)
+                if deviations
+                else None,
+                "within_band": (sum(abs(d) <= FORMULA_BAND for d in deviations) / len(deviations))
+                if deviations
+                else None,
+            }
+        )
+    return out
+
+
+def cost(table_rows: list[dict[str, Any]], methods: list[str]) -> list[dict[str, Any]]:
+    """Seconds per conversion and per verification, per method (tokens: LLM only)."""
+    out = []
+    for method in methods:
+        chosen = [
+            r
+            for r in table_rows
+            if r["method"] == method
+            and r["verifier"] == "native"
+            and r["status"] in ("equivalent", "not_equivalent")
+        ]
+        if not chosen:
+            out.append({"method": method, "text": NOT_RUN})
+            continue
+        convert = sorted(r["timings"].get("convert", 0.0) for r in chosen)
+        verify = sorted(r["timings"].get("verify", 0.0) for r in chosen)
+        out.append(
+            cast(
+                dict[str, Any],
+                {
+                    "method": method,
+                    "n": len(chosen),
+                    "convert_median_s": statistics.median(convert),
+                    "convert_p95_s": convert[int(0.95 * (len(convert) - 1))],
+                    "convert_max_s": convert[-1],
+                    "verify_median_s": statistics.median(verify),
+                    "verify_p95_s": verify[int(0.95 * (len(verify) - 1))],
+                    "tokens": NOT_RUN,
+                },
+            )
+        )
+    return out
+
+
+def nusmv_table(table_rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """The NuSMV sample: per method, rows checked by native and NuSMV together."""
+    out = []
+    for method in RULE_ENGINES:
+        chosen = [r for r in table_rows if r["method"] == method and r["verifier"] == "both"]
+        out.append(
+            {
+                "method": method,
+                "sampled": len(chosen),
+                "both_equivalent": sum(r["status"] == "equivalent" for r in chosen),
+                "not_equivalent": sum(r["status"] == "not_equivalent" for r in chosen),
+                "not_encodable_or_error": sum(
+                    r["status"] not in ("equivalent", "not_equivalent") for r in chosen
+                ),
+                "reasons": sorted(
+                    {(r["error_message"] or "")[:90] for r in chosen if r["error_message"]}
+                )[:3],
+            }
+        )
+    return out
