@@ -352,6 +352,5 @@ def _event_agent(model: FSM | BTDocument, events: list[str], engine: str,
         raise InputError(f"{where}: an event-driven role needs an FSM or a BT converted from one "
                          "(LEBT, BSD, CHDS); this is a plain BT")
     if engine in ("btcpp", "py_trees"):
-        return EngineEventAgent(EngineAsMachine(_converted_machine(model, events, engine)()).run,
-                                engine)
+        return EngineEventAgent(_converted_machine(model, events, engine)().run, engine)
     return MachineEventAgent(_converted_machine(model, events, engine)(), engine)

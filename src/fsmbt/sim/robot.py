@@ -123,6 +123,9 @@ class RobotWorld:
         self._running = (behaviour, steps + 1) if outcome == RUNNING else None
         return outcome
 
+    def agent_terminated(self, role: str) -> None:
+        """Not used: the robot is leaf-driven (its end is its root's SUCCESS)."""
+
     def root_result(self, role: str, result: str) -> None:
         """The robot's tree returned ``result``: SUCCESS ends the mission; FAILURE is retried
         from the root on the next step."""

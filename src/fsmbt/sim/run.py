@@ -79,6 +79,8 @@ def run_episode(world: World, side: Side, seed: int) -> Trajectory:
                 for event in events:
                     agent.post(event)
                 world.run_action(role, agent.action)
+                if agent.terminated:
+                    world.agent_terminated(role)  # type: ignore[attr-defined]
                 behaviour[role] = f"{'+'.join(events) or '-'} -> {agent.action}"
             else:
                 leaves, result = agent.tick(lambda name, r=role: world.leaf(r, name))
