@@ -112,6 +112,14 @@ class PredatorPreyWorld:
         self._events: list[str] = []
 
     # -- the interface ------------------------------------------------------------------------
+    size = SIZE
+    movers = (PREDATOR, *PREY_ROLES)
+
+    def landmarks(self) -> list[tuple[str, Point]]:
+        """Fixed places, for pictures."""
+        return [*((f"haven {i}", h) for i, h in enumerate(HAVENS)),
+                *((f"food {i}", f) for i, f in enumerate(FOOD))]
+
     def known_names(self, role: str) -> Sequence[str]:
         return tuple(PREDATOR_NAMES) if role == PREDATOR else tuple(PREY_NAMES)
 

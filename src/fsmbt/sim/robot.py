@@ -99,6 +99,13 @@ class RobotWorld:
         self._latched = 0
 
     # -- the interface ------------------------------------------------------------------------
+    size = SIZE
+    movers = ("robot", "cube")
+
+    def landmarks(self) -> list[tuple[str, Point]]:
+        """Fixed places, for pictures."""
+        return [("charger", CHARGER), ("delivery", DELIVERY), ("inspection dock", DOCK)]
+
     def known_names(self, role: str) -> Sequence[str]:
         return tuple(NAMES)
 
