@@ -11,7 +11,6 @@ is identical in every episode; 1 when one diverges; 2 on bad input (docs/simulat
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Optional
 
 import typer
 
@@ -23,7 +22,7 @@ def register(app: typer.Typer) -> None:
     def simulate_command(
         world: str = typer.Argument(..., help="robot or predator-prey."),
         model: Path = typer.Argument(..., help="The model (BT, FSM, or a conversion)."),
-        against: Optional[Path] = typer.Option(
+        against: Path | None = typer.Option(
             None, "--against", help="The model to compare with (default: MODEL's conversion)."),
         episodes: int = typer.Option(100, "--episodes", "-n", min=1, help="Seeded episodes."),
         seed: int = typer.Option(0, "--seed", help="The first episode's seed."),
@@ -33,11 +32,11 @@ def register(app: typer.Typer) -> None:
         convert_engine: str = typer.Option(
             "rules", "--convert-engine", help="Engine of the default conversion (rules, bsd, "
             "chds)."),
-        role: Optional[str] = typer.Option(
+        role: str | None = typer.Option(
             None, "--role", help="predator-prey: predator or prey (default: from the names)."),
-        max_steps: Optional[int] = typer.Option(None, "--max-steps", min=1,
+        max_steps: int | None = typer.Option(None, "--max-steps", min=1,
                                                 help="Step limit per episode."),
-        output: Optional[Path] = typer.Option(None, "-o", "--output",
+        output: Path | None = typer.Option(None, "-o", "--output",
                                               help="Folder for the GIF and the PNG."),
         force: bool = typer.Option(False, "--force", help="Replace existing pictures."),
     ) -> None:

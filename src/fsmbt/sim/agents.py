@@ -31,6 +31,7 @@ from typing import Any, Protocol
 
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import InputError, UnsupportedError
+from fsmbt.model.bt_nodes import NodeKind
 from fsmbt.model.flatten import flatten, needs_flattening
 from fsmbt.model.fsm import FSM
 from fsmbt.semantics.machine import FINAL
@@ -45,6 +46,9 @@ LEAF_OUTCOMES = tuple(outcome.value for outcome in LeafOutcome)
 MAX_LEAVES_PER_STEP = 10_000
 
 Answer = Callable[[str], str]
+#: Leaves the interpreter answers itself (never asked of the world).
+INTERNAL_LEAVES = frozenset({"AlwaysSuccess", "AlwaysFailure", "Script", "SetBlackboard",
+                             "UnsetBlackboard"})
 
 
 class LeafAgent(Protocol):
@@ -229,8 +233,8 @@ def model_names(model: FSM | BTDocument) -> list[str]:
     flavour = bt_flavour(model)
     for _tree, node in model.nodes():
         if flavour == "plain":
-            if node.is_leaf and node.kind.value in ("action", "condition") and \
-                    node.type not in ("AlwaysSuccess", "AlwaysFailure"):
+            if node.is_leaf and node.kind in (NodeKind.ACTION, NodeKind.CONDITION) and \
+                    node.type not in INTERNAL_LEAVES:
                 names.setdefault(node.name or node.type, None)
         elif node.attrs.get("action") and node.attrs["action"] not in ROOT_RESULTS:
             names.setdefault(node.attrs["action"], None)

@@ -93,6 +93,8 @@ def role_of(world_name: str, model: Model, role: str | None = None) -> str:
     from fsmbt.sim.predator_prey import PREDATOR_NAMES, PREY_NAMES
 
     names = set(model_names(model))
+    if not names:
+        raise InputError("the model asks the world for nothing (no leaf, no state action)")
     if names <= set(PREDATOR_NAMES):
         return "predator"
     if names <= set(PREY_NAMES):
