@@ -128,7 +128,9 @@ class MachineLeafAgent:
             if self.current is None:
                 raise InputError("the state machine runs no leaf (its state has no action)")
             if len(leaves) >= MAX_LEAVES_PER_STEP:
-                raise InputError("a step does not end (too many leaf ticks without RUNNING)")
+                raise InputError(f"a step does not end: {MAX_LEAVES_PER_STEP} leaf ticks "
+                                 f"without RUNNING or a root result (last leaf "
+                                 f"'{self.current}'); a real engine would hang here")
             outcome = answer(self.current)
             leaves.append((self.current, outcome))
             self.state, outputs = self.machine.step(self.state, outcome)
@@ -282,6 +284,10 @@ def build_agent(model: FSM | BTDocument, world: World, role: str, engine: str = 
     if engine not in engines_for(model):
         raise UnsupportedError(f"{where} cannot run on {engine} "
                                f"(it runs on: {', '.join(engines_for(model))})")
+    if world.roles[role] == EVENT_DRIVEN and isinstance(model, BTDocument) \
+            and bt_flavour(model) == "plain":
+        raise InputError(f"{where}: an event-driven role needs an FSM or a BT converted from one "
+                         "(LEBT, BSD, CHDS); this is a plain BT")
     check_names(world, role, model_names(model), where)
     if world.roles[role] == EVENT_DRIVEN:
         return _event_agent(model, list(world.event_names(role)), engine, where)
