@@ -7,13 +7,13 @@ import collections
 from importlib import resources
 
 import pytest
-from support.sim_helpers import EXAMPLES, assert_first_divergence_is_real, example, mutant, side
 
 from fsmbt import api
 from fsmbt.model.errors import InputError
 from fsmbt.sim.predator_prey import PredatorPreyWorld
 from fsmbt.sim.run import compare, run_episode
 from fsmbt.sim.simulate import role_of
+from support.sim_helpers import EXAMPLES, assert_first_divergence_is_real, example, mutant, side
 
 EPISODES = 100
 

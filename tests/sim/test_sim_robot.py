@@ -6,13 +6,13 @@ from __future__ import annotations
 import collections
 
 import pytest
-from support.sim_helpers import assert_first_divergence_is_real, example, mutant, side
 
 from fsmbt import api
 from fsmbt.model.errors import InputError
 from fsmbt.sim.agents import build_agent
 from fsmbt.sim.robot import NAMES, RobotWorld
 from fsmbt.sim.run import compare, run_episode
+from support.sim_helpers import assert_first_divergence_is_real, example, mutant, side
 
 EPISODES = 100
 

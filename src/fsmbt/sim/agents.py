@@ -30,8 +30,8 @@ from collections.abc import Callable, Sequence
 from typing import Any, Protocol
 
 from fsmbt.model.bt import BTDocument
-from fsmbt.model.errors import InputError, UnsupportedError
 from fsmbt.model.bt_nodes import NodeKind
+from fsmbt.model.errors import InputError, UnsupportedError
 from fsmbt.model.flatten import flatten, needs_flattening
 from fsmbt.model.fsm import FSM
 from fsmbt.semantics.machine import FINAL
