@@ -104,6 +104,10 @@ def _print(result, names: tuple[str, str]) -> None:  # type: ignore[no-untyped-d
             print(f"\nfirst divergence ({row.engine}), episode seed {first.seed}, "
                   + first.divergence.describe(*names))
             break
+    if not result.ran:
+        print("\nNOT RUN: no engine asked for runs either model (a skipped engine is never "
+              "counted as identical)")
+        return
     verdict = "IDENTICAL" if result.all_identical else "DIVERGENT"
     print(f"\n{verdict}: {sum(r.comparison.identical for r in result.ran if r.comparison)} of "
           f"{sum(len(r.comparison.episodes) for r in result.ran if r.comparison)} episodes "
