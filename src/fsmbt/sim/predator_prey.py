@@ -175,9 +175,9 @@ class PredatorPreyWorld:
             if self.predator == goal:
                 self.waypoint = (self.waypoint + 1) % len(WAYPOINTS)
         elif behaviour == "chase":
-            goal = target[1].position if target is not None else self.last_seen
-            if goal is not None:
-                self.predator = step_towards(self.predator, goal, CHASE_SPEED)
+            chased = target[1].position if target is not None else self.last_seen
+            if chased is not None:
+                self.predator = step_towards(self.predator, chased, CHASE_SPEED)
         elif behaviour == "capture":
             if target is not None:
                 self.predator = step_towards(self.predator, target[1].position, CHASE_SPEED)
