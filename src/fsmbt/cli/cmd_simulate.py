@@ -39,6 +39,9 @@ def register(app: typer.Typer) -> None:
         output: Path | None = typer.Option(None, "-o", "--output",
                                               help="Folder for the GIF and the PNG."),
         force: bool = typer.Option(False, "--force", help="Replace existing pictures."),
+        show: int | None = typer.Option(
+            None, "--show", min=0, help="Episode (0-based) drawn in the pictures (default: the "
+            "first divergent one, else the first)."),
     ) -> None:
         """Run MODEL and OTHER (or MODEL's conversion) in the same seeded world; compare the
         trajectories step by step."""
@@ -47,6 +50,8 @@ def register(app: typer.Typer) -> None:
         from fsmbt.sim.agents import ENGINES
         from fsmbt.sim.simulate import simulate
 
+        if show is not None and show >= episodes:
+            raise fail(f"--show {show}: there are only {episodes} episodes (0 to {episodes - 1})")
         gif = png = None
         if output is not None:
             if output.exists() and not output.is_dir():
@@ -61,7 +66,7 @@ def register(app: typer.Typer) -> None:
             other = api.convert_model(source, convert_engine).model
             names = (model.name, f"conversion ({convert_engine})")
         result = simulate(world, source, other, engines=engine or ENGINES, episodes=episodes,
-                          seed=seed, role=role, names=names, max_steps=max_steps)
+                          seed=seed, role=role, names=names, max_steps=max_steps, keep=show)
         _print(result, names)
         kept = next((r.comparison for r in result.ran
                      if r.comparison is not None and not r.comparison.all_identical), None)

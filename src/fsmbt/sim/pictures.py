@@ -17,7 +17,7 @@ from typing import Any
 
 from fsmbt.sim.world import Divergence, StepRecord, Trajectory
 
-MAX_FRAMES = 80
+MAX_FRAMES = 48
 COLOURS = ("tab:blue", "tab:red", "tab:green", "tab:orange", "tab:purple")
 
 
@@ -39,7 +39,8 @@ def _frame(ax: Any, world: Any, record: StepRecord | None, title: str, upto: lis
     for name, (x, y) in world.landmarks():
         ax.plot(x, y, marker="s", color="0.6", markersize=9)
         ax.annotate(name, (x, y), fontsize=6, xytext=(3, 3), textcoords="offset points")
-    for colour, mover in zip(COLOURS, world.movers):
+    # the first mover (the robot, the predator) is drawn last: on top of what it carries
+    for colour, mover in reversed(list(zip(COLOURS, world.movers))):
         xs = [dict(r.positions)[mover][0] for r in upto if mover in dict(r.positions)]
         ys = [dict(r.positions)[mover][1] for r in upto if mover in dict(r.positions)]
         ax.plot(xs, ys, color=colour, linewidth=0.8, alpha=0.6)
@@ -78,7 +79,7 @@ def write_gif(left: Trajectory, right: Trajectory, world: Any, path: Path,
     steps = list(range(0, length, stride))
     if steps[-1] != length - 1:
         steps.append(length - 1)
-    fig, axes = plt.subplots(1, 2, figsize=(7.2, 3.8), dpi=70)
+    fig, axes = plt.subplots(1, 2, figsize=(7.2, 3.8), dpi=60)
 
     def draw(step: int) -> list[Any]:
         for ax, trajectory, name in zip(axes, (left, right), names):

@@ -111,7 +111,8 @@ def _roles(world: World, family: str) -> list[str]:
 def simulate(world_name: str, model: Model, other: Model, *, engines: Sequence[str] = ENGINES,
              episodes: int = 100, seed: int = 0, role: str | None = None,
              names: tuple[str, str] = ("model", "other"), max_steps: int | None = None,
-             statemachine_available: Callable[[], bool] | None = None) -> Simulation:
+             statemachine_available: Callable[[], bool] | None = None,
+             keep: int | None = None) -> Simulation:
     """Compare ``model`` and ``other`` in a world, one row per engine.
 
     Args:
@@ -126,6 +127,7 @@ def simulate(world_name: str, model: Model, other: Model, *, engines: Sequence[s
         names: the two sides' labels.
         max_steps: the step limit of an episode (the world's default when ``None``).
         statemachine_available: tells whether python-statemachine imports (tests pass one).
+        keep: the episode whose trajectories are kept for pictures (``compare``'s ``keep``).
 
     Returns:
         The ``Simulation``.
@@ -169,6 +171,6 @@ def simulate(world_name: str, model: Model, other: Model, *, engines: Sequence[s
                     dict.fromkeys(played, left_engine))
         right = Side(names[1], {**companions, **dict.fromkeys(played, other)},
                      dict.fromkeys(played, right_engine))
-        comparison = compare(make_world, left, right, episodes=episodes, seed=seed)
+        comparison = compare(make_world, left, right, episodes=episodes, seed=seed, keep=keep)
         result.rows.append(Row(engine, left_engine, right_engine, comparison))
     return result
