@@ -59,22 +59,41 @@ def main() -> None:
         ("robot", RobotWorld, "robot HFSM", {"robot": robot_hfsm}, ["fsmbt", *psm]),
         ("robot", RobotWorld, "HFSM -> BSD BT", {"robot": robot_bsd}, ["fsmbt"]),
         ("robot", RobotWorld, "HFSM -> CHDS BT", {"robot": robot_chds}, ["fsmbt"]),
-        ("predator-prey", PredatorPreyWorld, "predator FSM + prey BT", game(predator, prey),
-         ["fsmbt"]),
-        ("predator-prey", PredatorPreyWorld, "predator LEBT + prey BT", game(predator_lebt, prey),
-         ["fsmbt", "btcpp", "py_trees"]),
-        ("predator-prey", PredatorPreyWorld, "predator FSM + prey HFSM", game(predator, prey_hfsm),
-         ["fsmbt", *psm]),
+        (
+            "predator-prey",
+            PredatorPreyWorld,
+            "predator FSM + prey BT",
+            game(predator, prey),
+            ["fsmbt"],
+        ),
+        (
+            "predator-prey",
+            PredatorPreyWorld,
+            "predator LEBT + prey BT",
+            game(predator_lebt, prey),
+            ["fsmbt", "btcpp", "py_trees"],
+        ),
+        (
+            "predator-prey",
+            PredatorPreyWorld,
+            "predator FSM + prey HFSM",
+            game(predator, prey_hfsm),
+            ["fsmbt", *psm],
+        ),
     ]
     if not psm:
         print("note: python-statemachine does not import: its rows are skipped")
-    print(f"{'world':<14} {'side':<26} {'engine':<20} {'episodes':>8} {'steps':>7} "
-          f"{'wall s':>7} {'cpu s':>7} {'steps/s (cpu)':>13}")
+    print(
+        f"{'world':<14} {'side':<26} {'engine':<20} {'episodes':>8} {'steps':>7} "
+        f"{'wall s':>7} {'cpu s':>7} {'steps/s (cpu)':>13}"
+    )
     for world_name, make, label, models, engines in rows:
         for engine in engines:
             # each role on the engine when its model runs there, else on fsmbt's runner
-            engine_of = {role: engine if engine in engines_for(model) else "fsmbt"
-                         for role, model in models.items()}
+            engine_of = {
+                role: engine if engine in engines_for(model) else "fsmbt"
+                for role, model in models.items()
+            }
             s = Side(label, models, engine_of)
             world = make()
             wall, cpu = time.perf_counter(), time.process_time()
@@ -82,21 +101,33 @@ def main() -> None:
             for index in range(args.episodes):
                 steps += len(run_episode(world, s, args.seed + index).records)
             wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
-            print(f"{world_name:<14} {label:<26} {engine:<20} {args.episodes:>8} {steps:>7} "
-                  f"{wall:>7.2f} {cpu:>7.2f} {steps / cpu:>13.0f}")
+            print(
+                f"{world_name:<14} {label:<26} {engine:<20} {args.episodes:>8} {steps:>7} "
+                f"{wall:>7.2f} {cpu:>7.2f} {steps / cpu:>13.0f}"
+            )
 
-    bad = next(m.model for m in mutants(prey, per_operator=None)
-               if m.operator == "swap_children"
-               and m.description == "children 0 and 1 of PreyRoot swapped")
-    c = compare(PredatorPreyWorld, side("prey mutant", game(predator, bad), "fsmbt"),
-                side("prey HFSM", game(predator, prey_hfsm), "fsmbt"), episodes=args.episodes,
-                seed=args.seed)
+    bad = next(
+        m.model
+        for m in mutants(prey, per_operator=None)
+        if m.operator == "swap_children" and m.description == "children 0 and 1 of PreyRoot swapped"
+    )
+    c = compare(
+        PredatorPreyWorld,
+        side("prey mutant", game(predator, bad), "fsmbt"),
+        side("prey HFSM", game(predator, prey_hfsm), "fsmbt"),
+        episodes=args.episodes,
+        seed=args.seed,
+    )
     first = c.first_divergence
-    print(f"\nmutant 'children 0 and 1 of PreyRoot swapped' vs the prey HFSM: "
-          f"{len(c.episodes) - c.identical} of {len(c.episodes)} episodes diverge")
+    print(
+        f"\nmutant 'children 0 and 1 of PreyRoot swapped' vs the prey HFSM: "
+        f"{len(c.episodes) - c.identical} of {len(c.episodes)} episodes diverge"
+    )
     if first is not None and first.divergence is not None:
-        print(f"first divergence, episode seed {first.seed}, "
-              + first.divergence.describe("prey mutant", "prey HFSM"))
+        print(
+            f"first divergence, episode seed {first.seed}, "
+            + first.divergence.describe("prey mutant", "prey HFSM")
+        )
 
 
 if __name__ == "__main__":

@@ -24,13 +24,24 @@ def simulate(capsys):
         code = main(["simulate", *map(str, args)])
         captured = capsys.readouterr()
         return Result(code, captured.out + captured.err)
+
     return run
 
 
 def test_robot_with_pictures(simulate, tmp_path: Path):
     out = tmp_path / "pics"
-    result = simulate("robot", EXAMPLES / "robot_bt.xml", "-n", "5", "--engine", "fsmbt",
-                      "--engine", "py_trees", "-o", out)
+    result = simulate(
+        "robot",
+        EXAMPLES / "robot_bt.xml",
+        "-n",
+        "5",
+        "--engine",
+        "fsmbt",
+        "--engine",
+        "py_trees",
+        "-o",
+        out,
+    )
     assert result.exit_code == 0, result.output
     assert "fsmbt / fsmbt" in result.output and "py_trees / fsmbt" in result.output
     assert "IDENTICAL: 10 of 10 episodes identical" in result.output
@@ -46,8 +57,18 @@ def test_robot_with_pictures(simulate, tmp_path: Path):
 def test_predator_against_its_lebt_file(simulate, tmp_path: Path):
     lebt = tmp_path / "predator_bt.xml"
     api.write(api.convert_model(example("predator_fsm.scxml")).model, lebt, "btcpp")
-    result = simulate("predator-prey", EXAMPLES / "predator_fsm.scxml", "--against", lebt,
-                      "-n", "3", "--engine", "fsmbt", "--engine", "btcpp")
+    result = simulate(
+        "predator-prey",
+        EXAMPLES / "predator_fsm.scxml",
+        "--against",
+        lebt,
+        "-n",
+        "3",
+        "--engine",
+        "fsmbt",
+        "--engine",
+        "btcpp",
+    )
     assert result.exit_code == 0, result.output
     assert "role predator" in result.output and "fsmbt / btcpp" in result.output
 
@@ -58,8 +79,18 @@ def test_mutant_diverges_exit_1_and_names_the_step(simulate, tmp_path: Path):
     api.write(bad, path, "btcpp")
     hfsm = tmp_path / "prey_hfsm.scxml"
     api.write(api.convert_model(example("prey_bt.xml")).model, hfsm, "scxml")
-    result = simulate("predator-prey", path, "--against", hfsm, "-n", "10", "--engine", "fsmbt",
-                      "-o", tmp_path / "pics")
+    result = simulate(
+        "predator-prey",
+        path,
+        "--against",
+        hfsm,
+        "-n",
+        "10",
+        "--engine",
+        "fsmbt",
+        "-o",
+        tmp_path / "pics",
+    )
     assert result.exit_code == 1, result.output
     assert "DIVERGENT" in result.output
     assert "first divergence (fsmbt), episode seed" in result.output
@@ -72,22 +103,50 @@ def test_skipped_engine_is_not_counted(simulate):
     real = simulate("robot", EXAMPLES / "robot_bt.xml", "-n", "1", "--engine", "btcpp")
     assert real.exit_code == 0 and "btcpp / fsmbt" in real.output
     # two plain BTs: python-statemachine runs neither; the row is skipped, nothing ran: exit 1
-    skipped = simulate("robot", EXAMPLES / "robot_bt.xml", "-n", "1",
-                       "--engine", "python-statemachine", "--against", EXAMPLES / "robot_bt.xml")
+    skipped = simulate(
+        "robot",
+        EXAMPLES / "robot_bt.xml",
+        "-n",
+        "1",
+        "--engine",
+        "python-statemachine",
+        "--against",
+        EXAMPLES / "robot_bt.xml",
+    )
     assert skipped.exit_code == 1
     assert "skipped python-statemachine: neither model runs on it" in skipped.output
     assert "NOT RUN" in skipped.output and "IDENTICAL:" not in skipped.output
 
 
-@pytest.mark.parametrize("args, message", [
-    (["moon", EXAMPLES / "robot_bt.xml"], "unknown world"),
-    (["robot", EXAMPLES / "game_npc_bt.xml"], "not known to the robot world"),
-    (["predator-prey", EXAMPLES / "robot_bt.xml"], "neither the predator nor the prey"),
-    (["robot", EXAMPLES / "robot_bt.xml", "--engine", "gazebo"], "unknown engine"),
-    (["robot", EXAMPLES / "no_such_file.xml"], "no_such_file"),
-])
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (["moon", EXAMPLES / "robot_bt.xml"], "unknown world"),
+        (["robot", EXAMPLES / "game_npc_bt.xml"], "not known to the robot world"),
+        (["predator-prey", EXAMPLES / "robot_bt.xml"], "neither the predator nor the prey"),
+        (["robot", EXAMPLES / "robot_bt.xml", "--engine", "gazebo"], "unknown engine"),
+        (["robot", EXAMPLES / "no_such_file.xml"], "no_such_file"),
+    ],
+)
 def test_bad_input_exit_2(simulate, args, message):
     result = simulate(*args, "-n", "1")
     assert result.exit_code == 2, result.output
     assert message in result.output
     assert "Traceback" not in result.output
+
+
+def test_missing_statemachine_is_a_note_never_identical():
+    from fsmbt.sim.simulate import simulate as run_simulation
+
+    bt = example("robot_bt.xml")
+    result = run_simulation(
+        "robot",
+        bt,
+        api.convert_model(bt).model,
+        engines=["python-statemachine"],
+        episodes=1,
+        statemachine_available=lambda: False,
+    )
+    assert [row.comparison for row in result.rows] == [None]
+    assert "does not import" in result.rows[0].note
+    assert not result.all_identical

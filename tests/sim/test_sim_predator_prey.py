@@ -41,29 +41,56 @@ def test_shipped_companions_are_the_examples():
 def test_game_is_exercised(predator, prey):
     counts: collections.Counter[str] = collections.Counter()
     for seed in range(EPISODES):
-        for record in run_episode(PredatorPreyWorld(), side("g", game(predator, prey)), seed).records:
+        for record in run_episode(
+            PredatorPreyWorld(), side("g", game(predator, prey)), seed
+        ).records:
             counts.update(record.events)
             for role, what in record.behaviour:
-                counts.update(f"{role}:{token.split(':')[0]}" for token in what.replace(
-                    " -> ", " ").replace("+", " ").split() if token != "=>")
-    for key in ("predator:Patrol", "predator:Detect", "predator:Chase", "predator:Capture",
-                "predator:GiveUp", "predator:tired", "predator:rested", "predator:escaped",
-                "prey0:GoToHaven", "prey0:Flee", "prey0:Eat", "prey0:Wander", "ate",
-                "lunge_missed", "prey0_caught", "prey1_caught"):
+                counts.update(
+                    f"{role}:{token.split(':')[0]}"
+                    for token in what.replace(" -> ", " ").replace("+", " ").split()
+                    if token != "=>"
+                )
+    for key in (
+        "predator:Patrol",
+        "predator:Detect",
+        "predator:Chase",
+        "predator:Capture",
+        "predator:GiveUp",
+        "predator:tired",
+        "predator:rested",
+        "predator:escaped",
+        "prey0:GoToHaven",
+        "prey0:Flee",
+        "prey0:Eat",
+        "prey0:Wander",
+        "ate",
+        "lunge_missed",
+        "prey0_caught",
+        "prey1_caught",
+    ):
         assert counts[key] > 0, key
 
 
 def test_predator_fsm_vs_its_lebt_identical(predator, prey):
     lebt = api.convert_model(predator).model
-    c = compare(PredatorPreyWorld, side("fsm", game(predator, prey)),
-                side("lebt", game(lebt, prey)), episodes=EPISODES)
+    c = compare(
+        PredatorPreyWorld,
+        side("fsm", game(predator, prey)),
+        side("lebt", game(lebt, prey)),
+        episodes=EPISODES,
+    )
     assert c.all_identical, c.first_divergence
 
 
 def test_prey_bt_vs_its_hfsm_identical(predator, prey):
     hfsm = api.convert_model(prey).model
-    c = compare(PredatorPreyWorld, side("bt", game(predator, prey)),
-                side("hfsm", game(predator, hfsm)), episodes=EPISODES)
+    c = compare(
+        PredatorPreyWorld,
+        side("bt", game(predator, prey)),
+        side("hfsm", game(predator, hfsm)),
+        episodes=EPISODES,
+    )
     assert c.all_identical, c.first_divergence
 
 
@@ -72,16 +99,24 @@ def test_real_engines(predator, prey, engine):
     lebt = api.convert_model(predator).model
     hfsm = api.convert_model(prey).model
     # the LEBT predator and the prey BT on the engine, against FSM predator and HFSM prey
-    c = compare(PredatorPreyWorld, side(engine, game(lebt, prey), engine),
-                side("fsmbt", game(predator, hfsm)), episodes=20)
+    c = compare(
+        PredatorPreyWorld,
+        side(engine, game(lebt, prey), engine),
+        side("fsmbt", game(predator, hfsm)),
+        episodes=20,
+    )
     assert c.all_identical, c.first_divergence
 
 
 def test_python_statemachine(predator, prey):
     pytest.importorskip("statemachine")
     hfsm = api.convert_model(prey).model
-    c = compare(PredatorPreyWorld, side("fsmbt", game(predator, prey)),
-                side("psm", game(predator, hfsm), "python-statemachine"), episodes=10)
+    c = compare(
+        PredatorPreyWorld,
+        side("fsmbt", game(predator, prey)),
+        side("psm", game(predator, hfsm), "python-statemachine"),
+        episodes=10,
+    )
     assert c.all_identical, c.first_divergence
 
 
@@ -89,8 +124,12 @@ def test_predator_retargeted_transition_diverges(predator, prey):
     lebt = api.convert_model(predator).model
     bad = mutant(predator, "retarget_transition", "Detect -prey_seen-> Chase now goes to Patrol")
     assert not api.verify_models(bad, lebt).equivalent
-    c = compare(PredatorPreyWorld, side("mutant", game(bad, prey)),
-                side("lebt", game(lebt, prey)), episodes=EPISODES)
+    c = compare(
+        PredatorPreyWorld,
+        side("mutant", game(bad, prey)),
+        side("lebt", game(lebt, prey)),
+        episodes=EPISODES,
+    )
     assert not c.all_identical
     assert_first_divergence_is_real("predator-prey", c)
 
@@ -99,8 +138,12 @@ def test_lebt_moved_guard_pair_diverges(predator, prey):
     lebt = api.convert_model(predator).model
     bad = mutant(lebt, "retarget_transition", "pair Detect/prey_seen moved from Enter_Chase")
     assert not api.verify_models(predator, bad).equivalent
-    c = compare(PredatorPreyWorld, side("fsm", game(predator, prey)),
-                side("mutant", game(bad, prey)), episodes=EPISODES)
+    c = compare(
+        PredatorPreyWorld,
+        side("fsm", game(predator, prey)),
+        side("mutant", game(bad, prey)),
+        episodes=EPISODES,
+    )
     assert not c.all_identical
     assert_first_divergence_is_real("predator-prey", c)
 
@@ -109,8 +152,12 @@ def test_prey_swapped_children_diverges(predator, prey):
     hfsm = api.convert_model(prey).model
     bad = mutant(prey, "swap_children", "children 0 and 1 of PreyRoot swapped")
     assert not api.verify_models(bad, hfsm).equivalent
-    c = compare(PredatorPreyWorld, side("mutant", game(predator, bad)),
-                side("hfsm", game(predator, hfsm)), episodes=EPISODES)
+    c = compare(
+        PredatorPreyWorld,
+        side("mutant", game(predator, bad)),
+        side("hfsm", game(predator, hfsm)),
+        episodes=EPISODES,
+    )
     assert not c.all_identical
     step = assert_first_divergence_is_real("predator-prey", c)
     assert f"step {step}:" in c.first_divergence.divergence.describe()
@@ -120,8 +167,12 @@ def test_prey_hfsm_retargeted_transition_diverges(predator, prey):
     hfsm = api.convert_model(prey).model
     bad = mutant(hfsm, "retarget_transition", "Wander -success-> SUCCESS now goes to FAILURE")
     assert not api.verify_models(prey, bad).equivalent
-    c = compare(PredatorPreyWorld, side("bt", game(predator, prey)),
-                side("mutant", game(predator, bad)), episodes=EPISODES)
+    c = compare(
+        PredatorPreyWorld,
+        side("bt", game(predator, prey)),
+        side("mutant", game(predator, bad)),
+        episodes=EPISODES,
+    )
     assert not c.all_identical
     assert_first_divergence_is_real("predator-prey", c)
 

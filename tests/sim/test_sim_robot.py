@@ -37,8 +37,15 @@ def test_world_is_exercised_and_deterministic(bt):
             counts.update(record.events)
     # every part of the world happens somewhere in 100 episodes: picks fail by chance, the
     # battery is recharged, missions fail and are retried, cubes are delivered, robots dock
-    for event in ("picked", "pick_failed", "charged", "mission_failed", "delivered", "docked",
-                  "mission_complete"):
+    for event in (
+        "picked",
+        "pick_failed",
+        "charged",
+        "mission_failed",
+        "delivered",
+        "docked",
+        "mission_complete",
+    ):
         assert counts[event] > 0, event
     assert ended["done"] == counts["mission_complete"] > EPISODES // 2
     again = run_episode(RobotWorld(), side("bt", {"robot": bt}), 7)
@@ -47,8 +54,9 @@ def test_world_is_exercised_and_deterministic(bt):
 
 
 def test_bt_vs_its_hfsm_identical(bt, hfsm):
-    c = compare(RobotWorld, side("bt", {"robot": bt}), side("hfsm", {"robot": hfsm}),
-                episodes=EPISODES)
+    c = compare(
+        RobotWorld, side("bt", {"robot": bt}), side("hfsm", {"robot": hfsm}), episodes=EPISODES
+    )
     assert c.all_identical, c.first_divergence
     assert len(c.episodes) == EPISODES and c.steps > 20 * EPISODES
 
@@ -56,38 +64,46 @@ def test_bt_vs_its_hfsm_identical(bt, hfsm):
 @pytest.mark.parametrize("baseline", ["bsd", "chds"])
 def test_bt_vs_baseline_bt_of_its_hfsm_identical(bt, hfsm, baseline):
     rebuilt = api.convert_model(hfsm, baseline).model  # BT -> HFSM (rules) -> BT (baseline)
-    c = compare(RobotWorld, side("bt", {"robot": bt}), side(baseline, {"robot": rebuilt}),
-                episodes=EPISODES)
+    c = compare(
+        RobotWorld, side("bt", {"robot": bt}), side(baseline, {"robot": rebuilt}), episodes=EPISODES
+    )
     assert c.all_identical, c.first_divergence
 
 
 @pytest.mark.parametrize("engine", ["btcpp", "py_trees"])
 def test_bt_on_real_engines_vs_hfsm(bt, hfsm, engine):
-    c = compare(RobotWorld, side(engine, {"robot": bt}, engine), side("hfsm", {"robot": hfsm}),
-                episodes=30)
+    c = compare(
+        RobotWorld, side(engine, {"robot": bt}, engine), side("hfsm", {"robot": hfsm}), episodes=30
+    )
     assert c.all_identical, c.first_divergence
 
 
 @pytest.mark.parametrize("engine", ["btcpp", "py_trees"])
 def test_lebt_of_hfsm_on_real_engines(bt, hfsm, engine):
     lebt = api.convert_model(hfsm).model  # HFSM -> BT (rules): an LEBT in leaf execution
-    c = compare(RobotWorld, side("bt", {"robot": bt}), side(engine, {"robot": lebt}, engine),
-                episodes=20)
+    c = compare(
+        RobotWorld, side("bt", {"robot": bt}), side(engine, {"robot": lebt}, engine), episodes=20
+    )
     assert c.all_identical, c.first_divergence
 
 
 def test_hfsm_on_python_statemachine(bt, hfsm):
     pytest.importorskip("statemachine")
-    c = compare(RobotWorld, side("bt", {"robot": bt}),
-                side("psm", {"robot": hfsm}, "python-statemachine"), episodes=20)
+    c = compare(
+        RobotWorld,
+        side("bt", {"robot": bt}),
+        side("psm", {"robot": hfsm}, "python-statemachine"),
+        episodes=20,
+    )
     assert c.all_identical, c.first_divergence
 
 
 def test_swapped_children_mutant_diverges(bt, hfsm):
     bad = mutant(bt, "swap_children", "children 0 and 1 of Sequence swapped")
     assert not api.verify_models(bad, hfsm).equivalent  # the checker agrees it changed
-    c = compare(RobotWorld, side("mutant", {"robot": bad}), side("hfsm", {"robot": hfsm}),
-                episodes=EPISODES)
+    c = compare(
+        RobotWorld, side("mutant", {"robot": bad}), side("hfsm", {"robot": hfsm}), episodes=EPISODES
+    )
     assert not c.all_identical
     step = assert_first_divergence_is_real("robot", c)
     report = c.first_divergence.divergence.describe("mutant", "hfsm")
@@ -97,8 +113,9 @@ def test_swapped_children_mutant_diverges(bt, hfsm):
 def test_retargeted_transition_mutant_diverges(bt, hfsm):
     bad = mutant(hfsm, "retarget_transition", "Dock -success-> SUCCESS now goes to Dock")
     assert not api.verify_models(bt, bad).equivalent
-    c = compare(RobotWorld, side("bt", {"robot": bt}), side("mutant", {"robot": bad}),
-                episodes=EPISODES)
+    c = compare(
+        RobotWorld, side("bt", {"robot": bt}), side("mutant", {"robot": bad}), episodes=EPISODES
+    )
     assert not c.all_identical
     assert_first_divergence_is_real("robot", c)
 

@@ -23,25 +23,35 @@ def register(app: typer.Typer) -> None:
         world: str = typer.Argument(..., help="robot or predator-prey."),
         model: Path = typer.Argument(..., help="The model (BT, FSM, or a conversion)."),
         against: Path | None = typer.Option(
-            None, "--against", help="The model to compare with (default: MODEL's conversion)."),
+            None, "--against", help="The model to compare with (default: MODEL's conversion)."
+        ),
         episodes: int = typer.Option(100, "--episodes", "-n", min=1, help="Seeded episodes."),
         seed: int = typer.Option(0, "--seed", help="The first episode's seed."),
         engine: list[str] = typer.Option(
-            [], "--engine", help="fsmbt, btcpp, py_trees, python-statemachine (repeatable; "
-            "default: all)."),
+            [],
+            "--engine",
+            help="fsmbt, btcpp, py_trees, python-statemachine (repeatable; default: all).",
+        ),
         convert_engine: str = typer.Option(
-            "rules", "--convert-engine", help="Engine of the default conversion (rules, bsd, "
-            "chds)."),
+            "rules", "--convert-engine", help="Engine of the default conversion (rules, bsd, chds)."
+        ),
         role: str | None = typer.Option(
-            None, "--role", help="predator-prey: predator or prey (default: from the names)."),
-        max_steps: int | None = typer.Option(None, "--max-steps", min=1,
-                                                help="Step limit per episode."),
-        output: Path | None = typer.Option(None, "-o", "--output",
-                                              help="Folder for the GIF and the PNG."),
+            None, "--role", help="predator-prey: predator or prey (default: from the names)."
+        ),
+        max_steps: int | None = typer.Option(
+            None, "--max-steps", min=1, help="Step limit per episode."
+        ),
+        output: Path | None = typer.Option(
+            None, "-o", "--output", help="Folder for the GIF and the PNG."
+        ),
         force: bool = typer.Option(False, "--force", help="Replace existing pictures."),
         show: int | None = typer.Option(
-            None, "--show", min=0, help="Episode (0-based) drawn in the pictures (default: the "
-            "first divergent one, else the first)."),
+            None,
+            "--show",
+            min=0,
+            help="Episode (0-based) drawn in the pictures (default: the "
+            "first divergent one, else the first).",
+        ),
     ) -> None:
         """Run MODEL and OTHER (or MODEL's conversion) in the same seeded world; compare the
         trajectories step by step."""
@@ -65,11 +75,27 @@ def register(app: typer.Typer) -> None:
         else:
             other = api.convert_model(source, convert_engine).model
             names = (model.name, f"conversion ({convert_engine})")
-        result = simulate(world, source, other, engines=engine or ENGINES, episodes=episodes,
-                          seed=seed, role=role, names=names, max_steps=max_steps, keep=show)
+        result = simulate(
+            world,
+            source,
+            other,
+            engines=engine or ENGINES,
+            episodes=episodes,
+            seed=seed,
+            role=role,
+            names=names,
+            max_steps=max_steps,
+            keep=show,
+        )
         _print(result, names)
-        kept = next((r.comparison for r in result.ran
-                     if r.comparison is not None and not r.comparison.all_identical), None)
+        kept = next(
+            (
+                r.comparison
+                for r in result.ran
+                if r.comparison is not None and not r.comparison.all_identical
+            ),
+            None,
+        )
         kept = kept or (result.ran[0].comparison if result.ran else None)
         if gif is not None and png is not None and kept is not None and kept.first is not None:
             from fsmbt.sim.pictures import write_gif, write_plot
@@ -88,8 +114,10 @@ def register(app: typer.Typer) -> None:
 
 def _print(result, names: tuple[str, str]) -> None:  # type: ignore[no-untyped-def]
     print(f"world {result.world}, role {result.role}: {names[0]} vs {names[1]}")
-    header = f"{'engine':<22} {'runs on (model / other)':<32} {'episodes':>8} {'steps':>8} " \
-             f"{'identical':>9} {'steps/s':>8}  first divergence"
+    header = (
+        f"{'engine':<22} {'runs on (model / other)':<32} {'episodes':>8} {'steps':>8} "
+        f"{'identical':>9} {'steps/s':>8}  first divergence"
+    )
     print(header)
     print("-" * len(header))
     for row in result.rows:
@@ -101,19 +129,27 @@ def _print(result, names: tuple[str, str]) -> None:  # type: ignore[no-untyped-d
         where = "-" if first is None else f"episode seed {first.seed}, step {first.divergence.step}"
         rate = c.steps / c.seconds if c.seconds > 0 else float("inf")
         runs = f"{row.left_engine} / {row.right_engine}"
-        print(f"{row.engine:<22} {runs:<32} {len(c.episodes):>8} {c.steps:>8} "
-              f"{c.identical:>5}/{len(c.episodes):<3} {rate:>8.0f}  {where}")
+        print(
+            f"{row.engine:<22} {runs:<32} {len(c.episodes):>8} {c.steps:>8} "
+            f"{c.identical:>5}/{len(c.episodes):<3} {rate:>8.0f}  {where}"
+        )
     for row in result.ran:
         first = row.comparison.first_divergence if row.comparison else None
         if first is not None and first.divergence is not None:
-            print(f"\nfirst divergence ({row.engine}), episode seed {first.seed}, "
-                  + first.divergence.describe(*names))
+            print(
+                f"\nfirst divergence ({row.engine}), episode seed {first.seed}, "
+                + first.divergence.describe(*names)
+            )
             break
     if not result.ran:
-        print("\nNOT RUN: no engine asked for runs either model (a skipped engine is never "
-              "counted as identical)")
+        print(
+            "\nNOT RUN: no engine asked for runs either model (a skipped engine is never "
+            "counted as identical)"
+        )
         return
     verdict = "IDENTICAL" if result.all_identical else "DIVERGENT"
-    print(f"\n{verdict}: {sum(r.comparison.identical for r in result.ran if r.comparison)} of "
-          f"{sum(len(r.comparison.episodes) for r in result.ran if r.comparison)} episodes "
-          "identical")
+    print(
+        f"\n{verdict}: {sum(r.comparison.identical for r in result.ran if r.comparison)} of "
+        f"{sum(len(r.comparison.episodes) for r in result.ran if r.comparison)} episodes "
+        "identical"
+    )

@@ -47,8 +47,9 @@ MAX_LEAVES_PER_STEP = 10_000
 
 Answer = Callable[[str], str]
 #: Leaves the interpreter answers itself (never asked of the world).
-INTERNAL_LEAVES = frozenset({"AlwaysSuccess", "AlwaysFailure", "Script", "SetBlackboard",
-                             "UnsetBlackboard"})
+INTERNAL_LEAVES = frozenset(
+    {"AlwaysSuccess", "AlwaysFailure", "Script", "SetBlackboard", "UnsetBlackboard"}
+)
 
 
 class LeafAgent(Protocol):
@@ -67,21 +68,20 @@ class EventAgent(Protocol):
     engine: str
     action: str | None
 
-    def start(self) -> None:
-        ...
+    def start(self) -> None: ...
 
-    def post(self, event: str) -> None:
-        ...
+    def post(self, event: str) -> None: ...
 
     @property
-    def terminated(self) -> bool:
-        ...
+    def terminated(self) -> bool: ...
 
 
 class BTTickAgent:
     """A BT ticked once per step by a runner whose leaves ask the world."""
 
-    def __init__(self, make_runner: Callable[[Callable[[Any, str], str]], Any], engine: str) -> None:
+    def __init__(
+        self, make_runner: Callable[[Callable[[Any, str], str]], Any], engine: str
+    ) -> None:
         self.engine = engine
         self._answer: Answer | None = None
         self.runner = make_runner(self._env)
@@ -128,9 +128,11 @@ class MachineLeafAgent:
             if self.current is None:
                 raise InputError("the state machine runs no leaf (its state has no action)")
             if len(leaves) >= MAX_LEAVES_PER_STEP:
-                raise InputError(f"a step does not end: {MAX_LEAVES_PER_STEP} leaf ticks "
-                                 f"without RUNNING or a root result (last leaf "
-                                 f"'{self.current}'); a real engine would hang here")
+                raise InputError(
+                    f"a step does not end: {MAX_LEAVES_PER_STEP} leaf ticks "
+                    f"without RUNNING or a root result (last leaf "
+                    f"'{self.current}'); a real engine would hang here"
+                )
             outcome = answer(self.current)
             leaves.append((self.current, outcome))
             self.state, outputs = self.machine.step(self.state, outcome)
@@ -235,8 +237,11 @@ def model_names(model: FSM | BTDocument) -> list[str]:
     flavour = bt_flavour(model)
     for _tree, node in model.nodes():
         if flavour == "plain":
-            if node.is_leaf and node.kind in (NodeKind.ACTION, NodeKind.CONDITION) and \
-                    node.type not in INTERNAL_LEAVES:
+            if (
+                node.is_leaf
+                and node.kind in (NodeKind.ACTION, NodeKind.CONDITION)
+                and node.type not in INTERNAL_LEAVES
+            ):
                 names.setdefault(node.name or node.type, None)
         elif node.attrs.get("action") and node.attrs["action"] not in ROOT_RESULTS:
             names.setdefault(node.attrs["action"], None)
@@ -258,8 +263,9 @@ def engines_for(model: FSM | BTDocument) -> tuple[str, ...]:
     return ("fsmbt", "btcpp", "py_trees") if supports(CompiledTree(model)) else ("fsmbt", "btcpp")
 
 
-def build_agent(model: FSM | BTDocument, world: World, role: str, engine: str = "fsmbt",
-                *, where: str = "model") -> LeafAgent | EventAgent:
+def build_agent(
+    model: FSM | BTDocument, world: World, role: str, engine: str = "fsmbt", *, where: str = "model"
+) -> LeafAgent | EventAgent:
     """An agent running ``model`` as ``role`` of ``world`` on ``engine``.
 
     Args:
@@ -277,17 +283,24 @@ def build_agent(model: FSM | BTDocument, world: World, role: str, engine: str = 
             an event-driven role. UnsupportedError: the engine cannot run this model.
     """
     if role not in world.roles:
-        raise InputError(f"the {world.name} world has no role '{role}' "
-                         f"(roles: {', '.join(world.roles)})")
+        raise InputError(
+            f"the {world.name} world has no role '{role}' (roles: {', '.join(world.roles)})"
+        )
     if engine not in ENGINES:
         raise InputError(f"unknown engine '{engine}' (known: {', '.join(ENGINES)})")
     if engine not in engines_for(model):
-        raise UnsupportedError(f"{where} cannot run on {engine} "
-                               f"(it runs on: {', '.join(engines_for(model))})")
-    if world.roles[role] == EVENT_DRIVEN and isinstance(model, BTDocument) \
-            and bt_flavour(model) == "plain":
-        raise InputError(f"{where}: an event-driven role needs an FSM or a BT converted from one "
-                         "(LEBT, BSD, CHDS); this is a plain BT")
+        raise UnsupportedError(
+            f"{where} cannot run on {engine} (it runs on: {', '.join(engines_for(model))})"
+        )
+    if (
+        world.roles[role] == EVENT_DRIVEN
+        and isinstance(model, BTDocument)
+        and bt_flavour(model) == "plain"
+    ):
+        raise InputError(
+            f"{where}: an event-driven role needs an FSM or a BT converted from one "
+            "(LEBT, BSD, CHDS); this is a plain BT"
+        )
     check_names(world, role, model_names(model), where)
     if world.roles[role] == EVENT_DRIVEN:
         return _event_agent(model, list(world.event_names(role)), engine, where)
@@ -347,8 +360,7 @@ def _converted_machine(doc: BTDocument, alphabet: Sequence[str], engine: str) ->
     return lambda: lebt
 
 
-def _event_agent(model: FSM | BTDocument, events: list[str], engine: str,
-                 where: str) -> EventAgent:
+def _event_agent(model: FSM | BTDocument, events: list[str], engine: str, where: str) -> EventAgent:
     if isinstance(model, FSM):
         if engine == "python-statemachine":
             from fsmbt.sim.scxml_engine import SCXMLEventAgent
@@ -359,8 +371,10 @@ def _event_agent(model: FSM | BTDocument, events: list[str], engine: str,
         alphabet = list(dict.fromkeys([*FSMMachine(model).alphabet, *events]))
         return MachineEventAgent(FSMMachine(model, alphabet=alphabet), engine)
     if bt_flavour(model) == "plain":
-        raise InputError(f"{where}: an event-driven role needs an FSM or a BT converted from one "
-                         "(LEBT, BSD, CHDS); this is a plain BT")
+        raise InputError(
+            f"{where}: an event-driven role needs an FSM or a BT converted from one "
+            "(LEBT, BSD, CHDS); this is a plain BT"
+        )
     if engine in ("btcpp", "py_trees"):
         return EngineEventAgent(_converted_machine(model, events, engine)().run, engine)
     return MachineEventAgent(_converted_machine(model, events, engine)(), engine)

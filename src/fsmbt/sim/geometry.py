@@ -18,7 +18,10 @@ def step_towards(origin: Point, target: Point, speed: float) -> Point:
     if gap <= speed:
         return target
     ratio = speed / gap
-    return (origin[0] + (target[0] - origin[0]) * ratio, origin[1] + (target[1] - origin[1]) * ratio)
+    return (
+        origin[0] + (target[0] - origin[0]) * ratio,
+        origin[1] + (target[1] - origin[1]) * ratio,
+    )
 
 
 def step_away(origin: Point, threat: Point, speed: float, size: float) -> Point:

@@ -29,7 +29,9 @@ def _short(behaviour: str) -> str:
     return trail[-1].split(":")[0] if trail else "-"
 
 
-def _frame(ax: Any, world: Any, record: StepRecord | None, title: str, upto: list[StepRecord]) -> None:
+def _frame(
+    ax: Any, world: Any, record: StepRecord | None, title: str, upto: list[StepRecord]
+) -> None:
     ax.clear()
     ax.set_xlim(-0.5, world.size + 0.5)
     ax.set_ylim(-0.5, world.size + 0.5)
@@ -53,8 +55,14 @@ def _frame(ax: Any, world: Any, record: StepRecord | None, title: str, upto: lis
     ax.set_title(f"{title} - step {record.step}\n{doing}", fontsize=7)
 
 
-def write_gif(left: Trajectory, right: Trajectory, world: Any, path: Path,
-              names: tuple[str, str] = ("model", "other"), fps: int = 8) -> Path:
+def write_gif(
+    left: Trajectory,
+    right: Trajectory,
+    world: Any,
+    path: Path,
+    names: tuple[str, str] = ("model", "other"),
+    fps: int = 8,
+) -> Path:
     """An animated GIF of ``left`` and ``right`` side by side.
 
     Args:
@@ -95,9 +103,14 @@ def write_gif(left: Trajectory, right: Trajectory, world: Any, path: Path,
     return path
 
 
-def write_plot(left: Trajectory, right: Trajectory, world: Any, path: Path,
-               names: tuple[str, str] = ("model", "other"),
-               divergence: Divergence | None = None) -> Path:
+def write_plot(
+    left: Trajectory,
+    right: Trajectory,
+    world: Any,
+    path: Path,
+    names: tuple[str, str] = ("model", "other"),
+    divergence: Divergence | None = None,
+) -> Path:
     """A PNG of both trajectories (one panel each), the divergence marked when there is one.
 
     Args:
@@ -120,8 +133,10 @@ def write_plot(left: Trajectory, right: Trajectory, world: Any, path: Path,
     for ax, trajectory, name in zip(axes, (left, right), names):
         last = trajectory.records[-1] if trajectory.records else None
         _frame(ax, world, last, name, trajectory.records)
-        ax.set_title(f"{name}: {len(trajectory.records)} steps ({trajectory.ended}), "
-                     f"seed {trajectory.seed}", fontsize=8)
+        ax.set_title(
+            f"{name}: {len(trajectory.records)} steps ({trajectory.ended}), seed {trajectory.seed}",
+            fontsize=8,
+        )
         if divergence is not None:
             record = divergence.left if trajectory is left else divergence.right
             if record is not None:

@@ -56,20 +56,42 @@ EAT_STEPS = 2
 SUCCESS, FAILURE, RUNNING = "success", "failure", "running"
 PREDATOR = "predator"
 PREY_ROLES = ("prey0", "prey1")
-EVENTS = ("all_caught", "caught", "escaped", "tired", "rested", "prey_seen", "prey_lost",
-          "in_reach")
+EVENTS = (
+    "all_caught",
+    "caught",
+    "escaped",
+    "tired",
+    "rested",
+    "prey_seen",
+    "prey_lost",
+    "in_reach",
+)
 
 PREDATOR_ACTIONS = ("patrol", "detect", "chase", "capture", "rest")
 PREDATOR_NAMES: dict[str, str] = {
-    "Patrol": "patrol", "Detect": "detect", "Chase": "chase", "Capture": "capture",
-    "GiveUp": "rest", "Sated": "rest", **{name: name for name in PREDATOR_ACTIONS}}
+    "Patrol": "patrol",
+    "Detect": "detect",
+    "Chase": "chase",
+    "Capture": "capture",
+    "GiveUp": "rest",
+    "Sated": "rest",
+    **{name: name for name in PREDATOR_ACTIONS},
+}
 PREY_CONDITIONS = ("predator_near", "in_haven", "haven_closer", "hungry", "at_food")
 PREY_ACTIONS = ("go_to_haven", "flee", "move_to_food", "eat", "wander")
 PREY_NAMES: dict[str, str] = {
-    "PredatorNear": "predator_near", "InHaven": "in_haven",
-    "HavenCloserThanPredator": "haven_closer", "Hungry": "hungry", "AtFood": "at_food",
-    "GoToHaven": "go_to_haven", "Flee": "flee", "MoveToFood": "move_to_food", "Eat": "eat",
-    "Wander": "wander", **{name: name for name in (*PREY_CONDITIONS, *PREY_ACTIONS)}}
+    "PredatorNear": "predator_near",
+    "InHaven": "in_haven",
+    "HavenCloserThanPredator": "haven_closer",
+    "Hungry": "hungry",
+    "AtFood": "at_food",
+    "GoToHaven": "go_to_haven",
+    "Flee": "flee",
+    "MoveToFood": "move_to_food",
+    "Eat": "eat",
+    "Wander": "wander",
+    **{name: name for name in (*PREY_CONDITIONS, *PREY_ACTIONS)},
+}
 
 
 def _nearest(origin: Point, places: Sequence[Point]) -> Point:
@@ -99,8 +121,12 @@ class PredatorPreyWorld:
         self.rng = random.Random(seed)
         self.waypoint = self.rng.randrange(len(WAYPOINTS))
         self.predator: Point = WAYPOINTS[self.waypoint]
-        self.prey = {role: _Prey((round(self.rng.uniform(1.0, 11.0), 3),
-                                  round(self.rng.uniform(1.0, 11.0), 3))) for role in PREY_ROLES}
+        self.prey = {
+            role: _Prey(
+                (round(self.rng.uniform(1.0, 11.0), 3), round(self.rng.uniform(1.0, 11.0), 3))
+            )
+            for role in PREY_ROLES
+        }
         for prey in self.prey.values():
             prey.hunger = self.rng.randrange(HUNGRY)
         self.last_seen: Point | None = None
@@ -117,8 +143,10 @@ class PredatorPreyWorld:
 
     def landmarks(self) -> list[tuple[str, Point]]:
         """Fixed places, for pictures."""
-        return [*((f"haven {i}", h) for i, h in enumerate(HAVENS)),
-                *((f"food {i}", f) for i, f in enumerate(FOOD))]
+        return [
+            *((f"haven {i}", h) for i, h in enumerate(HAVENS)),
+            *((f"food {i}", f) for i, f in enumerate(FOOD)),
+        ]
 
     def known_names(self, role: str) -> Sequence[str]:
         return tuple(PREDATOR_NAMES) if role == PREDATOR else tuple(PREY_NAMES)
@@ -135,9 +163,13 @@ class PredatorPreyWorld:
         return self.terminated or all(p.caught for p in self.prey.values())
 
     def _visible(self) -> list[tuple[str, _Prey]]:
-        return [(role, p) for role, p in self.prey.items()
-                if not p.caught and not self._in_haven(p.position)
-                and distance(self.predator, p.position) <= PREDATOR_RANGE]
+        return [
+            (role, p)
+            for role, p in self.prey.items()
+            if not p.caught
+            and not self._in_haven(p.position)
+            and distance(self.predator, p.position) <= PREDATOR_RANGE
+        ]
 
     def _target(self) -> tuple[str, _Prey] | None:
         visible = self._visible()
@@ -186,8 +218,11 @@ class PredatorPreyWorld:
 
     def _resolve_lunge(self) -> None:
         target = self._target()
-        if target is not None and distance(self.predator, target[1].position) <= REACH \
-                and self.rng.random() < CATCH_CHANCE:
+        if (
+            target is not None
+            and distance(self.predator, target[1].position) <= REACH
+            and self.rng.random() < CATCH_CHANCE
+        ):
             target[1].caught = True
             self.pending.append("caught")
             self._events.append(f"{target[0]}_caught")
@@ -241,8 +276,13 @@ class PredatorPreyWorld:
             return SUCCESS
         if name == "wander":
             angle = self.rng.uniform(0.0, 2.0 * math.pi)
-            prey.position = clamp((prey.position[0] + PREY_SPEED * math.cos(angle),
-                                   prey.position[1] + PREY_SPEED * math.sin(angle)), SIZE)
+            prey.position = clamp(
+                (
+                    prey.position[0] + PREY_SPEED * math.cos(angle),
+                    prey.position[1] + PREY_SPEED * math.sin(angle),
+                ),
+                SIZE,
+            )
             return SUCCESS
         if self._near(prey):
             return FAILURE  # move_to_food / eat: the predator is near
@@ -264,8 +304,10 @@ class PredatorPreyWorld:
                 prey.hunger += 1
         record = StepRecord(
             step=self.step_index,
-            positions=(("predator", rounded(self.predator)),
-                       *((role, rounded(p.position)) for role, p in self.prey.items())),
+            positions=(
+                ("predator", rounded(self.predator)),
+                *((role, rounded(p.position)) for role, p in self.prey.items()),
+            ),
             behaviour=tuple(sorted(behaviour.items())),
             events=tuple(self._events),
             state=tuple((f"{role}.hunger", str(p.hunger)) for role, p in self.prey.items())

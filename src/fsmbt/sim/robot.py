@@ -50,8 +50,15 @@ REACH = 1e-9  # "at" a place: on it (moves land exactly on their target)
 SUCCESS, FAILURE, RUNNING = "success", "failure", "running"
 
 #: The world's behaviours: conditions and actions.
-CONDITIONS = ("battery_ok", "battery_low", "cube_delivered", "cube_in_hand", "at_cube",
-              "at_delivery", "at_inspection")
+CONDITIONS = (
+    "battery_ok",
+    "battery_low",
+    "cube_delivered",
+    "cube_in_hand",
+    "at_cube",
+    "at_delivery",
+    "at_inspection",
+)
 ACTIONS = ("recharge", "move_to_cube", "pick", "move_to_delivery", "place", "dock")
 #: Model leaf name -> world behaviour (the paper's robot BT, then the world's own names).
 NAMES: dict[str, str] = {
@@ -85,8 +92,14 @@ class RobotWorld:
     def reset(self, seed: int) -> None:
         """A new episode: robot, cube and charge placed from ``seed``."""
         self.rng = random.Random(seed)
-        self.robot: Point = (round(self.rng.uniform(0.5, 9.5), 3), round(self.rng.uniform(0.5, 9.5), 3))
-        self.cube: Point = (round(self.rng.uniform(2.0, 8.0), 3), round(self.rng.uniform(3.0, 7.0), 3))
+        self.robot: Point = (
+            round(self.rng.uniform(0.5, 9.5), 3),
+            round(self.rng.uniform(0.5, 9.5), 3),
+        )
+        self.cube: Point = (
+            round(self.rng.uniform(2.0, 8.0), 3),
+            round(self.rng.uniform(3.0, 7.0), 3),
+        )
         self.battery = float(self.rng.randint(20, 100))
         self.in_hand = False
         self.delivered = False
@@ -149,8 +162,11 @@ class RobotWorld:
             positions=(("robot", rounded(self.robot)), ("cube", rounded(self.cube))),
             behaviour=tuple(sorted(behaviour.items())),
             events=tuple(self._events),
-            state=(("battery", f"{self.battery:.1f}"), ("in_hand", str(self.in_hand)),
-                   ("delivered", str(self.delivered))),
+            state=(
+                ("battery", f"{self.battery:.1f}"),
+                ("in_hand", str(self.in_hand)),
+                ("delivered", str(self.delivered)),
+            ),
         )
         self.records.append(record)
         self.step_index += 1

@@ -43,9 +43,12 @@ class Side:
 
     def agents(self, world: World) -> dict[str, Any]:
         """Fresh agents for one episode (name tables checked)."""
-        return {role: build_agent(model, world, role, self.engines.get(role, "fsmbt"),
-                                  where=f"{self.label} ({role})")
-                for role, model in self.models.items()}
+        return {
+            role: build_agent(
+                model, world, role, self.engines.get(role, "fsmbt"), where=f"{self.label} ({role})"
+            )
+            for role, model in self.models.items()
+        }
 
 
 def _outcome_letter(outcome: str) -> str:
@@ -132,8 +135,15 @@ class Comparison:
         return self.identical == len(self.episodes)
 
 
-def compare(make_world: Callable[[], World], left: Side, right: Side, *, episodes: int = 100,
-            seed: int = 0, keep: int | None = None) -> Comparison:
+def compare(
+    make_world: Callable[[], World],
+    left: Side,
+    right: Side,
+    *,
+    episodes: int = 100,
+    seed: int = 0,
+    keep: int | None = None,
+) -> Comparison:
     """Run both sides for ``episodes`` seeded episodes and compare them step by step.
 
     Args:

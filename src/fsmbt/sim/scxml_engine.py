@@ -47,8 +47,9 @@ class _Chart:
         from lxml import etree
         from statemachine.io.loader import load
 
-        root = etree.fromstring(text.encode(), etree.XMLParser(resolve_entities=False,
-                                                                 no_network=True))
+        root = etree.fromstring(
+            text.encode(), etree.XMLParser(resolve_entities=False, no_network=True)
+        )
         self.actions: dict[str, str | None] = {}
         for element in root.iter():
             if not isinstance(element.tag, str):
@@ -77,8 +78,10 @@ class _Instance:
     def action(self) -> str | None:
         atomic = [s.id for s in self.machine.configuration if not list(s.states)]
         if len(atomic) != 1:
-            raise UnsupportedError(f"python-statemachine has {len(atomic)} active states "
-                                   f"({', '.join(sorted(atomic))}): a simulation needs one")
+            raise UnsupportedError(
+                f"python-statemachine has {len(atomic)} active states "
+                f"({', '.join(sorted(atomic))}): a simulation needs one"
+            )
         return self.chart.actions.get(atomic[0])
 
     @property

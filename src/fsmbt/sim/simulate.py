@@ -61,8 +61,9 @@ class Simulation:
     @property
     def all_identical(self) -> bool:
         """True when at least one row ran and every row that ran is identical."""
-        return bool(self.ran) and all(r.comparison is not None and r.comparison.all_identical
-                                      for r in self.ran)
+        return bool(self.ran) and all(
+            r.comparison is not None and r.comparison.all_identical for r in self.ran
+        )
 
 
 def companion(family: str) -> Model:
@@ -85,8 +86,10 @@ def role_of(world_name: str, model: Model, role: str | None = None) -> str:
         raise InputError(f"unknown world '{world_name}' (worlds: {', '.join(families)})")
     if role is not None:
         if role not in families[world_name]:
-            raise InputError(f"the {world_name} world has no role '{role}' "
-                             f"(roles: {', '.join(families[world_name])})")
+            raise InputError(
+                f"the {world_name} world has no role '{role}' "
+                f"(roles: {', '.join(families[world_name])})"
+            )
         return role
     if world_name == "robot":
         return "robot"
@@ -100,19 +103,30 @@ def role_of(world_name: str, model: Model, role: str | None = None) -> str:
     if names <= set(PREY_NAMES):
         return "prey"
     unknown = sorted(names - set(PREDATOR_NAMES) - set(PREY_NAMES)) or sorted(names)
-    raise InputError(f"the model fits neither the predator nor the prey of the predator-prey "
-                     f"world: {', '.join(unknown)} (docs/simulation.md, 'Name tables')")
+    raise InputError(
+        f"the model fits neither the predator nor the prey of the predator-prey "
+        f"world: {', '.join(unknown)} (docs/simulation.md, 'Name tables')"
+    )
 
 
 def _roles(world: World, family: str) -> list[str]:
     return [r for r in world.roles if r == family or (family == "prey" and r.startswith("prey"))]
 
 
-def simulate(world_name: str, model: Model, other: Model, *, engines: Sequence[str] = ENGINES,
-             episodes: int = 100, seed: int = 0, role: str | None = None,
-             names: tuple[str, str] = ("model", "other"), max_steps: int | None = None,
-             statemachine_available: Callable[[], bool] | None = None,
-             keep: int | None = None) -> Simulation:
+def simulate(
+    world_name: str,
+    model: Model,
+    other: Model,
+    *,
+    engines: Sequence[str] = ENGINES,
+    episodes: int = 100,
+    seed: int = 0,
+    role: str | None = None,
+    names: tuple[str, str] = ("model", "other"),
+    max_steps: int | None = None,
+    statemachine_available: Callable[[], bool] | None = None,
+    keep: int | None = None,
+) -> Simulation:
     """Compare ``model`` and ``other`` in a world, one row per engine.
 
     Args:
@@ -159,18 +173,38 @@ def simulate(world_name: str, model: Model, other: Model, *, engines: Sequence[s
         left_engine = engine if engine in engines_for(model) else "fsmbt"
         right_engine = engine if engine in engines_for(other) else "fsmbt"
         if engine != "fsmbt" and left_engine == right_engine == "fsmbt":
-            result.rows.append(Row(engine, left_engine, right_engine, None,
-                                   f"skipped {engine}: neither model runs on it"))
+            result.rows.append(
+                Row(
+                    engine,
+                    left_engine,
+                    right_engine,
+                    None,
+                    f"skipped {engine}: neither model runs on it",
+                )
+            )
             continue
         if engine == "python-statemachine" and not has_statemachine:
-            result.rows.append(Row(engine, left_engine, right_engine, None,
-                                   "skipped python-statemachine: the statemachine package does "
-                                   "not import (pip install python-statemachine==3.2.2)"))
+            result.rows.append(
+                Row(
+                    engine,
+                    left_engine,
+                    right_engine,
+                    None,
+                    "skipped python-statemachine: the statemachine package does "
+                    "not import (pip install python-statemachine==3.2.2)",
+                )
+            )
             continue
-        left = Side(names[0], {**companions, **dict.fromkeys(played, model)},
-                    dict.fromkeys(played, left_engine))
-        right = Side(names[1], {**companions, **dict.fromkeys(played, other)},
-                     dict.fromkeys(played, right_engine))
+        left = Side(
+            names[0],
+            {**companions, **dict.fromkeys(played, model)},
+            dict.fromkeys(played, left_engine),
+        )
+        right = Side(
+            names[1],
+            {**companions, **dict.fromkeys(played, other)},
+            dict.fromkeys(played, right_engine),
+        )
         comparison = compare(make_world, left, right, episodes=episodes, seed=seed, keep=keep)
         result.rows.append(Row(engine, left_engine, right_engine, comparison))
     return result

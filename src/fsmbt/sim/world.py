@@ -74,10 +74,14 @@ class Divergence:
 
     def describe(self, left_name: str = "model", right_name: str = "other") -> str:
         """A short report: the step, then each side's behaviour and world state."""
+
         def side(record: StepRecord | None) -> str:
             return record.describe() if record is not None else "(episode already ended)"
-        return (f"step {self.step}:\n  {left_name}: {side(self.left)}\n"
-                f"  {right_name}: {side(self.right)}")
+
+        return (
+            f"step {self.step}:\n  {left_name}: {side(self.left)}\n"
+            f"  {right_name}: {side(self.right)}"
+        )
 
 
 def first_divergence(left: Trajectory, right: Trajectory) -> Divergence | None:
@@ -161,4 +165,5 @@ def check_names(world: World, role: str, names: Sequence[str], where: str) -> No
     if unknown:
         raise InputError(
             f"{where}: {', '.join(unknown)} not known to the {world.name} world's {role} "
-            f"(known: {', '.join(sorted(known))}; docs/simulation.md, 'Name tables')")
+            f"(known: {', '.join(sorted(known))}; docs/simulation.md, 'Name tables')"
+        )
