@@ -138,8 +138,8 @@ class PredatorPreyWorld:
         self._events: list[str] = []
 
     # -- the interface ------------------------------------------------------------------------
-    size = SIZE
-    movers = (PREDATOR, *PREY_ROLES)
+    size: float = SIZE
+    movers: tuple[str, ...] = (PREDATOR, *PREY_ROLES)
 
     def landmarks(self) -> list[tuple[str, Point]]:
         """Fixed places, for pictures."""

@@ -112,8 +112,8 @@ class RobotWorld:
         self._latched = 0
 
     # -- the interface ------------------------------------------------------------------------
-    size = SIZE
-    movers = ("robot", "cube")
+    size: float = SIZE
+    movers: tuple[str, ...] = ("robot", "cube")
 
     def landmarks(self) -> list[tuple[str, Point]]:
         """Fixed places, for pictures."""

@@ -71,7 +71,7 @@ def run_episode(world: World, side: Side, seed: int) -> Trajectory:
     for role, agent in agents.items():
         if world.roles[role] == EVENT_DRIVEN:
             agent.start()
-    while len(world.records) < world.max_steps and not world.done():  # type: ignore[attr-defined]
+    while len(world.records) < world.max_steps and not world.done():
         behaviour: dict[str, str] = {}
         for role in world.roles:
             agent = agents.get(role)
@@ -83,15 +83,15 @@ def run_episode(world: World, side: Side, seed: int) -> Trajectory:
                     agent.post(event)
                 world.run_action(role, agent.action)
                 if agent.terminated:
-                    world.agent_terminated(role)  # type: ignore[attr-defined]
+                    world.agent_terminated(role)
                 behaviour[role] = f"{'+'.join(events) or '-'} -> {agent.action}"
             else:
                 leaves, result = agent.tick(lambda name, r=role: world.leaf(r, name))
                 trail = " ".join(f"{label}:{_outcome_letter(o)}" for label, o in leaves)
                 behaviour[role] = f"{trail} => {result}"
-                world.root_result(role, result)  # type: ignore[attr-defined]
+                world.root_result(role, result)
         world.end_step(behaviour)
-    records = list(world.records)  # type: ignore[attr-defined]
+    records = list(world.records)
     return Trajectory(seed, records, "done" if world.done() else "step limit")
 
 

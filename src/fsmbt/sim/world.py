@@ -108,6 +108,21 @@ class World(Protocol):
     name: str
     roles: Mapping[str, str]  # role -> LEAF_DRIVEN / EVENT_DRIVEN
     max_steps: int
+    records: list[StepRecord]  # this episode's records so far
+    size: float  # the field is the square [0, size]^2 (pictures)
+    movers: tuple[str, ...]  # what moves, as named in StepRecord.positions (pictures)
+
+    def landmarks(self) -> list[tuple[str, tuple[float, float]]]:
+        """Fixed places (charger, havens ...), for pictures."""
+        ...
+
+    def root_result(self, role: str, result: str) -> None:
+        """A leaf-driven role's tree returned ``result`` (``SUCCESS``/``FAILURE``/``RUNNING``)."""
+        ...
+
+    def agent_terminated(self, role: str) -> None:
+        """An event-driven role's model reached a final state."""
+        ...
 
     def reset(self, seed: int) -> None:
         """Start a new episode from ``seed``."""
