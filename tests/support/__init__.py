@@ -9,4 +9,5 @@ test folders. Importable as ``support.<module>`` because pyproject.toml's pytest
 - ``random_trees``: seeded random behavior trees (and a hypothesis strategy) for the semantics
   tests.
 - ``scripted_server``: a local OpenAI-compatible server replaying scripted answers.
+- ``sim_helpers``: the simulation tests' models, mutants and divergence checks (tests/sim).
 """
