@@ -19,7 +19,7 @@ import typer
 
 from fsmbt import api
 from fsmbt.llm.config import PROVIDERS
-from fsmbt.cli.options import node_models_option, reader_options
+from fsmbt.cli.options import max_states_option, node_models_option, reader_options
 from fsmbt.cli.progress import StageProgress, format_timings
 from fsmbt.verify.report import Report
 
@@ -47,6 +47,7 @@ def register(app: typer.Typer) -> None:
         as_json: bool = typer.Option(False, "--json", help="print a JSON summary on stdout"),
         quiet: bool = typer.Option(False, "--quiet", "-q", help="no progress display on stderr"),
         node_models: list[Path] = node_models_option(),
+        max_states: int | None = max_states_option(),
         hierarchy: Literal["subtrees", "flatten"] = typer.Option("subtrees", "--hierarchy", help="FSM->BT of a "
                                       "hierarchical FSM: subtrees (one SubTree per composite "
                                       "state) or flatten (one flat LEBT)"),
@@ -64,6 +65,7 @@ def register(app: typer.Typer) -> None:
             outcome = api.convert_file(
                 source, output, to=to, source_format=source_format, engine=engine, style=style,
                 loop=loop, hierarchy=hierarchy, verify=not no_verify, overwrite=force,
+                max_states=max_states,
                 keep_not_equivalent=keep_failed, options=options, on_stage=progress)
         summary = outcome.to_dict()
         if as_json:

