@@ -7,6 +7,7 @@ identical warnings, an unreadable picture, jargon, a wrong port that verified si
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import pytest
@@ -78,3 +79,47 @@ def test_max_states_must_be_positive(reactive_bt: Path,
                                      capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["convert", str(reactive_bt), "--max-states", "0", "-q"]) == 2
     assert "--max-states" in capsys.readouterr().err
+
+
+# -- 7: one line per undeclared node type, with a count --------------------------------------
+UNDECLARED_BT = """<root BTCPP_format="4" main_tree_to_execute="Main">
+  <BehaviorTree ID="Main">
+    <Sequence>
+      <Spin name="a"/>
+      <Spin name="b"/>
+      <Spin name="c"/>
+      <Wait/>
+    </Sequence>
+  </BehaviorTree>
+</root>
+"""
+
+
+@pytest.fixture
+def undeclared_bt(tmp_path: Path) -> Path:
+    path = tmp_path / "nav.xml"
+    path.write_text(UNDECLARED_BT, encoding="utf-8")
+    return path
+
+
+def test_validate_collapses_repeated_not_declared_warnings(
+        undeclared_bt: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["validate", "--json", str(undeclared_bt)]) == 0
+    issues = json.loads(capsys.readouterr().out)["issues"]
+    spin = [i for i in issues if "'Spin'" in i["message"]]
+    wait = [i for i in issues if "'Wait'" in i["message"]]
+    assert len(spin) == 1 and "3 nodes" in spin[0]["message"] and spin[0]["line"] == 4
+    assert len(wait) == 1 and "nodes" not in wait[0]["message"]
+
+
+@pytest.mark.parametrize("command", [["info"], ["convert", "-q", "--no-verify"]])
+def test_info_and_convert_name_each_undeclared_type_once(
+        command: list[str], undeclared_bt: Path, tmp_path: Path,
+        capsys: pytest.CaptureFixture[str]) -> None:
+    extra = ["-o", str(tmp_path / "out.scxml")] if command[0] == "convert" else []
+    assert main([*command, str(undeclared_bt), *extra]) == 0
+    out = capsys.readouterr().out
+    lines = [line for line in out.splitlines() if "undeclared" in line]
+    assert len(lines) == 1
+    assert "2 undeclared leaf types (4 nodes)" in lines[0] and "Spin x3, Wait" in lines[0]
+    assert "--node-models" in lines[0]

@@ -18,6 +18,9 @@ from typing import Literal
 import typer
 
 from fsmbt import api
+from fsmbt.model.bt import BTDocument
+from fsmbt.model.undeclared import summary as undeclared_summary
+from fsmbt.model.undeclared import undeclared_leaf_types
 from fsmbt.llm.config import PROVIDERS
 from fsmbt.cli.options import max_states_option, node_models_option, reader_options
 from fsmbt.cli.progress import StageProgress, format_timings
@@ -84,6 +87,12 @@ def _print_summary(outcome: api.Outcome, *, to_stderr: bool) -> None:
     stream = sys.stderr if to_stderr else sys.stdout
     for warning in outcome.warnings:
         print(f"warning: {warning}", file=stream)
+    source = outcome.source.model
+    if isinstance(source, BTDocument):
+        undeclared = undeclared_leaf_types(source)
+        if undeclared:
+            print(f"warning: {undeclared_summary(undeclared)}; declare them with "
+                  "--node-models FILE", file=stream)
     figures = ", ".join(f"{k}={v}" for k, v in outcome.conversion.stats.items())
     where = str(outcome.output) if outcome.output is not None else "stdout"
     print(f"converted {outcome.conversion.direction} with {outcome.conversion.engine} -> "
