@@ -39,12 +39,12 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+from fsmbt import limits
 from fsmbt.convert.compress import inline_and_compress
 from fsmbt.convert.perf import without_gc_pauses
 from fsmbt.convert.result import ConversionResult
 from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.bt_nodes import NodeKind
-from fsmbt import limits
 from fsmbt.model.errors import Hint, InputError, UnsupportedError
 from fsmbt.model.fsm import FSM, State
 from fsmbt.semantics.nodes import (
