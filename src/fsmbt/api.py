@@ -48,6 +48,7 @@ from fsmbt.formats.registry import format_for_path, read_text
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import Hint, InputError, SourceLocation, UnsupportedError
 from fsmbt.model.fsm import FSM
+from fsmbt.model.validate import Issue
 from fsmbt.verify import Report, verify
 from fsmbt.verify.orient import orient, rules_text
 
@@ -316,6 +317,32 @@ def convert_model(model: Model, engine: str = "rules", *, style: str = "paper",
     if hierarchy is not None and engine == "rules" and isinstance(model, FSM):
         options["hierarchy"] = hierarchy
     return convert(model, engine=engine, style=style, **options)
+
+
+def lebt_port_issues(model: Model) -> list[Issue]:
+    """The LEBT leaves whose redundant ports (a guard's ``target``, a state's ``exits``)
+    contradict the tree's structure (``fsmbt.semantics.lebt.ports``); none for an FSM.
+
+    Args:
+        model: any model.
+
+    Returns:
+        Error issues, each naming the leaf and its line.
+    """
+    if not isinstance(model, BTDocument):
+        return []
+    from fsmbt.semantics.lebt.ports import lebt_port_issues as issues
+
+    return issues(model)
+
+
+def _warn_lebt_ports(loaded: Loaded) -> None:
+    """Add each LEBT port contradiction to ``loaded.warnings`` once (the checkers read the
+    structure, so the verdict stands; the file still says something false)."""
+    for issue in lebt_port_issues(loaded.model):
+        text = str(issue).replace(": error: ", ": ", 1)
+        if text not in loaded.warnings:
+            loaded.warnings.append(text)
 
 
 def _checker_limit(max_states: int | None) -> int:
@@ -590,6 +617,7 @@ def convert_loaded(loaded: Loaded, output: str | Path | None = None, *,
     destination = Path(output) if output is not None else None
     if destination is not None:
         check_destination(destination, overwrite=overwrite)
+    _warn_lebt_ports(loaded)
     timings: dict[str, float] = {}
     with _timed(timings, "convert", on_stage):
         engine_options = {k: v for k, v in options.items() if k not in READER_OPTIONS}
@@ -645,6 +673,8 @@ def verify_files(source: str | Path, converted: str | Path, *, engine: str = "na
     with _timed(timings, "read", on_stage):
         first = load(source, source_format, options=options)
         second = load(converted, converted_format, options=options)
+        _warn_lebt_ports(first)
+        _warn_lebt_ports(second)
     with _timed(timings, "verify", on_stage):
         report = verify_either_order(first.model, second.model, engine, loop=loop,
                                      max_states=max_states)

@@ -123,3 +123,58 @@ def test_info_and_convert_name_each_undeclared_type_once(
     assert len(lines) == 1
     assert "2 undeclared leaf types (4 nodes)" in lines[0] and "Spin x3, Wait" in lines[0]
     assert "--node-models" in lines[0]
+
+
+# -- 10: the LEBT leaves' redundant ports are checked against the structure ------------------
+@pytest.fixture
+def paper_lebt(tmp_path: Path) -> Path:
+    out = tmp_path / "paper_bt.xml"
+    assert main(["convert", str(EXAMPLES / "paper_fsm.xml"), "-q", "-o", str(out)]) == 0
+    return out
+
+
+def _edited(path: Path, old: str, new: str) -> Path:
+    text = path.read_text(encoding="utf-8")
+    assert text.count(old) == 1
+    edited = path.with_name("edited_" + path.name)
+    edited.write_text(text.replace(old, new), encoding="utf-8")
+    return edited
+
+
+def _line_of(path: Path, needle: str) -> int:
+    lines = path.read_text(encoding="utf-8").splitlines()
+    return next(n for n, line in enumerate(lines, 1) if needle in line)
+
+
+def test_honest_lebt_has_no_port_issue(paper_lebt: Path,
+                                       capsys: pytest.CaptureFixture[str]) -> None:
+    capsys.readouterr()
+    assert main(["validate", str(paper_lebt)]) == 0
+    assert main(["verify", str(EXAMPLES / "paper_fsm.xml"), str(paper_lebt), "-q"]) == 0
+    assert "warning" not in capsys.readouterr().err
+
+
+def test_wrong_guard_target_is_an_error_in_validate_and_a_warning_in_verify(
+        paper_lebt: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    bad = _edited(paper_lebt, 'name="Enter_B" target="B"', 'name="Enter_B" target="C"')
+    capsys.readouterr()
+    assert main(["validate", str(bad)]) == 2
+    err = capsys.readouterr().err
+    line = _line_of(bad, 'name="Enter_B"')
+    assert f"{bad}:{line}:" in err and "LebtGuard 'Enter_B'" in err
+    assert "target='C'" in err and "'B'" in err
+    # the checkers read the pairs, not the target: the verdict stands, the user is told
+    assert main(["verify", str(EXAMPLES / "paper_fsm.xml"), str(bad), "-q"]) == 0
+    captured = capsys.readouterr()
+    assert "EQUIVALENT" in captured.out
+    assert "warning:" in captured.err and "target='C'" in captured.err
+
+
+def test_exit_without_guard_and_pair_without_exit_are_named(
+        paper_lebt: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    bad = _edited(paper_lebt, 'exits="eventBC;eventBD"', 'exits="eventBC;eventBX"')
+    capsys.readouterr()
+    assert main(["validate", "--json", str(bad)]) == 2
+    messages = [i["message"] for i in json.loads(capsys.readouterr().out)["issues"]]
+    assert any("'B/eventBD'" in m and "never fires" in m for m in messages)
+    assert any("'eventBX'" in m and "no LebtGuard" in m for m in messages)

@@ -47,7 +47,7 @@ def register(app: typer.Typer) -> None:
         sequence that tells the two models apart."""
         try:
             with StageProgress(quiet=quiet or as_json, label=f"{source.name} ~ {converted.name}") as progress:
-                _, _, report = api.verify_files(source, converted, engine=engine, loop=loop,
+                first, second, report = api.verify_files(source, converted, engine=engine, loop=loop,
                                                 source_format=from_format,
                                                 converted_format=from_format2,
                                                 max_states=max_states,
@@ -57,6 +57,8 @@ def register(app: typer.Typer) -> None:
             print(f"error: ENGINES DISAGREE: {exc}; one of the checkers is wrong, please report "
                   "this with both files", file=sys.stderr)
             raise typer.Exit(EXIT_ENGINES_DISAGREE) from None
+        for warning in [*first.warnings, *second.warnings]:
+            print(f"warning: {warning}", file=sys.stderr)
         if as_json:
             data = report.to_dict()
             data["source_file"] = str(source)
