@@ -12,11 +12,11 @@ from rich.markup import escape
 from rich.table import Table
 
 from fsmbt import api
+from fsmbt.cli.options import node_models_option, reader_options
 from fsmbt.model.bt import BTDocument
+from fsmbt.model.stats import BTStats, FSMStats, model_stats
 from fsmbt.model.undeclared import summary as undeclared_summary
 from fsmbt.model.undeclared import undeclared_leaf_types
-from fsmbt.cli.options import node_models_option, reader_options
-from fsmbt.model.stats import BTStats, FSMStats, model_stats
 
 #: Lists longer than this are cut in the table (``--json`` always has them all).
 MAX_LISTED = 12
