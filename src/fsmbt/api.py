@@ -51,6 +51,7 @@ from fsmbt.model.fsm import FSM
 from fsmbt.model.validate import Issue
 from fsmbt.verify import Report, verify
 from fsmbt.verify.orient import orient, rules_text
+from fsmbt.verify.wording import readable
 
 Model = FSM | BTDocument
 
@@ -369,8 +370,9 @@ def verify_models(source: Model, result: Model, engine: str = "native", *, loop:
         EngineDisagreement: ``both`` and the engines disagree (a bug in one of them).
         InputError, UnsupportedError: the pair cannot be compared.
     """
-    return verify(source, result, engine=engine, loop=loop,
-                  max_states=_checker_limit(max_states))
+    report = verify(source, result, engine=engine, loop=loop,
+                    max_states=_checker_limit(max_states))
+    return readable(report, source, result)
 
 
 def verify_either_order(first: Model, second: Model, engine: str = "native", *,
@@ -400,6 +402,7 @@ def verify_either_order(first: Model, second: Model, engine: str = "native", *,
         raise InputError(f"{exc.message} (pairing rule tried: {oriented.rule}; the rules are: "
                          f"{rules_text()})", location=exc.location,
                          element=exc.element, hints=exc.hints) from None
+    readable(report, oriented.source, oriented.result)
     report.stats["pairing"] = oriented.rule
     report.stats["swapped"] = oriented.swapped
     return report

@@ -178,3 +178,61 @@ def test_exit_without_guard_and_pair_without_exit_are_named(
     messages = [i["message"] for i in json.loads(capsys.readouterr().out)["issues"]]
     assert any("'B/eventBD'" in m and "never fires" in m for m in messages)
     assert any("'eventBX'" in m and "no LebtGuard" in m for m in messages)
+
+
+# -- 9: words a robotics engineer can read ---------------------------------------------------
+def test_convert_summary_says_what_was_built(tmp_path: Path,
+                                             capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["convert", str(EXAMPLES / "robot_bt.xml"), "-q",
+                 "-o", str(tmp_path / "robot.scxml")]) == 0
+    out = capsys.readouterr().out
+    summary = next(line for line in out.splitlines() if line.startswith("converted"))
+    assert "k=" not in summary and "units=" not in summary
+    assert "12 leaves became a state machine with 2 sub-state-machines" in summary
+    assert "3 conversion units" in summary
+    # the checker's counts say what they count
+    assert "configurations (an FSM's states plus its start" in out
+
+
+def test_convert_json_keeps_its_keys(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["convert", str(EXAMPLES / "robot_bt.xml"), "-q", "--json",
+                 "-o", str(tmp_path / "robot.scxml")]) == 0
+    stats = json.loads(capsys.readouterr().out)["stats"]
+    assert {"k", "units", "explored_regions", "leaves"} <= set(stats)
+
+
+def test_leaf_execution_counterexample_in_the_users_words(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str],
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("COLUMNS", "250")  # rich tables do not wrap the words compared here
+    hfsm = tmp_path / "robot.scxml"
+    assert main(["convert", str(EXAMPLES / "robot_bt.xml"), "-q", "-o", str(hfsm)]) == 0
+    wrong = tmp_path / "wrong.scxml"
+    wrong.write_text(hfsm.read_text(encoding="utf-8").replace("MovetoCube2", "MovetoCubeX"),
+                     encoding="utf-8")
+    capsys.readouterr()
+    assert main(["verify", str(EXAMPLES / "robot_bt.xml"), str(wrong), "-q"]) == 1
+    out = " ".join(capsys.readouterr().out.split())  # the table wraps; compare the words
+    assert "NOT EQUIVALENT" in out
+    assert "input 'failure'" not in out and "when the previous leaf returned FAILURE" in out
+    assert "@" not in out  # no MovetoCube2@1/1/0/1/0/1
+    assert "never reached with matching behaviour: MovetoCube2" in out
+    assert "4 leaf outcomes" in out and "FAILURE" in out
+
+
+def test_one_step_counterexample_is_singular(paper_lebt: Path,
+                                             capsys: pytest.CaptureFixture[str]) -> None:
+    bad = _edited(paper_lebt, 'state="A" action="A"', 'state="A" action="Z"')
+    capsys.readouterr()
+    assert main(["verify", str(EXAMPLES / "paper_fsm.xml"), str(bad), "-q"]) == 1
+    out = " ".join(capsys.readouterr().out.split())
+    assert "shortest counterexample (1 input)" in out and "(1 inputs)" not in out
+
+
+def test_prose_text_points_to_llm_extract(tmp_path: Path,
+                                          capsys: pytest.CaptureFixture[str]) -> None:
+    prose = tmp_path / "mission.txt"
+    prose.write_text("The robot moves to the cube, picks it up and docks.\n", encoding="utf-8")
+    assert main(["convert", str(prose), "-q"]) == 2
+    err = capsys.readouterr().err
+    assert "mission.txt:1:" in err and "fsmbt llm extract" in err and "--engine llm" in err

@@ -24,6 +24,7 @@ from fsmbt.model.undeclared import undeclared_leaf_types
 from fsmbt.llm.config import PROVIDERS
 from fsmbt.cli.options import max_states_option, node_models_option, reader_options
 from fsmbt.cli.progress import StageProgress, format_timings
+from fsmbt.cli.wording import checked_counts, conversion_summary
 from fsmbt.verify.report import Report
 
 
@@ -93,7 +94,7 @@ def _print_summary(outcome: api.Outcome, *, to_stderr: bool) -> None:
         if undeclared:
             print(f"warning: {undeclared_summary(undeclared)}; declare them with "
                   "--node-models FILE", file=stream)
-    figures = ", ".join(f"{k}={v}" for k, v in outcome.conversion.stats.items())
+    figures = conversion_summary(outcome.conversion.direction, outcome.conversion.stats)
     where = str(outcome.output) if outcome.output is not None else "stdout"
     print(f"converted {outcome.conversion.direction} with {outcome.conversion.engine} -> "
           f"{where} ({outcome.output_format}): {figures}", file=stream)
@@ -103,6 +104,9 @@ def _print_summary(outcome: api.Outcome, *, to_stderr: bool) -> None:
         print("verification skipped (--no-verify)", file=stream)
         return
     print(f"verdict: {outcome.verdict}", file=stream)
+    counts = checked_counts(report.stats)
+    if counts:
+        print(f"  checked {counts}", file=stream)
     for name, prop in report.properties.items():
         mark = "ok  " if prop.holds else "FAIL"
         print(f"  {mark} {name}: {prop.detail}", file=stream)
