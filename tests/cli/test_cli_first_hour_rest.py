@@ -236,3 +236,86 @@ def test_prose_text_points_to_llm_extract(tmp_path: Path,
     assert main(["convert", str(prose), "-q"]) == 2
     err = capsys.readouterr().err
     assert "mission.txt:1:" in err and "fsmbt llm extract" in err and "--engine llm" in err
+
+
+# -- 8: large pictures -----------------------------------------------------------------------
+def _many_trees(count: int, leaves: int) -> str:
+    """``count`` trees of ``leaves`` actions each, the main tree written last."""
+    trees = []
+    for t in range(count):
+        body = "".join(f'<Action ID="Do{t}_{k}"/>' for k in range(leaves))
+        trees.append(f'<BehaviorTree ID="T{t}"><Sequence>{body}</Sequence></BehaviorTree>')
+    return (f'<root BTCPP_format="4" main_tree_to_execute="T{count - 1}">' + "".join(trees)
+            + "</root>")
+
+
+def _png_size(path: Path) -> tuple[int, int]:
+    head = path.read_bytes()[:24]
+    assert head[:8] == b"\x89PNG\r\n\x1a\n"
+    return int.from_bytes(head[16:20], "big"), int.from_bytes(head[20:24], "big")
+
+
+def test_multi_tree_picture_puts_the_main_tree_first_and_stacks_the_rest(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    source = tmp_path / "trees.xml"
+    source.write_text(_many_trees(24, 6), encoding="utf-8")
+    dot = tmp_path / "trees.dot"
+    assert main(["render", str(source), "-o", str(dot)]) == 0
+    text = dot.read_text(encoding="utf-8")
+    first_cluster_label = text[text.index("subgraph cluster_"):].split("label=", 1)[1]
+    assert first_cluster_label.startswith('"T23 (main)"')
+    assert text.count("style=invis") >= 2  # rows hang under each other
+    png = tmp_path / "trees.png"
+    assert main(["render", str(source), "-o", str(png)]) == 0
+    width, height = _png_size(png)
+    assert width < 4 * height, (width, height)  # not a strip
+
+
+def test_a_capped_picture_says_what_it_left_out(tmp_path: Path,
+                                                capsys: pytest.CaptureFixture[str]) -> None:
+    source = tmp_path / "many.xml"
+    source.write_text(_many_trees(40, 20), encoding="utf-8")  # 40 x 21 = 840 nodes
+    assert main(["render", str(source), "-o", str(tmp_path / "many.dot")]) == 0
+    err = capsys.readouterr().err
+    assert "capped at 600 nodes" in err and "of 40 trees" in err and "--tree ID" in err
+    one = tmp_path / "one.dot"
+    assert main(["render", str(source), "-o", str(one), "--tree", "T5"]) == 0
+    text = one.read_text(encoding="utf-8")
+    assert "Do5_0" in text and "Do6_0" not in text
+    assert main(["render", str(source), "-o", str(tmp_path / "x.dot"), "--tree", "Nope"]) == 2
+    assert "no tree 'Nope'" in capsys.readouterr().err
+
+
+def test_hfsm_one_level_at_a_time(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    door = EXAMPLES / "door_hfsm.scxml"
+    top = tmp_path / "top.dot"
+    assert main(["render", str(door), "-o", str(top), "--level", "0"]) == 0
+    text = top.read_text(encoding="utf-8")
+    assert "states inside" in text and "cluster" not in text and "Closing" not in text
+    inner = tmp_path / "operating.dot"
+    assert main(["render", str(door), "-o", str(inner), "--composite", "Operating"]) == 0
+    text = inner.read_text(encoding="utf-8")
+    assert "Closing" in text and "Emergency" not in text
+    full = tmp_path / "full.dot"
+    assert main(["render", str(door), "-o", str(full)]) == 0
+    assert "subgraph cluster_" in full.read_text(encoding="utf-8")  # clusters, as documented
+    capsys.readouterr()
+    assert main(["render", str(door), "-o", str(tmp_path / "x.dot"), "--composite", "Nope"]) == 2
+    assert "composite states: Operating" in capsys.readouterr().err
+
+
+def test_big_hfsm_is_drawn_to_the_level_that_fits(tmp_path: Path,
+                                                  capsys: pytest.CaptureFixture[str]) -> None:
+    big = tmp_path / "big_hfsm.scxml"
+    inner = "".join(f'<state id="c{k}"><transition event="e" target="c{(k + 1) % 70}"/></state>'
+                    for k in range(70))
+    big.write_text('<scxml xmlns="http://www.w3.org/2005/07/scxml" version="1.0" '
+                   'initial="Busy"><state id="Busy" initial="c0">' + inner +
+                   '<transition event="stop" target="Done"/></state><final id="Done"/></scxml>',
+                   encoding="utf-8")
+    out = tmp_path / "big.dot"
+    assert main(["render", str(big), "-o", str(out)]) == 0
+    err = capsys.readouterr().err
+    assert "picture capped" in err and "--composite NAME" in err and "Busy" in err
+    text = out.read_text(encoding="utf-8")
+    assert "70 states inside" in text and "c17" not in text

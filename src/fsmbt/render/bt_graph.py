@@ -31,7 +31,13 @@ from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.bt_nodes import NodeKind, canonical_type
 from fsmbt.model.errors import Hint, InputError
 from fsmbt.render.dot import (
-    DEFAULT_MAX_NODES, FONT, TooLargeError, assemble, check_size, edge_line, html_label,
+    DEFAULT_MAX_NODES,
+    FONT,
+    TooLargeError,
+    assemble,
+    check_size,
+    edge_line,
+    html_label,
     label_text,
 )
 
