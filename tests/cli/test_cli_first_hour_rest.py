@@ -319,3 +319,14 @@ def test_big_hfsm_is_drawn_to_the_level_that_fits(tmp_path: Path,
     assert "picture capped" in err and "--composite NAME" in err and "Busy" in err
     text = out.read_text(encoding="utf-8")
     assert "70 states inside" in text and "c17" not in text
+
+
+@pytest.mark.parametrize("engine", ["bsd", "chds"])
+def test_baseline_summaries_claim_only_what_they_built(
+        engine: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["convert", str(EXAMPLES / "paper_fsm.xml"), "--engine", engine, "-q",
+                 "--no-verify", "-o", str(tmp_path / "bt.xml")]) == 0
+    summary = next(line for line in capsys.readouterr().out.splitlines()
+                   if line.startswith("converted"))
+    assert "10 FSM states became a BT of" in summary
+    assert "loop-execution" not in summary and "?" not in summary.split("):", 1)[1]

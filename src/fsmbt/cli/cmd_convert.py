@@ -94,7 +94,8 @@ def _print_summary(outcome: api.Outcome, *, to_stderr: bool) -> None:
         if undeclared:
             print(f"warning: {undeclared_summary(undeclared)}; declare them with "
                   "--node-models FILE", file=stream)
-    figures = conversion_summary(outcome.conversion.direction, outcome.conversion.stats)
+    figures = conversion_summary(outcome.conversion.direction, outcome.conversion.stats,
+                                 outcome.conversion.engine)
     where = str(outcome.output) if outcome.output is not None else "stdout"
     print(f"converted {outcome.conversion.direction} with {outcome.conversion.engine} -> "
           f"{where} ({outcome.output_format}): {figures}", file=stream)

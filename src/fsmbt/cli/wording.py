@@ -30,75 +30,105 @@ def counted(n: object, noun: str, plural: str | None = None) -> str:
     return f"{n} {noun if one else (plural or noun + 's')}"
 
 
-_FSM_TO_BT = ("states", "transitions", "entry", "loop_states", "root_subtrees", "chains",
-              "branches", "unreachable_dropped", "flattened", "nodes", "depth")
-_BT_TO_FSM = ("k", "units", "explored_regions", "explored_states", "depth_before", "depth_after",
-              "merged_nodes", "leaves", "loop")
+def _fsm_to_bt(s: Mapping[str, object], engine: str, used: set[str]) -> list[str]:
+    def take(key: str) -> object:
+        used.add(key)
+        return s[key]
 
-
-def _fsm_to_bt(s: Mapping[str, object]) -> list[str]:
-    parts = [f"{counted(s['states'], 'FSM state')} and "
-             f"{counted(s.get('transitions', '?'), 'transition')} became a loop-execution BT of "
-             f"{counted(s.get('nodes', '?'), 'node')} (depth {s.get('depth', '?')})"]
-    shape = [f"entry state {s['entry']}"] if s.get("entry") else []
-    if "loop_states" in s:
-        shape.append(counted(s["loop_states"], "loop state"))
-    if "root_subtrees" in s:
-        shape.append(f"{counted(s['root_subtrees'], 'selector')} under the root")
-    if "chains" in s:
-        shape.append(counted(s["chains"], "chain"))
-    if "branches" in s:
-        shape.append(counted(s["branches"], "branch", "branches"))
-    if shape:
-        parts.append(", ".join(shape))
+    head = counted(take("states"), "FSM state")
+    if "transitions" in s:
+        head += f" and {counted(take('transitions'), 'transition')}"
+    head += " became " + ("a loop-execution BT" if engine == "rules" else "a BT")
+    if "nodes" in s:
+        head += f" of {counted(take('nodes'), 'node')}"
+    if "depth" in s:
+        head += f" (depth {take('depth')})"
+    shape: list[str] = []
+    if s.get("entry"):
+        shape.append(f"entry state {take('entry')}")
+    phrases = (("loop_states", "loop state", None, ""),
+               ("root_subtrees", "selector", None, " under the root"),
+               ("chains", "chain", None, ""), ("branches", "branch", "branches", ""),
+               ("subtrees", "SubTree", None, " for composite states"),
+               ("parallel_subtrees", "SubTree", None, " for parallel states"),
+               ("levels", "level", None, " of hierarchy"))
+    for key, noun, plural, tail in phrases:
+        if key in s and (key != "parallel_subtrees" or s[key]):
+            shape.append(counted(take(key), noun, plural) + tail)
+        used.add(key)
+    parts = [head] + ([", ".join(shape)] if shape else [])
     if s.get("unreachable_dropped"):
         parts.append(f"{counted(s['unreachable_dropped'], 'unreachable state')} dropped")
-    if s.get("flattened"):
-        parts.append("the hierarchy was flattened")
+    used.add("unreachable_dropped")
+    if "hierarchy" in s:
+        parts.append("composite states kept as SubTrees" if take("hierarchy") == "subtrees"
+                     else "the hierarchy flattened")
+        used.add("flattened")
+    elif s.get("flattened"):
+        parts.append("the hierarchy flattened")
+    used.add("flattened")
     return parts
 
 
-def _bt_to_fsm(s: Mapping[str, object]) -> list[str]:
-    machines = int(s["k"])  # type: ignore[call-overload]
-    subs = machines - 1
-    built = "1 state machine" if machines == 1 else (
-        f"a state machine with {counted(subs, 'sub-state-machine')}")
-    parts = [f"{counted(s.get('leaves', '?'), 'leaf', 'leaves')} became {built}, from "
-             f"{counted(s.get('units', '?'), 'conversion unit')} (a control node, its children "
-             "and grandchildren)"]
+def _bt_to_fsm(s: Mapping[str, object], used: set[str]) -> list[str]:
+    def take(key: str) -> object:
+        used.add(key)
+        return s[key]
+
+    leaves = counted(take("leaves"), "leaf", "leaves") if "leaves" in s else "the tree"
+    if "k" in s:
+        machines = int(take("k"))  # type: ignore[call-overload]
+        built = "1 state machine" if machines == 1 else (
+            f"a state machine with {counted(machines - 1, 'sub-state-machine')}")
+    else:
+        built = "an FSM"
+        if "states" in s:
+            built += f" of {counted(take('states'), 'state')}"
+            if "transitions" in s:
+                built += f" and {counted(take('transitions'), 'transition')}"
+    head = f"{leaves} became {built}"
+    if "units" in s:
+        head += (f", from {counted(take('units'), 'conversion unit')} (a control node, its "
+                 "children and grandchildren)")
+    parts = [head]
     if s.get("explored_regions"):
-        parts.append(f"{counted(s['explored_regions'], 'reactive or stateful subtree')} "
+        parts.append(f"{counted(take('explored_regions'), 'reactive or stateful subtree')} "
                      f"explored into {counted(s.get('explored_states', '?'), 'state')}")
+    used.update(("explored_regions", "explored_states"))
     if "depth_before" in s:
-        merged = s.get("merged_nodes", 0)
-        depth = (f"tree depth {s['depth_before']}" if s.get("depth_after") == s["depth_before"]
-                 else f"tree depth {s['depth_before']} -> {s.get('depth_after')}")
-        if merged:
-            depth += f" after merging {counted(merged, 'same-type child node')}"
+        before, after = take("depth_before"), s.get("depth_after", "?")
+        used.add("depth_after")
+        depth = f"tree depth {before}" if after == before else f"tree depth {before} -> {after}"
+        if s.get("merged_nodes"):
+            depth += f" after merging {counted(s['merged_nodes'], 'same-type child node')}"
+        used.add("merged_nodes")
         parts.append(depth)
     if s.get("loop"):
         parts.append("loop mode (the root is ticked again after it returns)")
+    used.add("loop")
     return parts
 
 
-def conversion_summary(direction: str, stats: Mapping[str, object]) -> str:
+def conversion_summary(direction: str, stats: Mapping[str, object],
+                       engine: str = "rules") -> str:
     """One readable sentence for a conversion's figures.
 
     Args:
         direction: ``fsm->bt`` or ``bt->fsm``.
         stats: the engine's figures (``ConversionResult.stats``).
+        engine: the engine that made them (only ``rules`` builds a loop-execution BT).
 
     Returns:
         E.g. ``12 leaves became a state machine with 2 sub-state-machines, from 3 conversion
-        units (...); tree depth 7``; unknown figures follow as ``key=value``.
+        units (...); tree depth 7``; figures it has no words for follow as ``key=value``.
     """
-    known: tuple[str, ...] = ()
+    used: set[str] = set()
     parts: list[str] = []
     if direction == "fsm->bt" and "states" in stats:
-        parts, known = _fsm_to_bt(stats), _FSM_TO_BT
-    elif direction == "bt->fsm" and "k" in stats:
-        parts, known = _bt_to_fsm(stats), _BT_TO_FSM
-    rest = [f"{k}={v}" for k, v in stats.items() if k not in known]
+        parts = _fsm_to_bt(stats, engine, used)
+    elif direction == "bt->fsm" and ("leaves" in stats or "k" in stats):
+        parts = _bt_to_fsm(stats, used)
+    rest = [f"{k}={v}" for k, v in stats.items() if k not in used]
     return "; ".join(parts + ([", ".join(rest)] if rest else []))
 
 
