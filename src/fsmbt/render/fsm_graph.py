@@ -90,7 +90,7 @@ def composite_paths(fsm: FSM) -> list[str]:
     stack: list[tuple[FSM, str]] = [(fsm, "")]
     while stack:
         machine, prefix = stack.pop()
-        inner = []
+        inner: list[tuple[FSM, str]] = []
         for state in machine.states.values():
             if not state.is_atomic:
                 found.append(prefix + state.name)
@@ -197,49 +197,49 @@ def fsm_to_dot(fsm: FSM, *, max_nodes: int | None = DEFAULT_MAX_NODES,
     edges: list[tuple[str, str, dict[str, str]]] = []
     clusters: list[tuple[graphviz.Digraph, graphviz.Digraph]] = []  # (cluster, parent), pre-order
 
-    level_cap = level
+    level_cap = level  # the drawing loop below names each machine being drawn ``lv``
     top = _Level(fsm, root)
     depth_of: dict[int, int] = {id(top): 0}
     pending: list[_Level] = [top]
     levels: list[_Level] = []
     while pending:
-        level = pending.pop()
-        levels.append(level)
-        for state in level.machine.states.values():
-            title = level.prefix + state.name
-            closed = (not exchange and level_cap is not None and not state.is_atomic
-                      and depth_of[id(level)] >= level_cap)
-            if closed:
-                node_id = counter.state_id(level, state.name)
-                level.ids[state.name] = node_id
+        lv = pending.pop()
+        levels.append(lv)
+        for state in lv.machine.states.values():
+            title = lv.prefix + state.name
+            is_closed = (not exchange and level_cap is not None and not state.is_atomic
+                         and depth_of[id(lv)] >= level_cap)
+            if is_closed:
+                node_id = counter.state_id(lv, state.name)
+                lv.ids[state.name] = node_id
                 inside = _inner_states(state)
-                level.graph.node(node_id, label=label_text(_state_title(state, title),
+                lv.graph.node(node_id, label=label_text(_state_title(state, title),
                                                          f"[{inside} states inside]"),
                                shape="box", style="rounded,bold,filled", fillcolor="gray95")
                 continue
             if state.is_atomic:
-                node_id = counter.state_id(level, state.name)
-                level.ids[state.name] = node_id
-                level.graph.node(node_id, **_state_attrs(state, title, compact=not layered))
+                node_id = counter.state_id(lv, state.name)
+                lv.ids[state.name] = node_id
+                lv.graph.node(node_id, **_state_attrs(state, title, compact=not layered))
                 continue
             if not layered:  # a box standing for the composite state, no cluster
                 node_id = counter.next("c")
-                level.graph.node(node_id, label=label_text(_state_title(state, title)),
+                lv.graph.node(node_id, label=label_text(_state_title(state, title)),
                                  shape="box", style="rounded,bold")
-                inner = [_Level(region, level.graph, prefix=f"{title}/", entry=node_id)
+                inner = [_Level(region, lv.graph, prefix=f"{title}/", entry=node_id)
                          for region in state.regions]
-                level.anchors[state.name] = (node_id, "")
-                depth_of.update((id(x), depth_of[id(level)] + 1) for x in inner)
+                lv.anchors[state.name] = (node_id, "")
+                depth_of.update((id(x), depth_of[id(lv)] + 1) for x in inner)
                 pending.extend(reversed(inner))
                 continue
             cluster = graphviz.Digraph(name=counter.next("cluster_"))
             cluster.attr(label=label_text(_state_title(state, state.name)), style="rounded",
                          color="gray30", fontname=FONT, fontsize="12", labeljust="l")
-            clusters.append((cluster, level.graph))
+            clusters.append((cluster, lv.graph))
             inner = []
             for index, region in enumerate(state.regions):
                 holder = cluster
-                path = f"{level.path}{state.name}/"
+                path = f"{lv.path}{state.name}/"
                 if state.is_parallel:
                     holder = graphviz.Digraph(name=counter.next("cluster_"))
                     holder.attr(label=label_text(_region_title(region, index)), style="dashed",
@@ -248,13 +248,13 @@ def fsm_to_dot(fsm: FSM, *, max_nodes: int | None = DEFAULT_MAX_NODES,
                     path = f"{path}{index}:"
                 inner.append(_Level(region, holder, path=path))
             # Arrows to/from the composite state end at its cluster, through its first initial point.
-            level.anchors[state.name] = (_initial_point_id(inner[0], counter), cluster.name)
-            depth_of.update((id(x), depth_of[id(level)] + 1) for x in inner)
+            lv.anchors[state.name] = (_initial_point_id(inner[0], counter), cluster.name)
+            depth_of.update((id(x), depth_of[id(lv)] + 1) for x in inner)
             pending.extend(reversed(inner))
 
-    for level in levels:
-        _draw_initial(level, edges, counter, is_top=level is top)
-        _draw_transitions(level, edges, exact=exchange)
+    for lv in levels:
+        _draw_initial(lv, edges, counter, is_top=lv is top)
+        _draw_transitions(lv, edges, exact=exchange)
 
     return assemble(root, clusters, [edge_line(tail, head, attrs) for tail, head, attrs in edges])
 
