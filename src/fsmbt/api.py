@@ -41,15 +41,17 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from fsmbt import limits
 from fsmbt.convert import ConversionResult, convert
 from fsmbt.formats import detect_format, dumps, get_format, loads
 from fsmbt.formats.registry import format_for_path, read_text
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import Hint, InputError, SourceLocation, UnsupportedError
 from fsmbt.model.fsm import FSM
+from fsmbt.model.validate import Issue
 from fsmbt.verify import Report, verify
-from fsmbt.verify.native import DEFAULT_MAX_STATES
 from fsmbt.verify.orient import orient, rules_text
+from fsmbt.verify.wording import readable
 
 Model = FSM | BTDocument
 
@@ -318,8 +320,39 @@ def convert_model(model: Model, engine: str = "rules", *, style: str = "paper",
     return convert(model, engine=engine, style=style, **options)
 
 
+def lebt_port_issues(model: Model) -> list[Issue]:
+    """The LEBT leaves whose redundant ports (a guard's ``target``, a state's ``exits``)
+    contradict the tree's structure (``fsmbt.semantics.lebt.ports``); none for an FSM.
+
+    Args:
+        model: any model.
+
+    Returns:
+        Error issues, each naming the leaf and its line.
+    """
+    if not isinstance(model, BTDocument):
+        return []
+    from fsmbt.semantics.lebt.ports import lebt_port_issues as issues
+
+    return issues(model)
+
+
+def _warn_lebt_ports(loaded: Loaded) -> None:
+    """Add each LEBT port contradiction to ``loaded.warnings`` once (the checkers read the
+    structure, so the verdict stands; the file still says something false)."""
+    for issue in lebt_port_issues(loaded.model):
+        text = str(issue).replace(": error: ", ": ", 1)
+        if text not in loaded.warnings:
+            loaded.warnings.append(text)
+
+
+def _checker_limit(max_states: int | None) -> int:
+    """The native checker's state limit: the one given, else the limits in force."""
+    return max_states if max_states is not None else limits.current().checker_max_states
+
+
 def verify_models(source: Model, result: Model, engine: str = "native", *, loop: bool = False,
-                  max_states: int = DEFAULT_MAX_STATES) -> Report:
+                  max_states: int | None = None) -> Report:
     """Check that ``result`` behaves exactly like ``source`` (the five properties).
 
     Args:
@@ -327,7 +360,8 @@ def verify_models(source: Model, result: Model, engine: str = "native", *, loop:
         result: the converted model.
         engine: ``native``, ``nusmv`` or ``both`` (both must agree).
         loop: the BT side's root is ticked again after it returns.
-        max_states: the native checker's state limit.
+        max_states: the native checker's state limit (``None``: ``fsmbt.limits.current()``'s
+            ``checker_max_states``).
 
     Returns:
         The ``Report``: verdict, five properties, shortest counterexamples.
@@ -336,11 +370,13 @@ def verify_models(source: Model, result: Model, engine: str = "native", *, loop:
         EngineDisagreement: ``both`` and the engines disagree (a bug in one of them).
         InputError, UnsupportedError: the pair cannot be compared.
     """
-    return verify(source, result, engine=engine, loop=loop, max_states=max_states)
+    report = verify(source, result, engine=engine, loop=loop,
+                    max_states=_checker_limit(max_states))
+    return readable(report, source, result)
 
 
 def verify_either_order(first: Model, second: Model, engine: str = "native", *,
-                        loop: bool = False, max_states: int = DEFAULT_MAX_STATES) -> Report:
+                        loop: bool = False, max_states: int | None = None) -> Report:
     """Like ``verify_models``, for two models given in either order.
 
     The pair is put in the order its pairing rule needs (``fsmbt.verify.orient``): an FSM and
@@ -357,13 +393,16 @@ def verify_either_order(first: Model, second: Model, engine: str = "native", *,
     oriented = orient(first, second)
     try:
         report = verify(oriented.source, oriented.result, engine=engine, loop=loop,
-                        max_states=max_states)
+                        max_states=_checker_limit(max_states))
     except UnsupportedError:
         raise
     except InputError as exc:
+        if Hint.MAX_STATES in exc.hints:  # a size limit, not a pairing problem
+            raise
         raise InputError(f"{exc.message} (pairing rule tried: {oriented.rule}; the rules are: "
                          f"{rules_text()})", location=exc.location,
-                         element=exc.element) from None
+                         element=exc.element, hints=exc.hints) from None
+    readable(report, oriented.source, oriented.result)
     report.stats["pairing"] = oriented.rule
     report.stats["swapped"] = oriented.swapped
     return report
@@ -503,7 +542,7 @@ def convert_file(source: str | Path, output: str | Path | None = None, *,
                  to: str | None = None, source_format: str | None = None,
                  engine: str = "rules", style: str = "paper", loop: bool = False,
                  hierarchy: str = "subtrees", verify: bool = True,
-                 verify_engine: str = "native", max_states: int = DEFAULT_MAX_STATES,
+                 verify_engine: str = "native", max_states: int | None = None,
                  overwrite: bool = False, keep_not_equivalent: bool = False,
                  options: dict[str, object] | None = None,
                  on_stage: StageHook | None = None) -> Outcome:
@@ -525,7 +564,8 @@ def convert_file(source: str | Path, output: str | Path | None = None, *,
         hierarchy: FSM -> BT of a hierarchical FSM: ``subtrees`` or ``flatten``.
         verify: run the equivalence check.
         verify_engine: ``native``, ``nusmv`` or ``both``.
-        max_states: the native checker's state limit.
+        max_states: the native checker's state limit (``None``: ``fsmbt.limits.current()``'s
+            ``checker_max_states``).
         overwrite: an existing output file may be replaced.
         keep_not_equivalent: write the result even when it is not equivalent.
         options: further engine options (LLM endpoint and model, node models, ...).
@@ -556,7 +596,7 @@ def convert_file(source: str | Path, output: str | Path | None = None, *,
 def convert_loaded(loaded: Loaded, output: str | Path | None = None, *,
                    to: str | None = None, engine: str = "rules", style: str = "paper",
                    loop: bool = False, hierarchy: str = "subtrees", verify: bool = True,
-                   verify_engine: str = "native", max_states: int = DEFAULT_MAX_STATES,
+                   verify_engine: str = "native", max_states: int | None = None,
                    overwrite: bool = False, keep_not_equivalent: bool = False,
                    options: dict[str, object] | None = None,
                    on_stage: StageHook | None = None) -> Outcome:
@@ -580,9 +620,12 @@ def convert_loaded(loaded: Loaded, output: str | Path | None = None, *,
     destination = Path(output) if output is not None else None
     if destination is not None:
         check_destination(destination, overwrite=overwrite)
+    _warn_lebt_ports(loaded)
     timings: dict[str, float] = {}
     with _timed(timings, "convert", on_stage):
         engine_options = {k: v for k, v in options.items() if k not in READER_OPTIONS}
+        if max_states is not None:
+            engine_options.setdefault("max_states", max_states)
         conversion = convert_model(loaded.model, engine, style=style, loop=loop,
                                    hierarchy=hierarchy, **engine_options)
     fmt = output_format_for(model_kind(conversion.model), to=to, output=destination)
@@ -604,7 +647,7 @@ def convert_loaded(loaded: Loaded, output: str | Path | None = None, *,
 def verify_files(source: str | Path, converted: str | Path, *, engine: str = "native",
                  loop: bool = False, source_format: str | None = None,
                  converted_format: str | None = None,
-                 max_states: int = DEFAULT_MAX_STATES,
+                 max_states: int | None = None,
                  options: dict[str, object] | None = None,
                  on_stage: StageHook | None = None) -> tuple[Loaded, Loaded, Report]:
     """Read two model files and check that the second behaves exactly like the first.
@@ -616,7 +659,8 @@ def verify_files(source: str | Path, converted: str | Path, *, engine: str = "na
         loop: the BT side's root is ticked again after it returns.
         source_format: the first file's format (default: detected).
         converted_format: the second file's format (default: detected).
-        max_states: the native checker's state limit.
+        max_states: the native checker's state limit (``None``: ``fsmbt.limits.current()``'s
+            ``checker_max_states``).
         options: reader options (e.g. ``node_models``).
         on_stage: told each step's name as it starts ("read", "verify").
 
@@ -632,6 +676,8 @@ def verify_files(source: str | Path, converted: str | Path, *, engine: str = "na
     with _timed(timings, "read", on_stage):
         first = load(source, source_format, options=options)
         second = load(converted, converted_format, options=options)
+        _warn_lebt_ports(first)
+        _warn_lebt_ports(second)
     with _timed(timings, "verify", on_stage):
         report = verify_either_order(first.model, second.model, engine, loop=loop,
                                      max_states=max_states)

@@ -42,6 +42,9 @@ class Limits:
             ``FSMBT_MAX_INCLUDE_DEPTH``.
         checker_max_states: reachable states the native checker explores per machine and in the
             product before it stops. ``FSMBT_MAX_CHECKER_STATES``.
+        conversion_max_states: reachable states BT -> FSM conversion explores for one region of
+            a reactive or stateful subtree (docs/conversion.md), with or without verification.
+            ``FSMBT_MAX_CONVERSION_STATES``.
         checker_max_seconds: wall seconds the native checker may run. ``FSMBT_MAX_CHECKER_SECONDS``.
         nusmv_max_seconds: wall seconds one NuSMV run may take. ``FSMBT_MAX_NUSMV_SECONDS``.
         nusmv_max_memory_mb: address space of the NuSMV process (``RLIMIT_AS``), MiB.
@@ -58,6 +61,7 @@ class Limits:
     max_nodes: int = 2_000_000
     max_include_depth: int = 64
     checker_max_states: int = 2_000_000
+    conversion_max_states: int = 200_000
     checker_max_seconds: float = 600.0
     nusmv_max_seconds: float = 300.0
     nusmv_max_memory_mb: int = 4096

@@ -18,9 +18,13 @@ from typing import Literal
 import typer
 
 from fsmbt import api
+from fsmbt.model.bt import BTDocument
+from fsmbt.model.undeclared import summary as undeclared_summary
+from fsmbt.model.undeclared import undeclared_leaf_types
 from fsmbt.llm.config import PROVIDERS
-from fsmbt.cli.options import node_models_option, reader_options
+from fsmbt.cli.options import max_states_option, node_models_option, reader_options
 from fsmbt.cli.progress import StageProgress, format_timings
+from fsmbt.cli.wording import checked_counts, conversion_summary
 from fsmbt.verify.report import Report
 
 
@@ -47,6 +51,7 @@ def register(app: typer.Typer) -> None:
         as_json: bool = typer.Option(False, "--json", help="print a JSON summary on stdout"),
         quiet: bool = typer.Option(False, "--quiet", "-q", help="no progress display on stderr"),
         node_models: list[Path] = node_models_option(),
+        max_states: int | None = max_states_option(),
         hierarchy: Literal["subtrees", "flatten"] = typer.Option("subtrees", "--hierarchy", help="FSM->BT of a "
                                       "hierarchical FSM: subtrees (one SubTree per composite "
                                       "state) or flatten (one flat LEBT)"),
@@ -64,6 +69,7 @@ def register(app: typer.Typer) -> None:
             outcome = api.convert_file(
                 source, output, to=to, source_format=source_format, engine=engine, style=style,
                 loop=loop, hierarchy=hierarchy, verify=not no_verify, overwrite=force,
+                max_states=max_states,
                 keep_not_equivalent=keep_failed, options=options, on_stage=progress)
         summary = outcome.to_dict()
         if as_json:
@@ -82,7 +88,14 @@ def _print_summary(outcome: api.Outcome, *, to_stderr: bool) -> None:
     stream = sys.stderr if to_stderr else sys.stdout
     for warning in outcome.warnings:
         print(f"warning: {warning}", file=stream)
-    figures = ", ".join(f"{k}={v}" for k, v in outcome.conversion.stats.items())
+    source = outcome.source.model
+    if isinstance(source, BTDocument):
+        undeclared = undeclared_leaf_types(source)
+        if undeclared:
+            print(f"warning: {undeclared_summary(undeclared)}; declare them with "
+                  "--node-models FILE", file=stream)
+    figures = conversion_summary(outcome.conversion.direction, outcome.conversion.stats,
+                                 outcome.conversion.engine)
     where = str(outcome.output) if outcome.output is not None else "stdout"
     print(f"converted {outcome.conversion.direction} with {outcome.conversion.engine} -> "
           f"{where} ({outcome.output_format}): {figures}", file=stream)
@@ -92,6 +105,9 @@ def _print_summary(outcome: api.Outcome, *, to_stderr: bool) -> None:
         print("verification skipped (--no-verify)", file=stream)
         return
     print(f"verdict: {outcome.verdict}", file=stream)
+    counts = checked_counts(report.stats)
+    if counts:
+        print(f"  checked {counts}", file=stream)
     for name, prop in report.properties.items():
         mark = "ok  " if prop.holds else "FAIL"
         print(f"  {mark} {name}: {prop.detail}", file=stream)

@@ -13,7 +13,10 @@ from rich.table import Table
 
 from fsmbt import api
 from fsmbt.cli.options import node_models_option, reader_options
+from fsmbt.model.bt import BTDocument
 from fsmbt.model.stats import BTStats, FSMStats, model_stats
+from fsmbt.model.undeclared import summary as undeclared_summary
+from fsmbt.model.undeclared import undeclared_leaf_types
 
 #: Lists longer than this are cut in the table (``--json`` always has them all).
 MAX_LISTED = 12
@@ -34,9 +37,14 @@ def register(app: typer.Typer) -> None:
         loop states of the LEBT structure (docs/conversion.md), hierarchy. BT: nodes by kind and type, depth, breadth,
         leaves, trees and SubTree references.
         """
-        stats = model_stats(api.load(model, from_format, options=reader_options(node_models)).model)
+        loaded = api.load(model, from_format, options=reader_options(node_models))
+        stats = model_stats(loaded.model)
+        undeclared = (undeclared_leaf_types(loaded.model)
+                      if isinstance(loaded.model, BTDocument) else None)
         if as_json:
-            print(json.dumps({"file": str(model), **stats.to_dict()}, indent=2, ensure_ascii=False))
+            extra = {} if undeclared is None else {"undeclared_leaf_types": dict(undeclared)}
+            print(json.dumps({"file": str(model), **stats.to_dict(), **extra}, indent=2,
+                             ensure_ascii=False))
             return
         table = _fsm_table(stats) if isinstance(stats, FSMStats) else _bt_table(stats)
         table.title = escape(str(model))
@@ -44,6 +52,8 @@ def register(app: typer.Typer) -> None:
         console.print(table)
         if isinstance(stats, BTStats) and len(stats.per_tree) > 1:
             console.print(_per_tree_table(stats))
+        if undeclared:
+            print(f"note: {undeclared_summary(undeclared)}; declare them with --node-models FILE")
 
 
 def _listed(items: list[str]) -> str:

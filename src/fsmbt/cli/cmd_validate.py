@@ -41,6 +41,7 @@ def register(app: typer.Typer) -> None:
         # reader warnings already start with their location; model issues get the file name
         issues = [Issue("warning", w) for w in loaded.warnings]
         issues += [_with_file(i, model) for i in validate(loaded.model)]
+        issues += [_with_file(i, model) for i in api.lebt_port_issues(loaded.model)]
         failing = [i for i in issues if i.severity == "error"] + (
             [i for i in issues if i.severity == "warning"] if strict else [])
         kind = loaded.kind

@@ -14,7 +14,7 @@ import typer
 from rich.console import Console
 
 from fsmbt import api
-from fsmbt.cli.options import node_models_option, reader_options
+from fsmbt.cli.options import max_states_option, node_models_option, reader_options
 from fsmbt.cli.progress import StageProgress
 from fsmbt.verify import EngineDisagreement
 from fsmbt.verify.render_report import print_report
@@ -32,6 +32,7 @@ def register(app: typer.Typer) -> None:
         as_json: bool = typer.Option(False, "--json", help="Print the report as JSON."),
         quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress display on stderr."),
         node_models: list[Path] = node_models_option(),
+        max_states: Optional[int] = max_states_option(),
         engine: str = typer.Option("native", "--engine",
                                    help="native, nusmv, or both (both must agree)."),
         loop: bool = typer.Option(False, "--loop",
@@ -46,15 +47,18 @@ def register(app: typer.Typer) -> None:
         sequence that tells the two models apart."""
         try:
             with StageProgress(quiet=quiet or as_json, label=f"{source.name} ~ {converted.name}") as progress:
-                _, _, report = api.verify_files(source, converted, engine=engine, loop=loop,
+                first, second, report = api.verify_files(source, converted, engine=engine, loop=loop,
                                                 source_format=from_format,
                                                 converted_format=from_format2,
+                                                max_states=max_states,
                                                 options=reader_options(node_models),
                                                 on_stage=progress)
         except EngineDisagreement as exc:
             print(f"error: ENGINES DISAGREE: {exc}; one of the checkers is wrong, please report "
                   "this with both files", file=sys.stderr)
             raise typer.Exit(EXIT_ENGINES_DISAGREE) from None
+        for warning in [*first.warnings, *second.warnings]:
+            print(f"warning: {warning}", file=sys.stderr)
         if as_json:
             data = report.to_dict()
             data["source_file"] = str(source)

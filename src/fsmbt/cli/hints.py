@@ -19,6 +19,7 @@ CLI_WORDING: Mapping[Hint, str] = {
     Hint.RULES_ENGINE: "use --engine rules",
     Hint.LLM_ENGINE: "use --engine llm|nllm|hybrid, or fsmbt llm extract",
     Hint.MAX_NODES: "raise the limit with --max-nodes",
+    Hint.MAX_STATES: "raise the limit with --max-states",
     Hint.STATISTICS: "use `fsmbt info` for its structure",
     Hint.NO_EXPANSION: "draw without --expand-subtrees",
     Hint.LLM_BASE_URL: "set --llm-base-url",

@@ -22,3 +22,14 @@ def reader_options(node_models: list[Path] | None) -> dict[str, object] | None:
     if not node_models:
         return None
     return {"node_models": [str(path) for path in node_models]}
+
+
+#: ``--max-states N``: one state limit for the native checker and for BT -> FSM exploration.
+MAX_STATES_HELP = ("most reachable states explored (BT->FSM regions, the native checker, its "
+                   "product); default: FSMBT_MAX_CONVERSION_STATES / FSMBT_MAX_CHECKER_STATES "
+                   "(200000 / 2000000)")
+
+
+def max_states_option() -> int | None:
+    """The ``--max-states`` option (``None``: the limits in force, ``fsmbt.limits``)."""
+    return typer.Option(None, "--max-states", min=1, help=MAX_STATES_HELP)  # type: ignore[no-any-return]

@@ -39,12 +39,13 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+from fsmbt import limits
 from fsmbt.convert.compress import inline_and_compress
 from fsmbt.convert.perf import without_gc_pauses
 from fsmbt.convert.result import ConversionResult
 from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.bt_nodes import NodeKind
-from fsmbt.model.errors import InputError, UnsupportedError
+from fsmbt.model.errors import Hint, InputError, UnsupportedError
 from fsmbt.model.fsm import FSM, State
 from fsmbt.semantics.nodes import (
     PLAIN_CONTROLS,
@@ -112,6 +113,8 @@ class _Builder:
     explored_states: int = 0
     warnings: list[str] = field(default_factory=list)
     loop: bool = False
+    max_states: int | None = None
+    where: _Places | None = None
 
     # -- naming ----------------------------------------------------------------------------
     @staticmethod
@@ -188,7 +191,8 @@ class _Builder:
 
     # -- explored regions --------------------------------------------------------------------
     def _explored_state(self, node: BTNode, cont: _Cont, machine: FSM) -> str:
-        sub, ends = explore_region(node, loop=False)
+        sub, ends = explore_region(node, loop=False, max_states=self.max_states,
+                                   where=self.where)
         self.explored += 1
         self.machines += 1
         self.explored_states += len(sub.states)
@@ -210,18 +214,72 @@ class _NeedsWholeTree(Exception):
     """A region ends in a way no sequence/fallback rule covers: explore the whole tree."""
 
 
-def explore_region(node: BTNode, *, loop: bool = False, top: bool = False) -> tuple[FSM, set[str]]:
+class _Places:
+    """Where each node of the prepared tree sits, in the words a user finds in the file: the
+    tree's id, then the labels (name, else type) from the root down, then the line."""
+
+    def __init__(self, tree_id: str, root: BTNode) -> None:
+        self.tree_id = tree_id
+        self.parent: dict[int, BTNode | None] = {id(root): None}
+        stack = [root]
+        while stack:
+            node = stack.pop()
+            for child in node.children:
+                self.parent[id(child)] = node
+                stack.append(child)
+
+    def path(self, node: BTNode) -> str:
+        """``tree 'MainTree', Sequence > Fallback 'patrol' > RetryUntilSuccessful`` - the
+        labels from the root down to ``node`` (at most 8, the middle elided)."""
+        labels: list[str] = []
+        current: BTNode | None = node
+        while current is not None:
+            labels.append(current.label if current.label == current.type
+                          else f"{current.type} '{current.label}'")
+            current = self.parent.get(id(current))
+        labels.reverse()
+        if len(labels) > 8:
+            labels = labels[:3] + ["..."] + labels[-4:]
+        return f"tree '{self.tree_id}', " + " > ".join(labels)
+
+
+def explore_region(node: BTNode, *, loop: bool = False, top: bool = False,
+                   max_states: int | None = None,
+                   where: _Places | None = None) -> tuple[FSM, set[str]]:
     """The leaf-execution machine of ``node``'s subtree as a (flat) FSM.
 
     One state per reachable interpreter configuration (``q0``, ``q1`` ... in breadth-first
     order), named after the leaf it is about to tick; its action is that leaf's label. A root
     result becomes an end state named after it (final; action = the result at the top, none
-    inside a composite). Returns the machine and the set of end states that occur.
-    """
-    from fsmbt.semantics.leaf_machine import LeafMachine, RootResult, explore
+    inside a composite).
 
+    Args:
+        node: the subtree's root.
+        loop: the subtree's root is ticked again after it returns.
+        top: the subtree is the whole tree (its results are the machine's actions).
+        max_states: most reachable configurations explored (``None``:
+            ``fsmbt.limits.current().conversion_max_states``).
+        where: names the subtree in a refusal (default: its label alone).
+
+    Returns:
+        The machine and the set of end states that occur.
+
+    Raises:
+        StateLimitError: more than ``max_states`` configurations; names the subtree (tree,
+        node path, line) and carries ``Hint.MAX_STATES``.
+    """
+    from fsmbt.semantics.leaf_machine import LeafMachine, RootResult, StateLimitError, explore
+
+    limit = max_states if max_states is not None else limits.current().conversion_max_states
     machine = LeafMachine(BTDocument.single(node), loop=loop)
-    explored = explore(machine)
+    try:
+        explored = explore(machine, max_states=limit)
+    except StateLimitError:
+        subtree = where.path(node) if where is not None else node.label
+        raise StateLimitError(
+            f"exploring this subtree (a {node.type} with memory or reactive children, "
+            f"converted as one composite state) reaches more than {limit} states",
+            element=subtree, location=node.location, hints=(Hint.MAX_STATES,)) from None
     fsm = FSM(name=f"explored_{node.label}")
     names: dict[object, str] = {}
     ends: set[str] = set()
@@ -278,13 +336,24 @@ def _looped_result(fsm: FSM, explored, target: object, outputs: tuple[str, ...],
 
 @without_gc_pauses
 def bt_to_hfsm(doc: BTDocument, *, loop: bool = False, style: str = "paper",
-               **_options: object) -> ConversionResult:
+               max_states: int | None = None, **_options: object) -> ConversionResult:
     """Convert a BT document into a hierarchical FSM whose flattening is the BT's
-    leaf-execution machine (see the module docstring)."""
+    leaf-execution machine (see the module docstring).
+
+    Args:
+        doc: the BT document (its main tree is converted).
+        loop: the root is ticked again after it returns.
+        style: the output style (``paper``).
+        max_states: most states explored per region (``None``: the limits in force).
+
+    Returns:
+        The HFSM with the conversion's figures and warnings.
+    """
     prepared = inline_and_compress(doc)
     compression = prepared.compression
     root = compression.root
-    builder = _Builder(loop=loop)
+    places = _Places(doc.main.id, root)
+    builder = _Builder(loop=loop, max_states=max_states, where=places)
     opaque_nodes = _opaque_roots(root)
     whole_tree = loop and bool(opaque_nodes)
     hfsm: FSM | None = None
@@ -295,8 +364,9 @@ def bt_to_hfsm(doc: BTDocument, *, loop: bool = False, style: str = "paper",
             builder.warnings.append(f"a region can end in {exc}: the whole tree is explored")
             whole_tree = True
     if whole_tree:
-        builder = _Builder(loop=loop)
-        hfsm, _ends = explore_region(root, loop=loop, top=True)
+        builder = _Builder(loop=loop, max_states=max_states, where=places)
+        hfsm, _ends = explore_region(root, loop=loop, top=True, max_states=max_states,
+                                     where=places)
         builder.explored, builder.machines = 1, 1
         builder.explored_states = len(hfsm.states)
     assert hfsm is not None

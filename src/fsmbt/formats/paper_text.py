@@ -30,7 +30,7 @@ import re
 
 from fsmbt.formats.registry import Format, ReadContext, register
 from fsmbt.model import Model
-from fsmbt.model.errors import InputError, UnsupportedError
+from fsmbt.model.errors import Hint, InputError, UnsupportedError
 from fsmbt.model.fsm import FSM, State
 
 HEADER = "FSM"
@@ -115,7 +115,9 @@ def read_paper_text(text: str, ctx: ReadContext) -> Model:
         line = raw.strip()
         if fsm is None:
             if not line.startswith(HEADER + " ") and line != HEADER:
-                raise InputError("paper-text starts with 'FSM <name>'", location=ctx.location(number))
+                raise InputError("not fsmbt's paper-text format (it starts with 'FSM <name>'); "
+                                 "a description in prose needs an LLM to extract the model",
+                                 location=ctx.location(number), hints=(Hint.LLM_ENGINE,))
             fsm = FSM(name=line[len(HEADER):].strip() or "fsm")
             stack.append([0, fsm, None])
             continue

@@ -27,6 +27,7 @@ class Hint(str, Enum):
     RULES_ENGINE = "rules_engine"  # convert with the rules engine
     LLM_ENGINE = "llm_engine"  # let an LLM engine extract the model from the input
     MAX_NODES = "max_nodes"  # raise a picture's node limit
+    MAX_STATES = "max_states"  # raise the explored / checked state limit
     STATISTICS = "statistics"  # read a model's structure from its statistics instead
     NO_EXPANSION = "no_expansion"  # draw without expanding SubTree references
     LLM_BASE_URL = "llm_base_url"  # give the LLM endpoint
@@ -42,6 +43,7 @@ HINT_TEXT: Mapping[Hint, str] = {
     Hint.RULES_ENGINE: "convert with engine='rules'",
     Hint.LLM_ENGINE: "convert with engine='llm', 'nllm' or 'hybrid', which extract the model",
     Hint.MAX_NODES: "raise max_nodes",
+    Hint.MAX_STATES: "raise max_states",
     Hint.STATISTICS: "read its structure from fsmbt.model.stats",
     Hint.NO_EXPANSION: "draw with expand_subtrees=False",
     Hint.LLM_BASE_URL: "pass base_url=...",

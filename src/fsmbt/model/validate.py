@@ -56,6 +56,26 @@ def validate(model: FSM | BTDocument) -> list[Issue]:
     raise TypeError(f"not a model: {type(model).__name__}")
 
 
+def collapse_repeated_warnings(issues: list[Issue]) -> list[Issue]:
+    """``issues`` with each warning whose message repeats (one per node of the same undeclared
+    type, say) kept once, at its first place, with the count: ``... (12 nodes; the first is
+    here)``. Errors are all kept. O(n) for n issues."""
+    counts: dict[str, int] = {}
+    for issue in issues:
+        if issue.severity == "warning":
+            counts[issue.message] = counts.get(issue.message, 0) + 1
+    kept: list[Issue] = []
+    seen: set[str] = set()
+    for issue in issues:
+        if issue.severity != "warning" or counts[issue.message] == 1:
+            kept.append(issue)
+        elif issue.message not in seen:
+            seen.add(issue.message)
+            kept.append(Issue("warning", f"{issue.message} ({counts[issue.message]} nodes; "
+                              "the first is here)", issue.location, issue.element))
+    return kept
+
+
 def errors(issues: list[Issue]) -> list[Issue]:
     return [i for i in issues if i.severity == "error"]
 
@@ -227,7 +247,7 @@ class _BtValidator:
                 continue
             self.tree(tree.id, tree.root, references[tree.id])
         self.cycles(references)
-        return self.issues
+        return collapse_repeated_warnings(self.issues)
 
     def tree(self, tree_id: str, root: BTNode, referenced: list[str]) -> None:
         """Pre-order with an explicit stack; element paths are built only for nodes with an

@@ -11,6 +11,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from fsmbt.model.bt import BTDocument
+from fsmbt.model.errors import InputError
 from fsmbt.model.fsm import FSM
 from fsmbt.render.anchor_ids import trace_anchors
 from fsmbt.render.bt_graph import bt_to_dot
@@ -28,22 +29,38 @@ from fsmbt.render.fsm_graph import fsm_to_dot
 
 
 def model_to_dot(model: FSM | BTDocument, *, expand_subtrees: bool = False,
-                 max_nodes: int = DEFAULT_MAX_NODES, anchors: bool = False) -> str:
-    """The DOT source of the picture of ``model``.
+                 max_nodes: int = DEFAULT_MAX_NODES, level: int | None = None,
+                 composite: str | None = None, tree: str | None = None,
+                 notes: list[str] | None = None, anchors: bool = False) -> str:
+    """The DOT source of ``model``'s picture.
 
     Args:
         model: an FSM or a BT document.
-        expand_subtrees: BT: draw the main tree with each SubTree's tree below its reference.
-        max_nodes: refuse (``TooLargeError``) larger models.
+        expand_subtrees: BT: the main (or ``tree``) tree with its SubTrees inlined.
+        max_nodes: refuse models with more states/nodes than this.
+        level: FSM: composite states nested deeper than this are drawn closed.
+        composite: FSM: draw only this composite state (path ``A/B``).
+        tree: BT: draw only this tree.
+        notes: told what a capped picture left out and how to draw it.
         anchors: give every state / node a predictable SVG id (``fsmbt.render.anchor_ids``).
 
     Returns:
         The DOT source.
+
+    Raises:
+        TooLargeError: past ``max_nodes``; InputError: an unknown ``composite`` / ``tree``, or
+        an option of the other model kind.
     """
     if isinstance(model, FSM):
-        return fsm_to_dot(model, max_nodes=max_nodes, anchors=anchors)
-    return bt_to_dot(model, expand_subtrees=expand_subtrees, max_nodes=max_nodes,
-                     anchors=anchors)
+        if tree is not None or expand_subtrees:
+            raise InputError("tree and expand_subtrees are for behavior trees; this is an FSM")
+        return fsm_to_dot(model, max_nodes=max_nodes, level=level, composite=composite,
+                          notes=notes, anchors=anchors)
+    if level is not None or composite is not None:
+        raise InputError("level and composite are for hierarchical FSMs; this is a behavior "
+                         "tree (draw one tree with tree=ID)")
+    return bt_to_dot(model, expand_subtrees=expand_subtrees, max_nodes=max_nodes, tree=tree,
+                     notes=notes, anchors=anchors)
 
 
 def svg_text(model: FSM | BTDocument, *, expand_subtrees: bool = False,
@@ -71,10 +88,23 @@ def svg_text(model: FSM | BTDocument, *, expand_subtrees: bool = False,
 
 
 def render_model(model: FSM | BTDocument, path: str | Path, *, overwrite: bool = False,
-                 expand_subtrees: bool = False, max_nodes: int = DEFAULT_MAX_NODES) -> Path:
-    """Draw ``model`` into ``path`` (format from the suffix) and return the path."""
+                 expand_subtrees: bool = False, max_nodes: int = DEFAULT_MAX_NODES,
+                 level: int | None = None, composite: str | None = None,
+                 tree: str | None = None, notes: list[str] | None = None) -> Path:
+    """Draw ``model`` into ``path`` (format from the suffix) and return the path.
+
+    Args:
+        model, expand_subtrees, max_nodes, level, composite, tree, notes: as for
+            ``model_to_dot``.
+        path: the picture file.
+        overwrite: replace an existing file.
+
+    Returns:
+        The path written.
+    """
     check_output(Path(path), overwrite=overwrite)  # fail before laying out a picture
-    source = model_to_dot(model, expand_subtrees=expand_subtrees, max_nodes=max_nodes)
+    source = model_to_dot(model, expand_subtrees=expand_subtrees, max_nodes=max_nodes,
+                          level=level, composite=composite, tree=tree, notes=notes)
     return write_picture(source, path, overwrite=overwrite)
 
 

@@ -7,7 +7,12 @@ hexagons with their name (Inverter ``¬``); conditions are ellipses, actions box
 corners; a SubTree reference is a folder tab. A node's name (when it differs from its type) and
 its attributes (ports, parameters; long values shortened) are shown under the symbol.
 
-Every tree of the document is drawn, each in a cluster when there are several. With
+Every tree of the document is drawn, each in a cluster when there are several: the main tree
+first, alone on the top row, the others below it in rows of at most ``ROW_LEAVES`` leaves (each
+row hangs under the previous one by invisible edges), so a 24-tree file reads top to bottom
+instead of as one strip tens of thousands of pixels wide. A picture holds at most
+``PICTURE_MAX_NODES`` nodes: past it, trees are drawn in that order while they fit and a note
+(``notes``) says how many were left out and how to draw them (``tree=ID``). With
 ``expand_subtrees`` only the main tree is drawn and each SubTree reference gets the tree it names
 below it, in a dashed cluster (a recursive reference is not expanded again). Built with an
 explicit stack; complexity O(N) for N drawn nodes, refused beyond ``max_nodes``.
@@ -17,6 +22,8 @@ This is also the DOT file format's BT writer (``fsmbt convert --to dot``, throug
 """
 
 from __future__ import annotations
+
+import dataclasses
 
 import graphviz
 
@@ -61,25 +68,56 @@ DECORATOR_SYMBOLS: dict[str, str] = {
 MAX_VALUE_CHARS = 32
 #: At most this many attributes are listed under a node.
 MAX_ATTRS_SHOWN = 4
+#: Trees after the main one are packed into rows of at most this many leaves (a width proxy).
+ROW_LEAVES = 24
+#: The most nodes drawn in one multi-tree picture before the remaining trees are left out.
+PICTURE_MAX_NODES = 600
+
+
+def _tree_size(root: BTNode | None) -> tuple[int, int, int]:
+    """(nodes, leaves, depth) of one tree, explicit stack."""
+    if root is None:
+        return 1, 1, 1
+    nodes = leaves = depth = 0
+    stack = [(root, 1)]
+    while stack:
+        node, level = stack.pop()
+        nodes += 1
+        depth = max(depth, level)
+        if not node.children:
+            leaves += 1
+        stack.extend((child, level + 1) for child in node.children)
+    return nodes, leaves, depth
 
 
 def bt_to_dot(doc: BTDocument, *, expand_subtrees: bool = False,
-              max_nodes: int | None = DEFAULT_MAX_NODES, anchors: bool = False) -> str:
+              max_nodes: int | None = DEFAULT_MAX_NODES, tree: str | None = None,
+              notes: list[str] | None = None, anchors: bool = False) -> str:
     """DOT source of the picture of ``doc``.
 
     Args:
         doc: the behavior tree document.
         expand_subtrees: draw the main tree only, each SubTree reference with its tree below it.
         max_nodes: refuse (``TooLargeError``) more drawn nodes than this; ``None``: no limit.
+        tree: draw only this tree (with ``expand_subtrees``: its SubTrees inlined).
+        notes: told what was left out of the picture and how to draw it.
         anchors: give every node an SVG id from its place (``fsmbt.render.anchor_ids``): the
             child-index path from the main root with ``expand_subtrees`` (the interpreter's
             path, docs/semantics.md), else the tree's id and the path inside that tree.
 
     Returns:
         The DOT source text.
+
+    Raises:
+        InputError: no tree, or ``tree`` names none (the message lists the trees).
     """
     if not doc.trees:
         raise InputError("the document holds no behavior tree")
+    if tree is not None:
+        if tree not in doc.trees:
+            raise InputError(f"no tree '{tree}' (trees: {', '.join(doc.trees)})",
+                             element=tree)
+        doc = dataclasses.replace(doc, main_tree=tree)
     if not expand_subtrees and max_nodes is not None:
         check_size(sum(1 for _ in doc.nodes()), max_nodes, "nodes")
     root = graphviz.Digraph(name="bt")
@@ -87,21 +125,63 @@ def bt_to_dot(doc: BTDocument, *, expand_subtrees: bool = False,
     root.attr("node", fontname=FONT, fontsize="11", height="0.4")
     root.attr("edge", arrowsize="0.6", color="gray25")
     builder = _Builder(doc, root, max_nodes, expand_subtrees, anchors)
-    if expand_subtrees:
+    if expand_subtrees or tree is not None:
         main = doc.main
         builder.draw_tree(main.root, root, parent=None, path=(main.id,))
     else:
-        several = len(doc.trees) > 1
-        for tree in doc.trees.values():
-            holder = root
-            if several:
-                holder = graphviz.Digraph(name=builder.next_id("cluster_"))
-                title = f"{tree.id} (main)" if tree.id == doc.main.id else tree.id
-                holder.attr(label=label_text(title), style="rounded", color="gray40",
-                            fontname=FONT, fontsize="12", labeljust="l")
-                builder.clusters.append((holder, root))
-            builder.draw_tree(tree.root, holder, parent=None, path=(tree.id,))
+        _draw_all_trees(doc, root, builder, notes)
     return builder.finish()
+
+
+def _draw_all_trees(doc: BTDocument, root: graphviz.Digraph, builder: _Builder,
+                    notes: list[str] | None) -> None:
+    """Every tree (main first, then rows), each in a cluster when there are several."""
+    main_id = doc.main.id
+    order = [doc.trees[main_id]] + [t for t in doc.trees.values() if t.id != main_id]
+    if len(order) == 1:
+        builder.draw_tree(order[0].root, root, parent=None, path=(main_id,))
+        return
+    sizes = {t.id: _tree_size(t.root) for t in order}
+    total = sum(n for n, _, _ in sizes.values())
+    left_out: list[str] = []
+    rows: list[list[str]] = [[main_id]]  # the main tree alone on the top row
+    drawn = sizes[main_id][0]
+    row_leaves = ROW_LEAVES  # so the first other tree opens a new row
+    for t in order[1:]:
+        nodes, leaves, _ = sizes[t.id]
+        if drawn + nodes > PICTURE_MAX_NODES:
+            left_out.append(t.id)
+            continue
+        drawn += nodes
+        if row_leaves + leaves > ROW_LEAVES:
+            rows.append([])
+            row_leaves = 0
+        rows[-1].append(t.id)
+        row_leaves += leaves
+    previous_bottom: str | None = None
+    for row in rows:
+        deepest: tuple[int, str] | None = None
+        for tree_id in row:
+            t = doc.trees[tree_id]
+            holder = graphviz.Digraph(name=builder.next_id("cluster_"))
+            title = f"{tree_id} (main)" if tree_id == main_id else tree_id
+            holder.attr(label=label_text(title), style="rounded", color="gray40",
+                        fontname=FONT, fontsize="12", labeljust="l")
+            builder.clusters.append((holder, root))
+            first = builder.serial + 1
+            builder.draw_tree(t.root, holder, parent=None, path=(tree_id,))
+            if previous_bottom is not None:  # hang this row under the previous one
+                builder.edges.append((previous_bottom, f"n{first}", {"style": "invis", "weight": "0"}))
+            depth = sizes[tree_id][2]
+            if deepest is None or depth > deepest[0]:
+                deepest = (depth, builder.deepest)
+        previous_bottom = deepest[1] if deepest is not None else previous_bottom
+    if left_out and notes is not None:
+        shown = ", ".join(left_out[:8]) + (f", ... (+{len(left_out) - 8})"
+                                           if len(left_out) > 8 else "")
+        notes.append(f"picture capped at {PICTURE_MAX_NODES} nodes: drew {len(order) - len(left_out)}"
+                     f" of {len(order)} trees ({drawn} of {total} nodes); left out: {shown}; "
+                     "draw one tree alone with tree=ID")
 
 
 class _Builder:
@@ -114,6 +194,7 @@ class _Builder:
         self.max_nodes = max_nodes
         self.count = 0
         self.serial = 0
+        self.deepest = ""  # the deepest node id of the last tree drawn
         self.edges: list[tuple[str, str, dict[str, str]]] = []
         self.clusters: list[tuple[graphviz.Digraph, graphviz.Digraph]] = []  # pre-order
 
@@ -124,18 +205,22 @@ class _Builder:
     def draw_tree(self, top: BTNode | None, graph: graphviz.Digraph, *, parent: str | None,
                   path: tuple[str, ...]) -> None:
         if top is None:
-            graph.node(self.next_id("n"), label="(empty tree)", shape="plaintext")
+            self.deepest = self.next_id("n")
+            graph.node(self.deepest, label="(empty tree)", shape="plaintext")
             return
-        stack: list[tuple[BTNode, str | None, graphviz.Digraph, tuple[str, ...], str]] = [
-            (top, parent, graph, path, "")]
+        stack: list[tuple[BTNode, str | None, graphviz.Digraph, tuple[str, ...], str, int]] = [
+            (top, parent, graph, path, "", 1)]
+        deepest_level = 0
         while stack:
-            node, parent_id, holder, trees, where = stack.pop()
+            node, parent_id, holder, trees, where, level = stack.pop()
             self.count += 1
             if self.max_nodes is not None and self.count > self.max_nodes:
                 raise TooLargeError(f"too large to draw: more than {self.max_nodes} nodes "
                                     f"(limit {self.max_nodes})",
                                     hints=(Hint.MAX_NODES, Hint.NO_EXPANSION))
             node_id = self.next_id("n")
+            if level > deepest_level:
+                deepest_level, self.deepest = level, node_id
             attrs = node_attrs(node, recursive=node.subtree_id in trees)
             if self.anchors:
                 attrs["id"] = node_anchor(where, None if self.expanding else trees[0])
@@ -150,8 +235,9 @@ class _Builder:
                 self.clusters.append((cluster, holder))
                 sub_root = self.doc.trees[ref].root
                 if sub_root is not None:
-                    stack.append((sub_root, node_id, cluster, (*trees, ref), child_path(where, 0)))
-            stack.extend((child, node_id, holder, trees, child_path(where, index))
+                    stack.append((sub_root, node_id, cluster, (*trees, ref), child_path(where, 0),
+                                  level + 1))
+            stack.extend((child, node_id, holder, trees, child_path(where, index), level + 1)
                          for index, child in reversed(list(enumerate(node.children))))
 
     def finish(self) -> str:

@@ -9,11 +9,13 @@ of a composite state end at its cluster's border (``compound=true`` with ``lhead
 Eventless transitions are labelled ``ε`` (from an atomic state) or ``done`` / ``done(x)`` (from a
 composite state when its sub-machine reaches a final state, ``x`` if only that one).
 
-Large machines (more than ``LAYERED_MAX_STATES`` states or ``LAYERED_MAX_ARROWS`` arrows) are
-drawn differently, because dot's layered layout with edge labels needs minutes from about a
-hundred states with crossing transitions: the force-directed ``sfdp`` layout is used (seconds for
-thousands of states), without clusters: a composite state is a box joined to its sub-machine's
-initial state by a dotted arrow, and nested states are named by their path (``Operating/Closed``).
+Levels: ``level=N`` draws the composite states nested at most N deep as clusters and deeper
+ones closed (a bold rounded box saying how many states it holds); ``composite="A/B"`` draws that
+composite state alone (its cluster, its sub-machines). A hierarchical machine too large for the
+layered layout (more than ``LAYERED_MAX_STATES`` states or ``LAYERED_MAX_ARROWS`` arrows) is drawn
+to the deepest level that fits, and ``notes`` says so and names the composites to draw next.
+A flat machine that large uses the force-directed ``sfdp`` layout (seconds for thousands of
+states; dot's layered layout with edge labels needs minutes from about a hundred states).
 
 The same builder writes the DOT *file format* (``fsmbt convert --to dot``, registered by
 ``fsmbt.formats.dot``) with ``exchange=True``: node ids are the state names (``Parent/child``
@@ -34,6 +36,7 @@ from dataclasses import dataclass, field
 
 import graphviz
 
+from fsmbt.model.errors import InputError
 from fsmbt.model.fsm import FSM, State
 from fsmbt.model.stats import fsm_stats
 from fsmbt.render.anchor_ids import START_ANCHOR, state_anchor
@@ -75,8 +78,65 @@ class _Level:
     anchor: str = ""  # anchors: the composite-state path of this level ("Parent/"), no regions
 
 
+def _find_composite(fsm: FSM, path: str) -> State:
+    """The composite state at ``path`` (``A/B``: B inside A), else a located error."""
+    machines, state = [fsm], None
+    for part in path.split("/"):
+        state = next((m.states[part] for m in machines if part in m.states), None)
+        if state is None:
+            break
+        machines = list(state.regions)
+    if state is None or state.is_atomic:
+        known = ", ".join(composite_paths(fsm)[:20]) or "none"
+        raise InputError(f"no composite state '{path}' (composite states: {known})",
+                         element=path)
+    return state
+
+
+def composite_paths(fsm: FSM) -> list[str]:
+    """Every composite state's path (``A``, ``A/B``), pre-order, explicit stack."""
+    found: list[str] = []
+    stack: list[tuple[FSM, str]] = [(fsm, "")]
+    while stack:
+        machine, prefix = stack.pop()
+        inner: list[tuple[FSM, str]] = []
+        for state in machine.states.values():
+            if not state.is_atomic:
+                found.append(prefix + state.name)
+                inner.extend((region, f"{prefix}{state.name}/") for region in state.regions)
+        stack.extend(reversed(inner))
+    return found
+
+
+def _inner_states(state: State) -> int:
+    """How many states (all levels) a composite state holds."""
+    count = 0
+    stack = list(state.regions)
+    while stack:
+        machine = stack.pop()
+        count += len(machine.states)
+        stack.extend(r for s in machine.states.values() for r in s.regions)
+    return count
+
+
+def _visible(fsm: FSM, level: int) -> tuple[int, int]:
+    """(states, transitions) drawn when composites deeper than ``level`` are closed."""
+    states = transitions = 0
+    stack: list[tuple[FSM, int]] = [(fsm, 0)]
+    while stack:
+        machine, depth = stack.pop()
+        states += len(machine.states)
+        transitions += len(machine.transitions)
+        if depth < level:
+            stack.extend((region, depth + 1) for state in machine.states.values()
+                         for region in state.regions)
+    return states, transitions
+
+
 def fsm_to_dot(fsm: FSM, *, max_nodes: int | None = DEFAULT_MAX_NODES,
-               exchange: bool = False, anchors: bool = False) -> str:
+               exchange: bool = False, level: int | None = None,
+               composite: str | None = None, notes: list[str] | None = None,
+               anchors: bool = False) -> str:
     """DOT source of ``fsm``.
 
     Args:
@@ -85,12 +145,27 @@ def fsm_to_dot(fsm: FSM, *, max_nodes: int | None = DEFAULT_MAX_NODES,
             as many transitions), and nesting deeper than ``MAX_NESTING``; ``None``: no limit.
         exchange: write the DOT file format that ``fsmbt.formats.dot`` reads back (see the
             module docstring) instead of the picture's DOT.
+        level: draw composite states nested at most this deep as clusters (0: the top machine
+            only, composites closed); default: all, or the deepest that fits (see above).
+        composite: draw only this composite state (path ``A/B``).
+        notes: told what was left out of the picture and how to draw it.
         anchors: give every state an SVG id from its name (``fsmbt.render.anchors``): atomic
             and composite states ``s@Parent/child``, the top initial point ``start@``.
 
     Returns:
         The DOT source text.
+
+    Raises:
+        InputError: ``composite`` names no composite state (the message lists them).
     """
+    first_level = 0
+    if composite is not None and not exchange:
+        state = _find_composite(fsm, composite)
+        if len(state.regions) == 1:  # its sub-machine is the picture
+            fsm = state.regions[0]
+        else:  # parallel: the state's cluster with one sub-cluster per region
+            fsm = FSM(name=composite, states={state.name: state}, initial=state.name)
+            first_level = 1
     stats = fsm_stats(fsm)
     if max_nodes is not None:
         check_size(stats.all_states, max_nodes, "states")
@@ -99,8 +174,29 @@ def fsm_to_dot(fsm: FSM, *, max_nodes: int | None = DEFAULT_MAX_NODES,
             raise TooLargeError(f"too deeply nested to draw: {stats.nesting_depth} levels "
                                 f"(limit {MAX_NESTING})")
 
-    layered = exchange or (stats.all_states <= LAYERED_MAX_STATES
-                           and stats.all_transitions <= LAYERED_MAX_ARROWS)
+    def fits(states: int, transitions: int) -> bool:
+        return states <= LAYERED_MAX_STATES and transitions <= LAYERED_MAX_ARROWS
+
+    if not exchange and level is None and stats.hierarchical \
+            and not fits(stats.all_states, stats.all_transitions):
+        level = first_level
+        while level + 1 < stats.nesting_depth and fits(*_visible(fsm, level + 1)):
+            level += 1
+        if notes is not None:
+            shown, _ = _visible(fsm, level)
+            closed = [p for p in composite_paths(fsm) if p.count("/") == level]
+            names = ", ".join(closed[:6]) + (f", ... (+{len(closed) - 6})"
+                                             if len(closed) > 6 else "")
+            notes.append(f"picture capped: {stats.all_states} states are too many for one "
+                         f"readable picture; drew {shown} states, composite states nested "
+                         f"deeper than level {level} closed ({names}); draw one with "
+                         "composite=NAME or more levels with level=N")
+    visible = _visible(fsm, level) if level is not None else (stats.all_states,
+                                                              stats.all_transitions)
+    layered = exchange or fits(*visible)
+    if not layered and notes is not None and level is None:
+        notes.append(f"{visible[0]} states without hierarchy to split into levels: drawn with "
+                     "a force-directed layout (no clusters); fsmbt info lists its structure")
     root = graphviz.Digraph(name=dot_id(fsm.name) if exchange else _safe_name(fsm.name))
     if layered:
         root.attr(rankdir="LR", compound="true", fontname=FONT, nodesep="0.35", ranksep="0.5")
@@ -113,43 +209,56 @@ def fsm_to_dot(fsm: FSM, *, max_nodes: int | None = DEFAULT_MAX_NODES,
     edges: list[tuple[str, str, dict[str, str]]] = []
     clusters: list[tuple[graphviz.Digraph, graphviz.Digraph]] = []  # (cluster, parent), pre-order
 
+    level_cap = level  # the drawing loop below names each machine being drawn ``lv``
     top = _Level(fsm, root)
+    depth_of: dict[int, int] = {id(top): 0}
     pending: list[_Level] = [top]
     levels: list[_Level] = []
     while pending:
-        level = pending.pop()
-        levels.append(level)
-        for state in level.machine.states.values():
-            title = level.prefix + state.name
+        lv = pending.pop()
+        levels.append(lv)
+        for state in lv.machine.states.values():
+            title = lv.prefix + state.name
+            is_closed = (not exchange and level_cap is not None and not state.is_atomic
+                         and depth_of[id(lv)] >= level_cap)
+            if is_closed:
+                node_id = counter.state_id(lv, state.name)
+                lv.ids[state.name] = node_id
+                inside = _inner_states(state)
+                lv.graph.node(node_id, label=label_text(_state_title(state, title),
+                                                         f"[{inside} states inside]"),
+                               shape="box", style="rounded,bold,filled", fillcolor="gray95")
+                continue
             if state.is_atomic:
-                node_id = counter.state_id(level, state.name)
-                level.ids[state.name] = node_id
+                node_id = counter.state_id(lv, state.name)
+                lv.ids[state.name] = node_id
                 attrs = _state_attrs(state, title, compact=not layered)
                 if anchors:
-                    attrs["id"] = state_anchor(level.anchor + state.name)
-                level.graph.node(node_id, **attrs)
+                    attrs["id"] = state_anchor(lv.anchor + state.name)
+                lv.graph.node(node_id, **attrs)
                 continue
             if not layered:  # a box standing for the composite state, no cluster
                 node_id = counter.next("c")
-                extra = {"id": state_anchor(level.anchor + state.name)} if anchors else {}
-                level.graph.node(node_id, label=label_text(_state_title(state, title)),
-                                 shape="box", style="rounded,bold", **extra)
-                inner = [_Level(region, level.graph, prefix=f"{title}/", entry=node_id,
-                                anchor=f"{level.anchor}{state.name}/")
+                extra = {"id": state_anchor(lv.anchor + state.name)} if anchors else {}
+                lv.graph.node(node_id, label=label_text(_state_title(state, title)),
+                              shape="box", style="rounded,bold", **extra)
+                inner = [_Level(region, lv.graph, prefix=f"{title}/", entry=node_id,
+                                anchor=f"{lv.anchor}{state.name}/")
                          for region in state.regions]
-                level.anchors[state.name] = (node_id, "")
+                lv.anchors[state.name] = (node_id, "")
+                depth_of.update((id(x), depth_of[id(lv)] + 1) for x in inner)
                 pending.extend(reversed(inner))
                 continue
             cluster = graphviz.Digraph(name=counter.next("cluster_"))
             cluster.attr(label=label_text(_state_title(state, state.name)), style="rounded",
                          color="gray30", fontname=FONT, fontsize="12", labeljust="l")
             if anchors:
-                cluster.attr(id=state_anchor(level.anchor + state.name))
-            clusters.append((cluster, level.graph))
+                cluster.attr(id=state_anchor(lv.anchor + state.name))
+            clusters.append((cluster, lv.graph))
             inner = []
             for index, region in enumerate(state.regions):
                 holder = cluster
-                path = f"{level.path}{state.name}/"
+                path = f"{lv.path}{state.name}/"
                 if state.is_parallel:
                     holder = graphviz.Digraph(name=counter.next("cluster_"))
                     holder.attr(label=label_text(_region_title(region, index)), style="dashed",
@@ -157,14 +266,15 @@ def fsm_to_dot(fsm: FSM, *, max_nodes: int | None = DEFAULT_MAX_NODES,
                     clusters.append((holder, cluster))
                     path = f"{path}{index}:"
                 inner.append(_Level(region, holder, path=path,
-                                    anchor=f"{level.anchor}{state.name}/"))
+                                    anchor=f"{lv.anchor}{state.name}/"))
             # Arrows to/from the composite state end at its cluster, through its first initial point.
-            level.anchors[state.name] = (_initial_point_id(inner[0], counter), cluster.name)
+            lv.anchors[state.name] = (_initial_point_id(inner[0], counter), cluster.name)
+            depth_of.update((id(x), depth_of[id(lv)] + 1) for x in inner)
             pending.extend(reversed(inner))
 
-    for level in levels:
-        _draw_initial(level, edges, counter, is_top=level is top, anchors=anchors)
-        _draw_transitions(level, edges, exact=exchange)
+    for lv in levels:
+        _draw_initial(lv, edges, counter, is_top=lv is top, anchors=anchors)
+        _draw_transitions(lv, edges, exact=exchange)
 
     return assemble(root, clusters, [edge_line(tail, head, attrs) for tail, head, attrs in edges])
 
@@ -209,7 +319,8 @@ def _state_attrs(state: State, title: str, *, compact: bool = False) -> dict[str
     """Circles (double for final states); ellipses in large pictures, where long path names
     would make circles huge."""
     lines = [title]
-    if state.action is not None and state.action != state.name:
+    if state.action is not None and state.action != state.name \
+            and not title.endswith(f":{state.action}"):  # ``q3:Move`` already says it
         lines.append(f"/ {state.action}")
     attrs = {"label": label_text(*lines), "shape": "doublecircle" if state.final else "circle"}
     if state.action != state.name:  # read back by fsmbt.formats.dot; Graphviz ignores it

@@ -42,7 +42,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from fsmbt.limits import Limits
-from fsmbt.model.errors import InputError
+from fsmbt.model.errors import Hint, InputError
 from fsmbt.semantics.machine import RUNNING, Machine
 from fsmbt.verify.report import (
     COMPLETENESS,
@@ -109,9 +109,9 @@ class _Explored:
             return found
         if len(self.states) >= self.max_states:
             raise StateLimitError(
-                f"the {self.role} machine has more than {self.max_states} reachable states; "
-                "raise max_states or check the model for an unbounded counter",
-                element=getattr(self.machine, "name", self.role))
+                f"the {self.role} machine has more than {self.max_states} reachable states "
+                "(check the model for an unbounded counter)",
+                element=getattr(self.machine, "name", self.role), hints=(Hint.MAX_STATES,))
         new_id = len(self.states)
         self.index[state] = new_id
         self.states.append(state)
@@ -339,8 +339,8 @@ class _Product:
         if found is not None:
             return found
         if len(self.pair_s) >= self.max_states:
-            raise StateLimitError(f"the product has more than {self.max_states} states; "
-                             "raise max_states")
+            raise StateLimitError(f"the product of the two machines has more than "
+                                  f"{self.max_states} states", hints=(Hint.MAX_STATES,))
         new_id = len(self.pair_s)
         self.index[key] = new_id
         self.pair_s.append(s)

@@ -42,27 +42,49 @@ def render(report: Report) -> RenderableType:
             key = tuple(step.input for step in prop.counterexample)
             groups.setdefault(key, []).append(prop)
     for props in groups.values():  # properties failing on the same trace share one table
-        parts.append(counterexample_table(props[0], [p.name for p in props]))
+        parts.append(counterexample_table(props[0], [p.name for p in props],
+                                          leaf_execution=report.mode == "leaf-execution"))
     stats = report.stats
     if stats:
         parts.append(Text(_stats_line(stats), style="dim"))
     return Group(*parts)
 
 
-def counterexample_table(prop: PropertyResult, names: list[str] | None = None) -> Table:
-    """The shortest counterexample of one failed property (or several sharing it)."""
+def counterexample_table(prop: PropertyResult, names: list[str] | None = None,
+                         leaf_execution: bool | None = None) -> Table:
+    """The shortest counterexample of one failed property (or several sharing it).
+
+    Args:
+        prop: the failed property.
+        names: the properties sharing this trace (default: ``prop``'s).
+        leaf_execution: the inputs are leaf outcomes (shown as "previous leaf returned
+            FAILURE"); default: guessed from the inputs.
+
+    Returns:
+        The table.
+    """
     titles = ", ".join(_TITLES.get(n, n) for n in (names or [prop.name]))
-    table = Table("step", "input", "source did", "result did", "states", "note",
+    steps = len(prop.counterexample or []) - 1
+    leaf_mode = leaf_execution if leaf_execution is not None else _leaf_outcomes(prop)
+    unit = "leaf outcome" if leaf_mode else "input"
+    table = Table("step", "previous leaf returned" if leaf_mode else "input", "source did",
+                  "result did", "states", "note",
                   title=f"{titles}: shortest counterexample "
-                        f"({len(prop.counterexample or []) - 1} inputs)", title_justify="left")
+                        f"({steps} {unit}{'' if steps == 1 else 's'})", title_justify="left")
     for step in prop.counterexample or []:
         style = "red" if step.note else None
-        cells = [str(step.step), "(start)" if step.input is None else step.input,
+        given = step.input.upper() if leaf_mode and step.input is not None else step.input
+        cells = [str(step.step), "(start)" if given is None else given,
                  _did(step.source_outputs, step.source_status),
                  _did(step.result_outputs, step.result_status),
                  f"{step.source_state} / {step.result_state}", step.note]
         table.add_row(*(Text(cell) for cell in cells), style=style)
     return table
+
+
+def _leaf_outcomes(prop: PropertyResult) -> bool:
+    inputs = {s.input for s in prop.counterexample or [] if s.input is not None}
+    return bool(inputs) and inputs <= {"success", "failure", "running"}
 
 
 def _did(outputs: list[str], status: str) -> str:
