@@ -211,15 +211,40 @@ def replay(text: str, model: FSM, rng: random.Random, *, length: int,
         seen = engine.configuration()
         done = engine.terminated
         fsmbt_done = fsmbt.status(state) == FINAL
-        if seen == state and done and not fsmbt_done and engine.top_parallel_completed():
+        shown = configuration_of(state)
+        if seen == shown and done and not fsmbt_done and engine.top_parallel_completed():
             return Replay(len(sent), departure=PARALLEL_STOPS)
-        if seen != state or done != fsmbt_done:
+        if seen != shown or done != fsmbt_done:
             return Replay(len(sent), Mismatch(list(sent), f"{seen} (terminated={done})",
                                               f"{state} ({fsmbt.status(state)})"))
         if done or len(sent) == length:
             break
         event = random_events(fsmbt, state, rng, events_alphabet, noise)
-        sent.append(event)
-        engine.send(event)
-        state, _ = fsmbt.step(state, event)
+        base = event_of(event)
+        sent.append(base)
+        engine.send(base)
+        state = follow(fsmbt, state, base, engine.configuration(), events_alphabet, event)
     return Replay(len(sent))
+
+
+def configuration_of(state: str) -> str:
+    """fsmbt's flat name without the history values (``a/a1#h=x`` -> ``a/a1``)."""
+    return state.split("#", 1)[0]
+
+
+def event_of(symbol: str) -> str:
+    """The event of an input symbol (``e[g1,!g2]`` -> ``e``; docs/formats/scxml.md)."""
+    return symbol.split("[", 1)[0]
+
+
+def follow(fsmbt: FSMMachine, state: str, event: str, seen: str, alphabet: Sequence[str],
+           chosen: str) -> str:
+    """fsmbt's step on ``event``: the guard valuation is the environment's choice, so among the
+    symbols of ``event`` the one that reaches the engine's configuration is taken (the engine's
+    behaviour must be one of fsmbt's); without one, the randomly chosen symbol's successor."""
+    symbols = [s for s in alphabet if event_of(s) == event] or [chosen]
+    for symbol in [chosen, *symbols]:
+        successor, _ = fsmbt.step(state, symbol)
+        if configuration_of(successor) == seen:
+            return successor
+    return fsmbt.step(state, chosen)[0]

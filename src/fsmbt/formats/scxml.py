@@ -34,12 +34,12 @@ T transitions and nesting depth d.
 from __future__ import annotations
 
 import re
-
 from dataclasses import dataclass, field
 
 from lxml import etree
 
 from fsmbt.formats.registry import Format, ReadContext, register
+from fsmbt.formats.scxml_w3c import read_scxml_w3c
 from fsmbt.formats.xml_safe import local_name, namespace, parse_xml, root_tag
 from fsmbt.model import Model
 from fsmbt.model.errors import InputError, SourceLocation, UnsupportedError
@@ -543,7 +543,22 @@ class _Reader:
 
 
 def read_scxml(text: str, ctx: ReadContext) -> FSM:
-    return _Reader(ctx).read(text)
+    """The hierarchical model of the document; a document the structural reader refuses for a
+    feature with a finite reading is read by running the W3C algorithm instead (a flat model,
+    ``fsmbt.formats.scxml_w3c``; docs/formats/scxml.md)."""
+    try:
+        return _Reader(ctx).read(text)
+    except UnsupportedError as first:
+        if "working-draft" in str(first) or "XInclude" in str(first):
+            raise
+        try:
+            flat = read_scxml_w3c(text, ctx)
+        except UnsupportedError as remaining:
+            raise remaining from None
+        ctx.warn(f"read by running the W3C algorithm (the structural reader refuses: "
+                 f"{first.message if hasattr(first, 'message') else first}); the model is the "
+                 "flat machine of the reachable configurations")
+        return flat
 
 
 # -- writing -------------------------------------------------------------------------------------
