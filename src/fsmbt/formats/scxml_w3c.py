@@ -650,7 +650,7 @@ def _symbols(doc: _Doc, interp: _Interpreter) -> list[tuple[str, str, dict[int, 
         return out
 
     internal = guards_of(sorted(generated), True)
-    symbols = []
+    symbols: list[tuple[str, str, dict[int, bool]]] = []
     for event in events:
         relevant = sorted(guards_of([event], False) | internal)
         if len(relevant) > MAX_GUARDS_PER_EVENT:
