@@ -726,3 +726,25 @@ def read_scxml_w3c(text: str, ctx: ReadContext) -> FSM:
             if run.moved:
                 flat.add_transition(source, symbol, visit(key_of(run)))
     return flat
+
+
+def representative_event(event: str, events: list[str]) -> str | None:
+    """The model's event an arbitrary SCXML event behaves like.
+
+    The descriptors matching an event are the token prefixes of it (W3C 5.9.3), so an event
+    matches exactly the descriptors its longest matching descriptor token matches: the model's
+    events (the descriptor tokens) stand for every event name.
+
+    Args:
+        event: Any event name (``foo.bar.bat.bif``).
+        events: The model's events (without guard suffixes).
+
+    Returns:
+        The longest event of ``events`` that is ``event`` or a token prefix of it, or ``None``.
+    """
+    best = None
+    for candidate in events:
+        if _matches(candidate, event) and candidate != "*" and (
+                best is None or len(candidate) > len(best)):
+            best = candidate
+    return best
