@@ -145,7 +145,9 @@ def test_structural_refusals_are_read_by_the_w3c_algorithm(body: str, feature: s
 @pytest.mark.parametrize("body, feature", [
     ('<state id="s"><onentry><send event="x" delay="1s"/></onentry></state>', "delay"),
     ('<state id="s"><onentry><script>x = 1</script></onentry></state>', "<script>"),
-    ('<state id="s"><onentry><if cond="a"><raise event="x"/></if></onentry></state>', "<if>"),
+    ('<state id="s"><onentry><foreach array="a" item="i"><raise event="x"/></foreach>'
+     '</onentry></state>', "<foreach>"),
+    ('<state id="s"><onentry><cancel sendid="t"/></onentry></state>', "<cancel>"),
     ('<state id="s"><invoke src="x"/></state>', "<invoke>"),
     ('<state id="s"><transition event="e" cond="x &gt; 1" target="s">'
      '<assign location="x" expr="x + 1"/></transition></state>', "a guard reads"),

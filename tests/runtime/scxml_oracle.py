@@ -127,6 +127,9 @@ class Engine:
 
     def __init__(self, text: str) -> None:
         self.doc, chart = _compiled(text)
+        if "<assign" in text:  # ASSIGN_SHARED_CLASS: a fresh class for each instance
+            with contextlib.redirect_stdout(io.StringIO()):
+                chart = load(text, format="scxml")
         with contextlib.redirect_stdout(io.StringIO()):  # the engine prints <log> content
             self.machine = chart()
 
@@ -182,6 +185,12 @@ def random_events(machine: FSMMachine, state: str, rng: random.Random,
         return rng.choice(active)
     return rng.choice(list(alphabet))
 
+
+#: python-statemachine 3.2.2: in the second and later instances of one class loaded from a
+#: document, an ``<assign>`` whose expression reads a ``<data>`` variable fails and the rest of
+#: its block (a ``<raise>`` after it) is skipped; the first instance runs it as W3C says.
+#: ``Engine`` therefore loads a fresh class per instance for documents with ``<assign>``.
+ASSIGN_SHARED_CLASS = "engine skips a block after <assign> in a reused class"
 
 #: The engine's known departure from the W3C algorithm that a replay meets (see
 #: docs/formats/scxml.md): it stops when a top-level <parallel> completes; W3C stops only on

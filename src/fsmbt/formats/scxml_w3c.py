@@ -54,7 +54,29 @@ MAX_MICROSTEPS = 10_000
 _IN = re.compile(r"""\s*In\(\s*(?:'([^']+)'|"([^"]+)")\s*\)\s*$""")
 _IDENT = re.compile(r"[A-Za-z_$][\w$]*")
 
-Action = tuple[str, str]  # ("raise" | "internal" | "external", event name)
+@dataclass
+class _If:
+    """``<if>`` with effects: the first branch whose guard holds (``None``: ``<else>``)."""
+
+    branches: list[tuple[int | None, list[Action]]]
+
+
+#: ("raise" | "internal" | "external", event name), or an ``<if>``.
+Action = tuple[str, str] | _If
+
+
+def _event_names(actions: list[Action]) -> list[str]:
+    """Every event ``actions`` may raise or send (all branches)."""
+    out: list[str] = []
+    stack = list(actions)
+    while stack:
+        action = stack.pop()
+        if isinstance(action, _If):
+            for _guard, inner in action.branches:
+                stack.extend(inner)
+        else:
+            out.append(action[1])
+    return out
 
 
 @dataclass
@@ -104,6 +126,7 @@ class _Doc:
         self.states: list[_S] = []
         self.by_id: dict[str, int] = {}
         self.guards: list[str] = []
+        self.branch_guards: set[int] = set()  # read by <if> branches, whatever the event
         self.assigned: list[tuple[str, int | None]] = []
         pending: list[tuple[int, etree._Element, str]] = []  # (state, element, target text)
         initial_text: dict[int, tuple[str, etree._Element]] = {}
@@ -214,16 +237,17 @@ class _Doc:
             raise InputError(f"unknown SCXML element <{tag}> in <{node.kind}>",
                              location=self.ctx.location(element.sourceline), element=f"<{tag}>")
 
-    def actions(self, block: etree._Element) -> list[Action]:
+    def actions(self, block: etree._Element | list[etree._Element]) -> list[Action]:
         """The queue effects of a block of executable content, in document order."""
         out: list[Action] = []
-        for item in block.iter():
-            if item is block or not isinstance(item.tag, str):
+        for item in block:
+            if not isinstance(item.tag, str):
                 continue
             tag = self.tag(item)
-            if tag is None or tag in ("param", "content"):
-                continue
-            if tag == "log":
+            if tag is None:
+                self.ctx.warn(f"element of another namespace ignored: <{local_name(item)}>",
+                              line=item.sourceline)
+            elif tag == "log":
                 self.ctx.warn("<log> ignored", line=item.sourceline, element="<log>")
             elif tag == "raise":
                 out.append(("raise", self.event_name(item)))
@@ -234,12 +258,45 @@ class _Doc:
                 self.assigned.append((location, item.sourceline))
                 self.ctx.warn(f"<assign> to '{location}' ignored (no guard reads it)",
                               line=item.sourceline, element="<assign>")
+            elif tag == "if":
+                out.extend(self.if_block(item))
             else:
-                feature = {"script": "<script>", "if": "<if>", "elseif": "<if>",
-                           "else": "<if>", "foreach": "<foreach>",
+                feature = {"script": "<script>", "elseif": "<elseif> outside <if>",
+                           "else": "<else> outside <if>", "foreach": "<foreach>",
                            "cancel": "<cancel> (of a delayed <send>)"}.get(tag, f"<{tag}>")
                 raise self.refuse(item, f"unsupported: {feature}")
         return out
+
+    def if_block(self, item: etree._Element) -> list[Action]:
+        """``<if>``/``<elseif>``/``<else>``: branches chosen by guards (inputs of the
+        environment, like transition guards); an ``<if>`` none of whose branches raises or
+        sends anything has no effect on the machine and is dropped with a warning."""
+        branches: list[tuple[str | None, etree._Element]] = [(item.get("cond"), item)]
+        body: list[list[etree._Element]] = [[]]
+        for child in item:
+            if not isinstance(child.tag, str):
+                continue
+            tag = self.tag(child)
+            if tag in ("elseif", "else"):
+                if branches[-1][0] is None and len(branches) > 1:
+                    raise InputError("<else> must be the last branch of <if>",
+                                     location=self.ctx.location(child.sourceline))
+                branches.append((child.get("cond") if tag == "elseif" else None, child))
+                body.append([])
+            else:
+                body[-1].append(child)
+        if item.get("cond") is None:
+            raise InputError("<if> needs a cond", location=self.ctx.location(item.sourceline))
+        wrapper_actions = [self.actions(elements) for elements in body]
+        if not any(wrapper_actions):
+            self.ctx.warn("<if> ignored: no branch raises or sends an event",
+                          line=item.sourceline, element="<if>")
+            return []
+        guarded: list[tuple[int | None, list[Action]]] = []
+        for (cond, _origin), effects in zip(branches, wrapper_actions):
+            index = None if cond is None else self.guard(cond, item, internal=True)
+            guarded.append((index, effects))
+        return [_If(guarded)]
 
     def event_name(self, item: etree._Element) -> str:
         event = item.get("event")
@@ -293,13 +350,20 @@ class _Doc:
                                   line=element.sourceline, element="<transition>")
                 cond = ("in", state_id)
             else:
-                text = " ".join(cond_text.split())
-                if text not in self.guards:
-                    self.guards.append(text)
-                cond = ("guard", self.guards.index(text))
+                cond = ("guard", self.guard(cond_text, element, internal=False))
         return _T(source, tuple(descriptors), cond, tuple(self.ids(target, element)),
                   element.get("type") == "internal", self.actions(element),
                   element.sourceline)
+
+    def guard(self, cond_text: str, element: etree._Element, *, internal: bool) -> int:
+        """The index of a guard (one per distinct cond text, in document order)."""
+        text = " ".join(cond_text.split())
+        if text not in self.guards:
+            self.guards.append(text)
+        index = self.guards.index(text)
+        if internal:
+            self.branch_guards.add(index)
+        return index
 
     def check_assignments(self) -> None:
         read: set[str] = set()
@@ -323,6 +387,8 @@ class _Run:
     external: deque[str] = field(default_factory=deque)
     running: bool = True
     moved: bool = False
+    valuation: dict[int, bool] = field(default_factory=dict)  # the environment's guard values
+    read: set[int] = field(default_factory=set)  # guards read so far
 
 
 class _Interpreter:
@@ -451,7 +517,18 @@ class _Interpreter:
 
     # -- micro step -----------------------------------------------------------------------------
     def perform(self, actions: list[Action], run: _Run) -> None:
-        for kind, name in actions:
+        stack = list(reversed(actions))
+        while stack:
+            action = stack.pop()
+            if isinstance(action, _If):
+                for guard, inner in action.branches:
+                    if guard is not None:
+                        run.read.add(guard)
+                    if guard is None or run.valuation.get(guard, False):
+                        stack.extend(reversed(inner))
+                        break
+                continue
+            kind, name = action
             (run.external if kind == "external" else run.internal).append(name)
 
     def microstep(self, enabled: list[_T], run: _Run) -> None:
@@ -563,6 +640,7 @@ class _Interpreter:
 
     def process(self, run: _Run, event: str | None, valuation: dict[int, bool],
                 read: set[int]) -> None:
+        run.valuation, run.read = valuation, read
         if event is None:
             self.enter([_T(0, (), None, tuple(self.s[0].initial), False,
                            list(self.s[0].initial_actions), None)], run)
@@ -630,10 +708,8 @@ def _symbols(doc: _Doc, interp: _Interpreter) -> list[tuple[str, str, dict[int, 
             for d in t.events:
                 if d != "*" and not d.startswith("done."):
                     events.setdefault(d, None)
-            for _k, name in t.actions:
-                generated.add(name)
-        for _k, name in [*node.onentry, *node.onexit, *node.initial_actions]:
-            generated.add(name)
+            generated.update(_event_names(t.actions))
+        generated.update(_event_names([*node.onentry, *node.onexit, *node.initial_actions]))
     if not events and any("*" in t.events for n in doc.states for t in n.transitions):
         events["event"] = None
     all_t = [t for n in doc.states for t in n.transitions]
@@ -649,7 +725,7 @@ def _symbols(doc: _Doc, interp: _Interpreter) -> list[tuple[str, str, dict[int, 
                 out.add(int(t.cond[1]))
         return out
 
-    internal = guards_of(sorted(generated), True)
+    internal = guards_of(sorted(generated), True) | doc.branch_guards
     symbols: list[tuple[str, str, dict[int, bool]]] = []
     for event in events:
         relevant = sorted(guards_of([event], False) | internal)
