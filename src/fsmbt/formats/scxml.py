@@ -546,17 +546,19 @@ def read_scxml(text: str, ctx: ReadContext) -> FSM:
     """The hierarchical model of the document; a document the structural reader refuses for a
     feature with a finite reading is read by running the W3C algorithm instead (a flat model,
     ``fsmbt.formats.scxml_w3c``; docs/formats/scxml.md)."""
+    kept = len(ctx.warnings)
     try:
         return _Reader(ctx).read(text)
     except UnsupportedError as first:
         if "working-draft" in str(first) or "XInclude" in str(first):
             raise
+        del ctx.warnings[kept:]  # the W3C reading warns about the same content again
         try:
             flat = read_scxml_w3c(text, ctx)
         except UnsupportedError as remaining:
             raise remaining from None
         ctx.warn(f"read by running the W3C algorithm (the structural reader refuses: "
-                 f"{first.message if hasattr(first, 'message') else first}); the model is the "
+                 f"{first.message}); the model is the "
                  "flat machine of the reachable configurations")
         return flat
 
