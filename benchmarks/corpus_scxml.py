@@ -38,9 +38,10 @@ def main() -> int:
     if not files:
         print(f"no SCXML files under {corpus}", file=sys.stderr)
         return 2
-    print("| file | result | flat states | ms |")
-    print("|---|---|---|---|")
+    print("| file | result | reader | states | ms |")
+    print("|---|---|---|---|---|")
     reasons: Counter[str] = Counter()
+    readers: Counter[str] = Counter()
     verified = 0
     for path in files:
         start = time.perf_counter()
@@ -48,6 +49,9 @@ def main() -> int:
             outcome = api.convert_file(path, to="btcpp")
             word = api.verdict_word(outcome.report)
             states = len(getattr(outcome.source.model, "states", {}))
+            w3c = any("W3C algorithm" in w for w in outcome.source.warnings)
+            reader = "W3C algorithm (flat)" if w3c else "structural"
+            readers[reader] += 1
             if outcome.report is not None and outcome.report.equivalent:
                 verified += 1
                 result = "converts + verifies"
@@ -55,13 +59,15 @@ def main() -> int:
                 result = f"converts, verdict {word}"
                 reasons[f"not verified ({word})"] += 1
         except FsmbtError as exc:
-            result, states = reason_of(exc), 0
+            result, states, reader = reason_of(exc), 0, ""
             reasons[result] += 1
         ms = (time.perf_counter() - start) * 1000
-        print(f"| {path.relative_to(corpus)} | {result} | {states or ''} | {ms:.0f} |")
+        print(f"| {path.relative_to(corpus)} | {result} | {reader} | {states or ''} | "
+              f"{ms:.0f} |")
     total = len(files)
     print(f"\n**{verified} of {total} well-formed SCXML files convert and verify "
-          f"({100 * verified / total:.0f} %).**\n")
+          f"({100 * verified / total:.0f} %); read by "
+          + ", ".join(f"{name} {count}" for name, count in sorted(readers.items())) + ".**\n")
     print("| remaining reason | files |")
     print("|---|---|")
     for reason, count in reasons.most_common():
