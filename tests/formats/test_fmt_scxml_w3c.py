@@ -9,12 +9,12 @@ from __future__ import annotations
 import pytest
 
 from fsmbt import api
-from fsmbt.formats import loads
+from fsmbt.formats import dumps, loads
 from fsmbt.formats.registry import ReadContext
 from fsmbt.formats.scxml import read_scxml
 from fsmbt.formats.scxml_w3c import MAX_GUARDS_PER_EVENT, representative_event
 from fsmbt.model.errors import InputError, UnsupportedError
-from fsmbt.model.fsm import FSM
+from fsmbt.model.fsm import FSM, State
 from fsmbt.semantics.machine import FINAL, FSMMachine
 from fsmbt.verify.nusmv.binary import find_nusmv
 
@@ -92,7 +92,7 @@ def test_guarded_input_is_one_symbol_per_event_and_guard_values() -> None:
   <state id="u"><transition event="back" cond="ready" target="s"/></state>"""
     warnings: list[str] = []
     model = read_scxml(doc(body), ReadContext(warnings=warnings))
-    assert model.events() == ["e[g1]", "e[!g1]", "back[g2]", "back[!g2]"]
+    assert sorted(model.events()) == ["back[!g2]", "back[g2]", "e[!g1]", "e[g1]"]
     assert model.attrs["{https://fsmbt.dev/ns/scxml}guard.g1"] == "x > 1"
     assert any("g2 is an input of the environment: ready" in w for w in warnings)
     assert walk(model, ["e[g1]", "back[!g2]", "back[g2]"]) == ["s", "t", "s", "s"]
@@ -143,6 +143,34 @@ def test_wildcard_and_prefix_descriptors() -> None:
     assert representative_event("ab", ["a", "a.b"]) is None
 
 
+def test_prefix_events_are_written_so_a_w3c_engine_reads_the_same_machine() -> None:
+    """Transitions on ``a.b`` come before those on ``a`` in each state, so the writer may write
+    both names and the file reads back equal (a W3C engine takes the first match)."""
+    body = """
+  <state id="s"><transition event="a.b" target="t"/><transition event="a" target="u"/></state>
+  <state id="t"><transition event="a" target="s"/></state><state id="u"/>"""
+    model = loads(doc(body), "scxml")
+    again = loads(dumps(model, "scxml"), "scxml")
+    assert again == model
+    assert walk(model, ["a.b", "a.b", "a"]) == ["s", "t", "s", "u"]  # a.b in t: via 'a'
+    first = loads(doc(body.replace('event="a.b" target="t"/><transition event="a" target="u"',
+                                   'event="a" target="u"/><transition event="a.b" target="t"')),
+                  "scxml")
+    assert walk(first, ["a.b"]) == ["s", "u"]  # W3C: the first match in document order
+
+
+def test_hierarchical_prefix_events_are_still_refused_by_the_writer() -> None:
+    inner = FSM(name="c")
+    inner.add_state("x")
+    inner.add_transition("x", "a", "x")
+    top = FSM()
+    top.add_state(State("c", regions=[inner]))
+    top.add_state("y")
+    top.add_transition("c", "a.b", "y")
+    with pytest.raises(UnsupportedError, match="prefix matching"):
+        dumps(top, "scxml")
+
+
 def test_targetless_transition_runs_its_content_and_stays() -> None:
     body = """
   <state id="c" initial="c1"><state id="c1"><transition event="n" target="c2"/></state>
@@ -184,3 +212,26 @@ def test_assign_to_an_unread_variable_is_warned_and_one_read_by_a_guard_refused(
         loads(doc('<state id="s"><transition event="e" cond="x" target="s">\n'
                   '<assign location="x" expr="1"/></transition></state>'), "scxml")
     assert "which a guard reads" in str(info.value)
+
+
+TIMER = """
+  <state id="s"><onentry><send event="tick" delay="1s"/></onentry>
+    <transition event="tick" target="t"/></state>
+  <state id="t"><onentry><cancel sendid="x"/></onentry><transition event="back" target="s"/>
+  </state>"""
+
+
+def test_delayed_send_is_refused_naming_the_abstraction_option() -> None:
+    with pytest.raises(UnsupportedError, match="abstract=time") as info:
+        loads(doc(TIMER), "scxml")
+    assert "line 3" in str(info.value)
+
+
+def test_delayed_send_under_the_time_abstraction_is_an_environment_input() -> None:
+    warnings: list[str] = []
+    model = read_scxml(doc(TIMER), ReadContext(options={"abstract": "time"}, warnings=warnings))
+    assert any("verified under the abstraction 'time'" in w and "tick" in w for w in warnings)
+    assert any("<cancel> ignored" in w for w in warnings)
+    assert walk(model, ["tick", "back"]) == ["s", "t", "s"]  # the timer fires when it likes
+    result = api.convert_model(model)
+    assert api.verify_models(model, result.model, "native").equivalent

@@ -796,7 +796,11 @@ def _event_descriptor(event: str, source: str) -> str:
 
 
 def _check_event_prefixes(fsm: FSM) -> None:
-    """SCXML's descriptor ``a`` also matches event ``a.b``: such an alphabet cannot be written."""
+    """SCXML's descriptor ``a`` also matches event ``a.b``: such an alphabet cannot be written,
+    except in a flat machine whose every state takes ``a.b`` by its own transition written
+    before the one on ``a`` (or by neither): there the first transition in document order a W3C
+    engine picks for ``a.b`` is the model's (the W3C reading of a document with prefix
+    descriptors gives such machines; docs/formats/scxml.md)."""
     names: set[str] = set()
     stack = [fsm]
     while stack:
@@ -811,10 +815,26 @@ def _check_event_prefixes(fsm: FSM) -> None:
         for other in ordered[i + 1:]:
             if not other.startswith(name):
                 break
-            if other.startswith(name + "."):
+            if other.startswith(name + ".") and not _prefix_order_exact(fsm, other):
                 raise UnsupportedError(f"events '{name}' and '{other}' cannot both be written as "
                                        f"SCXML: the descriptor '{name}' also matches '{other}' "
                                        "(SCXML prefix matching)")
+
+
+def _prefix_order_exact(fsm: FSM, event: str) -> bool:
+    """In flat ``fsm``, is the first transition of each state whose descriptor matches
+    ``event`` the transition on ``event`` itself (or is there none)?"""
+    if fsm.is_hierarchical or fsm.initial_event is not None:
+        return False
+    first: dict[str, str] = {}
+    for t in fsm.transitions:
+        if t.event is None or t.source in first:
+            continue
+        if t.event == event or event.startswith(t.event + "."):
+            first[t.source] = t.event
+    return all(matched == event for matched in first.values())
+
+
 def _is_parallel(state: State) -> bool:
     """Several regions, or one region holding one state named like it (a one-child parallel)."""
     if len(state.regions) > 1:

@@ -45,7 +45,7 @@ from fsmbt.model.fsm import FSM, State
 SCXML_NS = "http://www.w3.org/2005/07/scxml"
 FSMBT_NS = "https://fsmbt.dev/ns/scxml"
 XINCLUDE_NS = "http://www.w3.org/2001/XInclude"
-F_NAME, F_REGION = f"{{{FSMBT_NS}}}name", f"{{{FSMBT_NS}}}region"
+F_NAME, F_REGION, F_ACTION = (f"{{{FSMBT_NS}}}{n}" for n in ("name", "region", "action"))
 STATE_TAGS = frozenset({"state", "parallel", "final", "history"})
 #: Guards one event may read (2**N input symbols per event).
 MAX_GUARDS_PER_EVENT = 6
@@ -99,6 +99,8 @@ class _S:
     parent: int | None
     line: int | None
     wrapper: bool = False
+    action: str | None = None  # fsmbt:action of an atomic state (files fsmbt wrote)
+    has_action: bool = False
     deep: bool = False
     children: list[int] = field(default_factory=list)
     initial: list[int] = field(default_factory=list)
@@ -106,6 +108,21 @@ class _S:
     transitions: list[_T] = field(default_factory=list)
     onentry: list[Action] = field(default_factory=list)
     onexit: list[Action] = field(default_factory=list)
+
+
+def abstractions(value: object) -> set[str]:
+    """The abstraction names of the reader option ``abstract`` (``"time,blackboard"`` or a
+    list); SCXML knows ``time``: a delayed ``<send>`` is a timer whose event the environment
+    sends when it likes (docs/formats/scxml.md)."""
+    if value is None:
+        return set()
+    if isinstance(value, str):
+        items: list[object] = list(value.split(","))
+    elif isinstance(value, (list, tuple, set, frozenset)):
+        items = list(value)
+    else:
+        items = [value]
+    return {str(item).strip() for item in items if str(item).strip()}
 
 
 def _matches(descriptor: str, event: str) -> bool:
@@ -118,8 +135,12 @@ class _Doc:
 
     def __init__(self, text: str, ctx: ReadContext) -> None:
         self.ctx = ctx
+        self.abstract_time = "time" in abstractions(ctx.options.get("abstract"))
         root = parse_xml(text, ctx.display_name)
         self.ns = namespace(root)
+        self.root_name = root.get("name", "fsm")
+        self.root_attrs = {k: v for k, v in root.attrib.items()
+                           if k not in ("initial", "name", "version")}
         if local_name(root) != "scxml":
             raise InputError(f"not an SCXML document: root element is <{local_name(root)}>",
                              location=ctx.location(root.sourceline))
@@ -141,7 +162,9 @@ class _Doc:
                                  location=ctx.location(element.sourceline))
             node = _S(index, state_id, element.get(F_NAME, state_id), tag or "", parent,
                       element.sourceline, wrapper=element.get(F_REGION) == "true",
-                      deep=element.get("type") == "deep")
+                      deep=element.get("type") == "deep",
+                      action=element.get(F_ACTION) or None,
+                      has_action=F_ACTION in element.attrib)
             self.states.append(node)
             if parent is not None:
                 self.by_id[state_id] = index
@@ -252,7 +275,13 @@ class _Doc:
             elif tag == "raise":
                 out.append(("raise", self.event_name(item)))
             elif tag == "send":
-                out.append(self.send(item))
+                sent = self.send(item)
+                if sent is not None:
+                    out.append(sent)
+            elif tag == "cancel" and self.abstract_time:
+                self.ctx.warn("<cancel> ignored under the abstraction 'time' (a timer's event "
+                              "may arrive at any time)", line=item.sourceline,
+                              element="<cancel>")
             elif tag == "assign":
                 location = item.get("location") or ""
                 self.assigned.append((location, item.sourceline))
@@ -305,10 +334,18 @@ class _Doc:
                                     "event name (eventexpr)")
         return event
 
-    def send(self, item: etree._Element) -> Action:
+    def send(self, item: etree._Element) -> Action | None:
         delay = (item.get("delay") or "").strip()
         if item.get("delayexpr") is not None or delay not in ("", "0", "0s", "0ms"):
-            raise self.refuse(item, "unsupported: <send> with a delay (a timer)")
+            if not self.abstract_time:
+                raise self.refuse(item, "unsupported: <send> with a delay (a timer; the "
+                                        "option abstract=time reads it as an environment "
+                                        "input)")
+            self.ctx.warn(f"verified under the abstraction 'time': the timer of <send "
+                          f"event='{item.get('event') or item.get('eventexpr')}'> is an "
+                          "input of the environment (its event may arrive at any time, or "
+                          "never)", line=item.sourceline, element="<send>")
+            return None
         if item.get("targetexpr") is not None or item.get("typeexpr") is not None:
             raise self.refuse(item, "unsupported: <send> with a computed target or type")
         kind = item.get("type")
@@ -696,7 +733,8 @@ class _Interpreter:
     def action(self, config: frozenset[int]) -> str | None:
         atoms = sorted((i for i in config if self.atomic(i) and not self.s[i].wrapper),
                        key=self.order.__getitem__)
-        return "+".join(self.s[i].name for i in atoms) or None
+        parts = [self.s[i].action if self.s[i].has_action else self.s[i].name for i in atoms]
+        return "+".join(p for p in parts if p) or None
 
 
 def _symbols(doc: _Doc, interp: _Interpreter) -> list[tuple[str, str, dict[int, bool]]]:
@@ -726,7 +764,7 @@ def _symbols(doc: _Doc, interp: _Interpreter) -> list[tuple[str, str, dict[int, 
         return out
 
     internal = guards_of(sorted(generated), True) | doc.branch_guards
-    symbols: list[tuple[str, str, dict[int, bool]]] = []
+    symbols: list[tuple[str, str, dict[int, bool]]] = []  # sorted below
     for event in events:
         relevant = sorted(guards_of([event], False) | internal)
         if len(relevant) > MAX_GUARDS_PER_EVENT:
@@ -738,7 +776,10 @@ def _symbols(doc: _Doc, interp: _Interpreter) -> list[tuple[str, str, dict[int, 
         for values in product((True, False), repeat=len(relevant)):
             label = ",".join(("" if v else "!") + f"g{g + 1}" for g, v in zip(relevant, values))
             symbols.append((f"{event}[{label}]", event, dict(zip(relevant, values))))
-    return symbols
+    # one canonical order (more dot tokens first, then by name): transitions on ``a.b`` come
+    # before those on ``a`` in each state, so the SCXML writer's document order means the same
+    # to a W3C engine, and a written file reads back in the same order
+    return sorted(symbols, key=lambda item: (-item[1].count("."), item[0]))
 
 
 def read_scxml_w3c(text: str, ctx: ReadContext) -> FSM:
@@ -759,8 +800,7 @@ def read_scxml_w3c(text: str, ctx: ReadContext) -> FSM:
     interp = _Interpreter(doc)
     symbols = _symbols(doc, interp)
     has_history = any(s.kind == "history" for s in doc.states)
-    top_name = doc.states[0].id or "fsm"
-    flat = FSM(name=top_name)
+    flat = FSM(name=doc.root_name, attrs=dict(doc.root_attrs))
     for n, guard in enumerate(doc.guards):
         flat.attrs[f"{{{FSMBT_NS}}}guard.g{n + 1}"] = guard
         ctx.warn(f"guard g{n + 1} is an input of the environment: {guard}")
