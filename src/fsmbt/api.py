@@ -278,7 +278,7 @@ def load_for_engine(path: str | Path, engine: str, fmt: str | None = None, *,
 
 
 #: Options meant for the readers, not the engines (they travel in the same ``options`` dict).
-READER_OPTIONS = ("node_models", "abstract")
+READER_OPTIONS = ("node_models", "abstract", "data")
 
 
 def _reader_options(options: dict[str, object]) -> dict[str, object] | None:

@@ -37,6 +37,7 @@ from itertools import product
 from lxml import etree
 
 from fsmbt import limits
+from fsmbt.formats import scxml_expr
 from fsmbt.formats.registry import ReadContext
 from fsmbt.formats.xml_safe import local_name, namespace, parse_xml
 from fsmbt.model.errors import InputError, UnsupportedError
@@ -51,6 +52,8 @@ STATE_TAGS = frozenset({"state", "parallel", "final", "history"})
 MAX_GUARDS_PER_EVENT = 6
 #: Micro steps in one macro step, and events a machine may queue for itself.
 MAX_MICROSTEPS = 10_000
+#: Exact data: a number's magnitude (a string's length) past this is "without bound".
+MAX_DATA_MAGNITUDE = 10_000
 _IN = re.compile(r"""\s*In\(\s*(?:'([^']+)'|"([^"]+)")\s*\)\s*$""")
 _IDENT = re.compile(r"[A-Za-z_$][\w$]*")
 
@@ -59,6 +62,7 @@ class _If:
     """``<if>`` with effects: the first branch whose guard holds (``None``: ``<else>``)."""
 
     branches: list[tuple[int | None, list[Action]]]
+    effectless: bool = False  # only assignments: matters with exact data only
 
 
 #: ("raise" | "internal" | "external", event name), or an ``<if>``.
@@ -74,7 +78,7 @@ def _event_names(actions: list[Action]) -> list[str]:
         if isinstance(action, _If):
             for _guard, inner in action.branches:
                 stack.extend(inner)
-        else:
+        elif action[0] != "assign":
             out.append(action[1])
     return out
 
@@ -147,7 +151,17 @@ class _Doc:
         self.states: list[_S] = []
         self.by_id: dict[str, int] = {}
         self.guards: list[str] = []
+        self.data: list[tuple[str, str | None, bool, int | None]] = []
+        self.assign_exprs: list[tuple[str, str | None, int | None]] = []
+        self.data_mode = False
+        self.data_reason = ""
+        self.parsed_guards: list[scxml_expr.Expr] = []
+        self.parsed_assigns: list[scxml_expr.Expr] = []
+        self.initial_data: dict[str, scxml_expr.Value] = {}
         self.branch_guards: set[int] = set()  # read by <if> branches, whatever the event
+        self.data_only_guards: set[int] = set()  # of <if>s that only assign
+        self.transition_guards: set[int] = set()
+        self.effectless_ifs: list[int | None] = []
         self.assigned: list[tuple[str, int | None]] = []
         pending: list[tuple[int, etree._Element, str]] = []  # (state, element, target text)
         initial_text: dict[int, tuple[str, etree._Element]] = {}
@@ -215,7 +229,7 @@ class _Doc:
                     node.initial = first[:1]
         if not self.states[0].initial:
             raise InputError("the document has no state", location=ctx.location(root.sourceline))
-        self.check_assignments()
+        self.decide_data_mode()
 
     def tag(self, element: etree._Element) -> str | None:
         if namespace(element) == XINCLUDE_NS:
@@ -249,9 +263,14 @@ class _Doc:
             node.onentry.extend(self.actions(element))
         elif tag == "onexit":
             node.onexit.extend(self.actions(element))
-        elif tag in ("datamodel", "donedata"):
-            self.ctx.warn(f"<{tag}> ignored (guards are inputs of the environment)",
-                          line=element.sourceline, element=f"<{tag}>")
+        elif tag == "datamodel":
+            for data in element:
+                if isinstance(data.tag, str) and self.tag(data) == "data":
+                    has_content = len(data) > 0 or bool((data.text or "").strip())
+                    self.data.append((data.get("id") or "", data.get("expr"), has_content,
+                                      data.sourceline))
+        elif tag == "donedata":
+            self.ctx.warn("<donedata> ignored", line=element.sourceline, element="<donedata>")
         elif tag == "invoke":
             raise self.refuse(element, "unsupported: <invoke> (external services)")
         elif tag == "script":
@@ -285,8 +304,8 @@ class _Doc:
             elif tag == "assign":
                 location = item.get("location") or ""
                 self.assigned.append((location, item.sourceline))
-                self.ctx.warn(f"<assign> to '{location}' ignored (no guard reads it)",
-                              line=item.sourceline, element="<assign>")
+                self.assign_exprs.append((location, item.get("expr"), item.sourceline))
+                out.append(("assign", str(len(self.assign_exprs) - 1)))
             elif tag == "if":
                 out.extend(self.if_block(item))
             else:
@@ -318,14 +337,19 @@ class _Doc:
             raise InputError("<if> needs a cond", location=self.ctx.location(item.sourceline))
         wrapper_actions = [self.actions(elements) for elements in body]
         if not any(wrapper_actions):
-            self.ctx.warn("<if> ignored: no branch raises or sends an event",
-                          line=item.sourceline, element="<if>")
+            self.ctx.warn("<if> ignored: its branches are empty", line=item.sourceline,
+                          element="<if>")
             return []
+        effectless = not _event_names([a for branch in wrapper_actions for a in branch])
         guarded: list[tuple[int | None, list[Action]]] = []
         for (cond, _origin), effects in zip(branches, wrapper_actions):
-            index = None if cond is None else self.guard(cond, item, internal=True)
+            index = None if cond is None else self.guard(cond, item, internal=not effectless)
+            if index is not None and effectless:
+                self.data_only_guards.add(index)
             guarded.append((index, effects))
-        return [_If(guarded)]
+        if effectless:
+            self.effectless_ifs.append(item.sourceline)
+        return [_If(guarded, effectless)]
 
     def event_name(self, item: etree._Element) -> str:
         event = item.get("event")
@@ -388,6 +412,7 @@ class _Doc:
                 cond = ("in", state_id)
             else:
                 cond = ("guard", self.guard(cond_text, element, internal=False))
+                self.transition_guards.add(int(cond[1]))
         return _T(source, tuple(descriptors), cond, tuple(self.ids(target, element)),
                   element.get("type") == "internal", self.actions(element),
                   element.sourceline)
@@ -402,10 +427,63 @@ class _Doc:
             self.branch_guards.add(index)
         return index
 
+    def decide_data_mode(self) -> None:
+        """Exact data (every guard, assignment and initial value in the small expression
+        language, every variable declared) or guards as inputs of the environment."""
+        declared = {name for name, _expr, _content, _line in self.data}
+        try:
+            if self.ctx.options.get("data") != "exact":
+                raise scxml_expr.ExpressionError("exact data is opt-in (reader option "
+                                                 "data=exact)")
+            guards = [scxml_expr.parse(text) for text in self.guards]
+            assigns = []
+            for location, expr, _line in self.assign_exprs:
+                if location not in declared or expr is None:
+                    raise scxml_expr.ExpressionError(f"assignment to '{location}'")
+                assigns.append(scxml_expr.parse(expr))
+            initial: dict[str, scxml_expr.Value] = {}
+            for name, expr, has_content, _line in self.data:
+                if has_content:
+                    raise scxml_expr.ExpressionError(f"<data id='{name}'> with content")
+                value = scxml_expr.parse(expr) if expr is not None else None
+                if value is not None and value.names:
+                    raise scxml_expr.ExpressionError("initial value reads a variable")
+                initial[name] = (None if value is None
+                                 else scxml_expr.evaluate(value, {}, lambda _s: False))
+            if any(not e.names <= declared for e in [*guards, *assigns]):
+                raise scxml_expr.ExpressionError("reads an undeclared name")
+        except scxml_expr.ExpressionError as exc:
+            self.data_mode, self.data_reason = False, str(exc)
+            for line in self.effectless_ifs:
+                self.ctx.warn("<if> ignored: no branch raises or sends an event", line=line,
+                              element="<if>")
+            for location, _expr, line in self.assign_exprs:
+                self.ctx.warn(f"<assign> to '{location}' ignored (no guard reads it)",
+                              line=line, element="<assign>")
+            if self.data:
+                self.ctx.warn("<datamodel> ignored (guards are inputs of the environment: "
+                              f"{exc})", line=self.data[0][3], element="<datamodel>")
+            self.check_assignments()
+            return
+        self.data_mode = bool(self.data)
+        self.parsed_guards, self.parsed_assigns, self.initial_data = guards, assigns, initial
+        if not self.data_mode:
+            for line in self.effectless_ifs:
+                self.ctx.warn("<if> ignored: no branch raises or sends an event", line=line,
+                              element="<if>")
+            for location, _expr, line in self.assign_exprs:
+                self.ctx.warn(f"<assign> to '{location}' ignored (no guard reads it)",
+                              line=line, element="<assign>")
+            self.check_assignments()
+        else:
+            self.ctx.warn("the data model is read exactly (every guard and assignment is in "
+                          "fsmbt's expression language): its values are part of each state")
+
     def check_assignments(self) -> None:
         read: set[str] = set()
-        for text in self.guards:
-            read.update(_IDENT.findall(text))
+        for index, text in enumerate(self.guards):
+            if index in self.transition_guards or index in self.branch_guards:
+                read.update(_IDENT.findall(text))
         for location, line in self.assigned:
             root_name = _IDENT.match(location)
             if root_name and root_name.group(0) in read:
@@ -425,6 +503,7 @@ class _Run:
     running: bool = True
     moved: bool = False
     valuation: dict[int, bool] = field(default_factory=dict)  # the environment's guard values
+    data: dict[str, scxml_expr.Value] = field(default_factory=dict)  # exact data mode
     read: set[int] = field(default_factory=set)  # guards read so far
 
 
@@ -479,8 +558,21 @@ class _Interpreter:
         kind, value = t.cond
         if kind == "in":
             return self.doc.by_id.get(str(value), -1) in run.config
-        read.add(int(value))
-        return valuation.get(int(value), False)
+        return self.guard_holds(int(value), run, valuation, read)
+
+    def guard_holds(self, index: int, run: _Run, valuation: dict[int, bool],
+                    read: set[int]) -> bool:
+        """A guard's value: computed from the data (exact mode; an error is false, W3C
+        5.9.1) or the environment's choice."""
+        if self.doc.data_mode:
+            try:
+                return scxml_expr.truthy(scxml_expr.evaluate(
+                    self.doc.parsed_guards[index], run.data,
+                    lambda state_id: self.doc.by_id.get(state_id, -1) in run.config))
+            except scxml_expr.ExpressionError:
+                return False
+        read.add(index)
+        return valuation.get(index, False)
 
     def select(self, run: _Run, event: str | None, valuation: dict[int, bool],
                read: set[int]) -> list[_T]:
@@ -558,15 +650,34 @@ class _Interpreter:
         while stack:
             action = stack.pop()
             if isinstance(action, _If):
+                if action.effectless and not self.doc.data_mode:
+                    continue
                 for guard, inner in action.branches:
-                    if guard is not None:
-                        run.read.add(guard)
-                    if guard is None or run.valuation.get(guard, False):
+                    if guard is None or self.guard_holds(guard, run, run.valuation, run.read):
                         stack.extend(reversed(inner))
                         break
                 continue
             kind, name = action
+            if kind == "assign":
+                if self.doc.data_mode:
+                    self.assign(int(name), run)
+                continue
             (run.external if kind == "external" else run.internal).append(name)
+
+    def assign(self, index: int, run: _Run) -> None:
+        location = self.doc.assign_exprs[index][0]
+        try:
+            value = scxml_expr.evaluate(self.doc.parsed_assigns[index], run.data,
+                                        lambda state_id: self.doc.by_id.get(state_id, -1)
+                                        in run.config)
+        except scxml_expr.ExpressionError as exc:
+            raise UnsupportedError(f"unsupported: {exc} (error.execution), line "
+                                   f"{self.doc.assign_exprs[index][2]}") from None
+        if isinstance(value, (int, float)) and abs(value) > MAX_DATA_MAGNITUDE or \
+                isinstance(value, str) and len(value) > MAX_DATA_MAGNITUDE:
+            raise UnsupportedError(f"unsupported: '{location}' grows without bound (past "
+                                   f"{MAX_DATA_MAGNITUDE}), line {self.doc.assign_exprs[index][2]}")
+        run.data[location] = value
 
     def microstep(self, enabled: list[_T], run: _Run) -> None:
         run.moved = True
@@ -696,7 +807,8 @@ class _Interpreter:
         raise InputError("events the machine sends itself never run out")
 
     # -- naming ---------------------------------------------------------------------------------
-    def name(self, config: frozenset[int], history: tuple[tuple[int, frozenset[int]], ...]) -> str:
+    def name(self, config: frozenset[int], history: tuple[tuple[int, frozenset[int]], ...],
+             data: tuple[tuple[str, scxml_expr.Value], ...] = ()) -> str:
         out: list[str] = []
         top = [c for c in self.s[0].children if c in config]
         stack: list[int | str] = list(reversed(top))
@@ -728,6 +840,9 @@ class _Interpreter:
                 inner = ",".join(self.s[x].name for x in sorted(value, key=self.order.__getitem__))
                 parts.append(f"{self.s[h].name}={inner}")
             text += "#" + ";".join(parts)
+        if data:
+            values = ";".join(f"{k}={scxml_expr.text_of(v)}" for k, v in data)
+            text += ("#" if not history else ";") + values
         return text
 
     def action(self, config: frozenset[int]) -> str | None:
@@ -764,6 +879,9 @@ def _symbols(doc: _Doc, interp: _Interpreter) -> list[tuple[str, str, dict[int, 
         return out
 
     internal = guards_of(sorted(generated), True) | doc.branch_guards
+    if doc.data_mode:  # guards are computed from the data, not chosen
+        return sorted(((event, event, {}) for event in events),
+                      key=lambda item: (-item[1].count("."), item[0]))
     symbols: list[tuple[str, str, dict[int, bool]]] = []  # sorted below
     for event in events:
         relevant = sorted(guards_of([event], False) | internal)
@@ -804,18 +922,20 @@ def read_scxml_w3c(text: str, ctx: ReadContext) -> FSM:
     for n, guard in enumerate(doc.guards):
         flat.attrs[f"{{{FSMBT_NS}}}guard.g{n + 1}"] = guard
         ctx.warn(f"guard g{n + 1} is an input of the environment: {guard}")
-    start = _Run(set(), {})
+    start = _Run(set(), {}, data=dict(doc.initial_data))
     read: set[int] = set()
     interp.process(start, None, {}, read)
     if read:
         raise UnsupportedError("unsupported: a cond guard read before the first event "
                                f"(g{min(read) + 1}: {doc.guards[min(read)]})")
     max_states = limits.current().max_states
-    Key = tuple[frozenset[int], tuple[tuple[int, frozenset[int]], ...], bool]
+    Key = tuple[frozenset[int], tuple[tuple[int, frozenset[int]], ...], bool,
+                tuple[tuple[str, scxml_expr.Value], ...]]
 
     def key_of(run: _Run) -> Key:
         hist = tuple(sorted(run.history.items())) if has_history else ()
-        return (frozenset(run.config), hist, run.running)
+        data = tuple(sorted(run.data.items())) if doc.data_mode else ()
+        return (frozenset(run.config), hist, run.running, data)
 
     names: dict[Key, str] = {}
     queue: deque[Key] = deque()
@@ -824,7 +944,7 @@ def read_scxml_w3c(text: str, ctx: ReadContext) -> FSM:
         if key not in names:
             if len(names) >= max_states:
                 raise InputError(f"more than {max_states} reachable configurations")
-            name = interp.name(key[0], key[1])
+            name = interp.name(key[0], key[1], key[3])
             names[key] = name
             flat.add_state(State(name, action=interp.action(key[0]), final=not key[2]))
             queue.append(key)
@@ -837,7 +957,7 @@ def read_scxml_w3c(text: str, ctx: ReadContext) -> FSM:
             continue
         source = names[key]
         for symbol, event, valuation in symbols:
-            run = _Run(set(key[0]), dict(key[1]))
+            run = _Run(set(key[0]), dict(key[1]), data=dict(key[3]))
             interp.process(run, event, valuation, set())
             if run.moved:
                 flat.add_transition(source, symbol, visit(key_of(run)))
