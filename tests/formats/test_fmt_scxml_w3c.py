@@ -235,3 +235,35 @@ def test_delayed_send_under_the_time_abstraction_is_an_environment_input() -> No
     assert walk(model, ["tick", "back"]) == ["s", "t", "s"]  # the timer fires when it likes
     result = api.convert_model(model)
     assert api.verify_models(model, result.model, "native").equivalent
+
+
+COUNTER = """
+  <datamodel><data id="n" expr="0"/></datamodel>
+  <state id="s"><transition event="tick" cond="n &lt; 2" target="s">
+    <assign location="n" expr="n + 1"/></transition>
+    <transition event="tick" target="done"/></state>
+  <final id="done"/>"""
+
+
+def test_exact_data_is_opt_in_and_computes_guards() -> None:
+    model = read_scxml(doc(COUNTER), ReadContext(options={"data": "exact"}))
+    assert walk(model, ["tick", "tick", "tick"]) == ["s#n=0", "s#n=1", "s#n=2", "done#n=2"]
+    guarded = loads(doc(COUNTER.replace('<assign location="n" expr="n + 1"/>', "")), "scxml")
+    assert sorted(guarded.events()) == ["tick[!g1]", "tick[g1]"]  # default: guards as inputs
+
+
+@pytest.mark.parametrize("text, value", [
+    ("1 + 2 * 3", 7), ("(1 + 2) * 3", 9), ("!true || false", False), ("x ge 2 and x lt 5", True),
+    ("'a' + 1", "a1"), ("x === 3", True), ("x === '3'", False), ("-x + 1", -2),
+    ("empty(y)", True), ("In('s')", True),
+])
+def test_expression_language(text: str, value: object) -> None:
+    from fsmbt.formats.scxml_expr import evaluate, parse
+    assert evaluate(parse(text), {"x": 3, "y": ""}, lambda state: state == "s") == value
+
+
+@pytest.mark.parametrize("text", ["a.b", "f(1, 2)", "1 +", "(1", "1)", "_event.data"])
+def test_expressions_outside_the_language_do_not_parse(text: str) -> None:
+    from fsmbt.formats.scxml_expr import ExpressionError, parse
+    with pytest.raises(ExpressionError):
+        parse(text)
