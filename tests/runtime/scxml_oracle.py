@@ -127,6 +127,9 @@ class Engine:
 
     def __init__(self, text: str) -> None:
         self.doc, chart = _compiled(text)
+        if "<assign" in text:  # ASSIGN_SHARED_CLASS: a fresh class for each instance
+            with contextlib.redirect_stdout(io.StringIO()):
+                chart = load(text, format="scxml")
         with contextlib.redirect_stdout(io.StringIO()):  # the engine prints <log> content
             self.machine = chart()
 
@@ -183,6 +186,12 @@ def random_events(machine: FSMMachine, state: str, rng: random.Random,
     return rng.choice(list(alphabet))
 
 
+#: python-statemachine 3.2.2: in the second and later instances of one class loaded from a
+#: document, an ``<assign>`` whose expression reads a ``<data>`` variable fails and the rest of
+#: its block (a ``<raise>`` after it) is skipped; the first instance runs it as W3C says.
+#: ``Engine`` therefore loads a fresh class per instance for documents with ``<assign>``.
+ASSIGN_SHARED_CLASS = "engine skips a block after <assign> in a reused class"
+
 #: The engine's known departure from the W3C algorithm that a replay meets (see
 #: docs/formats/scxml.md): it stops when a top-level <parallel> completes; W3C stops only on
 #: entering a top-level <final> (the parallel's done.state event is raised and the machine runs
@@ -211,15 +220,40 @@ def replay(text: str, model: FSM, rng: random.Random, *, length: int,
         seen = engine.configuration()
         done = engine.terminated
         fsmbt_done = fsmbt.status(state) == FINAL
-        if seen == state and done and not fsmbt_done and engine.top_parallel_completed():
+        shown = state if seen == state else configuration_of(state)  # ids may hold '#' too
+        if seen == shown and done and not fsmbt_done and engine.top_parallel_completed():
             return Replay(len(sent), departure=PARALLEL_STOPS)
-        if seen != state or done != fsmbt_done:
+        if seen != shown or done != fsmbt_done:
             return Replay(len(sent), Mismatch(list(sent), f"{seen} (terminated={done})",
                                               f"{state} ({fsmbt.status(state)})"))
         if done or len(sent) == length:
             break
         event = random_events(fsmbt, state, rng, events_alphabet, noise)
-        sent.append(event)
-        engine.send(event)
-        state, _ = fsmbt.step(state, event)
+        base = event_of(event)
+        sent.append(base)
+        engine.send(base)
+        state = follow(fsmbt, state, base, engine.configuration(), events_alphabet, event)
     return Replay(len(sent))
+
+
+def configuration_of(state: str) -> str:
+    """fsmbt's flat name without the history values (``a/a1#h=x`` -> ``a/a1``)."""
+    return state.split("#", 1)[0]
+
+
+def event_of(symbol: str) -> str:
+    """The event of an input symbol (``e[g1,!g2]`` -> ``e``; docs/formats/scxml.md)."""
+    return symbol.split("[", 1)[0]
+
+
+def follow(fsmbt: FSMMachine, state: str, event: str, seen: str, alphabet: Sequence[str],
+           chosen: str) -> str:
+    """fsmbt's step on ``event``: the guard valuation is the environment's choice, so among the
+    symbols of ``event`` the one that reaches the engine's configuration is taken (the engine's
+    behaviour must be one of fsmbt's); without one, the randomly chosen symbol's successor."""
+    symbols = [s for s in alphabet if event_of(s) == event] or [chosen]
+    for symbol in [chosen, *symbols]:
+        successor, _ = fsmbt.step(state, symbol)
+        if seen in (successor, configuration_of(successor)):
+            return successor
+    return fsmbt.step(state, chosen)[0]

@@ -143,6 +143,78 @@ PROBES = {
 }
 
 
+#: Documents the structural reader refuses and fsmbt reads by running the W3C algorithm
+#: (``fsmbt.formats.scxml_w3c``, docs/formats/scxml.md): one per feature of issue 12 part 4.
+W3C_PROBES = {
+    "shallow history restores the last child, not its descendants": """
+  <state id="a" initial="a1"><history id="h"><transition target="a1"/></history>
+    <state id="a1"><transition event="n" target="a2"/></state>
+    <state id="a2" initial="x"><state id="x"><transition event="n" target="y"/></state>
+      <state id="y"/></state>
+    <transition event="out" target="b"/></state>
+  <state id="b"><transition event="back" target="h"/><transition event="reset" target="a"/></state>""",
+    "deep history restores the leaves": """
+  <state id="a" initial="a1"><history id="h" type="deep"><transition target="a1"/></history>
+    <state id="a1"><transition event="n" target="a2"/></state>
+    <state id="a2" initial="x"><state id="x"><transition event="n" target="y"/></state>
+      <state id="y"/></state>
+    <transition event="out" target="b"/></state>
+  <state id="b"><transition event="back" target="h"/></state>""",
+    "raise runs before the next external event, in order": """
+  <state id="s"><transition event="go" target="t"><raise event="one"/><raise event="two"/>
+    </transition></state>
+  <state id="t"><transition event="one" target="u"/><transition event="two" target="s"/></state>
+  <state id="u"><transition event="two" target="v"/><transition event="one" target="s"/></state>
+  <state id="v"><transition event="go" target="s"/></state>""",
+    "send without target: external queue, after the internal events": """
+  <state id="s"><onentry><send event="ext"/><raise event="int"/></onentry>
+    <transition event="int" target="t"/><transition event="ext" target="w"/></state>
+  <state id="t"><transition event="ext" target="u"/><transition event="int" target="w"/></state>
+  <state id="u"><transition event="again" target="s"/></state><state id="w"/>""",
+    "guards are chosen by the environment; the engine's choice is one of fsmbt's": """
+  <datamodel><data id="flag" expr="True"/></datamodel>
+  <state id="s"><transition event="e" cond="flag" target="t"/>
+    <transition event="e" target="u"/></state>
+  <state id="t"><transition event="back" target="s"/></state>
+  <state id="u"><transition event="back" target="s"/></state>""",
+    "wildcard and prefix descriptors": """
+  <state id="s"><transition event="a.b" target="t"/><transition event="a.*" target="u"/>
+    <transition event="*" target="w"/></state>
+  <state id="t"><transition event="a" target="s"/></state>
+  <state id="u"><transition event="x" target="s"/></state>
+  <state id="w"><transition event="a.b.c" target="s"/></state>""",
+    "done.state of an atomic parent never comes; entry into a non-initial child": """
+  <state id="s"><transition event="go" target="c2"/><transition event="done.state.s" target="s"/>
+    </state>
+  <state id="c" initial="c1"><state id="c1"><transition event="n" target="c2"/></state>
+    <state id="c2"><transition event="n" target="cf"/></state><final id="cf"/>
+    <transition event="done.state.c" target="s"/></state>""",
+    "targetless and internal transitions": """
+  <state id="c" initial="c1"><state id="c1"><transition event="n" target="c2"/></state>
+    <state id="c2"><transition event="n" target="c1"/></state>
+    <transition event="stay"><raise event="n"/></transition>
+    <transition event="in" type="internal" target="c1"/>
+    <transition event="ext" target="c1"/></state>""",
+    "if branches raise by guard; log and unread assign ignored": """
+  <datamodel><data id="flag" expr="False"/><data id="count" expr="0"/></datamodel>
+  <state id="s"><transition event="go" target="t"><log expr="'go'"/>
+    <assign location="count" expr="count + 1"/>
+    <if cond="flag"><raise event="yes"/><else/><raise event="no"/></if></transition></state>
+  <state id="t"><transition event="yes" target="y"/><transition event="no" target="n"/></state>
+  <state id="y"><transition event="back" target="s"/></state>
+  <state id="n"><transition event="back" target="s"/></state>""",
+}
+
+
+@pytest.mark.parametrize("case", sorted(W3C_PROBES))
+def test_w3c_probe_agrees(case: str) -> None:
+    text = f'<scxml {NS} version="1.0" datamodel="python">{W3C_PROBES[case]}\n</scxml>'
+    model = loads(text, "scxml")
+    assert not model.is_hierarchical  # read by the W3C algorithm
+    _events, mismatches = compare(text, model, SEED, 60)
+    assert not mismatches, mismatches[:3]
+
+
 @pytest.mark.parametrize("case", sorted(PROBES))
 def test_probe_agrees(case: str) -> None:
     text = f'<scxml {NS} version="1.0">{PROBES[case]}\n</scxml>'
@@ -193,3 +265,28 @@ def test_departure_engine_stops_when_a_top_level_parallel_completes() -> None:
     state, _ = machine.step(state, "e")
     engine.send("e")
     assert state == "out" and engine.configuration() == "p/[a/af|b/bf]"
+
+
+def test_departure_assign_fails_in_a_second_instance_of_one_loaded_class() -> None:
+    """python-statemachine 3.2.2: two instances of one class loaded from a document with
+    ``<assign location="count" expr="count + 1"/><raise event="no"/>`` differ: the first runs
+    the block (W3C: ``t`` then ``n``), the second skips the raise after the assign and stays in
+    ``t``. fsmbt keeps W3C's reading (the assign is ignored, the raise runs); the oracle loads
+    a fresh class per instance for such documents (``scxml_oracle.ASSIGN_SHARED_CLASS``)."""
+    from statemachine.io.loader import load
+    text = f"""<scxml {NS} version="1.0" datamodel="python">
+  <datamodel><data id="count" expr="0"/></datamodel>
+  <state id="s"><transition event="go" target="t"><assign location="count" expr="count + 1"/>
+    <raise event="no"/></transition></state>
+  <state id="t"><transition event="no" target="n"/></state><state id="n"/></scxml>"""
+    chart = load(text, format="scxml")
+    seen = []
+    for _ in range(2):
+        machine = chart()
+        machine.send("go")
+        seen.append(sorted(s.id for s in machine.configuration))
+    assert seen == [["n"], ["t"]]  # the departure, as of 3.2.2
+    fsmbt = FSMMachine(loads(text, "scxml"))
+    state, _ = fsmbt.start()
+    assert fsmbt.step(state, "go")[0] == "n"
+    assert Engine(text).configuration() == "s"

@@ -34,12 +34,12 @@ T transitions and nesting depth d.
 from __future__ import annotations
 
 import re
-
 from dataclasses import dataclass, field
 
 from lxml import etree
 
 from fsmbt.formats.registry import Format, ReadContext, register
+from fsmbt.formats.scxml_w3c import read_scxml_w3c
 from fsmbt.formats.xml_safe import local_name, namespace, parse_xml, root_tag
 from fsmbt.model import Model
 from fsmbt.model.errors import InputError, SourceLocation, UnsupportedError
@@ -543,7 +543,24 @@ class _Reader:
 
 
 def read_scxml(text: str, ctx: ReadContext) -> FSM:
-    return _Reader(ctx).read(text)
+    """The hierarchical model of the document; a document the structural reader refuses for a
+    feature with a finite reading is read by running the W3C algorithm instead (a flat model,
+    ``fsmbt.formats.scxml_w3c``; docs/formats/scxml.md)."""
+    kept = len(ctx.warnings)
+    try:
+        return _Reader(ctx).read(text)
+    except UnsupportedError as first:
+        if "working-draft" in str(first) or "XInclude" in str(first):
+            raise
+        del ctx.warnings[kept:]  # the W3C reading warns about the same content again
+        try:
+            flat = read_scxml_w3c(text, ctx)
+        except UnsupportedError as remaining:
+            raise remaining from None
+        ctx.warn(f"read by running the W3C algorithm (the structural reader refuses: "
+                 f"{first.message}); the model is the "
+                 "flat machine of the reachable configurations")
+        return flat
 
 
 # -- writing -------------------------------------------------------------------------------------
@@ -779,7 +796,11 @@ def _event_descriptor(event: str, source: str) -> str:
 
 
 def _check_event_prefixes(fsm: FSM) -> None:
-    """SCXML's descriptor ``a`` also matches event ``a.b``: such an alphabet cannot be written."""
+    """SCXML's descriptor ``a`` also matches event ``a.b``: such an alphabet cannot be written,
+    except in a flat machine whose every state takes ``a.b`` by its own transition written
+    before the one on ``a`` (or by neither): there the first transition in document order a W3C
+    engine picks for ``a.b`` is the model's (the W3C reading of a document with prefix
+    descriptors gives such machines; docs/formats/scxml.md)."""
     names: set[str] = set()
     stack = [fsm]
     while stack:
@@ -794,10 +815,26 @@ def _check_event_prefixes(fsm: FSM) -> None:
         for other in ordered[i + 1:]:
             if not other.startswith(name):
                 break
-            if other.startswith(name + "."):
+            if other.startswith(name + ".") and not _prefix_order_exact(fsm, other):
                 raise UnsupportedError(f"events '{name}' and '{other}' cannot both be written as "
                                        f"SCXML: the descriptor '{name}' also matches '{other}' "
                                        "(SCXML prefix matching)")
+
+
+def _prefix_order_exact(fsm: FSM, event: str) -> bool:
+    """In flat ``fsm``, is the first transition of each state whose descriptor matches
+    ``event`` the transition on ``event`` itself (or is there none)?"""
+    if fsm.is_hierarchical or fsm.initial_event is not None:
+        return False
+    first: dict[str, str] = {}
+    for t in fsm.transitions:
+        if t.event is None or t.source in first:
+            continue
+        if t.event == event or event.startswith(t.event + "."):
+            first[t.source] = t.event
+    return all(matched == event for matched in first.values())
+
+
 def _is_parallel(state: State) -> bool:
     """Several regions, or one region holding one state named like it (a one-child parallel)."""
     if len(state.regions) > 1:

@@ -70,7 +70,8 @@ def svg_text(model: FSM | BTDocument, *, expand_subtrees: bool = False,
 
     Args:
         model: an FSM or a BT document.
-        expand_subtrees, max_nodes, anchors: as for ``model_to_dot``.
+        expand_subtrees, max_nodes, anchors: as for ``model_to_dot`` (``expand_subtrees`` is
+            ignored for an FSM, so one call serves either kind).
         timeout: seconds Graphviz may take.
 
     Returns:
@@ -80,8 +81,8 @@ def svg_text(model: FSM | BTDocument, *, expand_subtrees: bool = False,
         TooLargeError: the model is over ``max_nodes``; GraphvizError: Graphviz is missing,
         failed or took longer than ``timeout``.
     """
-    source = model_to_dot(model, expand_subtrees=expand_subtrees, max_nodes=max_nodes,
-                          anchors=anchors)
+    expand = expand_subtrees and not isinstance(model, FSM)  # an FSM has no SubTrees
+    source = model_to_dot(model, expand_subtrees=expand, max_nodes=max_nodes, anchors=anchors)
     text = run_dot(source, "svg", timeout=timeout).decode("utf-8")
     start = text.find("<svg")
     return text[start:] if start >= 0 else text
