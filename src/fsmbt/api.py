@@ -278,11 +278,12 @@ def load_for_engine(path: str | Path, engine: str, fmt: str | None = None, *,
 
 
 #: Options meant for the readers, not the engines (they travel in the same ``options`` dict).
-READER_OPTIONS = ("node_models",)
+READER_OPTIONS = ("node_models", "nodes", "abstract")
 
 
 def _reader_options(options: dict[str, object]) -> dict[str, object] | None:
-    """The options a reader understands (``node_models``), out of the engine options."""
+    """The options a reader understands (``node_models``, ``nodes``, ``abstract``), out of the
+    engine options."""
     picked = {key: options[key] for key in READER_OPTIONS if key in options}
     return picked or None
 

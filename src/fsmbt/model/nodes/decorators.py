@@ -6,7 +6,7 @@ The rules are summaries; docs/semantics.md ("Decorators") is the reference.
 from __future__ import annotations
 
 from fsmbt.model.kinds import NodeKind
-from fsmbt.model.nodes.registry import Family, NodeSemantics, register
+from fsmbt.model.nodes.registry import Family, Gate, NodeSemantics, register
 
 _D = NodeKind.DECORATOR
 _BLACKBOARD = "its result depends on the blackboard"
@@ -137,6 +137,12 @@ PRECONDITION = register(
         rejection=_BLACKBOARD,
         nusmv_refusal=_BLACKBOARD,
         ports=("if", "else"),
+        handler="gated",
+        requires="blackboard",
+        abstraction="Precondition: whether its 'if' script holds is an environment input, asked "
+        "while its child is not running (closed: it returns its 'else' status)",
+        gate=Gate("if", closed="FAILURE"),
+        closed_port="else",
         source="script_precondition.h",
     )
 )
@@ -151,6 +157,11 @@ SKIP_UNLESS_UPDATED = register(
         rejection=_BLACKBOARD,
         nusmv_refusal=_BLACKBOARD,
         ports=("entry",),
+        handler="gated",
+        requires="blackboard",
+        abstraction="SkipUnlessUpdated: whether the entry was updated is an environment input, "
+        "asked while its child is not running (not updated: SKIPPED)",
+        gate=Gate("updated", closed="SKIPPED"),
         source="updated_decorator.cpp",
     )
 )
@@ -165,6 +176,11 @@ WAIT_VALUE_UPDATE = register(
         rejection=_BLACKBOARD,
         nusmv_refusal=_BLACKBOARD,
         ports=("entry",),
+        handler="gated",
+        requires="blackboard",
+        abstraction="WaitValueUpdate: whether the entry was updated is an environment input, "
+        "asked while its child is not running (not yet: RUNNING)",
+        gate=Gate("updated", closed="RUNNING"),
         source="updated_decorator.cpp",
     )
 )
@@ -195,6 +211,11 @@ DELAY = register(
         rejection=_CLOCK,
         nusmv_refusal=_CLOCK,
         ports=("delay_msec",),
+        handler="gated",
+        requires="time",
+        abstraction="Delay: whether its delay has elapsed is an environment input, asked until "
+        "the child starts (not yet: RUNNING)",
+        gate=Gate("timer", closed="RUNNING"),
         source="delay_node.cpp",
     )
 )
@@ -209,6 +230,11 @@ TIMEOUT = register(
         rejection=_CLOCK,
         nusmv_refusal=_CLOCK,
         ports=("msec",),
+        handler="timeout",
+        requires="time",
+        abstraction="Timeout: whether its timer has fired is an environment input, asked on "
+        "every tick after the first (fired: the child is halted, FAILURE)",
+        gate=Gate("timer", closed="FAILURE"),
         source="timeout_node.h",
     )
 )

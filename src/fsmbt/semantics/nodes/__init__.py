@@ -20,7 +20,9 @@ from typing import TypeVar
 
 from fsmbt.model.kinds import NodeKind
 from fsmbt.model.nodes import (
+    ABSTRACTIONS,
     BLACKBOARD_BASED,
+    PROFILES,
     FALLBACK_TYPES,
     INTERPRETED_CONTROLS,
     INTERPRETED_DECORATORS,
@@ -36,6 +38,7 @@ from fsmbt.model.nodes import (
     aliases,
     all_nodes,
     canonical_type,
+    enabling_option,
     kinds_where,
     node_semantics,
     register,
@@ -83,7 +86,10 @@ def internal_status(node: NodeSemantics) -> NodeStatus | None:
 
 
 def _build(nodes: tuple[NodeSemantics, ...]) -> RuntimeTables:
-    handlers = {n.name: n.handler for n in nodes if n.handler is not None}
+    # a condition kind's handler (``env_condition``) names no tick rule: it is ticked as an
+    # environment leaf
+    handlers = {n.name: n.handler for n in nodes
+                if n.handler is not None and n.kind is not NodeKind.CONDITION}
     internal = {
         n.name: int(NodeStatus[n.internal_result]) for n in nodes if n.internal_result is not None
     }
@@ -153,7 +159,9 @@ def runtime_tables() -> RuntimeTables:
 
 
 __all__ = [
+    "ABSTRACTIONS",
     "BLACKBOARD_BASED",
+    "PROFILES",
     "FALLBACK_TYPES",
     "INTERPRETED_CONTROLS",
     "INTERPRETED_DECORATORS",
@@ -170,6 +178,7 @@ __all__ = [
     "aliases",
     "all_nodes",
     "canonical_type",
+    "enabling_option",
     "internal_status",
     "kinds_where",
     "node_semantics",
