@@ -47,6 +47,8 @@ from fsmbt.formats.registry import format_for_path, read_text
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import Hint, InputError, SourceLocation, UnsupportedError
 from fsmbt.model.fsm import FSM
+from fsmbt.semantics.blockers import Blocker
+from fsmbt.semantics.blockers import conversion_blockers as blockers_of
 from fsmbt.verify import Report, verify
 from fsmbt.verify.native import DEFAULT_MAX_STATES
 from fsmbt.verify.orient import orient, rules_text
@@ -337,7 +339,22 @@ def verify_models(source: Model, result: Model, engine: str = "native", *, loop:
         EngineDisagreement: ``both`` and the engines disagree (a bug in one of them).
         InputError, UnsupportedError: the pair cannot be compared.
     """
-    return verify(source, result, engine=engine, loop=loop, max_states=max_states)
+    report = verify(source, result, engine=engine, loop=loop, max_states=max_states)
+    _name_abstractions(report, source, result)
+    return report
+
+
+def _name_abstractions(report: Report, *models: Model) -> None:
+    """Record in ``report.stats["abstractions"]`` every abstraction the BT side was modelled
+    under (docs/semantics.md §10): the verdict holds under them, and says so."""
+    from fsmbt.semantics.nodes import abstractions_used
+
+    found: dict[str, None] = {}
+    for model in models:
+        for sentence in abstractions_used(model):
+            found.setdefault(sentence, None)
+    if found:
+        report.stats["abstractions"] = list(found)
 
 
 def verify_either_order(first: Model, second: Model, engine: str = "native", *,
@@ -367,6 +384,7 @@ def verify_either_order(first: Model, second: Model, engine: str = "native", *,
                          element=exc.element) from None
     report.stats["pairing"] = oriented.rule
     report.stats["swapped"] = oriented.swapped
+    _name_abstractions(report, first, second)
     return report
 
 
@@ -500,6 +518,35 @@ def _timed(timings: dict[str, float], stage: str, on_stage: StageHook | None) ->
         timings[stage] = time.perf_counter() - started
 
 
+def conversion_blockers(model: Model) -> list[Blocker]:
+    """Everything conversion would refuse in ``model``, all at once (``validate``, ``info``,
+    ``render`` and ``convert`` report the same list).
+
+    Args:
+        model: a model; only BT documents have blockers here (an FSM reader refuses at read
+            time).
+
+    Returns:
+        The ``Blocker`` s (message, location, element), in tree order.
+    """
+    if not isinstance(model, BTDocument):
+        return []
+    return blockers_of(model)
+
+
+def _refuse_blockers(model: Model) -> None:
+    """Raise one ``UnsupportedError`` naming every blocker (located at the first)."""
+    found = conversion_blockers(model)
+    if not found:
+        return
+    first = found[0]
+    message = first.message
+    if len(found) > 1:
+        rest = "; ".join(str(b) for b in found[1:])
+        message = f"{message} (and {len(found) - 1} more blocker(s): {rest})"
+    raise UnsupportedError(message, location=first.location, element=first.element)
+
+
 def convert_file(source: str | Path, output: str | Path | None = None, *,
                  to: str | None = None, source_format: str | None = None,
                  engine: str = "rules", style: str = "paper", loop: bool = False,
@@ -582,6 +629,7 @@ def convert_loaded(loaded: Loaded, output: str | Path | None = None, *,
     if destination is not None:
         check_destination(destination, overwrite=overwrite)
     timings: dict[str, float] = {}
+    _refuse_blockers(loaded.model)
     with _timed(timings, "convert", on_stage):
         engine_options = {k: v for k, v in options.items() if k not in READER_OPTIONS}
         conversion = convert_model(loaded.model, engine, style=style, loop=loop,

@@ -12,7 +12,12 @@ from rich.markup import escape
 from rich.table import Table
 
 from fsmbt import api
-from fsmbt.cli.options import node_models_option, reader_options
+from fsmbt.cli.options import (
+    abstract_option,
+    node_models_option,
+    nodes_option,
+    reader_options,
+)
 from fsmbt.model.stats import BTStats, FSMStats, model_stats
 
 #: Lists longer than this are cut in the table (``--json`` always has them all).
@@ -26,6 +31,8 @@ def register(app: typer.Typer) -> None:
         from_format: Optional[str] = typer.Option(None, "--from",
                                                   help="Input format (default: detected)."),
         node_models: list[Path] = node_models_option(),
+        nodes: list[str] = nodes_option(),
+        abstract: list[str] = abstract_option(),
         as_json: bool = typer.Option(False, "--json", help="Print the figures as JSON."),
     ) -> None:
         """Structure at a glance: states, events, entry/loop states; BT nodes, depth, breadth.
@@ -34,9 +41,13 @@ def register(app: typer.Typer) -> None:
         loop states of DESIGN §3, hierarchy. BT: nodes by kind and type, depth, breadth,
         leaves, trees and SubTree references.
         """
-        stats = model_stats(api.load(model, from_format, options=reader_options(node_models)).model)
+        loaded = api.load(model, from_format,
+                          options=reader_options(node_models, nodes, abstract)).model
+        stats = model_stats(loaded)
+        blockers = [str(b) for b in api.conversion_blockers(loaded)]
         if as_json:
-            print(json.dumps({"file": str(model), **stats.to_dict()}, indent=2, ensure_ascii=False))
+            print(json.dumps({"file": str(model), **stats.to_dict(),
+                              "conversion_blockers": blockers}, indent=2, ensure_ascii=False))
             return
         table = _fsm_table(stats) if isinstance(stats, FSMStats) else _bt_table(stats)
         table.title = escape(str(model))
@@ -44,6 +55,10 @@ def register(app: typer.Typer) -> None:
         console.print(table)
         if isinstance(stats, BTStats) and len(stats.per_tree) > 1:
             console.print(_per_tree_table(stats))
+        if blockers:
+            console.print(f"conversion would refuse ({len(blockers)}):")
+            for text in blockers:
+                console.print(f"  - {escape(text)}")
 
 
 def _listed(items: list[str]) -> str:

@@ -9,7 +9,12 @@ import typer
 
 from fsmbt.cli import EXIT_INTERNAL, fail
 from fsmbt import api
-from fsmbt.cli.options import node_models_option, reader_options
+from fsmbt.cli.options import (
+    abstract_option,
+    node_models_option,
+    nodes_option,
+    reader_options,
+)
 from fsmbt.render import DEFAULT_MAX_NODES, GraphvizError, render_model
 
 
@@ -22,6 +27,8 @@ def register(app: typer.Typer) -> None:
         from_format: Optional[str] = typer.Option(None, "--from",
                                                   help="Input format (default: detected)."),
         node_models: list[Path] = node_models_option(),
+        nodes: list[str] = nodes_option(),
+        abstract: list[str] = abstract_option(),
         force: bool = typer.Option(False, "--force", help="Overwrite OUTPUT if it exists."),
         expand_subtrees: bool = typer.Option(
             False, "--expand-subtrees",
@@ -30,10 +37,12 @@ def register(app: typer.Typer) -> None:
                                       help="Refuse models with more states/nodes than this."),
     ) -> None:
         """Draw MODEL: FSMs as state diagrams, behavior trees top-down with the usual symbols."""
-        loaded = api.load(model, from_format, options=reader_options(node_models)).model
+        loaded = api.load(model, from_format, options=reader_options(node_models, nodes, abstract)).model
         try:
             written = render_model(loaded, output, overwrite=force,
                                    expand_subtrees=expand_subtrees, max_nodes=max_nodes)
         except GraphvizError as exc:
             raise fail(str(exc), EXIT_INTERNAL) from None
         print(f"wrote {written}")
+        for blocker in api.conversion_blockers(loaded):
+            print(f"note: conversion would refuse: {blocker}")

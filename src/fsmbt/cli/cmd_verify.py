@@ -14,7 +14,12 @@ import typer
 from rich.console import Console
 
 from fsmbt import api
-from fsmbt.cli.options import node_models_option, reader_options
+from fsmbt.cli.options import (
+    abstract_option,
+    node_models_option,
+    nodes_option,
+    reader_options,
+)
 from fsmbt.cli.progress import StageProgress
 from fsmbt.verify import EngineDisagreement
 from fsmbt.verify.render_report import print_report
@@ -32,6 +37,8 @@ def register(app: typer.Typer) -> None:
         as_json: bool = typer.Option(False, "--json", help="Print the report as JSON."),
         quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress display on stderr."),
         node_models: list[Path] = node_models_option(),
+        nodes: list[str] = nodes_option(),
+        abstract: list[str] = abstract_option(),
         engine: str = typer.Option("native", "--engine",
                                    help="native, nusmv, or both (both must agree)."),
         loop: bool = typer.Option(False, "--loop",
@@ -49,7 +56,7 @@ def register(app: typer.Typer) -> None:
                 _, _, report = api.verify_files(source, converted, engine=engine, loop=loop,
                                                 source_format=from_format,
                                                 converted_format=from_format2,
-                                                options=reader_options(node_models),
+                                                options=reader_options(node_models, nodes, abstract),
                                                 on_stage=progress)
         except EngineDisagreement as exc:
             print(f"error: ENGINES DISAGREE: {exc}; one of the checkers is wrong, please report "
@@ -62,6 +69,8 @@ def register(app: typer.Typer) -> None:
             print(json.dumps(data, indent=2, ensure_ascii=False))
         else:
             print_report(report, Console())
+            for sentence in report.stats.get("abstractions", []):
+                print(f"verified under the abstraction: {sentence}")
             if report.stats.get("swapped"):
                 print(f"note: {converted} was read as the source and {source} as its "
                       f"conversion (pairing rule: {report.stats['pairing']}); the verdict does "

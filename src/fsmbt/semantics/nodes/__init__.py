@@ -120,6 +120,34 @@ def _build(nodes: tuple[NodeSemantics, ...]) -> RuntimeTables:
 T = TypeVar("T")
 
 
+def abstractions_used(doc: object) -> list[str]:
+    """The abstraction sentences of every node of a BT document modelled as an abstraction
+    (``BTNode.semantics`` naming a kind with an ``abstraction``), once each, in tree order:
+    what a verdict over ``doc`` holds under (docs/semantics.md §10).
+
+    Args:
+        doc: a ``BTDocument`` (anything else has none).
+
+    Returns:
+        The sentences, e.g. ``["RateController may skip its child on any tick (...)"]``.
+    """
+    from fsmbt.model.bt import BTDocument
+
+    if not isinstance(doc, BTDocument):
+        return []
+    found: dict[str, None] = {}
+    for _tree, node in doc.nodes():
+        if node.semantics is None:
+            continue
+        spec = node_semantics(node.semantics)
+        if spec is not None and spec.abstraction is not None:
+            sentence = spec.abstraction
+            if node.semantics != node.type:
+                sentence = f"{node.type} (as {sentence})"
+            found.setdefault(sentence, None)
+    return list(found)
+
+
 def rewired(decorator: str, success: T, failure: T) -> tuple[T, T]:
     """Where a status-mapping decorator's child's SUCCESS and FAILURE lead, given where the
     decorator's own SUCCESS and FAILURE lead (its ``result_map``); the converters wire
@@ -175,6 +203,7 @@ __all__ = [
     "Family",
     "NodeSemantics",
     "RuntimeTables",
+    "abstractions_used",
     "aliases",
     "all_nodes",
     "canonical_type",
