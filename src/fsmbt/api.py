@@ -544,7 +544,8 @@ def _refuse_blockers(model: Model) -> None:
     if len(found) > 1:
         rest = "; ".join(str(b) for b in found[1:])
         message = f"{message} (and {len(found) - 1} more blocker(s): {rest})"
-    raise UnsupportedError(message, location=first.location, element=first.element)
+    error = UnsupportedError if first.unsupported else InputError
+    raise error(message, location=first.location, element=first.element)
 
 
 def convert_file(source: str | Path, output: str | Path | None = None, *,

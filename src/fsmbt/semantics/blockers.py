@@ -16,7 +16,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from fsmbt.model.bt import BTDocument, BTNode
-from fsmbt.model.errors import InputError, SourceLocation
+from fsmbt.model.errors import InputError, SourceLocation, UnsupportedError
 from fsmbt.semantics.bt_interpreter import CompiledTree
 
 #: Stop after this many node checks (a tree whose SubTrees multiply beyond it is refused
@@ -26,11 +26,13 @@ MAX_CHECKED = 200_000
 
 @dataclass(frozen=True)
 class Blocker:
-    """One refusal: the message, where it is and which node."""
+    """One refusal: the message, where it is, which node, and whether it is a feature fsmbt
+    does not model (``UnsupportedError``) rather than an invalid model (``InputError``)."""
 
     message: str
     location: SourceLocation | None
     element: str | None
+    unsupported: bool = True
 
     def __str__(self) -> str:
         where = f"{self.location}: " if self.location is not None else ""
@@ -51,9 +53,10 @@ def conversion_blockers(doc: BTDocument) -> list[Blocker]:
     try:
         tree = doc.main
     except KeyError:
-        return [Blocker("the document holds no behavior tree", None, None)]
+        return [Blocker("the document holds no behavior tree", None, None, False)]
     if tree.root is None:
-        return [Blocker("the main behavior tree is empty", tree.location, f"tree '{tree.id}'")]
+        return [Blocker("the main behavior tree is empty", tree.location, f"tree '{tree.id}'",
+                        False)]
     checker = CompiledTree.__new__(CompiledTree)
     checker.doc = doc
     seen: set[tuple[str, tuple[str, ...]]] = set()
@@ -65,7 +68,8 @@ def conversion_blockers(doc: BTDocument) -> list[Blocker]:
         try:
             ctype, _kind, _params, _internal, kids = checker._check(node, chain)
         except InputError as exc:  # UnsupportedError is an InputError
-            found.append(Blocker(exc.message, exc.location, exc.element))
+            found.append(Blocker(exc.message, exc.location, exc.element,
+                                 isinstance(exc, UnsupportedError)))
             kids = [] if node.is_leaf else list(node.children)
             ctype = None
         if ctype == "SubTree":

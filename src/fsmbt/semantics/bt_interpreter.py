@@ -249,7 +249,9 @@ class CompiledTree:
                     f"pre-condition '{attr}' depends on the blackboard", **_where(node))
         spec = node_semantics(ctype)
         if spec is not None and spec.requires is not None and node.semantics is None:
-            why = spec.rejection or f"a {spec.library} node whose control flow reads the robot's state"
+            why = spec.rejection or (f"a {spec.library} node whose control flow reads data fsmbt "
+                                     "does not model (a clock, the robot pose, a goal or a "
+                                     "blackboard vector)")
             raise UnsupportedError(
                 f"{ctype}: {why}; enable it with {enabling_option(spec.requires)} (an "
                 f"abstraction: {spec.abstraction})", **_where(node))
