@@ -14,6 +14,9 @@ Files under ``_malformed/`` or ``_legacy_draft/`` are negative inputs: they must
 (counted apart). A file "converts" when the result is EQUIVALENT. For the others the first
 blocker (the error's message, with node names and locations cut out) is tallied.
 
+A file still running after ``--budget`` seconds (default 60) is counted as "over the budget":
+its explored state space is too large for that time (it is reported, not hidden).
+
 Run: PYTHONPATH=src python benchmarks/corpus_coverage.py [--setting plain] [--markdown]
 """
 
@@ -22,7 +25,9 @@ from __future__ import annotations
 import argparse
 import os
 import re
+import signal
 import sys
+import time
 from collections import Counter
 from dataclasses import dataclass
 from pathlib import Path
@@ -42,6 +47,7 @@ class Row:
     negative: bool
     ok: bool
     reason: str
+    seconds: float = 0.0
 
 
 def corpus_root() -> Path:
@@ -95,17 +101,39 @@ def reason_of(exc: Exception) -> str:
     return text.strip()[:110]
 
 
-def run_one(path: Path, source: str, kind: str, setting: str, root: Path) -> Row:
+class _OverBudget(Exception):
+    pass
+
+
+def _alarm(_signum: int, _frame: object) -> None:
+    raise _OverBudget
+
+
+def run_one(path: Path, source: str, kind: str, setting: str, root: Path,
+            budget: int = 0) -> Row:
+    """Convert and verify one file; ``budget`` seconds (0: none) before it counts as "over
+    the time budget" (a state space too large to explore in that time)."""
     negative = any(part in NEGATIVE_DIRS for part in path.parts)
+    if budget:
+        signal.signal(signal.SIGALRM, _alarm)
+        signal.alarm(budget)
+    started = time.perf_counter()
     try:
         outcome = api.convert_file(path, options=options_for(setting, source, root))
         ok = outcome.equivalent is True
         reason = "" if ok else f"verdict {outcome.verdict}"
+    except _OverBudget:
+        ok, reason = False, f"over the {budget} s budget (state space too large)"
     except InputError as exc:  # UnsupportedError is an InputError
         ok, reason = False, reason_of(exc)
     except Exception as exc:  # noqa: BLE001 - a crash is a finding: count it, never hide it
         ok, reason = False, f"CRASH {type(exc).__name__}: {reason_of(exc)}"
-    return Row(path, source, kind, negative, ok, reason)
+    finally:
+        if budget:
+            signal.alarm(0)
+    row = Row(path, source, kind, negative, ok, reason)
+    row.seconds = time.perf_counter() - started
+    return row
 
 
 def table(title: str, header: list[str], rows: list[list[object]], markdown: bool) -> str:
@@ -129,6 +157,8 @@ def main() -> int:
     parser.add_argument("--setting", choices=SETTINGS, action="append")
     parser.add_argument("--markdown", action="store_true")
     parser.add_argument("--kind", choices=("bt", "scxml", "smach", "flexbe"), action="append")
+    parser.add_argument("--budget", type=int, default=60,
+                        help="seconds per file before it counts as over budget (0: none)")
     args = parser.parse_args()
     root = corpus_root()
     if not root.is_dir():
@@ -136,7 +166,7 @@ def main() -> int:
         return 2
     files = [f for f in corpus_files(root) if not args.kind or f[2] in args.kind]
     for setting in args.setting or SETTINGS:
-        rows = [run_one(p, s, k, setting, root) for p, s, k in files]
+        rows = [run_one(p, s, k, setting, root, args.budget) for p, s, k in files]
         positive = [r for r in rows if not r.negative]
         print(f"\n## setting: {setting} ({len(rows)} files, corpus {root})\n")
         by_source: dict[str, list[Row]] = {}
@@ -156,6 +186,9 @@ def main() -> int:
         negatives = [r for r in rows if r.negative]
         refused = sum(not r.ok and not r.reason.startswith("CRASH") for r in negatives)
         print(f"negative inputs refused with an error: {refused}/{len(negatives)}")
+        slowest = max(rows, key=lambda r: r.seconds)
+        print(f"time: {sum(r.seconds for r in rows):.1f} s in all, slowest "
+              f"{slowest.seconds:.1f} s ({slowest.path.relative_to(root)})")
         crashes = [r for r in rows if r.reason.startswith("CRASH")]
         for r in crashes:
             print(f"CRASH: {r.path.relative_to(root)}: {r.reason}")
