@@ -87,7 +87,7 @@ def options_for(setting: str, source: str, root: Path) -> dict[str, object]:
     return options
 
 
-_LOCATION = re.compile(r"^\S+:\d+(:\d+)?: ")
+_LOCATION = re.compile(r"^\S+?(:\d+(:\d+)?)?: ")
 _QUOTED = re.compile(r"'[^']*'")
 
 

@@ -18,7 +18,6 @@ from typing import Literal
 import typer
 
 from fsmbt import api
-from fsmbt.llm.config import PROVIDERS
 from fsmbt.cli.options import (
     abstract_option,
     node_models_option,
@@ -26,8 +25,8 @@ from fsmbt.cli.options import (
     reader_options,
 )
 from fsmbt.cli.progress import StageProgress, format_timings
+from fsmbt.llm.config import PROVIDERS
 from fsmbt.verify.report import Report
-
 
 PROVIDER_NAMES = ", ".join(sorted(PROVIDERS))
 

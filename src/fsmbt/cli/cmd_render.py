@@ -7,8 +7,8 @@ from typing import Optional
 
 import typer
 
-from fsmbt.cli import EXIT_INTERNAL, fail
 from fsmbt import api
+from fsmbt.cli import EXIT_INTERNAL, fail
 from fsmbt.cli.options import (
     abstract_option,
     node_models_option,

@@ -17,8 +17,8 @@ from rich.console import Console
 from rich.markup import escape
 from rich.table import Table
 
-from fsmbt.cli import EXIT_BAD_INPUT, EXIT_OK
 from fsmbt import api
+from fsmbt.cli import EXIT_BAD_INPUT, EXIT_OK
 from fsmbt.cli.options import (
     abstract_option,
     node_models_option,
