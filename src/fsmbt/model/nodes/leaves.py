@@ -52,9 +52,9 @@ SLEEP = register(
         halt="cancels its timer",
         time_based=True,
         rejection="time-based node (needs a clock)",
-        nusmv_refusal="time-based node (needs a clock)",
         ports=("msec",),
         handler="sleep",
+        nusmv="sleep",
         requires="time",
         abstraction="Sleep: whether its time is up is an environment input, asked on every tick "
         "(not yet: RUNNING, then SUCCESS)",

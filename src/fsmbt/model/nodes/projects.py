@@ -91,12 +91,12 @@ def _controller(name: str, what: str, source: str) -> NodeSemantics:
             "is not reset when it completes",
             halt=_CONTROLLER_HALT,
             handler="gated",
+        nusmv="gated",
             requires="nav2",
             abstraction=f"{name} may skip its child on any tick (whether {what} is an "
             "environment input)",
             gate=Gate("gate", free_when_idle=True, reset_on_done=False),
             library=_NAV2,
-            nusmv_refusal="the NuSMV encoding does not model it yet",
             source=f"nav2_behavior_tree/plugins/decorator/{source}",
         )
     )
@@ -119,12 +119,12 @@ GOAL_UPDATED_CONTROLLER = register(
         "otherwise the child is ticked only when the goal was updated (else RUNNING)",
         halt=_CONTROLLER_HALT,
         handler="gated",
+        nusmv="gated",
         requires="nav2",
         abstraction="GoalUpdatedController may skip its child on any tick (whether the goal was "
         "updated is an environment input)",
         gate=Gate("gate", free_when_idle=True, reset_on_done=False),
         library=_NAV2,
-        nusmv_refusal="the NuSMV encoding does not model it yet",
         source="nav2_behavior_tree/plugins/decorator/goal_updated_controller.cpp",
     )
 )
@@ -137,13 +137,13 @@ PATH_LONGER_ON_APPROACH = register(
         tick="ticks the child only when a new, longer path arrived near the goal (else "
         "SUCCESS without ticking it); a completed child is reset",
         handler="gated",
+        nusmv="gated",
         requires="nav2",
         abstraction="PathLongerOnApproach: whether a longer path arrived near the goal is an "
         "environment input on every tick (no: SUCCESS without ticking the child)",
         gate=Gate("gate", free_when_running=False, closed="SUCCESS", halt_on_closed=False),
         ports=("path", "prox_len", "length_factor"),
         library=_NAV2,
-        nusmv_refusal="the NuSMV encoding does not model it yet",
         source="nav2_behavior_tree/plugins/decorator/path_longer_on_approach.cpp",
     )
 )
@@ -157,12 +157,12 @@ GOAL_UPDATER = register(
         "status (the child is not reset)",
         halt="halts the child if running",
         handler="pass_through_keep",
+        nusmv="pass_through_keep",
         requires="nav2",
         abstraction="GoalUpdater: the goal it writes to the blackboard is not modelled (it "
         "passes its child's status on)",
         ports=("input_goal", "output_goal"),
         library=_NAV2,
-        nusmv_refusal="the NuSMV encoding does not model it yet",
         source="nav2_behavior_tree/plugins/decorator/goal_updater_node.cpp",
     )
 )
@@ -216,13 +216,13 @@ FOR_EACH = register(
         "no element left: SUCCESS",
         halt="forgets the position, halts the child",
         handler="for_each",
+        nusmv="for_each",
         requires="moveit_pro",
         abstraction="ForEach: whether its vector has another element is an environment input "
         "(asked before each child run)",
         gate=Gate("more", closed="SUCCESS"),
         ports=("vector_in", "out"),
         library="MoveIt Pro",
-        nusmv_refusal="the NuSMV encoding does not model it yet",
         source="docs.picknik.ai: ForEach",
     )
 )
@@ -236,13 +236,13 @@ FOR_EACH_UNTIL_SUCCESS = register(
         "element; no element left: FAILURE",
         halt="forgets the position, halts the child",
         handler="for_each",
+        nusmv="for_each",
         requires="moveit_pro",
         abstraction="ForEachUntilSuccess: whether its vector has another element is an "
         "environment input (asked before each child run)",
         gate=Gate("more", closed="FAILURE"),
         ports=("vector_in", "out", "index"),
         library="MoveIt Pro",
-        nusmv_refusal="the NuSMV encoding does not model it yet",
         source="docs.picknik.ai: ForEachUntilSuccess",
     )
 )
@@ -258,8 +258,8 @@ ROOT = register(
         "status (the child is reset when it completes, as a SubTree does)",
         halt="halts the child if running",
         handler="pass_through",
+        nusmv="pass_through",
         library="Groot 1",
-        nusmv_refusal="the NuSMV encoding does not model it yet",
         source="Groot 1 editor files (<Root> wrapping the root node)",
     )
 )
@@ -276,6 +276,7 @@ BLACKBOARD_CHECKS = tuple(
             halt="halts the child if running",
             blackboard_based=True,
             handler="gated",
+        nusmv="gated",
             requires="blackboard",
             abstraction=f"BlackboardCheck{value}: whether value_A equals value_B is an "
             "environment input (mismatch: return_on_mismatch)",
@@ -283,7 +284,6 @@ BLACKBOARD_CHECKS = tuple(
             closed_port="return_on_mismatch",
             ports=("value_A", "value_B", "return_on_mismatch"),
             rejection="its result depends on the blackboard",
-            nusmv_refusal="its result depends on the blackboard",
             source="BehaviorTree.CPP 3.8 blackboard_precondition.h",
         )
     )

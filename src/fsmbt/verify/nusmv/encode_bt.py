@@ -43,6 +43,10 @@ SEQ_LIKE = {n.name: (n.is_fallback, n.wakes_up, n.with_memory)
 #: type -> is_fallback
 REACTIVE = {n.name: n.is_fallback for n in all_nodes() if n.nusmv == "reactive"}
 SIMPLE_DECORATORS = frozenset(n.name for n in all_nodes() if n.nusmv == "simple_decorator")
+#: Abstractions and wrappers whose only state is statuses (docs/semantics.md §10): rule name.
+GATE_RULES = {n.name: n.nusmv for n in all_nodes()
+              if n.nusmv in ("gated", "timeout", "sleep", "for_each", "pass_through",
+                             "pass_through_keep")}
 SUPPORTED = NUSMV_ENCODED
 #: type -> why the encoding refuses it
 NOT_ENCODED = {n.name: n.nusmv_refusal for n in all_nodes() if n.nusmv_refusal is not None}
@@ -176,6 +180,9 @@ class BTCore:
             kids = list(x.children)
             k = len(kids)
             t = x.type
+            if t in GATE_RULES:
+                self._gate_rules(x, GATE_RULES[t], here, called, resets)
+                continue
             if t in SEQ_LIKE:
                 is_fb, wakes, memory = SEQ_LIKE[t]
                 stop, go_on = ("S", "F") if is_fb else ("F", "S")
@@ -270,6 +277,77 @@ class BTCore:
             if self.is_seq_like(x.id) and not SEQ_LIKE[x.type][2]:
                 self.rules.setdefault(f"idx_{x.id}", []).insert(0, (f"hlt_{x.id}", "0"))
             self.rules.setdefault(self.st(x.id), []).insert(0, (f"clr_{x.id}", "I"))
+
+    def _gate_rules(self, x: CompiledNode, rule: str, here: str, called: str,
+                    resets: dict[int, list[str]]) -> None:
+        """Project wrappers and gated abstractions (docs/semantics.md §10): the gate is the
+        last child, a condition leaf the environment answers; only statuses are kept."""
+        kids = list(x.children)
+        back = f"{here} & res != NONE"
+        passed = "case res = S : S; res = F : F; TRUE : R; esac"
+        self.rule(self.st(x.id), called, "R")
+        if rule in ("pass_through", "pass_through_keep"):
+            c = kids[0]
+            self.call(called, c)
+            if rule == "pass_through":
+                resets[c].append(f"{back} & (res = S | res = F)")
+            self.ret(back, x.id, passed)
+            return
+        gate = kids[-1]
+        from_gate = f"{back} & lidx = {len(kids) - 1}"
+        resets[gate].append(from_gate)
+        if rule == "sleep":
+            self.call(called, gate)
+            self.ret(f"{from_gate} & res = S", x.id, "S")
+            self.ret(from_gate, x.id, "R")
+            return
+        c = kids[0]
+        from_child = f"{back} & lidx = 0"
+        if rule == "timeout":  # the gate says the timer fired; not asked on the first tick
+            self.call(f"{called} & {self.st(x.id)} != R", c)
+            self.call(called, gate)
+            resets[c].append(f"{from_gate} & res = S")
+            self.ret(f"{from_gate} & res = S", x.id, "F")
+            self.call(from_gate, c)
+            resets[c].append(f"{from_child} & (res = S | res = F)")
+            self.ret(from_child, x.id, passed)
+            return
+        spec = node_semantics(x.type)
+        assert spec is not None and spec.gate is not None
+        closed_status = NodeStatus(x.params[0]).name
+        if closed_status not in ST or closed_status == NodeStatus.IDLE.name:
+            raise UnsupportedError(
+                f"the NuSMV encoding does not support {x.type} returning {closed_status} "
+                "(SKIPPED is not encoded); use --engine native", location=x.source.location,
+                element=f"<{x.type}> '{x.label}'")
+        closed = ST[closed_status]
+        if rule == "for_each":
+            self.call(f"{called} & {self.st(c)} = R", c)
+            self.call(called, gate)
+            self.call(f"{from_gate} & res = S", c)
+            self.ret(from_gate, x.id, closed)
+            stop = "F" if closed == _S else "S"
+            self.ret(f"{from_child} & res = R", x.id, "R")
+            resets[c].append(f"{from_child} & res != R")
+            self.ret(f"{from_child} & res = {stop}", x.id, stop)
+            self.ret(from_child, x.id, "R")
+            return
+        gate_rule = spec.gate
+        free = []
+        if gate_rule.free_when_idle:
+            free.append(f"{self.st(x.id)} = I")
+        if gate_rule.free_when_running:
+            free.append(f"{self.st(c)} = R")
+        if free:
+            self.call(f"{called} & {any_of(free)}", c)
+        self.call(called, gate)
+        self.call(f"{from_gate} & res = S", c)
+        if gate_rule.halt_on_closed:
+            resets[c].append(f"{from_gate} & res = F & {self.st(c)} = R")
+        self.ret(from_gate, x.id, closed)
+        if gate_rule.reset_on_done:
+            resets[c].append(f"{from_child} & (res = S | res = F)")
+        self.ret(from_child, x.id, passed)
 
     def leaf_request(self, nid: int) -> str:
         """The condition: ``cur`` is env leaf ``nid`` asking the environment."""
