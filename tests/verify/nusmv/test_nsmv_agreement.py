@@ -309,6 +309,14 @@ def _abstraction_trees() -> list[BTDocument]:
         _project("Root", _node("Sequence", _project("GoalUpdater", _leaf("a")), _leaf("b"))),
         _node("ReactiveFallback", _leaf("c", True),
               _project("DistanceController", _node("Sequence", _leaf("a"), _leaf("b")))),
+        _project("PipelineSequence", _leaf("c", True),
+                 _project("RateController", _leaf("plan")), _leaf("go")),
+        _project("RecoveryNode", _node("Sequence", _leaf("c", True), _leaf("a")), _leaf("r"),
+                 number_of_retries="2"),
+        _project("RoundRobin", _leaf("a"), _leaf("b", True), _leaf("c")),
+        _project("RoundRobin", _leaf("a"), _leaf("b"), wrap_around="true"),
+        _node("Sequence", _project("RepeatUnlessFailureEachTick", _leaf("a"), num_cycles="2"),
+              _leaf("b", True)),
     ]
     return [BTDocument.single(t) for t in trees]
 
