@@ -317,6 +317,15 @@ def _abstraction_trees() -> list[BTDocument]:
         _project("RoundRobin", _leaf("a"), _leaf("b"), wrap_around="true"),
         _node("Sequence", _project("RepeatUnlessFailureEachTick", _leaf("a"), num_cycles="2"),
               _leaf("b", True)),
+        # built-ins the encoding now covers too
+        BTNode("IfThenElse", NodeKind.CONTROL, children=[_leaf("c", True), _leaf("a"),
+                                                          _leaf("b")]),
+        _node("Sequence", BTNode("IfThenElse", NodeKind.CONTROL,
+                                 children=[_leaf("c"), _leaf("a")]), _leaf("d")),
+        BTNode("WhileDoElse", NodeKind.CONTROL, children=[_leaf("c", True), _leaf("a"),
+                                                           _leaf("b")]),
+        _node("Fallback", BTNode("WhileDoElse", NodeKind.CONTROL,
+                                 children=[_leaf("c", True), _leaf("a")]), _leaf("d")),
     ]
     return [BTDocument.single(t) for t in trees]
 

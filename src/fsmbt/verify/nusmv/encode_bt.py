@@ -45,7 +45,8 @@ REACTIVE = {n.name: n.is_fallback for n in all_nodes() if n.nusmv == "reactive"}
 SIMPLE_DECORATORS = frozenset(n.name for n in all_nodes() if n.nusmv == "simple_decorator")
 #: Project kinds with an index or counter (docs/semantics.md §10): rule name.
 MEMORY_RULES = {n.name: n.nusmv for n in all_nodes()
-                if n.nusmv in ("pipeline", "recovery", "round_robin", "repeat_each_tick")}
+                if n.nusmv in ("pipeline", "recovery", "round_robin", "repeat_each_tick",
+                               "if_then_else", "while_do_else")}
 #: Abstractions and wrappers whose only state is statuses (docs/semantics.md §10): rule name.
 GATE_RULES = {n.name: n.nusmv for n in all_nodes()
               if n.nusmv in ("gated", "timeout", "sleep", "for_each", "pass_through",
@@ -382,6 +383,39 @@ class BTCore:
             for c in kids:
                 resets[c].append(cond)
 
+        passed = "case res = S : S; res = F : F; TRUE : R; esac"
+        if rule in ("if_then_else", "while_do_else"):
+            # docs/semantics.md §2: IfThenElse keeps the chosen branch (ci), WhileDoElse
+            # re-ticks its condition every tick
+            memo = self.memory("ci", x.id, n - 1) if rule == "if_then_else" else None
+            if memo is not None:
+                for i in range(n - 1, 0, -1):
+                    self.call(f"{called} & {memo} = {i}", kids[i])
+            self.call(called, kids[0])
+            from_cond = f"{back} & lidx = 0"
+            self.ret(f"{from_cond} & res = R", x.id, "R")
+            if memo is not None:
+                self.rule(memo, f"{from_cond} & res = S", "1")
+            elif n == 3:
+                resets[kids[2]].append(f"{from_cond} & res = S")
+            self.call(f"{from_cond} & res = S", kids[1])
+            if n == 3:
+                if memo is not None:
+                    self.rule(memo, f"{from_cond} & res = F", "2")
+                else:
+                    resets[kids[1]].append(f"{from_cond} & res = F")
+                self.call(f"{from_cond} & res = F", kids[2])
+            else:
+                if memo is None:
+                    reset_all(f"{from_cond} & res = F")
+                self.ret(f"{from_cond} & res = F", x.id, "F")
+            from_branch = f"{back} & lidx != 0"
+            self.ret(f"{from_branch} & res = R", x.id, "R")
+            reset_all(f"{from_branch} & res != R")
+            if memo is not None:
+                self.rule(memo, f"{from_branch} & res != R", "0")
+            self.ret(from_branch, x.id, passed)
+            return
         if rule == "pipeline":
             last = self.memory("pl", x.id, n - 1)
             self.call(called, kids[0])
