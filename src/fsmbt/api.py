@@ -200,7 +200,9 @@ def load(path: str | Path, fmt: str | None = None, *,
     Args:
         path: the file.
         fmt: its format's name; detected from the content, then the extension, when ``None``.
-        options: reader options (e.g. ``node_models`` for BehaviorTree.CPP files).
+        options: reader options: for BehaviorTree.CPP files ``node_models`` (TreeNodesModel
+            files), ``nodes`` (node profiles ``nav2``/``moveit_pro`` and YAML/JSON node files)
+            and ``abstract`` (``time``, ``blackboard``); docs/semantics.md §10.
 
     Returns:
         The ``Loaded`` model with the reader's warnings.
