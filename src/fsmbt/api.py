@@ -49,6 +49,8 @@ from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import Hint, InputError, SourceLocation, UnsupportedError
 from fsmbt.model.fsm import FSM
 from fsmbt.model.validate import Issue
+from fsmbt.semantics.blockers import Blocker
+from fsmbt.semantics.blockers import conversion_blockers as blockers_of
 from fsmbt.verify import Report, verify
 from fsmbt.verify.orient import orient, rules_text
 from fsmbt.verify.wording import readable
@@ -200,7 +202,9 @@ def load(path: str | Path, fmt: str | None = None, *,
     Args:
         path: the file.
         fmt: its format's name; detected from the content, then the extension, when ``None``.
-        options: reader options (e.g. ``node_models`` for BehaviorTree.CPP files).
+        options: reader options: for BehaviorTree.CPP files ``node_models`` (TreeNodesModel
+            files), ``nodes`` (node profiles ``nav2``/``moveit_pro`` and YAML/JSON node files)
+            and ``abstract`` (``time``, ``blackboard``); docs/semantics.md §10.
 
     Returns:
         The ``Loaded`` model with the reader's warnings.
@@ -280,12 +284,12 @@ def load_for_engine(path: str | Path, engine: str, fmt: str | None = None, *,
 
 
 #: Options meant for the readers, not the engines (they travel in the same ``options`` dict).
-READER_OPTIONS = ("node_models", "abstract", "data")
+READER_OPTIONS = ("node_models", "nodes", "abstract", "data")
 
 
 def _reader_options(options: dict[str, object]) -> dict[str, object] | None:
-    """The options a reader understands (``node_models``, ``abstract``), out of the engine
-    options."""
+    """The options a reader understands (``node_models``, ``nodes``, ``abstract``, ``data``),
+    out of the engine options."""
     picked = {key: options[key] for key in READER_OPTIONS if key in options}
     return picked or None
 
@@ -373,7 +377,21 @@ def verify_models(source: Model, result: Model, engine: str = "native", *, loop:
     """
     report = verify(source, result, engine=engine, loop=loop,
                     max_states=_checker_limit(max_states))
+    _name_abstractions(report, source, result)
     return readable(report, source, result)
+
+
+def _name_abstractions(report: Report, *models: Model) -> None:
+    """Record in ``report.stats["abstractions"]`` every abstraction the BT side was modelled
+    under (docs/semantics.md §10): the verdict holds under them, and says so."""
+    from fsmbt.semantics.nodes import abstractions_used
+
+    found: dict[str, None] = {}
+    for model in models:
+        for sentence in abstractions_used(model):
+            found.setdefault(sentence, None)
+    if found:
+        report.stats["abstractions"] = list(found)
 
 
 def verify_either_order(first: Model, second: Model, engine: str = "native", *,
@@ -406,6 +424,7 @@ def verify_either_order(first: Model, second: Model, engine: str = "native", *,
     readable(report, oriented.source, oriented.result)
     report.stats["pairing"] = oriented.rule
     report.stats["swapped"] = oriented.swapped
+    _name_abstractions(report, first, second)
     return report
 
 
@@ -539,6 +558,36 @@ def _timed(timings: dict[str, float], stage: str, on_stage: StageHook | None) ->
         timings[stage] = time.perf_counter() - started
 
 
+def conversion_blockers(model: Model) -> list[Blocker]:
+    """Everything conversion would refuse in ``model``, all at once (``validate``, ``info``,
+    ``render`` and ``convert`` report the same list).
+
+    Args:
+        model: a model; only BT documents have blockers here (an FSM reader refuses at read
+            time).
+
+    Returns:
+        The ``Blocker`` s (message, location, element), in tree order.
+    """
+    if not isinstance(model, BTDocument):
+        return []
+    return blockers_of(model)
+
+
+def _refuse_blockers(model: Model) -> None:
+    """Raise one ``UnsupportedError`` naming every blocker (located at the first)."""
+    found = conversion_blockers(model)
+    if not found:
+        return
+    first = found[0]
+    message = first.message
+    if len(found) > 1:
+        rest = "; ".join(str(b) for b in found[1:])
+        message = f"{message} (and {len(found) - 1} more blocker(s): {rest})"
+    error = UnsupportedError if first.unsupported else InputError
+    raise error(message, location=first.location, element=first.element)
+
+
 def convert_file(source: str | Path, output: str | Path | None = None, *,
                  to: str | None = None, source_format: str | None = None,
                  engine: str = "rules", style: str = "paper", loop: bool = False,
@@ -623,6 +672,7 @@ def convert_loaded(loaded: Loaded, output: str | Path | None = None, *,
         check_destination(destination, overwrite=overwrite)
     _warn_lebt_ports(loaded)
     timings: dict[str, float] = {}
+    _refuse_blockers(loaded.model)
     with _timed(timings, "convert", on_stage):
         engine_options = {k: v for k, v in options.items() if k not in READER_OPTIONS}
         if max_states is not None:

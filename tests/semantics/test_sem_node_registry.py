@@ -76,14 +76,18 @@ def test_sem_registry_entries_are_consistent() -> None:
         if node.nusmv is None:
             assert node.nusmv_refusal, f"{node.name}: say why NuSMV does not encode it"
         if node.time_based or node.blackboard_based:
-            assert node.handler is None, node.name
+            # ticked only as an abstraction the user enables (--abstract), never by default
+            assert node.handler is None or node.requires in nodes.ABSTRACTIONS, node.name
+        if node.requires is not None:
+            assert node.abstraction and node.abstraction.startswith(node.name), node.name
         if node.default_memory is not None:
             assert len(node.default_memory) == len(node.memory), node.name
         if node.kind is NodeKind.DECORATOR:
             assert node.children == 1, node.name
         if node.kind in (NodeKind.ACTION, NodeKind.CONDITION):
             assert node.children == 0, node.name
-        if node.handler is not None:  # the interpreter has the tick rule it names
+        if node.handler is not None and node.kind is not NodeKind.CONDITION:
+            # the interpreter has the tick rule it names (a condition is an environment leaf)
             assert hasattr(bt_interpreter.BTInterpreter, f"_t_{node.handler}"), node.name
 
 

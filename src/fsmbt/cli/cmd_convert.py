@@ -22,11 +22,16 @@ from fsmbt.model.bt import BTDocument
 from fsmbt.model.undeclared import summary as undeclared_summary
 from fsmbt.model.undeclared import undeclared_leaf_types
 from fsmbt.llm.config import PROVIDERS
-from fsmbt.cli.options import max_states_option, node_models_option, reader_options
+from fsmbt.cli.options import (
+    abstract_option,
+    max_states_option,
+    node_models_option,
+    nodes_option,
+    reader_options,
+)
 from fsmbt.cli.progress import StageProgress, format_timings
 from fsmbt.cli.wording import checked_counts, conversion_summary
 from fsmbt.verify.report import Report
-
 
 PROVIDER_NAMES = ", ".join(sorted(PROVIDERS))
 
@@ -52,6 +57,8 @@ def register(app: typer.Typer) -> None:
         quiet: bool = typer.Option(False, "--quiet", "-q", help="no progress display on stderr"),
         node_models: list[Path] = node_models_option(),
         max_states: int | None = max_states_option(),
+        nodes: list[str] = nodes_option(),
+        abstract: list[str] = abstract_option(),
         hierarchy: Literal["subtrees", "flatten"] = typer.Option("subtrees", "--hierarchy", help="FSM->BT of a "
                                       "hierarchical FSM: subtrees (one SubTree per composite "
                                       "state) or flatten (one flat LEBT)"),
@@ -62,7 +69,7 @@ def register(app: typer.Typer) -> None:
     ) -> None:
         """Convert an FSM into a behavior tree or a behavior tree into a hierarchical FSM, and
         prove the result equivalent."""
-        options: dict[str, object] = dict(reader_options(node_models) or {})
+        options: dict[str, object] = dict(reader_options(node_models, nodes, abstract) or {})
         if engine in api.LLM_ENGINES:
             options.update(llm_base_url=llm_base_url, llm_model=llm_model)
         with StageProgress(quiet=quiet, label=source.name) as progress:
@@ -108,6 +115,8 @@ def _print_summary(outcome: api.Outcome, *, to_stderr: bool) -> None:
     counts = checked_counts(report.stats)
     if counts:
         print(f"  checked {counts}", file=stream)
+    for sentence in report.stats.get("abstractions", []):
+        print(f"verified under the abstraction: {sentence}", file=stream)
     for name, prop in report.properties.items():
         mark = "ok  " if prop.holds else "FAIL"
         print(f"  {mark} {name}: {prop.detail}", file=stream)

@@ -12,7 +12,12 @@ from rich.markup import escape
 from rich.table import Table
 
 from fsmbt import api
-from fsmbt.cli.options import node_models_option, reader_options
+from fsmbt.cli.options import (
+    abstract_option,
+    node_models_option,
+    nodes_option,
+    reader_options,
+)
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.stats import BTStats, FSMStats, model_stats
 from fsmbt.model.undeclared import summary as undeclared_summary
@@ -29,6 +34,8 @@ def register(app: typer.Typer) -> None:
         from_format: Optional[str] = typer.Option(None, "--from",
                                                   help="Input format (default: detected)."),
         node_models: list[Path] = node_models_option(),
+        nodes: list[str] = nodes_option(),
+        abstract: list[str] = abstract_option(),
         as_json: bool = typer.Option(False, "--json", help="Print the figures as JSON."),
     ) -> None:
         """Structure at a glance: states, events, entry/loop states; BT nodes, depth, breadth.
@@ -37,14 +44,15 @@ def register(app: typer.Typer) -> None:
         loop states of the LEBT structure (docs/conversion.md), hierarchy. BT: nodes by kind and type, depth, breadth,
         leaves, trees and SubTree references.
         """
-        loaded = api.load(model, from_format, options=reader_options(node_models))
+        loaded = api.load(model, from_format, options=reader_options(node_models, nodes, abstract))
         stats = model_stats(loaded.model)
         undeclared = (undeclared_leaf_types(loaded.model)
                       if isinstance(loaded.model, BTDocument) else None)
+        blockers = [str(b) for b in api.conversion_blockers(loaded.model)]
         if as_json:
             extra = {} if undeclared is None else {"undeclared_leaf_types": dict(undeclared)}
-            print(json.dumps({"file": str(model), **stats.to_dict(), **extra}, indent=2,
-                             ensure_ascii=False))
+            print(json.dumps({"file": str(model), **stats.to_dict(), **extra,
+                              "conversion_blockers": blockers}, indent=2, ensure_ascii=False))
             return
         table = _fsm_table(stats) if isinstance(stats, FSMStats) else _bt_table(stats)
         table.title = escape(str(model))
@@ -54,6 +62,10 @@ def register(app: typer.Typer) -> None:
             console.print(_per_tree_table(stats))
         if undeclared:
             print(f"note: {undeclared_summary(undeclared)}; declare them with --node-models FILE")
+        if blockers:
+            console.print(f"conversion would refuse ({len(blockers)}):")
+            for text in blockers:
+                console.print(f"  - {escape(text)}")
 
 
 def _listed(items: list[str]) -> str:

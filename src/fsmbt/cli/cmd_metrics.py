@@ -13,7 +13,12 @@ from rich.markup import escape
 from rich.table import Table
 
 from fsmbt import api
-from fsmbt.cli.options import node_models_option, reader_options
+from fsmbt.cli.options import (
+    abstract_option,
+    node_models_option,
+    nodes_option,
+    reader_options,
+)
 from fsmbt.metrics import edit_distance, elements
 from fsmbt.model.errors import InputError
 
@@ -27,17 +32,19 @@ def register(app: typer.Typer) -> None:
         from_format: Optional[str] = typer.Option(None, "--from",
                                                   help="Input format (default: detected)."),
         node_models: list[Path] = node_models_option(),
+        nodes: list[str] = nodes_option(),
+        abstract: list[str] = abstract_option(),
         timeout: float = typer.Option(5.0, "--timeout", min=0.01,
                                       help="Seconds for the FSM graph edit distance search."),
         as_json: bool = typer.Option(False, "--json", help="Print the figures as JSON."),
     ) -> None:
         """Graphical and active elements, depth, node counts by type, sub-FSMs; with OTHER the
         tree edit distance (BTs) or graph edit distance (FSMs, an upper bound when cut)."""
-        first = api.load(model, from_format, options=reader_options(node_models)).model
+        first = api.load(model, from_format, options=reader_options(node_models, nodes, abstract)).model
         figures = {"file": str(model), **elements(first).to_dict()}
         report: dict[str, object] = {"model": figures}
         if other is not None:
-            second = api.load(other, from_format, options=reader_options(node_models)).model
+            second = api.load(other, from_format, options=reader_options(node_models, nodes, abstract)).model
             report["other"] = {"file": str(other), **elements(second).to_dict()}
             try:
                 report["distance"] = edit_distance(first, second, timeout=timeout)

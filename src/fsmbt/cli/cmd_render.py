@@ -9,7 +9,12 @@ import typer
 
 from fsmbt import api
 from fsmbt.cli import EXIT_INTERNAL, fail
-from fsmbt.cli.options import node_models_option, reader_options
+from fsmbt.cli.options import (
+    abstract_option,
+    node_models_option,
+    nodes_option,
+    reader_options,
+)
 from fsmbt.render import DEFAULT_MAX_NODES, GraphvizError, render_model
 
 
@@ -28,6 +33,8 @@ def register(app: typer.Typer) -> None:
         from_format: str | None = typer.Option(None, "--from",
                                                   help="Input format (default: detected)."),
         node_models: list[Path] = node_models_option(),
+        nodes: list[str] = nodes_option(),
+        abstract: list[str] = abstract_option(),
         force: bool = typer.Option(False, "--force", help="Overwrite OUTPUT if it exists."),
         expand_subtrees: bool = typer.Option(
             False, "--expand-subtrees",
@@ -42,7 +49,8 @@ def register(app: typer.Typer) -> None:
         tree: str | None = typer.Option(None, "--tree", help="BT: draw only this tree."),
     ) -> None:
         """Draw MODEL: FSMs as state diagrams, behavior trees top-down with the usual symbols."""
-        loaded = api.load(model, from_format, options=reader_options(node_models)).model
+        loaded = api.load(model, from_format,
+                          options=reader_options(node_models, nodes, abstract)).model
         notes: list[str] = []
         try:
             written = render_model(loaded, output, overwrite=force,
@@ -53,3 +61,5 @@ def register(app: typer.Typer) -> None:
         print(f"wrote {written}")
         for note in notes:
             print(f"note: {_cli_words(note)}", file=sys.stderr)
+        for blocker in api.conversion_blockers(loaded):
+            print(f"note: conversion would refuse: {blocker}", file=sys.stderr)

@@ -17,9 +17,14 @@ from rich.console import Console
 from rich.markup import escape
 from rich.table import Table
 
-from fsmbt.cli import EXIT_BAD_INPUT, EXIT_OK
 from fsmbt import api
-from fsmbt.cli.options import node_models_option, reader_options
+from fsmbt.cli import EXIT_BAD_INPUT, EXIT_OK
+from fsmbt.cli.options import (
+    abstract_option,
+    node_models_option,
+    nodes_option,
+    reader_options,
+)
 from fsmbt.model.errors import SourceLocation
 from fsmbt.model.validate import Issue, validate
 
@@ -31,17 +36,28 @@ def register(app: typer.Typer) -> None:
         from_format: Optional[str] = typer.Option(None, "--from",
                                                   help="Input format (default: detected)."),
         node_models: list[Path] = node_models_option(),
+        nodes: list[str] = nodes_option(),
+        abstract: list[str] = abstract_option(),
         as_json: bool = typer.Option(False, "--json", help="Print the issues as JSON."),
         strict: bool = typer.Option(False, "--strict", help="Treat warnings as errors."),
     ) -> None:
         """Check a model: unknown nodes, wrong child counts, missing SubTrees, unknown or
         duplicate states, nondeterminism, empty models; warn about unreachable states,
         dead ends not marked final and parts fsmbt cannot model exactly."""
-        loaded = api.load(model, from_format, options=reader_options(node_models))
+        loaded = api.load(model, from_format, options=reader_options(node_models, nodes, abstract))
         # reader warnings already start with their location; model issues get the file name
         issues = [Issue("warning", w) for w in loaded.warnings]
         issues += [_with_file(i, model) for i in validate(loaded.model)]
         issues += [_with_file(i, model) for i in api.lebt_port_issues(loaded.model)]
+        # what conversion would refuse is an error too, so validate and convert agree
+        located = {(i.location, i.message) for i in issues if i.severity == "error"}
+        errors_at = {i.location for i in issues if i.severity == "error" and i.location}
+        for blocker in api.conversion_blockers(loaded.model):
+            if blocker.location in errors_at or (blocker.location, blocker.message) in located:
+                continue  # already reported by the structural checks
+            issues.append(_with_file(Issue("error", f"conversion would refuse: "
+                                           f"{blocker.message}", blocker.location,
+                                           blocker.element), model))
         failing = [i for i in issues if i.severity == "error"] + (
             [i for i in issues if i.severity == "warning"] if strict else [])
         kind = loaded.kind

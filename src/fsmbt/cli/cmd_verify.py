@@ -14,7 +14,13 @@ import typer
 from rich.console import Console
 
 from fsmbt import api
-from fsmbt.cli.options import max_states_option, node_models_option, reader_options
+from fsmbt.cli.options import (
+    abstract_option,
+    max_states_option,
+    node_models_option,
+    nodes_option,
+    reader_options,
+)
 from fsmbt.cli.progress import StageProgress
 from fsmbt.verify import EngineDisagreement
 from fsmbt.verify.render_report import print_report
@@ -33,6 +39,8 @@ def register(app: typer.Typer) -> None:
         quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress display on stderr."),
         node_models: list[Path] = node_models_option(),
         max_states: Optional[int] = max_states_option(),
+        nodes: list[str] = nodes_option(),
+        abstract: list[str] = abstract_option(),
         engine: str = typer.Option("native", "--engine",
                                    help="native, nusmv, or both (both must agree)."),
         loop: bool = typer.Option(False, "--loop",
@@ -51,7 +59,8 @@ def register(app: typer.Typer) -> None:
                                                 source_format=from_format,
                                                 converted_format=from_format2,
                                                 max_states=max_states,
-                                                options=reader_options(node_models),
+                                                options=reader_options(node_models, nodes,
+                                                                       abstract),
                                                 on_stage=progress)
         except EngineDisagreement as exc:
             print(f"error: ENGINES DISAGREE: {exc}; one of the checkers is wrong, please report "
@@ -66,6 +75,8 @@ def register(app: typer.Typer) -> None:
             print(json.dumps(data, indent=2, ensure_ascii=False))
         else:
             print_report(report, Console())
+            for sentence in report.stats.get("abstractions", []):
+                print(f"verified under the abstraction: {sentence}")
             if report.stats.get("swapped"):
                 print(f"note: {converted} was read as the source and {source} as its "
                       f"conversion (pairing rule: {report.stats['pairing']}); the verdict does "

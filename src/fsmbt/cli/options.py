@@ -10,6 +10,14 @@ import typer
 #: ``nav2_tree_nodes.xml``, a Groot palette) that declare the custom nodes a tree uses.
 NODE_MODELS_HELP = ("a file with <TreeNodesModel> declarations of custom BT nodes (e.g. Nav2's "
                     "nav2_tree_nodes.xml); repeatable")
+#: ``--nodes PROFILE|FILE`` (repeatable, comma lists allowed): node libraries
+#: (``fsmbt.model.nodes.library``, docs/semantics.md §10).
+NODES_HELP = ("node library: a profile (nav2, moveit_pro) or a YAML/JSON file declaring custom "
+              "nodes as aliases, exact semantics or abstractions; repeatable, comma lists allowed")
+#: ``--abstract FAMILIES``: abstraction families (``time``, ``blackboard``).
+ABSTRACT_HELP = ("model these node families as abstractions whose input the environment "
+                 "chooses: time (Sleep, Delay, Timeout), blackboard (Precondition, "
+                 "ScriptCondition, BlackboardCheck*, ...); comma list")
 
 
 def node_models_option() -> list[Path]:
@@ -17,11 +25,36 @@ def node_models_option() -> list[Path]:
     return typer.Option([], "--node-models", help=NODE_MODELS_HELP, exists=False)  # type: ignore[no-any-return]
 
 
-def reader_options(node_models: list[Path] | None) -> dict[str, object] | None:
-    """The reader options for ``fsmbt.api.load`` from the shared CLI options."""
-    if not node_models:
-        return None
-    return {"node_models": [str(path) for path in node_models]}
+def nodes_option() -> list[str]:
+    """The ``--nodes`` option (a fresh ``typer.Option`` per command)."""
+    return typer.Option([], "--nodes", help=NODES_HELP)  # type: ignore[no-any-return]
+
+
+def abstract_option() -> list[str]:
+    """The ``--abstract`` option (a fresh ``typer.Option`` per command)."""
+    return typer.Option([], "--abstract", help=ABSTRACT_HELP)  # type: ignore[no-any-return]
+
+
+def reader_options(node_models: list[Path] | None, nodes: list[str] | None = None,
+                   abstract: list[str] | None = None) -> dict[str, object] | None:
+    """The reader options for ``fsmbt.api.load`` from the shared CLI options.
+
+    Args:
+        node_models: ``--node-models`` files.
+        nodes: ``--nodes`` profiles and files.
+        abstract: ``--abstract`` families.
+
+    Returns:
+        The options dict, or ``None`` when none was given.
+    """
+    options: dict[str, object] = {}
+    if node_models:
+        options["node_models"] = [str(path) for path in node_models]
+    if nodes:
+        options["nodes"] = list(nodes)
+    if abstract:
+        options["abstract"] = list(abstract)
+    return options or None
 
 
 #: ``--max-states N``: one state limit for the native checker and for BT -> FSM exploration.

@@ -78,6 +78,8 @@ class _Cont:
 
 
 def _is_structural(node: BTNode) -> bool:
+    if node.semantics is not None and node.semantics != node.type:
+        return False  # a custom type with a library kind's meaning: explored
     if node.kind is NodeKind.CONTROL:
         return node.type in PLAIN_CONTROLS and not node.attrs
     if node.kind is NodeKind.DECORATOR:

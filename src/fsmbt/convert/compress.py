@@ -39,7 +39,8 @@ def tree_depth(root: BTNode) -> int:
 
 def _shallow_copy(node: BTNode) -> BTNode:
     return BTNode(type=node.type, kind=node.kind, name=node.name, attrs=dict(node.attrs),
-                  kind_declared=node.kind_declared, location=node.location)
+                  kind_declared=node.kind_declared, location=node.location,
+                  semantics=node.semantics)
 
 
 def inline_subtrees(doc: BTDocument) -> BTNode:

@@ -10,6 +10,8 @@ How a node's kind is decided (first rule that applies): a BehaviorTree.CPP built
 ``ReadContext.options["node_models"]``); the explicit-style tag; otherwise it is *assumed*
 (``kind_declared=False``): a childless element is an Action, one with one child a Decorator, one
 with more a Control. Validation reports undeclared non-leaf types as unknown node types.
+Then the node library of ``options["nodes"]`` / ``options["abstract"]`` is applied
+(``fsmbt.model.nodes.library``: project kinds, aliases, letter-case typos, abstractions).
 
 Everything is iterative: trees 10 000 levels deep read and write without recursion.
 Complexity: O(n) in the number of elements.
@@ -31,6 +33,7 @@ from fsmbt.model import Model
 from fsmbt.model.bt import BehaviorTree, BTDocument, BTNode, NodeModel, PortModel
 from fsmbt.model.bt_nodes import NodeKind, builtin_spec, canonical_type
 from fsmbt.model.errors import InputError, SourceLocation, UnsupportedError
+from fsmbt.model.nodes.library import apply_library, build_library
 
 #: Tags of Groot's explicit style and of ``<TreeNodesModel>`` entries, with the kind they declare.
 EXPLICIT_TAGS: dict[str, NodeKind] = {
@@ -324,7 +327,15 @@ def read_btcpp(text: str, ctx: ReadContext) -> BTDocument:
     if path is not None:
         loader.loaded.add(path)
     loader.load(text, ctx.path, (path,) if path is not None else ())
-    return loader.document()
+    doc = loader.document()
+    # --nodes / --abstract (fsmbt.model.nodes.library): project kinds, aliases, abstractions
+    library = build_library(ctx.options.get("nodes"), ctx.options.get("abstract"))
+
+    def warn(message: str, location: SourceLocation | None) -> None:
+        ctx.warnings.append(f"{location}: {message}" if location is not None else message)
+
+    apply_library(doc, library, warn)
+    return doc
 
 
 # -- writing -------------------------------------------------------------------------------------

@@ -21,7 +21,11 @@ class BTNode:
     ``attrs`` holds every XML attribute except ``name`` (ports included), in file order. For a
     ``SubTree`` node the referenced tree is ``attrs["ID"]``. ``kind_declared`` is False when a
     leaf's kind was not declared anywhere and was assumed (Action, the safe choice: it may
-    return RUNNING).
+    return RUNNING). ``semantics`` is the registered kind that gives the node its meaning when
+    a node library or an option enabled one (``fsmbt.model.nodes.library``): a project kind
+    (``RateController`` under ``--nodes nav2``), an abstraction (``Sleep`` under ``--abstract
+    time``) or the kind a user's ``--nodes`` file maps a custom type to; ``None``: the type's
+    own kind, if it needs no option.
 
     Attributes:
         type: The node type (registration ID).
@@ -30,6 +34,7 @@ class BTNode:
         attrs: The other XML attributes (ports), in file order.
         children: The child nodes, in order.
         kind_declared: False when a leaf's kind was assumed (see above).
+        semantics: The registered kind that gives the node its meaning (see above), or None.
         location: Where the node was read (not compared).
     """
 
@@ -40,6 +45,7 @@ class BTNode:
     children: list[BTNode] = field(default_factory=list)
     kind_declared: bool = True
     location: SourceLocation | None = field(default=None, compare=False, repr=False)
+    semantics: str | None = field(default=None, compare=False, repr=False)
 
     @property
     def label(self) -> str:

@@ -45,11 +45,13 @@ from fsmbt.model.errors import InputError
 from fsmbt.semantics.bt_interpreter import CompiledTree
 from fsmbt.semantics.lebt.driver import EngineLebtRun
 from fsmbt.semantics.lebt.spec import GUARD_TYPE, STATE_TYPE
+from fsmbt.semantics.nodes import PLAIN_CONTROLS
 
 #: The engines a tree can run on.
 ENGINES = ("py_trees", "btcpp")
-#: The non-leaf nodes an LEBT is built from (fsmbt.convert.lebt, hfsm_to_bt).
-LEBT_CONTROLS = frozenset({"Sequence", "Fallback"})
+#: The non-leaf nodes an LEBT is built from (fsmbt.convert.lebt, hfsm_to_bt): the plain,
+#: memoryless Sequence and Fallback of the node registry.
+LEBT_CONTROLS = PLAIN_CONTROLS
 LEBT_LEAVES = frozenset({GUARD_TYPE, STATE_TYPE})
 
 Action = Callable[[], object]

@@ -42,7 +42,7 @@ from fsmbt.limits import Limits
 from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.errors import InputError, UnsupportedError
 from fsmbt.model.kinds import NodeKind
-from fsmbt.semantics.nodes import canonical_type, node_semantics, runtime_tables
+from fsmbt.semantics.nodes import canonical_type, enabling_option, node_semantics, runtime_tables
 from fsmbt.semantics.status import LeafOutcome, NodeStatus
 
 # -- statuses (fsmbt.semantics.status; docs/semantics.md "Statuses") ---------------------------
@@ -147,6 +147,33 @@ def _bool_param(node: BTNode, port: str, default: bool) -> bool:
     raise InputError(f"port '{port}' is not a boolean: {raw!r}", **_where(node))
 
 
+def _status_param(node: BTNode, port: str | None, default: str) -> int:
+    """A port naming the status a node returns (``Precondition``'s ``else``...)."""
+    raw = node.attrs.get(port) if port is not None else None
+    text = (raw if raw is not None else default).strip()
+    if text.startswith("{"):
+        raise UnsupportedError(f"port '{port}' reads the blackboard ({text})", **_where(node))
+    if text not in ("SUCCESS", "FAILURE", "RUNNING", "SKIPPED"):
+        raise InputError(f"port '{port}' is not a status: {raw!r}", **_where(node))
+    return int(NodeStatus[text])
+
+
+#: The type of the synthetic gate leaves (never a registered kind, so always an env leaf).
+GATE_TYPE = "_fsmbt_gate"
+
+
+def _gate_leaf(node: BTNode, ctype: str) -> BTNode | None:
+    """The condition leaf that asks the environment for an abstraction's input
+    (``<label>.<word>``), when ``node`` is an enabled abstraction with a gate."""
+    if node.semantics is None:
+        return None
+    spec = node_semantics(ctype)
+    if spec is None or spec.gate is None:
+        return None
+    return BTNode(GATE_TYPE, NodeKind.CONDITION, f"{node.label}.{spec.gate.word}",
+                  location=node.location)
+
+
 def _threshold(value: int, count: int) -> int:
     """BehaviorTree.CPP's reading of a Parallel threshold: negative means "all but"."""
     return max(count + value + 1, 0) if value < 0 else value
@@ -183,6 +210,9 @@ class CompiledTree:
             children_of[nid] = []
             ctype, kind, params, internal, kids = self._check(node, chain)
             raw.append((node, ctype, parent, position, params, internal, kind))
+            gate = _gate_leaf(node, ctype)
+            if gate is not None:
+                kids = [*kids, gate]  # the gate is the last child (docs/semantics.md §10)
             if ctype == "SubTree":
                 target = node.attrs["ID"]
                 kids = [self.doc.trees[target].root]  # type: ignore[list-item]
@@ -213,18 +243,34 @@ class CompiledTree:
     def _check(self, node: BTNode, chain: tuple[str, ...]
                ) -> tuple[str, NodeKind, tuple[Any, ...], int | None, list[BTNode]]:
         tables = runtime_tables()
-        ctype = canonical_type(node.type)
+        ctype = node.semantics or canonical_type(node.type)
         kind = node.kind
         for attr in PRECONDITION_ATTRS:
             if attr in node.attrs:
                 raise UnsupportedError(
                     f"pre-condition '{attr}' depends on the blackboard", **_where(node))
+        spec = node_semantics(ctype)
+        if spec is not None and spec.requires is not None and node.semantics is None:
+            why = spec.rejection or (f"a {spec.library} node whose control flow reads data fsmbt "
+                                     "does not model (a clock, the robot pose, a goal or a "
+                                     "blackboard vector)")
+            raise UnsupportedError(
+                f"{ctype}: {why}; enable it with {enabling_option(spec.requires)} (an "
+                f"abstraction: {spec.abstraction})", **_where(node))
         reason = tables.rejected.get(ctype)
-        if reason is not None:
+        if reason is not None and node.semantics is None:
             raise UnsupportedError(f"{ctype}: {reason}", **_where(node))
         kids = list(node.children)
         params: tuple[Any, ...] = ()
         internal: int | None = None
+        if node.semantics is not None and spec is not None:
+            kind = spec.kind
+            if spec.handler == "env_condition":
+                kind = NodeKind.CONDITION
+            elif spec.gate is not None and kind in (NodeKind.ACTION, NodeKind.CONDITION):
+                if kids:
+                    raise InputError("a leaf node has children", **_where(node))
+                return ctype, NodeKind.DECORATOR, params, internal, kids  # Sleep: gate only
         if kind is NodeKind.SUBTREE or ctype == "SubTree":
             kind = NodeKind.SUBTREE
             ctype = "SubTree"
@@ -242,7 +288,9 @@ class CompiledTree:
                 raise InputError("a leaf node has children", **_where(node))
             if ctype in tables.internal_leaves:
                 internal = tables.internal_leaves[ctype]
-            elif node_semantics(ctype) is not None:
+            elif spec is not None and spec.handler == "env_condition" and node.semantics:
+                pass  # an abstraction: a condition the environment answers
+            elif spec is not None:
                 raise UnsupportedError(f"built-in leaf {ctype} is not supported", **_where(node))
             return ctype, kind, params, internal, kids
         if kind is NodeKind.DECORATOR:
@@ -258,6 +306,10 @@ class CompiledTree:
                 params = (_int_param(node, "num_attempts", None),)
             elif ctype == "RunOnce":
                 params = (_bool_param(node, "then_skip", True),)
+            elif ctype == "RepeatUnlessFailureEachTick":
+                params = (_int_param(node, "num_cycles", -1),)
+            elif spec is not None and spec.gate is not None:
+                params = (_status_param(node, spec.closed_port, spec.gate.closed),)
             return ctype, kind, params, internal, kids
         if kind is NodeKind.CONTROL:
             if ctype not in tables.controls:
@@ -278,6 +330,10 @@ class CompiledTree:
                     raise InputError("Parallel threshold exceeds the number of children",
                                      **_where(node))
                 params = (succ, fail)
+            elif ctype == "RecoveryNode":
+                params = (_int_param(node, "number_of_retries", 1),)
+            elif ctype == "RoundRobin":
+                params = (_bool_param(node, "wrap_around", False),)
             elif ctype == "ParallelAll":
                 fail = _int_param(node, "max_failures", 1)
                 if n < _threshold(fail, n):
@@ -816,6 +872,271 @@ class BTInterpreter:
         if result in (SUCCESS, FAILURE):
             self._reset_child(w, node.children[0], hook)
         return ("ret", result)
+
+    # -- project kinds and abstractions (docs/semantics.md §10) ---------------------------------
+    def _t_pipeline(self, w: _Work, node: CompiledNode, frame: Frame, result: int | None,
+                    hook: HaltHook | None) -> TickAction:
+        """Nav2 PipelineSequence (pipeline_sequence.cpp)."""
+        (last,) = self._mem(w, node)
+        n = len(node.children)
+        if frame[1] == 0:
+            w.st[node.id] = RUNNING
+            i, skipped = 0, 0
+        else:
+            i, skipped = frame[2], frame[3]
+            if result == FAILURE:
+                self._reset_children(w, node, hook)
+                self._set_mem(w, node, (0,))
+                return ("ret", FAILURE)
+            if result == SKIPPED:
+                skipped += 1
+            elif result == RUNNING:
+                if i >= last:
+                    self._set_mem(w, node, (i,))
+                    return ("ret", RUNNING)
+            elif result != SUCCESS:
+                raise BTRuntimeError("a child returned IDLE", element=node.label)
+            i += 1
+        if i < n:
+            return ("call", node.children[i], (node.id, 1, i, skipped))
+        self._reset_children(w, node, hook)
+        self._set_mem(w, node, (0,))
+        return ("ret", SKIPPED if skipped == n else SUCCESS)
+
+    def _t_recovery(self, w: _Work, node: CompiledNode, frame: Frame, result: int | None,
+                    hook: HaltHook | None) -> TickAction:
+        """Nav2 RecoveryNode (recovery_node.cpp): main child 0, recovery child 1."""
+        (retries,) = node.params
+        idx, tries = self._mem(w, node)
+        main, recovery = node.children
+        if frame[1] == 0:
+            w.st[node.id] = RUNNING
+        elif idx == 0:
+            if result == RUNNING:
+                return ("ret", RUNNING)
+            if result in (SUCCESS, SKIPPED):
+                self._reset_children(w, node, hook)  # haltChild(1), then halt()
+                self._set_mem(w, node, (0, 0))
+                return ("ret", result)
+            if result != FAILURE:
+                raise BTRuntimeError("a child returned IDLE", element=node.label)
+            if tries >= retries:
+                self._reset_children(w, node, hook)
+                self._set_mem(w, node, (0, 0))
+                return ("ret", FAILURE)
+            self._reset_child(w, main, hook)
+            idx = 1
+        else:
+            if result == RUNNING:
+                return ("ret", RUNNING)
+            if result == SKIPPED:  # no recovery possible; not a retry
+                self._reset_child(w, recovery, hook)
+                self._set_mem(w, node, (0, tries))
+                return ("ret", FAILURE)
+            if result == FAILURE:
+                self._reset_children(w, node, hook)
+                self._set_mem(w, node, (0, 0))
+                return ("ret", FAILURE)
+            if result != SUCCESS:
+                raise BTRuntimeError("a child returned IDLE", element=node.label)
+            self._reset_child(w, recovery, hook)
+            idx, tries = 0, tries + 1
+        if tries <= retries:
+            self._set_mem(w, node, (idx, tries))
+            return ("call", node.children[idx], (node.id, 1))
+        self._reset_children(w, node, hook)
+        self._set_mem(w, node, (0, 0))
+        return ("ret", FAILURE)
+
+    def _t_round_robin(self, w: _Work, node: CompiledNode, frame: Frame, result: int | None,
+                       hook: HaltHook | None) -> TickAction:
+        """Nav2 RoundRobin (round_robin_node.cpp), with its ``wrap_around`` port."""
+        (wrap,) = node.params
+        n = len(node.children)
+        idx, failed = self._mem(w, node)
+        ended = False
+        if frame[1] == 0:
+            w.st[node.id] = RUNNING
+            skipped = 0
+        else:
+            skipped = frame[2]
+            if result not in (SUCCESS, FAILURE, RUNNING, SKIPPED):
+                raise BTRuntimeError("a child returned IDLE", element=node.label)
+            if result != RUNNING:
+                idx += 1
+                if idx == n:
+                    if wrap:
+                        idx = 0
+                    else:  # the end of the list: counted, then the loop stops
+                        skipped += result == SKIPPED
+                        failed += result == FAILURE
+                        ended = True
+            if not ended:
+                if result == SUCCESS:
+                    self._reset_children(w, node, hook)
+                    self._set_mem(w, node, (idx, 0))
+                    return ("ret", SUCCESS)
+                if result == RUNNING:
+                    self._set_mem(w, node, (idx, failed))
+                    return ("ret", RUNNING)
+                if result == FAILURE:
+                    failed += 1
+                else:
+                    skipped += 1
+        if not ended and failed + skipped < n:
+            self._set_mem(w, node, (idx, failed))
+            return ("call", node.children[idx], (node.id, 1, skipped))
+        self._reset_children(w, node, hook)
+        self._set_mem(w, node, (0, 0))
+        return ("ret", SKIPPED if skipped == n else FAILURE)
+
+    def _t_repeat_each_tick(self, w: _Work, node: CompiledNode, frame: Frame,
+                            result: int | None, hook: HaltHook | None) -> TickAction:
+        """MoveIt Pro RepeatUnlessFailureEachTick: one cycle per tick, no wake-up."""
+        (limit,) = node.params
+        (count,) = self._mem(w, node)
+        child = node.children[0]
+        if frame[1] == 0:
+            w.st[node.id] = RUNNING
+            return ("call", child, (node.id, 1))
+        if result == RUNNING:
+            return ("ret", RUNNING)
+        self._reset_child(w, child, hook)
+        if result == SUCCESS:
+            if limit != -1:  # with -1 the count is never read: keep it 0 (finite states)
+                count += 1
+                if count >= limit:
+                    self._set_mem(w, node, (0,))
+                    return ("ret", SUCCESS)
+            self._set_mem(w, node, (count,))
+            return ("ret", RUNNING)
+        if result == FAILURE:
+            self._set_mem(w, node, (0,))
+            return ("ret", FAILURE)
+        return ("ret", SKIPPED)
+
+    def _t_single_trigger(self, w: _Work, node: CompiledNode, frame: Frame,
+                          result: int | None, hook: HaltHook | None) -> TickAction:
+        """Nav2 SingleTrigger: the child runs to completion once per activation."""
+        child = node.children[0]
+        if frame[1] == 0:
+            (triggered,) = self._mem(w, node)
+            if w.st.get(node.id, IDLE) == IDLE:
+                triggered = False
+                self._set_mem(w, node, (False,))
+            w.st[node.id] = RUNNING
+            if triggered:
+                return ("ret", FAILURE)
+            return ("call", child, (node.id, 1))
+        if result in (SUCCESS, FAILURE):
+            self._set_mem(w, node, (True,))
+        return ("ret", result)
+
+    def _t_pass_through(self, w: _Work, node: CompiledNode, frame: Frame, result: int | None,
+                        hook: HaltHook | None) -> TickAction:
+        """A transparent wrapper (Groot 1 ``Root``): the child's status, child reset when done."""
+        if frame[1] == 0:
+            w.st[node.id] = RUNNING
+            return ("call", node.children[0], (node.id, 1))
+        if result in (SUCCESS, FAILURE):
+            self._reset_child(w, node.children[0], hook)
+        return ("ret", result)
+
+    def _t_pass_through_keep(self, w: _Work, node: CompiledNode, frame: Frame,
+                             result: int | None, hook: HaltHook | None) -> TickAction:
+        """Nav2 GoalUpdater: ``return child_node_->executeTick()`` (the child is not reset)."""
+        if frame[1] == 0:
+            w.st[node.id] = RUNNING
+            return ("call", node.children[0], (node.id, 1))
+        return ("ret", result)
+
+    def _gate_of(self, node: CompiledNode) -> Any:
+        spec = node_semantics(node.type)
+        assert spec is not None and spec.gate is not None
+        return spec.gate
+
+    def _t_gated(self, w: _Work, node: CompiledNode, frame: Frame, result: int | None,
+                 hook: HaltHook | None) -> TickAction:
+        """An abstraction whose gate (the last child, a condition the environment answers)
+        decides whether the child is ticked: Nav2's controllers, Delay, Precondition,
+        BlackboardCheck* (docs/semantics.md §10)."""
+        gate_rule = self._gate_of(node)
+        child, gate = node.children[0], node.children[-1]
+        (closed,) = node.params
+        pc = frame[1]
+        if pc == 0:
+            prev = w.st.get(node.id, IDLE)
+            w.st[node.id] = RUNNING
+            child_status = w.st.get(child, IDLE)
+            if (gate_rule.free_when_idle and prev == IDLE) or (
+                    gate_rule.free_when_running and child_status == RUNNING):
+                return ("call", child, (node.id, 2))
+            return ("call", gate, (node.id, 1))
+        if pc == 1:
+            w.st.pop(gate, None)  # a gate keeps no status: it is asked afresh each time
+            if result == SUCCESS:
+                return ("call", child, (node.id, 2))
+            if gate_rule.halt_on_closed and w.st.get(child, IDLE) == RUNNING:
+                self._reset_child(w, child, hook)
+            return ("ret", closed)
+        if gate_rule.reset_on_done and result in (SUCCESS, FAILURE):
+            self._reset_child(w, child, hook)
+        return ("ret", result)
+
+    def _t_timeout(self, w: _Work, node: CompiledNode, frame: Frame, result: int | None,
+                   hook: HaltHook | None) -> TickAction:
+        """Timeout as an abstraction: the timer (the gate) may fire on any tick after the
+        first; fired, the child is halted and the node returns FAILURE."""
+        child, gate = node.children[0], node.children[-1]
+        pc = frame[1]
+        if pc == 0:
+            started = w.st.get(node.id, IDLE) == RUNNING
+            w.st[node.id] = RUNNING
+            if not started:
+                return ("call", child, (node.id, 2))
+            return ("call", gate, (node.id, 1))
+        if pc == 1:
+            w.st.pop(gate, None)
+            if result == SUCCESS:  # fired
+                self._reset_child(w, child, hook)
+                return ("ret", FAILURE)
+            return ("call", child, (node.id, 2))
+        if result in (SUCCESS, FAILURE):
+            self._reset_child(w, child, hook)
+        return ("ret", result)
+
+    def _t_sleep(self, w: _Work, node: CompiledNode, frame: Frame, result: int | None,
+                 hook: HaltHook | None) -> TickAction:
+        """Sleep as an abstraction: RUNNING until the timer (the gate) says the time is up."""
+        gate = node.children[-1]
+        if frame[1] == 0:
+            w.st[node.id] = RUNNING
+            return ("call", gate, (node.id, 1))
+        w.st.pop(gate, None)
+        return ("ret", SUCCESS if result == SUCCESS else RUNNING)
+
+    def _t_for_each(self, w: _Work, node: CompiledNode, frame: Frame, result: int | None,
+                    hook: HaltHook | None) -> TickAction:
+        """MoveIt Pro ForEach / ForEachUntilSuccess as an abstraction: the gate says whether
+        the vector has another element; one element per tick."""
+        (no_more,) = node.params
+        stop = FAILURE if no_more == SUCCESS else SUCCESS
+        child, gate = node.children[0], node.children[-1]
+        pc = frame[1]
+        if pc == 0:
+            w.st[node.id] = RUNNING
+            if w.st.get(child, IDLE) == RUNNING:
+                return ("call", child, (node.id, 2))
+            return ("call", gate, (node.id, 1))
+        if pc == 1:
+            w.st.pop(gate, None)
+            if result == SUCCESS:
+                return ("call", child, (node.id, 2))
+            return ("ret", no_more)
+        if result == RUNNING:
+            return ("ret", RUNNING)
+        self._reset_child(w, child, hook)
+        return ("ret", stop if result == stop else RUNNING)
 
 
 # -- a plain runner: the interpreter driven by an environment callback -------------------------

@@ -9,6 +9,8 @@ Four groups, one test each, so a failure names the group:
   engine, and mutants of each pair (both sides);
 - corpus: every corpus model (``FSMBT_CORPUS``, default ``<repo>/../shared/corpus``) that the
   rules engine converts (BT XML -> HFSM, SCXML -> BT);
+- abstractions: hand-built trees over the project kinds and abstractions the encoding covers
+  (docs/semantics.md §10), both loop modes, with mutants;
 - mutation suite: every mutant of every family of tests/verify/test_ver_mutations.py, mutated on
   the same side as there, plus the unmutated pairs.
 
@@ -281,6 +283,64 @@ def generated_pairs() -> Iterator[Pair | Rejected]:
         yield from with_mutants(item, made < MUTATED)
 
 
+def _project(kind: str, *children: BTNode, **attrs: str) -> BTNode:
+    """A project kind or abstraction, enabled as ``--nodes`` / ``--abstract`` would."""
+    from fsmbt.semantics.nodes import node_semantics
+
+    spec = node_semantics(kind)
+    assert spec is not None
+    return BTNode(kind, spec.kind, attrs=dict(attrs), children=list(children), semantics=kind)
+
+
+def _abstraction_trees() -> list[BTDocument]:
+    """Every kind the NuSMV encoding covers beyond the built-ins (docs/semantics.md §10)."""
+    trees = [
+        _node("Sequence", _project("RateController", _leaf("plan")), _leaf("go")),
+        _node("Fallback", _project("PathLongerOnApproach", _leaf("a")), _leaf("b", True)),
+        _node("Sequence", _project("Delay", _leaf("a"), delay_msec="5"), _leaf("b")),
+        _node("Fallback", _project("Timeout", _leaf("a"), msec="5"), _leaf("b")),
+        _node("Sequence", _project("Sleep", msec="5"), _leaf("a")),
+        _node("Sequence", _project("ForEach", _leaf("a")), _leaf("b", True)),
+        _node("Fallback", _project("ForEachUntilSuccess", _leaf("a")), _leaf("b")),
+        _node("ReactiveSequence", _leaf("c", True),
+              _project("Precondition", _leaf("a"), **{"if": "x", "else": "SUCCESS"})),
+        _project("BlackboardCheckString", _node("Sequence", _leaf("a"), _leaf("b")),
+                 value_A="{x}", value_B="1", return_on_mismatch="FAILURE"),
+        _project("Root", _node("Sequence", _project("GoalUpdater", _leaf("a")), _leaf("b"))),
+        _node("ReactiveFallback", _leaf("c", True),
+              _project("DistanceController", _node("Sequence", _leaf("a"), _leaf("b")))),
+        _project("PipelineSequence", _leaf("c", True),
+                 _project("RateController", _leaf("plan")), _leaf("go")),
+        _project("RecoveryNode", _node("Sequence", _leaf("c", True), _leaf("a")), _leaf("r"),
+                 number_of_retries="2"),
+        _project("RoundRobin", _leaf("a"), _leaf("b", True), _leaf("c")),
+        _project("RoundRobin", _leaf("a"), _leaf("b"), wrap_around="true"),
+        _node("Sequence", _project("RepeatUnlessFailureEachTick", _leaf("a"), num_cycles="2"),
+              _leaf("b", True)),
+        # built-ins the encoding now covers too
+        BTNode("IfThenElse", NodeKind.CONTROL, children=[_leaf("c", True), _leaf("a"),
+                                                          _leaf("b")]),
+        _node("Sequence", BTNode("IfThenElse", NodeKind.CONTROL,
+                                 children=[_leaf("c"), _leaf("a")]), _leaf("d")),
+        BTNode("WhileDoElse", NodeKind.CONTROL, children=[_leaf("c", True), _leaf("a"),
+                                                           _leaf("b")]),
+        _node("Fallback", BTNode("WhileDoElse", NodeKind.CONTROL,
+                                 children=[_leaf("c", True), _leaf("a")]), _leaf("d")),
+    ]
+    return [BTDocument.single(t) for t in trees]
+
+
+def abstraction_pairs() -> Iterator[Pair | Rejected]:
+    """The trees above, both loop modes, with mutants of both sides."""
+    for i, doc in enumerate(_abstraction_trees()):
+        for loop in (False, True):
+            item = _convert(f"abs{i}-loop{int(loop)}", doc, loop=loop)
+            if isinstance(item, Pair):
+                yield from _with_mutants(item, bt_side=2, fsm_side=1)
+            elif item is not None:
+                yield item
+
+
 # -- examples and corpus -------------------------------------------------------------------------
 def _read(path: Path, notes: Counter[str]) -> Model | None:
     from fsmbt.formats.registry import read_model
@@ -347,6 +407,11 @@ def mutation_suite_pairs() -> Iterator[Pair]:
 def test_agreement_generated(nusmv_binary):
     group = run_group("generated", generated_pairs())
     assert_agreement(group, min_agreed=PAIRS)
+
+
+def test_agreement_abstractions(nusmv_binary):
+    group = run_group("abstractions", abstraction_pairs())
+    assert_agreement(group, min_agreed=2 * len(_abstraction_trees()))
 
 
 def test_agreement_examples(nusmv_binary):

@@ -52,7 +52,7 @@ def _leaf(name: str, kind: NodeKind = NodeKind.ACTION) -> BTNode:
     return BTNode(name, kind, name=name)
 
 
-@pytest.mark.parametrize("node_type", ["Parallel", "Repeat", "RunOnce", "IfThenElse"])
+@pytest.mark.parametrize("node_type", ["Parallel", "Repeat", "RunOnce", "ParallelAll"])
 def test_unencodable_nodes_are_rejected_with_the_node_named(node_type):
     attrs = {"num_cycles": "2"} if node_type == "Repeat" else {}
     kind = NodeKind.DECORATOR if node_type in ("Repeat", "RunOnce") else NodeKind.CONTROL

@@ -10,13 +10,17 @@ says which module reads which set.
 from __future__ import annotations
 
 from fsmbt.model.kinds import NodeKind
-from fsmbt.model.nodes import controls, decorators, leaves
+from fsmbt.model.nodes import controls, decorators, leaves, projects
 from fsmbt.model.nodes.registry import (
+    ABSTRACTIONS,
+    PROFILES,
     Family,
+    Gate,
     NodeSemantics,
     aliases,
     all_nodes,
     canonical_type,
+    enabling_option,
     kinds_where,
     node_semantics,
     register,
@@ -51,7 +55,12 @@ BLACKBOARD_BASED = kinds_where(lambda n: n.blackboard_based)
 NUSMV_ENCODED = kinds_where(lambda n: n.nusmv is not None)
 
 __all__ = [
+    "ABSTRACTIONS",
     "BLACKBOARD_BASED",
+    "PROFILES",
+    "Gate",
+    "enabling_option",
+    "projects",
     "FALLBACK_TYPES",
     "INTERPRETED_CONTROLS",
     "INTERPRETED_DECORATORS",

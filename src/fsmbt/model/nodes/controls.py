@@ -187,7 +187,7 @@ IF_THEN_ELSE = register(
         default_memory=(0,),
         halt_resets_memory=True,
         handler="if_then_else",
-        nusmv_refusal="not encoded yet",
+        nusmv="if_then_else",
         source="if_then_else_node.cpp",
     )
 )
@@ -202,7 +202,7 @@ WHILE_DO_ELSE = register(
         "child 2 (halting child 1) or returns FAILURE with two children",
         halt="halts the running child; keeps no memory",
         handler="while_do_else",
-        nusmv_refusal="not encoded yet",
+        nusmv="while_do_else",
         source="while_do_else_node.cpp",
     )
 )

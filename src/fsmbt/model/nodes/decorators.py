@@ -6,7 +6,7 @@ The rules are summaries; docs/semantics.md ("Decorators") is the reference.
 from __future__ import annotations
 
 from fsmbt.model.kinds import NodeKind
-from fsmbt.model.nodes.registry import Family, NodeSemantics, register
+from fsmbt.model.nodes.registry import Family, Gate, NodeSemantics, register
 
 _D = NodeKind.DECORATOR
 _BLACKBOARD = "its result depends on the blackboard"
@@ -135,8 +135,14 @@ PRECONDITION = register(
         tick="evaluates a script on the blackboard to decide whether the child runs",
         blackboard_based=True,
         rejection=_BLACKBOARD,
-        nusmv_refusal=_BLACKBOARD,
         ports=("if", "else"),
+        handler="gated",
+        nusmv="gated",
+        requires="blackboard",
+        abstraction="Precondition: whether its 'if' script holds is an environment input, asked "
+        "while its child is not running (closed: it returns its 'else' status)",
+        gate=Gate("if", closed="FAILURE"),
+        closed_port="else",
         source="script_precondition.h",
     )
 )
@@ -149,8 +155,13 @@ SKIP_UNLESS_UPDATED = register(
         tick="ticks the child only if a blackboard entry changed since the last tick",
         blackboard_based=True,
         rejection=_BLACKBOARD,
-        nusmv_refusal=_BLACKBOARD,
         ports=("entry",),
+        handler="gated",
+        nusmv="gated",
+        requires="blackboard",
+        abstraction="SkipUnlessUpdated: whether the entry was updated is an environment input, "
+        "asked while its child is not running (not updated: SKIPPED)",
+        gate=Gate("updated", closed="SKIPPED"),
         source="updated_decorator.cpp",
     )
 )
@@ -163,8 +174,13 @@ WAIT_VALUE_UPDATE = register(
         tick="returns RUNNING until a blackboard entry changes, then ticks the child",
         blackboard_based=True,
         rejection=_BLACKBOARD,
-        nusmv_refusal=_BLACKBOARD,
         ports=("entry",),
+        handler="gated",
+        nusmv="gated",
+        requires="blackboard",
+        abstraction="WaitValueUpdate: whether the entry was updated is an environment input, "
+        "asked while its child is not running (not yet: RUNNING)",
+        gate=Gate("updated", closed="RUNNING"),
         source="updated_decorator.cpp",
     )
 )
@@ -193,8 +209,13 @@ DELAY = register(
         tick="returns RUNNING for delay_msec milliseconds, then ticks the child",
         time_based=True,
         rejection=_CLOCK,
-        nusmv_refusal=_CLOCK,
         ports=("delay_msec",),
+        handler="gated",
+        nusmv="gated",
+        requires="time",
+        abstraction="Delay: whether its delay has elapsed is an environment input, asked until "
+        "the child starts (not yet: RUNNING)",
+        gate=Gate("timer", closed="RUNNING"),
         source="delay_node.cpp",
     )
 )
@@ -207,8 +228,13 @@ TIMEOUT = register(
         tick="ticks the child; halts it and returns FAILURE after msec milliseconds",
         time_based=True,
         rejection=_CLOCK,
-        nusmv_refusal=_CLOCK,
         ports=("msec",),
+        handler="timeout",
+        nusmv="timeout",
+        requires="time",
+        abstraction="Timeout: whether its timer has fired is an environment input, asked on "
+        "every tick after the first (fired: the child is halted, FAILURE)",
+        gate=Gate("timer", closed="FAILURE"),
         source="timeout_node.h",
     )
 )

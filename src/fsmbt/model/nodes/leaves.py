@@ -9,7 +9,7 @@ time-based or blackboard-based.
 from __future__ import annotations
 
 from fsmbt.model.kinds import NodeKind
-from fsmbt.model.nodes.registry import Family, NodeSemantics, register
+from fsmbt.model.nodes.registry import Family, Gate, NodeSemantics, register
 
 _A, _Q = NodeKind.ACTION, NodeKind.CONDITION
 _BLACKBOARD = "its result depends on the blackboard"
@@ -52,8 +52,13 @@ SLEEP = register(
         halt="cancels its timer",
         time_based=True,
         rejection="time-based node (needs a clock)",
-        nusmv_refusal="time-based node (needs a clock)",
         ports=("msec",),
+        handler="sleep",
+        nusmv="sleep",
+        requires="time",
+        abstraction="Sleep: whether its time is up is an environment input, asked on every tick "
+        "(not yet: RUNNING, then SUCCESS)",
+        gate=Gate("timer", closed="RUNNING"),
         source="sleep_node.cpp",
     )
 )
@@ -69,6 +74,9 @@ SCRIPT_CONDITION = register(
         rejection=_BLACKBOARD,
         nusmv_refusal=_BLACKBOARD,
         ports=("code",),
+        handler="env_condition",
+        requires="blackboard",
+        abstraction="ScriptCondition: its script's value is an environment input (a condition)",
         source="script_condition.h",
     )
 )
@@ -84,6 +92,10 @@ WAS_ENTRY_UPDATED = register(
         rejection=_BLACKBOARD,
         nusmv_refusal=_BLACKBOARD,
         ports=("entry",),
+        handler="env_condition",
+        requires="blackboard",
+        abstraction="WasEntryUpdated: whether the entry was updated is an environment input "
+        "(a condition)",
         source="updated_action.cpp",
     )
 )

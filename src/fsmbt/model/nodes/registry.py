@@ -51,6 +51,38 @@ class Family(str, Enum):
     INTERNAL_LEAF = "internal_leaf"  # AlwaysSuccess & co: a fixed result, no environment
     BLACKBOARD_LEAF = "blackboard_leaf"  # ScriptCondition, WasEntryUpdated
     SUBTREE = "subtree"  # a reference to another tree
+    PIPELINE = "pipeline"  # Nav2 PipelineSequence: re-ticks earlier children every tick
+    RECOVERY = "recovery"  # Nav2 RecoveryNode: a main child and a recovery child, retried
+    ROUND_ROBIN = "round_robin"  # Nav2 RoundRobin: resumes at the child after the last one
+    CONTROLLER = "controller"  # Nav2 rate/distance/speed/goal controllers: a gated child
+    ITERATOR = "iterator"  # MoveIt Pro ForEach*: one child per element of a blackboard vector
+    WRAPPER = "wrapper"  # a transparent one-child wrapper (Groot 1 Root, GoalUpdater)
+
+
+@dataclass(frozen=True)
+class Gate:
+    """An abstraction's environment input: a condition the environment answers on each tick
+    where the node consults it (docs/semantics.md, "Abstractions").
+
+    The gate is ticked as an extra condition child labelled ``<node label>.<word>``; its
+    SUCCESS opens the gate (the child is ticked, the timer fired, the vector has another
+    element...), its FAILURE closes it.
+
+    Attributes:
+        word: the gate's label suffix (``gate``, ``timer``, ``more``, ``match``, ``if``).
+        free_when_idle: the first tick after the node was IDLE ticks the child without asking.
+        free_when_running: a RUNNING child is ticked without asking.
+        closed: the status the node returns when the gate is closed (a ``NodeStatus`` name).
+        reset_on_done: the child is reset when it completes (else it keeps its status).
+        halt_on_closed: a closed gate halts a RUNNING child (else the child stays RUNNING).
+    """
+
+    word: str
+    free_when_idle: bool = False
+    free_when_running: bool = True
+    closed: str = "RUNNING"
+    reset_on_done: bool = True
+    halt_on_closed: bool = True
 
 
 @dataclass(frozen=True)
@@ -89,6 +121,13 @@ class NodeSemantics:
         ports: the ports the rules read.
         aliases: older (v3) or misspelt names read as this kind.
         source: the BehaviorTree.CPP source the rules follow.
+        library: who defines the kind (BehaviorTree.CPP, Nav2, MoveIt Pro, Groot).
+        requires: the option that enables the kind (``nav2`` / ``moveit_pro``: ``--nodes``;
+            ``time`` / ``blackboard``: ``--abstract``); ``None``: always available.
+        abstraction: the sentence the verdict names when the kind is modelled as an
+            abstraction (``None``: modelled exactly).
+        gate: the abstraction's environment input (``Gate``), ``None`` for exact kinds.
+        closed_port: a port that overrides ``gate.closed`` (``Precondition``'s ``else``).
     """
 
     name: str
@@ -117,6 +156,11 @@ class NodeSemantics:
     ports: tuple[str, ...] = ()
     aliases: tuple[str, ...] = ()
     source: str = ""
+    library: str = "BehaviorTree.CPP"
+    requires: str | None = None
+    abstraction: str | None = None
+    gate: Gate | None = None
+    closed_port: str | None = None
 
     @property
     def type(self) -> str:
@@ -231,8 +275,24 @@ def kinds_where(
     return frozenset(n.name for n in (all_nodes() if nodes is None else nodes) if predicate(n))
 
 
+#: The options that enable kinds: ``--nodes`` profiles and ``--abstract`` families.
+PROFILES = ("nav2", "moveit_pro")
+ABSTRACTIONS = ("time", "blackboard")
+
+
+def enabling_option(requirement: str) -> str:
+    """The command-line option that enables a ``NodeSemantics.requires`` value."""
+    if requirement in ABSTRACTIONS:
+        return f"--abstract {requirement}"
+    return f"--nodes {requirement}"
+
+
 __all__ = [
+    "ABSTRACTIONS",
     "Family",
+    "Gate",
+    "PROFILES",
+    "enabling_option",
     "NodeSemantics",
     "aliases",
     "all_nodes",

@@ -20,6 +20,7 @@ from typing import TypeVar
 
 from fsmbt.model.kinds import NodeKind
 from fsmbt.model.nodes import (
+    ABSTRACTIONS,
     BLACKBOARD_BASED,
     FALLBACK_TYPES,
     INTERPRETED_CONTROLS,
@@ -27,6 +28,7 @@ from fsmbt.model.nodes import (
     MERGEABLE_CONTROLS,
     NUSMV_ENCODED,
     PLAIN_CONTROLS,
+    PROFILES,
     REACTIVE_CONTROLS,
     RESULT_MAP_DECORATORS,
     SEQUENCE_TYPES,
@@ -36,6 +38,7 @@ from fsmbt.model.nodes import (
     aliases,
     all_nodes,
     canonical_type,
+    enabling_option,
     kinds_where,
     node_semantics,
     register,
@@ -83,7 +86,10 @@ def internal_status(node: NodeSemantics) -> NodeStatus | None:
 
 
 def _build(nodes: tuple[NodeSemantics, ...]) -> RuntimeTables:
-    handlers = {n.name: n.handler for n in nodes if n.handler is not None}
+    # a condition kind's handler (``env_condition``) names no tick rule: it is ticked as an
+    # environment leaf
+    handlers = {n.name: n.handler for n in nodes
+                if n.handler is not None and n.kind is not NodeKind.CONDITION}
     internal = {
         n.name: int(NodeStatus[n.internal_result]) for n in nodes if n.internal_result is not None
     }
@@ -112,6 +118,34 @@ def _build(nodes: tuple[NodeSemantics, ...]) -> RuntimeTables:
 
 
 T = TypeVar("T")
+
+
+def abstractions_used(doc: object) -> list[str]:
+    """The abstraction sentences of every node of a BT document modelled as an abstraction
+    (``BTNode.semantics`` naming a kind with an ``abstraction``), once each, in tree order:
+    what a verdict over ``doc`` holds under (docs/semantics.md §10).
+
+    Args:
+        doc: a ``BTDocument`` (anything else has none).
+
+    Returns:
+        The sentences, e.g. ``["RateController may skip its child on any tick (...)"]``.
+    """
+    from fsmbt.model.bt import BTDocument
+
+    if not isinstance(doc, BTDocument):
+        return []
+    found: dict[str, None] = {}
+    for _tree, node in doc.nodes():
+        if node.semantics is None:
+            continue
+        spec = node_semantics(node.semantics)
+        if spec is not None and spec.abstraction is not None:
+            sentence = spec.abstraction
+            if node.semantics != node.type:
+                sentence = f"{node.type} (as {sentence})"
+            found.setdefault(sentence, None)
+    return list(found)
 
 
 def rewired(decorator: str, success: T, failure: T) -> tuple[T, T]:
@@ -153,7 +187,9 @@ def runtime_tables() -> RuntimeTables:
 
 
 __all__ = [
+    "ABSTRACTIONS",
     "BLACKBOARD_BASED",
+    "PROFILES",
     "FALLBACK_TYPES",
     "INTERPRETED_CONTROLS",
     "INTERPRETED_DECORATORS",
@@ -167,9 +203,11 @@ __all__ = [
     "Family",
     "NodeSemantics",
     "RuntimeTables",
+    "abstractions_used",
     "aliases",
     "all_nodes",
     "canonical_type",
+    "enabling_option",
     "internal_status",
     "kinds_where",
     "node_semantics",

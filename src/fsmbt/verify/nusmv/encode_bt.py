@@ -48,6 +48,14 @@ SEQ_LIKE = {n.name: (n.is_fallback, n.wakes_up, n.with_memory)
 #: type -> is_fallback
 REACTIVE = {n.name: n.is_fallback for n in all_nodes() if n.nusmv == "reactive"}
 SIMPLE_DECORATORS = frozenset(n.name for n in all_nodes() if n.nusmv == "simple_decorator")
+#: Project kinds with an index or counter (docs/semantics.md §10): rule name.
+MEMORY_RULES = {n.name: n.nusmv for n in all_nodes()
+                if n.nusmv in ("pipeline", "recovery", "round_robin", "repeat_each_tick",
+                               "if_then_else", "while_do_else")}
+#: Abstractions and wrappers whose only state is statuses (docs/semantics.md §10): rule name.
+GATE_RULES = {n.name: n.nusmv for n in all_nodes()
+              if n.nusmv in ("gated", "timeout", "sleep", "for_each", "pass_through",
+                             "pass_through_keep")}
 SUPPORTED = NUSMV_ENCODED
 #: type -> why the encoding refuses it
 NOT_ENCODED = {n.name: n.nusmv_refusal for n in all_nodes() if n.nusmv_refusal is not None}
@@ -108,6 +116,8 @@ class BTCore:
         self.var_types: dict[str, str] = {}
         self.defines: list[tuple[str, str]] = []
         self.init: dict[str, str] = {}
+        #: memory variables of project kinds (index, counters): reset to 0 by a halt
+        self.memory_vars: list[tuple[str, int]] = []
 
     # -- naming ----------------------------------------------------------------------------
     def n(self, nid: int) -> str:
@@ -145,7 +155,16 @@ class BTCore:
             out.append(self.st(x.id))
             if self.is_seq_like(x.id):
                 out += [f"idx_{x.id}", f"prev_{x.id}"]
+        out += [var for var, _nid in self.memory_vars]
         return out
+
+    def memory(self, name: str, nid: int, top: int) -> str:
+        """Declare a memory variable ``0..top`` of node ``nid`` (reset by its halt)."""
+        var = f"{name}_{nid}"
+        self.var_types[var] = f"0..{max(top, 1)}"
+        self.init[var] = "0"
+        self.memory_vars.append((var, nid))
+        return var
 
     # -- the rules -------------------------------------------------------------------------
     def call(self, cond: str, child: int) -> None:
@@ -182,6 +201,12 @@ class BTCore:
             kids = list(x.children)
             k = len(kids)
             t = x.type
+            if t in GATE_RULES:
+                self._gate_rules(x, GATE_RULES[t], here, called, resets)
+                continue
+            if t in MEMORY_RULES:
+                self._memory_rules(x, MEMORY_RULES[t], here, called, resets)
+                continue
             if t in SEQ_LIKE:
                 is_fb, wakes, memory = SEQ_LIKE[t]
                 stop, go_on = ("S", "F") if is_fb else ("F", "S")
@@ -275,7 +300,228 @@ class BTCore:
             # a halted node's memory is reset (Sequence/Fallback/Async*; not WithMemory)
             if self.is_seq_like(x.id) and not SEQ_LIKE[x.type][2]:
                 self.rules.setdefault(f"idx_{x.id}", []).insert(0, (f"hlt_{x.id}", "0"))
+        for var, nid in self.memory_vars:
+            self.rules.setdefault(var, []).insert(0, (f"hlt_{nid}", "0"))
+        for x in self.nodes:
             self.rules.setdefault(self.st(x.id), []).insert(0, (f"clr_{x.id}", "I"))
+
+    def _gate_rules(self, x: CompiledNode, rule: str, here: str, called: str,
+                    resets: dict[int, list[str]]) -> None:
+        """Project wrappers and gated abstractions (docs/semantics.md §10): the gate is the
+        last child, a condition leaf the environment answers; only statuses are kept."""
+        kids = list(x.children)
+        back = f"{here} & res != NONE"
+        passed = "case res = S : S; res = F : F; TRUE : R; esac"
+        self.rule(self.st(x.id), called, "R")
+        if rule in ("pass_through", "pass_through_keep"):
+            c = kids[0]
+            self.call(called, c)
+            if rule == "pass_through":
+                resets[c].append(f"{back} & (res = S | res = F)")
+            self.ret(back, x.id, passed)
+            return
+        gate = kids[-1]
+        from_gate = f"{back} & lidx = {len(kids) - 1}"
+        resets[gate].append(from_gate)
+        if rule == "sleep":
+            self.call(called, gate)
+            self.ret(f"{from_gate} & res = S", x.id, "S")
+            self.ret(from_gate, x.id, "R")
+            return
+        c = kids[0]
+        from_child = f"{back} & lidx = 0"
+        if rule == "timeout":  # the gate says the timer fired; not asked on the first tick
+            self.call(f"{called} & {self.st(x.id)} != R", c)
+            self.call(called, gate)
+            resets[c].append(f"{from_gate} & res = S")
+            self.ret(f"{from_gate} & res = S", x.id, "F")
+            self.call(from_gate, c)
+            resets[c].append(f"{from_child} & (res = S | res = F)")
+            self.ret(from_child, x.id, passed)
+            return
+        spec = node_semantics(x.type)
+        assert spec is not None and spec.gate is not None
+        closed_status = NodeStatus(x.params[0]).name
+        if closed_status not in ST or closed_status == NodeStatus.IDLE.name:
+            raise UnsupportedError(
+                f"the NuSMV encoding does not support {x.type} returning {closed_status} "
+                "(SKIPPED is not encoded); use --engine native", location=x.source.location,
+                element=f"<{x.type}> '{x.label}'")
+        closed = ST[closed_status]
+        if rule == "for_each":
+            self.call(f"{called} & {self.st(c)} = R", c)
+            self.call(called, gate)
+            self.call(f"{from_gate} & res = S", c)
+            self.ret(from_gate, x.id, closed)
+            stop = "F" if closed == _S else "S"
+            self.ret(f"{from_child} & res = R", x.id, "R")
+            resets[c].append(f"{from_child} & res != R")
+            self.ret(f"{from_child} & res = {stop}", x.id, stop)
+            self.ret(from_child, x.id, "R")
+            return
+        gate_rule = spec.gate
+        free = []
+        if gate_rule.free_when_idle:
+            free.append(f"{self.st(x.id)} = I")
+        if gate_rule.free_when_running:
+            free.append(f"{self.st(c)} = R")
+        if free:
+            self.call(f"{called} & {any_of(free)}", c)
+        self.call(called, gate)
+        self.call(f"{from_gate} & res = S", c)
+        if gate_rule.halt_on_closed:
+            resets[c].append(f"{from_gate} & res = F & {self.st(c)} = R")
+        self.ret(from_gate, x.id, closed)
+        if gate_rule.reset_on_done:
+            resets[c].append(f"{from_child} & (res = S | res = F)")
+        self.ret(from_child, x.id, passed)
+
+    def _memory_rules(self, x: CompiledNode, rule: str, here: str, called: str,
+                      resets: dict[int, list[str]]) -> None:
+        """PipelineSequence, RecoveryNode, RoundRobin, RepeatUnlessFailureEachTick
+        (docs/semantics.md §10; SKIPPED children are not encoded)."""
+        kids = list(x.children)
+        n = len(kids)
+        back = f"{here} & res != NONE"
+        self.rule(self.st(x.id), called, "R")
+
+        def reset_all(cond: str) -> None:
+            for c in kids:
+                resets[c].append(cond)
+
+        passed = "case res = S : S; res = F : F; TRUE : R; esac"
+        if rule in ("if_then_else", "while_do_else"):
+            # docs/semantics.md §2: IfThenElse keeps the chosen branch (ci), WhileDoElse
+            # re-ticks its condition every tick
+            memo = self.memory("ci", x.id, n - 1) if rule == "if_then_else" else None
+            if memo is not None:
+                for i in range(n - 1, 0, -1):
+                    self.call(f"{called} & {memo} = {i}", kids[i])
+            self.call(called, kids[0])
+            from_cond = f"{back} & lidx = 0"
+            self.ret(f"{from_cond} & res = R", x.id, "R")
+            if memo is not None:
+                self.rule(memo, f"{from_cond} & res = S", "1")
+            elif n == 3:
+                resets[kids[2]].append(f"{from_cond} & res = S")
+            self.call(f"{from_cond} & res = S", kids[1])
+            if n == 3:
+                if memo is not None:
+                    self.rule(memo, f"{from_cond} & res = F", "2")
+                else:
+                    resets[kids[1]].append(f"{from_cond} & res = F")
+                self.call(f"{from_cond} & res = F", kids[2])
+            else:
+                if memo is None:
+                    reset_all(f"{from_cond} & res = F")
+                self.ret(f"{from_cond} & res = F", x.id, "F")
+            from_branch = f"{back} & lidx != 0"
+            self.ret(f"{from_branch} & res = R", x.id, "R")
+            reset_all(f"{from_branch} & res != R")
+            if memo is not None:
+                self.rule(memo, f"{from_branch} & res != R", "0")
+            self.ret(from_branch, x.id, passed)
+            return
+        if rule == "pipeline":
+            last = self.memory("pl", x.id, n - 1)
+            self.call(called, kids[0])
+            failed = f"{back} & res = F"
+            reset_all(failed)
+            self.rule(last, failed, "0")
+            self.ret(failed, x.id, "F")
+            for i in range(n):
+                at = f"{back} & lidx = {i}"
+                self.ret(f"{at} & res = R & {last} <= {i}", x.id, "R")
+                self.rule(last, f"{at} & res = R & {last} <= {i}", str(i))
+                if i + 1 < n:
+                    self.call(at, kids[i + 1])  # SUCCESS, or RUNNING before the furthest
+                else:
+                    reset_all(f"{at} & res = S")  # (res = R returned above)
+                    self.rule(last, at, "0")
+                    self.ret(at, x.id, "S")
+            return
+        if rule == "repeat_each_tick":
+            (limit,) = x.params
+            c = kids[0]
+            self.call(called, c)
+            self.ret(f"{back} & res = R", x.id, "R")
+            done = f"{back} & (res = S | res = F)"
+            resets[c].append(done)
+            if limit == -1:
+                self.ret(f"{back} & res = S", x.id, "R")
+                self.ret(back, x.id, "F")
+                return
+            count = self.memory("rc", x.id, limit - 1)
+            self.rule(count, f"{back} & res = F", "0")
+            self.ret(f"{back} & res = F", x.id, "F")
+            finished = f"{back} & res = S & {count} >= {limit - 1}"
+            self.rule(count, finished, "0")
+            self.ret(finished, x.id, "S")
+            self.rule(count, f"{back} & res = S", _inc(count, limit - 1))
+            self.ret(f"{back} & res = S", x.id, "R")
+            return
+        if rule == "recovery":
+            (retries,) = x.params
+            main, recovery = kids
+            cur = self.memory("ri", x.id, 1)
+            tries = self.memory("rt", x.id, max(retries, 0))
+            self.call(f"{called} & {cur} = 0", main)
+            self.call(called, recovery)
+            from_main, from_rec = f"{back} & lidx = 0", f"{back} & lidx = 1"
+            for side in (from_main, from_rec):
+                self.ret(f"{side} & res = R", x.id, "R")
+            won = f"{from_main} & res = S"
+            retry = f"{from_main} & res = F & {tries} < {retries}"
+            lost = (f"({from_main} & res = F & {tries} >= {retries}) | "
+                    f"({from_rec} & res = F)")
+            for cond, status in ((won, "S"),):
+                reset_all(cond)
+                self.rule(cur, cond, "0")
+                self.rule(tries, cond, "0")
+                self.ret(cond, x.id, status)
+            resets[main].append(retry)
+            self.rule(cur, retry, "1")
+            self.call(retry, recovery)
+            reset_all(f"({lost})")
+            self.rule(cur, f"({lost})", "0")
+            self.rule(tries, f"({lost})", "0")
+            self.ret(f"({lost})", x.id, "F")
+            recovered = f"{from_rec} & res = S"
+            resets[recovery].append(recovered)
+            self.rule(cur, recovered, "0")
+            self.rule(tries, recovered, _inc(tries, max(retries, 0)))
+            self.call(recovered, main)
+            return
+        # round_robin
+        (wrap,) = x.params
+        pos = self.memory("rr", x.id, n - 1)
+        fails = self.memory("rf", x.id, n)
+        for i, c in enumerate(kids):
+            self.call(f"{called} & {pos} = {i}", c)
+        self.ret(f"{back} & res = R", x.id, "R")
+        for i in range(n):
+            at = f"{back} & lidx = {i}"
+            end = i + 1 == n and not wrap
+            nxt = (i + 1) % n
+            won, lost = f"{at} & res = S", f"{at} & res = F"
+            if end:  # the last child completed without wrap-around: FAILURE (as Nav2 reads)
+                reset_all(f"{at} & res != R")
+                self.rule(pos, f"{at} & res != R", "0")
+                self.rule(fails, f"{at} & res != R", "0")
+                self.ret(f"{at} & res != R", x.id, "F")
+                continue
+            reset_all(won)
+            self.rule(pos, won, str(nxt))
+            self.rule(fails, won, "0")
+            self.ret(won, x.id, "S")
+            more = f"{lost} & {fails} < {n - 1}"
+            self.rule(pos, more, str(nxt))
+            self.rule(fails, more, _inc(fails, n))
+            self.call(more, kids[nxt])
+            reset_all(lost)
+            self.rule(pos, lost, "0")
+            self.rule(fails, lost, "0")
+            self.ret(lost, x.id, "F")
 
     def leaf_request(self, nid: int) -> str:
         """The condition: ``cur`` is env leaf ``nid`` asking the environment."""
@@ -302,6 +548,12 @@ class BTCore:
         # NuSMV reserves S, F (and X, G, U, ...) as temporal operators: status constants are
         # written I/R/S/F/NONE above for readability and renamed to safe words here.
         return _SAFE_STATUS.sub(lambda m: "z" + m.group(1), "\n".join(lines) + "\n")
+
+
+def _inc(var: str, top: int) -> str:
+    """``var + 1`` kept inside ``0..top`` (NuSMV checks every assignment's range, even on
+    states the rules never reach)."""
+    return f"case {var} < {top} : {var} + 1; TRUE : {top}; esac"
 
 
 _SAFE_STATUS = re.compile(r"(?<![\w$#-])(I|R|S|F|NONE)(?![\w$#-])")

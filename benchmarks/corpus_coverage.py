@@ -1,0 +1,199 @@
+"""Corpus coverage: how many real files (written by others) convert and verify (prints tables).
+
+Runs ``fsmbt.api.convert_file`` (rules engine, native checker, nothing written) over every file
+of the corpus (``FSMBT_CORPUS``, default ``../shared/corpus``): BehaviorTree.CPP XML under
+``bt/``, SCXML, SMACH and FlexBE under ``fsm/``. Each file is tried in three settings:
+
+- ``plain``: no options, as a new user types ``fsmbt convert FILE -o OUT``;
+- ``profiles``: ``--nodes nav2,moveit_pro`` (the project node libraries; their gating
+  controllers are abstractions, named in the verdict) and, for Nav2 trees, Nav2's model file
+  as ``--node-models``;
+- ``abstract``: ``profiles`` plus ``--abstract time,blackboard``.
+
+Files under ``_malformed/`` or ``_legacy_draft/`` are negative inputs: they must be refused
+(counted apart). A file "converts" when the result is EQUIVALENT. For the others the first
+blocker (the error's message, with node names and locations cut out) is tallied.
+
+A file still running after ``--budget`` seconds (default 60) is counted as "over the budget":
+its explored state space is too large for that time (it is reported, not hidden).
+
+Run: PYTHONPATH=src python benchmarks/corpus_coverage.py [--setting plain] [--markdown]
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import re
+import signal
+import sys
+import time
+from collections import Counter
+from dataclasses import dataclass
+from pathlib import Path
+
+from fsmbt import api
+from fsmbt.model.errors import InputError
+
+SETTINGS = ("plain", "profiles", "abstract")
+NEGATIVE_DIRS = ("_malformed", "_legacy_draft")
+
+
+@dataclass
+class Row:
+    path: Path
+    source: str  # "bt/nav2", "fsm/scion_tests", ...
+    kind: str  # "bt", "scxml", "smach", "flexbe"
+    negative: bool
+    ok: bool
+    reason: str
+    seconds: float = 0.0
+
+
+def corpus_root() -> Path:
+    return Path(os.environ.get("FSMBT_CORPUS", Path(__file__).resolve().parents[1] / ".."
+                               / "shared" / "corpus")).resolve()
+
+
+def corpus_files(root: Path) -> list[tuple[Path, str, str]]:
+    """(path, source folder, kind) for every model file of the corpus, sorted."""
+    found: list[tuple[Path, str, str]] = []
+    for path in sorted(root.rglob("*")):
+        if not path.is_file() or "models" in path.parts or "LICENSES" in path.parts:
+            continue
+        rel = path.relative_to(root)
+        if len(rel.parts) < 3:
+            continue
+        source = "/".join(rel.parts[:2])
+        if path.suffix == ".xml" and rel.parts[0] == "bt":
+            found.append((path, source, "bt"))
+        elif path.suffix == ".scxml":
+            found.append((path, source, "scxml"))
+        elif path.suffix == ".py" and "flexbe" in rel.parts[1]:
+            found.append((path, source, "flexbe"))
+        elif path.suffix == ".py" and "smach" in rel.parts[1]:
+            found.append((path, source, "smach"))
+    return found
+
+
+def options_for(setting: str, source: str, root: Path) -> dict[str, object]:
+    if setting == "plain":
+        return {}
+    options: dict[str, object] = {"nodes": ["nav2", "moveit_pro"]}
+    if source == "bt/nav2":
+        options["node_models"] = [str(root / "bt" / "nav2" / "models" / "nav2_tree_nodes.xml")]
+    if setting == "abstract":
+        options["abstract"] = ["time", "blackboard"]
+    return options
+
+
+_LOCATION = re.compile(r"^\S+?(:\d+(:\d+)?)?: ")
+_QUOTED = re.compile(r"'[^']*'")
+
+
+def reason_of(exc: Exception) -> str:
+    """The error's cause without the file location and quoted names (so causes tally)."""
+    text = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+    text = _LOCATION.sub("", text)
+    text = re.sub(r"<[^>]*> ", "", text)
+    text = _QUOTED.sub("'…'", text)
+    text = re.sub(r"\(and \d+ more.*", "", text)
+    return text.strip()[:110]
+
+
+class _OverBudget(Exception):
+    pass
+
+
+def _alarm(_signum: int, _frame: object) -> None:
+    raise _OverBudget
+
+
+def run_one(path: Path, source: str, kind: str, setting: str, root: Path,
+            budget: int = 0) -> Row:
+    """Convert and verify one file; ``budget`` seconds (0: none) before it counts as "over
+    the time budget" (a state space too large to explore in that time)."""
+    negative = any(part in NEGATIVE_DIRS for part in path.parts)
+    if budget:
+        signal.signal(signal.SIGALRM, _alarm)
+        signal.alarm(budget)
+    started = time.perf_counter()
+    try:
+        outcome = api.convert_file(path, options=options_for(setting, source, root))
+        ok = outcome.equivalent is True
+        reason = "" if ok else f"verdict {outcome.verdict}"
+    except _OverBudget:
+        ok, reason = False, f"over the {budget} s budget (state space too large)"
+    except InputError as exc:  # UnsupportedError is an InputError
+        ok, reason = False, reason_of(exc)
+    except Exception as exc:  # noqa: BLE001 - a crash is a finding: count it, never hide it
+        ok, reason = False, f"CRASH {type(exc).__name__}: {reason_of(exc)}"
+    finally:
+        if budget:
+            signal.alarm(0)
+    row = Row(path, source, kind, negative, ok, reason)
+    row.seconds = time.perf_counter() - started
+    return row
+
+
+def table(title: str, header: list[str], rows: list[list[object]], markdown: bool) -> str:
+    if markdown:
+        lines = [f"**{title}**", "", "| " + " | ".join(header) + " |",
+                 "|" + "|".join("---" for _ in header) + "|"]
+        lines += ["| " + " | ".join(str(c) for c in r) + " |" for r in rows]
+        return "\n".join(lines) + "\n"
+    widths = [max(len(str(x)) for x in [h, *(r[i] for r in rows)]) for i, h in enumerate(header)]
+    out = [title, "  ".join(h.ljust(w) for h, w in zip(header, widths))]
+    out += ["  ".join(str(c).ljust(w) for c, w in zip(r, widths)) for r in rows]
+    return "\n".join(out) + "\n"
+
+
+def share(ok: int, total: int) -> str:
+    return f"{ok}/{total} ({100.0 * ok / total:.1f} %)" if total else "0/0"
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--setting", choices=SETTINGS, action="append")
+    parser.add_argument("--markdown", action="store_true")
+    parser.add_argument("--kind", choices=("bt", "scxml", "smach", "flexbe"), action="append")
+    parser.add_argument("--budget", type=int, default=60,
+                        help="seconds per file before it counts as over budget (0: none)")
+    args = parser.parse_args()
+    root = corpus_root()
+    if not root.is_dir():
+        print(f"corpus not found: {root} (set FSMBT_CORPUS)", file=sys.stderr)
+        return 2
+    files = [f for f in corpus_files(root) if not args.kind or f[2] in args.kind]
+    for setting in args.setting or SETTINGS:
+        rows = [run_one(p, s, k, setting, root, args.budget) for p, s, k in files]
+        positive = [r for r in rows if not r.negative]
+        print(f"\n## setting: {setting} ({len(rows)} files, corpus {root})\n")
+        by_source: dict[str, list[Row]] = {}
+        for r in positive:
+            by_source.setdefault(r.source, []).append(r)
+        print(table("by source (well-formed files)", ["source", "files", "convert+verify"],
+                    [[s, len(rs), share(sum(r.ok for r in rs), len(rs))]
+                     for s, rs in sorted(by_source.items())], args.markdown))
+        reasons = Counter(r.reason for r in positive if not r.ok)
+        print(table("remaining first blockers (well-formed files)", ["files", "reason"],
+                    [[n, reason] for reason, n in reasons.most_common()], args.markdown))
+        for kind in ("bt", "scxml", "smach", "flexbe"):
+            mine = [r for r in positive if r.kind == kind]
+            if mine:
+                print(f"{kind}: {share(sum(r.ok for r in mine), len(mine))} well-formed files "
+                      "convert and verify")
+        negatives = [r for r in rows if r.negative]
+        refused = sum(not r.ok and not r.reason.startswith("CRASH") for r in negatives)
+        print(f"negative inputs refused with an error: {refused}/{len(negatives)}")
+        slowest = max(rows, key=lambda r: r.seconds)
+        print(f"time: {sum(r.seconds for r in rows):.1f} s in all, slowest "
+              f"{slowest.seconds:.1f} s ({slowest.path.relative_to(root)})")
+        crashes = [r for r in rows if r.reason.startswith("CRASH")]
+        for r in crashes:
+            print(f"CRASH: {r.path.relative_to(root)}: {r.reason}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,74 @@
+"""``validate`` and ``convert`` agree on every well-formed corpus BT (issue 12 part 5): a file
+``validate`` passes (exit 0) is not refused by ``convert``, and a file ``convert`` refuses fails
+``validate`` (exit 2) with an error at the place convert names; ``info`` lists what would be refused.
+Skips only when the corpus folder is absent (FSMBT_CORPUS)."""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+
+import pytest
+
+from fsmbt import api
+from fsmbt.cli import main
+from fsmbt.model.errors import InputError
+
+CORPUS = Path(os.environ.get("FSMBT_CORPUS",
+                             Path(__file__).resolve().parents[2] / ".." / "shared" / "corpus"))
+
+
+def _bt_files() -> list[Path]:
+    root = CORPUS / "bt"
+    if not root.is_dir():
+        return []
+    return sorted(p for p in root.rglob("*.xml")
+                  if "_malformed" not in p.parts and "models" not in p.parts)
+
+
+def test_validate_and_convert_agree_on_the_corpus(capsys: pytest.CaptureFixture[str]) -> None:
+    files = _bt_files()
+    if not files:
+        pytest.skip(f"corpus not found at {CORPUS} (set FSMBT_CORPUS)")
+    disagreements: list[str] = []
+    refused = 0
+    for path in files:
+        code = main(["validate", str(path), "--json"])
+        captured = capsys.readouterr()
+        if not captured.out:  # the file itself cannot be read: validate says why, on stderr
+            assert code == 2 and captured.err.startswith("error:"), path
+            with pytest.raises(InputError):
+                api.convert_file(path, verify=False)  # and convert refuses it as well
+            refused += 1
+            continue
+        report = json.loads(captured.out)
+        try:
+            api.convert_file(path, verify=False)
+            converts = True
+        except InputError as exc:
+            converts = False
+            refused += 1
+            error_lines = {i["line"] for i in report["issues"] if i["severity"] == "error"}
+            if exc.location is not None and exc.location.line not in error_lines:
+                disagreements.append(f"{path.name}: convert refuses at {exc.location}, "
+                                     f"validate names no error there ({sorted(error_lines)})")
+        if (code == 0) != converts:
+            disagreements.append(f"{path.name}: validate exit {code}, convert "
+                                 f"{'converts' if converts else 'refuses'}")
+    assert disagreements == []
+    assert refused > 0  # the corpus has files conversion refuses: the check is not vacuous
+
+
+def test_info_lists_every_blocker(capsys: pytest.CaptureFixture[str]) -> None:
+    path = CORPUS / "bt" / "bt_in_action" / "julienbayle_stardust_r2_bt.xml"
+    if not path.is_file():
+        pytest.skip(f"corpus not found at {CORPUS} (set FSMBT_CORPUS)")
+    assert main(["info", str(path), "--json"]) == 0
+    blockers = json.loads(capsys.readouterr().out)["conversion_blockers"]
+    assert len(blockers) >= 2  # every one, not only the first
+    assert any("BlackboardCheckString" in b and "--abstract blackboard" in b for b in blockers)
+    # with the abstraction only the project's own custom control remains
+    assert main(["info", str(path), "--json", "--abstract", "blackboard"]) == 0
+    left = json.loads(capsys.readouterr().out)["conversion_blockers"]
+    assert left and all("RealParallel" in b for b in left)
