@@ -23,10 +23,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from fsmbt.model.bt import BTDocument, BTNode
+from fsmbt.model.bt_nodes import canonical_type
+from fsmbt.model.nodes import SEQUENCE_TYPES
 from fsmbt.model.validate import Issue
 from fsmbt.semantics.lebt.spec import GUARD_TYPE, STATE_TYPE, GuardSpec, StateSpec
 
-_CHAIN_TYPES = frozenset({"Sequence", "SequenceWithMemory", "SequenceStar"})
 
 
 @dataclass(frozen=True)
@@ -55,7 +56,7 @@ def _guarded(parent: BTNode, index: int) -> BTNode | None:
     if index + 1 >= len(parent.children):
         return None
     after = parent.children[index + 1]
-    if after.type in _CHAIN_TYPES and after.children:
+    if canonical_type(after.type) in SEQUENCE_TYPES and after.children:  # the guarded body
         return after.children[0]
     return after
 
