@@ -6,7 +6,9 @@
 Families (one random tree per size, the shape of ``bench_checker.random_tree``: groups of 2-4
 under a control, 40 % conditions; every control then re-typed, seeded):
 - ``plain``: Sequence/Fallback (the static table of ``leaf_fast``);
-- ``reactive``: ReactiveSequence/ReactiveFallback (canonical states, ``leaf_canonical``);
+- ``reactive``: ReactiveSequence/ReactiveFallback (the static table widened to reactive nodes);
+- ``reactive-plain``: each control reactive or plain at random (plain nodes under reactive ones
+  keep a running index: canonical states, ``leaf_canonical``);
 - ``memory``: SequenceWithMemory / Fallback (the WithMemory index is real, readable memory);
 - ``mixed``: each control drawn from all five kinds.
 Each tree is checked against its HFSM (``bt_to_hfsm``, not timed); ``time`` is the whole
@@ -39,6 +41,8 @@ from fsmbt.verify.pairing import machines_for  # noqa: E402
 FAMILIES: dict[str, dict[str, tuple[str, ...]]] = {
     "plain": {"Sequence": ("Sequence",), "Fallback": ("Fallback",)},
     "reactive": {"Sequence": ("ReactiveSequence",), "Fallback": ("ReactiveFallback",)},
+    "reactive-plain": {"Sequence": ("ReactiveSequence", "Sequence"),
+                       "Fallback": ("ReactiveFallback", "Fallback")},
     "memory": {"Sequence": ("SequenceWithMemory",), "Fallback": ("Fallback",)},
     "mixed": {"Sequence": ("Sequence", "ReactiveSequence", "SequenceWithMemory"),
               "Fallback": ("Fallback", "ReactiveFallback")},

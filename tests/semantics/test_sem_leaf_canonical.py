@@ -100,7 +100,7 @@ def test_checker_proves_canonical_equivalent_to_faithful(loop: bool) -> None:
         n_canon, n_faithful = len(explore(canon)), len(explore(faithful))
         assert n_canon <= n_faithful
         smaller += n_canon < n_faithful
-    assert smaller > len(docs) // 4  # the reduction does merge states
+    assert smaller > len(docs) // 8  # the reduction does merge states
 
 
 @settings(max_examples=60, deadline=None)
@@ -142,15 +142,18 @@ def test_checker_verdict_same_on_both_machines() -> None:
 
 
 def _wide_reactive(width: int) -> BTDocument:
-    """ReactiveSequence of ReactiveFallbacks (condition, action): the shape of Nav2 trees."""
+    """ReactiveSequence of ReactiveFallbacks (condition, Sequence(action)): the shape of Nav2
+    trees; the plain Sequence under a reactive node keeps it off the static table."""
     kids = [BTNode("ReactiveFallback", NodeKind.CONTROL, children=[
         BTNode("Check", NodeKind.CONDITION, name=f"c{i}"),
-        BTNode("Do", NodeKind.ACTION, name=f"a{i}")]) for i in range(width)]
+        BTNode("Sequence", NodeKind.CONTROL, children=[
+            BTNode("Do", NodeKind.ACTION, name=f"a{i}")])]) for i in range(width)]
     return BTDocument.single(BTNode("ReactiveSequence", NodeKind.CONTROL, children=kids))
 
 
 def test_reactive_tree_has_one_state_per_leaf() -> None:
     doc = _wide_reactive(12)
+    assert LeafMachine(doc).canonical
     canon, faithful = explore(LeafMachine(doc)), explore(LeafMachine(doc, generic=True))
     assert len(canon) == 24 + 2  # one per leaf, plus SUCCESS and FAILURE
     assert len(faithful) > 4 * len(canon)

@@ -58,7 +58,7 @@ from fsmbt.semantics.bt_interpreter import (
     Snapshot,
 )
 from fsmbt.semantics.leaf_canonical import Canonicalizer, is_canonical_class
-from fsmbt.semantics.leaf_fast import ROOT_RESULT_NAMES, PlainLeafTable, is_plain_tree
+from fsmbt.semantics.leaf_fast import ROOT_RESULT_NAMES, PlainLeafTable, is_static_tree
 from fsmbt.semantics.machine import FINAL, Machine, Outputs
 from fsmbt.semantics.machine import RUNNING as STATUS_RUNNING
 from fsmbt.semantics.status import LeafOutcome, NodeStatus
@@ -102,7 +102,7 @@ class LeafMachine:
         self.loop = loop
         main = self.tree.doc.main
         self.name = name or main.id
-        self.fast = not generic and is_plain_tree(self.tree)
+        self.fast = not generic and is_static_tree(self.tree)
         self.table = PlainLeafTable(self.tree) if self.fast else None
         self.canonicalizer = (Canonicalizer(self.tree)
                               if not generic and not self.fast and is_canonical_class(self.tree)
