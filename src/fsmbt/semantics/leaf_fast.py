@@ -16,6 +16,13 @@ the machine is static (derived from ``sequence_node.cpp``/``fallback_node.cpp``)
   A Fallback is the mirror image. A SubTree passes its child's result on. Leaving the root ends
   the tick with the root's result (``"SUCCESS"``/``"FAILURE"``).
 
+Widened class (``is_static_tree``, docs/semantics.md §4a): reactive Sequence/Fallback nodes
+(registry flag ``reactive``) with no plain control below them, and status-mapping decorators
+(registry ``result_map``; their child's exits are theirs rewired). Success/failure exits are the
+same tables (a reactive node goes on or stops within the tick like a plain one); ``running``
+leads to ``on_running[leaf]``: the leaf itself with no reactive ancestor, else the first leaf of
+the topmost reactive ancestor, which restarts at child 0 on the next tick.
+
 ``exits[o][N]`` ("outcome ``o`` leaving ``N`` leads to leaf X or root result R") depends only on
 ``N``'s parent's entry, so one forward pass over the pre-order ids (parents before children)
 fills the table: O(N) time and memory, no recursion (trees may be 100 000 deep). One step then

@@ -19,7 +19,8 @@ way: the root's result when a tick ends with one (``"SUCCESS"``/``"FAILURE"``, o
   ``RootResult("LIVELOCK")`` with output ``("LIVELOCK",)``: the real engine hangs there.
 
 Fast path: a tree of only plain ``Sequence``/``Fallback`` nodes, transparent SubTrees and
-environment leaves (``leaf_fast.is_plain_tree``) runs on ``leaf_fast.PlainLeafTable`` instead:
+environment leaves, widened with reactive nodes that hold no plain control below them and status
+maps (``leaf_fast.is_static_tree``), runs on ``leaf_fast.PlainLeafTable`` instead:
 a state is then the ``int`` id of the leaf about to be ticked, one step is O(1), and the outputs,
 statuses and inputs are the interpreter's (tests/semantics/test_sem_leaf_fast.py checks them in
 lockstep). ``generic=True`` forces the interpreter; ``fast`` says which path was taken.
