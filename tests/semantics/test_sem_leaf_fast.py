@@ -15,6 +15,7 @@ from fsmbt.convert.bt_to_hfsm import bt_to_hfsm
 from fsmbt.generate import random_bt
 from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.bt_nodes import NodeKind
+from fsmbt.semantics.leaf_fast import is_plain_tree
 from fsmbt.semantics.leaf_machine import LeafMachine, RootResult
 from fsmbt.verify import native
 from fsmbt.verify.mutations import mutants
@@ -125,14 +126,16 @@ def _leaf(name: str, kind: NodeKind = NodeKind.ACTION) -> BTNode:
 
 
 @pytest.mark.parametrize("root", [
-    BTNode("ReactiveSequence", NodeKind.CONTROL, children=[_leaf("a"), _leaf("b")]),
+    BTNode("ReactiveSequence", NodeKind.CONTROL, children=[
+        _leaf("a"), BTNode("Sequence", NodeKind.CONTROL, children=[_leaf("b"), _leaf("c")])]),
     BTNode("SequenceWithMemory", NodeKind.CONTROL, children=[_leaf("a"), _leaf("b")]),
     BTNode("Sequence", NodeKind.CONTROL, children=[
-        BTNode("Inverter", NodeKind.DECORATOR, children=[_leaf("a")]), _leaf("b")]),
+        BTNode("Repeat", NodeKind.DECORATOR, attrs={"num_cycles": "2"}, children=[_leaf("a")]),
+        _leaf("b")]),
     BTNode("Fallback", NodeKind.CONTROL, children=[
         _leaf("a"), BTNode("AlwaysSuccess", NodeKind.ACTION)]),
     BTNode("Parallel", NodeKind.CONTROL, children=[_leaf("a"), _leaf("b")]),
-], ids=["reactive", "with-memory", "decorator", "always-success", "parallel"])
+], ids=["plain-under-reactive", "with-memory", "loop-decorator", "always-success", "parallel"])
 def test_trees_outside_the_class_take_the_generic_path(root: BTNode) -> None:
     assert not LeafMachine(BTDocument.single(root)).fast
 
@@ -156,3 +159,55 @@ def test_deep_tree_builds_without_recursion() -> None:
     # bottom fails: its Fallback parent (i = 0) goes on to x0
     state, outputs = machine.step(state, "failure")
     assert outputs == ("x0",)
+
+
+# -- the static table widened: reactive nodes over reactive/plain-free subtrees, status maps ----
+STATIC_CONTROLS = ("Sequence", "Fallback", "ReactiveSequence", "ReactiveFallback")
+STATIC_DECORATORS = ("Inverter", "ForceSuccess", "ForceFailure", "SubTree")
+
+
+def static_documents(count: int = 400) -> list[BTDocument]:
+    docs = [random_tree(random.Random(10_000 + seed), controls=STATIC_CONTROLS,
+                        decorators=STATIC_DECORATORS, leaves=("Action", "Condition"),
+                        max_nodes=18) for seed in range(count)]
+    return [doc for doc in docs if LeafMachine(doc).fast and not is_plain_tree(
+        LeafMachine(doc).tree)]
+
+
+@pytest.mark.parametrize("loop", [False, True])
+def test_static_reactive_tables_agree_in_lockstep(loop: bool) -> None:
+    rng = random.Random(777 + loop)
+    docs = static_documents()
+    assert len(docs) >= 60
+    for doc in docs:
+        lockstep(doc, loop, rng)
+
+
+@pytest.mark.parametrize("loop", [False, True])
+def test_checker_proves_static_reactive_tables_equivalent(loop: bool) -> None:
+    """Every input sequence: the product of the table machine and the faithful one."""
+    for doc in static_documents(200):
+        report = native.check(LeafMachine(doc, loop=loop, generic=True),
+                              LeafMachine(doc, loop=loop), mode="lockstep")
+        assert report.equivalent, report.verdicts()
+
+
+def test_reactive_restart_goes_to_the_topmost_reactive_first_leaf() -> None:
+    inner = BTNode("ReactiveFallback", NodeKind.CONTROL, children=[
+        _leaf("c", NodeKind.CONDITION), _leaf("run")])
+    root = BTNode("Sequence", NodeKind.CONTROL, children=[
+        _leaf("first"), BTNode("ReactiveSequence", NodeKind.CONTROL, children=[
+            _leaf("guard", NodeKind.CONDITION), inner])])
+    machine = LeafMachine(BTDocument.single(root))
+    assert machine.fast
+    state, outputs = machine.start()
+    assert outputs == ("first",)
+    state, outputs = machine.step(state, "success")
+    assert outputs == ("guard",)
+    state, outputs = machine.step(state, "success")
+    assert outputs == ("c",)
+    state, outputs = machine.step(state, "failure")
+    assert outputs == ("run",)
+    # running: the plain root resumes its child 1, the ReactiveSequence restarts at 'guard'
+    state, outputs = machine.step(state, "running")
+    assert outputs == ("guard",)

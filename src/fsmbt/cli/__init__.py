@@ -21,6 +21,8 @@ EXIT_OK = 0
 EXIT_NOT_EQUIVALENT = 1
 EXIT_BAD_INPUT = 2
 EXIT_INTERNAL = 3
+#: A resource cap of a verification engine was reached (NuSMV's memory or time, docs/cli.md).
+EXIT_LIMIT = 4
 
 app = typer.Typer(
     name="fsmbt",
@@ -67,6 +69,13 @@ def _silence_stdout() -> None:
         pass
 
 
+def _is_engine_limit(exc: FsmbtError) -> bool:
+    """Whether ``exc`` is a verification engine's resource cap (exit ``EXIT_LIMIT``)."""
+    from fsmbt.verify.nusmv.runner import NuSMVLimitError
+
+    return isinstance(exc, NuSMVLimitError)
+
+
 def main(argv: list[str] | None = None) -> int:
     """Entry point: run the app, turning every error into one line and an exit code."""
     _register_commands()
@@ -78,7 +87,7 @@ def main(argv: list[str] | None = None) -> int:
         if debug:
             raise
         print(f"error: {cli_message(exc)}", file=sys.stderr)
-        return EXIT_BAD_INPUT
+        return EXIT_LIMIT if _is_engine_limit(exc) else EXIT_BAD_INPUT
     except typer.Exit as exc:
         return int(exc.exit_code)
     except (RecursionError, MemoryError) as exc:

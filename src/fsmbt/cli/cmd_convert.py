@@ -24,10 +24,13 @@ from fsmbt.model.undeclared import undeclared_leaf_types
 from fsmbt.llm.config import PROVIDERS
 from fsmbt.cli.options import (
     abstract_option,
+    apply_engine_caps,
     max_states_option,
     node_models_option,
     nodes_option,
+    nusmv_memory_option,
     reader_options,
+    timeout_option,
 )
 from fsmbt.cli.progress import StageProgress, format_timings
 from fsmbt.cli.wording import checked_counts, conversion_summary
@@ -50,6 +53,8 @@ def register(app: typer.Typer) -> None:
         loop: bool = typer.Option(False, "--loop", help="BT->FSM: the root is ticked again "
                                   "after it returns (checked in loop mode)"),
         no_verify: bool = typer.Option(False, "--no-verify", help="skip the equivalence check"),
+        verify_engine: str = typer.Option("native", "--verify-engine", help="the equivalence "
+                                          "check's engine: native, nusmv or both"),
         force: bool = typer.Option(False, "--force", help="overwrite an existing output file"),
         keep_failed: bool = typer.Option(False, "--keep-failed", help="write the result even "
                                          "when it is not equivalent (default: not written)"),
@@ -66,17 +71,20 @@ def register(app: typer.Typer) -> None:
                                                 f"endpoint URL or provider ({PROVIDER_NAMES})"),
         llm_model: str | None = typer.Option(None, "--llm-model", help="LLM engines: model "
                                              "name"),
+        timeout: float | None = timeout_option(),
+        nusmv_memory: int | None = nusmv_memory_option(),
     ) -> None:
         """Convert an FSM into a behavior tree or a behavior tree into a hierarchical FSM, and
         prove the result equivalent."""
+        apply_engine_caps(timeout, nusmv_memory)
         options: dict[str, object] = dict(reader_options(node_models, nodes, abstract) or {})
         if engine in api.LLM_ENGINES:
             options.update(llm_base_url=llm_base_url, llm_model=llm_model)
         with StageProgress(quiet=quiet, label=source.name) as progress:
             outcome = api.convert_file(
                 source, output, to=to, source_format=source_format, engine=engine, style=style,
-                loop=loop, hierarchy=hierarchy, verify=not no_verify, overwrite=force,
-                max_states=max_states,
+                loop=loop, hierarchy=hierarchy, verify=not no_verify,
+                verify_engine=verify_engine, overwrite=force, max_states=max_states,
                 keep_not_equivalent=keep_failed, options=options, on_stage=progress)
         summary = outcome.to_dict()
         if as_json:

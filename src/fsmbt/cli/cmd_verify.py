@@ -1,6 +1,7 @@
 """``fsmbt verify SOURCE CONVERTED``: is the converted model equivalent to its source?
 
-Exit 0 equivalent, 1 not equivalent, 2 bad input, 3 the two engines disagree (``--engine both``).
+Exit 0 equivalent, 1 not equivalent, 2 bad input, 3 the two engines disagree (``--engine both``),
+4 a verification engine reached its memory or time cap (``--timeout``, ``--nusmv-memory``).
 """
 
 from __future__ import annotations
@@ -16,10 +17,13 @@ from rich.console import Console
 from fsmbt import api
 from fsmbt.cli.options import (
     abstract_option,
+    apply_engine_caps,
     max_states_option,
     node_models_option,
     nodes_option,
+    nusmv_memory_option,
     reader_options,
+    timeout_option,
 )
 from fsmbt.cli.progress import StageProgress
 from fsmbt.verify import EngineDisagreement
@@ -49,10 +53,13 @@ def register(app: typer.Typer) -> None:
                                                   help="Format of SOURCE (default: detected)."),
         from_format2: Optional[str] = typer.Option(None, "--from2",
                                                    help="Format of CONVERTED (default: detected)."),
+        timeout: float | None = timeout_option(),
+        nusmv_memory: int | None = nusmv_memory_option(),
     ) -> None:
         """Check the five properties (reachability, completeness, no additional behaviour,
         deadlock absence, termination consistency); on failure, show the shortest input
         sequence that tells the two models apart."""
+        apply_engine_caps(timeout, nusmv_memory)
         try:
             with StageProgress(quiet=quiet or as_json, label=f"{source.name} ~ {converted.name}") as progress:
                 first, second, report = api.verify_files(source, converted, engine=engine, loop=loop,

@@ -24,6 +24,7 @@ CLI_WORDING: Mapping[Hint, str] = {
     Hint.NO_EXPANSION: "draw without --expand-subtrees",
     Hint.LLM_BASE_URL: "set --llm-base-url",
     Hint.LLM_MODEL: "set --llm-model",
+    Hint.NUSMV_LIMITS: "raise the cap with --timeout SECONDS or --nusmv-memory MIB",
 }
 
 

@@ -66,3 +66,29 @@ MAX_STATES_HELP = ("most reachable states explored (BT->FSM regions, the native 
 def max_states_option() -> int | None:
     """The ``--max-states`` option (``None``: the limits in force, ``fsmbt.limits``)."""
     return typer.Option(None, "--max-states", min=1, help=MAX_STATES_HELP)  # type: ignore[no-any-return]
+
+
+def timeout_option() -> float | None:
+    """``--timeout SECONDS``: the wall-time cap of each NuSMV run (``fsmbt.limits``
+    ``nusmv_max_seconds``; the native checker is bounded by its state limit)."""
+    return typer.Option(None, "--timeout", min=0.001, help="seconds NuSMV may run "  # type: ignore[no-any-return]
+                        "(--engine nusmv|both); past it: exit 4")
+
+
+def nusmv_memory_option() -> int | None:
+    """``--nusmv-memory MIB``: NuSMV's address-space cap (``nusmv_max_memory_mb``)."""
+    return typer.Option(None, "--nusmv-memory", min=1, help="MiB of memory NuSMV may use "  # type: ignore[no-any-return]
+                        "(RLIMIT_AS); past it: exit 4")
+
+
+def apply_engine_caps(timeout: float | None, nusmv_memory: int | None) -> None:
+    """Install ``--timeout`` / ``--nusmv-memory`` as the process's limits (``fsmbt.limits``)."""
+    from fsmbt import limits
+
+    changes: dict[str, int | float] = {}
+    if timeout is not None:
+        changes["nusmv_max_seconds"] = timeout
+    if nusmv_memory is not None:
+        changes["nusmv_max_memory_mb"] = nusmv_memory
+    if changes:
+        limits.use(limits.current().with_changes(**changes))

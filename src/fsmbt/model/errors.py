@@ -32,6 +32,7 @@ class Hint(str, Enum):
     NO_EXPANSION = "no_expansion"  # draw without expanding SubTree references
     LLM_BASE_URL = "llm_base_url"  # give the LLM endpoint
     LLM_MODEL = "llm_model"  # give the LLM model name
+    NUSMV_LIMITS = "nusmv_limits"  # raise NuSMV's time or memory cap
 
 
 #: Each hint in the library's own words (``str(error)``).
@@ -48,6 +49,7 @@ HINT_TEXT: Mapping[Hint, str] = {
     Hint.NO_EXPANSION: "draw with expand_subtrees=False",
     Hint.LLM_BASE_URL: "pass base_url=...",
     Hint.LLM_MODEL: "pass model=...",
+    Hint.NUSMV_LIMITS: "raise the cap with fsmbt.limits.use(limits.current().with_changes(...))",
 }
 
 _LINE_BREAKS = re.compile(r"\s*[\r\n\v\f\x1c-\x1e\x85\u2028\u2029]+\s*")

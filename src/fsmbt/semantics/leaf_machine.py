@@ -19,10 +19,19 @@ way: the root's result when a tick ends with one (``"SUCCESS"``/``"FAILURE"``, o
   ``RootResult("LIVELOCK")`` with output ``("LIVELOCK",)``: the real engine hangs there.
 
 Fast path: a tree of only plain ``Sequence``/``Fallback`` nodes, transparent SubTrees and
-environment leaves (``leaf_fast.is_plain_tree``) runs on ``leaf_fast.PlainLeafTable`` instead:
+environment leaves, widened with reactive nodes that hold no plain control below them and status
+maps (``leaf_fast.is_static_tree``), runs on ``leaf_fast.PlainLeafTable`` instead:
 a state is then the ``int`` id of the leaf about to be ticked, one step is O(1), and the outputs,
 statuses and inputs are the interpreter's (tests/semantics/test_sem_leaf_fast.py checks them in
 lockstep). ``generic=True`` forces the interpreter; ``fast`` says which path was taken.
+
+Canonical states: a tree of the canonical class (``leaf_canonical.is_canonical_class``: the
+Sequence/Fallback families - plain, reactive, WithMemory, Async -, status maps, SubTrees and
+leaves) that is not plain runs on the interpreter, but every state is passed through
+``leaf_canonical.Canonicalizer.canonical``: statuses and frame locals that are reset before they
+are read are erased, so engine snapshots with the same future are one state (docs/semantics.md
+§4a; tests/semantics/test_sem_leaf_canonical.py checks it in lockstep against the faithful
+interpreter). ``canonical`` says whether it is used; ``generic=True`` is the faithful machine.
 
 Complexity: ``step`` costs the nodes ticked between two leaves plus a snapshot
 (O(k log k + depth)) on the interpreter, O(1) on the fast path; ``explore`` is O(S · I) steps for S reachable states and I ≤ 3 inputs.
@@ -49,7 +58,8 @@ from fsmbt.semantics.bt_interpreter import (
     LeafRequest,
     Snapshot,
 )
-from fsmbt.semantics.leaf_fast import ROOT_RESULT_NAMES, PlainLeafTable, is_plain_tree
+from fsmbt.semantics.leaf_canonical import Canonicalizer, is_canonical_class
+from fsmbt.semantics.leaf_fast import ROOT_RESULT_NAMES, PlainLeafTable, is_static_tree
 from fsmbt.semantics.machine import FINAL, Machine, Outputs
 from fsmbt.semantics.machine import RUNNING as STATUS_RUNNING
 from fsmbt.semantics.status import LeafOutcome, NodeStatus
@@ -93,8 +103,12 @@ class LeafMachine:
         self.loop = loop
         main = self.tree.doc.main
         self.name = name or main.id
-        self.fast = not generic and is_plain_tree(self.tree)
+        self.fast = not generic and is_static_tree(self.tree)
         self.table = PlainLeafTable(self.tree) if self.fast else None
+        self.canonicalizer = (Canonicalizer(self.tree)
+                              if not generic and not self.fast and is_canonical_class(self.tree)
+                              else None)
+        self.canonical = self.canonicalizer is not None
 
     # -- Machine protocol --------------------------------------------------------------------
     def start(self) -> tuple[LeafState, Outputs]:
@@ -173,6 +187,8 @@ class LeafMachine:
                 outputs.append(LIVELOCK)
                 return RootResult(LIVELOCK)
             outcome = None
+            if self.canonicalizer is not None:
+                snap = self.canonicalizer.canonical(snap)
             if isinstance(event, LeafRequest):
                 outputs.append(event.node.label)
                 return snap

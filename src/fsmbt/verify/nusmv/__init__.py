@@ -18,7 +18,7 @@ from fsmbt.model.fsm import FSM
 from fsmbt.verify.nusmv.binary import NuSMVNotFound, find_nusmv, require_nusmv
 from fsmbt.verify.nusmv.encode_bt import LeafBTEncoder
 from fsmbt.verify.nusmv.encode_fsm import FSMEncoder
-from fsmbt.verify.nusmv.runner import NuSMVError, run_nusmv
+from fsmbt.verify.nusmv.runner import NuSMVError, NuSMVLimitError, run_nusmv
 from fsmbt.verify.nusmv.smv import Symbols
 from fsmbt.verify.nusmv.specs import product
 from fsmbt.verify.nusmv.traces import Context, Encoder, build_report
@@ -85,11 +85,13 @@ def build_model(source: FSM | BTDocument, result: FSM | BTDocument, *, loop: boo
 
 
 def check(source_model: FSM | BTDocument, result_model: FSM | BTDocument, *,
-          loop: bool = False, timeout: float = 300.0) -> Report:
+          loop: bool = False, timeout: float | None = None) -> Report:
     """Verify ``result_model`` against ``source_model`` with NuSMV; see the module docstring.
 
-    Raises ``UnsupportedError`` for BT node types the encoding does not model (docs/nusmv.md)
-    and ``NuSMVNotFound`` when no binary is available.
+    ``timeout`` defaults to ``fsmbt.limits.current().nusmv_max_seconds``; the memory cap is
+    ``nusmv_max_memory_mb``. Raises ``UnsupportedError`` for BT node types the encoding does not
+    model (docs/nusmv.md), ``NuSMVLimitError`` past a cap and ``NuSMVNotFound`` when no binary is
+    available.
     """
     started = time.perf_counter()
     text, names, context = build_model(source_model, result_model, loop=loop)
@@ -105,4 +107,5 @@ def check(source_model: FSM | BTDocument, result_model: FSM | BTDocument, *,
     return report
 
 
-__all__ = ["check", "build_model", "find_nusmv", "require_nusmv", "NuSMVNotFound", "NuSMVError"]
+__all__ = ["check", "build_model", "find_nusmv", "require_nusmv", "NuSMVNotFound", "NuSMVError",
+           "NuSMVLimitError"]

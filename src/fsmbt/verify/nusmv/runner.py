@@ -1,5 +1,13 @@
 """Running NuSMV on a product model and reading its answer: true/false per SPEC, and each
-counterexample as a list of states (full variable valuations; NuSMV prints only changes)."""
+counterexample as a list of states (full variable valuations; NuSMV prints only changes).
+
+Resource caps (docs/nusmv.md, "Limits"): every run is bounded by ``fsmbt.limits`` -
+``nusmv_max_seconds`` (wall time; the child is killed past it) and ``nusmv_max_memory_mb``
+(the child's address space, ``RLIMIT_AS`` set in the child before ``exec``). Going past either
+is a ``NuSMVLimitError`` that names the resource, the cap, the model's number of state
+variables and how to raise the cap (CLI exit code 4, docs/cli.md). NuSMV's output is decoded as
+UTF-8 with ``errors="replace"``: a stray byte never hides the verdicts.
+"""
 
 from __future__ import annotations
 
@@ -9,10 +17,19 @@ import subprocess
 import tempfile
 from dataclasses import dataclass, field
 
+from fsmbt import limits
 from fsmbt.limits import Limits
+from fsmbt.model.errors import FsmbtError, Hint
 from fsmbt.verify.nusmv.binary import require_nusmv
 
 DEFAULT_TIMEOUT_S = Limits.nusmv_max_seconds  # the default lives in fsmbt.limits
+#: Words NuSMV / CUDD / the C library print when an allocation fails under RLIMIT_AS.
+_MEMORY_WORDS = ("out of memory", "cannot allocate", "memory exhausted", "bad_alloc",
+                 "malloc", "memory limit", "failed to map segment")
+_VAR_SECTION = re.compile(r"^\s*(?:VAR|IVAR|FROZENVAR)\b(.*)$")
+_SECTION = re.compile(r"^\s*(?:MODULE|DEFINE|ASSIGN|INIT|TRANS|INVAR|SPEC|CTLSPEC|LTLSPEC|"
+                      r"INVARSPEC|FAIRNESS|JUSTICE|COMPASSION)\b")
+_DECLARATION = re.compile(r"^\s*[A-Za-z_][\w.$#\[\]-]*\s*:\s*[^=]")
 _SPEC = re.compile(r"^-- (?:specification|invariant) (.*) is (true|false)\s*$")
 _STATE = re.compile(r"^\s*-> State: \d+\.\d+ <-")
 _INPUT = re.compile(r"^\s*-> Input: \d+\.\d+ <-")
@@ -20,7 +37,63 @@ _ASSIGN = re.compile(r"^\s*([\w.\[\]$#-]+) = (\S+)\s*$")
 
 
 class NuSMVError(RuntimeError):
-    """NuSMV failed (syntax/type error in the generated model, crash, timeout): a bug here."""
+    """NuSMV failed (syntax/type error in the generated model, crash): a bug here."""
+
+
+class NuSMVLimitError(FsmbtError):
+    """NuSMV went past a resource cap of ``fsmbt.limits`` (memory or time).
+
+    Attributes:
+        resource: ``"memory"`` or ``"time"``.
+        variables: the number of state and input variables of the model NuSMV was given.
+        limit_name: the ``Limits`` field that was exceeded.
+    """
+
+    def __init__(self, resource: str, variables: int, limit_name: str, limit: float) -> None:
+        unit = "MiB" if resource == "memory" else "s"
+        message = (f"NuSMV ran out of {resource} at {variables} variables (cap {limit:g} {unit}; "
+                   f"raise it with {limits.env_name(limit_name)})")
+        super().__init__(message, element="NuSMV", hints=(Hint.NUSMV_LIMITS,
+                                                           Hint.NATIVE_VERIFIER))
+        self.resource = resource
+        self.variables = variables
+        self.limit_name = limit_name
+
+
+def count_variables(model: str) -> int:
+    """How many variables (VAR, IVAR, FROZENVAR) an SMV text declares. O(lines)."""
+    count = 0
+    in_vars = False
+    for line in model.splitlines():
+        head = _VAR_SECTION.match(line)
+        if head:
+            in_vars = True
+            rest = head.group(1)
+            count += bool(_DECLARATION.match(rest))
+            continue
+        if _SECTION.match(line):
+            in_vars = False
+            continue
+        if in_vars and _DECLARATION.match(line):
+            count += 1
+    return count
+
+
+def _address_space_cap(megabytes: int):  # type: ignore[no-untyped-def]
+    """A ``preexec_fn`` that caps the child's address space (runs in the child, before exec)."""
+    import resource
+
+    def apply() -> None:
+        cap = megabytes * 1024 * 1024
+        resource.setrlimit(resource.RLIMIT_AS, (cap, cap))
+
+    return apply
+
+
+def _out_of_memory(proc: subprocess.CompletedProcess[str]) -> bool:
+    text = (proc.stderr + "\n" + proc.stdout[-4000:]).lower()
+    # killed by a signal (SIGSEGV/SIGABRT when CUDD's allocation fails), or NuSMV says so
+    return proc.returncode < 0 or any(word in text for word in _MEMORY_WORDS)
 
 
 @dataclass
@@ -36,10 +109,31 @@ class SpecResult:
 
 
 def run_nusmv(model: str, expected_specs: int, *, order: str | None = None,
-              timeout: float = DEFAULT_TIMEOUT_S, keep: str | None = None) -> tuple[list[SpecResult], float]:
-    """Check every SPEC of ``model``; returns the results in file order and NuSMV's seconds."""
+              timeout: float | None = None, memory_mb: int | None = None,
+              keep: str | None = None) -> tuple[list[SpecResult], float]:
+    """Check every SPEC of ``model``; returns the results in file order and NuSMV's seconds.
+
+    Args:
+        model: the SMV text.
+        expected_specs: how many verdicts NuSMV must print.
+        order: a variable order file's text (``-i``), or ``None``.
+        timeout: wall seconds; ``None``: ``limits.current().nusmv_max_seconds``.
+        memory_mb: address-space cap of the child, MiB; ``None``:
+            ``limits.current().nusmv_max_memory_mb``.
+        keep: also write the model to this path (debugging).
+
+    Returns:
+        The results in file order and NuSMV's wall seconds.
+
+    Raises:
+        NuSMVLimitError: past the time or the memory cap.
+        NuSMVError: NuSMV failed otherwise (a bug in the encoding).
+    """
     import time
 
+    caps = limits.current()
+    timeout = caps.nusmv_max_seconds if timeout is None else timeout
+    memory_mb = caps.nusmv_max_memory_mb if memory_mb is None else memory_mb
     binary = require_nusmv()
     with tempfile.TemporaryDirectory(prefix="fsmbt-nusmv-") as tmp:
         path = os.path.join(tmp, "product.smv")
@@ -58,12 +152,17 @@ def run_nusmv(model: str, expected_specs: int, *, order: str | None = None,
             command += ["-i", order_path]
         started = time.perf_counter()
         try:
-            proc = subprocess.run(command + [path], capture_output=True,
-                                  text=True, timeout=timeout, cwd=tmp)
+            proc = subprocess.run(command + [path], capture_output=True, text=True,
+                                  encoding="utf-8", errors="replace", timeout=timeout, cwd=tmp,
+                                  preexec_fn=_address_space_cap(memory_mb))
         except subprocess.TimeoutExpired:
-            raise NuSMVError(f"NuSMV did not finish within {timeout:.0f} s") from None
+            raise NuSMVLimitError("time", count_variables(model), "nusmv_max_seconds",
+                                  timeout) from None
         elapsed = time.perf_counter() - started
     results = parse_output(proc.stdout)
+    if (proc.returncode != 0 or len(results) != expected_specs) and _out_of_memory(proc):
+        raise NuSMVLimitError("memory", count_variables(model), "nusmv_max_memory_mb",
+                              memory_mb)
     if proc.returncode != 0 or len(results) != expected_specs:
         tail = (proc.stderr or proc.stdout).strip().splitlines()[-8:]
         raise NuSMVError(f"NuSMV failed (exit {proc.returncode}, {len(results)} of "

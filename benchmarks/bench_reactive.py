@@ -1,0 +1,145 @@
+"""The native checker on reactive and memory trees of 100 … 10 000 nodes (issue 19). Prints a table.
+
+    .venv/bin/python benchmarks/bench_reactive.py [--sizes 100,1000,10000] [--limit 120]
+        [--faithful-up-to 1000]
+
+Families (one random tree per size, the shape of ``bench_checker.random_tree``: groups of 2-4
+under a control, 40 % conditions; every control then re-typed, seeded):
+- ``plain``: Sequence/Fallback (the static table of ``leaf_fast``);
+- ``reactive``: ReactiveSequence/ReactiveFallback (the static table widened to reactive nodes);
+- ``reactive-plain``: each control reactive or plain at random (plain nodes under reactive ones
+  keep a running index: canonical states, ``leaf_canonical``);
+- ``memory``: SequenceWithMemory / Fallback (the WithMemory index is real, readable memory);
+- ``mixed``: each control drawn from all five kinds.
+Each tree is checked against its HFSM (``bt_to_hfsm``, not timed); ``time`` is the whole
+``check`` (both machines explored, then the product). A row that stops prints why (the time limit,
+or the state limit: WithMemory indices are real memory, so a tree with k of them may have a
+product of k index ranges as states; the first stop ends the family). ``faithful`` is the number of states of the faithful
+interpreter's leaf machine (``LeafMachine(generic=True)``), explored for trees up to
+``--faithful-up-to`` nodes (it is the cost this work removes; past the limit it is not run).
+Targets (issue 19): a 1 000-node reactive tree under 1 s, a 10 000-node one under 10 s.
+"""
+
+from __future__ import annotations
+
+import argparse
+import random
+import signal
+import sys
+import time
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).parent))
+from bench_checker import random_tree  # noqa: E402
+
+from fsmbt.convert.bt_to_hfsm import bt_to_hfsm  # noqa: E402
+from fsmbt.model import BTDocument  # noqa: E402
+from fsmbt.semantics.leaf_machine import LeafMachine, StateLimitError, explore  # noqa: E402
+from fsmbt.verify.native import check  # noqa: E402
+from fsmbt.verify.pairing import machines_for  # noqa: E402
+
+FAMILIES: dict[str, dict[str, tuple[str, ...]]] = {
+    "plain": {"Sequence": ("Sequence",), "Fallback": ("Fallback",)},
+    "reactive": {"Sequence": ("ReactiveSequence",), "Fallback": ("ReactiveFallback",)},
+    "reactive-plain": {"Sequence": ("ReactiveSequence", "Sequence"),
+                       "Fallback": ("ReactiveFallback", "Fallback")},
+    "memory": {"Sequence": ("SequenceWithMemory",), "Fallback": ("Fallback",)},
+    "mixed": {"Sequence": ("Sequence", "ReactiveSequence", "SequenceWithMemory"),
+              "Fallback": ("Fallback", "ReactiveFallback")},
+}
+
+
+def family_tree(family: str, leaves: int, seed: int) -> BTDocument:
+    """``random_tree(leaves, seed)`` with every control re-typed as ``family`` says."""
+    doc = random_tree(leaves, seed)
+    rng = random.Random(seed * 7 + len(family))
+    table = FAMILIES[family]
+    stack = [doc.main.root]
+    while stack:
+        node = stack.pop()
+        if node.type in table:
+            node.type = rng.choice(table[node.type])
+        stack.extend(node.children)
+    return doc
+
+
+def node_count(doc: BTDocument) -> int:
+    count, stack = 0, [doc.main.root]
+    while stack:
+        node = stack.pop()
+        count += 1
+        stack.extend(node.children)
+    return count
+
+
+class _Timeout(Exception):
+    pass
+
+
+def _alarm(_signum, _frame):  # type: ignore[no-untyped-def]
+    raise _Timeout
+
+
+def leaves_for(nodes: int) -> int:
+    """Leaves giving about ``nodes`` nodes (the generator makes ~1.45 nodes per leaf)."""
+    return max(2, round(nodes / 1.45))
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--sizes", default="100,300,1000,3000,10000", help="nodes per tree")
+    parser.add_argument("--limit", type=int, default=120, help="seconds per check")
+    parser.add_argument("--faithful-up-to", type=int, default=1000,
+                        help="explore the faithful machine for trees up to this many nodes")
+    parser.add_argument("--families", default=",".join(FAMILIES))
+    args = parser.parse_args(argv)
+    header = (f"{'family':<9} {'nodes':>6} {'path':<9} {'leaf st':>8} {'faithful':>9} "
+              f"{'product':>8} {'time s':>8} {'us/node':>8} {'x time':>7} {'x nodes':>7}")
+    print(header)
+    print("-" * len(header))
+    signal.signal(signal.SIGALRM, _alarm)
+    for family in args.families.split(","):
+        previous: tuple[float, int] | None = None
+        for size in (int(s) for s in args.sizes.split(",")):
+            doc = family_tree(family, leaves_for(size), size)
+            nodes = node_count(doc)
+            machine = LeafMachine(doc)
+            path = "table" if machine.fast else "canonical" if machine.canonical else "faithful"
+            faithful = "-"
+            signal.alarm(args.limit)
+            try:
+                hfsm = bt_to_hfsm(doc).model
+                source, result, _mode = machines_for(doc, hfsm)
+                started = time.perf_counter()
+                report = check(source, result)
+                seconds = time.perf_counter() - started
+                signal.alarm(0)
+                if nodes <= args.faithful_up_to:
+                    signal.alarm(args.limit)
+                    try:
+                        faithful = str(len(explore(LeafMachine(doc, generic=True), 2_000_000)))
+                    except (_Timeout, StateLimitError):
+                        faithful = f">{args.limit}s"
+                    signal.alarm(0)
+            except (_Timeout, StateLimitError) as exc:
+                signal.alarm(0)
+                print(f"{family:<9} {nodes:>6} {path:<9}  stopped: "
+                      f"{'over ' + str(args.limit) + ' s' if isinstance(exc, _Timeout) else exc}",
+                      flush=True)
+                break
+            if not report.equivalent:
+                raise SystemExit(f"{family} {nodes}: tree and HFSM differ: {report.verdicts()}")
+            stats = report.stats
+            ratio_t = f"{seconds / previous[0]:.1f}" if previous else "-"
+            ratio_n = f"{nodes / previous[1]:.1f}" if previous else "-"
+            print(f"{family:<9} {nodes:>6} {path:<9} {stats['source_states']:>8} {faithful:>9} "
+                  f"{stats['product_states']:>8} {seconds:>8.3f} {seconds / nodes * 1e6:>8.1f} "
+                  f"{ratio_t:>7} {ratio_n:>7}", flush=True)
+            previous = (seconds, nodes)
+    print("path: table = leaf_fast static table; canonical = interpreter on canonical states "
+          "(leaf_canonical); faithful = full interpreter snapshots")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
