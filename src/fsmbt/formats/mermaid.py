@@ -253,7 +253,13 @@ class _MermaidReader:
             except json.JSONDecodeError:
                 raise self.fail("the fsmbt-exit directive needs a quoted name", line_no) from None
         elif match := _DIRECTIVE_NAME.match(line):
-            self.names[match.group(1)] = json.loads(match.group(2))
+            if match.group(1) in self.home:  # the state exists under its id: too late to rename
+                raise self.fail(f"the fsmbt-name directive for '{match.group(1)}' comes after "
+                                "that state is used; put it before the first use", line_no)
+            try:
+                self.names[match.group(1)] = str(json.loads(match.group(2)))
+            except json.JSONDecodeError:
+                raise self.fail("the fsmbt-name directive needs a quoted name", line_no) from None
         elif match := _DIRECTIVE_NO_ACTION.match(line):
             self.no_action.add(match.group(1))
         elif match := _DIRECTIVE_START.match(line):
