@@ -115,23 +115,39 @@ def run_one(folder: Path, workers: int, executor: str, scratch: Path) -> dict[st
             done[0] += 1
             if done[0] % PROGRESS_EVERY == 0 or done[0] == len(jobs):
                 elapsed = time.perf_counter() - started
-                progress.write(f"{done[0]} of {len(jobs)} in {elapsed:.1f} s: "
-                               f"{done[0] / elapsed:.1f} models/s, driver "
-                               f"{driver_peak_mb():.0f} MB, worker {memory.worker_peak / MB:.0f}"
-                               f" MB, all {memory.total_peak / MB:.0f} MB\n")
+                progress.write(
+                    f"{done[0]} of {len(jobs)} in {elapsed:.1f} s: "
+                    f"{done[0] / elapsed:.1f} models/s, driver "
+                    f"{driver_peak_mb():.0f} MB, worker {memory.worker_peak / MB:.0f}"
+                    f" MB, all {memory.total_peak / MB:.0f} MB\n"
+                )
                 progress.flush()
 
         with ResultStore(out) as store:
-            run_jobs(jobs, store=store, executor=executor, workers=workers, collect=False,
-                     on_result=report)
+            run_jobs(
+                jobs,
+                store=store,
+                executor=executor,
+                workers=workers,
+                collect=False,
+                on_result=report,
+            )
             statuses = Counter({k: v for k, v in store.summary()["statuses"].items() if v})
         store_bytes = ResultStore(out).size_bytes()
     seconds = time.perf_counter() - started
     shutil.rmtree(out, ignore_errors=True)
-    return {"executor": executor, "workers": workers, "models": len(jobs), "seconds": seconds,
-            "rate": len(jobs) / seconds, "driver_mb": driver_peak_mb(),
-            "worker_mb": memory.worker_peak / MB, "all_mb": memory.total_peak / MB,
-            "store_mb": store_bytes / MB, "statuses": dict(statuses)}
+    return {
+        "executor": executor,
+        "workers": workers,
+        "models": len(jobs),
+        "seconds": seconds,
+        "rate": len(jobs) / seconds,
+        "driver_mb": driver_peak_mb(),
+        "worker_mb": memory.worker_peak / MB,
+        "all_mb": memory.total_peak / MB,
+        "store_mb": store_bytes / MB,
+        "statuses": dict(statuses),
+    }
 
 
 def driver_peak_mb() -> float:
@@ -141,8 +157,16 @@ def driver_peak_mb() -> float:
 
 def run_isolated(folder: Path, workers: int, executor: str, scratch: Path) -> dict[str, object]:
     """``run_one`` in a fresh interpreter, so each driver's peak RSS is its own."""
-    command = [sys.executable, __file__, "--one", f"{executor}:{workers}", "--models",
-               str(folder), "--folder", str(scratch)]
+    command = [
+        sys.executable,
+        __file__,
+        "--one",
+        f"{executor}:{workers}",
+        "--models",
+        str(folder),
+        "--folder",
+        str(scratch),
+    ]
     done = subprocess.run(command, check=True, capture_output=True, text=True)
     return json.loads(done.stdout.strip().splitlines()[-1])  # type: ignore[no-any-return]
 
@@ -152,9 +176,12 @@ def print_row(row: dict[str, object], base: dict[str, float]) -> None:
     key = str(row["executor"])
     scaling = rate / base[key] if key in base else 1.0
     statuses = ", ".join(f"{k} {v}" for k, v in row["statuses"].items())  # type: ignore[attr-defined]
-    print(f"| {row['executor']} | {row['workers']} | {row['models']} | {row['seconds']:.1f} | "
-          f"{rate:.1f} | {scaling:.2f} | {row['driver_mb']:.0f} | {row['worker_mb']:.0f} | "
-          f"{row['all_mb']:.0f} | {row['store_mb']:.1f} | {statuses} |", flush=True)
+    print(
+        f"| {row['executor']} | {row['workers']} | {row['models']} | {row['seconds']:.1f} | "
+        f"{rate:.1f} | {scaling:.2f} | {row['driver_mb']:.0f} | {row['worker_mb']:.0f} | "
+        f"{row['all_mb']:.0f} | {row['store_mb']:.1f} | {statuses} |",
+        flush=True,
+    )
 
 
 def main() -> int:
@@ -164,8 +191,12 @@ def main() -> int:
     parser.add_argument("--workers", default="1,2")
     parser.add_argument("--executors", default="local,ray")
     parser.add_argument("--big-workers", type=int, default=2)
-    parser.add_argument("--folder", type=Path, default=None,
-                        help="where the generated models are kept (default: a temp folder)")
+    parser.add_argument(
+        "--folder",
+        type=Path,
+        default=None,
+        help="where the generated models are kept (default: a temp folder)",
+    )
     parser.add_argument("--one", default=None, help=argparse.SUPPRESS)  # EXECUTOR:WORKERS
     parser.add_argument("--models", type=Path, default=None, help=argparse.SUPPRESS)
     args = parser.parse_args()
@@ -174,14 +205,19 @@ def main() -> int:
         executor, workers = args.one.split(":")
         print(json.dumps(run_one(args.models, int(workers), executor, scratch)))
         return 0
-    print(f"# fsmbt batch benchmark: {os.cpu_count()} cores, load average "
-          f"{', '.join(f'{x:.1f}' for x in os.getloadavg())}, python "
-          f"{sys.version.split()[0]}", flush=True)
+    print(
+        f"# fsmbt batch benchmark: {os.cpu_count()} cores, load average "
+        f"{', '.join(f'{x:.1f}' for x in os.getloadavg())}, python "
+        f"{sys.version.split()[0]}",
+        flush=True,
+    )
     started = time.perf_counter()
     build_folder(scratch / f"models-{args.n}", args.n)
     print(f"# generated {args.n} models in {time.perf_counter() - started:.1f} s", flush=True)
-    print("| executor | workers | models | seconds | models/s | scaling | driver MB | "
-          "worker MB | all MB | store MB | statuses |")
+    print(
+        "| executor | workers | models | seconds | models/s | scaling | driver MB | "
+        "worker MB | all MB | store MB | statuses |"
+    )
     print("|---|---|---|---|---|---|---|---|---|---|---|", flush=True)
     base: dict[str, float] = {}
     for executor in args.executors.split(","):
@@ -192,12 +228,12 @@ def main() -> int:
     if args.big:
         started = time.perf_counter()
         build_folder(scratch / f"models-{args.big}", args.big)
-        print(f"# generated {args.big} models in {time.perf_counter() - started:.1f} s",
-              flush=True)
+        print(f"# generated {args.big} models in {time.perf_counter() - started:.1f} s", flush=True)
         row = run_isolated(scratch / f"models-{args.big}", args.big_workers, "local", scratch)
         print_row(row, {})
-    print(f"# load average at the end: {', '.join(f'{x:.1f}' for x in os.getloadavg())}",
-          flush=True)
+    print(
+        f"# load average at the end: {', '.join(f'{x:.1f}' for x in os.getloadavg())}", flush=True
+    )
     return 0
 
 

@@ -42,8 +42,13 @@ print(time.perf_counter() - started, fsm.number_of_nodes())
 
 def peer_seconds(python: str, path: Path, timeout: float) -> str:
     try:
-        proc = subprocess.run([python, "-c", PEER, str(path)], capture_output=True, text=True,
-                              errors="replace", timeout=timeout)
+        proc = subprocess.run(
+            [python, "-c", PEER, str(path)],
+            capture_output=True,
+            text=True,
+            errors="replace",
+            timeout=timeout,
+        )
     except subprocess.TimeoutExpired:
         return f">{timeout:.0f}s"
     if proc.returncode != 0:
@@ -60,8 +65,10 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     have_peer = Path(args.bt_tools_python).exists()
     if not have_peer:
-        print(f"note: {args.bt_tools_python} not found: the bt_tools column is skipped "
-              "(see the module docstring for the install steps)")
+        print(
+            f"note: {args.bt_tools_python} not found: the bt_tools column is skipped "
+            "(see the module docstring for the install steps)"
+        )
     print(f"{'nodes':>6} {'fsmbt s':>9} {'fsmbt st':>8}  bt_tools s")
     with tempfile.TemporaryDirectory(prefix="fsmbt-bttools-") as tmp:
         for size in (int(s) for s in args.sizes.split(",")):

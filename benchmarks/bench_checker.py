@@ -80,7 +80,7 @@ def random_tree(leaves: int, seed: int) -> BTDocument:
                 i += 1
                 continue
             control = rng.choice(("Sequence", "Fallback"))
-            grouped.append(BTNode(control, NodeKind.CONTROL, children=level[i:i + k]))
+            grouped.append(BTNode(control, NodeKind.CONTROL, children=level[i : i + k]))
             i += k
         level = grouped
     root = level[0]
@@ -120,8 +120,13 @@ def machines(pair: Pair, generic: bool):  # type: ignore[no-untyped-def]
     """The checker's machines for ``pair``; ``generic`` puts an LEBT on the interpreter path."""
     source, result, _mode = machines_for(pair[0], pair[1])  # type: ignore[arg-type]
     if isinstance(result, LEBTWithActiveInputs) and generic:
-        result = LEBTWithActiveInputs(LEBTMachine(pair[1], result.alphabet,  # type: ignore[arg-type]
-                                                  generic=True))
+        result = LEBTWithActiveInputs(
+            LEBTMachine(
+                pair[1],
+                result.alphabet,  # type: ignore[arg-type]
+                generic=True,
+            )
+        )
     return source, result
 
 
@@ -130,8 +135,9 @@ def uses_fast_lebt(pair: Pair) -> bool:
     return isinstance(result, LEBTWithActiveInputs) and result.machine.fast  # type: ignore[attr-defined]
 
 
-def measure(pair: Pair, repeat: int, limit_s: int,
-            generic: bool = False) -> tuple[float, dict] | None:
+def measure(
+    pair: Pair, repeat: int, limit_s: int, generic: bool = False
+) -> tuple[float, dict] | None:
     best = float("inf")
     stats: dict = {}
     signal.signal(signal.SIGALRM, _alarm)
@@ -161,15 +167,20 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--sizes", default="10,30,100,1000,10000")
     parser.add_argument("--repeat", type=int, default=3, help="best of R runs (runs under 1 s)")
     parser.add_argument("--limit", type=int, default=120, help="seconds per check before giving up")
-    parser.add_argument("--generic", action="store_true",
-                        help="run LEBTs on the generic BT interpreter, not the fast runtime")
+    parser.add_argument(
+        "--generic",
+        action="store_true",
+        help="run LEBTs on the generic BT interpreter, not the fast runtime",
+    )
     parser.add_argument("--families", default="", help="comma-separated subset of the families")
     args = parser.parse_args(argv)
     sizes = [int(s) for s in args.sizes.split(",")]
     sys.setrecursionlimit(10_000)
-    header = (f"{'pair':<9} {'N':>6} {'src st':>7} {'res st':>7} {'product':>8} {'edges':>8} "
-              f"{'time ms':>9} {'explore':>9} {'product':>8} {'us/state':>9} {'x time':>7} "
-              f"{'x size':>7}")
+    header = (
+        f"{'pair':<9} {'N':>6} {'src st':>7} {'res st':>7} {'product':>8} {'edges':>8} "
+        f"{'time ms':>9} {'explore':>9} {'product':>8} {'us/state':>9} {'x time':>7} "
+        f"{'x size':>7}"
+    )
     print(header)
     print("-" * len(header))
     wanted = set(filter(None, args.families.split(",")))
@@ -189,13 +200,18 @@ def main(argv: list[str] | None = None) -> int:
             product = stats["product_states"]
             ratio_t = f"{seconds / previous[0]:.1f}" if previous else "-"
             ratio_s = f"{product / previous[1]:.1f}" if previous else "-"
-            print(f"{family:<9} {n:>6} {stats['source_states']:>7} {stats['result_states']:>7} "
-                  f"{product:>8} {stats['product_edges']:>8} {seconds * 1000:>9.2f} "
-                  f"{stats['explore_seconds'] * 1000:>9.2f} {stats['product_seconds'] * 1000:>8.2f} "
-                  f"{seconds / product * 1e6:>9.1f} {ratio_t:>7} {ratio_s:>7}", flush=True)
+            print(
+                f"{family:<9} {n:>6} {stats['source_states']:>7} {stats['result_states']:>7} "
+                f"{product:>8} {stats['product_edges']:>8} {seconds * 1000:>9.2f} "
+                f"{stats['explore_seconds'] * 1000:>9.2f} {stats['product_seconds'] * 1000:>8.2f} "
+                f"{seconds / product * 1e6:>9.1f} {ratio_t:>7} {ratio_s:>7}",
+                flush=True,
+            )
             previous = (seconds, product)
     if not args.generic:
-        print("* LEBT on the fast strict-grammar runtime (semantics/lebt/fast.py); --generic for the interpreter")
+        print(
+            "* LEBT on the fast strict-grammar runtime (semantics/lebt/fast.py); --generic for the interpreter"
+        )
     print("bt~hfsm: plain Sequence/Fallback trees run on the fast leaf machine (leaf_fast)")
     return 0
 

@@ -40,8 +40,9 @@ def deep_bt(depth: int) -> BTDocument:
         node.children.append(BTNode(type=f"L{level}", kind=NodeKind.ACTION))
         if level == depth - 1:
             break
-        child = BTNode(type="Fallback" if node.type == "Sequence" else "Sequence",
-                       kind=NodeKind.CONTROL)
+        child = BTNode(
+            type="Fallback" if node.type == "Sequence" else "Sequence", kind=NodeKind.CONTROL
+        )
         node.children.append(child)
         node = child
     return BTDocument.single(root)
@@ -53,24 +54,30 @@ def main() -> None:
     rows = []
     for n in sizes:
         fsm = random_fsm(n, n, "basic", extra_edges=n // 2)
-        seconds = best_of(lambda fsm=fsm: fsm_to_lebt(fsm), 50 if n <= 1000 else 3 if n <= 10_000 else 2)
+        seconds = best_of(
+            lambda fsm=fsm: fsm_to_lebt(fsm), 50 if n <= 1000 else 3 if n <= 10_000 else 2
+        )
         rows.append(("FSM->BT random", f"{n} states", seconds))
     chain_n = 10_000 if quick else 100_000
     chain = random_fsm(1, chain_n, "basic", shape="chain", extra_edges=0)
     seconds = best_of(lambda: fsm_to_lebt(chain), 1)
     rows.append(("FSM->BT chain", f"{chain_n} states", seconds))
-    for n in ([100, 1_000, 10_000] if quick else [100, 1_000, 10_000, 100_000]):
+    for n in [100, 1_000, 10_000] if quick else [100, 1_000, 10_000, 100_000]:
         doc = random_bt(n, 40, 10, "basic", max_nodes=n)
         nodes = sum(1 for _ in doc.main.root.walk())
-        seconds = best_of(lambda doc=doc: bt_to_hfsm(doc), 20 if n <= 1000 else 3 if n <= 10_000 else 2)
+        seconds = best_of(
+            lambda doc=doc: bt_to_hfsm(doc), 20 if n <= 1000 else 3 if n <= 10_000 else 2
+        )
         rows.append(("BT->HFSM random", f"{nodes} nodes", seconds))
     deep = deep_bt(chain_n // 2)
     nodes = sum(1 for _ in deep.main.root.walk())
     seconds = best_of(lambda: bt_to_hfsm(deep), 1)
     rows.append(("BT->HFSM deep", f"{nodes} nodes", seconds))
 
-    print(f"{'conversion':<18} {'size':>14} {'wall':>12} {'cpu':>12} {'cpu/element':>12} "
-          f"{'growth':>7}")
+    print(
+        f"{'conversion':<18} {'size':>14} {'wall':>12} {'cpu':>12} {'cpu/element':>12} "
+        f"{'growth':>7}"
+    )
     previous: dict[str, tuple[int, float]] = {}
     for kind, size, (wall, cpu) in rows:
         count = int(size.split()[0])
@@ -79,8 +86,10 @@ def main() -> None:
             before_count, before_cpu = previous[kind]
             growth = f"x{cpu / before_cpu:.1f}/{count / before_count:.0f}"
         previous[kind] = (count, cpu)
-        print(f"{kind:<18} {size:>14} {wall * 1000:>10.2f}ms {cpu * 1000:>10.2f}ms "
-              f"{cpu / count * 1e6:>10.2f}us {growth:>7}")
+        print(
+            f"{kind:<18} {size:>14} {wall * 1000:>10.2f}ms {cpu * 1000:>10.2f}ms "
+            f"{cpu / count * 1e6:>10.2f}us {growth:>7}"
+        )
 
 
 if __name__ == "__main__":

@@ -43,8 +43,12 @@ def models(n_fsms: int, n_bts: int, seed: int) -> list[tuple[str, object]]:
         out.append((f"fsm-{i}-{states}", random_fsm(f"{seed}-fsm-{i}", states, scenarios[i % 3])))
     for i in range(n_bts):
         size = 2 + i % 4
-        out.append((f"bt-{i}-d{size}", random_bt(f"{seed}-bt-{i}", size, size, scenarios[i % 3],
-                                                max_nodes=60)))
+        out.append(
+            (
+                f"bt-{i}-d{size}",
+                random_bt(f"{seed}-bt-{i}", size, size, scenarios[i % 3], max_nodes=60),
+            )
+        )
     return out
 
 
@@ -65,21 +69,31 @@ def main(argv: list[str] | None = None) -> int:
         print("refusing to run on CI: accuracy needs a real LLM endpoint", file=sys.stderr)
         return 2
     try:
-        settings = resolve_settings(base_url=args.llm_base_url, model=args.llm_model,
-                                    max_regenerations=args.max_regenerations, log_path=args.log)
+        settings = resolve_settings(
+            base_url=args.llm_base_url,
+            model=args.llm_model,
+            max_regenerations=args.max_regenerations,
+            log_path=args.log,
+        )
     except LLMConfigError as exc:
         print(f"refusing to run: {exc}", file=sys.stderr)
         return 2
     host = urlparse(settings.base_url).hostname or ""
     if host.startswith(LOOPBACK) and not args.allow_local:
-        print(f"refusing to run against {settings.base_url} (loopback): pass --allow-local for a "
-              "real local model server", file=sys.stderr)
+        print(
+            f"refusing to run against {settings.base_url} (loopback): pass --allow-local for a "
+            "real local model server",
+            file=sys.stderr,
+        )
         return 2
     client = LLMClient(settings)
     from fsmbt.llm.pipeline import default_verifier
 
     verifier = default_verifier(args.verify_engine)
-    variants: list[tuple[str, bool, frozenset[str]]] = [("llm", True, frozenset()), ("nllm", False, frozenset())]
+    variants: list[tuple[str, bool, frozenset[str]]] = [
+        ("llm", True, frozenset()),
+        ("nllm", False, frozenset()),
+    ]
     if args.ablate:
         for direction_modules in MODULES.values():
             for module in direction_modules:
@@ -92,25 +106,39 @@ def main(argv: list[str] | None = None) -> int:
             if ablated and not ablated <= set(direction_modules):
                 continue
             try:
-                outcome = convert_with_llm(model, client, scp=scp, disabled_modules=ablated,  # type: ignore[arg-type]
-                                           verifier=verifier, engine_name=label, source_name=name)
+                outcome = convert_with_llm(
+                    model,
+                    client,
+                    scp=scp,
+                    disabled_modules=ablated,  # type: ignore[arg-type]
+                    verifier=verifier,
+                    engine_name=label,
+                    source_name=name,
+                )
             except LLMUnavailableError as exc:
                 print(f"stopping: {exc}", file=sys.stderr)
                 return 2
             results[label].append(outcome.record)
-            print(f"{name:<16} {label:<28} {outcome.record.verdict:<16} "
-                  f"rounds={len(outcome.record.rounds)} tokens={outcome.record.tokens_in}/"
-                  f"{outcome.record.tokens_out}", flush=True)
-    print("\nengine                        n  first-pass  final   regen  tokens-in  tokens-out  latency-s")
+            print(
+                f"{name:<16} {label:<28} {outcome.record.verdict:<16} "
+                f"rounds={len(outcome.record.rounds)} tokens={outcome.record.tokens_in}/"
+                f"{outcome.record.tokens_out}",
+                flush=True,
+            )
+    print(
+        "\nengine                        n  first-pass  final   regen  tokens-in  tokens-out  latency-s"
+    )
     for label, records in results.items():
         n = len(records)
         first = sum(r.first_pass_success for r in records) / n
         final = sum(r.verdict == "equivalent" for r in records) / n
-        print(f"{label:<28} {n:>3}  {first:>9.1%}  {final:>6.1%}  "
-              f"{statistics.mean(r.regenerations for r in records):>5.2f}  "
-              f"{statistics.mean(r.tokens_in for r in records):>9.0f}  "
-              f"{statistics.mean(r.tokens_out for r in records):>10.0f}  "
-              f"{statistics.mean(r.latency_s for r in records):>9.2f}")
+        print(
+            f"{label:<28} {n:>3}  {first:>9.1%}  {final:>6.1%}  "
+            f"{statistics.mean(r.regenerations for r in records):>5.2f}  "
+            f"{statistics.mean(r.tokens_in for r in records):>9.0f}  "
+            f"{statistics.mean(r.tokens_out for r in records):>10.0f}  "
+            f"{statistics.mean(r.latency_s for r in records):>9.2f}"
+        )
     return 0
 
 

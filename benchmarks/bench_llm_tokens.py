@@ -35,8 +35,10 @@ def prompt_tokens(model: FSM | object) -> dict[str, int]:
     variants = {"llm": PromptOptions(direction), "nllm": PromptOptions(direction, scp=False)}
     for module in MODULES[direction]:
         variants[f"-{module}"] = PromptOptions(direction, disabled_modules=frozenset({module}))
-    return {name: count_messages(conversion_messages(shown, options))  # type: ignore[arg-type]
-            for name, options in variants.items()}
+    return {
+        name: count_messages(conversion_messages(shown, options))  # type: ignore[arg-type]
+        for name, options in variants.items()
+    }
 
 
 def size(model: object) -> str:
@@ -73,19 +75,27 @@ def main() -> int:
             counts = [prompt_tokens(random_fsm(seed, n, scenario))["llm"] for seed in range(5)]
             if n == 30:
                 thirty.extend(counts)
-            print(f"{n:>2} states, {scenario:<6} llm prompt tokens: min {min(counts)}, "
-                  f"mean {statistics.mean(counts):.0f}, max {max(counts)}")
+            print(
+                f"{n:>2} states, {scenario:<6} llm prompt tokens: min {min(counts)}, "
+                f"mean {statistics.mean(counts):.0f}, max {max(counts)}"
+            )
     print("\n== generated BTs (paper node set, seeds 0-4)")
     for depth, breadth in ((3, 3), (4, 4), (5, 5)):
-        results = [(sum(1 for _ in bt.nodes()), prompt_tokens(bt)["llm"])
-                   for bt in (random_bt(seed, depth, breadth, "robot", max_nodes=60) for seed in range(5))]
+        results = [
+            (sum(1 for _ in bt.nodes()), prompt_tokens(bt)["llm"])
+            for bt in (random_bt(seed, depth, breadth, "robot", max_nodes=60) for seed in range(5))
+        ]
         nodes = [n for n, _ in results]
         counts = [c for _, c in results]
-        print(f"depth {depth} breadth {breadth} ({min(nodes)}-{max(nodes)} nodes) llm prompt tokens: "
-              f"min {min(counts)}, mean {statistics.mean(counts):.0f}, max {max(counts)}")
+        print(
+            f"depth {depth} breadth {breadth} ({min(nodes)}-{max(nodes)} nodes) llm prompt tokens: "
+            f"min {min(counts)}, mean {statistics.mean(counts):.0f}, max {max(counts)}"
+        )
     within = all(c <= BUDGET for c in thirty)
-    print(f"\n30-state FSMs: llm prompt tokens min {min(thirty)}, mean {statistics.mean(thirty):.0f}, "
-          f"max {max(thirty)}; within the paper's {BUDGET}: {'yes' if within else 'NO'}")
+    print(
+        f"\n30-state FSMs: llm prompt tokens min {min(thirty)}, mean {statistics.mean(thirty):.0f}, "
+        f"max {max(thirty)}; within the paper's {BUDGET}: {'yes' if within else 'NO'}"
+    )
     return 0 if within else 1
 
 

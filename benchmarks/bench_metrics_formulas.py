@@ -27,8 +27,12 @@ def fsm_rows(n: int) -> list[Comparison]:
         measured: dict[str, list[int]] = {"rules": [], "bsd": [], "chds": []}
         predicted: dict[str, list[int]] = {"rules": [], "bsd": [], "chds": []}
         for i in range(n):
-            fsm = random_fsm(seed=f"formula-{low}-{i}", min_states=low, max_states=high,
-                             scenario=SCENARIOS[i % 3])
+            fsm = random_fsm(
+                seed=f"formula-{low}-{i}",
+                min_states=low,
+                max_states=high,
+                scenario=SCENARIOS[i % 3],
+            )
             for engine in measured:
                 result = converter_for(engine, fsm)(fsm)
                 measured[engine].append(elements(result.model).graphical)
@@ -40,9 +44,14 @@ def fsm_rows(n: int) -> list[Comparison]:
                 else:
                     predicted[engine].append(chds(m, result.stats["switches"]))
         for engine, formula in (("rules", "lebt"), ("bsd", "bsd"), ("chds", "chds")):
-            rows.append(Comparison.of(f"FSM->BT {engine:5} M={low}-{high}",
-                                      FORMULA_TEXT[formula], measured[engine],
-                                      predicted[engine]))
+            rows.append(
+                Comparison.of(
+                    f"FSM->BT {engine:5} M={low}-{high}",
+                    FORMULA_TEXT[formula],
+                    measured[engine],
+                    predicted[engine],
+                )
+            )
     return rows
 
 
@@ -56,9 +65,15 @@ def bt_rows(n: int) -> list[Comparison]:
             e = elements(converter_for(engine, bt)(bt).model)
             measured[engine].append(e.graphical)
             predicted[engine].append(hfsm(leaves, e.sub_fsms))
-    return [Comparison.of(f"BT->FSM {engine:5} (k={'0' if engine == 'bsd' else 'sub-FSMs'})",
-                          FORMULA_TEXT["hfsm"], measured[engine], predicted[engine])
-            for engine in measured]
+    return [
+        Comparison.of(
+            f"BT->FSM {engine:5} (k={'0' if engine == 'bsd' else 'sub-FSMs'})",
+            FORMULA_TEXT["hfsm"],
+            measured[engine],
+            predicted[engine],
+        )
+        for engine in measured
+    ]
 
 
 def main() -> None:
@@ -67,14 +82,18 @@ def main() -> None:
     args = parser.parse_args()
     began = time.perf_counter()
     rows = fsm_rows(args.n) + bt_rows(args.n)
-    header = (f"{'set':34} {'formula':8} {'n':>4} {'meas.mean':>9} {'min':>5} {'max':>5} "
-              f"{'pred.mean':>9} {'dev.mean':>8} {'dev.min':>8} {'dev.max':>8} {'exact':>6}")
+    header = (
+        f"{'set':34} {'formula':8} {'n':>4} {'meas.mean':>9} {'min':>5} {'max':>5} "
+        f"{'pred.mean':>9} {'dev.mean':>8} {'dev.min':>8} {'dev.max':>8} {'exact':>6}"
+    )
     print(header)
     print("-" * len(header))
     for r in rows:
-        print(f"{r.label:34} {r.formula:8} {r.n:>4} {r.measured_mean:>9.1f} {r.measured_min:>5} "
-              f"{r.measured_max:>5} {r.predicted_mean:>9.1f} {r.deviation_mean:>+8.1%} "
-              f"{r.deviation_min:>+8.1%} {r.deviation_max:>+8.1%} {r.exact_share:>6.0%}")
+        print(
+            f"{r.label:34} {r.formula:8} {r.n:>4} {r.measured_mean:>9.1f} {r.measured_min:>5} "
+            f"{r.measured_max:>5} {r.predicted_mean:>9.1f} {r.deviation_mean:>+8.1%} "
+            f"{r.deviation_min:>+8.1%} {r.deviation_max:>+8.1%} {r.exact_share:>6.0%}"
+        )
     print(f"({time.perf_counter() - began:.1f} s; deviation = (measured - formula) / formula)")
 
 

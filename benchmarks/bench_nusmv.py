@@ -42,8 +42,9 @@ def random_bt(rng: random.Random, leaves: int) -> BTDocument:
     def build(budget: int) -> BTNode:
         if budget <= 1:
             i = next(names)
-            return BTNode("L", NodeKind.CONDITION if rng.random() < 0.4 else NodeKind.ACTION,
-                          name=f"l{i}")
+            return BTNode(
+                "L", NodeKind.CONDITION if rng.random() < 0.4 else NodeKind.ACTION, name=f"l{i}"
+            )
         parts = min(budget, rng.randint(2, 3))
         sizes = [budget // parts] * parts
         sizes[0] += budget - sum(sizes)
@@ -66,7 +67,9 @@ def measure(pairs, timeout: float) -> tuple[list[float], list[float], int, int, 
     for source, result in pairs:
         t_native, native = timed(lambda source=source, result=result: verify(source, result))
         try:
-            t_smv, smv = timed(lambda source=source, result=result: check(source, result, timeout=timeout))
+            t_smv, smv = timed(
+                lambda source=source, result=result: check(source, result, timeout=timeout)
+            )
         except UnsupportedError as exc:
             return native_t, smv_t, agree, timeouts, str(exc).split("unsupported: ")[-1][:60]
         except NuSMVError:
@@ -89,8 +92,11 @@ def row(label: str, size: int, measured, timeout: float) -> tuple[float, float] 
         return None
     a, b = statistics.median(native_t), statistics.median(smv_t)
     note = f" ({timeouts} timed out)" if timeouts else ""
-    print(f"{label:<26}{size:>5}{a:>11.4f}{b:>10.2f}{b / max(a, 1e-6):>9.0f}"
-          f"{f'{agree}/{len(smv_t)}':>7}{note}", flush=True)
+    print(
+        f"{label:<26}{size:>5}{a:>11.4f}{b:>10.2f}{b / max(a, 1e-6):>9.0f}"
+        f"{f'{agree}/{len(smv_t)}':>7}{note}",
+        flush=True,
+    )
     return a, b
 
 
@@ -101,9 +107,8 @@ def per_doubling(points: list[tuple[int, float]]) -> float | None:
         return None
     xs, ys = [math.log2(s) for s, _ in points], [math.log2(t) for _, t in points]
     mx, my = statistics.fmean(xs), statistics.fmean(ys)
-    slope = (sum((x - mx) * (y - my) for x, y in zip(xs, ys))
-             / sum((x - mx) ** 2 for x in xs))
-    return 2 ** slope
+    slope = sum((x - mx) * (y - my) for x, y in zip(xs, ys)) / sum((x - mx) ** 2 for x in xs)
+    return 2**slope
 
 
 def warm_up() -> None:
@@ -136,8 +141,10 @@ def generated(sizes: list[int], repeat: int, timeout: float) -> None:
                 smv_points.append((n, medians[1]))
         smv_growth, native_growth = per_doubling(smv_points), per_doubling(native_points)
         if smv_growth and native_growth:
-            print(f"  growth {family}: NuSMV x{smv_growth:.2f}, native x{native_growth:.2f} "
-                  f"per size doubling (sizes {smv_points[0][0]}..{smv_points[-1][0]})")
+            print(
+                f"  growth {family}: NuSMV x{smv_growth:.2f}, native x{native_growth:.2f} "
+                f"per size doubling (sizes {smv_points[0][0]}..{smv_points[-1][0]})"
+            )
 
 
 def model_size(model) -> int:
@@ -156,8 +163,9 @@ def examples(repeat: int, timeout: float) -> None:
         except FsmbtError:
             continue  # not a model (README) or not convertible
         label = f"{path.name} {converted.direction}"
-        row(label, model_size(model), measure([(model, converted.model)] * repeat, timeout),
-            timeout)
+        row(
+            label, model_size(model), measure([(model, converted.model)] * repeat, timeout), timeout
+        )
 
 
 def main() -> None:

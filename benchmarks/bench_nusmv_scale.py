@@ -34,8 +34,11 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--timeout", type=float, default=60.0, help="NuSMV seconds per run")
     parser.add_argument("--memory", type=int, default=2048, help="NuSMV MiB per run")
     args = parser.parse_args(argv)
-    limits.use(limits.current().with_changes(nusmv_max_seconds=args.timeout,
-                                             nusmv_max_memory_mb=args.memory))
+    limits.use(
+        limits.current().with_changes(
+            nusmv_max_seconds=args.timeout, nusmv_max_memory_mb=args.memory
+        )
+    )
     sizes = [int(s) for s in args.sizes.split(",")]
     header = f"{'states':>6} {'SMV vars':>8} {'native s':>9} {'NuSMV s':>9} {'ratio':>8}  verdict"
     print(header)
@@ -56,15 +59,21 @@ def main(argv: list[str] | None = None) -> int:
         except NuSMVLimitError as exc:
             print(f"{n:>6} {variables:>8} {native_s:>9.4f} {'-':>9} {'-':>8}  {exc}", flush=True)
             if index < len(sizes) - 1:
-                print(f"{'':>6} sizes {', '.join(map(str, sizes[index + 1:-1])) or '-'} skipped: "
-                      "the cap is reached; running the largest", flush=True)
+                print(
+                    f"{'':>6} sizes {', '.join(map(str, sizes[index + 1 : -1])) or '-'} skipped: "
+                    "the cap is reached; running the largest",
+                    flush=True,
+                )
                 index = len(sizes) - 1
                 continue
             break
         nusmv_s = time.perf_counter() - started
         agree = "agree" if report.equivalent == native_report.equivalent else "DISAGREE"
-        print(f"{n:>6} {variables:>8} {native_s:>9.4f} {nusmv_s:>9.2f} "
-              f"{nusmv_s / native_s:>8.0f}  equivalent={report.equivalent} ({agree})", flush=True)
+        print(
+            f"{n:>6} {variables:>8} {native_s:>9.4f} {nusmv_s:>9.2f} "
+            f"{nusmv_s / native_s:>8.0f}  equivalent={report.equivalent} ({agree})",
+            flush=True,
+        )
         index += 1
     return 0
 

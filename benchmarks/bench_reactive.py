@@ -41,11 +41,15 @@ from fsmbt.verify.pairing import machines_for  # noqa: E402
 FAMILIES: dict[str, dict[str, tuple[str, ...]]] = {
     "plain": {"Sequence": ("Sequence",), "Fallback": ("Fallback",)},
     "reactive": {"Sequence": ("ReactiveSequence",), "Fallback": ("ReactiveFallback",)},
-    "reactive-plain": {"Sequence": ("ReactiveSequence", "Sequence"),
-                       "Fallback": ("ReactiveFallback", "Fallback")},
+    "reactive-plain": {
+        "Sequence": ("ReactiveSequence", "Sequence"),
+        "Fallback": ("ReactiveFallback", "Fallback"),
+    },
     "memory": {"Sequence": ("SequenceWithMemory",), "Fallback": ("Fallback",)},
-    "mixed": {"Sequence": ("Sequence", "ReactiveSequence", "SequenceWithMemory"),
-              "Fallback": ("Fallback", "ReactiveFallback")},
+    "mixed": {
+        "Sequence": ("Sequence", "ReactiveSequence", "SequenceWithMemory"),
+        "Fallback": ("Fallback", "ReactiveFallback"),
+    },
 }
 
 
@@ -89,12 +93,18 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--sizes", default="100,300,1000,3000,10000", help="nodes per tree")
     parser.add_argument("--limit", type=int, default=120, help="seconds per check")
-    parser.add_argument("--faithful-up-to", type=int, default=1000,
-                        help="explore the faithful machine for trees up to this many nodes")
+    parser.add_argument(
+        "--faithful-up-to",
+        type=int,
+        default=1000,
+        help="explore the faithful machine for trees up to this many nodes",
+    )
     parser.add_argument("--families", default=",".join(FAMILIES))
     args = parser.parse_args(argv)
-    header = (f"{'family':<9} {'nodes':>6} {'path':<9} {'leaf st':>8} {'faithful':>9} "
-              f"{'product':>8} {'time s':>8} {'us/node':>8} {'x time':>7} {'x nodes':>7}")
+    header = (
+        f"{'family':<9} {'nodes':>6} {'path':<9} {'leaf st':>8} {'faithful':>9} "
+        f"{'product':>8} {'time s':>8} {'us/node':>8} {'x time':>7} {'x nodes':>7}"
+    )
     print(header)
     print("-" * len(header))
     signal.signal(signal.SIGALRM, _alarm)
@@ -123,21 +133,28 @@ def main(argv: list[str] | None = None) -> int:
                     signal.alarm(0)
             except (_Timeout, StateLimitError) as exc:
                 signal.alarm(0)
-                print(f"{family:<9} {nodes:>6} {path:<9}  stopped: "
-                      f"{'over ' + str(args.limit) + ' s' if isinstance(exc, _Timeout) else exc}",
-                      flush=True)
+                print(
+                    f"{family:<9} {nodes:>6} {path:<9}  stopped: "
+                    f"{'over ' + str(args.limit) + ' s' if isinstance(exc, _Timeout) else exc}",
+                    flush=True,
+                )
                 break
             if not report.equivalent:
                 raise SystemExit(f"{family} {nodes}: tree and HFSM differ: {report.verdicts()}")
             stats = report.stats
             ratio_t = f"{seconds / previous[0]:.1f}" if previous else "-"
             ratio_n = f"{nodes / previous[1]:.1f}" if previous else "-"
-            print(f"{family:<9} {nodes:>6} {path:<9} {stats['source_states']:>8} {faithful:>9} "
-                  f"{stats['product_states']:>8} {seconds:>8.3f} {seconds / nodes * 1e6:>8.1f} "
-                  f"{ratio_t:>7} {ratio_n:>7}", flush=True)
+            print(
+                f"{family:<9} {nodes:>6} {path:<9} {stats['source_states']:>8} {faithful:>9} "
+                f"{stats['product_states']:>8} {seconds:>8.3f} {seconds / nodes * 1e6:>8.1f} "
+                f"{ratio_t:>7} {ratio_n:>7}",
+                flush=True,
+            )
             previous = (seconds, nodes)
-    print("path: table = leaf_fast static table; canonical = interpreter on canonical states "
-          "(leaf_canonical); faithful = full interpreter snapshots")
+    print(
+        "path: table = leaf_fast static table; canonical = interpreter on canonical states "
+        "(leaf_canonical); faithful = full interpreter snapshots"
+    )
     return 0
 
 

@@ -42,8 +42,10 @@ from fsmbt.semantics.engines.pytrees_engine import PyTreesLebtRunner
 from fsmbt.semantics.machine import FINAL, FSMMachine
 
 #: shape -> random_fsm arguments: shallow random trees, and a pure chain (no extra edge)
-SHAPES: dict[str, dict[str, object]] = {"random": {"shape": "tree"},
-                                        "chain": {"shape": "chain", "extra_edges": 0}}
+SHAPES: dict[str, dict[str, object]] = {
+    "random": {"shape": "tree"},
+    "chain": {"shape": "chain", "extra_edges": 0},
+}
 
 
 def living(fsm: FSM) -> FSM:
@@ -76,8 +78,7 @@ def walk(fsm: FSM, steps: int, seed: str) -> list[list[str]]:
     return [s for s in sequences if s]
 
 
-def pytrees_ns_per_step(doc, sequences: list[list[str]],
-                        budget: float) -> tuple[float, float, int]:
+def pytrees_ns_per_step(doc, sequences: list[list[str]], budget: float) -> tuple[float, float, int]:
     """(CPU ns, wall ns) per macro step in py_trees over the sequences, and the steps measured
     (stops after ``budget`` wall seconds)."""
     spent, cpu, steps = 0.0, 0.0, 0
@@ -96,8 +97,7 @@ def pytrees_ns_per_step(doc, sequences: list[list[str]],
 
 
 def measure(shape: str, n: int, args: argparse.Namespace, tmp: Path) -> dict[str, object]:
-    fsm = living(random_fsm(f"bench-runtime-{shape}-{n}", n, start_event=False,
-                            **SHAPES[shape]))  # type: ignore[arg-type]
+    fsm = living(random_fsm(f"bench-runtime-{shape}-{n}", n, start_event=False, **SHAPES[shape]))  # type: ignore[arg-type]
     started = time.perf_counter()
     result = convert(fsm)
     convert_s = time.perf_counter() - started
@@ -107,9 +107,15 @@ def measure(shape: str, n: int, args: argparse.Namespace, tmp: Path) -> dict[str
     steps = max(1_000, min(args.steps, args.step_budget // n))
     repeat = args.repeat if n < 1_000 else 1
     sequences = walk(fsm, steps, f"{shape}-{n}")
-    row: dict[str, object] = {"shape": shape, "states": n, "nodes": result.stats["nodes"],
-                              "depth": result.stats["depth"], "convert_s": convert_s,
-                              "roots": result.stats["root_subtrees"], "steps": steps * repeat}
+    row: dict[str, object] = {
+        "shape": shape,
+        "states": n,
+        "nodes": result.stats["nodes"],
+        "depth": result.stats["depth"],
+        "convert_s": convert_s,
+        "roots": result.stats["root_subtrees"],
+        "steps": steps * repeat,
+    }
     driver = find_driver()
     if driver is None:
         row["cpp"] = row["table"] = f"driver not built ({status().problem})"
@@ -119,8 +125,7 @@ def measure(shape: str, n: int, args: argparse.Namespace, tmp: Path) -> dict[str
             row["cpp"] = bt["cpu_ns_per_step"]
             row["cpp_wall"] = bt["ns_per_step"]
             row["leaf_ticks"] = bt["leaf_ticks"] / max(bt["steps"], 1)
-            once = DriverSession(tree, driver=driver, tick="once", timeout=1200).bench(
-                sequences, 1)
+            once = DriverSession(tree, driver=driver, tick="once", timeout=1200).bench(sequences, 1)
             row["cpp_once"], row["cpp_once_wall"] = once["cpu_ns_per_step"], once["ns_per_step"]
         except CppRuntimeError as exc:
             row["cpp"] = "cannot load: " + str(exc).split(": ", 2)[-1][:90]
@@ -155,16 +160,31 @@ def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--sizes", default="10,100,1000,10000")
     parser.add_argument("--steps", type=int, default=20_000, help="macro steps per model")
-    parser.add_argument("--step-budget", type=int, default=2_000_000,
-                        help="at most this / states steps per model (at least 1 000)")
+    parser.add_argument(
+        "--step-budget",
+        type=int,
+        default=2_000_000,
+        help="at most this / states steps per model (at least 1 000)",
+    )
     parser.add_argument("--repeat", type=int, default=5, help="C++ replays of the walk")
     parser.add_argument("--pytrees-max-states", type=int, default=10_000)
-    parser.add_argument("--pytrees-max-depth", type=int, default=2_100,
-                        help="deeper trees are not run in py_trees (recursive ticks)")
-    parser.add_argument("--pytrees-budget", type=float, default=20.0,
-                        help="seconds of py_trees stepping per model (then it stops early)")
-    parser.add_argument("--depth-series", default="10,25,50,100,200,240",
-                        help="chain sizes for the O(depth) series (loadable in C++)")
+    parser.add_argument(
+        "--pytrees-max-depth",
+        type=int,
+        default=2_100,
+        help="deeper trees are not run in py_trees (recursive ticks)",
+    )
+    parser.add_argument(
+        "--pytrees-budget",
+        type=float,
+        default=20.0,
+        help="seconds of py_trees stepping per model (then it stops early)",
+    )
+    parser.add_argument(
+        "--depth-series",
+        default="10,25,50,100,200,240",
+        help="chain sizes for the O(depth) series (loadable in C++)",
+    )
     args = parser.parse_args()
     sys.setrecursionlimit(max(sys.getrecursionlimit(), 10_000))
     if find_driver() is None:
@@ -177,50 +197,71 @@ def main() -> int:
             for n in sizes:
                 rows.append(measure(shape, n, args, tmp))
                 print(f"  measured {shape} {n}", file=sys.stderr, flush=True)
-        header = (f"{'shape':7} {'states':>6} {'nodes':>6} {'depth':>5} {'roots':>5} "
-                  f"{'steps':>6} {'C++ BT':>10} {'table':>6} {'BT/table':>9} {'ticks':>7} "
-                  f"{'py_trees':>11} {'(steps)':>7} {'py/C++':>7} {'tickOnce':>10} "
-                  f"{'| wall:':>7} {'C++ BT':>10} {'tickOnce':>10} {'py_trees':>11}")
-        print("\nRuntime cost per macro step, ns of CPU time (process CPU clock; wall-clock "
-              "columns on the right: this machine is\nshared, wall time includes waiting for a "
-              "core). BehaviorTree.CPP 4.8.2 via fsmbt/lebt.hpp, py_trees 2.6, plain C++ table.\n"
-              "steps = macro steps timed in C++; ticks = LEBT leaf ticks per step; (steps) = "
-              "py_trees steps timed.\n")
+        header = (
+            f"{'shape':7} {'states':>6} {'nodes':>6} {'depth':>5} {'roots':>5} "
+            f"{'steps':>6} {'C++ BT':>10} {'table':>6} {'BT/table':>9} {'ticks':>7} "
+            f"{'py_trees':>11} {'(steps)':>7} {'py/C++':>7} {'tickOnce':>10} "
+            f"{'| wall:':>7} {'C++ BT':>10} {'tickOnce':>10} {'py_trees':>11}"
+        )
+        print(
+            "\nRuntime cost per macro step, ns of CPU time (process CPU clock; wall-clock "
+            "columns on the right: this machine is\nshared, wall time includes waiting for a "
+            "core). BehaviorTree.CPP 4.8.2 via fsmbt/lebt.hpp, py_trees 2.6, plain C++ table.\n"
+            "steps = macro steps timed in C++; ticks = LEBT leaf ticks per step; (steps) = "
+            "py_trees steps timed.\n"
+        )
         print(header)
         print("-" * len(header))
         for row in rows:
             cpp, table, py = row.get("cpp"), row.get("table"), row.get("pytrees")
-            ratio = fmt(cpp / table, unit="x") if isinstance(cpp, float) and isinstance(
-                table, float) and table else "-"
-            py_ratio = fmt(py / cpp, unit="x") if isinstance(py, float) and isinstance(
-                cpp, float) else "-"
-            lead = (f"{row['shape']:7} {row['states']:>6} {row['nodes']:>6} {row['depth']:>5} "
-                    f"{row['roots']:>5} {row['steps']:>6}")
+            ratio = (
+                fmt(cpp / table, unit="x")
+                if isinstance(cpp, float) and isinstance(table, float) and table
+                else "-"
+            )
+            py_ratio = (
+                fmt(py / cpp, unit="x") if isinstance(py, float) and isinstance(cpp, float) else "-"
+            )
+            lead = (
+                f"{row['shape']:7} {row['states']:>6} {row['nodes']:>6} {row['depth']:>5} "
+                f"{row['roots']:>5} {row['steps']:>6}"
+            )
             if isinstance(cpp, str):
                 print(f"{lead} {cpp}")
-                print(f"{'':42} table: {fmt(table)}; py_trees {fmt(py)} ns/step CPU "
-                      f"({row.get('pytrees_steps', '-')} steps), wall {fmt(row.get('pytrees_wall'))}")
+                print(
+                    f"{'':42} table: {fmt(table)}; py_trees {fmt(py)} ns/step CPU "
+                    f"({row.get('pytrees_steps', '-')} steps), wall {fmt(row.get('pytrees_wall'))}"
+                )
                 continue
-            print(f"{lead} {fmt(cpp):>10} {fmt(table):>6} {ratio:>9} "
-                  f"{fmt(row.get('leaf_ticks')):>7} {fmt(py):>11} "
-                  f"{row.get('pytrees_steps', '-'):>7} {py_ratio:>7} {fmt(row.get('cpp_once')):>10} "
-                  f"{'|':>7} {fmt(row.get('cpp_wall')):>10} {fmt(row.get('cpp_once_wall')):>10} "
-                  f"{fmt(row.get('pytrees_wall')):>11}")
-        print("\nroots = selectors of the root Sequence (the entry state and every state entered "
-              "from two or more states):\nan event that leaves the running subtree towards one "
-              "of them makes the second tick scan the root Sequence,\nso a step costs "
-              "O(depth + roots) node ticks; the table is O(1).")
-        print("C++ BT = fsmbt/lebt.hpp's default (tickExactlyOnce: no node of an LEBT emits a "
-              "wake-up); tickOnce = the same tree ticked\nwith BehaviorTree.CPP's tickOnce(), "
-              "whose wake-up check is a futex system call per RUNNING tick (same results).")
+            print(
+                f"{lead} {fmt(cpp):>10} {fmt(table):>6} {ratio:>9} "
+                f"{fmt(row.get('leaf_ticks')):>7} {fmt(py):>11} "
+                f"{row.get('pytrees_steps', '-'):>7} {py_ratio:>7} {fmt(row.get('cpp_once')):>10} "
+                f"{'|':>7} {fmt(row.get('cpp_wall')):>10} {fmt(row.get('cpp_once_wall')):>10} "
+                f"{fmt(row.get('pytrees_wall')):>11}"
+            )
+        print(
+            "\nroots = selectors of the root Sequence (the entry state and every state entered "
+            "from two or more states):\nan event that leaves the running subtree towards one "
+            "of them makes the second tick scan the root Sequence,\nso a step costs "
+            "O(depth + roots) node ticks; the table is O(1)."
+        )
+        print(
+            "C++ BT = fsmbt/lebt.hpp's default (tickExactlyOnce: no node of an LEBT emits a "
+            "wake-up); tickOnce = the same tree ticked\nwith BehaviorTree.CPP's tickOnce(), "
+            "whose wake-up check is a futex system call per RUNNING tick (same results)."
+        )
         print("\nO(depth) series: chains loadable in BehaviorTree.CPP (tinyxml2 nests <= 500)\n")
-        series_header = (f"{'states':>6} {'depth':>6} {'C++ BT CPU ns/step':>19} "
-                         f"{'leaf ticks/step':>15} {'ns per level':>13}")
+        series_header = (
+            f"{'states':>6} {'depth':>6} {'C++ BT CPU ns/step':>19} "
+            f"{'leaf ticks/step':>15} {'ns per level':>13}"
+        )
         print(series_header)
         print("-" * len(series_header))
         for n in [int(s) for s in args.depth_series.split(",") if s]:
-            row = measure("chain", n, argparse.Namespace(**{**vars(args), "pytrees_max_states": 0}),
-                          tmp)
+            row = measure(
+                "chain", n, argparse.Namespace(**{**vars(args), "pytrees_max_states": 0}), tmp
+            )
             cpp, ticks = row.get("cpp"), row.get("leaf_ticks")
             depth = int(str(row["depth"]))
             per_level = fmt(cpp / depth) if isinstance(cpp, float) and depth else "-"

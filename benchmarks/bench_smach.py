@@ -37,8 +37,10 @@ def main() -> int:
         start = time.perf_counter()
         equivalent = verify(model, back).equivalent
         verify_ms = (time.perf_counter() - start) * 1000
-        print(f"| {size} | {len(text.encode()) / 1024:.0f} | {write_ms:.0f} | {read_s * 1000:.0f} "
-              f"| {read_s * 1e6 / size:.0f} | {verify_ms:.0f} | {equivalent} |")
+        print(
+            f"| {size} | {len(text.encode()) / 1024:.0f} | {write_ms:.0f} | {read_s * 1000:.0f} "
+            f"| {read_s * 1e6 / size:.0f} | {verify_ms:.0f} | {equivalent} |"
+        )
     return 0
 
 

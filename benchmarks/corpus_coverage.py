@@ -51,8 +51,11 @@ class Row:
 
 
 def corpus_root() -> Path:
-    return Path(os.environ.get("FSMBT_CORPUS", Path(__file__).resolve().parents[1] / ".."
-                               / "shared" / "corpus")).resolve()
+    return Path(
+        os.environ.get(
+            "FSMBT_CORPUS", Path(__file__).resolve().parents[1] / ".." / "shared" / "corpus"
+        )
+    ).resolve()
 
 
 def corpus_files(root: Path) -> list[tuple[Path, str, str]]:
@@ -109,8 +112,7 @@ def _alarm(_signum: int, _frame: object) -> None:
     raise _OverBudget
 
 
-def run_one(path: Path, source: str, kind: str, setting: str, root: Path,
-            budget: int = 0) -> Row:
+def run_one(path: Path, source: str, kind: str, setting: str, root: Path, budget: int = 0) -> Row:
     """Convert and verify one file; ``budget`` seconds (0: none) before it counts as "over
     the time budget" (a state space too large to explore in that time)."""
     negative = any(part in NEGATIVE_DIRS for part in path.parts)
@@ -138,8 +140,12 @@ def run_one(path: Path, source: str, kind: str, setting: str, root: Path,
 
 def table(title: str, header: list[str], rows: list[list[object]], markdown: bool) -> str:
     if markdown:
-        lines = [f"**{title}**", "", "| " + " | ".join(header) + " |",
-                 "|" + "|".join("---" for _ in header) + "|"]
+        lines = [
+            f"**{title}**",
+            "",
+            "| " + " | ".join(header) + " |",
+            "|" + "|".join("---" for _ in header) + "|",
+        ]
         lines += ["| " + " | ".join(str(c) for c in r) + " |" for r in rows]
         return "\n".join(lines) + "\n"
     widths = [max(len(str(x)) for x in [h, *(r[i] for r in rows)]) for i, h in enumerate(header)]
@@ -157,8 +163,12 @@ def main() -> int:
     parser.add_argument("--setting", choices=SETTINGS, action="append")
     parser.add_argument("--markdown", action="store_true")
     parser.add_argument("--kind", choices=("bt", "scxml", "smach", "flexbe"), action="append")
-    parser.add_argument("--budget", type=int, default=60,
-                        help="seconds per file before it counts as over budget (0: none)")
+    parser.add_argument(
+        "--budget",
+        type=int,
+        default=60,
+        help="seconds per file before it counts as over budget (0: none)",
+    )
     args = parser.parse_args()
     root = corpus_root()
     if not root.is_dir():
@@ -172,23 +182,41 @@ def main() -> int:
         by_source: dict[str, list[Row]] = {}
         for r in positive:
             by_source.setdefault(r.source, []).append(r)
-        print(table("by source (well-formed files)", ["source", "files", "convert+verify"],
-                    [[s, len(rs), share(sum(r.ok for r in rs), len(rs))]
-                     for s, rs in sorted(by_source.items())], args.markdown))
+        print(
+            table(
+                "by source (well-formed files)",
+                ["source", "files", "convert+verify"],
+                [
+                    [s, len(rs), share(sum(r.ok for r in rs), len(rs))]
+                    for s, rs in sorted(by_source.items())
+                ],
+                args.markdown,
+            )
+        )
         reasons = Counter(r.reason for r in positive if not r.ok)
-        print(table("remaining first blockers (well-formed files)", ["files", "reason"],
-                    [[n, reason] for reason, n in reasons.most_common()], args.markdown))
+        print(
+            table(
+                "remaining first blockers (well-formed files)",
+                ["files", "reason"],
+                [[n, reason] for reason, n in reasons.most_common()],
+                args.markdown,
+            )
+        )
         for kind in ("bt", "scxml", "smach", "flexbe"):
             mine = [r for r in positive if r.kind == kind]
             if mine:
-                print(f"{kind}: {share(sum(r.ok for r in mine), len(mine))} well-formed files "
-                      "convert and verify")
+                print(
+                    f"{kind}: {share(sum(r.ok for r in mine), len(mine))} well-formed files "
+                    "convert and verify"
+                )
         negatives = [r for r in rows if r.negative]
         refused = sum(not r.ok and not r.reason.startswith("CRASH") for r in negatives)
         print(f"negative inputs refused with an error: {refused}/{len(negatives)}")
         slowest = max(rows, key=lambda r: r.seconds)
-        print(f"time: {sum(r.seconds for r in rows):.1f} s in all, slowest "
-              f"{slowest.seconds:.1f} s ({slowest.path.relative_to(root)})")
+        print(
+            f"time: {sum(r.seconds for r in rows):.1f} s in all, slowest "
+            f"{slowest.seconds:.1f} s ({slowest.path.relative_to(root)})"
+        )
         crashes = [r for r in rows if r.reason.startswith("CRASH")]
         for r in crashes:
             print(f"CRASH: {r.path.relative_to(root)}: {r.reason}")

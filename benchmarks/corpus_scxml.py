@@ -23,18 +23,25 @@ from fsmbt.model.errors import FsmbtError
 def reason_of(error: Exception) -> str:
     """A short group name for a refusal (``unsupported: <send> with a delay``)."""
     text = str(error)
-    found = re.search(r"(unsupported: [^,(]+|not an SCXML document[^:(]*|unknown SCXML "
-                      r"element <\w+>)", text)
+    found = re.search(
+        r"(unsupported: [^,(]+|not an SCXML document[^:(]*|unknown SCXML "
+        r"element <\w+>)",
+        text,
+    )
     reason = (found.group(1) if found else text.split(": ", 2)[-1]).strip()
     return re.sub(r"'[^']*'", "'…'", reason)[:70]
 
 
 def main() -> int:
-    default = os.environ.get("FSMBT_CORPUS", str(Path(__file__).resolve().parents[1] / ".."
-                                                  / "shared" / "corpus"))
+    default = os.environ.get(
+        "FSMBT_CORPUS", str(Path(__file__).resolve().parents[1] / ".." / "shared" / "corpus")
+    )
     corpus = Path(sys.argv[1] if len(sys.argv) > 1 else default) / "fsm"
-    files = sorted(p for p in corpus.rglob("*.scxml")
-                   if "_malformed" not in p.parts and "_legacy_draft" not in p.parts)
+    files = sorted(
+        p
+        for p in corpus.rglob("*.scxml")
+        if "_malformed" not in p.parts and "_legacy_draft" not in p.parts
+    )
     if not files:
         print(f"no SCXML files under {corpus}", file=sys.stderr)
         return 2
@@ -62,12 +69,14 @@ def main() -> int:
             result, states, reader = reason_of(exc), 0, ""
             reasons[result] += 1
         ms = (time.perf_counter() - start) * 1000
-        print(f"| {path.relative_to(corpus)} | {result} | {reader} | {states or ''} | "
-              f"{ms:.0f} |")
+        print(f"| {path.relative_to(corpus)} | {result} | {reader} | {states or ''} | {ms:.0f} |")
     total = len(files)
-    print(f"\n**{verified} of {total} well-formed SCXML files convert and verify "
-          f"({100 * verified / total:.0f} %); read by "
-          + ", ".join(f"{name} {count}" for name, count in sorted(readers.items())) + ".**\n")
+    print(
+        f"\n**{verified} of {total} well-formed SCXML files convert and verify "
+        f"({100 * verified / total:.0f} %); read by "
+        + ", ".join(f"{name} {count}" for name, count in sorted(readers.items()))
+        + ".**\n"
+    )
     print("| remaining reason | files |")
     print("|---|---|")
     for reason, count in reasons.most_common():
@@ -79,8 +88,10 @@ def main() -> int:
             abstracted += bool(outcome.report is not None and outcome.report.equivalent)
         except FsmbtError:
             pass
-    print(f"\nWith the abstraction `abstract=time` (a delayed <send> is an environment input): "
-          f"**{abstracted} of {total} ({100 * abstracted / total:.0f} %)** convert and verify.")
+    print(
+        f"\nWith the abstraction `abstract=time` (a delayed <send> is an environment input): "
+        f"**{abstracted} of {total} ({100 * abstracted / total:.0f} %)** convert and verify."
+    )
     return 0
 
 

@@ -23,16 +23,24 @@ from fsmbt.verify import verify
 
 
 def main() -> int:
-    default = os.environ.get("FSMBT_CORPUS", str(Path(__file__).resolve().parents[1] / ".."
-                                                  / "shared" / "corpus"))
+    default = os.environ.get(
+        "FSMBT_CORPUS", str(Path(__file__).resolve().parents[1] / ".." / "shared" / "corpus")
+    )
     corpus = Path(sys.argv[1] if len(sys.argv) > 1 else default) / "fsm"
-    files = sorted([*corpus.glob("smach_tutorials/*.py"), *corpus.glob("smach_tests/*.py"),
-                    *corpus.glob("flexbe_turtlesim_demo/*_sm.py")])
+    files = sorted(
+        [
+            *corpus.glob("smach_tutorials/*.py"),
+            *corpus.glob("smach_tests/*.py"),
+            *corpus.glob("flexbe_turtlesim_demo/*_sm.py"),
+        ]
+    )
     if not files:
         print(f"no SMACH/FlexBE files under {corpus}", file=sys.stderr)
         return 2
-    print("| file | reads | states (all levels / flat) | warnings | converts + verifies | "
-          "SMACH round trip | read ms | convert+verify ms |")
+    print(
+        "| file | reads | states (all levels / flat) | warnings | converts + verifies | "
+        "SMACH round trip | read ms | convert+verify ms |"
+    )
     print("|---|---|---|---|---|---|---|---|")
     totals = {"read": 0, "verified": 0, "round": 0}
     for path in files:
@@ -62,10 +70,14 @@ def main() -> int:
         except FsmbtError as exc:
             round_trip = f"no: {exc}"
         totals["round"] += round_trip == "equivalent"
-        print(f"| {name} | yes | {size} | {len(warnings)} | {verdict} | {round_trip} | "
-              f"{read_ms:.1f} | {convert_ms:.1f} |")
-    print(f"\n{len(files)} files: {totals['read']} read, {totals['verified']} convert and verify, "
-          f"{totals['round']} round-trip through the SMACH writer")
+        print(
+            f"| {name} | yes | {size} | {len(warnings)} | {verdict} | {round_trip} | "
+            f"{read_ms:.1f} | {convert_ms:.1f} |"
+        )
+    print(
+        f"\n{len(files)} files: {totals['read']} read, {totals['verified']} convert and verify, "
+        f"{totals['round']} round-trip through the SMACH writer"
+    )
     return 0
 
 

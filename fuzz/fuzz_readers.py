@@ -161,8 +161,10 @@ def build_seeds(reader: str, out: Path, *, max_seed_bytes: int) -> int:
     return len(seeds)
 
 
-_DICT_TOKEN = re.compile(rb"</?[A-Za-z_][\w:.-]*|[A-Za-z_][\w:.-]*=\"?|[A-Za-z_]\w{2,}"
-                         rb"|[-=<>|*\[\]{}():;,#]{1,4}")
+_DICT_TOKEN = re.compile(
+    rb"</?[A-Za-z_][\w:.-]*|[A-Za-z_][\w:.-]*=\"?|[A-Za-z_]\w{2,}"
+    rb"|[-=<>|*\[\]{}():;,#]{1,4}"
+)
 
 
 def build_dictionary(seeds: Path, out: Path, *, max_tokens: int = 500) -> Path:
@@ -174,8 +176,12 @@ def build_dictionary(seeds: Path, out: Path, *, max_tokens: int = 500) -> Path:
             if len(token) <= 40:
                 counts[token] = counts.get(token, 0) + 1
     best = sorted(counts, key=lambda t: (-counts[t], t))[:max_tokens]
-    lines = ['"' + "".join(chr(b) if 32 <= b < 127 and b not in (34, 92) else f"\\x{b:02x}"
-                           for b in token) + '"' for token in best]
+    lines = [
+        '"'
+        + "".join(chr(b) if 32 <= b < 127 and b not in (34, 92) else f"\\x{b:02x}" for b in token)
+        + '"'
+        for token in best
+    ]
     out.write_text("\n".join(lines) + "\n", encoding="ascii")
     return out
 
@@ -203,21 +209,47 @@ def run_reader(reader: str, args: argparse.Namespace) -> ReaderResult:
         for stale in artifacts.iterdir():
             stale.unlink()
         command = [
-            sys.executable, str(Path(__file__).resolve()), "--worker",
-            "--reader", reader, "--iterations", str(runs),
-            "--seed", str(args.seed * 1000 + batch_index),
-            "--timeout-per-input", str(args.timeout_per_input),
-            "--hard-timeout", str(args.hard_timeout),
-            "--memory-mb", str(args.memory_mb), "--max-len", str(args.max_len),
-            "--regressions", str(args.regressions), "--status", str(status_file),
-            "--artifacts", str(artifacts), "--dict", str(dictionary),
+            sys.executable,
+            str(Path(__file__).resolve()),
+            "--worker",
+            "--reader",
+            reader,
+            "--iterations",
+            str(runs),
+            "--seed",
+            str(args.seed * 1000 + batch_index),
+            "--timeout-per-input",
+            str(args.timeout_per_input),
+            "--hard-timeout",
+            str(args.hard_timeout),
+            "--memory-mb",
+            str(args.memory_mb),
+            "--max-len",
+            str(args.max_len),
+            "--regressions",
+            str(args.regressions),
+            "--status",
+            str(status_file),
+            "--artifacts",
+            str(artifacts),
+            "--dict",
+            str(dictionary),
             *(["--value-profile"] if args.value_profile else []),
-            *[f"--import={name}" for name in args.imports], str(corpus), str(seeds),
+            *[f"--import={name}" for name in args.imports],
+            str(corpus),
+            str(seeds),
         ]
-        env = dict(os.environ, PYTHONPATH=str(ROOT / "src") + os.pathsep
-                   + os.environ.get("PYTHONPATH", ""))
-        proc = subprocess.run(command, env=env, stdout=subprocess.PIPE,
-                              stderr=subprocess.STDOUT, text=True, errors="replace")
+        env = dict(
+            os.environ, PYTHONPATH=str(ROOT / "src") + os.pathsep + os.environ.get("PYTHONPATH", "")
+        )
+        proc = subprocess.run(
+            command,
+            env=env,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.STDOUT,
+            text=True,
+            errors="replace",
+        )
         status = _read_status(status_file)
         done = int(status.get("iterations", 0))
         result.crashes += int(status.get("crashes", 0))
@@ -230,22 +262,27 @@ def run_reader(reader: str, args: argparse.Namespace) -> ReaderResult:
         if proc.returncode != 0:
             # the worker died: libFuzzer's hard alarm, its RSS limit, or a crash in C code
             done += 1  # the input that killed it
-            kind = _save_artifacts(reader, artifacts, Path(args.regressions), proc.stdout,
-                                   result)
+            kind = _save_artifacts(reader, artifacts, Path(args.regressions), proc.stdout, result)
             if args.verbose:
                 print(proc.stdout[-3000:], file=sys.stderr)
-            print(f"  {reader}: worker exited {proc.returncode} ({kind}) after {done} inputs",
-                  file=sys.stderr)
+            print(
+                f"  {reader}: worker exited {proc.returncode} ({kind}) after {done} inputs",
+                file=sys.stderr,
+            )
         result.iterations += done
         stalled = stalled + 1 if done <= 1 else 0
         if stalled >= 3:
-            print(f"  {reader}: three batches in a row died at once; giving up on it",
-                  file=sys.stderr)
+            print(
+                f"  {reader}: three batches in a row died at once; giving up on it", file=sys.stderr
+            )
             break
         batch_index += 1
-        print(f"  {reader}: {result.iterations}/{args.iterations} inputs, "
-              f"{result.crashes} crash(es), {result.timeouts} timeout(s), "
-              f"{result.memory} memory; cov {result.cov} ft {result.ft}", file=sys.stderr)
+        print(
+            f"  {reader}: {result.iterations}/{args.iterations} inputs, "
+            f"{result.crashes} crash(es), {result.timeouts} timeout(s), "
+            f"{result.memory} memory; cov {result.cov} ft {result.ft}",
+            file=sys.stderr,
+        )
     result.seconds = time.monotonic() - started
     return result
 
@@ -257,16 +294,19 @@ def _read_status(path: Path) -> dict[str, object]:
         return {}
 
 
-def _save_artifacts(reader: str, artifacts: Path, regressions: Path, output: str,
-                    result: ReaderResult) -> str:
+def _save_artifacts(
+    reader: str, artifacts: Path, regressions: Path, output: str, result: ReaderResult
+) -> str:
     """Keep the input libFuzzer wrote when it killed the worker; count it by its kind."""
     kind = "crash"
     for artifact in sorted(artifacts.iterdir()):
         prefix = artifact.name.split("-", 1)[0]
         kind = {"timeout": "timeout", "oom": "memory"}.get(prefix, "crash")
         data = artifact.read_bytes()
-        cause = {"timeout": "hard timeout (libFuzzer alarm): the reader did not return",
-                 "memory": "out of memory (libFuzzer RSS limit)"}.get(kind, "worker crashed")
+        cause = {
+            "timeout": "hard timeout (libFuzzer alarm): the reader did not return",
+            "memory": "out of memory (libFuzzer RSS limit)",
+        }.get(kind, "worker crashed")
         tail = [line for line in output.splitlines() if line.strip()][-3:]
         saved = save_finding(regressions / reader, kind, data, f"{cause}; {' | '.join(tail)}")
         result.findings.append(str(saved))
@@ -286,28 +326,37 @@ def save_finding(folder: Path, kind: str, data: bytes, cause: str) -> Path:
     path = folder / f"{kind}-{digest}.input"
     if not path.exists():
         path.write_bytes(data)
-        path.with_suffix(".cause").write_text(" ".join(cause.split())[:500] + "\n",
-                                              encoding="utf-8")
+        path.with_suffix(".cause").write_text(
+            " ".join(cause.split())[:500] + "\n", encoding="utf-8"
+        )
     return path
 
 
 def print_table(results: list[ReaderResult]) -> str:
     """The figures, as a Markdown table (also what docs/security.md quotes)."""
-    rows = ["| reader | iterations | crashes | timeouts | memory | cov (edges) | ft (features) "
-            "| seeds | seconds |",
-            "|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
+    rows = [
+        "| reader | iterations | crashes | timeouts | memory | cov (edges) | ft (features) "
+        "| seeds | seconds |",
+        "|---|---:|---:|---:|---:|---:|---:|---:|---:|",
+    ]
     for r in results:
-        rows.append(f"| {r.reader} | {r.iterations} | {r.crashes} | {r.timeouts} | {r.memory} "
-                    f"| {r.cov} | {r.ft} | {r.seeds} | {r.seconds:.0f} |")
+        rows.append(
+            f"| {r.reader} | {r.iterations} | {r.crashes} | {r.timeouts} | {r.memory} "
+            f"| {r.cov} | {r.ft} | {r.seeds} | {r.seconds:.0f} |"
+        )
     total = sum(r.iterations for r in results)
-    rows.append(f"| **total** | {total} | {sum(r.crashes for r in results)} "
-                f"| {sum(r.timeouts for r in results)} | {sum(r.memory for r in results)} "
-                "| | | | "
-                f"{sum(r.seconds for r in results):.0f} |")
+    rows.append(
+        f"| **total** | {total} | {sum(r.crashes for r in results)} "
+        f"| {sum(r.timeouts for r in results)} | {sum(r.memory for r in results)} "
+        "| | | | "
+        f"{sum(r.seconds for r in results):.0f} |"
+    )
     table = "\n".join(rows)
     print(table)
-    print("coverage: libFuzzer's cov (edges) and ft (features) over the atheris-instrumented "
-          "fsmbt bytecode, at the end of each reader's last batch")
+    print(
+        "coverage: libFuzzer's cov (edges) and ft (features) over the atheris-instrumented "
+        "fsmbt bytecode, at the end of each reader's last batch"
+    )
     return table
 
 
@@ -322,8 +371,9 @@ def parent_main(args: argparse.Namespace) -> int:
     results = [run_reader(name, args) for name in chosen]
     print_table(results)
     if args.json:
-        Path(args.json).write_text(json.dumps([asdict(r) for r in results], indent=2),
-                                   encoding="utf-8")
+        Path(args.json).write_text(
+            json.dumps([asdict(r) for r in results], indent=2), encoding="utf-8"
+        )
     found = sum(r.crashes + r.timeouts + r.memory for r in results)
     return 1 if found else 0
 
@@ -376,8 +426,7 @@ def check_input(reader: str, data: bytes, path: Path) -> tuple[str, str] | None:
     except MemoryError as exc:
         return "memory", f"MemoryError at {innermost_fsmbt_frame(exc)}"
     except Exception as exc:  # noqa: BLE001 - every other exception is the finding
-        return "crash", (f"{type(exc).__name__} at {innermost_fsmbt_frame(exc)}: "
-                         f"{str(exc)[:200]}")
+        return "crash", (f"{type(exc).__name__} at {innermost_fsmbt_frame(exc)}: {str(exc)[:200]}")
     if not isinstance(model, (FSM, BTDocument)):
         return "crash", f"reader returned {type(model).__name__}, not a model"
     return None
@@ -434,12 +483,22 @@ def worker_main(args: argparse.Namespace) -> int:
             write_status()
 
     write_status()
-    atheris.Setup([sys.argv[0], f"-runs={args.iterations}", f"-seed={args.seed}",
-                   f"-timeout={args.hard_timeout}", f"-rss_limit_mb={args.memory_mb}",
-                   f"-max_len={args.max_len}", f"-artifact_prefix={args.artifacts}/",
-                   "-print_final_stats=1", *([f"-dict={args.dict}"] if args.dict else []),
-                   *(["-use_value_profile=1"] if args.value_profile else []),
-                   *args.dirs], one_input)
+    atheris.Setup(
+        [
+            sys.argv[0],
+            f"-runs={args.iterations}",
+            f"-seed={args.seed}",
+            f"-timeout={args.hard_timeout}",
+            f"-rss_limit_mb={args.memory_mb}",
+            f"-max_len={args.max_len}",
+            f"-artifact_prefix={args.artifacts}/",
+            "-print_final_stats=1",
+            *([f"-dict={args.dict}"] if args.dict else []),
+            *(["-use_value_profile=1"] if args.value_profile else []),
+            *args.dirs,
+        ],
+        one_input,
+    )
     atheris.Fuzz()
     return 0
 
@@ -448,25 +507,47 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     parser = argparse.ArgumentParser(description=__doc__.split("\n", 1)[0])
     parser.add_argument("--iterations", type=int, default=10_000, help="inputs per reader")
     parser.add_argument("--reader", default="all", help="a format name, or 'all'")
-    parser.add_argument("--seed", type=int, default=1, help="libFuzzer seed (batches derive "
-                        "theirs from it)")
-    parser.add_argument("--timeout-per-input", type=float, default=2.0,
-                        help="CPU seconds one input may take (soft alarm)")
-    parser.add_argument("--hard-timeout", type=int, default=20,
-                        help="wall seconds before libFuzzer kills the worker")
+    parser.add_argument(
+        "--seed", type=int, default=1, help="libFuzzer seed (batches derive theirs from it)"
+    )
+    parser.add_argument(
+        "--timeout-per-input",
+        type=float,
+        default=2.0,
+        help="CPU seconds one input may take (soft alarm)",
+    )
+    parser.add_argument(
+        "--hard-timeout",
+        type=int,
+        default=20,
+        help="wall seconds before libFuzzer kills the worker",
+    )
     parser.add_argument("--memory-mb", type=int, default=2048, help="address-space cap")
     parser.add_argument("--max-len", type=int, default=16384, help="largest input in bytes")
     parser.add_argument("--batch", type=int, default=50_000, help="inputs per worker")
-    parser.add_argument("--work-dir", default=str(DEFAULT_WORK_DIR),
-                        help="working corpus and seeds (kept between runs)")
-    parser.add_argument("--regressions", default=str(DEFAULT_REGRESSIONS),
-                        help="where finding inputs are saved")
+    parser.add_argument(
+        "--work-dir",
+        default=str(DEFAULT_WORK_DIR),
+        help="working corpus and seeds (kept between runs)",
+    )
+    parser.add_argument(
+        "--regressions", default=str(DEFAULT_REGRESSIONS), help="where finding inputs are saved"
+    )
     parser.add_argument("--json", help="also write the figures to this JSON file")
-    parser.add_argument("--value-profile", action="store_true",
-                        help="libFuzzer -use_value_profile=1 (guides mutations by comparison "
-                        "operands; slower, finds magic values)")
-    parser.add_argument("--import", dest="imports", action="append", default=[],
-                        metavar="MODULE", help="import a module that registers more formats")
+    parser.add_argument(
+        "--value-profile",
+        action="store_true",
+        help="libFuzzer -use_value_profile=1 (guides mutations by comparison "
+        "operands; slower, finds magic values)",
+    )
+    parser.add_argument(
+        "--import",
+        dest="imports",
+        action="append",
+        default=[],
+        metavar="MODULE",
+        help="import a module that registers more formats",
+    )
     parser.add_argument("--verbose", action="store_true")
     parser.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
     parser.add_argument("--status", help=argparse.SUPPRESS)

@@ -15,9 +15,9 @@ export PYTHONPATH="$REPO_ROOT/src${PYTHONPATH:+:$PYTHONPATH}"
 export MYPYPATH="$REPO_ROOT/src"
 
 echo "== ruff check (lint: src tests benchmarks)"
-"$VENV/bin/ruff" check src tests benchmarks
+"$VENV/bin/ruff" check src tests benchmarks fuzz
 echo "== ruff format --check (src tests benchmarks)"
-"$VENV/bin/ruff" format --check src tests benchmarks
+"$VENV/bin/ruff" format --check src tests benchmarks fuzz
 echo "== mypy (package fsmbt)"
 "$VENV/bin/mypy"
 echo "== lint-imports (layer contracts)"

@@ -55,8 +55,9 @@ def test_stages_are_announced_in_order(tmp_path: Path) -> None:
     assert seen == ["read", "convert"]
 
 
-def test_existing_destination_is_refused_before_any_work(tmp_path: Path,
-                                                          monkeypatch: pytest.MonkeyPatch) -> None:
+def test_existing_destination_is_refused_before_any_work(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     out = tmp_path / "taken.xml"
     out.write_text("the user's file", encoding="utf-8")
 
@@ -75,6 +76,7 @@ def test_existing_destination_is_refused_before_any_work(tmp_path: Path,
 @pytest.fixture
 def wrong_engine():
     """An engine whose FSM -> BT result is a behaviour-changing mutant of the right one."""
+
     def fsm_to_bt(model: FSM, **options: object) -> ConversionResult:
         right = api.convert_model(model, "rules")
         for mutant in mutants(right.model, seed=3):
@@ -88,8 +90,9 @@ def wrong_engine():
     _ENGINES.pop("wrong-for-test", None)
 
 
-def test_not_equivalent_result_is_not_written_unless_asked(tmp_path: Path,
-                                                           wrong_engine: str) -> None:
+def test_not_equivalent_result_is_not_written_unless_asked(
+    tmp_path: Path, wrong_engine: str
+) -> None:
     out = tmp_path / "bt.xml"
     outcome = api.convert_file(PAPER_FSM, out, engine=wrong_engine)
     assert outcome.equivalent is False and outcome.verdict == api.NOT_EQUIVALENT

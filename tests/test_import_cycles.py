@@ -14,8 +14,13 @@ SCRIPT = ROOT / "scripts" / "import_cycles.py"
 
 
 def run(*args: str) -> tuple[int, str]:
-    done = subprocess.run([sys.executable, str(SCRIPT), *args], capture_output=True, text=True,
-                          check=False, timeout=120)
+    done = subprocess.run(
+        [sys.executable, str(SCRIPT), *args],
+        capture_output=True,
+        text=True,
+        check=False,
+        timeout=120,
+    )
     assert done.stderr == "", done.stderr
     return done.returncode, done.stdout
 
@@ -27,8 +32,11 @@ def cycle_edges(output: str) -> list[str]:
 def test_no_import_cycle_in_semantics_or_convert() -> None:
     _code, output = run("--root", str(ROOT / "src"))
     assert output.startswith(tuple("0123456789")), output  # the summary line came out
-    offending = [edge for edge in cycle_edges(output)
-                 if edge.startswith(("fsmbt.semantics", "fsmbt.convert"))]
+    offending = [
+        edge
+        for edge in cycle_edges(output)
+        if edge.startswith(("fsmbt.semantics", "fsmbt.convert"))
+    ]
     assert offending == [], output
 
 
@@ -40,11 +48,14 @@ def test_import_cycles_script_finds_a_local_import_cycle(tmp_path: Path) -> None
     (package / "b.py").write_text(
         "from typing import TYPE_CHECKING\n"
         "if TYPE_CHECKING:\n    from pkg.c import x\n"
-        "def thing():\n    from pkg import a\n    return a\n")
+        "def thing():\n    from pkg import a\n    return a\n"
+    )
     (package / "c.py").write_text("import pkg.b\n")
     code, output = run("--root", str(tmp_path), "--package", "pkg")
     assert code == 1
-    assert cycle_edges(output) == ["pkg.a -> pkg.b  " + str(package / "a.py") + ":1",
-                                   "pkg.b -> pkg.a  " + str(package / "b.py") + ":5  (local)"]
+    assert cycle_edges(output) == [
+        "pkg.a -> pkg.b  " + str(package / "a.py") + ":1",
+        "pkg.b -> pkg.a  " + str(package / "b.py") + ":5  (local)",
+    ]
     code, output = run("--root", str(tmp_path), "--package", "pkg", "--module-level-only")
     assert code == 0 and cycle_edges(output) == []

@@ -14,11 +14,22 @@ from fsmbt import limits
 from fsmbt.formats import loads, read_model
 from fsmbt.model.errors import InputError
 
-FSM_JSON = json.dumps({"kind": "fsm", "initial": "A", "states": [
-    {"name": "A", "action": "A"}, {"name": "B", "action": "B"}, {"name": "C", "action": "C"}],
-    "transitions": [{"source": "A", "event": "go", "target": "B"}]})
-BT_XML = ('<root BTCPP_format="4"><BehaviorTree ID="T"><Sequence><Inverter><Inverter>'
-          '<AlwaysSuccess/></Inverter></Inverter><AlwaysFailure/></Sequence></BehaviorTree></root>')
+FSM_JSON = json.dumps(
+    {
+        "kind": "fsm",
+        "initial": "A",
+        "states": [
+            {"name": "A", "action": "A"},
+            {"name": "B", "action": "B"},
+            {"name": "C", "action": "C"},
+        ],
+        "transitions": [{"source": "A", "event": "go", "target": "B"}],
+    }
+)
+BT_XML = (
+    '<root BTCPP_format="4"><BehaviorTree ID="T"><Sequence><Inverter><Inverter>'
+    "<AlwaysSuccess/></Inverter></Inverter><AlwaysFailure/></Sequence></BehaviorTree></root>"
+)
 
 
 @pytest.fixture
@@ -42,8 +53,11 @@ def test_every_limit_has_a_documented_environment_variable() -> None:
 
 
 def test_environment_overrides_and_bad_values_are_refused() -> None:
-    env = {"FSMBT_MAX_STATES": "7", "FSMBT_MAX_NUSMV_SECONDS": "2.5",
-           "FSMBT_MAX_CHECKER_STATES": "99"}
+    env = {
+        "FSMBT_MAX_STATES": "7",
+        "FSMBT_MAX_NUSMV_SECONDS": "2.5",
+        "FSMBT_MAX_CHECKER_STATES": "99",
+    }
     got = limits.from_environment(environ=env)
     assert (got.max_states, got.nusmv_max_seconds, got.checker_max_states) == (7, 2.5, 99)
     assert got.max_nodes == limits.Limits().max_nodes  # the rest keep their defaults
@@ -93,11 +107,18 @@ def test_state_and_node_counts(override: None) -> None:
         loads(BT_XML, "btcpp")
 
 
-@pytest.mark.parametrize(("fmt", "text", "variable"), [
-    ("btcpp", BT_XML, "FSMBT_MAX_XML_DEPTH"),
-    ("json", FSM_JSON, "FSMBT_MAX_JSON_DEPTH"),
-    ("yaml", "kind: fsm\nstates:\n  - name: A\n    attrs: {x: {y: 1}}\n", "FSMBT_MAX_YAML_DEPTH"),
-])
+@pytest.mark.parametrize(
+    ("fmt", "text", "variable"),
+    [
+        ("btcpp", BT_XML, "FSMBT_MAX_XML_DEPTH"),
+        ("json", FSM_JSON, "FSMBT_MAX_JSON_DEPTH"),
+        (
+            "yaml",
+            "kind: fsm\nstates:\n  - name: A\n    attrs: {x: {y: 1}}\n",
+            "FSMBT_MAX_YAML_DEPTH",
+        ),
+    ],
+)
 def test_nesting_depth(fmt: str, text: str, variable: str, override: None) -> None:
     assert loads(text, fmt)
     use(max_xml_depth=3, max_json_depth=2, max_yaml_depth=3)
@@ -111,7 +132,8 @@ def test_include_chain_depth(tmp_path: Path, override: None) -> None:
         include = f'<include path="f{n + 1}.xml"/>' if n < 3 else ""
         (tmp_path / f"f{n}.xml").write_text(
             f'<root BTCPP_format="4" main_tree_to_execute="T0">{include}{body.format(n=n)}</root>',
-            encoding="utf-8")
+            encoding="utf-8",
+        )
     assert read_model(tmp_path / "f0.xml")
     use(max_include_depth=2)
     with pytest.raises(InputError, match="include chain of 3 files.*FSMBT_MAX_INCLUDE_DEPTH"):
@@ -120,39 +142,55 @@ def test_include_chain_depth(tmp_path: Path, override: None) -> None:
 
 def test_includes_are_confined_to_the_read_files_folder(tmp_path: Path) -> None:
     outside = tmp_path / "outside.xml"
-    outside.write_text('<root BTCPP_format="4"><BehaviorTree ID="X"><AlwaysSuccess/>'
-                       '</BehaviorTree></root>', encoding="utf-8")
+    outside.write_text(
+        '<root BTCPP_format="4"><BehaviorTree ID="X"><AlwaysSuccess/></BehaviorTree></root>',
+        encoding="utf-8",
+    )
     project = tmp_path / "project"
     (project / "sub").mkdir(parents=True)
     (project / "sibling.xml").write_text(
         '<root BTCPP_format="4"><BehaviorTree ID="S"><AlwaysSuccess/></BehaviorTree></root>',
-        encoding="utf-8")
+        encoding="utf-8",
+    )
     # ../sibling.xml from a subfolder stays inside the read file's folder: allowed
     (project / "sub" / "child.xml").write_text(
         '<root BTCPP_format="4"><include path="../sibling.xml"/><BehaviorTree ID="C">'
-        '<SubTree ID="S"/></BehaviorTree></root>', encoding="utf-8")
+        '<SubTree ID="S"/></BehaviorTree></root>',
+        encoding="utf-8",
+    )
     main = project / "main.xml"
-    main.write_text('<root BTCPP_format="4" main_tree_to_execute="M">'
-                    '<include path="sub/child.xml"/><BehaviorTree ID="M"><SubTree ID="C"/>'
-                    '</BehaviorTree></root>', encoding="utf-8")
+    main.write_text(
+        '<root BTCPP_format="4" main_tree_to_execute="M">'
+        '<include path="sub/child.xml"/><BehaviorTree ID="M"><SubTree ID="C"/>'
+        "</BehaviorTree></root>",
+        encoding="utf-8",
+    )
     assert set(read_model(main).trees) == {"M", "C", "S"}
     for target in ("../outside.xml", str(outside), "/etc/passwd", "/dev/zero"):
-        main.write_text(f'<root BTCPP_format="4"><include path="{target}"/>'
-                        '<BehaviorTree ID="M"><AlwaysSuccess/></BehaviorTree></root>',
-                        encoding="utf-8")
+        main.write_text(
+            f'<root BTCPP_format="4"><include path="{target}"/>'
+            '<BehaviorTree ID="M"><AlwaysSuccess/></BehaviorTree></root>',
+            encoding="utf-8",
+        )
         with pytest.raises(InputError, match="outside the folder of the file read"):
             read_model(main)
     (project / "link.xml").symlink_to(outside)
-    main.write_text('<root BTCPP_format="4"><include path="link.xml"/>'
-                    '<BehaviorTree ID="M"><AlwaysSuccess/></BehaviorTree></root>', encoding="utf-8")
+    main.write_text(
+        '<root BTCPP_format="4"><include path="link.xml"/>'
+        '<BehaviorTree ID="M"><AlwaysSuccess/></BehaviorTree></root>',
+        encoding="utf-8",
+    )
     with pytest.raises(InputError, match="outside the folder"):
         read_model(main)
     fifo = project / "pipe.xml"
     import os
 
     os.mkfifo(fifo)
-    main.write_text('<root BTCPP_format="4"><include path="pipe.xml"/>'
-                    '<BehaviorTree ID="M"><AlwaysSuccess/></BehaviorTree></root>', encoding="utf-8")
+    main.write_text(
+        '<root BTCPP_format="4"><include path="pipe.xml"/>'
+        '<BehaviorTree ID="M"><AlwaysSuccess/></BehaviorTree></root>',
+        encoding="utf-8",
+    )
     with pytest.raises(InputError, match="not a regular file"):
         read_model(main)
 
@@ -161,22 +199,31 @@ def test_limits_module_imports_nothing_from_fsmbt() -> None:
     import ast
 
     source = Path(limits.__file__).read_text(encoding="utf-8")
-    imported = [n for node in ast.walk(ast.parse(source))
-                if isinstance(node, (ast.Import, ast.ImportFrom))
-                for n in ([node.module or ""] if isinstance(node, ast.ImportFrom)
-                          else [a.name for a in node.names])]
+    imported = [
+        n
+        for node in ast.walk(ast.parse(source))
+        if isinstance(node, (ast.Import, ast.ImportFrom))
+        for n in (
+            [node.module or ""]
+            if isinstance(node, ast.ImportFrom)
+            else [a.name for a in node.names]
+        )
+    ]
     assert not [n for n in imported if n.startswith("fsmbt")], imported
 
 
 def test_include_root_option_widens_the_confinement(tmp_path: Path) -> None:
     (tmp_path / "common.xml").write_text(
         '<root BTCPP_format="4"><BehaviorTree ID="S"><AlwaysSuccess/></BehaviorTree></root>',
-        encoding="utf-8")
+        encoding="utf-8",
+    )
     (tmp_path / "sub").mkdir()
     child = tmp_path / "sub" / "child.xml"
-    child.write_text('<root BTCPP_format="4" main_tree_to_execute="C"><include path="../common.xml"/>'
-                     '<BehaviorTree ID="C"><SubTree ID="S"/></BehaviorTree></root>',
-                     encoding="utf-8")
+    child.write_text(
+        '<root BTCPP_format="4" main_tree_to_execute="C"><include path="../common.xml"/>'
+        '<BehaviorTree ID="C"><SubTree ID="S"/></BehaviorTree></root>',
+        encoding="utf-8",
+    )
     with pytest.raises(InputError, match="outside the folder of the file read"):
         read_model(child)
     assert set(read_model(child, options={"include_root": str(tmp_path)}).trees) == {"C", "S"}

@@ -188,15 +188,15 @@ class DestinationExists(InputError):
     """The output file exists and replacing it was not asked for (the CLI names ``--force``)."""
 
     def __init__(self, location: SourceLocation) -> None:
-        super().__init__("exists", location=location,
-                         hints=(Hint.OVERWRITE,))
+        super().__init__("exists", location=location, hints=(Hint.OVERWRITE,))
 
 
 # -- read -------------------------------------------------------------------------------------
 
 
-def load(path: str | Path, fmt: str | None = None, *,
-         options: dict[str, object] | None = None) -> Loaded:
+def load(
+    path: str | Path, fmt: str | None = None, *, options: dict[str, object] | None = None
+) -> Loaded:
     """Read one model file.
 
     Args:
@@ -221,8 +221,13 @@ def load(path: str | Path, fmt: str | None = None, *,
     return Loaded(model, path, chosen, warnings)
 
 
-def load_text(text: str, fmt: str | None = None, *, filename: str | None = None,
-              options: dict[str, object] | None = None) -> Loaded:
+def load_text(
+    text: str,
+    fmt: str | None = None,
+    *,
+    filename: str | None = None,
+    options: dict[str, object] | None = None,
+) -> Loaded:
     """Read one model from a text (a paste, an upload, an LLM answer).
 
     Args:
@@ -245,8 +250,9 @@ def load_text(text: str, fmt: str | None = None, *, filename: str | None = None,
     return Loaded(model, None, chosen, warnings)
 
 
-def load_for_engine(path: str | Path, engine: str, fmt: str | None = None, *,
-                    options: dict[str, object]) -> Loaded:
+def load_for_engine(
+    path: str | Path, engine: str, fmt: str | None = None, *, options: dict[str, object]
+) -> Loaded:
     """Read the source of a conversion; for the LLM engines through LLM extraction.
 
     The LLM engines (``llm``, ``nllm``, ``hybrid``) read prose, unknown notations and pictures
@@ -276,8 +282,12 @@ def load_for_engine(path: str | Path, engine: str, fmt: str | None = None, *,
     if engine != "hybrid" or needs_llm(path, fmt):
         client = client_from_options(options)
     regenerations = options.get("max_regenerations")
-    loaded = read_input(path, fmt, client=client,
-                        max_regenerations=regenerations if isinstance(regenerations, int) else None)
+    loaded = read_input(
+        path,
+        fmt,
+        client=client,
+        max_regenerations=regenerations if isinstance(regenerations, int) else None,
+    )
     options.update(client=client, source_name=str(path), extracted_by_llm=loaded.extracted)
     name = "llm" if loaded.extracted else (fmt or "detected")
     return Loaded(loaded.model, path, name, [], loaded.extracted)
@@ -297,9 +307,15 @@ def _reader_options(options: dict[str, object]) -> dict[str, object] | None:
 # -- convert and verify ----------------------------------------------------------------------
 
 
-def convert_model(model: Model, engine: str = "rules", *, style: str = "paper",
-                  loop: bool = False, hierarchy: str | None = None,
-                  **options: object) -> ConversionResult:
+def convert_model(
+    model: Model,
+    engine: str = "rules",
+    *,
+    style: str = "paper",
+    loop: bool = False,
+    hierarchy: str | None = None,
+    **options: object,
+) -> ConversionResult:
     """Convert an FSM into a BT, or a BT into a hierarchical FSM.
 
     Args:
@@ -356,8 +372,14 @@ def _checker_limit(max_states: int | None) -> int:
     return max_states if max_states is not None else limits.current().checker_max_states
 
 
-def verify_models(source: Model, result: Model, engine: str = "native", *, loop: bool = False,
-                  max_states: int | None = None) -> Report:
+def verify_models(
+    source: Model,
+    result: Model,
+    engine: str = "native",
+    *,
+    loop: bool = False,
+    max_states: int | None = None,
+) -> Report:
     """Check that ``result`` behaves exactly like ``source`` (the five properties).
 
     Args:
@@ -375,8 +397,7 @@ def verify_models(source: Model, result: Model, engine: str = "native", *, loop:
         EngineDisagreement: ``both`` and the engines disagree (a bug in one of them).
         InputError, UnsupportedError: the pair cannot be compared.
     """
-    report = verify(source, result, engine=engine, loop=loop,
-                    max_states=_checker_limit(max_states))
+    report = verify(source, result, engine=engine, loop=loop, max_states=_checker_limit(max_states))
     _name_abstractions(report, source, result)
     return readable(report, source, result)
 
@@ -394,8 +415,14 @@ def _name_abstractions(report: Report, *models: Model) -> None:
         report.stats["abstractions"] = list(found)
 
 
-def verify_either_order(first: Model, second: Model, engine: str = "native", *,
-                        loop: bool = False, max_states: int | None = None) -> Report:
+def verify_either_order(
+    first: Model,
+    second: Model,
+    engine: str = "native",
+    *,
+    loop: bool = False,
+    max_states: int | None = None,
+) -> Report:
     """Like ``verify_models``, for two models given in either order.
 
     The pair is put in the order its pairing rule needs (``fsmbt.verify.orient``): an FSM and
@@ -411,16 +438,24 @@ def verify_either_order(first: Model, second: Model, engine: str = "native", *,
     """
     oriented = orient(first, second)
     try:
-        report = verify(oriented.source, oriented.result, engine=engine, loop=loop,
-                        max_states=_checker_limit(max_states))
+        report = verify(
+            oriented.source,
+            oriented.result,
+            engine=engine,
+            loop=loop,
+            max_states=_checker_limit(max_states),
+        )
     except UnsupportedError:
         raise
     except InputError as exc:
         if Hint.MAX_STATES in exc.hints:  # a size limit, not a pairing problem
             raise
-        raise InputError(f"{exc.message} (pairing rule tried: {oriented.rule}; the rules are: "
-                         f"{rules_text()})", location=exc.location,
-                         element=exc.element, hints=exc.hints) from None
+        raise InputError(
+            f"{exc.message} (pairing rule tried: {oriented.rule}; the rules are: {rules_text()})",
+            location=exc.location,
+            element=exc.element,
+            hints=exc.hints,
+        ) from None
     readable(report, oriented.source, oriented.result)
     report.stats["pairing"] = oriented.rule
     report.stats["swapped"] = oriented.swapped
@@ -454,11 +489,13 @@ def check_destination(path: str | Path, *, overwrite: bool = False) -> Path:
     for parent in path.parents:
         if parent.exists():
             if not parent.is_dir():
-                raise InputError(f"cannot write here: '{parent}' is a file, not a folder",
-                                 location=where)
+                raise InputError(
+                    f"cannot write here: '{parent}' is a file, not a folder", location=where
+                )
             if not os.access(parent, os.W_OK):
-                raise InputError(f"cannot write here: no permission to write in '{parent}'",
-                                 location=where)
+                raise InputError(
+                    f"cannot write here: no permission to write in '{parent}'", location=where
+                )
             break
     return path
 
@@ -484,8 +521,9 @@ def output_format_for(kind: str, *, to: str | None = None, output: Path | None =
     return DEFAULT_FSM_FORMAT if kind == "fsm" else DEFAULT_BT_FORMAT
 
 
-def write(model: Model, path: str | Path, fmt: str | None = None, *,
-          overwrite: bool = False) -> Path:
+def write(
+    model: Model, path: str | Path, fmt: str | None = None, *, overwrite: bool = False
+) -> Path:
     """Write a model to a file, atomically.
 
     Args:
@@ -525,8 +563,9 @@ def write_text(text: str, path: str | Path, *, overwrite: bool = False) -> Path:
     path = check_destination(path, overwrite=overwrite)
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
-        handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp",
-                                             dir=path.parent)
+        handle, temporary = tempfile.mkstemp(
+            prefix=f".{path.name}.", suffix=".tmp", dir=path.parent
+        )
         try:
             with os.fdopen(handle, "w", encoding="utf-8", newline="") as stream:
                 stream.write(text)
@@ -539,8 +578,9 @@ def write_text(text: str, path: str | Path, *, overwrite: bool = False) -> Path:
             if os.path.exists(temporary):
                 os.unlink(temporary)
     except OSError as exc:
-        raise InputError(f"cannot write: {exc.strerror}",
-                         location=SourceLocation(str(path))) from None
+        raise InputError(
+            f"cannot write: {exc.strerror}", location=SourceLocation(str(path))
+        ) from None
     return path
 
 
@@ -588,14 +628,24 @@ def _refuse_blockers(model: Model) -> None:
     raise error(message, location=first.location, element=first.element)
 
 
-def convert_file(source: str | Path, output: str | Path | None = None, *,
-                 to: str | None = None, source_format: str | None = None,
-                 engine: str = "rules", style: str = "paper", loop: bool = False,
-                 hierarchy: str = "subtrees", verify: bool = True,
-                 verify_engine: str = "native", max_states: int | None = None,
-                 overwrite: bool = False, keep_not_equivalent: bool = False,
-                 options: dict[str, object] | None = None,
-                 on_stage: StageHook | None = None) -> Outcome:
+def convert_file(
+    source: str | Path,
+    output: str | Path | None = None,
+    *,
+    to: str | None = None,
+    source_format: str | None = None,
+    engine: str = "rules",
+    style: str = "paper",
+    loop: bool = False,
+    hierarchy: str = "subtrees",
+    verify: bool = True,
+    verify_engine: str = "native",
+    max_states: int | None = None,
+    overwrite: bool = False,
+    keep_not_equivalent: bool = False,
+    options: dict[str, object] | None = None,
+    on_stage: StageHook | None = None,
+) -> Outcome:
     """Read, convert, verify and write one model file.
 
     The destination is checked first, so a refused output costs no conversion. The result is
@@ -634,22 +684,43 @@ def convert_file(source: str | Path, output: str | Path | None = None, *,
     timings: dict[str, float] = {}
     with _timed(timings, "read", on_stage):
         loaded = load_for_engine(source, engine, source_format, options=options)
-    outcome = convert_loaded(loaded, output, to=to, engine=engine, style=style, loop=loop,
-                             hierarchy=hierarchy, verify=verify, verify_engine=verify_engine,
-                             max_states=max_states, overwrite=overwrite,
-                             keep_not_equivalent=keep_not_equivalent, options=options,
-                             on_stage=on_stage)
+    outcome = convert_loaded(
+        loaded,
+        output,
+        to=to,
+        engine=engine,
+        style=style,
+        loop=loop,
+        hierarchy=hierarchy,
+        verify=verify,
+        verify_engine=verify_engine,
+        max_states=max_states,
+        overwrite=overwrite,
+        keep_not_equivalent=keep_not_equivalent,
+        options=options,
+        on_stage=on_stage,
+    )
     outcome.timings = {**timings, **outcome.timings}
     return outcome
 
 
-def convert_loaded(loaded: Loaded, output: str | Path | None = None, *,
-                   to: str | None = None, engine: str = "rules", style: str = "paper",
-                   loop: bool = False, hierarchy: str = "subtrees", verify: bool = True,
-                   verify_engine: str = "native", max_states: int | None = None,
-                   overwrite: bool = False, keep_not_equivalent: bool = False,
-                   options: dict[str, object] | None = None,
-                   on_stage: StageHook | None = None) -> Outcome:
+def convert_loaded(
+    loaded: Loaded,
+    output: str | Path | None = None,
+    *,
+    to: str | None = None,
+    engine: str = "rules",
+    style: str = "paper",
+    loop: bool = False,
+    hierarchy: str = "subtrees",
+    verify: bool = True,
+    verify_engine: str = "native",
+    max_states: int | None = None,
+    overwrite: bool = False,
+    keep_not_equivalent: bool = False,
+    options: dict[str, object] | None = None,
+    on_stage: StageHook | None = None,
+) -> Outcome:
     """Convert, verify and (optionally) write a model already read (a file, a text, an upload).
 
     The same steps and rules as ``convert_file`` after reading; a text from ``load_text`` goes
@@ -677,15 +748,17 @@ def convert_loaded(loaded: Loaded, output: str | Path | None = None, *,
         engine_options = {k: v for k, v in options.items() if k not in READER_OPTIONS}
         if max_states is not None:
             engine_options.setdefault("max_states", max_states)
-        conversion = convert_model(loaded.model, engine, style=style, loop=loop,
-                                   hierarchy=hierarchy, **engine_options)
+        conversion = convert_model(
+            loaded.model, engine, style=style, loop=loop, hierarchy=hierarchy, **engine_options
+        )
     fmt = output_format_for(model_kind(conversion.model), to=to, output=destination)
     text = dumps(conversion.model, fmt)
     report: Report | None = None
     if verify:
         with _timed(timings, "verify", on_stage):
-            report = verify_models(loaded.model, conversion.model, verify_engine, loop=loop,
-                                   max_states=max_states)
+            report = verify_models(
+                loaded.model, conversion.model, verify_engine, loop=loop, max_states=max_states
+            )
     outcome = Outcome(loaded, conversion, report, fmt, text, output=destination)
     if destination is not None and (report is None or report.equivalent or keep_not_equivalent):
         with _timed(timings, "write", on_stage):
@@ -695,12 +768,18 @@ def convert_loaded(loaded: Loaded, output: str | Path | None = None, *,
     return outcome
 
 
-def verify_files(source: str | Path, converted: str | Path, *, engine: str = "native",
-                 loop: bool = False, source_format: str | None = None,
-                 converted_format: str | None = None,
-                 max_states: int | None = None,
-                 options: dict[str, object] | None = None,
-                 on_stage: StageHook | None = None) -> tuple[Loaded, Loaded, Report]:
+def verify_files(
+    source: str | Path,
+    converted: str | Path,
+    *,
+    engine: str = "native",
+    loop: bool = False,
+    source_format: str | None = None,
+    converted_format: str | None = None,
+    max_states: int | None = None,
+    options: dict[str, object] | None = None,
+    on_stage: StageHook | None = None,
+) -> tuple[Loaded, Loaded, Report]:
     """Read two model files and check that the second behaves exactly like the first.
 
     Args:
@@ -730,14 +809,36 @@ def verify_files(source: str | Path, converted: str | Path, *, engine: str = "na
         _warn_lebt_ports(first)
         _warn_lebt_ports(second)
     with _timed(timings, "verify", on_stage):
-        report = verify_either_order(first.model, second.model, engine, loop=loop,
-                                     max_states=max_states)
+        report = verify_either_order(
+            first.model, second.model, engine, loop=loop, max_states=max_states
+        )
     return first, second, report
 
 
 __all__ = [
-    "DEFAULT_BT_FORMAT", "DEFAULT_FSM_FORMAT", "EQUIVALENT", "LLM_ENGINES", "NOT_EQUIVALENT",
-    "NOT_VERIFIED", "DestinationExists", "Loaded", "Model", "Outcome", "check_destination", "convert_file", "convert_loaded",
-    "convert_model", "load", "load_for_engine", "load_text", "model_kind", "output_format_for",
-    "verdict_word", "verify_either_order", "verify_files", "verify_models", "write", "write_text",
+    "DEFAULT_BT_FORMAT",
+    "DEFAULT_FSM_FORMAT",
+    "EQUIVALENT",
+    "LLM_ENGINES",
+    "NOT_EQUIVALENT",
+    "NOT_VERIFIED",
+    "DestinationExists",
+    "Loaded",
+    "Model",
+    "Outcome",
+    "check_destination",
+    "convert_file",
+    "convert_loaded",
+    "convert_model",
+    "load",
+    "load_for_engine",
+    "load_text",
+    "model_kind",
+    "output_format_for",
+    "verdict_word",
+    "verify_either_order",
+    "verify_files",
+    "verify_models",
+    "write",
+    "write_text",
 ]

@@ -92,8 +92,7 @@ def env_name(field_name: str) -> str:
     return ENV_PREFIX + name
 
 
-def from_environment(base: Limits | None = None,
-                     environ: dict[str, str] | None = None) -> Limits:
+def from_environment(base: Limits | None = None, environ: dict[str, str] | None = None) -> Limits:
     """``base`` (the defaults) with every ``FSMBT_MAX_...`` variable that is set applied.
 
     Raises:

@@ -15,13 +15,17 @@ from fsmbt.cli.cmd_batch import exit_code
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 #: the example models (not the README, not the runnable run_*.py programs)
-EXAMPLE_MODELS = sorted(p.name for p in EXAMPLES.iterdir()
-                        if p.is_file() and p.name != "README.md" and not p.name.startswith("run_"))
+EXAMPLE_MODELS = sorted(
+    p.name
+    for p in EXAMPLES.iterdir()
+    if p.is_file() and p.name != "README.md" and not p.name.startswith("run_")
+)
 CORPUS = Path(os.environ.get("FSMBT_CORPUS", "/nonexistent"))
 
 
 def test_examples_convert_into_a_new_nested_folder_and_report_again(
-        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     out = tmp_path / "a" / "b" / "out"
     assert main(["batch", str(EXAMPLES), "-o", str(out), "-j", "2", "--quiet"]) == 0
     table = capsys.readouterr().out
@@ -41,17 +45,20 @@ def test_bad_input_is_a_row_and_exit_2(tmp_path: Path, capsys: pytest.CaptureFix
     broken.parent.mkdir()
     broken.write_text("<root><BehaviorTree>", encoding="utf-8")
     (tmp_path / "in" / "robot.xml").write_text(
-        (EXAMPLES / "robot_bt.xml").read_text(encoding="utf-8"), encoding="utf-8")
-    assert main(["batch", str(tmp_path / "in"), "-o", str(tmp_path / "out"), "--quiet",
-                 "--json"]) == 2
+        (EXAMPLES / "robot_bt.xml").read_text(encoding="utf-8"), encoding="utf-8"
+    )
+    assert (
+        main(["batch", str(tmp_path / "in"), "-o", str(tmp_path / "out"), "--quiet", "--json"]) == 2
+    )
     rows = {Path(r["input"]).name: r for r in json.loads(capsys.readouterr().out)["results"]}
     assert rows["broken.xml"]["status"] == "bad_input"
     assert "broken.xml" in rows["broken.xml"]["error_message"]
     assert rows["robot.xml"]["status"] == "equivalent"
 
 
-def test_an_existing_output_is_kept_without_force(tmp_path: Path,
-                                                  capsys: pytest.CaptureFixture[str]) -> None:
+def test_an_existing_output_is_kept_without_force(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     out = tmp_path / "out"
     out.mkdir()
     mine = out / "robot_bt.scxml"
@@ -66,7 +73,8 @@ def test_an_existing_output_is_kept_without_force(tmp_path: Path,
 
 
 def test_an_output_path_that_is_a_file_is_one_error_line(
-        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     target = tmp_path / "file.txt"
     target.write_text("x", encoding="utf-8")
     assert main(["batch", str(EXAMPLES), "-o", str(target)]) == 2
@@ -82,12 +90,16 @@ def test_exit_codes() -> None:
 
 @pytest.mark.skipif(not CORPUS.is_dir(), reason="FSMBT_CORPUS is not set")
 def test_the_corpus_malformed_files_are_rows_not_a_crash(
-        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    folders = [CORPUS / "bt" / "bt_in_action" / "_malformed",
-               CORPUS / "fsm" / "w3c_scxml_examples" / "_malformed"]
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    folders = [
+        CORPUS / "bt" / "bt_in_action" / "_malformed",
+        CORPUS / "fsm" / "w3c_scxml_examples" / "_malformed",
+    ]
     expected = sorted(p.name for folder in folders for p in folder.iterdir() if p.is_file())
-    assert main(["batch", *map(str, folders), "-o", str(tmp_path / "out"), "--quiet",
-                 "--json"]) == 2
+    assert (
+        main(["batch", *map(str, folders), "-o", str(tmp_path / "out"), "--quiet", "--json"]) == 2
+    )
     captured = capsys.readouterr()
     rows = json.loads(captured.out)["results"]
     assert sorted(Path(r["input"]).name for r in rows) == expected
@@ -96,8 +108,9 @@ def test_the_corpus_malformed_files_are_rows_not_a_crash(
     assert "Traceback" not in captured.err
 
 
-def test_the_progress_bar_counts_per_status_on_a_terminal(monkeypatch: pytest.MonkeyPatch,
-                                                          capsys: pytest.CaptureFixture[str]) -> None:
+def test_the_progress_bar_counts_per_status_on_a_terminal(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
     from fsmbt.batch import JobResult
     from fsmbt.cli.cmd_batch import BatchProgress
 
@@ -112,10 +125,28 @@ def test_the_progress_bar_counts_per_status_on_a_terminal(monkeypatch: pytest.Mo
 
 
 @pytest.mark.slow
-def test_the_ray_executor_from_the_command_line(tmp_path: Path,
-                                                capsys: pytest.CaptureFixture[str]) -> None:
+def test_the_ray_executor_from_the_command_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     out = tmp_path / "out"
-    assert main(["batch", str(EXAMPLES), "-o", str(out), "--executor", "ray", "-j", "2",
-                 "--chunk-size", "2", "--quiet", "--json"]) == 0
+    assert (
+        main(
+            [
+                "batch",
+                str(EXAMPLES),
+                "-o",
+                str(out),
+                "--executor",
+                "ray",
+                "-j",
+                "2",
+                "--chunk-size",
+                "2",
+                "--quiet",
+                "--json",
+            ]
+        )
+        == 0
+    )
     rows = json.loads(capsys.readouterr().out)["results"]
     assert len(rows) == len(EXAMPLE_MODELS) and {r["status"] for r in rows} == {"equivalent"}

@@ -23,8 +23,12 @@ SRC = Path(__file__).resolve().parents[2] / "src"
 
 def _batch(args: list[str]) -> subprocess.Popen[bytes]:
     env = {**os.environ, "PYTHONPATH": f"{SRC}{os.pathsep}{os.environ.get('PYTHONPATH', '')}"}
-    return subprocess.Popen([sys.executable, "-m", "fsmbt.cli", "batch", *args], env=env,
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    return subprocess.Popen(
+        [sys.executable, "-m", "fsmbt.cli", "batch", *args],
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+    )
 
 
 def _done_rows(store: Path) -> dict[str, float]:
@@ -60,8 +64,9 @@ def test_sigkill_mid_run_then_resume_loses_and_duplicates_nothing(tmp_path: Path
     stdout, stderr = resumed.communicate(timeout=600)
     assert resumed.returncode == 0, stderr.decode()
     with sqlite3.connect(store) as db:
-        rows = db.execute("SELECT input, state, status, output, key, finished_at "
-                          "FROM results").fetchall()
+        rows = db.execute(
+            "SELECT input, state, status, output, key, finished_at FROM results"
+        ).fetchall()
     assert sorted(row[0] for row in rows) == sorted(str(p) for p in inputs)  # one row each
     assert {row[1] for row in rows} == {"done"} and {row[2] for row in rows} == {"equivalent"}
     after = {row[4]: row[5] for row in rows}

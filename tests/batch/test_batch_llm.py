@@ -15,16 +15,27 @@ from fsmbt.batch.ratelimit import MinuteRateLimit
 from fsmbt.formats import dumps
 from support.scripted_server import ScriptedServer
 
-FSM_JSON = {"kind": "fsm", "name": "door", "initial": "Closed",
-            "states": [{"name": "Closed", "action": "close"}, {"name": "Open", "action": "open"}],
-            "transitions": [{"source": "Closed", "event": "push", "target": "Open"},
-                            {"source": "Open", "event": "pull", "target": "Closed"}]}
+FSM_JSON = {
+    "kind": "fsm",
+    "name": "door",
+    "initial": "Closed",
+    "states": [{"name": "Closed", "action": "close"}, {"name": "Open", "action": "open"}],
+    "transitions": [
+        {"source": "Closed", "event": "push", "target": "Open"},
+        {"source": "Open", "event": "pull", "target": "Closed"},
+    ],
+}
 
 
 @pytest.fixture(autouse=True)
 def llm_env(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
-    for name in ("FSMBT_LLM_BASE_URL", "FSMBT_LLM_MODEL", "OPENAI_API_KEY", "FSMBT_LLM_CONFIG",
-                 "FSMBT_LLM_TIMEOUT"):
+    for name in (
+        "FSMBT_LLM_BASE_URL",
+        "FSMBT_LLM_MODEL",
+        "OPENAI_API_KEY",
+        "FSMBT_LLM_CONFIG",
+        "FSMBT_LLM_TIMEOUT",
+    ):
         monkeypatch.delenv(name, raising=False)
     monkeypatch.setenv("FSMBT_LLM_API_KEY", "k")
     monkeypatch.setenv("HOME", str(tmp_path))
@@ -48,13 +59,17 @@ def _answer() -> str:
 
 
 def test_a_failing_endpoint_is_a_row_with_its_cause_and_runs_again_on_resume(
-        tmp_path: Path) -> None:
+    tmp_path: Path,
+) -> None:
     _doors(tmp_path / "in", 1)
     out = tmp_path / "out"
     with ScriptedServer([{"status": 503}]) as server:
-        jobs = make_jobs([tmp_path / "in"], out, engine="llm",
-                         options={"llm_base_url": server.base_url, "llm_model": "m",
-                                  "llm_timeout": 3.0})
+        jobs = make_jobs(
+            [tmp_path / "in"],
+            out,
+            engine="llm",
+            options={"llm_base_url": server.base_url, "llm_model": "m", "llm_timeout": 3.0},
+        )
         with ResultStore(out) as store:
             [failed] = run_jobs(jobs, store=store)
             assert failed.status == "error" and failed.error_class == "LLMUnavailableError"
@@ -62,9 +77,12 @@ def test_a_failing_endpoint_is_a_row_with_its_cause_and_runs_again_on_resume(
             assert not store.done(jobs[0].key)
         assert len(server.requests) > 1  # the client retried the 5xx before giving up
     with ScriptedServer([{"content": _answer()}]) as server:
-        jobs = make_jobs([tmp_path / "in"], out, engine="llm",
-                         options={"llm_base_url": server.base_url, "llm_model": "m",
-                                  "llm_timeout": 30.0})
+        jobs = make_jobs(
+            [tmp_path / "in"],
+            out,
+            engine="llm",
+            options={"llm_base_url": server.base_url, "llm_model": "m", "llm_timeout": 30.0},
+        )
         with ResultStore(out) as store:
             [resumed] = run_jobs(jobs, store=store)
             assert resumed.status == "equivalent", resumed.error_message
@@ -77,14 +95,19 @@ def test_requests_at_once_are_bounded_by_the_concurrency_limit(tmp_path: Path) -
     _doors(tmp_path / "in", 4)
     delay = 1.0
     with ScriptedServer([{"content": _answer(), "delay": delay}]) as server:
-        jobs = make_jobs([tmp_path / "in"], tmp_path / "out", engine="llm",
-                         options={"llm_base_url": server.base_url, "llm_model": "m"})
+        jobs = make_jobs(
+            [tmp_path / "in"],
+            tmp_path / "out",
+            engine="llm",
+            options={"llm_base_url": server.base_url, "llm_model": "m"},
+        )
         results = run_jobs(jobs, workers=4, llm_concurrency=2)
         arrivals = sorted(request["time"] for request in server.requests)
     assert {r.status for r in results} == {"equivalent"}, [r.error_message for r in results]
     assert len(arrivals) == 4
-    overlapping = max(sum(1 for other in arrivals if start <= other < start + delay)
-                      for start in arrivals)
+    overlapping = max(
+        sum(1 for other in arrivals if start <= other < start + delay) for start in arrivals
+    )
     assert overlapping <= 2
 
 

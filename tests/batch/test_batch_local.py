@@ -33,8 +33,11 @@ def test_a_killed_worker_loses_no_result(tmp_path: Path) -> None:
     def kill_one(result: JobResult) -> None:
         if killed:
             return
-        workers = [p.pid for p in multiprocessing.active_children()
-                   if p.pid is not None and p.pid not in before]
+        workers = [
+            p.pid
+            for p in multiprocessing.active_children()
+            if p.pid is not None and p.pid not in before
+        ]
         if workers:
             os.kill(workers[0], signal.SIGKILL)
             killed.append(workers[0])

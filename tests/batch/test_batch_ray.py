@@ -47,16 +47,21 @@ def test_a_killed_ray_worker_loses_no_result(tmp_path: Path) -> None:
             killed.append(process.pid)
             return
 
-    ray.init(num_cpus=2, include_dashboard=False, _node_ip_address="127.0.0.1",
-             logging_level="ERROR", log_to_driver=False)
+    ray.init(
+        num_cpus=2,
+        include_dashboard=False,
+        _node_ip_address="127.0.0.1",
+        logging_level="ERROR",
+        log_to_driver=False,
+    )
     try:
         with ResultStore(tmp_path / "out") as store:
-            results = run_jobs(jobs, store=store, executor="ray", workers=2, chunk_size=2,
-                               on_result=kill_a_worker)
+            results = run_jobs(
+                jobs, store=store, executor="ray", workers=2, chunk_size=2, on_result=kill_a_worker
+            )
             assert killed, "no Ray worker process was found to kill"
             assert sorted(r.key for r in results) == sorted(j.key for j in jobs)
-            assert {r.status for r in results} == {"equivalent"}, \
-                [r.error_message for r in results]
+            assert {r.status for r in results} == {"equivalent"}, [r.error_message for r in results]
             assert len(store.results()) == len(jobs) and store.summary()["pending"] == 0
     finally:
         ray.shutdown()

@@ -8,15 +8,37 @@ from fsmbt.batch import Job, JobResult, ResultStore
 
 
 def test_rows_round_trip_and_replace_by_key(tmp_path: Path) -> None:
-    row = JobResult("k1", "a.xml", "equivalent", verdict="EQUIVALENT",
-                    properties={"reachability": True}, timings={"total": 0.5},
-                    output="out/a.scxml", stats={"product_states": 12}, options={"loop": True})
+    row = JobResult(
+        "k1",
+        "a.xml",
+        "equivalent",
+        verdict="EQUIVALENT",
+        properties={"reachability": True},
+        timings={"total": 0.5},
+        output="out/a.scxml",
+        stats={"product_states": 12},
+        options={"loop": True},
+    )
     with ResultStore(tmp_path) as store:
         store.put(row)
-        store.put(JobResult("k2", "b.xml", "bad_input", error_class="InputError",
-                            error_message="b.xml:3: not well-formed"))
-        store.put(JobResult("k2", "b.xml", "bad_input", error_class="InputError",
-                            error_message="b.xml:4: not well-formed"))
+        store.put(
+            JobResult(
+                "k2",
+                "b.xml",
+                "bad_input",
+                error_class="InputError",
+                error_message="b.xml:3: not well-formed",
+            )
+        )
+        store.put(
+            JobResult(
+                "k2",
+                "b.xml",
+                "bad_input",
+                error_class="InputError",
+                error_message="b.xml:4: not well-formed",
+            )
+        )
     with ResultStore(tmp_path) as store:  # reopened: everything committed is there
         results = {r.key: r for r in store.results()}
         assert set(results) == {"k1", "k2"}
@@ -44,8 +66,16 @@ def test_claims_are_pending_until_a_result_and_never_replace_a_result(tmp_path: 
 
 def test_retryable_rows_are_stored_but_not_done(tmp_path: Path) -> None:
     with ResultStore(tmp_path) as store:
-        store.put(JobResult("k", "x.json", "error", error_class="LLMUnavailableError",
-                            error_message="HTTP 503", retry=True))
+        store.put(
+            JobResult(
+                "k",
+                "x.json",
+                "error",
+                error_class="LLMUnavailableError",
+                error_message="HTTP 503",
+                retry=True,
+            )
+        )
         assert not store.done("k")
         assert store.summary()["retry"] == 1
         assert [r.error_message for r in store.results()] == ["HTTP 503"]

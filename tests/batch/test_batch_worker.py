@@ -32,14 +32,22 @@ def test_an_equivalent_result_is_written_and_verifies_on_reading_back(tmp_path: 
         assert api.verify_either_order(source, written).equivalent
 
 
-@pytest.mark.parametrize(("name", "text", "cause"), [
-    ("broken.xml", "<root><BehaviorTree><Sequence></root>", "broken.xml"),
-    ("bomb.xml", '<?xml version="1.0"?><!DOCTYPE r [<!ENTITY a "aaaa">'
-                 '<!ENTITY b "&a;&a;&a;&a;">]><root>&b;</root>', "bomb.xml"),
-    ("binary.json", "\x00\x01\x02 not text", "binary.json"),
-])
-def test_malformed_and_hostile_inputs_are_bad_input_rows(tmp_path: Path, name: str, text: str,
-                                                         cause: str) -> None:
+@pytest.mark.parametrize(
+    ("name", "text", "cause"),
+    [
+        ("broken.xml", "<root><BehaviorTree><Sequence></root>", "broken.xml"),
+        (
+            "bomb.xml",
+            '<?xml version="1.0"?><!DOCTYPE r [<!ENTITY a "aaaa">'
+            '<!ENTITY b "&a;&a;&a;&a;">]><root>&b;</root>',
+            "bomb.xml",
+        ),
+        ("binary.json", "\x00\x01\x02 not text", "binary.json"),
+    ],
+)
+def test_malformed_and_hostile_inputs_are_bad_input_rows(
+    tmp_path: Path, name: str, text: str, cause: str
+) -> None:
     path = tmp_path / name
     path.write_text(text, encoding="utf-8")
     result = run_job(Job(str(path), str(tmp_path / "out.scxml")))
@@ -69,10 +77,18 @@ def test_a_too_large_input_is_a_row(tmp_path: Path, monkeypatch: pytest.MonkeyPa
 
 def test_a_model_the_engine_cannot_convert_exactly_is_a_refused_row(tmp_path: Path) -> None:
     path = tmp_path / "start.json"
-    path.write_text(json.dumps({
-        "kind": "fsm", "name": "m", "initial": "__start__",
-        "states": [{"name": "__start__", "action": "a"}, {"name": "B", "action": "b"}],
-        "transitions": [{"source": "__start__", "event": "go", "target": "B"}]}), encoding="utf-8")
+    path.write_text(
+        json.dumps(
+            {
+                "kind": "fsm",
+                "name": "m",
+                "initial": "__start__",
+                "states": [{"name": "__start__", "action": "a"}, {"name": "B", "action": "b"}],
+                "transitions": [{"source": "__start__", "event": "go", "target": "B"}],
+            }
+        ),
+        encoding="utf-8",
+    )
     result = run_job(Job(str(path), None))
     assert result.status == "refused" and result.error_class == "UnsupportedError"
     assert "start pseudo-state" in (result.error_message or "")
@@ -110,8 +126,9 @@ def test_the_time_limit_is_a_timeout_row(tmp_path: Path) -> None:
 
 
 def test_no_verify_is_a_not_verified_row(tmp_path: Path) -> None:
-    result = run_job(Job(str(EXAMPLES / "robot_bt.xml"), str(tmp_path / "r.scxml"),
-                         verify_engine="none"))
+    result = run_job(
+        Job(str(EXAMPLES / "robot_bt.xml"), str(tmp_path / "r.scxml"), verify_engine="none")
+    )
     assert result.status == "not_verified" and result.properties == {}
     assert Path(result.output or "").exists()
 
@@ -122,7 +139,8 @@ def test_both_verifiers_in_a_batch_row(tmp_path: Path) -> None:
 
     if find_nusmv() is None:
         pytest.skip("NuSMV is not available (FSMBT_NUSMV, PATH or .cache/nusmv)")
-    result = run_job(Job(str(EXAMPLES / "paper_fsm.xml"), str(tmp_path / "p.xml"),
-                         verify_engine="both"))
+    result = run_job(
+        Job(str(EXAMPLES / "paper_fsm.xml"), str(tmp_path / "p.xml"), verify_engine="both")
+    )
     assert result.status == "equivalent", result.error_message
     assert result.verify_engine == "both" and all(result.properties.values())

@@ -45,6 +45,7 @@ def sparse(size: int) -> Callable[[Path], None]:
     def make(path: Path) -> None:
         with path.open("wb") as stream:
             stream.truncate(size)  # a hole: claims the size without using the disk
+
     return make
 
 
@@ -73,23 +74,36 @@ HUGE_DOCTYPE = """<?xml version="1.0"?>
 <root BTCPP_format="4"><BehaviorTree ID="T"><Action ID="&huge;"/></BehaviorTree></root>
 """
 
-YAML_ALIAS_BOMB = "\n".join(
-    ["kind: bt", "a0: &a0 [lol, lol, lol, lol, lol, lol, lol, lol, lol]"]
-    + [f"a{i}: &a{i} [" + ", ".join([f"*a{i - 1}"] * 9) + "]" for i in range(1, 10)]
-    + ["trees: [{id: T, root: {type: A, attrs: {x: *a9}}}]"]) + "\n"
+YAML_ALIAS_BOMB = (
+    "\n".join(
+        ["kind: bt", "a0: &a0 [lol, lol, lol, lol, lol, lol, lol, lol, lol]"]
+        + [f"a{i}: &a{i} [" + ", ".join([f"*a{i - 1}"] * 9) + "]" for i in range(1, 10)]
+        + ["trees: [{id: T, root: {type: A, attrs: {x: *a9}}}]"]
+    )
+    + "\n"
+)
 
-FSM_JSON_UNKNOWN_TARGET = json.dumps({
-    "kind": "fsm", "name": "m", "initial": "A",
-    "states": [{"name": "A"}, {"name": "B"}],
-    "transitions": [{"source": "A", "event": "go", "target": "Nowhere"}],
-})
+FSM_JSON_UNKNOWN_TARGET = json.dumps(
+    {
+        "kind": "fsm",
+        "name": "m",
+        "initial": "A",
+        "states": [{"name": "A"}, {"name": "B"}],
+        "transitions": [{"source": "A", "event": "go", "target": "Nowhere"}],
+    }
+)
 
 
 def deep_json() -> str:
     node = '{"type": "A", "kind": "Action"}'
     opening = '{"type": "Inverter", "kind": "Decorator", "children": ['
-    return ('{"kind": "bt", "main_tree": "T", "trees": [{"id": "T", "root": '
-            + opening * DEEP + node + "]}" * DEEP + "}]}")
+    return (
+        '{"kind": "bt", "main_tree": "T", "trees": [{"id": "T", "root": '
+        + opening * DEEP
+        + node
+        + "]}" * DEEP
+        + "}]}"
+    )
 
 
 def deep_yaml() -> str:
@@ -98,58 +112,113 @@ def deep_yaml() -> str:
 
 
 CASES = [
-    Case("broken_xml", "broken.xml",
-         text(BT_HEAD + "<Sequence><AlwaysSuccess/></BehaviorTree></root>"),
-         r"xml|mismatch|well-formed|tag"),
+    Case(
+        "broken_xml",
+        "broken.xml",
+        text(BT_HEAD + "<Sequence><AlwaysSuccess/></BehaviorTree></root>"),
+        r"xml|mismatch|well-formed|tag",
+    ),
     Case("entity_bomb", "bomb.xml", text(BILLION_LAUGHS), r"entit|DTD|DOCTYPE"),
     Case("external_entity", "xxe.xml", text(XXE), r"entit|DTD|DOCTYPE"),
-    Case("doctype_claims_huge_content", "huge_doctype.xml", text(HUGE_DOCTYPE),
-         r"entit|DTD|DOCTYPE"),
-    Case("deep_xml", "deep.xml",
-         text(BT_HEAD + "<Inverter>" * DEEP + "<AlwaysSuccess/>" + "</Inverter>" * DEEP + BT_TAIL),
-         r"deep|depth|nest"),
+    Case(
+        "doctype_claims_huge_content", "huge_doctype.xml", text(HUGE_DOCTYPE), r"entit|DTD|DOCTYPE"
+    ),
+    Case(
+        "deep_xml",
+        "deep.xml",
+        text(BT_HEAD + "<Inverter>" * DEEP + "<AlwaysSuccess/>" + "</Inverter>" * DEEP + BT_TAIL),
+        r"deep|depth|nest",
+    ),
     Case("deep_json", "deep.json", text(deep_json()), r"deep|depth|nest"),
     Case("deep_yaml", "deep.yaml", text(deep_yaml()), r"deep|depth|nest"),
-    Case("unknown_node_with_children", "unknown.xml",
-         text(BT_HEAD + "<Frobnicate><AlwaysSuccess/></Frobnicate>" + BT_TAIL), r"Frobnicate"),
-    Case("nondeterministic_fsm", "nd.csv",
-         text("source,event,target\nA,go,B\nA,go,C\nB,back,A\n"), r"nondeterministic"),
-    Case("transition_to_unknown_state", "unknown_target.json", text(FSM_JSON_UNKNOWN_TARGET),
-         r"Nowhere"),
+    Case(
+        "unknown_node_with_children",
+        "unknown.xml",
+        text(BT_HEAD + "<Frobnicate><AlwaysSuccess/></Frobnicate>" + BT_TAIL),
+        r"Frobnicate",
+    ),
+    Case(
+        "nondeterministic_fsm",
+        "nd.csv",
+        text("source,event,target\nA,go,B\nA,go,C\nB,back,A\n"),
+        r"nondeterministic",
+    ),
+    Case(
+        "transition_to_unknown_state",
+        "unknown_target.json",
+        text(FSM_JSON_UNKNOWN_TARGET),
+        r"Nowhere",
+    ),
     Case("empty_file", "empty.json", text(""), r"empty"),
     Case("whitespace_only", "blank.xml", text("  \n\t\n   \n"), r"empty"),
-    Case("binary_garbage", "garbage.json",
-         raw(b"\x89PNG\r\n\x1a\n\x00\x00\x00\rIHDR" + bytes(range(256)) * 4), r"binary"),
-    Case("random_bytes_with_nul", "random.xml",
-         raw(bytes((i * 7919 + 13) % 256 for i in range(4096)) + b"\x00"), r"binary"),
-    Case("latin1_bytes", "latin1.csv",
-         raw("source,event,target\nA,café,B\n".encode("latin-1")), r"UTF-8"),
-    Case("utf16_without_bom", "utf16.csv",
-         raw("source,event,target\nA,go,B\n".encode("utf-16-le")), r"UTF-16"),
-    Case("sparse_2GB_file", "huge.json", sparse(2 * 1024 ** 3), r"limit|bytes|too large"),
+    Case(
+        "binary_garbage",
+        "garbage.json",
+        raw(b"\x89PNG\r\n\x1a\n\x00\x00\x00\rIHDR" + bytes(range(256)) * 4),
+        r"binary",
+    ),
+    Case(
+        "random_bytes_with_nul",
+        "random.xml",
+        raw(bytes((i * 7919 + 13) % 256 for i in range(4096)) + b"\x00"),
+        r"binary",
+    ),
+    Case(
+        "latin1_bytes",
+        "latin1.csv",
+        raw("source,event,target\nA,café,B\n".encode("latin-1")),
+        r"UTF-8",
+    ),
+    Case(
+        "utf16_without_bom",
+        "utf16.csv",
+        raw("source,event,target\nA,go,B\n".encode("utf-16-le")),
+        r"UTF-16",
+    ),
+    Case("sparse_2GB_file", "huge.json", sparse(2 * 1024**3), r"limit|bytes|too large"),
     Case("yaml_alias_bomb", "bomb.yaml", text(YAML_ALIAS_BOMB), r"alias"),
-    Case("json_wrong_types", "types.json",
-         text('{"kind": "fsm", "states": "A", "transitions": 5}'), r"expected a list"),
-    Case("json_syntax_error", "syntax.json", text('{"kind": "fsm", "states": [}'),
-         r"invalid JSON"),
+    Case(
+        "json_wrong_types",
+        "types.json",
+        text('{"kind": "fsm", "states": "A", "transitions": 5}'),
+        r"expected a list",
+    ),
+    Case("json_syntax_error", "syntax.json", text('{"kind": "fsm", "states": [}'), r"invalid JSON"),
     Case("directory_instead_of_file", "adir", lambda path: path.mkdir(), r"directory"),
     Case("missing_file", "does_not_exist.xml", lambda path: None, r"no such file|cannot read"),
-    Case("subtree_to_missing_tree", "subtree.xml",
-         text(BT_HEAD + '<Sequence><SubTree ID="Nowhere"/></Sequence>' + BT_TAIL),
-         r"Nowhere"),
-    Case("decorator_with_two_children", "decorator.xml",
-         text(BT_HEAD + "<Inverter><AlwaysSuccess/><AlwaysFailure/></Inverter>" + BT_TAIL),
-         r"one child"),
-    Case("control_without_children", "control.xml", text(BT_HEAD + "<Sequence/>" + BT_TAIL),
-         r"no children|child"),
+    Case(
+        "subtree_to_missing_tree",
+        "subtree.xml",
+        text(BT_HEAD + '<Sequence><SubTree ID="Nowhere"/></Sequence>' + BT_TAIL),
+        r"Nowhere",
+    ),
+    Case(
+        "decorator_with_two_children",
+        "decorator.xml",
+        text(BT_HEAD + "<Inverter><AlwaysSuccess/><AlwaysFailure/></Inverter>" + BT_TAIL),
+        r"one child",
+    ),
+    Case(
+        "control_without_children",
+        "control.xml",
+        text(BT_HEAD + "<Sequence/>" + BT_TAIL),
+        r"no children|child",
+    ),
     Case("csv_missing_columns", "cols.csv", text("source,event\nA,go\n"), r"column"),
-    Case("mermaid_garbage", "garbage.mmd", text("stateDiagram-v2\n  A ==> B ??? !!\n"),
-         r"cannot read"),
-    Case("mermaid_fork", "fork.mmd", text("stateDiagram-v2\n  state F <<fork>>\n"),
-         r"unsupported.*fork"),
+    Case(
+        "mermaid_garbage",
+        "garbage.mmd",
+        text("stateDiagram-v2\n  A ==> B ??? !!\n"),
+        r"cannot read",
+    ),
+    Case(
+        "mermaid_fork",
+        "fork.mmd",
+        text("stateDiagram-v2\n  state F <<fork>>\n"),
+        r"unsupported.*fork",
+    ),
     Case("dot_undirected", "graph.dot", text("graph G { a -- b }\n"), r"undirected"),
-    Case("unknown_format", "notes.dat", text("just some words, not a model\n"),
-         r"format|cannot"),
+    Case("unknown_format", "notes.dat", text("just some words, not a model\n"), r"format|cannot"),
 ]
 
 
@@ -159,9 +228,14 @@ def run_validate(target: Path) -> tuple[subprocess.CompletedProcess[str], float,
     env.pop("FSMBT_DEBUG", None)
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     started = time.monotonic()
-    result = subprocess.run([sys.executable, "-m", "fsmbt.cli", "validate", str(target)],
-                            capture_output=True, text=True, timeout=10, env=env,
-                            cwd=target.parent)
+    result = subprocess.run(
+        [sys.executable, "-m", "fsmbt.cli", "validate", str(target)],
+        capture_output=True,
+        text=True,
+        timeout=10,
+        env=env,
+        cwd=target.parent,
+    )
     elapsed = time.monotonic() - started
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)

@@ -15,16 +15,18 @@ from fsmbt import api
 from fsmbt.cli import main
 from fsmbt.model.errors import InputError
 
-CORPUS = Path(os.environ.get("FSMBT_CORPUS",
-                             Path(__file__).resolve().parents[2] / ".." / "shared" / "corpus"))
+CORPUS = Path(
+    os.environ.get("FSMBT_CORPUS", Path(__file__).resolve().parents[2] / ".." / "shared" / "corpus")
+)
 
 
 def _bt_files() -> list[Path]:
     root = CORPUS / "bt"
     if not root.is_dir():
         return []
-    return sorted(p for p in root.rglob("*.xml")
-                  if "_malformed" not in p.parts and "models" not in p.parts)
+    return sorted(
+        p for p in root.rglob("*.xml") if "_malformed" not in p.parts and "models" not in p.parts
+    )
 
 
 def test_validate_and_convert_agree_on_the_corpus(capsys: pytest.CaptureFixture[str]) -> None:
@@ -51,11 +53,15 @@ def test_validate_and_convert_agree_on_the_corpus(capsys: pytest.CaptureFixture[
             refused += 1
             error_lines = {i["line"] for i in report["issues"] if i["severity"] == "error"}
             if exc.location is not None and exc.location.line not in error_lines:
-                disagreements.append(f"{path.name}: convert refuses at {exc.location}, "
-                                     f"validate names no error there ({sorted(error_lines)})")
+                disagreements.append(
+                    f"{path.name}: convert refuses at {exc.location}, "
+                    f"validate names no error there ({sorted(error_lines)})"
+                )
         if (code == 0) != converts:
-            disagreements.append(f"{path.name}: validate exit {code}, convert "
-                                 f"{'converts' if converts else 'refuses'}")
+            disagreements.append(
+                f"{path.name}: validate exit {code}, convert "
+                f"{'converts' if converts else 'refuses'}"
+            )
     assert disagreements == []
     assert refused > 0  # the corpus has files conversion refuses: the check is not vacuous
 

@@ -21,8 +21,9 @@ from fsmbt.model import FSM, BTDocument, BTNode, NodeKind
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 #: runnable example programs (not models): run_*.py
 SCRIPTS = sorted(p for p in EXAMPLES.iterdir() if p.suffix == ".py" and p.name.startswith("run_"))
-MODEL_FILES = sorted(p for p in EXAMPLES.iterdir()
-                     if p.is_file() and p.name != "README.md" and p not in SCRIPTS)
+MODEL_FILES = sorted(
+    p for p in EXAMPLES.iterdir() if p.is_file() and p.name != "README.md" and p not in SCRIPTS
+)
 
 
 def _readable(path: Path) -> bool:
@@ -30,7 +31,8 @@ def _readable(path: Path) -> bool:
     claims yet is skipped (with the reason), never silently passed."""
     return format_for_path(path) is not None or any(
         f.read is not None and f.sniff is not None and f.sniff(path.read_text(encoding="utf-8"))
-        for f in formats())
+        for f in formats()
+    )
 
 
 def _need_reader(path: Path) -> None:
@@ -44,8 +46,9 @@ def test_examples_readme_lists_exactly_the_example_files() -> None:
 
 
 @pytest.mark.parametrize("path", MODEL_FILES, ids=lambda p: p.name)
-def test_info_and_render_every_example(path: Path, tmp_path: Path,
-                                       capsys: pytest.CaptureFixture) -> None:
+def test_info_and_render_every_example(
+    path: Path, tmp_path: Path, capsys: pytest.CaptureFixture
+) -> None:
     _need_reader(path)
     assert main(["info", str(path), "--json"]) == 0
     data = json.loads(capsys.readouterr().out)
@@ -57,14 +60,16 @@ def test_info_and_render_every_example(path: Path, tmp_path: Path,
     assert main(["render", str(path), "-o", str(out)]) == 0
     svg = out.read_text(encoding="utf-8")
     assert "<svg" in svg
-    names = list(model.states) if isinstance(model, FSM) else [
-        node.label for _, node in model.nodes() if node.is_leaf]
+    names = (
+        list(model.states)
+        if isinstance(model, FSM)
+        else [node.label for _, node in model.nodes() if node.is_leaf]
+    )
     assert all(f">{name}<" in svg for name in names)  # every state / leaf is in the picture
 
 
 @pytest.mark.parametrize("path", MODEL_FILES, ids=lambda p: p.name)
-def test_validate_every_example(path: Path,
-                                                        capsys: pytest.CaptureFixture) -> None:
+def test_validate_every_example(path: Path, capsys: pytest.CaptureFixture) -> None:
     _need_reader(path)
     code = main(["validate", str(path)])
     captured = capsys.readouterr()
@@ -73,31 +78,50 @@ def test_validate_every_example(path: Path,
 
 def test_cli_as_a_process_prints_no_traceback(tmp_path: Path) -> None:
     missing = tmp_path / "nope.json"
-    done = subprocess.run([sys.executable, "-m", "fsmbt.cli", "info", str(missing)],
-                          capture_output=True, text=True, timeout=60, check=False)
+    done = subprocess.run(
+        [sys.executable, "-m", "fsmbt.cli", "info", str(missing)],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        check=False,
+    )
     assert done.returncode == 2
     assert "Traceback" not in done.stderr and len(done.stderr.strip().splitlines()) == 1
-    done = subprocess.run([sys.executable, "-m", "fsmbt.cli", "info",
-                           str(EXAMPLES / "robot_bt.xml"), "--json"],
-                          capture_output=True, text=True, timeout=60, check=False)
+    done = subprocess.run(
+        [sys.executable, "-m", "fsmbt.cli", "info", str(EXAMPLES / "robot_bt.xml"), "--json"],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        check=False,
+    )
     assert done.returncode == 0 and json.loads(done.stdout)["nodes"] == 21
 
 
 # -- the paper's models, as issue 2 describes them ----------------------------------------------
 PAPER_FSM = "Start→A; A→B, A→C, A→D, A→F; B→C, B→D; C→D; D→E; E→C, E→D, E→G; G→H; F→I; I→J"
-ROBOT_BT = ("Sequence[ Fallback(BatteryBelow, Recharge), Fallback(Cube2inDelivery, Sequence[ "
-            "Fallback(CubeinHand, Sequence[Fallback(RobotatCube2, MovetoCube2), Pickcube2]), "
-            "Fallback(RobotatDelivery, MovetoDelivery), PlaceCube2 ]), "
-            "Fallback(RobotAtInspection, Dock) ]")
-ROBOT_CONDITIONS = {"BatteryBelow", "Cube2inDelivery", "CubeinHand", "RobotatCube2",
-                    "RobotatDelivery", "RobotAtInspection"}
+ROBOT_BT = (
+    "Sequence[ Fallback(BatteryBelow, Recharge), Fallback(Cube2inDelivery, Sequence[ "
+    "Fallback(CubeinHand, Sequence[Fallback(RobotatCube2, MovetoCube2), Pickcube2]), "
+    "Fallback(RobotatDelivery, MovetoDelivery), PlaceCube2 ]), "
+    "Fallback(RobotAtInspection, Dock) ]"
+)
+ROBOT_CONDITIONS = {
+    "BatteryBelow",
+    "Cube2inDelivery",
+    "CubeinHand",
+    "RobotatCube2",
+    "RobotatDelivery",
+    "RobotAtInspection",
+}
 
 
 @pytest.mark.parametrize("name", ["paper_fsm.xml", "paper_fsm.json"])
 def test_paper_fsm_is_the_issues_fsm(name: str) -> None:
     fsm = read_model(EXAMPLES / name)
     assert isinstance(fsm, FSM)
-    pairs = {tuple(p.strip().split("→")) for group in PAPER_FSM.split(";") for p in group.split(",")}
+    pairs = {
+        tuple(p.strip().split("→")) for group in PAPER_FSM.split(";") for p in group.split(",")
+    }
     drawn = {(t.source, t.target) for t in fsm.transitions} | {(fsm.start_name, fsm.initial)}
     assert drawn == pairs
     for t in fsm.transitions:
@@ -165,8 +189,10 @@ def _btcpp_run(xml: str, conditions: set[str], actions: set[str]) -> tuple[str, 
 
 def _declared(path: Path) -> tuple[set[str], set[str]]:
     model = etree.parse(str(path)).getroot().find("TreeNodesModel")
-    return ({m.get("ID") for m in model if m.tag == "Condition"},
-            {m.get("ID") for m in model if m.tag == "Action"})
+    return (
+        {m.get("ID") for m in model if m.tag == "Condition"},
+        {m.get("ID") for m in model if m.tag == "Action"},
+    )
 
 
 def test_robot_bt_runs_in_behaviortree_cpp() -> None:
@@ -196,13 +222,19 @@ def _registered_commands() -> set[str]:
     from fsmbt import cli
 
     assert main(["--help"]) == 0  # registers every cmd_*.py module
-    return ({c.name for c in cli.app.registered_commands}
-            | {g.name for g in cli.app.registered_groups})
+    return {c.name for c in cli.app.registered_commands} | {
+        g.name for g in cli.app.registered_groups
+    }
 
 
-def test_readme_marks_exactly_the_existing_commands_available(capsys: pytest.CaptureFixture) -> None:
-    rows = re.findall(r"^\| `fsmbt (\w+)[^|]*\|[^|]*\| (\w+) \|$",
-                      (ROOT / "README.md").read_text(encoding="utf-8"), flags=re.M)
+def test_readme_marks_exactly_the_existing_commands_available(
+    capsys: pytest.CaptureFixture,
+) -> None:
+    rows = re.findall(
+        r"^\| `fsmbt (\w+)[^|]*\|[^|]*\| (\w+) \|$",
+        (ROOT / "README.md").read_text(encoding="utf-8"),
+        flags=re.M,
+    )
     available = {name for name, status in rows if status == "available"}
     registered = _registered_commands()
     capsys.readouterr()
@@ -225,6 +257,9 @@ def test_docs_index_links_every_document_and_nothing_missing() -> None:
     assert all((docs / link).resolve().exists() for link in links), links
     linked = {(docs / link).resolve() for link in links}
     documents = [*docs.glob("*.md"), *docs.glob("*/README.md")]  # sub-folders have an index
-    unlisted = [str(p.relative_to(docs)) for p in documents
-                if p != docs / "README.md" and p.resolve() not in linked]
+    unlisted = [
+        str(p.relative_to(docs))
+        for p in documents
+        if p != docs / "README.md" and p.resolve() not in linked
+    ]
     assert not unlisted, f"docs/README.md does not list {unlisted}"

@@ -21,8 +21,9 @@ PAPER_FSM = EXAMPLES / "paper_fsm.xml"
 FSMBT = [sys.executable, "-m", "fsmbt.cli"]
 
 
-def test_output_is_checked_before_any_work(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
-                                            capsys: pytest.CaptureFixture[str]) -> None:
+def test_output_is_checked_before_any_work(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
     existing = tmp_path / "mine.xml"
     existing.write_text("keep me", encoding="utf-8")
 
@@ -38,8 +39,7 @@ def test_output_is_checked_before_any_work(tmp_path: Path, monkeypatch: pytest.M
     assert "is a folder" in capsys.readouterr().err
 
 
-def test_convert_prints_each_step_time(tmp_path: Path,
-                                       capsys: pytest.CaptureFixture[str]) -> None:
+def test_convert_prints_each_step_time(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["convert", str(PAPER_FSM), "-o", str(tmp_path / "bt.xml")]) == 0
     out = capsys.readouterr().out
     time_line = next(line for line in out.splitlines() if line.startswith("time:"))
@@ -48,15 +48,24 @@ def test_convert_prints_each_step_time(tmp_path: Path,
 
 
 def test_no_progress_display_when_stderr_is_not_a_terminal(tmp_path: Path) -> None:
-    proc = subprocess.run([*FSMBT, "convert", str(PAPER_FSM), "-o", str(tmp_path / "x.xml")],
-                          capture_output=True, text=True, timeout=120)
+    proc = subprocess.run(
+        [*FSMBT, "convert", str(PAPER_FSM), "-o", str(tmp_path / "x.xml")],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert proc.returncode == 0, proc.stderr
     assert proc.stderr == ""  # no spinner, no escape codes in a pipe
 
 
 def test_help_is_plain_and_lists_choices() -> None:
-    proc = subprocess.run([*FSMBT, "convert", "--help"], capture_output=True, text=True,
-                          timeout=60, env={"COLUMNS": "100", "PATH": "/usr/bin:/bin"})
+    proc = subprocess.run(
+        [*FSMBT, "convert", "--help"],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        env={"COLUMNS": "100", "PATH": "/usr/bin:/bin"},
+    )
     assert proc.returncode == 0
     assert "<bool>" not in proc.stdout
     assert "<subtrees|flatten>" in proc.stdout
@@ -64,14 +73,24 @@ def test_help_is_plain_and_lists_choices() -> None:
 
 
 def test_closed_pipe_exits_zero_without_a_message() -> None:
-    proc = subprocess.run(f"{sys.executable} -m fsmbt.cli llm prompt {PAPER_FSM} | head -1",
-                          shell=True, capture_output=True, text=True, timeout=60,
-                          executable="/bin/bash")
+    proc = subprocess.run(
+        f"{sys.executable} -m fsmbt.cli llm prompt {PAPER_FSM} | head -1",
+        shell=True,
+        capture_output=True,
+        text=True,
+        timeout=60,
+        executable="/bin/bash",
+    )
     assert proc.stdout.startswith("=== system ===")
     status = subprocess.run(
         f"set -o pipefail; {sys.executable} -m fsmbt.cli llm prompt {PAPER_FSM} | head -1 "
-        ">/dev/null", shell=True, capture_output=True, text=True, timeout=60,
-        executable="/bin/bash")
+        ">/dev/null",
+        shell=True,
+        capture_output=True,
+        text=True,
+        timeout=60,
+        executable="/bin/bash",
+    )
     assert status.returncode == 0, status.stderr
     assert "Traceback" not in status.stderr and "Broken pipe" not in status.stderr
 
@@ -90,8 +109,9 @@ def test_generate_node_budget_is_an_option(tmp_path: Path) -> None:
     assert main([*common, "-o", str(small), "--max-nodes", "0"]) == 2
 
 
-def test_convert_json_summary_has_verdict_and_timings(tmp_path: Path,
-                                                      capsys: pytest.CaptureFixture[str]) -> None:
+def test_convert_json_summary_has_verdict_and_timings(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     assert main(["convert", str(PAPER_FSM), "-o", str(tmp_path / "bt.xml"), "--json"]) == 0
     data = json.loads(capsys.readouterr().out)
     assert data["verdict"] == "EQUIVALENT" and data["written"] is True
@@ -102,9 +122,9 @@ ROBOT_BT = EXAMPLES / "robot_bt.xml"
 
 
 @pytest.mark.parametrize("source, convert_to", [(PAPER_FSM, "bt.xml"), (ROBOT_BT, "hfsm.scxml")])
-def test_verify_verdict_does_not_depend_on_the_order(tmp_path: Path, source: Path,
-                                                     convert_to: str,
-                                                     capsys: pytest.CaptureFixture[str]) -> None:
+def test_verify_verdict_does_not_depend_on_the_order(
+    tmp_path: Path, source: Path, convert_to: str, capsys: pytest.CaptureFixture[str]
+) -> None:
     converted = tmp_path / convert_to
     assert main(["convert", str(source), "-o", str(converted)]) == 0
     capsys.readouterr()
@@ -123,16 +143,20 @@ def test_not_equivalent_in_both_orders(tmp_path: Path) -> None:
     from fsmbt.verify.mutations import mutants
 
     converted = api.convert_file(PAPER_FSM).result
-    wrong = next(m.model for m in mutants(converted, seed=1)
-                 if not api.verify_models(api.load(PAPER_FSM).model, m.model).equivalent)
+    wrong = next(
+        m.model
+        for m in mutants(converted, seed=1)
+        if not api.verify_models(api.load(PAPER_FSM).model, m.model).equivalent
+    )
     path = tmp_path / "wrong.xml"
     api.write(wrong, path)
     assert main(["verify", str(PAPER_FSM), str(path)]) == 1
     assert main(["verify", str(path), str(PAPER_FSM)]) == 1
 
 
-def test_a_pair_no_rule_compares_names_the_rules(tmp_path: Path,
-                                                 capsys: pytest.CaptureFixture[str]) -> None:
+def test_a_pair_no_rule_compares_names_the_rules(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     lebt = api.convert_file(PAPER_FSM).text
     # an LEBT with one foreign action leaf: neither a loop-execution BT nor a plain BT's FSM
     broken = lebt.replace("<LebtState", "<SomeRobotAction", 1)
@@ -159,24 +183,27 @@ CUSTOM_TREE = """<root BTCPP_format="4" main_tree_to_execute="Main">
 
 
 def _models_file(path: Path, entries: str) -> Path:
-    path.write_text(f'<root BTCPP_format="4"><TreeNodesModel>{entries}</TreeNodesModel></root>',
-                    encoding="utf-8")
+    path.write_text(
+        f'<root BTCPP_format="4"><TreeNodesModel>{entries}</TreeNodesModel></root>',
+        encoding="utf-8",
+    )
     return path
 
 
 @pytest.mark.parametrize("command", ["validate", "info"])
-def test_node_models_files_declare_custom_nodes(tmp_path: Path, command: str,
-                                                capsys: pytest.CaptureFixture[str]) -> None:
+def test_node_models_files_declare_custom_nodes(
+    tmp_path: Path, command: str, capsys: pytest.CaptureFixture[str]
+) -> None:
     tree = tmp_path / "tree.xml"
     tree.write_text(CUSTOM_TREE, encoding="utf-8")
     controls = _models_file(tmp_path / "controls.xml", '<Control ID="MyPipeline"/>')
-    leaves = _models_file(tmp_path / "leaves.xml",
-                          '<Condition ID="IsReady"/><Action ID="DoWork"/>')
+    leaves = _models_file(tmp_path / "leaves.xml", '<Condition ID="IsReady"/><Action ID="DoWork"/>')
     if command == "validate":
         assert main(["validate", str(tree)]) == 2
         assert "MyPipeline" in capsys.readouterr().err
-    code = main([command, str(tree), "--node-models", str(controls), "--node-models",
-                 str(leaves), "--json"])
+    code = main(
+        [command, str(tree), "--node-models", str(controls), "--node-models", str(leaves), "--json"]
+    )
     out = json.loads(capsys.readouterr().out)
     if command == "validate":
         # the control is declared by the first file, the leaves by the second; what is left
@@ -195,9 +222,9 @@ def test_node_models_files_declare_custom_nodes(tmp_path: Path, command: str,
     assert "missing.xml" in capsys.readouterr().err
 
 
-def test_bt_to_mermaid_writes_exits_and_reads_back_equivalent(tmp_path: Path,
-                                                              capsys: pytest.CaptureFixture[str]
-                                                              ) -> None:
+def test_bt_to_mermaid_writes_exits_and_reads_back_equivalent(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     out = tmp_path / "robot.mmd"
     assert main(["convert", str(ROBOT_BT), "-o", str(out)]) == 0
     text = out.read_text(encoding="utf-8")

@@ -43,10 +43,15 @@ def reactive_bt(tmp_path: Path) -> Path:
 
 # -- 6: a state limit the user can see and raise ---------------------------------------------
 def test_no_verify_exploration_names_the_subtree_and_the_flag(
-        reactive_bt: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    reactive_bt: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     out = tmp_path / "patrol.scxml"
-    assert main(["convert", str(reactive_bt), "--no-verify", "--max-states", "3", "-q",
-                 "-o", str(out)]) == 2
+    assert (
+        main(
+            ["convert", str(reactive_bt), "--no-verify", "--max-states", "3", "-q", "-o", str(out)]
+        )
+        == 2
+    )
     err = capsys.readouterr().err.strip()
     assert err.count("\n") == 0
     # tree id, node labels from the root down, the line of the exploding node, the flag
@@ -56,15 +61,17 @@ def test_no_verify_exploration_names_the_subtree_and_the_flag(
     assert "@" not in err and not out.exists()
 
 
-def test_raising_the_limit_converts_and_verifies(reactive_bt: Path, tmp_path: Path,
-                                                 capsys: pytest.CaptureFixture[str]) -> None:
+def test_raising_the_limit_converts_and_verifies(
+    reactive_bt: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     out = tmp_path / "patrol.scxml"
     assert main(["convert", str(reactive_bt), "--max-states", "5000", "-q", "-o", str(out)]) == 0
     assert "EQUIVALENT" in capsys.readouterr().out and out.exists()
 
 
-def test_verify_state_limit_is_an_option(reactive_bt: Path, tmp_path: Path,
-                                         capsys: pytest.CaptureFixture[str]) -> None:
+def test_verify_state_limit_is_an_option(
+    reactive_bt: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     out = tmp_path / "patrol.scxml"
     assert main(["convert", str(reactive_bt), "-q", "-o", str(out)]) == 0
     capsys.readouterr()
@@ -75,8 +82,7 @@ def test_verify_state_limit_is_an_option(reactive_bt: Path, tmp_path: Path,
     assert main(["verify", str(reactive_bt), str(out), "--max-states", "100000", "-q"]) == 0
 
 
-def test_max_states_must_be_positive(reactive_bt: Path,
-                                     capsys: pytest.CaptureFixture[str]) -> None:
+def test_max_states_must_be_positive(reactive_bt: Path, capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["convert", str(reactive_bt), "--max-states", "0", "-q"]) == 2
     assert "--max-states" in capsys.readouterr().err
 
@@ -103,7 +109,8 @@ def undeclared_bt(tmp_path: Path) -> Path:
 
 
 def test_validate_collapses_repeated_not_declared_warnings(
-        undeclared_bt: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    undeclared_bt: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     assert main(["validate", "--json", str(undeclared_bt)]) == 0
     issues = json.loads(capsys.readouterr().out)["issues"]
     spin = [i for i in issues if "'Spin'" in i["message"]]
@@ -114,8 +121,8 @@ def test_validate_collapses_repeated_not_declared_warnings(
 
 @pytest.mark.parametrize("command", [["info"], ["convert", "-q", "--no-verify"]])
 def test_info_and_convert_name_each_undeclared_type_once(
-        command: list[str], undeclared_bt: Path, tmp_path: Path,
-        capsys: pytest.CaptureFixture[str]) -> None:
+    command: list[str], undeclared_bt: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     extra = ["-o", str(tmp_path / "out.scxml")] if command[0] == "convert" else []
     assert main([*command, str(undeclared_bt), *extra]) == 0
     out = capsys.readouterr().out
@@ -146,8 +153,9 @@ def _line_of(path: Path, needle: str) -> int:
     return next(n for n, line in enumerate(lines, 1) if needle in line)
 
 
-def test_honest_lebt_has_no_port_issue(paper_lebt: Path,
-                                       capsys: pytest.CaptureFixture[str]) -> None:
+def test_honest_lebt_has_no_port_issue(
+    paper_lebt: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     capsys.readouterr()
     assert main(["validate", str(paper_lebt)]) == 0
     assert main(["verify", str(EXAMPLES / "paper_fsm.xml"), str(paper_lebt), "-q"]) == 0
@@ -155,7 +163,8 @@ def test_honest_lebt_has_no_port_issue(paper_lebt: Path,
 
 
 def test_wrong_guard_target_is_an_error_in_validate_and_a_warning_in_verify(
-        paper_lebt: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    paper_lebt: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     bad = _edited(paper_lebt, 'name="Enter_B" target="B"', 'name="Enter_B" target="C"')
     capsys.readouterr()
     assert main(["validate", str(bad)]) == 2
@@ -171,7 +180,8 @@ def test_wrong_guard_target_is_an_error_in_validate_and_a_warning_in_verify(
 
 
 def test_exit_without_guard_and_pair_without_exit_are_named(
-        paper_lebt: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    paper_lebt: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     bad = _edited(paper_lebt, 'exits="eventBC;eventBD"', 'exits="eventBC;eventBX"')
     capsys.readouterr()
     assert main(["validate", "--json", str(bad)]) == 2
@@ -181,10 +191,13 @@ def test_exit_without_guard_and_pair_without_exit_are_named(
 
 
 # -- 9: words a robotics engineer can read ---------------------------------------------------
-def test_convert_summary_says_what_was_built(tmp_path: Path,
-                                             capsys: pytest.CaptureFixture[str]) -> None:
-    assert main(["convert", str(EXAMPLES / "robot_bt.xml"), "-q",
-                 "-o", str(tmp_path / "robot.scxml")]) == 0
+def test_convert_summary_says_what_was_built(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    assert (
+        main(["convert", str(EXAMPLES / "robot_bt.xml"), "-q", "-o", str(tmp_path / "robot.scxml")])
+        == 0
+    )
     out = capsys.readouterr().out
     summary = next(line for line in out.splitlines() if line.startswith("converted"))
     assert "k=" not in summary and "units=" not in summary
@@ -195,21 +208,33 @@ def test_convert_summary_says_what_was_built(tmp_path: Path,
 
 
 def test_convert_json_keeps_its_keys(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    assert main(["convert", str(EXAMPLES / "robot_bt.xml"), "-q", "--json",
-                 "-o", str(tmp_path / "robot.scxml")]) == 0
+    assert (
+        main(
+            [
+                "convert",
+                str(EXAMPLES / "robot_bt.xml"),
+                "-q",
+                "--json",
+                "-o",
+                str(tmp_path / "robot.scxml"),
+            ]
+        )
+        == 0
+    )
     stats = json.loads(capsys.readouterr().out)["stats"]
     assert {"k", "units", "explored_regions", "leaves"} <= set(stats)
 
 
 def test_leaf_execution_counterexample_in_the_users_words(
-        tmp_path: Path, capsys: pytest.CaptureFixture[str],
-        monkeypatch: pytest.MonkeyPatch) -> None:
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
     monkeypatch.setenv("COLUMNS", "250")  # rich tables do not wrap the words compared here
     hfsm = tmp_path / "robot.scxml"
     assert main(["convert", str(EXAMPLES / "robot_bt.xml"), "-q", "-o", str(hfsm)]) == 0
     wrong = tmp_path / "wrong.scxml"
-    wrong.write_text(hfsm.read_text(encoding="utf-8").replace("MovetoCube2", "MovetoCubeX"),
-                     encoding="utf-8")
+    wrong.write_text(
+        hfsm.read_text(encoding="utf-8").replace("MovetoCube2", "MovetoCubeX"), encoding="utf-8"
+    )
     capsys.readouterr()
     assert main(["verify", str(EXAMPLES / "robot_bt.xml"), str(wrong), "-q"]) == 1
     out = " ".join(capsys.readouterr().out.split())  # the table wraps; compare the words
@@ -220,8 +245,9 @@ def test_leaf_execution_counterexample_in_the_users_words(
     assert "4 leaf outcomes" in out and "FAILURE" in out
 
 
-def test_one_step_counterexample_is_singular(paper_lebt: Path,
-                                             capsys: pytest.CaptureFixture[str]) -> None:
+def test_one_step_counterexample_is_singular(
+    paper_lebt: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     bad = _edited(paper_lebt, 'state="A" action="A"', 'state="A" action="Z"')
     capsys.readouterr()
     assert main(["verify", str(EXAMPLES / "paper_fsm.xml"), str(bad), "-q"]) == 1
@@ -229,8 +255,9 @@ def test_one_step_counterexample_is_singular(paper_lebt: Path,
     assert "shortest counterexample (1 input)" in out and "(1 inputs)" not in out
 
 
-def test_prose_text_points_to_llm_extract(tmp_path: Path,
-                                          capsys: pytest.CaptureFixture[str]) -> None:
+def test_prose_text_points_to_llm_extract(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     prose = tmp_path / "mission.txt"
     prose.write_text("The robot moves to the cube, picks it up and docks.\n", encoding="utf-8")
     assert main(["convert", str(prose), "-q"]) == 2
@@ -245,8 +272,9 @@ def _many_trees(count: int, leaves: int) -> str:
     for t in range(count):
         body = "".join(f'<Action ID="Do{t}_{k}"/>' for k in range(leaves))
         trees.append(f'<BehaviorTree ID="T{t}"><Sequence>{body}</Sequence></BehaviorTree>')
-    return (f'<root BTCPP_format="4" main_tree_to_execute="T{count - 1}">' + "".join(trees)
-            + "</root>")
+    return (
+        f'<root BTCPP_format="4" main_tree_to_execute="T{count - 1}">' + "".join(trees) + "</root>"
+    )
 
 
 def _png_size(path: Path) -> tuple[int, int]:
@@ -256,13 +284,14 @@ def _png_size(path: Path) -> tuple[int, int]:
 
 
 def test_multi_tree_picture_puts_the_main_tree_first_and_stacks_the_rest(
-        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     source = tmp_path / "trees.xml"
     source.write_text(_many_trees(24, 6), encoding="utf-8")
     dot = tmp_path / "trees.dot"
     assert main(["render", str(source), "-o", str(dot)]) == 0
     text = dot.read_text(encoding="utf-8")
-    first_cluster_label = text[text.index("subgraph cluster_"):].split("label=", 1)[1]
+    first_cluster_label = text[text.index("subgraph cluster_") :].split("label=", 1)[1]
     assert first_cluster_label.startswith('"T23 (main)"')
     assert text.count("style=invis") >= 2  # rows hang under each other
     png = tmp_path / "trees.png"
@@ -271,8 +300,9 @@ def test_multi_tree_picture_puts_the_main_tree_first_and_stacks_the_rest(
     assert width < 4 * height, (width, height)  # not a strip
 
 
-def test_a_capped_picture_says_what_it_left_out(tmp_path: Path,
-                                                capsys: pytest.CaptureFixture[str]) -> None:
+def test_a_capped_picture_says_what_it_left_out(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     source = tmp_path / "many.xml"
     source.write_text(_many_trees(40, 20), encoding="utf-8")  # 40 x 21 = 840 nodes
     assert main(["render", str(source), "-o", str(tmp_path / "many.dot")]) == 0
@@ -304,15 +334,21 @@ def test_hfsm_one_level_at_a_time(tmp_path: Path, capsys: pytest.CaptureFixture[
     assert "composite states: Operating" in capsys.readouterr().err
 
 
-def test_big_hfsm_is_drawn_to_the_level_that_fits(tmp_path: Path,
-                                                  capsys: pytest.CaptureFixture[str]) -> None:
+def test_big_hfsm_is_drawn_to_the_level_that_fits(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     big = tmp_path / "big_hfsm.scxml"
-    inner = "".join(f'<state id="c{k}"><transition event="e" target="c{(k + 1) % 70}"/></state>'
-                    for k in range(70))
-    big.write_text('<scxml xmlns="http://www.w3.org/2005/07/scxml" version="1.0" '
-                   'initial="Busy"><state id="Busy" initial="c0">' + inner +
-                   '<transition event="stop" target="Done"/></state><final id="Done"/></scxml>',
-                   encoding="utf-8")
+    inner = "".join(
+        f'<state id="c{k}"><transition event="e" target="c{(k + 1) % 70}"/></state>'
+        for k in range(70)
+    )
+    big.write_text(
+        '<scxml xmlns="http://www.w3.org/2005/07/scxml" version="1.0" '
+        'initial="Busy"><state id="Busy" initial="c0">'
+        + inner
+        + '<transition event="stop" target="Done"/></state><final id="Done"/></scxml>',
+        encoding="utf-8",
+    )
     out = tmp_path / "big.dot"
     assert main(["render", str(big), "-o", str(out)]) == 0
     err = capsys.readouterr().err
@@ -323,10 +359,25 @@ def test_big_hfsm_is_drawn_to_the_level_that_fits(tmp_path: Path,
 
 @pytest.mark.parametrize("engine", ["bsd", "chds"])
 def test_baseline_summaries_claim_only_what_they_built(
-        engine: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    assert main(["convert", str(EXAMPLES / "paper_fsm.xml"), "--engine", engine, "-q",
-                 "--no-verify", "-o", str(tmp_path / "bt.xml")]) == 0
-    summary = next(line for line in capsys.readouterr().out.splitlines()
-                   if line.startswith("converted"))
+    engine: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    assert (
+        main(
+            [
+                "convert",
+                str(EXAMPLES / "paper_fsm.xml"),
+                "--engine",
+                engine,
+                "-q",
+                "--no-verify",
+                "-o",
+                str(tmp_path / "bt.xml"),
+            ]
+        )
+        == 0
+    )
+    summary = next(
+        line for line in capsys.readouterr().out.splitlines() if line.startswith("converted")
+    )
     assert "10 FSM states became a BT of" in summary
     assert "loop-execution" not in summary and "?" not in summary.split("):", 1)[1]

@@ -32,8 +32,9 @@ def test_every_hint_has_library_and_cli_words() -> None:
     assert all("--" in text or "fsmbt " in text for text in CLI_WORDING.values())
 
 
-def test_library_errors_carry_hints_and_name_no_flag(tmp_path: Path,
-                                                     monkeypatch: pytest.MonkeyPatch) -> None:
+def test_library_errors_carry_hints_and_name_no_flag(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     target = tmp_path / "m.json"
     write_model(small_fsm(), target)
     with pytest.raises(InputError) as exists:
@@ -51,9 +52,13 @@ def test_library_errors_carry_hints_and_name_no_flag(tmp_path: Path,
     monkeypatch.chdir(tmp_path)
     with pytest.raises(LLMConfigError) as no_llm:
         resolve_settings()
-    cases = [(exists, (Hint.OVERWRITE,)), (unknown, (Hint.INPUT_FORMAT,)),
-             (no_suffix, (Hint.OUTPUT_FORMAT,)), (too_large, (Hint.MAX_NODES, Hint.STATISTICS)),
-             (no_llm, (Hint.LLM_BASE_URL, Hint.RULES_ENGINE))]
+    cases = [
+        (exists, (Hint.OVERWRITE,)),
+        (unknown, (Hint.INPUT_FORMAT,)),
+        (no_suffix, (Hint.OUTPUT_FORMAT,)),
+        (too_large, (Hint.MAX_NODES, Hint.STATISTICS)),
+        (no_llm, (Hint.LLM_BASE_URL, Hint.RULES_ENGINE)),
+    ]
     for caught, hints in cases:
         assert caught.value.hints == hints
         text = str(caught.value)
@@ -74,8 +79,19 @@ def test_cli_prints_the_flag(tmp_path: Path, capsys: pytest.CaptureFixture[str])
     assert main(["info", str(odd)]) == 2
     err = capsys.readouterr().err
     assert "cannot tell the format of this input" in err and "name it with --from" in err
-    assert main(["render", str(EXAMPLES / "paper_fsm.json"), "-o", str(tmp_path / "p.svg"),
-                 "--max-nodes", "2"]) == 2
+    assert (
+        main(
+            [
+                "render",
+                str(EXAMPLES / "paper_fsm.json"),
+                "-o",
+                str(tmp_path / "p.svg"),
+                "--max-nodes",
+                "2",
+            ]
+        )
+        == 2
+    )
     err = capsys.readouterr().err
     assert "too large to draw" in err and "--max-nodes" in err and "fsmbt info" in err
     assert len(err.strip().splitlines()) == 1
@@ -88,6 +104,7 @@ def test_wrapped_errors_keep_their_hints() -> None:
     except TooLargeError as exc:
         again = InputError(exc.message, location=exc.location, hints=exc.hints)
         assert again.text(CLI_WORDING).endswith(
-            "raise the limit with --max-nodes or use `fsmbt info` for its structure")
+            "raise the limit with --max-nodes or use `fsmbt info` for its structure"
+        )
     else:  # pragma: no cover - the example has more than one state
         pytest.fail("not refused")

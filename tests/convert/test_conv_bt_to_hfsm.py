@@ -42,8 +42,13 @@ def test_robot_bt_units_depths_and_equivalence() -> None:
     composites = [path for path, _m, s in hfsm.walk() if s.is_composite]
     assert len(composites) == 2
     top_leaves = {s.action for s in hfsm.states.values() if s.is_atomic and not s.final}
-    assert top_leaves == {"BatteryBelow", "Recharge", "Cube2inDelivery", "RobotAtInspection",
-                          "Dock"}
+    assert top_leaves == {
+        "BatteryBelow",
+        "Recharge",
+        "Cube2inDelivery",
+        "RobotAtInspection",
+        "Dock",
+    }
     assert {s.name for s in hfsm.states.values() if s.final} == {"SUCCESS", "FAILURE"}
     flat = flatten(hfsm)
     assert flat.states[flat.initial].action == "BatteryBelow"
@@ -60,8 +65,11 @@ def test_depth_compression_merges_only_same_plain_type() -> None:
     reactive = _ctl("ReactiveSequence", _leaf("a"), _ctl("Sequence", _leaf("b"), _leaf("c")))
     kept = compress(reactive)
     assert kept.merged == 0 and kept.depth_after == 3
-    fb = _ctl("Fallback", _ctl("Fallback", _leaf("x", NodeKind.CONDITION), _leaf("y")),
-              _ctl("Sequence", _leaf("z")))
+    fb = _ctl(
+        "Fallback",
+        _ctl("Fallback", _leaf("x", NodeKind.CONDITION), _leaf("y")),
+        _ctl("Sequence", _leaf("z")),
+    )
     assert compress(fb).merged == 1
     doc = BTDocument.single(root)
     conv = convert(doc)
@@ -71,38 +79,71 @@ def test_depth_compression_merges_only_same_plain_type() -> None:
 
 def test_extended_nodes_and_subtrees_convert_equivalently() -> None:
     cond = lambda n: _leaf(n, NodeKind.CONDITION)  # noqa: E731
-    combat = _ctl("Fallback",
-                  _ctl("Sequence", cond("InRange"),
-                       _ctl("Parallel", _leaf("Attack"),
-                            _ctl("ForceSuccess", _leaf("Taunt"), node_kind=NodeKind.DECORATOR))),
-                  BTNode(type="RetryUntilSuccessful", kind=NodeKind.DECORATOR,
-                         attrs={"num_attempts": "2"}, children=[_leaf("Chase")]))
+    combat = _ctl(
+        "Fallback",
+        _ctl(
+            "Sequence",
+            cond("InRange"),
+            _ctl(
+                "Parallel",
+                _leaf("Attack"),
+                _ctl("ForceSuccess", _leaf("Taunt"), node_kind=NodeKind.DECORATOR),
+            ),
+        ),
+        BTNode(
+            type="RetryUntilSuccessful",
+            kind=NodeKind.DECORATOR,
+            attrs={"num_attempts": "2"},
+            children=[_leaf("Chase")],
+        ),
+    )
     combat.children[0].children[1].attrs.update({"success_count": "2", "failure_count": "1"})
-    main = _ctl("ReactiveFallback",
-                _ctl("Sequence", cond("HealthLow"),
-                     _ctl("Inverter", cond("Cornered"), node_kind=NodeKind.DECORATOR),
-                     _leaf("Flee")),
-                _ctl("ReactiveSequence", cond("SeeEnemy"),
-                     BTNode(type="SubTree", kind=NodeKind.SUBTREE, attrs={"ID": "Combat"})),
-                _ctl("SequenceWithMemory", _leaf("GoGate"),
-                     BTNode(type="Repeat", kind=NodeKind.DECORATOR, attrs={"num_cycles": "2"},
-                            children=[_leaf("Look")])))
-    doc = BTDocument(trees={"Main": BehaviorTree("Main", main),
-                            "Combat": BehaviorTree("Combat", combat)}, main_tree="Main")
+    main = _ctl(
+        "ReactiveFallback",
+        _ctl(
+            "Sequence",
+            cond("HealthLow"),
+            _ctl("Inverter", cond("Cornered"), node_kind=NodeKind.DECORATOR),
+            _leaf("Flee"),
+        ),
+        _ctl(
+            "ReactiveSequence",
+            cond("SeeEnemy"),
+            BTNode(type="SubTree", kind=NodeKind.SUBTREE, attrs={"ID": "Combat"}),
+        ),
+        _ctl(
+            "SequenceWithMemory",
+            _leaf("GoGate"),
+            BTNode(
+                type="Repeat",
+                kind=NodeKind.DECORATOR,
+                attrs={"num_cycles": "2"},
+                children=[_leaf("Look")],
+            ),
+        ),
+    )
+    doc = BTDocument(
+        trees={"Main": BehaviorTree("Main", main), "Combat": BehaviorTree("Combat", combat)},
+        main_tree="Main",
+    )
     result = convert(doc)
     assert result.stats["explored_regions"] >= 1
     assert check(doc, result.model).equivalent
 
-    stateless = _ctl("Sequence", _ctl("Inverter", cond("Busy"), node_kind=NodeKind.DECORATOR),
-                     _ctl("ForceFailure", _leaf("Work"), node_kind=NodeKind.DECORATOR))
+    stateless = _ctl(
+        "Sequence",
+        _ctl("Inverter", cond("Busy"), node_kind=NodeKind.DECORATOR),
+        _ctl("ForceFailure", _leaf("Work"), node_kind=NodeKind.DECORATOR),
+    )
     plain = convert(BTDocument.single(stateless))
     assert plain.stats["explored_regions"] == 0, "stateless decorators stay structural"
     assert check(BTDocument.single(stateless), plain.model).equivalent
 
 
 def test_missing_subtree_is_a_clear_error() -> None:
-    doc = BTDocument.single(_ctl("Sequence", BTNode(type="SubTree", kind=NodeKind.SUBTREE,
-                                                    attrs={"ID": "Nowhere"})))
+    doc = BTDocument.single(
+        _ctl("Sequence", BTNode(type="SubTree", kind=NodeKind.SUBTREE, attrs={"ID": "Nowhere"}))
+    )
     with pytest.raises(InputError, match="Nowhere"):
         convert(doc)
 
@@ -115,12 +156,22 @@ def test_leaf_label_matches_the_leaf_machine() -> None:
         assert leaf_label(node) == shared(node)
 
 
-@pytest.mark.parametrize("tree", [
-    lambda: _ctl("ReactiveFallback", _leaf("a", NodeKind.CONDITION),
-                 _ctl("Inverter", _leaf("b"), node_kind=NodeKind.DECORATOR), _leaf("c")),
-    lambda: _ctl("KeepRunningUntilFailure", _ctl("Sequence", _leaf("a", NodeKind.CONDITION),
-                                                 _leaf("b")), node_kind=NodeKind.DECORATOR),
-])
+@pytest.mark.parametrize(
+    "tree",
+    [
+        lambda: _ctl(
+            "ReactiveFallback",
+            _leaf("a", NodeKind.CONDITION),
+            _ctl("Inverter", _leaf("b"), node_kind=NodeKind.DECORATOR),
+            _leaf("c"),
+        ),
+        lambda: _ctl(
+            "KeepRunningUntilFailure",
+            _ctl("Sequence", _leaf("a", NodeKind.CONDITION), _leaf("b")),
+            node_kind=NodeKind.DECORATOR,
+        ),
+    ],
+)
 def test_loop_conversion_of_explored_trees_keeps_the_root_result(tree) -> None:
     """With loop, a step that ends the tick outputs (result, first leaf); the HFSM must say
     both (a final state named after the result), not jump back to the start silently."""
@@ -139,7 +190,12 @@ def test_loop_step_that_cannot_be_one_state_is_refused() -> None:
     from fsmbt.convert.bt_to_hfsm import bt_to_hfsm
     from fsmbt.model.errors import UnsupportedError
 
-    doc = BTDocument.single(_ctl("ReactiveSequence", _leaf("a", NodeKind.CONDITION),
-                                 _ctl("SequenceWithMemory", _leaf("b"), _leaf("c"))))
+    doc = BTDocument.single(
+        _ctl(
+            "ReactiveSequence",
+            _leaf("a", NodeKind.CONDITION),
+            _ctl("SequenceWithMemory", _leaf("b"), _leaf("c")),
+        )
+    )
     with pytest.raises(UnsupportedError, match="cannot express the outputs"):
         bt_to_hfsm(doc, loop=True)

@@ -14,16 +14,23 @@ from fsmbt.formats import read_model
 from fsmbt.model.errors import InputError
 from support.conv_helpers import check
 
-CORPUS = Path(os.environ.get("FSMBT_CORPUS", Path(__file__).resolve().parents[3] / "shared" / "corpus"))
+CORPUS = Path(
+    os.environ.get("FSMBT_CORPUS", Path(__file__).resolve().parents[3] / "shared" / "corpus")
+)
 MAX_CHECK_STATES = 200_000
 
 
 def _files() -> list[Path]:
     if not CORPUS.is_dir():
         return []
-    return sorted(p for p in CORPUS.rglob("*")
-                  if p.suffix in (".xml", ".scxml") and "_malformed" not in p.parts
-                  and "_legacy_draft" not in p.parts and "LICENSES" not in p.parts)
+    return sorted(
+        p
+        for p in CORPUS.rglob("*")
+        if p.suffix in (".xml", ".scxml")
+        and "_malformed" not in p.parts
+        and "_legacy_draft" not in p.parts
+        and "LICENSES" not in p.parts
+    )
 
 
 def test_corpus_converts_or_is_rejected_clearly() -> None:

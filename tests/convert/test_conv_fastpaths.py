@@ -24,8 +24,9 @@ def _with_subtrees(seed: int) -> BTDocument:
     for index, child in enumerate(root.children):
         if child.kind is NodeKind.CONTROL:
             doc.trees["Inner"] = BehaviorTree("Inner", child)
-            root.children[index] = BTNode(type="SubTree", kind=NodeKind.SUBTREE,
-                                          attrs={"ID": "Inner"})
+            root.children[index] = BTNode(
+                type="SubTree", kind=NodeKind.SUBTREE, attrs={"ID": "Inner"}
+            )
             break
     return doc
 
@@ -47,8 +48,9 @@ def test_leaf_ports_equal_the_spec_classes_and_counts_equal_a_walk() -> None:
     fsm = paper_aj_fsm()
     fsm.add_state("odd;na/me\\x")
     fsm.add_transition("B", "ev/;x", "odd;na/me\\x")
-    models = [fsm] + [random_fsm(seed, scenario="game", min_states=2, max_states=30)
-                      for seed in range(60)]
+    models = [fsm] + [
+        random_fsm(seed, scenario="game", min_states=2, max_states=30) for seed in range(60)
+    ]
     for model in models:
         result = convert(model)
         root = result.model.main.root

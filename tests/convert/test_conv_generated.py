@@ -36,8 +36,10 @@ def test_generated_fsms_convert_equivalently(size: str) -> None:
         seeds, low, high = range(FSM_SMALL), 2, 12
     else:
         seeds, low, high = range(10_000, 10_000 + FSM_LARGE), 13, 30
-    models = ((f"fsm seed {s}", random_fsm(s, scenario=SCENARIOS[s % 3], min_states=low,
-                                           max_states=high)) for s in seeds)
+    models = (
+        (f"fsm seed {s}", random_fsm(s, scenario=SCENARIOS[s % 3], min_states=low, max_states=high))
+        for s in seeds
+    )
     count, failures = _failures(models)
     assert count == len(seeds) and failures == []
 
@@ -45,8 +47,12 @@ def test_generated_fsms_convert_equivalently(size: str) -> None:
 @pytest.mark.parametrize("extended", [False, True])
 def test_generated_bts_convert_equivalently(extended: bool) -> None:
     n, budget = (BT_EXTENDED, 20) if extended else (BT_PAPER, 60)
-    models = ((f"bt seed {s} extended={extended}",
-               random_bt(s, scenario=SCENARIOS[s % 3], extended=extended, max_nodes=budget))
-              for s in range(n))
+    models = (
+        (
+            f"bt seed {s} extended={extended}",
+            random_bt(s, scenario=SCENARIOS[s % 3], extended=extended, max_nodes=budget),
+        )
+        for s in range(n)
+    )
     count, failures = _failures(models)
     assert count == n and failures == []

@@ -83,9 +83,9 @@ def test_no_initial_event_self_loops_and_unreachable() -> None:
     for name in ("Idle", "Run", "Done", "Orphan"):
         fsm.add_state(name, final=name == "Done")
     fsm.add_transition("Idle", "go", "Run")
-    fsm.add_transition("Run", "tick", "Run")          # self-loop: Run becomes a loop state
+    fsm.add_transition("Run", "tick", "Run")  # self-loop: Run becomes a loop state
     fsm.add_transition("Run", "stop", "Done")
-    fsm.add_transition("Orphan", "go", "Idle")        # unreachable source
+    fsm.add_transition("Orphan", "go", "Idle")  # unreachable source
     result = convert(fsm)
     root = result.model.main.root
     assert [_subtree_state(c) for c in root.children] == ["Idle", "Run"]

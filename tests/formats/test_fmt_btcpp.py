@@ -15,7 +15,9 @@ from fsmbt.limits import current as current_limits
 from fsmbt.model import BTDocument, BTNode, NodeKind
 from fsmbt.model.errors import InputError, UnsupportedError
 
-CORPUS = Path(os.environ.get("FSMBT_CORPUS", Path(__file__).resolve().parents[2] / ".." / "shared" / "corpus"))
+CORPUS = Path(
+    os.environ.get("FSMBT_CORPUS", Path(__file__).resolve().parents[2] / ".." / "shared" / "corpus")
+)
 
 
 def corpus(rel: str) -> Path:
@@ -84,8 +86,11 @@ def test_v3_aliases_and_explicit_groot_style_equal_compact() -> None:
 
 
 def test_undeclared_types_are_assumed_and_stay_assumed() -> None:
-    doc = loads("""<root BTCPP_format="4"><BehaviorTree ID="T">
-        <Pipeline><Leaf/><Wrap><Leaf/></Wrap></Pipeline></BehaviorTree></root>""", "btcpp")
+    doc = loads(
+        """<root BTCPP_format="4"><BehaviorTree ID="T">
+        <Pipeline><Leaf/><Wrap><Leaf/></Wrap></Pipeline></BehaviorTree></root>""",
+        "btcpp",
+    )
     root = doc.main.root
     assert root is not None
     assert (root.kind, root.kind_declared) == (NodeKind.CONTROL, False)
@@ -114,8 +119,11 @@ def test_writer_declares_custom_types_for_groot() -> None:
 def test_includes_resolve_relative_and_are_written_inline() -> None:
     path = corpus("bt/btcpp/trees/parent_include_child_include_parent.xml")
     doc = read_model(path)
-    assert set(doc.trees) == {"ParentIncludeChildIncludeParent", "ChildIncludeParent",
-                              "ParentNoInclude"}
+    assert set(doc.trees) == {
+        "ParentIncludeChildIncludeParent",
+        "ChildIncludeParent",
+        "ParentNoInclude",
+    }
     assert len(doc.includes) == 2
     text = dumps(doc, "btcpp")
     assert "<include" not in text
@@ -125,17 +133,23 @@ def test_includes_resolve_relative_and_are_written_inline() -> None:
 
 def test_include_cycle_is_reported(tmp_path: Path) -> None:
     (tmp_path / "sub").mkdir()
-    (tmp_path / "a.xml").write_text('<root BTCPP_format="4"><include path="sub/b.xml"/>'
-                                    '<BehaviorTree ID="A"><AlwaysSuccess/></BehaviorTree></root>')
-    (tmp_path / "sub" / "b.xml").write_text('<root BTCPP_format="4"><include path="../a.xml"/>'
-                                            '<BehaviorTree ID="B"><AlwaysSuccess/></BehaviorTree></root>')
+    (tmp_path / "a.xml").write_text(
+        '<root BTCPP_format="4"><include path="sub/b.xml"/>'
+        '<BehaviorTree ID="A"><AlwaysSuccess/></BehaviorTree></root>'
+    )
+    (tmp_path / "sub" / "b.xml").write_text(
+        '<root BTCPP_format="4"><include path="../a.xml"/>'
+        '<BehaviorTree ID="B"><AlwaysSuccess/></BehaviorTree></root>'
+    )
     with pytest.raises(InputError, match="include cycle"):
         read_model(tmp_path / "a.xml")
 
 
 def test_missing_include_names_the_line(tmp_path: Path) -> None:
-    (tmp_path / "a.xml").write_text('<root BTCPP_format="4">\n<include path="nope.xml"/>\n'
-                                    '<BehaviorTree ID="A"><AlwaysSuccess/></BehaviorTree></root>')
+    (tmp_path / "a.xml").write_text(
+        '<root BTCPP_format="4">\n<include path="nope.xml"/>\n'
+        '<BehaviorTree ID="A"><AlwaysSuccess/></BehaviorTree></root>'
+    )
     with pytest.raises(InputError) as info:
         read_model(tmp_path / "a.xml")
     assert info.value.location is not None and info.value.location.line == 2
@@ -149,17 +163,24 @@ def test_external_node_models_option_decides_leaf_kinds() -> None:
     undeclared = [n for _, n in plain.nodes() if not n.kind_declared]
     assert undeclared, "without Nav2's model file some kinds are assumed"
     assert all(n.kind_declared for _, n in informed.nodes())
-    assert any(n.kind is NodeKind.CONTROL and n.type == "PipelineSequence"
-               for _, n in informed.nodes())
+    assert any(
+        n.kind is NodeKind.CONTROL and n.type == "PipelineSequence" for _, n in informed.nodes()
+    )
     assert roundtrip(informed) == informed
 
 
 def test_bad_structure_errors_name_line() -> None:
     with pytest.raises(InputError, match="exactly one") as info:
-        loads('<root BTCPP_format="4">\n<BehaviorTree ID="T">\n<A/><B/></BehaviorTree></root>', "btcpp")
+        loads(
+            '<root BTCPP_format="4">\n<BehaviorTree ID="T">\n<A/><B/></BehaviorTree></root>',
+            "btcpp",
+        )
     assert info.value.location.line == 2
     with pytest.raises(InputError, match="duplicate BehaviorTree"):
-        loads('<root><BehaviorTree ID="T"><A/></BehaviorTree><BehaviorTree ID="T"><A/></BehaviorTree></root>', "btcpp")
+        loads(
+            '<root><BehaviorTree ID="T"><A/></BehaviorTree><BehaviorTree ID="T"><A/></BehaviorTree></root>',
+            "btcpp",
+        )
     with pytest.raises(UnsupportedError, match="BTCPP_format"):
         loads('<root BTCPP_format="9"/>', "btcpp")
     with pytest.raises(InputError, match="without ID"):
@@ -176,10 +197,13 @@ def test_malformed_xml_names_line_column_and_cause() -> None:
     assert "malformed XML" in str(err) and "mismatch" in str(err)
 
 
-@pytest.mark.parametrize("doctype", [
-    '<!DOCTYPE r [<!ENTITY a "aaaaaaaaaa"><!ENTITY b "&a;&a;&a;&a;&a;&a;&a;&a;&a;&a;">]>',
-    '<!DOCTYPE r [<!ENTITY x SYSTEM "file:///etc/passwd">]>',
-])
+@pytest.mark.parametrize(
+    "doctype",
+    [
+        '<!DOCTYPE r [<!ENTITY a "aaaaaaaaaa"><!ENTITY b "&a;&a;&a;&a;&a;&a;&a;&a;&a;&a;">]>',
+        '<!DOCTYPE r [<!ENTITY x SYSTEM "file:///etc/passwd">]>',
+    ],
+)
 def test_entity_declarations_are_refused(doctype: str) -> None:
     start = time.monotonic()
     with pytest.raises(InputError, match="entities"):
@@ -189,8 +213,13 @@ def test_entity_declarations_are_refused(doctype: str) -> None:
 
 def test_deep_documents_read_and_deeper_ones_fail_fast() -> None:
     depth = 5000  # beyond libxml2's 2 048 levels: goes through the expat path
-    text = ('<root BTCPP_format="4"><BehaviorTree ID="T">' + "<Inverter>" * depth
-            + "<Leaf/>" + "</Inverter>" * depth + "</BehaviorTree></root>")
+    text = (
+        '<root BTCPP_format="4"><BehaviorTree ID="T">'
+        + "<Inverter>" * depth
+        + "<Leaf/>"
+        + "</Inverter>" * depth
+        + "</BehaviorTree></root>"
+    )
     doc = loads(text, "btcpp")
     assert sum(1 for _ in doc.nodes()) == depth + 1
     # BTNode's dataclass ``==`` recurses, so deep trees are compared node by node, in order.

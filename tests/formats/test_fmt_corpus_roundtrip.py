@@ -19,7 +19,9 @@ from fsmbt.formats import dumps, loads, read_model
 from fsmbt.model import BTDocument
 from fsmbt.model.errors import InputError, UnsupportedError
 
-CORPUS = Path(os.environ.get("FSMBT_CORPUS", Path(__file__).resolve().parents[2] / ".." / "shared" / "corpus"))
+CORPUS = Path(
+    os.environ.get("FSMBT_CORPUS", Path(__file__).resolve().parents[2] / ".." / "shared" / "corpus")
+)
 NAV2_MODELS = CORPUS / "bt" / "nav2" / "models" / "nav2_tree_nodes.xml"
 
 #: Floors: a regression that makes more files fail lowers these counts and fails the test.

@@ -100,7 +100,8 @@ def test_format_dot_of_odd_names_is_accepted_by_graphviz() -> None:
     dot = shutil.which("dot")
     if dot is None:
         pytest.skip("Graphviz 'dot' is not installed")
-    done = subprocess.run([dot, "-Tsvg"], input=dumps(odd_fsm(), "dot"), text=True,
-                          capture_output=True, timeout=30)
+    done = subprocess.run(
+        [dot, "-Tsvg"], input=dumps(odd_fsm(), "dot"), text=True, capture_output=True, timeout=30
+    )
     assert done.returncode == 0, done.stderr
     assert "Warning" not in done.stderr, done.stderr

@@ -34,8 +34,9 @@ class {name}(Behavior):
 
 
 def behaviour(body: str, name: str = "DemoSM", imports: str = "") -> str:
-    return HEAD.format(name=name, imports=imports) + textwrap.indent(textwrap.dedent(body),
-                                                                      "        ")
+    return HEAD.format(name=name, imports=imports) + textwrap.indent(
+        textwrap.dedent(body), "        "
+    )
 
 
 def edges(machine: FSM) -> set[tuple[str, str | None, str, str | None]]:
@@ -108,7 +109,8 @@ def test_concurrency_container_first_satisfied_condition_ends_it() -> None:
 
 
 def test_priority_container_is_read_as_a_state_machine() -> None:
-    model = loads(behaviour("""
+    model = loads(
+        behaviour("""
         _sm = OperatableStateMachine(outcomes=['finished'])
         _p = PriorityContainer(outcomes=['finished'])
         with _p:
@@ -116,7 +118,8 @@ def test_priority_container_is_read_as_a_state_machine() -> None:
         with _sm:
             OperatableStateMachine.add('Prio', _p, transitions={'finished': 'finished'})
         return _sm
-    """))
+    """)
+    )
     assert edges(model.states["Prio"].regions[0]) == {("Log", "done", "finished", None)}
 
 
@@ -132,30 +135,40 @@ return _sm
 
 
 def test_embedded_behaviour_is_read_from_its_file_beside(tmp_path: Path) -> None:
-    (tmp_path / "inner_sm.py").write_text(behaviour("""
+    (tmp_path / "inner_sm.py").write_text(
+        behaviour(
+            """
         _sm = OperatableStateMachine(outcomes=['finished', 'failed'])
         with _sm:
             OperatableStateMachine.add('Work', my_states__WorkState(),
                                        transitions={'done': 'finished', 'failed': 'failed'})
         return _sm
-    """, name="InnerSM"), encoding="utf-8")
+    """,
+            name="InnerSM",
+        ),
+        encoding="utf-8",
+    )
     outer = tmp_path / "outer_sm.py"
-    outer.write_text(behaviour(EMBEDDED, name="OuterSM",
-                               imports="from my_behaviors.inner_sm import InnerSM"),
-                     encoding="utf-8")
+    outer.write_text(
+        behaviour(EMBEDDED, name="OuterSM", imports="from my_behaviors.inner_sm import InnerSM"),
+        encoding="utf-8",
+    )
     model = read_model(outer)
     inner = model.states["Inner"]
     assert inner.attrs["flexbe.behaviour"] == "InnerSM"
-    assert edges(inner.regions[0]) == {("Work", "done", "finished", None),
-                                       ("Work", "failed", "failed", None)}
+    assert edges(inner.regions[0]) == {
+        ("Work", "done", "finished", None),
+        ("Work", "failed", "failed", None),
+    }
     assert ("Inner", None, "failed", "failed") in edges(model)
 
 
 def test_missing_embedded_behaviour_names_the_file_expected(tmp_path: Path) -> None:
     outer = tmp_path / "outer_sm.py"
-    outer.write_text(behaviour(EMBEDDED, name="OuterSM",
-                               imports="from my_behaviors.inner_sm import InnerSM"),
-                     encoding="utf-8")
+    outer.write_text(
+        behaviour(EMBEDDED, name="OuterSM", imports="from my_behaviors.inner_sm import InnerSM"),
+        encoding="utf-8",
+    )
     with pytest.raises(UnsupportedError) as caught:
         read_model(outer)
     assert str(tmp_path / "inner_sm.py") in str(caught.value)
@@ -165,12 +178,18 @@ def test_missing_embedded_behaviour_names_the_file_expected(tmp_path: Path) -> N
 
 
 def test_behaviours_embedding_each_other_are_refused(tmp_path: Path) -> None:
-    (tmp_path / "a_sm.py").write_text(behaviour(EMBEDDED.replace("InnerSM", "BSM"), name="ASM",
-                                                imports="from pkg.b_sm import BSM"),
-                                      encoding="utf-8")
-    (tmp_path / "b_sm.py").write_text(behaviour(EMBEDDED.replace("InnerSM", "ASM"), name="BSM",
-                                                imports="from pkg.a_sm import ASM"),
-                                      encoding="utf-8")
+    (tmp_path / "a_sm.py").write_text(
+        behaviour(
+            EMBEDDED.replace("InnerSM", "BSM"), name="ASM", imports="from pkg.b_sm import BSM"
+        ),
+        encoding="utf-8",
+    )
+    (tmp_path / "b_sm.py").write_text(
+        behaviour(
+            EMBEDDED.replace("InnerSM", "ASM"), name="BSM", imports="from pkg.a_sm import ASM"
+        ),
+        encoding="utf-8",
+    )
     with pytest.raises(InputError, match="embeds itself"):
         read_model(tmp_path / "a_sm.py")
 
@@ -182,7 +201,8 @@ def test_create_that_returns_nothing_readable_is_an_error() -> None:
 
 def test_priority_container_inside_a_concurrency_container_is_named() -> None:
     warnings: list[str] = []
-    model = loads(behaviour("""
+    model = loads(
+        behaviour("""
         _sm = OperatableStateMachine(outcomes=['finished'])
         _cc = ConcurrencyContainer(outcomes=['finished'],
                                    conditions=[('finished', [('P', 'finished'), ('W', 'done')])])
@@ -197,7 +217,10 @@ def test_priority_container_inside_a_concurrency_container_is_named() -> None:
         with _sm:
             OperatableStateMachine.add('Both', _cc, transitions={'finished': 'finished'})
         return _sm
-    """), "flexbe", warnings=warnings)
+    """),
+        "flexbe",
+        warnings=warnings,
+    )
     assert any("PriorityContainer 'P' inside a concurrency container" in w for w in warnings)
     out, status = outputs(model, ["P.done", "W.done"])
     assert status == "final"

@@ -49,9 +49,11 @@ def test_round_trip_restores_the_pseudo_state() -> None:
 
 
 def test_initial_state_naming_a_real_state_and_text_form() -> None:
-    fsm = loads("<FSM><InitialState>B</InitialState><States><State name='A'/><State name='B'/>"
-                "</States><Transitions><Transition from='B' to='A' event='e'/></Transitions></FSM>",
-                "paper-xml")
+    fsm = loads(
+        "<FSM><InitialState>B</InitialState><States><State name='A'/><State name='B'/>"
+        "</States><Transitions><Transition from='B' to='A' event='e'/></Transitions></FSM>",
+        "paper-xml",
+    )
     assert (fsm.initial, fsm.start_name, fsm.initial_event) == ("B", None, None)
     # no state is marked final: a state with no way out is final (docs/semantics.md, 'Models')
     assert fsm.states["A"].final and not fsm.states["B"].final
@@ -75,18 +77,24 @@ def test_duplicate_state_names_its_line() -> None:
 
 
 def test_unknown_target_is_kept_for_validation() -> None:
-    fsm = loads("<FSM><InitialState name='A'/><States><State name='A'/></States><Transitions>"
-                "<Transition from='A' to='Z' event='e'/></Transitions></FSM>", "paper-xml")
+    fsm = loads(
+        "<FSM><InitialState name='A'/><States><State name='A'/></States><Transitions>"
+        "<Transition from='A' to='Z' event='e'/></Transitions></FSM>",
+        "paper-xml",
+    )
     assert fsm.transitions[0].target == "Z" and "Z" not in fsm.states
 
 
-@pytest.mark.parametrize("text, match", [
-    ("<FSM><States><State/></States></FSM>", "without name"),
-    ("<FSM><States><State name='A' type='weird'/></States></FSM>", "unknown state type"),
-    ("<FSM><InitialState name='S'/><States><State name='A'/></States></FSM>", "exactly one"),
-    ("<FSM><Bogus/></FSM>", "unexpected element"),
-    ("<FSM><Transitions><Transition from='A'/></Transitions></FSM>", "'from' and 'to'"),
-])
+@pytest.mark.parametrize(
+    "text, match",
+    [
+        ("<FSM><States><State/></States></FSM>", "without name"),
+        ("<FSM><States><State name='A' type='weird'/></States></FSM>", "unknown state type"),
+        ("<FSM><InitialState name='S'/><States><State name='A'/></States></FSM>", "exactly one"),
+        ("<FSM><Bogus/></FSM>", "unexpected element"),
+        ("<FSM><Transitions><Transition from='A'/></Transitions></FSM>", "'from' and 'to'"),
+    ],
+)
 def test_errors(text: str, match: str) -> None:
     with pytest.raises(InputError, match=match):
         loads(text, "paper-xml")

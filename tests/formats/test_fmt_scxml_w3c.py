@@ -153,9 +153,15 @@ def test_prefix_events_are_written_so_a_w3c_engine_reads_the_same_machine() -> N
     again = loads(dumps(model, "scxml"), "scxml")
     assert again == model
     assert walk(model, ["a.b", "a.b", "a"]) == ["s", "t", "s", "u"]  # a.b in t: via 'a'
-    first = loads(doc(body.replace('event="a.b" target="t"/><transition event="a" target="u"',
-                                   'event="a" target="u"/><transition event="a.b" target="t"')),
-                  "scxml")
+    first = loads(
+        doc(
+            body.replace(
+                'event="a.b" target="t"/><transition event="a" target="u"',
+                'event="a" target="u"/><transition event="a.b" target="t"',
+            )
+        ),
+        "scxml",
+    )
     assert walk(first, ["a.b"]) == ["s", "u"]  # W3C: the first match in document order
 
 
@@ -178,12 +184,21 @@ def test_targetless_transition_runs_its_content_and_stays() -> None:
     assert walk(loads(doc(body), "scxml"), ["poke"]) == ["c/c1", "c/c2"]
 
 
-@pytest.mark.parametrize("body, message", [
-    ('<state id="s"><onentry><raise event="x"/></onentry><transition event="x" target="s"/>'
-     '</state>', "macro step does not end"),
-    ('<state id="s"><transition target="t"/><transition event="*" target="s"/></state>'
-     '<state id="t"><transition target="s"/></state>', "macro step does not end"),
-])
+@pytest.mark.parametrize(
+    "body, message",
+    [
+        (
+            '<state id="s"><onentry><raise event="x"/></onentry><transition event="x" target="s"/>'
+            "</state>",
+            "macro step does not end",
+        ),
+        (
+            '<state id="s"><transition target="t"/><transition event="*" target="s"/></state>'
+            '<state id="t"><transition target="s"/></state>',
+            "macro step does not end",
+        ),
+    ],
+)
 def test_cycles_within_a_macro_step_are_errors_not_hangs(body: str, message: str) -> None:
     with pytest.raises(InputError, match=message):
         loads(doc(body), "scxml")
@@ -191,26 +206,37 @@ def test_cycles_within_a_macro_step_are_errors_not_hangs(body: str, message: str
 
 def test_guard_read_before_the_first_event_is_refused() -> None:
     with pytest.raises(UnsupportedError, match="before the first event"):
-        loads(doc('<state id="s"><transition cond="x" target="t"/></state><state id="t"/>'),
-              "scxml")
+        loads(
+            doc('<state id="s"><transition cond="x" target="t"/></state><state id="t"/>'), "scxml"
+        )
 
 
 def test_too_many_guards_on_one_event_are_refused() -> None:
-    transitions = "".join(f'<transition event="e" cond="v{i}" target="s"/>'
-                          for i in range(MAX_GUARDS_PER_EVENT + 1))
+    transitions = "".join(
+        f'<transition event="e" cond="v{i}" target="s"/>' for i in range(MAX_GUARDS_PER_EVENT + 1)
+    )
     with pytest.raises(UnsupportedError, match="guards read on event 'e'"):
         loads(doc(f'<state id="s">{transitions}</state>'), "scxml")
 
 
 def test_assign_to_an_unread_variable_is_warned_and_one_read_by_a_guard_refused() -> None:
     warnings: list[str] = []
-    read_scxml(doc('<state id="s"><transition event="e" cond="x" target="s">'
-                   '<assign location="y" expr="1"/></transition></state>'),
-               ReadContext(warnings=warnings))
+    read_scxml(
+        doc(
+            '<state id="s"><transition event="e" cond="x" target="s">'
+            '<assign location="y" expr="1"/></transition></state>'
+        ),
+        ReadContext(warnings=warnings),
+    )
     assert any("<assign> to 'y' ignored" in w for w in warnings)
     with pytest.raises(UnsupportedError, match="line 3") as info:
-        loads(doc('<state id="s"><transition event="e" cond="x" target="s">\n'
-                  '<assign location="x" expr="1"/></transition></state>'), "scxml")
+        loads(
+            doc(
+                '<state id="s"><transition event="e" cond="x" target="s">\n'
+                '<assign location="x" expr="1"/></transition></state>'
+            ),
+            "scxml",
+        )
     assert "which a guard reads" in str(info.value)
 
 
@@ -252,18 +278,30 @@ def test_exact_data_is_opt_in_and_computes_guards() -> None:
     assert sorted(guarded.events()) == ["tick[!g1]", "tick[g1]"]  # default: guards as inputs
 
 
-@pytest.mark.parametrize("text, value", [
-    ("1 + 2 * 3", 7), ("(1 + 2) * 3", 9), ("!true || false", False), ("x ge 2 and x lt 5", True),
-    ("'a' + 1", "a1"), ("x === 3", True), ("x === '3'", False), ("-x + 1", -2),
-    ("empty(y)", True), ("In('s')", True),
-])
+@pytest.mark.parametrize(
+    "text, value",
+    [
+        ("1 + 2 * 3", 7),
+        ("(1 + 2) * 3", 9),
+        ("!true || false", False),
+        ("x ge 2 and x lt 5", True),
+        ("'a' + 1", "a1"),
+        ("x === 3", True),
+        ("x === '3'", False),
+        ("-x + 1", -2),
+        ("empty(y)", True),
+        ("In('s')", True),
+    ],
+)
 def test_expression_language(text: str, value: object) -> None:
     from fsmbt.formats.scxml_expr import evaluate, parse
+
     assert evaluate(parse(text), {"x": 3, "y": ""}, lambda state: state == "s") == value
 
 
 @pytest.mark.parametrize("text", ["a.b", "f(1, 2)", "1 +", "(1", "1)", "_event.data"])
 def test_expressions_outside_the_language_do_not_parse(text: str) -> None:
     from fsmbt.formats.scxml_expr import ExpressionError, parse
+
     with pytest.raises(ExpressionError):
         parse(text)

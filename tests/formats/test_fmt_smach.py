@@ -78,37 +78,45 @@ def run(model: FSM, events: list[str]) -> list[str]:
 
 # -- constructs -------------------------------------------------------------------------------
 def test_state_machine_positional_and_keyword_transitions() -> None:
-    model, warnings = read(smach("""
+    model, warnings = read(
+        smach("""
         sm = smach.StateMachine(outcomes=['outcome4', 'outcome5'])
         with sm:
             smach.StateMachine.add('FOO', Foo(), {'outcome1': 'BAR', 'outcome2': 'outcome4'})
             smach.StateMachine.add(label='BAR', state=Bar(), transitions={'outcome1': 'FOO'})
         sm.execute()
-    """))
+    """)
+    )
     assert model.name == "sm"
     assert model.initial == "FOO"
     assert [s.name for s in model.states.values()] == ["FOO", "BAR", "outcome4", "outcome5"]
     assert model.states["FOO"].action == "Foo" and model.states["BAR"].action == "Bar"
     assert model.states["outcome4"].final and model.states["outcome5"].final
-    assert edges(model) == {("FOO", "outcome1", "BAR", None), ("FOO", "outcome2", "outcome4", None),
-                            ("BAR", "outcome1", "FOO", None)}
+    assert edges(model) == {
+        ("FOO", "outcome1", "BAR", None),
+        ("FOO", "outcome2", "outcome4", None),
+        ("BAR", "outcome1", "FOO", None),
+    }
     assert any("declares outcome 'outcome5' that no transition reaches" in w for w in warnings)
     assert detect_format(smach("sm = smach.StateMachine(outcomes=['a'])")).name == "smach"
 
 
 def test_set_initial_state_overrides_the_first_added() -> None:
-    model, _ = read(smach("""
+    model, _ = read(
+        smach("""
         sm = smach.StateMachine(['done'])
         with sm:
             smach.StateMachine.add('FOO', Foo(), {'outcome1': 'done', 'outcome2': 'BAR'})
             smach.StateMachine.add('BAR', Bar(), {'outcome1': 'FOO'})
         sm.set_initial_state(['BAR'])
-    """))
+    """)
+    )
     assert model.initial == "BAR"
 
 
 def test_nested_state_machine_is_a_composite_with_completion_transitions() -> None:
-    model, _ = read(smach("""
+    model, _ = read(
+        smach("""
         top = smach.StateMachine(outcomes=['end'])
         with top:
             smach.StateMachine.add('BAR', Bar(), transitions={'outcome1': 'SUB'})
@@ -116,54 +124,70 @@ def test_nested_state_machine_is_a_composite_with_completion_transitions() -> No
             with sub:
                 smach.StateMachine.add('FOO', Foo(), {'outcome1': 'ok', 'outcome2': 'bad'})
             smach.StateMachine.add('SUB', sub, transitions={'ok': 'end', 'bad': 'BAR'})
-    """))
+    """)
+    )
     composite = model.states["SUB"]
     assert composite.is_composite and composite.action is None
-    assert edges(composite.regions[0]) == {("FOO", "outcome1", "ok", None),
-                                           ("FOO", "outcome2", "bad", None)}
-    assert edges(model) == {("BAR", "outcome1", "SUB", None), ("SUB", None, "end", "ok"),
-                            ("SUB", None, "BAR", "bad")}
-    assert run(model, ["outcome1", "outcome2", "outcome1", "outcome1"]) == [
-        "Foo", "Bar", "Foo", ""]
+    assert edges(composite.regions[0]) == {
+        ("FOO", "outcome1", "ok", None),
+        ("FOO", "outcome2", "bad", None),
+    }
+    assert edges(model) == {
+        ("BAR", "outcome1", "SUB", None),
+        ("SUB", None, "end", "ok"),
+        ("SUB", None, "BAR", "bad"),
+    }
+    assert run(model, ["outcome1", "outcome2", "outcome1", "outcome1"]) == ["Foo", "Bar", "Foo", ""]
 
 
 def test_sequence_links_the_connector_outcome_to_the_next_state() -> None:
-    model, _ = read(smach("""
+    model, _ = read(
+        smach("""
         sq = smach.Sequence(outcomes=['outcome1', 'outcome2'], connector_outcome='outcome1')
         with sq:
             smach.Sequence.add('A', Foo())
             smach.Sequence.add('B', Foo(), transitions={'outcome1': 'A'})
             smach.Sequence.add('C', Bar())
-    """))
-    assert edges(model) == {("A", "outcome1", "B", None), ("A", "outcome2", "outcome2", None),
-                            ("B", "outcome1", "A", None), ("B", "outcome2", "outcome2", None),
-                            ("C", "outcome1", "outcome1", None)}
+    """)
+    )
+    assert edges(model) == {
+        ("A", "outcome1", "B", None),
+        ("A", "outcome2", "outcome2", None),
+        ("B", "outcome1", "A", None),
+        ("B", "outcome2", "outcome2", None),
+        ("C", "outcome1", "outcome1", None),
+    }
 
 
 def test_add_auto_connects_to_the_next_added_state() -> None:
-    model, _ = read(smach("""
+    model, _ = read(
+        smach("""
         sm = smach.StateMachine(outcomes=['outcome2', 'end'])
         with sm:
             smach.StateMachine.add_auto('A', Foo(), ['outcome1'])
             smach.StateMachine.add_auto('B', Foo(), connector_outcomes=['outcome1'],
                                         transitions={'outcome1': 'end'})
             smach.StateMachine.add('C', Bar(), {'outcome1': 'end'})
-    """))
+    """)
+    )
     assert ("A", "outcome1", "B", None) in edges(model)
     assert ("B", "outcome1", "C", None) in edges(model)  # SMACH's code overrides the mapping
 
 
 def test_unmapped_outcome_falls_through_to_the_container_outcome_of_that_name() -> None:
-    model, _ = read(smach("""
+    model, _ = read(
+        smach("""
         sm = smach.StateMachine(outcomes=['outcome2', 'done'])
         with sm:
             smach.StateMachine.add('A', Foo(), {'outcome1': 'done'})
-    """))
+    """)
+    )
     assert ("A", "outcome2", "outcome2", None) in edges(model)
 
 
 def test_concurrence_is_the_product_of_its_children_with_the_outcome_map() -> None:
-    model, _ = read(smach("""
+    model, _ = read(
+        smach("""
         top = smach.StateMachine(outcomes=['outcome6'])
         with top:
             cc = smach.Concurrence(outcomes=['outcome4', 'outcome5'], default_outcome='outcome4',
@@ -173,7 +197,8 @@ def test_concurrence_is_the_product_of_its_children_with_the_outcome_map() -> No
                 smach.Concurrence.add('BAR', Bar())
             smach.StateMachine.add('CON', cc, transitions={'outcome4': 'CON',
                                                            'outcome5': 'outcome6'})
-    """))
+    """)
+    )
     con = model.states["CON"]
     assert con.attrs["smach.container"] == "Concurrence"
     inner = con.regions[0]
@@ -194,19 +219,22 @@ def test_concurrence_is_the_product_of_its_children_with_the_outcome_map() -> No
 
 
 def test_concurrence_last_matching_outcome_map_entry_wins() -> None:
-    model, _ = read(smach("""
+    model, _ = read(
+        smach("""
         cc = smach.Concurrence(outcomes=['x', 'y', 'd'], default_outcome='d',
                                outcome_map={'x': {'FOO': 'outcome1'}, 'y': {'BAR': 'outcome1'}})
         with cc:
             smach.Concurrence.add('FOO', Foo())
             smach.Concurrence.add('BAR', Bar())
-    """))
+    """)
+    )
     assert ("FOO=outcome1,BAR", "BAR.outcome1", "y", None) in edges(model)
     assert ("FOO=outcome2,BAR", "BAR.outcome1", "y", None) in edges(model)
 
 
 def test_concurrence_of_a_container_child_runs_it_alongside_the_leaf() -> None:
-    model, _ = read(smach("""
+    model, _ = read(
+        smach("""
         cc = smach.Concurrence(outcomes=['ok', 'ko'], default_outcome='ko',
                                outcome_map={'ok': {'SUB': 'fine', 'BAR': 'outcome1'}})
         with cc:
@@ -216,7 +244,8 @@ def test_concurrence_of_a_container_child_runs_it_alongside_the_leaf() -> None:
                 smach.StateMachine.add('G', Bar(), {'outcome1': 'fine'})
             smach.Concurrence.add('SUB', sub)
             smach.Concurrence.add('BAR', Bar())
-    """))
+    """)
+    )
     assert model.states[model.initial].action == "Foo+Bar"
     # SUB's F and BAR share 'outcome1': every child event is qualified by its child
     runner = Runner(model)
@@ -232,7 +261,8 @@ def test_concurrence_of_a_container_child_runs_it_alongside_the_leaf() -> None:
 
 
 def test_iterator_with_static_items_is_unrolled() -> None:
-    model, warnings = read(smach("""
+    model, warnings = read(
+        smach("""
         sm = smach.StateMachine(outcomes=['succeeded', 'aborted'])
         with sm:
             it = smach.Iterator(outcomes=['succeeded', 'aborted'], input_keys=[], output_keys=[],
@@ -241,7 +271,8 @@ def test_iterator_with_static_items_is_unrolled() -> None:
                 smach.Iterator.set_contained_state('BODY', Foo(), loop_outcomes=['outcome1'],
                                                    final_outcome_map={'outcome2': 'aborted'})
             smach.StateMachine.add('IT', it, {'succeeded': 'succeeded', 'aborted': 'aborted'})
-    """))
+    """)
+    )
     inner = model.states["IT"].regions[0]
     assert [n for n in inner.states if not inner.states[n].final] == ["BODY#1", "BODY#2", "BODY#3"]
     assert ("BODY#3", "outcome1", "succeeded", None) in edges(inner)
@@ -251,7 +282,8 @@ def test_iterator_with_static_items_is_unrolled() -> None:
 
 
 def test_iterator_with_computed_items_reads_their_number_as_an_environment_choice() -> None:
-    model, warnings = read(smach("""
+    model, warnings = read(
+        smach("""
         sm = smach.StateMachine(outcomes=['done'])
         with sm:
             it = smach.Iterator(['done'], [], [], it=lambda: range(len(items)), it_label='i',
@@ -259,10 +291,10 @@ def test_iterator_with_computed_items_reads_their_number_as_an_environment_choic
             with it:
                 smach.Iterator.set_contained_state('BODY', Bar(), loop_outcomes=['outcome1'])
             smach.StateMachine.add('IT', it, {'done': 'done'})
-    """))
+    """)
+    )
     assert any("known only at run time" in w and "'IT.exhausted'" in w for w in warnings)
-    assert run(model, ["outcome1", "IT.next", "outcome1", "IT.exhausted"]) == [
-        "", "Bar", "", ""]
+    assert run(model, ["outcome1", "IT.next", "outcome1", "IT.exhausted"]) == ["", "Bar", "", ""]
     runner = Runner(model)
     for event in ["outcome1", "IT.exhausted"]:
         runner.step(event)
@@ -270,41 +302,57 @@ def test_iterator_with_computed_items_reads_their_number_as_an_environment_choic
 
 
 def test_cbstate_outcomes_come_from_cb_interface_and_its_action_is_the_callback() -> None:
-    model, _ = read(smach("""
+    model, _ = read(
+        smach("""
         @smach.cb_interface(outcomes=['yes', 'no'])
         def decide(ud):
             return 'yes'
         sm = smach.StateMachine(outcomes=['yes', 'no'])
         with sm:
             smach.StateMachine.add('DECIDE', smach.CBState(decide))
-    """))
+    """)
+    )
     assert model.states["DECIDE"].action == "decide"
     assert edges(model) == {("DECIDE", "yes", "yes", None), ("DECIDE", "no", "no", None)}
 
 
 def test_aliases_literals_through_names_and_opened() -> None:
-    model, _ = read(smach("""
+    model, _ = read(
+        smach(
+            """
         label = 'FIRST'
         moves = {'outcome1': 'end', 'outcome2': label}
         sm = SM(outcomes=['end'])
         with sm.opened():
             sm.add(label, Foo(), moves)
-    """, head=HEAD + "from smach import StateMachine as SM\n"))
-    assert edges(model) == {("FIRST", "outcome1", "end", None), ("FIRST", "outcome2", "FIRST", None)}
+    """,
+            head=HEAD + "from smach import StateMachine as SM\n",
+        )
+    )
+    assert edges(model) == {
+        ("FIRST", "outcome1", "end", None),
+        ("FIRST", "outcome2", "FIRST", None),
+    }
 
 
 def test_container_subclass_built_in_its_init() -> None:
-    model, _ = read(smach("""
+    model, _ = read(
+        smach(
+            """
         top = smach.StateMachine(outcomes=['end'])
         with top:
             smach.StateMachine.add('INNER', Inner(), {'fine': 'end'})
-    """, head=HEAD + textwrap.dedent("""
+    """,
+            head=HEAD
+            + textwrap.dedent("""
         class Inner(smach.StateMachine):
             def __init__(self):
                 smach.StateMachine.__init__(self, outcomes=['fine'])
                 with self:
                     self.add('B', Bar(), transitions={'outcome1': 'fine'})
-        """)))
+        """),
+        )
+    )
     assert edges(model.states["INNER"].regions[0]) == {("B", "outcome1", "fine", None)}
 
 
@@ -326,49 +374,73 @@ def test_several_top_level_machines_first_is_read_the_others_named() -> None:
 
 # -- refusals -----------------------------------------------------------------------------------
 UNSUPPORTED = {
-    "label built at run time": ("""
+    "label built at run time": (
+        """
         sm = smach.StateMachine(outcomes=['a'])
         with sm:
             smach.StateMachine.add('S' + str(1), Bar(), {'outcome1': 'a'})
-    """, "label built at run time"),
-    "f-string label": ("""
+    """,
+        "label built at run time",
+    ),
+    "f-string label": (
+        """
         sm = smach.StateMachine(outcomes=['a'])
         with sm:
             smach.StateMachine.add(f'S{n}', Bar(), {'outcome1': 'a'})
-    """, "label built at run time"),
-    "states added in a loop": ("""
+    """,
+        "label built at run time",
+    ),
+    "states added in a loop": (
+        """
         sm = smach.StateMachine(outcomes=['a'])
         with sm:
             for i in range(3):
                 smach.StateMachine.add('S', Bar(), {'outcome1': 'a'})
-    """, "in a loop"),
-    "computed transitions": ("""
+    """,
+        "in a loop",
+    ),
+    "computed transitions": (
+        """
         sm = smach.StateMachine(outcomes=['a'])
         with sm:
             smach.StateMachine.add('S', Bar(), {o: 'a' for o in ['outcome1']})
-    """, "transitions of 'S'"),
-    "transitions from a call": ("""
+    """,
+        "transitions of 'S'",
+    ),
+    "transitions from a call": (
+        """
         sm = smach.StateMachine(outcomes=['a'])
         with sm:
             smach.StateMachine.add('S', Bar(), make_transitions())
-    """, "transitions of 'S'"),
-    "add under a condition": ("""
+    """,
+        "transitions of 'S'",
+    ),
+    "add under a condition": (
+        """
         sm = smach.StateMachine(outcomes=['a'])
         with sm:
             if debug:
                 smach.StateMachine.add('S', Bar(), {'outcome1': 'a'})
-    """, "under a condition"),
-    "concurrence callback": ("""
+    """,
+        "under a condition",
+    ),
+    "concurrence callback": (
+        """
         cc = smach.Concurrence(outcomes=['a'], default_outcome='a',
                                child_termination_cb=lambda so: True)
         with cc:
             smach.Concurrence.add('B', Bar())
-    """, "child_termination_cb"),
-    "concurrence child of unknown outcomes": ("""
+    """,
+        "child_termination_cb",
+    ),
+    "concurrence child of unknown outcomes": (
+        """
         cc = smach.Concurrence(outcomes=['a'], default_outcome='a')
         with cc:
             smach.Concurrence.add('EXT', ImportedState())
-    """, "outcomes of Concurrence child 'EXT'"),
+    """,
+        "outcomes of Concurrence child 'EXT'",
+    ),
 }
 
 
@@ -385,48 +457,72 @@ def test_unsupported_constructs_are_named_with_their_line(case: str) -> None:
 
 
 INVALID = {
-    "outcome mapped to nothing": ("""
+    "outcome mapped to nothing": (
+        """
         sm = smach.StateMachine(outcomes=['done'])
         with sm:
             smach.StateMachine.add('A', Foo(), {'outcome1': 'done'})
-    """, "outcome 'outcome2' of state 'A' is mapped to nothing"),
-    "outcome mapped to None": ("""
+    """,
+        "outcome 'outcome2' of state 'A' is mapped to nothing",
+    ),
+    "outcome mapped to None": (
+        """
         sm = smach.StateMachine(outcomes=['done'])
         with sm:
             smach.StateMachine.add('A', Bar(), {'outcome1': None})
-    """, "mapped to nothing"),
-    "unknown target": ("""
+    """,
+        "mapped to nothing",
+    ),
+    "unknown target": (
+        """
         sm = smach.StateMachine(outcomes=['done'])
         with sm:
             smach.StateMachine.add('A', Bar(), {'outcome1': 'NOWHERE'})
-    """, "neither a state"),
-    "outcome the class lacks": ("""
+    """,
+        "neither a state",
+    ),
+    "outcome the class lacks": (
+        """
         sm = smach.StateMachine(outcomes=['done'])
         with sm:
             smach.StateMachine.add('A', Bar(), {'outcome1': 'done', 'oops': 'done'})
-    """, "outcome 'oops' it does not have"),
-    "unknown initial state": ("""
+    """,
+        "outcome 'oops' it does not have",
+    ),
+    "unknown initial state": (
+        """
         sm = smach.StateMachine(outcomes=['done'])
         with sm:
             smach.StateMachine.add('A', Bar(), {'outcome1': 'done'})
         sm.set_initial_state(['B'])
-    """, "set_initial_state names 'B'"),
-    "add outside with": ("""
+    """,
+        "set_initial_state names 'B'",
+    ),
+    "add outside with": (
+        """
         sm = smach.StateMachine(outcomes=['done'])
         smach.StateMachine.add('A', Bar(), {'outcome1': 'done'})
-    """, "outside a 'with container:' block"),
-    "outcome map naming no child": ("""
+    """,
+        "outside a 'with container:' block",
+    ),
+    "outcome map naming no child": (
+        """
         cc = smach.Concurrence(outcomes=['a', 'b'], default_outcome='a',
                                outcome_map={'b': {'GHOST': 'outcome1'}})
         with cc:
             smach.Concurrence.add('B', Bar())
-    """, "names 'GHOST'"),
-    "duplicate label": ("""
+    """,
+        "names 'GHOST'",
+    ),
+    "duplicate label": (
+        """
         sm = smach.StateMachine(outcomes=['done'])
         with sm:
             smach.StateMachine.add('A', Bar(), {'outcome1': 'done'})
             smach.StateMachine.add('A', Bar(), {'outcome1': 'done'})
-    """, "already used"),
+    """,
+        "already used",
+    ),
     "no state machine": ("x = 1\n", "no state machine is built"),
 }
 
@@ -444,7 +540,8 @@ def test_invalid_machines_are_located_input_errors(case: str) -> None:
 def test_code_in_the_file_is_never_executed(tmp_path: Path) -> None:
     marker = tmp_path / "EXECUTED"
     path = tmp_path / "hostile.py"
-    path.write_text(textwrap.dedent(f"""\
+    path.write_text(
+        textwrap.dedent(f"""\
         import smach
         open({str(marker)!r}, 'w').write('module level ran')
         __import__('os').system('touch {marker}')
@@ -462,7 +559,9 @@ def test_code_in_the_file_is_never_executed(tmp_path: Path) -> None:
 
         if __name__ == '__main__':
             main()
-        """), encoding="utf-8")
+        """),
+        encoding="utf-8",
+    )
     model = read_model(path)
     assert isinstance(model, FSM) and list(model.states) == ["F", "a"]
     assert not marker.exists()
@@ -475,8 +574,15 @@ def test_syntax_error_is_a_located_input_error() -> None:
     assert caught.value.location.line is not None
 
 
-@pytest.mark.parametrize("expression", ["-" * 100_000 + "1", "1" + "+1" * 100_000,
-                                        "(" * 100_000 + ")" * 100_000, "a" + ".b" * 100_000])
+@pytest.mark.parametrize(
+    "expression",
+    [
+        "-" * 100_000 + "1",
+        "1" + "+1" * 100_000,
+        "(" * 100_000 + ")" * 100_000,
+        "a" + ".b" * 100_000,
+    ],
+)
 def test_hundred_thousand_deep_expression_is_a_clean_error(expression: str) -> None:
     with pytest.raises(InputError) as caught:
         read("import smach\nx = " + expression + "\n")
@@ -496,19 +602,31 @@ def test_deeply_nested_with_blocks_are_refused_cleanly() -> None:
 def _cli(*args: str) -> subprocess.CompletedProcess[str]:
     root = Path(__file__).resolve().parents[2]
     env = dict(os.environ, PYTHONPATH=str(root / "src"))
-    return subprocess.run([sys.executable, "-m", "fsmbt.cli", *args], capture_output=True,
-                          text=True, timeout=120, env=env, check=False)
+    return subprocess.run(
+        [sys.executable, "-m", "fsmbt.cli", *args],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        env=env,
+        check=False,
+    )
 
 
 def test_cli_converts_a_smach_file_without_running_it(tmp_path: Path) -> None:
     marker = tmp_path / "EXECUTED"
     source = tmp_path / "robot.py"
-    source.write_text(smach("""
+    source.write_text(
+        smach(
+            """
         sm = smach.StateMachine(outcomes=['done'])
         with sm:
             smach.StateMachine.add('FOO', Foo(), {'outcome1': 'BAR', 'outcome2': 'done'})
             smach.StateMachine.add('BAR', Bar(), {'outcome1': 'FOO'})
-    """, head=HEAD + f"open({str(marker)!r}, 'w')\n"), encoding="utf-8")
+    """,
+            head=HEAD + f"open({str(marker)!r}, 'w')\n",
+        ),
+        encoding="utf-8",
+    )
     out = tmp_path / "robot_bt.xml"
     done = _cli("convert", str(source), "-o", str(out))
     assert done.returncode == 0, done.stderr

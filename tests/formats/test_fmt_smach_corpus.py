@@ -18,8 +18,9 @@ from fsmbt.formats._smach_write import write_smach
 from fsmbt.model.fsm import FSM
 from fsmbt.verify import verify
 
-CORPUS = Path(os.environ.get("FSMBT_CORPUS",
-                             Path(__file__).resolve().parents[2] / ".." / "shared" / "corpus"))
+CORPUS = Path(
+    os.environ.get("FSMBT_CORPUS", Path(__file__).resolve().parents[2] / ".." / "shared" / "corpus")
+)
 FSM_DIR = CORPUS / "fsm"
 SMACH_FILES = sorted([*FSM_DIR.glob("smach_tutorials/*.py"), *FSM_DIR.glob("smach_tests/*.py")])
 FLEXBE_FILES = sorted(FSM_DIR.glob("flexbe_turtlesim_demo/*_sm.py"))

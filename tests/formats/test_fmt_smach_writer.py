@@ -27,8 +27,14 @@ from fsmbt.model.fsm import FSM, State
 from fsmbt.verify import verify
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
-FSM_EXAMPLES = ["paper_fsm.xml", "paper_fsm.json", "guard_npc.csv", "turnstile.mmd",
-                "door_hfsm.scxml", "delivery_smach.py"]
+FSM_EXAMPLES = [
+    "paper_fsm.xml",
+    "paper_fsm.json",
+    "guard_npc.csv",
+    "turnstile.mmd",
+    "door_hfsm.scxml",
+    "delivery_smach.py",
+]
 
 
 def round_trip(model: FSM) -> FSM:
@@ -91,21 +97,23 @@ def test_parallel_state_is_written_as_its_product_and_named_as_a_loss() -> None:
 
 
 def test_concurrence_read_from_smach_is_written_back_as_a_concurrence() -> None:
-    text = "\n".join([
-        "import smach",
-        "class Foo(smach.State):",
-        "    def __init__(self):",
-        "        smach.State.__init__(self, outcomes=['a', 'b'])",
-        "def main():",
-        "    top = smach.StateMachine(outcomes=['end'])",
-        "    with top:",
-        "        cc = smach.Concurrence(outcomes=['x', 'y'], default_outcome='y',",
-        "                               outcome_map={'x': {'F1': 'a', 'F2': 'a'}})",
-        "        with cc:",
-        "            smach.Concurrence.add('F1', Foo())",
-        "            smach.Concurrence.add('F2', Foo())",
-        "        smach.StateMachine.add('CC', cc, transitions={'x': 'end', 'y': 'CC'})",
-    ])
+    text = "\n".join(
+        [
+            "import smach",
+            "class Foo(smach.State):",
+            "    def __init__(self):",
+            "        smach.State.__init__(self, outcomes=['a', 'b'])",
+            "def main():",
+            "    top = smach.StateMachine(outcomes=['end'])",
+            "    with top:",
+            "        cc = smach.Concurrence(outcomes=['x', 'y'], default_outcome='y',",
+            "                               outcome_map={'x': {'F1': 'a', 'F2': 'a'}})",
+            "        with cc:",
+            "            smach.Concurrence.add('F1', Foo())",
+            "            smach.Concurrence.add('F2', Foo())",
+            "        smach.StateMachine.add('CC', cc, transitions={'x': 'end', 'y': 'CC'})",
+        ]
+    )
     model = loads(text, "smach")
     written = write_smach(model)
     assert "smach.Concurrence(outcomes=['x', 'y'], default_outcome='y'" in written
@@ -187,8 +195,9 @@ def _recording_smach() -> types.ModuleType:
         def add(label, state):  # noqa: ANN001, ANN205
             container = opened[-1]
             container.states[label] = state
-            container.transitions[label] = {o: container.options["default_outcome"]
-                                            for o in state.outcomes}
+            container.transitions[label] = {
+                o: container.options["default_outcome"] for o in state.outcomes
+            }
             container.initial = next(iter(container.states))
             return state
 
@@ -207,10 +216,12 @@ def _containers(root) -> list:  # noqa: ANN001
     return out
 
 
-@pytest.mark.parametrize("source", ["paper_fsm.xml", "door_hfsm.scxml", "hfsm:3", "hfsm:7",
-                                    "parallel"])
-def test_written_module_builds_a_consistent_smach_machine(source: str,
-                                                         monkeypatch: pytest.MonkeyPatch) -> None:
+@pytest.mark.parametrize(
+    "source", ["paper_fsm.xml", "door_hfsm.scxml", "hfsm:3", "hfsm:7", "parallel"]
+)
+def test_written_module_builds_a_consistent_smach_machine(
+    source: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
     if source == "parallel":
         model = _parallel_model()
     elif source.startswith("hfsm:"):

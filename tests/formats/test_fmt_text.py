@@ -92,11 +92,12 @@ def robot_bt() -> BTDocument:
     def control(kind: str, *children: BTNode) -> BTNode:
         return BTNode(kind, NodeKind.CONTROL, children=list(children))
 
-    root = control("Sequence",
-                   control("Fallback", leaf("BatteryBelow", NodeKind.CONDITION), leaf("Recharge")),
-                   BTNode("Inverter", NodeKind.DECORATOR, name="not",
-                          children=[leaf("Dock")]),
-                   BTNode("SubTree", NodeKind.SUBTREE, attrs={"ID": "Sub", "_autoremap": "true"}))
+    root = control(
+        "Sequence",
+        control("Fallback", leaf("BatteryBelow", NodeKind.CONDITION), leaf("Recharge")),
+        BTNode("Inverter", NodeKind.DECORATOR, name="not", children=[leaf("Dock")]),
+        BTNode("SubTree", NodeKind.SUBTREE, attrs={"ID": "Sub", "_autoremap": "true"}),
+    )
     doc = BTDocument.single(root, "Main")
     doc.trees["Sub"] = BTDocument.single(leaf("Wave"), "Sub").trees["Sub"]
     return doc
@@ -134,7 +135,9 @@ def test_hierarchical_mermaid_file_roundtrip() -> None:
     assert alarm.regions[0].initial == "Ringing"
     assert alarm.regions[0].states["Quiet"].final
     assert [(t.source, t.event, t.target) for t in fsm.transitions if t.source == "Locked"] == [
-        ("Locked", None, "Closed"), ("Locked", "kaboom", "Gone")]
+        ("Locked", None, "Closed"),
+        ("Locked", "kaboom", "Gone"),
+    ]
     assert roundtrip(fsm, "mermaid") == fsm
 
 
@@ -174,8 +177,9 @@ def test_dot_output_is_accepted_by_graphviz() -> None:
     if dot is None:
         pytest.skip("Graphviz 'dot' is not installed")
     for model in (hierarchical_fsm(), robot_bt(), random_flat_fsm(7)):
-        result = subprocess.run([dot, "-Tsvg"], input=dumps(model, "dot"), text=True,
-                                capture_output=True, timeout=30)
+        result = subprocess.run(
+            [dot, "-Tsvg"], input=dumps(model, "dot"), text=True, capture_output=True, timeout=30
+        )
         assert result.returncode == 0, result.stderr
         assert "<svg" in result.stdout
         assert "Warning" not in result.stderr, result.stderr
@@ -202,15 +206,21 @@ def test_table_rules_initial_final_and_target_action() -> None:
 def test_table_header_is_case_and_space_insensitive_in_any_order() -> None:
     fsm = loads("  Target , SOURCE ,Event \nB,A,go\nA,B,back\n", "csv")
     assert [(t.source, t.event, t.target) for t in fsm.transitions] == [
-        ("A", "go", "B"), ("B", "back", "A")]
+        ("A", "go", "B"),
+        ("B", "back", "A"),
+    ]
 
 
 def test_markdown_table_inside_prose() -> None:
-    text = ("# My machine\n\nSome words.\n\n| Source | Event | Target |\n|:---|---|---:|\n"
-            "| `A` | go | B |\n| B | a\\|b | A |\n\nMore prose | with a pipe.\n")
+    text = (
+        "# My machine\n\nSome words.\n\n| Source | Event | Target |\n|:---|---|---:|\n"
+        "| `A` | go | B |\n| B | a\\|b | A |\n\nMore prose | with a pipe.\n"
+    )
     fsm = loads(text)
     assert [(t.source, t.event, t.target) for t in fsm.transitions] == [
-        ("A", "go", "B"), ("B", "a|b", "A")]
+        ("A", "go", "B"),
+        ("B", "a|b", "A"),
+    ]
     assert loads(dumps(fsm, "md"), "md") == fsm
 
 
@@ -220,13 +230,16 @@ def test_conflicting_actions_name_both_rows() -> None:
     assert ":3" in str(info.value) and "line 2" in str(info.value)
 
 
-@pytest.mark.parametrize("text,needle", [
-    ("source,event\nA,go\n", "lacks column(s) target"),
-    ("source,event,target,colour\nA,go,B,red\n", "unknown column 'colour'"),
-    ("source,event,target\nA,go\n", ":2: row has 2 cells"),
-    ("source,event,target\n,go,B\n", ":2: empty 'source'"),
-    ("source,event,target\n", "no transitions"),
-])
+@pytest.mark.parametrize(
+    "text,needle",
+    [
+        ("source,event\nA,go\n", "lacks column(s) target"),
+        ("source,event,target,colour\nA,go,B,red\n", "unknown column 'colour'"),
+        ("source,event,target\nA,go\n", ":2: row has 2 cells"),
+        ("source,event,target\n,go,B\n", ":2: empty 'source'"),
+        ("source,event,target\n", "no transitions"),
+    ],
+)
 def test_csv_errors_name_the_line(text: str, needle: str) -> None:
     with pytest.raises(InputError, match=None) as info:
         loads(text, "csv")
@@ -247,17 +260,23 @@ def test_table_writer_refuses_what_a_table_cannot_say() -> None:
 
 
 # -- Mermaid and DOT rules ---------------------------------------------------------------------
-@pytest.mark.parametrize("text,needle", [
-    ("stateDiagram-v2\nstate F <<fork>>\n", "unsupported: <<fork>>"),
-    ("stateDiagram-v2\nstate C <<choice>>\n", "unsupported: <<choice>>"),
-    ("stateDiagram-v2\nstate P {\n a --> b\n --\n c --> d\n}\n", ":4: unsupported: concurrent"),
-    ("stateDiagram-v2\nA --> [*] : quit\n", "unsupported: a labelled transition to [*]"),
-    ("stateDiagram-v2\nstate C {\n a --> b\n}\nb --> D\n", ":5: unsupported: state 'b' belongs"),
-    ("stateDiagram-v2\n[*] --> A\n[*] --> B\n", "two initial states"),
-    ("stateDiagram-v2\nA ==> B\n", ":2: cannot read"),
-    ("flowchart TD\nA-->B\n", "not a Mermaid state diagram"),
-    ("stateDiagram-v2\nstate C {\nA --> B\n", "never closed"),
-])
+@pytest.mark.parametrize(
+    "text,needle",
+    [
+        ("stateDiagram-v2\nstate F <<fork>>\n", "unsupported: <<fork>>"),
+        ("stateDiagram-v2\nstate C <<choice>>\n", "unsupported: <<choice>>"),
+        ("stateDiagram-v2\nstate P {\n a --> b\n --\n c --> d\n}\n", ":4: unsupported: concurrent"),
+        ("stateDiagram-v2\nA --> [*] : quit\n", "unsupported: a labelled transition to [*]"),
+        (
+            "stateDiagram-v2\nstate C {\n a --> b\n}\nb --> D\n",
+            ":5: unsupported: state 'b' belongs",
+        ),
+        ("stateDiagram-v2\n[*] --> A\n[*] --> B\n", "two initial states"),
+        ("stateDiagram-v2\nA ==> B\n", ":2: cannot read"),
+        ("flowchart TD\nA-->B\n", "not a Mermaid state diagram"),
+        ("stateDiagram-v2\nstate C {\nA --> B\n", "never closed"),
+    ],
+)
 def test_mermaid_errors(text: str, needle: str) -> None:
     with pytest.raises(InputError) as info:
         loads(text, "mermaid")
@@ -279,16 +298,22 @@ def test_dot_reads_the_classic_fsm_idiom() -> None:
     assert fsm.states["LR_3"].final and not fsm.states["LR_2"].final
     assert "__start__" not in fsm.states
     assert [(t.source, t.event, t.target) for t in fsm.transitions] == [
-        ("LR_0", "SS(B)", "LR_2"), ("LR_2", "S(A)", "LR_3"), ("LR_3", "S(A)", "LR_0")]
+        ("LR_0", "SS(B)", "LR_2"),
+        ("LR_2", "S(A)", "LR_3"),
+        ("LR_3", "S(A)", "LR_0"),
+    ]
 
 
-@pytest.mark.parametrize("text,needle", [
-    ("graph G { a -- b }", "undirected"),
-    ("digraph { subgraph cluster_x { a } }", "subgraphs"),
-    ("digraph { a:p -> b }", "ports"),
-    ("digraph { a -> b", "missing '}'"),
-    ("digraph { s [shape=point]; s -> a; s -> b }", "more than one initial arrow"),
-])
+@pytest.mark.parametrize(
+    "text,needle",
+    [
+        ("graph G { a -- b }", "undirected"),
+        ("digraph { subgraph cluster_x { a } }", "subgraphs"),
+        ("digraph { a:p -> b }", "ports"),
+        ("digraph { a -> b", "missing '}'"),
+        ("digraph { s [shape=point]; s -> a; s -> b }", "more than one initial arrow"),
+    ],
+)
 def test_dot_errors(text: str, needle: str) -> None:
     with pytest.raises(InputError) as info:
         loads(text, "dot")
@@ -303,9 +328,13 @@ def test_yaml_alias_is_refused_with_its_line() -> None:
 
 def test_yaml_deep_nesting_refused_and_moderate_depth_read() -> None:
     depth = 1000
-    text = ("kind: bt\ntrees:\n- id: T\n  root: "
-            + "{type: Inverter, kind: Decorator, children: [" * depth + "{type: A}"
-            + "]}" * depth + "\n")
+    text = (
+        "kind: bt\ntrees:\n- id: T\n  root: "
+        + "{type: Inverter, kind: Decorator, children: [" * depth
+        + "{type: A}"
+        + "]}" * depth
+        + "\n"
+    )
     doc = loads(text, "yaml")
     assert sum(1 for _ in doc.nodes()) == depth + 1
     with pytest.raises(InputError, match="nested deeper"):

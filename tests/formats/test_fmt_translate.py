@@ -17,7 +17,12 @@ import pytest
 
 from fsmbt.formats import Format, loads, read_model
 from fsmbt.formats.json_format import write_json
-from fsmbt.formats.translate import rename_events, scxml_event_renames, differences_between, translate
+from fsmbt.formats.translate import (
+    differences_between,
+    rename_events,
+    scxml_event_renames,
+    translate,
+)
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import UnsupportedError
 from fsmbt.model.fsm import FSM
@@ -31,8 +36,14 @@ needs_corpus = pytest.mark.skipif(not (CORPUS / "fsm").exists(), reason="corpus 
 
 def cli(*args: str) -> subprocess.CompletedProcess[str]:
     env = dict(os.environ, PYTHONPATH=str(ROOT / "src"))
-    return subprocess.run([sys.executable, "-m", "fsmbt.cli", *args], capture_output=True,
-                          text=True, timeout=120, env=env, check=False)
+    return subprocess.run(
+        [sys.executable, "-m", "fsmbt.cli", *args],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        env=env,
+        check=False,
+    )
 
 
 SMACH_SOURCE = """\
@@ -72,15 +83,17 @@ def test_smach_to_scxml(tmp_path: Path) -> None:
 @needs_corpus
 def test_smach_concurrence_to_scxml_names_what_scxml_cannot_say(tmp_path: Path) -> None:
     out = tmp_path / "c.scxml"
-    done = cli("translate", str(CORPUS / "fsm" / "smach_tutorials" / "concurrence2.py"),
-               "-o", str(out))
+    done = cli(
+        "translate", str(CORPUS / "fsm" / "smach_tutorials" / "concurrence2.py"), "-o", str(out)
+    )
     assert done.returncode == 0, done.stderr
     # SCXML can say how CON ended: each completion transition is guarded by In('<final>')
     text = out.read_text(encoding="utf-8")
-    assert 'event="done.state.CON"' in text and "cond=\"In(" in text
+    assert 'event="done.state.CON"' in text and 'cond="In(' in text
     assert "ends differently by final state" not in done.stderr
-    assert verify(read_model(CORPUS / "fsm" / "smach_tutorials" / "concurrence2.py"),
-                  read_model(out)).equivalent
+    assert verify(
+        read_model(CORPUS / "fsm" / "smach_tutorials" / "concurrence2.py"), read_model(out)
+    ).equivalent
 
 
 @needs_corpus
@@ -133,11 +146,15 @@ def test_flexbe_to_json(tmp_path: Path) -> None:
 
 def test_reader_option_picks_another_machine(tmp_path: Path) -> None:
     source = tmp_path / "two.py"
-    source.write_text(SMACH_SOURCE + """
+    source.write_text(
+        SMACH_SOURCE
+        + """
     other = smach.StateMachine(outcomes=['end'])
     with other:
         smach.StateMachine.add('SOLO', Foo(), {'outcome1': 'end', 'outcome2': 'end'})
-""", encoding="utf-8")
+""",
+        encoding="utf-8",
+    )
     first = cli("translate", str(source), "--to", "json")
     assert first.returncode == 0 and "not read: 'other'" in first.stderr
     assert list(loads(first.stdout, "json").states) == ["FOO", "BAR", "outcome4"]
@@ -160,17 +177,31 @@ def test_stdout_needs_a_target_format(tmp_path: Path) -> None:
 def test_a_loss_that_changes_behaviour_is_refused(monkeypatch: pytest.MonkeyPatch) -> None:
     def drop_last_transition(model: FSM) -> str:  # a target that silently loses an edge
         assert isinstance(model, FSM)
-        cut = FSM(name=model.name, states=dict(model.states), transitions=model.transitions[:-1],
-                  initial=model.initial, start_name=model.start_name,
-                  initial_event=model.initial_event)
+        cut = FSM(
+            name=model.name,
+            states=dict(model.states),
+            transitions=model.transitions[:-1],
+            initial=model.initial,
+            start_name=model.start_name,
+            initial_event=model.initial_event,
+        )
         return write_json(cut)
 
     from fsmbt.formats import registry
 
     registry.formats()  # the built-in formats first, then the test's (removed afterwards)
-    monkeypatch.setitem(registry._FORMATS, "lossy-for-test", Format(
-        "lossy-for-test", (".lossy",), frozenset({"fsm"}), "test only",
-        lambda text, ctx: loads(text, "json"), drop_last_transition))
+    monkeypatch.setitem(
+        registry._FORMATS,
+        "lossy-for-test",
+        Format(
+            "lossy-for-test",
+            (".lossy",),
+            frozenset({"fsm"}),
+            "test only",
+            lambda text, ctx: loads(text, "json"),
+            drop_last_transition,
+        ),
+    )
     model = read_model(EXAMPLES / "paper_fsm.xml")
     with pytest.raises(UnsupportedError, match="changes the model's behaviour"):
         translate(model, "lossy-for-test", check=verify)

@@ -27,5 +27,15 @@ def read_planted(text: str, ctx: ReadContext) -> object:
     raise InputError("not a planted model", location=ctx.location(1))
 
 
-register(Format("planted-bug", (".planted",), frozenset({"fsm"}), "harness self-test only",
-                read_planted, None, None, priority=99))
+register(
+    Format(
+        "planted-bug",
+        (".planted",),
+        frozenset({"fsm"}),
+        "harness self-test only",
+        read_planted,
+        None,
+        None,
+        priority=99,
+    )
+)

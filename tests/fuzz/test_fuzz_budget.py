@@ -15,9 +15,9 @@ import sys
 from pathlib import Path
 
 import pytest
-from support.fuzz_harness_loader import ROOT, SCRIPT
 
 from fsmbt.formats import formats
+from support.fuzz_harness_loader import ROOT, SCRIPT
 
 ITERATIONS = 2_000
 SEED = 18
@@ -30,11 +30,31 @@ def test_seeded_fuzz_budget_of_every_reader_finds_nothing(tmp_path: Path) -> Non
     regressions = tmp_path / "regressions"
     env = dict(os.environ, PYTHONPATH=str(ROOT / "src"))
     proc = subprocess.run(
-        [sys.executable, str(SCRIPT), "--iterations", str(ITERATIONS), "--reader", "all",
-         "--seed", str(SEED), "--batch", str(ITERATIONS), "--timeout-per-input", "5",
-         "--work-dir", str(tmp_path / "work"), "--regressions", str(regressions),
-         "--json", str(figures)],
-        capture_output=True, text=True, env=env, timeout=900)
+        [
+            sys.executable,
+            str(SCRIPT),
+            "--iterations",
+            str(ITERATIONS),
+            "--reader",
+            "all",
+            "--seed",
+            str(SEED),
+            "--batch",
+            str(ITERATIONS),
+            "--timeout-per-input",
+            "5",
+            "--work-dir",
+            str(tmp_path / "work"),
+            "--regressions",
+            str(regressions),
+            "--json",
+            str(figures),
+        ],
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=900,
+    )
     print(proc.stdout)
     rows = {row["reader"]: row for row in json.loads(figures.read_text(encoding="utf-8"))}
     assert set(rows) == {f.name for f in formats() if f.read is not None}
@@ -48,30 +68,63 @@ def test_seeded_fuzz_budget_of_every_reader_finds_nothing(tmp_path: Path) -> Non
 
 
 def test_the_harness_reports_crashes_timeouts_and_memory_and_saves_the_inputs(
-        tmp_path: Path) -> None:
+    tmp_path: Path,
+) -> None:
     """The fuzz script against a reader with planted bugs: each kind of finding is counted and
     its input saved with its cause, and the run goes on past each one (no finding stops it)."""
     figures = tmp_path / "figures.json"
     regressions = tmp_path / "regressions"
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(ROOT / "src"),
-                                                       str(Path(__file__).parent)]))
+    env = dict(
+        os.environ, PYTHONPATH=os.pathsep.join([str(ROOT / "src"), str(Path(__file__).parent)])
+    )
     proc = subprocess.run(
-        [sys.executable, str(SCRIPT), "--import", "planted_reader", "--reader", "planted-bug",
-         "--iterations", "2000", "--seed", "1", "--timeout-per-input", "0.05",
-         "--memory-mb", "1024", "--hard-timeout", "2", "--batch", "1000", "--work-dir", str(tmp_path / "work"),
-         "--regressions", str(regressions), "--json", str(figures)],
-        capture_output=True, text=True, env=env, timeout=600)
+        [
+            sys.executable,
+            str(SCRIPT),
+            "--import",
+            "planted_reader",
+            "--reader",
+            "planted-bug",
+            "--iterations",
+            "2000",
+            "--seed",
+            "1",
+            "--timeout-per-input",
+            "0.05",
+            "--memory-mb",
+            "1024",
+            "--hard-timeout",
+            "2",
+            "--batch",
+            "1000",
+            "--work-dir",
+            str(tmp_path / "work"),
+            "--regressions",
+            str(regressions),
+            "--json",
+            str(figures),
+        ],
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=600,
+    )
     (row,) = json.loads(figures.read_text(encoding="utf-8"))
     assert proc.returncode == 1, proc.stderr[-2000:]  # findings: exit 1
     assert row["iterations"] == 2000
     assert row["crashes"] > 0 and row["timeouts"] > 0 and row["memory"] > 0, row
-    causes = {p.stem.split("-")[0]: p.read_text(encoding="utf-8")
-              for p in (regressions / "planted-bug").glob("*.cause")}
+    causes = {
+        p.stem.split("-")[0]: p.read_text(encoding="utf-8")
+        for p in (regressions / "planted-bug").glob("*.cause")
+    }
     assert "KeyError at " in causes["crash"] and "planted" in causes["crash"]
     assert "no answer within 0.05 s" in causes["timeout"]
     assert "MemoryError" in causes["memory"]
-    hard = [p.read_text(encoding="utf-8") for p in (regressions / "planted-bug").glob("*.cause")
-            if "hard timeout" in p.read_text(encoding="utf-8")]
+    hard = [
+        p.read_text(encoding="utf-8")
+        for p in (regressions / "planted-bug").glob("*.cause")
+        if "hard timeout" in p.read_text(encoding="utf-8")
+    ]
     assert hard, "the sleeping input was not caught by the wall-clock alarm"
     for kind in ("crash", "timeout", "memory"):
         saved = [p.read_bytes() for p in (regressions / "planted-bug").glob(f"{kind}-*.input")]

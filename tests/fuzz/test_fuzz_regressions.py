@@ -11,9 +11,9 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from support.fuzz_harness_loader import REGRESSIONS, harness
 
 from fsmbt.formats import formats, get_format
+from support.fuzz_harness_loader import REGRESSIONS, harness
 
 INPUTS = sorted(REGRESSIONS.glob("*/*.input"))
 

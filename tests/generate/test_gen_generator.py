@@ -62,7 +62,8 @@ def test_fsm_vocabularies_and_sizes() -> None:
         assert t.event == f"event{t.source}{t.target}"
     chain = random_fsm(1, 10, shape="chain", extra_edges=0, start_event=True)
     assert [(t.source, t.target) for t in chain.transitions] == [
-        (a, b) for a, b in zip("ABCDEFGHI", "BCDEFGHIJ")]
+        (a, b) for a, b in zip("ABCDEFGHI", "BCDEFGHIJ")
+    ]
     assert chain.start_name == "Start" and chain.initial_event == "eventSA"
 
 
@@ -85,8 +86,11 @@ def test_bt_limits(extended: bool) -> None:
                     assert node.type in allowed_controls
                 else:
                     assert node.type in allowed_decorators
-    seen_types = {n.type for s in range(60)
-                  for n in random_bt(s, scenario="robot", extended=True).main.root.walk()}
+    seen_types = {
+        n.type
+        for s in range(60)
+        for n in random_bt(s, scenario="robot", extended=True).main.root.walk()
+    }
     if extended:
         assert allowed_controls | allowed_decorators <= seen_types
 
@@ -101,14 +105,48 @@ def test_bt_reproducible_and_large_without_recursion() -> None:
 def test_generate_cli_is_reproducible(tmp_path: Path) -> None:
     first, second = tmp_path / "a", tmp_path / "b"
     for out in (first, second):
-        assert main(["generate", "--kind", "fsm", "--scenario", "robot", "--n", "3",
-                     "--seed", "9", "-o", str(out)]) == 0
+        assert (
+            main(
+                [
+                    "generate",
+                    "--kind",
+                    "fsm",
+                    "--scenario",
+                    "robot",
+                    "--n",
+                    "3",
+                    "--seed",
+                    "9",
+                    "-o",
+                    str(out),
+                ]
+            )
+            == 0
+        )
     names = sorted(p.name for p in first.iterdir())
     assert names == ["fsm_robot_9_0000.json", "fsm_robot_9_0001.json", "fsm_robot_9_0002.json"]
     for name in names:
         assert (first / name).read_text() == (second / name).read_text()
-    assert main(["generate", "--kind", "fsm", "--n", "1", "--seed", "9", "--scenario", "robot",
-                 "-o", str(first)]) == 2, "never overwrites without --force"
-    assert main(["generate", "--kind", "bt", "--n", "2", "--extended", "-o",
-                 str(tmp_path / "bt")]) == 0
+    assert (
+        main(
+            [
+                "generate",
+                "--kind",
+                "fsm",
+                "--n",
+                "1",
+                "--seed",
+                "9",
+                "--scenario",
+                "robot",
+                "-o",
+                str(first),
+            ]
+        )
+        == 2
+    ), "never overwrites without --force"
+    assert (
+        main(["generate", "--kind", "bt", "--n", "2", "--extended", "-o", str(tmp_path / "bt")])
+        == 0
+    )
     assert main(["generate", "--kind", "tree", "-o", str(tmp_path / "x")]) == 2

@@ -12,10 +12,16 @@ import pytest
 from fsmbt.cli import main
 from support.scripted_server import ScriptedServer, closed_port
 
-FSM_JSON = {"kind": "fsm", "name": "door", "initial": "Closed",
-            "states": [{"name": "Closed", "action": "close"}, {"name": "Open", "action": "open"}],
-            "transitions": [{"source": "Closed", "event": "push", "target": "Open"},
-                            {"source": "Open", "event": "pull", "target": "Closed"}]}
+FSM_JSON = {
+    "kind": "fsm",
+    "name": "door",
+    "initial": "Closed",
+    "states": [{"name": "Closed", "action": "close"}, {"name": "Open", "action": "open"}],
+    "transitions": [
+        {"source": "Closed", "event": "push", "target": "Open"},
+        {"source": "Open", "event": "pull", "target": "Closed"},
+    ],
+}
 
 
 @pytest.fixture
@@ -27,8 +33,14 @@ def model_file(tmp_path: Path) -> Path:
 
 @pytest.fixture(autouse=True)
 def clean_env(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
-    for name in ("FSMBT_LLM_BASE_URL", "FSMBT_LLM_MODEL", "FSMBT_LLM_API_KEY", "OPENAI_API_KEY",
-                 "FSMBT_LLM_CONFIG", "FSMBT_LLM_TIMEOUT"):
+    for name in (
+        "FSMBT_LLM_BASE_URL",
+        "FSMBT_LLM_MODEL",
+        "FSMBT_LLM_API_KEY",
+        "OPENAI_API_KEY",
+        "FSMBT_LLM_CONFIG",
+        "FSMBT_LLM_TIMEOUT",
+    ):
         monkeypatch.delenv(name, raising=False)
     monkeypatch.setenv("HOME", str(tmp_path))
     monkeypatch.setenv("XDG_CONFIG_HOME", str(tmp_path / "config"))
@@ -46,7 +58,9 @@ def convert_commands(model_file: Path) -> list[list[str]]:
     return commands
 
 
-def test_no_endpoint_is_one_line_and_exit_2(model_file: Path, capsys: pytest.CaptureFixture[str]) -> None:
+def test_no_endpoint_is_one_line_and_exit_2(
+    model_file: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     for argv in convert_commands(model_file):
         assert main(argv) == 2
         err = capsys.readouterr().err.strip()
@@ -54,8 +68,9 @@ def test_no_endpoint_is_one_line_and_exit_2(model_file: Path, capsys: pytest.Cap
         assert "Traceback" not in err
 
 
-def test_missing_key_is_one_line_and_exit_2(model_file: Path, monkeypatch: pytest.MonkeyPatch,
-                                            capsys: pytest.CaptureFixture[str]) -> None:
+def test_missing_key_is_one_line_and_exit_2(
+    model_file: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
     monkeypatch.setenv("FSMBT_LLM_BASE_URL", "http://127.0.0.1:9/v1")
     monkeypatch.setenv("FSMBT_LLM_MODEL", "m")
     for argv in convert_commands(model_file):
@@ -63,8 +78,9 @@ def test_missing_key_is_one_line_and_exit_2(model_file: Path, monkeypatch: pytes
         assert "no API key" in capsys.readouterr().err
 
 
-def test_unreachable_endpoint_fails_within_the_timeout(model_file: Path, monkeypatch: pytest.MonkeyPatch,
-                                                       capsys: pytest.CaptureFixture[str]) -> None:
+def test_unreachable_endpoint_fails_within_the_timeout(
+    model_file: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
     monkeypatch.setenv("FSMBT_LLM_API_KEY", "k")
     monkeypatch.setenv("FSMBT_LLM_MODEL", "m")
     monkeypatch.setenv("FSMBT_LLM_TIMEOUT", "2")
@@ -75,17 +91,32 @@ def test_unreachable_endpoint_fails_within_the_timeout(model_file: Path, monkeyp
         assert main(argv) == 2
         assert time.monotonic() - start < 2.0 + 1.0
         err = capsys.readouterr().err.strip()
-        assert err.startswith(f"error: the LLM endpoint {url} failed after") and "cannot connect" in err
+        assert (
+            err.startswith(f"error: the LLM endpoint {url} failed after")
+            and "cannot connect" in err
+        )
         assert "\n" not in err
 
 
-def test_slow_endpoint_fails_within_the_timeout_via_flag(model_file: Path, monkeypatch: pytest.MonkeyPatch,
-                                                         capsys: pytest.CaptureFixture[str]) -> None:
+def test_slow_endpoint_fails_within_the_timeout_via_flag(
+    model_file: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
     monkeypatch.setenv("FSMBT_LLM_API_KEY", "k")
     with ScriptedServer([{"delay": 5.0, "content": "late"}]) as server:
         start = time.monotonic()
-        code = main(["llm", "convert", str(model_file), "--llm-base-url", server.base_url,
-                     "--llm-model", "m", "--llm-timeout", "0.5"])
+        code = main(
+            [
+                "llm",
+                "convert",
+                str(model_file),
+                "--llm-base-url",
+                server.base_url,
+                "--llm-model",
+                "m",
+                "--llm-timeout",
+                "0.5",
+            ]
+        )
         # The server answers after 5 s: ending well before that shows the 0.5 s timeout cut it
         # (the margin absorbs start-up time on a loaded 2-core machine).
         assert time.monotonic() - start < 4.0
@@ -96,7 +127,9 @@ def test_rules_engine_needs_no_llm(model_file: Path, capsys: pytest.CaptureFixtu
     assert main(["convert", str(model_file)]) == 0
 
 
-def test_prompt_and_tokens_commands_work_offline(model_file: Path, capsys: pytest.CaptureFixture[str]) -> None:
+def test_prompt_and_tokens_commands_work_offline(
+    model_file: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     assert main(["llm", "prompt", str(model_file), "--nllm"]) == 0
     out = capsys.readouterr()
     assert "=== system ===" in out.out and "Stepwise" not in out.out
@@ -106,9 +139,12 @@ def test_prompt_and_tokens_commands_work_offline(model_file: Path, capsys: pytes
     assert row[1] == "fsm_to_bt" and int(row[2]) > int(row[3]) > 0
 
 
-def test_llm_convert_writes_only_a_verified_result(model_file: Path, tmp_path: Path,
-                                                   monkeypatch: pytest.MonkeyPatch,
-                                                   capsys: pytest.CaptureFixture[str]) -> None:
+def test_llm_convert_writes_only_a_verified_result(
+    model_file: Path,
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
     from fsmbt.convert.engines import converter_for
     from fsmbt.formats.registry import dumps, read_model
 
@@ -117,8 +153,19 @@ def test_llm_convert_writes_only_a_verified_result(model_file: Path, tmp_path: P
     monkeypatch.setenv("FSMBT_LLM_API_KEY", "k")
     out = tmp_path / "door_bt.xml"
     with ScriptedServer([{"content": answer}]) as server:
-        code = main(["llm", "convert", str(model_file), "-o", str(out), "--llm-base-url",
-                     server.base_url, "--llm-model", "m"])
+        code = main(
+            [
+                "llm",
+                "convert",
+                str(model_file),
+                "-o",
+                str(out),
+                "--llm-base-url",
+                server.base_url,
+                "--llm-model",
+                "m",
+            ]
+        )
     assert code == 0 and out.exists()
     assert "llm: verified equivalent" in capsys.readouterr().err
     from fsmbt.verify import verify
@@ -135,14 +182,28 @@ def test_hybrid_on_a_parsed_file_needs_no_endpoint(model_file: Path, tmp_path: P
     assert verify(read_model(model_file), read_model(out)).equivalent
 
 
-def test_hybrid_on_prose_asks_the_llm_only_to_extract(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
-                                                      capsys: pytest.CaptureFixture[str]) -> None:
+def test_hybrid_on_prose_asks_the_llm_only_to_extract(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
     notes = tmp_path / "door.txt"
-    notes.write_text("A door is Closed until pushed open; pulling closes it again.\n", encoding="utf-8")
+    notes.write_text(
+        "A door is Closed until pushed open; pulling closes it again.\n", encoding="utf-8"
+    )
     monkeypatch.setenv("FSMBT_LLM_API_KEY", "k")
     with ScriptedServer([{"content": json.dumps(FSM_JSON)}]) as server:
-        code = main(["llm", "convert", str(notes), "--engine", "hybrid", "--llm-base-url",
-                     server.base_url, "--llm-model", "m"])
+        code = main(
+            [
+                "llm",
+                "convert",
+                str(notes),
+                "--engine",
+                "hybrid",
+                "--llm-base-url",
+                server.base_url,
+                "--llm-model",
+                "m",
+            ]
+        )
     assert code == 0 and len(server.requests) == 1
     assert "Extract the behavior model" in server.user_texts(0)
     captured = capsys.readouterr()

@@ -20,15 +20,22 @@ from support.scripted_server import ScriptedServer, closed_port
 
 
 def settings_for(url: str, **changes: object) -> LLMSettings:
-    base = LLMSettings(base_url=url, model="scripted-model", api_key="test-key", backoff_s=0.01,
-                       timeout_s=5.0, log_path=None)
+    base = LLMSettings(
+        base_url=url,
+        model="scripted-model",
+        api_key="test-key",
+        backoff_s=0.01,
+        timeout_s=5.0,
+        log_path=None,
+    )
     return replace(base, **changes)
 
 
 def test_request_carries_the_papers_settings_and_returns_usage() -> None:
     with ScriptedServer([{"content": "hello"}]) as server:
         completion = LLMClient(settings_for(server.base_url)).complete(
-            [{"role": "user", "content": "hi"}])
+            [{"role": "user", "content": "hi"}]
+        )
     assert completion.text == "hello"
     assert completion.attempts == 1 and completion.usage_reported
     assert completion.tokens_in == 101
@@ -42,26 +49,32 @@ def test_request_carries_the_papers_settings_and_returns_usage() -> None:
 def test_missing_usage_is_counted_locally_with_tiktoken() -> None:
     with ScriptedServer([{"content": "hello world", "usage": False}]) as server:
         completion = LLMClient(settings_for(server.base_url)).complete(
-            [{"role": "user", "content": "hi"}])
+            [{"role": "user", "content": "hi"}]
+        )
     assert not completion.usage_reported
     assert completion.tokens_out == 2  # cl100k_base: "hello", " world"
 
 
 @pytest.mark.parametrize("status", [429, 500, 503])
 def test_rate_limit_and_server_errors_are_retried(status: int) -> None:
-    with ScriptedServer([{"status": status}, {"status": status}, {"content": "third time"}]) as server:
+    with ScriptedServer(
+        [{"status": status}, {"status": status}, {"content": "third time"}]
+    ) as server:
         completion = LLMClient(settings_for(server.base_url)).complete(
-            [{"role": "user", "content": "hi"}])
+            [{"role": "user", "content": "hi"}]
+        )
     assert completion.text == "third time"
     assert completion.attempts == 3 and len(server.requests) == 3
 
 
 def test_retry_after_header_is_honoured() -> None:
     waits: list[float] = []
-    with ScriptedServer([{"status": 429, "headers": {"Retry-After": "0.2"}},
-                         {"content": "ok"}]) as server:
+    with ScriptedServer(
+        [{"status": 429, "headers": {"Retry-After": "0.2"}}, {"content": "ok"}]
+    ) as server:
         LLMClient(settings_for(server.base_url), sleep=waits.append).complete(
-            [{"role": "user", "content": "hi"}])
+            [{"role": "user", "content": "hi"}]
+        )
     assert waits == [0.2]
 
 
@@ -69,7 +82,8 @@ def test_retries_are_bounded_then_a_clear_error() -> None:
     with ScriptedServer([{"status": 500}]) as server:
         with pytest.raises(LLMUnavailableError, match=r"failed after 4 attempt\(s\): HTTP 500"):
             LLMClient(settings_for(server.base_url, max_retries=3)).complete(
-                [{"role": "user", "content": "hi"}])
+                [{"role": "user", "content": "hi"}]
+            )
     assert len(server.requests) == 4
 
 
@@ -85,7 +99,8 @@ def test_a_slow_endpoint_times_out_within_the_timeout() -> None:
         start = time.monotonic()
         with pytest.raises(LLMUnavailableError, match="timed out|within"):
             LLMClient(settings_for(server.base_url, timeout_s=0.5)).complete(
-                [{"role": "user", "content": "hi"}])
+                [{"role": "user", "content": "hi"}]
+            )
         elapsed = time.monotonic() - start
     assert elapsed < 1.5
 
@@ -105,8 +120,11 @@ def test_no_endpoint_is_a_config_error_naming_the_rules_engine(tmp_path: Path) -
 
 
 def test_missing_key_is_a_config_error(tmp_path: Path) -> None:
-    env = {"FSMBT_LLM_BASE_URL": "http://127.0.0.1:9/v1", "FSMBT_LLM_MODEL": "m",
-           "HOME": str(tmp_path)}
+    env = {
+        "FSMBT_LLM_BASE_URL": "http://127.0.0.1:9/v1",
+        "FSMBT_LLM_MODEL": "m",
+        "HOME": str(tmp_path),
+    }
     with pytest.raises(LLMConfigError, match="no API key"):
         resolve_settings(env=env, cwd=tmp_path)
 
@@ -116,14 +134,17 @@ def test_openai_api_key_is_the_fallback_and_flags_beat_the_environment(tmp_path:
     settings = resolve_settings(env=env, cwd=tmp_path)
     assert settings.base_url == "https://api.deepseek.com/v1"
     assert settings.model == "deepseek-chat" and settings.api_key == "sk-fallback"
-    flagged = resolve_settings(base_url="http://10.0.0.5:8000/v1", model="qwen2.5", env=env, cwd=tmp_path)
+    flagged = resolve_settings(
+        base_url="http://10.0.0.5:8000/v1", model="qwen2.5", env=env, cwd=tmp_path
+    )
     assert flagged.base_url == "http://10.0.0.5:8000/v1" and flagged.model == "qwen2.5"
     assert "sk-fallback" not in repr(flagged)
 
 
 def test_local_providers_need_no_key(tmp_path: Path) -> None:
-    settings = resolve_settings(base_url="ollama", model="llama3.1",
-                                env={"HOME": str(tmp_path)}, cwd=tmp_path)
+    settings = resolve_settings(
+        base_url="ollama", model="llama3.1", env={"HOME": str(tmp_path)}, cwd=tmp_path
+    )
     assert settings.base_url == "http://localhost:11434/v1" and settings.api_key == PLACEHOLDER_KEY
     with pytest.raises(LLMConfigError, match="no LLM model"):
         resolve_settings(base_url="vllm", env={"HOME": str(tmp_path)}, cwd=tmp_path)
@@ -132,7 +153,9 @@ def test_local_providers_need_no_key(tmp_path: Path) -> None:
 def test_config_file_supplies_settings(tmp_path: Path) -> None:
     (tmp_path / "fsmbt.toml").write_text(
         '[llm]\nbase_url = "qwen"\napi_key = "k"\ntimeout_s = 30\nmax_regenerations = 5\n'
-        'temperature = 0.0\n', encoding="utf-8")
+        "temperature = 0.0\n",
+        encoding="utf-8",
+    )
     settings = resolve_settings(env={"HOME": str(tmp_path)}, cwd=tmp_path)
     assert settings.base_url.startswith("https://dashscope")
     assert (settings.timeout_s, settings.max_regenerations, settings.temperature) == (30.0, 5, 0.0)
@@ -140,8 +163,9 @@ def test_config_file_supplies_settings(tmp_path: Path) -> None:
 
 
 def test_bad_config_values_are_reported(tmp_path: Path) -> None:
-    (tmp_path / "fsmbt.toml").write_text('[llm]\nbase_url = "openai"\napi_key="k"\ntimeout_s = "soon"\n',
-                                         encoding="utf-8")
+    (tmp_path / "fsmbt.toml").write_text(
+        '[llm]\nbase_url = "openai"\napi_key="k"\ntimeout_s = "soon"\n', encoding="utf-8"
+    )
     with pytest.raises(LLMConfigError, match="timeout_s must be a float"):
         resolve_settings(env={"HOME": str(tmp_path)}, cwd=tmp_path)
     with pytest.raises(LLMConfigError, match="neither a URL nor a provider"):

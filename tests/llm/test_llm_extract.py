@@ -16,19 +16,33 @@ from fsmbt.model.errors import InputError
 from fsmbt.model.fsm import FSM
 from support.scripted_server import ScriptedServer
 
-TURNSTILE = {"kind": "fsm", "name": "turnstile", "initial": "Locked",
-             "states": [{"name": "Locked", "action": "lock"}, {"name": "Unlocked", "action": "unlock"}],
-             "transitions": [{"source": "Locked", "event": "coin", "target": "Unlocked"},
-                             {"source": "Unlocked", "event": "push", "target": "Locked"}]}
-PROSE = ("The turnstile starts Locked (it locks). A coin unlocks it; pushing it locks it again.\n")
+TURNSTILE = {
+    "kind": "fsm",
+    "name": "turnstile",
+    "initial": "Locked",
+    "states": [{"name": "Locked", "action": "lock"}, {"name": "Unlocked", "action": "unlock"}],
+    "transitions": [
+        {"source": "Locked", "event": "coin", "target": "Unlocked"},
+        {"source": "Unlocked", "event": "push", "target": "Locked"},
+    ],
+}
+PROSE = "The turnstile starts Locked (it locks). A coin unlocks it; pushing it locks it again.\n"
 # the smallest valid PNG header bytes are enough: the model never sees them here
 PNG = b"\x89PNG\r\n\x1a\n" + b"\x00\x00\x00\rIHDR" + bytes(range(40))
 
 
 def client_for(server: ScriptedServer, tmp_path: Path) -> LLMClient:
-    return LLMClient(LLMSettings(base_url=server.base_url, model="vision", api_key="k",
-                                 backoff_s=0.01, timeout_s=5.0, max_regenerations=1,
-                                 log_path=tmp_path / "log.jsonl"))
+    return LLMClient(
+        LLMSettings(
+            base_url=server.base_url,
+            model="vision",
+            api_key="k",
+            backoff_s=0.01,
+            timeout_s=5.0,
+            max_regenerations=1,
+            log_path=tmp_path / "log.jsonl",
+        )
+    )
 
 
 def test_a_file_a_parser_reads_never_reaches_the_llm(tmp_path: Path) -> None:
@@ -110,7 +124,7 @@ def test_an_image_is_sent_as_a_base64_data_url_part(tmp_path: Path) -> None:
     assert image_part["type"] == "image_url"
     url = image_part["image_url"]["url"]
     prefix = "data:image/png;base64,"
-    assert url.startswith(prefix) and base64.b64decode(url[len(prefix):]) == PNG
+    assert url.startswith(prefix) and base64.b64decode(url[len(prefix) :]) == PNG
     assert server.requests[0]["body"]["model"] == "vision"
 
 
@@ -133,5 +147,7 @@ def test_hybrid_lets_the_llm_extract_and_the_rules_convert(tmp_path: Path) -> No
         loaded = read_input(path, client=client_for(server, tmp_path))
     result = converter_for("hybrid", loaded.model)(loaded.model, extracted_by_llm=loaded.extracted)
     assert isinstance(result.model, BTDocument)
-    assert result.engine == "hybrid" and result.stats["verified"] and result.stats["extracted_by_llm"]
+    assert (
+        result.engine == "hybrid" and result.stats["verified"] and result.stats["extracted_by_llm"]
+    )
     assert len(server.requests) == 1  # the conversion itself asked the LLM nothing

@@ -25,18 +25,22 @@ BT_XML = """<root BTCPP_format="4"><BehaviorTree ID="Main"><Sequence>
 <Condition ID="IsReady" name="IsReady"/><Action ID="Work" name="Work"/></Sequence></BehaviorTree>
 <TreeNodesModel><Condition ID="IsReady"/><Action ID="Work"/></TreeNodesModel></root>"""
 
-STATES = ('[{"name": "IsReady", "action": "IsReady"}, {"name": "Work", "action": "Work"}, '
-          '{"name": "SUCCESS", "action": "SUCCESS", "final": true}, '
-          '{"name": "FAILURE", "action": "FAILURE", "final": true}]')
+STATES = (
+    '[{"name": "IsReady", "action": "IsReady"}, {"name": "Work", "action": "Work"}, '
+    '{"name": "SUCCESS", "action": "SUCCESS", "final": true}, '
+    '{"name": "FAILURE", "action": "FAILURE", "final": true}]'
+)
 
 
 def fsm_answer(work_failure_target: str = "FAILURE", states: str = STATES) -> str:
-    return ('{"kind": "fsm", "initial": "IsReady", "states": ' + states + ', "transitions": ['
-            '{"source": "IsReady", "event": "success", "target": "Work"},'
-            '{"source": "IsReady", "event": "failure", "target": "FAILURE"},'
-            '{"source": "Work", "event": "success", "target": "SUCCESS"},'
-            f'{{"source": "Work", "event": "failure", "target": "{work_failure_target}"}},'
-            '{"source": "Work", "event": "running", "target": "Work"}]}')
+    return (
+        '{"kind": "fsm", "initial": "IsReady", "states": ' + states + ', "transitions": ['
+        '{"source": "IsReady", "event": "success", "target": "Work"},'
+        '{"source": "IsReady", "event": "failure", "target": "FAILURE"},'
+        '{"source": "Work", "event": "success", "target": "SUCCESS"},'
+        f'{{"source": "Work", "event": "failure", "target": "{work_failure_target}"}},'
+        '{"source": "Work", "event": "running", "target": "Work"}]}'
+    )
 
 
 GOOD = "Here is the HFSM:\n```json\n" + fsm_answer() + "\n```\nIt follows the rules."
@@ -51,8 +55,15 @@ def bt() -> BTDocument:
 
 
 def client_for(server: ScriptedServer, tmp_path: Path, **changes: object) -> LLMClient:
-    settings = LLMSettings(base_url=server.base_url, model="scripted", api_key="k", backoff_s=0.01,
-                           timeout_s=5.0, max_regenerations=2, log_path=tmp_path / "llm.jsonl")
+    settings = LLMSettings(
+        base_url=server.base_url,
+        model="scripted",
+        api_key="k",
+        backoff_s=0.01,
+        timeout_s=5.0,
+        max_regenerations=2,
+        log_path=tmp_path / "llm.jsonl",
+    )
     return LLMClient(replace(settings, **changes))
 
 
@@ -65,7 +76,9 @@ def test_first_pass_success_is_verified_and_logged(bt: BTDocument, tmp_path: Pat
     assert record["first_pass_success"] is True and record["regenerations"] == 0
     assert record["verdict"] == "equivalent" and record["task"] == "bt_to_fsm"
     assert record["tokens_in"] == 101 and record["tokens_out"] > 0 and record["latency_s"] >= 0
-    assert record["source"] == "seq.xml" and "k" not in json.dumps(record).split('"api_key"')[0][-3:]
+    assert (
+        record["source"] == "seq.xml" and "k" not in json.dumps(record).split('"api_key"')[0][-3:]
+    )
     # the prompt has the four parts and the model
     text = server.user_texts(0)
     system = server.requests[0]["body"]["messages"][0]
@@ -74,8 +87,9 @@ def test_first_pass_success_is_verified_and_logged(bt: BTDocument, tmp_path: Pat
         assert part in text
 
 
-def test_wrong_answer_is_corrected_after_feedback_with_the_counterexample(bt: BTDocument,
-                                                                          tmp_path: Path) -> None:
+def test_wrong_answer_is_corrected_after_feedback_with_the_counterexample(
+    bt: BTDocument, tmp_path: Path
+) -> None:
     with ScriptedServer([{"content": WRONG}, {"content": GOOD}]) as server:
         outcome = convert_with_llm(bt, client_for(server, tmp_path))
     assert outcome.equivalent
@@ -92,9 +106,14 @@ def test_wrong_answer_is_corrected_after_feedback_with_the_counterexample(bt: BT
     assert [r.stage for r in record.rounds] == ["verify", "ok"]
 
 
-def test_structural_problems_are_fed_back_before_verification(bt: BTDocument, tmp_path: Path) -> None:
-    missing_leaf = fsm_answer(states=STATES.replace('{"name": "Work", "action": "Work"}',
-                                                    '{"name": "Work", "action": "Wrok"}'))
+def test_structural_problems_are_fed_back_before_verification(
+    bt: BTDocument, tmp_path: Path
+) -> None:
+    missing_leaf = fsm_answer(
+        states=STATES.replace(
+            '{"name": "Work", "action": "Work"}', '{"name": "Work", "action": "Wrok"}'
+        )
+    )
     with ScriptedServer([{"content": missing_leaf}, {"content": GOOD}]) as server:
         outcome = convert_with_llm(bt, client_for(server, tmp_path))
     assert outcome.equivalent
@@ -105,8 +124,13 @@ def test_structural_problems_are_fed_back_before_verification(bt: BTDocument, tm
 
 
 def test_garbage_is_retried_then_fails_clearly(bt: BTDocument, tmp_path: Path) -> None:
-    with ScriptedServer([{"content": "I am sorry, I cannot do that."},
-                         {"content": "{not json at all"}, {"content": ""}]) as server:
+    with ScriptedServer(
+        [
+            {"content": "I am sorry, I cannot do that."},
+            {"content": "{not json at all"},
+            {"content": ""},
+        ]
+    ) as server:
         client = client_for(server, tmp_path)
         outcome = convert_with_llm(bt, client)
         assert outcome.result is None and not outcome.equivalent
@@ -117,7 +141,9 @@ def test_garbage_is_retried_then_fails_clearly(bt: BTDocument, tmp_path: Path) -
             _run("llm", bt, True, {"client": client})
 
 
-def test_not_equivalent_after_all_rounds_is_an_error_not_a_result(bt: BTDocument, tmp_path: Path) -> None:
+def test_not_equivalent_after_all_rounds_is_an_error_not_a_result(
+    bt: BTDocument, tmp_path: Path
+) -> None:
     with ScriptedServer([{"content": WRONG}]) as server:
         client = client_for(server, tmp_path, max_regenerations=1)
         with pytest.raises(LLMConversionError, match="not equivalent after 2 round"):

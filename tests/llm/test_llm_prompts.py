@@ -58,8 +58,9 @@ def test_templates_have_the_four_parts_and_their_modules(direction: str) -> None
 
 def test_ablation_drops_exactly_one_module() -> None:
     full = conversion_messages(door(), PromptOptions(FSM_TO_BT))[1]["content"]
-    ablated = conversion_messages(door(), PromptOptions(
-        FSM_TO_BT, disabled_modules=frozenset({"lebt_mapping"})))[1]["content"]
+    ablated = conversion_messages(
+        door(), PromptOptions(FSM_TO_BT, disabled_modules=frozenset({"lebt_mapping"}))
+    )[1]["content"]
     assert "Entry state:" in ablated and "Entry state:" in full
     assert "Selector subtree of state S" in full and "Selector subtree of state S" not in ablated
     with pytest.raises(InputError, match="unknown SCP module"):
@@ -97,8 +98,12 @@ def test_parsing_tolerates_fences_and_chatter_but_not_bad_content() -> None:
     with pytest.raises(AnswerError, match="no BT.CPP XML"):
         parse_bt_answer("I would need more information.")
     with pytest.raises(AnswerError):
-        parse_bt_answer("<root BTCPP_format='4'><BehaviorTree ID='M'><Sequence></BehaviorTree></root>")
-    fsm = parse_fsm_answer('```\n{"initial": "a", "states": [{"name": "a"}], "transitions": []}\n```')
+        parse_bt_answer(
+            "<root BTCPP_format='4'><BehaviorTree ID='M'><Sequence></BehaviorTree></root>"
+        )
+    fsm = parse_fsm_answer(
+        '```\n{"initial": "a", "states": [{"name": "a"}], "transitions": []}\n```'
+    )
     assert fsm.initial == "a"  # a missing "kind" is tolerated in an FSM answer
     with pytest.raises(AnswerError, match="expected an FSM"):
         parse_fsm_answer('{"kind": "bt", "trees": []}')
@@ -115,12 +120,20 @@ def test_the_structural_check_names_missing_duplicate_and_dangling_nodes() -> No
     assert "state Gone has no LebtState node" in problems
     assert any("names state 'Gon', which the FSM does not have" in p for p in problems)
     dangling = xml.replace('pairs="Open/exit"', 'pairs="Closed/exit"')
-    assert any("no transition Closed --exit--> Gone" in p for p in check_lebt(fsm, parse_bt_answer(dangling)))
+    assert any(
+        "no transition Closed --exit--> Gone" in p
+        for p in check_lebt(fsm, parse_bt_answer(dangling))
+    )
     wrong_port = xml.replace('action="leave"', 'action="stay"')
-    assert any("must have action='leave'" in p for p in check_lebt(fsm, parse_bt_answer(wrong_port)))
-    doubled = xml.replace("</Sequence>\n  </BehaviorTree>",
-                          '<LebtState state="Open" action="open" final="false" exits="pull;exit"/>'
-                          "</Sequence>\n  </BehaviorTree>", 1)
+    assert any(
+        "must have action='leave'" in p for p in check_lebt(fsm, parse_bt_answer(wrong_port))
+    )
+    doubled = xml.replace(
+        "</Sequence>\n  </BehaviorTree>",
+        '<LebtState state="Open" action="open" final="false" exits="pull;exit"/>'
+        "</Sequence>\n  </BehaviorTree>",
+        1,
+    )
     assert doubled != xml
     assert any("Open has 2 LebtState nodes" in p for p in check_lebt(fsm, parse_bt_answer(doubled)))
 
@@ -130,8 +143,16 @@ def test_fsm_to_bt_round_with_a_scripted_correct_lebt(tmp_path: Path) -> None:
     answer = "```xml\n" + lebt_xml(fsm) + "```"
     broken = answer.replace('exits="pull;exit"', 'exits="pull"')
     with ScriptedServer([{"content": broken}, {"content": answer}]) as server:
-        client = LLMClient(LLMSettings(base_url=server.base_url, model="m", api_key="k",
-                                       backoff_s=0.01, timeout_s=5, log_path=None))
+        client = LLMClient(
+            LLMSettings(
+                base_url=server.base_url,
+                model="m",
+                api_key="k",
+                backoff_s=0.01,
+                timeout_s=5,
+                log_path=None,
+            )
+        )
         outcome = convert_with_llm(fsm, client)
     assert outcome.equivalent and outcome.record.regenerations == 1
     assert "must have exits='pull;exit'" in server.requests[1]["body"]["messages"][-1]["content"]

@@ -27,8 +27,9 @@ def _ctrl(kind: str, *children: BTNode) -> BTNode:
 def small_bt() -> BTDocument:
     # Sequence(Fallback(c1, a1), Inverter(a2), a3): 7 nodes, 6 edges, 4 leaves, depth 3
     inverter = BTNode(type="Inverter", kind=NodeKind.DECORATOR, children=[_leaf("a2")])
-    return BTDocument.single(_ctrl("Sequence", _ctrl("Fallback", _leaf("c1", True),
-                                                     _leaf("a1")), inverter, _leaf("a3")))
+    return BTDocument.single(
+        _ctrl("Sequence", _ctrl("Fallback", _leaf("c1", True), _leaf("a1")), inverter, _leaf("a3"))
+    )
 
 
 def small_hfsm() -> FSM:
@@ -107,8 +108,14 @@ def test_graph_edit_distance_timeout_reports_upper_bound():
 
 
 def test_metrics_cli_json_and_errors():
-    run = lambda *args: subprocess.run([sys.executable, "-m", "fsmbt.cli", "metrics", *args],  # noqa: E731
-                                       capture_output=True, text=True, timeout=120)
+    def run(*args):
+        return subprocess.run(
+            [sys.executable, "-m", "fsmbt.cli", "metrics", *args],  # noqa: E731
+            capture_output=True,
+            text=True,
+            timeout=120,
+        )
+
     proc = run(str(EXAMPLES / "robot_bt.xml"), str(EXAMPLES / "robot_bt.xml"), "--json")
     assert proc.returncode == 0, proc.stderr
     data = json.loads(proc.stdout)

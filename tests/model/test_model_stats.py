@@ -11,7 +11,6 @@ import pytest
 from lxml import etree
 
 from fsmbt.cli import main
-from fsmbt.formats import read_model
 from fsmbt.model import FSM, BehaviorTree, BTDocument, BTNode, NodeKind, State
 from fsmbt.model.stats import bt_stats, expanded_depth, fsm_stats
 
@@ -34,9 +33,14 @@ def paper_xml_facts() -> dict:
     for source, _event, target in edges:
         preds[target].add(source)
     (entry,) = [target for source, _e, target in edges if source == start]
-    return {"start": start, "states": states, "edges": edges, "entry": entry,
-            "loops": [s for s in states if len(preds[s]) >= 2],
-            "finals": [s.get("name") for s in root.iter("State") if s.get("type") == "final"]}
+    return {
+        "start": start,
+        "states": states,
+        "edges": edges,
+        "entry": entry,
+        "loops": [s for s in states if len(preds[s]) >= 2],
+        "finals": [s.get("name") for s in root.iter("State") if s.get("type") == "final"],
+    }
 
 
 @pytest.mark.parametrize("name", ["paper_fsm.json", "paper_fsm.xml"])
@@ -50,7 +54,9 @@ def test_paper_fsm_figures(name: str, capsys: pytest.CaptureFixture) -> None:
     assert set(data["events"]) == {event for _s, event, _t in facts["edges"]}
     assert data["start"] == facts["start"] and data["initial_event"] == "eventSA"
     assert data["entry_state"] == facts["entry"] == "A"
-    assert data["loop_states"] == facts["loops"] == ["C", "D"]  # docs/conversion.md, 'FSM -> BT', on the paper's FSM
+    assert (
+        data["loop_states"] == facts["loops"] == ["C", "D"]
+    )  # docs/conversion.md, 'FSM -> BT', on the paper's FSM
     assert data["finals"] == facts["finals"] == ["H", "J"]
     assert data["unreachable"] == []
     assert data["in_degree"]["C"] == 3 and data["in_degree"]["D"] == 4  # C: A,B,E; D: A,B,C,E
@@ -111,9 +117,14 @@ def robot_xml_facts() -> dict:
     nodes = [e for e in tree.iter() if isinstance(e.tag, str) and e is not tree]
     levels = Counter(len(list(e.iterancestors())) - 1 for e in nodes)  # root element: level 1
     kinds = Counter(declared.get(e.tag, "Control") for e in nodes)
-    return {"nodes": len(nodes), "depth": max(levels), "breadth": max(levels.values()),
-            "kinds": dict(kinds), "types": Counter(e.tag for e in nodes),
-            "leaves": sum(1 for e in nodes if len(e) == 0)}
+    return {
+        "nodes": len(nodes),
+        "depth": max(levels),
+        "breadth": max(levels.values()),
+        "kinds": dict(kinds),
+        "types": Counter(e.tag for e in nodes),
+        "leaves": sum(1 for e in nodes if len(e) == 0),
+    }
 
 
 def test_robot_bt_figures(capsys: pytest.CaptureFixture) -> None:
@@ -132,11 +143,20 @@ def test_robot_bt_figures(capsys: pytest.CaptureFixture) -> None:
 
 def test_subtree_expansion_depth_cycles_and_dangling_references() -> None:
     leaf = BTNode("Tick", NodeKind.ACTION)
-    sub = BTDocument(trees={
-        "Main": BehaviorTree("Main", BTNode("Sequence", NodeKind.CONTROL, children=[
-            BTNode("SubTree", NodeKind.SUBTREE, attrs={"ID": "Deep"})])),
-        "Deep": BehaviorTree("Deep", BTNode("Inverter", NodeKind.DECORATOR, children=[leaf])),
-    }, main_tree="Main")
+    sub = BTDocument(
+        trees={
+            "Main": BehaviorTree(
+                "Main",
+                BTNode(
+                    "Sequence",
+                    NodeKind.CONTROL,
+                    children=[BTNode("SubTree", NodeKind.SUBTREE, attrs={"ID": "Deep"})],
+                ),
+            ),
+            "Deep": BehaviorTree("Deep", BTNode("Inverter", NodeKind.DECORATOR, children=[leaf])),
+        },
+        main_tree="Main",
+    )
     s = bt_stats(sub)
     assert (s.depth, s.expanded_depth, s.subtree_references, s.trees) == (2, 4, 1, 2)
     sub.trees["Deep"].root.children[0] = BTNode("SubTree", NodeKind.SUBTREE, attrs={"ID": "Main"})
@@ -164,7 +184,9 @@ def test_info_table_for_both_kinds(capsys: pytest.CaptureFixture) -> None:
     assert "subtree references" in out and "per tree" in out and "Combat" in out
 
 
-def test_info_bad_input_is_one_line_and_exit_2(tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
+def test_info_bad_input_is_one_line_and_exit_2(
+    tmp_path: Path, capsys: pytest.CaptureFixture
+) -> None:
     bad = tmp_path / "bad.json"
     bad.write_text('{"kind": "fsm", "states": [1]}', encoding="utf-8")
     assert main(["info", str(bad)]) == 2

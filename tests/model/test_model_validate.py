@@ -57,7 +57,9 @@ def test_unknown_states_and_missing_initial() -> None:
 
 
 def test_empty_fsm_and_final_with_outgoing() -> None:
-    assert issues_of(FSM(name="nothing"), "error") == ["nothing: error: the state machine has no states"]
+    assert issues_of(FSM(name="nothing"), "error") == [
+        "nothing: error: the state machine has no states"
+    ]
     fsm = good_fsm()
     fsm.states["B"].final = True
     assert any("final state 'B' has an outgoing transition" in e for e in issues_of(fsm, "error"))
@@ -98,8 +100,10 @@ def test_hierarchical_checks_every_level() -> None:
 
 
 def test_inner_dead_end_is_fine_when_the_composite_can_be_left() -> None:
-    fsm = loads("stateDiagram-v2\n[*] --> C\nstate C {\n [*] --> a\n a --> b : e\n}\n"
-                "C --> D : leave\nD --> [*]\n")
+    fsm = loads(
+        "stateDiagram-v2\n[*] --> C\nstate C {\n [*] --> a\n a --> b : e\n}\n"
+        "C --> D : leave\nD --> [*]\n"
+    )
     assert not any("no way out" in w for w in issues_of(fsm))
 
 
@@ -118,24 +122,44 @@ def test_good_bt_has_no_issue() -> None:
     assert validate(doc) == []
 
 
-@pytest.mark.parametrize("node,needle", [
-    (BTNode("Frob", NodeKind.CONTROL, kind_declared=False, children=[leaf("a")]),
-     "error: unknown node type 'Frob'"),
-    (BTNode("Fallback", NodeKind.CONTROL), "error: control node 'Fallback' has no children"),
-    (BTNode("Inverter", NodeKind.DECORATOR, children=[leaf("a"), leaf("b")]),
-     "error: decorator 'Inverter' needs exactly one child, has 2"),
-    (BTNode("Switch2", NodeKind.CONTROL, children=[leaf("a")]),
-     "error: 'Switch2' needs exactly 3 children, has 1"),
-    (BTNode("Check", NodeKind.CONDITION, children=[leaf("a")]),
-     "error: condition leaf 'Check' has 1 child(ren)"),
-    (BTNode("SubTree", NodeKind.SUBTREE, attrs={"ID": "Gone"}),
-     "error: SubTree references missing tree 'Gone'"),
-    (BTNode("Delay", NodeKind.DECORATOR, children=[leaf("a")]), "warning: time-based node 'Delay'"),
-    (BTNode("Mystery", NodeKind.ACTION, kind_declared=False),
-     "warning: leaf type 'Mystery' is not declared"),
-    (BTNode("Pipeline", NodeKind.CONTROL, children=[leaf("a")]),
-     "warning: custom control 'Pipeline' has no known semantics"),
-])
+@pytest.mark.parametrize(
+    "node,needle",
+    [
+        (
+            BTNode("Frob", NodeKind.CONTROL, kind_declared=False, children=[leaf("a")]),
+            "error: unknown node type 'Frob'",
+        ),
+        (BTNode("Fallback", NodeKind.CONTROL), "error: control node 'Fallback' has no children"),
+        (
+            BTNode("Inverter", NodeKind.DECORATOR, children=[leaf("a"), leaf("b")]),
+            "error: decorator 'Inverter' needs exactly one child, has 2",
+        ),
+        (
+            BTNode("Switch2", NodeKind.CONTROL, children=[leaf("a")]),
+            "error: 'Switch2' needs exactly 3 children, has 1",
+        ),
+        (
+            BTNode("Check", NodeKind.CONDITION, children=[leaf("a")]),
+            "error: condition leaf 'Check' has 1 child(ren)",
+        ),
+        (
+            BTNode("SubTree", NodeKind.SUBTREE, attrs={"ID": "Gone"}),
+            "error: SubTree references missing tree 'Gone'",
+        ),
+        (
+            BTNode("Delay", NodeKind.DECORATOR, children=[leaf("a")]),
+            "warning: time-based node 'Delay'",
+        ),
+        (
+            BTNode("Mystery", NodeKind.ACTION, kind_declared=False),
+            "warning: leaf type 'Mystery' is not declared",
+        ),
+        (
+            BTNode("Pipeline", NodeKind.CONTROL, children=[leaf("a")]),
+            "warning: custom control 'Pipeline' has no known semantics",
+        ),
+    ],
+)
 def test_bt_rules(node: BTNode, needle: str) -> None:
     found = issues_of(bt(leaf("first"), node))
     assert any(needle in f for f in found), found
@@ -154,8 +178,9 @@ def test_bt_document_level_errors() -> None:
 
 def test_recursive_subtrees_reported_once() -> None:
     doc = bt(BTNode("SubTree", NodeKind.SUBTREE, attrs={"ID": "U"}))
-    doc.trees["U"] = BTDocument.single(BTNode("SubTree", NodeKind.SUBTREE, attrs={"ID": "T"}),
-                                       "U").trees["U"]
+    doc.trees["U"] = BTDocument.single(
+        BTNode("SubTree", NodeKind.SUBTREE, attrs={"ID": "T"}), "U"
+    ).trees["U"]
     cycles = [e for e in issues_of(doc, "error") if "recursive SubTree" in e]
     assert len(cycles) == 1 and "T -> U -> T" in cycles[0]
 
@@ -186,16 +211,21 @@ def test_validate_handles_100000_deep_trees() -> None:
 
 # -- the command ------------------------------------------------------------------------------
 def run_cli(*args: str) -> subprocess.CompletedProcess[str]:
-    return subprocess.run([sys.executable, "-m", "fsmbt.cli", "validate", *args],
-                          capture_output=True, text=True, timeout=60)
+    return subprocess.run(
+        [sys.executable, "-m", "fsmbt.cli", "validate", *args],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
 
 
 def test_cli_exit_codes_json_and_strict(tmp_path: Path) -> None:
     good = tmp_path / "good.csv"
     good.write_text("source,event,target\nA,go,B\nB,back,A\nB,stop,C\n", encoding="utf-8")
     warned = tmp_path / "warned.mmd"
-    warned.write_text("stateDiagram-v2\n[*] --> A\nA --> B : go\nC --> A : x\nB --> [*]\n",
-                      encoding="utf-8")
+    warned.write_text(
+        "stateDiagram-v2\n[*] --> A\nA --> B : go\nC --> A : x\nB --> [*]\n", encoding="utf-8"
+    )
     assert run_cli(str(good)).returncode == 0
     result = run_cli(str(warned))
     assert result.returncode == 0 and "unreachable" in result.stdout

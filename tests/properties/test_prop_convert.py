@@ -22,7 +22,6 @@ from collections import Counter
 
 from hypothesis import given
 from hypothesis import strategies as st
-from support.prop_strategies import BUDGET, bts, fsms
 
 from fsmbt.convert import convert
 from fsmbt.model.bt import BTDocument
@@ -31,6 +30,7 @@ from fsmbt.model.fsm import FSM
 from fsmbt.verify import replay, verify
 from fsmbt.verify.mutations import mutants
 from fsmbt.verify.pairing import machines_for
+from support.prop_strategies import BUDGET, bts, fsms
 
 ENGINES = ("rules", "bsd", "chds")
 Model = FSM | BTDocument
@@ -70,8 +70,9 @@ def test_every_rule_engine_converts_random_models_to_verified_equivalents() -> N
     assert tally["rules fsm->bt: refused"] == 0 and tally["rules bt->fsm: refused"] == 0
 
 
-def simulation_differs(source: Model, result: Model, seed: int, runs: int = 120,
-                       length: int = 25) -> bool:
+def simulation_differs(
+    source: Model, result: Model, seed: int, runs: int = 120, length: int = 25
+) -> bool:
     """Random input sequences on both machines; any difference in outputs, status or offered
     inputs counts. Independent of the checker's product construction."""
     src, res, _mode = machines_for(source, result)

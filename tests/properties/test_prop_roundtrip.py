@@ -18,7 +18,6 @@ from collections import Counter
 
 from hypothesis import given
 from hypothesis import strategies as st
-from support.prop_strategies import BUDGET, bts, fsms
 
 from fsmbt.formats import dumps, formats, loads
 from fsmbt.model.bt import BTDocument
@@ -26,6 +25,7 @@ from fsmbt.model.errors import InputError
 from fsmbt.model.fsm import FSM
 from fsmbt.model.serialize import model_to_dict
 from fsmbt.model.validate import errors, validate
+from support.prop_strategies import BUDGET, bts, fsms
 
 #: Formats that hold no machine name and order states by first appearance.
 TABLES = {"csv", "md"}
@@ -62,8 +62,9 @@ def copy_fsm(model: FSM) -> FSM:
     return copy.deepcopy(model)
 
 
-def without_added_declarations(back: FSM | BTDocument,
-                                original: FSM | BTDocument) -> FSM | BTDocument:
+def without_added_declarations(
+    back: FSM | BTDocument, original: FSM | BTDocument
+) -> FSM | BTDocument:
     """BehaviorTree.CPP XML declares every custom leaf type in ``<TreeNodesModel>`` (its reader
     needs the kind); drop the declarations the original did not have, after checking each
     declares the kind the original's nodes of that type have."""
@@ -82,8 +83,11 @@ def round_trip_formats(model: FSM | BTDocument) -> list[str]:
         write_only = {"dot"}
     else:
         write_only = {f for f, k in WRITE_ONLY if k == kind}
-    return [f.name for f in formats() if f.read and f.write and kind in f.kinds
-            and f.name not in write_only]
+    return [
+        f.name
+        for f in formats()
+        if f.read and f.write and kind in f.kinds and f.name not in write_only
+    ]
 
 
 #: Writers that may rewrite a model's structure while keeping its behaviour (documented in
@@ -113,7 +117,8 @@ def check_round_trips(model: FSM | BTDocument, tally: Counter[str]) -> None:
             continue
         assert held(compared, fmt) == held(model, fmt), (
             f"{fmt} changed the model:\n{text}\n{model_to_dict(held(model, fmt))}\n"
-            f"{model_to_dict(held(compared, fmt))}")
+            f"{model_to_dict(held(compared, fmt))}"
+        )
         again = loads(dumps(back, fmt), fmt)
         assert again == back, f"{fmt}: read -> write -> read is not stable"
         tally[f"{fmt}: equal"] += 1
@@ -133,7 +138,8 @@ def test_every_format_reads_back_what_it_wrote_fsm() -> None:
     assert tally["examples"] > 0
     for fmt in round_trip_formats(FSM(name="x")):
         assert tally[f"{fmt}: equal"] + tally[f"{fmt}: equivalent"] > 0, (
-            f"{fmt} never round-tripped a drawn FSM")
+            f"{fmt} never round-tripped a drawn FSM"
+        )
 
 
 def test_every_format_reads_back_what_it_wrote_bt() -> None:

@@ -57,7 +57,12 @@ def plain(value: str) -> str:
     """A DOT label value as text: quotes and HTML markup removed, line breaks as newlines."""
     if value.startswith("<"):
         value = re.sub(r"<BR/>", "\n", value[1:-1])
-        return re.sub(r"<[^>]+>", "", value).replace("&amp;", "&").replace("&lt;", "<").replace("&gt;", ">")
+        return (
+            re.sub(r"<[^>]+>", "", value)
+            .replace("&amp;", "&")
+            .replace("&lt;", "<")
+            .replace("&gt;", ">")
+        )
     if value.startswith('"'):
         value = value[1:-1].replace('\\"', '"')
     return value.replace("\\n", "\n")
@@ -125,7 +130,12 @@ def test_parallel_transitions_share_one_labelled_arrow() -> None:
     dot = parse_dot(fsm_to_dot(fsm))
     state_edges = [e for e in dot.edges if dot.nodes[e[0]].get("shape") != "point"]
     assert len(state_edges) == 1
-    assert set(re.split(r"[,\n] ?", attrs_value(state_edges[0][2]["label"]))) == {"e1", "e2", "e3", "e4"}
+    assert set(re.split(r"[,\n] ?", attrs_value(state_edges[0][2]["label"]))) == {
+        "e1",
+        "e2",
+        "e3",
+        "e4",
+    }
 
 
 def door_hfsm() -> FSM:
@@ -161,13 +171,17 @@ def test_composite_states_are_clusters_and_parallel_regions_dashed_subclusters()
     operating, panel = by_label["Operating"], by_label["Panel"]
     assert operating.parent is dot.root and panel.parent is dot.root
     assert {dot.label(n) for n in operating.nodes if dot.nodes[n].get("shape") != "point"} == {
-        "Closed", "Open"}
+        "Closed",
+        "Open",
+    }
     assert not operating.children
     regions = panel.children
     assert [attrs_value(r.attrs.get("label")) for r in regions] == ["lights", "fan"]
     assert all("dashed" in r.attrs.get("style", "") for r in regions)
     assert {dot.label(n) for n in regions[1].nodes if dot.nodes[n].get("shape") != "point"} == {
-        "Idle", "Done"}
+        "Idle",
+        "Done",
+    }
     # every region has its own initial point
     assert all(any(dot.nodes[n].get("shape") == "point" for n in r.nodes) for r in regions)
     # arrows into / out of a composite state end at its cluster's border
@@ -209,7 +223,9 @@ def _freeze(item: tuple) -> tuple:
 
 
 def _tree_from_model(node: BTNode) -> tuple:
-    symbol = CONTROL_SYMBOLS.get(node.type, node.type) if node.kind is NodeKind.CONTROL else node.label
+    symbol = (
+        CONTROL_SYMBOLS.get(node.type, node.type) if node.kind is NodeKind.CONTROL else node.label
+    )
     return (symbol, tuple(_tree_from_model(c) for c in node.children))
 
 
@@ -238,7 +254,9 @@ def test_decorators_parallel_reactive_memory_and_subtrees() -> None:
     assert firsts["¬"]["shape"] == "hexagon"
     assert firsts["R?"]["shape"] == "box" and firsts["R→"]["shape"] == "box"
     assert firsts["→*"]["shape"] == "box" and firsts["⇉"]["shape"] == "box"
-    assert "success_count=2" in dot.label(next(n for n in dot.nodes if dot.label(n).startswith("⇉")))
+    assert "success_count=2" in dot.label(
+        next(n for n in dot.nodes if dot.label(n).startswith("⇉"))
+    )
     assert firsts["SubTree Combat"]["shape"] == "tab"
     assert firsts["IsCornered"]["shape"] == "ellipse"
     assert firsts["Retry ↻"]["shape"] == "hexagon"
@@ -256,20 +274,34 @@ def test_expanded_subtrees_hang_below_their_reference_in_a_cluster() -> None:
     cluster = dot.clusters[dot.cluster_of(child)]
     assert attrs_value(cluster.attrs.get("label")) == "Combat"
     expected = sum(1 for _ in doc.main.root.walk()) + sum(
-        1 for tid in ("Combat", "Patrol") for _ in doc.trees[tid].root.walk())
+        1 for tid in ("Combat", "Patrol") for _ in doc.trees[tid].root.walk()
+    )
     assert len(dot.nodes) == expected
 
 
 def test_recursive_subtree_reference_is_not_expanded_forever() -> None:
-    a = BTNode("Sequence", NodeKind.CONTROL, children=[
-        BTNode("TickA", NodeKind.ACTION), BTNode("SubTree", NodeKind.SUBTREE, attrs={"ID": "B"})])
-    b = BTNode("Fallback", NodeKind.CONTROL, children=[
-        BTNode("TickB", NodeKind.ACTION), BTNode("SubTree", NodeKind.SUBTREE, attrs={"ID": "A"})])
+    a = BTNode(
+        "Sequence",
+        NodeKind.CONTROL,
+        children=[
+            BTNode("TickA", NodeKind.ACTION),
+            BTNode("SubTree", NodeKind.SUBTREE, attrs={"ID": "B"}),
+        ],
+    )
+    b = BTNode(
+        "Fallback",
+        NodeKind.CONTROL,
+        children=[
+            BTNode("TickB", NodeKind.ACTION),
+            BTNode("SubTree", NodeKind.SUBTREE, attrs={"ID": "A"}),
+        ],
+    )
     doc = BTDocument(trees={"A": BehaviorTree("A", a), "B": BehaviorTree("B", b)}, main_tree="A")
     dot = parse_dot(bt_to_dot(doc, expand_subtrees=True))
     # A, then B once below its reference, then B's reference back to A stops
     assert sorted(dot.label(n).split("\n")[0] for n in dot.nodes) == sorted(
-        ["→", "TickA", "SubTree B", "?", "TickB", "SubTree A"])
+        ["→", "TickA", "SubTree B", "?", "TickB", "SubTree A"]
+    )
     (back,) = [n for n in dot.nodes if dot.label(n).startswith("SubTree A")]
     assert "recursive" in dot.label(back) and not dot.children(back)
 
@@ -290,16 +322,26 @@ def test_large_models_are_refused_with_a_clear_message_not_drawn() -> None:
         wide.add_state(f"s{i}")
     with pytest.raises(TooLargeError, match="5001 states"):
         fsm_to_dot(wide)
-    assert len(parse_dot(bt_to_dot(BTDocument.single(_chain(6_000)), max_nodes=7_000)).nodes) == 6_001
+    assert (
+        len(parse_dot(bt_to_dot(BTDocument.single(_chain(6_000)), max_nodes=7_000)).nodes) == 6_001
+    )
 
 
 def test_expansion_that_grows_past_the_limit_is_refused() -> None:
     trees = {"T0": BehaviorTree("T0", BTNode("Tick", NodeKind.ACTION))}
     for i in range(1, 16):  # each tree references the previous one twice: 2^15 leaves expanded
         ref = {"ID": f"T{i - 1}"}
-        trees[f"T{i}"] = BehaviorTree(f"T{i}", BTNode("Sequence", NodeKind.CONTROL, children=[
-            BTNode("SubTree", NodeKind.SUBTREE, attrs=dict(ref)),
-            BTNode("SubTree", NodeKind.SUBTREE, attrs=dict(ref))]))
+        trees[f"T{i}"] = BehaviorTree(
+            f"T{i}",
+            BTNode(
+                "Sequence",
+                NodeKind.CONTROL,
+                children=[
+                    BTNode("SubTree", NodeKind.SUBTREE, attrs=dict(ref)),
+                    BTNode("SubTree", NodeKind.SUBTREE, attrs=dict(ref)),
+                ],
+            ),
+        )
     doc = BTDocument(trees=trees, main_tree="T15")
     bt_to_dot(doc)  # 46 nodes unexpanded: fine
     with pytest.raises(TooLargeError, match="more than 5000 nodes"):
@@ -331,11 +373,23 @@ def test_cli_never_overwrites_without_force(tmp_path: Path, capsys: pytest.Captu
 
 
 def test_cli_refuses_unknown_picture_formats_and_large_models(
-        tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
+    tmp_path: Path, capsys: pytest.CaptureFixture
+) -> None:
     assert main(["render", str(EXAMPLES / "paper_fsm.json"), "-o", str(tmp_path / "a.jpg")]) == 2
     assert "use one of" in capsys.readouterr().err
-    assert main(["render", str(EXAMPLES / "robot_bt.xml"), "-o", str(tmp_path / "a.svg"),
-                 "--max-nodes", "10"]) == 2
+    assert (
+        main(
+            [
+                "render",
+                str(EXAMPLES / "robot_bt.xml"),
+                "-o",
+                str(tmp_path / "a.svg"),
+                "--max-nodes",
+                "10",
+            ]
+        )
+        == 2
+    )
     err = capsys.readouterr().err
     assert "too large to draw: 21 nodes (limit 10)" in err
     assert not (tmp_path / "a.svg").exists() and not (tmp_path / "a.jpg").exists()

@@ -15,7 +15,6 @@ import pytest
 from fsmbt.runtime.cpp import build_script, find_driver, status
 
 
-
 def missing_tools() -> list[str]:
     """The build tools this machine lacks (empty: the C++ runtime can be built here)."""
     missing = [tool for tool in ("cmake",) if shutil.which(tool) is None]

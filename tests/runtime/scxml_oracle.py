@@ -78,8 +78,9 @@ class Document:
         """fsmbt's flat configuration name for the engine's set of active ids."""
         top = [s for s in self.children[None] if s in active]
         if len(top) != 1:
-            raise AssertionError(f"engine configuration {sorted(active)} has {len(top)} "
-                                 "top-level states")
+            raise AssertionError(
+                f"engine configuration {sorted(active)} has {len(top)} top-level states"
+            )
         # explicit stack: (state id, parts list to fill, is-done marker)
         out: list[str] = []
         stack: list[str | tuple[str]] = [top[0]]
@@ -176,8 +177,9 @@ class Mismatch:
         return f"after {self.events}: engine {self.engine}, fsmbt {self.fsmbt}"
 
 
-def random_events(machine: FSMMachine, state: str, rng: random.Random,
-                  alphabet: Sequence[str], noise: float) -> str:
+def random_events(
+    machine: FSMMachine, state: str, rng: random.Random, alphabet: Sequence[str], noise: float
+) -> str:
     """An event that does something in ``state`` (most of the time) or any event of the
     alphabet (``noise``: ignored events must be ignored by both)."""
     active = list(machine.active_inputs(state))
@@ -206,9 +208,16 @@ class Replay:
     departure: str | None = None  # a documented engine departure ended the comparison
 
 
-def replay(text: str, model: FSM, rng: random.Random, *, length: int,
-           alphabet: Sequence[str] | None = None, noise: float = 0.2,
-           machine: FSMMachine | None = None) -> Replay:
+def replay(
+    text: str,
+    model: FSM,
+    rng: random.Random,
+    *,
+    length: int,
+    alphabet: Sequence[str] | None = None,
+    noise: float = 0.2,
+    machine: FSMMachine | None = None,
+) -> Replay:
     """Drive the engine on ``text`` and fsmbt's machine of ``model`` with one random sequence
     (stops at termination, at the first mismatch, or at a documented engine departure)."""
     fsmbt = machine if machine is not None else FSMMachine(model)
@@ -224,8 +233,12 @@ def replay(text: str, model: FSM, rng: random.Random, *, length: int,
         if seen == shown and done and not fsmbt_done and engine.top_parallel_completed():
             return Replay(len(sent), departure=PARALLEL_STOPS)
         if seen != shown or done != fsmbt_done:
-            return Replay(len(sent), Mismatch(list(sent), f"{seen} (terminated={done})",
-                                              f"{state} ({fsmbt.status(state)})"))
+            return Replay(
+                len(sent),
+                Mismatch(
+                    list(sent), f"{seen} (terminated={done})", f"{state} ({fsmbt.status(state)})"
+                ),
+            )
         if done or len(sent) == length:
             break
         event = random_events(fsmbt, state, rng, events_alphabet, noise)
@@ -246,8 +259,9 @@ def event_of(symbol: str) -> str:
     return symbol.split("[", 1)[0]
 
 
-def follow(fsmbt: FSMMachine, state: str, event: str, seen: str, alphabet: Sequence[str],
-           chosen: str) -> str:
+def follow(
+    fsmbt: FSMMachine, state: str, event: str, seen: str, alphabet: Sequence[str], chosen: str
+) -> str:
     """fsmbt's step on ``event``: the guard valuation is the environment's choice, so among the
     symbols of ``event`` the one that reaches the engine's configuration is taken (the engine's
     behaviour must be one of fsmbt's); without one, the randomly chosen symbol's successor."""

@@ -87,10 +87,14 @@ def compare(fsm: FSM, tree: str, rng: random.Random) -> list[str]:
                 got.append((tuple(recorder.calls), runner.state, runner.terminated))
             want = [(outs, state, status == FINAL) for state, outs, status in steps]
             if got != want or [g[0] for g in got] != seen:
-                index = next(i for i, (g, w) in enumerate(zip(got, want)) if g != w) \
-                    if got != want else -1
-                problems.append(f"{engine}: after {events[:index]} got {got[index]}, FSM "
-                                f"{want[index]}")
+                index = (
+                    next(i for i, (g, w) in enumerate(zip(got, want)) if g != w)
+                    if got != want
+                    else -1
+                )
+                problems.append(
+                    f"{engine}: after {events[:index]} got {got[index]}, FSM {want[index]}"
+                )
     return problems
 
 
@@ -119,8 +123,9 @@ def test_generated_fsms_and_hfsms_run_the_fsms_actions_on_both_engines() -> None
     from support.conv_hfsm_gen import random_hfsm
 
     models = [(f"fsm{i}", random_fsm(seed=SEED * 1000 + i, max_states=15)) for i in range(FSMS)]
-    models += [(f"hfsm{i}", random_hfsm(SEED * 1000 + i, parallel=i % 3 == 2))
-               for i in range(HFSMS)]
+    models += [
+        (f"hfsm{i}", random_hfsm(SEED * 1000 + i, parallel=i % 3 == 2)) for i in range(HFSMS)
+    ]
     compared, refused, problems = 0, 0, {}
     for name, fsm in models:
         try:
@@ -131,16 +136,20 @@ def test_generated_fsms_and_hfsms_run_the_fsms_actions_on_both_engines() -> None
         compared += 1
         if found := compare(fsm, tree, rng):
             problems[name] = found[:2]
-    print(f"\n[python runtime] {compared} models x {SEQUENCES} sequences x {LENGTH} events x "
-          f"{len(ENGINES)} engines: {len(problems)} with differences; {refused} not converted")
+    print(
+        f"\n[python runtime] {compared} models x {SEQUENCES} sequences x {LENGTH} events x "
+        f"{len(ENGINES)} engines: {len(problems)} with differences; {refused} not converted"
+    )
     assert compared >= 0.9 * len(models) and not problems, problems
 
 
 def test_the_runtime_reports_what_the_callables_did() -> None:
     """Actions run once per entry and in order; the state and termination are readable."""
     calls: list[str] = []
-    actions = {name: (lambda n=name: calls.append(n))
-               for name in ("Closed", "Opening", "Open", "Closing", "Emergency", "Off")}
+    actions = {
+        name: (lambda n=name: calls.append(n))
+        for name in ("Closed", "Opening", "Open", "Closing", "Emergency", "Off")
+    }
     for engine in ENGINES:
         calls.clear()
         runner = load_tree(tree_of(read_model(DOOR)), actions, engine=engine)
@@ -156,8 +165,9 @@ def test_the_runtime_reports_what_the_callables_did() -> None:
 
 
 # -- errors at load time --------------------------------------------------------------------------
-DOOR_ACTIONS = {name: (lambda: None)
-                for name in ("Closed", "Opening", "Open", "Closing", "Emergency", "Off")}
+DOOR_ACTIONS = {
+    name: (lambda: None) for name in ("Closed", "Opening", "Open", "Closing", "Emergency", "Off")
+}
 
 
 def door_tree() -> str:
@@ -167,28 +177,34 @@ def door_tree() -> str:
 def test_missing_callable_is_a_load_error_naming_the_action() -> None:
     partial = {k: v for k, v in DOOR_ACTIONS.items() if k != "Emergency"}
     for engine in ENGINES:
-        with pytest.raises(InputError, match=r"no callable for the action\(s\) 'Emergency' "
-                                             r"\(state 'Emergency'\)"):
+        with pytest.raises(
+            InputError,
+            match=r"no callable for the action\(s\) 'Emergency' "
+            r"\(state 'Emergency'\)",
+        ):
             load_tree(door_tree(), partial, engine=engine)
 
 
 def test_unused_or_uncallable_actions_are_load_errors() -> None:
     with pytest.raises(InputError, match="'Emergncy'.*a typo"):
         load_tree(door_tree(), {**DOOR_ACTIONS, "Emergncy": lambda: None})
-    assert load_tree(door_tree(), {**DOOR_ACTIONS, "Spare": lambda: None},
-                     allow_unused=True).used_actions == frozenset(DOOR_ACTIONS)
+    assert load_tree(
+        door_tree(), {**DOOR_ACTIONS, "Spare": lambda: None}, allow_unused=True
+    ).used_actions == frozenset(DOOR_ACTIONS)
     with pytest.raises(InputError, match="'Off' are not callable"):
         load_tree(door_tree(), {**DOOR_ACTIONS, "Off": "print('x')"})  # type: ignore[dict-item]
 
 
-@pytest.mark.parametrize("tag, attrs, wrap", [
-    ("MoveBase", {}, False),  # a foreign leaf in place of a state leaf
-    ("Parallel", {"success_count": "1", "failure_count": "1"}, True),  # a foreign control
-    ("ReactiveSequence", {}, True),
-    ("Inverter", {}, True),  # a decorator
-])
-def test_a_foreign_node_is_named_with_its_line(tag: str, attrs: dict[str, str],
-                                               wrap: bool) -> None:
+@pytest.mark.parametrize(
+    "tag, attrs, wrap",
+    [
+        ("MoveBase", {}, False),  # a foreign leaf in place of a state leaf
+        ("Parallel", {"success_count": "1", "failure_count": "1"}, True),  # a foreign control
+        ("ReactiveSequence", {}, True),
+        ("Inverter", {}, True),  # a decorator
+    ],
+)
+def test_a_foreign_node_is_named_with_its_line(tag: str, attrs: dict[str, str], wrap: bool) -> None:
     root = etree.fromstring(door_tree().encode())
     leaf = root.find(".//LebtState[@name='Emergency']")
     assert leaf is not None
@@ -260,9 +276,15 @@ def test_write_files_refuses_to_overwrite_and_the_script_runs(tmp_path: Path) ->
     (tmp_path / "file").write_text("x", encoding="utf-8")
     with pytest.raises(InputError, match="not a folder"):
         write_files(tmp_path / "file", overwrite=True)
-    done = subprocess.run([sys.executable, "run_lebt.py"], cwd=folder, capture_output=True,
-                          text=True, timeout=120, check=False,
-                          env={**os.environ, "PYTHONPATH": str(REPO / "src")})
+    done = subprocess.run(
+        [sys.executable, "run_lebt.py"],
+        cwd=folder,
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=False,
+        env={**os.environ, "PYTHONPATH": str(REPO / "src")},
+    )
     assert done.returncode == 0, done.stderr
     for engine in ENGINES:
         assert f"engine {engine}" in done.stdout
@@ -271,9 +293,14 @@ def test_write_files_refuses_to_overwrite_and_the_script_runs(tmp_path: Path) ->
 
 
 def test_example_script_runs() -> None:
-    done = subprocess.run([sys.executable, str(REPO / "examples" / "run_lebt_python.py")],
-                          capture_output=True, text=True, timeout=120, check=False,
-                          env={**os.environ, "PYTHONPATH": str(REPO / "src")})
+    done = subprocess.run(
+        [sys.executable, str(REPO / "examples" / "run_lebt_python.py")],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=False,
+        env={**os.environ, "PYTHONPATH": str(REPO / "src")},
+    )
     assert done.returncode == 0, done.stderr
     assert done.stdout.strip().endswith("both engines ran the FSM's actions")
     assert done.stdout.count("running action H") == 2
@@ -290,14 +317,28 @@ def test_the_docs_snippet_runs_as_written(tmp_path: Path) -> None:
     env = {**os.environ, "PYTHONPATH": str(REPO / "src")}
     args = shell.replace("examples/", f"{REPO / 'examples'}/").split()
     assert args[0] == "fsmbt"
-    done = subprocess.run([sys.executable, "-m", "fsmbt.cli", *args[1:]], cwd=tmp_path,
-                          capture_output=True, text=True, timeout=120, check=False, env=env)
+    done = subprocess.run(
+        [sys.executable, "-m", "fsmbt.cli", *args[1:]],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=False,
+        env=env,
+    )
     assert done.returncode == 0, done.stderr
     (tmp_path / "snippet.py").write_text(python, encoding="utf-8")
     for engine in ENGINES:
         script = python.replace('engine="py_trees")', f'engine="{engine}")')
         (tmp_path / "snippet.py").write_text(script, encoding="utf-8")
-        done = subprocess.run([sys.executable, "snippet.py"], cwd=tmp_path, capture_output=True,
-                              text=True, timeout=120, check=False, env=env)
+        done = subprocess.run(
+            [sys.executable, "snippet.py"],
+            cwd=tmp_path,
+            capture_output=True,
+            text=True,
+            timeout=120,
+            check=False,
+            env=env,
+        )
         assert done.returncode == 0, done.stderr
         assert done.stdout == shown, (engine, done.stdout)

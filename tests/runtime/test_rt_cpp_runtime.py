@@ -6,7 +6,6 @@ from __future__ import annotations
 import os
 import shutil
 import subprocess
-import sys
 from pathlib import Path
 
 import pytest
@@ -40,9 +39,12 @@ MINIMAL = """<root BTCPP_format="4" main_tree_to_execute="MainTree">
 GOOD_LEAF = '<LebtState name="B" state="B" action="do_B" final="true" exits=""/>'
 
 
-def _driver_call(driver: Path, tree: Path, *args: str, stdin: str = "") -> subprocess.CompletedProcess:
-    return subprocess.run([str(driver), str(tree), *args], input=stdin, capture_output=True,
-                          text=True, timeout=60)
+def _driver_call(
+    driver: Path, tree: Path, *args: str, stdin: str = ""
+) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [str(driver), str(tree), *args], input=stdin, capture_output=True, text=True, timeout=60
+    )
 
 
 def _tree(tmp_path: Path, leaf: str = GOOD_LEAF, name: str = "tree.xml") -> Path:
@@ -62,10 +64,10 @@ def test_minimal_tree_runs_enters_once_and_terminates(driver: Path, tmp_path: Pa
     tree = _tree(tmp_path)
     [run] = DriverSession(tree, driver=driver).run([["nothing", "go", "go"]])
     assert [(s.event, s.actions, s.terminated, s.state) for s in run] == [
-        (None, ("do_A",), False, "A"),          # no initial event: A is entered at start
-        ("nothing", (), False, "A"),            # no transition: ignored, A not re-entered
-        ("go", ("do_B",), True, "B"),           # final state: terminated
-        ("go", (), True, "B"),                  # a final state ignores every event
+        (None, ("do_A",), False, "A"),  # no initial event: A is entered at start
+        ("nothing", (), False, "A"),  # no transition: ignored, A not re-entered
+        ("go", ("do_B",), True, "B"),  # final state: terminated
+        ("go", (), True, "B"),  # a final state ignores every event
     ]
 
 
@@ -74,9 +76,18 @@ def test_hierarchical_door_runs_its_subtree_unchanged(driver: Path, tmp_path: Pa
     text = tree.read_text(encoding="utf-8")
     assert '<SubTree name="Operating" ID="Operating"/>' in text  # one tree per composite
     [run] = DriverSession(tree, driver=driver).run(
-        [["open_cmd", "fully_open", "fire_alarm", "open_cmd", "reset", "fire_alarm", "shutdown"]])
-    assert [s.actions for s in run] == [("Closed",), ("Opening",), ("Open",), ("Emergency",), (),
-                                        ("Closed",), ("Emergency",), ("Off",)]
+        [["open_cmd", "fully_open", "fire_alarm", "open_cmd", "reset", "fire_alarm", "shutdown"]]
+    )
+    assert [s.actions for s in run] == [
+        ("Closed",),
+        ("Opening",),
+        ("Open",),
+        ("Emergency",),
+        (),
+        ("Closed",),
+        ("Emergency",),
+        ("Off",),
+    ]
     assert [s.terminated for s in run][-2:] == [False, True]
     assert run[2].state == "Operating/Open"
 
@@ -84,7 +95,10 @@ def test_hierarchical_door_runs_its_subtree_unchanged(driver: Path, tmp_path: Pa
 def test_reset_between_sequences_starts_afresh(driver: Path, tmp_path: Path) -> None:
     runs = DriverSession(_tree(tmp_path), driver=driver).run([["go"], ["nothing"], []])
     assert [[s.actions for s in run] for run in runs] == [
-        [("do_A",), ("do_B",)], [("do_A",), ()], [("do_A",)]]
+        [("do_A",), ("do_B",)],
+        [("do_A",), ()],
+        [("do_A",)],
+    ]
 
 
 # -- bad input: clear, located errors at load time -------------------------------------------
@@ -96,30 +110,38 @@ def test_unknown_leaf_names_the_node_and_its_line(driver: Path, tmp_path: Path) 
     assert "MoveBase" in line and "line 10" in line, line
 
 
-def test_builtin_leaf_that_is_not_lebt_is_refused_with_its_line(driver: Path,
-                                                                tmp_path: Path) -> None:
+def test_builtin_leaf_that_is_not_lebt_is_refused_with_its_line(
+    driver: Path, tmp_path: Path
+) -> None:
     tree = _tree(tmp_path, '<Sleep name="nap" msec="10"/>')
     proc = _driver_call(driver, tree)
     assert proc.returncode == 1
-    assert "<Sleep name=\"nap\">" in proc.stderr and "line 10" in proc.stderr
+    assert '<Sleep name="nap">' in proc.stderr and "line 10" in proc.stderr
     assert "not an LEBT leaf" in proc.stderr
 
 
 def test_refused_leaf_line_is_the_named_element(driver: Path, tmp_path: Path) -> None:
-    leaf = ('<Sequence name="s">\n  <SleepLonger/>\n  <Sleep name="first" msec="1"/>\n'
-            '  <Sleep name="nap" msec="1"/>\n</Sequence>')
+    leaf = (
+        '<Sequence name="s">\n  <SleepLonger/>\n  <Sleep name="first" msec="1"/>\n'
+        '  <Sleep name="nap" msec="1"/>\n</Sequence>'
+    )
     path = tmp_path / "two_sleeps.xml"
-    path.write_text(MINIMAL.replace("{leaf}", leaf).replace(
-        '<LebtGuard name="Enter_B" target="B" pairs="A/go"/>', ""), encoding="utf-8")
+    path.write_text(
+        MINIMAL.replace("{leaf}", leaf).replace(
+            '<LebtGuard name="Enter_B" target="B" pairs="A/go"/>', ""
+        ),
+        encoding="utf-8",
+    )
     proc = _driver_call(driver, path)
     assert proc.returncode == 1
     # BehaviorTree.CPP refuses the unknown <SleepLonger> first, with the line tinyxml2 gives
     # (for a first child, the line its preceding whitespace starts on)
     assert "Error at line 10: -> Node not recognized: SleepLonger" in proc.stderr
-    path.write_text(path.read_text(encoding="utf-8").replace("  <SleepLonger/>\n", ""),
-                    encoding="utf-8")
+    path.write_text(
+        path.read_text(encoding="utf-8").replace("  <SleepLonger/>\n", ""), encoding="utf-8"
+    )
     proc = _driver_call(driver, path)
-    assert "<Sleep name=\"first\">" in proc.stderr and "line 11" in proc.stderr, proc.stderr
+    assert '<Sleep name="first">' in proc.stderr and "line 11" in proc.stderr, proc.stderr
 
 
 def test_missing_action_callback_is_a_load_error(driver: Path, tmp_path: Path) -> None:
@@ -131,17 +153,23 @@ def test_missing_action_callback_is_a_load_error(driver: Path, tmp_path: Path) -
     assert ok.returncode == 0 and '"actions":["do_B"]' in ok.stdout
 
 
-@pytest.mark.parametrize(("leaf", "message"), [
-    ('<LebtGuard name="bad" target="B" pairs="A-go"/>', "malformed pair 'A-go'"),
-    ('<LebtState name="B" state="{bb_state}" action="x" final="true" exits=""/>',
-     "blackboard reference"),
-    ('<LebtState name="B" state="B" action="x" final="maybe" exits=""/>', "port 'final'"),
-])
-def test_malformed_lebt_ports_are_load_errors(driver: Path, tmp_path: Path, leaf: str,
-                                              message: str) -> None:
+@pytest.mark.parametrize(
+    ("leaf", "message"),
+    [
+        ('<LebtGuard name="bad" target="B" pairs="A-go"/>', "malformed pair 'A-go'"),
+        (
+            '<LebtState name="B" state="{bb_state}" action="x" final="true" exits=""/>',
+            "blackboard reference",
+        ),
+        ('<LebtState name="B" state="B" action="x" final="maybe" exits=""/>', "port 'final'"),
+    ],
+)
+def test_malformed_lebt_ports_are_load_errors(
+    driver: Path, tmp_path: Path, leaf: str, message: str
+) -> None:
     proc = _driver_call(driver, _tree(tmp_path, leaf))
     assert proc.returncode == 1 and message in proc.stderr, proc.stderr
-    assert "name=\"" in proc.stderr  # names the node
+    assert 'name="' in proc.stderr  # names the node
 
 
 def test_malformed_xml_and_missing_file_are_one_line_errors(driver: Path, tmp_path: Path) -> None:
@@ -155,8 +183,21 @@ def test_malformed_xml_and_missing_file_are_one_line_errors(driver: Path, tmp_pa
 
 def test_table_mode_matches_the_tree_on_the_door(driver: Path, tmp_path: Path) -> None:
     tree = _door_tree(tmp_path)
-    events = [["open_cmd", "obstacle", "fully_open", "close_cmd", "fully_closed", "fire_alarm",
-               "bogus", "reset", "fire_alarm", "shutdown", "reset"]]
+    events = [
+        [
+            "open_cmd",
+            "obstacle",
+            "fully_open",
+            "close_cmd",
+            "fully_closed",
+            "fire_alarm",
+            "bogus",
+            "reset",
+            "fire_alarm",
+            "shutdown",
+            "reset",
+        ]
+    ]
     bt = DriverSession(tree, driver=driver).run(events)
     table = DriverSession(tree, driver=driver, table=True).run(events)
     assert bt == table
@@ -200,21 +241,51 @@ def test_cmake_example_builds_and_runs_the_door(driver: Path, tmp_path: Path) ->
     assert main(["runtime", "cpp", str(project)]) == 0
     build = project / "build"
     configure = subprocess.run(
-        ["cmake", "-S", str(project), "-B", str(build), f"-DCMAKE_PREFIX_PATH={library_prefix()}",
-         "-DCMAKE_BUILD_TYPE=Release"], capture_output=True, text=True, timeout=300)
+        [
+            "cmake",
+            "-S",
+            str(project),
+            "-B",
+            str(build),
+            f"-DCMAKE_PREFIX_PATH={library_prefix()}",
+            "-DCMAKE_BUILD_TYPE=Release",
+        ],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     assert configure.returncode == 0, configure.stderr[-2000:]
-    compiled = subprocess.run(["nice", "-n", "10", "cmake", "--build", str(build)],
-                              capture_output=True, text=True, timeout=900)
+    compiled = subprocess.run(
+        ["nice", "-n", "10", "cmake", "--build", str(build)],
+        capture_output=True,
+        text=True,
+        timeout=900,
+    )
     assert compiled.returncode == 0, compiled.stdout[-2000:] + compiled.stderr[-2000:]
     tree = _door_tree(tmp_path)
     snippet, printed = _documented_example()
     documented_args = snippet.strip().splitlines()[-1].split()[2:]  # after binary and tree
-    run = subprocess.run([str(build / "lebt_example"), str(tree), *documented_args],
-                         capture_output=True, text=True, timeout=60)
+    run = subprocess.run(
+        [str(build / "lebt_example"), str(tree), *documented_args],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
     assert run.returncode == 0, run.stderr
     assert run.stdout == printed  # docs/runtime.md shows what it prints
-    run = subprocess.run([str(build / "lebt_example"), str(tree), "open_cmd", "fully_open",
-                          "fire_alarm", "shutdown"], capture_output=True, text=True, timeout=60)
+    run = subprocess.run(
+        [
+            str(build / "lebt_example"),
+            str(tree),
+            "open_cmd",
+            "fully_open",
+            "fire_alarm",
+            "shutdown",
+        ],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
     assert run.returncode == 0, run.stderr
     assert run.stdout.splitlines() == [
         "  action Closed (entered Operating/Closed)",
@@ -229,8 +300,9 @@ def test_cmake_example_builds_and_runs_the_door(driver: Path, tmp_path: Path) ->
         "event shutdown: state Off, terminated",
     ]
     other = _tree(tmp_path)  # actions do_A/do_B have no callbacks in main.cpp
-    refused = subprocess.run([str(build / "lebt_example"), str(other)], capture_output=True,
-                             text=True, timeout=60)
+    refused = subprocess.run(
+        [str(build / "lebt_example"), str(other)], capture_output=True, text=True, timeout=60
+    )
     assert refused.returncode == 1 and "'do_A' (state A)" in refused.stderr
 
 
@@ -250,11 +322,15 @@ def test_docs_show_the_shipped_example_files() -> None:
     import re
 
     doc = (REPO / "docs" / "runtime.md").read_text(encoding="utf-8")
-    blocks = dict((lang, body) for lang, body in re.findall(r"```(\w+)\n(.*?)```", doc, re.S)
-                  if lang in ("cpp", "cmake"))
+    blocks = dict(
+        (lang, body)
+        for lang, body in re.findall(r"```(\w+)\n(.*?)```", doc, re.S)
+        if lang in ("cpp", "cmake")
+    )
     assert blocks["cpp"] == (cpp_runtime.EXAMPLE_DIR / "main.cpp").read_text(encoding="utf-8")
     assert blocks["cmake"] == (cpp_runtime.EXAMPLE_DIR / "CMakeLists.txt").read_text(
-        encoding="utf-8")
+        encoding="utf-8"
+    )
     snippet, _ = _documented_example()
     assert "fsmbt runtime cpp out/lebt_example" in snippet
 
@@ -296,8 +372,13 @@ def test_build_script_without_compiler_says_what_is_missing(tmp_path: Path) -> N
         assert found is not None
         (bin_dir / tool).symlink_to(found)
     script = REPO / "scripts" / "build_btcpp.sh"
-    proc = subprocess.run([str(bin_dir / "bash"), str(script)], capture_output=True, text=True,
-                          timeout=60, env={"PATH": str(bin_dir), "HOME": str(tmp_path)})
+    proc = subprocess.run(
+        [str(bin_dir / "bash"), str(script)],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        env={"PATH": str(bin_dir), "HOME": str(tmp_path)},
+    )
     assert proc.returncode == 2
     [line] = proc.stderr.strip().splitlines()
     assert "missing cmake, a C++17 compiler" in line, line
@@ -307,8 +388,9 @@ def test_build_script_without_compiler_says_what_is_missing(tmp_path: Path) -> N
 
 def test_build_script_is_executable_in_git() -> None:
     script = REPO / "scripts" / "build_btcpp.sh"
-    mode = subprocess.run(["git", "ls-files", "-s", str(script)], capture_output=True, text=True,
-                          cwd=REPO).stdout.split()
+    mode = subprocess.run(
+        ["git", "ls-files", "-s", str(script)], capture_output=True, text=True, cwd=REPO
+    ).stdout.split()
     assert mode and mode[0] == "100755" and os.access(script, os.X_OK)
 
 
@@ -335,13 +417,23 @@ def test_nusmv_build_script_reuses_the_old_checkout_binary(tmp_path: Path) -> No
     legacy.chmod(0o755)
     env = {**os.environ, "FSMBT_CACHE": str(tmp_path / "cache")}
     env.pop("FSMBT_NUSMV_PREFIX", None)
-    first = subprocess.run([str(repo / "scripts" / "build_nusmv.sh")], capture_output=True,
-                           text=True, timeout=60, env=env)
+    first = subprocess.run(
+        [str(repo / "scripts" / "build_nusmv.sh")],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        env=env,
+    )
     assert first.returncode == 0, first.stderr
     cached = tmp_path / "cache" / "nusmv-2.5.4" / "bin" / "NuSMV"
     assert "copied from the old per-checkout cache" in first.stdout
     assert cached.read_bytes() == legacy.read_bytes()
     legacy.unlink()
-    second = subprocess.run([str(repo / "scripts" / "build_nusmv.sh")], capture_output=True,
-                            text=True, timeout=60, env=env)
+    second = subprocess.run(
+        [str(repo / "scripts" / "build_nusmv.sh")],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        env=env,
+    )
     assert second.returncode == 0 and f"already built: {cached}" in second.stdout

@@ -24,7 +24,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import pytest
-from support.conv_hfsm_gen import random_hfsm
 
 from fsmbt.convert import convert
 from fsmbt.formats import dumps, loads, read_model
@@ -35,6 +34,7 @@ from fsmbt.runtime.cpp import DriverSession, library_prefix
 from fsmbt.semantics.engines.btcpp_engine import BTCppLebtRunner
 from fsmbt.semantics.engines.pytrees_engine import PyTreesLebtRunner
 from fsmbt.semantics.machine import FINAL, FSMMachine
+from support.conv_hfsm_gen import random_hfsm
 
 REPO = Path(__file__).resolve().parents[2]
 CORPUS = Path(os.environ.get("FSMBT_CORPUS", REPO.parent / "shared" / "corpus"))
@@ -58,12 +58,14 @@ class Tally:
     cpp_seconds: float = 0.0
 
     def report(self, group: str) -> str:
-        return (f"\n[runtime differential] {group}: {self.models} models, {self.sequences} "
-                f"sequences, {self.steps} macro steps compared in 6 runs (FSM, C++ "
-                f"BehaviorTree.CPP (auto tick, tickOnce), C++ table, behaviortreepy, py_trees); "
-                f"C++ driver time (auto tick) "
-                f"{self.cpp_seconds:.2f} s; refused by the converter: {len(self.refused)}; "
-                f"differences: {len(self.differences)}")
+        return (
+            f"\n[runtime differential] {group}: {self.models} models, {self.sequences} "
+            f"sequences, {self.steps} macro steps compared in 6 runs (FSM, C++ "
+            f"BehaviorTree.CPP (auto tick, tickOnce), C++ table, behaviortreepy, py_trees); "
+            f"C++ driver time (auto tick) "
+            f"{self.cpp_seconds:.2f} s; refused by the converter: {len(self.refused)}; "
+            f"differences: {len(self.differences)}"
+        )
 
 
 def _sequences(alphabet: tuple[str, ...], seed: str) -> list[list[str]]:
@@ -116,8 +118,9 @@ def _compare(label: str, fsm: FSM, tmp: Path, driver: Path, tally: Tally) -> Non
     table = DriverSession(tree_file, driver=driver, table=True).run(sequences)
     observed = {
         "C++ BehaviorTree.CPP": [[(s.actions, s.terminated) for s in run] for run in cpp],
-        "C++ BehaviorTree.CPP tickOnce": [[(s.actions, s.terminated) for s in run]
-                                          for run in literal],
+        "C++ BehaviorTree.CPP tickOnce": [
+            [(s.actions, s.terminated) for s in run] for run in literal
+        ],
         "C++ table": [[(s.actions, s.terminated) for s in run] for run in table],
         "behaviortreepy": _engine_runs(lambda: BTCppLebtRunner(doc), sequences),
         "py_trees": _engine_runs(lambda: PyTreesLebtRunner(doc), sequences),
@@ -125,13 +128,16 @@ def _compare(label: str, fsm: FSM, tmp: Path, driver: Path, tally: Tally) -> Non
     for runtime, runs in observed.items():
         for index, (want, got) in enumerate(zip(expected, runs)):
             if want != got:
-                step = next((i for i, (w, g) in enumerate(zip(want, got)) if w != g),
-                            min(len(want), len(got)))
+                step = next(
+                    (i for i, (w, g) in enumerate(zip(want, got)) if w != g),
+                    min(len(want), len(got)),
+                )
                 event = "start" if step == 0 else sequences[index][step - 1]
                 tally.differences.append(
                     f"{label} [{runtime}] sequence {index} step {step} ({event}): FSM "
                     f"{want[step] if step < len(want) else None} vs "
-                    f"{got[step] if step < len(got) else None}")
+                    f"{got[step] if step < len(got) else None}"
+                )
     tally.models += 1
     tally.sequences += SEQUENCES
     tally.steps += SEQUENCES * LENGTH
@@ -154,8 +160,12 @@ def _corpus_fsms() -> list[tuple[str, FSM]]:
         return []
     found = []
     for path in sorted(CORPUS.rglob("*")):
-        if (not path.is_file() or path.suffix in (".md", ".txt") or "_malformed" in path.parts
-                or "LICENSES" in path.parts):
+        if (
+            not path.is_file()
+            or path.suffix in (".md", ".txt")
+            or "_malformed" in path.parts
+            or "LICENSES" in path.parts
+        ):
             continue
         try:
             model = read_model(path)
@@ -171,7 +181,8 @@ def _build_times() -> str:
     if not record.is_file():
         return "C++ build times: not recorded"
     return "C++ build times (scripts/build_btcpp.sh, this machine): " + ", ".join(
-        record.read_text(encoding="utf-8").split())
+        record.read_text(encoding="utf-8").split()
+    )
 
 
 def test_rt_examples_and_corpus_run_alike_everywhere(driver: Path, tmp_path: Path) -> None:
@@ -190,8 +201,11 @@ def test_rt_examples_and_corpus_run_alike_everywhere(driver: Path, tmp_path: Pat
 def test_rt_generated_fsms_run_alike_everywhere(driver: Path, tmp_path: Path) -> None:
     tally = Tally()
     for seed in range(GENERATED_FSMS):
-        fsm = random_fsm(f"runtime-{seed}", scenario="basic" if seed % 2 else "robot",
-                         shape=("mixed", "chain", "tree", "loop")[seed % 4])
+        fsm = random_fsm(
+            f"runtime-{seed}",
+            scenario="basic" if seed % 2 else "robot",
+            shape=("mixed", "chain", "tree", "loop")[seed % 4],
+        )
         _compare(f"random_fsm(runtime-{seed})", fsm, tmp_path, driver, tally)
     print(tally.report("generated FSMs"))
     assert tally.differences == []
@@ -200,20 +214,21 @@ def test_rt_generated_fsms_run_alike_everywhere(driver: Path, tmp_path: Path) ->
 
 
 @pytest.mark.parametrize("parallel", [False, True])
-def test_rt_generated_hfsms_run_alike_everywhere(driver: Path, tmp_path: Path,
-                                                 parallel: bool) -> None:
+def test_rt_generated_hfsms_run_alike_everywhere(
+    driver: Path, tmp_path: Path, parallel: bool
+) -> None:
     count = GENERATED_HFSMS * 2 // 3 if not parallel else GENERATED_HFSMS // 3
     tally = Tally()
     seed = 0
     while tally.models < count:
         fsm = random_hfsm(10_000 + seed, parallel=parallel)
-        _compare(f"random_hfsm({10_000 + seed}, parallel={parallel})", fsm, tmp_path, driver,
-                 tally)
+        _compare(f"random_hfsm({10_000 + seed}, parallel={parallel})", fsm, tmp_path, driver, tally)
         seed += 1
         assert seed < 3 * count, "too many generated HFSMs refused"
     print(tally.report(f"generated HFSMs (parallel={parallel})"))
     assert tally.differences == []
     # the converter refuses e.g. cycles of completion transitions, clearly
-    assert all("eventless" in reason or "completion" in reason for reason in tally.refused), \
+    assert all("eventless" in reason or "completion" in reason for reason in tally.refused), (
         tally.refused[:3]
+    )
     assert tally.models == count

@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import os
 import random
-import sys
 from collections import Counter
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -62,11 +61,13 @@ class Tally:
             self.departures[result.departure] += 1
 
     def report(self) -> str:
-        return (f"\n[{self.group}] {self.models} models, {self.sequences} sequences, "
-                f"{self.events} events, {len(self.mismatches)} mismatches, "
-                f"{sum(self.departures.values())} sequences ended by a documented engine "
-                f"departure {dict(self.departures)}; not converted/written: "
-                f"{sum(self.refused.values())} {dict(self.refused.most_common(4))}")
+        return (
+            f"\n[{self.group}] {self.models} models, {self.sequences} sequences, "
+            f"{self.events} events, {len(self.mismatches)} mismatches, "
+            f"{sum(self.departures.values())} sequences ended by a documented engine "
+            f"departure {dict(self.departures)}; not converted/written: "
+            f"{sum(self.refused.values())} {dict(self.refused.most_common(4))}"
+        )
 
 
 def random_hfsm(seed: int, *, parallel: bool) -> FSM:
@@ -76,8 +77,15 @@ def random_hfsm(seed: int, *, parallel: bool) -> FSM:
     return make(seed, parallel=parallel)
 
 
-def check_tree(tally: Tally, label: str, doc: BTDocument, rng: random.Random,
-               sequences: int, *, loop: bool = False) -> None:
+def check_tree(
+    tally: Tally,
+    label: str,
+    doc: BTDocument,
+    rng: random.Random,
+    sequences: int,
+    *,
+    loop: bool = False,
+) -> None:
     try:
         hfsm = bt_to_hfsm(doc, loop=loop).model
     except FsmbtError as exc:
@@ -88,8 +96,14 @@ def check_tree(tally: Tally, label: str, doc: BTDocument, rng: random.Random,
     machine = FSMMachine(hfsm)
     tally.models += 1
     for _ in range(sequences):
-        result = replay(text, hfsm, rng, length=LENGTH, machine=machine,
-                        alphabet=("success", "failure", "running"))
+        result = replay(
+            text,
+            hfsm,
+            rng,
+            length=LENGTH,
+            machine=machine,
+            alphabet=("success", "failure", "running"),
+        )
         tally.add(label, result)
 
 
@@ -144,8 +158,13 @@ def test_generated_bts() -> None:
     tally = Tally("generated bt")
     rng = random.Random(SEED)
     for index in range(GENERATED):
-        doc = random_bt(seed=SEED * 100_000 + index, depth=rng.randint(2, 5),
-                        breadth=rng.randint(2, 4), extended=index % 2 == 1, max_nodes=40)
+        doc = random_bt(
+            seed=SEED * 100_000 + index,
+            depth=rng.randint(2, 5),
+            breadth=rng.randint(2, 4),
+            extended=index % 2 == 1,
+            max_nodes=40,
+        )
         check_tree(tally, f"gen{index}", doc, rng, SEQUENCES, loop=index % 4 == 3)
     print(tally.report())
     refused = sum(tally.refused.values())
@@ -188,8 +207,7 @@ def test_mismatch_is_reported_on_a_wrong_model() -> None:
     found: list[Mismatch] = []
     rng = random.Random(SEED)
     for _ in range(40):
-        result = replay(text, hfsm, rng, length=LENGTH,
-                        alphabet=("success", "failure", "running"))
+        result = replay(text, hfsm, rng, length=LENGTH, alphabet=("success", "failure", "running"))
         if result.mismatch is not None:
             found.append(result.mismatch)
     assert found

@@ -37,8 +37,11 @@ NS = 'xmlns="http://www.w3.org/2005/07/scxml"'
 
 def corpus_scxml() -> list[Path]:
     folder = CORPUS / "fsm"
-    return sorted(p for p in folder.rglob("*.scxml")
-                  if "_malformed" not in p.parts and "_legacy_draft" not in p.parts)
+    return sorted(
+        p
+        for p in folder.rglob("*.scxml")
+        if "_malformed" not in p.parts and "_legacy_draft" not in p.parts
+    )
 
 
 def compare(text: str, model: FSM, seed: int, sequences: int) -> tuple[int, list[str]]:
@@ -80,11 +83,13 @@ def test_corpus_files_both_read_agree() -> None:
         compared.append(label)
         if mismatches:
             disagreements[label] = mismatches[:2]
-    print(f"\n[corpus scxml] {len(paths)} files: {len(compared)} read by both and compared "
-          f"({len(compared) * SEQUENCES} sequences, {events} events), "
-          f"{len(compared) - len(disagreements)} agree, {len(disagreements)} disagree; "
-          f"refused by fsmbt {len(fsmbt_refuses)}, by the engine (fsmbt reads them) "
-          f"{len(engine_refuses)} {engine_refuses}")
+    print(
+        f"\n[corpus scxml] {len(paths)} files: {len(compared)} read by both and compared "
+        f"({len(compared) * SEQUENCES} sequences, {events} events), "
+        f"{len(compared) - len(disagreements)} agree, {len(disagreements)} disagree; "
+        f"refused by fsmbt {len(fsmbt_refuses)}, by the engine (fsmbt reads them) "
+        f"{len(engine_refuses)} {engine_refuses}"
+    )
     assert len(compared) >= 15
     assert not disagreements, disagreements
 
@@ -224,15 +229,23 @@ def test_probe_agrees(case: str) -> None:
 
 
 # -- departures of the engine from the W3C algorithm -----------------------------------------------
-@pytest.mark.parametrize("body, w3c, engine", [
-    # W3C 3.3: no initial attribute -> the first child state in document order (here <parallel>)
-    ('<state id="top"><parallel id="p"><state id="a"/><state id="b"/></parallel>'
-     '<state id="t"/></state>', "top/p/[a|b]", "top/t"),
-    # ... and here the <final>
-    ('<state id="c"><final id="f"/><state id="s"/></state>', "c/f", "c/s"),
-])
-def test_departure_default_initial_of_compound_ignores_document_order(body: str, w3c: str,
-                                                                      engine: str) -> None:
+@pytest.mark.parametrize(
+    "body, w3c, engine",
+    [
+        # W3C 3.3: no initial attribute -> the first child state in document order (here <parallel>)
+        (
+            '<state id="top"><parallel id="p"><state id="a"/><state id="b"/></parallel>'
+            '<state id="t"/></state>',
+            "top/p/[a|b]",
+            "top/t",
+        ),
+        # ... and here the <final>
+        ('<state id="c"><final id="f"/><state id="s"/></state>', "c/f", "c/s"),
+    ],
+)
+def test_departure_default_initial_of_compound_ignores_document_order(
+    body: str, w3c: str, engine: str
+) -> None:
     """python-statemachine 3.2.2 collects a compound state's children by tag (<state>, then
     <final>, then <parallel>), so without ``initial`` it starts in the first <state> child, not
     the first child in document order as W3C says. fsmbt keeps W3C's rule; the files fsmbt
@@ -274,6 +287,7 @@ def test_departure_assign_fails_in_a_second_instance_of_one_loaded_class() -> No
     ``t``. fsmbt keeps W3C's reading (the assign is ignored, the raise runs); the oracle loads
     a fresh class per instance for such documents (``scxml_oracle.ASSIGN_SHARED_CLASS``)."""
     from statemachine.io.loader import load
+
     text = f"""<scxml {NS} version="1.0" datamodel="python">
   <datamodel><data id="count" expr="0"/></datamodel>
   <state id="s"><transition event="go" target="t"><assign location="count" expr="count + 1"/>

@@ -19,8 +19,9 @@ from support.random_trees import ALL_NODE_TYPES, OutcomeScript, random_tree
 
 TICKS = 8
 SEEDS = st.integers(min_value=0, max_value=2**31 - 1)
-SETTINGS = settings(max_examples=500, deadline=None, derandomize=True,
-                    suppress_health_check=[HealthCheck.too_slow])
+SETTINGS = settings(
+    max_examples=500, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow]
+)
 
 
 def _run_interpreter(doc, script, exactly_once):
@@ -53,7 +54,7 @@ def _compare(seed: int, exactly_once: bool) -> bool:
     except Exception as exc:  # noqa: BLE001 - BehaviorTree.CPP's logic_error
         engine_error = exc
     assert (error is None) == (engine_error is None), (seed, error, engine_error, engine.xml)
-    assert theirs[:len(ours)] == ours, (seed, engine.xml)
+    assert theirs[: len(ours)] == ours, (seed, engine.xml)
     return True
 
 
@@ -75,7 +76,12 @@ def test_sem_random_trees_cover_every_node_type() -> None:
     for seed in range(300):
         doc = random_tree(random.Random(seed), max_nodes=16)
         for _, node in doc.nodes():
-            seen["Action" if node.type.startswith("Act") else
-                 "Condition" if node.type.startswith("Cond") else node.type] += 1
+            seen[
+                "Action"
+                if node.type.startswith("Act")
+                else "Condition"
+                if node.type.startswith("Cond")
+                else node.type
+            ] += 1
     missing = [t for t in ALL_NODE_TYPES if seen[t] == 0]
     assert not missing, missing

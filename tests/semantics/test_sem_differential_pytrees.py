@@ -31,8 +31,12 @@ TICKS = 8
 @settings(max_examples=400, deadline=None, derandomize=True)
 @given(st.integers(min_value=0, max_value=2**31 - 1))
 def test_sem_pytrees_traces_match(seed: int) -> None:
-    doc = random_tree(random.Random(seed), controls=PYTREES_CONTROLS,
-                      decorators=PYTREES_DECORATORS + ("SubTree",), max_nodes=16)
+    doc = random_tree(
+        random.Random(seed),
+        controls=PYTREES_CONTROLS,
+        decorators=PYTREES_DECORATORS + ("SubTree",),
+        max_nodes=16,
+    )
     script = OutcomeScript(seed)
     ours = BTRunner(doc, script)
     theirs = PyTreesRunner(doc, script.fresh())

@@ -57,28 +57,35 @@ def test_sem_tick_once_reticks_on_wake_up_but_exactly_once_does_not() -> None:
     plans = {"c": "success " * 6, "a": "success", "b": "running success"}
     assert both(tree, 2, **plans) == [(["c", "a", "c", "b"], "RUNNING"), (["c", "b"], "SUCCESS")]
     assert both(tree, 3, exactly_once=True, **plans) == [
-        (["c", "a"], "RUNNING"), (["c", "b"], "RUNNING"), (["c", "b"], "SUCCESS")]
+        (["c", "a"], "RUNNING"),
+        (["c", "b"], "RUNNING"),
+        (["c", "b"], "SUCCESS"),
+    ]
 
 
 def test_sem_sequence_resumes_running_child_and_restarts_after_failure() -> None:
     tree = ctl("Sequence", act("a"), act("b"))
     assert both(tree, 3, a="success success", b="running failure success") == [
-        (["a", "b"], "RUNNING"), (["b"], "FAILURE"), (["a", "b"], "SUCCESS")]
+        (["a", "b"], "RUNNING"),
+        (["b"], "FAILURE"),
+        (["a", "b"], "SUCCESS"),
+    ]
 
 
 def test_sem_sequence_with_memory_keeps_its_index_after_failure() -> None:
     tree = ctl("SequenceWithMemory", act("a"), act("b"))
     result = both(tree, 2, exactly_once=True, a="success", b="failure success")
     assert result == [(["a"], "RUNNING"), (["b"], "FAILURE")]
-    plain = both(ctl("Sequence", act("a"), act("b")), 2, a="success success",
-                 b="failure success")
+    plain = both(ctl("Sequence", act("a"), act("b")), 2, a="success success", b="failure success")
     assert plain == [(["a", "b"], "FAILURE"), (["a", "b"], "SUCCESS")]
 
 
 def test_sem_reactive_sequence_rechecks_conditions_and_halts_running_child() -> None:
     tree = ctl("ReactiveSequence", cond("c"), act("a"))
     assert both(tree, 2, c="success failure", a="running") == [
-        (["c", "a"], "RUNNING"), (["c"], "FAILURE")]
+        (["c", "a"], "RUNNING"),
+        (["c"], "FAILURE"),
+    ]
 
 
 def test_sem_parallel_thresholds_and_all_but_negative_values() -> None:
@@ -86,13 +93,17 @@ def test_sem_parallel_thresholds_and_all_but_negative_values() -> None:
     # "-2" = all but one: two successes suffice
     assert both(tree, 1, a="success", b="running", c="success") == [(["a", "b", "c"], "SUCCESS")]
     assert both(tree, 2, a="failure", b="running running", c="running failure") == [
-        (["a", "b", "c"], "RUNNING"), (["b", "c"], "FAILURE")]
+        (["a", "b", "c"], "RUNNING"),
+        (["b", "c"], "FAILURE"),
+    ]
 
 
 def test_sem_parallel_all_counts_failures() -> None:
     tree = ctl("ParallelAll", act("a"), act("b"), max_failures="2")
     assert both(tree, 2, a="failure", b="running success") == [
-        (["a", "b"], "RUNNING"), (["b"], "SUCCESS")]
+        (["a", "b"], "RUNNING"),
+        (["b"], "SUCCESS"),
+    ]
 
 
 def test_sem_run_once_skips_afterwards() -> None:
@@ -101,37 +112,45 @@ def test_sem_run_once_skips_afterwards() -> None:
 
 
 def test_sem_retry_and_repeat_counters() -> None:
-    assert both(dec("RetryUntilSuccessful", act("a"), num_attempts="2"), 1,
-                a="failure failure") == [(["a", "a"], "FAILURE")]
+    assert both(
+        dec("RetryUntilSuccessful", act("a"), num_attempts="2"), 1, a="failure failure"
+    ) == [(["a", "a"], "FAILURE")]
     assert both(dec("Repeat", act("a"), num_cycles="3"), 1, a="success success failure") == [
-        (["a", "a", "a"], "FAILURE")]
+        (["a", "a", "a"], "FAILURE")
+    ]
 
 
 def test_sem_stateful_action_keeps_a_stale_status_under_while_do_else() -> None:
     """An action ticked while still SUCCESS returns it without asking (StatefulActionNode)."""
     tree = ctl("WhileDoElse", act("cond_action"), act("body"))
     assert both(tree, 2, cond_action="success", body="running success") == [
-        (["cond_action", "body"], "RUNNING"), (["body"], "SUCCESS")]
+        (["cond_action", "body"], "RUNNING"),
+        (["body"], "SUCCESS"),
+    ]
 
 
 def test_sem_subtree_is_expanded() -> None:
-    doc = BTDocument.single(ctl("Sequence", BTNode("SubTree", NodeKind.SUBTREE,
-                                                    attrs={"ID": "Sub"}), act("b")))
+    doc = BTDocument.single(
+        ctl("Sequence", BTNode("SubTree", NodeKind.SUBTREE, attrs={"ID": "Sub"}), act("b"))
+    )
     doc.trees["Sub"] = BehaviorTree("Sub", ctl("Fallback", cond("c"), act("a")))
     record = BTRunner(doc, Plan(c="failure", a="success", b="success")).tick_once()
     assert [leaf[:2] for leaf in record.leaves] == [("c", "0/0/0"), ("a", "0/0/1"), ("b", "1")]
     assert record.result == "SUCCESS"
 
 
-@pytest.mark.parametrize("node", [
-    dec("Delay", act("a"), delay_msec="10"),
-    dec("Timeout", act("a"), msec="10"),
-    BTNode("Sleep", NodeKind.ACTION, attrs={"msec": "5"}),
-    ctl("MyCustomControl", act("a")),
-    dec("MyCustomDecorator", act("a")),
-    BTNode("Act", NodeKind.ACTION, name="x", attrs={"_skipIf": "flag"}),
-    dec("Repeat", act("a"), num_cycles="{n}"),
-])
+@pytest.mark.parametrize(
+    "node",
+    [
+        dec("Delay", act("a"), delay_msec="10"),
+        dec("Timeout", act("a"), msec="10"),
+        BTNode("Sleep", NodeKind.ACTION, attrs={"msec": "5"}),
+        ctl("MyCustomControl", act("a")),
+        dec("MyCustomDecorator", act("a")),
+        BTNode("Act", NodeKind.ACTION, name="x", attrs={"_skipIf": "flag"}),
+        dec("Repeat", act("a"), num_cycles="{n}"),
+    ],
+)
 def test_sem_unsupported_nodes_are_rejected_with_their_location(node: BTNode) -> None:
     node.location = SourceLocation("tree.xml", 7, 3)
     with pytest.raises(UnsupportedError) as info:

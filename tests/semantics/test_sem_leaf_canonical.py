@@ -29,18 +29,28 @@ from fsmbt.verify.pairing import machines_for
 from support.random_trees import bt_documents, random_tree
 
 #: The class, from the registry: controls ticked by the canonical rules, status maps, SubTree.
-CLASS_CONTROLS = tuple(sorted(n.name for n in all_nodes()
-                              if n.kind is NodeKind.CONTROL and n.handler in CANONICAL_RULES))
+CLASS_CONTROLS = tuple(
+    sorted(
+        n.name for n in all_nodes() if n.kind is NodeKind.CONTROL and n.handler in CANONICAL_RULES
+    )
+)
 CLASS_DECORATORS = tuple(sorted(n.name for n in all_nodes() if n.result_map is not None)) + (
-    "SubTree",)
+    "SubTree",
+)
 CLASS_LEAVES = ("Action", "Condition", "Action", "Condition", "AlwaysSuccess", "AlwaysFailure")
 WALK_STEPS = 80
 
 
-def class_tree(seed: int, max_nodes: int = 16,
-               leaves: tuple[str, ...] = CLASS_LEAVES) -> BTDocument:
-    return random_tree(random.Random(seed), controls=CLASS_CONTROLS, decorators=CLASS_DECORATORS,
-                       leaves=leaves, max_nodes=max_nodes)
+def class_tree(
+    seed: int, max_nodes: int = 16, leaves: tuple[str, ...] = CLASS_LEAVES
+) -> BTDocument:
+    return random_tree(
+        random.Random(seed),
+        controls=CLASS_CONTROLS,
+        decorators=CLASS_DECORATORS,
+        leaves=leaves,
+        max_nodes=max_nodes,
+    )
 
 
 def canonical_documents(count: int = 250) -> list[BTDocument]:
@@ -104,8 +114,11 @@ def test_checker_proves_canonical_equivalent_to_faithful(loop: bool) -> None:
 
 
 @settings(max_examples=60, deadline=None)
-@given(bt_documents(controls=CLASS_CONTROLS, decorators=CLASS_DECORATORS, leaves=CLASS_LEAVES,
-                    max_nodes=20))
+@given(
+    bt_documents(
+        controls=CLASS_CONTROLS, decorators=CLASS_DECORATORS, leaves=CLASS_LEAVES, max_nodes=20
+    )
+)
 def test_canonical_equivalent_on_hypothesis_trees(doc: BTDocument) -> None:
     try:
         canon = LeafMachine(doc)
@@ -128,13 +141,15 @@ def test_checker_verdict_same_on_both_machines() -> None:
             hfsm = bt_to_hfsm(doc).model
         except UnsupportedError:
             continue
-        targets = [hfsm] + [m.model for m in mutants(hfsm, seed=rng.randrange(1000),
-                                                      per_operator=1)]
+        targets = [hfsm] + [
+            m.model for m in mutants(hfsm, seed=rng.randrange(1000), per_operator=1)
+        ]
         for target in targets:
             _src, result, _mode = machines_for(doc, target)
             on_canon = native.check(LeafMachine(doc), result, mode="lockstep").equivalent
-            on_faithful = native.check(LeafMachine(doc, generic=True), result,
-                                       mode="lockstep").equivalent
+            on_faithful = native.check(
+                LeafMachine(doc, generic=True), result, mode="lockstep"
+            ).equivalent
             assert on_canon == on_faithful
             checked += 1
             caught += not on_canon
@@ -144,10 +159,21 @@ def test_checker_verdict_same_on_both_machines() -> None:
 def _wide_reactive(width: int) -> BTDocument:
     """ReactiveSequence of ReactiveFallbacks (condition, Sequence(action)): the shape of Nav2
     trees; the plain Sequence under a reactive node keeps it off the static table."""
-    kids = [BTNode("ReactiveFallback", NodeKind.CONTROL, children=[
-        BTNode("Check", NodeKind.CONDITION, name=f"c{i}"),
-        BTNode("Sequence", NodeKind.CONTROL, children=[
-            BTNode("Do", NodeKind.ACTION, name=f"a{i}")])]) for i in range(width)]
+    kids = [
+        BTNode(
+            "ReactiveFallback",
+            NodeKind.CONTROL,
+            children=[
+                BTNode("Check", NodeKind.CONDITION, name=f"c{i}"),
+                BTNode(
+                    "Sequence",
+                    NodeKind.CONTROL,
+                    children=[BTNode("Do", NodeKind.ACTION, name=f"a{i}")],
+                ),
+            ],
+        )
+        for i in range(width)
+    ]
     return BTDocument.single(BTNode("ReactiveSequence", NodeKind.CONTROL, children=kids))
 
 
@@ -160,7 +186,10 @@ def test_reactive_tree_has_one_state_per_leaf() -> None:
 
 
 def test_trees_outside_the_class_stay_faithful() -> None:
-    root = BTNode("Parallel", NodeKind.CONTROL, children=[
-        BTNode("Do", NodeKind.ACTION, name="a"), BTNode("Do", NodeKind.ACTION, name="b")])
+    root = BTNode(
+        "Parallel",
+        NodeKind.CONTROL,
+        children=[BTNode("Do", NodeKind.ACTION, name="a"), BTNode("Do", NodeKind.ACTION, name="b")],
+    )
     machine = LeafMachine(BTDocument.single(root))
     assert not machine.canonical and not is_canonical_class(machine.tree)

@@ -29,8 +29,12 @@ WALK_STEPS = 80
 
 
 def plain_random_tree(seed: int) -> BTDocument:
-    return random_tree(random.Random(seed), controls=("Sequence", "Fallback"),
-                       decorators=("SubTree",), leaves=("Action", "Condition"))
+    return random_tree(
+        random.Random(seed),
+        controls=("Sequence", "Fallback"),
+        decorators=("SubTree",),
+        leaves=("Action", "Condition"),
+    )
 
 
 def plain_documents() -> list[BTDocument]:
@@ -89,8 +93,16 @@ def _summary(report) -> dict:
             continue
         trace = None
         if prop.counterexample is not None:
-            trace = [(s.input, tuple(s.source_outputs), tuple(s.result_outputs), s.source_status,
-                      s.result_status) for s in prop.counterexample]
+            trace = [
+                (
+                    s.input,
+                    tuple(s.source_outputs),
+                    tuple(s.result_outputs),
+                    s.source_status,
+                    s.result_status,
+                )
+                for s in prop.counterexample
+            ]
         out[name] = (prop.holds, trace)
     return out
 
@@ -99,8 +111,10 @@ def _verdicts(doc: BTDocument, result, loop: bool) -> tuple[dict, dict]:
     source, target, mode = machines_for(doc, result, loop=loop)
     assert isinstance(source, LeafMachine) and source.fast
     generic = LeafMachine(doc, loop=loop, generic=True)
-    return (_summary(native.check(source, target, mode="lockstep")),
-            _summary(native.check(generic, target, mode="lockstep")))
+    return (
+        _summary(native.check(source, target, mode="lockstep")),
+        _summary(native.check(generic, target, mode="lockstep")),
+    )
 
 
 @pytest.mark.parametrize("loop", [False, True])
@@ -125,17 +139,37 @@ def _leaf(name: str, kind: NodeKind = NodeKind.ACTION) -> BTNode:
     return BTNode("Act", kind, name=name)
 
 
-@pytest.mark.parametrize("root", [
-    BTNode("ReactiveSequence", NodeKind.CONTROL, children=[
-        _leaf("a"), BTNode("Sequence", NodeKind.CONTROL, children=[_leaf("b"), _leaf("c")])]),
-    BTNode("SequenceWithMemory", NodeKind.CONTROL, children=[_leaf("a"), _leaf("b")]),
-    BTNode("Sequence", NodeKind.CONTROL, children=[
-        BTNode("Repeat", NodeKind.DECORATOR, attrs={"num_cycles": "2"}, children=[_leaf("a")]),
-        _leaf("b")]),
-    BTNode("Fallback", NodeKind.CONTROL, children=[
-        _leaf("a"), BTNode("AlwaysSuccess", NodeKind.ACTION)]),
-    BTNode("Parallel", NodeKind.CONTROL, children=[_leaf("a"), _leaf("b")]),
-], ids=["plain-under-reactive", "with-memory", "loop-decorator", "always-success", "parallel"])
+@pytest.mark.parametrize(
+    "root",
+    [
+        BTNode(
+            "ReactiveSequence",
+            NodeKind.CONTROL,
+            children=[
+                _leaf("a"),
+                BTNode("Sequence", NodeKind.CONTROL, children=[_leaf("b"), _leaf("c")]),
+            ],
+        ),
+        BTNode("SequenceWithMemory", NodeKind.CONTROL, children=[_leaf("a"), _leaf("b")]),
+        BTNode(
+            "Sequence",
+            NodeKind.CONTROL,
+            children=[
+                BTNode(
+                    "Repeat", NodeKind.DECORATOR, attrs={"num_cycles": "2"}, children=[_leaf("a")]
+                ),
+                _leaf("b"),
+            ],
+        ),
+        BTNode(
+            "Fallback",
+            NodeKind.CONTROL,
+            children=[_leaf("a"), BTNode("AlwaysSuccess", NodeKind.ACTION)],
+        ),
+        BTNode("Parallel", NodeKind.CONTROL, children=[_leaf("a"), _leaf("b")]),
+    ],
+    ids=["plain-under-reactive", "with-memory", "loop-decorator", "always-success", "parallel"],
+)
 def test_trees_outside_the_class_take_the_generic_path(root: BTNode) -> None:
     assert not LeafMachine(BTDocument.single(root)).fast
 
@@ -150,8 +184,11 @@ def test_deep_tree_builds_without_recursion() -> None:
     depth = 100_000
     node = _leaf("bottom")
     for i in range(depth):
-        node = BTNode("Sequence" if i % 2 else "Fallback", NodeKind.CONTROL,
-                      children=[node, _leaf(f"x{i}", NodeKind.CONDITION)])
+        node = BTNode(
+            "Sequence" if i % 2 else "Fallback",
+            NodeKind.CONTROL,
+            children=[node, _leaf(f"x{i}", NodeKind.CONDITION)],
+        )
     machine = LeafMachine(BTDocument.single(node))
     assert machine.fast
     state, outputs = machine.start()
@@ -167,11 +204,19 @@ STATIC_DECORATORS = ("Inverter", "ForceSuccess", "ForceFailure", "SubTree")
 
 
 def static_documents(count: int = 400) -> list[BTDocument]:
-    docs = [random_tree(random.Random(10_000 + seed), controls=STATIC_CONTROLS,
-                        decorators=STATIC_DECORATORS, leaves=("Action", "Condition"),
-                        max_nodes=18) for seed in range(count)]
-    return [doc for doc in docs if LeafMachine(doc).fast and not is_plain_tree(
-        LeafMachine(doc).tree)]
+    docs = [
+        random_tree(
+            random.Random(10_000 + seed),
+            controls=STATIC_CONTROLS,
+            decorators=STATIC_DECORATORS,
+            leaves=("Action", "Condition"),
+            max_nodes=18,
+        )
+        for seed in range(count)
+    ]
+    return [
+        doc for doc in docs if LeafMachine(doc).fast and not is_plain_tree(LeafMachine(doc).tree)
+    ]
 
 
 @pytest.mark.parametrize("loop", [False, True])
@@ -187,17 +232,30 @@ def test_static_reactive_tables_agree_in_lockstep(loop: bool) -> None:
 def test_checker_proves_static_reactive_tables_equivalent(loop: bool) -> None:
     """Every input sequence: the product of the table machine and the faithful one."""
     for doc in static_documents(200):
-        report = native.check(LeafMachine(doc, loop=loop, generic=True),
-                              LeafMachine(doc, loop=loop), mode="lockstep")
+        report = native.check(
+            LeafMachine(doc, loop=loop, generic=True), LeafMachine(doc, loop=loop), mode="lockstep"
+        )
         assert report.equivalent, report.verdicts()
 
 
 def test_reactive_restart_goes_to_the_topmost_reactive_first_leaf() -> None:
-    inner = BTNode("ReactiveFallback", NodeKind.CONTROL, children=[
-        _leaf("c", NodeKind.CONDITION), _leaf("run")])
-    root = BTNode("Sequence", NodeKind.CONTROL, children=[
-        _leaf("first"), BTNode("ReactiveSequence", NodeKind.CONTROL, children=[
-            _leaf("guard", NodeKind.CONDITION), inner])])
+    inner = BTNode(
+        "ReactiveFallback",
+        NodeKind.CONTROL,
+        children=[_leaf("c", NodeKind.CONDITION), _leaf("run")],
+    )
+    root = BTNode(
+        "Sequence",
+        NodeKind.CONTROL,
+        children=[
+            _leaf("first"),
+            BTNode(
+                "ReactiveSequence",
+                NodeKind.CONTROL,
+                children=[_leaf("guard", NodeKind.CONDITION), inner],
+            ),
+        ],
+    )
     machine = LeafMachine(BTDocument.single(root))
     assert machine.fast
     state, outputs = machine.start()

@@ -34,8 +34,16 @@ def cond(name: str) -> BTNode:
 
 
 def seq_fallback() -> BTDocument:
-    return BTDocument.single(BTNode("Sequence", NodeKind.CONTROL, children=[
-        cond("c"), BTNode("Fallback", NodeKind.CONTROL, children=[act("a"), act("b")])]))
+    return BTDocument.single(
+        BTNode(
+            "Sequence",
+            NodeKind.CONTROL,
+            children=[
+                cond("c"),
+                BTNode("Fallback", NodeKind.CONTROL, children=[act("a"), act("b")]),
+            ],
+        )
+    )
 
 
 def test_sem_leaf_machine_explores_a_small_tree() -> None:
@@ -45,8 +53,7 @@ def test_sem_leaf_machine_explores_a_small_tree() -> None:
     assert machine.inputs(explored.start) == ("success", "failure")
     after_c, out = explored.transitions[explored.start]["success"]
     assert out == ("a",) and machine.inputs(after_c) == ("success", "failure", "running")
-    assert explored.transitions[explored.start]["failure"] == (RootResult("FAILURE"),
-                                                               ("FAILURE",))
+    assert explored.transitions[explored.start]["failure"] == (RootResult("FAILURE"), ("FAILURE",))
     # a running leaf under a non-reactive parent is ticked again
     resumed, out = explored.transitions[after_c]["running"]
     assert out == ("a",) and machine.describe(resumed) == "a@1/0"
@@ -67,8 +74,9 @@ def test_sem_loop_mode_outputs_result_then_first_leaf() -> None:
 
 
 def test_sem_reactive_parent_restarts_at_its_first_child() -> None:
-    doc = BTDocument.single(BTNode("ReactiveSequence", NodeKind.CONTROL,
-                                   children=[cond("c"), act("a")]))
+    doc = BTDocument.single(
+        BTNode("ReactiveSequence", NodeKind.CONTROL, children=[cond("c"), act("a")])
+    )
     machine = LeafMachine(doc)
     state, _ = machine.start()
     state, out = machine.step(state, "success")
@@ -77,11 +85,21 @@ def test_sem_reactive_parent_restarts_at_its_first_child() -> None:
 
 
 def test_sem_internal_leaves_are_not_observed_and_livelock_is_reported() -> None:
-    doc = BTDocument.single(BTNode("Sequence", NodeKind.CONTROL, children=[
-        BTNode("AlwaysSuccess", NodeKind.ACTION), act("a")]))
+    doc = BTDocument.single(
+        BTNode(
+            "Sequence",
+            NodeKind.CONTROL,
+            children=[BTNode("AlwaysSuccess", NodeKind.ACTION), act("a")],
+        )
+    )
     assert LeafMachine(doc).start()[1] == ("a",)
-    stuck = BTDocument.single(BTNode("KeepRunningUntilFailure", NodeKind.DECORATOR,
-                                     children=[BTNode("AlwaysSuccess", NodeKind.ACTION)]))
+    stuck = BTDocument.single(
+        BTNode(
+            "KeepRunningUntilFailure",
+            NodeKind.DECORATOR,
+            children=[BTNode("AlwaysSuccess", NodeKind.ACTION)],
+        )
+    )
     state, out = LeafMachine(stuck).start()
     assert out == (LIVELOCK,) and state == RootResult(LIVELOCK)
 
@@ -141,7 +159,7 @@ def test_sem_random_walks_replay_identically_in_btcpp(seed: int) -> None:
         observed.extend(outputs)
     livelock = LIVELOCK in observed
     if livelock:
-        observed = observed[:observed.index(LIVELOCK)]
+        observed = observed[: observed.index(LIVELOCK)]
     replay = _Replay(chosen)
     engine = BTCppRunner(doc, replay, exactly_once=True)
     engine_seen: list[str] = []
@@ -157,8 +175,7 @@ def test_sem_random_walks_replay_identically_in_btcpp(seed: int) -> None:
             break  # this tick's result came after the walk ended
         if record.result != "RUNNING":
             engine_seen.append(record.result)
-        if (livelock or errored) and not replay.outcomes \
-                and len(engine_seen) >= len(observed):
+        if (livelock or errored) and not replay.outcomes and len(engine_seen) >= len(observed):
             break
-    assert engine_seen[:len(observed)] == observed, seed
+    assert engine_seen[: len(observed)] == observed, seed
     assert len(engine_seen) >= len(observed)

@@ -31,8 +31,9 @@ class ScriptedTick:
         self.script = list(script)  # (status, consume the event, new bb.state or None)
         self.seen: list[tuple[int, str, str]] = []  # (memory, state, event) at each tick
 
-    def __call__(self, memory: int, bb: LebtBlackboard,
-                 actions: list[str]) -> tuple[int, NodeStatus]:
+    def __call__(
+        self, memory: int, bb: LebtBlackboard, actions: list[str]
+    ) -> tuple[int, NodeStatus]:
         self.seen.append((memory, bb.state, bb.event))
         status, consume, new_state = self.script.pop(0)
         if new_state is not None:
@@ -43,9 +44,12 @@ class ScriptedTick:
         return memory + 1, status
 
 
-def driver(script: list[tuple[NodeStatus, bool, str | None]], *, init: bool = False,
-           blackboard: PlainBlackboard | None = None,
-           ) -> tuple[MacroStepDriver[int, ScriptState], ScriptedTick]:
+def driver(
+    script: list[tuple[NodeStatus, bool, str | None]],
+    *,
+    init: bool = False,
+    blackboard: PlainBlackboard | None = None,
+) -> tuple[MacroStepDriver[int, ScriptState], ScriptedTick]:
     tick = ScriptedTick(script)
     leaves = LebtLeaves({}, {}, START, init)
     if blackboard is None:
@@ -55,6 +59,7 @@ def driver(script: list[tuple[NodeStatus, bool, str | None]], *, init: bool = Fa
     def same_blackboard(state: str, event: str) -> LebtBlackboard:
         persistent.state, persistent.event = state, event
         return persistent
+
     return MacroStepDriver(leaves, tick, 0, ScriptState, same_blackboard), tick
 
 
@@ -82,8 +87,13 @@ def test_sem_lebt_driver_ticks_twice_only_on_success_with_the_event_pending() ->
 
 
 def test_sem_lebt_driver_never_ticks_a_third_time() -> None:
-    run, tick = driver([(NodeStatus.SUCCESS, False, None), (NodeStatus.SUCCESS, False, None),
-                        (NodeStatus.SUCCESS, False, None)])
+    run, tick = driver(
+        [
+            (NodeStatus.SUCCESS, False, None),
+            (NodeStatus.SUCCESS, False, None),
+            (NodeStatus.SUCCESS, False, None),
+        ]
+    )
     state, _ = run.macro_step(ScriptState(0, "A", None), "go")
     assert len(tick.seen) == 2 and state == ScriptState(2, "A", NodeStatus.SUCCESS)
 

@@ -24,16 +24,25 @@ SEQUENCES = 40
 LENGTH = 14
 
 
-def _fsm(name: str, edges: list[tuple[str, str, str]], finals: str = "", *,
-         initial: str, initial_event: str | None = None, silent: str = "") -> FSM:
-    fsm = FSM(name=name, start_name="Start" if initial_event else None,
-              initial_event=initial_event)
+def _fsm(
+    name: str,
+    edges: list[tuple[str, str, str]],
+    finals: str = "",
+    *,
+    initial: str,
+    initial_event: str | None = None,
+    silent: str = "",
+) -> FSM:
+    fsm = FSM(name=name, start_name="Start" if initial_event else None, initial_event=initial_event)
     names: list[str] = [initial]
     for s, _, t in edges:
         names += [s, t]
     for state in dict.fromkeys(names):
-        fsm.add_state(state, final=state in finals.split(),
-                      action=None if state in silent.split() else f"do_{state}")
+        fsm.add_state(
+            state,
+            final=state in finals.split(),
+            action=None if state in silent.split() else f"do_{state}",
+        )
     fsm.initial = initial
     for s, e, t in edges:
         fsm.add_transition(s, e, t)
@@ -42,38 +51,86 @@ def _fsm(name: str, edges: list[tuple[str, str, str]], finals: str = "", *,
 
 def _paper() -> tuple[FSM, list[Structure]]:
     pairs = ["AB", "AC", "AD", "AF", "BC", "BD", "CD", "DE", "EC", "ED", "EG", "GH", "FI", "IJ"]
-    fsm = _fsm("paper", [(a, f"event{a}{b}", b) for a, b in pairs], "H J", initial="A",
-               initial_event="eventStartA")
-    structure = [("A", [("B", []), ("F", [("I", [("J", [])])])]), ("C", []),
-                 ("D", [("E", [("G", [("H", [])])])])]
+    fsm = _fsm(
+        "paper",
+        [(a, f"event{a}{b}", b) for a, b in pairs],
+        "H J",
+        initial="A",
+        initial_event="eventStartA",
+    )
+    structure = [
+        ("A", [("B", []), ("F", [("I", [("J", [])])])]),
+        ("C", []),
+        ("D", [("E", [("G", [("H", [])])])]),
+    ]
     return fsm, structure
 
 
 CASES: dict[str, tuple[FSM, list[Structure]]] = {
     "paper_A_J": _paper(),
-    "linear": (_fsm("linear", [("S0", "next", "S1"), ("S1", "next", "S2")], "S2",
-                    initial="S0"), [("S0", [("S1", [("S2", [])])])]),
-    "self_loop": (_fsm("self_loop", [("A", "a", "A"), ("A", "b", "B")], "B", initial="A"),
-                  [("A", [("B", [])])]),
-    "two_cycle": (_fsm("two_cycle", [("A", "go", "B"), ("B", "back", "A")], initial="A"),
-                  [("A", [("B", [])])]),
-    "branch": (_fsm("branch", [("A", "x", "B"), ("A", "y", "C")], "B C", initial="A"),
-               [("A", [("B", []), ("C", [])])]),
-    "shared_target": (_fsm("shared", [("A", "x", "C"), ("A", "y", "B"), ("B", "z", "C")], "C",
-                           initial="A"), [("A", [("B", [])]), ("C", [])]),
-    "traffic_light": (_fsm("traffic", [("Red", "t", "Green"), ("Green", "t", "Yellow"),
-                                       ("Yellow", "t", "Red"), ("Green", "e", "Red")],
-                           initial="Red"), [("Red", [("Green", [("Yellow", [])])])]),
-    "initial_event": (_fsm("init_event", [("A", "x", "B")], "B", initial="A",
-                           initial_event="go"), [("A", [("B", [])])]),
-    "ring": (_fsm("ring", [("A", "n", "B"), ("B", "n", "C"), ("C", "n", "D"), ("D", "n", "A")],
-                  initial="A"), [("A", [("B", [("C", [("D", [])])])])]),
-    "all_loops": (_fsm("all_loops", [("A", "a", "B"), ("B", "b", "C"), ("C", "c", "B"),
-                                     ("C", "d", "A"), ("A", "e", "C")], initial="A"),
-                  [("A", []), ("B", []), ("C", [])]),
-    "silent_state": (_fsm("silent", [("A", "n", "B"), ("B", "n", "C"), ("C", "n", "A"),
-                                     ("B", "stop", "End")], "End", initial="A", silent="B"),
-                     [("A", [("B", [("C", []), ("End", [])])])]),
+    "linear": (
+        _fsm("linear", [("S0", "next", "S1"), ("S1", "next", "S2")], "S2", initial="S0"),
+        [("S0", [("S1", [("S2", [])])])],
+    ),
+    "self_loop": (
+        _fsm("self_loop", [("A", "a", "A"), ("A", "b", "B")], "B", initial="A"),
+        [("A", [("B", [])])],
+    ),
+    "two_cycle": (
+        _fsm("two_cycle", [("A", "go", "B"), ("B", "back", "A")], initial="A"),
+        [("A", [("B", [])])],
+    ),
+    "branch": (
+        _fsm("branch", [("A", "x", "B"), ("A", "y", "C")], "B C", initial="A"),
+        [("A", [("B", []), ("C", [])])],
+    ),
+    "shared_target": (
+        _fsm("shared", [("A", "x", "C"), ("A", "y", "B"), ("B", "z", "C")], "C", initial="A"),
+        [("A", [("B", [])]), ("C", [])],
+    ),
+    "traffic_light": (
+        _fsm(
+            "traffic",
+            [
+                ("Red", "t", "Green"),
+                ("Green", "t", "Yellow"),
+                ("Yellow", "t", "Red"),
+                ("Green", "e", "Red"),
+            ],
+            initial="Red",
+        ),
+        [("Red", [("Green", [("Yellow", [])])])],
+    ),
+    "initial_event": (
+        _fsm("init_event", [("A", "x", "B")], "B", initial="A", initial_event="go"),
+        [("A", [("B", [])])],
+    ),
+    "ring": (
+        _fsm(
+            "ring",
+            [("A", "n", "B"), ("B", "n", "C"), ("C", "n", "D"), ("D", "n", "A")],
+            initial="A",
+        ),
+        [("A", [("B", [("C", [("D", [])])])])],
+    ),
+    "all_loops": (
+        _fsm(
+            "all_loops",
+            [("A", "a", "B"), ("B", "b", "C"), ("C", "c", "B"), ("C", "d", "A"), ("A", "e", "C")],
+            initial="A",
+        ),
+        [("A", []), ("B", []), ("C", [])],
+    ),
+    "silent_state": (
+        _fsm(
+            "silent",
+            [("A", "n", "B"), ("B", "n", "C"), ("C", "n", "A"), ("B", "stop", "End")],
+            "End",
+            initial="A",
+            silent="B",
+        ),
+        [("A", [("B", [("C", []), ("End", [])])])],
+    ),
 }
 
 
@@ -98,8 +155,9 @@ def test_sem_lebt_runtimes_agree_with_the_fsm(case: str) -> None:
             c_out, p_out = btcpp.macro_step(event), pytrees.macro_step(event)
             assert f_out == o_out == c_out == p_out, (case, step, event, f_state)
             final = reference.status(f_state) == FINAL
-            assert (ours.status(o_state) == FINAL) == final == btcpp.terminated \
-                == pytrees.terminated, (case, step, event, f_state)
+            assert (
+                (ours.status(o_state) == FINAL) == final == btcpp.terminated == pytrees.terminated
+            ), (case, step, event, f_state)
             compared += 1
     assert compared == SEQUENCES * LENGTH
 
@@ -117,8 +175,12 @@ def test_sem_lebt_paper_example_walkthrough() -> None:
     assert out == ("do_C",) and machine.status(state) != FINAL
     state, out = machine.step(state, "eventAB")  # no transition from C: ignored
     assert out == ()
-    for event, action in [("eventCD", "do_D"), ("eventDE", "do_E"), ("eventEG", "do_G"),
-                          ("eventGH", "do_H")]:
+    for event, action in [
+        ("eventCD", "do_D"),
+        ("eventDE", "do_E"),
+        ("eventEG", "do_G"),
+        ("eventGH", "do_H"),
+    ]:
         state, out = machine.step(state, event)
         assert out == (action,)
     assert machine.status(state) == FINAL
@@ -141,10 +203,16 @@ def _random_fsm(rng: random.Random, index: int) -> FSM:
         event = rng.choice(free)
         used.add((source, event))
         labelled.append((source, event, target))
-    finals = " ".join(s for s in names[1:] if rng.random() < 0.2
-                      and all(src != s for src, _, _ in labelled))
-    return _fsm(f"random{index}", labelled, finals, initial="S0",
-                initial_event="start" if rng.random() < 0.5 else None)
+    finals = " ".join(
+        s for s in names[1:] if rng.random() < 0.2 and all(src != s for src, _, _ in labelled)
+    )
+    return _fsm(
+        f"random{index}",
+        labelled,
+        finals,
+        initial="S0",
+        initial_event="start" if rng.random() < 0.5 else None,
+    )
 
 
 def test_sem_converter_lebts_run_alike_in_every_runtime() -> None:
@@ -167,7 +235,13 @@ def test_sem_converter_lebts_run_alike_in_every_runtime() -> None:
                 event = rng.choice(reference.alphabet)
                 f_state, f_out = reference.step(f_state, event)
                 o_state, o_out = ours.step(o_state, event)
-                assert f_out == o_out == btcpp.macro_step(event) == pytrees.macro_step(event), \
-                    (fsm.name, event)
-                assert (reference.status(f_state) == FINAL) == (ours.status(o_state) == FINAL) \
-                    == btcpp.terminated == pytrees.terminated, (fsm.name, event)
+                assert f_out == o_out == btcpp.macro_step(event) == pytrees.macro_step(event), (
+                    fsm.name,
+                    event,
+                )
+                assert (
+                    (reference.status(f_state) == FINAL)
+                    == (ours.status(o_state) == FINAL)
+                    == btcpp.terminated
+                    == pytrees.terminated
+                ), (fsm.name, event)

@@ -54,8 +54,9 @@ def exits_by_state(doc: BTDocument) -> dict[str, list[str]]:
     return out
 
 
-def assert_same_runs(doc: BTDocument, alphabet: list[str], rng: random.Random, *,
-                     runs: int = 3, length: int = 25) -> int:
+def assert_same_runs(
+    doc: BTDocument, alphabet: list[str], rng: random.Random, *, runs: int = 3, length: int = 25
+) -> int:
     """Lockstep random runs; events favour the current state's exits so runs go deep.
     Also checks that fast and generic states correspond one to one. Returns steps taken."""
     fast, generic = both_paths(doc, alphabet)
@@ -158,30 +159,57 @@ def test_sem_fast_matches_generic_on_mutants() -> None:
     assert differing > 0  # the fast path also reproduces non-equivalent verdicts
 
 
-def selector(guard_pairs: str, state: str, final: bool = False, exits: str = "",
-             children: list[BTNode] | None = None) -> BTNode:
+def selector(
+    guard_pairs: str,
+    state: str,
+    final: bool = False,
+    exits: str = "",
+    children: list[BTNode] | None = None,
+) -> BTNode:
     guard = BTNode("LebtGuard", NodeKind.CONDITION, attrs={"target": state, "pairs": guard_pairs})
-    leaf = BTNode("LebtState", NodeKind.ACTION, attrs={
-        "state": state, "action": f"do_{state}", "final": "true" if final else "false",
-        "exits": exits})
-    body = leaf if children is None else BTNode("Sequence", NodeKind.CONTROL,
-                                                children=[leaf, *children])
+    leaf = BTNode(
+        "LebtState",
+        NodeKind.ACTION,
+        attrs={
+            "state": state,
+            "action": f"do_{state}",
+            "final": "true" if final else "false",
+            "exits": exits,
+        },
+    )
+    body = (
+        leaf
+        if children is None
+        else BTNode("Sequence", NodeKind.CONTROL, children=[leaf, *children])
+    )
     return BTNode("Fallback", NodeKind.CONTROL, children=[guard, body])
 
 
 def tiny_lebt() -> BTDocument:
     """A -go-> B (chain), B -back-> A (loop), B -end-> C final, A final-free."""
-    b = selector("A/go", "B", exits="back;end",
-                 children=[selector("B/end", "C", final=True)])
-    root = BTNode("Sequence", NodeKind.CONTROL, children=[
-        selector("S/;A/back", "A", exits="go", children=[b])])
+    b = selector("A/go", "B", exits="back;end", children=[selector("B/end", "C", final=True)])
+    root = BTNode(
+        "Sequence",
+        NodeKind.CONTROL,
+        children=[selector("S/;A/back", "A", exits="go", children=[b])],
+    )
     # A has in-degree 2 (init and back): it is a root selector, the loop target
     root.children[0].children[0].attrs["pairs"] = "S/;B/back"
     return BTDocument.single(root)
 
 
-@pytest.mark.parametrize("change", ["reactive_root", "subtree", "extra_child", "always_success",
-                                    "inverter", "guard_after_body", "body_without_state"])
+@pytest.mark.parametrize(
+    "change",
+    [
+        "reactive_root",
+        "subtree",
+        "extra_child",
+        "always_success",
+        "inverter",
+        "guard_after_body",
+        "body_without_state",
+    ],
+)
 def test_sem_grammar_refuses_other_shapes(change: str) -> None:
     doc = tiny_lebt()
     assert strict_lebt_sels(CompiledTree(doc)) is not None
@@ -217,8 +245,13 @@ def test_sem_fast_tiny_lebt_by_hand() -> None:
     assert machine.fast
     state, out = machine.start()
     assert out == ("do_A",) and machine.status(state) == "running"
-    for event, expected in [("end", ()), ("go", ("do_B",)), ("back", ("do_A",)),
-                            ("go", ("do_B",)), ("end", ("do_C",))]:
+    for event, expected in [
+        ("end", ()),
+        ("go", ("do_B",)),
+        ("back", ("do_A",)),
+        ("go", ("do_B",)),
+        ("end", ("do_C",)),
+    ]:
         state, out = machine.step(state, event)
         assert out == expected, event
     assert machine.status(state) == "final" and state.running is None

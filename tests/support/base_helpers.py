@@ -47,5 +47,6 @@ def plain_under_reactive() -> BTDocument:
     """ReactiveSequence(c1, Sequence(c2, a3)): after a3 runs, the next tick re-checks c1 and then
     RESUMES a3 (the plain Sequence remembers its running child) - memory one state per leaf
     cannot hold."""
-    return BTDocument.single(ctrl("ReactiveSequence", leaf("c1", True),
-                                  ctrl("Sequence", leaf("c2", True), leaf("a3"))))
+    return BTDocument.single(
+        ctrl("ReactiveSequence", leaf("c1", True), ctrl("Sequence", leaf("c2", True), leaf("a3")))
+    )

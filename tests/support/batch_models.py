@@ -8,8 +8,15 @@ from fsmbt import api
 from fsmbt.generate import DatasetSpec, generate_models
 
 
-def write_models(folder: Path, n: int, *, seed: int = 7, max_states: int = 8,
-                 depth: int | None = 3, nested: bool = True) -> list[Path]:
+def write_models(
+    folder: Path,
+    n: int,
+    *,
+    seed: int = 7,
+    max_states: int = 8,
+    depth: int | None = 3,
+    nested: bool = True,
+) -> list[Path]:
     """Write ``n`` generated models (half FSMs, half BTs) under ``folder``.
 
     Args:

@@ -29,24 +29,36 @@ def _control(kind: str, *children: BTNode) -> BTNode:
     return BTNode(type=kind, kind=NodeKind.CONTROL, children=list(children))
 
 
-ROBOT_CONDITIONS = ("BatteryBelow", "Cube2inDelivery", "CubeinHand", "RobotatCube2",
-                    "RobotatDelivery", "RobotAtInspection")
+ROBOT_CONDITIONS = (
+    "BatteryBelow",
+    "Cube2inDelivery",
+    "CubeinHand",
+    "RobotatCube2",
+    "RobotatDelivery",
+    "RobotAtInspection",
+)
 
 
 def paper_robot_bt() -> BTDocument:
     """The paper's robot BT (conditions as listed in the paper, the rest actions)."""
+
     def leaf(name: str) -> BTNode:
         return _leaf(name, name in ROBOT_CONDITIONS)
 
     seq, fb = (lambda *c: _control("Sequence", *c)), (lambda *c: _control("Fallback", *c))
     root = seq(
         fb(leaf("BatteryBelow"), leaf("Recharge")),
-        fb(leaf("Cube2inDelivery"), seq(
-            fb(leaf("CubeinHand"), seq(fb(leaf("RobotatCube2"), leaf("MovetoCube2")),
-                                      leaf("Pickcube2"))),
-            fb(leaf("RobotatDelivery"), leaf("MovetoDelivery")),
-            leaf("PlaceCube2"),
-        )),
+        fb(
+            leaf("Cube2inDelivery"),
+            seq(
+                fb(
+                    leaf("CubeinHand"),
+                    seq(fb(leaf("RobotatCube2"), leaf("MovetoCube2")), leaf("Pickcube2")),
+                ),
+                fb(leaf("RobotatDelivery"), leaf("MovetoDelivery")),
+                leaf("PlaceCube2"),
+            ),
+        ),
         fb(leaf("RobotAtInspection"), leaf("Dock")),
     )
     return BTDocument.single(root)

@@ -13,8 +13,9 @@ from fsmbt.model.fsm import FSM, State
 EVENTS = ("a", "b", "c", "d", "e")
 
 
-def random_hfsm(seed: int, *, max_depth: int = 3, parallel: bool = False,
-                max_states: int = 5) -> FSM:
+def random_hfsm(
+    seed: int, *, max_depth: int = 3, parallel: bool = False, max_states: int = 5
+) -> FSM:
     rng = random.Random(seed)
     top = FSM(name=f"hfsm_{seed}")
     if rng.random() < 0.5:
@@ -44,8 +45,11 @@ def random_hfsm(seed: int, *, max_depth: int = 3, parallel: bool = False,
                     state.regions.append(sub)
                     work.append((sub, f"{name}_r{region_index}_", max_depth))  # flat regions
             machine.add_state(state)
-        finals = [n for n in names[1:] if rng.random() < (0.3 if depth else 0.15)
-                  and machine.states[n].is_atomic]
+        finals = [
+            n
+            for n in names[1:]
+            if rng.random() < (0.3 if depth else 0.15) and machine.states[n].is_atomic
+        ]
         for name in finals:
             machine.states[name].final = True
         for name in names:

@@ -19,8 +19,11 @@ from fsmbt.verify.mutations import Mutant, mutants
 from support.random_trees import lebt_from_structure
 from support.ver_models import paper_fsm, renamed_copy
 
-PAPER_STRUCTURE = [("A", [("B", []), ("F", [("I", [("J", [])])])]), ("C", []),
-                   ("D", [("E", [("G", [("H", [])])])])]
+PAPER_STRUCTURE = [
+    ("A", [("B", []), ("F", [("I", [("J", [])])])]),
+    ("C", []),
+    ("D", [("E", [("G", [("H", [])])])]),
+]
 PER_OPERATOR = 4  # mutants per operator and pair, as run_family draws them
 
 
@@ -30,17 +33,29 @@ def leaf(name: str, kind: NodeKind = NodeKind.ACTION) -> BTNode:
 
 def small_bt_and_leaf_fsm() -> tuple[BTDocument, FSM]:
     """Sequence(c1?, Fallback(a1, a2)) and its leaf FSM, derived by hand."""
-    root = BTNode("Sequence", NodeKind.CONTROL, children=[
-        leaf("c1", NodeKind.CONDITION),
-        BTNode("Fallback", NodeKind.CONTROL, children=[leaf("a1"), leaf("a2")])])
+    root = BTNode(
+        "Sequence",
+        NodeKind.CONTROL,
+        children=[
+            leaf("c1", NodeKind.CONDITION),
+            BTNode("Fallback", NodeKind.CONTROL, children=[leaf("a1"), leaf("a2")]),
+        ],
+    )
     fsm = FSM(name="leaf_fsm")
     for name in ("c1", "a1", "a2"):
         fsm.add_state(name)
     fsm.add_state(State("S", action="SUCCESS", final=True))
     fsm.add_state(State("F", action="FAILURE", final=True))
-    for a, e, b in [("c1", "success", "a1"), ("c1", "failure", "F"), ("a1", "success", "S"),
-                    ("a1", "failure", "a2"), ("a1", "running", "a1"), ("a2", "success", "S"),
-                    ("a2", "failure", "F"), ("a2", "running", "a2")]:
+    for a, e, b in [
+        ("c1", "success", "a1"),
+        ("c1", "failure", "F"),
+        ("a1", "success", "S"),
+        ("a1", "failure", "a2"),
+        ("a1", "running", "a1"),
+        ("a2", "success", "S"),
+        ("a2", "failure", "F"),
+        ("a2", "running", "a2"),
+    ]:
         fsm.add_transition(a, e, b)
     return BTDocument.single(root), fsm
 
@@ -60,8 +75,9 @@ def leaf_fsm_by_exploration(doc: BTDocument) -> FSM:
             nxt, outs = machine.step(state, symbol)
             if nxt not in names:
                 names[nxt] = f"q{len(names)}"
-                fsm.add_state(State(names[nxt], action=outs[-1],
-                                    final=machine.status(nxt) != "running"))
+                fsm.add_state(
+                    State(names[nxt], action=outs[-1], final=machine.status(nxt) != "running")
+                )
                 queue.append((nxt, outs))
             fsm.add_transition(names[state], symbol, names[nxt])
     return fsm

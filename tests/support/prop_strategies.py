@@ -22,11 +22,16 @@ from fsmbt.model.fsm import FSM, State
 # the random-tree helpers move to tests/support/random_trees.py; this is the one line to change
 from support.random_trees import ALL_CONTROLS, ALL_DECORATORS, bt_documents
 
-EXAMPLES = int(os.environ.get("FSMBT_PROPERTY_EXAMPLES", "100"))
+EXAMPLES = int(os.environ.get("FSMBT_PROPERTY_EXAMPLES", "40"))  # CI budget; raise for a full run
 
 #: The CI profile: seeded, bounded, no deadline (the checker's time varies with the machine).
-BUDGET = settings(max_examples=EXAMPLES, derandomize=True, database=None, deadline=None,
-                  suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+BUDGET = settings(
+    max_examples=EXAMPLES,
+    derandomize=True,
+    database=None,
+    deadline=None,
+    suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large],
+)
 
 PLAIN_NAME = st.from_regex(r"\A[A-Za-z][A-Za-z0-9_]{0,5}\Z", fullmatch=True)
 ODD_NAME = st.sampled_from(["with space", "dash-name", "Ünïcode", "dot.ted", "x/y", "q'uote"])
@@ -38,10 +43,14 @@ def generated_fsms() -> st.SearchStrategy[FSM]:
     """FSMs from ``fsmbt.generate.random_fsm`` (seed, size, shape, scenario drawn)."""
     return st.builds(
         lambda seed, n, shape, scenario, start: random_fsm(
-            seed=seed, n_states=n, shape=shape, scenario=scenario, start_event=start),
-        st.integers(0, 2**31), st.integers(1, 9),
+            seed=seed, n_states=n, shape=shape, scenario=scenario, start_event=start
+        ),
+        st.integers(0, 2**31),
+        st.integers(1, 9),
         st.sampled_from(["chain", "tree", "loop", "mixed"]),
-        st.sampled_from(["basic", "robot", "game"]), st.sampled_from([None, True, False]))
+        st.sampled_from(["basic", "robot", "game"]),
+        st.sampled_from([None, True, False]),
+    )
 
 
 @st.composite
@@ -72,17 +81,18 @@ def generated_bts() -> st.SearchStrategy:
     """BT documents from ``fsmbt.generate.random_bt`` (seed, depth, breadth drawn)."""
     return st.builds(
         lambda seed, depth, breadth, scenario: random_bt(
-            seed=seed, depth=depth, breadth=breadth, scenario=scenario, max_nodes=16),
-        st.integers(0, 2**31), st.integers(2, 4), st.integers(1, 3),
-        st.sampled_from(["basic", "robot", "game"]))
+            seed=seed, depth=depth, breadth=breadth, scenario=scenario, max_nodes=16
+        ),
+        st.integers(0, 2**31),
+        st.integers(2, 4),
+        st.integers(1, 3),
+        st.sampled_from(["basic", "robot", "game"]),
+    )
 
 
 def drawn_bts() -> st.SearchStrategy:
     """Random trees over every control and decorator node type the interpreter supports."""
     return bt_documents(controls=ALL_CONTROLS, decorators=ALL_DECORATORS, max_nodes=10)
-
-
-
 
 
 def bts() -> st.SearchStrategy:
@@ -103,8 +113,9 @@ def drawn_hfsms(draw: st.DrawFn) -> FSM:
     host = candidates[0]
     renamed = FSM(name=host.name)  # a region is named after its state (every reader does so)
     for state in inner.states.values():
-        renamed.add_state(State(f"{host.name}.{state.name}", action=state.action,
-                                final=state.final))
+        renamed.add_state(
+            State(f"{host.name}.{state.name}", action=state.action, final=state.final)
+        )
     for t in inner.transitions:
         renamed.add_transition(f"{host.name}.{t.source}", t.event, f"{host.name}.{t.target}")
     renamed.initial = f"{host.name}.{inner.initial}"

@@ -27,10 +27,27 @@ from fsmbt.semantics.lebt.spec import (
     StateSpec,
 )
 
-ALL_CONTROLS = ("Sequence", "ReactiveSequence", "SequenceWithMemory", "Fallback",
-                "ReactiveFallback", "Parallel", "ParallelAll", "IfThenElse", "WhileDoElse")
-ALL_DECORATORS = ("Inverter", "ForceSuccess", "ForceFailure", "Repeat", "RetryUntilSuccessful",
-                  "KeepRunningUntilFailure", "RunOnce", "SubTree")
+ALL_CONTROLS = (
+    "Sequence",
+    "ReactiveSequence",
+    "SequenceWithMemory",
+    "Fallback",
+    "ReactiveFallback",
+    "Parallel",
+    "ParallelAll",
+    "IfThenElse",
+    "WhileDoElse",
+)
+ALL_DECORATORS = (
+    "Inverter",
+    "ForceSuccess",
+    "ForceFailure",
+    "Repeat",
+    "RetryUntilSuccessful",
+    "KeepRunningUntilFailure",
+    "RunOnce",
+    "SubTree",
+)
 ALL_LEAVES = ("Action", "Condition", "AlwaysSuccess", "AlwaysFailure")
 PYTREES_CONTROLS = ("Sequence", "ReactiveSequence", "Fallback", "ReactiveFallback")
 PYTREES_DECORATORS = ("Inverter", "ForceSuccess", "ForceFailure")
@@ -84,21 +101,34 @@ class _Gen:
         children = [self.node(depth + 1) for _ in range(n)]
         attrs = {}
         if t == "Parallel":
-            attrs["success_count"] = str(self.rng.choice(
-                [v for v in range(-n - 1, n + 1) if v < 0 or v <= n]))
-            attrs["failure_count"] = str(self.rng.choice(
-                [v for v in range(-n - 1, n + 1) if v < 0 or v <= n]))
+            attrs["success_count"] = str(
+                self.rng.choice([v for v in range(-n - 1, n + 1) if v < 0 or v <= n])
+            )
+            attrs["failure_count"] = str(
+                self.rng.choice([v for v in range(-n - 1, n + 1) if v < 0 or v <= n])
+            )
         elif t == "ParallelAll":
-            attrs["max_failures"] = str(self.rng.choice(
-                [v for v in range(-n - 1, n + 1) if v < 0 or v <= n]))
+            attrs["max_failures"] = str(
+                self.rng.choice([v for v in range(-n - 1, n + 1) if v < 0 or v <= n])
+            )
         return BTNode(t, NodeKind.CONTROL, attrs=attrs, children=children)
 
 
-def random_tree(rng: random.Random, *, controls: Sequence[str] = ALL_CONTROLS,
-                decorators: Sequence[str] = ALL_DECORATORS,
-                leaves: Sequence[str] = ("Action", "Condition", "Action", "Condition",
-                                         "AlwaysSuccess", "AlwaysFailure"),
-                max_nodes: int = 14) -> BTDocument:
+def random_tree(
+    rng: random.Random,
+    *,
+    controls: Sequence[str] = ALL_CONTROLS,
+    decorators: Sequence[str] = ALL_DECORATORS,
+    leaves: Sequence[str] = (
+        "Action",
+        "Condition",
+        "Action",
+        "Condition",
+        "AlwaysSuccess",
+        "AlwaysFailure",
+    ),
+    max_nodes: int = 14,
+) -> BTDocument:
     """A random document (main tree ``MainTree`` plus one tree per SubTree occurrence)."""
     gen = _Gen(rng, controls, decorators, leaves, max_nodes)
     root = gen.node(0)
@@ -113,7 +143,8 @@ def bt_documents(**kwargs):
     from hypothesis import strategies as st
 
     return st.integers(min_value=0, max_value=2**32 - 1).map(
-        lambda seed: random_tree(random.Random(seed), **kwargs))
+        lambda seed: random_tree(random.Random(seed), **kwargs)
+    )
 
 
 class OutcomeScript:
@@ -192,13 +223,25 @@ def lebt_from_structure(fsm: FSM, structure: Sequence[Structure]) -> BTDocument:
         for cur in reversed(order):
             name, kids = cur
             state = fsm.states[name]
-            guard = BTNode(GUARD_TYPE, NodeKind.CONDITION, name=f"Guard_{name}",
-                           attrs=GuardSpec(name, tuple(entering[name])).to_attrs())
-            leaf = BTNode(STATE_TYPE, NodeKind.ACTION, name=f"State_{name}",
-                          attrs=StateSpec(name, state.action, state.final,
-                                          tuple(exits[name])).to_attrs())
-            body = leaf if not kids else BTNode(
-                "Sequence", NodeKind.CONTROL, children=[leaf] + [made[id(k)] for k in kids])
+            guard = BTNode(
+                GUARD_TYPE,
+                NodeKind.CONDITION,
+                name=f"Guard_{name}",
+                attrs=GuardSpec(name, tuple(entering[name])).to_attrs(),
+            )
+            leaf = BTNode(
+                STATE_TYPE,
+                NodeKind.ACTION,
+                name=f"State_{name}",
+                attrs=StateSpec(name, state.action, state.final, tuple(exits[name])).to_attrs(),
+            )
+            body = (
+                leaf
+                if not kids
+                else BTNode(
+                    "Sequence", NodeKind.CONTROL, children=[leaf] + [made[id(k)] for k in kids]
+                )
+            )
             made[id(cur)] = BTNode("Fallback", NodeKind.CONTROL, children=[guard, body])
         return made[id(item)]
 

@@ -46,8 +46,14 @@ class ScriptedServer:
                 except json.JSONDecodeError:
                     body = None
                 with server._lock:
-                    server.requests.append({"path": self.path, "headers": dict(self.headers),
-                                            "body": body, "time": time.monotonic()})
+                    server.requests.append(
+                        {
+                            "path": self.path,
+                            "headers": dict(self.headers),
+                            "body": body,
+                            "time": time.monotonic(),
+                        }
+                    )
                     index = min(len(server.requests) - 1, len(server.steps) - 1)
                     step = server.steps[index]
                 deadline = time.monotonic() + float(step.get("delay", 0))
@@ -60,29 +66,51 @@ class ScriptedServer:
                     return
                 if "raw" in step:
                     raw_body = step["raw"]
-                    self._send_bytes(200, raw_body.encode() if isinstance(raw_body, str) else raw_body,
-                                     step, step.get("content_type", "application/json"))
+                    self._send_bytes(
+                        200,
+                        raw_body.encode() if isinstance(raw_body, str) else raw_body,
+                        step,
+                        step.get("content_type", "application/json"),
+                    )
                     return
                 status = int(step.get("status", 200))
                 if status != 200:
-                    self._send(status, {"error": {"message": step.get("message", f"scripted {status}"),
-                                                  "type": "scripted"}}, step.get("headers", {}))
+                    self._send(
+                        status,
+                        {
+                            "error": {
+                                "message": step.get("message", f"scripted {status}"),
+                                "type": "scripted",
+                            }
+                        },
+                        step.get("headers", {}),
+                    )
                     return
                 content = step.get("content", "")
                 reply: dict[str, Any] = {
-                    "id": f"chatcmpl-{len(server.requests)}", "object": "chat.completion",
-                    "created": 0, "model": (body or {}).get("model", "scripted"),
-                    "choices": [{"index": 0, "finish_reason": "stop",
-                                 "message": {"role": "assistant", "content": content}}],
+                    "id": f"chatcmpl-{len(server.requests)}",
+                    "object": "chat.completion",
+                    "created": 0,
+                    "model": (body or {}).get("model", "scripted"),
+                    "choices": [
+                        {
+                            "index": 0,
+                            "finish_reason": "stop",
+                            "message": {"role": "assistant", "content": content},
+                        }
+                    ],
                 }
                 if step.get("usage", True):
-                    reply["usage"] = {"prompt_tokens": 100 + len(server.requests),
-                                      "completion_tokens": max(1, len(content) // 4),
-                                      "total_tokens": 0}
+                    reply["usage"] = {
+                        "prompt_tokens": 100 + len(server.requests),
+                        "completion_tokens": max(1, len(content) // 4),
+                        "total_tokens": 0,
+                    }
                 self._send_bytes(200, json.dumps(reply).encode(), step, "application/json")
 
-            def _send_bytes(self, status: int, data: bytes, step: dict[str, Any],
-                            content_type: str) -> None:
+            def _send_bytes(
+                self, status: int, data: bytes, step: dict[str, Any], content_type: str
+            ) -> None:
                 try:
                     self.send_response(status)
                     self.send_header("Content-Type", content_type)
@@ -92,8 +120,9 @@ class ScriptedServer:
                         self.wfile.write(data[: int(step["reset_after"])])
                         self.wfile.flush()
                         # SO_LINGER 0: close() sends a TCP RST instead of a clean FIN
-                        self.connection.setsockopt(socket.SOL_SOCKET, socket.SO_LINGER,
-                                                   struct.pack("ii", 1, 0))
+                        self.connection.setsockopt(
+                            socket.SOL_SOCKET, socket.SO_LINGER, struct.pack("ii", 1, 0)
+                        )
                         self.connection.close()
                         self.close_connection = True
                         return
@@ -102,7 +131,7 @@ class ScriptedServer:
                         for start in range(0, len(data), chunk):
                             if server._stop.is_set():
                                 return
-                            self.wfile.write(data[start:start + chunk])
+                            self.wfile.write(data[start : start + chunk])
                             self.wfile.flush()
                             time.sleep(float(step["trickle"]))
                         return
@@ -116,8 +145,9 @@ class ScriptedServer:
                 except OSError:
                     pass  # the connection was reset on purpose
 
-            def _send(self, status: int, payload: dict[str, Any],
-                      headers: dict[str, str] | None = None) -> None:
+            def _send(
+                self, status: int, payload: dict[str, Any], headers: dict[str, str] | None = None
+            ) -> None:
                 data = json.dumps(payload).encode()
                 try:
                     self.send_response(status)

@@ -84,8 +84,9 @@ def test_engine_disagreement_exits_3(files, monkeypatch, capsys):
 
 
 def test_engine_both_agreeing_exits_like_native(files, monkeypatch):
-    monkeypatch.setattr(verify_module, "_nusmv",
-                        lambda source, result, loop: verify_module.verify(source, result))
+    monkeypatch.setattr(
+        verify_module, "_nusmv", lambda source, result, loop: verify_module.verify(source, result)
+    )
     assert main(["verify", files["source"], files["mutated"], "--engine", "both"]) == 1
 
 

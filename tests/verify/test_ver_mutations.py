@@ -31,8 +31,9 @@ from support.ver_models import PAPER_EDGES, paper_fsm
 
 
 # -- independent random simulation ----------------------------------------------------------------
-def simulation_finds_difference(source_model, result_model, seed: int, runs: int = 150,
-                                length: int = 30) -> bool:
+def simulation_finds_difference(
+    source_model, result_model, seed: int, runs: int = 150, length: int = 30
+) -> bool:
     """Random input sequences (from the source's offered inputs, 80 % of the time among those
     the source reacts to) run step by step on fresh machines; any difference in outputs, status
     or offered inputs counts."""
@@ -68,8 +69,10 @@ class Tally:
     by_operator: dict[str, list[int]] = field(default_factory=dict)
 
     def line(self, family: str) -> str:
-        return (f"{family}: {self.generated} mutants, {self.differ} differ by simulation, "
-                f"{self.caught} caught, {self.checker_only} more found by the checker only")
+        return (
+            f"{family}: {self.generated} mutants, {self.differ} differ by simulation, "
+            f"{self.caught} caught, {self.checker_only} more found by the checker only"
+        )
 
 
 def judge(source_model, result_model, operator: str, tally: Tally, seed: int) -> None:
@@ -113,14 +116,22 @@ def run_family(pairs, mutate: str, family: str) -> Tally:
 def test_fsm_vs_fsm_mutants_are_caught():
     tally = run_family(fsm_pairs(), "result", "FSM vs FSM")
     assert {"retarget_transition", "drop_transition", "change_action", "flip_final"} <= set(
-        tally.by_operator)
+        tally.by_operator
+    )
 
 
 def test_fsm_vs_lebt_mutants_are_caught():
     tally = run_family(lebt_pairs(), "result", "FSM vs LEBT")
-    assert {"swap_children", "sequence_to_fallback", "invert_condition", "drop_leaf",
-            "drop_guard_pair", "retarget_transition", "change_action", "flip_final"} <= set(
-        tally.by_operator)
+    assert {
+        "swap_children",
+        "sequence_to_fallback",
+        "invert_condition",
+        "drop_leaf",
+        "drop_guard_pair",
+        "retarget_transition",
+        "change_action",
+        "flip_final",
+    } <= set(tally.by_operator)
 
 
 def test_lebt_active_inputs_are_sound_and_change_no_verdict():
@@ -149,14 +160,20 @@ def test_lebt_active_inputs_are_sound_and_change_no_verdict():
 
 def test_bt_source_mutants_are_caught():
     tally = run_family(bt_pairs(), "source", "mutated BT vs leaf FSM")
-    assert {"swap_children", "sequence_to_fallback", "invert_condition", "drop_leaf",
-            "change_action"} <= set(tally.by_operator)
+    assert {
+        "swap_children",
+        "sequence_to_fallback",
+        "invert_condition",
+        "drop_leaf",
+        "change_action",
+    } <= set(tally.by_operator)
 
 
 def test_leaf_fsm_mutants_are_caught():
     tally = run_family(bt_pairs(), "result", "BT vs mutated leaf FSM")
     assert {"retarget_transition", "drop_transition", "change_action", "flip_final"} <= set(
-        tally.by_operator)
+        tally.by_operator
+    )
 
 
 def test_converted_hfsm_pairs_mutated_on_either_side_are_caught():

@@ -83,8 +83,11 @@ def test_retargeted_transition_fails_with_a_shortest_real_counterexample():
     assert not report.equivalent
     completeness = report.properties[COMPLETENESS]
     assert not completeness.holds
-    assert [s.input for s in completeness.counterexample[1:]] == ["eventStartA", "eventAB",
-                                                                  "eventBC"]
+    assert [s.input for s in completeness.counterexample[1:]] == [
+        "eventStartA",
+        "eventAB",
+        "eventBC",
+    ]
     assert completeness.counterexample[-1].source_outputs == ["C"]
     assert completeness.counterexample[-1].result_outputs == ["D"]
     assert_counterexamples_real(src, res, report)
@@ -248,9 +251,11 @@ def test_verdict_and_shortest_counterexample_match_brute_force(seed, n1, n2):
     bound = 7
     alphabet = list(src.alphabet)
     brute = shortest_difference(src, res, alphabet, bound)
-    trace_lengths = [len(p.counterexample) - 1 for p in report.properties.values()
-                     if not p.holds and p.name in (COMPLETENESS, NO_ADDITIONAL_BEHAVIOR,
-                                                   TERMINATION_CONSISTENCY)]
+    trace_lengths = [
+        len(p.counterexample) - 1
+        for p in report.properties.values()
+        if not p.holds and p.name in (COMPLETENESS, NO_ADDITIONAL_BEHAVIOR, TERMINATION_CONSISTENCY)
+    ]
     if report.equivalent:
         assert brute is None
         rng2 = random.Random(seed + 1)

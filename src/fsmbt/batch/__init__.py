@@ -18,5 +18,13 @@ from fsmbt.batch.result import STATUSES, JobResult
 from fsmbt.batch.store import STORE_NAME, ResultStore
 from fsmbt.batch.worker import run_job
 
-__all__ = ["Job", "JobResult", "ResultStore", "STATUSES", "STORE_NAME", "make_jobs", "run_job",
-           "run_jobs"]
+__all__ = [
+    "Job",
+    "JobResult",
+    "ResultStore",
+    "STATUSES",
+    "STORE_NAME",
+    "make_jobs",
+    "run_job",
+    "run_jobs",
+]

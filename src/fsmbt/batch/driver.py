@@ -69,9 +69,17 @@ def needs_run(store: ResultStore | None, job: Job) -> bool:
 def refused_destination(job: Job) -> JobResult:
     """The row of a job whose output exists and may not be replaced."""
     error = api.DestinationExists(SourceLocation(str(job.output)))
-    return JobResult(job.key, job.input, REFUSED, error_class="DestinationExists",
-                     error_message=" ".join(str(error).split()), engine=job.engine,
-                     verify_engine=job.verify_engine, options=public_options(job.options), retry=True)
+    return JobResult(
+        job.key,
+        job.input,
+        REFUSED,
+        error_class="DestinationExists",
+        error_message=" ".join(str(error).split()),
+        engine=job.engine,
+        verify_engine=job.verify_engine,
+        options=public_options(job.options),
+        retry=True,
+    )
 
 
 def remove_stale_temporaries(output: Path) -> int:
@@ -111,11 +119,19 @@ def _prepare(store: ResultStore | None, job: Job) -> Job | JobResult:
     return dataclasses.replace(job, overwrite=True)
 
 
-def run_jobs(jobs: Sequence[Job], *, store: ResultStore | None = None,
-             executor: Literal["local", "ray"] | str = "local", workers: int = 1,
-             ray_address: str | None = None, on_result: OnResult | None = None,
-             collect: bool = True, llm_concurrency: int | None = None,
-             max_attempts: int = 3, chunk_size: int | None = None) -> list[JobResult]:
+def run_jobs(
+    jobs: Sequence[Job],
+    *,
+    store: ResultStore | None = None,
+    executor: Literal["local", "ray"] | str = "local",
+    workers: int = 1,
+    ray_address: str | None = None,
+    on_result: OnResult | None = None,
+    collect: bool = True,
+    llm_concurrency: int | None = None,
+    max_attempts: int = 3,
+    chunk_size: int | None = None,
+) -> list[JobResult]:
     """Run the jobs that are not done, store each result as it arrives.
 
     Args:
@@ -171,9 +187,12 @@ def run_jobs(jobs: Sequence[Job], *, store: ResultStore | None = None,
     if executor == "ray":
         from fsmbt.batch.ray_executor import DEFAULT_CHUNK, RayExecutor
 
-        runner = RayExecutor(workers, address=ray_address,
-                             chunk_size=chunk_size or DEFAULT_CHUNK,
-                             max_retries=max(0, max_attempts - 1))
+        runner = RayExecutor(
+            workers,
+            address=ray_address,
+            chunk_size=chunk_size or DEFAULT_CHUNK,
+            max_retries=max(0, max_attempts - 1),
+        )
     else:
         from fsmbt.batch.local import LocalExecutor
 

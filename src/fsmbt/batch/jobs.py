@@ -40,8 +40,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from fsmbt.api import DEFAULT_BT_FORMAT, DEFAULT_FSM_FORMAT
 from fsmbt import limits
+from fsmbt.api import DEFAULT_BT_FORMAT, DEFAULT_FSM_FORMAT
 from fsmbt.formats.registry import Format, formats, get_format
 from fsmbt.model.errors import InputError
 
@@ -90,8 +90,11 @@ class Job:
 
     def __post_init__(self) -> None:
         if not self.key:
-            object.__setattr__(self, "key", job_key(self.input, self.output, self.engine,
-                                                    self.verify_engine, self.options))
+            object.__setattr__(
+                self,
+                "key",
+                job_key(self.input, self.output, self.engine, self.verify_engine, self.options),
+            )
 
     def __hash__(self) -> int:
         return hash(self.key)
@@ -137,8 +140,9 @@ def content_hash(path: str | Path) -> str:
     return digest.hexdigest()
 
 
-def job_key(input_path: str, output: str | None, engine: str, verify_engine: str,
-            options: dict[str, Any]) -> str:
+def job_key(
+    input_path: str, output: str | None, engine: str, verify_engine: str, options: dict[str, Any]
+) -> str:
     """A job's key: ``<content hash>-<settings hash>`` (see the module text).
 
     Args:
@@ -151,9 +155,13 @@ def job_key(input_path: str, output: str | None, engine: str, verify_engine: str
         48 hex digits and a dash.
     """
     settings = {
-        "engine": engine, "verify": verify_engine,
-        "options": {k: v for k, v in sorted(options.items())
-                    if k not in LIMIT_OPTIONS and k not in ENDPOINT_OPTIONS},
+        "engine": engine,
+        "verify": verify_engine,
+        "options": {
+            k: v
+            for k, v in sorted(options.items())
+            if k not in LIMIT_OPTIONS and k not in ENDPOINT_OPTIONS
+        },
         "output": Path(output).name if output is not None else Path(input_path).name,
     }
     encoded = json.dumps(settings, sort_keys=True, default=str).encode()
@@ -357,10 +365,17 @@ def output_for(path: Path, root: Path, outdir: Path, to: str | None) -> Path:
     return outdir / relative / f"{stem}{extension}"
 
 
-def make_jobs(inputs: Sequence[str | Path], outdir: Path, *, engine: str = "rules",
-              verify_engine: str = "native", options: dict[str, Any] | None = None,
-              to: str | None = None, overwrite: bool = False,
-              runtime: dict[str, Any] | None = None) -> list[Job]:
+def make_jobs(
+    inputs: Sequence[str | Path],
+    outdir: Path,
+    *,
+    engine: str = "rules",
+    verify_engine: str = "native",
+    options: dict[str, Any] | None = None,
+    to: str | None = None,
+    overwrite: bool = False,
+    runtime: dict[str, Any] | None = None,
+) -> list[Job]:
     """One ``Job`` per input file, outputs mirrored under ``outdir``.
 
     Args:
@@ -396,6 +411,15 @@ def make_jobs(inputs: Sequence[str | Path], outdir: Path, *, engine: str = "rule
     for path, output in zip(expanded.files, outputs):
         if clashes[output] > 1:
             output = output.with_name(f"{path.name}{output.suffix}")
-        jobs.append(Job(str(path), str(output), engine, verify_engine, dict(job_options),
-                        overwrite, dict(runtime or {})))
+        jobs.append(
+            Job(
+                str(path),
+                str(output),
+                engine,
+                verify_engine,
+                dict(job_options),
+                overwrite,
+                dict(runtime or {}),
+            )
+        )
     return jobs

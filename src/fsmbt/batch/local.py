@@ -44,19 +44,34 @@ Claim = Callable[[list[Job]], None]
 
 def worker_died(job: Job, attempts: int) -> JobResult:
     """The row of a job whose worker died ``attempts`` times."""
-    return JobResult(job.key, job.input, ERROR, error_class="WorkerDied",
-                     error_message=f"{job.input}: the worker process died {attempts} time(s) "
-                     "while converting this input", engine=job.engine,
-                     verify_engine=job.verify_engine, options=public_options(job.options),
-                     attempts=attempts, retry=True)
+    return JobResult(
+        job.key,
+        job.input,
+        ERROR,
+        error_class="WorkerDied",
+        error_message=f"{job.input}: the worker process died {attempts} time(s) "
+        "while converting this input",
+        engine=job.engine,
+        verify_engine=job.verify_engine,
+        options=public_options(job.options),
+        attempts=attempts,
+        retry=True,
+    )
 
 
 def overran(job: Job, seconds: float) -> JobResult:
     """The row of a job the watchdog stopped after ``seconds``."""
-    return JobResult(job.key, job.input, TIMEOUT, error_class="JobTimeout",
-                     error_message=f"{job.input}: no result after {seconds:.0f} s; the worker "
-                     "was stopped", timings={"total": seconds}, engine=job.engine,
-                     verify_engine=job.verify_engine, options=public_options(job.options))
+    return JobResult(
+        job.key,
+        job.input,
+        TIMEOUT,
+        error_class="JobTimeout",
+        error_message=f"{job.input}: no result after {seconds:.0f} s; the worker was stopped",
+        timings={"total": seconds},
+        engine=job.engine,
+        verify_engine=job.verify_engine,
+        options=public_options(job.options),
+    )
 
 
 def _hard_deadline(job: Job) -> float | None:
@@ -73,8 +88,13 @@ class LocalExecutor:
         max_tasks_per_child: jobs per worker process before it is replaced.
     """
 
-    def __init__(self, workers: int = 1, *, max_attempts: int = 3,
-                 max_tasks_per_child: int = MAX_TASKS_PER_CHILD) -> None:
+    def __init__(
+        self,
+        workers: int = 1,
+        *,
+        max_attempts: int = 3,
+        max_tasks_per_child: int = MAX_TASKS_PER_CHILD,
+    ) -> None:
         self.workers = max(1, workers)
         self.max_attempts = max(1, max_attempts)
         self.max_tasks_per_child = max_tasks_per_child
@@ -83,13 +103,19 @@ class LocalExecutor:
         self.worker_pids: set[int] = set()
 
     def _pool(self) -> ProcessPoolExecutor:
-        return ProcessPoolExecutor(max_workers=self.workers, mp_context=self._context,
-                                   max_tasks_per_child=self.max_tasks_per_child,
-                                   initializer=warm_up)
+        return ProcessPoolExecutor(
+            max_workers=self.workers,
+            mp_context=self._context,
+            max_tasks_per_child=self.max_tasks_per_child,
+            initializer=warm_up,
+        )
 
     def _pool_pids(self) -> list[int]:
-        pids = [p.pid for p in multiprocessing.active_children()
-                if p.pid is not None and p.pid not in self._before]
+        pids = [
+            p.pid
+            for p in multiprocessing.active_children()
+            if p.pid is not None and p.pid not in self._before
+        ]
         self.worker_pids.update(pids)
         return pids
 
@@ -135,9 +161,11 @@ class LocalExecutor:
                     result.attempts = attempts
                     deliver(result)
                 now = time.monotonic()
-                overdue = [future for future, (job, _, started) in out.items()
-                           if (deadline := _hard_deadline(job)) is not None
-                           and now - started > deadline]
+                overdue = [
+                    future
+                    for future, (job, _, started) in out.items()
+                    if (deadline := _hard_deadline(job)) is not None and now - started > deadline
+                ]
                 if overdue:
                     for future in overdue:
                         job, _, started = out.pop(future)
@@ -157,8 +185,9 @@ class LocalExecutor:
         finally:
             pool.shutdown(wait=True, cancel_futures=True)
 
-    def _requeue(self, queue: deque[tuple[Job, int]], deliver: Deliver, job: Job,
-                 attempts: int) -> None:
+    def _requeue(
+        self, queue: deque[tuple[Job, int]], deliver: Deliver, job: Job, attempts: int
+    ) -> None:
         if attempts >= self.max_attempts:
             deliver(worker_died(job, attempts))
         else:

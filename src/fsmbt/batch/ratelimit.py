@@ -36,9 +36,14 @@ class MinuteRateLimit:
         clock, sleep: for tests (wall-clock time, since processes share it).
     """
 
-    def __init__(self, path: str | Path, per_minute: int, *,
-                 clock: Callable[[], float] = time.time,
-                 sleep: Callable[[float], None] = time.sleep) -> None:
+    def __init__(
+        self,
+        path: str | Path,
+        per_minute: int,
+        *,
+        clock: Callable[[], float] = time.time,
+        sleep: Callable[[float], None] = time.sleep,
+    ) -> None:
         self.path = Path(path)
         self.per_minute = max(1, int(per_minute))
         self._clock = clock

@@ -45,7 +45,9 @@ def _import_ray() -> Any:
     try:
         import ray
     except ImportError:  # pragma: no cover - ray is a dependency; a broken install says so
-        raise InputError("the Ray executor needs the 'ray' package (pip install 'fsmbt[ray]')") from None
+        raise InputError(
+            "the Ray executor needs the 'ray' package (pip install 'fsmbt[ray]')"
+        ) from None
     return ray
 
 
@@ -59,8 +61,14 @@ class RayExecutor:
         max_retries: Ray's retries of a task whose worker died.
     """
 
-    def __init__(self, workers: int = 1, *, address: str | None = None,
-                 chunk_size: int = DEFAULT_CHUNK, max_retries: int = 3) -> None:
+    def __init__(
+        self,
+        workers: int = 1,
+        *,
+        address: str | None = None,
+        chunk_size: int = DEFAULT_CHUNK,
+        max_retries: int = 3,
+    ) -> None:
         self.workers = max(1, workers)
         self.address = address
         self.chunk_size = max(1, chunk_size)
@@ -75,12 +83,17 @@ class RayExecutor:
             if self.address:
                 ray.init(address=self.address, **quiet)
             else:
-                ray.init(num_cpus=self.workers, include_dashboard=False,
-                         _node_ip_address="127.0.0.1", **quiet)
+                ray.init(
+                    num_cpus=self.workers,
+                    include_dashboard=False,
+                    _node_ip_address="127.0.0.1",
+                    **quiet,
+                )
         except (ConnectionError, RuntimeError, ValueError) as exc:
             where = self.address or "a local Ray"
-            raise InputError(f"cannot start or reach Ray at {where}: "
-                             f"{' '.join(str(exc).split())[:300]}") from None
+            raise InputError(
+                f"cannot start or reach Ray at {where}: {' '.join(str(exc).split())[:300]}"
+            ) from None
         return True
 
     def run(self, jobs: Iterable[Job], deliver: Deliver, claim: Claim) -> None:
@@ -93,8 +106,9 @@ class RayExecutor:
         """
         ray = _import_ray()
         started_here = self._start(ray)
-        task = ray.remote(num_cpus=1, max_retries=self.max_retries,
-                          retry_exceptions=False)(run_chunk)
+        task = ray.remote(num_cpus=1, max_retries=self.max_retries, retry_exceptions=False)(
+            run_chunk
+        )
         queue = deque(jobs)
         out: dict[Any, list[Job]] = {}
         try:

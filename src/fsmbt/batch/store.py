@@ -32,9 +32,24 @@ SCHEMA_VERSION = 1
 #: The store's file name in the output folder.
 STORE_NAME = "fsmbt-batch.sqlite"
 
-_COLUMNS = ("key", "input", "status", "verdict", "properties", "error_class", "error_message",
-            "timings", "output", "stats", "engine", "verify_engine", "options", "attempts",
-            "retry", "finished_at")
+_COLUMNS = (
+    "key",
+    "input",
+    "status",
+    "verdict",
+    "properties",
+    "error_class",
+    "error_message",
+    "timings",
+    "output",
+    "stats",
+    "engine",
+    "verify_engine",
+    "options",
+    "attempts",
+    "retry",
+    "finished_at",
+)
 _JSON_COLUMNS = ("properties", "timings", "stats", "options")
 
 _CREATE = """
@@ -79,8 +94,9 @@ class ResultStore:
         self._db.execute("PRAGMA journal_mode=WAL")
         self._db.execute("PRAGMA synchronous=NORMAL")  # durable across a process crash
         self._db.executescript(_CREATE)
-        self._db.execute("INSERT OR IGNORE INTO meta VALUES ('schema_version', ?)",
-                         (str(SCHEMA_VERSION),))
+        self._db.execute(
+            "INSERT OR IGNORE INTO meta VALUES ('schema_version', ?)", (str(SCHEMA_VERSION),)
+        )
 
     # -- writing (the driver only) --------------------------------------------------------
 
@@ -90,8 +106,10 @@ class ResultStore:
             result.finished_at = time.time()
         values = _encode(result)
         marks = ", ".join("?" for _ in range(len(_COLUMNS) + 1))
-        self._db.execute(f"INSERT OR REPLACE INTO results (state, {', '.join(_COLUMNS)}) "
-                         f"VALUES ({marks})", ("done", *values))
+        self._db.execute(
+            f"INSERT OR REPLACE INTO results (state, {', '.join(_COLUMNS)}) VALUES ({marks})",
+            ("done", *values),
+        )
 
     def claim(self, jobs: Iterable[Job]) -> None:
         """Mark jobs as handed out (``pending``), in one transaction; done rows are kept."""
@@ -100,8 +118,15 @@ class ResultStore:
                 self._db.execute(
                     "INSERT INTO results (key, input, state, output, engine, verify_engine, "
                     "options) VALUES (?, ?, 'pending', ?, ?, ?, ?) ON CONFLICT(key) DO NOTHING",
-                    (job.key, job.input, job.output, job.engine, job.verify_engine,
-                     json.dumps(public_options(job.options), sort_keys=True, default=str)))
+                    (
+                        job.key,
+                        job.input,
+                        job.output,
+                        job.engine,
+                        job.verify_engine,
+                        json.dumps(public_options(job.options), sort_keys=True, default=str),
+                    ),
+                )
 
     def _transaction(self) -> _Transaction:
         return _Transaction(self._db)
@@ -110,26 +135,31 @@ class ResultStore:
 
     def get(self, key: str) -> JobResult | None:
         """The finished result stored under ``key``, or ``None``."""
-        row = self._db.execute(f"SELECT {', '.join(_COLUMNS)} FROM results "
-                               "WHERE key = ? AND state = 'done'", (key,)).fetchone()
+        row = self._db.execute(
+            f"SELECT {', '.join(_COLUMNS)} FROM results WHERE key = ? AND state = 'done'", (key,)
+        ).fetchone()
         return _decode(row) if row is not None else None
 
     def done(self, key: str) -> bool:
         """Whether ``key`` has a finished result that a resumed batch skips (not retryable)."""
-        row = self._db.execute("SELECT retry FROM results WHERE key = ? AND state = 'done'",
-                               (key,)).fetchone()
+        row = self._db.execute(
+            "SELECT retry FROM results WHERE key = ? AND state = 'done'", (key,)
+        ).fetchone()
         return row is not None and not row[0]
 
     def pending_output(self, key: str) -> bool:
         """Whether ``key`` was claimed by an earlier run (its output, if any, is this batch's)."""
-        row = self._db.execute("SELECT state, error_class FROM results WHERE key = ?",
-                               (key,)).fetchone()
+        row = self._db.execute(
+            "SELECT state, error_class FROM results WHERE key = ?", (key,)
+        ).fetchone()
         return row is not None and (row[0] == "pending" or row[1] == "WorkerDied")
 
     def results(self) -> list[JobResult]:
         """Every finished result, in the order they were stored."""
-        rows = self._db.execute(f"SELECT {', '.join(_COLUMNS)} FROM results "
-                                "WHERE state = 'done' ORDER BY finished_at, key").fetchall()
+        rows = self._db.execute(
+            f"SELECT {', '.join(_COLUMNS)} FROM results "
+            "WHERE state = 'done' ORDER BY finished_at, key"
+        ).fetchall()
         return [_decode(row) for row in rows]
 
     def summary(self) -> dict[str, Any]:
@@ -142,15 +172,23 @@ class ResultStore:
         """
         counts = dict.fromkeys(STATUSES, 0)
         for status, count in self._db.execute(
-                "SELECT status, COUNT(*) FROM results WHERE state = 'done' GROUP BY status"):
+            "SELECT status, COUNT(*) FROM results WHERE state = 'done' GROUP BY status"
+        ):
             counts[str(status)] = int(count)
         pending = self._db.execute(
-            "SELECT COUNT(*) FROM results WHERE state = 'pending'").fetchone()[0]
+            "SELECT COUNT(*) FROM results WHERE state = 'pending'"
+        ).fetchone()[0]
         retry = self._db.execute(
-            "SELECT COUNT(*) FROM results WHERE state = 'done' AND retry").fetchone()[0]
-        return {"total": sum(counts.values()) + int(pending), "pending": int(pending),
-                "retry": int(retry), "statuses": counts, "store": str(self.path),
-                "bytes": self.size_bytes()}
+            "SELECT COUNT(*) FROM results WHERE state = 'done' AND retry"
+        ).fetchone()[0]
+        return {
+            "total": sum(counts.values()) + int(pending),
+            "pending": int(pending),
+            "retry": int(retry),
+            "statuses": counts,
+            "store": str(self.path),
+            "bytes": self.size_bytes(),
+        }
 
     def size_bytes(self) -> int:
         """The store's size on disk (database, WAL and shared-memory files)."""

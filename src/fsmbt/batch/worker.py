@@ -59,8 +59,16 @@ from fsmbt.model.stats import model_stats
 from fsmbt.verify.native import DEFAULT_MAX_STATES, StateLimitError
 
 #: The options ``run_job`` hands to ``fsmbt.api`` as keyword arguments, not engine options.
-PIPELINE_OPTIONS = ("to", "source_format", "style", "loop", "hierarchy", "max_states",
-                    "keep_not_equivalent", "timeout_s")
+PIPELINE_OPTIONS = (
+    "to",
+    "source_format",
+    "style",
+    "loop",
+    "hierarchy",
+    "max_states",
+    "keep_not_equivalent",
+    "timeout_s",
+)
 
 
 class JobTimeout(BaseException):
@@ -91,11 +99,10 @@ def time_limit(seconds: float | None) -> Iterator[None]:
 
 
 def _size(model: Any) -> dict[str, Any]:
-    stats = model_stats(model)
+    stats: Any = model_stats(model)  # FSMStats for an FSM, BTStats for a BT
     if isinstance(model, FSM):
-        return {"kind": "fsm", "states": stats.all_states,  # type: ignore[union-attr]
-                "transitions": stats.all_transitions}  # type: ignore[union-attr]
-    return {"kind": "bt", "nodes": stats.nodes, "depth": stats.depth}  # type: ignore[union-attr]
+        return {"kind": "fsm", "states": stats.all_states, "transitions": stats.all_transitions}
+    return {"kind": "bt", "nodes": stats.nodes, "depth": stats.depth}
 
 
 def _one_line(error: BaseException) -> str:
@@ -129,24 +136,33 @@ def _pipeline(job: Job, options: dict[str, Any], timings: dict[str, float]) -> a
     pipeline.pop("timeout_s", None)
     verify = job.verify_engine != "none"
     common: dict[str, Any] = {
-        "to": pipeline.get("to"), "engine": job.engine, "style": pipeline.get("style", "paper"),
+        "to": pipeline.get("to"),
+        "engine": job.engine,
+        "style": pipeline.get("style", "paper"),
         "loop": bool(pipeline.get("loop", False)),
-        "hierarchy": pipeline.get("hierarchy", "subtrees"), "verify": verify,
+        "hierarchy": pipeline.get("hierarchy", "subtrees"),
+        "verify": verify,
         "verify_engine": job.verify_engine if verify else "native",
         "max_states": int(pipeline.get("max_states", DEFAULT_MAX_STATES)),
         "overwrite": job.overwrite,
         "keep_not_equivalent": bool(pipeline.get("keep_not_equivalent", False)),
     }
     if job.engine not in api.LLM_ENGINES:
-        return api.convert_file(job.input, job.output, source_format=pipeline.get("source_format"),
-                                options=options, **common)
+        return api.convert_file(
+            job.input,
+            job.output,
+            source_format=pipeline.get("source_format"),
+            options=options,
+            **common,
+        )
     if job.output is not None:
         api.check_destination(job.output, overwrite=job.overwrite)
     started = time.perf_counter()
     if job.verify_engine != "none":
         options.setdefault("verify_engine", job.verify_engine)
-    loaded = api.load_for_engine(job.input, job.engine, pipeline.get("source_format"),
-                                 options=options)
+    loaded = api.load_for_engine(
+        job.input, job.engine, pipeline.get("source_format"), options=options
+    )
     timings["read"] = time.perf_counter() - started
     per_minute = job.runtime.get("llm_rate_per_minute")
     rate_file = job.runtime.get("llm_rate_file")
@@ -162,11 +178,18 @@ def _pipeline(job: Job, options: dict[str, Any], timings: dict[str, float]) -> a
 
 
 #: A two-state FSM converted both ways by ``warm_up``.
-_WARM_UP_MODEL = json.dumps({
-    "kind": "fsm", "name": "warm_up", "initial": "A",
-    "states": [{"name": "A", "action": "a"}, {"name": "B", "action": "b"}],
-    "transitions": [{"source": "A", "event": "e", "target": "B"},
-                    {"source": "B", "event": "f", "target": "A"}]})
+_WARM_UP_MODEL = json.dumps(
+    {
+        "kind": "fsm",
+        "name": "warm_up",
+        "initial": "A",
+        "states": [{"name": "A", "action": "a"}, {"name": "B", "action": "b"}],
+        "transitions": [
+            {"source": "A", "event": "e", "target": "B"},
+            {"source": "B", "event": "f", "target": "A"},
+        ],
+    }
+)
 _warmed = False
 
 
@@ -198,21 +221,29 @@ def run_job(job: Job) -> JobResult:
     """
     started = time.perf_counter()
     timings: dict[str, float] = {}
-    result = JobResult(job.key, job.input, ERROR, engine=job.engine,
-                       verify_engine=job.verify_engine, options=public_options(job.options))
+    result = JobResult(
+        job.key,
+        job.input,
+        ERROR,
+        engine=job.engine,
+        verify_engine=job.verify_engine,
+        options=public_options(job.options),
+    )
     options = {k: v for k, v in job.options.items()}
     try:
         with time_limit(job.options.get("timeout_s")):
             outcome = _pipeline(job, options, timings)
             stats: dict[str, Any] = {
-                "conversion": outcome.conversion.stats, "direction": outcome.conversion.direction,
-                "source_format": outcome.source.format, "output_format": outcome.output_format,
+                "conversion": outcome.conversion.stats,
+                "direction": outcome.conversion.direction,
+                "source_format": outcome.source.format,
+                "output_format": outcome.output_format,
                 "source_size": _size(outcome.source.model),
-                "result_size": _size(outcome.result), "warnings": len(outcome.warnings),
+                "result_size": _size(outcome.result),
+                "warnings": len(outcome.warnings),
             }
             if outcome.report is not None:
-                for name in ("product_states", "product_edges", "source_states",
-                             "result_states"):
+                for name in ("product_states", "product_edges", "source_states", "result_states"):
                     if name in outcome.report.stats:
                         stats[name] = outcome.report.stats[name]
     except BaseException as error:  # noqa: BLE001 - every problem of a model is a row

@@ -93,7 +93,9 @@ def main(argv: list[str] | None = None) -> int:
     except (RecursionError, MemoryError) as exc:
         if debug:
             raise
-        print(f"error: input too large or too deeply nested ({type(exc).__name__})", file=sys.stderr)
+        print(
+            f"error: input too large or too deeply nested ({type(exc).__name__})", file=sys.stderr
+        )
         return EXIT_BAD_INPUT
     except KeyboardInterrupt:
         return 130
@@ -115,8 +117,10 @@ def main(argv: list[str] | None = None) -> int:
             return EXIT_BAD_INPUT
         if debug:
             raise
-        print(f"internal error: {type(exc).__name__}: {exc} (FSMBT_DEBUG=1 shows the traceback)",
-              file=sys.stderr)
+        print(
+            f"internal error: {type(exc).__name__}: {exc} (FSMBT_DEBUG=1 shows the traceback)",
+            file=sys.stderr,
+        )
         return EXIT_INTERNAL
     return code if isinstance(code, int) else EXIT_OK
 

@@ -92,17 +92,26 @@ class BatchProgress:
                 TimeRemainingColumn,
             )
 
-            self._progress = Progress(TextColumn("{task.description}"), BarColumn(),
-                                      MofNCompleteColumn(), TimeElapsedColumn(),
-                                      TextColumn("ETA"), TimeRemainingColumn(),
-                                      console=Console(stderr=True), transient=True)
+            self._progress = Progress(
+                TextColumn("{task.description}"),
+                BarColumn(),
+                MofNCompleteColumn(),
+                TimeElapsedColumn(),
+                TextColumn("ETA"),
+                TimeRemainingColumn(),
+                console=Console(stderr=True),
+                transient=True,
+            )
             self._progress.start()
             self._task = self._progress.add_task(self._describe(), total=self._total)
         return self
 
     def _describe(self) -> str:
-        shown = [f"{status.replace('_', ' ')} {self.counts[status]}" for status in STATUSES
-                 if self.counts[status]]
+        shown = [
+            f"{status.replace('_', ' ')} {self.counts[status]}"
+            for status in STATUSES
+            if self.counts[status]
+        ]
         return ", ".join(shown) or "starting"
 
     def __call__(self, result: JobResult) -> None:
@@ -147,8 +156,11 @@ def print_table(results: list[JobResult], summary: dict[str, Any]) -> None:
     if summary.get("pending"):
         counts.add_row("unfinished", str(summary["pending"]))
     console.print(counts)
-    for title, wanted in (("not equivalent", (NOT_EQUIVALENT,)), ("refused", (REFUSED,)),
-                          ("errors", FAILED)):
+    for title, wanted in (
+        ("not equivalent", (NOT_EQUIVALENT,)),
+        ("refused", (REFUSED,)),
+        ("errors", FAILED),
+    ):
         rows = [r for r in results if r.status in wanted]
         if not rows:
             continue
@@ -176,8 +188,10 @@ def print_table(results: list[JobResult], summary: dict[str, Any]) -> None:
 def _report(outdir: Path, as_json: bool, keys: list[str] | None = None) -> int:
     store_file = outdir / STORE_NAME if outdir.is_dir() else outdir
     if not store_file.is_file():
-        raise InputError("no batch store here (run fsmbt batch INPUTS -o OUTDIR first)",
-                             location=SourceLocation(str(store_file)))
+        raise InputError(
+            "no batch store here (run fsmbt batch INPUTS -o OUTDIR first)",
+            location=SourceLocation(str(store_file)),
+        )
     with ResultStore(store_file) as store:
         results = store.results()
         summary = store.summary()
@@ -185,11 +199,20 @@ def _report(outdir: Path, as_json: bool, keys: list[str] | None = None) -> int:
         wanted = set(keys)
         results = [r for r in results if r.key in wanted]
         counts = Counter(r.status for r in results)
-        summary = {**summary, "statuses": {s: counts[s] for s in STATUSES},
-                   "pending": len(wanted) - len(results), "total": len(wanted)}
+        summary = {
+            **summary,
+            "statuses": {s: counts[s] for s in STATUSES},
+            "pending": len(wanted) - len(results),
+            "total": len(wanted),
+        }
     if as_json:
-        print(json.dumps({"summary": summary, "results": [r.to_row() for r in results]},
-                         indent=2, default=str))
+        print(
+            json.dumps(
+                {"summary": summary, "results": [r.to_row() for r in results]},
+                indent=2,
+                default=str,
+            )
+        )
     else:
         print_table(results, summary)
     return exit_code(r.status for r in results)
@@ -198,54 +221,85 @@ def _report(outdir: Path, as_json: bool, keys: list[str] | None = None) -> int:
 def register(app: typer.Typer) -> None:
     @app.command("batch")
     def batch_command(
-        inputs: list[str] = typer.Argument(None, help="model files, folders (walked "
-                                           "recursively) and glob patterns"),
-        outdir: Path = typer.Option(..., "-o", "--output", help="the output folder (mirrors "
-                                    "the inputs' layout; holds the results store)"),
-        to: str | None = typer.Option(None, "--to", help="output format (default: btcpp for "
-                                      "a BT result, scxml for an FSM result)"),
-        source_format: str | None = typer.Option(None, "--from", help="input format (default: "
-                                                 "detected per file)"),
+        inputs: list[str] = typer.Argument(
+            None, help="model files, folders (walked recursively) and glob patterns"
+        ),
+        outdir: Path = typer.Option(
+            ...,
+            "-o",
+            "--output",
+            help="the output folder (mirrors the inputs' layout; holds the results store)",
+        ),
+        to: str | None = typer.Option(
+            None,
+            "--to",
+            help="output format (default: btcpp for a BT result, scxml for an FSM result)",
+        ),
+        source_format: str | None = typer.Option(
+            None, "--from", help="input format (default: detected per file)"
+        ),
         engine: str = typer.Option("rules", "--engine", help="rules, or a registered engine"),
         style: str = typer.Option("paper", "--style", help="output structure style"),
-        loop: bool = typer.Option(False, "--loop", help="BT->FSM: the root is ticked again "
-                                  "after it returns (checked in loop mode)"),
+        loop: bool = typer.Option(
+            False,
+            "--loop",
+            help="BT->FSM: the root is ticked again after it returns (checked in loop mode)",
+        ),
         no_verify: bool = typer.Option(False, "--no-verify", help="skip the equivalence check"),
         verifier: Literal["native", "nusmv", "both"] = typer.Option(
-            "native", "--verifier", help="native, nusmv, or both (both must agree)"),
+            "native", "--verifier", help="native, nusmv, or both (both must agree)"
+        ),
         force: bool = typer.Option(False, "--force", help="overwrite existing output files"),
-        keep_failed: bool = typer.Option(False, "--keep-failed", help="write results even "
-                                         "when they are not equivalent (default: not written)"),
-        as_json: bool = typer.Option(False, "--json", help="print the summary and every row "
-                                     "as JSON on stdout"),
+        keep_failed: bool = typer.Option(
+            False,
+            "--keep-failed",
+            help="write results even when they are not equivalent (default: not written)",
+        ),
+        as_json: bool = typer.Option(
+            False, "--json", help="print the summary and every row as JSON on stdout"
+        ),
         quiet: bool = typer.Option(False, "--quiet", "-q", help="no progress bar on stderr"),
-        report: bool = typer.Option(False, "--report", help="print the summary of OUTDIR's "
-                                    "store again; runs nothing"),
+        report: bool = typer.Option(
+            False, "--report", help="print the summary of OUTDIR's store again; runs nothing"
+        ),
         node_models: list[Path] = node_models_option(),
         hierarchy: Literal["subtrees", "flatten"] = typer.Option(
-            "subtrees", "--hierarchy", help="FSM->BT of a hierarchical FSM: subtrees or "
-            "flatten"),
-        workers: int = typer.Option(max(1, min(4, os.cpu_count() or 1)), "--workers", "-j",
-                                    min=1, help="worker processes (or Ray tasks at once)"),
-        executor: Literal["local", "ray"] = typer.Option("local", "--executor",
-                                                         help="local processes or Ray"),
-        ray_address: str | None = typer.Option(None, "--ray-address", help="Ray cluster to "
-                                               "join: auto or HOST:PORT (default: a private "
-                                               "local Ray)"),
-        timeout: float | None = typer.Option(None, "--timeout", min=0.01, help="seconds per "
-                                             "model (a model over it is a timeout row)"),
-        max_states: int | None = typer.Option(None, "--max-states", min=1, help="the "
-                                              "checker's state limit per model"),
-        chunk_size: int | None = typer.Option(None, "--chunk-size", min=1,
-                                              help="Ray: models per task (8)"),
-        llm_base_url: str | None = typer.Option(None, "--llm-base-url", help="LLM engines: "
-                                                f"endpoint URL or provider ({PROVIDER_NAMES})"),
-        llm_model: str | None = typer.Option(None, "--llm-model", help="LLM engines: model "
-                                             "name"),
-        llm_concurrency: int = typer.Option(4, "--llm-concurrency", min=1, help="LLM "
-                                            "engines: requests at once"),
-        llm_rate: int | None = typer.Option(None, "--llm-rate", min=1, help="LLM engines: "
-                                            "requests per minute, over all workers"),
+            "subtrees", "--hierarchy", help="FSM->BT of a hierarchical FSM: subtrees or flatten"
+        ),
+        workers: int = typer.Option(
+            max(1, min(4, os.cpu_count() or 1)),
+            "--workers",
+            "-j",
+            min=1,
+            help="worker processes (or Ray tasks at once)",
+        ),
+        executor: Literal["local", "ray"] = typer.Option(
+            "local", "--executor", help="local processes or Ray"
+        ),
+        ray_address: str | None = typer.Option(
+            None,
+            "--ray-address",
+            help="Ray cluster to join: auto or HOST:PORT (default: a private local Ray)",
+        ),
+        timeout: float | None = typer.Option(
+            None, "--timeout", min=0.01, help="seconds per model (a model over it is a timeout row)"
+        ),
+        max_states: int | None = typer.Option(
+            None, "--max-states", min=1, help="the checker's state limit per model"
+        ),
+        chunk_size: int | None = typer.Option(
+            None, "--chunk-size", min=1, help="Ray: models per task (8)"
+        ),
+        llm_base_url: str | None = typer.Option(
+            None, "--llm-base-url", help=f"LLM engines: endpoint URL or provider ({PROVIDER_NAMES})"
+        ),
+        llm_model: str | None = typer.Option(None, "--llm-model", help="LLM engines: model name"),
+        llm_concurrency: int = typer.Option(
+            4, "--llm-concurrency", min=1, help="LLM engines: requests at once"
+        ),
+        llm_rate: int | None = typer.Option(
+            None, "--llm-rate", min=1, help="LLM engines: requests per minute, over all workers"
+        ),
     ) -> None:
         """Convert and verify many models (files, folders, globs) into OUTDIR; a second run
         skips what is done, a killed run resumes."""
@@ -254,8 +308,9 @@ def register(app: typer.Typer) -> None:
         if not inputs:
             raise InputError("name at least one input file, folder or glob")
         if outdir.exists() and not outdir.is_dir():
-            raise InputError("is a file; -o names the output folder",
-                                 location=SourceLocation(str(outdir)))
+            raise InputError(
+                "is a file; -o names the output folder", location=SourceLocation(str(outdir))
+            )
         outdir.mkdir(parents=True, exist_ok=True)
         options: dict[str, Any] = dict(reader_options(node_models) or {})
         options.update(style=style, loop=loop, hierarchy=hierarchy)
@@ -269,19 +324,37 @@ def register(app: typer.Typer) -> None:
             options["max_states"] = max_states
         runtime: dict[str, Any] = {}
         if engine in api.LLM_ENGINES:
-            options.update({k: v for k, v in (("llm_base_url", llm_base_url),
-                                              ("llm_model", llm_model)) if v})
+            options.update(
+                {k: v for k, v in (("llm_base_url", llm_base_url), ("llm_model", llm_model)) if v}
+            )
             if llm_rate:
-                runtime = {"llm_rate_per_minute": llm_rate,
-                           "llm_rate_file": str(outdir / ".fsmbt-llm-rate")}
-        jobs = make_jobs(inputs, outdir, engine=engine,
-                         verify_engine="none" if no_verify else verifier, options=options,
-                         to=to, overwrite=force, runtime=runtime)
+                runtime = {
+                    "llm_rate_per_minute": llm_rate,
+                    "llm_rate_file": str(outdir / ".fsmbt-llm-rate"),
+                }
+        jobs = make_jobs(
+            inputs,
+            outdir,
+            engine=engine,
+            verify_engine="none" if no_verify else verifier,
+            options=options,
+            to=to,
+            overwrite=force,
+            runtime=runtime,
+        )
         if not jobs:
             raise InputError("no model files found in the inputs")
         with ResultStore(outdir) as store:
             with BatchProgress(len(jobs), quiet=quiet or as_json) as progress:
-                run_jobs(jobs, store=store, executor=executor, workers=workers,
-                         ray_address=ray_address, on_result=progress, collect=False,
-                         llm_concurrency=llm_concurrency, chunk_size=chunk_size)
+                run_jobs(
+                    jobs,
+                    store=store,
+                    executor=executor,
+                    workers=workers,
+                    ray_address=ray_address,
+                    on_result=progress,
+                    collect=False,
+                    llm_concurrency=llm_concurrency,
+                    chunk_size=chunk_size,
+                )
         raise typer.Exit(_report(outdir, as_json, [job.key for job in jobs]))

@@ -18,10 +18,6 @@ from typing import Literal
 import typer
 
 from fsmbt import api
-from fsmbt.model.bt import BTDocument
-from fsmbt.model.undeclared import summary as undeclared_summary
-from fsmbt.model.undeclared import undeclared_leaf_types
-from fsmbt.llm.config import PROVIDERS
 from fsmbt.cli.options import (
     abstract_option,
     apply_engine_caps,
@@ -34,6 +30,10 @@ from fsmbt.cli.options import (
 )
 from fsmbt.cli.progress import StageProgress, format_timings
 from fsmbt.cli.wording import checked_counts, conversion_summary
+from fsmbt.llm.config import PROVIDERS
+from fsmbt.model.bt import BTDocument
+from fsmbt.model.undeclared import summary as undeclared_summary
+from fsmbt.model.undeclared import undeclared_leaf_types
 from fsmbt.verify.report import Report
 
 PROVIDER_NAMES = ", ".join(sorted(PROVIDERS))
@@ -43,34 +43,52 @@ def register(app: typer.Typer) -> None:
     @app.command("convert")
     def convert_command(
         source: Path = typer.Argument(..., help="the model to convert (FSM or BT)"),
-        output: Path | None = typer.Option(None, "-o", "--output",
-                                           help="write here (default: stdout)"),
-        to: str | None = typer.Option(None, "--to", help="output format (default: from -o's "
-                                      "extension, else btcpp for a BT, scxml for an FSM)"),
+        output: Path | None = typer.Option(
+            None, "-o", "--output", help="write here (default: stdout)"
+        ),
+        to: str | None = typer.Option(
+            None,
+            "--to",
+            help="output format (default: from -o's "
+            "extension, else btcpp for a BT, scxml for an FSM)",
+        ),
         source_format: str | None = typer.Option(None, "--from", help="input format"),
         engine: str = typer.Option("rules", "--engine", help="rules, or a registered engine"),
         style: str = typer.Option("paper", "--style", help="output structure style"),
-        loop: bool = typer.Option(False, "--loop", help="BT->FSM: the root is ticked again "
-                                  "after it returns (checked in loop mode)"),
+        loop: bool = typer.Option(
+            False,
+            "--loop",
+            help="BT->FSM: the root is ticked again after it returns (checked in loop mode)",
+        ),
         no_verify: bool = typer.Option(False, "--no-verify", help="skip the equivalence check"),
-        verify_engine: str = typer.Option("native", "--verify-engine", help="the equivalence "
-                                          "check's engine: native, nusmv or both"),
+        verify_engine: str = typer.Option(
+            "native",
+            "--verify-engine",
+            help="the equivalence check's engine: native, nusmv or both",
+        ),
         force: bool = typer.Option(False, "--force", help="overwrite an existing output file"),
-        keep_failed: bool = typer.Option(False, "--keep-failed", help="write the result even "
-                                         "when it is not equivalent (default: not written)"),
+        keep_failed: bool = typer.Option(
+            False,
+            "--keep-failed",
+            help="write the result even when it is not equivalent (default: not written)",
+        ),
         as_json: bool = typer.Option(False, "--json", help="print a JSON summary on stdout"),
         quiet: bool = typer.Option(False, "--quiet", "-q", help="no progress display on stderr"),
         node_models: list[Path] = node_models_option(),
         max_states: int | None = max_states_option(),
         nodes: list[str] = nodes_option(),
         abstract: list[str] = abstract_option(),
-        hierarchy: Literal["subtrees", "flatten"] = typer.Option("subtrees", "--hierarchy", help="FSM->BT of a "
-                                      "hierarchical FSM: subtrees (one SubTree per composite "
-                                      "state) or flatten (one flat LEBT)"),
-        llm_base_url: str | None = typer.Option(None, "--llm-base-url", help="LLM engines: "
-                                                f"endpoint URL or provider ({PROVIDER_NAMES})"),
-        llm_model: str | None = typer.Option(None, "--llm-model", help="LLM engines: model "
-                                             "name"),
+        hierarchy: Literal["subtrees", "flatten"] = typer.Option(
+            "subtrees",
+            "--hierarchy",
+            help="FSM->BT of a "
+            "hierarchical FSM: subtrees (one SubTree per composite "
+            "state) or flatten (one flat LEBT)",
+        ),
+        llm_base_url: str | None = typer.Option(
+            None, "--llm-base-url", help=f"LLM engines: endpoint URL or provider ({PROVIDER_NAMES})"
+        ),
+        llm_model: str | None = typer.Option(None, "--llm-model", help="LLM engines: model name"),
         timeout: float | None = timeout_option(),
         nusmv_memory: int | None = nusmv_memory_option(),
     ) -> None:
@@ -82,10 +100,22 @@ def register(app: typer.Typer) -> None:
             options.update(llm_base_url=llm_base_url, llm_model=llm_model)
         with StageProgress(quiet=quiet, label=source.name) as progress:
             outcome = api.convert_file(
-                source, output, to=to, source_format=source_format, engine=engine, style=style,
-                loop=loop, hierarchy=hierarchy, verify=not no_verify,
-                verify_engine=verify_engine, overwrite=force, max_states=max_states,
-                keep_not_equivalent=keep_failed, options=options, on_stage=progress)
+                source,
+                output,
+                to=to,
+                source_format=source_format,
+                engine=engine,
+                style=style,
+                loop=loop,
+                hierarchy=hierarchy,
+                verify=not no_verify,
+                verify_engine=verify_engine,
+                overwrite=force,
+                max_states=max_states,
+                keep_not_equivalent=keep_failed,
+                options=options,
+                on_stage=progress,
+            )
         summary = outcome.to_dict()
         if as_json:
             if output is None:
@@ -107,13 +137,19 @@ def _print_summary(outcome: api.Outcome, *, to_stderr: bool) -> None:
     if isinstance(source, BTDocument):
         undeclared = undeclared_leaf_types(source)
         if undeclared:
-            print(f"warning: {undeclared_summary(undeclared)}; declare them with "
-                  "--node-models FILE", file=stream)
-    figures = conversion_summary(outcome.conversion.direction, outcome.conversion.stats,
-                                 outcome.conversion.engine)
+            print(
+                f"warning: {undeclared_summary(undeclared)}; declare them with --node-models FILE",
+                file=stream,
+            )
+    figures = conversion_summary(
+        outcome.conversion.direction, outcome.conversion.stats, outcome.conversion.engine
+    )
     where = str(outcome.output) if outcome.output is not None else "stdout"
-    print(f"converted {outcome.conversion.direction} with {outcome.conversion.engine} -> "
-          f"{where} ({outcome.output_format}): {figures}", file=stream)
+    print(
+        f"converted {outcome.conversion.direction} with {outcome.conversion.engine} -> "
+        f"{where} ({outcome.output_format}): {figures}",
+        file=stream,
+    )
     print(f"time: {format_timings(outcome.timings)}", file=stream)
     report: Report | None = outcome.report
     if report is None:
@@ -129,5 +165,8 @@ def _print_summary(outcome: api.Outcome, *, to_stderr: bool) -> None:
         mark = "ok  " if prop.holds else "FAIL"
         print(f"  {mark} {name}: {prop.detail}", file=stream)
     if outcome.output is not None and not outcome.written:
-        print(f"not written: {outcome.output} (the result is not equivalent; --keep-failed "
-              "writes it anyway)", file=stream)
+        print(
+            f"not written: {outcome.output} (the result is not equivalent; --keep-failed "
+            "writes it anyway)",
+            file=stream,
+        )

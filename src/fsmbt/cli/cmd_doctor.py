@@ -32,8 +32,9 @@ def _nusmv() -> Check:
 
     path = find_nusmv()
     if path is None:
-        return Check("NuSMV", False, "not found",
-                     f"run {BUILD_SCRIPT.name} (scripts/) or set {ENV_VAR}")
+        return Check(
+            "NuSMV", False, "not found", f"run {BUILD_SCRIPT.name} (scripts/) or set {ENV_VAR}"
+        )
     return Check("NuSMV", True, f"{nusmv_version(str(path))} at {path}")
 
 
@@ -53,8 +54,12 @@ def _module(label: str, module: str, dist: str) -> Check:
     try:
         importlib.import_module(module)
     except Exception as exc:  # noqa: BLE001 - a broken install is reported, not raised
-        return Check(label, False, f"cannot import {module}: {type(exc).__name__}",
-                     f"pip install {dist} (see pyproject.toml)")
+        return Check(
+            label,
+            False,
+            f"cannot import {module}: {type(exc).__name__}",
+            f"pip install {dist} (see pyproject.toml)",
+        )
     from importlib.metadata import PackageNotFoundError, version
 
     try:
@@ -69,18 +74,32 @@ def _cpp_runtime() -> list[Check]:
 
     found = status()
     hint = "run scripts/build_btcpp.sh (needs cmake and g++)"
-    library = (Check(f"BehaviorTree.CPP {BTCPP_VERSION} (C++)", True, f"built at {found.library}")
-               if found.library else
-               Check(f"BehaviorTree.CPP {BTCPP_VERSION} (C++)", False,
-                     f"not built at {library_prefix()}", hint))
-    driver = (Check("C++ LEBT driver", True, f"built at {found.driver}") if found.driver else
-              Check("C++ LEBT driver", False, found.problem, hint))
+    library = (
+        Check(f"BehaviorTree.CPP {BTCPP_VERSION} (C++)", True, f"built at {found.library}")
+        if found.library
+        else Check(
+            f"BehaviorTree.CPP {BTCPP_VERSION} (C++)",
+            False,
+            f"not built at {library_prefix()}",
+            hint,
+        )
+    )
+    driver = (
+        Check("C++ LEBT driver", True, f"built at {found.driver}")
+        if found.driver
+        else Check("C++ LEBT driver", False, found.problem, hint)
+    )
     return [library, driver]
 
 
 def checks() -> list[Check]:
-    return [_nusmv(), _dot(), _module("behaviortreepy", "behaviortreepy", "behaviortreepy"),
-            _module("py_trees", "py_trees", "py_trees"), *_cpp_runtime()]
+    return [
+        _nusmv(),
+        _dot(),
+        _module("behaviortreepy", "behaviortreepy", "behaviortreepy"),
+        _module("py_trees", "py_trees", "py_trees"),
+        *_cpp_runtime(),
+    ]
 
 
 def register(app: typer.Typer) -> None:

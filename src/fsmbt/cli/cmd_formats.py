@@ -13,10 +13,17 @@ def register(app: typer.Typer) -> None:
     @app.command("formats")
     def formats_command() -> None:
         """List the file formats, what they hold, and whether fsmbt reads and writes them."""
-        table = Table("format", "extensions", "models", "read", "write", "cannot hold",
-                      "description")
+        table = Table(
+            "format", "extensions", "models", "read", "write", "cannot hold", "description"
+        )
         for fmt in formats():
-            table.add_row(fmt.name, " ".join(fmt.extensions), ", ".join(sorted(fmt.kinds)),
-                          "yes" if fmt.read else "-", "yes" if fmt.write else "-",
-                          fmt.cannot_hold or "-", fmt.description)
+            table.add_row(
+                fmt.name,
+                " ".join(fmt.extensions),
+                ", ".join(sorted(fmt.kinds)),
+                "yes" if fmt.read else "-",
+                "yes" if fmt.write else "-",
+                fmt.cannot_hold or "-",
+                fmt.description,
+            )
         Console().print(table)

@@ -28,14 +28,20 @@ def register(app: typer.Typer) -> None:
         fmt: str = typer.Option("json", "--format", help="output format (see `fsmbt formats`)"),
         states: str = typer.Option("2-30", "--states", help="FSM size: N or MIN-MAX"),
         depth: int | None = typer.Option(None, "--depth", min=2, help="BT depth (default 2-10)"),
-        breadth: int | None = typer.Option(None, "--breadth", min=1,
-                                           help="BT breadth (default 2-10)"),
-        max_nodes: int = typer.Option(DEFAULT_MAX_NODES, "--max-nodes", min=1,
-                                      help="BT node budget, soft: past it no new control "
-                                      "node is opened, but open ones keep their breadth "
-                                      "and the spine keeps its --depth levels"),
-        extended: bool = typer.Option(False, "--extended",
-                                      help="BTs: add Reactive/WithMemory, Parallel, decorators"),
+        breadth: int | None = typer.Option(
+            None, "--breadth", min=1, help="BT breadth (default 2-10)"
+        ),
+        max_nodes: int = typer.Option(
+            DEFAULT_MAX_NODES,
+            "--max-nodes",
+            min=1,
+            help="BT node budget, soft: past it no new control "
+            "node is opened, but open ones keep their breadth "
+            "and the spine keeps its --depth levels",
+        ),
+        extended: bool = typer.Option(
+            False, "--extended", help="BTs: add Reactive/WithMemory, Parallel, decorators"
+        ),
         force: bool = typer.Option(False, "--force", help="overwrite existing files"),
     ) -> None:
         """Write N random FSMs or BTs within the paper's limits, reproducibly from --seed."""

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
-from typing import Optional
 
 import typer
 from rich.console import Console
@@ -31,8 +30,9 @@ def register(app: typer.Typer) -> None:
     @app.command("info")
     def info_command(
         model: Path = typer.Argument(..., help="Model file (FSM or BT, any format fsmbt reads)."),
-        from_format: Optional[str] = typer.Option(None, "--from",
-                                                  help="Input format (default: detected)."),
+        from_format: str | None = typer.Option(
+            None, "--from", help="Input format (default: detected)."
+        ),
         node_models: list[Path] = node_models_option(),
         nodes: list[str] = nodes_option(),
         abstract: list[str] = abstract_option(),
@@ -46,13 +46,24 @@ def register(app: typer.Typer) -> None:
         """
         loaded = api.load(model, from_format, options=reader_options(node_models, nodes, abstract))
         stats = model_stats(loaded.model)
-        undeclared = (undeclared_leaf_types(loaded.model)
-                      if isinstance(loaded.model, BTDocument) else None)
+        undeclared = (
+            undeclared_leaf_types(loaded.model) if isinstance(loaded.model, BTDocument) else None
+        )
         blockers = [str(b) for b in api.conversion_blockers(loaded.model)]
         if as_json:
             extra = {} if undeclared is None else {"undeclared_leaf_types": dict(undeclared)}
-            print(json.dumps({"file": str(model), **stats.to_dict(), **extra,
-                              "conversion_blockers": blockers}, indent=2, ensure_ascii=False))
+            print(
+                json.dumps(
+                    {
+                        "file": str(model),
+                        **stats.to_dict(),
+                        **extra,
+                        "conversion_blockers": blockers,
+                    },
+                    indent=2,
+                    ensure_ascii=False,
+                )
+            )
             return
         table = _fsm_table(stats) if isinstance(stats, FSMStats) else _bt_table(stats)
         table.title = escape(str(model))
@@ -87,10 +98,15 @@ def _fsm_table(s: FSMStats) -> Table:
     table = _table()
     kind = "hierarchical FSM" if s.hierarchical else "FSM"
     table.add_row("model", f"{kind} {escape(s.name)}")
-    table.add_row("states", str(s.states) + (f" (all levels: {s.all_states})" if s.hierarchical else ""))
-    table.add_row("transitions", str(s.transitions)
-                  + (" + the initial one" if s.initial_event is not None else "")
-                  + (f" (all levels: {s.all_transitions})" if s.hierarchical else ""))
+    table.add_row(
+        "states", str(s.states) + (f" (all levels: {s.all_states})" if s.hierarchical else "")
+    )
+    table.add_row(
+        "transitions",
+        str(s.transitions)
+        + (" + the initial one" if s.initial_event is not None else "")
+        + (f" (all levels: {s.all_transitions})" if s.hierarchical else ""),
+    )
     table.add_row("events", f"{len(s.events)}: {_listed(s.events)}")
     start = f"{escape(s.start)} --{escape(s.initial_event or '')}--> " if s.start else ""
     table.add_row("initial", f"{start}{escape(str(s.initial))}")
@@ -124,8 +140,9 @@ def _bt_table(s: BTStats) -> Table:
 
 
 def _per_tree_table(s: BTStats) -> Table:
-    table = Table("tree", "nodes", "depth", "breadth", "leaves", title="per tree",
-                  title_justify="left")
+    table = Table(
+        "tree", "nodes", "depth", "breadth", "leaves", title="per tree", title_justify="left"
+    )
     for t in s.per_tree:
         table.add_row(escape(t.id), str(t.nodes), str(t.depth), str(t.breadth), str(t.leaves))
     return table

@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
-from typing import Optional
 
 import typer
 from rich.console import Console
@@ -27,24 +26,31 @@ def register(app: typer.Typer) -> None:
     @app.command("metrics")
     def metrics_command(
         model: Path = typer.Argument(..., help="Model file (FSM or BT)."),
-        other: Optional[Path] = typer.Argument(
-            None, help="A second model of the same kind: adds the edit distance."),
-        from_format: Optional[str] = typer.Option(None, "--from",
-                                                  help="Input format (default: detected)."),
+        other: Path | None = typer.Argument(
+            None, help="A second model of the same kind: adds the edit distance."
+        ),
+        from_format: str | None = typer.Option(
+            None, "--from", help="Input format (default: detected)."
+        ),
         node_models: list[Path] = node_models_option(),
         nodes: list[str] = nodes_option(),
         abstract: list[str] = abstract_option(),
-        timeout: float = typer.Option(5.0, "--timeout", min=0.01,
-                                      help="Seconds for the FSM graph edit distance search."),
+        timeout: float = typer.Option(
+            5.0, "--timeout", min=0.01, help="Seconds for the FSM graph edit distance search."
+        ),
         as_json: bool = typer.Option(False, "--json", help="Print the figures as JSON."),
     ) -> None:
         """Graphical and active elements, depth, node counts by type, sub-FSMs; with OTHER the
         tree edit distance (BTs) or graph edit distance (FSMs, an upper bound when cut)."""
-        first = api.load(model, from_format, options=reader_options(node_models, nodes, abstract)).model
+        first = api.load(
+            model, from_format, options=reader_options(node_models, nodes, abstract)
+        ).model
         figures = {"file": str(model), **elements(first).to_dict()}
         report: dict[str, object] = {"model": figures}
         if other is not None:
-            second = api.load(other, from_format, options=reader_options(node_models, nodes, abstract)).model
+            second = api.load(
+                other, from_format, options=reader_options(node_models, nodes, abstract)
+            ).model
             report["other"] = {"file": str(other), **elements(second).to_dict()}
             try:
                 report["distance"] = edit_distance(first, second, timeout=timeout)
@@ -56,8 +62,19 @@ def register(app: typer.Typer) -> None:
         _print(report)
 
 
-ROWS = ("kind", "graphical", "active", "depth", "nodes", "edges", "leaves", "states",
-        "transitions", "machines", "sub_fsms")
+ROWS = (
+    "kind",
+    "graphical",
+    "active",
+    "depth",
+    "nodes",
+    "edges",
+    "leaves",
+    "states",
+    "transitions",
+    "machines",
+    "sub_fsms",
+)
 
 
 def _print(report: dict) -> None:
@@ -71,11 +88,15 @@ def _print(report: dict) -> None:
         if all(v in (0, None) for v in values) and row not in ("graphical", "active"):
             continue
         table.add_row(row, *(escape(str(v)) for v in values))
-    table.add_row("by type", *(escape(", ".join(f"{k}={v}" for k, v in c["by_type"].items()))
-                               for c in columns))
+    table.add_row(
+        "by type",
+        *(escape(", ".join(f"{k}={v}" for k, v in c["by_type"].items())) for c in columns),
+    )
     console = Console()
     console.print(table)
     distance = report.get("distance")
     if distance:
-        console.print(f"{distance['type']}: {distance['value']:g} ({distance['kind']}, "
-                      f"{distance['method']}, {distance['seconds']:.3f} s)")
+        console.print(
+            f"{distance['type']}: {distance['value']:g} ({distance['kind']}, "
+            f"{distance['method']}, {distance['seconds']:.3f} s)"
+        )

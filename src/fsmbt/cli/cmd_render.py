@@ -20,42 +20,66 @@ from fsmbt.render import DEFAULT_MAX_NODES, GraphvizError, render_model
 
 def _cli_words(note: str) -> str:
     """A library note with its option names as this command's flags."""
-    return (note.replace("composite=NAME", "--composite NAME").replace("level=N", "--level N")
-            .replace("tree=ID", "--tree ID"))
+    return (
+        note.replace("composite=NAME", "--composite NAME")
+        .replace("level=N", "--level N")
+        .replace("tree=ID", "--tree ID")
+    )
 
 
 def register(app: typer.Typer) -> None:
     @app.command("render")
     def render_command(
         model: Path = typer.Argument(..., help="Model file (FSM or BT, any format fsmbt reads)."),
-        output: Path = typer.Option(..., "-o", "--output",
-                                    help="Picture to write: .svg, .png, .pdf, or .dot (source)."),
-        from_format: str | None = typer.Option(None, "--from",
-                                                  help="Input format (default: detected)."),
+        output: Path = typer.Option(
+            ..., "-o", "--output", help="Picture to write: .svg, .png, .pdf, or .dot (source)."
+        ),
+        from_format: str | None = typer.Option(
+            None, "--from", help="Input format (default: detected)."
+        ),
         node_models: list[Path] = node_models_option(),
         nodes: list[str] = nodes_option(),
         abstract: list[str] = abstract_option(),
         force: bool = typer.Option(False, "--force", help="Overwrite OUTPUT if it exists."),
         expand_subtrees: bool = typer.Option(
-            False, "--expand-subtrees",
-            help="BT: draw the main tree with each SubTree's tree inlined below it."),
-        max_nodes: int = typer.Option(DEFAULT_MAX_NODES, "--max-nodes", min=1,
-                                      help="Refuse models with more states/nodes than this."),
+            False,
+            "--expand-subtrees",
+            help="BT: draw the main tree with each SubTree's tree inlined below it.",
+        ),
+        max_nodes: int = typer.Option(
+            DEFAULT_MAX_NODES,
+            "--max-nodes",
+            min=1,
+            help="Refuse models with more states/nodes than this.",
+        ),
         level: int | None = typer.Option(
-            None, "--level", min=0,
-            help="FSM: open composite states down to this nesting level (0: top machine only)."),
+            None,
+            "--level",
+            min=0,
+            help="FSM: open composite states down to this nesting level (0: top machine only).",
+        ),
         composite: str | None = typer.Option(
-            None, "--composite", help="FSM: draw only this composite state (path A/B)."),
+            None, "--composite", help="FSM: draw only this composite state (path A/B)."
+        ),
         tree: str | None = typer.Option(None, "--tree", help="BT: draw only this tree."),
     ) -> None:
         """Draw MODEL: FSMs as state diagrams, behavior trees top-down with the usual symbols."""
-        loaded = api.load(model, from_format,
-                          options=reader_options(node_models, nodes, abstract)).model
+        loaded = api.load(
+            model, from_format, options=reader_options(node_models, nodes, abstract)
+        ).model
         notes: list[str] = []
         try:
-            written = render_model(loaded, output, overwrite=force,
-                                   expand_subtrees=expand_subtrees, max_nodes=max_nodes,
-                                   level=level, composite=composite, tree=tree, notes=notes)
+            written = render_model(
+                loaded,
+                output,
+                overwrite=force,
+                expand_subtrees=expand_subtrees,
+                max_nodes=max_nodes,
+                level=level,
+                composite=composite,
+                tree=tree,
+                notes=notes,
+            )
         except GraphvizError as exc:
             raise fail(str(exc), EXIT_INTERNAL) from None
         print(f"wrote {written}")

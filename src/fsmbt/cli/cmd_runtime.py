@@ -50,8 +50,10 @@ def register(app: typer.Typer) -> None:
         from fsmbt.runtime.cpp import write_files
 
         _write(directory, force, write_files, "C++ (BehaviorTree.CPP v4)")
-        print("build: cmake -S DIR -B DIR/build -DCMAKE_PREFIX_PATH=<behaviortree_cpp prefix> "
-              "(docs/runtime.md)")
+        print(
+            "build: cmake -S DIR -B DIR/build -DCMAKE_PREFIX_PATH=<behaviortree_cpp prefix> "
+            "(docs/runtime.md)"
+        )
 
     @runtime_app.command("python")
     def python_command(

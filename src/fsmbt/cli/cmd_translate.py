@@ -24,19 +24,30 @@ def register(app: typer.Typer) -> None:
     @app.command("translate")
     def translate_command(
         source: Path = typer.Argument(..., help="the model to translate (any readable format)"),
-        output: Path | None = typer.Option(None, "-o", "--output",
-                                           help="write here (default: stdout)"),
-        to: str | None = typer.Option(None, "--to", help="target format (default: from -o's "
-                                      "extension)"),
-        source_format: str | None = typer.Option(None, "--from", help="input format "
-                                                 "(default: detected)"),
+        output: Path | None = typer.Option(
+            None, "-o", "--output", help="write here (default: stdout)"
+        ),
+        to: str | None = typer.Option(
+            None, "--to", help="target format (default: from -o's extension)"
+        ),
+        source_format: str | None = typer.Option(
+            None, "--from", help="input format (default: detected)"
+        ),
         force: bool = typer.Option(False, "--force", help="overwrite an existing output file"),
-        flatten: bool = typer.Option(False, "--flatten", help="write a hierarchical FSM as its "
-                                     "flat machine (named as a loss)"),
+        flatten: bool = typer.Option(
+            False,
+            "--flatten",
+            help="write a hierarchical FSM as its flat machine (named as a loss)",
+        ),
         as_json: bool = typer.Option(False, "--json", help="print a JSON summary on stdout"),
-        option: list[str] = typer.Option([], "--option", "-O", help="a reader option "
-                                         "KEY=VALUE, e.g. machine=sm_top (SMACH: which "
-                                         "top-level container), behaviour=MySM (FlexBE)"),
+        option: list[str] = typer.Option(
+            [],
+            "--option",
+            "-O",
+            help="a reader option "
+            "KEY=VALUE, e.g. machine=sm_top (SMACH: which "
+            "top-level container), behaviour=MySM (FlexBE)",
+        ),
     ) -> None:
         """Write the same model in another format; name whatever the target cannot hold."""
         if output is None and to is None:
@@ -51,12 +62,23 @@ def register(app: typer.Typer) -> None:
             options[key.strip()] = value.strip()
         from fsmbt.verify import verify
 
-        result = translate_file(source, to, output, source_format=source_format,
-                                flatten=flatten, overwrite=force, options=options, check=verify)
+        result = translate_file(
+            source,
+            to,
+            output,
+            source_format=source_format,
+            flatten=flatten,
+            overwrite=force,
+            options=options,
+            check=verify,
+        )
         summary = {
-            "source": str(source), "from": result.source_format, "to": result.target_format,
+            "source": str(source),
+            "from": result.source_format,
+            "to": result.target_format,
             "output": str(output) if output is not None else None,
-            "warnings": result.warnings, "losses": result.losses,
+            "warnings": result.warnings,
+            "losses": result.losses,
             "verified_equivalent": result.verified,
         }
         if as_json:
@@ -70,8 +92,10 @@ def register(app: typer.Typer) -> None:
             print(f"warning: {warning}", file=sys.stderr)
         for loss in result.losses:
             print(f"warning: {result.target_format}: {loss}", file=sys.stderr)
-        check = ("read back and verified equivalent" if result.verified
-                 else "not read back")
-        print(f"translated {source} ({result.source_format or '?'}) -> "
-              f"{output or 'stdout'} ({result.target_format}): {len(result.losses)} "
-              f"loss(es), {check}", file=sys.stderr)
+        check = "read back and verified equivalent" if result.verified else "not read back"
+        print(
+            f"translated {source} ({result.source_format or '?'}) -> "
+            f"{output or 'stdout'} ({result.target_format}): {len(result.losses)} "
+            f"loss(es), {check}",
+            file=sys.stderr,
+        )

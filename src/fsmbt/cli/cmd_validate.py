@@ -10,7 +10,6 @@ from __future__ import annotations
 import json
 import sys
 from pathlib import Path
-from typing import Optional
 
 import typer
 from rich.console import Console
@@ -33,8 +32,9 @@ def register(app: typer.Typer) -> None:
     @app.command("validate")
     def validate_command(
         model: Path = typer.Argument(..., help="Model file (FSM or BT, any format fsmbt reads)."),
-        from_format: Optional[str] = typer.Option(None, "--from",
-                                                  help="Input format (default: detected)."),
+        from_format: str | None = typer.Option(
+            None, "--from", help="Input format (default: detected)."
+        ),
         node_models: list[Path] = node_models_option(),
         nodes: list[str] = nodes_option(),
         abstract: list[str] = abstract_option(),
@@ -55,19 +55,36 @@ def register(app: typer.Typer) -> None:
         for blocker in api.conversion_blockers(loaded.model):
             if blocker.location in errors_at or (blocker.location, blocker.message) in located:
                 continue  # already reported by the structural checks
-            issues.append(_with_file(Issue("error", f"conversion would refuse: "
-                                           f"{blocker.message}", blocker.location,
-                                           blocker.element), model))
+            issues.append(
+                _with_file(
+                    Issue(
+                        "error",
+                        f"conversion would refuse: {blocker.message}",
+                        blocker.location,
+                        blocker.element,
+                    ),
+                    model,
+                )
+            )
         failing = [i for i in issues if i.severity == "error"] + (
-            [i for i in issues if i.severity == "warning"] if strict else [])
+            [i for i in issues if i.severity == "warning"] if strict else []
+        )
         kind = loaded.kind
         if as_json:
-            print(json.dumps({
-                "file": str(model), "kind": kind, "valid": not failing,
-                "errors": sum(i.severity == "error" for i in issues),
-                "warnings": sum(i.severity == "warning" for i in issues),
-                "issues": [i.to_dict() for i in issues],
-            }, indent=2, ensure_ascii=False))
+            print(
+                json.dumps(
+                    {
+                        "file": str(model),
+                        "kind": kind,
+                        "valid": not failing,
+                        "errors": sum(i.severity == "error" for i in issues),
+                        "warnings": sum(i.severity == "warning" for i in issues),
+                        "issues": [i.to_dict() for i in issues],
+                    },
+                    indent=2,
+                    ensure_ascii=False,
+                )
+            )
         else:
             _print_table(model, kind, issues)
         if failing:
@@ -96,13 +113,17 @@ def _print_table(model: Path, kind: str, issues: list[Issue]) -> None:
     if not issues:
         console.print(f"{escape(str(model))}: valid {kind.upper()}, no issues")
         return
-    table = Table("severity", "where", "element", "message", title=escape(str(model)),
-                  title_justify="left")
+    table = Table(
+        "severity", "where", "element", "message", title=escape(str(model)), title_justify="left"
+    )
     for issue in issues:
         style = "red" if issue.severity == "error" else "yellow"
-        table.add_row(f"[{style}]{issue.severity}[/{style}]",
-                      escape(str(issue.location)) if issue.location else "-",
-                      escape(issue.element or "-"), escape(issue.message))
+        table.add_row(
+            f"[{style}]{issue.severity}[/{style}]",
+            escape(str(issue.location)) if issue.location else "-",
+            escape(issue.element or "-"),
+            escape(issue.message),
+        )
     console.print(table)
     errors = sum(i.severity == "error" for i in issues)
     console.print(f"{errors} error(s), {len(issues) - errors} warning(s)")

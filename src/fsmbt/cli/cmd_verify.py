@@ -9,7 +9,6 @@ from __future__ import annotations
 import json
 import sys
 from pathlib import Path
-from typing import Optional
 
 import typer
 from rich.console import Console
@@ -42,17 +41,21 @@ def register(app: typer.Typer) -> None:
         as_json: bool = typer.Option(False, "--json", help="Print the report as JSON."),
         quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress display on stderr."),
         node_models: list[Path] = node_models_option(),
-        max_states: Optional[int] = max_states_option(),
+        max_states: int | None = max_states_option(),
         nodes: list[str] = nodes_option(),
         abstract: list[str] = abstract_option(),
-        engine: str = typer.Option("native", "--engine",
-                                   help="native, nusmv, or both (both must agree)."),
-        loop: bool = typer.Option(False, "--loop",
-                                  help="BT side: tick the root again after it returns."),
-        from_format: Optional[str] = typer.Option(None, "--from",
-                                                  help="Format of SOURCE (default: detected)."),
-        from_format2: Optional[str] = typer.Option(None, "--from2",
-                                                   help="Format of CONVERTED (default: detected)."),
+        engine: str = typer.Option(
+            "native", "--engine", help="native, nusmv, or both (both must agree)."
+        ),
+        loop: bool = typer.Option(
+            False, "--loop", help="BT side: tick the root again after it returns."
+        ),
+        from_format: str | None = typer.Option(
+            None, "--from", help="Format of SOURCE (default: detected)."
+        ),
+        from_format2: str | None = typer.Option(
+            None, "--from2", help="Format of CONVERTED (default: detected)."
+        ),
         timeout: float | None = timeout_option(),
         nusmv_memory: int | None = nusmv_memory_option(),
     ) -> None:
@@ -61,17 +64,26 @@ def register(app: typer.Typer) -> None:
         sequence that tells the two models apart."""
         apply_engine_caps(timeout, nusmv_memory)
         try:
-            with StageProgress(quiet=quiet or as_json, label=f"{source.name} ~ {converted.name}") as progress:
-                first, second, report = api.verify_files(source, converted, engine=engine, loop=loop,
-                                                source_format=from_format,
-                                                converted_format=from_format2,
-                                                max_states=max_states,
-                                                options=reader_options(node_models, nodes,
-                                                                       abstract),
-                                                on_stage=progress)
+            with StageProgress(
+                quiet=quiet or as_json, label=f"{source.name} ~ {converted.name}"
+            ) as progress:
+                first, second, report = api.verify_files(
+                    source,
+                    converted,
+                    engine=engine,
+                    loop=loop,
+                    source_format=from_format,
+                    converted_format=from_format2,
+                    max_states=max_states,
+                    options=reader_options(node_models, nodes, abstract),
+                    on_stage=progress,
+                )
         except EngineDisagreement as exc:
-            print(f"error: ENGINES DISAGREE: {exc}; one of the checkers is wrong, please report "
-                  "this with both files", file=sys.stderr)
+            print(
+                f"error: ENGINES DISAGREE: {exc}; one of the checkers is wrong, please report "
+                "this with both files",
+                file=sys.stderr,
+            )
             raise typer.Exit(EXIT_ENGINES_DISAGREE) from None
         for warning in [*first.warnings, *second.warnings]:
             print(f"warning: {warning}", file=sys.stderr)
@@ -85,7 +97,9 @@ def register(app: typer.Typer) -> None:
             for sentence in report.stats.get("abstractions", []):
                 print(f"verified under the abstraction: {sentence}")
             if report.stats.get("swapped"):
-                print(f"note: {converted} was read as the source and {source} as its "
-                      f"conversion (pairing rule: {report.stats['pairing']}); the verdict does "
-                      "not depend on the order")
+                print(
+                    f"note: {converted} was read as the source and {source} as its "
+                    f"conversion (pairing rule: {report.stats['pairing']}); the verdict does "
+                    "not depend on the order"
+                )
         raise typer.Exit(EXIT_EQUIVALENT if report.equivalent else EXIT_NOT_EQUIVALENT)

@@ -8,16 +8,22 @@ import typer
 
 #: ``--node-models FILE`` (repeatable): BehaviorTree.CPP ``<TreeNodesModel>`` files (Nav2's
 #: ``nav2_tree_nodes.xml``, a Groot palette) that declare the custom nodes a tree uses.
-NODE_MODELS_HELP = ("a file with <TreeNodesModel> declarations of custom BT nodes (e.g. Nav2's "
-                    "nav2_tree_nodes.xml); repeatable")
+NODE_MODELS_HELP = (
+    "a file with <TreeNodesModel> declarations of custom BT nodes (e.g. Nav2's "
+    "nav2_tree_nodes.xml); repeatable"
+)
 #: ``--nodes PROFILE|FILE`` (repeatable, comma lists allowed): node libraries
 #: (``fsmbt.model.nodes.library``, docs/semantics.md §10).
-NODES_HELP = ("node library: a profile (nav2, moveit_pro) or a YAML/JSON file declaring custom "
-              "nodes as aliases, exact semantics or abstractions; repeatable, comma lists allowed")
+NODES_HELP = (
+    "node library: a profile (nav2, moveit_pro) or a YAML/JSON file declaring custom "
+    "nodes as aliases, exact semantics or abstractions; repeatable, comma lists allowed"
+)
 #: ``--abstract FAMILIES``: abstraction families (``time``, ``blackboard``).
-ABSTRACT_HELP = ("model these node families as abstractions whose input the environment "
-                 "chooses: time (Sleep, Delay, Timeout), blackboard (Precondition, "
-                 "ScriptCondition, BlackboardCheck*, ...); comma list")
+ABSTRACT_HELP = (
+    "model these node families as abstractions whose input the environment "
+    "chooses: time (Sleep, Delay, Timeout), blackboard (Precondition, "
+    "ScriptCondition, BlackboardCheck*, ...); comma list"
+)
 
 
 def node_models_option() -> list[Path]:
@@ -35,8 +41,11 @@ def abstract_option() -> list[str]:
     return typer.Option([], "--abstract", help=ABSTRACT_HELP)  # type: ignore[no-any-return]
 
 
-def reader_options(node_models: list[Path] | None, nodes: list[str] | None = None,
-                   abstract: list[str] | None = None) -> dict[str, object] | None:
+def reader_options(
+    node_models: list[Path] | None,
+    nodes: list[str] | None = None,
+    abstract: list[str] | None = None,
+) -> dict[str, object] | None:
     """The reader options for ``fsmbt.api.load`` from the shared CLI options.
 
     Args:
@@ -58,9 +67,11 @@ def reader_options(node_models: list[Path] | None, nodes: list[str] | None = Non
 
 
 #: ``--max-states N``: one state limit for the native checker and for BT -> FSM exploration.
-MAX_STATES_HELP = ("most reachable states explored (BT->FSM regions, the native checker, its "
-                   "product); default: FSMBT_MAX_CONVERSION_STATES / FSMBT_MAX_CHECKER_STATES "
-                   "(200000 / 2000000)")
+MAX_STATES_HELP = (
+    "most reachable states explored (BT->FSM regions, the native checker, its "
+    "product); default: FSMBT_MAX_CONVERSION_STATES / FSMBT_MAX_CHECKER_STATES "
+    "(200000 / 2000000)"
+)
 
 
 def max_states_option() -> int | None:
@@ -71,14 +82,24 @@ def max_states_option() -> int | None:
 def timeout_option() -> float | None:
     """``--timeout SECONDS``: the wall-time cap of each NuSMV run (``fsmbt.limits``
     ``nusmv_max_seconds``; the native checker is bounded by its state limit)."""
-    return typer.Option(None, "--timeout", min=0.001, help="seconds NuSMV may run "  # type: ignore[no-any-return]
-                        "(--engine nusmv|both); past it: exit 4")
+    return typer.Option(
+        None,
+        "--timeout",
+        min=0.001,
+        help="seconds NuSMV may run "  # type: ignore[no-any-return]
+        "(--engine nusmv|both); past it: exit 4",
+    )
 
 
 def nusmv_memory_option() -> int | None:
     """``--nusmv-memory MIB``: NuSMV's address-space cap (``nusmv_max_memory_mb``)."""
-    return typer.Option(None, "--nusmv-memory", min=1, help="MiB of memory NuSMV may use "  # type: ignore[no-any-return]
-                        "(RLIMIT_AS); past it: exit 4")
+    return typer.Option(
+        None,
+        "--nusmv-memory",
+        min=1,
+        help="MiB of memory NuSMV may use "  # type: ignore[no-any-return]
+        "(RLIMIT_AS); past it: exit 4",
+    )
 
 
 def apply_engine_caps(timeout: float | None, nusmv_memory: int | None) -> None:

@@ -46,12 +46,15 @@ def _fsm_to_bt(s: Mapping[str, object], engine: str, used: set[str]) -> list[str
     shape: list[str] = []
     if s.get("entry"):
         shape.append(f"entry state {take('entry')}")
-    phrases = (("loop_states", "loop state", None, ""),
-               ("root_subtrees", "selector", None, " under the root"),
-               ("chains", "chain", None, ""), ("branches", "branch", "branches", ""),
-               ("subtrees", "SubTree", None, " for composite states"),
-               ("parallel_subtrees", "SubTree", None, " for parallel states"),
-               ("levels", "level", None, " of hierarchy"))
+    phrases = (
+        ("loop_states", "loop state", None, ""),
+        ("root_subtrees", "selector", None, " under the root"),
+        ("chains", "chain", None, ""),
+        ("branches", "branch", "branches", ""),
+        ("subtrees", "SubTree", None, " for composite states"),
+        ("parallel_subtrees", "SubTree", None, " for parallel states"),
+        ("levels", "level", None, " of hierarchy"),
+    )
     for key, noun, plural, tail in phrases:
         if key in s and (key != "parallel_subtrees" or s[key]):
             shape.append(counted(take(key), noun, plural) + tail)
@@ -61,8 +64,11 @@ def _fsm_to_bt(s: Mapping[str, object], engine: str, used: set[str]) -> list[str
         parts.append(f"{counted(s['unreachable_dropped'], 'unreachable state')} dropped")
     used.add("unreachable_dropped")
     if "hierarchy" in s:
-        parts.append("composite states kept as SubTrees" if take("hierarchy") == "subtrees"
-                     else "the hierarchy flattened")
+        parts.append(
+            "composite states kept as SubTrees"
+            if take("hierarchy") == "subtrees"
+            else "the hierarchy flattened"
+        )
         used.add("flattened")
     elif s.get("flattened"):
         parts.append("the hierarchy flattened")
@@ -78,8 +84,11 @@ def _bt_to_fsm(s: Mapping[str, object], used: set[str]) -> list[str]:
     leaves = counted(take("leaves"), "leaf", "leaves") if "leaves" in s else "the tree"
     if "k" in s:
         machines = int(take("k"))  # type: ignore[call-overload]
-        built = "1 state machine" if machines == 1 else (
-            f"a state machine with {counted(machines - 1, 'sub-state-machine')}")
+        built = (
+            "1 state machine"
+            if machines == 1
+            else (f"a state machine with {counted(machines - 1, 'sub-state-machine')}")
+        )
     else:
         built = "an FSM"
         if "states" in s:
@@ -88,12 +97,16 @@ def _bt_to_fsm(s: Mapping[str, object], used: set[str]) -> list[str]:
                 built += f" and {counted(take('transitions'), 'transition')}"
     head = f"{leaves} became {built}"
     if "units" in s:
-        head += (f", from {counted(take('units'), 'conversion unit')} (a control node, its "
-                 "children and grandchildren)")
+        head += (
+            f", from {counted(take('units'), 'conversion unit')} (a control node, its "
+            "children and grandchildren)"
+        )
     parts = [head]
     if s.get("explored_regions"):
-        parts.append(f"{counted(take('explored_regions'), 'reactive or stateful subtree')} "
-                     f"explored into {counted(s.get('explored_states', '?'), 'state')}")
+        parts.append(
+            f"{counted(take('explored_regions'), 'reactive or stateful subtree')} "
+            f"explored into {counted(s.get('explored_states', '?'), 'state')}"
+        )
     used.update(("explored_regions", "explored_states"))
     if "depth_before" in s:
         before, after = take("depth_before"), s.get("depth_after", "?")
@@ -109,8 +122,7 @@ def _bt_to_fsm(s: Mapping[str, object], used: set[str]) -> list[str]:
     return parts
 
 
-def conversion_summary(direction: str, stats: Mapping[str, object],
-                       engine: str = "rules") -> str:
+def conversion_summary(direction: str, stats: Mapping[str, object], engine: str = "rules") -> str:
     """One readable sentence for a conversion's figures.
 
     Args:
@@ -148,9 +160,11 @@ def checked_counts(stats: Mapping[str, object]) -> str:
     """
     if "source_states" not in stats or "result_states" not in stats:
         return ""
-    text = (f"{stats['source_states']} source and {stats['result_states']} result "
-            "configurations (an FSM's states plus its start; a BT's leaves about to tick plus "
-            "its results)")
+    text = (
+        f"{stats['source_states']} source and {stats['result_states']} result "
+        "configurations (an FSM's states plus its start; a BT's leaves about to tick plus "
+        "its results)"
+    )
     if "product_states" in stats:
         text += f", {counted(stats['product_states'], 'pair')} of them explored together"
     return text

@@ -13,8 +13,9 @@ from fsmbt.model.bt import BTDocument
 from fsmbt.model.fsm import FSM
 
 
-def convert(model: FSM | BTDocument, *, engine: str = "rules", style: str = "paper",
-            **options: object) -> ConversionResult:
+def convert(
+    model: FSM | BTDocument, *, engine: str = "rules", style: str = "paper", **options: object
+) -> ConversionResult:
     """Convert an FSM into a BT or a BT into a (hierarchical) FSM with ``engine``.
 
     Args:
@@ -34,5 +35,12 @@ def convert(model: FSM | BTDocument, *, engine: str = "rules", style: str = "pap
     return converter_for(engine, model)(model, style=style, **options)
 
 
-__all__ = ["convert", "ConversionResult", "Engine", "engines", "get_engine", "register_engine",
-           "converter_for"]
+__all__ = [
+    "convert",
+    "ConversionResult",
+    "Engine",
+    "engines",
+    "get_engine",
+    "register_engine",
+    "converter_for",
+]

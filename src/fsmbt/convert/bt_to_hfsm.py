@@ -59,7 +59,10 @@ from fsmbt.semantics.status import LeafOutcome, NodeStatus, RootResult
 SUCCESS, FAILURE = RootResult.SUCCESS.value, RootResult.FAILURE.value
 RUNNING = NodeStatus.RUNNING.name
 EV_SUCCESS, EV_FAILURE, EV_RUNNING = (
-    LeafOutcome.SUCCESS.value, LeafOutcome.FAILURE.value, LeafOutcome.RUNNING.value)
+    LeafOutcome.SUCCESS.value,
+    LeafOutcome.FAILURE.value,
+    LeafOutcome.RUNNING.value,
+)
 ROOT_RESULTS = (SUCCESS, FAILURE)
 
 
@@ -98,10 +101,14 @@ def _opaque_roots(root: BTNode) -> list[BTNode]:
         if not _is_structural(node):
             found.append(node)
             continue
-        if node.kind is not NodeKind.ACTION and node.kind is not NodeKind.CONDITION \
-                and not node.children:
-            raise InputError(f"{node.type} node without children", element=node.label,
-                             location=node.location)
+        if (
+            node.kind is not NodeKind.ACTION
+            and node.kind is not NodeKind.CONDITION
+            and not node.children
+        ):
+            raise InputError(
+                f"{node.type} node without children", element=node.label, location=node.location
+            )
         stack.extend(node.children)
     return found
 
@@ -148,15 +155,23 @@ class _Builder:
             machine.initial = entry
         return top
 
-    def _compile_unit(self, unit_root: BTNode, machine: FSM, opaque: set[int],
-                      work: list[tuple[BTNode, FSM]]) -> str:
+    def _compile_unit(
+        self, unit_root: BTNode, machine: FSM, opaque: set[int], work: list[tuple[BTNode, FSM]]
+    ) -> str:
         """Wire the unit's nodes into ``machine``; returns the unit's initial state."""
         # items: (node, level, continuation); processed so a node's later siblings are wired
         # first (their entry states are the earlier siblings' targets)
         return self._compile(unit_root, 0, _Cont(SUCCESS, FAILURE), machine, opaque, work)
 
-    def _compile(self, node: BTNode, level: int, cont: _Cont, machine: FSM,
-                 opaque: set[int], work: list[tuple[BTNode, FSM]]) -> str:
+    def _compile(
+        self,
+        node: BTNode,
+        level: int,
+        cont: _Cont,
+        machine: FSM,
+        opaque: set[int],
+        work: list[tuple[BTNode, FSM]],
+    ) -> str:
         """The entry state of ``node`` wired to ``cont`` (recursion depth <= 3 levels; chains
         of transparent decorators are unrolled in a loop)."""
         while node.kind is NodeKind.DECORATOR and id(node) not in opaque:
@@ -193,8 +208,7 @@ class _Builder:
 
     # -- explored regions --------------------------------------------------------------------
     def _explored_state(self, node: BTNode, cont: _Cont, machine: FSM) -> str:
-        sub, ends = explore_region(node, loop=False, max_states=self.max_states,
-                                   where=self.where)
+        sub, ends = explore_region(node, loop=False, max_states=self.max_states, where=self.where)
         self.explored += 1
         self.machines += 1
         self.explored_states += len(sub.states)
@@ -236,8 +250,11 @@ class _Places:
         labels: list[str] = []
         current: BTNode | None = node
         while current is not None:
-            labels.append(current.label if current.label == current.type
-                          else f"{current.type} '{current.label}'")
+            labels.append(
+                current.label
+                if current.label == current.type
+                else f"{current.type} '{current.label}'"
+            )
             current = self.parent.get(id(current))
         labels.reverse()
         if len(labels) > 8:
@@ -245,9 +262,14 @@ class _Places:
         return f"tree '{self.tree_id}', " + " > ".join(labels)
 
 
-def explore_region(node: BTNode, *, loop: bool = False, top: bool = False,
-                   max_states: int | None = None,
-                   where: _Places | None = None) -> tuple[FSM, set[str]]:
+def explore_region(
+    node: BTNode,
+    *,
+    loop: bool = False,
+    top: bool = False,
+    max_states: int | None = None,
+    where: _Places | None = None,
+) -> tuple[FSM, set[str]]:
     """The leaf-execution machine of ``node``'s subtree as a (flat) FSM.
 
     One state per reachable interpreter configuration (``q0``, ``q1`` ... in breadth-first
@@ -281,7 +303,10 @@ def explore_region(node: BTNode, *, loop: bool = False, top: bool = False,
         raise StateLimitError(
             f"exploring this subtree (a {node.type} with memory or reactive children, "
             f"converted as one composite state) reaches more than {limit} states",
-            element=subtree, location=node.location, hints=(Hint.MAX_STATES,)) from None
+            element=subtree,
+            location=node.location,
+            hints=(Hint.MAX_STATES,),
+        ) from None
     fsm = FSM(name=f"explored_{node.label}")
     names: dict[object, str] = {}
     ends: set[str] = set()
@@ -296,8 +321,10 @@ def explore_region(node: BTNode, *, loop: bool = False, top: bool = False,
             fsm.add_state(State(name, action=name if top else None, final=True))
         else:
             if len(outputs) != 1:
-                raise InputError(f"cannot express the outputs {outputs} of one step as one "
-                                 "state's action", element=node.label)
+                raise InputError(
+                    f"cannot express the outputs {outputs} of one step as one state's action",
+                    element=node.label,
+                )
             name = f"q{len(names)}:{outputs[0]}"
             fsm.add_state(State(name, action=outputs[0]))
         names[state] = name
@@ -312,15 +339,18 @@ def explore_region(node: BTNode, *, loop: bool = False, top: bool = False,
             else:
                 name = state_for(target, outputs)
                 if top and outputs != (fsm.states[name].action,):  # never drop an output
-                    raise UnsupportedError(f"cannot express the outputs {outputs} of one step "
-                                           "as one state's action", element=node.label)
+                    raise UnsupportedError(
+                        f"cannot express the outputs {outputs} of one step as one state's action",
+                        element=node.label,
+                    )
             fsm.add_transition(source, symbol, name)
     fsm.initial = names[explored.start]
     return fsm, ends
 
 
-def _looped_result(fsm: FSM, explored, target: object, outputs: tuple[str, ...],
-                   ends: set[str], node: BTNode) -> str:
+def _looped_result(
+    fsm: FSM, explored, target: object, outputs: tuple[str, ...], ends: set[str], node: BTNode
+) -> str:
     """With ``loop`` a step can end the tick and start the next one: outputs ``(result,
     first leaf)``. An FSM read as a leaf machine with ``loop`` says exactly that on entering a
     final state named after the result (its action, then the initial state's), provided the
@@ -328,8 +358,10 @@ def _looped_result(fsm: FSM, explored, target: object, outputs: tuple[str, ...],
     result, leaf = outputs
     start_action = fsm.states[fsm.initial].action if fsm.initial else None
     if target != explored.start or result not in ROOT_RESULTS or leaf != start_action:
-        raise UnsupportedError(f"cannot express the outputs {outputs} of one step as one "
-                               "state's action", element=node.label)
+        raise UnsupportedError(
+            f"cannot express the outputs {outputs} of one step as one state's action",
+            element=node.label,
+        )
     if result not in fsm.states:
         fsm.add_state(State(result, action=result, final=True))
     ends.add(result)
@@ -337,8 +369,14 @@ def _looped_result(fsm: FSM, explored, target: object, outputs: tuple[str, ...],
 
 
 @without_gc_pauses
-def bt_to_hfsm(doc: BTDocument, *, loop: bool = False, style: str = "paper",
-               max_states: int | None = None, **_options: object) -> ConversionResult:
+def bt_to_hfsm(
+    doc: BTDocument,
+    *,
+    loop: bool = False,
+    style: str = "paper",
+    max_states: int | None = None,
+    **_options: object,
+) -> ConversionResult:
     """Convert a BT document into a hierarchical FSM whose flattening is the BT's
     leaf-execution machine (see the module docstring).
 
@@ -367,8 +405,7 @@ def bt_to_hfsm(doc: BTDocument, *, loop: bool = False, style: str = "paper",
             whole_tree = True
     if whole_tree:
         builder = _Builder(loop=loop, max_states=max_states, where=places)
-        hfsm, _ends = explore_region(root, loop=loop, top=True, max_states=max_states,
-                                     where=places)
+        hfsm, _ends = explore_region(root, loop=loop, top=True, max_states=max_states, where=places)
         builder.explored, builder.machines = 1, 1
         builder.explored_states = len(hfsm.states)
     assert hfsm is not None

@@ -38,9 +38,15 @@ def tree_depth(root: BTNode) -> int:
 
 
 def _shallow_copy(node: BTNode) -> BTNode:
-    return BTNode(type=node.type, kind=node.kind, name=node.name, attrs=dict(node.attrs),
-                  kind_declared=node.kind_declared, location=node.location,
-                  semantics=node.semantics)
+    return BTNode(
+        type=node.type,
+        kind=node.kind,
+        name=node.name,
+        attrs=dict(node.attrs),
+        kind_declared=node.kind_declared,
+        location=node.location,
+        semantics=node.semantics,
+    )
 
 
 def inline_subtrees(doc: BTDocument) -> BTNode:
@@ -74,16 +80,22 @@ def _resolved_main_root(doc: BTDocument) -> tuple[BTNode, tuple[str, ...]]:
     return _resolve(doc, main.root, (main.id,))
 
 
-def _resolve(doc: BTDocument, node: BTNode, chain: tuple[str, ...]) -> tuple[BTNode, tuple[str, ...]]:
+def _resolve(
+    doc: BTDocument, node: BTNode, chain: tuple[str, ...]
+) -> tuple[BTNode, tuple[str, ...]]:
     """Follow ``SubTree`` references from ``node`` to a real node."""
     while node.kind is NodeKind.SUBTREE:
         ref = node.subtree_id
         if ref is None or ref not in doc.trees or doc.trees[ref].root is None:
-            raise InputError(f"SubTree refers to unknown or empty tree '{ref}'",
-                             element=node.label, location=node.location)
+            raise InputError(
+                f"SubTree refers to unknown or empty tree '{ref}'",
+                element=node.label,
+                location=node.location,
+            )
         if ref in chain:
-            raise InputError(f"SubTree '{ref}' includes itself", element=node.label,
-                             location=node.location)
+            raise InputError(
+                f"SubTree '{ref}' includes itself", element=node.label, location=node.location
+            )
         chain = chain + (ref,)
         node = doc.trees[ref].root  # type: ignore[assignment]
     return node, chain
@@ -98,8 +110,12 @@ class Compression:
 
 
 def _mergeable(parent: BTNode, child: BTNode) -> bool:
-    return (child.type == parent.type and parent.type in MERGEABLE_CONTROLS
-            and child.kind is NodeKind.CONTROL and not child.attrs)
+    return (
+        child.type == parent.type
+        and parent.type in MERGEABLE_CONTROLS
+        and child.kind is NodeKind.CONTROL
+        and not child.attrs
+    )
 
 
 def compress(root: BTNode) -> Compression:
@@ -157,8 +173,9 @@ def inline_and_compress(doc: BTDocument) -> Prepared:
                 depth_before = child_level
             if _mergeable(copy, child):
                 merged += 1
-                pending.extend((grand, child_chain, child_level + 1)
-                               for grand in reversed(child.children))
+                pending.extend(
+                    (grand, child_chain, child_level + 1) for grand in reversed(child.children)
+                )
                 continue
             child_copy = _shallow_copy(child)
             copy.children.append(child_copy)

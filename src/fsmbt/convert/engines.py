@@ -42,8 +42,9 @@ _PLUGIN_MODULES = (
 )
 
 
-def register_engine(name: str, fsm_to_bt: Converter | None, bt_to_fsm: Converter | None,
-                    description: str = "") -> Engine:
+def register_engine(
+    name: str, fsm_to_bt: Converter | None, bt_to_fsm: Converter | None, description: str = ""
+) -> Engine:
     """Add (or replace) an engine under ``name``."""
     engine = Engine(name, fsm_to_bt, bt_to_fsm, description)
     _ENGINES[name] = engine
@@ -53,8 +54,12 @@ def register_engine(name: str, fsm_to_bt: Converter | None, bt_to_fsm: Converter
 def _register_rules() -> None:
     """The default engine: LEBT for FSM -> BT (a SubTree per composite state of a hierarchical
     FSM, option ``hierarchy``), hierarchical conversion units for BT -> FSM."""
-    register_engine("rules", fsm_to_bt, bt_to_hfsm,
-                    "the paper's algorithms done exactly (LEBT; depth compression + units)")
+    register_engine(
+        "rules",
+        fsm_to_bt,
+        bt_to_hfsm,
+        "the paper's algorithms done exactly (LEBT; depth compression + units)",
+    )
 
 
 def _load_plugins(until: str | None = None) -> None:

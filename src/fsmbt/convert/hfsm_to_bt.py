@@ -74,8 +74,9 @@ def _cluster_key(path: str) -> str:
 
 
 def _ambiguous_names(fsm: FSM) -> list[str]:
-    return [path for path, _machine, state in fsm.walk()
-            if any(ch in state.name for ch in _AMBIGUOUS)]
+    return [
+        path for path, _machine, state in fsm.walk() if any(ch in state.name for ch in _AMBIGUOUS)
+    ]
 
 
 def _classify(fsm: FSM, flat: FSM) -> tuple[dict[str, _Cluster], dict[str, str | None]]:
@@ -93,24 +94,35 @@ def _classify(fsm: FSM, flat: FSM) -> tuple[dict[str, _Cluster], dict[str, str |
             path = prefix + head
             if path not in clusters:
                 parent_cluster: _Cluster | None = (
-                    clusters.get(parent) if parent is not None else None)
-                clusters[path] = _Cluster(path, parent, state.is_parallel,
-                                          depth=0 if parent_cluster is None
-                                          else parent_cluster.depth + 1)
-                (parent_cluster.members if parent_cluster is not None else
-                 clusters.setdefault("", _Cluster("", None)).members).append(_cluster_key(path))
+                    clusters.get(parent) if parent is not None else None
+                )
+                clusters[path] = _Cluster(
+                    path,
+                    parent,
+                    state.is_parallel,
+                    depth=0 if parent_cluster is None else parent_cluster.depth + 1,
+                )
+                (
+                    parent_cluster.members
+                    if parent_cluster is not None
+                    else clusters.setdefault("", _Cluster("", None)).members
+                ).append(_cluster_key(path))
             parent = path
             if state.is_parallel:
                 break  # the regions' combinations are atomic members of the parallel cluster
             machine, prefix, rest = state.regions[0], path + PATH_SEPARATOR, tail
         owner[flat_name] = parent
-        (clusters[parent].members if parent is not None else
-         clusters.setdefault("", _Cluster("", None)).members).append(_state_key(flat_name))
+        (
+            clusters[parent].members
+            if parent is not None
+            else clusters.setdefault("", _Cluster("", None)).members
+        ).append(_state_key(flat_name))
     return clusters, owner
 
 
-def _node_at(flat_name: str, level: str | None, owner: dict[str, str | None],
-             clusters: dict[str, _Cluster]) -> str | None:
+def _node_at(
+    flat_name: str, level: str | None, owner: dict[str, str | None], clusters: dict[str, _Cluster]
+) -> str | None:
     """The node of ``level`` containing ``flat_name`` (None = not inside ``level``)."""
     path = owner[flat_name]
     if path == level:
@@ -133,7 +145,8 @@ def fsm_to_subtree_bt(fsm: FSM, *, style: str = "paper", **options: object) -> C
         result = fsm_to_lebt(fsm, style=style, **options)
         result.warnings.append(
             f"state name(s) {', '.join(ambiguous[:5])} contain '/', '[' or '|' and cannot be "
-            "told apart from flattened paths: converted flat, without SubTrees")
+            "told apart from flattened paths: converted flat, without SubTrees"
+        )
         return result
     if style != "paper":
         return fsm_to_lebt(fsm, style=style, **options)  # raises the style error
@@ -142,12 +155,16 @@ def fsm_to_subtree_bt(fsm: FSM, *, style: str = "paper", **options: object) -> C
     clusters, owner = _classify(fsm, flat)
     top = clusters.setdefault("", _Cluster("", None))
     levels = [path for path in clusters if path != ""]
-    warnings = [f"hierarchical FSM flattened to {len(flat.states)} states; composite states "
-                f"kept as {len(levels)} SubTree(s)"]
+    warnings = [
+        f"hierarchical FSM flattened to {len(flat.states)} states; composite states "
+        f"kept as {len(levels)} SubTree(s)"
+    ]
     parallel = [c.path for c in clusters.values() if c.parallel]
     if parallel:
-        warnings.append(f"parallel state(s) {', '.join(parallel[:5])}: their regions are one "
-                        "SubTree over the product of the regions (no tree per region)")
+        warnings.append(
+            f"parallel state(s) {', '.join(parallel[:5])}: their regions are one "
+            "SubTree over the product of the regions (no tree per region)"
+        )
 
     writer = LebtLeafWriter(flat, structure)
     # per level: predecessor nodes of each node, and where each flat pair's target lies
@@ -180,20 +197,29 @@ def fsm_to_subtree_bt(fsm: FSM, *, style: str = "paper", **options: object) -> C
         if key.startswith("s:"):
             return writer.state_leaf(key[2:])
         path = key[2:]
-        return BTNode(type="SubTree", kind=NodeKind.SUBTREE, name=path,
-                      attrs={"ID": tree_ids[path]})
+        return BTNode(
+            type="SubTree", kind=NodeKind.SUBTREE, name=path, attrs={"ID": tree_ids[path]}
+        )
 
     def guard(key: str) -> BTNode:
         label = key[2:]
         pairs = ";".join(f"{writer.esc(s)}/{writer.esc(e)}" for s, e in guard_pairs[key])
-        return BTNode(type="LebtGuard", kind=NodeKind.CONDITION, name=f"Enter_{label}",
-                      attrs={"target": label, "pairs": pairs})
+        return BTNode(
+            type="LebtGuard",
+            kind=NodeKind.CONDITION,
+            name=f"Enter_{label}",
+            attrs={"target": label, "pairs": pairs},
+        )
 
     def build_level(cluster: _Cluster) -> BTNode:
         members = cluster.members
-        roots = [k for k in members
-                 if k.startswith("c:") or _OUTSIDE in preds.get(k, {_OUTSIDE: None})
-                 or len(preds.get(k, ())) >= 2]
+        roots = [
+            k
+            for k in members
+            if k.startswith("c:")
+            or _OUTSIDE in preds.get(k, {_OUTSIDE: None})
+            or len(preds.get(k, ())) >= 2
+        ]
         root_set = set(roots)
         below: dict[str, list[str]] = {}
         for key in members:
@@ -206,13 +232,25 @@ def fsm_to_subtree_bt(fsm: FSM, *, style: str = "paper", **options: object) -> C
             body_head = leaf_or_subtree(key)
             children = below.get(key, [])
             if not children:
-                return BTNode(type="Fallback", kind=NodeKind.CONTROL, name=f"{label}_selector",
-                              children=[guard(key), body_head]), None
+                return BTNode(
+                    type="Fallback",
+                    kind=NodeKind.CONTROL,
+                    name=f"{label}_selector",
+                    children=[guard(key), body_head],
+                ), None
             shape = "chain" if len(children) == 1 else "branch"
-            body = BTNode(type="Sequence", kind=NodeKind.CONTROL, name=f"{label}_{shape}",
-                          children=[body_head])
-            return BTNode(type="Fallback", kind=NodeKind.CONTROL, name=f"{label}_selector",
-                          children=[guard(key), body]), body
+            body = BTNode(
+                type="Sequence",
+                kind=NodeKind.CONTROL,
+                name=f"{label}_{shape}",
+                children=[body_head],
+            )
+            return BTNode(
+                type="Fallback",
+                kind=NodeKind.CONTROL,
+                name=f"{label}_selector",
+                children=[guard(key), body],
+            ), body
 
         name = ROOT_NAME if cluster.path == "" else f"{cluster.path}_LEBT"
         level_root = BTNode(type="Sequence", kind=NodeKind.CONTROL, name=name)
@@ -254,12 +292,14 @@ def fsm_to_subtree_bt(fsm: FSM, *, style: str = "paper", **options: object) -> C
     return ConversionResult(doc, "rules", "fsm->bt", stats, warnings)
 
 
-def fsm_to_bt(fsm: FSM, *, style: str = "paper", hierarchy: str = "subtrees",
-              **options: object) -> ConversionResult:
+def fsm_to_bt(
+    fsm: FSM, *, style: str = "paper", hierarchy: str = "subtrees", **options: object
+) -> ConversionResult:
     """The rules engine's FSM -> BT: SubTrees per composite state, or one flat LEBT."""
     if hierarchy not in HIERARCHY_MODES:
-        raise UnsupportedError(f"hierarchy mode '{hierarchy}' (offered: "
-                               f"{', '.join(HIERARCHY_MODES)})")
+        raise UnsupportedError(
+            f"hierarchy mode '{hierarchy}' (offered: {', '.join(HIERARCHY_MODES)})"
+        )
     if hierarchy == "flatten":
         return fsm_to_lebt(fsm, style=style, **options)
     return fsm_to_subtree_bt(fsm, style=style, **options)

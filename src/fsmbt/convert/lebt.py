@@ -43,17 +43,28 @@ ROOT_NAME = "LEBT"
 def lebt_node_models() -> dict[str, NodeModel]:
     """``TreeNodesModel`` entries for the two LEBT leaf types (so Groot2 knows them)."""
     return {
-        GUARD_TYPE: NodeModel(GUARD_TYPE, NodeKind.CONDITION, [
-            PortModel("target", "input", description="the state this guard enters"),
-            PortModel("pairs", "input",
-                      description="source/event pairs entering the target, ';'-separated"),
-        ]),
-        STATE_TYPE: NodeModel(STATE_TYPE, NodeKind.ACTION, [
-            PortModel("state", "input", description="the FSM state"),
-            PortModel("action", "input", description="the state's action (empty = none)"),
-            PortModel("final", "input", description="true when the state is final"),
-            PortModel("exits", "input", description="events leaving the state, ';'-separated"),
-        ]),
+        GUARD_TYPE: NodeModel(
+            GUARD_TYPE,
+            NodeKind.CONDITION,
+            [
+                PortModel("target", "input", description="the state this guard enters"),
+                PortModel(
+                    "pairs",
+                    "input",
+                    description="source/event pairs entering the target, ';'-separated",
+                ),
+            ],
+        ),
+        STATE_TYPE: NodeModel(
+            STATE_TYPE,
+            NodeKind.ACTION,
+            [
+                PortModel("state", "input", description="the FSM state"),
+                PortModel("action", "input", description="the state's action (empty = none)"),
+                PortModel("final", "input", description="true when the state is final"),
+                PortModel("exits", "input", description="events leaving the state, ';'-separated"),
+            ],
+        ),
     }
 
 
@@ -80,10 +91,15 @@ class LebtLeafWriter:
 
     def guard(self, state: str) -> BTNode:
         esc = self.esc
-        pairs = ";".join(f"{esc(source)}/{esc(event)}"
-                         for source, event in self.structure.guard_pairs[state])
-        return BTNode(type=GUARD_TYPE, kind=NodeKind.CONDITION, name=f"Enter_{state}",
-                      attrs={"target": state, "pairs": pairs})
+        pairs = ";".join(
+            f"{esc(source)}/{esc(event)}" for source, event in self.structure.guard_pairs[state]
+        )
+        return BTNode(
+            type=GUARD_TYPE,
+            kind=NodeKind.CONDITION,
+            name=f"Enter_{state}",
+            attrs={"target": state, "pairs": pairs},
+        )
 
     def state_leaf(self, state: str) -> BTNode:
         model_state = self.fsm.states[state]
@@ -101,13 +117,22 @@ class LebtLeafWriter:
         leaf = self.state_leaf(state)
         below = self.structure.children[state]
         if not below:
-            return BTNode(type="Fallback", kind=NodeKind.CONTROL, name=f"{state}_selector",
-                          children=[self.guard(state), leaf]), None
+            return BTNode(
+                type="Fallback",
+                kind=NodeKind.CONTROL,
+                name=f"{state}_selector",
+                children=[self.guard(state), leaf],
+            ), None
         shape = "chain" if len(below) == 1 else "branch"
-        body = BTNode(type="Sequence", kind=NodeKind.CONTROL, name=f"{state}_{shape}",
-                      children=[leaf])
-        return BTNode(type="Fallback", kind=NodeKind.CONTROL, name=f"{state}_selector",
-                      children=[self.guard(state), body]), body
+        body = BTNode(
+            type="Sequence", kind=NodeKind.CONTROL, name=f"{state}_{shape}", children=[leaf]
+        )
+        return BTNode(
+            type="Fallback",
+            kind=NodeKind.CONTROL,
+            name=f"{state}_selector",
+            children=[self.guard(state), body],
+        ), body
 
 
 def build_lebt(fsm: FSM, structure: LebtStructure) -> BTNode:
@@ -164,14 +189,17 @@ def tree_depth(root: BTNode) -> int:
 def fsm_to_lebt(fsm: FSM, *, style: str = "paper", **_options: object) -> ConversionResult:
     """Convert an FSM (flat or hierarchical) into its LEBT document."""
     if style not in STYLES:
-        raise UnsupportedError(f"LEBT style '{style}' (offered: {', '.join(STYLES)}); a compact "
-                               "chain is not macro-step equivalent under the LEBT protocol")
+        raise UnsupportedError(
+            f"LEBT style '{style}' (offered: {', '.join(STYLES)}); a compact "
+            "chain is not macro-step equivalent under the LEBT protocol"
+        )
     warnings: list[str] = []
     flat = fsm
     if needs_flattening(fsm):
         flat = flatten(fsm)
-        warnings.append(f"hierarchical FSM flattened to {len(flat.states)} states before "
-                        "conversion")
+        warnings.append(
+            f"hierarchical FSM flattened to {len(flat.states)} states before conversion"
+        )
     structure = analyse(flat)
     if structure.unreachable:
         shown = ", ".join(structure.unreachable[:10])

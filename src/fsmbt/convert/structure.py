@@ -74,20 +74,30 @@ def analyse(fsm: FSM) -> LebtStructure:
         raise InputError("the state machine has no initial state", element=fsm.name)
     start = fsm.start_name or DEFAULT_START
     if start in fsm.states:
-        raise UnsupportedError(f"a state is named like the start pseudo-state '{start}'",
-                               element=start)
+        raise UnsupportedError(
+            f"a state is named like the start pseudo-state '{start}'", element=start
+        )
     table: dict[str, list[Transition]] = {}
     for t in fsm.transitions:
         if t.source not in fsm.states or t.target not in fsm.states:
             missing = t.source if t.source not in fsm.states else t.target
-            raise InputError(f"transition refers to unknown state '{missing}'",
-                             element=fsm.name, location=t.location)
+            raise InputError(
+                f"transition refers to unknown state '{missing}'",
+                element=fsm.name,
+                location=t.location,
+            )
         if t.event is None:
-            raise InputError("eventless transition in a flat FSM; flatten it first",
-                             element=t.source, location=t.location)
+            raise InputError(
+                "eventless transition in a flat FSM; flatten it first",
+                element=t.source,
+                location=t.location,
+            )
         if t.event == NO_EVENT:
-            raise UnsupportedError("an empty event name cannot be told from 'no event'",
-                                   element=t.source, location=t.location)
+            raise UnsupportedError(
+                "an empty event name cannot be told from 'no event'",
+                element=t.source,
+                location=t.location,
+            )
         if fsm.states[t.source].final:
             continue  # never fires
         table.setdefault(t.source, []).append(t)
@@ -100,8 +110,9 @@ def analyse(fsm: FSM) -> LebtStructure:
     guard_pairs: dict[str, list[tuple[str, str]]] = {name: [] for name in reachable}
     exits: dict[str, list[str]] = {name: [] for name in reachable}
     predecessors[entry].append(start)
-    guard_pairs[entry].append((start, fsm.initial_event if fsm.initial_event is not None
-                               else NO_EVENT))
+    guard_pairs[entry].append(
+        (start, fsm.initial_event if fsm.initial_event is not None else NO_EVENT)
+    )
     seen_pred: set[tuple[str, str]] = {(start, entry)}
     for source in reachable:
         events_out: dict[str, None] = {}
@@ -130,5 +141,6 @@ def analyse(fsm: FSM) -> LebtStructure:
             if len(preds) == 1 and preds[0] == source:
                 linked.add(target)
                 below.append(target)
-    return LebtStructure(start, entry, roots, loop_states, children, guard_pairs, exits,
-                         predecessors, unreachable)
+    return LebtStructure(
+        start, entry, roots, loop_states, children, guard_pairs, exits, predecessors, unreachable
+    )

@@ -13,5 +13,15 @@ from fsmbt.formats.registry import (
     write_model,
 )
 
-__all__ = ["Format", "ReadContext", "detect_format", "dumps", "formats", "get_format", "loads",
-           "read_model", "register", "write_model"]
+__all__ = [
+    "Format",
+    "ReadContext",
+    "detect_format",
+    "dumps",
+    "formats",
+    "get_format",
+    "loads",
+    "read_model",
+    "register",
+    "write_model",
+]

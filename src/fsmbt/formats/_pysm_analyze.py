@@ -30,11 +30,19 @@ from dataclasses import dataclass, field
 from fsmbt.formats._pysm_source import NotStatic, last_name, literal, source_text
 from fsmbt.model.errors import InputError, SourceLocation, UnsupportedError
 
-SMACH_CONTAINERS = {"StateMachine": "sm", "Sequence": "sequence", "Concurrence": "concurrence",
-                    "Iterator": "iterator"}
-FLEXBE_CONTAINERS = {"OperatableStateMachine": "sm", "ConcurrencyContainer": "flexbe-concurrency",
-                     "PriorityContainer": "priority", "LockableStateMachine": "sm",
-                     "PreemptableStateMachine": "sm"}
+SMACH_CONTAINERS = {
+    "StateMachine": "sm",
+    "Sequence": "sequence",
+    "Concurrence": "concurrence",
+    "Iterator": "iterator",
+}
+FLEXBE_CONTAINERS = {
+    "OperatableStateMachine": "sm",
+    "ConcurrencyContainer": "flexbe-concurrency",
+    "PriorityContainer": "priority",
+    "LockableStateMachine": "sm",
+    "PreemptableStateMachine": "sm",
+}
 CONTAINER_CLASSES = {**SMACH_CONTAINERS, **FLEXBE_CONTAINERS}
 #: Registered outcomes of library states whose source is not in the file (smach_ros).
 LIBRARY_OUTCOMES: dict[str, tuple[str, ...]] = {
@@ -44,8 +52,13 @@ LIBRARY_OUTCOMES: dict[str, tuple[str, ...]] = {
     "ConditionState": ("true", "false", "preempted"),
 }
 _ADD_METHODS = frozenset({"add", "add_auto"})
-_CONTAINER_METHODS = _ADD_METHODS | {"set_contained_state", "set_initial_state",
-                                     "add_outcome_map", "set_iteritems", "register_outcomes"}
+_CONTAINER_METHODS = _ADD_METHODS | {
+    "set_contained_state",
+    "set_initial_state",
+    "add_outcome_map",
+    "set_iteritems",
+    "register_outcomes",
+}
 
 
 @dataclass
@@ -167,23 +180,31 @@ class Analyzer:
     def run(self) -> Analysis:
         self.collect_definitions()
         self.walk(self.tree.body, _Ctx(ChainMap(), (), None, None, None, None))
-        return Analysis(self.containers, self.behaviours, self.imports, self.warnings,
-                        self.extension())
+        return Analysis(
+            self.containers, self.behaviours, self.imports, self.warnings, self.extension()
+        )
 
     def extension(self) -> dict[str, object]:
         """The module-level ``__fsmbt__ = {...}`` literal the SMACH writer adds, if any."""
         for stmt in self.tree.body:
-            if (isinstance(stmt, ast.Assign) and len(stmt.targets) == 1
-                    and isinstance(stmt.targets[0], ast.Name)
-                    and stmt.targets[0].id == "__fsmbt__"):
+            if (
+                isinstance(stmt, ast.Assign)
+                and len(stmt.targets) == 1
+                and isinstance(stmt.targets[0], ast.Name)
+                and stmt.targets[0].id == "__fsmbt__"
+            ):
                 try:
                     value = literal(stmt.value)
                 except NotStatic:
                     value = None
                 if isinstance(value, dict) and value.get("version") == 1:
                     return {str(k): v for k, v in value.items()}
-                self.warnings.append((stmt.lineno, "__fsmbt__ is not a version-1 literal dict "
-                                                   "written by fsmbt; ignored"))
+                self.warnings.append(
+                    (
+                        stmt.lineno,
+                        "__fsmbt__ is not a version-1 literal dict written by fsmbt; ignored",
+                    )
+                )
         return {}
 
     def collect_definitions(self) -> None:
@@ -206,7 +227,10 @@ class Analyzer:
                     self.class_outcomes.setdefault(node.name, outcomes)
             elif isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
                 for decorator in node.decorator_list:
-                    if isinstance(decorator, ast.Call) and last_name(decorator.func) == "cb_interface":
+                    if (
+                        isinstance(decorator, ast.Call)
+                        and last_name(decorator.func) == "cb_interface"
+                    ):
                         found = self.keyword_literal(decorator, "outcomes")
                         if isinstance(found, list):
                             self.callback_outcomes[node.name] = [str(o) for o in found]
@@ -216,8 +240,11 @@ class Analyzer:
         for item in cls.body:
             if isinstance(item, ast.FunctionDef) and item.name == "__init__":
                 for node in ast.walk(item):
-                    if (isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute)
-                            and node.func.attr == "__init__"):
+                    if (
+                        isinstance(node, ast.Call)
+                        and isinstance(node.func, ast.Attribute)
+                        and node.func.attr == "__init__"
+                    ):
                         found = self.keyword_literal(node, "outcomes")
                         if found is None:
                             for arg in node.args:
@@ -225,7 +252,9 @@ class Analyzer:
                                     value = literal(arg)
                                 except NotStatic:
                                     continue
-                                if isinstance(value, list) and all(isinstance(v, str) for v in value):
+                                if isinstance(value, list) and all(
+                                    isinstance(v, str) for v in value
+                                ):
                                     found = value
                                     break
                         if isinstance(found, (list, tuple)):
@@ -307,34 +336,67 @@ class Analyzer:
                 container = self.opened_container(item.context_expr, ctx)
                 if container is not None:
                     if ctx.loop_line is not None:
-                        raise self.unsupported(stmt, f"a container opened in a loop (line "
-                                                     f"{ctx.loop_line}): how often it is "
-                                                     "filled is decided at run time")
+                        raise self.unsupported(
+                            stmt,
+                            f"a container opened in a loop (line "
+                            f"{ctx.loop_line}): how often it is "
+                            "filled is decided at run time",
+                        )
                     opened.append(container)
-            inner = _Ctx(ctx.env, tuple(opened), ctx.loop_line, ctx.cond_line,
-                         ctx.behaviour, ctx.self_container)
+            inner = _Ctx(
+                ctx.env,
+                tuple(opened),
+                ctx.loop_line,
+                ctx.cond_line,
+                ctx.behaviour,
+                ctx.self_container,
+            )
             return [(s, inner) for s in stmt.body]
         if isinstance(stmt, (ast.For, ast.AsyncFor, ast.While)):
-            inner = _Ctx(ctx.env, ctx.opened, ctx.loop_line or line, ctx.cond_line,
-                         ctx.behaviour, ctx.self_container)
+            inner = _Ctx(
+                ctx.env,
+                ctx.opened,
+                ctx.loop_line or line,
+                ctx.cond_line,
+                ctx.behaviour,
+                ctx.self_container,
+            )
             return [(s, inner) for s in [*stmt.body, *stmt.orelse]]
         if isinstance(stmt, ast.If):
             if _is_main_guard(stmt):
                 return []  # what runs as a script is not the state machine's construction
-            inner = _Ctx(ctx.env, ctx.opened, ctx.loop_line, ctx.cond_line or line,
-                         ctx.behaviour, ctx.self_container)
+            inner = _Ctx(
+                ctx.env,
+                ctx.opened,
+                ctx.loop_line,
+                ctx.cond_line or line,
+                ctx.behaviour,
+                ctx.self_container,
+            )
             return [(s, inner) for s in [*stmt.body, *stmt.orelse]]
         if isinstance(stmt, ast.Try | ast.TryStar):
-            cond = _Ctx(ctx.env, ctx.opened, ctx.loop_line, ctx.cond_line or line,
-                        ctx.behaviour, ctx.self_container)
+            cond = _Ctx(
+                ctx.env,
+                ctx.opened,
+                ctx.loop_line,
+                ctx.cond_line or line,
+                ctx.behaviour,
+                ctx.self_container,
+            )
             out = [(s, ctx) for s in stmt.body]
             for handler in stmt.handlers:
                 out.extend((s, cond) for s in handler.body)
             out.extend((s, ctx) for s in [*stmt.orelse, *stmt.finalbody])
             return out
         if isinstance(stmt, ast.Match):
-            cond = _Ctx(ctx.env, ctx.opened, ctx.loop_line, ctx.cond_line or line,
-                        ctx.behaviour, ctx.self_container)
+            cond = _Ctx(
+                ctx.env,
+                ctx.opened,
+                ctx.loop_line,
+                ctx.cond_line or line,
+                ctx.behaviour,
+                ctx.self_container,
+            )
             return [(s, cond) for case in stmt.cases for s in case.body]
         if isinstance(stmt, ast.Assign):
             value = self.expression(stmt.value, ctx, stmt)
@@ -395,8 +457,12 @@ class Analyzer:
             return _UNKNOWN
 
     def opened_container(self, expr: ast.expr, ctx: _Ctx) -> Container | None:
-        if (isinstance(expr, ast.Call) and isinstance(expr.func, ast.Attribute)
-                and expr.func.attr == "opened" and not expr.args):
+        if (
+            isinstance(expr, ast.Call)
+            and isinstance(expr.func, ast.Attribute)
+            and expr.func.attr == "opened"
+            and not expr.args
+        ):
             expr = expr.func.value
         value = self.value_of(expr, ctx)
         return value if isinstance(value, Container) else None
@@ -409,8 +475,10 @@ class Analyzer:
             if isinstance(func, ast.Attribute) and func.attr in _CONTAINER_METHODS:
                 receiver = func.value
                 receiver_value = self.value_of(receiver, ctx)
-                if isinstance(receiver_value, Container) or self.container_kind(
-                        last_name(receiver)) is not None:
+                if (
+                    isinstance(receiver_value, Container)
+                    or self.container_kind(last_name(receiver)) is not None
+                ):
                     target = receiver_value if isinstance(receiver_value, Container) else None
                     return self.container_call(func.attr, expr, target, ctx)
             name = last_name(func)
@@ -425,21 +493,29 @@ class Analyzer:
 
     def guard_static(self, node: ast.AST, ctx: _Ctx, what: str) -> None:
         if ctx.loop_line is not None:
-            raise self.unsupported(node, f"{what} in a loop (line {ctx.loop_line}): which "
-                                         "states exist is decided at run time")
+            raise self.unsupported(
+                node,
+                f"{what} in a loop (line {ctx.loop_line}): which "
+                "states exist is decided at run time",
+            )
         if ctx.cond_line is not None:
-            raise self.unsupported(node, f"{what} under a condition (line {ctx.cond_line}): "
-                                         "which states exist is decided at run time")
+            raise self.unsupported(
+                node,
+                f"{what} under a condition (line {ctx.cond_line}): "
+                "which states exist is decided at run time",
+            )
 
-    def new_container(self, cls: str, kind: str, call: ast.Call, ctx: _Ctx,
-                      stmt: ast.stmt) -> Container:
+    def new_container(
+        self, cls: str, kind: str, call: ast.Call, ctx: _Ctx, stmt: ast.stmt
+    ) -> Container:
         self.guard_static(call, ctx, f"a {cls} created")
         args = self.bind_args(call, _CONSTRUCTOR_PARAMS[self.aliases.get(cls, cls)])
         outcomes = self.string_list(args.get("outcomes"), ctx, call, "the container's outcomes")
         container = Container(self.aliases.get(cls, cls), kind, outcomes, call.lineno)
         if kind == "sequence":
-            container.connector = self.string(args.get("connector_outcome"), ctx, call,
-                                              "the connector outcome")
+            container.connector = self.string(
+                args.get("connector_outcome"), ctx, call, "the connector outcome"
+            )
         elif kind == "concurrence":
             self.concurrence_options(container, args, ctx, call)
         elif kind == "flexbe-concurrency":
@@ -455,47 +531,65 @@ class Analyzer:
             return self.subclass_containers[cls]
         definition = self.class_defs[cls]
         kind = self.subclass_kind(cls) or "sm"
-        init = next((s for s in definition.body
-                     if isinstance(s, ast.FunctionDef) and s.name == "__init__"), None)
+        init = next(
+            (s for s in definition.body if isinstance(s, ast.FunctionDef) and s.name == "__init__"),
+            None,
+        )
         if init is None:
             raise self.unsupported(call, f"container class '{cls}' without __init__")
-        base_call = next((n for n in ast.walk(init)
-                          if isinstance(n, ast.Call) and isinstance(n.func, ast.Attribute)
-                          and n.func.attr == "__init__"), None)
+        base_call = next(
+            (
+                n
+                for n in ast.walk(init)
+                if isinstance(n, ast.Call)
+                and isinstance(n.func, ast.Attribute)
+                and n.func.attr == "__init__"
+            ),
+            None,
+        )
         if base_call is None:
-            raise self.unsupported(init, f"container class '{cls}': its base __init__ call "
-                                         "(with the outcomes) is not found")
-        base = next((b for b in self.class_bases.get(cls, []) if self.container_kind(b)),
-                    "StateMachine")
+            raise self.unsupported(
+                init,
+                f"container class '{cls}': its base __init__ call (with the outcomes) is not found",
+            )
+        base = next(
+            (b for b in self.class_bases.get(cls, []) if self.container_kind(b)), "StateMachine"
+        )
         original = self.aliases.get(base, base)
         args = list(base_call.args)
         if args and isinstance(args[0], ast.Name) and args[0].id == "self":
             args = args[1:]
-        fake = ast.Call(func=ast.Name(id=base, ctx=ast.Load()), args=args,
-                        keywords=base_call.keywords)
+        fake = ast.Call(
+            func=ast.Name(id=base, ctx=ast.Load()), args=args, keywords=base_call.keywords
+        )
         ast.copy_location(fake, base_call)
         ctx0 = _Ctx(ChainMap(), (), None, None, None, None)
         container = self.new_container(original, kind, fake, ctx0, init)
         container.var = cls
         self.subclass_containers[cls] = container
         inner = _Ctx(ChainMap(), (), None, None, None, container)
-        self.walk([s for s in init.body if not (isinstance(s, ast.Expr) and s.value is base_call)],
-                  inner)
+        self.walk(
+            [s for s in init.body if not (isinstance(s, ast.Expr) and s.value is base_call)], inner
+        )
         return container
 
     def bind_args(self, call: ast.Call, params: tuple[str, ...]) -> dict[str, ast.expr]:
         out: dict[str, ast.expr] = {}
         for index, arg in enumerate(call.args):
             if isinstance(arg, ast.Starred):
-                raise self.unsupported(arg, "arguments passed with * unpacking (known only at "
-                                            "run time)")
+                raise self.unsupported(
+                    arg, "arguments passed with * unpacking (known only at run time)"
+                )
             if index >= len(params):
-                raise self.invalid(arg, f"too many positional arguments to {last_name(call.func)}()")
+                raise self.invalid(
+                    arg, f"too many positional arguments to {last_name(call.func)}()"
+                )
             out[params[index]] = arg
         for keyword in call.keywords:
             if keyword.arg is None:
-                raise self.unsupported(keyword.value, "arguments passed with ** unpacking "
-                                                      "(known only at run time)")
+                raise self.unsupported(
+                    keyword.value, "arguments passed with ** unpacking (known only at run time)"
+                )
             out[keyword.arg] = keyword.value
         return out
 
@@ -504,8 +598,9 @@ class Analyzer:
         try:
             return literal(node, lambda n: self.lookup_literal(n, ctx))
         except NotStatic as exc:
-            raise self.unsupported(exc.node, f"{what} is {exc.what} "
-                                             f"('{source_text(self.text, node, 80)}')") from None
+            raise self.unsupported(
+                exc.node, f"{what} is {exc.what} ('{source_text(self.text, node, 80)}')"
+            ) from None
 
     def string(self, node: ast.expr | None, ctx: _Ctx, call: ast.AST, what: str) -> str:
         if node is None:
@@ -523,16 +618,20 @@ class Analyzer:
             raise self.invalid(node, f"{what} must be a list of strings")
         return [str(v) for v in value]
 
-    def concurrence_options(self, container: Container, args: dict[str, ast.expr], ctx: _Ctx,
-                            call: ast.Call) -> None:
+    def concurrence_options(
+        self, container: Container, args: dict[str, ast.expr], ctx: _Ctx, call: ast.Call
+    ) -> None:
         for callback in ("outcome_cb", "child_termination_cb"):
             node = args.get(callback)
             if node is not None and not (isinstance(node, ast.Constant) and node.value is None):
                 container.blocker = self.unsupported(
-                    node, f"Concurrence {callback}: a callback decides the container's "
-                          "behaviour at run time")
-        container.default_outcome = self.string(args.get("default_outcome"), ctx, call,
-                                                "the Concurrence default_outcome")
+                    node,
+                    f"Concurrence {callback}: a callback decides the container's "
+                    "behaviour at run time",
+                )
+        container.default_outcome = self.string(
+            args.get("default_outcome"), ctx, call, "the Concurrence default_outcome"
+        )
         node = args.get("outcome_map")
         if node is None:
             return
@@ -540,14 +639,21 @@ class Analyzer:
         if not isinstance(mapping, dict):
             raise self.invalid(node, "the Concurrence outcome_map must be a dict")
         for outcome, children in mapping.items():
-            if not isinstance(outcome, str) or not isinstance(children, dict) or not all(
-                    isinstance(k, str) and isinstance(v, str) for k, v in children.items()):
-                raise self.invalid(node, "the Concurrence outcome_map must map each container "
-                                         "outcome to {child label: child outcome}")
+            if (
+                not isinstance(outcome, str)
+                or not isinstance(children, dict)
+                or not all(isinstance(k, str) and isinstance(v, str) for k, v in children.items())
+            ):
+                raise self.invalid(
+                    node,
+                    "the Concurrence outcome_map must map each container "
+                    "outcome to {child label: child outcome}",
+                )
             container.outcome_map.append((outcome, dict(children)))
 
-    def flexbe_conditions(self, container: Container, node: ast.expr | None, ctx: _Ctx,
-                          call: ast.Call) -> None:
+    def flexbe_conditions(
+        self, container: Container, node: ast.expr | None, ctx: _Ctx, call: ast.Call
+    ) -> None:
         if node is None:
             return
         value = self.static(node, ctx, "the ConcurrencyContainer conditions")
@@ -556,27 +662,45 @@ class Analyzer:
         elif isinstance(value, (list, tuple)):
             items = list(value)
         else:
-            raise self.invalid(node, "ConcurrencyContainer conditions must be a list of "
-                                     "(outcome, [(state, outcome), ...])")
+            raise self.invalid(
+                node,
+                "ConcurrencyContainer conditions must be a list of "
+                "(outcome, [(state, outcome), ...])",
+            )
         for item in items:
-            if (not isinstance(item, (list, tuple)) or len(item) != 2
-                    or not isinstance(item[0], str) or not isinstance(item[1], (list, tuple))):
-                raise self.invalid(node, "ConcurrencyContainer conditions must be a list of "
-                                         "(outcome, [(state, outcome), ...])")
+            if (
+                not isinstance(item, (list, tuple))
+                or len(item) != 2
+                or not isinstance(item[0], str)
+                or not isinstance(item[1], (list, tuple))
+            ):
+                raise self.invalid(
+                    node,
+                    "ConcurrencyContainer conditions must be a list of "
+                    "(outcome, [(state, outcome), ...])",
+                )
             pairs: dict[str, str] = {}
             for pair in item[1]:
-                if (not isinstance(pair, (list, tuple)) or len(pair) != 2
-                        or not all(isinstance(p, str) for p in pair)):
-                    raise self.invalid(node, "a ConcurrencyContainer condition is a list of "
-                                             "(state label, outcome) pairs")
+                if (
+                    not isinstance(pair, (list, tuple))
+                    or len(pair) != 2
+                    or not all(isinstance(p, str) for p in pair)
+                ):
+                    raise self.invalid(
+                        node,
+                        "a ConcurrencyContainer condition is a list of "
+                        "(state label, outcome) pairs",
+                    )
                 pairs[pair[0]] = pair[1]
             container.outcome_map.append((item[0], pairs))
 
-    def iterator_options(self, container: Container, args: dict[str, ast.expr], ctx: _Ctx,
-                         call: ast.Call) -> None:
+    def iterator_options(
+        self, container: Container, args: dict[str, ast.expr], ctx: _Ctx, call: ast.Call
+    ) -> None:
         if "exhausted_outcome" in args:
-            container.exhausted_outcome = self.string(args["exhausted_outcome"], ctx, call,
-                                                      "the Iterator exhausted_outcome")
+            container.exhausted_outcome = self.string(
+                args["exhausted_outcome"], ctx, call, "the Iterator exhausted_outcome"
+            )
         if container.exhausted_outcome not in container.outcomes:
             container.outcomes.append(container.exhausted_outcome)  # as SMACH does
         self.iterator_items(container, args.get("it"), ctx)
@@ -589,22 +713,26 @@ class Analyzer:
         count = _static_count(node, lambda n: self.lookup_literal(n, ctx))
         container.items = count
 
-    def container_call(self, method: str, call: ast.Call, target: Container | None,
-                       ctx: _Ctx) -> object:
+    def container_call(
+        self, method: str, call: ast.Call, target: Container | None, ctx: _Ctx
+    ) -> object:
         if method in ("add_outcome_map", "set_iteritems", "register_outcomes"):
             self.guard_static(call, ctx, f"{method}()")
             container = self.current(call, ctx, target if method != "set_iteritems" else None)
             if method == "add_outcome_map":
-                raise self.unsupported(call, "Concurrence.add_outcome_map (give the outcome_map "
-                                             "to the constructor)")
+                raise self.unsupported(
+                    call, "Concurrence.add_outcome_map (give the outcome_map to the constructor)"
+                )
             if method == "set_iteritems":
                 args = self.bind_args(call, ("it", "it_label"))
                 self.iterator_items(container, args.get("it"), ctx)
                 return _UNKNOWN
             args = self.bind_args(call, ("outcomes",))
-            container.outcomes.extend(o for o in self.string_list(args.get("outcomes"), ctx, call,
-                                                                  "the outcomes")
-                                      if o not in container.outcomes)
+            container.outcomes.extend(
+                o
+                for o in self.string_list(args.get("outcomes"), ctx, call, "the outcomes")
+                if o not in container.outcomes
+            )
             return _UNKNOWN
         if method == "set_initial_state":
             self.guard_static(call, ctx, "set_initial_state()")
@@ -612,8 +740,11 @@ class Analyzer:
             args = self.bind_args(call, ("initial_states", "userdata"))
             labels = self.string_list(args.get("initial_states"), ctx, call, "the initial states")
             if len(labels) != 1:
-                raise self.invalid(call, "set_initial_state needs exactly one label for a "
-                                         f"state machine (got {len(labels)})")
+                raise self.invalid(
+                    call,
+                    "set_initial_state needs exactly one label for a "
+                    f"state machine (got {len(labels)})",
+                )
             container.initial = labels[0]
             container.initial_line = call.lineno
             return _UNKNOWN
@@ -628,13 +759,17 @@ class Analyzer:
             return ctx.opened[-1]
         if fallback is not None:
             return fallback
-        raise self.invalid(call, f"{last_name(call.func)}() outside a 'with container:' block "
-                                 "(SMACH/FlexBE add to the container opened by 'with')")
+        raise self.invalid(
+            call,
+            f"{last_name(call.func)}() outside a 'with container:' block "
+            "(SMACH/FlexBE add to the container opened by 'with')",
+        )
 
     def add(self, container: Container, method: str, call: ast.Call, ctx: _Ctx) -> object:
         if container.kind == "iterator":
-            raise self.invalid(call, "an Iterator holds one state, set with "
-                                     "Iterator.set_contained_state")
+            raise self.invalid(
+                call, "an Iterator holds one state, set with Iterator.set_contained_state"
+            )
         if container.kind == "concurrence":
             params: tuple[str, ...] = ("label", "state", "remapping")
         elif method == "add_auto":
@@ -651,27 +786,34 @@ class Analyzer:
             try:
                 label_value = literal(label_node, lambda n: self.lookup_literal(n, ctx))
             except NotStatic:
-                raise self.unsupported(label_node, "a state label built at run time "
-                                                   f"('{source_text(self.text, label_node, 60)}')"
-                                       ) from None
+                raise self.unsupported(
+                    label_node,
+                    f"a state label built at run time ('{source_text(self.text, label_node, 60)}')",
+                ) from None
             if not isinstance(label_value, str):
                 raise self.invalid(label_node, "a state label must be a string")
             label = label_value
         else:
             label = label_node.value
         if label in container.labels:
-            raise self.invalid(call, f"state label '{label}' is already used in this container "
-                                     "(SMACH raises InvalidStateError)")
+            raise self.invalid(
+                call,
+                f"state label '{label}' is already used in this container "
+                "(SMACH raises InvalidStateError)",
+            )
         state = self.state(args["state"], ctx, label)
         transitions: dict[str, str | None] = {}
         node = args.get("transitions")
         if node is not None and not (isinstance(node, ast.Constant) and node.value is None):
             value = self.static(node, ctx, f"the transitions of '{label}'")
             if not isinstance(value, dict) or not all(
-                    isinstance(k, str) and (v is None or isinstance(v, str))
-                    for k, v in value.items()):
-                raise self.invalid(node, f"the transitions of '{label}' must map outcome names "
-                                         "to labels or container outcomes")
+                isinstance(k, str) and (v is None or isinstance(v, str)) for k, v in value.items()
+            ):
+                raise self.invalid(
+                    node,
+                    f"the transitions of '{label}' must map outcome names "
+                    "to labels or container outcomes",
+                )
             transitions = {str(k): (v if v != "" else None) for k, v in value.items()}
         child = Child(label, state, transitions, call.lineno)
         autonomy = args.get("autonomy")
@@ -683,12 +825,16 @@ class Analyzer:
             if isinstance(found, dict):
                 child.autonomy = {str(k): str(v) for k, v in found.items()}
         if method == "add_auto":
-            child.connectors = self.string_list(args.get("connector_outcomes"), ctx, call,
-                                                "the connector outcomes")
+            child.connectors = self.string_list(
+                args.get("connector_outcomes"), ctx, call, "the connector outcomes"
+            )
         if isinstance(state, Container):
             if state.parent is not None:
-                raise self.unsupported(call, f"container '{state.name}' is added twice "
-                                             f"(as '{label}'); SMACH shares one instance")
+                raise self.unsupported(
+                    call,
+                    f"container '{state.name}' is added twice "
+                    f"(as '{label}'); SMACH shares one instance",
+                )
             state.parent = container
         container.children.append(child)
         container.labels.add(label)
@@ -697,21 +843,29 @@ class Analyzer:
     def set_contained(self, container: Container, call: ast.Call, ctx: _Ctx) -> object:
         if container.kind != "iterator":
             raise self.invalid(call, "set_contained_state() needs an open Iterator")
-        args = self.bind_args(call, ("label", "state", "loop_outcomes", "break_outcomes",
-                                     "final_outcome_map"))
+        args = self.bind_args(
+            call, ("label", "state", "loop_outcomes", "break_outcomes", "final_outcome_map")
+        )
         label = self.string(args.get("label"), ctx, call, "the contained state's label")
         state = self.state(args["state"], ctx, label) if "state" in args else None
         if state is None:
             raise self.invalid(call, "set_contained_state() needs a state")
-        loop = self.string_list(args["loop_outcomes"], ctx, call, "loop_outcomes") \
-            if "loop_outcomes" in args else []
-        brk = self.string_list(args["break_outcomes"], ctx, call, "break_outcomes") \
-            if "break_outcomes" in args else []
+        loop = (
+            self.string_list(args["loop_outcomes"], ctx, call, "loop_outcomes")
+            if "loop_outcomes" in args
+            else []
+        )
+        brk = (
+            self.string_list(args["break_outcomes"], ctx, call, "break_outcomes")
+            if "break_outcomes" in args
+            else []
+        )
         final_map: dict[str, str] = {}
         if "final_outcome_map" in args:
             value = self.static(args["final_outcome_map"], ctx, "final_outcome_map")
             if not isinstance(value, dict) or not all(
-                    isinstance(k, str) and isinstance(v, str) for k, v in value.items()):
+                isinstance(k, str) and isinstance(v, str) for k, v in value.items()
+            ):
                 raise self.invalid(call, "final_outcome_map must map outcomes to outcomes")
             final_map = {str(k): str(v) for k, v in value.items()}
         container.children = [Child(label, state, {}, call.lineno)]
@@ -723,8 +877,11 @@ class Analyzer:
         return state
 
     def state(self, node: ast.expr, ctx: _Ctx, label: str) -> StateRef | Container | Embedded:
-        value = self.expression(node, ctx, ast.Expr(node)) if isinstance(node, ast.Call) \
+        value = (
+            self.expression(node, ctx, ast.Expr(node))
+            if isinstance(node, ast.Call)
             else self.value_of(node, ctx)
+        )
         if isinstance(value, Container | StateRef | Embedded):
             return value
         if isinstance(node, ast.Call):
@@ -739,33 +896,48 @@ class Analyzer:
                 return Embedded(cls, module.rsplit(".", 1)[0] if module else None, node.lineno)
             cls = last_name(func)
             if cls is None:
-                raise self.unsupported(node, f"state '{label}' is made by an expression "
-                                             f"('{source_text(self.text, node, 60)}')")
+                raise self.unsupported(
+                    node,
+                    f"state '{label}' is made by an expression "
+                    f"('{source_text(self.text, node, 60)}')",
+                )
             return self.state_ref(cls, node, ctx)
-        raise self.unsupported(node, f"state '{label}' is {source_text(self.text, node, 60)!r}, "
-                                     "a value known only at run time")
+        raise self.unsupported(
+            node,
+            f"state '{label}' is {source_text(self.text, node, 60)!r}, "
+            "a value known only at run time",
+        )
 
     def state_ref(self, cls: str, call: ast.Call, ctx: _Ctx) -> StateRef:
         original = self.aliases.get(cls, cls)
         outcomes = self.outcomes_of_class(cls)
         callback = None
         if original == "CBState":
-            cb = call.args[0] if call.args else next(
-                (k.value for k in call.keywords if k.arg == "cb"), None)
+            cb = (
+                call.args[0]
+                if call.args
+                else next((k.value for k in call.keywords if k.arg == "cb"), None)
+            )
             callback = last_name(cb) if cb is not None else None
             outcomes = list(self.callback_outcomes.get(callback or "", [])) or None
         given = self.keyword_literal(call, "outcomes")
         if isinstance(given, list) and all(isinstance(o, str) for o in given):
-            outcomes = list(dict.fromkeys([*(outcomes or [] if original == "CBState" else []),
-                                           *given]))
+            outcomes = list(
+                dict.fromkeys([*(outcomes or [] if original == "CBState" else []), *given])
+            )
         if original in ("SimpleActionState", "ServiceState"):
             for keyword in call.keywords:
                 if keyword.arg in ("result_cb", "response_cb"):
                     extra = self.callback_interface(keyword.value)
                     if extra is None:
-                        self.warnings.append((call.lineno, f"{original} {keyword.arg} may add "
-                                              "outcomes fsmbt cannot see (no cb_interface); "
-                                              "only the mapped ones are read"))
+                        self.warnings.append(
+                            (
+                                call.lineno,
+                                f"{original} {keyword.arg} may add "
+                                "outcomes fsmbt cannot see (no cb_interface); "
+                                "only the mapped ones are read",
+                            )
+                        )
                         outcomes = None
                     elif outcomes is not None:
                         outcomes = list(dict.fromkeys([*outcomes, *extra]))
@@ -787,8 +959,15 @@ _UNKNOWN = object()
 _CONSTRUCTOR_PARAMS: dict[str, tuple[str, ...]] = {
     "StateMachine": ("outcomes", "input_keys", "output_keys"),
     "Sequence": ("outcomes", "connector_outcome", "input_keys", "output_keys"),
-    "Concurrence": ("outcomes", "default_outcome", "input_keys", "output_keys", "outcome_map",
-                    "outcome_cb", "child_termination_cb"),
+    "Concurrence": (
+        "outcomes",
+        "default_outcome",
+        "input_keys",
+        "output_keys",
+        "outcome_map",
+        "outcome_cb",
+        "child_termination_cb",
+    ),
     "Iterator": ("outcomes", "input_keys", "output_keys", "it", "it_label", "exhausted_outcome"),
     "OperatableStateMachine": ("outcomes", "input_keys", "output_keys"),
     "LockableStateMachine": ("outcomes", "input_keys", "output_keys"),
@@ -826,8 +1005,11 @@ def _target_key(node: ast.expr) -> str | None:
 
 def _is_main_guard(stmt: ast.If) -> bool:
     test = stmt.test
-    return (isinstance(test, ast.Compare) and isinstance(test.left, ast.Name)
-            and test.left.id == "__name__")
+    return (
+        isinstance(test, ast.Compare)
+        and isinstance(test.left, ast.Name)
+        and test.left.id == "__name__"
+    )
 
 
 #: A static item list longer than this is read like a computed one (an environment choice).
@@ -843,8 +1025,9 @@ def _static_count(node: ast.expr, lookup) -> int | None:  # type: ignore[no-unty
             bounds = [literal(a, lookup) for a in node.args]
         except NotStatic:
             return None
-        if not 1 <= len(bounds) <= 3 or not all(isinstance(b, int) and not isinstance(b, bool)
-                                                for b in bounds):
+        if not 1 <= len(bounds) <= 3 or not all(
+            isinstance(b, int) and not isinstance(b, bool) for b in bounds
+        ):
             return None
         ints = [b for b in bounds if isinstance(b, int)]
         return len(range(*ints))

@@ -44,6 +44,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from fsmbt import limits
 from fsmbt.formats._pysm_analyze import (
     MAX_UNROLLED_ITEMS,
     Analysis,
@@ -54,7 +55,6 @@ from fsmbt.formats._pysm_analyze import (
     analyze,
 )
 from fsmbt.formats._pysm_source import parse_source
-from fsmbt import limits
 from fsmbt.formats.registry import ReadContext, decode, read_bounded
 from fsmbt.model.errors import InputError, SourceLocation, UnsupportedError
 from fsmbt.model.flatten import flatten
@@ -134,8 +134,9 @@ class Builder:
         return top
 
     # -- children -----------------------------------------------------------------------------
-    def child_state(self, work: _Work, child: Child, name: str | None = None
-                    ) -> tuple[State, list[str] | None, _Work | None]:
+    def child_state(
+        self, work: _Work, child: Child, name: str | None = None
+    ) -> tuple[State, list[str] | None, _Work | None]:
         """The state for ``child``, its outcomes (None = unknown), and the work to fill it."""
         label = name or child.label
         where = self.loc(work.source, child.line)
@@ -148,18 +149,21 @@ class Builder:
                 mapped = actions[state.cls]
                 action = mapped if isinstance(mapped, str) else None
             attrs = {A_CLASS: "CBState"} if state.callback else {}
-            return (State(label, action=action, attrs=attrs, location=where),
-                    state.outcomes, None)
+            return (State(label, action=action, attrs=attrs, location=where), state.outcomes, None)
         if isinstance(state, Container):
             region = FSM(name=label)
             composite = State(label, action=None, regions=[region], location=where)
             self.owners[id(region)] = composite
-            return composite, list(state.outcomes), _Work(state, region, label, work.source,
-                                                          work.chain, sub_path)
+            return (
+                composite,
+                list(state.outcomes),
+                _Work(state, region, label, work.source, work.chain, sub_path),
+            )
         root, source = self.embedded(work, state, child)
         region = FSM(name=label)
-        composite = State(label, action=None, regions=[region], location=where,
-                          attrs={A_BEHAVIOUR: state.cls})
+        composite = State(
+            label, action=None, regions=[region], location=where, attrs={A_BEHAVIOUR: state.cls}
+        )
         self.owners[id(region)] = composite
         chain = (*work.chain, str(source.path))
         return composite, list(root.outcomes), _Work(root, region, label, source, chain, "")
@@ -169,15 +173,18 @@ class Builder:
         found = here.analysis.behaviours.get(ref.cls)
         if ref.cls in here.analysis.behaviours:
             if found is None:
-                raise UnsupportedError(f"embedded behaviour '{ref.cls}': its create() does not "
-                                       "return a state machine fsmbt can read",
-                                       location=self.loc(here, child.line))
+                raise UnsupportedError(
+                    f"embedded behaviour '{ref.cls}': its create() does not "
+                    "return a state machine fsmbt can read",
+                    location=self.loc(here, child.line),
+                )
             return found, here
         if here.path is None:
             raise UnsupportedError(
                 f"embedded behaviour '{ref.cls}' is defined in another file; read this "
                 "behaviour from its file so the embedded one can be found beside it",
-                location=self.loc(here, child.line))
+                location=self.loc(here, child.line),
+            )
         folder = here.path.parent
         module_file = folder / f"{ref.module.rsplit('.', 1)[-1]}.py" if ref.module else None
         candidates = [module_file] if module_file is not None and module_file.is_file() else []
@@ -185,8 +192,10 @@ class Builder:
             marker = f"class {ref.cls}("
             for path in sorted(folder.glob("*.py")):
                 try:
-                    if path.stat().st_size <= limits.current().max_input_bytes and marker in path.read_text(
-                            encoding="utf-8", errors="replace"):
+                    if (
+                        path.stat().st_size <= limits.current().max_input_bytes
+                        and marker in path.read_text(encoding="utf-8", errors="replace")
+                    ):
                         candidates.append(path)
                         break
                 except OSError:
@@ -196,17 +205,27 @@ class Builder:
             raise UnsupportedError(
                 f"embedded behaviour '{ref.cls}' not found: expected its file {expected} "
                 "beside this one (FlexBE behaviours embed others by class; give the embedded "
-                "behaviour's file in the same folder)", location=self.loc(here, child.line))
+                "behaviour's file in the same folder)",
+                location=self.loc(here, child.line),
+            )
         path = candidates[0].resolve()
-        if str(path) in work.chain or path == (self.main.path.resolve() if self.main.path else None):
-            raise InputError(f"embedded behaviour '{ref.cls}' ({path.name}) embeds itself "
-                             "(directly or through others)", location=self.loc(here, child.line))
+        if str(path) in work.chain or path == (
+            self.main.path.resolve() if self.main.path else None
+        ):
+            raise InputError(
+                f"embedded behaviour '{ref.cls}' ({path.name}) embeds itself "
+                "(directly or through others)",
+                location=self.loc(here, child.line),
+            )
         source = self.load(path)
         root = source.analysis.behaviours.get(ref.cls)
         if root is None:
-            raise UnsupportedError(f"embedded behaviour '{ref.cls}': {path.name} has no "
-                                   f"Behavior class '{ref.cls}' whose create() returns a state "
-                                   "machine", location=self.loc(here, child.line))
+            raise UnsupportedError(
+                f"embedded behaviour '{ref.cls}': {path.name} has no "
+                f"Behavior class '{ref.cls}' whose create() returns a state "
+                "machine",
+                location=self.loc(here, child.line),
+            )
         return root, source
 
     def load(self, path: Path) -> _Source:
@@ -215,8 +234,9 @@ class Builder:
         try:
             data = read_bounded(path)
         except OSError as exc:
-            raise InputError(f"cannot read: {exc.strerror}", location=SourceLocation(str(path))) \
-                from None
+            raise InputError(
+                f"cannot read: {exc.strerror}", location=SourceLocation(str(path))
+            ) from None
         text = decode(data, str(path))
         tree = parse_source(text, str(path))
         analysis = analyze(text, tree, str(path))
@@ -231,14 +251,17 @@ class Builder:
         container, fsm = work.container, work.machine
         children = container.children
         if not children:
-            raise InputError(f"container '{container.name}' has no states (SMACH's consistency "
-                             "check fails)", location=self.loc(work.source, container.line))
+            raise InputError(
+                f"container '{container.name}' has no states (SMACH's consistency check fails)",
+                location=self.loc(work.source, container.line),
+            )
         labels = {c.label for c in children}
         for outcome in container.outcomes:
             if outcome in labels:
-                raise UnsupportedError(f"container outcome '{outcome}' is also a state label in "
-                                       f"'{container.name}'", location=self.loc(work.source,
-                                                                                container.line))
+                raise UnsupportedError(
+                    f"container outcome '{outcome}' is also a state label in '{container.name}'",
+                    location=self.loc(work.source, container.line),
+                )
         pending: list[_Work] = []
         outcomes_of: dict[str, list[str] | None] = {}
         for child in children:
@@ -251,13 +274,18 @@ class Builder:
         final_actions = finals.get(work.path, {}) if isinstance(finals, dict) else {}
         for outcome in container.outcomes:
             action = final_actions.get(outcome) if isinstance(final_actions, dict) else None
-            fsm.states[outcome] = State(outcome, action=action if isinstance(action, str) else None,
-                                        final=True, location=self.loc(work.source, container.line))
+            fsm.states[outcome] = State(
+                outcome,
+                action=action if isinstance(action, str) else None,
+                final=True,
+                location=self.loc(work.source, container.line),
+            )
         initial = container.initial or children[0].label
         if initial not in labels:
-            raise InputError(f"set_initial_state names '{initial}', not a state of "
-                             f"'{container.name}'", location=self.loc(work.source,
-                                                                      container.initial_line))
+            raise InputError(
+                f"set_initial_state names '{initial}', not a state of '{container.name}'",
+                location=self.loc(work.source, container.initial_line),
+            )
         fsm.initial = initial
         transitions = self.linked_transitions(container)
         reached: set[str] = set()
@@ -265,9 +293,12 @@ class Builder:
             self.add_transitions(work, child, mapping, outcomes_of[child.label], labels, reached)
         for outcome in container.outcomes:
             if outcome not in reached:
-                self.warn(work.source, container.line,
-                          f"container '{container.name}' declares outcome '{outcome}' that no "
-                          "transition reaches")
+                self.warn(
+                    work.source,
+                    container.line,
+                    f"container '{container.name}' declares outcome '{outcome}' that no "
+                    "transition reaches",
+                )
         return pending
 
     def linked_transitions(self, container: Container) -> list[dict[str, str | None]]:
@@ -282,20 +313,33 @@ class Builder:
                 out[index][connector] = following
         return out
 
-    def add_transitions(self, work: _Work, child: Child, mapping: dict[str, str | None],
-                        outcomes: list[str] | None, labels: set[str], reached: set[str]) -> None:
+    def add_transitions(
+        self,
+        work: _Work,
+        child: Child,
+        mapping: dict[str, str | None],
+        outcomes: list[str] | None,
+        labels: set[str],
+        reached: set[str],
+    ) -> None:
         container, fsm = work.container, work.machine
         where = self.loc(work.source, child.line)
         if outcomes is not None:
             for outcome in mapping:
                 if outcome not in outcomes:
-                    raise InputError(f"state '{child.label}' maps outcome '{outcome}' it does "
-                                     f"not have (its outcomes: {', '.join(outcomes)}); SMACH "
-                                     "raises InvalidTransitionError", location=where)
+                    raise InputError(
+                        f"state '{child.label}' maps outcome '{outcome}' it does "
+                        f"not have (its outcomes: {', '.join(outcomes)}); SMACH "
+                        "raises InvalidTransitionError",
+                        location=where,
+                    )
             for connector in child.connectors:
                 if connector not in outcomes:
-                    raise InputError(f"add_auto connector outcome '{connector}' is not an "
-                                     f"outcome of '{child.label}'", location=where)
+                    raise InputError(
+                        f"add_auto connector outcome '{connector}' is not an "
+                        f"outcome of '{child.label}'",
+                        location=where,
+                    )
         every = list(mapping) + [o for o in (outcomes or []) if o not in mapping]
         composite = not isinstance(child.state, StateRef)
         for outcome in every:
@@ -306,18 +350,23 @@ class Builder:
                         f"outcome '{outcome}' of state '{child.label}' is mapped to nothing: no "
                         f"transition and no container outcome '{outcome}' in "
                         f"'{container.name}' (SMACH's consistency check fails at run time)",
-                        location=where)
+                        location=where,
+                    )
                 target = outcome
             elif target not in labels and target not in container.outcomes:
-                raise InputError(f"outcome '{outcome}' of state '{child.label}' goes to "
-                                 f"'{target}', which is neither a state of '{container.name}' "
-                                 "nor one of its outcomes", location=where)
+                raise InputError(
+                    f"outcome '{outcome}' of state '{child.label}' goes to "
+                    f"'{target}', which is neither a state of '{container.name}' "
+                    "nor one of its outcomes",
+                    location=where,
+                )
             if target in container.outcomes and target not in labels:
                 reached.add(target)
             attrs = {"autonomy": child.autonomy[outcome]} if outcome in child.autonomy else {}
             if composite:
-                fsm.add_transition(child.label, None, target, exit=outcome, attrs=attrs,
-                                   location=where)
+                fsm.add_transition(
+                    child.label, None, target, exit=outcome, attrs=attrs, location=where
+                )
             else:
                 fsm.add_transition(child.label, outcome, target, attrs=attrs, location=where)
 
@@ -327,10 +376,13 @@ class Builder:
         pending: list[_Work] = []
         for child in work.container.children:
             if isinstance(child.state, Container) and child.state.kind == "priority":
-                self.warn(work.source, child.line,
-                          f"PriorityContainer '{child.label}' inside a concurrency container: "
-                          "FlexBE pauses its siblings while it runs; read without that "
-                          "priority (siblings may return meanwhile)")
+                self.warn(
+                    work.source,
+                    child.line,
+                    f"PriorityContainer '{child.label}' inside a concurrency container: "
+                    "FlexBE pauses its siblings while it runs; read without that "
+                    "priority (siblings may return meanwhile)",
+                )
             if not isinstance(child.state, StateRef):
                 state, _, sub = self.child_state(work, child)
                 work.child_machines[child.label] = state.regions[0]
@@ -344,8 +396,10 @@ class Builder:
         if not isinstance(child.state, StateRef):
             flat = flatten(work.child_machines[child.label])
             if flat.initial is None or flat.start_name is not None:
-                raise UnsupportedError(f"{what} child '{child.label}' has no plain initial state",
-                                       location=self.loc(work.source, child.line))
+                raise UnsupportedError(
+                    f"{what} child '{child.label}' has no plain initial state",
+                    location=self.loc(work.source, child.line),
+                )
             return flat
         known = child.state.outcomes
         if not smach and child.transitions:
@@ -356,11 +410,16 @@ class Builder:
                 raise UnsupportedError(
                     f"outcomes of {what} child '{child.label}' (class {child.state.cls}) are "
                     "unknown: its class is not in the file and no outcome map names it",
-                    location=self.loc(work.source, child.line))
+                    location=self.loc(work.source, child.line),
+                )
             known = list(dict.fromkeys(from_map))
-            self.warn(work.source, child.line, f"outcomes of '{child.label}' (class "
-                      f"{child.state.cls}, defined elsewhere) read from the outcome map: "
-                      f"{', '.join(known)}")
+            self.warn(
+                work.source,
+                child.line,
+                f"outcomes of '{child.label}' (class "
+                f"{child.state.cls}, defined elsewhere) read from the outcome map: "
+                f"{', '.join(known)}",
+            )
         leaf = FSM(name=child.label)
         leaf.add_state(State(child.label, action=child.state.cls))
         for outcome in known:
@@ -386,8 +445,12 @@ class Builder:
         shared = _shares_outcomes([m.events() for m in machines])
         tables = [m.transition_map() for m in machines]
         start_positions = tuple((False, str(m.initial)) for m in machines)
-        start_action = "+".join(a for a in (m.states[str(m.initial)].action for m in machines)
-                                if a is not None) or None
+        start_action = (
+            "+".join(
+                a for a in (m.states[str(m.initial)].action for m in machines) if a is not None
+            )
+            or None
+        )
         names: dict[Key, str] = {}
         queue: deque[Key] = deque()
 
@@ -400,17 +463,22 @@ class Builder:
         def visit(key: Key) -> str:
             if key not in names:
                 if len(names) >= MAX_PRODUCT_STATES:
-                    raise UnsupportedError(f"{what} '{container.name}' has more than "
-                                           f"{MAX_PRODUCT_STATES} combinations of child states",
-                                           location=where)
+                    raise UnsupportedError(
+                        f"{what} '{container.name}' has more than "
+                        f"{MAX_PRODUCT_STATES} combinations of child states",
+                        location=where,
+                    )
                 positions, action = key
-                name = ",".join(part(lab, pos, m) for lab, pos, m in zip(labels, positions,
-                                                                           machines))
+                name = ",".join(
+                    part(lab, pos, m) for lab, pos, m in zip(labels, positions, machines)
+                )
                 if key[0] != start_positions and action is not None:
                     name = f"{name} ({action})"
                 if name in fsm.states:
-                    raise UnsupportedError(f"{what} '{container.name}': state name '{name}' "
-                                           "clashes with an outcome", location=where)
+                    raise UnsupportedError(
+                        f"{what} '{container.name}': state name '{name}' clashes with an outcome",
+                        location=where,
+                    )
                 names[key] = name
                 fsm.states[name] = State(name, action=action, location=where)
                 queue.append(key)
@@ -431,7 +499,7 @@ class Builder:
                         continue
                     target_state = machines[index].states[transition.target]
                     moved: Position = (target_state.final, transition.target)
-                    after = positions[:index] + (moved,) + positions[index + 1:]
+                    after = positions[:index] + (moved,) + positions[index + 1 :]
                     combo = tuple(name if is_done else None for is_done, name in after)
                     qualified = f"{labels[index]}.{event}" if shared else event
                     decided = self.decide(container, smach, labels, combo)
@@ -445,33 +513,43 @@ class Builder:
                     if all(is_done for is_done, _ in after):
                         stuck.append(target)
         for name in dict.fromkeys(stuck):
-            self.warn(work.source, container.line,
-                      f"{what} '{container.name}': when its children end as '{name}' no "
-                      "condition holds, so FlexBE waits there forever")
+            self.warn(
+                work.source,
+                container.line,
+                f"{what} '{container.name}': when its children end as '{name}' no "
+                "condition holds, so FlexBE waits there forever",
+            )
         for outcome in container.outcomes:
             if outcome not in reached:
-                self.warn(work.source, container.line,
-                          f"{what} '{container.name}' declares outcome '{outcome}' that no "
-                          "combination of child outcomes gives")
+                self.warn(
+                    work.source,
+                    container.line,
+                    f"{what} '{container.name}' declares outcome '{outcome}' that no "
+                    "combination of child outcomes gives",
+                )
         refs = [c.state for c in container.children if isinstance(c.state, StateRef)]
         if not leaves:
             return
         owner = self.owner_state(work)
         attrs = owner.attrs if owner is not None else fsm.attrs
-        attrs.update({
-            A_CONTAINER: container.cls,
-            A_CHILDREN: json.dumps([[lab, r.cls, outs]
-                                    for lab, r, outs in zip(labels, refs, outcomes)]),
-            A_MAP: json.dumps(container.outcome_map),
-        })
+        attrs.update(
+            {
+                A_CONTAINER: container.cls,
+                A_CHILDREN: json.dumps(
+                    [[lab, r.cls, outs] for lab, r, outs in zip(labels, refs, outcomes)]
+                ),
+                A_MAP: json.dumps(container.outcome_map),
+            }
+        )
         if container.default_outcome is not None:
             attrs[A_DEFAULT] = container.default_outcome
 
     def owner_state(self, work: _Work) -> State | None:
         return self.owners.get(id(work.machine))
 
-    def decide(self, container: Container, smach: bool, labels: list[str],
-               combo: tuple[str | None, ...]) -> str | None:
+    def decide(
+        self, container: Container, smach: bool, labels: list[str], combo: tuple[str | None, ...]
+    ) -> str | None:
         """The container outcome once ``combo`` is reached, or ``None`` while it runs on."""
         done = dict(zip(labels, combo))
         if smach:
@@ -487,42 +565,61 @@ class Builder:
                 return candidate
         return None
 
-    def check_outcome_map(self, work: _Work, what: str, labels: list[str],
-                          outcomes: list[list[str]]) -> None:
+    def check_outcome_map(
+        self, work: _Work, what: str, labels: list[str], outcomes: list[list[str]]
+    ) -> None:
         container = work.container
         where = self.loc(work.source, container.line)
-        if container.default_outcome is not None and container.default_outcome not in \
-                container.outcomes:
-            raise InputError(f"{what} default_outcome '{container.default_outcome}' is not one "
-                             f"of its outcomes ({', '.join(container.outcomes)})", location=where)
+        if (
+            container.default_outcome is not None
+            and container.default_outcome not in container.outcomes
+        ):
+            raise InputError(
+                f"{what} default_outcome '{container.default_outcome}' is not one "
+                f"of its outcomes ({', '.join(container.outcomes)})",
+                location=where,
+            )
         by_label = dict(zip(labels, outcomes))
         for outcome, required in container.outcome_map:
             if outcome not in container.outcomes:
-                raise InputError(f"{what} maps to '{outcome}', not one of its outcomes "
-                                 f"({', '.join(container.outcomes)})", location=where)
+                raise InputError(
+                    f"{what} maps to '{outcome}', not one of its outcomes "
+                    f"({', '.join(container.outcomes)})",
+                    location=where,
+                )
             for label, child_outcome in required.items():
                 if label not in by_label:
-                    raise InputError(f"{what} outcome map names '{label}', not a child "
-                                     f"({', '.join(labels)}); SMACH fails at run time",
-                                     location=where)
+                    raise InputError(
+                        f"{what} outcome map names '{label}', not a child "
+                        f"({', '.join(labels)}); SMACH fails at run time",
+                        location=where,
+                    )
                 if child_outcome not in by_label[label]:
-                    self.warn(work.source, container.line,
-                              f"{what} outcome map expects '{label}' to return "
-                              f"'{child_outcome}', which it never does")
+                    self.warn(
+                        work.source,
+                        container.line,
+                        f"{what} outcome map expects '{label}' to return "
+                        f"'{child_outcome}', which it never does",
+                    )
 
     # -- iterator -----------------------------------------------------------------------------
     def iterator(self, work: _Work) -> list[_Work]:
         container, fsm = work.container, work.machine
         where = self.loc(work.source, container.line)
         if not container.children:
-            raise InputError(f"Iterator '{container.name}' has no contained state "
-                             "(Iterator.set_contained_state)", location=where)
+            raise InputError(
+                f"Iterator '{container.name}' has no contained state "
+                "(Iterator.set_contained_state)",
+                location=where,
+            )
         child = container.children[0]
         state0, outcomes, _ = self.child_state(work, child)
         if outcomes is None:
-            raise UnsupportedError(f"outcomes of the Iterator's state '{child.label}' are "
-                                   "unknown (its class is not in the file)",
-                                   location=self.loc(work.source, child.line))
+            raise UnsupportedError(
+                f"outcomes of the Iterator's state '{child.label}' are "
+                "unknown (its class is not in the file)",
+                location=self.loc(work.source, child.line),
+            )
         if container.break_outcomes:
             loop = [o for o in outcomes if o not in container.break_outcomes]
         else:
@@ -532,8 +629,11 @@ class Builder:
         def final_of(outcome: str) -> str:
             mapped = container.final_outcome_map.get(outcome, outcome)
             if mapped not in container.outcomes:
-                raise InputError(f"Iterator '{container.name}' ends with '{mapped}' (from "
-                                 f"'{outcome}'), not one of its outcomes", location=where)
+                raise InputError(
+                    f"Iterator '{container.name}' ends with '{mapped}' (from "
+                    f"'{outcome}'), not one of its outcomes",
+                    location=where,
+                )
             return mapped
 
         for outcome in container.outcomes:
@@ -551,8 +651,9 @@ class Builder:
 
         if static:
             count = container.items or 0
-            copies = [f"{child.label}#{i + 1}" for i in range(count)] if count != 1 \
-                else [child.label]
+            copies = (
+                [f"{child.label}#{i + 1}" for i in range(count)] if count != 1 else [child.label]
+            )
             for index, name in enumerate(copies):
                 state, _, sub = self.child_state(work, child, name)
                 fsm.states[name] = state
@@ -578,13 +679,15 @@ class Builder:
         fsm.add_transition(choice, f"{work.label}.next", state.name, location=where)
         fsm.add_transition(choice, f"{work.label}.exhausted", exhausted, location=where)
         fsm.initial = state.name
-        self.warn(work.source, container.line,
-                  f"Iterator '{work.label}': its items ({container.items_text or 'it'}) are "
-                  "known only at run time; read with their number as an environment choice "
-                  f"after each loop outcome (events '{work.label}.next' / "
-                  f"'{work.label}.exhausted'; an empty item list is not modelled)")
+        self.warn(
+            work.source,
+            container.line,
+            f"Iterator '{work.label}': its items ({container.items_text or 'it'}) are "
+            "known only at run time; read with their number as an environment choice "
+            f"after each loop outcome (events '{work.label}.next' / "
+            f"'{work.label}.exhausted'; an empty item list is not modelled)",
+        )
         return pending
-
 
 
 def _shares_outcomes(outcomes: list[list[str]]) -> bool:
@@ -596,8 +699,11 @@ def _shares_outcomes(outcomes: list[list[str]]) -> bool:
     return False
 
 
-def build_fsm(text: str, ctx: ReadContext, choose_root: Callable[[Analysis, ReadContext], tuple[
-        Container, str]]) -> FSM:
+def build_fsm(
+    text: str,
+    ctx: ReadContext,
+    choose_root: Callable[[Analysis, ReadContext], tuple[Container, str]],
+) -> FSM:
     """Parse, analyse and build (the shared path of the SMACH and FlexBE readers).
 
     Args:
@@ -610,8 +716,7 @@ def build_fsm(text: str, ctx: ReadContext, choose_root: Callable[[Analysis, Read
     """
     tree = parse_source(text, ctx.display_name)
     analysis = analyze(text, tree, ctx.display_name)
-    main = _Source(ctx.path.resolve() if ctx.path is not None else None, ctx.display_name,
-                   analysis)
+    main = _Source(ctx.path.resolve() if ctx.path is not None else None, ctx.display_name, analysis)
     builder = Builder(ctx, main)
     for line, message in analysis.warnings:
         builder.warn(main, line, message)
@@ -621,7 +726,10 @@ def build_fsm(text: str, ctx: ReadContext, choose_root: Callable[[Analysis, Read
         name = str(extension["name"])
     fsm = builder.build(root, name)
     start = extension.get("start")
-    if isinstance(start, dict) and isinstance(start.get("name"), str) and isinstance(
-            start.get("event"), str):
+    if (
+        isinstance(start, dict)
+        and isinstance(start.get("name"), str)
+        and isinstance(start.get("event"), str)
+    ):
         fsm.start_name, fsm.initial_event = start["name"], start["event"]
     return fsm

@@ -48,17 +48,22 @@ def parse_source(text: str, name: str) -> ast.Module:
         The parsed module (not executed).
     """
     if len(text.encode("utf-8", "surrogatepass")) > MAX_SOURCE_BYTES:
-        raise InputError(f"Python source larger than {MAX_SOURCE_BYTES} bytes; not read",
-                         location=SourceLocation(name))
+        raise InputError(
+            f"Python source larger than {MAX_SOURCE_BYTES} bytes; not read",
+            location=SourceLocation(name),
+        )
     try:
         tree = ast.parse(text, filename=name, mode="exec")
     except SyntaxError as exc:
-        raise InputError(f"Python syntax error: {exc.msg}",
-                         location=SourceLocation(name, exc.lineno, exc.offset)) from None
+        raise InputError(
+            f"Python syntax error: {exc.msg}", location=SourceLocation(name, exc.lineno, exc.offset)
+        ) from None
     except (RecursionError, MemoryError):
-        raise InputError("Python source nested too deeply for the parser (an expression or "
-                         "statement thousands of levels deep); not read",
-                         location=SourceLocation(name)) from None
+        raise InputError(
+            "Python source nested too deeply for the parser (an expression or "
+            "statement thousands of levels deep); not read",
+            location=SourceLocation(name),
+        ) from None
     except ValueError as exc:  # e.g. NUL bytes
         raise InputError(f"not Python source: {exc}", location=SourceLocation(name)) from None
     _check_depth(tree, name)
@@ -71,8 +76,10 @@ def _check_depth(tree: ast.AST, name: str) -> None:
         node, depth = stack.pop()
         if depth > MAX_AST_DEPTH:
             line = getattr(node, "lineno", None)
-            raise InputError(f"Python syntax nested more than {MAX_AST_DEPTH} levels deep; "
-                             "not read", location=SourceLocation(name, line))
+            raise InputError(
+                f"Python syntax nested more than {MAX_AST_DEPTH} levels deep; not read",
+                location=SourceLocation(name, line),
+            )
         stack.extend((child, depth + 1) for child in ast.iter_child_nodes(node))
 
 
@@ -117,8 +124,9 @@ def _literal_children(node: ast.AST, lookup: Callable[[str], object] | None) -> 
     return []
 
 
-def _literal_value(node: ast.AST, results: dict[int, object],
-                   lookup: Callable[[str], object] | None) -> object:
+def _literal_value(
+    node: ast.AST, results: dict[int, object], lookup: Callable[[str], object] | None
+) -> object:
     if isinstance(node, ast.Constant):
         return node.value
     if isinstance(node, ast.List):
@@ -196,7 +204,6 @@ def source_text(text: str, node: ast.AST, limit: int = 200) -> str:
     if start == end:
         chunk = lines[start - 1][first:last]
     else:
-        chunk = b"".join([lines[start - 1][first:], *lines[start:end - 1],
-                          lines[end - 1][:last]])
+        chunk = b"".join([lines[start - 1][first:], *lines[start : end - 1], lines[end - 1][:last]])
     segment = " ".join(chunk.decode("utf-8", "replace").split())
     return segment if len(segment) <= limit else segment[: limit - 3] + "..."

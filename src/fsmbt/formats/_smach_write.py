@@ -134,7 +134,9 @@ def _push_down(top: FSM) -> None:
             if not state.is_composite:
                 continue
             region = state.regions[0]
-            moved = [t for t in machine.transitions if t.source == state.name and t.event is not None]
+            moved = [
+                t for t in machine.transitions if t.source == state.name and t.event is not None
+            ]
             for t in moved:
                 exit_name = _unique(f"on {t.event}", region.states)
                 region.states[exit_name] = State(exit_name, action=None, final=True)
@@ -188,8 +190,9 @@ class _Writer:
     def prepare(self) -> None:
         top_attrs = {k for k in self.fsm.attrs if k not in _READER_ATTRS}
         if top_attrs:
-            self.losses.append(f"model attributes {', '.join(sorted(top_attrs))} have no place "
-                               "in SMACH; dropped")
+            self.losses.append(
+                f"model attributes {', '.join(sorted(top_attrs))} have no place in SMACH; dropped"
+            )
         for path, machine, _owner in _machines(self.fsm):
             for state in list(machine.states.values()):
                 where = f"'{path}/{state.name}'" if path else f"'{state.name}'"
@@ -197,53 +200,71 @@ class _Writer:
                     self.losses.append(
                         f"parallel state {where} written as the StateMachine of its combined "
                         "configurations: SMACH's Concurrence runs its children independently, "
-                        "fsmbt's regions share events (docs/formats/smach.md)")
+                        "fsmbt's regions share events (docs/formats/smach.md)"
+                    )
                     _product_of_parallel(state, machine)
                 elif state.attrs.get(A_CONTAINER) == "ConcurrencyContainer":
                     self.losses.append(
                         f"FlexBE ConcurrencyContainer {where} written as the StateMachine of its "
-                        "child-outcome combinations (SMACH's Concurrence waits for every child)")
+                        "child-outcome combinations (SMACH's Concurrence waits for every child)"
+                    )
                     state.attrs.pop(A_CONTAINER)
                 if not state.is_atomic and state.action is not None:
-                    self.losses.append(f"composite state {where} has action '{state.action}', "
-                                       "which no semantics runs (docs/semantics.md §6); dropped")
+                    self.losses.append(
+                        f"composite state {where} has action '{state.action}', "
+                        "which no semantics runs (docs/semantics.md §6); dropped"
+                    )
                     state.action = None
                 if state.attrs.get("class") == "CBState":
-                    self.losses.append(f"state {where} was a CBState calling "
-                                       f"'{state.action}'; written as a stub state class")
+                    self.losses.append(
+                        f"state {where} was a CBState calling "
+                        f"'{state.action}'; written as a stub state class"
+                    )
                 extra = {k: v for k, v in state.attrs.items() if k not in _READER_ATTRS}
                 if extra:
-                    self.losses.append(f"state {where}: attributes {', '.join(extra)} have no "
-                                       "place in SMACH; dropped")
+                    self.losses.append(
+                        f"state {where}: attributes {', '.join(extra)} have no "
+                        "place in SMACH; dropped"
+                    )
             for t in machine.transitions:
                 source = machine.states.get(t.source)
                 if source is None or t.target not in machine.states:
-                    raise InputError(f"transition {t.source} -> {t.target} names an unknown "
-                                     "state", element=machine.name)
+                    raise InputError(
+                        f"transition {t.source} -> {t.target} names an unknown state",
+                        element=machine.name,
+                    )
                 if t.event is None and source.is_atomic:
                     raise UnsupportedError(
                         f"state '{t.source}' has an eventless transition to '{t.target}': a "
                         "SMACH state always returns an outcome; flatten the model first "
-                        "(fsmbt translate --flatten) or remove the transient state")
+                        "(fsmbt translate --flatten) or remove the transient state"
+                    )
                 if "autonomy" in t.attrs and not any("autonomy" in x for x in self.losses):
-                    self.losses.append("FlexBE autonomy levels of transitions have no place in "
-                                       "SMACH; dropped")
+                    self.losses.append(
+                        "FlexBE autonomy levels of transitions have no place in SMACH; dropped"
+                    )
                 dropped = sorted(k for k in t.attrs if k != "autonomy")
                 if dropped:
-                    self.losses.append(f"transition {t.source} -> {t.target}: attributes "
-                                       f"{', '.join(dropped)} have no place in SMACH; "
-                                       "dropped")
+                    self.losses.append(
+                        f"transition {t.source} -> {t.target}: attributes "
+                        f"{', '.join(dropped)} have no place in SMACH; "
+                        "dropped"
+                    )
             acting = [s.name for s in machine.states.values() if s.final and s.action is not None]
             if acting:
                 where = f" of '{path}'" if path else ""
-                self.losses.append(f"final state(s) {', '.join(acting)}{where} run an action in "
-                                   "the model; a SMACH container outcome runs nothing (kept in "
-                                   "__fsmbt__)")
+                self.losses.append(
+                    f"final state(s) {', '.join(acting)}{where} run an action in "
+                    "the model; a SMACH container outcome runs nothing (kept in "
+                    "__fsmbt__)"
+                )
         _push_down(self.fsm)
         if self.fsm.start_name is not None and self.fsm.initial_event is not None:
-            self.losses.append(f"the machine waits for '{self.fsm.initial_event}' in start "
-                               f"state '{self.fsm.start_name}' before '{self.fsm.initial}'; "
-                               "SMACH starts at once (kept in __fsmbt__)")
+            self.losses.append(
+                f"the machine waits for '{self.fsm.initial_event}' in start "
+                f"state '{self.fsm.start_name}' before '{self.fsm.initial}'; "
+                "SMACH starts at once (kept in __fsmbt__)"
+            )
 
     def state_class(self, action: str | None, outcomes: tuple[str, ...]) -> str:
         key = (action, outcomes)
@@ -260,7 +281,7 @@ class _Writer:
     def header(self) -> list[str]:
         title = self.fsm.name
         lines = [
-            '"""SMACH state machine ' + repr(title) + ', written by fsmbt.',
+            '"""SMACH state machine ' + repr(title) + ", written by fsmbt.",
             "",
             "Each state class is a stub: its execute() must return one of its outcomes.",
             "Build the machine with build_state_machine(); __fsmbt__ keeps what SMACH cannot",
@@ -285,7 +306,8 @@ class _Writer:
             lines += [
                 "",
                 f"class {name}(smach.State):",
-                f'    """Runs action {action!r}."""' if action is not None
+                f'    """Runs action {action!r}."""'
+                if action is not None
                 else '    """Runs nothing."""',
                 "",
                 "    def __init__(self):",
@@ -298,8 +320,11 @@ class _Writer:
         return lines
 
     def machine_code(self) -> list[str]:
-        lines = ["", "def build_state_machine():",
-                 '    """The top-level container (not executed here)."""']
+        lines = [
+            "",
+            "def build_state_machine():",
+            '    """The top-level container (not executed here)."""',
+        ]
         root_var = self.emit_machine(self.fsm, "", 1, lines)
         lines.append(f"    return {root_var}")
         lines += ["", "", 'if __name__ == "__main__":', "    build_state_machine().execute()"]
@@ -310,9 +335,15 @@ class _Writer:
         # frames: (machine, path, var, indent, remaining states, pending add line after sub)
         first_var = self.new_container(top, top_path, indent, lines)
         stack: list[tuple[FSM, str, str, int, list[State], list[str] | None]] = [
-            (top, top_path, first_var, indent + 1, [s for s in reversed(top.states.values())
-                                                     if not s.final],
-             self.initial_line(top, first_var, indent))]
+            (
+                top,
+                top_path,
+                first_var,
+                indent + 1,
+                [s for s in reversed(top.states.values()) if not s.final],
+                self.initial_line(top, first_var, indent),
+            )
+        ]
         while stack:
             machine, path, var, level, remaining, after = stack[-1]
             if not remaining:
@@ -329,30 +360,46 @@ class _Writer:
                 concurrence = self.concurrence(state, region)
                 if concurrence is not None:
                     sub_var = self.emit_concurrence(state, concurrence, level, lines)
-                    lines.append(f"{pad}smach.StateMachine.add({_py(state.name)}, {sub_var}, "
-                                 f"transitions={_py(transitions)})")
+                    lines.append(
+                        f"{pad}smach.StateMachine.add({_py(state.name)}, {sub_var}, "
+                        f"transitions={_py(transitions)})"
+                    )
                     continue
                 sub_var = self.new_container(region, sub_path, level, lines)
-                after_lines = [*self.initial_line(region, sub_var, level),
-                               f"{pad}smach.StateMachine.add({_py(state.name)}, {sub_var}, "
-                               f"transitions={_py(transitions)})"]
-                stack.append((region, sub_path, sub_var, level + 1,
-                              [s for s in reversed(region.states.values()) if not s.final],
-                              after_lines))
+                after_lines = [
+                    *self.initial_line(region, sub_var, level),
+                    f"{pad}smach.StateMachine.add({_py(state.name)}, {sub_var}, "
+                    f"transitions={_py(transitions)})",
+                ]
+                stack.append(
+                    (
+                        region,
+                        sub_path,
+                        sub_var,
+                        level + 1,
+                        [s for s in reversed(region.states.values()) if not s.final],
+                        after_lines,
+                    )
+                )
                 continue
             cls = self.state_class(state.action, tuple(transitions))
-            lines.append(f"{pad}smach.StateMachine.add({_py(state.name)}, {cls}(), "
-                         f"transitions={_py(transitions)})")
+            lines.append(
+                f"{pad}smach.StateMachine.add({_py(state.name)}, {cls}(), "
+                f"transitions={_py(transitions)})"
+            )
         return first_var
 
     def new_container(self, machine: FSM, path: str, level: int, lines: list[str]) -> str:
         finals = [s for s in machine.states.values() if s.final]
         if machine.initial is None or machine.states.get(machine.initial) is None:
-            raise InputError("a machine without initial state cannot be written",
-                             element=machine.name)
+            raise InputError(
+                "a machine without initial state cannot be written", element=machine.name
+            )
         if machine.states[machine.initial].final:
-            raise UnsupportedError(f"machine '{machine.name}' starts in a final state; a SMACH "
-                                   "container needs a state to run first")
+            raise UnsupportedError(
+                f"machine '{machine.name}' starts in a final state; a SMACH "
+                "container needs a state to run first"
+            )
         self.final_actions[path] = {s.name: s.action for s in finals if s.action is not None}
         var = f"sm_{self.counter}"
         self.counter += 1
@@ -382,9 +429,11 @@ class _Writer:
             else:
                 key = t.exit
                 if key is None:
-                    raise UnsupportedError(f"composite state '{state.name}' has a completion "
-                                           "transition on any final state; SMACH maps each "
-                                           "container outcome: name the final state (exit)")
+                    raise UnsupportedError(
+                        f"composite state '{state.name}' has a completion "
+                        "transition on any final state; SMACH maps each "
+                        "container outcome: name the final state (exit)"
+                    )
             assert key is not None
             if key not in out:
                 out[key] = t.target
@@ -394,7 +443,8 @@ class _Writer:
                 if inner.final and inner.name not in out:
                     raise UnsupportedError(
                         f"composite state '{state.name}': its final state '{inner.name}' has no "
-                        "completion transition; SMACH needs every container outcome mapped")
+                        "completion transition; SMACH needs every container outcome mapped"
+                    )
         return out
 
     # -- concurrence --------------------------------------------------------------------------
@@ -407,25 +457,33 @@ class _Writer:
             outcome_map = json.loads(state.attrs.get(A_MAP, "[]"))
         except (KeyError, ValueError):
             return None
-        spec = {"children": children, "outcome_map": outcome_map,
-                "default": state.attrs.get(A_DEFAULT),
-                "outcomes": [s.name for s in region.states.values() if s.final]}
+        spec = {
+            "children": children,
+            "outcome_map": outcome_map,
+            "default": state.attrs.get(A_DEFAULT),
+            "outcomes": [s.name for s in region.states.values() if s.final],
+        }
         if not _product_matches(spec, region):
-            self.losses.append(f"Concurrence '{state.name}' was changed after reading; written "
-                               "as the StateMachine of its combinations")
+            self.losses.append(
+                f"Concurrence '{state.name}' was changed after reading; written "
+                "as the StateMachine of its combinations"
+            )
             return None
         return spec
 
-    def emit_concurrence(self, state: State, spec: dict[str, object], level: int,
-                         lines: list[str]) -> str:
+    def emit_concurrence(
+        self, state: State, spec: dict[str, object], level: int, lines: list[str]
+    ) -> str:
         var = f"cc_{self.counter}"
         self.counter += 1
         pad = "    " * level
         outcome_map: dict[str, dict[str, str]] = {}
         for outcome, required in spec["outcome_map"]:  # type: ignore[attr-defined]
             outcome_map[outcome] = required
-        lines.append(f"{pad}{var} = smach.Concurrence(outcomes={_py(spec['outcomes'])}, "
-                     f"default_outcome={_py(spec['default'])}, outcome_map={_py(outcome_map)})")
+        lines.append(
+            f"{pad}{var} = smach.Concurrence(outcomes={_py(spec['outcomes'])}, "
+            f"default_outcome={_py(spec['default'])}, outcome_map={_py(outcome_map)})"
+        )
         lines.append(f"{pad}with {var}:")
         for label, action, outcomes in spec["children"]:  # type: ignore[attr-defined]
             cls = self.state_class(action, tuple(outcomes))
@@ -446,18 +504,25 @@ def _product_matches(spec: dict[str, object], region: FSM) -> bool:
         container.children.append(Child(label, StateRef(action, list(outcomes), 0), {}, 0))
     rebuilt = FSM(name=region.name)
     from fsmbt.formats._pysm_analyze import Analysis
+
     source = _Source(None, "<check>", Analysis([], {}, {}))
     try:
-        Builder(ReadContext(), source).concurrence(_Work(container, rebuilt, region.name, source, ()))
+        Builder(ReadContext(), source).concurrence(
+            _Work(container, rebuilt, region.name, source, ())
+        )
     except InputError:
         return False
-    return (rebuilt.states.keys() == region.states.keys()
-            and all(rebuilt.states[n].action == region.states[n].action
-                    and rebuilt.states[n].final == region.states[n].final
-                    for n in region.states)
-            and rebuilt.initial == region.initial
-            and [(t.source, t.event, t.target) for t in rebuilt.transitions]
-            == [(t.source, t.event, t.target) for t in region.transitions])
+    return (
+        rebuilt.states.keys() == region.states.keys()
+        and all(
+            rebuilt.states[n].action == region.states[n].action
+            and rebuilt.states[n].final == region.states[n].final
+            for n in region.states
+        )
+        and rebuilt.initial == region.initial
+        and [(t.source, t.event, t.target) for t in rebuilt.transitions]
+        == [(t.source, t.event, t.target) for t in region.transitions]
+    )
 
 
 def _py(value: object) -> str:

@@ -43,8 +43,12 @@ EXPLICIT_TAGS: dict[str, NodeKind] = {
     "Decorator": NodeKind.DECORATOR,
     "SubTree": NodeKind.SUBTREE,
 }
-PORT_TAGS = {"input_port": "input", "output_port": "output", "inout_port": "inout",
-             "bidirectional_port": "inout"}
+PORT_TAGS = {
+    "input_port": "input",
+    "output_port": "output",
+    "inout_port": "inout",
+    "bidirectional_port": "inout",
+}
 PORT_ELEMENT = {"input": "input_port", "output": "output_port", "inout": "inout_port"}
 #: Written on ``<TreeNodesModel>`` entries fsmbt had to assume (kind not declared anywhere); the
 #: reader does not take such an entry as a declaration, so the assumption survives a round trip.
@@ -77,59 +81,91 @@ class _Loader:
         name = str(path) if path is not None else self.ctx.display_name
         root = parse_xml(text, name)
         if root.tag != "root":
-            raise InputError(f"not a BehaviorTree.CPP file: root element is <{str(root.tag)}>, "
-                             "expected <root>", location=SourceLocation(name, root.sourceline))
+            raise InputError(
+                f"not a BehaviorTree.CPP file: root element is <{str(root.tag)}>, expected <root>",
+                location=SourceLocation(name, root.sourceline),
+            )
         version = root.get("BTCPP_format", "3")
         if version not in ("3", "4"):
-            raise UnsupportedError(f"BTCPP_format=\"{version}\" (fsmbt reads 3 and 4)",
-                                   location=SourceLocation(name, root.sourceline), element="root")
+            raise UnsupportedError(
+                f'BTCPP_format="{version}" (fsmbt reads 3 and 4)',
+                location=SourceLocation(name, root.sourceline),
+                element="root",
+            )
         self.files.append(_File(name, root, version))
         for child in _elements(root):
             if child.tag == "include":
                 self.include(child, path, name, chain)
 
-    def include(self, element: etree._Element, path: Path | None, name: str,
-                chain: tuple[Path, ...]) -> None:
+    def include(
+        self, element: etree._Element, path: Path | None, name: str, chain: tuple[Path, ...]
+    ) -> None:
         where = SourceLocation(name, element.sourceline)
         if element.get("ros_pkg") is not None:
-            raise UnsupportedError("<include ros_pkg=...> needs a ROS installation to resolve",
-                                   location=where, element="include")
+            raise UnsupportedError(
+                "<include ros_pkg=...> needs a ROS installation to resolve",
+                location=where,
+                element="include",
+            )
         target = element.get("path")
         if not target:
-            raise InputError("<include> without a path attribute", location=where, element="include")
+            raise InputError(
+                "<include> without a path attribute", location=where, element="include"
+            )
         if path is None:
-            raise InputError("<include> needs the including file's path to resolve "
-                             f"'{target}' (read the file, not text)", location=where, element="include")
+            raise InputError(
+                "<include> needs the including file's path to resolve "
+                f"'{target}' (read the file, not text)",
+                location=where,
+                element="include",
+            )
         resolved = (path.parent / target).resolve()
         # includes are confined to the folder of the file the user gave, or to the folder the
         # caller names with the option include_root (docs/security.md): "../x.xml" from a
         # subfolder is fine, "/etc/passwd" or a symlink out of the folder is not
         root_option = self.ctx.options.get("include_root")
-        top_folder = (Path(str(root_option)).resolve() if root_option
-                      else (chain[0] if chain else path.resolve()).parent)
+        top_folder = (
+            Path(str(root_option)).resolve()
+            if root_option
+            else (chain[0] if chain else path.resolve()).parent
+        )
         if not resolved.is_relative_to(top_folder):
-            raise InputError(f"include '{target}' resolves to {resolved}, outside the folder of "
-                             f"the file read ({top_folder}); refused (allow a wider folder "
-                             "with the include_root option)", location=where, element="include")
+            raise InputError(
+                f"include '{target}' resolves to {resolved}, outside the folder of "
+                f"the file read ({top_folder}); refused (allow a wider folder "
+                "with the include_root option)",
+                location=where,
+                element="include",
+            )
         if resolved in chain:
             cycle = " -> ".join(str(p) for p in (*chain, resolved))
             raise InputError(f"include cycle: {cycle}", location=where, element="include")
         max_include_depth = limits.current().max_include_depth
         if len(chain) >= max_include_depth:
-            raise InputError(limits.exceeded(f"an include chain of {len(chain) + 1} files",
-                                             "max_include_depth", max_include_depth),
-                             location=where, element="include")
+            raise InputError(
+                limits.exceeded(
+                    f"an include chain of {len(chain) + 1} files",
+                    "max_include_depth",
+                    max_include_depth,
+                ),
+                location=where,
+                element="include",
+            )
         if resolved in self.loaded:
             return  # included twice (diamond): BehaviorTree.CPP registers it once
         self.loaded.add(resolved)
         try:
             if not resolved.is_file():  # a FIFO or a device could block or never end
-                raise InputError(f"included '{target}' is not a regular file", location=where,
-                                 element="include")
+                raise InputError(
+                    f"included '{target}' is not a regular file", location=where, element="include"
+                )
             text = read_bounded(resolved)
         except OSError as exc:
-            raise InputError(f"cannot read included file '{target}' ({resolved}): {exc.strerror}",
-                             location=where, element="include") from None
+            raise InputError(
+                f"cannot read included file '{target}' ({resolved}): {exc.strerror}",
+                location=where,
+                element="include",
+            ) from None
         self.load(decode(text, str(resolved)), resolved, (*chain, resolved))
 
     def load_external_models(self) -> None:
@@ -145,8 +181,10 @@ class _Loader:
             try:
                 data = read_bounded(model_path)
             except OSError as exc:
-                raise InputError(f"cannot read node model file: {exc.strerror}",
-                                 location=SourceLocation(str(model_path))) from None
+                raise InputError(
+                    f"cannot read node model file: {exc.strerror}",
+                    location=SourceLocation(str(model_path)),
+                ) from None
             root = parse_xml(decode(data, str(model_path)), str(model_path))
             for models in root.iter("TreeNodesModel"):
                 for model in _read_models(models, str(model_path)):
@@ -156,8 +194,11 @@ class _Loader:
     def document(self) -> BTDocument:
         main = self.files[0]
         doc = BTDocument(format_version=main.version)
-        doc.attrs = {k: v for k, v in main.root.attrib.items()
-                     if k not in ("BTCPP_format", "main_tree_to_execute")}
+        doc.attrs = {
+            k: v
+            for k, v in main.root.attrib.items()
+            if k not in ("BTCPP_format", "main_tree_to_execute")
+        }
         doc.includes = [f.path for f in self.files[1:]]
         for f in self.files:
             for child in _elements(f.root):
@@ -166,9 +207,11 @@ class _Loader:
                         if model.attrs.get(ASSUMED_MARK) != "true":
                             self.declared.setdefault(model.type, model)
                 elif child.tag not in ("BehaviorTree", "include"):
-                    raise UnsupportedError(f"unknown element <{str(child.tag)}> under <root>",
-                                           location=SourceLocation(f.path, child.sourceline),
-                                           element=str(child.tag))
+                    raise UnsupportedError(
+                        f"unknown element <{str(child.tag)}> under <root>",
+                        location=SourceLocation(f.path, child.sourceline),
+                        element=str(child.tag),
+                    )
         doc.node_models = dict(self.declared)
         ports_seen: dict[str, dict[str, None]] = {}
         implied: dict[str, NodeKind] = {}
@@ -177,8 +220,11 @@ class _Loader:
                 if child.tag == "BehaviorTree":
                     tree = self.tree(child, f, ports_seen, implied)
                     if tree.id in doc.trees:
-                        raise InputError(f"duplicate BehaviorTree ID '{tree.id}'",
-                                         location=tree.location, element="BehaviorTree")
+                        raise InputError(
+                            f"duplicate BehaviorTree ID '{tree.id}'",
+                            location=tree.location,
+                            element="BehaviorTree",
+                        )
                     doc.trees[tree.id] = tree
         # Complete the declarations for every used type whose kind is known (so the writer's
         # <TreeNodesModel> lets Groot2 know it and a re-read gives the same document).
@@ -199,32 +245,51 @@ class _Loader:
             return named
         own = [c.get("ID") for c in _elements(main.root) if c.tag == "BehaviorTree"]
         if len(own) > 1:
-            self.ctx.warn(f"no main_tree_to_execute and {len(own)} trees; the first, "
-                          f"'{own[0]}', is taken as the main tree", line=main.root.sourceline)
+            self.ctx.warn(
+                f"no main_tree_to_execute and {len(own)} trees; the first, "
+                f"'{own[0]}', is taken as the main tree",
+                line=main.root.sourceline,
+            )
         if own:
             return own[0]
         return next(iter(doc.trees), None)
 
-    def tree(self, element: etree._Element, f: _File, ports_seen: dict[str, dict[str, None]],
-             implied: dict[str, NodeKind]) -> BehaviorTree:
+    def tree(
+        self,
+        element: etree._Element,
+        f: _File,
+        ports_seen: dict[str, dict[str, None]],
+        implied: dict[str, NodeKind],
+    ) -> BehaviorTree:
         where = SourceLocation(f.path, element.sourceline)
         tree_id = element.get("ID")
         if not tree_id:
             if len([c for c in _elements(f.root) if c.tag == "BehaviorTree"]) > 1:
-                raise InputError("<BehaviorTree> without ID in a file with several trees",
-                                 location=where, element="BehaviorTree")
+                raise InputError(
+                    "<BehaviorTree> without ID in a file with several trees",
+                    location=where,
+                    element="BehaviorTree",
+                )
             tree_id = "MainTree"
         attrs = {k: v for k, v in element.attrib.items() if k != "ID"}
         roots = _elements(element)
         if len(roots) > 1:
-            raise InputError(f"BehaviorTree '{tree_id}' has {len(roots)} root nodes; "
-                             "BehaviorTree.CPP allows exactly one", location=where,
-                             element="BehaviorTree")
+            raise InputError(
+                f"BehaviorTree '{tree_id}' has {len(roots)} root nodes; "
+                "BehaviorTree.CPP allows exactly one",
+                location=where,
+                element="BehaviorTree",
+            )
         root = self.nodes(roots[0], f, ports_seen, implied) if roots else None
         return BehaviorTree(tree_id, root, attrs, where)
 
-    def nodes(self, top: etree._Element, f: _File, ports_seen: dict[str, dict[str, None]],
-              implied: dict[str, NodeKind]) -> BTNode:
+    def nodes(
+        self,
+        top: etree._Element,
+        f: _File,
+        ports_seen: dict[str, dict[str, None]],
+        implied: dict[str, NodeKind],
+    ) -> BTNode:
         """Build the node tree with an explicit stack (pre-order, children kept in order)."""
         result: BTNode | None = None
         stack: list[tuple[etree._Element, BTNode | None]] = [(top, None)]
@@ -240,8 +305,14 @@ class _Loader:
         assert result is not None
         return result
 
-    def node(self, element: etree._Element, n_children: int, f: _File,
-             ports_seen: dict[str, dict[str, None]], implied: dict[str, NodeKind]) -> BTNode:
+    def node(
+        self,
+        element: etree._Element,
+        n_children: int,
+        f: _File,
+        ports_seen: dict[str, dict[str, None]],
+        implied: dict[str, NodeKind],
+    ) -> BTNode:
         where = SourceLocation(f.path, element.sourceline)
         tag = str(element.tag)
         attrs = dict(element.attrib)
@@ -250,8 +321,11 @@ class _Loader:
         if tag in EXPLICIT_TAGS and tag != "SubTree":
             type_id = attrs.pop("ID", None)
             if not type_id:
-                raise InputError(f"<{tag}> without ID (explicit style names the node type in ID)",
-                                 location=where, element=tag)
+                raise InputError(
+                    f"<{tag}> without ID (explicit style names the node type in ID)",
+                    location=where,
+                    element=tag,
+                )
             explicit = EXPLICIT_TAGS[tag]
             type_name = canonical_type(type_id)
         else:
@@ -273,8 +347,13 @@ class _Loader:
         elif explicit is not None:
             kind = explicit
         else:
-            kind = (NodeKind.ACTION if n_children == 0
-                    else NodeKind.DECORATOR if n_children == 1 else NodeKind.CONTROL)
+            kind = (
+                NodeKind.ACTION
+                if n_children == 0
+                else NodeKind.DECORATOR
+                if n_children == 1
+                else NodeKind.CONTROL
+            )
             return BTNode(type_name, kind, name, attrs, kind_declared=False, location=where)
         implied.setdefault(type_name, kind)
         return BTNode(type_name, kind, name, attrs, location=where)
@@ -290,14 +369,20 @@ def _read_models(element: etree._Element, source: str) -> list[NodeModel]:
         where = SourceLocation(source, entry.sourceline)
         kind = EXPLICIT_TAGS.get(str(entry.tag))
         if kind is None:
-            raise InputError(f"unknown <TreeNodesModel> entry <{str(entry.tag)}> (expected Action, "
-                             "Condition, Control, Decorator or SubTree)", location=where,
-                             element=str(entry.tag))
+            raise InputError(
+                f"unknown <TreeNodesModel> entry <{str(entry.tag)}> (expected Action, "
+                "Condition, Control, Decorator or SubTree)",
+                location=where,
+                element=str(entry.tag),
+            )
         attrs = dict(entry.attrib)
         type_id = attrs.pop("ID", None)
         if not type_id:
-            raise InputError(f"<{str(entry.tag)}> in <TreeNodesModel> without ID", location=where,
-                             element=str(entry.tag))
+            raise InputError(
+                f"<{str(entry.tag)}> in <TreeNodesModel> without ID",
+                location=where,
+                element=str(entry.tag),
+            )
         ports: list[PortModel] = []
         extra: list[str] = []
         for child in _elements(entry):
@@ -307,11 +392,15 @@ def _read_models(element: etree._Element, source: str) -> list[NodeModel]:
                 continue
             port_name = child.get("name")
             if not port_name:
-                raise InputError(f"<{str(child.tag)}> without name", element=str(child.tag),
-                                 location=SourceLocation(source, child.sourceline))
+                raise InputError(
+                    f"<{str(child.tag)}> without name",
+                    element=str(child.tag),
+                    location=SourceLocation(source, child.sourceline),
+                )
             text = (child.text or "").strip() or child.get("description")
-            ports.append(PortModel(port_name, direction, child.get("default"), text,
-                                   child.get("type")))
+            ports.append(
+                PortModel(port_name, direction, child.get("default"), text, child.get("type"))
+            )
         if extra:
             attrs[EXTRA_XML_KEY] = "".join(extra)
         type_name = type_id if kind is NodeKind.SUBTREE else canonical_type(type_id)
@@ -424,8 +513,9 @@ def _model_element(parent: etree._Element, model: NodeModel) -> etree._Element:
         if key != EXTRA_XML_KEY:
             element.set(key, value)
     for port in model.ports:
-        port_element = etree.SubElement(element, PORT_ELEMENT.get(port.direction, "input_port"),
-                                        name=port.name)
+        port_element = etree.SubElement(
+            element, PORT_ELEMENT.get(port.direction, "input_port"), name=port.name
+        )
         if port.type is not None:
             port_element.set("type", port.type)
         if port.default is not None:
@@ -443,8 +533,15 @@ def _sniff(text: str) -> bool:
     return root_tag(text) == "root"
 
 
-register(Format(
-    "btcpp", (".xml",), frozenset({"bt"}),
-    "BehaviorTree.CPP XML (read v3/v4, write v4; Groot2 compatible)",
-    read_btcpp, write_btcpp, _sniff, priority=30,
-))
+register(
+    Format(
+        "btcpp",
+        (".xml",),
+        frozenset({"bt"}),
+        "BehaviorTree.CPP XML (read v3/v4, write v4; Groot2 compatible)",
+        read_btcpp,
+        write_btcpp,
+        _sniff,
+        priority=30,
+    )
+)

@@ -43,7 +43,8 @@ class _Token:
     column: int
 
 
-_TOKEN = re.compile(r"""
+_TOKEN = re.compile(
+    r"""
     (?P<space>[ \t\r\f\v]+)
   | (?P<newline>\n)
   | (?P<line_comment>//[^\n]*)
@@ -54,7 +55,9 @@ _TOKEN = re.compile(r"""
   | (?P<name>[A-Za-z_\u0080-\U0010ffff][A-Za-z_0-9\u0080-\U0010ffff]*)
   | (?P<punct>[{}\[\];,=:])
   | (?P<html><)
-""", re.VERBOSE | re.DOTALL)
+""",
+    re.VERBOSE | re.DOTALL,
+)
 
 
 def _tokenize(text: str, ctx: ReadContext) -> list[_Token]:
@@ -69,18 +72,22 @@ def _tokenize(text: str, ctx: ReadContext) -> list[_Token]:
         match = _TOKEN.match(text, position)
         column = position - line_start + 1
         if match is None:
-            raise InputError(f"unexpected character {text[position]!r} in DOT",
-                             location=ctx.location(line, column))
+            raise InputError(
+                f"unexpected character {text[position]!r} in DOT",
+                location=ctx.location(line, column),
+            )
         kind = match.lastgroup or ""
         value = match.group()
         if kind == "html":
-            raise UnsupportedError("HTML-like labels (<...>) are not read",
-                                   location=ctx.location(line, column))
+            raise UnsupportedError(
+                "HTML-like labels (<...>) are not read", location=ctx.location(line, column)
+            )
         if kind == "block_comment" and not value.endswith("*/"):
             raise InputError("unterminated comment", location=ctx.location(line, column))
         if kind == "quoted":
-            tokens.append(_Token("id", value[1:-1].replace("\\\n", "").replace('\\"', '"'),
-                                 line, column))
+            tokens.append(
+                _Token("id", value[1:-1].replace("\\\n", "").replace('\\"', '"'), line, column)
+            )
         elif kind in ("name", "number"):
             tokens.append(_Token("id", value, line, column))
         elif kind in ("punct", "edgeop"):
@@ -114,8 +121,10 @@ class _DotReader:
         token = self.peek()
         if token is None:
             last = self.tokens[-1] if self.tokens else None
-            raise InputError("unexpected end of DOT input (missing '}'?)",
-                             location=self.ctx.location(last.line if last else None))
+            raise InputError(
+                "unexpected end of DOT input (missing '}'?)",
+                location=self.ctx.location(last.line if last else None),
+            )
         self.pos += 1
         return token
 
@@ -136,8 +145,9 @@ class _DotReader:
         if first.kind != "id" or first.text.lower() not in ("digraph", "graph"):
             raise self.error(first, f"a DOT file starts with 'digraph', found '{first.text}'")
         if first.text.lower() == "graph":
-            raise self.error(first, "an undirected graph is not a state machine; use 'digraph'",
-                             unsupported=True)
+            raise self.error(
+                first, "an undirected graph is not a state machine; use 'digraph'", unsupported=True
+            )
         name = "fsm"
         token = self.peek()
         if token is not None and token.kind == "id":
@@ -148,8 +158,10 @@ class _DotReader:
         while True:
             token = self.peek()
             if token is None:
-                raise InputError("unexpected end of DOT input: missing '}'",
-                                 location=self.ctx.location(self.tokens[-1].line))
+                raise InputError(
+                    "unexpected end of DOT input: missing '}'",
+                    location=self.ctx.location(self.tokens[-1].line),
+                )
             if token.kind == "punct" and token.text == "}":
                 self.take()
                 break
@@ -184,11 +196,18 @@ class _DotReader:
 
     def statement(self) -> None:
         token = self.take()
-        if token.kind == "punct" and token.text == "{" or (
-                token.kind == "id" and token.text.lower() == "subgraph"):
-            raise self.error(token, "subgraphs and clusters are not read (fsmbt reads simple "
-                                    "state digraphs; composite states: use Mermaid, SCXML or "
-                                    "JSON)", unsupported=True)
+        if (
+            token.kind == "punct"
+            and token.text == "{"
+            or (token.kind == "id" and token.text.lower() == "subgraph")
+        ):
+            raise self.error(
+                token,
+                "subgraphs and clusters are not read (fsmbt reads simple "
+                "state digraphs; composite states: use Mermaid, SCXML or "
+                "JSON)",
+                unsupported=True,
+            )
         if token.kind != "id":
             raise self.error(token, f"unexpected '{token.text}'")
         keyword = token.text.lower()
@@ -227,24 +246,35 @@ class _DotReader:
 
     def build(self, name: str) -> FSM:
         fsm = FSM(name=name)
-        markers = {n for n, a in self.nodes.items()
-                   if n == START_NODE or a.get("shape", "").lower() == "point"}
+        markers = {
+            n
+            for n, a in self.nodes.items()
+            if n == START_NODE or a.get("shape", "").lower() == "point"
+        }
         for node, attrs in self.nodes.items():
             if node in markers:
                 continue
             action: str | None = attrs.get("action", node)
-            fsm.add_state(State(node, action=action or None,
-                                final=attrs.get("shape", "").lower() == "doublecircle",
-                                location=self.ctx.location(self.node_line[node])))
+            fsm.add_state(
+                State(
+                    node,
+                    action=action or None,
+                    final=attrs.get("shape", "").lower() == "doublecircle",
+                    location=self.ctx.location(self.node_line[node]),
+                )
+            )
         fsm.initial = next(iter(fsm.states), None)
         start_edges = [e for e in self.edges if e[0] in markers]
         if len(start_edges) > 1:
-            raise InputError("more than one initial arrow (edges from the start marker)",
-                             location=self.ctx.location(start_edges[1][3]))
+            raise InputError(
+                "more than one initial arrow (edges from the start marker)",
+                location=self.ctx.location(start_edges[1][3]),
+            )
         for source, target, attrs, line in self.edges:
             if target in markers:
-                raise InputError(f"edge into the start marker '{target}'",
-                                 location=self.ctx.location(line))
+                raise InputError(
+                    f"edge into the start marker '{target}'", location=self.ctx.location(line)
+                )
             label = attrs.get("label") or None
             if source in markers:
                 fsm.initial = target
@@ -292,6 +322,15 @@ def _sniff(text: str) -> bool:
     return re.match(r"(?i)(strict\s+)?(di)?graph\b", head) is not None
 
 
-register(Format("dot", (".dot", ".gv"), frozenset({"fsm", "bt"}),
-                "Graphviz DOT (write FSM/BT; read simple state digraphs)",
-                read_dot, write_dot, _sniff, priority=26))
+register(
+    Format(
+        "dot",
+        (".dot", ".gv"),
+        frozenset({"fsm", "bt"}),
+        "Graphviz DOT (write FSM/BT; read simple state digraphs)",
+        read_dot,
+        write_dot,
+        _sniff,
+        priority=26,
+    )
+)

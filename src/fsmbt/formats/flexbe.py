@@ -25,8 +25,9 @@ from fsmbt.formats.smach import choose_machine
 from fsmbt.model.errors import InputError
 from fsmbt.model.fsm import FSM
 
-_FLEXBE_IMPORT = re.compile(r"^\s*(from\s+flexbe_core(\.\w+)*\s+import\b|import\s+flexbe_core\b)",
-                            re.M)
+_FLEXBE_IMPORT = re.compile(
+    r"^\s*(from\s+flexbe_core(\.\w+)*\s+import\b|import\s+flexbe_core\b)", re.M
+)
 
 
 def read_flexbe(text: str, ctx: ReadContext) -> FSM:
@@ -40,23 +41,32 @@ def choose_behaviour(analysis: Analysis, ctx: ReadContext) -> tuple[Container, s
     readable = {name: c for name, c in analysis.behaviours.items() if c is not None}
     if wanted is not None:
         if wanted not in analysis.behaviours:
-            raise InputError(f"no Behavior class '{wanted}' in this file (found: "
-                             f"{', '.join(analysis.behaviours) or 'none'})",
-                             location=ctx.location())
+            raise InputError(
+                f"no Behavior class '{wanted}' in this file (found: "
+                f"{', '.join(analysis.behaviours) or 'none'})",
+                location=ctx.location(),
+            )
         found = analysis.behaviours[str(wanted)]
         if found is None:
-            raise InputError(f"Behavior '{wanted}': create() does not return a state machine",
-                             location=ctx.location())
+            raise InputError(
+                f"Behavior '{wanted}': create() does not return a state machine",
+                location=ctx.location(),
+            )
         return found, str(wanted)
     if readable:
         name, container = next(iter(readable.items()))
         if len(readable) > 1:
-            ctx.warn(f"{len(readable)} Behavior classes; read '{name}' (others: "
-                     f"{', '.join(list(readable)[1:])}; choose one with the 'behaviour' option)")
+            ctx.warn(
+                f"{len(readable)} Behavior classes; read '{name}' (others: "
+                f"{', '.join(list(readable)[1:])}; choose one with the 'behaviour' option)"
+            )
         return container, name
     if analysis.behaviours:
-        raise InputError("the Behavior's create() does not return a state machine built in "
-                         "it (return _state_machine)", location=ctx.location())
+        raise InputError(
+            "the Behavior's create() does not return a state machine built in "
+            "it (return _state_machine)",
+            location=ctx.location(),
+        )
     return choose_machine(analysis, ctx)
 
 
@@ -64,8 +74,15 @@ def _sniff(text: str) -> bool:
     return _FLEXBE_IMPORT.search(text[:65536]) is not None
 
 
-register(Format(
-    "flexbe", (".py",), frozenset({"fsm"}),
-    "FlexBE behaviour (Python, read statically, never run)",
-    read_flexbe, None, _sniff, priority=34,
-))
+register(
+    Format(
+        "flexbe",
+        (".py",),
+        frozenset({"fsm"}),
+        "FlexBE behaviour (Python, read statically, never run)",
+        read_flexbe,
+        None,
+        _sniff,
+        priority=34,
+    )
+)

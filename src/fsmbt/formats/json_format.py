@@ -20,11 +20,18 @@ def read_json(text: str, ctx: ReadContext) -> Model:
     try:
         data = json.loads(text)
     except json.JSONDecodeError as exc:
-        raise InputError(f"invalid JSON: {exc.msg}", location=ctx.location(exc.lineno, exc.colno)) from None
+        raise InputError(
+            f"invalid JSON: {exc.msg}", location=ctx.location(exc.lineno, exc.colno)
+        ) from None
     except RecursionError:  # the parser recurses; Python's recursion limit stopped it first
-        raise InputError(limits.exceeded("JSON nesting deeper than the parser allows",
-                                         "max_json_depth", limits.current().max_json_depth),
-                         location=ctx.location()) from None
+        raise InputError(
+            limits.exceeded(
+                "JSON nesting deeper than the parser allows",
+                "max_json_depth",
+                limits.current().max_json_depth,
+            ),
+            location=ctx.location(),
+        ) from None
     _check_depth(data, ctx)
     try:
         return model_from_dict(data, where="$")
@@ -41,9 +48,12 @@ def _check_depth(data: object, ctx: ReadContext) -> None:
         value, depth = stack.pop()
         if isinstance(value, (dict, list)):
             if depth > max_depth:
-                raise InputError(limits.exceeded(f"JSON nested deeper than {max_depth} levels",
-                                                 "max_json_depth", max_depth),
-                                 location=ctx.location())
+                raise InputError(
+                    limits.exceeded(
+                        f"JSON nested deeper than {max_depth} levels", "max_json_depth", max_depth
+                    ),
+                    location=ctx.location(),
+                )
             children = value.values() if isinstance(value, dict) else value
             stack.extend((child, depth + 1) for child in children)
 
@@ -57,5 +67,15 @@ def _sniff(text: str) -> bool:
     return head.startswith("{") and '"kind"' in head
 
 
-register(Format("json", (".json",), frozenset({"fsm", "bt"}), "fsmbt JSON (either model)",
-                read_json, write_json, _sniff, priority=20))
+register(
+    Format(
+        "json",
+        (".json",),
+        frozenset({"fsm", "bt"}),
+        "fsmbt JSON (either model)",
+        read_json,
+        write_json,
+        _sniff,
+        priority=20,
+    )
+)

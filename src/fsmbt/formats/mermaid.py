@@ -48,15 +48,38 @@ _DESCRIPTION = re.compile(rf"^({_ID})\s*:(.*)$")
 _BARE_ID = re.compile(rf"^({_ID})$")
 _CLASS_SUFFIX = re.compile(r":::[\w-]+")
 _NOTE_ONE_LINE = re.compile(r"^note\s+(left|right)\s+of\s+\S+\s*:")
-_IGNORED_KEYWORDS = ("direction", "classDef", "class", "style", "click", "accTitle", "accDescr",
-                     "linkStyle")
+_IGNORED_KEYWORDS = (
+    "direction",
+    "classDef",
+    "class",
+    "style",
+    "click",
+    "accTitle",
+    "accDescr",
+    "linkStyle",
+)
 _DIRECTIVE_NAME = re.compile(r'^%%\s*fsmbt-name:\s*(\S+)\s*=\s*(".*")\s*$')
 _DIRECTIVE_NO_ACTION = re.compile(r"^%%\s*fsmbt-no-action:\s*(\S+)\s*$")
 _DIRECTIVE_START = re.compile(r'^%%\s*fsmbt-start:\s*(".*")\s*$')
 _DIRECTIVE_EXIT = re.compile(r'^%%\s*fsmbt-exit:\s*(".*")\s*$')
 _WRITABLE_ID = re.compile(r"^[A-Za-z_]\w*$")
-_KEYWORDS = frozenset({"state", "note", "end", "direction", "class", "classDef", "style",
-                       "click", "as", "stateDiagram", "accTitle", "accDescr", "linkStyle"})
+_KEYWORDS = frozenset(
+    {
+        "state",
+        "note",
+        "end",
+        "direction",
+        "class",
+        "classDef",
+        "style",
+        "click",
+        "as",
+        "stateDiagram",
+        "accTitle",
+        "accDescr",
+        "linkStyle",
+    }
+)
 
 
 @dataclass
@@ -93,8 +116,12 @@ class _MermaidReader:
         home = self.home.get(mermaid_id)
         if home is not None and home is not self.level:
             where = f"inside composite state '{home.owner}'" if home.owner else "at the top level"
-            raise self.fail(f"state '{mermaid_id}' belongs {where}; transitions across "
-                            "composite state boundaries are not supported", line, True)
+            raise self.fail(
+                f"state '{mermaid_id}' belongs {where}; transitions across "
+                "composite state boundaries are not supported",
+                line,
+                True,
+            )
         name = self.names.get(mermaid_id, mermaid_id)
         machine = self.level.machine
         if home is None:
@@ -108,8 +135,11 @@ class _MermaidReader:
         text = text.strip()
         earlier = self.level.describes.get(state.name)
         if earlier is not None and state.action != text:
-            raise self.fail(f"state '{mermaid_id}' is described twice ('{state.action}' on line "
-                            f"{earlier}, '{text}' here)", line)
+            raise self.fail(
+                f"state '{mermaid_id}' is described twice ('{state.action}' on line "
+                f"{earlier}, '{text}' here)",
+                line,
+            )
         self.level.describes[state.name] = line
         state.action = text
 
@@ -124,8 +154,10 @@ class _MermaidReader:
         if source == "[*]":
             state = self.declare(target, line)
             if self.level.initial is not None and self.level.initial != state.name:
-                raise self.fail(f"two initial states at one level: '{self.level.initial}' and "
-                                f"'{state.name}'", line)
+                raise self.fail(
+                    f"two initial states at one level: '{self.level.initial}' and '{state.name}'",
+                    line,
+                )
             self.level.initial = state.name
             if event is not None:
                 self.level.machine.initial_event = event
@@ -134,14 +166,19 @@ class _MermaidReader:
             return
         if target == "[*]":
             if event is not None:
-                raise self.fail(f"a labelled transition to [*] ('{event}'); add an explicit "
-                                "final state and a transition to it", line, True)
+                raise self.fail(
+                    f"a labelled transition to [*] ('{event}'); add an explicit "
+                    "final state and a transition to it",
+                    line,
+                    True,
+                )
             self.declare(source, line).final = True
             return
         src = self.declare(source, line)
         dst = self.declare(target, line)
-        self.level.machine.add_transition(src.name, event, dst.name,
-                                          location=self.ctx.location(line))
+        self.level.machine.add_transition(
+            src.name, event, dst.name, location=self.ctx.location(line)
+        )
 
     def exit_transition(self, source: str, target: str, label: str | None, line: int) -> None:
         """The transition after an ``fsmbt-exit`` directive: a completion transition by exit."""
@@ -149,16 +186,23 @@ class _MermaidReader:
         exit_name, directive_line = self.pending_exit
         self.pending_exit = None
         if "[*]" in (source, target):
-            raise self.fail(f"the fsmbt-exit directive on line {directive_line} must precede a "
-                            "transition between two states", line)
+            raise self.fail(
+                f"the fsmbt-exit directive on line {directive_line} must precede a "
+                "transition between two states",
+                line,
+            )
         if label is not None and label != exit_name:
-            raise self.fail(f"the transition's label '{label}' differs from the exit "
-                            f"'{exit_name}' named by the fsmbt-exit directive on line "
-                            f"{directive_line}", line)
+            raise self.fail(
+                f"the transition's label '{label}' differs from the exit "
+                f"'{exit_name}' named by the fsmbt-exit directive on line "
+                f"{directive_line}",
+                line,
+            )
         src = self.declare(source, line)
         dst = self.declare(target, line)
-        self.level.machine.add_transition(src.name, None, dst.name, exit=exit_name,
-                                          location=self.ctx.location(line))
+        self.level.machine.add_transition(
+            src.name, None, dst.name, exit=exit_name, location=self.ctx.location(line)
+        )
 
     def open_composite(self, mermaid_id: str, description: str | None, line: int) -> None:
         state = self.declare(mermaid_id, line)
@@ -204,21 +248,28 @@ class _MermaidReader:
                 continue
             if not seen_header:
                 if not _HEADER.match(line):
-                    raise self.fail(f"not a Mermaid state diagram: expected 'stateDiagram-v2', "
-                                    f"found {line[:40]!r}", line_no)
+                    raise self.fail(
+                        f"not a Mermaid state diagram: expected 'stateDiagram-v2', "
+                        f"found {line[:40]!r}",
+                        line_no,
+                    )
                 seen_header = True
                 continue
             if self.pending_exit is not None and not _TRANSITION.match(line):
-                raise self.fail(f"the fsmbt-exit directive on line {self.pending_exit[1]} must "
-                                "be followed by a transition", line_no)
+                raise self.fail(
+                    f"the fsmbt-exit directive on line {self.pending_exit[1]} must "
+                    "be followed by a transition",
+                    line_no,
+                )
             skip_until = self.statement(line, line_no)
         if not seen_header:
             raise self.fail("not a Mermaid state diagram: no 'stateDiagram-v2' line", 1)
         if skip_until is not None:
             raise self.fail(f"unterminated block: expected '{skip_until}'", len(lines))
         if len(self.levels) > 1:
-            raise self.fail(f"composite state '{self.level.owner}' opened here is never closed",
-                            self.level.line)
+            raise self.fail(
+                f"composite state '{self.level.owner}' opened here is never closed", self.level.line
+            )
         self.finish(self.levels[0])
         if not self.top.states:
             raise self.fail("the state diagram has no states", len(lines))
@@ -234,7 +285,7 @@ class _MermaidReader:
             if stripped == "---":
                 return i + 1
             if stripped.startswith("title:"):
-                title = stripped[len("title:"):].strip()
+                title = stripped[len("title:") :].strip()
                 if title.startswith('"'):
                     try:
                         title = str(json.loads(title))
@@ -246,16 +297,20 @@ class _MermaidReader:
     def directive(self, line: str, line_no: int) -> None:
         if match := _DIRECTIVE_EXIT.match(line):
             if self.pending_exit is not None:
-                raise self.fail("two fsmbt-exit directives without a transition between them",
-                                line_no)
+                raise self.fail(
+                    "two fsmbt-exit directives without a transition between them", line_no
+                )
             try:
                 self.pending_exit = (str(json.loads(match.group(1))), line_no)
             except json.JSONDecodeError:
                 raise self.fail("the fsmbt-exit directive needs a quoted name", line_no) from None
         elif match := _DIRECTIVE_NAME.match(line):
             if match.group(1) in self.home:  # the state exists under its id: too late to rename
-                raise self.fail(f"the fsmbt-name directive for '{match.group(1)}' comes after "
-                                "that state is used; put it before the first use", line_no)
+                raise self.fail(
+                    f"the fsmbt-name directive for '{match.group(1)}' comes after "
+                    "that state is used; put it before the first use",
+                    line_no,
+                )
             try:
                 self.names[match.group(1)] = str(json.loads(match.group(2)))
             except json.JSONDecodeError:
@@ -282,8 +337,11 @@ class _MermaidReader:
             return None
         if match := _STATE_SPECIAL.match(line):
             kind = match.group(2)
-            raise self.fail(f"<<{kind}>> pseudo-states are not supported", line_no,
-                            unsupported=kind in ("fork", "join", "choice"))
+            raise self.fail(
+                f"<<{kind}>> pseudo-states are not supported",
+                line_no,
+                unsupported=kind in ("fork", "join", "choice"),
+            )
         if match := _STATE_AS.match(line):
             if match.group(3):
                 self.open_composite(match.group(2), match.group(1), line_no)
@@ -346,8 +404,9 @@ def write_mermaid(model: Model) -> str:
     machines = [model]
     for _path, _owner, state in model.walk():
         if state.is_parallel:
-            raise UnsupportedError(f"parallel state '{state.name}' (concurrent regions) cannot "
-                                   "be written as Mermaid")
+            raise UnsupportedError(
+                f"parallel state '{state.name}' (concurrent regions) cannot be written as Mermaid"
+            )
         machines.extend(state.regions)
     for machine in machines:
         ids.assign(machine)
@@ -377,8 +436,7 @@ def write_mermaid(model: Model) -> str:
             if machine.initial_event is not None:
                 if machine.start_name not in (None, "Start"):
                     tail.append(f"%% fsmbt-start: {json.dumps(machine.start_name)}")
-                tail.append(f"[*] --> {ids.of(machine, machine.initial)} : "
-                            f"{machine.initial_event}")
+                tail.append(f"[*] --> {ids.of(machine, machine.initial)} : {machine.initial_event}")
             else:
                 tail.append(f"[*] --> {ids.of(machine, machine.initial)}")
         for t in machine.transitions:
@@ -394,7 +452,9 @@ def write_mermaid(model: Model) -> str:
             if state.final:
                 tail.append(f"{ids.of(machine, state.name)} --> [*]")
         mentioned = {machine.initial, *(s.name for s in machine.states.values() if s.final)}
-        mentioned |= {t.source for t in machine.transitions} | {t.target for t in machine.transitions}
+        mentioned |= {t.source for t in machine.transitions} | {
+            t.target for t in machine.transitions
+        }
         for state in machine.states.values():
             sid = ids.of(machine, state.name)
             if state.name not in mentioned and not state.regions and sid not in head:
@@ -408,8 +468,11 @@ def write_mermaid(model: Model) -> str:
             stack.append(("line", "}", depth))
             stack.append(("level", state.regions[0], depth + 1))
             description = state.attrs.get("description")
-            opener = (f'state "{description}" as {sid} {{' if description and '"' not in description
-                      else f"state {sid} {{")
+            opener = (
+                f'state "{description}" as {sid} {{'
+                if description and '"' not in description
+                else f"state {sid} {{"
+            )
             stack.append(("line", opener, depth))
         for line in reversed(head):
             stack.append(("line", line, depth))
@@ -434,7 +497,16 @@ def _sniff(text: str) -> bool:
     return False
 
 
-register(Format("mermaid", (".mmd", ".mermaid"), frozenset({"fsm"}),
-                "Mermaid stateDiagram-v2 (flat and composite states)",
-                read_mermaid, write_mermaid, _sniff, priority=25,
-                cannot_hold="parallel states"))
+register(
+    Format(
+        "mermaid",
+        (".mmd", ".mermaid"),
+        frozenset({"fsm"}),
+        "Mermaid stateDiagram-v2 (flat and composite states)",
+        read_mermaid,
+        write_mermaid,
+        _sniff,
+        priority=25,
+        cannot_hold="parallel states",
+    )
+)

@@ -41,8 +41,10 @@ _EXIT = re.compile(r"^\(\s*(?:exit\s+(\S+))?\s*\)$")
 
 def _check_name(name: str, what: str) -> str:
     if not name or re.search(r"\s|\[|\]|--", name):
-        raise UnsupportedError(f"{what} name {name!r} cannot be written in paper-text "
-                               "(no whitespace, brackets or '--')")
+        raise UnsupportedError(
+            f"{what} name {name!r} cannot be written in paper-text "
+            "(no whitespace, brackets or '--')"
+        )
     return name
 
 
@@ -68,8 +70,9 @@ def _write_machine(fsm: FSM, indent: int, lines: list[str], *, top: bool) -> Non
         block: list[tuple[str, object, int]] = []
         if machine.initial_event is not None and machine is fsm and top:
             start = _check_name(machine.start_name or "Start", "start")
-            block.append(("line", f"{pad}Start: {start} --{machine.initial_event}--> "
-                                  f"{machine.initial}", 0))
+            block.append(
+                ("line", f"{pad}Start: {start} --{machine.initial_event}--> {machine.initial}", 0)
+            )
         elif machine.initial is not None:
             block.append(("line", f"{pad}Initial: {machine.initial}", 0))
         block.append(("line", f"{pad}States:", 0))
@@ -81,8 +84,9 @@ def _write_machine(fsm: FSM, indent: int, lines: list[str], *, top: bool) -> Non
             if state.action != state.name:
                 tags.append(f"action={state.action or ''}")
             if state.is_parallel:
-                raise UnsupportedError("parallel states cannot be written in paper-text",
-                                       element=state.name)
+                raise UnsupportedError(
+                    "parallel states cannot be written in paper-text", element=state.name
+                )
             if state.is_composite:
                 tags.append("composite")
             suffix = f" [{', '.join(tags)}]" if tags else ""
@@ -115,10 +119,13 @@ def read_paper_text(text: str, ctx: ReadContext) -> Model:
         line = raw.strip()
         if fsm is None:
             if not line.startswith(HEADER + " ") and line != HEADER:
-                raise InputError("not fsmbt's paper-text format (it starts with 'FSM <name>'); "
-                                 "a description in prose needs an LLM to extract the model",
-                                 location=ctx.location(number), hints=(Hint.LLM_ENGINE,))
-            fsm = FSM(name=line[len(HEADER):].strip() or "fsm")
+                raise InputError(
+                    "not fsmbt's paper-text format (it starts with 'FSM <name>'); "
+                    "a description in prose needs an LLM to extract the model",
+                    location=ctx.location(number),
+                    hints=(Hint.LLM_ENGINE,),
+                )
+            fsm = FSM(name=line[len(HEADER) :].strip() or "fsm")
             stack.append([0, fsm, None])
             continue
         while stack and indent < stack[-1][0]:
@@ -139,8 +146,10 @@ def read_paper_text(text: str, ctx: ReadContext) -> Model:
             elif line in ("States:", "Transitions:"):
                 block[2] = line[:-1]
             else:
-                raise InputError(f"expected States:, Transitions:, Initial: or Start:, "
-                                 f"not {line!r}", location=where)
+                raise InputError(
+                    f"expected States:, Transitions:, Initial: or Start:, not {line!r}",
+                    location=where,
+                )
             continue
         if block[2] == "States":
             match = _STATE.match(line)
@@ -174,13 +183,15 @@ def read_paper_text(text: str, ctx: ReadContext) -> Model:
             source, label, target = match.groups()
             exit_match = _EXIT.match(label.strip())
             if exit_match is not None:
-                machine.add_transition(source, None, target, exit=exit_match.group(1),
-                                       location=where)
+                machine.add_transition(
+                    source, None, target, exit=exit_match.group(1), location=where
+                )
             else:
                 machine.add_transition(source, label, target, location=where)
         else:
-            raise InputError("a state or transition line before 'States:'/'Transitions:'",
-                             location=where)
+            raise InputError(
+                "a state or transition line before 'States:'/'Transitions:'", location=where
+            )
     if fsm is None:
         raise InputError("empty paper-text input", location=ctx.location())
     for _path, owner, parent in [("", fsm, None), *fsm.walk()]:
@@ -189,8 +200,11 @@ def read_paper_text(text: str, ctx: ReadContext) -> Model:
             for t in m.transitions:
                 for end in (t.source, t.target):
                     if end not in m.states:
-                        raise InputError(f"transition refers to unknown state '{end}'",
-                                         location=t.location, element=m.name)
+                        raise InputError(
+                            f"transition refers to unknown state '{end}'",
+                            location=t.location,
+                            element=m.name,
+                        )
     return fsm
 
 
@@ -202,7 +216,16 @@ def _sniff(text: str) -> bool:
     return False
 
 
-register(Format("paper-text", (".txt",), frozenset({"fsm"}),
-                "the paper's 'States / Transitions' text (hierarchy by indentation)",
-                read_paper_text, write_paper_text, _sniff, priority=60,
-                cannot_hold="parallel states"))
+register(
+    Format(
+        "paper-text",
+        (".txt",),
+        frozenset({"fsm"}),
+        "the paper's 'States / Transitions' text (hierarchy by indentation)",
+        read_paper_text,
+        write_paper_text,
+        _sniff,
+        priority=60,
+        cannot_hold="parallel states",
+    )
+)

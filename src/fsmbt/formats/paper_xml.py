@@ -39,10 +39,14 @@ _FSM_KEYS = frozenset({"name", "finals"})
 def read_paper_xml(text: str, ctx: ReadContext) -> FSM:
     root = parse_xml(text, ctx.display_name)
     if root.tag != "FSM":
-        raise InputError(f"not the paper's FSM XML: root element is <{str(root.tag)}>, expected <FSM>",
-                         location=ctx.location(root.sourceline))
-    fsm = FSM(name=root.get("name", "fsm"),
-              attrs={k: v for k, v in root.attrib.items() if k not in _FSM_KEYS})
+        raise InputError(
+            f"not the paper's FSM XML: root element is <{str(root.tag)}>, expected <FSM>",
+            location=ctx.location(root.sourceline),
+        )
+    fsm = FSM(
+        name=root.get("name", "fsm"),
+        attrs={k: v for k, v in root.attrib.items() if k not in _FSM_KEYS},
+    )
     initial_name: str | None = None
     initial_line: int | None = None
     pseudo_listed: set[str] = set()
@@ -55,8 +59,11 @@ def read_paper_xml(text: str, ctx: ReadContext) -> FSM:
             for element in _children(section, "State", ctx):
                 state = _state(element, ctx)
                 if state.name in fsm.states or state.name in pseudo_listed:
-                    raise InputError(f"duplicate state '{state.name}'",
-                                     location=ctx.location(element.sourceline), element="State")
+                    raise InputError(
+                        f"duplicate state '{state.name}'",
+                        location=ctx.location(element.sourceline),
+                        element="State",
+                    )
                 if element.get("type") in PSEUDO_TYPES:
                     pseudo_listed.add(state.name)
                     continue
@@ -67,15 +74,22 @@ def read_paper_xml(text: str, ctx: ReadContext) -> FSM:
                 attrs = dict(element.attrib)
                 source, target = attrs.pop("from", None), attrs.pop("to", None)
                 if not source or not target:
-                    raise InputError("<Transition> needs 'from' and 'to'",
-                                     location=ctx.location(element.sourceline), element="Transition")
+                    raise InputError(
+                        "<Transition> needs 'from' and 'to'",
+                        location=ctx.location(element.sourceline),
+                        element="Transition",
+                    )
                 event = attrs.pop("event", None)
-                fsm.add_transition(source, event, target, attrs=attrs,
-                                   location=ctx.location(element.sourceline))
+                fsm.add_transition(
+                    source, event, target, attrs=attrs, location=ctx.location(element.sourceline)
+                )
         else:
-            raise InputError(f"unexpected element <{str(section.tag)}> in <FSM> (expected "
-                             "InitialState, States, Transitions)",
-                             location=ctx.location(section.sourceline), element=str(section.tag))
+            raise InputError(
+                f"unexpected element <{str(section.tag)}> in <FSM> (expected "
+                "InitialState, States, Transitions)",
+                location=ctx.location(section.sourceline),
+                element=str(section.tag),
+            )
     _set_initial(fsm, initial_name, initial_line, pseudo_listed, ctx)
     if not any_marked_final and root.get("finals") != "marked":
         sources = {t.source for t in fsm.transitions}
@@ -84,8 +98,9 @@ def read_paper_xml(text: str, ctx: ReadContext) -> FSM:
     return fsm
 
 
-def _set_initial(fsm: FSM, name: str | None, line: int | None, pseudo_listed: set[str],
-                 ctx: ReadContext) -> None:
+def _set_initial(
+    fsm: FSM, name: str | None, line: int | None, pseudo_listed: set[str], ctx: ReadContext
+) -> None:
     if name is None:
         fsm.initial = next(iter(fsm.states), None)
         return
@@ -97,10 +112,15 @@ def _set_initial(fsm: FSM, name: str | None, line: int | None, pseudo_listed: se
         raise InputError(
             f"InitialState '{name}' is not a listed state, and as a start pseudo-state it needs "
             f"exactly one outgoing transition (it has {len(leaving)})",
-            location=ctx.location(line), element="InitialState")
+            location=ctx.location(line),
+            element="InitialState",
+        )
     if any(t.target == name for t in fsm.transitions):
-        raise InputError(f"start pseudo-state '{name}' has incoming transitions",
-                         location=ctx.location(line), element="InitialState")
+        raise InputError(
+            f"start pseudo-state '{name}' has incoming transitions",
+            location=ctx.location(line),
+            element="InitialState",
+        )
     (start,) = leaving
     fsm.transitions.remove(start)
     fsm.initial = start.target
@@ -112,16 +132,24 @@ def _set_initial(fsm: FSM, name: str | None, line: int | None, pseudo_listed: se
 def _state(element: etree._Element, ctx: ReadContext) -> State:
     name = element.get("name")
     if not name:
-        raise InputError("<State> without name", location=ctx.location(element.sourceline),
-                         element="State")
+        raise InputError(
+            "<State> without name", location=ctx.location(element.sourceline), element="State"
+        )
     kind = element.get("type", "normal")
     if kind not in STATE_TYPES:
-        raise InputError(f"unknown state type '{kind}' (normal, final, start)",
-                         location=ctx.location(element.sourceline), element="State")
+        raise InputError(
+            f"unknown state type '{kind}' (normal, final, start)",
+            location=ctx.location(element.sourceline),
+            element="State",
+        )
     action = element.get("action", name)
-    return State(name, action=action or None, final=kind == "final",
-                 attrs={k: v for k, v in element.attrib.items() if k not in _STATE_KEYS},
-                 location=ctx.location(element.sourceline))
+    return State(
+        name,
+        action=action or None,
+        final=kind == "final",
+        attrs={k: v for k, v in element.attrib.items() if k not in _STATE_KEYS},
+        location=ctx.location(element.sourceline),
+    )
 
 
 def _elements(element: etree._Element) -> list[etree._Element]:
@@ -132,8 +160,11 @@ def _children(section: etree._Element, tag: str, ctx: ReadContext) -> list[etree
     children = _elements(section)
     for child in children:
         if child.tag != tag:
-            raise InputError(f"unexpected <{str(child.tag)}> in <{str(section.tag)}> (expected <{tag}>)",
-                             location=ctx.location(child.sourceline), element=str(child.tag))
+            raise InputError(
+                f"unexpected <{str(child.tag)}> in <{str(section.tag)}> (expected <{tag}>)",
+                location=ctx.location(child.sourceline),
+                element=str(child.tag),
+            )
     return children
 
 
@@ -142,8 +173,9 @@ def write_paper_xml(model: Model) -> str:
         raise InputError("the paper's FSM XML holds a state machine, not a behavior tree")
     fsm = model
     if fsm.is_hierarchical:
-        raise UnsupportedError("the paper's FSM XML holds flat state machines only; "
-                               "flatten it first or write SCXML")
+        raise UnsupportedError(
+            "the paper's FSM XML holds flat state machines only; flatten it first or write SCXML"
+        )
     root = etree.Element("FSM")
     if fsm.name != "fsm":
         root.set("name", fsm.name)
@@ -159,16 +191,20 @@ def write_paper_xml(model: Model) -> str:
         etree.SubElement(root, "InitialState", name=initial)
     states = etree.SubElement(root, "States")
     for state in fsm.states.values():
-        element = etree.SubElement(states, "State", name=state.name,
-                                   type="final" if state.final else "normal")
+        element = etree.SubElement(
+            states, "State", name=state.name, type="final" if state.final else "normal"
+        )
         if state.action != state.name:
             element.set("action", state.action or "")
         for key, value in state.attrs.items():
             element.set(key, value)
     transitions = etree.SubElement(root, "Transitions")
     if fsm.initial_event is not None and fsm.initial is not None:
-        etree.SubElement(transitions, "Transition", {"from": start, "to": fsm.initial,
-                                                     "event": fsm.initial_event})
+        etree.SubElement(
+            transitions,
+            "Transition",
+            {"from": start, "to": fsm.initial, "event": fsm.initial_event},
+        )
     for t in fsm.transitions:
         element = etree.SubElement(transitions, "Transition", {"from": t.source, "to": t.target})
         if t.event is not None:
@@ -182,8 +218,16 @@ def _sniff(text: str) -> bool:
     return root_tag(text) == "FSM"
 
 
-register(Format(
-    "paper-xml", (".fsm.xml",), frozenset({"fsm"}),
-    "the reference paper's FSM XML (<FSM>, <States>, <Transitions>)",
-    read_paper_xml, write_paper_xml, _sniff, priority=30,
-    cannot_hold="composite or parallel states (flatten first)"))
+register(
+    Format(
+        "paper-xml",
+        (".fsm.xml",),
+        frozenset({"fsm"}),
+        "the reference paper's FSM XML (<FSM>, <States>, <Transitions>)",
+        read_paper_xml,
+        write_paper_xml,
+        _sniff,
+        priority=30,
+        cannot_hold="composite or parallel states (flatten first)",
+    )
+)

@@ -164,7 +164,8 @@ def format_for_path(path: Path, *, writing: bool = False, kind: str | None = Non
     """
     suffixes = "".join(path.suffixes).lower()
     candidates = [
-        f for f in formats()
+        f
+        for f in formats()
         if any(suffixes.endswith(ext) for ext in f.extensions)
         and (f.write if writing else f.read) is not None
         and (kind is None or kind in f.kinds)
@@ -195,10 +196,12 @@ def detect_format(text: str, path: Path | None = None) -> Format:
         by_ext = format_for_path(path)
         if by_ext is not None:
             return by_ext
-    raise InputError("cannot tell the format of this input "
-                     f"(known: {', '.join(f.name for f in formats() if f.read)})",
-                     location=SourceLocation(str(path) if path else None),
-                     hints=(Hint.INPUT_FORMAT,))
+    raise InputError(
+        "cannot tell the format of this input "
+        f"(known: {', '.join(f.name for f in formats() if f.read)})",
+        location=SourceLocation(str(path) if path else None),
+        hints=(Hint.INPUT_FORMAT,),
+    )
 
 
 def decode(data: bytes, name: str) -> str:
@@ -225,10 +228,14 @@ def decode(data: bytes, name: str) -> str:
             raise InputError(f"invalid UTF-16 at byte {exc.start}", location=location) from None
     if b"\x00" in data[:8192]:
         head = data[:8192]
-        if len(head) >= 4 and (head[1::2].count(0) > 0.9 * len(head[1::2])
-                               or head[0::2].count(0) > 0.9 * len(head[0::2])):
-            raise InputError("looks like UTF-16 without a byte-order mark; save the file as "
-                             "UTF-8", location=location)
+        if len(head) >= 4 and (
+            head[1::2].count(0) > 0.9 * len(head[1::2])
+            or head[0::2].count(0) > 0.9 * len(head[0::2])
+        ):
+            raise InputError(
+                "looks like UTF-16 without a byte-order mark; save the file as UTF-8",
+                location=location,
+            )
         raise InputError("binary data, not a text model", location=location)
     try:
         return data.decode("utf-8-sig")
@@ -236,12 +243,18 @@ def decode(data: bytes, name: str) -> str:
         line = data[: exc.start].count(b"\n") + 1
         raise InputError(
             f"not valid UTF-8 at byte {exc.start} (line {line}); save the file as UTF-8",
-            location=location) from None
+            location=location,
+        ) from None
 
 
-def loads(text: str, fmt: str | None = None, *, path: Path | None = None,
-          options: dict[str, object] | None = None,
-          warnings: list[str] | None = None) -> Model:
+def loads(
+    text: str,
+    fmt: str | None = None,
+    *,
+    path: Path | None = None,
+    options: dict[str, object] | None = None,
+    warnings: list[str] | None = None,
+) -> Model:
     """Parse a model from text.
 
     Args:
@@ -278,10 +291,17 @@ def loads(text: str, fmt: str | None = None, *, path: Path | None = None,
 
 def _check_text_size(text: str, path: Path | None) -> None:
     limit = limits.current().max_input_bytes
-    if len(text) > limit or (len(text) * 4 > limit and len(text.encode("utf-8", "replace")) > limit):
-        raise InputError(limits.exceeded(f"the input's {len(text.encode('utf-8', 'replace'))} "
-                                         "bytes", "max_input_bytes", limit),
-                         location=SourceLocation(str(path) if path else None))
+    if len(text) > limit or (
+        len(text) * 4 > limit and len(text.encode("utf-8", "replace")) > limit
+    ):
+        raise InputError(
+            limits.exceeded(
+                f"the input's {len(text.encode('utf-8', 'replace'))} bytes",
+                "max_input_bytes",
+                limit,
+            ),
+            location=SourceLocation(str(path) if path else None),
+        )
 
 
 def check_model_size(model: Model, location: SourceLocation) -> None:
@@ -297,9 +317,12 @@ def check_model_size(model: Model, location: SourceLocation) -> None:
             machine = machines.pop()
             count += len(machine.states)
             if count > bounds.max_states:
-                raise InputError(limits.exceeded(f"the machine's {count}+ states", "max_states",
-                                                 bounds.max_states),
-                                 location=location)
+                raise InputError(
+                    limits.exceeded(
+                        f"the machine's {count}+ states", "max_states", bounds.max_states
+                    ),
+                    location=location,
+                )
             for state in machine.states.values():
                 machines.extend(state.regions)
         return
@@ -308,9 +331,10 @@ def check_model_size(model: Model, location: SourceLocation) -> None:
         node = nodes.pop()
         count += 1
         if count > bounds.max_nodes:
-            raise InputError(limits.exceeded(f"the document's {count}+ nodes", "max_nodes",
-                                             bounds.max_nodes),
-                             location=location)
+            raise InputError(
+                limits.exceeded(f"the document's {count}+ nodes", "max_nodes", bounds.max_nodes),
+                location=location,
+            )
         nodes.extend(node.children)
 
 
@@ -321,8 +345,9 @@ def read_bounded(path: Path) -> bytes:
     location = SourceLocation(str(path))
     size = path.stat().st_size
     if size > limit:
-        raise InputError(limits.exceeded(f"the file's {size} bytes", "max_input_bytes", limit),
-                         location=location)
+        raise InputError(
+            limits.exceeded(f"the file's {size} bytes", "max_input_bytes", limit), location=location
+        )
     if path.is_dir():
         raise InputError("is a directory, not a model file", location=location)
     if not path.is_file():  # a FIFO or a device (/dev/zero) could block or never end
@@ -330,8 +355,10 @@ def read_bounded(path: Path) -> bytes:
     with path.open("rb") as stream:
         data = stream.read(limit + 1)
     if len(data) > limit:
-        raise InputError(limits.exceeded(f"the file's {len(data)}+ bytes", "max_input_bytes",
-                                         limit), location=location)
+        raise InputError(
+            limits.exceeded(f"the file's {len(data)}+ bytes", "max_input_bytes", limit),
+            location=location,
+        )
     return data
 
 
@@ -345,13 +372,19 @@ def read_text(path: str | Path) -> str:
     try:
         data = read_bounded(path)
     except OSError as exc:
-        raise InputError(f"cannot read: {exc.strerror}", location=SourceLocation(str(path))) from None
+        raise InputError(
+            f"cannot read: {exc.strerror}", location=SourceLocation(str(path))
+        ) from None
     return decode(data, str(path))
 
 
-def read_model(path: str | Path, fmt: str | None = None,
-               options: dict[str, object] | None = None, *,
-               warnings: list[str] | None = None) -> Model:
+def read_model(
+    path: str | Path,
+    fmt: str | None = None,
+    options: dict[str, object] | None = None,
+    *,
+    warnings: list[str] | None = None,
+) -> Model:
     """Read one model file: size and encoding checks, then the format's reader.
 
     Args:
@@ -395,8 +428,9 @@ def dumps(model: Model, fmt: str) -> str:
     return chosen.write(model)
 
 
-def write_model(model: Model, path: str | Path, fmt: str | None = None, *,
-                overwrite: bool = False) -> Path:
+def write_model(
+    model: Model, path: str | Path, fmt: str | None = None, *, overwrite: bool = False
+) -> Path:
     """Write a model to a file; never replaces an existing file unless ``overwrite``.
 
     Args:
@@ -417,8 +451,9 @@ def write_model(model: Model, path: str | Path, fmt: str | None = None, *,
     kind = "fsm" if _is_fsm(model) else "bt"
     chosen = get_format(fmt) if fmt else format_for_path(path, writing=True, kind=kind)
     if chosen is None:
-        raise InputError(f"cannot tell the output format from '{path.name}'",
-                         hints=(Hint.OUTPUT_FORMAT,))
+        raise InputError(
+            f"cannot tell the output format from '{path.name}'", hints=(Hint.OUTPUT_FORMAT,)
+        )
     text = dumps(model, chosen.name)
     if path.exists() and not overwrite:
         raise InputError("exists", location=SourceLocation(str(path)), hints=(Hint.OVERWRITE,))
@@ -426,7 +461,9 @@ def write_model(model: Model, path: str | Path, fmt: str | None = None, *,
         path.parent.mkdir(parents=True, exist_ok=True)
         path.write_text(text, encoding="utf-8")
     except OSError as exc:
-        raise InputError(f"cannot write: {exc.strerror}", location=SourceLocation(str(path))) from None
+        raise InputError(
+            f"cannot write: {exc.strerror}", location=SourceLocation(str(path))
+        ) from None
     return path
 
 

@@ -52,13 +52,15 @@ XINCLUDE_NS = "http://www.w3.org/2001/XInclude"
 #: a model name that is not a unique id, the final state a completion transition waits for).
 FSMBT_NS = "https://fsmbt.dev/ns/scxml"
 F_NAME, F_ACTION, F_START, F_EXIT, F_REGION = (
-    f"{{{FSMBT_NS}}}{n}" for n in ("name", "action", "start", "exit", "region"))
+    f"{{{FSMBT_NS}}}{n}" for n in ("name", "action", "start", "exit", "region")
+)
 #: ``State.attrs`` mark of the transient final states that encode a transition leaving its parent.
 EXIT_MARK = f"{{{FSMBT_NS}}}exit-state"
 
 STATE_TAGS = frozenset({"state", "parallel", "final"})
-UNSUPPORTED_CONTENT = frozenset({"raise", "send", "assign", "script", "if", "elseif", "else",
-                                 "foreach", "cancel", "invoke"})
+UNSUPPORTED_CONTENT = frozenset(
+    {"raise", "send", "assign", "script", "if", "elseif", "else", "foreach", "cancel", "invoke"}
+)
 WARNED_CONTENT = frozenset({"log"})
 _SCXML_KEYS = frozenset({"initial", "name", "version"})
 _STATE_KEYS = frozenset({"id", "initial", F_NAME, F_ACTION, F_START, F_REGION})
@@ -95,14 +97,16 @@ class _Reader:
         return self.ctx.location(element.sourceline)
 
     def unsupported(self, element: etree._Element, feature: str) -> UnsupportedError:
-        return UnsupportedError(feature, location=self.where(element),
-                                element=f"<{local_name(element)}>")
+        return UnsupportedError(
+            feature, location=self.where(element), element=f"<{local_name(element)}>"
+        )
 
     def tag(self, element: etree._Element) -> str | None:
         """The SCXML local name, or ``None`` for an element of another namespace."""
         if namespace(element) == XINCLUDE_NS:
-            raise self.unsupported(element, "XInclude (include the fragment's content in the "
-                                            "file itself)")
+            raise self.unsupported(
+                element, "XInclude (include the fragment's content in the file itself)"
+            )
         return local_name(element) if namespace(element) == self.ns else None
 
     def children(self, element: etree._Element) -> list[etree._Element]:
@@ -113,18 +117,26 @@ class _Reader:
         root = parse_xml(text, self.ctx.display_name)
         self.ns = namespace(root)
         if self.ns == LEGACY_NS:
-            raise UnsupportedError("the obsolete 2005 SCXML working-draft syntax "
-                                   f"(namespace {LEGACY_NS}); SCXML 1.0 uses {SCXML_NS}",
-                                   location=self.where(root), element="<scxml>")
+            raise UnsupportedError(
+                "the obsolete 2005 SCXML working-draft syntax "
+                f"(namespace {LEGACY_NS}); SCXML 1.0 uses {SCXML_NS}",
+                location=self.where(root),
+                element="<scxml>",
+            )
         if local_name(root) != "scxml":
-            raise InputError(f"not an SCXML document: root element is <{local_name(root)}>, "
-                             "expected <scxml> (a fragment meant for XInclude?)",
-                             location=self.where(root))
+            raise InputError(
+                f"not an SCXML document: root element is <{local_name(root)}>, "
+                "expected <scxml> (a fragment meant for XInclude?)",
+                location=self.where(root),
+            )
         if self.ns not in (SCXML_NS, None):
-            raise InputError(f"not an SCXML document: unknown namespace {self.ns}",
-                             location=self.where(root))
-        top = FSM(name=root.get("name", "fsm"),
-                  attrs={k: v for k, v in root.attrib.items() if k not in _SCXML_KEYS})
+            raise InputError(
+                f"not an SCXML document: unknown namespace {self.ns}", location=self.where(root)
+            )
+        top = FSM(
+            name=root.get("name", "fsm"),
+            attrs={k: v for k, v in root.attrib.items() if k not in _SCXML_KEYS},
+        )
         self.parent_of[id(top)] = None
         self.build(root, top)
         for node in self.order:
@@ -165,15 +177,22 @@ class _Reader:
         tag = self.tag(element) or ""
         state_id = element.get("id") or f"_state{len(self.order) + 1}"
         if element.get(F_REGION) is not None:  # a wrapper never gets here (``regions``)
-            raise InputError('fsmbt:region="true" is only meaningful on a <state> child of '
-                             "<parallel>", location=self.where(element), element=f"<{tag}>")
+            raise InputError(
+                'fsmbt:region="true" is only meaningful on a <state> child of <parallel>',
+                location=self.where(element),
+                element=f"<{tag}>",
+            )
         if state_id in self.by_id or state_id in self.wrapper_ids:
-            raise InputError(f"duplicate state id '{state_id}'", location=self.where(element),
-                             element=f"<{tag}>")
+            raise InputError(
+                f"duplicate state id '{state_id}'", location=self.where(element), element=f"<{tag}>"
+            )
         name = element.get(F_NAME, state_id)
         if name in machine.states:
-            raise InputError(f"duplicate state name '{name}' in one machine",
-                             location=self.where(element), element=f"<{tag}>")
+            raise InputError(
+                f"duplicate state name '{name}' in one machine",
+                location=self.where(element),
+                element=f"<{tag}>",
+            )
         nested = []
         for child in self.children(element):
             if self.tag(child) in STATE_TAGS:
@@ -181,14 +200,16 @@ class _Reader:
             else:
                 self.content(child, element)
         if tag == "final" and nested:
-            raise InputError("<final> cannot hold states", location=self.where(element),
-                             element="<final>")
+            raise InputError(
+                "<final> cannot hold states", location=self.where(element), element="<final>"
+            )
         action: str | None = name if not nested else None
         if F_ACTION in element.attrib:
             action = element.get(F_ACTION) or None
         attrs = {k: v for k, v in element.attrib.items() if k not in _STATE_KEYS}
-        state = State(name, action=action, final=tag == "final", attrs=attrs,
-                      location=self.where(element))
+        state = State(
+            name, action=action, final=tag == "final", attrs=attrs, location=self.where(element)
+        )
         machine.states[name] = state
         node = _Node(element, state, machine, owner)
         self.by_id[state_id] = node
@@ -223,43 +244,60 @@ class _Reader:
         writes around a region of several states: the region itself, not a state of it (a
         compound state with the same W3C meaning). It may hold states only."""
         if local_name(element) != "state":
-            raise InputError("fsmbt:region is only meaningful on a <state>",
-                             location=self.where(element), element=f"<{local_name(element)}>")
+            raise InputError(
+                "fsmbt:region is only meaningful on a <state>",
+                location=self.where(element),
+                element=f"<{local_name(element)}>",
+            )
         for child in self.children(element):
             if self.tag(child) not in STATE_TAGS and self.tag(child) != "initial":
-                raise InputError(f"a region wrapper (fsmbt:region) holds states only, not "
-                                 f"<{local_name(child)}>", location=self.where(child),
-                                 element=f"<{local_name(child)}>")
+                raise InputError(
+                    f"a region wrapper (fsmbt:region) holds states only, not <{local_name(child)}>",
+                    location=self.where(child),
+                    element=f"<{local_name(child)}>",
+                )
         wrapper_id = element.get("id")
         if wrapper_id is not None:
             if wrapper_id in self.by_id or wrapper_id in self.wrapper_ids:
-                raise InputError(f"duplicate state id '{wrapper_id}'",
-                                 location=self.where(element), element="<state>")
+                raise InputError(
+                    f"duplicate state id '{wrapper_id}'",
+                    location=self.where(element),
+                    element="<state>",
+                )
             self.wrapper_ids.add(wrapper_id)
 
     def content(self, element: etree._Element, container: etree._Element) -> None:
         """Non-state children of a state or of <scxml>: supported, warned or refused."""
         tag = self.tag(element)
         if tag is None:
-            self.ctx.warn(f"element of another namespace ignored: <{etree.QName(element).localname}>",
-                          line=element.sourceline)
+            self.ctx.warn(
+                f"element of another namespace ignored: <{etree.QName(element).localname}>",
+                line=element.sourceline,
+            )
         elif tag in ("transition", "initial"):
             return  # handled with the transitions / the initial state
         elif tag in ("onentry", "onexit", "donedata"):
             self.executable(element)
         elif tag == "datamodel":
-            self.ctx.warn("<datamodel> ignored (no supported construct reads data)",
-                          line=element.sourceline, element="<datamodel>")
+            self.ctx.warn(
+                "<datamodel> ignored (no supported construct reads data)",
+                line=element.sourceline,
+                element="<datamodel>",
+            )
         elif tag in UNSUPPORTED_CONTENT:
-            raise self.unsupported(element, f"<{tag}> (executable content and external "
-                                            "communication change behaviour)")
+            raise self.unsupported(
+                element, f"<{tag}> (executable content and external communication change behaviour)"
+            )
         elif tag == "history":
             raise self.unsupported(element, "<history> (the model has no history states)")
         elif tag == "invoke":
             raise self.unsupported(element, "<invoke> (external services)")
         else:
-            raise InputError(f"unknown SCXML element <{tag}> in <{local_name(container)}>",
-                             location=self.where(element), element=f"<{tag}>")
+            raise InputError(
+                f"unknown SCXML element <{tag}> in <{local_name(container)}>",
+                location=self.where(element),
+                element=f"<{tag}>",
+            )
 
     def executable(self, block: etree._Element) -> None:
         """A block of executable content: only ``<log>`` (warned) is harmless."""
@@ -268,16 +306,20 @@ class _Reader:
                 continue
             tag = self.tag(item)
             if tag is None:
-                self.ctx.warn("element of another namespace ignored: "
-                              f"<{etree.QName(item).localname}>", line=item.sourceline)
+                self.ctx.warn(
+                    f"element of another namespace ignored: <{etree.QName(item).localname}>",
+                    line=item.sourceline,
+                )
             elif tag in WARNED_CONTENT:
-                self.ctx.warn(f"<{tag}> ignored (no effect on the state machine)",
-                              line=item.sourceline, element=f"<{tag}>")
+                self.ctx.warn(
+                    f"<{tag}> ignored (no effect on the state machine)",
+                    line=item.sourceline,
+                    element=f"<{tag}>",
+                )
             elif tag in ("param", "content") and local_name(block) == "donedata":
                 self.ctx.warn("<donedata> ignored", line=item.sourceline, element="<donedata>")
             else:
-                raise self.unsupported(item, f"<{tag}> (executable content that changes "
-                                             "behaviour)")
+                raise self.unsupported(item, f"<{tag}> (executable content that changes behaviour)")
 
     def set_initial(self, container: etree._Element, machine: FSM) -> None:
         """The machine's initial state: ``initial`` attribute, ``<initial>``, or first child."""
@@ -287,8 +329,11 @@ class _Reader:
             if self.tag(child) == "initial":
                 transitions = [t for t in self.children(child) if self.tag(t) == "transition"]
                 if len(transitions) != 1:
-                    raise InputError("<initial> needs exactly one <transition>",
-                                     location=self.where(child), element="<initial>")
+                    raise InputError(
+                        "<initial> needs exactly one <transition>",
+                        location=self.where(child),
+                        element="<initial>",
+                    )
                 self.executable(transitions[0])
                 targets, where = transitions[0].get("target"), transitions[0]
         if not machine.states:
@@ -301,12 +346,16 @@ class _Reader:
         for target_id in ids:
             node = self.by_id.get(target_id)
             if node is None:
-                raise InputError(f"initial state '{target_id}' does not exist",
-                                 location=self.where(where), element=f"<{local_name(where)}>")
+                raise InputError(
+                    f"initial state '{target_id}' does not exist",
+                    location=self.where(where),
+                    element=f"<{local_name(where)}>",
+                )
             chosen.add(self.entry_in(node, machine, where).state.name)
         if len(chosen) != 1:
-            raise self.unsupported(where, "an initial configuration spanning several states "
-                                          "of one machine")
+            raise self.unsupported(
+                where, "an initial configuration spanning several states of one machine"
+            )
         machine.initial = chosen.pop()
 
     # transitions --------------------------------------------------------------------------------
@@ -321,7 +370,9 @@ class _Reader:
                     self.ctx.warn(
                         f"transition on {transition.event or 'completion'} from "
                         f"'{node.state.name}' dropped: an earlier one in document order wins",
-                        line=element.sourceline, element="<transition>")
+                        line=element.sourceline,
+                        element="<transition>",
+                    )
                     continue
                 seen.add(key)
                 node.machine.transitions.append(transition)
@@ -329,26 +380,33 @@ class _Reader:
     def transition(self, node: _Node, element: etree._Element) -> list[Transition]:
         cond_exit = self.completion_guard(node, element)
         if element.get("type", "external") != "external":
-            raise self.unsupported(element, f"type=\"{element.get('type')}\" transitions")
+            raise self.unsupported(element, f'type="{element.get("type")}" transitions')
         target_ids = (element.get("target") or "").split()
         if not target_ids:
-            raise self.unsupported(element, "targetless transitions (they only run executable "
-                                            "content)")
+            raise self.unsupported(
+                element, "targetless transitions (they only run executable content)"
+            )
         if len(target_ids) > 1:
             raise self.unsupported(element, "transitions with several targets")
         self.executable(element)
         target = self.by_id.get(target_ids[0])
         if target is None:
-            raise InputError(f"transition to unknown state '{target_ids[0]}'",
-                             location=self.where(element), element="<transition>")
+            raise InputError(
+                f"transition to unknown state '{target_ids[0]}'",
+                location=self.where(element),
+                element="<transition>",
+            )
         attrs = {k: v for k, v in element.attrib.items() if k not in _TRANSITION_KEYS}
         exit_name = self.exit_of(node, element, cond_exit)
         events = element.get("event")
         location = self.where(element)
         if events is None:
             if not node.state.is_atomic:
-                raise self.unsupported(element, "eventless transitions of a compound state "
-                                                "(they fire at once, unlike completion)")
+                raise self.unsupported(
+                    element,
+                    "eventless transitions of a compound state "
+                    "(they fire at once, unlike completion)",
+                )
             return [self.route(node, None, target, element, attrs, exit_name, location)]
         out = []
         names = events.split()
@@ -360,11 +418,14 @@ class _Reader:
             event: str | None = name
             if name.startswith("done.state."):
                 if node.state.is_atomic:
-                    raise self.unsupported(element, f"'{name}' on an atomic state (only compound "
-                                                    "and parallel states complete)")
+                    raise self.unsupported(
+                        element,
+                        f"'{name}' on an atomic state (only compound and parallel states complete)",
+                    )
                 if name != f"done.state.{node.element.get('id')}":
-                    raise self.unsupported(element, f"'{name}' on another state than the one "
-                                                    "that completes")
+                    raise self.unsupported(
+                        element, f"'{name}' on another state than the one that completes"
+                    )
                 event = None
                 self.done_transitions.append((node, element, exit_name is not None))
             else:
@@ -383,14 +444,22 @@ class _Reader:
         events = (element.get("event") or "").split()
         own_done = f"done.state.{node.element.get('id')}"
         if match is None or events != [own_done] or local_name(node.element) != "state":
-            raise self.unsupported(element, "cond guards (the model has no data; the only guard "
-                                            "read is In('F') on a compound state's own "
-                                            "done.state event, F one of its <final> children)")
+            raise self.unsupported(
+                element,
+                "cond guards (the model has no data; the only guard "
+                "read is In('F') on a compound state's own "
+                "done.state event, F one of its <final> children)",
+            )
         final = self.by_id.get(match.group("single") or match.group("double"))
-        if final is None or local_name(final.element) != "final" \
-                or final.element.getparent() is not node.element:
-            raise self.unsupported(element, f"cond=\"{cond}\": In() must name a <final> child "
-                                            f"of '{node.element.get('id')}'")
+        if (
+            final is None
+            or local_name(final.element) != "final"
+            or final.element.getparent() is not node.element
+        ):
+            raise self.unsupported(
+                element,
+                f"cond=\"{cond}\": In() must name a <final> child of '{node.element.get('id')}'",
+            )
         return final.state.name
 
     def exit_of(self, node: _Node, element: etree._Element, cond_exit: str | None) -> str | None:
@@ -400,20 +469,33 @@ class _Reader:
         legacy = element.get(F_EXIT)
         if legacy is None or cond_exit is not None:
             if legacy is not None and legacy != cond_exit:
-                raise InputError(f"fsmbt:exit=\"{legacy}\" contradicts cond=\""
-                                 f"{element.get('cond')}\" (the guard is the meaning)",
-                                 location=self.where(element), element="<transition>")
+                raise InputError(
+                    f'fsmbt:exit="{legacy}" contradicts cond="'
+                    f'{element.get("cond")}" (the guard is the meaning)',
+                    location=self.where(element),
+                    element="<transition>",
+                )
             return cond_exit
-        self.ctx.warn(f"fsmbt:exit=\"{legacy}\" without a cond=\"In(...)\" guard (a file "
-                      "written by an older fsmbt): read as fsmbt meant it, but a W3C engine "
-                      "takes the first done.state transition in document order; write the "
-                      "file again to get the guard", line=element.sourceline,
-                      element="<transition>")
+        self.ctx.warn(
+            f'fsmbt:exit="{legacy}" without a cond="In(...)" guard (a file '
+            "written by an older fsmbt): read as fsmbt meant it, but a W3C engine "
+            "takes the first done.state transition in document order; write the "
+            "file again to get the guard",
+            line=element.sourceline,
+            element="<transition>",
+        )
         return legacy
 
-    def route(self, node: _Node, event: str | None, target: _Node, element: etree._Element,
-              attrs: dict[str, str], exit_name: str | None,
-              location: SourceLocation) -> Transition:
+    def route(
+        self,
+        node: _Node,
+        event: str | None,
+        target: _Node,
+        element: etree._Element,
+        attrs: dict[str, str],
+        exit_name: str | None,
+        location: SourceLocation,
+    ) -> Transition:
         """The model transition for ``node --event--> target``, leaving parents if needed."""
         ancestors = self.machine_chain(node.machine)
         entered = None
@@ -422,13 +504,17 @@ class _Reader:
             if entered is not None:
                 break
         if entered is None:
-            raise InputError("transition target is not in this document's tree",
-                             location=location, element="<transition>")
+            raise InputError(
+                "transition target is not in this document's tree",
+                location=location,
+                element="<transition>",
+            )
         if entered is not target:
             entered = self.entry_in(target, entered.machine, element)
         if index == 0:
-            return Transition(node.state.name, event, entered.state.name, exit_name,
-                              dict(attrs), location)
+            return Transition(
+                node.state.name, event, entered.state.name, exit_name, dict(attrs), location
+            )
         # Leave ``index`` levels: transient final states carry the transition out.
         label = f"exit({node.state.name},{event or ''},{target.state.name})"
         first = Transition(node.state.name, event, label, exit_name, dict(attrs), location)
@@ -439,10 +525,12 @@ class _Reader:
             if owner.state.is_parallel:
                 raise self.unsupported(element, "transitions that leave a <parallel> region")
             self.synthetic_states.append(
-                (source_machine, State(label, action=None, final=True, attrs={EXIT_MARK: "true"})))
+                (source_machine, State(label, action=None, final=True, attrs={EXIT_MARK: "true"}))
+            )
             next_label = label if level < index else entered.state.name
             self.synthetic_transitions.append(
-                (owner.machine, Transition(owner.state.name, None, next_label, label)))
+                (owner.machine, Transition(owner.state.name, None, next_label, label))
+            )
             source_machine = owner.machine
         return first
 
@@ -466,41 +554,51 @@ class _Reader:
         node = target
         while node.machine is not machine:
             if node.machine.initial is not None and node.machine.initial != node.state.name:
-                raise self.unsupported(element, f"entering nested state '{target.state.name}' "
-                                                "that is not its parent's initial state")
+                raise self.unsupported(
+                    element,
+                    f"entering nested state '{target.state.name}' "
+                    "that is not its parent's initial state",
+                )
             owner = self.parent_of[id(node.machine)]
             if owner is None:
-                raise InputError(f"state '{target.state.name}' is not inside this state",
-                                 location=self.where(element))
+                raise InputError(
+                    f"state '{target.state.name}' is not inside this state",
+                    location=self.where(element),
+                )
             node = owner
         return node
 
     def check_prefix_matching(self) -> None:
         for name, line in self.descriptors.items():
             if name in ("done", "done.state"):
-                raise UnsupportedError(f"event descriptor '{name}' also matches every "
-                                       "done.state.<id> completion event (SCXML prefix "
-                                       "matching)", location=self.ctx.location(line),
-                                       element="<transition>")
+                raise UnsupportedError(
+                    f"event descriptor '{name}' also matches every "
+                    "done.state.<id> completion event (SCXML prefix "
+                    "matching)",
+                    location=self.ctx.location(line),
+                    element="<transition>",
+                )
         self.check_done_prefixes()
         names = sorted(self.descriptors)
         for i, name in enumerate(names):
-            for other in names[i + 1:]:
+            for other in names[i + 1 :]:
                 if not other.startswith(name):
                     break
                 if other.startswith(name + "."):
                     raise UnsupportedError(
-                        f"event descriptor '{name}' also matches '{other}' (SCXML prefix "
-                        "matching)", location=self.ctx.location(self.descriptors[name]),
-                        element="<transition>")
+                        f"event descriptor '{name}' also matches '{other}' (SCXML prefix matching)",
+                        location=self.ctx.location(self.descriptors[name]),
+                        element="<transition>",
+                    )
 
     def check_done_prefixes(self) -> None:
         """``done.state.a`` also matches ``done.state.a.b`` (SCXML prefix matching): refuse a
         completion transition of ``a`` that a W3C engine could take on the completion of another
         compound/parallel state ``a.b``, unless its ``In()`` guard rules that out (``a.b``
         inside compound ``a``, whose guard names a final child of ``a``: not active then)."""
-        composite_ids = {state_id for state_id, node in self.by_id.items()
-                         if not node.state.is_atomic}
+        composite_ids = {
+            state_id for state_id, node in self.by_id.items() if not node.state.is_atomic
+        }
         for node, element, guarded in self.done_transitions:
             own = node.element.get("id") or ""
             for other in composite_ids:
@@ -508,9 +606,12 @@ class _Reader:
                     continue
                 if guarded and self.is_inside(self.by_id[other], node):
                     continue
-                raise self.unsupported(element, f"'done.state.{own}' also matches the "
-                                                f"completion event of '{other}' (SCXML prefix "
-                                                "matching)")
+                raise self.unsupported(
+                    element,
+                    f"'done.state.{own}' also matches the "
+                    f"completion event of '{other}' (SCXML prefix "
+                    "matching)",
+                )
 
     def is_inside(self, inner: _Node, outer: _Node) -> bool:
         owner = self.parent_of[id(inner.machine)]
@@ -528,8 +629,11 @@ class _Reader:
                 continue
             leaving = [t for t in top.transitions if t.source == name]
             if len(leaving) != 1 or top.initial != name or leaving[0].event is None:
-                raise InputError("an fsmbt:start state needs to be the initial state with one "
-                                 "outgoing transition on an event", location=state.location)
+                raise InputError(
+                    "an fsmbt:start state needs to be the initial state with one "
+                    "outgoing transition on an event",
+                    location=state.location,
+                )
             del top.states[name]
             top.transitions.remove(leaving[0])
             top.start_name, top.initial_event = name, leaving[0].event
@@ -557,9 +661,11 @@ def read_scxml(text: str, ctx: ReadContext) -> FSM:
             flat = read_scxml_w3c(text, ctx)
         except UnsupportedError as remaining:
             raise remaining from None
-        ctx.warn(f"read by running the W3C algorithm (the structural reader refuses: "
-                 f"{first.message}); the model is the "
-                 "flat machine of the reachable configurations")
+        ctx.warn(
+            f"read by running the W3C algorithm (the structural reader refuses: "
+            f"{first.message}); the model is the "
+            "flat machine of the reachable configurations"
+        )
         return flat
 
 
@@ -609,8 +715,8 @@ class _Writer:
                     continue
                 prefix = self.ids[(id(owner[0]), owner[1].name)] if owner else "top"
                 self.ids[(id(machine), state.name)] = self.allocate(
-                    state.name, prefix, composite=not state.is_atomic,
-                    shared=used[state.name] > 1)
+                    state.name, prefix, composite=not state.is_atomic, shared=used[state.name] > 1
+                )
 
     def allocate(self, name: str, prefix: str, *, composite: bool, shared: bool) -> str:
         """A unique id for ``name`` (``<prefix>.<name>`` when the name repeats or is taken).
@@ -650,8 +756,11 @@ class _Writer:
             if up is None:
                 return None
             parent, composite = up
-            completion = [t for t in parent.transitions if t.source == composite.name
-                          and t.event is None and t.exit == target]
+            completion = [
+                t
+                for t in parent.transitions
+                if t.source == composite.name and t.event is None and t.exit == target
+            ]
             if len(completion) != 1 or not composite.is_composite:
                 return None
             chain_states.append((id(machine), target))
@@ -681,14 +790,21 @@ class _Writer:
         if start is not None and fsm.initial is not None:
             element = etree.SubElement(root, _q("state"), id=start)
             element.set(F_START, "true")
-            etree.SubElement(element, _q("transition"), event=_event_descriptor(fsm.initial_event or "", start),
-                             target=self.ids[(id(fsm), fsm.initial)])
+            etree.SubElement(
+                element,
+                _q("transition"),
+                event=_event_descriptor(fsm.initial_event or "", start),
+                target=self.ids[(id(fsm), fsm.initial)],
+            )
         stack: list[tuple[FSM, etree._Element]] = [(fsm, root)]
         while stack:
             machine, container = stack.pop()
             if machine is not fsm and machine.initial_event is not None:
-                raise UnsupportedError("a sub-machine with a start pseudo-state and initial "
-                                       "event cannot be written as SCXML", element=machine.name)
+                raise UnsupportedError(
+                    "a sub-machine with a start pseudo-state and initial "
+                    "event cannot be written as SCXML",
+                    element=machine.name,
+                )
             pending = []
             for state in machine.states.values():
                 if (id(machine), state.name) in self.skip_states:
@@ -699,10 +815,16 @@ class _Writer:
         text = etree.tostring(root, encoding="unicode", pretty_print=True)
         return '<?xml version="1.0" encoding="UTF-8"?>\n' + text
 
-    def state_element(self, container: etree._Element, machine: FSM,
-                      state: State) -> etree._Element:
-        tag = ("final" if state.final and state.is_atomic
-               else "parallel" if _is_parallel(state) else "state")
+    def state_element(
+        self, container: etree._Element, machine: FSM, state: State
+    ) -> etree._Element:
+        tag = (
+            "final"
+            if state.final and state.is_atomic
+            else "parallel"
+            if _is_parallel(state)
+            else "state"
+        )
         state_id = self.ids[(id(machine), state.name)]
         element = etree.SubElement(container, _q(tag), id=state_id)
         if state_id != state.name:
@@ -722,8 +844,9 @@ class _Writer:
             self.transition_element(element, machine, state, state_id, t)
         return element
 
-    def transition_element(self, element: etree._Element, machine: FSM, state: State,
-                           state_id: str, t: Transition) -> None:
+    def transition_element(
+        self, element: etree._Element, machine: FSM, state: State, state_id: str, t: Transition
+    ) -> None:
         out = etree.SubElement(element, _q("transition"))
         if t.event is not None:
             out.set("event", _event_descriptor(t.event, state.name))
@@ -745,14 +868,17 @@ class _Writer:
         final = region.states.get(exit_name)
         if not state.is_composite or final is None or not final.final or not final.is_atomic:
             where = "a parallel state" if state.is_parallel else f"'{state.name}'"
-            raise UnsupportedError(f"a completion transition of {where} waiting for "
-                                   f"'{exit_name}', which is not a final state of its "
-                                   "sub-machine, cannot be written as SCXML (it never fires)",
-                                   element=state.name)
+            raise UnsupportedError(
+                f"a completion transition of {where} waiting for "
+                f"'{exit_name}', which is not a final state of its "
+                "sub-machine, cannot be written as SCXML (it never fires)",
+                element=state.name,
+            )
         return self.ids[(id(region), exit_name)]
 
-    def region_elements(self, element: etree._Element,
-                        state: State) -> list[tuple[FSM, etree._Element]]:
+    def region_elements(
+        self, element: etree._Element, state: State
+    ) -> list[tuple[FSM, etree._Element]]:
         if not state.regions:
             return []
         if state.is_composite and not _is_parallel(state):
@@ -762,8 +888,9 @@ class _Writer:
             if len(region.states) == 1 and region.initial in region.states:
                 out.append((region, element))
             else:  # a region of several states needs a wrapper state in SCXML
-                wrapper_id = self.allocate(region.name, element.get("id") or state.name,
-                                           composite=True, shared=True)
+                wrapper_id = self.allocate(
+                    region.name, element.get("id") or state.name, composite=True, shared=True
+                )
                 wrapper = etree.SubElement(element, _q("state"), id=wrapper_id)
                 wrapper.set(F_REGION, "true")
                 if wrapper_id != region.name:
@@ -780,18 +907,30 @@ def _in_predicate(state_id: str, source: str) -> str:
         return f"In('{state_id}')"
     if '"' not in state_id:
         return f'In("{state_id}")'
-    raise UnsupportedError(f"the state id {state_id!r} holds both quote characters and cannot "
-                           "be named in a cond guard", element=source)
+    raise UnsupportedError(
+        f"the state id {state_id!r} holds both quote characters and cannot "
+        "be named in a cond guard",
+        element=source,
+    )
 
 
 def _event_descriptor(event: str, source: str) -> str:
     """The event as an SCXML descriptor; names SCXML would read as something else are refused
     (see also ``_check_event_prefixes``)."""
-    if not event or any(c.isspace() for c in event) or event == "*" or event.endswith(".*") \
-            or event.endswith(".") or event in ("done", "done.state") \
-            or event.startswith("done.state."):
-        raise UnsupportedError(f"event '{event}' cannot be an SCXML event name (whitespace, a "
-                               "wildcard, or a done.state event)", element=source)
+    if (
+        not event
+        or any(c.isspace() for c in event)
+        or event == "*"
+        or event.endswith(".*")
+        or event.endswith(".")
+        or event in ("done", "done.state")
+        or event.startswith("done.state.")
+    ):
+        raise UnsupportedError(
+            f"event '{event}' cannot be an SCXML event name (whitespace, a "
+            "wildcard, or a done.state event)",
+            element=source,
+        )
     return event
 
 
@@ -812,13 +951,15 @@ def _check_event_prefixes(fsm: FSM) -> None:
             stack.extend(state.regions)
     ordered = sorted(names)
     for i, name in enumerate(ordered):
-        for other in ordered[i + 1:]:
+        for other in ordered[i + 1 :]:
             if not other.startswith(name):
                 break
             if other.startswith(name + ".") and not _prefix_order_exact(fsm, other):
-                raise UnsupportedError(f"events '{name}' and '{other}' cannot both be written as "
-                                       f"SCXML: the descriptor '{name}' also matches '{other}' "
-                                       "(SCXML prefix matching)")
+                raise UnsupportedError(
+                    f"events '{name}' and '{other}' cannot both be written as "
+                    f"SCXML: the descriptor '{name}' also matches '{other}' "
+                    "(SCXML prefix matching)"
+                )
 
 
 def _prefix_order_exact(fsm: FSM, event: str) -> bool:
@@ -841,8 +982,9 @@ def _is_parallel(state: State) -> bool:
         return True
     if len(state.regions) == 1:
         region = state.regions[0]
-        return (len(region.states) == 1 and region.name in region.states
-                and region.name != state.name)
+        return (
+            len(region.states) == 1 and region.name in region.states and region.name != state.name
+        )
     return False
 
 
@@ -864,8 +1006,15 @@ def _sniff(text: str) -> bool:
     return root_tag(text) == "scxml"
 
 
-register(Format(
-    "scxml", (".scxml",), frozenset({"fsm"}),
-    "W3C SCXML (states, compound and parallel states, final, initial, events)",
-    read_scxml, write_scxml, _sniff, priority=30,
-))
+register(
+    Format(
+        "scxml",
+        (".scxml",),
+        frozenset({"fsm"}),
+        "W3C SCXML (states, compound and parallel states, final, initial, events)",
+        read_scxml,
+        write_scxml,
+        _sniff,
+        priority=30,
+    )
+)

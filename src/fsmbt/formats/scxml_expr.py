@@ -15,20 +15,53 @@ from __future__ import annotations
 import re
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
+from typing import Any
 
 Value = int | float | str | bool | None
 
-_TOKEN = re.compile(r"""\s*(?:(?P<num>\d+(?:\.\d+)?)|(?P<str>'[^']*'|"[^"]*")|"""
-                    r"""(?P<op>===|!==|==|!=|>=|<=|&&|\|\||[-+*/%<>!(),])|"""
-                    r"""(?P<name>[A-Za-z_$][\w$]*))""")
-_WORDS = {"and": "&&", "or": "||", "not": "!", "lt": "<", "le": "<=", "gt": ">", "ge": ">=",
-          "eq": "==", "ne": "!="}
-_BINARY = {"||": 1, "&&": 2, "==": 3, "!=": 3, "===": 3, "!==": 3, "<": 4, "<=": 4, ">": 4,
-           ">=": 4, "+": 5, "-": 5, "*": 6, "/": 6, "%": 6}
+_TOKEN = re.compile(
+    r"""\s*(?:(?P<num>\d+(?:\.\d+)?)|(?P<str>'[^']*'|"[^"]*")|"""
+    r"""(?P<op>===|!==|==|!=|>=|<=|&&|\|\||[-+*/%<>!(),])|"""
+    r"""(?P<name>[A-Za-z_$][\w$]*))"""
+)
+_WORDS = {
+    "and": "&&",
+    "or": "||",
+    "not": "!",
+    "lt": "<",
+    "le": "<=",
+    "gt": ">",
+    "ge": ">=",
+    "eq": "==",
+    "ne": "!=",
+}
+_BINARY = {
+    "||": 1,
+    "&&": 2,
+    "==": 3,
+    "!=": 3,
+    "===": 3,
+    "!==": 3,
+    "<": 4,
+    "<=": 4,
+    ">": 4,
+    ">=": 4,
+    "+": 5,
+    "-": 5,
+    "*": 6,
+    "/": 6,
+    "%": 6,
+}
 _UNARY_PRECEDENCE = 7
 _FUNCTIONS = frozenset({"In", "empty"})
-_CONSTANTS: dict[str, Value] = {"true": True, "false": False, "null": None, "True": True,
-                                "False": False, "None": None}
+_CONSTANTS: dict[str, Value] = {
+    "true": True,
+    "false": False,
+    "null": None,
+    "True": True,
+    "False": False,
+    "None": None,
+}
 
 
 class ExpressionError(ValueError):
@@ -64,7 +97,7 @@ def parse(text: str) -> Expr:
     while position < text_length:
         found = _TOKEN.match(text, position)
         if found is None or found.end() == position:
-            raise ExpressionError(f"cannot read {text[position:position + 20]!r}")
+            raise ExpressionError(f"cannot read {text[position : position + 20]!r}")
         position = found.end()
         if found.group("num") is not None:
             number = found.group("num")
@@ -105,9 +138,12 @@ def parse(text: str) -> Expr:
             ops.append(("unary", token))
         elif token in _BINARY and not expect_operand:
             precedence = _BINARY[token]
-            while ops and ops[-1][0] in ("binary", "unary") and (
-                    _UNARY_PRECEDENCE if ops[-1][0] == "unary"
-                    else _BINARY[str(ops[-1][1])]) >= precedence:
+            while (
+                ops
+                and ops[-1][0] in ("binary", "unary")
+                and (_UNARY_PRECEDENCE if ops[-1][0] == "unary" else _BINARY[str(ops[-1][1])])
+                >= precedence
+            ):
                 out.append(ops.pop())
             ops.append(("binary", token))
             expect_operand = True
@@ -161,12 +197,15 @@ def evaluate(expr: Expr, data: Mapping[str, Value], in_state: Callable[[str], bo
                 stack.append(data[str(item)])
             elif kind == "call":
                 argument = stack.pop()
-                stack.append(in_state(str(argument)) if item == "In"
-                             else argument in (None, "", 0, False))
+                stack.append(
+                    in_state(str(argument)) if item == "In" else argument in (None, "", 0, False)
+                )
             elif kind == "unary":
-                argument = stack.pop()
-                stack.append(not _truthy(argument) if item == "!"
-                             else -argument if item == "-" else +argument)  # type: ignore[operator]
+                operand: Any = stack.pop()  # a number here, or the operator raises below
+                if item == "!":
+                    stack.append(not _truthy(operand))
+                else:
+                    stack.append(-operand if item == "-" else +operand)
             else:
                 right, left = stack.pop(), stack.pop()
                 stack.append(_binary(str(item), left, right))
@@ -194,11 +233,19 @@ def _binary(op: str, left: Value, right: Value) -> Value:
         return left != right
     if op == "+" and (isinstance(left, str) or isinstance(right, str)):
         return f"{_text(left)}{_text(right)}"
-    result = {"<": lambda: left < right, "<=": lambda: left <= right,  # type: ignore[operator]
-              ">": lambda: left > right, ">=": lambda: left >= right,  # type: ignore[operator]
-              "+": lambda: left + right, "-": lambda: left - right,  # type: ignore[operator]
-              "*": lambda: left * right, "/": lambda: left / right,  # type: ignore[operator]
-              "%": lambda: left % right}[op]()  # type: ignore[operator]
+    a: Any = left  # operands of mixed types fail here with TypeError, which the caller reports
+    b: Any = right
+    result = {
+        "<": lambda: a < b,
+        "<=": lambda: a <= b,
+        ">": lambda: a > b,
+        ">=": lambda: a >= b,
+        "+": lambda: a + b,
+        "-": lambda: a - b,
+        "*": lambda: a * b,
+        "/": lambda: a / b,
+        "%": lambda: a % b,
+    }[op]()
     if isinstance(result, float) and result.is_integer() and op != "/":
         return int(result)
     return result  # type: ignore[no-any-return]

@@ -57,6 +57,7 @@ MAX_DATA_MAGNITUDE = 10_000
 _IN = re.compile(r"""\s*In\(\s*(?:'([^']+)'|"([^"]+)")\s*\)\s*$""")
 _IDENT = re.compile(r"[A-Za-z_$][\w$]*")
 
+
 @dataclass
 class _If:
     """``<if>`` with effects: the first branch whose guard holds (``None``: ``<else>``)."""
@@ -143,11 +144,14 @@ class _Doc:
         root = parse_xml(text, ctx.display_name)
         self.ns = namespace(root)
         self.root_name = root.get("name", "fsm")
-        self.root_attrs = {k: v for k, v in root.attrib.items()
-                           if k not in ("initial", "name", "version")}
+        self.root_attrs = {
+            k: v for k, v in root.attrib.items() if k not in ("initial", "name", "version")
+        }
         if local_name(root) != "scxml":
-            raise InputError(f"not an SCXML document: root element is <{local_name(root)}>",
-                             location=ctx.location(root.sourceline))
+            raise InputError(
+                f"not an SCXML document: root element is <{local_name(root)}>",
+                location=ctx.location(root.sourceline),
+            )
         self.states: list[_S] = []
         self.by_id: dict[str, int] = {}
         self.guards: list[str] = []
@@ -172,13 +176,21 @@ class _Doc:
             index = len(self.states)
             state_id = element.get("id") or ("" if parent is None else f"_state{index}")
             if state_id in self.by_id:
-                raise InputError(f"duplicate state id '{state_id}'",
-                                 location=ctx.location(element.sourceline))
-            node = _S(index, state_id, element.get(F_NAME, state_id), tag or "", parent,
-                      element.sourceline, wrapper=element.get(F_REGION) == "true",
-                      deep=element.get("type") == "deep",
-                      action=element.get(F_ACTION) or None,
-                      has_action=F_ACTION in element.attrib)
+                raise InputError(
+                    f"duplicate state id '{state_id}'", location=ctx.location(element.sourceline)
+                )
+            node = _S(
+                index,
+                state_id,
+                element.get(F_NAME, state_id),
+                tag or "",
+                parent,
+                element.sourceline,
+                wrapper=element.get(F_REGION) == "true",
+                deep=element.get("type") == "deep",
+                action=element.get(F_ACTION) or None,
+                has_action=F_ACTION in element.attrib,
+            )
             self.states.append(node)
             if parent is not None:
                 self.by_id[state_id] = index
@@ -193,23 +205,30 @@ class _Doc:
                 elif ctag == "transition":
                     pending.append((index, child, child.get("target") or ""))
                 elif ctag == "initial":
-                    inner = [t for t in child if isinstance(t.tag, str)
-                             and self.tag(t) == "transition"]
+                    inner = [
+                        t for t in child if isinstance(t.tag, str) and self.tag(t) == "transition"
+                    ]
                     if len(inner) != 1:
-                        raise InputError("<initial> needs exactly one <transition>",
-                                         location=ctx.location(child.sourceline))
+                        raise InputError(
+                            "<initial> needs exactly one <transition>",
+                            location=ctx.location(child.sourceline),
+                        )
                     initial_text[index] = (inner[0].get("target") or "", inner[0])
                 else:
                     self.content(child, node)
             if tag == "history":
-                inner = [t for t in element if isinstance(t.tag, str)
-                         and self.tag(t) == "transition"]
+                inner = [
+                    t for t in element if isinstance(t.tag, str) and self.tag(t) == "transition"
+                ]
                 if len(inner) != 1:
-                    raise InputError("<history> needs exactly one default <transition>",
-                                     location=ctx.location(element.sourceline))
+                    raise InputError(
+                        "<history> needs exactly one default <transition>",
+                        location=ctx.location(element.sourceline),
+                    )
             if tag == "final" and any(self.tag(k) != "history" for k in kids):
-                raise InputError("<final> cannot hold states",
-                                 location=ctx.location(element.sourceline))
+                raise InputError(
+                    "<final> cannot hold states", location=ctx.location(element.sourceline)
+                )
             if element.get("initial"):
                 initial_text[index] = (element.get("initial") or "", element)
             stack.extend((k, index) for k in reversed(kids))
@@ -233,17 +252,20 @@ class _Doc:
 
     def tag(self, element: etree._Element) -> str | None:
         if namespace(element) == XINCLUDE_NS:
-            raise self.refuse(element, "unsupported: XInclude (include the fragment's content "
-                                       "in the file itself)")
+            raise self.refuse(
+                element, "unsupported: XInclude (include the fragment's content in the file itself)"
+            )
         return local_name(element) if namespace(element) == self.ns else None
 
     def where(self, element: etree._Element) -> str:
         return f"<{local_name(element)}>"
 
     def refuse(self, element: etree._Element, feature: str) -> UnsupportedError:
-        return UnsupportedError(f"{feature}, line {element.sourceline}",
-                                location=self.ctx.location(element.sourceline),
-                                element=self.where(element))
+        return UnsupportedError(
+            f"{feature}, line {element.sourceline}",
+            location=self.ctx.location(element.sourceline),
+            element=self.where(element),
+        )
 
     def preorder(self) -> dict[int, int]:
         order: dict[int, int] = {}
@@ -257,8 +279,10 @@ class _Doc:
     def content(self, element: etree._Element, node: _S) -> None:
         tag = self.tag(element)
         if tag is None:
-            self.ctx.warn(f"element of another namespace ignored: <{local_name(element)}>",
-                          line=element.sourceline)
+            self.ctx.warn(
+                f"element of another namespace ignored: <{local_name(element)}>",
+                line=element.sourceline,
+            )
         elif tag == "onentry":
             node.onentry.extend(self.actions(element))
         elif tag == "onexit":
@@ -267,8 +291,9 @@ class _Doc:
             for data in element:
                 if isinstance(data.tag, str) and self.tag(data) == "data":
                     has_content = len(data) > 0 or bool((data.text or "").strip())
-                    self.data.append((data.get("id") or "", data.get("expr"), has_content,
-                                      data.sourceline))
+                    self.data.append(
+                        (data.get("id") or "", data.get("expr"), has_content, data.sourceline)
+                    )
         elif tag == "donedata":
             self.ctx.warn("<donedata> ignored", line=element.sourceline, element="<donedata>")
         elif tag == "invoke":
@@ -276,8 +301,11 @@ class _Doc:
         elif tag == "script":
             raise self.refuse(element, "unsupported: <script>")
         else:
-            raise InputError(f"unknown SCXML element <{tag}> in <{node.kind}>",
-                             location=self.ctx.location(element.sourceline), element=f"<{tag}>")
+            raise InputError(
+                f"unknown SCXML element <{tag}> in <{node.kind}>",
+                location=self.ctx.location(element.sourceline),
+                element=f"<{tag}>",
+            )
 
     def actions(self, block: etree._Element | list[etree._Element]) -> list[Action]:
         """The queue effects of a block of executable content, in document order."""
@@ -287,8 +315,10 @@ class _Doc:
                 continue
             tag = self.tag(item)
             if tag is None:
-                self.ctx.warn(f"element of another namespace ignored: <{local_name(item)}>",
-                              line=item.sourceline)
+                self.ctx.warn(
+                    f"element of another namespace ignored: <{local_name(item)}>",
+                    line=item.sourceline,
+                )
             elif tag == "log":
                 self.ctx.warn("<log> ignored", line=item.sourceline, element="<log>")
             elif tag == "raise":
@@ -298,9 +328,12 @@ class _Doc:
                 if sent is not None:
                     out.append(sent)
             elif tag == "cancel" and self.abstract_time:
-                self.ctx.warn("<cancel> ignored under the abstraction 'time' (a timer's event "
-                              "may arrive at any time)", line=item.sourceline,
-                              element="<cancel>")
+                self.ctx.warn(
+                    "<cancel> ignored under the abstraction 'time' (a timer's event "
+                    "may arrive at any time)",
+                    line=item.sourceline,
+                    element="<cancel>",
+                )
             elif tag == "assign":
                 location = item.get("location") or ""
                 self.assigned.append((location, item.sourceline))
@@ -309,9 +342,13 @@ class _Doc:
             elif tag == "if":
                 out.extend(self.if_block(item))
             else:
-                feature = {"script": "<script>", "elseif": "<elseif> outside <if>",
-                           "else": "<else> outside <if>", "foreach": "<foreach>",
-                           "cancel": "<cancel> (of a delayed <send>)"}.get(tag, f"<{tag}>")
+                feature = {
+                    "script": "<script>",
+                    "elseif": "<elseif> outside <if>",
+                    "else": "<else> outside <if>",
+                    "foreach": "<foreach>",
+                    "cancel": "<cancel> (of a delayed <send>)",
+                }.get(tag, f"<{tag}>")
                 raise self.refuse(item, f"unsupported: {feature}")
         return out
 
@@ -327,8 +364,10 @@ class _Doc:
             tag = self.tag(child)
             if tag in ("elseif", "else"):
                 if branches[-1][0] is None and len(branches) > 1:
-                    raise InputError("<else> must be the last branch of <if>",
-                                     location=self.ctx.location(child.sourceline))
+                    raise InputError(
+                        "<else> must be the last branch of <if>",
+                        location=self.ctx.location(child.sourceline),
+                    )
                 branches.append((child.get("cond") if tag == "elseif" else None, child))
                 body.append([])
             else:
@@ -337,8 +376,9 @@ class _Doc:
             raise InputError("<if> needs a cond", location=self.ctx.location(item.sourceline))
         wrapper_actions = [self.actions(elements) for elements in body]
         if not any(wrapper_actions):
-            self.ctx.warn("<if> ignored: its branches are empty", line=item.sourceline,
-                          element="<if>")
+            self.ctx.warn(
+                "<if> ignored: its branches are empty", line=item.sourceline, element="<if>"
+            )
             return []
         effectless = not _event_names([a for branch in wrapper_actions for a in branch])
         guarded: list[tuple[int | None, list[Action]]] = []
@@ -354,21 +394,29 @@ class _Doc:
     def event_name(self, item: etree._Element) -> str:
         event = item.get("event")
         if not event or item.get("eventexpr") is not None:
-            raise self.refuse(item, f"unsupported: <{local_name(item)}> without a literal "
-                                    "event name (eventexpr)")
+            raise self.refuse(
+                item, f"unsupported: <{local_name(item)}> without a literal event name (eventexpr)"
+            )
         return event
 
     def send(self, item: etree._Element) -> Action | None:
         delay = (item.get("delay") or "").strip()
         if item.get("delayexpr") is not None or delay not in ("", "0", "0s", "0ms"):
             if not self.abstract_time:
-                raise self.refuse(item, "unsupported: <send> with a delay (a timer; the "
-                                        "option abstract=time reads it as an environment "
-                                        "input)")
-            self.ctx.warn(f"verified under the abstraction 'time': the timer of <send "
-                          f"event='{item.get('event') or item.get('eventexpr')}'> is an "
-                          "input of the environment (its event may arrive at any time, or "
-                          "never)", line=item.sourceline, element="<send>")
+                raise self.refuse(
+                    item,
+                    "unsupported: <send> with a delay (a timer; the "
+                    "option abstract=time reads it as an environment "
+                    "input)",
+                )
+            self.ctx.warn(
+                f"verified under the abstraction 'time': the timer of <send "
+                f"event='{item.get('event') or item.get('eventexpr')}'> is an "
+                "input of the environment (its event may arrive at any time, or "
+                "never)",
+                line=item.sourceline,
+                element="<send>",
+            )
             return None
         if item.get("targetexpr") is not None or item.get("typeexpr") is not None:
             raise self.refuse(item, "unsupported: <send> with a computed target or type")
@@ -387,9 +435,11 @@ class _Doc:
         out = []
         for target_id in text.split():
             if target_id not in self.by_id:
-                raise InputError(f"target state '{target_id}' does not exist",
-                                 location=self.ctx.location(element.sourceline),
-                                 element=self.where(element))
+                raise InputError(
+                    f"target state '{target_id}' does not exist",
+                    location=self.ctx.location(element.sourceline),
+                    element=self.where(element),
+                )
             out.append(self.by_id[target_id])
         return out
 
@@ -407,15 +457,24 @@ class _Doc:
             if found:
                 state_id = found.group(1) or found.group(2)
                 if state_id not in self.by_id:
-                    self.ctx.warn(f"In('{state_id}') names no state: always false",
-                                  line=element.sourceline, element="<transition>")
+                    self.ctx.warn(
+                        f"In('{state_id}') names no state: always false",
+                        line=element.sourceline,
+                        element="<transition>",
+                    )
                 cond = ("in", state_id)
             else:
                 cond = ("guard", self.guard(cond_text, element, internal=False))
                 self.transition_guards.add(int(cond[1]))
-        return _T(source, tuple(descriptors), cond, tuple(self.ids(target, element)),
-                  element.get("type") == "internal", self.actions(element),
-                  element.sourceline)
+        return _T(
+            source,
+            tuple(descriptors),
+            cond,
+            tuple(self.ids(target, element)),
+            element.get("type") == "internal",
+            self.actions(element),
+            element.sourceline,
+        )
 
     def guard(self, cond_text: str, element: etree._Element, *, internal: bool) -> int:
         """The index of a guard (one per distinct cond text, in document order)."""
@@ -433,8 +492,7 @@ class _Doc:
         declared = {name for name, _expr, _content, _line in self.data}
         try:
             if self.ctx.options.get("data") != "exact":
-                raise scxml_expr.ExpressionError("exact data is opt-in (reader option "
-                                                 "data=exact)")
+                raise scxml_expr.ExpressionError("exact data is opt-in (reader option data=exact)")
             guards = [scxml_expr.parse(text) for text in self.guards]
             assigns = []
             for location, expr, _line in self.assign_exprs:
@@ -448,36 +506,50 @@ class _Doc:
                 value = scxml_expr.parse(expr) if expr is not None else None
                 if value is not None and value.names:
                     raise scxml_expr.ExpressionError("initial value reads a variable")
-                initial[name] = (None if value is None
-                                 else scxml_expr.evaluate(value, {}, lambda _s: False))
+                initial[name] = (
+                    None if value is None else scxml_expr.evaluate(value, {}, lambda _s: False)
+                )
             if any(not e.names <= declared for e in [*guards, *assigns]):
                 raise scxml_expr.ExpressionError("reads an undeclared name")
         except scxml_expr.ExpressionError as exc:
             self.data_mode, self.data_reason = False, str(exc)
             for line in self.effectless_ifs:
-                self.ctx.warn("<if> ignored: no branch raises or sends an event", line=line,
-                              element="<if>")
+                self.ctx.warn(
+                    "<if> ignored: no branch raises or sends an event", line=line, element="<if>"
+                )
             for location, _expr, line in self.assign_exprs:
-                self.ctx.warn(f"<assign> to '{location}' ignored (no guard reads it)",
-                              line=line, element="<assign>")
+                self.ctx.warn(
+                    f"<assign> to '{location}' ignored (no guard reads it)",
+                    line=line,
+                    element="<assign>",
+                )
             if self.data:
-                self.ctx.warn("<datamodel> ignored (guards are inputs of the environment: "
-                              f"{exc})", line=self.data[0][3], element="<datamodel>")
+                self.ctx.warn(
+                    f"<datamodel> ignored (guards are inputs of the environment: {exc})",
+                    line=self.data[0][3],
+                    element="<datamodel>",
+                )
             self.check_assignments()
             return
         self.data_mode = bool(self.data)
         self.parsed_guards, self.parsed_assigns, self.initial_data = guards, assigns, initial
         if not self.data_mode:
             for line in self.effectless_ifs:
-                self.ctx.warn("<if> ignored: no branch raises or sends an event", line=line,
-                              element="<if>")
+                self.ctx.warn(
+                    "<if> ignored: no branch raises or sends an event", line=line, element="<if>"
+                )
             for location, _expr, line in self.assign_exprs:
-                self.ctx.warn(f"<assign> to '{location}' ignored (no guard reads it)",
-                              line=line, element="<assign>")
+                self.ctx.warn(
+                    f"<assign> to '{location}' ignored (no guard reads it)",
+                    line=line,
+                    element="<assign>",
+                )
             self.check_assignments()
         else:
-            self.ctx.warn("the data model is read exactly (every guard and assignment is in "
-                          "fsmbt's expression language): its values are part of each state")
+            self.ctx.warn(
+                "the data model is read exactly (every guard and assignment is in "
+                "fsmbt's expression language): its values are part of each state"
+            )
 
     def check_assignments(self) -> None:
         read: set[str] = set()
@@ -487,9 +559,11 @@ class _Doc:
         for location, line in self.assigned:
             root_name = _IDENT.match(location)
             if root_name and root_name.group(0) in read:
-                raise UnsupportedError(f"unsupported: <assign> to '{location}', which a guard "
-                                       f"reads, line {line}", location=self.ctx.location(line),
-                                       element="<assign>")
+                raise UnsupportedError(
+                    f"unsupported: <assign> to '{location}', which a guard reads, line {line}",
+                    location=self.ctx.location(line),
+                    element="<assign>",
+                )
 
 
 @dataclass
@@ -543,7 +617,9 @@ class _Interpreter:
         while stack and pending:
             node = stack.pop()
             if self.compound(node):
-                if not any(c in config and self.s[c].kind == "final" for c in self.s[node].children):
+                if not any(
+                    c in config and self.s[c].kind == "final" for c in self.s[node].children
+                ):
                     return False
             elif self.s[node].kind == "parallel":
                 stack.extend(self.s[node].children)
@@ -560,22 +636,28 @@ class _Interpreter:
             return self.doc.by_id.get(str(value), -1) in run.config
         return self.guard_holds(int(value), run, valuation, read)
 
-    def guard_holds(self, index: int, run: _Run, valuation: dict[int, bool],
-                    read: set[int]) -> bool:
+    def guard_holds(
+        self, index: int, run: _Run, valuation: dict[int, bool], read: set[int]
+    ) -> bool:
         """A guard's value: computed from the data (exact mode; an error is false, W3C
         5.9.1) or the environment's choice."""
         if self.doc.data_mode:
             try:
-                return scxml_expr.truthy(scxml_expr.evaluate(
-                    self.doc.parsed_guards[index], run.data,
-                    lambda state_id: self.doc.by_id.get(state_id, -1) in run.config))
+                return scxml_expr.truthy(
+                    scxml_expr.evaluate(
+                        self.doc.parsed_guards[index],
+                        run.data,
+                        lambda state_id: self.doc.by_id.get(state_id, -1) in run.config,
+                    )
+                )
             except scxml_expr.ExpressionError:
                 return False
         read.add(index)
         return valuation.get(index, False)
 
-    def select(self, run: _Run, event: str | None, valuation: dict[int, bool],
-               read: set[int]) -> list[_T]:
+    def select(
+        self, run: _Run, event: str | None, valuation: dict[int, bool], read: set[int]
+    ) -> list[_T]:
         enabled: list[_T] = []
         atoms = sorted((i for i in run.config if self.atomic(i)), key=self.order.__getitem__)
         for atom in atoms:
@@ -617,8 +699,11 @@ class _Interpreter:
             s = work.pop()
             if self.s[s].kind == "history":
                 if s in run.history:
-                    out.extend(x for x in sorted(run.history[s], key=self.order.__getitem__)
-                               if x not in out)
+                    out.extend(
+                        x
+                        for x in sorted(run.history[s], key=self.order.__getitem__)
+                        if x not in out
+                    )
                 else:
                     work.extend(reversed(self.s[s].transitions[0].targets))
             elif s not in out:
@@ -629,12 +714,14 @@ class _Interpreter:
         targets = self.effective_targets(t, run)
         if not targets:
             return None
-        if t.internal and self.compound(t.source) and all(
-                self.descendant(x, t.source) for x in targets):
+        if (
+            t.internal
+            and self.compound(t.source)
+            and all(self.descendant(x, t.source) for x in targets)
+        ):
             return t.source
         for anc in self.ancestors[t.source]:
-            if (self.compound(anc) or anc == 0) and all(self.descendant(x, anc)
-                                                         for x in targets):
+            if (self.compound(anc) or anc == 0) and all(self.descendant(x, anc) for x in targets):
                 return anc
         return 0
 
@@ -667,16 +754,25 @@ class _Interpreter:
     def assign(self, index: int, run: _Run) -> None:
         location = self.doc.assign_exprs[index][0]
         try:
-            value = scxml_expr.evaluate(self.doc.parsed_assigns[index], run.data,
-                                        lambda state_id: self.doc.by_id.get(state_id, -1)
-                                        in run.config)
+            value = scxml_expr.evaluate(
+                self.doc.parsed_assigns[index],
+                run.data,
+                lambda state_id: self.doc.by_id.get(state_id, -1) in run.config,
+            )
         except scxml_expr.ExpressionError as exc:
-            raise UnsupportedError(f"unsupported: {exc} (error.execution), line "
-                                   f"{self.doc.assign_exprs[index][2]}") from None
-        if isinstance(value, (int, float)) and abs(value) > MAX_DATA_MAGNITUDE or \
-                isinstance(value, str) and len(value) > MAX_DATA_MAGNITUDE:
-            raise UnsupportedError(f"unsupported: '{location}' grows without bound (past "
-                                   f"{MAX_DATA_MAGNITUDE}), line {self.doc.assign_exprs[index][2]}")
+            raise UnsupportedError(
+                f"unsupported: {exc} (error.execution), line {self.doc.assign_exprs[index][2]}"
+            ) from None
+        if (
+            isinstance(value, (int, float))
+            and abs(value) > MAX_DATA_MAGNITUDE
+            or isinstance(value, str)
+            and len(value) > MAX_DATA_MAGNITUDE
+        ):
+            raise UnsupportedError(
+                f"unsupported: '{location}' grows without bound (past "
+                f"{MAX_DATA_MAGNITUDE}), line {self.doc.assign_exprs[index][2]}"
+            )
         run.data[location] = value
 
     def microstep(self, enabled: list[_T], run: _Run) -> None:
@@ -766,9 +862,15 @@ class _Interpreter:
                     continue
                 run.internal.append(f"done.state.{self.s[parent].id}")
                 grand = self.s[parent].parent
-                if grand is not None and self.s[grand].kind == "parallel" and all(
-                        self.in_final(c, run.config) for c in self.s[grand].children
-                        if self.s[c].kind != "history"):
+                if (
+                    grand is not None
+                    and self.s[grand].kind == "parallel"
+                    and all(
+                        self.in_final(c, run.config)
+                        for c in self.s[grand].children
+                        if self.s[c].kind != "history"
+                    )
+                ):
                     run.internal.append(f"done.state.{self.s[grand].id}")
 
     # -- macro step -----------------------------------------------------------------------------
@@ -783,15 +885,30 @@ class _Interpreter:
                 enabled = self.select(run, run.internal.popleft(), valuation, read)
             if enabled:
                 self.microstep(enabled, run)
-        raise InputError(f"a macro step does not end within {MAX_MICROSTEPS} micro steps "
-                         "(eventless transitions or raised events form a cycle)")
+        raise InputError(
+            f"a macro step does not end within {MAX_MICROSTEPS} micro steps "
+            "(eventless transitions or raised events form a cycle)"
+        )
 
-    def process(self, run: _Run, event: str | None, valuation: dict[int, bool],
-                read: set[int]) -> None:
+    def process(
+        self, run: _Run, event: str | None, valuation: dict[int, bool], read: set[int]
+    ) -> None:
         run.valuation, run.read = valuation, read
         if event is None:
-            self.enter([_T(0, (), None, tuple(self.s[0].initial), False,
-                           list(self.s[0].initial_actions), None)], run)
+            self.enter(
+                [
+                    _T(
+                        0,
+                        (),
+                        None,
+                        tuple(self.s[0].initial),
+                        False,
+                        list(self.s[0].initial_actions),
+                        None,
+                    )
+                ],
+                run,
+            )
         else:
             enabled = self.select(run, event, valuation, read)
             if enabled:
@@ -807,8 +924,12 @@ class _Interpreter:
         raise InputError("events the machine sends itself never run out")
 
     # -- naming ---------------------------------------------------------------------------------
-    def name(self, config: frozenset[int], history: tuple[tuple[int, frozenset[int]], ...],
-             data: tuple[tuple[str, scxml_expr.Value], ...] = ()) -> str:
+    def name(
+        self,
+        config: frozenset[int],
+        history: tuple[tuple[int, frozenset[int]], ...],
+        data: tuple[tuple[str, scxml_expr.Value], ...] = (),
+    ) -> str:
         out: list[str] = []
         top = [c for c in self.s[0].children if c in config]
         stack: list[int | str] = list(reversed(top))
@@ -846,8 +967,10 @@ class _Interpreter:
         return text
 
     def action(self, config: frozenset[int]) -> str | None:
-        atoms = sorted((i for i in config if self.atomic(i) and not self.s[i].wrapper),
-                       key=self.order.__getitem__)
+        atoms = sorted(
+            (i for i in config if self.atomic(i) and not self.s[i].wrapper),
+            key=self.order.__getitem__,
+        )
         parts = [self.s[i].action if self.s[i].has_action else self.s[i].name for i in atoms]
         return "+".join(p for p in parts if p) or None
 
@@ -873,21 +996,26 @@ def _symbols(doc: _Doc, interp: _Interpreter) -> list[tuple[str, str, dict[int, 
             if t.cond is None or t.cond[0] != "guard":
                 continue
             hit = (eventless and not t.events) or any(
-                _matches(d, e) for d in t.events for e in names)
+                _matches(d, e) for d in t.events for e in names
+            )
             if hit or (eventless and any(d == "*" or d.startswith("done") for d in t.events)):
                 out.add(int(t.cond[1]))
         return out
 
     internal = guards_of(sorted(generated), True) | doc.branch_guards
     if doc.data_mode:  # guards are computed from the data, not chosen
-        return sorted(((event, event, {}) for event in events),
-                      key=lambda item: (-item[1].count("."), item[0]))
+        return sorted(
+            ((event, event, {}) for event in events),
+            key=lambda item: (-item[1].count("."), item[0]),
+        )
     symbols: list[tuple[str, str, dict[int, bool]]] = []  # sorted below
     for event in events:
         relevant = sorted(guards_of([event], False) | internal)
         if len(relevant) > MAX_GUARDS_PER_EVENT:
-            raise UnsupportedError(f"unsupported: {len(relevant)} guards read on event "
-                                   f"'{event}' (at most {MAX_GUARDS_PER_EVENT})")
+            raise UnsupportedError(
+                f"unsupported: {len(relevant)} guards read on event "
+                f"'{event}' (at most {MAX_GUARDS_PER_EVENT})"
+            )
         if not relevant:
             symbols.append((event, event, {}))
             continue
@@ -926,11 +1054,17 @@ def read_scxml_w3c(text: str, ctx: ReadContext) -> FSM:
     read: set[int] = set()
     interp.process(start, None, {}, read)
     if read:
-        raise UnsupportedError("unsupported: a cond guard read before the first event "
-                               f"(g{min(read) + 1}: {doc.guards[min(read)]})")
+        raise UnsupportedError(
+            "unsupported: a cond guard read before the first event "
+            f"(g{min(read) + 1}: {doc.guards[min(read)]})"
+        )
     max_states = limits.current().max_states
-    Key = tuple[frozenset[int], tuple[tuple[int, frozenset[int]], ...], bool,
-                tuple[tuple[str, scxml_expr.Value], ...]]
+    Key = tuple[
+        frozenset[int],
+        tuple[tuple[int, frozenset[int]], ...],
+        bool,
+        tuple[tuple[str, scxml_expr.Value], ...],
+    ]
 
     def key_of(run: _Run) -> Key:
         hist = tuple(sorted(run.history.items())) if has_history else ()
@@ -980,7 +1114,10 @@ def representative_event(event: str, events: list[str]) -> str | None:
     """
     best = None
     for candidate in events:
-        if _matches(candidate, event) and candidate != "*" and (
-                best is None or len(candidate) > len(best)):
+        if (
+            _matches(candidate, event)
+            and candidate != "*"
+            and (best is None or len(candidate) > len(best))
+        ):
             best = candidate
     return best

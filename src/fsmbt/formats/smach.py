@@ -37,20 +37,27 @@ def choose_machine(analysis: Analysis, ctx: ReadContext) -> tuple[Container, str
     """The top-level container that is the model (first built, or option ``machine``)."""
     roots = [c for c in analysis.containers if c.parent is None]
     if not roots:
-        raise InputError("no state machine is built in this file (no StateMachine, Sequence, "
-                         "Concurrence or Iterator is constructed)", location=ctx.location())
+        raise InputError(
+            "no state machine is built in this file (no StateMachine, Sequence, "
+            "Concurrence or Iterator is constructed)",
+            location=ctx.location(),
+        )
     wanted = ctx.options.get("machine")
     if wanted is not None:
         chosen = [c for c in roots if c.name == wanted]
         if not chosen:
-            raise InputError(f"no top-level container '{wanted}' (found: "
-                             f"{', '.join(c.name for c in roots)})", location=ctx.location())
+            raise InputError(
+                f"no top-level container '{wanted}' (found: {', '.join(c.name for c in roots)})",
+                location=ctx.location(),
+            )
         return chosen[0], chosen[0].name
     root = roots[0]
     if len(roots) > 1:
         others = ", ".join(f"'{c.name}' (line {c.line})" for c in roots[1:])
-        ctx.warn(f"{len(roots)} top-level containers; read '{root.name}' (line {root.line}); "
-                 f"not read: {others} (choose one with the 'machine' option)")
+        ctx.warn(
+            f"{len(roots)} top-level containers; read '{root.name}' (line {root.line}); "
+            f"not read: {others} (choose one with the 'machine' option)"
+        )
     return root, root.name
 
 
@@ -59,8 +66,15 @@ def _sniff(text: str) -> bool:
     return _SMACH_IMPORT.search(head) is not None and "flexbe_core" not in head
 
 
-register(Format(
-    "smach", (".py",), frozenset({"fsm"}),
-    "SMACH state machine (Python; read statically, never run; write stub states)",
-    read_smach, write_smach, _sniff, priority=35,
-))
+register(
+    Format(
+        "smach",
+        (".py",),
+        frozenset({"fsm"}),
+        "SMACH state machine (Python; read statically, never run; write stub states)",
+        read_smach,
+        write_smach,
+        _sniff,
+        priority=35,
+    )
+)

@@ -47,18 +47,23 @@ def column_index(header: Sequence[str], ctx: ReadContext, line: int) -> dict[str
     index: dict[str, int] = {}
     for position, name in enumerate(names):
         if name not in REQUIRED_COLUMNS + OPTIONAL_COLUMNS:
-            raise InputError(f"unknown column '{header[position].strip()}' in the header "
-                             f"(columns: source, event, target[, action])",
-                             location=ctx.location(line))
+            raise InputError(
+                f"unknown column '{header[position].strip()}' in the header "
+                f"(columns: source, event, target[, action])",
+                location=ctx.location(line),
+            )
         if name in index:
-            raise InputError(f"column '{name}' appears twice in the header",
-                             location=ctx.location(line))
+            raise InputError(
+                f"column '{name}' appears twice in the header", location=ctx.location(line)
+            )
         index[name] = position
     missing = [c for c in REQUIRED_COLUMNS if c not in index]
     if missing:
-        raise InputError(f"header lacks column(s) {', '.join(missing)} "
-                         f"(columns: source, event, target[, action])",
-                         location=ctx.location(line))
+        raise InputError(
+            f"header lacks column(s) {', '.join(missing)} "
+            f"(columns: source, event, target[, action])",
+            location=ctx.location(line),
+        )
     return index
 
 
@@ -68,8 +73,9 @@ def is_header(cells: Sequence[str]) -> bool:
     return set(REQUIRED_COLUMNS) <= names
 
 
-def fsm_from_rows(header: Sequence[str], header_line: int, rows: Iterable[TableRow],
-                  ctx: ReadContext) -> FSM:
+def fsm_from_rows(
+    header: Sequence[str], header_line: int, rows: Iterable[TableRow], ctx: ReadContext
+) -> FSM:
     """Build the FSM a transition table describes (rules in the module docstring). O(rows)."""
     index = column_index(header, ctx, header_line)
     name = ctx.path.stem if ctx.path is not None else "fsm"
@@ -78,8 +84,10 @@ def fsm_from_rows(header: Sequence[str], header_line: int, rows: Iterable[TableR
     first_source: str | None = None
     for row in rows:
         if len(row.cells) != len(header):
-            raise InputError(f"row has {len(row.cells)} cells, the header has {len(header)}",
-                             location=ctx.location(row.line))
+            raise InputError(
+                f"row has {len(row.cells)} cells, the header has {len(header)}",
+                location=ctx.location(row.line),
+            )
         cell = {column: row.cells[position].strip() for column, position in index.items()}
         source, event, target = cell["source"], cell["event"], cell["target"]
         for column in ("source", "target"):
@@ -87,8 +95,7 @@ def fsm_from_rows(header: Sequence[str], header_line: int, rows: Iterable[TableR
                 raise InputError(f"empty '{column}' cell", location=ctx.location(row.line))
         for state_name in (source, target):
             if state_name not in fsm.states:
-                fsm.add_state(State(state_name, action=state_name,
-                                    location=ctx.location(row.line)))
+                fsm.add_state(State(state_name, action=state_name, location=ctx.location(row.line)))
         if first_source is None:
             first_source = source
         action = cell.get("action", "")
@@ -98,7 +105,9 @@ def fsm_from_rows(header: Sequence[str], header_line: int, rows: Iterable[TableR
                 raise InputError(
                     f"state '{target}' gets action '{action}' here but '{previous[0]}' on line "
                     f"{previous[1]}; the action column is the target state's action",
-                    location=ctx.location(row.line), element=target)
+                    location=ctx.location(row.line),
+                    element=target,
+                )
             action_of[target] = (action, row.line)
             fsm.states[target].action = action
         fsm.add_transition(source, event or None, target, location=ctx.location(row.line))
@@ -107,8 +116,10 @@ def fsm_from_rows(header: Sequence[str], header_line: int, rows: Iterable[TableR
     initial = ctx.options.get("initial")
     if initial is not None:
         if str(initial) not in fsm.states:
-            raise InputError(f"initial state '{initial}' (from the option) is not in the table",
-                             location=ctx.location())
+            raise InputError(
+                f"initial state '{initial}' (from the option) is not in the table",
+                location=ctx.location(),
+            )
         fsm.initial = str(initial)
     else:
         fsm.initial = first_source
@@ -125,12 +136,16 @@ def rows_from_fsm(model: Model, table: str) -> tuple[list[str], list[list[str]]]
         raise UnsupportedError(f"a {table} transition table holds an FSM, not a behavior tree")
     fsm = model
     if fsm.is_hierarchical:
-        raise UnsupportedError(f"a {table} transition table cannot hold composite states; "
-                               "flatten the machine first (e.g. write JSON or Mermaid)")
+        raise UnsupportedError(
+            f"a {table} transition table cannot hold composite states; "
+            "flatten the machine first (e.g. write JSON or Mermaid)"
+        )
     if fsm.start_name is not None or fsm.initial_event is not None:
-        raise UnsupportedError(f"a {table} transition table cannot mark a start pseudo-state "
-                               f"('{fsm.start_name}' --{fsm.initial_event}-->); use JSON, "
-                               "YAML or the paper's XML")
+        raise UnsupportedError(
+            f"a {table} transition table cannot mark a start pseudo-state "
+            f"('{fsm.start_name}' --{fsm.initial_event}-->); use JSON, "
+            "YAML or the paper's XML"
+        )
     if fsm.initial is None or fsm.initial not in fsm.states:
         raise UnsupportedError(f"a {table} transition table needs an initial state")
     sources = {t.source for t in fsm.transitions}
@@ -138,20 +153,29 @@ def rows_from_fsm(model: Model, table: str) -> tuple[list[str], list[list[str]]]
     if not fsm.transitions:
         raise UnsupportedError(f"a {table} transition table needs at least one transition")
     if not fsm.outgoing(fsm.initial):
-        raise UnsupportedError(f"initial state '{fsm.initial}' has no outgoing transition, so "
-                               "a table cannot put it first")
+        raise UnsupportedError(
+            f"initial state '{fsm.initial}' has no outgoing transition, so "
+            "a table cannot put it first"
+        )
     for state in fsm.states.values():
         if state.final == (state.name in sources):
-            why = ("is final but has outgoing transitions" if state.final
-                   else "has no outgoing transition but is not final")
-            raise UnsupportedError(f"state '{state.name}' {why}; in a table a state is final "
-                                   "exactly when it has no outgoing transition")
+            why = (
+                "is final but has outgoing transitions"
+                if state.final
+                else "has no outgoing transition but is not final"
+            )
+            raise UnsupportedError(
+                f"state '{state.name}' {why}; in a table a state is final "
+                "exactly when it has no outgoing transition"
+            )
         if state.name not in sources | targets:
             raise UnsupportedError(f"state '{state.name}' has no transition, so no row names it")
         if state.action != state.name and state.name not in targets:
-            raise UnsupportedError(f"state '{state.name}' has action '{state.action}' but no "
-                                   "transition enters it, and the action column gives the "
-                                   "target's action")
+            raise UnsupportedError(
+                f"state '{state.name}' has action '{state.action}' but no "
+                "transition enters it, and the action column gives the "
+                "target's action"
+            )
         if state.action is None:
             raise UnsupportedError(f"state '{state.name}' has no action; a table cannot say so")
     with_action = any(s.action != s.name for s in fsm.states.values())
@@ -208,8 +232,17 @@ def _sniff(text: str) -> bool:
     return False
 
 
-register(Format("csv", (".csv",), frozenset({"fsm"}),
-                "transition table, CSV (source,event,target[,action])",
-                read_csv, write_csv, _sniff, priority=40,
-                cannot_hold="composite or parallel states, a start pseudo-state, final states "
-                "with transitions, states without an action"))
+register(
+    Format(
+        "csv",
+        (".csv",),
+        frozenset({"fsm"}),
+        "transition table, CSV (source,event,target[,action])",
+        read_csv,
+        write_csv,
+        _sniff,
+        priority=40,
+        cannot_hold="composite or parallel states, a start pseudo-state, final states "
+        "with transitions, states without an action",
+    )
+)

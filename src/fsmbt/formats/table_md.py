@@ -46,8 +46,10 @@ def read_md(text: str, ctx: ReadContext) -> Model:
         if not _is_table_line(line) or not is_header(split_row(line)):
             continue
         if number + 1 >= len(lines) or not _is_separator(lines[number + 1]):
-            raise InputError("a table header must be followed by a separator row like "
-                             "'|---|---|---|'", location=ctx.location(number + 2))
+            raise InputError(
+                "a table header must be followed by a separator row like '|---|---|---|'",
+                location=ctx.location(number + 2),
+            )
         header = split_row(line)
         rows = []
         for row_number in range(number + 2, len(lines)):
@@ -56,8 +58,9 @@ def read_md(text: str, ctx: ReadContext) -> Model:
                 break  # the table ends at the first line that is not a table row
             rows.append(TableRow(row_number + 1, tuple(split_row(row_line))))
         return fsm_from_rows(header, number + 1, rows, ctx)
-    raise InputError("no Markdown table with columns source | event | target found",
-                     location=ctx.location())
+    raise InputError(
+        "no Markdown table with columns source | event | target found", location=ctx.location()
+    )
 
 
 def _escape(cell: str) -> str:
@@ -79,8 +82,17 @@ def _sniff(text: str) -> bool:
     return False
 
 
-register(Format("md", (".md", ".markdown"), frozenset({"fsm"}),
-                "transition table, Markdown pipe table (source | event | target [| action])",
-                read_md, write_md, _sniff, priority=41,
-                cannot_hold="composite or parallel states, a start pseudo-state, final states "
-                "with transitions, states without an action"))
+register(
+    Format(
+        "md",
+        (".md", ".markdown"),
+        frozenset({"fsm"}),
+        "transition table, Markdown pipe table (source | event | target [| action])",
+        read_md,
+        write_md,
+        _sniff,
+        priority=41,
+        cannot_hold="composite or parallel states, a start pseudo-state, final states "
+        "with transitions, states without an action",
+    )
+)

@@ -65,8 +65,14 @@ class Translation:
 Checker = Callable[[Model, Model], Any]
 
 
-def translate(model: Model, to: str, *, flatten: bool = False,
-              source_format: str | None = None, check: Checker | None = None) -> Translation:
+def translate(
+    model: Model,
+    to: str,
+    *,
+    flatten: bool = False,
+    source_format: str | None = None,
+    check: Checker | None = None,
+) -> Translation:
     """Write ``model`` in format ``to`` and name everything the format cannot hold.
 
     Args:
@@ -94,8 +100,10 @@ def translate(model: Model, to: str, *, flatten: bool = False,
     written = model
     if flatten and isinstance(model, FSM) and needs_flattening(model):
         written = flatten_fsm(model)
-        losses.append(f"flattened: {len(written.states)} flat states replace the composite, "
-                      "parallel and transient states")
+        losses.append(
+            f"flattened: {len(written.states)} flat states replace the composite, "
+            "parallel and transient states"
+        )
     checked = model  # what the read-back must equal in behaviour (events renamed, if any)
     if target.name == "scxml" and isinstance(written, FSM):
         events = scxml_event_renames(written)
@@ -105,16 +113,20 @@ def translate(model: Model, to: str, *, flatten: bool = False,
                 checked = rename_events(model, events)
             shown = ", ".join(f"'{a}' -> '{b}'" for a, b in list(events.items())[:5])
             more = f" and {len(events) - 5} more" if len(events) > 5 else ""
-            losses.append(f"{len(events)} event name(s) mean something else to an SCXML engine "
-                          "(done.state prefixes, wildcards, blanks, or one event a dot-prefix of "
-                          f"another): renamed {shown}{more}; send the new names to the engine")
+            losses.append(
+                f"{len(events)} event name(s) mean something else to an SCXML engine "
+                "(done.state prefixes, wildcards, blanks, or one event a dot-prefix of "
+                f"another): renamed {shown}{more}; send the new names to the engine"
+            )
         written, renamed = scxml_safe_names(written)
         if renamed:
             shown = ", ".join(f"'{a}' -> '{b}'" for a, b in list(renamed.items())[:5])
             more = f" and {len(renamed) - 5} more" if len(renamed) > 5 else ""
-            losses.append(f"{len(renamed)} state name(s) are not SCXML ids (an id is an XML "
-                          f"NCName; a space would split a transition's target): renamed "
-                          f"{shown}{more}")
+            losses.append(
+                f"{len(renamed)} state name(s) are not SCXML ids (an id is an XML "
+                f"NCName; a space would split a transition's target): renamed "
+                f"{shown}{more}"
+            )
     try:
         text = target.write(written)
     except UnsupportedError as exc:
@@ -122,8 +134,11 @@ def translate(model: Model, to: str, *, flatten: bool = False,
         if isinstance(written, FSM) and needs_flattening(written):
             hint = " (--flatten writes the flat machine instead, naming that as a loss)"
         reason = exc.message.removeprefix("unsupported: ")
-        raise UnsupportedError(f"{target.name} cannot hold this model: {reason}{hint}",
-                               location=exc.location, element=exc.element) from None
+        raise UnsupportedError(
+            f"{target.name} cannot hold this model: {reason}{hint}",
+            location=exc.location,
+            element=exc.element,
+        ) from None
     own_losses = _writer_losses(target.name, written)
     losses.extend(own_losses or [])
     result = Translation(text, source_format, target.name, losses)
@@ -133,8 +148,10 @@ def translate(model: Model, to: str, *, flatten: bool = False,
     try:
         back = loads(text, target.name)
     except InputError as exc:
-        losses.append(f"fsmbt cannot read this {target.name} back ({exc.message}), so what it "
-                      "loses is not checked")
+        losses.append(
+            f"fsmbt cannot read this {target.name} back ({exc.message}), so what it "
+            "loses is not checked"
+        )
         return result
     if check is not None:
         _check_meaning(checked, back, target.name, check)
@@ -144,10 +161,17 @@ def translate(model: Model, to: str, *, flatten: bool = False,
     return result
 
 
-def translate_file(source: str | Path, to: str | None = None, output: str | Path | None = None,
-                   *, source_format: str | None = None, flatten: bool = False,
-                   overwrite: bool = False, options: dict[str, object] | None = None,
-                   check: Checker | None = None) -> Translation:
+def translate_file(
+    source: str | Path,
+    to: str | None = None,
+    output: str | Path | None = None,
+    *,
+    source_format: str | None = None,
+    flatten: bool = False,
+    overwrite: bool = False,
+    options: dict[str, object] | None = None,
+    check: Checker | None = None,
+) -> Translation:
     """Read ``source``, translate it, write ``output`` (never replacing it unless asked).
 
     Args:
@@ -171,22 +195,26 @@ def translate_file(source: str | Path, to: str | None = None, output: str | Path
         guessed = format_for_path(Path(output), writing=True, kind=kind)
         target = guessed.name if guessed is not None else None
     if target is None:
-        raise InputError("cannot tell the target format; name it with --to"
-                         + (f" (from '{Path(output).name}')" if output is not None else ""))
+        raise InputError(
+            "cannot tell the target format; name it with --to"
+            + (f" (from '{Path(output).name}')" if output is not None else "")
+        )
     chosen_source = source_format or _detected(source)
     result = translate(model, target, flatten=flatten, source_format=chosen_source, check=check)
     result.warnings = warnings
     if output is not None:
         path = Path(output)
         if path.exists() and not overwrite:
-            raise InputError("exists; pass --force to overwrite it",
-                             location=SourceLocation(str(path)))
+            raise InputError(
+                "exists; pass --force to overwrite it", location=SourceLocation(str(path))
+            )
         try:
             path.parent.mkdir(parents=True, exist_ok=True)
             path.write_text(result.text, encoding="utf-8")
         except OSError as exc:
-            raise InputError(f"cannot write: {exc.strerror}",
-                             location=SourceLocation(str(path))) from None
+            raise InputError(
+                f"cannot write: {exc.strerror}", location=SourceLocation(str(path))
+            ) from None
     return result
 
 
@@ -195,7 +223,7 @@ def _detected(source: str | Path) -> str | None:
 
     path = Path(source)
     try:
-        return detect_format(decode(path.read_bytes()[:1 << 20], str(path)), path).name
+        return detect_format(decode(path.read_bytes()[: 1 << 20], str(path)), path).name
     except (InputError, OSError):
         return None
 
@@ -239,8 +267,14 @@ def scxml_event_renames(fsm: FSM) -> dict[str, str]:
     renames: dict[str, str] = {}
     for event in events:
         related = event in prefixes or any(event.startswith(p + ".") for p in prefixes)
-        bad = (not event or any(c.isspace() for c in event) or "*" in event
-               or event.endswith(".") or event == "done" or event.startswith("done."))
+        bad = (
+            not event
+            or any(c.isspace() for c in event)
+            or "*" in event
+            or event.endswith(".")
+            or event == "done"
+            or event.startswith("done.")
+        )
         if not (bad or related):
             continue
         base = re.sub(r"[\s*]+", "_", event)
@@ -300,9 +334,14 @@ def scxml_safe_names(fsm: FSM) -> tuple[FSM, dict[str, str]]:
 
     machines = [copy_, *(region for _p, _m, state in copy_.walk() for region in state.regions)]
     for machine in machines:
-        if not any(not _NCNAME.match(n) for n in machine.states) and machine.initial is not None \
-                and _NCNAME.match(machine.initial) and not any(
-                    t.exit is not None and not _NCNAME.match(t.exit) for t in machine.transitions):
+        if (
+            not any(not _NCNAME.match(n) for n in machine.states)
+            and machine.initial is not None
+            and _NCNAME.match(machine.initial)
+            and not any(
+                t.exit is not None and not _NCNAME.match(t.exit) for t in machine.transitions
+            )
+        ):
             continue
         machine.states = {safe(name): state for name, state in machine.states.items()}
         for new_name, state in machine.states.items():
@@ -325,8 +364,9 @@ def _check_meaning(model: Model, back: Model, target: str, verify: Checker) -> N
     if not report.equivalent:
         failed = [name for name, prop in report.properties.items() if not prop.holds]
         details = "; ".join(f"{name}: {report.properties[name].detail}" for name in failed)
-        raise UnsupportedError(f"translating to {target} changes the model's behaviour "
-                               f"({details}); nothing written")
+        raise UnsupportedError(
+            f"translating to {target} changes the model's behaviour ({details}); nothing written"
+        )
 
 
 # -- generic differences ------------------------------------------------------------------------
@@ -370,11 +410,13 @@ def _normalised(data: Any) -> Any:
         items = node.items() if isinstance(node, dict) else enumerate(node)
         for key, value in list(items):
             if isinstance(value, dict) and "states" in value and isinstance(value["states"], list):
-                value["states"] = {s.get("name"): s for s in value["states"]
-                                   if isinstance(s, dict)}
+                value["states"] = {s.get("name"): s for s in value["states"] if isinstance(s, dict)}
                 if isinstance(value.get("transitions"), list):
-                    value["transitions"] = {_transition_key(t): t.get("attrs", {})
-                                            for t in value["transitions"] if isinstance(t, dict)}
+                    value["transitions"] = {
+                        _transition_key(t): t.get("attrs", {})
+                        for t in value["transitions"]
+                        if isinstance(t, dict)
+                    }
             if isinstance(value, (dict, list)):
                 stack.append(value)
             node[key] = value
@@ -384,7 +426,9 @@ def _normalised(data: Any) -> Any:
 def _transition_key(t: dict[str, Any]) -> str:
     exit_name = f" (exit {t['exit']})" if t.get("exit") is not None else ""
     event = t.get("event")
-    return f"{t.get('source')} --{event if event is not None else ''}--> {t.get('target')}{exit_name}"
+    return (
+        f"{t.get('source')} --{event if event is not None else ''}--> {t.get('target')}{exit_name}"
+    )
 
 
 def _short(value: Any) -> str:

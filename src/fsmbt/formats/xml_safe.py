@@ -72,8 +72,13 @@ def parse_xml(text: str, source: str | None = None) -> etree._Element:
     _refuse_entity_declarations(text, source)
     data = text.encode("utf-8")
     parser = etree.XMLParser(
-        resolve_entities=False, no_network=True, load_dtd=False, huge_tree=True,
-        remove_comments=True, remove_pis=True, encoding="utf-8",
+        resolve_entities=False,
+        no_network=True,
+        load_dtd=False,
+        huge_tree=True,
+        remove_comments=True,
+        remove_pis=True,
+        encoding="utf-8",
     )
     max_depth = limits.current().max_xml_depth
     try:
@@ -83,8 +88,9 @@ def parse_xml(text: str, source: str | None = None) -> etree._Element:
             return _parse_deep(data, source, max_depth)
         line, column = exc.position if exc.position else (exc.lineno, None)
         cause = re.sub(r",\s*line \d+, column \d+\s*$", "", exc.msg or str(exc))
-        raise InputError(f"malformed XML: {cause}",
-                         location=SourceLocation(source, line, column)) from None
+        raise InputError(
+            f"malformed XML: {cause}", location=SourceLocation(source, line, column)
+        ) from None
     except ValueError as exc:  # lxml refuses some text before parsing (e.g. an XML declaration)
         raise InputError(f"malformed XML: {exc}", location=SourceLocation(source)) from None
     if max_depth < _LIBXML_MAX_DEPTH:
@@ -98,14 +104,14 @@ def _check_depth(root: etree._Element, source: str | None, max_depth: int) -> No
     while stack:
         element, depth = stack.pop()
         if depth > max_depth:
-            raise InputError(_too_deep(max_depth),
-                             location=SourceLocation(source, element.sourceline))
+            raise InputError(
+                _too_deep(max_depth), location=SourceLocation(source, element.sourceline)
+            )
         stack.extend((child, depth + 1) for child in element)
 
 
 def _too_deep(max_depth: int) -> str:
-    return limits.exceeded(f"XML nested deeper than {max_depth} levels", "max_xml_depth",
-                           max_depth)
+    return limits.exceeded(f"XML nested deeper than {max_depth} levels", "max_xml_depth", max_depth)
 
 
 def _refuse_entity_declarations(text: str, source: str | None) -> None:
@@ -115,7 +121,8 @@ def _refuse_entity_declarations(text: str, source: str | None) -> None:
             raise InputError(
                 "DOCTYPE declares entities; refused (entity expansion and external entities "
                 "are a security risk, and no model format needs them)",
-                location=SourceLocation(source, line))
+                location=SourceLocation(source, line),
+            )
 
 
 class _TooDeep(Exception):
@@ -140,7 +147,8 @@ def _parse_deep(data: bytes, source: str | None, max_depth: int) -> etree._Eleme
             raise _TooDeep
         # lxml's TreeBuilder.start returns the new element (types-lxml declares None)
         element: Any = builder.start(  # type: ignore[func-returns-value]
-            clark(name), {clark(k): v for k, v in attrs.items()})
+            clark(name), {clark(k): v for k, v in attrs.items()}
+        )
         element.sourceline = parser.CurrentLineNumber
 
     def end(name: str) -> None:
@@ -149,8 +157,10 @@ def _parse_deep(data: bytes, source: str | None, max_depth: int) -> etree._Eleme
         builder.end(clark(name))
 
     def entity_declared(*_args: object) -> None:
-        raise InputError("DOCTYPE declares entities; refused",
-                         location=SourceLocation(source, parser.CurrentLineNumber))
+        raise InputError(
+            "DOCTYPE declares entities; refused",
+            location=SourceLocation(source, parser.CurrentLineNumber),
+        )
 
     parser.StartElementHandler = start
     parser.EndElementHandler = end
@@ -161,9 +171,13 @@ def _parse_deep(data: bytes, source: str | None, max_depth: int) -> etree._Eleme
     except _TooDeep:
         raise InputError(
             _too_deep(max_depth),
-            location=SourceLocation(source, parser.CurrentLineNumber,
-                                    parser.CurrentColumnNumber + 1)) from None
+            location=SourceLocation(
+                source, parser.CurrentLineNumber, parser.CurrentColumnNumber + 1
+            ),
+        ) from None
     except expat.ExpatError as exc:
-        raise InputError(f"malformed XML: {expat.ErrorString(exc.code)}",
-                         location=SourceLocation(source, exc.lineno, exc.offset + 1)) from None
+        raise InputError(
+            f"malformed XML: {expat.ErrorString(exc.code)}",
+            location=SourceLocation(source, exc.lineno, exc.offset + 1),
+        ) from None
     return builder.close()

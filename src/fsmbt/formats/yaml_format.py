@@ -79,8 +79,9 @@ class _GuardedLoader(_Parser, yaml.constructor.SafeConstructor, yaml.resolver.Re
             following = self.peek_event()
             assert following is not None  # check_event saw an event
             mark = following.start_mark
-            raise _Refused("expected one YAML document, found several", mark.line + 1,
-                           mark.column + 1)
+            raise _Refused(
+                "expected one YAML document, found several", mark.line + 1, mark.column + 1
+            )
         self.get_event()
         return document
 
@@ -93,9 +94,12 @@ class _GuardedLoader(_Parser, yaml.constructor.SafeConstructor, yaml.resolver.Re
                 raise _Refused("unexpected end of the YAML stream", 1, 1)
             mark = event.start_mark
             if isinstance(event, AliasEvent):
-                raise _Refused("YAML aliases (*name) are not allowed in fsmbt models (they can "
-                               "expand exponentially); write the value out",
-                               mark.line + 1, mark.column + 1)
+                raise _Refused(
+                    "YAML aliases (*name) are not allowed in fsmbt models (they can "
+                    "expand exponentially); write the value out",
+                    mark.line + 1,
+                    mark.column + 1,
+                )
             node: Node
             if isinstance(event, ScalarEvent):
                 tag = event.tag
@@ -104,9 +108,15 @@ class _GuardedLoader(_Parser, yaml.constructor.SafeConstructor, yaml.resolver.Re
                 node = ScalarNode(tag, event.value, mark, event.end_mark, style=event.style)
             elif isinstance(event, (SequenceStartEvent, MappingStartEvent)):
                 if len(stack) >= max_depth:
-                    raise _Refused(limits.exceeded(f"YAML nested deeper than {max_depth} levels",
-                                                   "max_yaml_depth", max_depth),
-                                   mark.line + 1, mark.column + 1)
+                    raise _Refused(
+                        limits.exceeded(
+                            f"YAML nested deeper than {max_depth} levels",
+                            "max_yaml_depth",
+                            max_depth,
+                        ),
+                        mark.line + 1,
+                        mark.column + 1,
+                    )
                 kind = SequenceNode if isinstance(event, SequenceStartEvent) else MappingNode
                 tag = event.tag
                 if tag is None or tag == "!":
@@ -117,8 +127,9 @@ class _GuardedLoader(_Parser, yaml.constructor.SafeConstructor, yaml.resolver.Re
                 node = stack.pop()[0]
                 node.end_mark = event.end_mark
             else:  # pragma: no cover - the parser yields nothing else inside a document
-                raise _Refused(f"unexpected YAML event {type(event).__name__}",
-                               mark.line + 1, mark.column + 1)
+                raise _Refused(
+                    f"unexpected YAML event {type(event).__name__}", mark.line + 1, mark.column + 1
+                )
             if not stack:
                 return node
             top = stack[-1]
@@ -141,8 +152,7 @@ def load_yaml(text: str, ctx: ReadContext) -> Any:
     except yaml.MarkedYAMLError as exc:
         mark = exc.problem_mark or exc.context_mark
         location = ctx.location(mark.line + 1, mark.column + 1) if mark else ctx.location()
-        raise InputError(f"invalid YAML: {exc.problem or exc.context}",
-                         location=location) from None
+        raise InputError(f"invalid YAML: {exc.problem or exc.context}", location=location) from None
     except yaml.YAMLError as exc:
         raise InputError(f"invalid YAML: {exc}", location=ctx.location()) from None
     except RecursionError:
@@ -170,8 +180,14 @@ class _BlockDumper(yaml.SafeDumper):
 def write_yaml(model: Model) -> str:
     """Block-style YAML; PyYAML's emitter recurses per level, so very deep trees are refused."""
     try:
-        return yaml.dump(model_to_dict(model), Dumper=_BlockDumper, sort_keys=False,
-                         allow_unicode=True, default_flow_style=False, width=100)
+        return yaml.dump(
+            model_to_dict(model),
+            Dumper=_BlockDumper,
+            sort_keys=False,
+            allow_unicode=True,
+            default_flow_style=False,
+            width=100,
+        )
     except RecursionError:
         raise InputError("model nested too deeply to write as YAML; use JSON or XML") from None
 
@@ -180,14 +196,26 @@ def _sniff(text: str) -> bool:
     """A top-level ``kind: fsm`` / ``kind: bt`` line in the first lines (JSON is tried first)."""
     for line in text[:4096].splitlines():
         stripped = line.strip()
-        if stripped in ("kind: fsm", "kind: bt", "kind: 'fsm'", "kind: 'bt'",
-                        'kind: "fsm"', 'kind: "bt"') and not line[:1].isspace():
+        if (
+            stripped
+            in ("kind: fsm", "kind: bt", "kind: 'fsm'", "kind: 'bt'", 'kind: "fsm"', 'kind: "bt"')
+            and not line[:1].isspace()
+        ):
             return True
     return False
 
 
-register(Format("yaml", (".yaml", ".yml"), frozenset({"fsm", "bt"}),
-                "fsmbt YAML (either model; same schema as JSON)",
-                read_yaml, write_yaml, _sniff, priority=30))
+register(
+    Format(
+        "yaml",
+        (".yaml", ".yml"),
+        frozenset({"fsm", "bt"}),
+        "fsmbt YAML (either model; same schema as JSON)",
+        read_yaml,
+        write_yaml,
+        _sniff,
+        priority=30,
+    )
+)
 
 __all__ = ["load_yaml", "read_yaml", "write_yaml"]

@@ -62,14 +62,18 @@ class DatasetSpec:
         if self.kind not in KINDS:
             raise InputError(f"the kind must be fsm or bt, not {self.kind!r}")
         if self.scenario not in SCENARIOS:
-            raise InputError(f"the scenario must be one of {', '.join(SCENARIOS)}, "
-                             f"not {self.scenario!r}")
+            raise InputError(
+                f"the scenario must be one of {', '.join(SCENARIOS)}, not {self.scenario!r}"
+            )
         if not 1 <= self.min_states <= self.max_states:
-            raise InputError("the state range must satisfy 1 <= MIN <= MAX, not "
-                             f"{self.min_states}-{self.max_states}")
+            raise InputError(
+                "the state range must satisfy 1 <= MIN <= MAX, not "
+                f"{self.min_states}-{self.max_states}"
+            )
         if self.shape not in FSM_SHAPES:
-            raise InputError(f"the FSM shape must be one of {', '.join(FSM_SHAPES)}, "
-                             f"not {self.shape!r}")
+            raise InputError(
+                f"the FSM shape must be one of {', '.join(FSM_SHAPES)}, not {self.shape!r}"
+            )
         if self.max_nodes < 1:
             raise InputError(f"the node budget must be at least 1, not {self.max_nodes}")
 
@@ -77,10 +81,22 @@ class DatasetSpec:
         """The ``index``-th model of this run."""
         rng = model_seed(self.seed, index)
         if self.kind == "fsm":
-            return random_fsm(rng, None, self.scenario, shape=self.shape,
-                              min_states=self.min_states, max_states=self.max_states)
-        return random_bt(rng, self.depth, self.breadth, self.scenario, extended=self.extended,
-                         max_nodes=self.max_nodes)
+            return random_fsm(
+                rng,
+                None,
+                self.scenario,
+                shape=self.shape,
+                min_states=self.min_states,
+                max_states=self.max_states,
+            )
+        return random_bt(
+            rng,
+            self.depth,
+            self.breadth,
+            self.scenario,
+            extended=self.extended,
+            max_nodes=self.max_nodes,
+        )
 
     def file_stem(self, index: int) -> str:
         """The file name (without extension) of the ``index``-th model."""

@@ -32,11 +32,24 @@ Seed = int | str | random.Random | None
 
 FSM_SHAPES = ("mixed", "chain", "tree", "loop")
 PAPER_CONTROLS = ("Sequence", "Fallback")
-EXTENDED_CONTROLS = ("Sequence", "Fallback", "ReactiveSequence", "ReactiveFallback",
-                     "SequenceWithMemory", "Parallel")
+EXTENDED_CONTROLS = (
+    "Sequence",
+    "Fallback",
+    "ReactiveSequence",
+    "ReactiveFallback",
+    "SequenceWithMemory",
+    "Parallel",
+)
 _EXTENDED_WEIGHTS = (3, 3, 1, 1, 1, 0.7)
-DECORATORS = ("Inverter", "ForceSuccess", "ForceFailure", "Repeat", "RetryUntilSuccessful",
-              "KeepRunningUntilFailure", "RunOnce")
+DECORATORS = (
+    "Inverter",
+    "ForceSuccess",
+    "ForceFailure",
+    "Repeat",
+    "RetryUntilSuccessful",
+    "KeepRunningUntilFailure",
+    "RunOnce",
+)
 MAX_OUT_DEGREE = 4
 
 
@@ -136,8 +149,16 @@ def random_fsm(
 class _BTBuilder:
     """Breadth-first builder that keeps a node budget and one path of exactly ``depth`` levels."""
 
-    def __init__(self, rng: random.Random, depth: int, breadth: int, scenario: str,
-                 extended: bool, max_nodes: int, condition_ratio: float) -> None:
+    def __init__(
+        self,
+        rng: random.Random,
+        depth: int,
+        breadth: int,
+        scenario: str,
+        extended: bool,
+        max_nodes: int,
+        condition_ratio: float,
+    ) -> None:
         self.rng = rng
         self.depth = depth
         self.breadth = breadth
@@ -194,8 +215,9 @@ class _BTBuilder:
     # structure --------------------------------------------------------------------------------
     def child(self, level: int, spine: bool) -> tuple[BTNode, BTNode | None, int]:
         """A child at ``level``: (node to attach, control node to expand or None, its level)."""
-        make_control = spine or (level < self.depth and self.count < self.max_nodes
-                                 and self.rng.random() < 0.3)
+        make_control = spine or (
+            level < self.depth and self.count < self.max_nodes and self.rng.random() < 0.3
+        )
         decorate = self.extended and self.rng.random() < 0.2
         if decorate:
             # the decorated node sits one level lower; it must still fit in ``depth``
@@ -233,8 +255,9 @@ class _BTBuilder:
                 top, expand, expand_level = self.child(level + 1, continue_spine)
                 node.children.append(top)
                 if expand is not None:
-                    queue.append((expand, expand_level,
-                                  continue_spine and expand_level + 1 < self.depth))
+                    queue.append(
+                        (expand, expand_level, continue_spine and expand_level + 1 < self.depth)
+                    )
             if node.type == "Parallel":
                 n = len(node.children)
                 node.attrs["success_count"] = str(self.rng.randint(1, n))
@@ -274,5 +297,13 @@ def random_bt(
     return doc
 
 
-__all__ = ["random_fsm", "random_bt", "make_rng", "FSM_SHAPES", "DECORATORS",
-           "EXTENDED_CONTROLS", "PAPER_CONTROLS", "letters"]
+__all__ = [
+    "random_fsm",
+    "random_bt",
+    "make_rng",
+    "FSM_SHAPES",
+    "DECORATORS",
+    "EXTENDED_CONTROLS",
+    "PAPER_CONTROLS",
+    "letters",
+]

@@ -72,11 +72,13 @@ class _GuardedStream(httpx2.SyncByteStream):
             if received > limit:
                 raise ResponseGuardError(
                     f"the response exceeded {limit} bytes and was cut off (raise the limit with "
-                    f"{limits.env_name('llm_max_response_bytes')})")
+                    f"{limits.env_name('llm_max_response_bytes')})"
+                )
             if self._guard.clock() > self._guard.deadline:
                 raise ResponseGuardError(
                     f"the response was still arriving after {self._guard.timeout_s:g} s "
-                    f"({received} bytes so far)")
+                    f"({received} bytes so far)"
+                )
             yield chunk
 
     def close(self) -> None:
@@ -101,9 +103,12 @@ class _GuardedTransport(httpx2.HTTPTransport):
     def handle_request(self, request: httpx2.Request) -> httpx2.Response:
         response = super().handle_request(request)
         assert isinstance(response.stream, httpx2.SyncByteStream)
-        return httpx2.Response(status_code=response.status_code, headers=response.headers,
-                               stream=_GuardedStream(response.stream, self.guard),
-                               extensions=response.extensions)
+        return httpx2.Response(
+            status_code=response.status_code,
+            headers=response.headers,
+            stream=_GuardedStream(response.stream, self.guard),
+            extensions=response.extensions,
+        )
 
 
 class LLMClient:
@@ -121,9 +126,13 @@ class LLMClient:
         self._clock = clock
         self._guard = _Guard(clock, settings.timeout_s)
         http_client = openai.DefaultHttpxClient(transport=_GuardedTransport(self._guard))
-        self._client = openai.OpenAI(base_url=settings.base_url, api_key=settings.api_key,
-                                     timeout=settings.timeout_s, max_retries=0,
-                                     http_client=http_client)
+        self._client = openai.OpenAI(
+            base_url=settings.base_url,
+            api_key=settings.api_key,
+            timeout=settings.timeout_s,
+            max_retries=0,
+            http_client=http_client,
+        )
 
     def complete(self, messages: list[Message]) -> Completion:
         """Send ``messages``; return the first choice's text. Raises ``LLMUnavailableError``."""
@@ -139,14 +148,17 @@ class LLMClient:
             attempts += 1
             remaining = deadline - self._clock()
             if remaining <= 0:
-                raise self._give_up(f"no answer within {s.timeout_s:g} s ({last_problem})",
-                                    attempts - 1, failures)
+                raise self._give_up(
+                    f"no answer within {s.timeout_s:g} s ({last_problem})", attempts - 1, failures
+                )
             try:
                 response = self._client.chat.completions.create(
                     model=s.model,
                     messages=cast("list[ChatCompletionMessageParam]", messages),
-                    temperature=s.temperature, top_p=s.top_p,
-                    seed=s.seed, timeout=remaining,
+                    temperature=s.temperature,
+                    top_p=s.top_p,
+                    seed=s.seed,
+                    timeout=remaining,
                     max_tokens=s.max_output_tokens if s.max_output_tokens else openai.omit,
                 )
             except openai.APITimeoutError:
@@ -166,7 +178,8 @@ class LLMClient:
                 if status != 429 and status < 500:
                     error = LLMUnavailableError(
                         f"the LLM endpoint {s.base_url} refused the request: HTTP {status} "
-                        f"{_short(_strip_code(exc.message))}")
+                        f"{_short(_strip_code(exc.message))}"
+                    )
                     error.failures = [*failures, f"HTTP {status}"]
                     raise error from None
                 last_problem = f"HTTP {status}"
@@ -179,8 +192,9 @@ class LLMClient:
                 delay = None
             else:
                 try:
-                    completion = self._completion(response, messages, self._clock() - start,
-                                                  attempts)
+                    completion = self._completion(
+                        response, messages, self._clock() - start, attempts
+                    )
                 except (AttributeError, TypeError, ValueError) as exc:  # not the chat shape
                     last_problem = f"a response that is not a chat completion: {_short(str(exc))}"
                     delay = None
@@ -192,18 +206,23 @@ class LLMClient:
                 raise self._give_up(last_problem, attempts, failures)
             wait = delay if delay is not None else s.backoff_s * (2 ** (attempts - 1))
             if self._clock() + wait >= deadline:
-                raise self._give_up(f"{last_problem}; the next retry would pass the "
-                                    f"{s.timeout_s:g} s timeout", attempts, failures)
+                raise self._give_up(
+                    f"{last_problem}; the next retry would pass the {s.timeout_s:g} s timeout",
+                    attempts,
+                    failures,
+                )
             self._sleep(wait)
 
     def _give_up(self, problem: str, attempts: int, failures: list[str]) -> LLMUnavailableError:
         error = LLMUnavailableError(
-            f"the LLM endpoint {self.settings.base_url} failed after {attempts} attempt(s): {problem}")
+            f"the LLM endpoint {self.settings.base_url} failed after {attempts} attempt(s): {problem}"
+        )
         error.failures = list(failures)
         return error
 
-    def _completion(self, response: Any, messages: list[Message], latency: float,
-                    attempts: int) -> Completion:
+    def _completion(
+        self, response: Any, messages: list[Message], latency: float, attempts: int
+    ) -> Completion:
         if not hasattr(response, "choices"):  # e.g. an HTML error page the SDK passed on as text
             raise TypeError(f"got {_short(repr(response), 80)}")
         choices = getattr(response, "choices", None) or []
@@ -214,11 +233,19 @@ class LLMClient:
             raise TypeError(f"the message content is a {type(text).__name__}, not text")
         usage = getattr(response, "usage", None)
         if usage is not None and usage.prompt_tokens is not None:
-            return Completion(text, int(usage.prompt_tokens), int(usage.completion_tokens or 0),
-                              latency, attempts, True)
+            return Completion(
+                text,
+                int(usage.prompt_tokens),
+                int(usage.completion_tokens or 0),
+                latency,
+                attempts,
+                True,
+            )
         from fsmbt.llm.tokens import count_messages, count_text
 
-        return Completion(text, count_messages(messages), count_text(text), latency, attempts, False)
+        return Completion(
+            text, count_messages(messages), count_text(text), latency, attempts, False
+        )
 
 
 def _guard_error(exc: BaseException) -> ResponseGuardError | None:

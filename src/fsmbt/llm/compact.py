@@ -15,8 +15,17 @@ from fsmbt.model.fsm import FSM
 from fsmbt.semantics.lebt.spec import DEFAULT_START
 
 #: Attributes that change a node's behavior and so stay in the outline.
-BEHAVIOR_ATTRS = ("num_cycles", "num_attempts", "success_count", "failure_count", "max_failures",
-                  "if", "else", "code", "ID")
+BEHAVIOR_ATTRS = (
+    "num_cycles",
+    "num_attempts",
+    "success_count",
+    "failure_count",
+    "max_failures",
+    "if",
+    "else",
+    "code",
+    "ID",
+)
 
 
 def compact_fsm(fsm: FSM) -> str:
@@ -24,8 +33,11 @@ def compact_fsm(fsm: FSM) -> str:
     lines = [f"FSM {fsm.name}"]
     start = fsm.start_name or DEFAULT_START
     event = fsm.initial_event if fsm.initial_event is not None else ""
-    lines.append(f"start: {start} --{event}--> {fsm.initial}" if event
-                 else f"start: {start} enters {fsm.initial} with no event")
+    lines.append(
+        f"start: {start} --{event}--> {fsm.initial}"
+        if event
+        else f"start: {start} enters {fsm.initial} with no event"
+    )
     items = []
     for state in fsm.states.values():
         item = state.name
@@ -40,7 +52,9 @@ def compact_fsm(fsm: FSM) -> str:
     lines.append("transitions (source: event->target):")
     by_source: dict[str, list[str]] = {}
     for t in fsm.transitions:
-        by_source.setdefault(t.source, []).append(f"{t.event if t.event is not None else '(none)'}->{t.target}")
+        by_source.setdefault(t.source, []).append(
+            f"{t.event if t.event is not None else '(none)'}->{t.target}"
+        )
     lines.extend(f"{source}: {', '.join(items)}" for source, items in by_source.items())
     return "\n".join(lines)
 

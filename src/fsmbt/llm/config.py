@@ -95,7 +95,9 @@ def default_log_path(env: Mapping[str, str]) -> Path:
     return Path(state) / "fsmbt" / "llm.jsonl"
 
 
-def load_config_file(env: Mapping[str, str], cwd: Path | None = None) -> tuple[dict[str, Any], Path | None]:
+def load_config_file(
+    env: Mapping[str, str], cwd: Path | None = None
+) -> tuple[dict[str, Any], Path | None]:
     """The ``[llm]`` settings of the first config file found, and its path."""
     candidates: list[tuple[Path, bool]] = []  # (path, must_exist)
     if env.get("FSMBT_LLM_CONFIG"):
@@ -158,12 +160,16 @@ def resolve_settings(
         raise LLMConfigError(
             "no LLM endpoint configured (the rules engine needs none): set FSMBT_LLM_BASE_URL "
             f"(a URL or one of {', '.join(sorted(PROVIDERS))}) or base_url in fsmbt.toml [llm]",
-            hints=(Hint.LLM_BASE_URL, Hint.RULES_ENGINE))
+            hints=(Hint.LLM_BASE_URL, Hint.RULES_ENGINE),
+        )
     url, provider = resolve_base_url(str(raw_url))
-    chosen_model = pick(model, "FSMBT_LLM_MODEL", "model") or (provider.default_model if provider else None)
+    chosen_model = pick(model, "FSMBT_LLM_MODEL", "model") or (
+        provider.default_model if provider else None
+    )
     if not chosen_model:
-        raise LLMConfigError(f"no LLM model configured for {url}: set FSMBT_LLM_MODEL",
-                             hints=(Hint.LLM_MODEL,))
+        raise LLMConfigError(
+            f"no LLM model configured for {url}: set FSMBT_LLM_MODEL", hints=(Hint.LLM_MODEL,)
+        )
     key = pick(api_key, "FSMBT_LLM_API_KEY", "api_key") or env.get("OPENAI_API_KEY")
     if not key:
         if provider is not None and not provider.needs_key:
@@ -171,13 +177,25 @@ def resolve_settings(
         else:
             raise LLMConfigError(
                 f"no API key for {url}: set FSMBT_LLM_API_KEY (or OPENAI_API_KEY); "
-                "for a keyless local server use any value, e.g. FSMBT_LLM_API_KEY=none")
-    settings = LLMSettings(base_url=url, model=str(chosen_model), api_key=str(key),
-                           provider=provider.name if provider else None)
+                "for a keyless local server use any value, e.g. FSMBT_LLM_API_KEY=none"
+            )
+    settings = LLMSettings(
+        base_url=url,
+        model=str(chosen_model),
+        api_key=str(key),
+        provider=provider.name if provider else None,
+    )
     numeric: dict[str, Any] = {}
-    for name, conv in (("temperature", float), ("top_p", float), ("seed", int), ("max_retries", int),
-                       ("backoff_s", float), ("max_regenerations", int),
-                       ("max_output_tokens", int), ("timeout_s", float)):
+    for name, conv in (
+        ("temperature", float),
+        ("top_p", float),
+        ("seed", int),
+        ("max_retries", int),
+        ("backoff_s", float),
+        ("max_regenerations", int),
+        ("max_output_tokens", int),
+        ("timeout_s", float),
+    ):
         if name in file_cfg:
             numeric[name] = _convert(file_cfg[name], conv, name, file_path)
     env_timeout = env.get("FSMBT_LLM_TIMEOUT")

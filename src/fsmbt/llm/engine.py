@@ -42,47 +42,67 @@ class LLMConversionError(FsmbtError):
 def client_from_options(options: dict[str, Any]) -> LLMClient:
     """An ``LLMClient`` from engine options + environment + config (``LLMConfigError`` if none)."""
     settings = resolve_settings(
-        base_url=options.get("llm_base_url"), model=options.get("llm_model"),
-        api_key=options.get("llm_api_key"), timeout_s=options.get("llm_timeout"),
-        max_regenerations=options.get("max_regenerations"), log_path=options.get("llm_log"))
+        base_url=options.get("llm_base_url"),
+        model=options.get("llm_model"),
+        api_key=options.get("llm_api_key"),
+        timeout_s=options.get("llm_timeout"),
+        max_regenerations=options.get("max_regenerations"),
+        log_path=options.get("llm_log"),
+    )
     return LLMClient(settings)
 
 
 def _refuse_loop(engine: str, options: dict[str, Any]) -> None:
     if options.get("loop"):
-        raise UnsupportedError(f"engine '{engine}' converts without the loop option",
-                               hints=(Hint.RULES_ENGINE,))
+        raise UnsupportedError(
+            f"engine '{engine}' converts without the loop option", hints=(Hint.RULES_ENGINE,)
+        )
 
 
 def _run(engine: str, model: Model, scp: bool, options: dict[str, Any]) -> ConversionResult:
     _refuse_loop(engine, options)
     client = options.get("client") or client_from_options(options)
     outcome = convert_with_llm(
-        model, client, scp=scp, disabled_modules=_modules(options.get("ablate")),
+        model,
+        client,
+        scp=scp,
+        disabled_modules=_modules(options.get("ablate")),
         max_regenerations=options.get("max_regenerations"),
         verifier=default_verifier(options.get("verify_engine") or "native"),
-        engine_name=engine, source_name=str(options.get("source_name") or "<input>"))
+        engine_name=engine,
+        source_name=str(options.get("source_name") or "<input>"),
+    )
     if not outcome.equivalent or outcome.result is None:
         raise LLMConversionError(_failure_message(engine, outcome))
-    return ConversionResult(outcome.result, engine, DIRECTION[isinstance(model, FSM)],
-                            stats=_stats(outcome))
+    return ConversionResult(
+        outcome.result, engine, DIRECTION[isinstance(model, FSM)], stats=_stats(outcome)
+    )
 
 
 def _failure_message(engine: str, outcome: LLMOutcome) -> str:
     record = outcome.record
     last = record.rounds[-1] if record.rounds else None
     why = "; ".join(last.problems[:3]) if last and last.problems else "no usable answer"
-    stage = {"parse": "unreadable answer", "structure": "structurally wrong answer",
-             "verify": "not equivalent"}.get(last.stage if last else "", "failed")
-    return (f"engine '{engine}': {stage} after {len(record.rounds)} round(s) "
-            f"({record.model}): {why}")
+    stage = {
+        "parse": "unreadable answer",
+        "structure": "structurally wrong answer",
+        "verify": "not equivalent",
+    }.get(last.stage if last else "", "failed")
+    return f"engine '{engine}': {stage} after {len(record.rounds)} round(s) ({record.model}): {why}"
 
 
 def _stats(outcome: LLMOutcome) -> dict[str, Any]:
     r = outcome.record
-    return {"prompt": r.prompt, "llm_model": r.model, "first_pass_success": r.first_pass_success,
-            "regenerations": r.regenerations, "tokens_in": r.tokens_in, "tokens_out": r.tokens_out,
-            "latency_s": r.latency_s, "verdict": r.verdict}
+    return {
+        "prompt": r.prompt,
+        "llm_model": r.model,
+        "first_pass_success": r.first_pass_success,
+        "regenerations": r.regenerations,
+        "tokens_in": r.tokens_in,
+        "tokens_out": r.tokens_out,
+        "latency_s": r.latency_s,
+        "verdict": r.verdict,
+    }
 
 
 def _modules(value: Any) -> Iterable[str]:
@@ -101,16 +121,37 @@ def hybrid(model: Model, **options: Any) -> ConversionResult:
     report = default_verifier(options.get("verify_engine") or "native")(model, converted.model)
     if not report.equivalent:
         failing = ", ".join(p.name for p in report.properties.values() if not p.holds)
-        raise LLMConversionError(f"engine 'hybrid': the rules result failed verification ({failing})")
+        raise LLMConversionError(
+            f"engine 'hybrid': the rules result failed verification ({failing})"
+        )
     stats = dict(converted.stats)
-    stats.update({"verified": True, "verify_engine": report.engine,
-                  "extracted_by_llm": bool(options.get("extracted_by_llm", False))})
-    return ConversionResult(converted.model, "hybrid", converted.direction, stats, list(converted.warnings))
+    stats.update(
+        {
+            "verified": True,
+            "verify_engine": report.engine,
+            "extracted_by_llm": bool(options.get("extracted_by_llm", False)),
+        }
+    )
+    return ConversionResult(
+        converted.model, "hybrid", converted.direction, stats, list(converted.warnings)
+    )
 
 
-register_engine("llm", lambda m, **o: _run("llm", m, True, o), lambda m, **o: _run("llm", m, True, o),
-                "an LLM with the paper's structured prompt, verified, with feedback rounds")
-register_engine("nllm", lambda m, **o: _run("nllm", m, False, o), lambda m, **o: _run("nllm", m, False, o),
-                "baseline: the same LLM request without the stepwise procedure")
-register_engine("hybrid", hybrid, hybrid,
-                "the LLM only extracts the source model; rules convert; the checker verifies")
+register_engine(
+    "llm",
+    lambda m, **o: _run("llm", m, True, o),
+    lambda m, **o: _run("llm", m, True, o),
+    "an LLM with the paper's structured prompt, verified, with feedback rounds",
+)
+register_engine(
+    "nllm",
+    lambda m, **o: _run("nllm", m, False, o),
+    lambda m, **o: _run("nllm", m, False, o),
+    "baseline: the same LLM request without the stepwise procedure",
+)
+register_engine(
+    "hybrid",
+    hybrid,
+    hybrid,
+    "the LLM only extracts the source model; rules convert; the checker verifies",
+)

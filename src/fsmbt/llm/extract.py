@@ -96,8 +96,14 @@ def needs_llm(path: str | Path, fmt: str | None = None) -> bool:
     return False
 
 
-def read_input(path: str | Path, fmt: str | None = None, *, client: LLMClient | None = None,
-               kind: str | None = None, max_regenerations: int | None = None) -> InputOutcome:
+def read_input(
+    path: str | Path,
+    fmt: str | None = None,
+    *,
+    client: LLMClient | None = None,
+    kind: str | None = None,
+    max_regenerations: int | None = None,
+) -> InputOutcome:
     """Read ``path`` with a parser when one knows it; otherwise let the LLM extract it.
 
     A reader chosen by ``--from`` or by the content has the last word (its errors are reported);
@@ -117,33 +123,66 @@ def read_input(path: str | Path, fmt: str | None = None, *, client: LLMClient | 
                 if final:
                     raise
                 if client is None:
-                    raise InputError(f"{exc.message} (read as {parser.name} from the file name; if "
-                                     "it is prose or another notation, an LLM can extract the "
-                                     "model)", location=exc.location, element=exc.element,
-                                     hints=(*exc.hints, Hint.LLM_ENGINE)) from None
+                    raise InputError(
+                        f"{exc.message} (read as {parser.name} from the file name; if "
+                        "it is prose or another notation, an LLM can extract the "
+                        "model)",
+                        location=exc.location,
+                        element=exc.element,
+                        hints=(*exc.hints, Hint.LLM_ENGINE),
+                    ) from None
         elif client is None:
-            raise InputError("no reader knows this input; an LLM can extract the model from it",
-                             location=SourceLocation(str(path)), hints=(Hint.LLM_ENGINE,))
+            raise InputError(
+                "no reader knows this input; an LLM can extract the model from it",
+                location=SourceLocation(str(path)),
+                hints=(Hint.LLM_ENGINE,),
+            )
     if client is None:
-        raise InputError("this input needs an LLM to extract the model (configure one: "
-                         "docs/llm.md)", location=SourceLocation(str(path)))
+        raise InputError(
+            "this input needs an LLM to extract the model (configure one: docs/llm.md)",
+            location=SourceLocation(str(path)),
+        )
     if mime is not None:
-        return extract_model(client, image=data, image_mime_type=mime, kind=kind,
-                             source_name=str(path), max_regenerations=max_regenerations)
-    return extract_model(client, text=decode(data, str(path)), kind=kind, source_name=str(path),
-                         max_regenerations=max_regenerations)
+        return extract_model(
+            client,
+            image=data,
+            image_mime_type=mime,
+            kind=kind,
+            source_name=str(path),
+            max_regenerations=max_regenerations,
+        )
+    return extract_model(
+        client,
+        text=decode(data, str(path)),
+        kind=kind,
+        source_name=str(path),
+        max_regenerations=max_regenerations,
+    )
 
 
-def extract_model(client: LLMClient, *, text: str | None = None, image: bytes | None = None,
-                  image_mime_type: str | None = None, kind: str | None = None,
-                  source_name: str = "<input>", max_regenerations: int | None = None) -> InputOutcome:
+def extract_model(
+    client: LLMClient,
+    *,
+    text: str | None = None,
+    image: bytes | None = None,
+    image_mime_type: str | None = None,
+    kind: str | None = None,
+    source_name: str = "<input>",
+    max_regenerations: int | None = None,
+) -> InputOutcome:
     """Ask the LLM for the model in fsmbt JSON and read it like a JSON file."""
     settings = client.settings
-    rounds_allowed = 1 + (settings.max_regenerations if max_regenerations is None else max_regenerations)
+    rounds_allowed = 1 + (
+        settings.max_regenerations if max_regenerations is None else max_regenerations
+    )
     prompt = extraction_messages(text=text, image=image, image_mime=image_mime_type, kind=kind)
-    record = ConversionRecord(engine="extract", task="extract",
-                              prompt=f"extract.v{DEFAULT_VERSION}" + ("+image" if image else ""),
-                              model=settings.model, source=source_name)
+    record = ConversionRecord(
+        engine="extract",
+        task="extract",
+        prompt=f"extract.v{DEFAULT_VERSION}" + ("+image" if image else ""),
+        model=settings.model,
+        source=source_name,
+    )
     conversation: list[Message] = list(prompt)
     try:
         for round_no in range(rounds_allowed):
@@ -152,15 +191,33 @@ def extract_model(client: LLMClient, *, text: str | None = None, image: bytes | 
                 model = read_extracted(completion.text, kind=kind)
             except AnswerError as exc:
                 problems = [str(exc)]
-                record.add_round(RoundRecord(round_no, "parse", problems, completion.tokens_in,
-                                             completion.tokens_out, round(completion.latency_s, 4),
-                                             completion.attempts))
-                conversation = prompt + [{"role": "assistant", "content": completion.text},
-                                         feedback_message(problems, None, "fsmbt JSON")]
+                record.add_round(
+                    RoundRecord(
+                        round_no,
+                        "parse",
+                        problems,
+                        completion.tokens_in,
+                        completion.tokens_out,
+                        round(completion.latency_s, 4),
+                        completion.attempts,
+                    )
+                )
+                conversation = prompt + [
+                    {"role": "assistant", "content": completion.text},
+                    feedback_message(problems, None, "fsmbt JSON"),
+                ]
                 continue
-            record.add_round(RoundRecord(round_no, "ok", [], completion.tokens_in,
-                                         completion.tokens_out, round(completion.latency_s, 4),
-                                         completion.attempts))
+            record.add_round(
+                RoundRecord(
+                    round_no,
+                    "ok",
+                    [],
+                    completion.tokens_in,
+                    completion.tokens_out,
+                    round(completion.latency_s, 4),
+                    completion.attempts,
+                )
+            )
             record.verdict = EXTRACTED
             append_record(settings.log_path, record)
             return InputOutcome(model, True, record)
@@ -172,8 +229,10 @@ def extract_model(client: LLMClient, *, text: str | None = None, image: bytes | 
     record.verdict = INVALID_ANSWER
     append_record(settings.log_path, record)
     last = record.rounds[-1].problems[0] if record.rounds else "no answer"
-    raise LLMExtractionError(f"the LLM gave no valid model after {len(record.rounds)} round(s); "
-                             f"last problem: {last}", location=SourceLocation(source_name))
+    raise LLMExtractionError(
+        f"the LLM gave no valid model after {len(record.rounds)} round(s); last problem: {last}",
+        location=SourceLocation(source_name),
+    )
 
 
 def read_extracted(answer: str, *, kind: str | None = None) -> Model:
@@ -182,7 +241,9 @@ def read_extracted(answer: str, *, kind: str | None = None) -> Model:
     try:
         data = json.loads(payload)
     except json.JSONDecodeError as exc:
-        raise AnswerError(f"invalid JSON at line {exc.lineno} column {exc.colno}: {exc.msg}") from None
+        raise AnswerError(
+            f"invalid JSON at line {exc.lineno} column {exc.colno}: {exc.msg}"
+        ) from None
     if isinstance(data, dict) and "kind" not in data:
         data["kind"] = kind or ("bt" if "trees" in data else "fsm")
     if kind is not None and isinstance(data, dict) and data.get("kind") != kind:
@@ -212,4 +273,6 @@ def _read_bytes(path: Path) -> bytes:
     try:
         return read_bounded(path)
     except OSError as exc:
-        raise InputError(f"cannot read: {exc.strerror}", location=SourceLocation(str(path))) from None
+        raise InputError(
+            f"cannot read: {exc.strerror}", location=SourceLocation(str(path))
+        ) from None

@@ -85,4 +85,6 @@ def read_records(path: Path) -> list[dict[str, Any]]:
     """Every record of a log file (for benchmarks and tests)."""
     if not path.exists():
         return []
-    return [json.loads(line) for line in path.read_text(encoding="utf-8").splitlines() if line.strip()]
+    return [
+        json.loads(line) for line in path.read_text(encoding="utf-8").splitlines() if line.strip()
+    ]

@@ -40,8 +40,10 @@ def extract_xml(text: str) -> str:
     if start < 0 or end < start:
         raise AnswerError("the answer holds no BT.CPP XML document (<root ...>...</root>)")
     header = source[:start]
-    declaration = header[header.rfind("<?xml"):] if "<?xml" in header else ""
-    return (declaration.strip() + "\n" if declaration else "") + source[start:end + len("</root>")]
+    declaration = header[header.rfind("<?xml") :] if "<?xml" in header else ""
+    return (declaration.strip() + "\n" if declaration else "") + source[
+        start : end + len("</root>")
+    ]
 
 
 def extract_json(text: str) -> str:
@@ -51,7 +53,7 @@ def extract_json(text: str) -> str:
     start, end = source.find("{"), source.rfind("}")
     if start < 0 or end < start:
         raise AnswerError("the answer holds no JSON object")
-    return source[start:end + 1]
+    return source[start : end + 1]
 
 
 def parse_json_model(text: str, *, default_kind: str | None = None) -> FSM | BTDocument:
@@ -59,7 +61,9 @@ def parse_json_model(text: str, *, default_kind: str | None = None) -> FSM | BTD
     try:
         data = json.loads(payload)
     except json.JSONDecodeError as exc:
-        raise AnswerError(f"invalid JSON at line {exc.lineno} column {exc.colno}: {exc.msg}") from None
+        raise AnswerError(
+            f"invalid JSON at line {exc.lineno} column {exc.colno}: {exc.msg}"
+        ) from None
     except RecursionError:
         raise AnswerError("JSON nested too deeply") from None
     if isinstance(data, dict) and "kind" not in data and default_kind is not None:

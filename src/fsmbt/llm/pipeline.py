@@ -69,6 +69,7 @@ def direction_for(model: Model) -> str:
 
 def default_verifier(engine: str = "native") -> Verifier:
     """The project's checker through its public API (imported late: it is optional here)."""
+
     def run(source: Model, result: Model) -> Report:
         from fsmbt.verify import verify
 
@@ -96,11 +97,18 @@ def convert_with_llm(
     direction = direction_for(source)
     options = PromptOptions(direction, scp=scp, disabled_modules=frozenset(disabled_modules))
     settings = client.settings
-    rounds_allowed = 1 + (settings.max_regenerations if max_regenerations is None else max_regenerations)
+    rounds_allowed = 1 + (
+        settings.max_regenerations if max_regenerations is None else max_regenerations
+    )
     verify = verifier or default_verifier()
     flat_source = flatten(source) if isinstance(source, FSM) else None
-    record = ConversionRecord(engine=engine_name or ("llm" if scp else "nllm"), task=direction,
-                              prompt=options.label, model=settings.model, source=source_name)
+    record = ConversionRecord(
+        engine=engine_name or ("llm" if scp else "nllm"),
+        task=direction,
+        prompt=options.label,
+        model=settings.model,
+        source=source_name,
+    )
     prompt = conversion_messages(flat_source if flat_source is not None else source, options)
     conversation: list[Message] = list(prompt)
     result: Model | None = None
@@ -109,12 +117,22 @@ def convert_with_llm(
         for round_no in range(rounds_allowed):
             completion = client.complete(conversation)
             stage, problems, counterexample, candidate, candidate_report = _judge(
-                source, flat_source, completion.text, verify)
+                source, flat_source, completion.text, verify
+            )
             if candidate is not None:
                 result, report = candidate, candidate_report
-            record.add_round(RoundRecord(round_no, stage, problems, completion.tokens_in,
-                                         completion.tokens_out, round(completion.latency_s, 4),
-                                         completion.attempts, list(completion.failures)))
+            record.add_round(
+                RoundRecord(
+                    round_no,
+                    stage,
+                    problems,
+                    completion.tokens_in,
+                    completion.tokens_out,
+                    round(completion.latency_s, 4),
+                    completion.attempts,
+                    list(completion.failures),
+                )
+            )
             if stage == "ok":
                 break
             conversation = prompt + [
@@ -124,8 +142,18 @@ def convert_with_llm(
     except LLMUnavailableError as exc:
         # the round that could not be completed is recorded with each attempt's cause; the
         # rounds before it and their best result stay in the record and on the exception
-        record.add_round(RoundRecord(len(record.rounds), "unavailable", [str(exc)], 0, 0, 0.0,
-                                     len(exc.failures), list(exc.failures)))
+        record.add_round(
+            RoundRecord(
+                len(record.rounds),
+                "unavailable",
+                [str(exc)],
+                0,
+                0,
+                0.0,
+                len(exc.failures),
+                list(exc.failures),
+            )
+        )
         record.verdict = UNAVAILABLE
         record.extra["error"] = str(exc)
         append_record(settings.log_path, record)
@@ -139,11 +167,14 @@ def convert_with_llm(
     return LLMOutcome(result, report, record)
 
 
-def _judge(source: Model, flat_source: FSM | None, answer: str, verify: Verifier
-           ) -> tuple[str, list[str], str | None, Model | None, Report | None]:
+def _judge(
+    source: Model, flat_source: FSM | None, answer: str, verify: Verifier
+) -> tuple[str, list[str], str | None, Model | None, Report | None]:
     """(stage, problems, counterexample text, parsed result, report) of one answer."""
     try:
-        result: Model = parse_bt_answer(answer) if flat_source is not None else parse_fsm_answer(answer)
+        result: Model = (
+            parse_bt_answer(answer) if flat_source is not None else parse_fsm_answer(answer)
+        )
     except AnswerError as exc:
         return "parse", [str(exc)], None, None, None
     if flat_source is not None:
@@ -162,14 +193,18 @@ def _judge(source: Model, flat_source: FSM | None, answer: str, verify: Verifier
         return "ok", [], None, result, report
     failing = [p for p in report.properties.values() if not p.holds]
     problems = [f"{p.name} fails: {p.detail}".rstrip(": ") for p in failing] or [
-        "the checker found the result not equivalent"]
+        "the checker found the result not equivalent"
+    ]
     return "verify", problems, render_counterexample(report), result, report
 
 
 def render_counterexample(report: Report) -> str | None:
     """The shortest failing trace, one step a line, in words the model can act on."""
-    traces = [(p.name, p.counterexample) for p in report.properties.values()
-              if not p.holds and p.counterexample]
+    traces = [
+        (p.name, p.counterexample)
+        for p in report.properties.values()
+        if not p.holds and p.counterexample
+    ]
     if not traces:
         return None
     name, steps = min(traces, key=lambda item: len(item[1]))
@@ -181,7 +216,8 @@ def render_counterexample(report: Report) -> str | None:
         lines.append(
             f"{step.step}. {given}: source ran [{', '.join(step.source_outputs)}] and is in "
             f"{step.source_state} ({step.source_status}); yours ran [{', '.join(step.result_outputs)}] "
-            f"and is in {step.result_state} ({step.result_status})")
+            f"and is in {step.result_state} ({step.result_status})"
+        )
     if len(steps) > MAX_TRACE_STEPS:
         lines.append(f"... {len(steps) - MAX_TRACE_STEPS} more step(s)")
     return "\n".join(lines)

@@ -51,8 +51,10 @@ class PromptOptions:
             raise InputError(f"unknown conversion direction {self.direction!r}")
         unknown = set(self.disabled_modules) - set(MODULES[self.direction])
         if unknown:
-            raise InputError(f"unknown SCP module(s) {', '.join(sorted(unknown))} for "
-                             f"{self.direction} (known: {', '.join(MODULES[self.direction])})")
+            raise InputError(
+                f"unknown SCP module(s) {', '.join(sorted(unknown))} for "
+                f"{self.direction} (known: {', '.join(MODULES[self.direction])})"
+            )
 
     @property
     def template_id(self) -> str:
@@ -95,7 +97,7 @@ def select_modules(scp: str, disabled: frozenset[str]) -> str:
     keep = True
     for line in scp.splitlines():
         if line.startswith("### module: "):
-            keep = line[len("### module: "):].strip() not in disabled
+            keep = line[len("### module: ") :].strip() not in disabled
             continue
         if keep:
             kept.append(line)
@@ -112,7 +114,9 @@ def conversion_messages(model: FSM | BTDocument, options: PromptOptions) -> list
     """The system and user messages of one conversion request."""
     expected = FSM if options.direction == FSM_TO_BT else BTDocument
     if not isinstance(model, expected):
-        raise InputError(f"{options.direction} needs a {'FSM' if expected is FSM else 'BT'} as input")
+        raise InputError(
+            f"{options.direction} needs a {'FSM' if expected is FSM else 'BT'} as input"
+        )
     parts = split_parts(load_template(options.direction, options.version))
     user_parts = [f"# Task\n{parts['Task']}"]
     if options.scp:
@@ -121,12 +125,15 @@ def conversion_messages(model: FSM | BTDocument, options: PromptOptions) -> list
             user_parts.append(f"# {SCP_TITLE}\n{scp}")
     constraints = Template(parts["Constraints"]).substitute(model=render_model(model))
     user_parts.append(f"# Constraints\n{constraints}")
-    return [{"role": "system", "content": parts["Role"]},
-            {"role": "user", "content": "\n\n".join(user_parts)}]
+    return [
+        {"role": "system", "content": parts["Role"]},
+        {"role": "user", "content": "\n\n".join(user_parts)},
+    ]
 
 
-def messages_for(model: FSM | BTDocument, *, scp: bool = True,
-                 disabled_modules: frozenset[str] = frozenset()) -> tuple[PromptOptions, list[Message]]:
+def messages_for(
+    model: FSM | BTDocument, *, scp: bool = True, disabled_modules: frozenset[str] = frozenset()
+) -> tuple[PromptOptions, list[Message]]:
     """The exact messages a conversion of ``model`` sends (what ``fsmbt llm prompt`` shows).
 
     An FSM is shown flat (hierarchy flattened first), as the conversion engines send it.
@@ -147,19 +154,29 @@ def messages_for(model: FSM | BTDocument, *, scp: bool = True,
     return options, conversion_messages(shown, options)
 
 
-def feedback_message(problems: list[str], counterexample: str | None, output_format: str,
-                     version: int = DEFAULT_VERSION) -> Message:
+def feedback_message(
+    problems: list[str],
+    counterexample: str | None,
+    output_format: str,
+    version: int = DEFAULT_VERSION,
+) -> Message:
     """The user message that sends the concrete errors (and a counterexample) back."""
     listed = "\n".join(f"- {p}" for p in problems)
     trace = f"Counterexample:\n{counterexample}" if counterexample else ""
     text = Template(load_template("feedback", version)).substitute(
-        problems=f"Problems:\n{listed}", counterexample=trace, format=output_format)
+        problems=f"Problems:\n{listed}", counterexample=trace, format=output_format
+    )
     return {"role": "user", "content": re.sub(r"\n{3,}", "\n\n", text).strip()}
 
 
-def extraction_messages(*, text: str | None = None, image: bytes | None = None,
-                        image_mime: str | None = None, kind: str | None = None,
-                        version: int = DEFAULT_VERSION) -> list[Message]:
+def extraction_messages(
+    *,
+    text: str | None = None,
+    image: bytes | None = None,
+    image_mime: str | None = None,
+    kind: str | None = None,
+    version: int = DEFAULT_VERSION,
+) -> list[Message]:
     """Messages asking the model to write a model given as text or as a picture in fsmbt JSON.
 
     An image travels as an ``image_url`` part holding a base64 ``data:`` URL (the OpenAI vision
@@ -167,8 +184,9 @@ def extraction_messages(*, text: str | None = None, image: bytes | None = None,
     """
     if (text is None) == (image is None):
         raise ValueError("give exactly one of text and image")
-    hint = {"fsm": "It is a state machine.", "bt": "It is a behavior tree."}.get(kind or "",
-                                                                            "It is a state machine or a behavior tree.")
+    hint = {"fsm": "It is a state machine.", "bt": "It is a behavior tree."}.get(
+        kind or "", "It is a state machine or a behavior tree."
+    )
     parts = split_parts(load_template("extract", version))
     instructions = f"# Task\n{Template(parts['Task']).substitute(kind_hint=hint)}\n\n# Constraints\n{parts['Constraints']}"
     system = {"role": "system", "content": parts["Role"]}
@@ -176,7 +194,13 @@ def extraction_messages(*, text: str | None = None, image: bytes | None = None,
         return [system, {"role": "user", "content": f"{instructions}\n\nInput:\n{text}"}]
     assert image is not None and image_mime is not None
     url = f"data:{image_mime};base64,{base64.b64encode(image).decode('ascii')}"
-    return [system, {"role": "user", "content": [
-        {"type": "text", "text": f"{instructions}\n\nInput: the diagram in the image."},
-        {"type": "image_url", "image_url": {"url": url}},
-    ]}]
+    return [
+        system,
+        {
+            "role": "user",
+            "content": [
+                {"type": "text", "text": f"{instructions}\n\nInput: the diagram in the image."},
+                {"type": "image_url", "image_url": {"url": url}},
+            ],
+        },
+    ]

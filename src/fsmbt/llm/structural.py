@@ -71,8 +71,10 @@ def check_lebt(source: FSM, result: BTDocument) -> list[str]:
     for node in root.walk():
         where = _where(node)
         if node.type not in LEBT_NODE_TYPES:
-            problems.append(f"{where}: node type {node.type} is not allowed (use Sequence, Fallback, "
-                            f"{GUARD_TYPE}, {STATE_TYPE})")
+            problems.append(
+                f"{where}: node type {node.type} is not allowed (use Sequence, Fallback, "
+                f"{GUARD_TYPE}, {STATE_TYPE})"
+            )
         elif node.type in PAPER_CONTROLS and not node.children:
             problems.append(f"{where}: empty {node.type}")
         elif node.type == STATE_TYPE:
@@ -88,11 +90,15 @@ def check_lebt(source: FSM, result: BTDocument) -> list[str]:
             problems.append(f"state {name} has no {GUARD_TYPE} guarding it")
     for name, count in state_nodes.items():
         if count > 1:
-            problems.append(f"state {name} has {count} {STATE_TYPE} nodes; it must have exactly one")
+            problems.append(
+                f"state {name} has {count} {STATE_TYPE} nodes; it must have exactly one"
+            )
     for name, count in guard_targets.items():
         if count > 1:
-            problems.append(f"state {name} has {count} {GUARD_TYPE} nodes; all transitions into a "
-                            "state share one guard")
+            problems.append(
+                f"state {name} has {count} {GUARD_TYPE} nodes; all transitions into a "
+                "state share one guard"
+            )
     return _summarise(problems)
 
 
@@ -100,7 +106,9 @@ def _needs_guard(source: FSM, name: str) -> bool:
     return name == source.initial or any(t.target == name for t in source.transitions)
 
 
-def _check_state_leaf(source: FSM, spec: StateSpec, exits: dict[str, list[str]], where: str) -> list[str]:
+def _check_state_leaf(
+    source: FSM, spec: StateSpec, exits: dict[str, list[str]], where: str
+) -> list[str]:
     if not spec.state:
         return [f"{where}: {STATE_TYPE} without a 'state' port"]
     state = source.states.get(spec.state)
@@ -108,19 +116,30 @@ def _check_state_leaf(source: FSM, spec: StateSpec, exits: dict[str, list[str]],
         return [f"{where}: {STATE_TYPE} names state {spec.state!r}, which the FSM does not have"]
     problems = []
     if (spec.action or None) != (state.action or None):
-        problems.append(f"{where}: state {spec.state} must have action={state.action or ''!r}, "
-                        f"not {spec.action or ''!r}")
+        problems.append(
+            f"{where}: state {spec.state} must have action={state.action or ''!r}, "
+            f"not {spec.action or ''!r}"
+        )
     if spec.final != state.final:
-        problems.append(f"{where}: state {spec.state} must have final={'true' if state.final else 'false'}")
+        problems.append(
+            f"{where}: state {spec.state} must have final={'true' if state.final else 'false'}"
+        )
     expected = exits.get(spec.state, [])
     if sorted(spec.exits) != sorted(expected):
-        problems.append(f"{where}: state {spec.state} must have exits={';'.join(expected)!r}, "
-                        f"not {';'.join(spec.exits)!r}")
+        problems.append(
+            f"{where}: state {spec.state} must have exits={';'.join(expected)!r}, "
+            f"not {';'.join(spec.exits)!r}"
+        )
     return problems
 
 
-def _check_guard(source: FSM, attrs: dict[str, str], real_pairs: set[tuple[str, str, str]],
-                 targets: Counter[str], where: str) -> list[str]:
+def _check_guard(
+    source: FSM,
+    attrs: dict[str, str],
+    real_pairs: set[tuple[str, str, str]],
+    targets: Counter[str],
+    where: str,
+) -> list[str]:
     try:
         spec = GuardSpec.from_attrs(attrs)
     except ValueError as exc:
@@ -131,8 +150,10 @@ def _check_guard(source: FSM, attrs: dict[str, str], real_pairs: set[tuple[str, 
     problems = []
     for src, event in spec.pairs:
         if (src, event, spec.target) not in real_pairs:
-            problems.append(f"{where}: guard of {spec.target} lists {src}/{event}, but the FSM has "
-                            f"no transition {src} --{event or '(start)'}--> {spec.target}")
+            problems.append(
+                f"{where}: guard of {spec.target} lists {src}/{event}, but the FSM has "
+                f"no transition {src} --{event or '(start)'}--> {spec.target}"
+            )
     missing = sorted({(s, e) for s, e, t in real_pairs if t == spec.target} - set(spec.pairs))
     for src, event in missing:
         problems.append(f"{where}: guard of {spec.target} misses the pair {src}/{event}")
@@ -153,20 +174,27 @@ def check_hfsm(source: BTDocument, result: FSM) -> list[str]:
         for t in machine.transitions:
             for end in (t.source, t.target):
                 if end not in machine.states:
-                    problems.append(f"{level}: transition {t.source} --{t.event}--> {t.target} "
-                                    f"refers to a missing state {end!r}")
+                    problems.append(
+                        f"{level}: transition {t.source} --{t.event}--> {t.target} "
+                        f"refers to a missing state {end!r}"
+                    )
             if t.event is not None and t.event not in LEAF_EVENTS:
-                problems.append(f"{level}: event {t.event!r} is not a leaf outcome "
-                                "(success, failure, running)")
+                problems.append(
+                    f"{level}: event {t.event!r} is not a leaf outcome (success, failure, running)"
+                )
             key = (t.source, t.event if t.event is not None else f"exit:{t.exit}")
             if key in seen and seen[key] != t.target:
-                problems.append(f"{level}: {t.source} has two transitions on {key[1]} "
-                                f"({seen[key]} and {t.target})")
+                problems.append(
+                    f"{level}: {t.source} has two transitions on {key[1]} "
+                    f"({seen[key]} and {t.target})"
+                )
             seen.setdefault(key, t.target)
         for state in machine.states.values():
             if state.regions:
                 stack.extend((f"{prefix}{state.name}/", region) for region in state.regions)
-            elif not state.final and state.action is not None and state.action not in TERMINAL_STATES:
+            elif (
+                not state.final and state.action is not None and state.action not in TERMINAL_STATES
+            ):
                 actions[state.action] += 1
     leaves: Counter[str] = Counter()
     for _, node in source.nodes():
@@ -177,8 +205,10 @@ def check_hfsm(source: BTDocument, result: FSM) -> list[str]:
         if leaves[name] == 0:
             problems.append(f"a state runs {name!r}, which is not a leaf of the tree")
         elif exact and leaves[name] != actions[name]:
-            problems.append(f"leaf {name} occurs {leaves[name]} time(s) in the tree but has "
-                            f"{actions[name]} state(s)")
+            problems.append(
+                f"leaf {name} occurs {leaves[name]} time(s) in the tree but has "
+                f"{actions[name]} state(s)"
+            )
     return _summarise(problems)
 
 

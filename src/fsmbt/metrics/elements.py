@@ -46,10 +46,16 @@ class Elements:
 def bt_elements(doc: BTDocument) -> Elements:
     stats = bt_stats(doc)
     edges = sum(max(t.nodes - 1, 0) for t in stats.per_tree)
-    return Elements(kind="bt", graphical=stats.nodes + edges,
-                    active=stats.actions + stats.conditions, depth=stats.depth,
-                    nodes=stats.nodes, edges=edges, by_type=dict(stats.by_type),
-                    leaves=stats.leaves)
+    return Elements(
+        kind="bt",
+        graphical=stats.nodes + edges,
+        active=stats.actions + stats.conditions,
+        depth=stats.depth,
+        nodes=stats.nodes,
+        edges=edges,
+        by_type=dict(stats.by_type),
+        leaves=stats.leaves,
+    )
 
 
 def fsm_elements(fsm: FSM) -> Elements:
@@ -65,14 +71,29 @@ def fsm_elements(fsm: FSM) -> Elements:
         for state in machine.states.values():
             states += 1
             active += state.action is not None and not state.regions
-            kind = ("parallel" if state.is_parallel else "composite" if state.is_composite
-                    else "final" if state.final else "atomic")
+            kind = (
+                "parallel"
+                if state.is_parallel
+                else "composite"
+                if state.is_composite
+                else "final"
+                if state.final
+                else "atomic"
+            )
             kinds[kind] = kinds.get(kind, 0) + 1
             stack.extend((region, level + 1) for region in state.regions)
     graphical = states + machines + transitions + machines  # + start markers + initial arrows
-    return Elements(kind="fsm", graphical=graphical, active=active, depth=depth,
-                    by_type=dict(sorted(kinds.items())), states=states,
-                    transitions=transitions, machines=machines, sub_fsms=machines - 1)
+    return Elements(
+        kind="fsm",
+        graphical=graphical,
+        active=active,
+        depth=depth,
+        by_type=dict(sorted(kinds.items())),
+        states=states,
+        transitions=transitions,
+        machines=machines,
+        sub_fsms=machines - 1,
+    )
 
 
 def elements(model: FSM | BTDocument) -> Elements:

@@ -52,11 +52,22 @@ class Comparison:
     exact_share: float  # share of models where measured == predicted
 
     @classmethod
-    def of(cls, label: str, formula: str, measured: Sequence[int],
-           predicted: Sequence[int]) -> Comparison:
+    def of(
+        cls, label: str, formula: str, measured: Sequence[int], predicted: Sequence[int]
+    ) -> Comparison:
         if not measured or len(measured) != len(predicted):
             raise ValueError("need as many predictions as measurements (at least one)")
         deviations = [(m - p) / p if p else 0.0 for m, p in zip(measured, predicted)]
-        return cls(label, formula, len(measured), mean(measured), min(measured), max(measured),
-                   mean(predicted), mean(deviations), min(deviations), max(deviations),
-                   sum(m == p for m, p in zip(measured, predicted)) / len(measured))
+        return cls(
+            label,
+            formula,
+            len(measured),
+            mean(measured),
+            min(measured),
+            max(measured),
+            mean(predicted),
+            mean(deviations),
+            min(deviations),
+            max(deviations),
+            sum(m == p for m, p in zip(measured, predicted)) / len(measured),
+        )

@@ -9,7 +9,19 @@ from fsmbt.model.fsm import FSM, State, Transition
 Model = FSM | BTDocument
 
 __all__ = [
-    "FSM", "State", "Transition", "BTDocument", "BehaviorTree", "BTNode", "NodeModel",
-    "PortModel", "NodeKind", "FsmbtError", "InputError", "UnsupportedError", "SourceLocation",
-    "flatten", "Model",
+    "FSM",
+    "State",
+    "Transition",
+    "BTDocument",
+    "BehaviorTree",
+    "BTNode",
+    "NodeModel",
+    "PortModel",
+    "NodeKind",
+    "FsmbtError",
+    "InputError",
+    "UnsupportedError",
+    "SourceLocation",
+    "flatten",
+    "Model",
 ]

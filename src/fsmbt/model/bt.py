@@ -75,7 +75,12 @@ class BTNode:
         while stack:
             a, b = stack.pop()
             if (a.type, a.kind, a.name, a.attrs, a.kind_declared, len(a.children)) != (
-                b.type, b.kind, b.name, b.attrs, b.kind_declared, len(b.children)
+                b.type,
+                b.kind,
+                b.name,
+                b.attrs,
+                b.kind_declared,
+                len(b.children),
             ):
                 return False
             stack.extend(zip(a.children, b.children))

@@ -32,6 +32,12 @@ def builtin_spec(type_name: str) -> NodeSpec | None:
 
 
 __all__ = [
-    "BUILTIN_NODES", "FALLBACK_TYPES", "SEQUENCE_TYPES", "V3_ALIASES", "NodeKind", "NodeSpec",
-    "builtin_spec", "canonical_type",
+    "BUILTIN_NODES",
+    "FALLBACK_TYPES",
+    "SEQUENCE_TYPES",
+    "V3_ALIASES",
+    "NodeKind",
+    "NodeSpec",
+    "builtin_spec",
+    "canonical_type",
 ]

@@ -71,7 +71,9 @@ class _Flattener:
         try:
             return machine.states[name]
         except KeyError:
-            raise InputError(f"transition to unknown state '{name}'", element=machine.name) from None
+            raise InputError(
+                f"transition to unknown state '{name}'", element=machine.name
+            ) from None
 
     # -- semantics ----------------------------------------------------------------------------
     def enter(self, machine: FSM, name: str) -> _Config:
@@ -82,8 +84,11 @@ class _Flattener:
             inner = []
             for region in state.regions:
                 if region.initial is None:
-                    raise InputError("composite state has a sub-machine without initial state",
-                                     element=name, location=state.location)
+                    raise InputError(
+                        "composite state has a sub-machine without initial state",
+                        element=name,
+                        location=state.location,
+                    )
                 inner.append(self.enter(region, region.initial))
             config = _Config(name, tuple(inner))
         return self.settle(machine, config)
@@ -129,8 +134,9 @@ class _Flattener:
         if state.is_composite:
             done = self.is_done(state.regions[0], config.inner[0])
         else:
-            done = all(self.in_final(region, sub)
-                       for region, sub in zip(state.regions, config.inner))
+            done = all(
+                self.in_final(region, sub) for region, sub in zip(state.regions, config.inner)
+            )
         if not done:
             return None
         exit_name = config.inner[0].state if state.is_composite else None
@@ -166,9 +172,7 @@ class _Flattener:
         state = self.state(machine, config.state)
         if not config.inner:
             return state.action
-        parts = [
-            self.action(region, sub) for region, sub in zip(state.regions, config.inner)
-        ]
+        parts = [self.action(region, sub) for region, sub in zip(state.regions, config.inner)]
         kept = [p for p in parts if p is not None]
         return "+".join(kept) if kept else None
 
@@ -194,13 +198,20 @@ class _Flattener:
                 if len(seen) >= self.max_configurations:
                     raise InputError(
                         f"flattening exceeds {self.max_configurations} configurations "
-                        "(parallel regions multiply)", element=fsm.name)
+                        "(parallel regions multiply)",
+                        element=fsm.name,
+                    )
                 name = config.name()
                 seen[config] = name
                 top = self.state(fsm, config.state)
-                flat.add_state(State(name, action=self.action(fsm, config),
-                                     final=top.final and not config.inner,
-                                     location=top.location))
+                flat.add_state(
+                    State(
+                        name,
+                        action=self.action(fsm, config),
+                        final=top.final and not config.inner,
+                        location=top.location,
+                    )
+                )
                 queue.append(config)
             return name
 

@@ -95,13 +95,17 @@ def _machine_from_dict(data: dict[str, Any], where: str) -> FSM:
     return top
 
 
-def _fill_machine(data: dict[str, Any], where: str, fsm: FSM,
-                  stack: list[tuple[Any, str, FSM]]) -> None:
+def _fill_machine(
+    data: dict[str, Any], where: str, fsm: FSM, stack: list[tuple[Any, str, FSM]]
+) -> None:
     fsm.name = str(data.get("name", "fsm"))
     for i, s in enumerate(_as_list(data.get("states", []), f"{where}.states")):
         path = f"{where}.states[{i}]"
-        _expect(isinstance(s, dict) and isinstance(s.get("name"), str), path,
-                "a state needs a string 'name'")
+        _expect(
+            isinstance(s, dict) and isinstance(s.get("name"), str),
+            path,
+            "a state needs a string 'name'",
+        )
         if s["name"] in fsm.states:
             raise InputError(f"duplicate state '{s['name']}'", element=path)
         regions: list[FSM] = []
@@ -109,24 +113,34 @@ def _fill_machine(data: dict[str, Any], where: str, fsm: FSM,
             region = FSM(name="region")
             regions.append(region)
             stack.append((r, f"{path}.regions[{j}]", region))
-        fsm.add_state(State(
-            s["name"],
-            action=_opt_str(s.get("action", s["name"]), f"{path}.action"),
-            final=bool(s.get("final", False)),
-            regions=regions,
-            attrs=_str_dict(s.get("attrs", {})),
-        ))
+        fsm.add_state(
+            State(
+                s["name"],
+                action=_opt_str(s.get("action", s["name"]), f"{path}.action"),
+                final=bool(s.get("final", False)),
+                regions=regions,
+                attrs=_str_dict(s.get("attrs", {})),
+            )
+        )
     transitions = _as_list(data.get("transitions", []), f"{where}.transitions")
     for i, t in enumerate(transitions):
         path = f"{where}.transitions[{i}]"
-        _expect(isinstance(t, dict) and isinstance(t.get("source"), str)
-                and isinstance(t.get("target"), str), path,
-                "a transition needs string 'source' and 'target'")
+        _expect(
+            isinstance(t, dict)
+            and isinstance(t.get("source"), str)
+            and isinstance(t.get("target"), str),
+            path,
+            "a transition needs string 'source' and 'target'",
+        )
         event = t.get("event")
         _expect(event is None or isinstance(event, str), path, "'event' must be a string or null")
-        fsm.add_transition(t["source"], event, t["target"],
-                           exit=_opt_str(t.get("exit"), f"{path}.exit"),
-                           attrs=_str_dict(t.get("attrs", {})))
+        fsm.add_transition(
+            t["source"],
+            event,
+            t["target"],
+            exit=_opt_str(t.get("exit"), f"{path}.exit"),
+            attrs=_str_dict(t.get("attrs", {})),
+        )
     if "initial" in data:
         fsm.initial = _opt_str(data["initial"], f"{where}.initial")
     fsm.start_name = _opt_str(data.get("start"), f"{where}.start")
@@ -150,16 +164,22 @@ def bt_to_dict(doc: BTDocument) -> dict[str, Any]:
         "format_version": doc.format_version,
         "main_tree": doc.main_tree,
         "trees": [
-            {"id": t.id, "root": node_to_dict(t.root) if t.root is not None else None,
-             **({"attrs": dict(t.attrs)} if t.attrs else {})}
+            {
+                "id": t.id,
+                "root": node_to_dict(t.root) if t.root is not None else None,
+                **({"attrs": dict(t.attrs)} if t.attrs else {}),
+            }
             for t in doc.trees.values()
         ],
     }
     if doc.node_models:
         out["node_models"] = [
-            {"type": m.type, "kind": m.kind.value,
-             "ports": [vars(p).copy() for p in m.ports],
-             **({"attrs": dict(m.attrs)} if m.attrs else {})}
+            {
+                "type": m.type,
+                "kind": m.kind.value,
+                "ports": [vars(p).copy() for p in m.ports],
+                **({"attrs": dict(m.attrs)} if m.attrs else {}),
+            }
             for m in doc.node_models.values()
         ]
     if doc.includes:
@@ -179,6 +199,7 @@ def node_to_dict(root: BTNode) -> dict[str, Any]:
     Returns:
         Nested dicts, children under ``"children"``.
     """
+
     def shallow(node: BTNode) -> dict[str, Any]:
         d: dict[str, Any] = {"type": node.type, "kind": node.kind.value}
         if node.name is not None:
@@ -213,13 +234,21 @@ def node_from_dict(data: dict[str, Any], where: str = "node") -> BTNode:
     Raises:
         InputError: A missing or mistyped field, named by its path in the data.
     """
+
     def shallow(d: Any, path: str) -> BTNode:
-        _expect(isinstance(d, dict) and isinstance(d.get("type"), str), path,
-                "a node needs a string 'type'")
+        _expect(
+            isinstance(d, dict) and isinstance(d.get("type"), str),
+            path,
+            "a node needs a string 'type'",
+        )
         kind = _node_kind(d.get("kind", "Action"), path)
-        return BTNode(type=d["type"], kind=kind, name=_opt_str(d.get("name"), f"{path}.name"),
-                      attrs=_str_dict(d.get("attrs", {})),
-                      kind_declared=bool(d.get("kind_declared", True)))
+        return BTNode(
+            type=d["type"],
+            kind=kind,
+            name=_opt_str(d.get("name"), f"{path}.name"),
+            attrs=_str_dict(d.get("attrs", {})),
+            kind_declared=bool(d.get("kind_declared", True)),
+        )
 
     root = shallow(data, where)
     stack = [(data, root, where)]
@@ -246,25 +275,34 @@ def bt_from_dict(data: dict[str, Any], *, where: str = "bt") -> BTDocument:
         InputError: A missing or mistyped field, named by its path in the data.
     """
     _expect(isinstance(data, dict), where, "expected an object")
-    doc = BTDocument(format_version=str(data.get("format_version", "4")),
-                     main_tree=_opt_str(data.get("main_tree"), f"{where}.main_tree"),
-                     includes=[str(i) for i in _as_list(data.get("includes", []),
-                                                        f"{where}.includes")],
-                     attrs=_str_dict(data.get("attrs", {})))
+    doc = BTDocument(
+        format_version=str(data.get("format_version", "4")),
+        main_tree=_opt_str(data.get("main_tree"), f"{where}.main_tree"),
+        includes=[str(i) for i in _as_list(data.get("includes", []), f"{where}.includes")],
+        attrs=_str_dict(data.get("attrs", {})),
+    )
     for i, t in enumerate(_as_list(data.get("trees", []), f"{where}.trees")):
         path = f"{where}.trees[{i}]"
-        _expect(isinstance(t, dict) and isinstance(t.get("id"), str), path,
-                "a tree needs a string 'id'")
+        _expect(
+            isinstance(t, dict) and isinstance(t.get("id"), str), path, "a tree needs a string 'id'"
+        )
         root = node_from_dict(t["root"], f"{path}.root") if t.get("root") is not None else None
         doc.trees[t["id"]] = BehaviorTree(t["id"], root, attrs=_str_dict(t.get("attrs", {})))
     for i, m in enumerate(_as_list(data.get("node_models", []), f"{where}.node_models")):
         path = f"{where}.node_models[{i}]"
-        _expect(isinstance(m, dict) and isinstance(m.get("type"), str), path,
-                "a node model needs a string 'type'")
+        _expect(
+            isinstance(m, dict) and isinstance(m.get("type"), str),
+            path,
+            "a node model needs a string 'type'",
+        )
         kind = _node_kind(m.get("kind", "Action"), path)
-        ports = [_port_from_dict(p, f"{path}.ports[{j}]")
-                 for j, p in enumerate(_as_list(m.get("ports", []), f"{path}.ports"))]
-        doc.node_models[m["type"]] = NodeModel(m["type"], kind, ports, _str_dict(m.get("attrs", {})))
+        ports = [
+            _port_from_dict(p, f"{path}.ports[{j}]")
+            for j, p in enumerate(_as_list(m.get("ports", []), f"{path}.ports"))
+        ]
+        doc.node_models[m["type"]] = NodeModel(
+            m["type"], kind, ports, _str_dict(m.get("attrs", {}))
+        )
     return doc
 
 
@@ -301,23 +339,31 @@ def model_from_dict(data: Any, *, where: str = "model") -> FSM | BTDocument:
         return fsm_from_dict(data, where=where)
     if kind == "bt":
         return bt_from_dict(data, where=where)
-    raise InputError(f"'kind' must be \"fsm\" or \"bt\", not {kind!r}", element=where)
+    raise InputError(f'\'kind\' must be "fsm" or "bt", not {kind!r}', element=where)
 
 
 _PORT_FIELDS = ("name", "direction", "default", "description", "type")
 
 
 def _port_from_dict(data: Any, where: str) -> PortModel:
-    _expect(isinstance(data, dict) and isinstance(data.get("name"), str), where,
-            "a port needs a string 'name'")
+    _expect(
+        isinstance(data, dict) and isinstance(data.get("name"), str),
+        where,
+        "a port needs a string 'name'",
+    )
     unknown = sorted(str(k) for k in data if k not in _PORT_FIELDS)
-    _expect(not unknown, where, f"unknown port field(s) {', '.join(unknown)} "
-            f"(known: {', '.join(_PORT_FIELDS)})")
-    return PortModel(name=data["name"],
-                     direction=str(data.get("direction", "input")),
-                     default=_opt_str(data.get("default"), f"{where}.default"),
-                     description=_opt_str(data.get("description"), f"{where}.description"),
-                     type=_opt_str(data.get("type"), f"{where}.type"))
+    _expect(
+        not unknown,
+        where,
+        f"unknown port field(s) {', '.join(unknown)} (known: {', '.join(_PORT_FIELDS)})",
+    )
+    return PortModel(
+        name=data["name"],
+        direction=str(data.get("direction", "input")),
+        default=_opt_str(data.get("default"), f"{where}.default"),
+        description=_opt_str(data.get("description"), f"{where}.description"),
+        type=_opt_str(data.get("type"), f"{where}.type"),
+    )
 
 
 def _node_kind(value: Any, where: str) -> NodeKind:

@@ -49,5 +49,7 @@ def summary(counts: Counter[str], *, shown: int = 12) -> str:
         named.append(f"... (+{types - shown} more types)")
     kind = "type" if types == 1 else "types"
     node_word = "node" if nodes == 1 else "nodes"
-    return (f"{types} undeclared leaf {kind} ({nodes} {node_word}) assumed to be Actions that "
-            f"may return RUNNING: {', '.join(named)}")
+    return (
+        f"{types} undeclared leaf {kind} ({nodes} {node_word}) assumed to be Actions that "
+        f"may return RUNNING: {', '.join(named)}"
+    )

@@ -42,9 +42,14 @@ class Issue:
 
     def to_dict(self) -> dict[str, object]:
         loc = self.location
-        return {"severity": self.severity, "message": self.message, "element": self.element,
-                "file": loc.file if loc else None, "line": loc.line if loc else None,
-                "column": loc.column if loc else None}
+        return {
+            "severity": self.severity,
+            "message": self.message,
+            "element": self.element,
+            "file": loc.file if loc else None,
+            "line": loc.line if loc else None,
+            "column": loc.column if loc else None,
+        }
 
 
 def validate(model: FSM | BTDocument) -> list[Issue]:
@@ -71,8 +76,14 @@ def collapse_repeated_warnings(issues: list[Issue]) -> list[Issue]:
             kept.append(issue)
         elif issue.message not in seen:
             seen.add(issue.message)
-            kept.append(Issue("warning", f"{issue.message} ({counts[issue.message]} nodes; "
-                              "the first is here)", issue.location, issue.element))
+            kept.append(
+                Issue(
+                    "warning",
+                    f"{issue.message} ({counts[issue.message]} nodes; the first is here)",
+                    issue.location,
+                    issue.element,
+                )
+            )
     return kept
 
 
@@ -100,8 +111,9 @@ class _FsmValidator:
     def __init__(self) -> None:
         self.issues: list[Issue] = []
 
-    def add(self, severity: Severity, message: str, location: SourceLocation | None,
-            element: str | None) -> None:
+    def add(
+        self, severity: Severity, message: str, location: SourceLocation | None, element: str | None
+    ) -> None:
         self.issues.append(Issue(severity, message, location, element))
 
     def run(self, fsm: FSM) -> list[Issue]:
@@ -119,22 +131,31 @@ class _FsmValidator:
                 path = f"{prefix}{state.name}"
                 earlier = seen_at.setdefault(state.name, path)
                 if earlier != path:
-                    self.add("warning", f"state name '{state.name}' is also used at "
-                             f"'{earlier}'; formats with global names (Mermaid, DOT, tables) "
-                             "would merge them", state.location, path)
-                leaves = can_leave or any(t.event is not None
-                                          for t in outgoing.get(state.name, ()))
+                    self.add(
+                        "warning",
+                        f"state name '{state.name}' is also used at "
+                        f"'{earlier}'; formats with global names (Mermaid, DOT, tables) "
+                        "would merge them",
+                        state.location,
+                        path,
+                    )
+                leaves = can_leave or any(t.event is not None for t in outgoing.get(state.name, ()))
                 for index, region in enumerate(state.regions):
                     if not region.states:
-                        self.add("error", "composite state has an empty sub-machine",
-                                 state.location, path)
+                        self.add(
+                            "error",
+                            "composite state has an empty sub-machine",
+                            state.location,
+                            path,
+                        )
                         continue
                     sub = f"{path}/" if state.is_composite else f"{path}/{index}:"
                     stack.append((region, sub, leaves))
         return self.issues
 
-    def level(self, machine: FSM, prefix: str, can_leave: bool,
-              outgoing: dict[str, list[Transition]]) -> None:
+    def level(
+        self, machine: FSM, prefix: str, can_leave: bool, outgoing: dict[str, list[Transition]]
+    ) -> None:
         """Checks of one machine level (``prefix`` is its path, e.g. ``C/``)."""
         where = prefix.rstrip("/") or machine.name
         states = machine.states
@@ -142,47 +163,76 @@ class _FsmValidator:
             self.add("error", "no initial state", None, where)
         elif machine.initial not in states:
             self.add("error", f"initial state '{machine.initial}' is not a state", None, where)
-        targets_by_key: dict[tuple[str, str | None, str | None], tuple[str, SourceLocation | None]] = {}
+        targets_by_key: dict[
+            tuple[str, str | None, str | None], tuple[str, SourceLocation | None]
+        ] = {}
         for t in machine.transitions:
             label = f"{prefix}{t.source} --{t.event if t.event is not None else '(eventless)'}--> {t.target}"
             for end, name in (("source", t.source), ("target", t.target)):
                 if name not in states:
-                    self.add("error", f"transition {end} '{name}' is not a state at this level",
-                             t.location, label)
+                    self.add(
+                        "error",
+                        f"transition {end} '{name}' is not a state at this level",
+                        t.location,
+                        label,
+                    )
             key = (t.source, t.event, t.exit)
             earlier = targets_by_key.get(key)
             if earlier is None:
                 targets_by_key[key] = (t.target, t.location)
             elif earlier[0] != t.target:
                 event = f"event '{t.event}'" if t.event is not None else "no event (eventless)"
-                self.add("error", f"nondeterministic: state '{t.source}' goes to both "
-                         f"'{earlier[0]}' and '{t.target}' on {event}", t.location, label)
+                self.add(
+                    "error",
+                    f"nondeterministic: state '{t.source}' goes to both "
+                    f"'{earlier[0]}' and '{t.target}' on {event}",
+                    t.location,
+                    label,
+                )
             else:
                 self.add("warning", "duplicate transition", t.location, label)
             source = states.get(t.source)
             if source is not None and source.final:
-                self.add("error", f"final state '{t.source}' has an outgoing transition; a final "
-                         "state accepts no event", t.location, label)
+                self.add(
+                    "error",
+                    f"final state '{t.source}' has an outgoing transition; a final "
+                    "state accepts no event",
+                    t.location,
+                    label,
+                )
         for state in states.values():
             self.state(state, outgoing.get(state.name, []), prefix, can_leave)
         self.reachability(machine, prefix, outgoing)
 
-    def state(self, state: State, outgoing: list[Transition], prefix: str,
-              can_leave: bool) -> None:
+    def state(self, state: State, outgoing: list[Transition], prefix: str, can_leave: bool) -> None:
         path = f"{prefix}{state.name}"
         if state.regions and state.action is not None:
-            self.add("error", f"composite state has its own action '{state.action}'; only atomic "
-                     "states run actions (the flat state's action is its sub-states')",
-                     state.location, path)
+            self.add(
+                "error",
+                f"composite state has its own action '{state.action}'; only atomic "
+                "states run actions (the flat state's action is its sub-states')",
+                state.location,
+                path,
+            )
         if state.is_atomic and not state.final and not outgoing and not can_leave:
-            self.add("warning", "no way out and not marked final: the machine gets stuck here",
-                     state.location, path)
+            self.add(
+                "warning",
+                "no way out and not marked final: the machine gets stuck here",
+                state.location,
+                path,
+            )
         if state.is_atomic and state.action is not None and any(t.event is None for t in outgoing):
-            self.add("warning", f"transient state (eventless transition out): its action "
-                     f"'{state.action}' is never observed", state.location, path)
+            self.add(
+                "warning",
+                f"transient state (eventless transition out): its action "
+                f"'{state.action}' is never observed",
+                state.location,
+                path,
+            )
 
-    def reachability(self, machine: FSM, prefix: str,
-                     outgoing: dict[str, list[Transition]]) -> None:
+    def reachability(
+        self, machine: FSM, prefix: str, outgoing: dict[str, list[Transition]]
+    ) -> None:
         """Breadth-first from the initial state over every transition of this level."""
         if machine.initial not in machine.states:
             return
@@ -195,8 +245,12 @@ class _FsmValidator:
                     queue.append(t.target)
         for state in machine.states.values():
             if state.name not in seen:
-                self.add("warning", "unreachable from the initial state", state.location,
-                         f"{prefix}{state.name}")
+                self.add(
+                    "warning",
+                    "unreachable from the initial state",
+                    state.location,
+                    f"{prefix}{state.name}",
+                )
 
 
 def _path(trail: list[tuple[str, int]], index: int, keep: int = 4) -> str:
@@ -233,17 +287,30 @@ class _BtValidator:
             self.issues.append(Issue("error", "the document holds no behavior tree"))
             return self.issues
         if doc.main_tree is not None and doc.main_tree not in doc.trees:
-            self.issues.append(Issue("error", f"main tree '{doc.main_tree}' is not defined "
-                                     f"(trees: {', '.join(doc.trees)})", None, doc.main_tree))
+            self.issues.append(
+                Issue(
+                    "error",
+                    f"main tree '{doc.main_tree}' is not defined (trees: {', '.join(doc.trees)})",
+                    None,
+                    doc.main_tree,
+                )
+            )
         elif doc.main_tree is None and len(doc.trees) > 1:
             first = next(iter(doc.trees))
-            self.issues.append(Issue("warning", f"{len(doc.trees)} trees and no main tree named; "
-                                     f"'{first}' is executed", None, first))
+            self.issues.append(
+                Issue(
+                    "warning",
+                    f"{len(doc.trees)} trees and no main tree named; '{first}' is executed",
+                    None,
+                    first,
+                )
+            )
         references: dict[str, list[str]] = {tree_id: [] for tree_id in doc.trees}
         for tree in doc.trees.values():
             if tree.root is None:
-                self.issues.append(Issue("error", "the tree is empty", tree.location,
-                                         f"tree '{tree.id}'"))
+                self.issues.append(
+                    Issue("error", "the tree is empty", tree.location, f"tree '{tree.id}'")
+                )
                 continue
             self.tree(tree.id, tree.root, references[tree.id])
         self.cycles(references)
@@ -261,8 +328,9 @@ class _BtValidator:
             self.node(node, here, trail, referenced)
             stack.extend((child, here) for child in reversed(node.children))
 
-    def node(self, node: BTNode, here: int, trail: list[tuple[str, int]],
-             referenced: list[str]) -> None:
+    def node(
+        self, node: BTNode, here: int, trail: list[tuple[str, int]], referenced: list[str]
+    ) -> None:
         def where() -> str:
             return _path(trail, here)
 
@@ -270,49 +338,86 @@ class _BtValidator:
         spec = builtin_spec(node.type)
         if not node.kind_declared:
             if count:
-                self.add("error", f"unknown node type '{node.type}' (not built in, not declared "
-                         f"in TreeNodesModel) with {count} child(ren)", node, where())
+                self.add(
+                    "error",
+                    f"unknown node type '{node.type}' (not built in, not declared "
+                    f"in TreeNodesModel) with {count} child(ren)",
+                    node,
+                    where(),
+                )
                 return
-            self.add("warning", f"leaf type '{node.type}' is not declared; assumed to be an "
-                     "Action (it may return RUNNING)", node, where())
+            self.add(
+                "warning",
+                f"leaf type '{node.type}' is not declared; assumed to be an "
+                "Action (it may return RUNNING)",
+                node,
+                where(),
+            )
         if spec is None and node.kind in (NodeKind.CONTROL, NodeKind.DECORATOR):
             # declared (TreeNodesModel or a <Control ID=..> / <Decorator ID=..> tag)
             kind = "control" if node.kind is NodeKind.CONTROL else "decorator"
-            self.add("warning", f"custom {kind} '{node.type}' has no known semantics; it cannot "
-                     "be converted or verified", node, where())
+            self.add(
+                "warning",
+                f"custom {kind} '{node.type}' has no known semantics; it cannot "
+                "be converted or verified",
+                node,
+                where(),
+            )
         if node.kind is NodeKind.CONTROL:
             if count == 0:
                 self.add("error", f"control node '{node.type}' has no children", node, where())
             elif spec is not None and spec.children is not None and count != spec.children:
-                self.add("error", f"'{node.type}' needs exactly {spec.children} children, has "
-                         f"{count}", node, where())
+                self.add(
+                    "error",
+                    f"'{node.type}' needs exactly {spec.children} children, has {count}",
+                    node,
+                    where(),
+                )
             elif spec is not None and not spec.allows_children(count):
                 allowed = " or ".join(str(c) for c in spec.child_counts or ())
-                self.add("error", f"'{node.type}' needs {allowed} children, has {count}", node,
-                         where())
+                self.add(
+                    "error", f"'{node.type}' needs {allowed} children, has {count}", node, where()
+                )
         elif node.kind is NodeKind.DECORATOR:
             if count != 1:
-                self.add("error", f"decorator '{node.type}' needs exactly one child, has {count}",
-                         node, where())
+                self.add(
+                    "error",
+                    f"decorator '{node.type}' needs exactly one child, has {count}",
+                    node,
+                    where(),
+                )
         elif node.kind is NodeKind.SUBTREE:
             if count:
-                self.add("error", f"SubTree node has {count} child(ren); it takes none", node, where())
+                self.add(
+                    "error", f"SubTree node has {count} child(ren); it takes none", node, where()
+                )
             target = node.subtree_id
             if not target:
                 self.add("error", "SubTree node without an ID naming the tree", node, where())
             elif target not in self.doc.trees:
                 severity: Severity = "warning" if self.doc.includes else "error"
                 hint = " (it may come from an included file)" if self.doc.includes else ""
-                self.add(severity, f"SubTree references missing tree '{target}'{hint}", node, where())
+                self.add(
+                    severity, f"SubTree references missing tree '{target}'{hint}", node, where()
+                )
             else:
                 referenced.append(target)
         elif count:
             kind = "condition" if node.kind is NodeKind.CONDITION else "action"
-            self.add("error", f"{kind} leaf '{node.type}' has {count} child(ren); leaves take none",
-                     node, where())
+            self.add(
+                "error",
+                f"{kind} leaf '{node.type}' has {count} child(ren); leaves take none",
+                node,
+                where(),
+            )
         if spec is not None and spec.time_based:
-            self.add("warning", f"time-based node '{node.type}': fsmbt does not model time; its "
-                     "timing is ignored when converting or verifying", node, where())
+            self.add(
+                "warning",
+                f"time-based node '{node.type}': fsmbt does not model time; its "
+                "timing is ignored when converting or verifying",
+                node,
+                where(),
+            )
 
     def cycles(self, references: dict[str, list[str]]) -> None:
         """Recursive SubTree references (a tree that reaches itself) via iterative DFS."""
@@ -333,14 +438,19 @@ class _BtValidator:
                     stack.append((tree_id, index + 1))
                     child = children[index]
                     if colour.get(child) == 1:
-                        cycle = path[path.index(child):] + [child]
+                        cycle = path[path.index(child) :] + [child]
                         key = frozenset(cycle)
                         if key not in reported:
                             reported.add(key)
                             tree = self.doc.trees[child]
-                            self.issues.append(Issue(
-                                "error", "recursive SubTree: " + " -> ".join(cycle),
-                                tree.location, f"tree '{child}'"))
+                            self.issues.append(
+                                Issue(
+                                    "error",
+                                    "recursive SubTree: " + " -> ".join(cycle),
+                                    tree.location,
+                                    f"tree '{child}'",
+                                )
+                            )
                     elif not colour.get(child):
                         stack.append((child, 0))
                 else:

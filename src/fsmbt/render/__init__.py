@@ -28,10 +28,17 @@ from fsmbt.render.dot import (
 from fsmbt.render.fsm_graph import fsm_to_dot
 
 
-def model_to_dot(model: FSM | BTDocument, *, expand_subtrees: bool = False,
-                 max_nodes: int = DEFAULT_MAX_NODES, level: int | None = None,
-                 composite: str | None = None, tree: str | None = None,
-                 notes: list[str] | None = None, anchors: bool = False) -> str:
+def model_to_dot(
+    model: FSM | BTDocument,
+    *,
+    expand_subtrees: bool = False,
+    max_nodes: int = DEFAULT_MAX_NODES,
+    level: int | None = None,
+    composite: str | None = None,
+    tree: str | None = None,
+    notes: list[str] | None = None,
+    anchors: bool = False,
+) -> str:
     """The DOT source of ``model``'s picture.
 
     Args:
@@ -54,18 +61,37 @@ def model_to_dot(model: FSM | BTDocument, *, expand_subtrees: bool = False,
     if isinstance(model, FSM):
         if tree is not None or expand_subtrees:
             raise InputError("tree and expand_subtrees are for behavior trees; this is an FSM")
-        return fsm_to_dot(model, max_nodes=max_nodes, level=level, composite=composite,
-                          notes=notes, anchors=anchors)
+        return fsm_to_dot(
+            model,
+            max_nodes=max_nodes,
+            level=level,
+            composite=composite,
+            notes=notes,
+            anchors=anchors,
+        )
     if level is not None or composite is not None:
-        raise InputError("level and composite are for hierarchical FSMs; this is a behavior "
-                         "tree (draw one tree with tree=ID)")
-    return bt_to_dot(model, expand_subtrees=expand_subtrees, max_nodes=max_nodes, tree=tree,
-                     notes=notes, anchors=anchors)
+        raise InputError(
+            "level and composite are for hierarchical FSMs; this is a behavior "
+            "tree (draw one tree with tree=ID)"
+        )
+    return bt_to_dot(
+        model,
+        expand_subtrees=expand_subtrees,
+        max_nodes=max_nodes,
+        tree=tree,
+        notes=notes,
+        anchors=anchors,
+    )
 
 
-def svg_text(model: FSM | BTDocument, *, expand_subtrees: bool = False,
-             max_nodes: int = DEFAULT_MAX_NODES, anchors: bool = True,
-             timeout: float = DOT_TIMEOUT_S) -> str:
+def svg_text(
+    model: FSM | BTDocument,
+    *,
+    expand_subtrees: bool = False,
+    max_nodes: int = DEFAULT_MAX_NODES,
+    anchors: bool = True,
+    timeout: float = DOT_TIMEOUT_S,
+) -> str:
     """The picture of ``model`` as an SVG document to embed in a page (no XML prolog).
 
     Args:
@@ -88,10 +114,18 @@ def svg_text(model: FSM | BTDocument, *, expand_subtrees: bool = False,
     return text[start:] if start >= 0 else text
 
 
-def render_model(model: FSM | BTDocument, path: str | Path, *, overwrite: bool = False,
-                 expand_subtrees: bool = False, max_nodes: int = DEFAULT_MAX_NODES,
-                 level: int | None = None, composite: str | None = None,
-                 tree: str | None = None, notes: list[str] | None = None) -> Path:
+def render_model(
+    model: FSM | BTDocument,
+    path: str | Path,
+    *,
+    overwrite: bool = False,
+    expand_subtrees: bool = False,
+    max_nodes: int = DEFAULT_MAX_NODES,
+    level: int | None = None,
+    composite: str | None = None,
+    tree: str | None = None,
+    notes: list[str] | None = None,
+) -> Path:
     """Draw ``model`` into ``path`` (format from the suffix) and return the path.
 
     Args:
@@ -104,10 +138,29 @@ def render_model(model: FSM | BTDocument, path: str | Path, *, overwrite: bool =
         The path written.
     """
     check_output(Path(path), overwrite=overwrite)  # fail before laying out a picture
-    source = model_to_dot(model, expand_subtrees=expand_subtrees, max_nodes=max_nodes,
-                          level=level, composite=composite, tree=tree, notes=notes)
+    source = model_to_dot(
+        model,
+        expand_subtrees=expand_subtrees,
+        max_nodes=max_nodes,
+        level=level,
+        composite=composite,
+        tree=tree,
+        notes=notes,
+    )
     return write_picture(source, path, overwrite=overwrite)
 
 
-__all__ = ["model_to_dot", "svg_text", "trace_anchors", "fsm_to_dot", "bt_to_dot", "render_model", "run_dot", "write_picture",
-           "GraphvizError", "TooLargeError", "DEFAULT_MAX_NODES", "OUTPUT_FORMATS"]
+__all__ = [
+    "model_to_dot",
+    "svg_text",
+    "trace_anchors",
+    "fsm_to_dot",
+    "bt_to_dot",
+    "render_model",
+    "run_dot",
+    "write_picture",
+    "GraphvizError",
+    "TooLargeError",
+    "DEFAULT_MAX_NODES",
+    "OUTPUT_FORMATS",
+]

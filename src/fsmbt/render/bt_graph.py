@@ -90,9 +90,15 @@ def _tree_size(root: BTNode | None) -> tuple[int, int, int]:
     return nodes, leaves, depth
 
 
-def bt_to_dot(doc: BTDocument, *, expand_subtrees: bool = False,
-              max_nodes: int | None = DEFAULT_MAX_NODES, tree: str | None = None,
-              notes: list[str] | None = None, anchors: bool = False) -> str:
+def bt_to_dot(
+    doc: BTDocument,
+    *,
+    expand_subtrees: bool = False,
+    max_nodes: int | None = DEFAULT_MAX_NODES,
+    tree: str | None = None,
+    notes: list[str] | None = None,
+    anchors: bool = False,
+) -> str:
     """DOT source of the picture of ``doc``.
 
     Args:
@@ -115,8 +121,7 @@ def bt_to_dot(doc: BTDocument, *, expand_subtrees: bool = False,
         raise InputError("the document holds no behavior tree")
     if tree is not None:
         if tree not in doc.trees:
-            raise InputError(f"no tree '{tree}' (trees: {', '.join(doc.trees)})",
-                             element=tree)
+            raise InputError(f"no tree '{tree}' (trees: {', '.join(doc.trees)})", element=tree)
         doc = dataclasses.replace(doc, main_tree=tree)
     if not expand_subtrees and max_nodes is not None:
         check_size(sum(1 for _ in doc.nodes()), max_nodes, "nodes")
@@ -133,8 +138,9 @@ def bt_to_dot(doc: BTDocument, *, expand_subtrees: bool = False,
     return builder.finish()
 
 
-def _draw_all_trees(doc: BTDocument, root: graphviz.Digraph, builder: _Builder,
-                    notes: list[str] | None) -> None:
+def _draw_all_trees(
+    doc: BTDocument, root: graphviz.Digraph, builder: _Builder, notes: list[str] | None
+) -> None:
     """Every tree (main first, then rows), each in a cluster when there are several."""
     main_id = doc.main.id
     order = [doc.trees[main_id]] + [t for t in doc.trees.values() if t.id != main_id]
@@ -165,28 +171,45 @@ def _draw_all_trees(doc: BTDocument, root: graphviz.Digraph, builder: _Builder,
             t = doc.trees[tree_id]
             holder = graphviz.Digraph(name=builder.next_id("cluster_"))
             title = f"{tree_id} (main)" if tree_id == main_id else tree_id
-            holder.attr(label=label_text(title), style="rounded", color="gray40",
-                        fontname=FONT, fontsize="12", labeljust="l")
+            holder.attr(
+                label=label_text(title),
+                style="rounded",
+                color="gray40",
+                fontname=FONT,
+                fontsize="12",
+                labeljust="l",
+            )
             builder.clusters.append((holder, root))
             first = builder.serial + 1
             builder.draw_tree(t.root, holder, parent=None, path=(tree_id,))
             if previous_bottom is not None:  # hang this row under the previous one
-                builder.edges.append((previous_bottom, f"n{first}", {"style": "invis", "weight": "0"}))
+                builder.edges.append(
+                    (previous_bottom, f"n{first}", {"style": "invis", "weight": "0"})
+                )
             depth = sizes[tree_id][2]
             if deepest is None or depth > deepest[0]:
                 deepest = (depth, builder.deepest)
         previous_bottom = deepest[1] if deepest is not None else previous_bottom
     if left_out and notes is not None:
-        shown = ", ".join(left_out[:8]) + (f", ... (+{len(left_out) - 8})"
-                                           if len(left_out) > 8 else "")
-        notes.append(f"picture capped at {PICTURE_MAX_NODES} nodes: drew {len(order) - len(left_out)}"
-                     f" of {len(order)} trees ({drawn} of {total} nodes); left out: {shown}; "
-                     "draw one tree alone with tree=ID")
+        shown = ", ".join(left_out[:8]) + (
+            f", ... (+{len(left_out) - 8})" if len(left_out) > 8 else ""
+        )
+        notes.append(
+            f"picture capped at {PICTURE_MAX_NODES} nodes: drew {len(order) - len(left_out)}"
+            f" of {len(order)} trees ({drawn} of {total} nodes); left out: {shown}; "
+            "draw one tree alone with tree=ID"
+        )
 
 
 class _Builder:
-    def __init__(self, doc: BTDocument, root: graphviz.Digraph, max_nodes: int | None,
-                 expanding: bool, anchors: bool = False) -> None:
+    def __init__(
+        self,
+        doc: BTDocument,
+        root: graphviz.Digraph,
+        max_nodes: int | None,
+        expanding: bool,
+        anchors: bool = False,
+    ) -> None:
         self.doc = doc
         self.anchors = anchors
         self.expanding = expanding
@@ -202,22 +225,30 @@ class _Builder:
         self.serial += 1
         return f"{prefix}{self.serial}"
 
-    def draw_tree(self, top: BTNode | None, graph: graphviz.Digraph, *, parent: str | None,
-                  path: tuple[str, ...]) -> None:
+    def draw_tree(
+        self,
+        top: BTNode | None,
+        graph: graphviz.Digraph,
+        *,
+        parent: str | None,
+        path: tuple[str, ...],
+    ) -> None:
         if top is None:
             self.deepest = self.next_id("n")
             graph.node(self.deepest, label="(empty tree)", shape="plaintext")
             return
         stack: list[tuple[BTNode, str | None, graphviz.Digraph, tuple[str, ...], str, int]] = [
-            (top, parent, graph, path, "", 1)]
+            (top, parent, graph, path, "", 1)
+        ]
         deepest_level = 0
         while stack:
             node, parent_id, holder, trees, where, level = stack.pop()
             self.count += 1
             if self.max_nodes is not None and self.count > self.max_nodes:
-                raise TooLargeError(f"too large to draw: more than {self.max_nodes} nodes "
-                                    f"(limit {self.max_nodes})",
-                                    hints=(Hint.MAX_NODES, Hint.NO_EXPANSION))
+                raise TooLargeError(
+                    f"too large to draw: more than {self.max_nodes} nodes (limit {self.max_nodes})",
+                    hints=(Hint.MAX_NODES, Hint.NO_EXPANSION),
+                )
             node_id = self.next_id("n")
             if level > deepest_level:
                 deepest_level, self.deepest = level, node_id
@@ -230,53 +261,88 @@ class _Builder:
             ref = node.subtree_id
             if self.expanding and ref is not None and ref in self.doc.trees and ref not in trees:
                 cluster = graphviz.Digraph(name=self.next_id("cluster_"))
-                cluster.attr(label=label_text(ref), style="dashed,rounded", color="gray50",
-                             fontname=FONT, fontsize="10", labeljust="l")
+                cluster.attr(
+                    label=label_text(ref),
+                    style="dashed,rounded",
+                    color="gray50",
+                    fontname=FONT,
+                    fontsize="10",
+                    labeljust="l",
+                )
                 self.clusters.append((cluster, holder))
                 sub_root = self.doc.trees[ref].root
                 if sub_root is not None:
-                    stack.append((sub_root, node_id, cluster, (*trees, ref), child_path(where, 0),
-                                  level + 1))
-            stack.extend((child, node_id, holder, trees, child_path(where, index), level + 1)
-                         for index, child in reversed(list(enumerate(node.children))))
+                    stack.append(
+                        (sub_root, node_id, cluster, (*trees, ref), child_path(where, 0), level + 1)
+                    )
+            stack.extend(
+                (child, node_id, holder, trees, child_path(where, index), level + 1)
+                for index, child in reversed(list(enumerate(node.children)))
+            )
 
     def finish(self) -> str:
-        return assemble(self.root, self.clusters,
-                        [edge_line(tail, head, attrs) for tail, head, attrs in self.edges])
+        return assemble(
+            self.root,
+            self.clusters,
+            [edge_line(tail, head, attrs) for tail, head, attrs in self.edges],
+        )
 
 
 def node_attrs(node: BTNode, *, recursive: bool = False) -> dict[str, str]:
     """Shape, style and label of one node."""
     type_name = canonical_type(node.type)
-    shown = [(k, v) for k, v in node.attrs.items()
-             if not (node.kind is NodeKind.SUBTREE and k == "ID")]
+    shown = [
+        (k, v) for k, v in node.attrs.items() if not (node.kind is NodeKind.SUBTREE and k == "ID")
+    ]
     details = [f"{k}={_shorten(v)}" for k, v in shown[:MAX_ATTRS_SHOWN]]
     if len(shown) > MAX_ATTRS_SHOWN:
         details.append(f"… (+{len(shown) - MAX_ATTRS_SHOWN})")
     name = [node.name] if node.name is not None and node.name != node.type else []
     if node.kind is NodeKind.CONTROL:
         symbol = CONTROL_SYMBOLS.get(type_name, type_name)
-        return {"label": html_label([symbol, *name], details, head_size=16 if len(symbol) <= 2 else 12),
-                "shape": "box", "style": "filled", "fillcolor": "gray88"}
+        return {
+            "label": html_label([symbol, *name], details, head_size=16 if len(symbol) <= 2 else 12),
+            "shape": "box",
+            "style": "filled",
+            "fillcolor": "gray88",
+        }
     if node.kind is NodeKind.DECORATOR:
         symbol = DECORATOR_SYMBOLS.get(type_name, type_name)
-        return {"label": html_label([symbol, *name], details, head_size=16 if len(symbol) <= 2 else None),
-                "shape": "hexagon", "style": "filled", "fillcolor": "lightcyan"}
+        return {
+            "label": html_label(
+                [symbol, *name], details, head_size=16 if len(symbol) <= 2 else None
+            ),
+            "shape": "hexagon",
+            "style": "filled",
+            "fillcolor": "lightcyan",
+        }
     if node.kind is NodeKind.SUBTREE:
         ref = node.subtree_id or "?"
         head = [f"SubTree {ref}"] + [n for n in name if n != ref]
         if recursive:
             details.insert(0, "(recursive: not expanded)")
-        return {"label": html_label(head, details), "shape": "tab", "style": "filled",
-                "fillcolor": "lavender"}
+        return {
+            "label": html_label(head, details),
+            "shape": "tab",
+            "style": "filled",
+            "fillcolor": "lavender",
+        }
     head = [node.label] + ([f"({node.type})"] if name else [])
     if node.kind is NodeKind.CONDITION:
-        return {"label": html_label(head, details), "shape": "ellipse", "style": "filled",
-                "fillcolor": "honeydew"}
+        return {
+            "label": html_label(head, details),
+            "shape": "ellipse",
+            "style": "filled",
+            "fillcolor": "honeydew",
+        }
     # An action whose kind nobody declared (assumed Action) gets a dashed border.
     style = "rounded,filled" if node.kind_declared else "rounded,filled,dashed"
-    return {"label": html_label(head, details), "shape": "box", "style": style,
-            "fillcolor": "lightyellow"}
+    return {
+        "label": html_label(head, details),
+        "shape": "box",
+        "style": style,
+        "fillcolor": "lightyellow",
+    }
 
 
 def _shorten(value: str) -> str:

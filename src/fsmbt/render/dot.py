@@ -64,7 +64,8 @@ def check_size(count: int, max_nodes: int, what: str) -> None:
         raise TooLargeError(
             f"too large to draw: {count} {what} (limit {max_nodes}); "
             "a picture this big is unreadable and slow to lay out",
-            hints=(Hint.MAX_NODES, Hint.STATISTICS))
+            hints=(Hint.MAX_NODES, Hint.STATISTICS),
+        )
 
 
 def dot_id(text: str) -> str:
@@ -83,8 +84,11 @@ def edge_line(tail: str, head: str, attrs: dict[str, str]) -> str:
     return f"\t{quoting.quote(tail)} -> {quoting.quote(head)}{listed}\n"
 
 
-def assemble(root: graphviz.Digraph, clusters: list[tuple[graphviz.Digraph, graphviz.Digraph]],
-             edges: list[str]) -> str:
+def assemble(
+    root: graphviz.Digraph,
+    clusters: list[tuple[graphviz.Digraph, graphviz.Digraph]],
+    edges: list[str],
+) -> str:
     """The DOT source of ``root`` with ``clusters`` nested inside it and ``edges`` after them.
 
     ``clusters`` lists ``(cluster, parent)`` in pre-order. The source is written out in one
@@ -117,8 +121,10 @@ def output_format(path: Path) -> str:
         return OUTPUT_FORMATS[suffix]
     except KeyError:
         known = ", ".join(OUTPUT_FORMATS)
-        raise InputError(f"cannot draw into '{path.name}': use one of {known}",
-                         location=SourceLocation(str(path))) from None
+        raise InputError(
+            f"cannot draw into '{path.name}': use one of {known}",
+            location=SourceLocation(str(path)),
+        ) from None
 
 
 def check_output(path: Path, *, overwrite: bool) -> str:
@@ -132,16 +138,23 @@ def check_output(path: Path, *, overwrite: bool) -> str:
 def dot_binary() -> str:
     found = shutil.which("dot")
     if found is None:
-        raise GraphvizError("Graphviz's `dot` is not installed (Debian: apt-get install graphviz; "
-                            "or run ./scripts/setup.sh)")
+        raise GraphvizError(
+            "Graphviz's `dot` is not installed (Debian: apt-get install graphviz; "
+            "or run ./scripts/setup.sh)"
+        )
     return found
 
 
 def run_dot(source: str, fmt: str, *, timeout: float = DOT_TIMEOUT_S) -> bytes:
     """The picture bytes of ``source`` in ``fmt`` (svg, png, pdf)."""
     try:
-        done = subprocess.run([dot_binary(), f"-T{fmt}"], input=source.encode("utf-8"),
-                              capture_output=True, timeout=timeout, check=False)
+        done = subprocess.run(
+            [dot_binary(), f"-T{fmt}"],
+            input=source.encode("utf-8"),
+            capture_output=True,
+            timeout=timeout,
+            check=False,
+        )
     except subprocess.TimeoutExpired:
         raise GraphvizError(f"Graphviz did not finish within {timeout:g} s") from None
     if done.returncode != 0:
@@ -150,8 +163,9 @@ def run_dot(source: str, fmt: str, *, timeout: float = DOT_TIMEOUT_S) -> bytes:
     return done.stdout
 
 
-def write_picture(source: str, path: str | Path, *, overwrite: bool = False,
-                  timeout: float = DOT_TIMEOUT_S) -> Path:
+def write_picture(
+    source: str, path: str | Path, *, overwrite: bool = False, timeout: float = DOT_TIMEOUT_S
+) -> Path:
     """Write ``source`` as the picture ``path`` names (by suffix); refuse to replace a file."""
     path = Path(path)
     fmt = check_output(path, overwrite=overwrite)
@@ -160,5 +174,7 @@ def write_picture(source: str, path: str | Path, *, overwrite: bool = False,
         path.parent.mkdir(parents=True, exist_ok=True)
         path.write_bytes(data)
     except OSError as exc:
-        raise InputError(f"cannot write: {exc.strerror}", location=SourceLocation(str(path))) from None
+        raise InputError(
+            f"cannot write: {exc.strerror}", location=SourceLocation(str(path))
+        ) from None
     return path

@@ -71,7 +71,9 @@ class _Level:
     machine: FSM
     graph: graphviz.Digraph
     ids: dict[str, str] = field(default_factory=dict)
-    anchors: dict[str, tuple[str, str]] = field(default_factory=dict)  # composite -> (node, cluster)
+    anchors: dict[str, tuple[str, str]] = field(
+        default_factory=dict
+    )  # composite -> (node, cluster)
     prefix: str = ""  # large pictures: nested states are named by their path
     entry: str | None = None  # large pictures: the composite state's box, drawn instead of a point
     path: str = ""  # exchange DOT: the node-id prefix of this level's states
@@ -88,8 +90,7 @@ def _find_composite(fsm: FSM, path: str) -> State:
         machines = list(state.regions)
     if state is None or state.is_atomic:
         known = ", ".join(composite_paths(fsm)[:20]) or "none"
-        raise InputError(f"no composite state '{path}' (composite states: {known})",
-                         element=path)
+        raise InputError(f"no composite state '{path}' (composite states: {known})", element=path)
     return state
 
 
@@ -128,15 +129,22 @@ def _visible(fsm: FSM, level: int) -> tuple[int, int]:
         states += len(machine.states)
         transitions += len(machine.transitions)
         if depth < level:
-            stack.extend((region, depth + 1) for state in machine.states.values()
-                         for region in state.regions)
+            stack.extend(
+                (region, depth + 1) for state in machine.states.values() for region in state.regions
+            )
     return states, transitions
 
 
-def fsm_to_dot(fsm: FSM, *, max_nodes: int | None = DEFAULT_MAX_NODES,
-               exchange: bool = False, level: int | None = None,
-               composite: str | None = None, notes: list[str] | None = None,
-               anchors: bool = False) -> str:
+def fsm_to_dot(
+    fsm: FSM,
+    *,
+    max_nodes: int | None = DEFAULT_MAX_NODES,
+    exchange: bool = False,
+    level: int | None = None,
+    composite: str | None = None,
+    notes: list[str] | None = None,
+    anchors: bool = False,
+) -> str:
     """DOT source of ``fsm``.
 
     Args:
@@ -171,38 +179,50 @@ def fsm_to_dot(fsm: FSM, *, max_nodes: int | None = DEFAULT_MAX_NODES,
         check_size(stats.all_states, max_nodes, "states")
         check_size(stats.all_transitions, 5 * max_nodes, "transitions")
         if stats.nesting_depth > MAX_NESTING:
-            raise TooLargeError(f"too deeply nested to draw: {stats.nesting_depth} levels "
-                                f"(limit {MAX_NESTING})")
+            raise TooLargeError(
+                f"too deeply nested to draw: {stats.nesting_depth} levels (limit {MAX_NESTING})"
+            )
 
     def fits(states: int, transitions: int) -> bool:
         return states <= LAYERED_MAX_STATES and transitions <= LAYERED_MAX_ARROWS
 
-    if not exchange and level is None and stats.hierarchical \
-            and not fits(stats.all_states, stats.all_transitions):
+    if (
+        not exchange
+        and level is None
+        and stats.hierarchical
+        and not fits(stats.all_states, stats.all_transitions)
+    ):
         level = first_level
         while level + 1 < stats.nesting_depth and fits(*_visible(fsm, level + 1)):
             level += 1
         if notes is not None:
             shown, _ = _visible(fsm, level)
             closed = [p for p in composite_paths(fsm) if p.count("/") == level]
-            names = ", ".join(closed[:6]) + (f", ... (+{len(closed) - 6})"
-                                             if len(closed) > 6 else "")
-            notes.append(f"picture capped: {stats.all_states} states are too many for one "
-                         f"readable picture; drew {shown} states, composite states nested "
-                         f"deeper than level {level} closed ({names}); draw one with "
-                         "composite=NAME or more levels with level=N")
-    visible = _visible(fsm, level) if level is not None else (stats.all_states,
-                                                              stats.all_transitions)
+            names = ", ".join(closed[:6]) + (
+                f", ... (+{len(closed) - 6})" if len(closed) > 6 else ""
+            )
+            notes.append(
+                f"picture capped: {stats.all_states} states are too many for one "
+                f"readable picture; drew {shown} states, composite states nested "
+                f"deeper than level {level} closed ({names}); draw one with "
+                "composite=NAME or more levels with level=N"
+            )
+    visible = (
+        _visible(fsm, level) if level is not None else (stats.all_states, stats.all_transitions)
+    )
     layered = exchange or fits(*visible)
     if not layered and notes is not None and level is None:
-        notes.append(f"{visible[0]} states without hierarchy to split into levels: drawn with "
-                     "a force-directed layout (no clusters); fsmbt info lists its structure")
+        notes.append(
+            f"{visible[0]} states without hierarchy to split into levels: drawn with "
+            "a force-directed layout (no clusters); fsmbt info lists its structure"
+        )
     root = graphviz.Digraph(name=dot_id(fsm.name) if exchange else _safe_name(fsm.name))
     if layered:
         root.attr(rankdir="LR", compound="true", fontname=FONT, nodesep="0.35", ranksep="0.5")
     else:
-        root.attr(layout="sfdp", overlap="prism", splines="false", outputorder="edgesfirst",
-                  fontname=FONT)
+        root.attr(
+            layout="sfdp", overlap="prism", splines="false", outputorder="edgesfirst", fontname=FONT
+        )
     root.attr("node", fontname=FONT, fontsize="12")
     root.attr("edge", fontname=FONT, fontsize="10", arrowsize="0.8")
     counter = _Counter(exchange)
@@ -219,15 +239,23 @@ def fsm_to_dot(fsm: FSM, *, max_nodes: int | None = DEFAULT_MAX_NODES,
         levels.append(lv)
         for state in lv.machine.states.values():
             title = lv.prefix + state.name
-            is_closed = (not exchange and level_cap is not None and not state.is_atomic
-                         and depth_of[id(lv)] >= level_cap)
+            is_closed = (
+                not exchange
+                and level_cap is not None
+                and not state.is_atomic
+                and depth_of[id(lv)] >= level_cap
+            )
             if is_closed:
                 node_id = counter.state_id(lv, state.name)
                 lv.ids[state.name] = node_id
                 inside = _inner_states(state)
-                lv.graph.node(node_id, label=label_text(_state_title(state, title),
-                                                         f"[{inside} states inside]"),
-                               shape="box", style="rounded,bold,filled", fillcolor="gray95")
+                lv.graph.node(
+                    node_id,
+                    label=label_text(_state_title(state, title), f"[{inside} states inside]"),
+                    shape="box",
+                    style="rounded,bold,filled",
+                    fillcolor="gray95",
+                )
                 continue
             if state.is_atomic:
                 node_id = counter.state_id(lv, state.name)
@@ -240,18 +268,36 @@ def fsm_to_dot(fsm: FSM, *, max_nodes: int | None = DEFAULT_MAX_NODES,
             if not layered:  # a box standing for the composite state, no cluster
                 node_id = counter.next("c")
                 extra = {"id": state_anchor(lv.anchor + state.name)} if anchors else {}
-                lv.graph.node(node_id, label=label_text(_state_title(state, title)),
-                              shape="box", style="rounded,bold", **extra)
-                inner = [_Level(region, lv.graph, prefix=f"{title}/", entry=node_id,
-                                anchor=f"{lv.anchor}{state.name}/")
-                         for region in state.regions]
+                lv.graph.node(
+                    node_id,
+                    label=label_text(_state_title(state, title)),
+                    shape="box",
+                    style="rounded,bold",
+                    **extra,
+                )
+                inner = [
+                    _Level(
+                        region,
+                        lv.graph,
+                        prefix=f"{title}/",
+                        entry=node_id,
+                        anchor=f"{lv.anchor}{state.name}/",
+                    )
+                    for region in state.regions
+                ]
                 lv.anchors[state.name] = (node_id, "")
                 depth_of.update((id(x), depth_of[id(lv)] + 1) for x in inner)
                 pending.extend(reversed(inner))
                 continue
             cluster = graphviz.Digraph(name=counter.next("cluster_"))
-            cluster.attr(label=label_text(_state_title(state, state.name)), style="rounded",
-                         color="gray30", fontname=FONT, fontsize="12", labeljust="l")
+            cluster.attr(
+                label=label_text(_state_title(state, state.name)),
+                style="rounded",
+                color="gray30",
+                fontname=FONT,
+                fontsize="12",
+                labeljust="l",
+            )
             if anchors:
                 cluster.attr(id=state_anchor(lv.anchor + state.name))
             clusters.append((cluster, lv.graph))
@@ -261,12 +307,16 @@ def fsm_to_dot(fsm: FSM, *, max_nodes: int | None = DEFAULT_MAX_NODES,
                 path = f"{lv.path}{state.name}/"
                 if state.is_parallel:
                     holder = graphviz.Digraph(name=counter.next("cluster_"))
-                    holder.attr(label=label_text(_region_title(region, index)), style="dashed",
-                                color="gray50", fontname=FONT, fontsize="10")
+                    holder.attr(
+                        label=label_text(_region_title(region, index)),
+                        style="dashed",
+                        color="gray50",
+                        fontname=FONT,
+                        fontsize="10",
+                    )
                     clusters.append((holder, cluster))
                     path = f"{path}{index}:"
-                inner.append(_Level(region, holder, path=path,
-                                    anchor=f"{lv.anchor}{state.name}/"))
+                inner.append(_Level(region, holder, path=path, anchor=f"{lv.anchor}{state.name}/"))
             # Arrows to/from the composite state end at its cluster, through its first initial point.
             lv.anchors[state.name] = (_initial_point_id(inner[0], counter), cluster.name)
             depth_of.update((id(x), depth_of[id(lv)] + 1) for x in inner)
@@ -319,8 +369,11 @@ def _state_attrs(state: State, title: str, *, compact: bool = False) -> dict[str
     """Circles (double for final states); ellipses in large pictures, where long path names
     would make circles huge."""
     lines = [title]
-    if state.action is not None and state.action != state.name \
-            and not title.endswith(f":{state.action}"):  # ``q3:Move`` already says it
+    if (
+        state.action is not None
+        and state.action != state.name
+        and not title.endswith(f":{state.action}")
+    ):  # ``q3:Move`` already says it
         lines.append(f"/ {state.action}")
     attrs = {"label": label_text(*lines), "shape": "doublecircle" if state.final else "circle"}
     if state.action != state.name:  # read back by fsmbt.formats.dot; Graphviz ignores it
@@ -341,8 +394,9 @@ def _initial_point_id(level: _Level, counter: _Counter) -> str:
     return point
 
 
-def _draw_initial(level: _Level, edges: list, counter: _Counter, *, is_top: bool,
-                  anchors: bool = False) -> None:
+def _draw_initial(
+    level: _Level, edges: list, counter: _Counter, *, is_top: bool, anchors: bool = False
+) -> None:
     """The arrow from a point into the level's initial state (a composite state's point is
     its anchor and already exists)."""
     fsm = level.machine
@@ -362,8 +416,9 @@ def _draw_initial(level: _Level, edges: list, counter: _Counter, *, is_top: bool
         level.graph.node(point, label="", shape="point", width="0.12", **extra)
     attrs: dict[str, str] = {}
     if is_top and fsm.initial_event is not None:
-        attrs["label"] = (_exact_label(fsm.initial_event) if counter.exchange
-                          else label_text(fsm.initial_event))
+        attrs["label"] = (
+            _exact_label(fsm.initial_event) if counter.exchange else label_text(fsm.initial_event)
+        )
     edges.append((point, head, {**attrs, **head_attrs}))
 
 
@@ -420,5 +475,7 @@ def _event_label(level: _Level, t) -> str:
 
 
 def _wrap(labels: list[str]) -> str:
-    lines = [", ".join(labels[i:i + EVENTS_PER_LINE]) for i in range(0, len(labels), EVENTS_PER_LINE)]
+    lines = [
+        ", ".join(labels[i : i + EVENTS_PER_LINE]) for i in range(0, len(labels), EVENTS_PER_LINE)
+    ]
     return label_text(*lines)

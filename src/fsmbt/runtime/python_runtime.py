@@ -62,8 +62,14 @@ __all__ = ["ENGINES", "TreeRunner", "load_tree", "write_files"]
 class TreeRunner:
     """A loaded LEBT on one engine, with the user's actions (build it with ``load_tree``)."""
 
-    def __init__(self, doc: BTDocument, actions: Mapping[str, Action], *,
-                 engine: str = "py_trees", allow_unused: bool = False) -> None:
+    def __init__(
+        self,
+        doc: BTDocument,
+        actions: Mapping[str, Action],
+        *,
+        engine: str = "py_trees",
+        allow_unused: bool = False,
+    ) -> None:
         """Check ``doc`` and ``actions`` and build the engine's tree (not started).
 
         Args:
@@ -137,8 +143,13 @@ class TreeRunner:
         return names
 
 
-def load_tree(source: Path | str, actions: Mapping[str, Action], *, engine: str = "py_trees",
-              allow_unused: bool = False) -> TreeRunner:
+def load_tree(
+    source: Path | str,
+    actions: Mapping[str, Action],
+    *,
+    engine: str = "py_trees",
+    allow_unused: bool = False,
+) -> TreeRunner:
     """Load a converted tree and bind the user's actions.
 
     Args:
@@ -157,8 +168,10 @@ def load_tree(source: Path | str, actions: Mapping[str, Action], *, engine: str 
     else:
         model = read_model(Path(source))
     if not isinstance(model, BTDocument):
-        raise InputError("not a behavior tree: the runtime runs converted trees "
-                         "(fsmbt convert model -o tree.xml)")
+        raise InputError(
+            "not a behavior tree: the runtime runs converted trees "
+            "(fsmbt convert model -o tree.xml)"
+        )
     return TreeRunner(model, actions, engine=engine, allow_unused=allow_unused)
 
 
@@ -172,14 +185,19 @@ def check_lebt_nodes(doc: BTDocument) -> None:
         stack: list[BTNode] = [tree.root] if tree.root is not None else []
         while stack:
             node = stack.pop()
-            allowed = (node.type in LEBT_LEAVES if node.is_leaf
-                       else node.kind is NodeKind.SUBTREE or node.type in LEBT_CONTROLS)
+            allowed = (
+                node.type in LEBT_LEAVES
+                if node.is_leaf
+                else node.kind is NodeKind.SUBTREE or node.type in LEBT_CONTROLS
+            )
             if not allowed:
                 raise InputError(
                     f"<{node.type}> is not a node of a converted tree (loop-execution BT: "
                     f"leaves {GUARD_TYPE} and {STATE_TYPE}, controls "
                     f"{', '.join(sorted(LEBT_CONTROLS))}, SubTree)",
-                    location=node.location, element=f"<{node.type}> '{node.label}'")
+                    location=node.location,
+                    element=f"<{node.type}> '{node.label}'",
+                )
             stack.extend(reversed(node.children))
 
 
@@ -194,8 +212,9 @@ def _engine_runner(engine: str, tree: CompiledTree) -> EngineLebtRun:
     return PyTreesLebtRunner(tree)
 
 
-def _check_actions(run: EngineLebtRun, actions: Mapping[str, Action], *,
-                   allow_unused: bool) -> frozenset[str]:
+def _check_actions(
+    run: EngineLebtRun, actions: Mapping[str, Action], *, allow_unused: bool
+) -> frozenset[str]:
     """Every action of the tree has a callable (and every callable an action)."""
     used: dict[str, str] = {}  # action -> a state that runs it
     for spec in run.leaves.states.values():
@@ -204,16 +223,20 @@ def _check_actions(run: EngineLebtRun, actions: Mapping[str, Action], *,
     missing = [name for name in used if name not in actions]
     if missing:
         shown = ", ".join(f"'{name}' (state '{used[name]}')" for name in missing)
-        raise InputError(f"no callable for the action(s) {shown}; pass one per action name "
-                         f"(the tree's actions: {', '.join(sorted(used))})")
+        raise InputError(
+            f"no callable for the action(s) {shown}; pass one per action name "
+            f"(the tree's actions: {', '.join(sorted(used))})"
+        )
     not_callable = [name for name, action in actions.items() if not callable(action)]
     if not_callable:
         raise InputError(f"the action(s) {', '.join(map(repr, not_callable))} are not callable")
     unused = [name for name in actions if name not in used]
     if unused and not allow_unused:
-        raise InputError(f"no state of the tree runs the action(s) "
-                         f"{', '.join(map(repr, unused))} (a typo? pass allow_unused=True to "
-                         f"accept them); the tree's actions: {', '.join(sorted(used))}")
+        raise InputError(
+            f"no state of the tree runs the action(s) "
+            f"{', '.join(map(repr, unused))} (a typo? pass allow_unused=True to "
+            f"accept them); the tree's actions: {', '.join(sorted(used))}"
+        )
     return frozenset(used)
 
 
@@ -242,8 +265,10 @@ def write_files(directory: Path, *, overwrite: bool) -> list[Path]:
     paths = [directory / EXAMPLE_TREE, directory / EXAMPLE_SCRIPT]
     existing = [p for p in paths if p.exists()]
     if existing and not overwrite:
-        raise InputError(f"{', '.join(map(str, existing))} already exist(s); nothing written "
-                         "(overwrite=True / --force replaces them)")
+        raise InputError(
+            f"{', '.join(map(str, existing))} already exist(s); nothing written "
+            "(overwrite=True / --force replaces them)"
+        )
     directory.mkdir(parents=True, exist_ok=True)
     paths[0].write_text(_example_tree(), encoding="utf-8")
     paths[1].write_text(_EXAMPLE_SCRIPT_TEXT, encoding="utf-8")

@@ -55,8 +55,9 @@ def conversion_blockers(doc: BTDocument) -> list[Blocker]:
     except KeyError:
         return [Blocker("the document holds no behavior tree", None, None, False)]
     if tree.root is None:
-        return [Blocker("the main behavior tree is empty", tree.location, f"tree '{tree.id}'",
-                        False)]
+        return [
+            Blocker("the main behavior tree is empty", tree.location, f"tree '{tree.id}'", False)
+        ]
     checker = CompiledTree.__new__(CompiledTree)
     checker.doc = doc
     seen: set[tuple[str, tuple[str, ...]]] = set()
@@ -68,8 +69,9 @@ def conversion_blockers(doc: BTDocument) -> list[Blocker]:
         try:
             ctype, _kind, _params, _internal, kids = checker._check(node, chain)
         except InputError as exc:  # UnsupportedError is an InputError
-            found.append(Blocker(exc.message, exc.location, exc.element,
-                                 isinstance(exc, UnsupportedError)))
+            found.append(
+                Blocker(exc.message, exc.location, exc.element, isinstance(exc, UnsupportedError))
+            )
             kids = [] if node.is_leaf else list(node.children)
             ctype = None
         if ctype == "SubTree":

@@ -170,8 +170,9 @@ def _gate_leaf(node: BTNode, ctype: str) -> BTNode | None:
     spec = node_semantics(ctype)
     if spec is None or spec.gate is None:
         return None
-    return BTNode(GATE_TYPE, NodeKind.CONDITION, f"{node.label}.{spec.gate.word}",
-                  location=node.location)
+    return BTNode(
+        GATE_TYPE, NodeKind.CONDITION, f"{node.label}.{spec.gate.word}", location=node.location
+    )
 
 
 def _threshold(value: int, count: int) -> int:
@@ -192,19 +193,24 @@ class CompiledTree:
     def _compile(self) -> None:
         tree = self.doc.main
         if tree.root is None:
-            raise InputError("the main behavior tree is empty", location=tree.location,
-                             element=f"BehaviorTree '{tree.id}'")
+            raise InputError(
+                "the main behavior tree is empty",
+                location=tree.location,
+                element=f"BehaviorTree '{tree.id}'",
+            )
         children_of: dict[int, list[int]] = {}
-        raw: list[tuple[BTNode, str, int | None, int, tuple[Any, ...], int | None,
-                        NodeKind]] = []
+        raw: list[tuple[BTNode, str, int | None, int, tuple[Any, ...], int | None, NodeKind]] = []
         stack: list[tuple[BTNode, int | None, int, tuple[str, ...]]] = [
-            (tree.root, None, 0, (tree.id,))]
+            (tree.root, None, 0, (tree.id,))
+        ]
         while stack:
             node, parent, position, chain = stack.pop()
             nid = len(raw)
             if nid >= MAX_COMPILED_NODES:
-                raise InputError(f"the tree has more than {MAX_COMPILED_NODES} nodes once "
-                                 "SubTrees are expanded", element=tree.id)
+                raise InputError(
+                    f"the tree has more than {MAX_COMPILED_NODES} nodes once SubTrees are expanded",
+                    element=tree.id,
+                )
             if parent is not None:
                 children_of[parent].append(nid)
             children_of[nid] = []
@@ -221,10 +227,21 @@ class CompiledTree:
                 stack.append((kids[index], nid, index, chain))
         # pre-order ids: stack pushes reversed, so children ids were assigned in order
         for nid, (node, ctype, parent, position, params, internal, kind) in enumerate(raw):
-            self.nodes.append(CompiledNode(
-                id=nid, type=ctype, kind=kind, children=tuple(children_of[nid]),
-                label=node.label, parent=parent, index=position, source=node, params=params,
-                internal_status=internal, tree=self))
+            self.nodes.append(
+                CompiledNode(
+                    id=nid,
+                    type=ctype,
+                    kind=kind,
+                    children=tuple(children_of[nid]),
+                    label=node.label,
+                    parent=parent,
+                    index=position,
+                    source=node,
+                    params=params,
+                    internal_status=internal,
+                    tree=self,
+                )
+            )
 
     def path_of(self, nid: int) -> str:
         """See ``CompiledNode.path``; cached per node."""
@@ -240,23 +257,29 @@ class CompiledTree:
             self._paths[nid] = cached
         return cached
 
-    def _check(self, node: BTNode, chain: tuple[str, ...]
-               ) -> tuple[str, NodeKind, tuple[Any, ...], int | None, list[BTNode]]:
+    def _check(
+        self, node: BTNode, chain: tuple[str, ...]
+    ) -> tuple[str, NodeKind, tuple[Any, ...], int | None, list[BTNode]]:
         tables = runtime_tables()
         ctype = node.semantics or canonical_type(node.type)
         kind = node.kind
         for attr in PRECONDITION_ATTRS:
             if attr in node.attrs:
                 raise UnsupportedError(
-                    f"pre-condition '{attr}' depends on the blackboard", **_where(node))
+                    f"pre-condition '{attr}' depends on the blackboard", **_where(node)
+                )
         spec = node_semantics(ctype)
         if spec is not None and spec.requires is not None and node.semantics is None:
-            why = spec.rejection or (f"a {spec.library} node whose control flow reads data fsmbt "
-                                     "does not model (a clock, the robot pose, a goal or a "
-                                     "blackboard vector)")
+            why = spec.rejection or (
+                f"a {spec.library} node whose control flow reads data fsmbt "
+                "does not model (a clock, the robot pose, a goal or a "
+                "blackboard vector)"
+            )
             raise UnsupportedError(
                 f"{ctype}: {why}; enable it with {enabling_option(spec.requires)} (an "
-                f"abstraction: {spec.abstraction})", **_where(node))
+                f"abstraction: {spec.abstraction})",
+                **_where(node),
+            )
         reason = tables.rejected.get(ctype)
         if reason is not None and node.semantics is None:
             raise UnsupportedError(f"{ctype}: {reason}", **_where(node))
@@ -278,8 +301,9 @@ class CompiledTree:
             if not target or target not in self.doc.trees:
                 raise InputError(f"SubTree refers to unknown tree {target!r}", **_where(node))
             if target in chain:
-                raise UnsupportedError(f"SubTree '{target}' includes itself (recursion)",
-                                       **_where(node))
+                raise UnsupportedError(
+                    f"SubTree '{target}' includes itself (recursion)", **_where(node)
+                )
             if self.doc.trees[target].root is None:
                 raise InputError(f"SubTree '{target}' is empty", **_where(node))
             return ctype, kind, params, internal, []
@@ -295,11 +319,14 @@ class CompiledTree:
             return ctype, kind, params, internal, kids
         if kind is NodeKind.DECORATOR:
             if ctype not in tables.decorators:
-                raise UnsupportedError(f"decorator type '{node.type}' is not supported "
-                                       "(custom or unknown semantics)", **_where(node))
+                raise UnsupportedError(
+                    f"decorator type '{node.type}' is not supported (custom or unknown semantics)",
+                    **_where(node),
+                )
             if len(kids) != 1:
-                raise InputError(f"decorator {ctype} needs exactly one child, has {len(kids)}",
-                                 **_where(node))
+                raise InputError(
+                    f"decorator {ctype} needs exactly one child, has {len(kids)}", **_where(node)
+                )
             if ctype == "Repeat":
                 params = (_int_param(node, "num_cycles", None),)
             elif ctype == "RetryUntilSuccessful":
@@ -313,8 +340,10 @@ class CompiledTree:
             return ctype, kind, params, internal, kids
         if kind is NodeKind.CONTROL:
             if ctype not in tables.controls:
-                raise UnsupportedError(f"control type '{node.type}' is not supported "
-                                       "(custom or unknown semantics)", **_where(node))
+                raise UnsupportedError(
+                    f"control type '{node.type}' is not supported (custom or unknown semantics)",
+                    **_where(node),
+                )
             if not kids:
                 raise InputError(f"control node {ctype} has no children", **_where(node))
             n = len(kids)
@@ -327,8 +356,9 @@ class CompiledTree:
                 succ = _int_param(node, "success_count", -1)
                 fail = _int_param(node, "failure_count", 1)
                 if n < _threshold(succ, n) or n < _threshold(fail, n):
-                    raise InputError("Parallel threshold exceeds the number of children",
-                                     **_where(node))
+                    raise InputError(
+                        "Parallel threshold exceeds the number of children", **_where(node)
+                    )
                 params = (succ, fail)
             elif ctype == "RecoveryNode":
                 params = (_int_param(node, "number_of_retries", 1),)
@@ -337,8 +367,9 @@ class CompiledTree:
             elif ctype == "ParallelAll":
                 fail = _int_param(node, "max_failures", 1)
                 if n < _threshold(fail, n):
-                    raise InputError("ParallelAll max_failures exceeds the number of children",
-                                     **_where(node))
+                    raise InputError(
+                        "ParallelAll max_failures exceeds the number of children", **_where(node)
+                    )
                 params = (_threshold(fail, n),)
             return ctype, kind, params, internal, kids
         raise UnsupportedError(f"node kind {kind} is not supported", **_where(node))
@@ -351,8 +382,12 @@ class CompiledTree:
 # -- run-time configuration ------------------------------------------------------------------
 #: A snapshot: (statuses, memories, frames, wake-up pending). Hashable; equal snapshots behave
 #: the same for every future input.
-Snapshot = tuple[tuple[tuple[int, int], ...], tuple[tuple[int, tuple[Any, ...]], ...],
-                 tuple[tuple[Any, ...], ...], bool]
+Snapshot = tuple[
+    tuple[tuple[int, int], ...],
+    tuple[tuple[int, tuple[Any, ...]], ...],
+    tuple[tuple[Any, ...], ...],
+    bool,
+]
 
 
 @dataclass(frozen=True)
@@ -392,8 +427,12 @@ class _Work:
         self.wake: bool = snap[3]
 
     def snapshot(self) -> Snapshot:
-        return (tuple(sorted(self.st.items())), tuple(sorted(self.mem.items())),
-                tuple(self.frames), self.wake)
+        return (
+            tuple(sorted(self.st.items())),
+            tuple(sorted(self.mem.items())),
+            tuple(self.frames),
+            self.wake,
+        )
 
 
 EMPTY_SNAPSHOT: Snapshot = ((), (), (), False)
@@ -420,7 +459,8 @@ class BTInterpreter:
         # Dispatch data from the node registry (docs/semantics.md "Node registry").
         tables = runtime_tables()
         self._tick: dict[str, TickRule] = {
-            kind: getattr(self, f"_t_{handler}") for kind, handler in tables.handlers.items()}
+            kind: getattr(self, f"_t_{handler}") for kind, handler in tables.handlers.items()
+        }
         self._default_mem = tables.default_memory
         self._halt_resets = tables.halt_resets_memory
         self._seq_flags = tables.sequence_flags
@@ -437,8 +477,9 @@ class BTInterpreter:
             raise ValueError("a tick is already in progress")
         return (snap[0], snap[1], ((0, 0),), snap[3])
 
-    def advance(self, snap: Snapshot, outcome: int | None = None,
-                halt_hook: HaltHook | None = None) -> tuple[Snapshot, LeafRequest | TickDone]:
+    def advance(
+        self, snap: Snapshot, outcome: int | None = None, halt_hook: HaltHook | None = None
+    ) -> tuple[Snapshot, LeafRequest | TickDone]:
         """Run until the next environment leaf must be ticked or the ``tickOnce`` returns.
 
         ``outcome`` answers the ``LeafRequest`` the snapshot stopped at (``None`` right after
@@ -466,8 +507,10 @@ class BTInterpreter:
                     w.wake = False
                     key = w.snapshot()
                     if key in seen_reticks:
-                        raise BTLivelock("the tree re-ticks its root forever without ticking "
-                                         "a leaf", element=self.nodes[0].label)
+                        raise BTLivelock(
+                            "the tree re-ticks its root forever without ticking a leaf",
+                            element=self.nodes[0].label,
+                        )
                     seen_reticks.add(key)
                     w.frames.append((0, 0))
                     result = None
@@ -536,8 +579,9 @@ class BTInterpreter:
             self._halt(w, child, hook)
         w.st.pop(child, None)
 
-    def _reset_children(self, w: _Work, node: CompiledNode, hook: HaltHook | None,
-                        first: int = 0) -> None:
+    def _reset_children(
+        self, w: _Work, node: CompiledNode, hook: HaltHook | None, first: int = 0
+    ) -> None:
         for child in node.children[first:]:
             self._reset_child(w, child, hook)
 
@@ -551,8 +595,12 @@ class BTInterpreter:
             if t in self._halt_resets:
                 w.mem.pop(x.id, None)  # these halt() reset their memory
             # the others (SequenceWithMemory, RunOnce...) keep theirs: NodeSemantics.halt
-            if x.kind is NodeKind.ACTION and x.internal_status is None and hook is not None \
-                    and w.st.get(x.id, IDLE) == RUNNING:
+            if (
+                x.kind is NodeKind.ACTION
+                and x.internal_status is None
+                and hook is not None
+                and w.st.get(x.id, IDLE) == RUNNING
+            ):
                 hook(x)
             for child in reversed(x.children):
                 if w.st.get(child, IDLE) == RUNNING:
@@ -563,8 +611,9 @@ class BTInterpreter:
             # running children reset their own status when popped (after their halt)
 
     # -- node types: each returns ("call", child, new_frame) or ("ret", status) ---------------
-    def _t_sequence(self, w: _Work, node: CompiledNode, frame: Frame, result: int | None,
-                    hook: HaltHook | None) -> TickAction:
+    def _t_sequence(
+        self, w: _Work, node: CompiledNode, frame: Frame, result: int | None, hook: HaltHook | None
+    ) -> TickAction:
         """Sequence / Fallback / Async* / SequenceWithMemory (sequence_node.cpp & co)."""
         is_fallback, asynch, with_memory = self._seq_flags[node.type]
         stop, go_on = (SUCCESS, FAILURE) if is_fallback else (FAILURE, SUCCESS)
@@ -607,8 +656,9 @@ class BTInterpreter:
         self._set_mem(w, node, (0, 0))
         return ("ret", SKIPPED if all_skipped else go_on)
 
-    def _t_reactive(self, w: _Work, node: CompiledNode, frame: Frame, result: int | None,
-                    hook: HaltHook | None) -> TickAction:
+    def _t_reactive(
+        self, w: _Work, node: CompiledNode, frame: Frame, result: int | None, hook: HaltHook | None
+    ) -> TickAction:
         """ReactiveSequence / ReactiveFallback (reactive_sequence.cpp, reactive_fallback.cpp)."""
         is_fallback = node.type in self._reactive_fallbacks
         stop, go_on = (SUCCESS, FAILURE) if is_fallback else (FAILURE, SUCCESS)
@@ -636,8 +686,9 @@ class BTInterpreter:
         self._reset_children(w, node, hook)
         return ("ret", SKIPPED if all_skipped else go_on)
 
-    def _t_parallel(self, w: _Work, node: CompiledNode, frame: Frame, result: int | None,
-                    hook: HaltHook | None) -> TickAction:
+    def _t_parallel(
+        self, w: _Work, node: CompiledNode, frame: Frame, result: int | None, hook: HaltHook | None
+    ) -> TickAction:
         """Parallel with success_count / failure_count (parallel_node.cpp)."""
         n = len(node.children)
         succ_param, fail_param = node.params
@@ -675,8 +726,9 @@ class BTInterpreter:
         self._set_mem(w, node, (completed, sc, fc))
         return ("ret", SKIPPED if skipped == n else RUNNING)
 
-    def _t_parallel_all(self, w: _Work, node: CompiledNode, frame: Frame, result: int | None,
-                        hook: HaltHook | None) -> TickAction:
+    def _t_parallel_all(
+        self, w: _Work, node: CompiledNode, frame: Frame, result: int | None, hook: HaltHook | None
+    ) -> TickAction:
         """ParallelAll with max_failures (parallel_all_node.cpp)."""
         n = len(node.children)
         (need_f,) = node.params
@@ -711,8 +763,9 @@ class BTInterpreter:
         self._set_mem(w, node, (completed, fc))
         return ("ret", RUNNING)
 
-    def _t_if_then_else(self, w: _Work, node: CompiledNode, frame: Frame, result: int | None,
-                        hook: HaltHook | None) -> TickAction:
+    def _t_if_then_else(
+        self, w: _Work, node: CompiledNode, frame: Frame, result: int | None, hook: HaltHook | None
+    ) -> TickAction:
         """IfThenElse (if_then_else_node.cpp): the condition is not re-evaluated while a branch
         runs."""
         (child_idx,) = self._mem(w, node)
@@ -733,8 +786,10 @@ class BTInterpreter:
                 else:
                     return ("ret", FAILURE)
             else:
-                raise BTRuntimeError("IfThenElse: the condition was skipped (BehaviorTree.CPP "
-                                     "throws a logic_error)", element=node.label)
+                raise BTRuntimeError(
+                    "IfThenElse: the condition was skipped (BehaviorTree.CPP throws a logic_error)",
+                    element=node.label,
+                )
             self._set_mem(w, node, (child_idx,))
         else:  # pc == 2: the branch returned
             if result == RUNNING:
@@ -744,8 +799,9 @@ class BTInterpreter:
             return ("ret", result)
         return ("call", node.children[child_idx], (node.id, 2))
 
-    def _t_while_do_else(self, w: _Work, node: CompiledNode, frame: Frame, result: int | None,
-                         hook: HaltHook | None) -> TickAction:
+    def _t_while_do_else(
+        self, w: _Work, node: CompiledNode, frame: Frame, result: int | None, hook: HaltHook | None
+    ) -> TickAction:
         """WhileDoElse (while_do_else_node.cpp): the condition is re-evaluated every tick."""
         n = len(node.children)
         pc = frame[1]
@@ -765,8 +821,10 @@ class BTInterpreter:
                     return ("call", node.children[2], (node.id, 2))
                 status = FAILURE
             else:
-                raise BTRuntimeError("WhileDoElse: the condition was skipped (the node would "
-                                     "return IDLE)", element=node.label)
+                raise BTRuntimeError(
+                    "WhileDoElse: the condition was skipped (the node would return IDLE)",
+                    element=node.label,
+                )
         else:
             assert result is not None  # pc == 2: the branch returned
             status = result
@@ -775,8 +833,9 @@ class BTInterpreter:
         self._reset_children(w, node, hook)
         return ("ret", status)
 
-    def _t_simple_decorator(self, w: _Work, node: CompiledNode, frame: Frame, result: int | None,
-                            hook: HaltHook | None) -> TickAction:
+    def _t_simple_decorator(
+        self, w: _Work, node: CompiledNode, frame: Frame, result: int | None, hook: HaltHook | None
+    ) -> TickAction:
         """Inverter, ForceSuccess, ForceFailure, KeepRunningUntilFailure."""
         child = node.children[0]
         if frame[1] == 0:
@@ -796,18 +855,28 @@ class BTInterpreter:
         self._reset_child(w, child, hook)
         return ("ret", mapped[0] if result == SUCCESS else mapped[1])
 
-    def _t_repeat(self, w: _Work, node: CompiledNode, frame: Frame, result: int | None,
-                  hook: HaltHook | None) -> TickAction:
+    def _t_repeat(
+        self, w: _Work, node: CompiledNode, frame: Frame, result: int | None, hook: HaltHook | None
+    ) -> TickAction:
         """Repeat num_cycles (repeat_node.cpp); -1 repeats forever."""
         return self._loop_decorator(w, node, frame, result, hook, again_on=SUCCESS)
 
-    def _t_retry(self, w: _Work, node: CompiledNode, frame: Frame, result: int | None,
-                 hook: HaltHook | None) -> TickAction:
+    def _t_retry(
+        self, w: _Work, node: CompiledNode, frame: Frame, result: int | None, hook: HaltHook | None
+    ) -> TickAction:
         """RetryUntilSuccessful num_attempts (retry_node.cpp); -1 retries forever."""
         return self._loop_decorator(w, node, frame, result, hook, again_on=FAILURE)
 
-    def _loop_decorator(self, w: _Work, node: CompiledNode, frame: Frame, result: int | None,
-                        hook: HaltHook | None, *, again_on: int) -> TickAction:
+    def _loop_decorator(
+        self,
+        w: _Work,
+        node: CompiledNode,
+        frame: Frame,
+        result: int | None,
+        hook: HaltHook | None,
+        *,
+        again_on: int,
+    ) -> TickAction:
         """Repeat and RetryUntilSuccessful are mirror images in BehaviorTree.CPP: the child is
         ticked again while it returns ``again_on``, at most ``node.params[0]`` times (-1: no
         bound); the other result ends the loop at once. A loop that goes on in the same tick
@@ -847,8 +916,9 @@ class BTInterpreter:
         self._set_mem(w, node, (0,))
         return ("ret", again_on)
 
-    def _t_run_once(self, w: _Work, node: CompiledNode, frame: Frame, result: int | None,
-                    hook: HaltHook | None) -> TickAction:
+    def _t_run_once(
+        self, w: _Work, node: CompiledNode, frame: Frame, result: int | None, hook: HaltHook | None
+    ) -> TickAction:
         """RunOnce then_skip (run_once_node.h): memory survives halts."""
         (then_skip,) = node.params
         ticked, returned = self._mem(w, node)
@@ -862,8 +932,9 @@ class BTInterpreter:
             self._reset_child(w, node.children[0], hook)
         return ("ret", result)
 
-    def _t_subtree(self, w: _Work, node: CompiledNode, frame: Frame, result: int | None,
-                   hook: HaltHook | None) -> TickAction:
+    def _t_subtree(
+        self, w: _Work, node: CompiledNode, frame: Frame, result: int | None, hook: HaltHook | None
+    ) -> TickAction:
         """SubTree (subtree_node.cpp): a transparent decorator; port remapping is irrelevant."""
         if frame[1] == 0:
             if w.st.get(node.id, IDLE) == IDLE:
@@ -874,8 +945,9 @@ class BTInterpreter:
         return ("ret", result)
 
     # -- project kinds and abstractions (docs/semantics.md §10) ---------------------------------
-    def _t_pipeline(self, w: _Work, node: CompiledNode, frame: Frame, result: int | None,
-                    hook: HaltHook | None) -> TickAction:
+    def _t_pipeline(
+        self, w: _Work, node: CompiledNode, frame: Frame, result: int | None, hook: HaltHook | None
+    ) -> TickAction:
         """Nav2 PipelineSequence (pipeline_sequence.cpp)."""
         (last,) = self._mem(w, node)
         n = len(node.children)
@@ -903,8 +975,9 @@ class BTInterpreter:
         self._set_mem(w, node, (0,))
         return ("ret", SKIPPED if skipped == n else SUCCESS)
 
-    def _t_recovery(self, w: _Work, node: CompiledNode, frame: Frame, result: int | None,
-                    hook: HaltHook | None) -> TickAction:
+    def _t_recovery(
+        self, w: _Work, node: CompiledNode, frame: Frame, result: int | None, hook: HaltHook | None
+    ) -> TickAction:
         """Nav2 RecoveryNode (recovery_node.cpp): main child 0, recovery child 1."""
         (retries,) = node.params
         idx, tries = self._mem(w, node)
@@ -948,8 +1021,9 @@ class BTInterpreter:
         self._set_mem(w, node, (0, 0))
         return ("ret", FAILURE)
 
-    def _t_round_robin(self, w: _Work, node: CompiledNode, frame: Frame, result: int | None,
-                       hook: HaltHook | None) -> TickAction:
+    def _t_round_robin(
+        self, w: _Work, node: CompiledNode, frame: Frame, result: int | None, hook: HaltHook | None
+    ) -> TickAction:
         """Nav2 RoundRobin (round_robin_node.cpp), with its ``wrap_around`` port."""
         (wrap,) = node.params
         n = len(node.children)
@@ -990,8 +1064,9 @@ class BTInterpreter:
         self._set_mem(w, node, (0, 0))
         return ("ret", SKIPPED if skipped == n else FAILURE)
 
-    def _t_repeat_each_tick(self, w: _Work, node: CompiledNode, frame: Frame,
-                            result: int | None, hook: HaltHook | None) -> TickAction:
+    def _t_repeat_each_tick(
+        self, w: _Work, node: CompiledNode, frame: Frame, result: int | None, hook: HaltHook | None
+    ) -> TickAction:
         """MoveIt Pro RepeatUnlessFailureEachTick: one cycle per tick, no wake-up."""
         (limit,) = node.params
         (count,) = self._mem(w, node)
@@ -1015,8 +1090,9 @@ class BTInterpreter:
             return ("ret", FAILURE)
         return ("ret", SKIPPED)
 
-    def _t_single_trigger(self, w: _Work, node: CompiledNode, frame: Frame,
-                          result: int | None, hook: HaltHook | None) -> TickAction:
+    def _t_single_trigger(
+        self, w: _Work, node: CompiledNode, frame: Frame, result: int | None, hook: HaltHook | None
+    ) -> TickAction:
         """Nav2 SingleTrigger: the child runs to completion once per activation."""
         child = node.children[0]
         if frame[1] == 0:
@@ -1032,8 +1108,9 @@ class BTInterpreter:
             self._set_mem(w, node, (True,))
         return ("ret", result)
 
-    def _t_pass_through(self, w: _Work, node: CompiledNode, frame: Frame, result: int | None,
-                        hook: HaltHook | None) -> TickAction:
+    def _t_pass_through(
+        self, w: _Work, node: CompiledNode, frame: Frame, result: int | None, hook: HaltHook | None
+    ) -> TickAction:
         """A transparent wrapper (Groot 1 ``Root``): the child's status, child reset when done."""
         if frame[1] == 0:
             w.st[node.id] = RUNNING
@@ -1042,8 +1119,9 @@ class BTInterpreter:
             self._reset_child(w, node.children[0], hook)
         return ("ret", result)
 
-    def _t_pass_through_keep(self, w: _Work, node: CompiledNode, frame: Frame,
-                             result: int | None, hook: HaltHook | None) -> TickAction:
+    def _t_pass_through_keep(
+        self, w: _Work, node: CompiledNode, frame: Frame, result: int | None, hook: HaltHook | None
+    ) -> TickAction:
         """Nav2 GoalUpdater: ``return child_node_->executeTick()`` (the child is not reset)."""
         if frame[1] == 0:
             w.st[node.id] = RUNNING
@@ -1055,8 +1133,9 @@ class BTInterpreter:
         assert spec is not None and spec.gate is not None
         return spec.gate
 
-    def _t_gated(self, w: _Work, node: CompiledNode, frame: Frame, result: int | None,
-                 hook: HaltHook | None) -> TickAction:
+    def _t_gated(
+        self, w: _Work, node: CompiledNode, frame: Frame, result: int | None, hook: HaltHook | None
+    ) -> TickAction:
         """An abstraction whose gate (the last child, a condition the environment answers)
         decides whether the child is ticked: Nav2's controllers, Delay, Precondition,
         BlackboardCheck* (docs/semantics.md §10)."""
@@ -1069,7 +1148,8 @@ class BTInterpreter:
             w.st[node.id] = RUNNING
             child_status = w.st.get(child, IDLE)
             if (gate_rule.free_when_idle and prev == IDLE) or (
-                    gate_rule.free_when_running and child_status == RUNNING):
+                gate_rule.free_when_running and child_status == RUNNING
+            ):
                 return ("call", child, (node.id, 2))
             return ("call", gate, (node.id, 1))
         if pc == 1:
@@ -1083,8 +1163,9 @@ class BTInterpreter:
             self._reset_child(w, child, hook)
         return ("ret", result)
 
-    def _t_timeout(self, w: _Work, node: CompiledNode, frame: Frame, result: int | None,
-                   hook: HaltHook | None) -> TickAction:
+    def _t_timeout(
+        self, w: _Work, node: CompiledNode, frame: Frame, result: int | None, hook: HaltHook | None
+    ) -> TickAction:
         """Timeout as an abstraction: the timer (the gate) may fire on any tick after the
         first; fired, the child is halted and the node returns FAILURE."""
         child, gate = node.children[0], node.children[-1]
@@ -1105,8 +1186,9 @@ class BTInterpreter:
             self._reset_child(w, child, hook)
         return ("ret", result)
 
-    def _t_sleep(self, w: _Work, node: CompiledNode, frame: Frame, result: int | None,
-                 hook: HaltHook | None) -> TickAction:
+    def _t_sleep(
+        self, w: _Work, node: CompiledNode, frame: Frame, result: int | None, hook: HaltHook | None
+    ) -> TickAction:
         """Sleep as an abstraction: RUNNING until the timer (the gate) says the time is up."""
         gate = node.children[-1]
         if frame[1] == 0:
@@ -1115,8 +1197,9 @@ class BTInterpreter:
         w.st.pop(gate, None)
         return ("ret", SUCCESS if result == SUCCESS else RUNNING)
 
-    def _t_for_each(self, w: _Work, node: CompiledNode, frame: Frame, result: int | None,
-                    hook: HaltHook | None) -> TickAction:
+    def _t_for_each(
+        self, w: _Work, node: CompiledNode, frame: Frame, result: int | None, hook: HaltHook | None
+    ) -> TickAction:
         """MoveIt Pro ForEach / ForEachUntilSuccess as an abstraction: the gate says whether
         the vector has another element; one element per tick."""
         (no_more,) = node.params
@@ -1155,9 +1238,15 @@ class BTRunner:
     """Run a document tick by tick; each leaf asks ``env(node, path)`` for its outcome
     (``"success"``/``"failure"``/``"running"``). Mirrors behaviortreepy's ``Tree``."""
 
-    def __init__(self, doc: BTDocument | CompiledTree, env: Environment, *,
-                 exactly_once: bool = False, halt_hook: HaltHook | None = None,
-                 max_leaf_ticks_per_tick: int = 1_000_000) -> None:
+    def __init__(
+        self,
+        doc: BTDocument | CompiledTree,
+        env: Environment,
+        *,
+        exactly_once: bool = False,
+        halt_hook: HaltHook | None = None,
+        max_leaf_ticks_per_tick: int = 1_000_000,
+    ) -> None:
         self.interp = BTInterpreter(doc, exactly_once=exactly_once)
         self.env = env
         self.halt_hook = halt_hook

@@ -75,14 +75,16 @@ class Canonicalizer:
         flags = tables.sequence_flags
         nodes = tree.nodes
         #: reads_prev[n]: n's tick rule reads its child's status before the call (wake-up test).
-        self.reads_prev = [node.type in flags and (flags[node.type][1] or flags[node.type][2])
-                           for node in nodes]
+        self.reads_prev = [
+            node.type in flags and (flags[node.type][1] or flags[node.type][2]) for node in nodes
+        ]
         #: sequence_frame[n]: n's frames are (id, pc, prev) of the ``sequence`` rule.
         self.sequence_frame = [node.type in flags for node in nodes]
         #: halt_resets[n]: n's halt() forgets its memory.
         self.halt_resets = [node.type in tables.halt_resets_memory for node in nodes]
-        self.parent_reads_prev = [node.parent is not None and self.reads_prev[node.parent]
-                                  for node in nodes]
+        self.parent_reads_prev = [
+            node.parent is not None and self.reads_prev[node.parent] for node in nodes
+        ]
         self.parent = [node.parent if node.parent is not None else -1 for node in nodes]
 
     def canonical(self, snap: Snapshot) -> Snapshot:
@@ -100,14 +102,20 @@ class Canonicalizer:
         kept: set[int] = set()
         if running:
             with_memory = {nid for nid, _ in memories}
-            parent_reads_prev, halt_resets, parent = (self.parent_reads_prev, self.halt_resets,
-                                                      self.parent)
+            parent_reads_prev, halt_resets, parent = (
+                self.parent_reads_prev,
+                self.halt_resets,
+                self.parent,
+            )
             # Reverse pre-order: every child is decided before its parent, and a kept child
             # marks its parent (rule 3) through ``needed``.
             needed: set[int] = set()
             for nid in reversed(running):
-                if nid in needed or parent_reads_prev[nid] or \
-                        (halt_resets[nid] and nid in with_memory):
+                if (
+                    nid in needed
+                    or parent_reads_prev[nid]
+                    or (halt_resets[nid] and nid in with_memory)
+                ):
                     kept.add(nid)
                     needed.add(parent[nid])
         # Rule 4: the nodes on the stack (the path to the requested leaf) get their status from
@@ -120,5 +128,6 @@ class Canonicalizer:
             (frame[0], frame[1], IDLE)
             if len(frame) == 3 and sequence_frame[frame[0]] and not reads_prev[frame[0]]
             else frame
-            for frame in frames)
+            for frame in frames
+        )
         return (new_statuses, memories, new_frames, wake)

@@ -43,8 +43,10 @@ from fsmbt.semantics.status import LeafOutcome, RootResult
 ROOT = 0  # the compiled root's id (ids are pre-order indices)
 #: Negative targets in the exit tables: the root returned this result.
 ROOT_SUCCESS, ROOT_FAILURE = -1, -2
-ROOT_RESULT_NAMES: dict[int, str] = {ROOT_SUCCESS: RootResult.SUCCESS.value,
-                                     ROOT_FAILURE: RootResult.FAILURE.value}
+ROOT_RESULT_NAMES: dict[int, str] = {
+    ROOT_SUCCESS: RootResult.SUCCESS.value,
+    ROOT_FAILURE: RootResult.FAILURE.value,
+}
 _SUCCESS: Final[str] = LeafOutcome.SUCCESS.value
 _FAILURE: Final[str] = LeafOutcome.FAILURE.value
 _RUNNING: Final[str] = LeafOutcome.RUNNING.value
@@ -79,8 +81,12 @@ def is_static_tree(tree: CompiledTree) -> bool:
         below = under_reactive[node.id]
         if node.kind is NodeKind.CONTROL:
             spec = node_semantics(node.type)
-            if spec is None or not node.children or node.type not in PLAIN_CONTROLS and not (
-                    spec.reactive and spec.handler == "reactive"):
+            if (
+                spec is None
+                or not node.children
+                or node.type not in PLAIN_CONTROLS
+                and not (spec.reactive and spec.handler == "reactive")
+            ):
                 return False
             if node.type in PLAIN_CONTROLS and below:
                 return False
@@ -135,7 +141,8 @@ class PlainLeafTable:
             last = len(kids) - 1
             if node.kind is NodeKind.DECORATOR:  # a status map: its child's exits rewired
                 on_success[kids[0]], on_failure[kids[0]] = rewired(
-                    node.type, parent_success, parent_failure)
+                    node.type, parent_success, parent_failure
+                )
             elif node.kind is NodeKind.CONTROL and node.type not in FALLBACK_TYPES:  # Sequence
                 for i, kid in enumerate(kids):
                     on_success[kid] = first_leaf[kids[i + 1]] if i < last else parent_success

@@ -96,8 +96,14 @@ LeafState = Snapshot | RootResult | int
 class LeafMachine:
     """``Machine`` over leaf outcomes for a BT document (``fsmbt.semantics.machine``)."""
 
-    def __init__(self, doc: BTDocument | CompiledTree, loop: bool = False, *,
-                 name: str | None = None, generic: bool = False) -> None:
+    def __init__(
+        self,
+        doc: BTDocument | CompiledTree,
+        loop: bool = False,
+        *,
+        name: str | None = None,
+        generic: bool = False,
+    ) -> None:
         self.interp = BTInterpreter(doc)
         self.tree = self.interp.tree
         self.loop = loop
@@ -105,9 +111,11 @@ class LeafMachine:
         self.name = name or main.id
         self.fast = not generic and is_static_tree(self.tree)
         self.table = PlainLeafTable(self.tree) if self.fast else None
-        self.canonicalizer = (Canonicalizer(self.tree)
-                              if not generic and not self.fast and is_canonical_class(self.tree)
-                              else None)
+        self.canonicalizer = (
+            Canonicalizer(self.tree)
+            if not generic and not self.fast and is_canonical_class(self.tree)
+            else None
+        )
         self.canonical = self.canonicalizer is not None
 
     # -- Machine protocol --------------------------------------------------------------------
@@ -165,8 +173,11 @@ class LeafMachine:
         """``step`` on the fast path: O(1) table look-ups, the same loop rules as ``_run``."""
         table = self.table
         assert table is not None
-        if symbol == _OUTCOME_RUNNING and table.is_condition[leaf] or \
-                symbol not in OUTCOME_TO_STATUS:
+        if (
+            symbol == _OUTCOME_RUNNING
+            and table.is_condition[leaf]
+            or symbol not in OUTCOME_TO_STATUS
+        ):
             raise ValueError(f"input {symbol!r} is not allowed in state {self.describe(leaf)}")
         target = table.after(leaf, symbol)
         if target >= 0:
@@ -232,7 +243,9 @@ class ExploredMachine(Generic[S]):
         import networkx as nx  # only tests and reports need the graph object
 
         index = {s: i for i, s in enumerate(self.states)}
-        graph: nx.MultiDiGraph[int] = nx.MultiDiGraph(start=index[self.start], start_outputs=self.start_outputs)
+        graph: nx.MultiDiGraph[int] = nx.MultiDiGraph(
+            start=index[self.start], start_outputs=self.start_outputs
+        )
         for s, i in index.items():
             graph.add_node(i, status=self.statuses[s], name=self.names[s])
         for s, moves in self.transitions.items():
@@ -263,7 +276,8 @@ def explore(machine: Machine[Any], max_states: int = 200_000) -> ExploredMachine
                 if len(seen) >= max_states:
                     raise StateLimitError(
                         f"the machine has more than {max_states} reachable states",
-                        element=getattr(machine, "name", None))
+                        element=getattr(machine, "name", None),
+                    )
                 seen.add(target)
                 queue.append(target)
         result.transitions[state] = moves

@@ -74,7 +74,9 @@ class FSMMachine:
         self.name = self.fsm.name
         self.start_state = self.fsm.start_name or "__start__"
         self.table = self.fsm.transition_map()
-        self.alphabet: tuple[str, ...] = tuple(alphabet if alphabet is not None else self.fsm.events())
+        self.alphabet: tuple[str, ...] = tuple(
+            alphabet if alphabet is not None else self.fsm.events()
+        )
 
     def start(self) -> tuple[str, Outputs]:
         assert self.fsm.initial is not None, "validated FSMs have an initial state"

@@ -102,20 +102,28 @@ def _parse_leaf(node) -> SvLeaf:  # type: ignore[no-untyped-def]
     where = {"location": node.source.location, "element": f"<{node.type}> '{node.label}'"}
     expected = NodeKind.CONDITION if node.type in CONDITION_TYPES else NodeKind.ACTION
     if node.type not in SV_TYPES:
-        raise InputError("a state-variable BT only has Sv* leaves "
-                         f"({', '.join(sorted(SV_TYPES))})", **where)
+        raise InputError(
+            f"a state-variable BT only has Sv* leaves ({', '.join(sorted(SV_TYPES))})", **where
+        )
     if node.kind is not expected:
-        raise InputError(f"{node.type} must be a{'n' if expected is NodeKind.ACTION else ''} "
-                         f"{expected.value}", **where)
+        raise InputError(
+            f"{node.type} must be a{'n' if expected is NodeKind.ACTION else ''} {expected.value}",
+            **where,
+        )
     try:
         transitions = tuple(decode_transitions(attrs.get("transitions", "")).items())
     except ValueError as exc:
         raise InputError(str(exc), **where) from None
     return SvLeaf(
-        type=node.type, state=attrs.get("state", ""), action=attrs.get("action") or None,
-        final=attrs.get("final", "false").lower() == "true", event=attrs.get("event", ""),
-        target=attrs.get("target", ""), transitions=transitions,
-        initial=attrs.get("initial", "false").lower() == "true")
+        type=node.type,
+        state=attrs.get("state", ""),
+        action=attrs.get("action") or None,
+        final=attrs.get("final", "false").lower() == "true",
+        event=attrs.get("event", ""),
+        target=attrs.get("target", ""),
+        transitions=transitions,
+        initial=attrs.get("initial", "false").lower() == "true",
+    )
 
 
 def leaf_outcome(leaf: SvLeaf, bb: SvBlackboard, actions: list[str]) -> LeafOutcome:
@@ -168,8 +176,9 @@ class SvState:
 class StateVariableMachine:
     """``Machine`` of a state-variable BT's macro steps: inputs are events, outputs actions."""
 
-    def __init__(self, doc: BTDocument, alphabet: Sequence[str], *,
-                 name: str | None = None) -> None:
+    def __init__(
+        self, doc: BTDocument, alphabet: Sequence[str], *, name: str | None = None
+    ) -> None:
         self.interp = BTInterpreter(doc)
         self.tree: CompiledTree = self.interp.tree
         self.name = name or self.tree.doc.main.id
@@ -180,17 +189,23 @@ class StateVariableMachine:
             if node.is_env_leaf:
                 self.leaves[node.id] = _parse_leaf(node)
             elif node.kind in (NodeKind.ACTION, NodeKind.CONDITION):
-                raise InputError("a state-variable BT only has Sv* leaves",
-                                 location=node.source.location,
-                                 element=f"<{node.type}> '{node.label}'")
+                raise InputError(
+                    "a state-variable BT only has Sv* leaves",
+                    location=node.source.location,
+                    element=f"<{node.type}> '{node.label}'",
+                )
         initial = [leaf for leaf in self.leaves.values() if leaf.initial]
         if len({leaf.state for leaf in initial}) != 1:
-            raise InputError("a state-variable BT needs exactly one initial state (a leaf with "
-                             f"initial=\"true\"), found {len(initial)}", element=self.name)
+            raise InputError(
+                "a state-variable BT needs exactly one initial state (a leaf with "
+                f'initial="true"), found {len(initial)}',
+                element=self.name,
+            )
         self.initial_state = initial[0].state
         # the start pseudo-state: initial, but without a mode/entry-action leaf of its own
-        entered_by = {leaf.state for leaf in self.leaves.values()
-                      if leaf.type in (ENTRY_ACTION, MODE)}
+        entered_by = {
+            leaf.state for leaf in self.leaves.values() if leaf.type in (ENTRY_ACTION, MODE)
+        }
         self.pseudo_start = self.initial_state not in entered_by
         self._events_from: dict[str, set[str]] = {}
         for leaf in self.leaves.values():
@@ -198,7 +213,8 @@ class StateVariableMachine:
                 self._events_from.setdefault(leaf.state, set()).add(leaf.event)
             elif leaf.type == TRANSITION:
                 self._events_from.setdefault(leaf.state, set()).update(
-                    e for e, _t in leaf.transitions)
+                    e for e, _t in leaf.transitions
+                )
 
     def events(self) -> list[str]:
         """Every event the leaves name, sorted (so the checker can offer them all)."""
@@ -251,12 +267,15 @@ class StateVariableMachine:
             if not bb.switched:
                 break
         else:
-            raise InputError(f"the tree does not settle within {MAX_TICKS_PER_STEP} ticks "
-                             "(livelock)", element=self.name)
+            raise InputError(
+                f"the tree does not settle within {MAX_TICKS_PER_STEP} ticks (livelock)",
+                element=self.name,
+            )
         return SvState(snap, bb.state, bb.entered, result), tuple(actions)
 
-    def _tick(self, snap: Snapshot, bb: SvBlackboard,
-              actions: list[str]) -> tuple[Snapshot, NodeStatus]:
+    def _tick(
+        self, snap: Snapshot, bb: SvBlackboard, actions: list[str]
+    ) -> tuple[Snapshot, NodeStatus]:
         snap = self.interp.begin_tick(snap)
         snap, request = self.interp.advance(snap)
         while isinstance(request, LeafRequest):
@@ -265,8 +284,9 @@ class StateVariableMachine:
         return snap, NodeStatus(request.status)
 
 
-def machines_for_state_variable(source: FSM, result: BTDocument) -> tuple[FSMMachine,
-                                                                          StateVariableMachine]:
+def machines_for_state_variable(
+    source: FSM, result: BTDocument
+) -> tuple[FSMMachine, StateVariableMachine]:
     """The checker's pair for (FSM, state-variable BT): both over the union of their events."""
     base = FSMMachine(source)
     probe = StateVariableMachine(result, ())

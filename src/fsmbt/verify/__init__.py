@@ -22,18 +22,28 @@ class EngineDisagreement(RuntimeError):
     """The native checker and NuSMV disagree on a property: a bug in one of them (exit 3)."""
 
     def __init__(self, native: Report, nusmv: Report) -> None:
-        differing = [name for name in PROPERTIES
-                     if native.verdicts().get(name) != nusmv.verdicts().get(name)]
-        shown = ", ".join(f"{name} (native {_word(native.verdicts().get(name))}, "
-                          f"NuSMV {_word(nusmv.verdicts().get(name))})" for name in differing)
+        differing = [
+            name for name in PROPERTIES if native.verdicts().get(name) != nusmv.verdicts().get(name)
+        ]
+        shown = ", ".join(
+            f"{name} (native {_word(native.verdicts().get(name))}, "
+            f"NuSMV {_word(nusmv.verdicts().get(name))})"
+            for name in differing
+        )
         super().__init__(f"the engines disagree on {shown}")
         self.native = native
         self.nusmv = nusmv
         self.differing = differing
 
 
-def verify(source: FSM | BTDocument, result: FSM | BTDocument, *, engine: str = "native",
-           loop: bool = False, max_states: int = DEFAULT_MAX_STATES) -> Report:
+def verify(
+    source: FSM | BTDocument,
+    result: FSM | BTDocument,
+    *,
+    engine: str = "native",
+    loop: bool = False,
+    max_states: int = DEFAULT_MAX_STATES,
+) -> Report:
     """Check that ``result`` behaves exactly like ``source`` (see ``fsmbt.verify.pairing``).
 
     Args:
@@ -76,18 +86,23 @@ def _nusmv(source: FSM | BTDocument, result: FSM | BTDocument, loop: bool) -> Re
     try:
         from fsmbt.verify import nusmv
     except ImportError as exc:
-        raise InputError(f"the NuSMV engine is not available ({exc})",
-                         hints=(Hint.NATIVE_VERIFIER,)) from None
+        raise InputError(
+            f"the NuSMV engine is not available ({exc})", hints=(Hint.NATIVE_VERIFIER,)
+        ) from None
     checker = getattr(nusmv, "check", None)
     if checker is None:
-        raise InputError("the NuSMV engine is not available (fsmbt.verify.nusmv has no check)",
-                         hints=(Hint.NATIVE_VERIFIER,))
+        raise InputError(
+            "the NuSMV engine is not available (fsmbt.verify.nusmv has no check)",
+            hints=(Hint.NATIVE_VERIFIER,),
+        )
     try:
         report: Report = checker(source, result, loop=loop)
         return report
     except FileNotFoundError as exc:
-        raise InputError(f"the NuSMV binary is not installed ({exc}); scripts/setup.sh builds it",
-                         hints=(Hint.NATIVE_VERIFIER,)) from None
+        raise InputError(
+            f"the NuSMV binary is not installed ({exc}); scripts/setup.sh builds it",
+            hints=(Hint.NATIVE_VERIFIER,),
+        ) from None
 
 
 def _model_name(model: FSM | BTDocument, fallback: str) -> str:
@@ -104,6 +119,16 @@ def _word(verdict: bool | None) -> str:
 
 
 __all__ = [
-    "verify", "check", "replay", "Replay", "Report", "PropertyResult", "TraceStep", "PROPERTIES",
-    "EngineDisagreement", "FSMLeafMachine", "machines_for", "ENGINES",
+    "verify",
+    "check",
+    "replay",
+    "Replay",
+    "Report",
+    "PropertyResult",
+    "TraceStep",
+    "PROPERTIES",
+    "EngineDisagreement",
+    "FSMLeafMachine",
+    "machines_for",
+    "ENGINES",
 ]

@@ -44,19 +44,30 @@ def _fsm_candidates(fsm: FSM) -> Iterator[tuple[str, str, Callable[[FSM], None]]
     for index, t in enumerate(fsm.transitions):
         for target in names:
             if target != t.target:
+
                 def retarget(m: FSM, i: int = index, to: str = target) -> None:
                     m.transitions[i].target = to
-                yield ("retarget_transition",
-                       f"{t.source} -{t.event}-> {t.target} now goes to {target}", retarget)
+
+                yield (
+                    "retarget_transition",
+                    f"{t.source} -{t.event}-> {t.target} now goes to {target}",
+                    retarget,
+                )
+
         def drop(m: FSM, i: int = index) -> None:
             del m.transitions[i]
+
         yield "drop_transition", f"dropped {t.source} -{t.event}-> {t.target}", drop
     for name, state in fsm.states.items():
+
         def relabel(m: FSM, n: str = name) -> None:
             m.states[n].action = f"{m.states[n].action}_mutated"
+
         yield "change_action", f"action of {name} changed", relabel
+
         def flip(m: FSM, n: str = name) -> None:
             m.states[n].final = not m.states[n].final
+
         yield "flip_final", f"final flag of {name} flipped to {not state.final}", flip
 
 
@@ -74,63 +85,88 @@ def _bt_candidates(doc: BTDocument) -> Iterator[tuple[str, str, Callable[[list[B
         label = node.label
         if node.kind is NodeKind.CONTROL and len(node.children) >= 2:
             for a in range(len(node.children) - 1):
+
                 def swap(ns: list[BTNode], i: int = i, a: int = a) -> None:
                     kids = ns[i].children
                     kids[a], kids[a + 1] = kids[a + 1], kids[a]
+
                 yield "swap_children", f"children {a} and {a + 1} of {label} swapped", swap
         if node.type in PLAIN_CONTROLS:  # the paper's two controls swap into each other
             other = "Fallback" if node.type == "Sequence" else "Sequence"
+
             def turn(ns: list[BTNode], i: int = i, other: str = other) -> None:
                 ns[i].type = other
+
             operator = "sequence_to_fallback" if node.type == "Sequence" else "fallback_to_sequence"
             yield operator, f"{label} ({node.type}) turned into a {other}", turn
         if node.kind is NodeKind.CONDITION:
+
             def invert(ns: list[BTNode], i: int = i) -> None:
                 parent = ns[parent_at[i]]
                 wrapper = BTNode(type="Inverter", kind=NodeKind.DECORATOR, children=[ns[i]])
                 parent.children[_index_of(parent, ns[i])] = wrapper
+
             if i in parent_at:
                 yield "invert_condition", f"condition {label} wrapped in an Inverter", invert
         if node.is_leaf and i in parent_at:
             parent = nodes[parent_at[i]]
             if parent.kind is NodeKind.CONTROL and len(parent.children) >= 2:
+
                 def drop(ns: list[BTNode], i: int = i) -> None:
                     parent = ns[parent_at[i]]
                     del parent.children[_index_of(parent, ns[i])]
+
                 yield "drop_leaf", f"leaf {label} dropped", drop
         if node.type == STATE_TYPE:
             spec = StateSpec.from_attrs(node.attrs)
+
             def relabel_state(ns: list[BTNode], i: int = i) -> None:
                 ns[i].attrs["action"] = f"{ns[i].attrs.get('action', '')}_mutated"
+
             yield "change_action", f"action of state leaf {label} changed", relabel_state
+
             def flip(ns: list[BTNode], i: int = i) -> None:
                 ns[i].attrs["final"] = "false" if ns[i].attrs.get("final") == "true" else "true"
-            yield "flip_final", f"final flag of state leaf {label} flipped to {not spec.final}", flip
+
+            yield (
+                "flip_final",
+                f"final flag of state leaf {label} flipped to {not spec.final}",
+                flip,
+            )
         elif node.is_leaf and node.type != GUARD_TYPE:
+
             def relabel(ns: list[BTNode], i: int = i) -> None:
                 ns[i].name = f"{ns[i].label}_mutated"
+
             yield "change_action", f"leaf {label} renamed", relabel
         if node.type == GUARD_TYPE:
             guard = GuardSpec.from_attrs(node.attrs)
             for k, pair in enumerate(guard.pairs):
+
                 def drop_pair(ns: list[BTNode], i: int = i, k: int = k) -> None:
                     old = GuardSpec.from_attrs(ns[i].attrs)
-                    pairs = old.pairs[:k] + old.pairs[k + 1:]
+                    pairs = old.pairs[:k] + old.pairs[k + 1 :]
                     ns[i].attrs.update(GuardSpec(old.target, pairs).to_attrs())
+
                 yield "drop_guard_pair", f"pair {pair[0]}/{pair[1]} dropped from {label}", drop_pair
                 for j in guards:
                     if j == i:
                         continue
+
                     def move_pair(ns: list[BTNode], i: int = i, k: int = k, j: int = j) -> None:
                         old = GuardSpec.from_attrs(ns[i].attrs)
                         moved = old.pairs[k]
-                        ns[i].attrs.update(GuardSpec(old.target,
-                                                     old.pairs[:k] + old.pairs[k + 1:]).to_attrs())
+                        ns[i].attrs.update(
+                            GuardSpec(old.target, old.pairs[:k] + old.pairs[k + 1 :]).to_attrs()
+                        )
                         dest = GuardSpec.from_attrs(ns[j].attrs)
                         ns[j].attrs.update(GuardSpec(dest.target, dest.pairs + (moved,)).to_attrs())
-                    yield ("retarget_transition",
-                           f"pair {pair[0]}/{pair[1]} moved from {label} to {nodes[j].label}",
-                           move_pair)
+
+                    yield (
+                        "retarget_transition",
+                        f"pair {pair[0]}/{pair[1]} moved from {label} to {nodes[j].label}",
+                        move_pair,
+                    )
 
 
 def _index_of(parent: BTNode, child: BTNode) -> int:
@@ -170,7 +206,14 @@ def mutants(model: Model, *, seed: int = 0, per_operator: int | None = 4) -> lis
 
 
 OPERATORS = (
-    "retarget_transition", "drop_transition", "change_action", "flip_final", "swap_children",
-    "sequence_to_fallback", "fallback_to_sequence", "invert_condition", "drop_leaf",
+    "retarget_transition",
+    "drop_transition",
+    "change_action",
+    "flip_final",
+    "swap_children",
+    "sequence_to_fallback",
+    "fallback_to_sequence",
+    "invert_condition",
+    "drop_leaf",
     "drop_guard_pair",
 )

@@ -67,6 +67,8 @@ class StateLimitError(InputError):
     An ``InputError`` (callers that only know that class still see bad input); the batch
     runner tells it apart to record the model as over the state limit, not as malformed.
     """
+
+
 _NO_OUTPUT: tuple[str, ...] = ()
 
 
@@ -78,7 +80,9 @@ class _Explored:
     offered inputs that are not explored are silent self-loops (see ``active_inputs``).
     """
 
-    def __init__(self, machine: Machine[Any], outputs: _Interner, max_states: int, role: str) -> None:
+    def __init__(
+        self, machine: Machine[Any], outputs: _Interner, max_states: int, role: str
+    ) -> None:
         self.machine = machine
         self.role = role
         self.outputs = outputs
@@ -111,7 +115,9 @@ class _Explored:
             raise StateLimitError(
                 f"the {self.role} machine has more than {self.max_states} reachable states "
                 "(check the model for an unbounded counter)",
-                element=getattr(self.machine, "name", self.role), hints=(Hint.MAX_STATES,))
+                element=getattr(self.machine, "name", self.role),
+                hints=(Hint.MAX_STATES,),
+            )
         new_id = len(self.states)
         self.index[state] = new_id
         self.states.append(state)
@@ -200,8 +206,11 @@ class _Explored:
             return hit
         if not self.follows_environment or self.accepts(x, symbol):
             return x, self.outputs.intern(_NO_OUTPUT)
-        raise InputError(f"the {self.role} machine was given input {symbol!r} that it does not "
-                         "list among its inputs", element=getattr(self.machine, "name", self.role))
+        raise InputError(
+            f"the {self.role} machine was given input {symbol!r} that it does not "
+            "list among its inputs",
+            element=getattr(self.machine, "name", self.role),
+        )
 
     def path_to(self, x: int) -> list[str]:
         inputs: list[str] = []
@@ -271,8 +280,9 @@ def replay(source: Machine[Any], result: Machine[Any], inputs: Sequence[str]) ->
     steps: list[TraceStep] = []
     differences: list[str] = []
 
-    def record(index: int, symbol: str | None, o1: Sequence[str], o2: Sequence[str],
-               note: str) -> None:
+    def record(
+        index: int, symbol: str | None, o1: Sequence[str], o2: Sequence[str], note: str
+    ) -> None:
         st_s, st_r = source.status(s), result.status(r)
         notes = [note] if note else []
         if tuple(o1) != tuple(o2):
@@ -282,8 +292,19 @@ def replay(source: Machine[Any], result: Machine[Any], inputs: Sequence[str]) ->
         text = "; ".join(notes)
         if text:
             differences.append(f"step {index}: {text}")
-        steps.append(TraceStep(index, symbol, list(o1), list(o2), source.describe(s),
-                               result.describe(r), st_s, st_r, note=text))
+        steps.append(
+            TraceStep(
+                index,
+                symbol,
+                list(o1),
+                list(o2),
+                source.describe(s),
+                result.describe(r),
+                st_s,
+                st_r,
+                note=text,
+            )
+        )
 
     record(0, None, out_s, out_r, "")
     for index, symbol in enumerate(inputs, start=1):
@@ -339,8 +360,10 @@ class _Product:
         if found is not None:
             return found
         if len(self.pair_s) >= self.max_states:
-            raise StateLimitError(f"the product of the two machines has more than "
-                                  f"{self.max_states} states", hints=(Hint.MAX_STATES,))
+            raise StateLimitError(
+                f"the product of the two machines has more than {self.max_states} states",
+                hints=(Hint.MAX_STATES,),
+            )
         new_id = len(self.pair_s)
         self.index[key] = new_id
         self.pair_s.append(s)
@@ -366,11 +389,19 @@ class _Product:
         v1, v2 = values[o1], values[o2]
         where = "at the start" if symbol is None else f"on input {symbol!r}"
         if not _is_subsequence(v1, v2):
-            self.violate(COMPLETENESS, _Violation(
-                p, symbol, f"{where} the source does {_show(v1)}, the result {_show(v2)}"))
+            self.violate(
+                COMPLETENESS,
+                _Violation(
+                    p, symbol, f"{where} the source does {_show(v1)}, the result {_show(v2)}"
+                ),
+            )
         if not _is_subsequence(v2, v1):
-            self.violate(NO_ADDITIONAL_BEHAVIOR, _Violation(
-                p, symbol, f"{where} the result does {_show(v2)}, the source {_show(v1)}"))
+            self.violate(
+                NO_ADDITIONAL_BEHAVIOR,
+                _Violation(
+                    p, symbol, f"{where} the result does {_show(v2)}, the source {_show(v1)}"
+                ),
+            )
 
     def run(self) -> None:
         """Breadth first over agreeing steps only: every pair explored is faithful."""
@@ -379,9 +410,14 @@ class _Product:
         if src.start_outputs != res.start_outputs:
             self.compare_outputs(start, None, src.start_outputs, res.start_outputs)
         if src.status[0] != res.status[0]:
-            self.violate(TERMINATION_CONSISTENCY, _Violation(
-                start, None, f"at the start the source is {src.status[0]!r}, the result "
-                             f"{res.status[0]!r}"))
+            self.violate(
+                TERMINATION_CONSISTENCY,
+                _Violation(
+                    start,
+                    None,
+                    f"at the start the source is {src.status[0]!r}, the result {res.status[0]!r}",
+                ),
+            )
         self.start_ok = src.start_outputs == res.start_outputs and src.status[0] == res.status[0]
         if not self.start_ok:
             return
@@ -396,13 +432,25 @@ class _Product:
             if not follows:
                 missing, extra = self.input_difference(s, r)
                 if missing:
-                    self.violate(COMPLETENESS, _Violation(
-                        p, missing[0], f"the result does not accept input {missing[0]!r} "
-                                       f"(the source does; {len(missing)} such inputs)"))
+                    self.violate(
+                        COMPLETENESS,
+                        _Violation(
+                            p,
+                            missing[0],
+                            f"the result does not accept input {missing[0]!r} "
+                            f"(the source does; {len(missing)} such inputs)",
+                        ),
+                    )
                 if extra:
-                    self.violate(NO_ADDITIONAL_BEHAVIOR, _Violation(
-                        p, extra[0], f"the result accepts input {extra[0]!r} that the source "
-                                     f"refuses ({len(extra)} such inputs)"))
+                    self.violate(
+                        NO_ADDITIONAL_BEHAVIOR,
+                        _Violation(
+                            p,
+                            extra[0],
+                            f"the result accepts input {extra[0]!r} that the source "
+                            f"refuses ({len(extra)} such inputs)",
+                        ),
+                    )
             s_row, r_row = src.edges[s], res.edges[r]
             symbols = list(s_row)
             symbols.extend(a for a in r_row if a not in s_row)
@@ -419,9 +467,15 @@ class _Product:
                     self.compare_outputs(p, symbol, o1, o2)
                     agree = False
                 if src.status[s2] != res.status[r2]:
-                    self.violate(TERMINATION_CONSISTENCY, _Violation(
-                        p, symbol, f"after input {symbol!r} the source is {src.status[s2]!r}, "
-                                   f"the result {res.status[r2]!r}"))
+                    self.violate(
+                        TERMINATION_CONSISTENCY,
+                        _Violation(
+                            p,
+                            symbol,
+                            f"after input {symbol!r} the source is {src.status[s2]!r}, "
+                            f"the result {res.status[r2]!r}",
+                        ),
+                    )
                     agree = False
                 if agree:
                     self.pair(s2, r2, p, symbol)
@@ -434,10 +488,19 @@ class _Product:
         else:
             dead, live, live_side = "result", src, "source"
             live_state = s
-        extension = live.path_to_observable(live_state) if live.status[live_state] == RUNNING else []
-        self.violate(DEADLOCK_ABSENCE, _Violation(
-            p, None, f"the {dead} is stuck in a non-terminal state (no input ever makes it "
-                     f"act) while the {live_side} can still act", extension))
+        extension = (
+            live.path_to_observable(live_state) if live.status[live_state] == RUNNING else []
+        )
+        self.violate(
+            DEADLOCK_ABSENCE,
+            _Violation(
+                p,
+                None,
+                f"the {dead} is stuck in a non-terminal state (no input ever makes it "
+                f"act) while the {live_side} can still act",
+                extension,
+            ),
+        )
 
     def faithful(self) -> list[bool]:
         """Pairs reached on a path where both machines agreed at every step: all explored ones,
@@ -458,8 +521,13 @@ def _show(outputs: tuple[str, ...]) -> str:
 
 
 # -- the checker ----------------------------------------------------------------------------------
-def check(source: Machine[Any], result: Machine[Any], *, max_states: int = DEFAULT_MAX_STATES,
-          mode: str = "lockstep") -> Report:
+def check(
+    source: Machine[Any],
+    result: Machine[Any],
+    *,
+    max_states: int = DEFAULT_MAX_STATES,
+    mode: str = "lockstep",
+) -> Report:
     """Compare two deterministic machines; the five properties, each with a shortest
     counterexample when it fails (see the module docstring and docs/verification.md)."""
     collecting = gc.isenabled()
@@ -484,8 +552,12 @@ def _check(source: Machine[Any], result: Machine[Any], max_states: int, mode: st
     if reachability is not None:
         product.violate(REACHABILITY, reachability)
 
-    report = Report(engine="native", source=getattr(source, "name", "source"),
-                    result=getattr(result, "name", "result"), mode=mode)
+    report = Report(
+        engine="native",
+        source=getattr(source, "name", "source"),
+        result=getattr(result, "name", "result"),
+        mode=mode,
+    )
     for name in PROPERTIES:
         violation = product.first.get(name)
         if violation is None:
@@ -513,8 +585,9 @@ def _check(source: Machine[Any], result: Machine[Any], max_states: int, mode: st
     return report
 
 
-def _reachability(src: _Explored, res: _Explored, product: _Product,
-                  faithful: list[bool]) -> _Violation | None:
+def _reachability(
+    src: _Explored, res: _Explored, product: _Product, faithful: list[bool]
+) -> _Violation | None:
     """Source states, and result states, reachable on their own but never in a faithful pair.
 
     The counterexample is the shortest path to the first such state in that machine alone
@@ -529,17 +602,22 @@ def _reachability(src: _Explored, res: _Explored, product: _Product,
             source_ok[product.pair_s[p]] = True
             result_ok[product.pair_r[p]] = True
     unmatched_source = [x for x, ok in enumerate(source_ok) if not ok]
-    unmatched_result = [] if res.follows_environment else [
-        x for x, ok in enumerate(result_ok) if not ok]
+    unmatched_result = (
+        [] if res.follows_environment else [x for x, ok in enumerate(result_ok) if not ok]
+    )
     if not unmatched_source and not unmatched_result:
         return None
     parts = []
     if unmatched_source:
-        parts.append(f"{len(unmatched_source)} source state(s) never reached with matching "
-                     f"behaviour: {_names(src, unmatched_source)}")
+        parts.append(
+            f"{len(unmatched_source)} source state(s) never reached with matching "
+            f"behaviour: {_names(src, unmatched_source)}"
+        )
     if unmatched_result:
-        parts.append(f"{len(unmatched_result)} result state(s) reachable only through behaviour "
-                     f"the source does not have: {_names(res, unmatched_result)}")
+        parts.append(
+            f"{len(unmatched_result)} result state(s) reachable only through behaviour "
+            f"the source does not have: {_names(res, unmatched_result)}"
+        )
     paths = []
     if unmatched_source:
         paths.append(src.path_to(unmatched_source[0]))

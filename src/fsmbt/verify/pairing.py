@@ -19,7 +19,7 @@ from fsmbt.model.fsm import FSM
 from fsmbt.semantics.lebt.machine import LEBTMachine
 from fsmbt.semantics.lebt.spec import GUARD_TYPE, GuardSpec
 from fsmbt.semantics.machine import FINAL, RUNNING, FSMMachine, Machine, Outputs
-from fsmbt.semantics.status import LeafOutcome, NodeStatus
+from fsmbt.semantics.status import LeafOutcome
 
 MACRO_STEP = "macro-step"
 LEAF_EXECUTION = "leaf-execution"
@@ -153,13 +153,17 @@ def lebt_guard_events(doc: BTDocument) -> list[str]:
     return list(seen)
 
 
-def machines_for(source: FSM | BTDocument, result: FSM | BTDocument, *,
-                 loop: bool = False) -> tuple[Machine[Any], Machine[Any], str]:
+def machines_for(
+    source: FSM | BTDocument, result: FSM | BTDocument, *, loop: bool = False
+) -> tuple[Machine[Any], Machine[Any], str]:
     """The (source machine, result machine, mode) for a pair of models."""
     if isinstance(source, FSM) and isinstance(result, FSM):
         alphabet = _union(source.events(), result.events(), *sub_machine_events(source, result))
-        return (FSMMachine(source, alphabet=alphabet), FSMMachine(result, alphabet=alphabet),
-                MACRO_STEP)
+        return (
+            FSMMachine(source, alphabet=alphabet),
+            FSMMachine(result, alphabet=alphabet),
+            MACRO_STEP,
+        )
     if isinstance(source, FSM) and isinstance(result, BTDocument):
         from fsmbt.semantics.state_variable_runtime import (
             is_state_variable_bt,

@@ -21,10 +21,16 @@ _TITLES = {
 def render(report: Report) -> RenderableType:
     """The whole report as one rich renderable."""
     parts: list[RenderableType] = []
-    verdict = Text("EQUIVALENT", style="bold green") if report.equivalent else Text(
-        "NOT EQUIVALENT", style="bold red")
-    header = Text.assemble(verdict, f"  {report.source} -> {report.result}",
-                           f"  ({report.mode}, engine {report.engine})")
+    verdict = (
+        Text("EQUIVALENT", style="bold green")
+        if report.equivalent
+        else Text("NOT EQUIVALENT", style="bold red")
+    )
+    header = Text.assemble(
+        verdict,
+        f"  {report.source} -> {report.result}",
+        f"  ({report.mode}, engine {report.engine})",
+    )
     parts.append(header)
     table = Table("property", "verdict", "detail", show_lines=False)
     for name in PROPERTIES:
@@ -42,16 +48,20 @@ def render(report: Report) -> RenderableType:
             key = tuple(step.input for step in prop.counterexample)
             groups.setdefault(key, []).append(prop)
     for props in groups.values():  # properties failing on the same trace share one table
-        parts.append(counterexample_table(props[0], [p.name for p in props],
-                                          leaf_execution=report.mode == "leaf-execution"))
+        parts.append(
+            counterexample_table(
+                props[0], [p.name for p in props], leaf_execution=report.mode == "leaf-execution"
+            )
+        )
     stats = report.stats
     if stats:
         parts.append(Text(_stats_line(stats), style="dim"))
     return Group(*parts)
 
 
-def counterexample_table(prop: PropertyResult, names: list[str] | None = None,
-                         leaf_execution: bool | None = None) -> Table:
+def counterexample_table(
+    prop: PropertyResult, names: list[str] | None = None, leaf_execution: bool | None = None
+) -> Table:
     """The shortest counterexample of one failed property (or several sharing it).
 
     Args:
@@ -67,17 +77,27 @@ def counterexample_table(prop: PropertyResult, names: list[str] | None = None,
     steps = len(prop.counterexample or []) - 1
     leaf_mode = leaf_execution if leaf_execution is not None else _leaf_outcomes(prop)
     unit = "leaf outcome" if leaf_mode else "input"
-    table = Table("step", "previous leaf returned" if leaf_mode else "input", "source did",
-                  "result did", "states", "note",
-                  title=f"{titles}: shortest counterexample "
-                        f"({steps} {unit}{'' if steps == 1 else 's'})", title_justify="left")
+    table = Table(
+        "step",
+        "previous leaf returned" if leaf_mode else "input",
+        "source did",
+        "result did",
+        "states",
+        "note",
+        title=f"{titles}: shortest counterexample ({steps} {unit}{'' if steps == 1 else 's'})",
+        title_justify="left",
+    )
     for step in prop.counterexample or []:
         style = "red" if step.note else None
         given = step.input.upper() if leaf_mode and step.input is not None else step.input
-        cells = [str(step.step), "(start)" if given is None else given,
-                 _did(step.source_outputs, step.source_status),
-                 _did(step.result_outputs, step.result_status),
-                 f"{step.source_state} / {step.result_state}", step.note]
+        cells = [
+            str(step.step),
+            "(start)" if given is None else given,
+            _did(step.source_outputs, step.source_status),
+            _did(step.result_outputs, step.result_status),
+            f"{step.source_state} / {step.result_state}",
+            step.note,
+        ]
         table.add_row(*(Text(cell) for cell in cells), style=style)
     return table
 
@@ -98,7 +118,9 @@ def _stats_line(stats: dict[str, object]) -> str:
     nusmv = stats.get("nusmv")
     if isinstance(nusmv, dict) and "seconds" in nusmv:  # --engine both: each engine's time
         native_seconds = stats.get("seconds", 0.0)
-        shown.append(f"native {float(native_seconds) if isinstance(native_seconds, (int, float)) else 0.0:.3f} s")
+        shown.append(
+            f"native {float(native_seconds) if isinstance(native_seconds, (int, float)) else 0.0:.3f} s"
+        )
         shown.append(f"NuSMV {float(nusmv['seconds']):.3f} s")
     elif "seconds" in stats:
         shown.append(f"{stats['seconds']:.3f} s")
@@ -112,7 +134,12 @@ def print_report(report: Report, console: Console | None = None) -> None:
 def trace_rows(trace: list[TraceStep]) -> list[dict[str, object]]:
     """Plain rows of a counterexample (for JSON or other front ends)."""
     return [
-        {"step": s.step, "input": s.input, "source": s.source_outputs, "result": s.result_outputs,
-         "note": s.note}
+        {
+            "step": s.step,
+            "input": s.input,
+            "source": s.source_outputs,
+            "result": s.result_outputs,
+            "note": s.note,
+        }
         for s in trace
     ]

@@ -12,8 +12,13 @@ COMPLETENESS = "completeness"
 NO_ADDITIONAL_BEHAVIOR = "no_additional_behavior"
 DEADLOCK_ABSENCE = "deadlock_absence"
 TERMINATION_CONSISTENCY = "termination_consistency"
-PROPERTIES = (REACHABILITY, COMPLETENESS, NO_ADDITIONAL_BEHAVIOR, DEADLOCK_ABSENCE,
-              TERMINATION_CONSISTENCY)
+PROPERTIES = (
+    REACHABILITY,
+    COMPLETENESS,
+    NO_ADDITIONAL_BEHAVIOR,
+    DEADLOCK_ABSENCE,
+    TERMINATION_CONSISTENCY,
+)
 
 
 @dataclass
@@ -72,7 +77,9 @@ class Report:
     @property
     def equivalent(self) -> bool:
         """Whether all five properties were checked and hold."""
-        return all(p.holds for p in self.properties.values()) and len(self.properties) == len(PROPERTIES)
+        return all(p.holds for p in self.properties.values()) and len(self.properties) == len(
+            PROPERTIES
+        )
 
     def verdicts(self) -> dict[str, bool]:
         """Each checked property's name and whether it holds.

@@ -79,7 +79,9 @@ def _rename(text: str, names: dict[str, str]) -> str:
 
 
 def _outcome_words(text: str) -> str:
-    return _OUTCOME_INPUT.sub(lambda m: f"when the previous leaf returned {m.group(1).upper()}", text)
+    return _OUTCOME_INPUT.sub(
+        lambda m: f"when the previous leaf returned {m.group(1).upper()}", text
+    )
 
 
 def readable(report: Report, source: FSM | BTDocument, result: FSM | BTDocument) -> Report:

@@ -13,7 +13,7 @@ from fsmbt.formats import read_model
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import UnsupportedError
 from fsmbt.semantics import state_variable_runtime as sv
-from fsmbt.verify import replay, verify
+from fsmbt.verify import verify
 from support.base_helpers import (
     convert,
     ctrl,
@@ -93,9 +93,14 @@ def test_bsd_plain_node_under_reactive_is_not_equivalent_by_construction():
 
 
 def test_bsd_all_reactive_tree_is_exact():
-    bt = BTDocument.single(ctrl("ReactiveSequence", leaf("c1", True),
-                                ctrl("ReactiveFallback", leaf("c2", True), leaf("a3")),
-                                leaf("a4")))
+    bt = BTDocument.single(
+        ctrl(
+            "ReactiveSequence",
+            leaf("c1", True),
+            ctrl("ReactiveFallback", leaf("c2", True), leaf("a3")),
+            leaf("a4"),
+        )
+    )
     assert verify(bt, convert("bsd", bt).model).equivalent
 
 
@@ -107,9 +112,22 @@ def test_bsd_refuses_nodes_without_classical_mapping():
 
 def test_bsd_cli_convert_engine(tmp_path):
     out = tmp_path / "aj_bsd.xml"
-    proc = subprocess.run([sys.executable, "-m", "fsmbt.cli", "convert",
-                           str(EXAMPLES / "paper_fsm.json"), "--engine", "bsd", "-o", str(out)],
-                          capture_output=True, text=True, timeout=120)
+    proc = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "fsmbt.cli",
+            "convert",
+            str(EXAMPLES / "paper_fsm.json"),
+            "--engine",
+            "bsd",
+            "-o",
+            str(out),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert proc.returncode == 0, proc.stderr
     assert "EQUIVALENT" in proc.stdout
     written = read_model(out)  # the XML round trip keeps the state-variable leaves

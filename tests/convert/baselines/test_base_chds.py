@@ -52,9 +52,17 @@ def test_chds_robot_bt_one_sub_fsm_per_control_node():
 
 
 def test_chds_reactive_restart_crosses_levels():
-    bt = BTDocument.single(ctrl("Sequence", leaf("a0"),
-                                ctrl("ReactiveSequence", leaf("c1", True),
-                                     ctrl("ReactiveFallback", leaf("c2", True), leaf("a3")))))
+    bt = BTDocument.single(
+        ctrl(
+            "Sequence",
+            leaf("a0"),
+            ctrl(
+                "ReactiveSequence",
+                leaf("c1", True),
+                ctrl("ReactiveFallback", leaf("c2", True), leaf("a3")),
+            ),
+        )
+    )
     result = convert("chds", bt)
     assert verify(bt, result.model).equivalent
 

@@ -51,8 +51,7 @@ TIMEOUT_S = 600  # a hang guard, not a speed target: workers share 2 cores with 
 WORKERS = os.cpu_count() or 2
 MUTATED = 4  # generated pairs whose mutants are checked too (the hand-built ones all are)
 SHOWN = 5  # disagreements printed in full
-CONTROLS = ("Sequence", "Fallback", "ReactiveSequence", "ReactiveFallback",
-            "SequenceWithMemory")
+CONTROLS = ("Sequence", "Fallback", "ReactiveSequence", "ReactiveFallback", "SequenceWithMemory")
 DECORATORS = ("Inverter", "ForceSuccess", "ForceFailure", "KeepRunningUntilFailure")
 Model = FSM | BTDocument
 
@@ -101,28 +100,40 @@ class GroupResult:
 
     def wrong_conversions(self) -> list[str]:
         """Unmutated conversions that both engines call not equivalent."""
-        return [o.pair.label for o in self.of("agreed")
-                if o.pair.conversion and not all(o.native.values())]
+        return [
+            o.pair.label
+            for o in self.of("agreed")
+            if o.pair.conversion and not all(o.native.values())
+        ]
 
     def summary(self) -> str:
         timed = [o.nusmv_seconds for o in self.outcomes if o.nusmv_seconds]
         reasons = Counter(o.reason for o in self.of("unsupported"))
-        lines = [f"\n[{self.name}] {len(self.outcomes)} pairs: {len(self.of('agreed'))} agreed, "
-                 f"{len(self.of('disagreed'))} disagreed, {len(self.of('unsupported'))} "
-                 f"unsupported, {len(self.of('timeout'))} timed out, {len(self.of('error'))} "
-                 f"errors; {self.failing_verdicts} failing verdicts compared; NuSMV "
-                 f"{sum(timed):.1f} s total, {max(timed, default=0):.1f} s max; "
-                 f"wall {self.wall_seconds:.1f} s ({WORKERS} workers)"]
+        lines = [
+            f"\n[{self.name}] {len(self.outcomes)} pairs: {len(self.of('agreed'))} agreed, "
+            f"{len(self.of('disagreed'))} disagreed, {len(self.of('unsupported'))} "
+            f"unsupported, {len(self.of('timeout'))} timed out, {len(self.of('error'))} "
+            f"errors; {self.failing_verdicts} failing verdicts compared; NuSMV "
+            f"{sum(timed):.1f} s total, {max(timed, default=0):.1f} s max; "
+            f"wall {self.wall_seconds:.1f} s ({WORKERS} workers)"
+        ]
         slowest = sorted(self.outcomes, key=lambda o: -o.nusmv_seconds)[:3]
-        lines.append("  slowest NuSMV: " + ", ".join(
-            f"{o.pair.label} {o.nusmv_seconds:.1f} s" for o in slowest if o.nusmv_seconds))
+        lines.append(
+            "  slowest NuSMV: "
+            + ", ".join(
+                f"{o.pair.label} {o.nusmv_seconds:.1f} s" for o in slowest if o.nusmv_seconds
+            )
+        )
         if self.wrong_conversions():
-            lines.append(f"  conversions not equivalent (both engines): "
-                         f"{len(self.wrong_conversions())}: {self.wrong_conversions()[:8]}")
+            lines.append(
+                f"  conversions not equivalent (both engines): "
+                f"{len(self.wrong_conversions())}: {self.wrong_conversions()[:8]}"
+            )
         lines += [f"  unsupported x{n}: {reason}" for reason, n in reasons.most_common()]
         lines += [f"  left out x{n}: {note}" for note, n in self.notes.most_common()]
-        lines += [f"  {o.kind}: {o.pair.label}: {o.reason}"
-                  for o in self.of("timeout") + self.of("error")]
+        lines += [
+            f"  {o.kind}: {o.pair.label}: {o.reason}" for o in self.of("timeout") + self.of("error")
+        ]
         for o in self.of("disagreed")[:SHOWN]:
             lines.append(f"  DISAGREE {o.pair.label}: native {o.native} nusmv {o.smv}")
         return "\n".join(lines)
@@ -156,27 +167,33 @@ def compare(pair: Pair) -> Outcome:
     return Outcome(pair, kind, "", native, smv.verdicts(), seconds)
 
 
-def run_group(name: str, items: Iterable[Pair | Rejected],
-              notes: Counter[str] | None = None) -> GroupResult:
+def run_group(
+    name: str, items: Iterable[Pair | Rejected], notes: Counter[str] | None = None
+) -> GroupResult:
     """Compare every pair in parallel (results in input order) and print the group's figures."""
     started = time.perf_counter()
     items = list(items)
     pairs = [item for item in items if isinstance(item, Pair)]
     with ThreadPoolExecutor(max_workers=WORKERS) as pool:
         compared = iter(pool.map(compare, pairs))
-    outcomes = [next(compared) if isinstance(item, Pair)
-                else Outcome(item, "unsupported", item.reason) for item in items]
+    outcomes = [
+        next(compared) if isinstance(item, Pair) else Outcome(item, "unsupported", item.reason)
+        for item in items
+    ]
     group = GroupResult(name, outcomes, time.perf_counter() - started, notes or Counter())
     print(group.summary())
     return group
 
 
-def assert_agreement(group: GroupResult, *, min_agreed: int = 1,
-                     expect_failing: bool = True) -> None:
+def assert_agreement(
+    group: GroupResult, *, min_agreed: int = 1, expect_failing: bool = True
+) -> None:
     assert not group.of("disagreed"), [
-        (o.pair.label, o.native, o.smv) for o in group.of("disagreed")[:SHOWN]]
+        (o.pair.label, o.native, o.smv) for o in group.of("disagreed")[:SHOWN]
+    ]
     assert not group.of("timeout") and not group.of("error"), [
-        (o.pair.label, o.reason) for o in group.of("timeout") + group.of("error")]
+        (o.pair.label, o.reason) for o in group.of("timeout") + group.of("error")
+    ]
     assert len(group.of("agreed")) >= min_agreed
     if expect_failing:
         assert group.failing_verdicts > 0  # the mutants really exercise failing properties
@@ -241,18 +258,23 @@ def _hand_built() -> list[BTDocument]:
     a, b, c, d = (_leaf("a", True), _leaf("b"), _leaf("c"), _leaf("d"))
     trees = [
         _node("Sequence", a, _node("Fallback", b, c)),
-        _node("ReactiveSequence", _leaf("a", True), _node("SequenceWithMemory", _leaf("b"),
-                                                           _leaf("c"))),
+        _node(
+            "ReactiveSequence",
+            _leaf("a", True),
+            _node("SequenceWithMemory", _leaf("b"), _leaf("c")),
+        ),
         _node("ReactiveFallback", _leaf("a", True), _node("Inverter", _leaf("b")), _leaf("c")),
         _node("Fallback", _node("SequenceWithMemory", _leaf("a"), _leaf("b")), _leaf("c")),
-        _node("Sequence", _node("ForceSuccess", _leaf("a")), _node("ForceFailure", _leaf("b")),
-              d),
+        _node("Sequence", _node("ForceSuccess", _leaf("a")), _node("ForceFailure", _leaf("b")), d),
         _node("KeepRunningUntilFailure", _node("Sequence", _leaf("a", True), _leaf("b"))),
         _node("AsyncSequence", _leaf("a"), _leaf("b")),
     ]
     docs = [BTDocument.single(t) for t in trees]
-    sub = BTDocument.single(_node("Sequence", _leaf("x", True),
-                                  BTNode("SubTree", NodeKind.SUBTREE, attrs={"ID": "Inner"})))
+    sub = BTDocument.single(
+        _node(
+            "Sequence", _leaf("x", True), BTNode("SubTree", NodeKind.SUBTREE, attrs={"ID": "Inner"})
+        )
+    )
     sub.trees["Inner"] = BehaviorTree("Inner", _node("Fallback", _leaf("y"), _leaf("z")))
     docs.append(sub)
     return docs
@@ -302,30 +324,58 @@ def _abstraction_trees() -> list[BTDocument]:
         _node("Sequence", _project("Sleep", msec="5"), _leaf("a")),
         _node("Sequence", _project("ForEach", _leaf("a")), _leaf("b", True)),
         _node("Fallback", _project("ForEachUntilSuccess", _leaf("a")), _leaf("b")),
-        _node("ReactiveSequence", _leaf("c", True),
-              _project("Precondition", _leaf("a"), **{"if": "x", "else": "SUCCESS"})),
-        _project("BlackboardCheckString", _node("Sequence", _leaf("a"), _leaf("b")),
-                 value_A="{x}", value_B="1", return_on_mismatch="FAILURE"),
+        _node(
+            "ReactiveSequence",
+            _leaf("c", True),
+            _project("Precondition", _leaf("a"), **{"if": "x", "else": "SUCCESS"}),
+        ),
+        _project(
+            "BlackboardCheckString",
+            _node("Sequence", _leaf("a"), _leaf("b")),
+            value_A="{x}",
+            value_B="1",
+            return_on_mismatch="FAILURE",
+        ),
         _project("Root", _node("Sequence", _project("GoalUpdater", _leaf("a")), _leaf("b"))),
-        _node("ReactiveFallback", _leaf("c", True),
-              _project("DistanceController", _node("Sequence", _leaf("a"), _leaf("b")))),
-        _project("PipelineSequence", _leaf("c", True),
-                 _project("RateController", _leaf("plan")), _leaf("go")),
-        _project("RecoveryNode", _node("Sequence", _leaf("c", True), _leaf("a")), _leaf("r"),
-                 number_of_retries="2"),
+        _node(
+            "ReactiveFallback",
+            _leaf("c", True),
+            _project("DistanceController", _node("Sequence", _leaf("a"), _leaf("b"))),
+        ),
+        _project(
+            "PipelineSequence",
+            _leaf("c", True),
+            _project("RateController", _leaf("plan")),
+            _leaf("go"),
+        ),
+        _project(
+            "RecoveryNode",
+            _node("Sequence", _leaf("c", True), _leaf("a")),
+            _leaf("r"),
+            number_of_retries="2",
+        ),
         _project("RoundRobin", _leaf("a"), _leaf("b", True), _leaf("c")),
         _project("RoundRobin", _leaf("a"), _leaf("b"), wrap_around="true"),
-        _node("Sequence", _project("RepeatUnlessFailureEachTick", _leaf("a"), num_cycles="2"),
-              _leaf("b", True)),
+        _node(
+            "Sequence",
+            _project("RepeatUnlessFailureEachTick", _leaf("a"), num_cycles="2"),
+            _leaf("b", True),
+        ),
         # built-ins the encoding now covers too
-        BTNode("IfThenElse", NodeKind.CONTROL, children=[_leaf("c", True), _leaf("a"),
-                                                          _leaf("b")]),
-        _node("Sequence", BTNode("IfThenElse", NodeKind.CONTROL,
-                                 children=[_leaf("c"), _leaf("a")]), _leaf("d")),
-        BTNode("WhileDoElse", NodeKind.CONTROL, children=[_leaf("c", True), _leaf("a"),
-                                                           _leaf("b")]),
-        _node("Fallback", BTNode("WhileDoElse", NodeKind.CONTROL,
-                                 children=[_leaf("c", True), _leaf("a")]), _leaf("d")),
+        BTNode("IfThenElse", NodeKind.CONTROL, children=[_leaf("c", True), _leaf("a"), _leaf("b")]),
+        _node(
+            "Sequence",
+            BTNode("IfThenElse", NodeKind.CONTROL, children=[_leaf("c"), _leaf("a")]),
+            _leaf("d"),
+        ),
+        BTNode(
+            "WhileDoElse", NodeKind.CONTROL, children=[_leaf("c", True), _leaf("a"), _leaf("b")]
+        ),
+        _node(
+            "Fallback",
+            BTNode("WhileDoElse", NodeKind.CONTROL, children=[_leaf("c", True), _leaf("a")]),
+            _leaf("d"),
+        ),
     ]
     return [BTDocument.single(t) for t in trees]
 
@@ -370,9 +420,14 @@ def example_pairs(notes: Counter[str]) -> Iterator[Pair | Rejected]:
 
 
 def corpus_files() -> list[Path]:
-    return sorted(p for p in CORPUS.rglob("*")
-                  if p.suffix in (".xml", ".scxml") and "_malformed" not in p.parts
-                  and "_legacy_draft" not in p.parts and "LICENSES" not in p.parts)
+    return sorted(
+        p
+        for p in CORPUS.rglob("*")
+        if p.suffix in (".xml", ".scxml")
+        and "_malformed" not in p.parts
+        and "_legacy_draft" not in p.parts
+        and "LICENSES" not in p.parts
+    )
 
 
 def corpus_pairs(notes: Counter[str]) -> Iterator[Pair | Rejected]:

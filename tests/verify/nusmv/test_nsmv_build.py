@@ -12,8 +12,12 @@ from fsmbt.verify.nusmv.binary import BUILD_SCRIPT, ENV_VAR, find_nusmv, nusmv_v
 def test_build_script_is_executable_in_git():
     assert BUILD_SCRIPT.exists()
     assert os.access(BUILD_SCRIPT, os.X_OK)
-    mode = subprocess.run(["git", "ls-files", "-s", str(BUILD_SCRIPT)], capture_output=True,
-                          text=True, cwd=BUILD_SCRIPT.parent).stdout.split()
+    mode = subprocess.run(
+        ["git", "ls-files", "-s", str(BUILD_SCRIPT)],
+        capture_output=True,
+        text=True,
+        cwd=BUILD_SCRIPT.parent,
+    ).stdout.split()
     assert mode and mode[0] == "100755"
 
 

@@ -56,8 +56,9 @@ def _leaf(name: str, kind: NodeKind = NodeKind.ACTION) -> BTNode:
 def test_unencodable_nodes_are_rejected_with_the_node_named(node_type):
     attrs = {"num_cycles": "2"} if node_type == "Repeat" else {}
     kind = NodeKind.DECORATOR if node_type in ("Repeat", "RunOnce") else NodeKind.CONTROL
-    kids = [_leaf("a")] if kind is NodeKind.DECORATOR else [_leaf("a", NodeKind.CONDITION),
-                                                           _leaf("b")]
+    kids = (
+        [_leaf("a")] if kind is NodeKind.DECORATOR else [_leaf("a", NodeKind.CONDITION), _leaf("b")]
+    )
     doc = BTDocument.single(BTNode(node_type, kind, name="N", attrs=attrs, children=kids))
     with pytest.raises(UnsupportedError, match=node_type):
         build_model(doc, doc)
@@ -66,13 +67,25 @@ def test_unencodable_nodes_are_rejected_with_the_node_named(node_type):
 def test_counterexample_replays_to_a_difference(nusmv_binary):
     """The trace NuSMV gives for a failing property, replayed on the native machines,
     really shows the two models differing at its last step."""
-    root = BTNode("Sequence", NodeKind.CONTROL, children=[
-        _leaf("a", NodeKind.CONDITION), BTNode("Fallback", NodeKind.CONTROL, children=[
-            _leaf("b"), _leaf("c")])])
+    root = BTNode(
+        "Sequence",
+        NodeKind.CONTROL,
+        children=[
+            _leaf("a", NodeKind.CONDITION),
+            BTNode("Fallback", NodeKind.CONTROL, children=[_leaf("b"), _leaf("c")]),
+        ],
+    )
     source = BTDocument.single(root)
-    mutated = BTDocument.single(BTNode("Sequence", NodeKind.CONTROL, children=[
-        _leaf("a", NodeKind.CONDITION), BTNode("Sequence", NodeKind.CONTROL, children=[
-            _leaf("b"), _leaf("c")])]))
+    mutated = BTDocument.single(
+        BTNode(
+            "Sequence",
+            NodeKind.CONTROL,
+            children=[
+                _leaf("a", NodeKind.CONDITION),
+                BTNode("Sequence", NodeKind.CONTROL, children=[_leaf("b"), _leaf("c")]),
+            ],
+        )
+    )
     report = check(source, mutated)
     failing = [p for p in report.properties.values() if not p.holds]
     assert failing

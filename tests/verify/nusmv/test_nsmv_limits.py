@@ -82,6 +82,8 @@ def test_output_is_decoded_with_replacement(tmp_path, monkeypatch) -> None:
 
 
 def test_count_variables() -> None:
-    text = ("MODULE m\nVAR\n  a : boolean;\n  b : {x, y};\nIVAR i : 0..3;\nDEFINE d := a;\n"
-            "ASSIGN init(a) := TRUE;\n")
+    text = (
+        "MODULE m\nVAR\n  a : boolean;\n  b : {x, y};\nIVAR i : 0..3;\nDEFINE d := a;\n"
+        "ASSIGN init(a) := TRUE;\n"
+    )
     assert count_variables(text) == 3

@@ -58,27 +58,50 @@ def fsm_to_bsd(fsm: FSM, **_options: object) -> ConversionResult:
     root = control("ReactiveFallback", "BSD", [])
     start = flat.start_name or "__start__"
     if flat.initial_event is not None and flat.initial is not None:
-        root.children.append(control("ReactiveSequence", f"{start}_subtree", [
-            leaf_node(sv.IS_STATE, f"Is_{start}", state=start, initial="true"),
-            leaf_node(sv.TRANSITION, f"{start}_transitions", state=start,
-                      transitions=sv.encode_transitions([(flat.initial_event, flat.initial)]),
-                      final="false"),
-        ]))
+        root.children.append(
+            control(
+                "ReactiveSequence",
+                f"{start}_subtree",
+                [
+                    leaf_node(sv.IS_STATE, f"Is_{start}", state=start, initial="true"),
+                    leaf_node(
+                        sv.TRANSITION,
+                        f"{start}_transitions",
+                        state=start,
+                        transitions=sv.encode_transitions([(flat.initial_event, flat.initial)]),
+                        final="false",
+                    ),
+                ],
+            )
+        )
     for name in reachable:
         state = flat.states[name]
         initial = "true" if name == flat.initial and flat.initial_event is None else "false"
-        root.children.append(control("ReactiveSequence", f"{name}_subtree", [
-            leaf_node(sv.IS_STATE, f"Is_{name}", state=name, initial=initial),
-            leaf_node(sv.ENTRY_ACTION, name, state=name, action=state.action or ""),
-            leaf_node(sv.TRANSITION, f"{name}_transitions", state=name,
-                      transitions=sv.encode_transitions(exits_of(flat, name)),
-                      final="true" if state.final else "false"),
-        ]))
+        root.children.append(
+            control(
+                "ReactiveSequence",
+                f"{name}_subtree",
+                [
+                    leaf_node(sv.IS_STATE, f"Is_{name}", state=name, initial=initial),
+                    leaf_node(sv.ENTRY_ACTION, name, state=name, action=state.action or ""),
+                    leaf_node(
+                        sv.TRANSITION,
+                        f"{name}_transitions",
+                        state=name,
+                        transitions=sv.encode_transitions(exits_of(flat, name)),
+                        final="true" if state.final else "false",
+                    ),
+                ],
+            )
+        )
     doc = BTDocument.single(root)
     doc.node_models.update(sv_node_models((sv.IS_STATE, sv.ENTRY_ACTION, sv.TRANSITION)))
     nodes = sum(1 for _ in root.walk())
-    stats = {"states": len(reachable), "nodes": nodes, "start_subtree":
-             flat.initial_event is not None}
+    stats = {
+        "states": len(reachable),
+        "nodes": nodes,
+        "start_subtree": flat.initial_event is not None,
+    }
     return ConversionResult(doc, ENGINE, "fsm->bt", stats, warnings)
 
 
@@ -158,5 +181,9 @@ def bt_to_bsd_fsm(doc: BTDocument, *, loop: bool = False, **_options: object) ->
     return ConversionResult(fsm, ENGINE, "bt->fsm", stats, [])
 
 
-register_engine(ENGINE, fsm_to_bsd, bt_to_bsd_fsm,
-                "Colledanchise & Ögren's explicit state-variable mapping (baseline)")
+register_engine(
+    ENGINE,
+    fsm_to_bsd,
+    bt_to_bsd_fsm,
+    "Colledanchise & Ögren's explicit state-variable mapping (baseline)",
+)

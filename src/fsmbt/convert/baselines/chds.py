@@ -74,25 +74,48 @@ def fsm_to_chds(fsm: FSM, **_options: object) -> ConversionResult:
     for name in reachable:
         state = flat.states[name]
         initial = "true" if name == flat.initial and flat.initial_event is None else "false"
-        modes.append(control("ReactiveSequence", f"{name}_mode", [
-            leaf_node(sv.IS_STATE, f"In_{name}", state=name, initial=initial),
-            leaf_node(sv.MODE, name, state=name, action=state.action or "",
-                      final="true" if state.final else "false"),
-        ]))
+        modes.append(
+            control(
+                "ReactiveSequence",
+                f"{name}_mode",
+                [
+                    leaf_node(sv.IS_STATE, f"In_{name}", state=name, initial=initial),
+                    leaf_node(
+                        sv.MODE,
+                        name,
+                        state=name,
+                        action=state.action or "",
+                        final="true" if state.final else "false",
+                    ),
+                ],
+            )
+        )
     root.children.extend(switches + modes)
     doc = BTDocument.single(root)
     doc.node_models.update(sv_node_models((sv.GUARD, sv.ASSIGN, sv.IS_STATE, sv.MODE)))
-    stats = {"states": len(reachable), "switches": len(switches),
-             "nodes": sum(1 for _ in root.walk())}
+    stats = {
+        "states": len(reachable),
+        "switches": len(switches),
+        "nodes": sum(1 for _ in root.walk()),
+    }
     return ConversionResult(doc, ENGINE, "fsm->bt", stats, warnings)
 
 
 def _switch(source: str, event: str, target: str, *, initial: bool) -> BTNode:
-    return control("ReactiveSequence", f"{source}_{event}_{target}", [
-        leaf_node(sv.GUARD, f"{source}_on_{event}", state=source, event=event,
-                  initial="true" if initial else "false"),
-        leaf_node(sv.ASSIGN, f"to_{target}", target=target),
-    ])
+    return control(
+        "ReactiveSequence",
+        f"{source}_{event}_{target}",
+        [
+            leaf_node(
+                sv.GUARD,
+                f"{source}_on_{event}",
+                state=source,
+                event=event,
+                initial="true" if initial else "false",
+            ),
+            leaf_node(sv.ASSIGN, f"to_{target}", target=target),
+        ],
+    )
 
 
 # -- BT -> FSM ---------------------------------------------------------------------------------
@@ -114,7 +137,7 @@ class _Builder:
             check_baseline_node(node)
             if node.is_leaf:
                 if reactive is not None and node.kind is NodeKind.ACTION:
-                    self.needs_restart_exit.update(chain[chain.index(reactive) + 1:])
+                    self.needs_restart_exit.update(chain[chain.index(reactive) + 1 :])
                 continue
             if node.kind is NodeKind.CONTROL:
                 if reactive is None and node.type in REACTIVE_CONTROLS:
@@ -152,8 +175,7 @@ class _Builder:
         return name
 
 
-def _fill(builder: _Builder, node: BTNode, machine: FSM,
-          work: list[tuple[BTNode, FSM]]) -> str:
+def _fill(builder: _Builder, node: BTNode, machine: FSM, work: list[tuple[BTNode, FSM]]) -> str:
     """Wire a control node's children into its own sub-FSM ``machine``; returns its entry."""
     owner = builder.owner[id(node)]
     is_sequence = node.type in SEQUENCE_TYPES
@@ -189,8 +211,7 @@ def _fill(builder: _Builder, node: BTNode, machine: FSM,
     return entry
 
 
-def bt_to_chds_fsm(doc: BTDocument, *, loop: bool = False,
-                   **_options: object) -> ConversionResult:
+def bt_to_chds_fsm(doc: BTDocument, *, loop: bool = False, **_options: object) -> ConversionResult:
     """A hierarchical FSM with one sub-FSM per control node (see the module docstring)."""
     from fsmbt.convert.compress import inline_subtrees
 
@@ -202,13 +223,15 @@ def bt_to_chds_fsm(doc: BTDocument, *, loop: bool = False,
     while work:
         node, machine = work.pop()
         machine.initial = _fill(builder, node, machine, work)
-    stats = {"k": builder.machines, "control_nodes": len(builder.owner),
-             "leaves": sum(1 for n in root.walk() if n.is_leaf)}
+    stats = {
+        "k": builder.machines,
+        "control_nodes": len(builder.owner),
+        "leaves": sum(1 for n in root.walk() if n.is_leaf),
+    }
     return ConversionResult(top, ENGINE, "bt->fsm", stats, [])
 
 
-def _top_entry(builder: _Builder, root: BTNode, top: FSM,
-               work: list[tuple[BTNode, FSM]]) -> str:
+def _top_entry(builder: _Builder, root: BTNode, top: FSM, work: list[tuple[BTNode, FSM]]) -> str:
     """The root inside the top machine: a leaf state, or the root control node's composite."""
     cont = Cont(SUCCESS, FAILURE)
     node = root
@@ -227,5 +250,6 @@ def _top_entry(builder: _Builder, root: BTNode, top: FSM,
     return name
 
 
-register_engine(ENGINE, fsm_to_chds, bt_to_chds_fsm,
-                "Marzinotto et al.'s BT <-> CHDS mappings (baseline)")
+register_engine(
+    ENGINE, fsm_to_chds, bt_to_chds_fsm, "Marzinotto et al.'s BT <-> CHDS mappings (baseline)"
+)

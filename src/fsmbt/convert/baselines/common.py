@@ -23,18 +23,30 @@ from fsmbt.semantics.status import LeafOutcome, RootResult
 #: End-state names (``RootResult``) and leaf-outcome events (``LeafOutcome``), as plain str.
 SUCCESS, FAILURE = RootResult.SUCCESS.value, RootResult.FAILURE.value
 EV_SUCCESS, EV_FAILURE, EV_RUNNING = (
-    LeafOutcome.SUCCESS.value, LeafOutcome.FAILURE.value, LeafOutcome.RUNNING.value)
+    LeafOutcome.SUCCESS.value,
+    LeafOutcome.FAILURE.value,
+    LeafOutcome.RUNNING.value,
+)
 
 
 def sv_node_models(types: tuple[str, ...]) -> dict[str, NodeModel]:
     """``TreeNodesModel`` entries for the state-variable leaves a baseline writes (Groot2)."""
     ports = {
-        sv.IS_STATE: ["state", "initial"], sv.ENTRY_ACTION: ["state", "action"],
-        sv.TRANSITION: ["state", "transitions", "final"], sv.GUARD: ["state", "event", "initial"],
-        sv.ASSIGN: ["target"], sv.MODE: ["state", "action", "final"],
+        sv.IS_STATE: ["state", "initial"],
+        sv.ENTRY_ACTION: ["state", "action"],
+        sv.TRANSITION: ["state", "transitions", "final"],
+        sv.GUARD: ["state", "event", "initial"],
+        sv.ASSIGN: ["target"],
+        sv.MODE: ["state", "action", "final"],
     }
-    return {t: NodeModel(t, NodeKind.CONDITION if t in sv.CONDITION_TYPES else NodeKind.ACTION,
-                         [PortModel(p, "input") for p in ports[t]]) for t in types}
+    return {
+        t: NodeModel(
+            t,
+            NodeKind.CONDITION if t in sv.CONDITION_TYPES else NodeKind.ACTION,
+            [PortModel(p, "input") for p in ports[t]],
+        )
+        for t in types
+    }
 
 
 def prepare_fsm(fsm: FSM) -> tuple[FSM, list[str], list[str]]:
@@ -49,8 +61,9 @@ def prepare_fsm(fsm: FSM) -> tuple[FSM, list[str], list[str]]:
         raise InputError("the state machine has no initial state", element=fsm.name)
     start = flat.start_name
     if start is not None and start in flat.states:
-        raise UnsupportedError(f"a state is named like the start pseudo-state '{start}'",
-                               element=start)
+        raise UnsupportedError(
+            f"a state is named like the start pseudo-state '{start}'", element=start
+        )
     table = flat.transition_map()
     seen = {flat.initial}
     queue = deque([flat.initial])
@@ -62,8 +75,9 @@ def prepare_fsm(fsm: FSM) -> tuple[FSM, list[str], list[str]]:
             if event is None:
                 raise InputError("eventless transition in a flat FSM", element=name)
             if event == NO_EVENT:
-                raise UnsupportedError("an empty event name cannot be told from 'no event'",
-                                       element=name)
+                raise UnsupportedError(
+                    "an empty event name cannot be told from 'no event'", element=name
+                )
             if t.target not in flat.states:
                 raise InputError(f"transition to unknown state '{t.target}'", element=name)
             if t.target not in seen:
@@ -104,17 +118,23 @@ def check_baseline_node(node: BTNode) -> None:
     """Refuse the node types the classical mappings do not describe (named, with location)."""
     if node.is_leaf:
         if node.is_builtin:
-            raise UnsupportedError(f"built-in leaf {node.type} has no classical mapping",
-                                   location=node.location, element=node.label)
+            raise UnsupportedError(
+                f"built-in leaf {node.type} has no classical mapping",
+                location=node.location,
+                element=node.label,
+            )
         return
     if node.kind is NodeKind.CONTROL and node.type in PLAIN_CONTROLS | REACTIVE_CONTROLS:
         if not node.children:
-            raise InputError(f"{node.type} has no children", location=node.location,
-                             element=node.label)
+            raise InputError(
+                f"{node.type} has no children", location=node.location, element=node.label
+            )
         return
     if node.kind is NodeKind.DECORATOR and node.type in RESULT_MAP_DECORATORS:
         return
     raise UnsupportedError(
         f"{node.type}: the classical baselines map Sequence, Fallback, their Reactive "
         "variants, Inverter, ForceSuccess, ForceFailure and leaves only",
-        location=node.location, element=node.label)
+        location=node.location,
+        element=node.label,
+    )

@@ -32,11 +32,14 @@ import json
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import InputError, SourceLocation
 from fsmbt.model.kinds import NodeKind
 from fsmbt.model.nodes.registry import ABSTRACTIONS, PROFILES, all_nodes, node_semantics
+
+if TYPE_CHECKING:  # only an annotation: model.bt reads the registry, not the reverse
+    from fsmbt.model.bt import BTDocument
 
 _LEAF_KINDS = {"action": NodeKind.ACTION, "condition": NodeKind.CONDITION}
 #: Warn(message, location) - the reader's warning sink.
@@ -90,8 +93,10 @@ def build_library(nodes: object = None, abstract: object = None) -> NodeLibrary:
     library = NodeLibrary()
     for family in _split(abstract):
         if family not in ABSTRACTIONS:
-            raise InputError(f"unknown abstraction '{family}' (known: {', '.join(ABSTRACTIONS)})",
-                             element="--abstract")
+            raise InputError(
+                f"unknown abstraction '{family}' (known: {', '.join(ABSTRACTIONS)})",
+                element="--abstract",
+            )
         library.enabled.add(family)
     pending = _split(nodes)
     seen: set[str] = set()
@@ -105,8 +110,11 @@ def build_library(nodes: object = None, abstract: object = None) -> NodeLibrary:
             continue
         path = Path(item)
         if not path.suffix and not path.exists():
-            raise InputError(f"unknown node profile '{item}' (profiles: {', '.join(PROFILES)}; "
-                             "or give a YAML/JSON node file)", element="--nodes")
+            raise InputError(
+                f"unknown node profile '{item}' (profiles: {', '.join(PROFILES)}; "
+                "or give a YAML/JSON node file)",
+                element="--nodes",
+            )
         pending += _read_file(path, library)
     return library
 
@@ -126,42 +134,56 @@ def _read_file(path: Path, library: NodeLibrary) -> list[str]:
 
             data = yaml.safe_load(text)
     except Exception as exc:  # noqa: BLE001 - any parse error is the user's file: report it
-        raise InputError(f"malformed node file: {str(exc).splitlines()[0]}",
-                         location=where) from None
+        raise InputError(
+            f"malformed node file: {str(exc).splitlines()[0]}", location=where
+        ) from None
     if not isinstance(data, dict):
-        raise InputError("a node file is a mapping with 'nodes' (and optional 'profiles')",
-                         location=where)
+        raise InputError(
+            "a node file is a mapping with 'nodes' (and optional 'profiles')", location=where
+        )
     unknown = set(data) - {"nodes", "profiles"}
     if unknown:
-        raise InputError(f"unknown key(s) {', '.join(sorted(map(str, unknown)))} (expected "
-                         "'nodes', 'profiles')", location=where)
+        raise InputError(
+            f"unknown key(s) {', '.join(sorted(map(str, unknown)))} (expected 'nodes', 'profiles')",
+            location=where,
+        )
     entries = data.get("nodes") or {}
     if not isinstance(entries, dict):
         raise InputError("'nodes' must map node types to declarations", location=where)
     for type_name, entry in entries.items():
         element = f"nodes.{type_name}"
         if not isinstance(entry, dict) or len(entry) != 1:
-            raise InputError("a declaration is one of {alias: KIND}, {semantics: KIND}, "
-                             "{kind: action|condition}", location=where, element=element)
-        (key, value), = entry.items()
+            raise InputError(
+                "a declaration is one of {alias: KIND}, {semantics: KIND}, "
+                "{kind: action|condition}",
+                location=where,
+                element=element,
+            )
+        ((key, value),) = entry.items()
         value = str(value)
         if key in ("alias", "semantics"):
             target = node_semantics(value)
             if target is None:
                 known = ", ".join(sorted(n.name for n in all_nodes()))
-                raise InputError(f"unknown node kind '{value}' (known: {known})",
-                                 location=where, element=element)
-            (library.aliases if key == "alias" else library.semantics)[str(type_name)] = (
-                target.name)
+                raise InputError(
+                    f"unknown node kind '{value}' (known: {known})", location=where, element=element
+                )
+            (library.aliases if key == "alias" else library.semantics)[str(type_name)] = target.name
         elif key == "kind":
             if value.lower() not in _LEAF_KINDS:
-                raise InputError(f"kind must be action or condition, not '{value}' (a control "
-                                 "or decorator needs 'alias' or 'semantics')", location=where,
-                                 element=element)
+                raise InputError(
+                    f"kind must be action or condition, not '{value}' (a control "
+                    "or decorator needs 'alias' or 'semantics')",
+                    location=where,
+                    element=element,
+                )
             library.leaf_kinds[str(type_name)] = _LEAF_KINDS[value.lower()]
         else:
-            raise InputError(f"unknown declaration '{key}' (alias, semantics or kind)",
-                             location=where, element=element)
+            raise InputError(
+                f"unknown declaration '{key}' (alias, semantics or kind)",
+                location=where,
+                element=element,
+            )
         library.sources[str(type_name)] = str(path)
     profiles = data.get("profiles") or []
     return _split(profiles)
@@ -187,14 +209,24 @@ def apply_library(doc: BTDocument, library: NodeLibrary, warn: Warn) -> None:
         original = node.type
         if original in library.aliases:
             target = library.aliases[original]
-            warn(f"node type '{original}' read as {target} (alias declared in "
-                 f"{library.sources[original]})", node.location)
+            warn(
+                f"node type '{original}' read as {target} (alias declared in "
+                f"{library.sources[original]})",
+                node.location,
+            )
             node.type = target
-        elif node_semantics(original) is None and original.lower() in by_case \
-                and original not in library.semantics and original not in doc.node_models:
+        elif (
+            node_semantics(original) is None
+            and original.lower() in by_case
+            and original not in library.semantics
+            and original not in doc.node_models
+        ):
             target = by_case[original.lower()]
-            warn(f"node type '{original}' is not a BehaviorTree.CPP type; read as {target} "
-                 "(same name up to letter case)", node.location)
+            warn(
+                f"node type '{original}' is not a BehaviorTree.CPP type; read as {target} "
+                "(same name up to letter case)",
+                node.location,
+            )
             node.type = target
         spec = node_semantics(node.type)
         if node.type != original and spec is not None:
@@ -213,4 +245,3 @@ def apply_library(doc: BTDocument, library: NodeLibrary, warn: Warn) -> None:
             node.kind_declared = True
         elif spec is not None and spec.requires is not None and spec.requires in library.enabled:
             node.semantics = spec.name
-

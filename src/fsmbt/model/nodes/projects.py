@@ -91,7 +91,7 @@ def _controller(name: str, what: str, source: str) -> NodeSemantics:
             "is not reset when it completes",
             halt=_CONTROLLER_HALT,
             handler="gated",
-        nusmv="gated",
+            nusmv="gated",
             requires="nav2",
             abstraction=f"{name} may skip its child on any tick (whether {what} is an "
             "environment input)",
@@ -276,7 +276,7 @@ BLACKBOARD_CHECKS = tuple(
             halt="halts the child if running",
             blackboard_based=True,
             handler="gated",
-        nusmv="gated",
+            nusmv="gated",
             requires="blackboard",
             abstraction=f"BlackboardCheck{value}: whether value_A equals value_B is an "
             "environment input (mismatch: return_on_mismatch)",

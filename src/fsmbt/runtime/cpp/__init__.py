@@ -71,8 +71,9 @@ def library_prefix() -> Path:
 def library_built() -> bool:
     """The installed CMake package and shared library are there."""
     prefix = library_prefix()
-    return ((prefix / "lib" / "cmake" / "behaviortree_cpp" / "behaviortree_cppConfig.cmake")
-            .is_file() and (prefix / "lib" / "libbehaviortree_cpp.so").is_file())
+    return (
+        prefix / "lib" / "cmake" / "behaviortree_cpp" / "behaviortree_cppConfig.cmake"
+    ).is_file() and (prefix / "lib" / "libbehaviortree_cpp.so").is_file()
 
 
 def sources_hash() -> str:
@@ -92,8 +93,8 @@ class RuntimeStatus:
     """What ``fsmbt doctor`` reports about the C++ runtime."""
 
     library: Path | None  # the install prefix when the library is built
-    driver: Path | None   # the driver when built from the current sources
-    problem: str          # "" when both are there, else what is missing
+    driver: Path | None  # the driver when built from the current sources
+    problem: str  # "" when both are there, else what is missing
 
 
 def status() -> RuntimeStatus:
@@ -171,9 +172,16 @@ class DriverStep:
 class DriverSession:
     """One driver process per tree file, fed every event sequence at once."""
 
-    def __init__(self, tree_file: Path, *, driver: Path | None = None, table: bool = False,
-                 start: str | None = None, tick: str | None = None,
-                 timeout: float = 120.0) -> None:
+    def __init__(
+        self,
+        tree_file: Path,
+        *,
+        driver: Path | None = None,
+        table: bool = False,
+        start: str | None = None,
+        tick: str | None = None,
+        timeout: float = 120.0,
+    ) -> None:
         self.tree_file = tree_file
         self.tick = tick  # "once", "exactly-once", "auto" (the driver's default) or None
         self.driver = driver or require_driver()
@@ -210,14 +218,17 @@ class DriverSession:
         runs: list[list[DriverStep]] = []
         for raw in out.splitlines():
             record = json.loads(raw)
-            step = DriverStep(record["event"], tuple(record["actions"]),
-                              bool(record["terminated"]), record["state"])
+            step = DriverStep(
+                record["event"],
+                tuple(record["actions"]),
+                bool(record["terminated"]),
+                record["state"],
+            )
             if step.event is None:
                 runs.append([])
             runs[-1].append(step)
         if len(runs) != max(1, len(sequences)):
-            raise CppRuntimeError(f"driver printed {len(runs)} runs for {len(sequences)} "
-                                  "sequences")
+            raise CppRuntimeError(f"driver printed {len(runs)} runs for {len(sequences)} sequences")
         return runs
 
     def bench(self, sequences: Sequence[Sequence[str]], repeat: int) -> dict[str, float]:
@@ -232,14 +243,23 @@ class DriverSession:
 
     def _call(self, lines: list[str], extra: Sequence[str] = ()) -> str:
         try:
-            proc = subprocess.run(self._command(extra), input="\n".join(lines) + "\n",
-                                  capture_output=True, text=True, encoding="utf-8",
-                                  timeout=self.timeout)
+            proc = subprocess.run(
+                self._command(extra),
+                input="\n".join(lines) + "\n",
+                capture_output=True,
+                text=True,
+                encoding="utf-8",
+                timeout=self.timeout,
+            )
         except subprocess.TimeoutExpired:
-            raise CppRuntimeError(f"driver timed out after {self.timeout} s on "
-                                  f"{self.tree_file}") from None
+            raise CppRuntimeError(
+                f"driver timed out after {self.timeout} s on {self.tree_file}"
+            ) from None
         if proc.returncode != 0:
-            message = proc.stderr.strip().splitlines()[-1] if proc.stderr.strip() else (
-                f"exit status {proc.returncode}")
+            message = (
+                proc.stderr.strip().splitlines()[-1]
+                if proc.stderr.strip()
+                else (f"exit status {proc.returncode}")
+            )
             raise CppRuntimeError(f"driver failed on {self.tree_file}: {message}")
         return proc.stdout

@@ -40,7 +40,9 @@ ACTION_ID = "FsmbtAction"
 CONDITION_ID = "FsmbtCondition"
 
 #: A leaf outcome (``LeafOutcome`` or its string) as the engine's status.
-_STATUS: dict[str, Any] = {outcome: getattr(btpy.NodeStatus, outcome.status.name) for outcome in LeafOutcome}
+_STATUS: dict[str, Any] = {
+    outcome: getattr(btpy.NodeStatus, outcome.status.name) for outcome in LeafOutcome
+}
 #: The engine's status as ours, and by name (the interpreter's ``TickRecord`` spelling).
 _NODE_STATUS = {getattr(btpy.NodeStatus, status.name): status for status in NodeStatus}
 _NAME_OF = {engine: status.name for engine, status in _NODE_STATUS.items()}
@@ -107,8 +109,9 @@ def compiled_to_xml(tree: CompiledTree, leaf_writer: LeafWriter = _default_leaf)
 class BTCppRunner:
     """A BehaviorTree.CPP tree whose leaves ask ``env(node, path)`` for their outcome."""
 
-    def __init__(self, doc: BTDocument | CompiledTree, env: Environment, *,
-                 exactly_once: bool = False) -> None:
+    def __init__(
+        self, doc: BTDocument | CompiledTree, env: Environment, *, exactly_once: bool = False
+    ) -> None:
         self.tree = doc if isinstance(doc, CompiledTree) else CompiledTree(doc)
         self.env = env
         self.exactly_once = exactly_once
@@ -175,8 +178,9 @@ class BTCppLebtRunner(EngineLebtRun):
         self.leaves = LebtLeaves.of(self.tree, start)
         factory = btpy.BehaviorTreeFactory()
         factory.register_simple_condition(GUARD_TYPE, self._guard)
-        factory.register_simple_stateful_action(STATE_TYPE, self._start, self._running,
-                                                lambda node: None)
+        factory.register_simple_stateful_action(
+            STATE_TYPE, self._start, self._running, lambda node: None
+        )
 
         def writer(node: CompiledNode) -> tuple[str, dict[str, str]]:
             return (GUARD_TYPE if node.id in self.leaves.guards else STATE_TYPE), {}

@@ -35,16 +35,33 @@ from fsmbt.semantics.lebt.leaves import (
 )
 from fsmbt.semantics.status import LeafOutcome, NodeStatus
 
-SUPPORTED_TYPES = frozenset({
-    "Sequence", "ReactiveSequence", "Fallback", "ReactiveFallback", "Inverter",
-    "ForceSuccess", "ForceFailure", "SubTree", "AlwaysSuccess", "AlwaysFailure",
-})
+SUPPORTED_TYPES = frozenset(
+    {
+        "Sequence",
+        "ReactiveSequence",
+        "Fallback",
+        "ReactiveFallback",
+        "Inverter",
+        "ForceSuccess",
+        "ForceFailure",
+        "SubTree",
+        "AlwaysSuccess",
+        "AlwaysFailure",
+    }
+)
 #: A leaf outcome (``LeafOutcome`` or its string) as py_trees' status.
-_STATUS: dict[str, Status] = {LeafOutcome.SUCCESS: Status.SUCCESS, LeafOutcome.FAILURE: Status.FAILURE,
-           LeafOutcome.RUNNING: Status.RUNNING}
+_STATUS: dict[str, Status] = {
+    LeafOutcome.SUCCESS: Status.SUCCESS,
+    LeafOutcome.FAILURE: Status.FAILURE,
+    LeafOutcome.RUNNING: Status.RUNNING,
+}
 #: py_trees' status as ours (INVALID = never ticked or halted = IDLE), and by name.
-_NODE_STATUS = {Status.SUCCESS: NodeStatus.SUCCESS, Status.FAILURE: NodeStatus.FAILURE,
-                Status.RUNNING: NodeStatus.RUNNING, Status.INVALID: NodeStatus.IDLE}
+_NODE_STATUS = {
+    Status.SUCCESS: NodeStatus.SUCCESS,
+    Status.FAILURE: NodeStatus.FAILURE,
+    Status.RUNNING: NodeStatus.RUNNING,
+    Status.INVALID: NodeStatus.IDLE,
+}
 _NAME = {engine: status.name for engine, status in _NODE_STATUS.items()}
 
 #: Builds the py_trees leaf for an environment leaf of the compiled tree.
@@ -80,8 +97,11 @@ def build(tree: CompiledTree, leaf_factory: LeafFactory) -> py_trees.behaviour.B
             made[node.id] = leaf_factory(node)
             continue
         if node.type not in SUPPORTED_TYPES:
-            raise UnsupportedError(f"py_trees has no equivalent of {node.type}",
-                                   location=node.source.location, element=node.label)
+            raise UnsupportedError(
+                f"py_trees has no equivalent of {node.type}",
+                location=node.source.location,
+                element=node.label,
+            )
         kids = [made.pop(c) for c in node.children]
         t = node.type
         if t == "AlwaysSuccess":
@@ -89,11 +109,13 @@ def build(tree: CompiledTree, leaf_factory: LeafFactory) -> py_trees.behaviour.B
         elif t == "AlwaysFailure":
             made[node.id] = py_trees.behaviours.Failure(name)
         elif t in ("Sequence", "ReactiveSequence"):
-            made[node.id] = py_trees.composites.Sequence(name, memory=t == "Sequence",
-                                                         children=kids)
+            made[node.id] = py_trees.composites.Sequence(
+                name, memory=t == "Sequence", children=kids
+            )
         elif t in ("Fallback", "ReactiveFallback"):
-            made[node.id] = py_trees.composites.Selector(name, memory=t == "Fallback",
-                                                         children=kids)
+            made[node.id] = py_trees.composites.Selector(
+                name, memory=t == "Fallback", children=kids
+            )
         elif t == "Inverter":
             made[node.id] = py_trees.decorators.Inverter(name, child=kids[0])
         elif t == "ForceSuccess":
@@ -119,6 +141,7 @@ class PyTreesRunner:
             outcome = self.env(node.source, node.path)
             self._leaves.append((node.label, node.path, outcome))
             return outcome
+
         return EnvLeaf(f"n{node.id}", ask)
 
     def tick_once(self) -> TickRecord:
@@ -149,6 +172,7 @@ class PyTreesLebtRunner(EngineLebtRun):
             if first:
                 return state_on_start(spec, self.bb, self.actions)
             return state_on_running(spec, self.bb)
+
         return EnvLeaf(f"n{node.id}", state_leaf)
 
     def _tick_engine(self) -> NodeStatus:

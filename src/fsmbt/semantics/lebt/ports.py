@@ -29,7 +29,6 @@ from fsmbt.model.validate import Issue
 from fsmbt.semantics.lebt.spec import GUARD_TYPE, STATE_TYPE, GuardSpec, StateSpec
 
 
-
 @dataclass(frozen=True)
 class _Guard:
     node: BTNode
@@ -81,8 +80,11 @@ def lebt_port_issues(doc: BTDocument) -> list[Issue]:
             node = stack.pop()
             for index, child in enumerate(node.children):
                 if child.type == GUARD_TYPE:
-                    guards.append(_Guard(child, tree.id, GuardSpec.from_attrs(child.attrs),
-                                         _guarded(node, index)))
+                    guards.append(
+                        _Guard(
+                            child, tree.id, GuardSpec.from_attrs(child.attrs), _guarded(node, index)
+                        )
+                    )
             if node.type == STATE_TYPE:
                 spec = StateSpec.from_attrs(node.attrs)
                 states.setdefault(spec.state, (node, spec))
@@ -93,26 +95,52 @@ def lebt_port_issues(doc: BTDocument) -> list[Issue]:
         guarded = guard.guarded
         name = _guarded_name(guarded) if guarded is not None else None
         if name is None:
-            issues.append(Issue("error", f"{GUARD_TYPE} is not followed by the state it "
-                                "enters (a LebtState or SubTree, alone or first in a chain)",
-                                guard.node.location, where))
+            issues.append(
+                Issue(
+                    "error",
+                    f"{GUARD_TYPE} is not followed by the state it "
+                    "enters (a LebtState or SubTree, alone or first in a chain)",
+                    guard.node.location,
+                    where,
+                )
+            )
         elif guard.spec.target != name:
             line = guarded.location.line if guarded is not None and guarded.location else None
             at = f" (line {line})" if line is not None else ""
-            issues.append(Issue("error", f"port target='{guard.spec.target}' but the guard "
-                                f"enters state '{name}'{at}; the target port must name the "
-                                "state the guard enters", guard.node.location, where))
+            issues.append(
+                Issue(
+                    "error",
+                    f"port target='{guard.spec.target}' but the guard "
+                    f"enters state '{name}'{at}; the target port must name the "
+                    "state the guard enters",
+                    guard.node.location,
+                    where,
+                )
+            )
         for source, event in guard.spec.pairs:
             known = states.get(source)
             if known is not None and event and event not in known[1].exits:
-                issues.append(Issue("error", f"pair '{source}/{event}': state '{source}' does "
-                                    f"not list '{event}' in its exits port, so this transition "
-                                    "never fires", guard.node.location, where))
+                issues.append(
+                    Issue(
+                        "error",
+                        f"pair '{source}/{event}': state '{source}' does "
+                        f"not list '{event}' in its exits port, so this transition "
+                        "never fires",
+                        guard.node.location,
+                        where,
+                    )
+                )
     left: set[tuple[str, str]] = {pair for guard in guards for pair in guard.spec.pairs}
     for name, (node, spec) in states.items():
         for event in spec.exits:
             if (name, event) not in left:
-                issues.append(Issue("error", f"exits port lists '{event}' but no LebtGuard "
-                                    f"has the pair '{name}/{event}'", node.location,
-                                    f"{STATE_TYPE} '{node.label}'"))
+                issues.append(
+                    Issue(
+                        "error",
+                        f"exits port lists '{event}' but no LebtGuard "
+                        f"has the pair '{name}/{event}'",
+                        node.location,
+                        f"{STATE_TYPE} '{node.label}'",
+                    )
+                )
     return issues

@@ -88,8 +88,11 @@ def internal_status(node: NodeSemantics) -> NodeStatus | None:
 def _build(nodes: tuple[NodeSemantics, ...]) -> RuntimeTables:
     # a condition kind's handler (``env_condition``) names no tick rule: it is ticked as an
     # environment leaf
-    handlers = {n.name: n.handler for n in nodes
-                if n.handler is not None and n.kind is not NodeKind.CONDITION}
+    handlers = {
+        n.name: n.handler
+        for n in nodes
+        if n.handler is not None and n.kind is not NodeKind.CONDITION
+    }
     internal = {
         n.name: int(NodeStatus[n.internal_result]) for n in nodes if n.internal_result is not None
     }

@@ -63,8 +63,11 @@ def require_nusmv() -> Path:
     path = find_nusmv()
     if path is None:
         env = os.environ.get(ENV_VAR)
-        hint = (f"{ENV_VAR}={env} is not an executable file" if env else
-                f"not on PATH and not built at {cached_binary()}")
+        hint = (
+            f"{ENV_VAR}={env} is not an executable file"
+            if env
+            else f"not on PATH and not built at {cached_binary()}"
+        )
         raise NuSMVNotFound(f"NuSMV not found ({hint}); run {BUILD_SCRIPT} or set {ENV_VAR}")
     return path
 

@@ -43,19 +43,25 @@ if TYPE_CHECKING:
 
 # The encoding rules by node kind, from the registry's ``nusmv`` field.
 #: type -> (is_fallback, emits wake-up after a fresh child succeeds/fails, with memory)
-SEQ_LIKE = {n.name: (n.is_fallback, n.wakes_up, n.with_memory)
-            for n in all_nodes() if n.nusmv == "sequence"}
+SEQ_LIKE = {
+    n.name: (n.is_fallback, n.wakes_up, n.with_memory) for n in all_nodes() if n.nusmv == "sequence"
+}
 #: type -> is_fallback
 REACTIVE = {n.name: n.is_fallback for n in all_nodes() if n.nusmv == "reactive"}
 SIMPLE_DECORATORS = frozenset(n.name for n in all_nodes() if n.nusmv == "simple_decorator")
 #: Project kinds with an index or counter (docs/semantics.md §10): rule name.
-MEMORY_RULES = {n.name: n.nusmv for n in all_nodes()
-                if n.nusmv in ("pipeline", "recovery", "round_robin", "repeat_each_tick",
-                               "if_then_else", "while_do_else")}
+MEMORY_RULES = {
+    n.name: n.nusmv
+    for n in all_nodes()
+    if n.nusmv
+    in ("pipeline", "recovery", "round_robin", "repeat_each_tick", "if_then_else", "while_do_else")
+}
 #: Abstractions and wrappers whose only state is statuses (docs/semantics.md §10): rule name.
-GATE_RULES = {n.name: n.nusmv for n in all_nodes()
-              if n.nusmv in ("gated", "timeout", "sleep", "for_each", "pass_through",
-                             "pass_through_keep")}
+GATE_RULES = {
+    n.name: n.nusmv
+    for n in all_nodes()
+    if n.nusmv in ("gated", "timeout", "sleep", "for_each", "pass_through", "pass_through_keep")
+}
 SUPPORTED = NUSMV_ENCODED
 #: type -> why the encoding refuses it
 NOT_ENCODED = {n.name: n.nusmv_refusal for n in all_nodes() if n.nusmv_refusal is not None}
@@ -98,19 +104,24 @@ class BTCore:
                 reason = NOT_ENCODED.get(node.type, "not encoded")
                 raise UnsupportedError(
                     f"the NuSMV encoding does not support {node.type} ({reason})",
-                    location=node.source.location, element=f"<{node.type}> '{node.label}'",
-                    hints=(Hint.NATIVE_VERIFIER,))
+                    location=node.source.location,
+                    element=f"<{node.type}> '{node.label}'",
+                    hints=(Hint.NATIVE_VERIFIER,),
+                )
             spec = node_semantics(node.type)
             # a simple decorator without a result map (KeepRunningUntilFailure) can tick forever
-            has_keep_running |= (node.type in SIMPLE_DECORATORS and spec is not None
-                                 and spec.result_map is None)
+            has_keep_running |= (
+                node.type in SIMPLE_DECORATORS and spec is not None and spec.result_map is None
+            )
             self.info.append(NodeInfo(node, False, None))
         if has_internal and (loop or has_keep_running):
             raise UnsupportedError(
                 "the NuSMV encoding does not model ticks that end without any leaf "
                 "(AlwaysSuccess/AlwaysFailure & co with loop or KeepRunningUntilFailure: the "
-                "engine could livelock)", element=self.nodes[0].label,
-                hints=(Hint.NATIVE_VERIFIER,))
+                "engine could livelock)",
+                element=self.nodes[0].label,
+                hints=(Hint.NATIVE_VERIFIER,),
+            )
         self.max_children = max((len(n.children) for n in self.nodes), default=0)
         self.rules: dict[str, list[tuple[str, str]]] = {}
         self.var_types: dict[str, str] = {}
@@ -288,8 +299,9 @@ class BTCore:
                 self.ret(f"{back} & res = R", x.id, "R")
                 resets[c].append(done)
                 # the child's S / F as the node returns them (a SubTree passes them on)
-                on_s, on_f = ((ST[result_map[0]], ST[result_map[1]]) if result_map is not None
-                              else (_S, _F))
+                on_s, on_f = (
+                    (ST[result_map[0]], ST[result_map[1]]) if result_map is not None else (_S, _F)
+                )
                 mapped = on_s if on_s == on_f else f"case res = S : {on_s}; TRUE : {on_f}; esac"
                 self.ret(done, x.id, mapped)
         # halt closure (pre-order ids: a parent's defines come before its children's)
@@ -305,8 +317,9 @@ class BTCore:
         for x in self.nodes:
             self.rules.setdefault(self.st(x.id), []).insert(0, (f"clr_{x.id}", "I"))
 
-    def _gate_rules(self, x: CompiledNode, rule: str, here: str, called: str,
-                    resets: dict[int, list[str]]) -> None:
+    def _gate_rules(
+        self, x: CompiledNode, rule: str, here: str, called: str, resets: dict[int, list[str]]
+    ) -> None:
         """Project wrappers and gated abstractions (docs/semantics.md §10): the gate is the
         last child, a condition leaf the environment answers; only statuses are kept."""
         kids = list(x.children)
@@ -345,8 +358,10 @@ class BTCore:
         if closed_status not in ST or closed_status == NodeStatus.IDLE.name:
             raise UnsupportedError(
                 f"the NuSMV encoding does not support {x.type} returning {closed_status} "
-                "(SKIPPED is not encoded); use --engine native", location=x.source.location,
-                element=f"<{x.type}> '{x.label}'")
+                "(SKIPPED is not encoded); use --engine native",
+                location=x.source.location,
+                element=f"<{x.type}> '{x.label}'",
+            )
         closed = ST[closed_status]
         if rule == "for_each":
             self.call(f"{called} & {self.st(c)} = R", c)
@@ -376,8 +391,9 @@ class BTCore:
             resets[c].append(f"{from_child} & (res = S | res = F)")
         self.ret(from_child, x.id, passed)
 
-    def _memory_rules(self, x: CompiledNode, rule: str, here: str, called: str,
-                      resets: dict[int, list[str]]) -> None:
+    def _memory_rules(
+        self, x: CompiledNode, rule: str, here: str, called: str, resets: dict[int, list[str]]
+    ) -> None:
         """PipelineSequence, RecoveryNode, RoundRobin, RepeatUnlessFailureEachTick
         (docs/semantics.md §10; SKIPPED children are not encoded)."""
         kids = list(x.children)
@@ -472,8 +488,7 @@ class BTCore:
                 self.ret(f"{side} & res = R", x.id, "R")
             won = f"{from_main} & res = S"
             retry = f"{from_main} & res = F & {tries} < {retries}"
-            lost = (f"({from_main} & res = F & {tries} >= {retries}) | "
-                    f"({from_rec} & res = F)")
+            lost = f"({from_main} & res = F & {tries} >= {retries}) | ({from_rec} & res = F)"
             for cond, status in ((won, "S"),):
                 reset_all(cond)
                 self.rule(cur, cond, "0")
@@ -580,8 +595,15 @@ def describe_bt(core: BTCore, values: dict[str, str]) -> str:
 class LeafBTEncoder:
     """The BT's leaf-execution machine (``fsmbt.semantics.leaf_machine.LeafMachine``)."""
 
-    def __init__(self, doc: BTDocument | CompiledTree, module: str, inputs: Symbols,
-                 outputs: Symbols, *, loop: bool) -> None:
+    def __init__(
+        self,
+        doc: BTDocument | CompiledTree,
+        module: str,
+        inputs: Symbols,
+        outputs: Symbols,
+        *,
+        loop: bool,
+    ) -> None:
         self.core = BTCore(doc, loop=loop)
         self.module = module
         self.inputs = inputs
@@ -640,12 +662,18 @@ class LeafBTEncoder:
                     if var not in ("cur", "res", "lidx", "bres"):
                         core.rules.setdefault(var, []).insert(0, (ended, core.init[var]))
         core.rules.setdefault("bres", []).insert(0, ("go", NONE_OUT))
-        label_rows = [(req, self.outputs.id(leaf.label))
-                      for req, leaf in zip(requests, core.env_leaves())]
-        defines = [("stable", stable), ("final", "(cur = DONE_S | cur = DONE_F)"),
-                   ("o1", "bres"), ("o2", case(label_rows, NONE_OUT))]
-        condition_req = any_of(r for r, leaf in zip(requests, core.env_leaves())
-                               if leaf.kind is NodeKind.CONDITION)
+        label_rows = [
+            (req, self.outputs.id(leaf.label)) for req, leaf in zip(requests, core.env_leaves())
+        ]
+        defines = [
+            ("stable", stable),
+            ("final", "(cur = DONE_S | cur = DONE_F)"),
+            ("o1", "bres"),
+            ("o2", case(label_rows, NONE_OUT)),
+        ]
+        condition_req = any_of(
+            r for r, leaf in zip(requests, core.env_leaves()) if leaf.kind is NodeKind.CONDITION
+        )
         for symbol, sid in sorted(ids.to_id.items()):
             if symbol == LeafOutcome.RUNNING:
                 value = f"(stable & !final & !{condition_req})"
@@ -656,6 +684,12 @@ class LeafBTEncoder:
             defines.append((f"offers_{sid}", value))
         text = core.emit(self.module, "go, inp", defines)
         ident = [(v, safe_text(core.var_types[v])) for v in self._identity()]
-        return Encoding(self.module, text, ["o1", "o2"], list(outcome), ident,
-                        decode_state=lambda values: describe_bt(core, values),
-                        var_order=list(core.var_types))
+        return Encoding(
+            self.module,
+            text,
+            ["o1", "o2"],
+            list(outcome),
+            ident,
+            decode_state=lambda values: describe_bt(core, values),
+            var_order=list(core.var_types),
+        )

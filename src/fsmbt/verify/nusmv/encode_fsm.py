@@ -42,8 +42,17 @@ class Encoding:
 class FSMEncoder:
     """Encodes a (flattened) FSM; ``leaf=True`` reads it as ``FSMLeafMachine`` does."""
 
-    def __init__(self, fsm: FSM, module: str, inputs: Symbols, outputs: Symbols, *,
-                 alphabet: Sequence[str], leaf: bool = False, loop: bool = False) -> None:
+    def __init__(
+        self,
+        fsm: FSM,
+        module: str,
+        inputs: Symbols,
+        outputs: Symbols,
+        *,
+        alphabet: Sequence[str],
+        leaf: bool = False,
+        loop: bool = False,
+    ) -> None:
         self.fsm = flatten(fsm)
         if self.fsm.initial is None:
             raise InputError("the state machine has no initial state", element=self.fsm.name)
@@ -71,8 +80,12 @@ class FSMEncoder:
     def encode(self) -> Encoding:
         fsm, q = self.fsm, self.states
         table = fsm.transition_map()
-        lines = [f"MODULE {self.module}(go, inp)", "VAR",
-                 f"  q : {q.enum()};", f"  o1 : {{{NONE_OUT}}};"]
+        lines = [
+            f"MODULE {self.module}(go, inp)",
+            "VAR",
+            f"  q : {q.enum()};",
+            f"  o1 : {{{NONE_OUT}}};",
+        ]
         # o1/o2 are typed after every output value is known (placeholder replaced below)
         next_q: list[tuple[str, str]] = []
         next_o1: list[tuple[str, str]] = []
@@ -122,27 +135,42 @@ class FSMEncoder:
         if self.leaf:
             lines.append(f"  o2 : {out_enum};")
         finals = [q.id(n) for n, s in fsm.states.items() if s.final]
-        lines += ["DEFINE", "  stable := TRUE;",
-                  f"  final := {any_of(f'q = {f}' for f in finals)};"]
+        lines += [
+            "DEFINE",
+            "  stable := TRUE;",
+            f"  final := {any_of(f'q = {f}' for f in finals)};",
+        ]
         for symbol in sorted(set(self.inputs.to_id) | set(self.alphabet)):
             offered = symbol in self.alphabet
             value = ("!final" if self.leaf else "TRUE") if offered else "FALSE"
             lines.append(f"  offers_{self.inputs.id(symbol)} := {value};")
-        lines += ["ASSIGN", f"  init(q) := {q.id(start_q)};",
-                  f"  next(q) := {case(next_q, 'q')};",
-                  f"  init(o1) := {start_o[0]};",
-                  f"  next(o1) := {case(next_o1 + [('go', NONE_OUT)], 'o1')};"]
+        lines += [
+            "ASSIGN",
+            f"  init(q) := {q.id(start_q)};",
+            f"  next(q) := {case(next_q, 'q')};",
+            f"  init(o1) := {start_o[0]};",
+            f"  next(o1) := {case(next_o1 + [('go', NONE_OUT)], 'o1')};",
+        ]
         if self.leaf:
-            lines += [f"  init(o2) := {start_o[1]};",
-                      f"  next(o2) := {case(next_o2 + [('go', NONE_OUT)], 'o2')};"]
+            lines += [
+                f"  init(o2) := {start_o[1]};",
+                f"  next(o2) := {case(next_o2 + [('go', NONE_OUT)], 'o2')};",
+            ]
         names = q.to_name
 
         def decode(values: dict[str, str]) -> str:
             return names.get(values.get("q", ""), "?")
 
-        return Encoding(self.module, "\n".join(lines) + "\n", slots, list(self.alphabet),
-                        [("q", q.enum())], follows=self.leaf, decode_state=decode,
-                        var_order=["q", *slots])
+        return Encoding(
+            self.module,
+            "\n".join(lines) + "\n",
+            slots,
+            list(self.alphabet),
+            [("q", q.enum())],
+            follows=self.leaf,
+            decode_state=decode,
+            var_order=["q", *slots],
+        )
 
     def status_of(self, values: dict[str, str]) -> str:
         name = self.states.to_name.get(values.get("q", ""))

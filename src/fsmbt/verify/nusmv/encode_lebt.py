@@ -32,8 +32,15 @@ MAX_SLOTS = 6
 
 
 class LebtEncoder:
-    def __init__(self, doc: BTDocument, module: str, inputs: Symbols, outputs: Symbols, *,
-                 alphabet: Sequence[str]) -> None:
+    def __init__(
+        self,
+        doc: BTDocument,
+        module: str,
+        inputs: Symbols,
+        outputs: Symbols,
+        *,
+        alphabet: Sequence[str],
+    ) -> None:
         self.core = BTCore(doc, loop=False)
         self.leaves = LebtLeaves.of(self.core.tree)
         self.module = module
@@ -59,8 +66,10 @@ class LebtEncoder:
         return [("output_overflow", "!r.ovf")]
 
     def extra_message(self, name: str) -> str:
-        return (f"the NuSMV encoding bounds the actions of one macro step at {self.slots}; this "
-                "LEBT runs more in one step")
+        return (
+            f"the NuSMV encoding bounds the actions of one macro step at {self.slots}; this "
+            "LEBT runs more in one step"
+        )
 
     def _ev(self, event: str) -> str | None:
         if event == NO_EVENT:
@@ -86,11 +95,22 @@ class LebtEncoder:
         init_cur = core.n(0) if self.leaves.init_on_start else "TOP"
         core.declare(["TOP"], init_cur)
         out_enum = self.outputs.enum([NONE_OUT])
-        extra_vars = {"bbs": self.states.enum(), "bbe": self.events.enum(["ev_none"]),
-                      "lres": "{lr_none, lr_R, lr_S, lr_F}", "tick2": "boolean",
-                      "nact": f"0..{k}", "ovf": "boolean"}
-        inits = {"bbs": self.states.id(self.leaves.start), "bbe": "ev_none", "lres": "lr_none",
-                 "tick2": "FALSE", "nact": "0", "ovf": "FALSE"}
+        extra_vars = {
+            "bbs": self.states.enum(),
+            "bbe": self.events.enum(["ev_none"]),
+            "lres": "{lr_none, lr_R, lr_S, lr_F}",
+            "tick2": "boolean",
+            "nact": f"0..{k}",
+            "ovf": "boolean",
+        }
+        inits = {
+            "bbs": self.states.id(self.leaves.start),
+            "bbe": "ev_none",
+            "lres": "lr_none",
+            "tick2": "FALSE",
+            "nact": "0",
+            "ovf": "FALSE",
+        }
         for j in range(1, k + 1):
             extra_vars[f"a{j}"] = out_enum
             inits[f"a{j}"] = NONE_OUT
@@ -100,8 +120,14 @@ class LebtEncoder:
         stable = "(cur = TOP & res = NONE)"
         # a macro step starts: set the event, tick the root
         core.call("go", 0)
-        core.rule("bbe", "go", case([(f"inp = {self.inputs.id(e)}", self.events.id(e))
-                                     for e in self.alphabet], "ev_none"))
+        core.rule(
+            "bbe",
+            "go",
+            case(
+                [(f"inp = {self.inputs.id(e)}", self.events.id(e)) for e in self.alphabet],
+                "ev_none",
+            ),
+        )
         core.rule("tick2", "go", "FALSE")
         core.rule("nact", "go", "0")
         for j in range(1, k + 1):
@@ -148,8 +174,10 @@ class LebtEncoder:
         core.rule("res", finish, "NONE")
         core.rule("bbe", finish, "ev_none")
         core.rule("tick2", finish, "FALSE")
-        defines = [("stable", stable),
-                   ("final", f"(lres = lr_S & bbs != {self.states.id(self.leaves.start)})")]
+        defines = [
+            ("stable", stable),
+            ("final", f"(lres = lr_S & bbs != {self.states.id(self.leaves.start)})"),
+        ]
         defines += [(f"o{j}", f"a{j}") for j in range(1, k + 1)]
         for symbol, sid in sorted(self.inputs.to_id.items()):
             defines.append((f"offers_{sid}", "TRUE" if symbol in self.alphabet else "FALSE"))
@@ -162,7 +190,12 @@ class LebtEncoder:
             ident.append(("runl", runl[1]))
         text = core.emit(self.module, "go, inp", defines)
         names = self.states.to_name
-        return Encoding(self.module, text, [f"o{j}" for j in range(1, k + 1)],
-                        list(self.alphabet), ident,
-                        decode_state=lambda values: names.get(values.get("bbs", ""), "?"),
-                        var_order=list(core.var_types))
+        return Encoding(
+            self.module,
+            text,
+            [f"o{j}" for j in range(1, k + 1)],
+            list(self.alphabet),
+            ident,
+            decode_state=lambda values: names.get(values.get("bbs", ""), "?"),
+            var_order=list(core.var_types),
+        )

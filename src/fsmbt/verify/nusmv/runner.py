@@ -24,11 +24,20 @@ from fsmbt.verify.nusmv.binary import require_nusmv
 
 DEFAULT_TIMEOUT_S = Limits.nusmv_max_seconds  # the default lives in fsmbt.limits
 #: Words NuSMV / CUDD / the C library print when an allocation fails under RLIMIT_AS.
-_MEMORY_WORDS = ("out of memory", "cannot allocate", "memory exhausted", "bad_alloc",
-                 "malloc", "memory limit", "failed to map segment")
+_MEMORY_WORDS = (
+    "out of memory",
+    "cannot allocate",
+    "memory exhausted",
+    "bad_alloc",
+    "malloc",
+    "memory limit",
+    "failed to map segment",
+)
 _VAR_SECTION = re.compile(r"^\s*(?:VAR|IVAR|FROZENVAR)\b(.*)$")
-_SECTION = re.compile(r"^\s*(?:MODULE|DEFINE|ASSIGN|INIT|TRANS|INVAR|SPEC|CTLSPEC|LTLSPEC|"
-                      r"INVARSPEC|FAIRNESS|JUSTICE|COMPASSION)\b")
+_SECTION = re.compile(
+    r"^\s*(?:MODULE|DEFINE|ASSIGN|INIT|TRANS|INVAR|SPEC|CTLSPEC|LTLSPEC|"
+    r"INVARSPEC|FAIRNESS|JUSTICE|COMPASSION)\b"
+)
 _DECLARATION = re.compile(r"^\s*[A-Za-z_][\w.$#\[\]-]*\s*:\s*[^=]")
 _SPEC = re.compile(r"^-- (?:specification|invariant) (.*) is (true|false)\s*$")
 _STATE = re.compile(r"^\s*-> State: \d+\.\d+ <-")
@@ -51,10 +60,11 @@ class NuSMVLimitError(FsmbtError):
 
     def __init__(self, resource: str, variables: int, limit_name: str, limit: float) -> None:
         unit = "MiB" if resource == "memory" else "s"
-        message = (f"NuSMV ran out of {resource} at {variables} variables (cap {limit:g} {unit}; "
-                   f"raise it with {limits.env_name(limit_name)})")
-        super().__init__(message, element="NuSMV", hints=(Hint.NUSMV_LIMITS,
-                                                           Hint.NATIVE_VERIFIER))
+        message = (
+            f"NuSMV ran out of {resource} at {variables} variables (cap {limit:g} {unit}; "
+            f"raise it with {limits.env_name(limit_name)})"
+        )
+        super().__init__(message, element="NuSMV", hints=(Hint.NUSMV_LIMITS, Hint.NATIVE_VERIFIER))
         self.resource = resource
         self.variables = variables
         self.limit_name = limit_name
@@ -108,9 +118,15 @@ class SpecResult:
     trace: list[TraceState] | None = None
 
 
-def run_nusmv(model: str, expected_specs: int, *, order: str | None = None,
-              timeout: float | None = None, memory_mb: int | None = None,
-              keep: str | None = None) -> tuple[list[SpecResult], float]:
+def run_nusmv(
+    model: str,
+    expected_specs: int,
+    *,
+    order: str | None = None,
+    timeout: float | None = None,
+    memory_mb: int | None = None,
+    keep: str | None = None,
+) -> tuple[list[SpecResult], float]:
     """Check every SPEC of ``model``; returns the results in file order and NuSMV's seconds.
 
     Args:
@@ -152,21 +168,30 @@ def run_nusmv(model: str, expected_specs: int, *, order: str | None = None,
             command += ["-i", order_path]
         started = time.perf_counter()
         try:
-            proc = subprocess.run(command + [path], capture_output=True, text=True,
-                                  encoding="utf-8", errors="replace", timeout=timeout, cwd=tmp,
-                                  preexec_fn=_address_space_cap(memory_mb))
+            proc = subprocess.run(
+                command + [path],
+                capture_output=True,
+                text=True,
+                encoding="utf-8",
+                errors="replace",
+                timeout=timeout,
+                cwd=tmp,
+                preexec_fn=_address_space_cap(memory_mb),
+            )
         except subprocess.TimeoutExpired:
-            raise NuSMVLimitError("time", count_variables(model), "nusmv_max_seconds",
-                                  timeout) from None
+            raise NuSMVLimitError(
+                "time", count_variables(model), "nusmv_max_seconds", timeout
+            ) from None
         elapsed = time.perf_counter() - started
     results = parse_output(proc.stdout)
     if (proc.returncode != 0 or len(results) != expected_specs) and _out_of_memory(proc):
-        raise NuSMVLimitError("memory", count_variables(model), "nusmv_max_memory_mb",
-                              memory_mb)
+        raise NuSMVLimitError("memory", count_variables(model), "nusmv_max_memory_mb", memory_mb)
     if proc.returncode != 0 or len(results) != expected_specs:
         tail = (proc.stderr or proc.stdout).strip().splitlines()[-8:]
-        raise NuSMVError(f"NuSMV failed (exit {proc.returncode}, {len(results)} of "
-                         f"{expected_specs} specs answered): " + " | ".join(tail))
+        raise NuSMVError(
+            f"NuSMV failed (exit {proc.returncode}, {len(results)} of "
+            f"{expected_specs} specs answered): " + " | ".join(tail)
+        )
     return results, elapsed
 
 

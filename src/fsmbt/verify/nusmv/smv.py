@@ -83,8 +83,9 @@ def subsequence(small: Sequence[str], big: Sequence[str], none: str) -> str:
     cases = []
     for mask in range(1 << m):
         filled = [i for i in range(m) if mask >> i & 1]
-        pattern = all_of([f"{small[i]} != {none}" if mask >> i & 1 else f"{small[i]} = {none}"
-                          for i in range(m)])
+        pattern = all_of(
+            [f"{small[i]} != {none}" if mask >> i & 1 else f"{small[i]} = {none}" for i in range(m)]
+        )
         matches = []
         for combo in _increasing(len(filled), len(big)):
             matches.append(all_of(f"{small[i]} = {big[j]}" for i, j in zip(filled, combo)))

@@ -45,29 +45,42 @@ class Product:
     order: str
 
 
-def product(src: Encoding, res: Encoding, inputs: Symbols,
-            extra_specs: list[tuple[str, str]] | None = None) -> Product:
+def product(
+    src: Encoding, res: Encoding, inputs: Symbols, extra_specs: list[tuple[str, str]] | None = None
+) -> Product:
     """The ``main`` module and the specs, in the order ``spec_names`` lists them."""
     in_ids = list(inputs.to_id.values())
     in_enum = enum_type(in_ids, "in_pad")  # never offered: no machine defines offers_in_pad
     follows = res.follows
     s_slots = [f"s.{x}" for x in src.slots]
     r_slots = [f"r.{x}" for x in res.slots]
-    equal_outs = all_of([subsequence(s_slots, r_slots, NONE_OUT),
-                         subsequence(r_slots, s_slots, NONE_OUT)])
+    equal_outs = all_of(
+        [subsequence(s_slots, r_slots, NONE_OUT), subsequence(r_slots, s_slots, NONE_OUT)]
+    )
     joint = any_of(
         f"(inp_s = {i} & s.offers_{i}" + ("" if follows else f" & r.offers_{i}") + ")"
-        for i in in_ids)
+        for i in in_ids
+    )
     alone_s = any_of(f"(inp_s = {i} & s.offers_{i})" for i in in_ids)
     alone_r = any_of(f"(inp_r = {i} & r.offers_{i})" for i in in_ids)
-    lines = ["MODULE main", "IVAR", f"  inp_s : {in_enum};", f"  inp_r : {in_enum};",
-             "  ctl : {step, alone_s, alone_r, idle};", "VAR",
-             "  s : " + src.module + "(go_s, inp_s);",
-             "  r : " + res.module + "(go_r, inp_eff_r);",
-             "  mode : {att, sa, ra};", "  s_obs : boolean;", "  r_obs : boolean;",
-             "  s_run : boolean;", "  r_run : boolean;", "  s_st0 : boolean;",
-             "  r_st0 : boolean;",
-             "FROZENVAR"]
+    lines = [
+        "MODULE main",
+        "IVAR",
+        f"  inp_s : {in_enum};",
+        f"  inp_r : {in_enum};",
+        "  ctl : {step, alone_s, alone_r, idle};",
+        "VAR",
+        "  s : " + src.module + "(go_s, inp_s);",
+        "  r : " + res.module + "(go_r, inp_eff_r);",
+        "  mode : {att, sa, ra};",
+        "  s_obs : boolean;",
+        "  r_obs : boolean;",
+        "  s_run : boolean;",
+        "  r_run : boolean;",
+        "  s_st0 : boolean;",
+        "  r_st0 : boolean;",
+        "FROZENVAR",
+    ]
     for prefix, enc in (("ts", src), ("tr", res)):
         for var, typ in enc.id_vars:
             lines.append(f"  {prefix}_{var} : {typ};")
@@ -121,8 +134,7 @@ def product(src: Encoding, res: Encoding, inputs: Symbols,
         noadd = f"{noadd} & (faithful -> {offers_r_in_s})"
     specs.append((COMPLETENESS, "INVARSPEC", compl))
     specs.append((NO_ADDITIONAL_BEHAVIOR, "INVARSPEC", noadd))
-    specs.append((TERMINATION_CONSISTENCY, "INVARSPEC",
-                  "((!det & both) -> (s.final <-> r.final))"))
+    specs.append((TERMINATION_CONSISTENCY, "INVARSPEC", "((!det & both) -> (s.final <-> r.final))"))
     specs += [(name, "INVARSPEC", formula) for name, formula in (extra_specs or [])]
     for _name, kind, formula in specs:
         lines.append(f"{kind} {formula};")
@@ -133,8 +145,7 @@ def product(src: Encoding, res: Encoding, inputs: Symbols,
 def _order(src: Encoding, res: Encoding) -> str:
     """A BDD variable order: each identity variable next to its frozen copy (the reachability
     spec compares them), inputs first. Without it NuSMV is 20x slower on small models."""
-    order = ["inp_s", "inp_r", "ctl", "mode", "s_obs", "r_obs", "s_run",
-             "r_run", "s_st0", "r_st0"]
+    order = ["inp_s", "inp_r", "ctl", "mode", "s_obs", "r_obs", "s_run", "r_run", "s_st0", "r_st0"]
     for side, copy, enc in (("s", "ts", src), ("r", "tr", res)):
         ids = {v for v, _ in enc.id_vars}
         for var in enc.var_order:

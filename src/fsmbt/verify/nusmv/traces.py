@@ -52,7 +52,8 @@ def _attached_go(before: dict[str, str], inputs: dict[str, str], follows: bool) 
     if before.get("faithful") != "TRUE" or inputs.get("ctl") != "step" or symbol is None:
         return False
     return before.get(f"s.offers_{symbol}") == "TRUE" and (
-        follows or before.get(f"r.offers_{symbol}") == "TRUE")
+        follows or before.get(f"r.offers_{symbol}") == "TRUE"
+    )
 
 
 def decode_trace(trace: list[TraceState], context: Context) -> list[TraceStep]:
@@ -73,22 +74,39 @@ def decode_trace(trace: list[TraceState], context: Context) -> list[TraceStep]:
         s_vals, r_vals = _side(v, "s"), _side(v, "r")
 
         def outs(vals: dict[str, str], enc: Encoding) -> list[str]:
-            return [outputs.name(vals[slot]) or vals[slot] for slot in enc.slots
-                    if vals.get(slot, NONE_OUT) != NONE_OUT]
+            return [
+                outputs.name(vals[slot]) or vals[slot]
+                for slot in enc.slots
+                if vals.get(slot, NONE_OUT) != NONE_OUT
+            ]
 
-        steps.append(TraceStep(
-            len(steps), pending if steps else None, outs(s_vals, src), outs(r_vals, res),
-            src.decode_state(s_vals), res.decode_state(r_vals),
-            _status(s_vals), _status(r_vals)))
+        steps.append(
+            TraceStep(
+                len(steps),
+                pending if steps else None,
+                outs(s_vals, src),
+                outs(r_vals, res),
+                src.decode_state(s_vals),
+                res.decode_state(r_vals),
+                _status(s_vals),
+                _status(r_vals),
+            )
+        )
         pending = None
     return steps
 
 
-def build_report(names: list[str], results: list[SpecResult], context: Context,
-                 source_model: FSM | BTDocument, result_model: FSM | BTDocument) -> Report:
+def build_report(
+    names: list[str],
+    results: list[SpecResult],
+    context: Context,
+    source_model: FSM | BTDocument,
+    result_model: FSM | BTDocument,
+) -> Report:
     src, res, src_enc, res_enc, inputs, outputs, mode, _order = context
-    report = Report(engine="nusmv", source=_name(source_model), result=_name(result_model),
-                    mode=mode)
+    report = Report(
+        engine="nusmv", source=_name(source_model), result=_name(result_model), mode=mode
+    )
     for name, result in zip(names, results):
         if name in PROPERTIES:
             continue
