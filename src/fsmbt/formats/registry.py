@@ -312,9 +312,7 @@ def check_model_size(model: Model, location: SourceLocation) -> None:
     bounds = limits.current()
     count = 0
     if isinstance(model, FSM):
-        machines = [model]
-        while machines:
-            machine = machines.pop()
+        for machine in model.machines():  # stops at the first machine past the limit
             count += len(machine.states)
             if count > bounds.max_states:
                 raise InputError(
@@ -323,8 +321,6 @@ def check_model_size(model: Model, location: SourceLocation) -> None:
                     ),
                     location=location,
                 )
-            for state in machine.states.values():
-                machines.extend(state.regions)
         return
     nodes = [tree.root for tree in model.trees.values() if tree.root is not None]
     while nodes:

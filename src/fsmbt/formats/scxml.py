@@ -941,14 +941,10 @@ def _check_event_prefixes(fsm: FSM) -> None:
     engine picks for ``a.b`` is the model's (the W3C reading of a document with prefix
     descriptors gives such machines; docs/formats/scxml.md)."""
     names: set[str] = set()
-    stack = [fsm]
-    while stack:
-        machine = stack.pop()
+    for machine in fsm.machines():
         names.update(t.event for t in machine.transitions if t.event is not None)
         if machine.initial_event is not None:
             names.add(machine.initial_event)
-        for state in machine.states.values():
-            stack.extend(state.regions)
     ordered = sorted(names)
     for i, name in enumerate(ordered):
         for other in ordered[i + 1 :]:

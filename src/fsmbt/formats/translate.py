@@ -243,8 +243,7 @@ _NCNAME = re.compile(r"[A-Za-z_][A-Za-z0-9_.\-]*\Z")
 def _all_events(fsm: FSM) -> list[str]:
     """Every event of ``fsm`` and its sub-machines, in walk order, once each."""
     seen: dict[str, None] = {}
-    machines = [fsm, *(region for _p, _m, state in fsm.walk() for region in state.regions)]
-    for machine in machines:
+    for machine in fsm.machines():
         if machine.initial_event is not None:
             seen.setdefault(machine.initial_event, None)
         for t in machine.transitions:
@@ -294,8 +293,7 @@ def scxml_event_renames(fsm: FSM) -> dict[str, str]:
 def rename_events(fsm: FSM, renames: dict[str, str]) -> FSM:
     """A copy of ``fsm`` with its events renamed (every level)."""
     copy_ = copy.deepcopy(fsm)
-    machines = [copy_, *(region for _p, _m, state in copy_.walk() for region in state.regions)]
-    for machine in machines:
+    for machine in copy_.machines():
         if machine.initial_event is not None:
             machine.initial_event = renames.get(machine.initial_event, machine.initial_event)
         for t in machine.transitions:
@@ -332,8 +330,7 @@ def scxml_safe_names(fsm: FSM) -> tuple[FSM, dict[str, str]]:
         renamed[name] = candidate
         return candidate
 
-    machines = [copy_, *(region for _p, _m, state in copy_.walk() for region in state.regions)]
-    for machine in machines:
+    for machine in copy_.machines():
         if (
             not any(not _NCNAME.match(n) for n in machine.states)
             and machine.initial is not None

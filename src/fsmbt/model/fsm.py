@@ -215,6 +215,20 @@ class FSM:
                 succ.setdefault(t.target, None)
         return list(succ)
 
+    def machines(self) -> Iterator[FSM]:
+        """This machine and every sub-machine (a composite or parallel state's region) at every
+        level, pre-order: the order ``walk`` meets the regions in. Iterative.
+
+        Returns:
+            An iterator of machines, this one first.
+        """
+        stack: list[FSM] = [self]
+        while stack:
+            machine = stack.pop()
+            yield machine
+            for state in reversed(list(machine.states.values())):
+                stack.extend(reversed(state.regions))
+
     def walk(self, prefix: str = "") -> Iterator[tuple[str, FSM, State]]:
         """Every state at every level, pre-order.
 
