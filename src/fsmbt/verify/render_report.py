@@ -112,18 +112,20 @@ def _did(outputs: list[str], status: str) -> str:
     return text if status == "running" else f"{text} [{status}]"
 
 
+def _seconds(value: object) -> str:
+    """A duration from the stats as ``1.234 s`` (``-`` when it is not a number)."""
+    return f"{value:.3f} s" if isinstance(value, (int, float)) else "-"
+
+
 def _stats_line(stats: dict[str, object]) -> str:
     keys = ("source_states", "result_states", "product_states", "product_edges")
     shown = [f"{k.replace('_', ' ')} {stats[k]}" for k in keys if k in stats]
     nusmv = stats.get("nusmv")
     if isinstance(nusmv, dict) and "seconds" in nusmv:  # --engine both: each engine's time
-        native_seconds = stats.get("seconds", 0.0)
-        shown.append(
-            f"native {float(native_seconds) if isinstance(native_seconds, (int, float)) else 0.0:.3f} s"
-        )
-        shown.append(f"NuSMV {float(nusmv['seconds']):.3f} s")
+        shown.append(f"native {_seconds(stats.get('seconds'))}")
+        shown.append(f"NuSMV {_seconds(nusmv['seconds'])}")
     elif "seconds" in stats:
-        shown.append(f"{stats['seconds']:.3f} s")
+        shown.append(_seconds(stats["seconds"]))
     return ", ".join(shown)
 
 
