@@ -438,12 +438,8 @@ def verify_either_order(
     """
     oriented = orient(first, second)
     try:
-        report = verify(
-            oriented.source,
-            oriented.result,
-            engine=engine,
-            loop=loop,
-            max_states=_checker_limit(max_states),
+        report = verify_models(
+            oriented.source, oriented.result, engine, loop=loop, max_states=max_states
         )
     except UnsupportedError:
         raise
@@ -456,10 +452,8 @@ def verify_either_order(
             element=exc.element,
             hints=exc.hints,
         ) from None
-    readable(report, oriented.source, oriented.result)
     report.stats["pairing"] = oriented.rule
     report.stats["swapped"] = oriented.swapped
-    _name_abstractions(report, first, second)
     return report
 
 
