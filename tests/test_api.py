@@ -139,3 +139,11 @@ def test_verify_files_reads_both_and_reports(tmp_path: Path) -> None:
     api.convert_file(PAPER_FSM, out)
     first, second, report = api.verify_files(PAPER_FSM, out)
     assert first.kind == "fsm" and second.kind == "bt" and report.equivalent
+
+
+def test_llm_engine_input_read_by_a_parser_keeps_its_format_and_warnings() -> None:
+    # hybrid asks the LLM only when no parser reads the file: here the paper's XML reader does
+    options: dict[str, object] = {}
+    loaded = api.load_for_engine(PAPER_FSM, "hybrid", options=options)
+    assert loaded.format == "paper-xml" and not loaded.extracted
+    assert loaded.warnings == api.load(PAPER_FSM).warnings

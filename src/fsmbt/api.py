@@ -289,8 +289,7 @@ def load_for_engine(
         max_regenerations=regenerations if isinstance(regenerations, int) else None,
     )
     options.update(client=client, source_name=str(path), extracted_by_llm=loaded.extracted)
-    name = "llm" if loaded.extracted else (fmt or "detected")
-    return Loaded(loaded.model, path, name, [], loaded.extracted)
+    return Loaded(loaded.model, path, loaded.format, loaded.warnings, loaded.extracted)
 
 
 #: Options meant for the readers, not the engines (they travel in the same ``options`` dict).

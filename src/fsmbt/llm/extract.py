@@ -12,7 +12,7 @@ with the reader's message, up to ``max_regenerations`` times.
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from fsmbt.formats.registry import (
@@ -57,6 +57,8 @@ class InputOutcome:
     model: Model
     extracted: bool  # True when the LLM wrote the model
     record: ConversionRecord | None = None
+    format: str = "llm"  # the parser's format name when a parser read it
+    warnings: list[str] = field(default_factory=list)  # that parser's documented warnings
 
 
 def image_mime(data: bytes) -> str | None:
@@ -118,7 +120,9 @@ def read_input(
         parser, final = _parser_for(text, path, fmt)
         if parser is not None:
             try:
-                return InputOutcome(loads(text, parser.name, path=path), False)
+                warnings: list[str] = []
+                model = loads(text, parser.name, path=path, warnings=warnings)
+                return InputOutcome(model, False, format=parser.name, warnings=warnings)
             except InputError as exc:
                 if final:
                     raise
