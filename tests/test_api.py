@@ -145,5 +145,5 @@ def test_llm_engine_input_read_by_a_parser_keeps_its_format_and_warnings() -> No
     # hybrid asks the LLM only when no parser reads the file: here the paper's XML reader does
     options: dict[str, object] = {}
     loaded = api.load_for_engine(PAPER_FSM, "hybrid", options=options)
-    assert loaded.format == "paper-xml" and not loaded.extracted
+    assert loaded.format == "paper-xml" and not loaded.extracted_by_llm
     assert loaded.warnings == api.load(PAPER_FSM).warnings
