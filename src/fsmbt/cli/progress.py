@@ -1,19 +1,19 @@
 """Progress on stderr for work that can take more than a second (``--quiet`` turns it off).
 
-Why a spinner with the step's name and elapsed time, not a bar: a conversion or a proof does not
-know its own length in advance (the checker explores a state space of unknown size), so a bar
-would lie; the name of the running step and the seconds spent tell the user what is going on.
+Why a spinner with the running step's name, not a bar: a conversion or a proof does not know
+its own length in advance (the checker explores a state space of unknown size), so a bar would
+lie; the name of the step that is running tells the user what is going on.
 
 The display is shown only when stderr is a terminal (never in pipes, logs or CI) and not
 ``--quiet``; it is drawn by rich's ``Status`` on stderr, so stdout stays clean for a model or
-JSON. ``StageProgress`` is handed to the library as its ``on_stage`` hook and records when each
-step started, so the command can print each step's time at the end.
+JSON. ``StageProgress`` is handed to the library as its ``on_stage`` hook; each step's time
+comes back in the ``Outcome``'s timings, which the command prints at the end
+(``format_timings``).
 """
 
 from __future__ import annotations
 
 import sys
-import time
 from types import TracebackType
 
 from rich.console import Console
@@ -48,7 +48,6 @@ class StageProgress:
         if self._console is not None:
             self._status = self._console.status("starting …", spinner="dots")
             self._status.start()
-        self._started = time.perf_counter()
         return self
 
     def __exit__(
