@@ -52,6 +52,7 @@ from fsmbt.model.validate import Issue
 from fsmbt.semantics.blockers import Blocker
 from fsmbt.semantics.blockers import conversion_blockers as blockers_of
 from fsmbt.verify import Report, verify
+from fsmbt.verify.native import StateLimitError
 from fsmbt.verify.orient import orient, rules_text
 from fsmbt.verify.wording import readable
 
@@ -440,10 +441,10 @@ def verify_either_order(
         report = verify_models(
             oriented.source, oriented.result, engine, loop=loop, max_states=max_states
         )
-    except UnsupportedError:
-        raise
+    except (UnsupportedError, StateLimitError):
+        raise  # a construct, or a size or time limit: not a pairing problem
     except InputError as exc:
-        if Hint.MAX_STATES in exc.hints:  # a size limit, not a pairing problem
+        if Hint.MAX_STATES in exc.hints:  # the explorers' own state limits
             raise
         raise InputError(
             f"{exc.message} (pairing rule tried: {oriented.rule}; the rules are: {rules_text()})",

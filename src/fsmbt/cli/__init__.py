@@ -21,7 +21,8 @@ EXIT_OK = 0
 EXIT_NOT_EQUIVALENT = 1
 EXIT_BAD_INPUT = 2
 EXIT_INTERNAL = 3
-#: A resource cap of a verification engine was reached (NuSMV's memory or time, docs/cli.md).
+#: A resource cap of a verification engine was reached (NuSMV's memory or time, the native
+#: checker's time; docs/cli.md).
 EXIT_LIMIT = 4
 
 app = typer.Typer(
@@ -71,9 +72,10 @@ def _silence_stdout() -> None:
 
 def _is_engine_limit(exc: FsmbtError) -> bool:
     """Whether ``exc`` is a verification engine's resource cap (exit ``EXIT_LIMIT``)."""
+    from fsmbt.verify.native import CheckerTimeLimitError
     from fsmbt.verify.nusmv.runner import NuSMVLimitError
 
-    return isinstance(exc, NuSMVLimitError)
+    return isinstance(exc, NuSMVLimitError | CheckerTimeLimitError)
 
 
 def main(argv: list[str] | None = None) -> int:

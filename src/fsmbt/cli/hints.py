@@ -25,6 +25,7 @@ CLI_WORDING: Mapping[Hint, str] = {
     Hint.LLM_BASE_URL: "set --llm-base-url",
     Hint.LLM_MODEL: "set --llm-model",
     Hint.NUSMV_LIMITS: "raise the cap with --timeout SECONDS or --nusmv-memory MIB",
+    Hint.CHECKER_TIME: "raise the limit with --timeout SECONDS",
 }
 
 

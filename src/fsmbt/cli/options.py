@@ -80,14 +80,13 @@ def max_states_option() -> int | None:
 
 
 def timeout_option() -> float | None:
-    """``--timeout SECONDS``: the wall-time cap of each NuSMV run (``fsmbt.limits``
-    ``nusmv_max_seconds``; the native checker is bounded by its state limit)."""
+    """``--timeout SECONDS``: the wall-time cap of the native checker and of each NuSMV run
+    (``fsmbt.limits``: ``checker_max_seconds`` and ``nusmv_max_seconds``)."""
     return typer.Option(
         None,
         "--timeout",
         min=0.001,
-        help="seconds NuSMV may run "  # type: ignore[no-any-return]
-        "(--engine nusmv|both); past it: exit 4",
+        help="seconds the checker, and each NuSMV run, may take; past it: exit 4",  # type: ignore[no-any-return]
     )
 
 
@@ -109,6 +108,7 @@ def apply_engine_caps(timeout: float | None, nusmv_memory: int | None) -> None:
     changes: dict[str, int | float] = {}
     if timeout is not None:
         changes["nusmv_max_seconds"] = timeout
+        changes["checker_max_seconds"] = timeout
     if nusmv_memory is not None:
         changes["nusmv_max_memory_mb"] = nusmv_memory
     if changes:

@@ -33,6 +33,7 @@ class Hint(str, Enum):
     LLM_BASE_URL = "llm_base_url"  # give the LLM endpoint
     LLM_MODEL = "llm_model"  # give the LLM model name
     NUSMV_LIMITS = "nusmv_limits"  # raise NuSMV's time or memory cap
+    CHECKER_TIME = "checker_time"  # raise the native checker's time limit
 
 
 #: Each hint in the library's own words (``str(error)``).
@@ -50,6 +51,7 @@ HINT_TEXT: Mapping[Hint, str] = {
     Hint.LLM_BASE_URL: "pass base_url=...",
     Hint.LLM_MODEL: "pass model=...",
     Hint.NUSMV_LIMITS: "raise the cap with fsmbt.limits.use(limits.current().with_changes(...))",
+    Hint.CHECKER_TIME: "raise checker_max_seconds (fsmbt.limits, FSMBT_MAX_CHECKER_SECONDS)",
 }
 
 _LINE_BREAKS = re.compile(r"\s*[\r\n\v\f\x1c-\x1e\x85\u2028\u2029]+\s*")
