@@ -38,6 +38,7 @@ from dataclasses import dataclass, field
 
 from lxml import etree
 
+from fsmbt.formats import scxml_include
 from fsmbt.formats.registry import Format, ReadContext, register
 from fsmbt.formats.scxml_w3c import read_scxml_w3c
 from fsmbt.formats.xml_safe import local_name, namespace, parse_xml, root_tag
@@ -114,7 +115,7 @@ class _Reader:
 
     # structure ----------------------------------------------------------------------------------
     def read(self, text: str) -> FSM:
-        root = parse_xml(text, self.ctx.display_name)
+        root, _included = scxml_include.parse_document(text, self.ctx)
         self.ns = namespace(root)
         if self.ns == LEGACY_NS:
             raise UnsupportedError(
@@ -650,6 +651,13 @@ def read_scxml(text: str, ctx: ReadContext) -> FSM:
     """The hierarchical model of the document; a document the structural reader refuses for a
     feature with a finite reading is read by running the W3C algorithm instead (a flat model,
     ``fsmbt.formats.scxml_w3c``; docs/formats/scxml.md)."""
+    try:
+        return _read_either(text, ctx)
+    except InputError as exc:  # UnsupportedError too: name the file included content came from
+        raise scxml_include.annotate(exc, text, ctx) from None
+
+
+def _read_either(text: str, ctx: ReadContext) -> FSM:
     kept = len(ctx.warnings)
     try:
         return _Reader(ctx).read(text)
