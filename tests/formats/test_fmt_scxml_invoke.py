@@ -117,8 +117,9 @@ def test_child_events_reach_the_parent_queue_before_the_environment_speaks() -> 
 
 
 def test_state_exited_in_the_macro_step_that_entered_it_invokes_nothing() -> None:
-    started = child('<state id="a"><onentry><send event="started" target="#_parent"/>'
-                    "</onentry></state>")
+    started = child(
+        '<state id="a"><onentry><send event="started" target="#_parent"/></onentry></state>'
+    )
     model = read(
         doc(
             f'<state id="s">{started}<transition target="t"/></state>'
@@ -135,7 +136,7 @@ def test_events_of_a_cancelled_session_are_ignored() -> None:
     # cancelling the child: 'late' is from a cancelled session and is not processed
     answer = child(
         '<state id="a"><transition event="e" target="b"><send event="late" target="#_parent"/>'
-        "</transition></state><state id=\"b\"/>",
+        '</transition></state><state id="b"/>',
         'id="c" autoforward="true"',
     )
     model = read(
@@ -168,8 +169,10 @@ def test_unreachable_send_targets_raise_error_communication() -> None:
 
 
 def test_finished_child_is_one_state_and_done_invoke_names_the_id() -> None:
-    quick = child('<state id="a"><transition event="stop" target="f"/></state><final id="f"/>',
-                  'id="job" autoforward="true"')
+    quick = child(
+        '<state id="a"><transition event="stop" target="f"/></state><final id="f"/>',
+        'id="job" autoforward="true"',
+    )
     model = read(
         doc(
             f'<state id="s">{quick}<transition event="done.invoke" target="t"/></state>'
@@ -178,19 +181,24 @@ def test_finished_child_is_one_state_and_done_invoke_names_the_id() -> None:
     )
     # 'done.invoke' matches done.invoke.job (prefix); the child's end moves the parent
     assert walk(model, ["stop"]) == ["s{job=a}", "t"]
-    stays = read(doc(f'<state id="s">{quick}<transition event="go" target="t"/></state>'
-                     '<state id="t"/>'))
-    assert walk(stays, ["stop", "stop", "go"]) == ["s{job=a}", "s{job=(done)}",
-                                                   "s{job=(done)}", "t"]
+    stays = read(
+        doc(f'<state id="s">{quick}<transition event="go" target="t"/></state><state id="t"/>')
+    )
+    assert walk(stays, ["stop", "stop", "go"]) == [
+        "s{job=a}",
+        "s{job=(done)}",
+        "s{job=(done)}",
+        "t",
+    ]
 
 
 def test_finalize_runs_harmless_content_only() -> None:
-    logged = child('<state id="a"><onentry><send event="hi" target="#_parent"/></onentry>'
-                   "</state>", 'id="c"').replace(
-        "</invoke>", '<finalize><log expr="1"/></finalize></invoke>'
+    logged = child(
+        '<state id="a"><onentry><send event="hi" target="#_parent"/></onentry></state>', 'id="c"'
+    ).replace("</invoke>", '<finalize><log expr="1"/></finalize></invoke>')
+    model = read(
+        doc(f'<state id="s">{logged}<transition event="hi" target="t"/></state><state id="t"/>')
     )
-    model = read(doc(f'<state id="s">{logged}<transition event="hi" target="t"/></state>'
-                     '<state id="t"/>'))
     assert model.initial == "t"
     raising = logged.replace('<log expr="1"/>', '<raise event="boom"/>')
     with pytest.raises(UnsupportedError, match="<finalize> that raises or sends"):
@@ -198,9 +206,11 @@ def test_finalize_runs_harmless_content_only() -> None:
 
 
 def test_nested_sessions_and_the_state_bound() -> None:
-    inner = child('<state id="x"><transition event="flip" target="y"/></state>'
-                  '<state id="y"><transition event="flip" target="x"/></state>',
-                  'id="g" autoforward="true"')
+    inner = child(
+        '<state id="x"><transition event="flip" target="y"/></state>'
+        '<state id="y"><transition event="flip" target="x"/></state>',
+        'id="g" autoforward="true"',
+    )
     outer = child(f'<state id="m">{inner}</state>', 'id="k" autoforward="true"')
     model = read(doc(f'<state id="s">{outer}</state>'))
     assert walk(model, ["flip", "flip"]) == ["s{k=m{g=x}}", "s{k=m{g=y}}", "s{k=m{g=x}}"]
@@ -226,12 +236,17 @@ def test_nested_sessions_and_the_state_bound() -> None:
         ('<invoke src="http://example.org/child.scxml"/>', "(external services) at"),
         ('<invoke typeexpr="t" src="x"/>', "typeexpr"),
         ('<invoke srcexpr="s"/>', "srcexpr"),
-        ('<invoke idlocation="loc"><content><scxml version="1.0"><state id="a"/></scxml>'
-         "</content></invoke>", "idlocation"),
+        (
+            '<invoke idlocation="loc"><content><scxml version="1.0"><state id="a"/></scxml>'
+            "</content></invoke>",
+            "idlocation",
+        ),
         ('<invoke><content expr="doc"/></invoke>', "<content expr"),
-        ('<invoke><content><scxml version="1.0"><state id="a"><transition event="e" '
-         'cond="x &gt; 1" target="a"/></state></scxml></content></invoke>',
-         "cond guard in an invoked document"),
+        (
+            '<invoke><content><scxml version="1.0"><state id="a"><transition event="e" '
+            'cond="x &gt; 1" target="a"/></state></scxml></content></invoke>',
+            "cond guard in an invoked document",
+        ),
     ],
 )
 def test_what_has_no_finite_reading_is_refused_with_its_line(invoke: str, message: str) -> None:
@@ -243,16 +258,28 @@ def test_what_has_no_finite_reading_is_refused_with_its_line(invoke: str, messag
 @pytest.mark.parametrize(
     "body, message",
     [
-        ('<state id="s"><invoke src="a.scxml"><content><scxml version="1.0"><state id="a"/>'
-         "</scxml></content></invoke></state>", "exactly one of src and <content>"),
+        (
+            '<state id="s"><invoke src="a.scxml"><content><scxml version="1.0"><state id="a"/>'
+            "</scxml></content></invoke></state>",
+            "exactly one of src and <content>",
+        ),
         ('<state id="s"><invoke><content>text</content></invoke></state>', "one <scxml>"),
-        ('<state id="s"><invoke autoforward="yes"><content><scxml version="1.0"><state '
-         'id="a"/></scxml></content></invoke></state>', "autoforward"),
-        ('<state id="s"><invoke id="c"><content><scxml version="1.0"><state id="a"/></scxml>'
-         '</content></invoke><invoke id="c"><content><scxml version="1.0"><state id="a"/>'
-         "</scxml></content></invoke></state>", "duplicate <invoke> id"),
-        ('<final id="f"><invoke><content><scxml version="1.0"><state id="a"/></scxml>'
-         "</content></invoke></final>", "<invoke> in <final>"),
+        (
+            '<state id="s"><invoke autoforward="yes"><content><scxml version="1.0"><state '
+            'id="a"/></scxml></content></invoke></state>',
+            "autoforward",
+        ),
+        (
+            '<state id="s"><invoke id="c"><content><scxml version="1.0"><state id="a"/></scxml>'
+            '</content></invoke><invoke id="c"><content><scxml version="1.0"><state id="a"/>'
+            "</scxml></content></invoke></state>",
+            "duplicate <invoke> id",
+        ),
+        (
+            '<final id="f"><invoke><content><scxml version="1.0"><state id="a"/></scxml>'
+            "</content></invoke></final>",
+            "<invoke> in <final>",
+        ),
         ('<state id="s"><invoke src="child.scxml"/></state>', "including file's path"),
     ],
 )
@@ -325,9 +352,7 @@ def test_error_in_an_invoked_file_names_that_file(tmp_path: Path) -> None:
     with pytest.raises(UnsupportedError) as info:
         api.load(main)
     assert info.value.location is not None
-    assert info.value.location.file is not None and info.value.location.file.endswith(
-        "child.scxml"
-    )
+    assert info.value.location.file is not None and info.value.location.file.endswith("child.scxml")
 
 
 def test_corpus_qt_invoke_example_converts_and_verifies(tmp_path: Path) -> None:

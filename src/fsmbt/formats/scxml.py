@@ -41,7 +41,7 @@ from lxml import etree
 from fsmbt.formats import scxml_include
 from fsmbt.formats.registry import Format, ReadContext, register
 from fsmbt.formats.scxml_w3c import read_scxml_w3c
-from fsmbt.formats.xml_safe import local_name, namespace, parse_xml, root_tag
+from fsmbt.formats.xml_safe import local_name, namespace, root_tag
 from fsmbt.model import Model
 from fsmbt.model.errors import InputError, SourceLocation, UnsupportedError
 from fsmbt.model.fsm import FSM, State, Transition

@@ -116,8 +116,7 @@ def resolve_confined(
         raise InputError(f"{what} without a file name", location=where, element=element)
     if base is None:
         raise InputError(
-            f"{what} '{href}' needs the including file's path to resolve (read the file, "
-            "not text)",
+            f"{what} '{href}' needs the including file's path to resolve (read the file, not text)",
             location=where,
             element=element,
         )
@@ -166,7 +165,9 @@ def check_chain(chain: tuple[Path, ...], resolved: Path, what: str, where: Sourc
     depth = limits.current().max_include_depth
     if len(chain) >= depth:
         raise InputError(
-            limits.exceeded(f"a chain of {len(chain) + 1} {what} files", "max_include_depth", depth),
+            limits.exceeded(
+                f"a chain of {len(chain) + 1} {what} files", "max_include_depth", depth
+            ),
             location=where,
         )
 
@@ -217,11 +218,12 @@ def parse_document(text: str, ctx: ReadContext) -> tuple[etree._Element, Include
         pending = []
         for new in replacement:
             pending.extend(_outer_includes(new))
-            if source is not None:  # content of another file: located at the include
+            if source is not None and line is not None:  # another file's content: at the include
                 for node in new.iter():
                     if isinstance(node.tag, str) and node.tag != _INCLUDE:
-                        node.sourceline = line
-        stack.extend((inner, inner_base, inner_chain, line) for inner in reversed(pending))
+                        node.sourceline = line  # type: ignore[misc]  # lxml allows it
+        inner_line = line if source is not None or main_line is not None else None
+        stack.extend((inner, inner_base, inner_chain, inner_line) for inner in reversed(pending))
     stray = next(root.iter(f"{{{XINCLUDE_NS}}}*"), None)
     if stray is not None:
         raise InputError(
@@ -267,7 +269,7 @@ def _expand_one(
     if parse == "text":
         raise UnsupportedError(
             'unsupported: XInclude parse="text" (it includes the file as character data, '
-            "which holds no state; use parse=\"xml\")",
+            'which holds no state; use parse="xml")',
             location=where,
             element=name,
         )
@@ -291,7 +293,8 @@ def _expand_one(
         )
         return [c for c in fallbacks[0] if isinstance(c.tag, str)], None
     fragment = parse_xml(text, str(resolved))
-    target_ns = namespace(element.getparent()) if element.getparent() is not None else None
+    holder = element.getparent()
+    target_ns = namespace(holder) if holder is not None else None
     moved = False
     if target_ns is not None:
         for node in fragment.iter():

@@ -204,9 +204,7 @@ def read_invoke(
         )
     invokeid = element.get("id") or f"{node.id}.{len(node.invokes) + 1}"
     if invokeid in doc.invocations:
-        raise InputError(
-            f"duplicate <invoke> id '{invokeid}'", location=where, element="<invoke>"
-        )
+        raise InputError(f"duplicate <invoke> id '{invokeid}'", location=where, element="<invoke>")
     invocation = Invocation(
         node.index,
         invokeid,
@@ -319,9 +317,7 @@ def session_events(doc: _Doc) -> tuple[set[str], set[str]]:
             for t in node.transitions:
                 actions.extend(t.actions)
                 if reaches:
-                    forwarded.update(
-                        d for d in t.events if d != "*" and not d.startswith("done.")
-                    )
+                    forwarded.update(d for d in t.events if d != "*" and not d.startswith("done."))
             if direct:
                 from_children.update(sent_names(actions, ("parent",)))
         stack.extend((grand, reaches, False) for grand in child.invocations.values())

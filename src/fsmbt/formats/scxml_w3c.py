@@ -39,7 +39,7 @@ from lxml import etree
 from fsmbt import limits
 from fsmbt.formats import scxml_expr, scxml_include, scxml_invoke
 from fsmbt.formats.registry import ReadContext
-from fsmbt.formats.xml_safe import local_name, namespace, parse_xml
+from fsmbt.formats.xml_safe import local_name, namespace
 from fsmbt.model.errors import InputError, UnsupportedError
 from fsmbt.model.fsm import FSM, State
 
