@@ -426,3 +426,29 @@ def test_parent_and_child_agree_with_python_statemachine() -> None:
         machine.send(event)
         seen.append(engine_name())
     assert seen == expected
+
+
+def test_departures_of_python_statemachine_from_the_w3c_invoke_rules() -> None:
+    """Named so a change of the engine shows (docs/formats/scxml.md, "XInclude and <invoke>"):
+    it sends done.invoke when the child has started, and stops autoforwarding then."""
+    loader = pytest.importorskip("statemachine.io.loader")
+    never_ends = doc(
+        '<state id="s">'
+        + child(
+            '<state id="a"><transition event="never" target="f"/></state><final id="f"/>', 'id="c"'
+        )
+        + '<transition event="done.invoke.c" target="t"/></state><state id="t"/>'
+    )
+    assert read(never_ends).initial == "s{c=a}"  # W3C: the child has not ended
+    with contextlib.redirect_stdout(io.StringIO()):
+        machine = loader.load(never_ends, format="scxml")()
+    assert _settled(lambda: machine.configuration) == ["t"]
+    toggle = doc(f'<state id="s">{TOGGLE}</state>')
+    assert walk(read(toggle), ["goThere"])[-1] == "s{s.1=there}"
+    with contextlib.redirect_stdout(io.StringIO()):
+        machine = loader.load(toggle, format="scxml")()
+    _settled(lambda: machine.configuration)
+    machine.send("goThere")
+    _settled(lambda: machine.configuration)
+    (invocation,) = machine._engine._invoke_manager._active.values()
+    assert sorted(s.id for s in invocation._handler._child.configuration) == ["here"]
