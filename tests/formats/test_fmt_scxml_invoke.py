@@ -452,3 +452,14 @@ def test_departures_of_python_statemachine_from_the_w3c_invoke_rules() -> None:
     _settled(lambda: machine.configuration)
     (invocation,) = machine._engine._invoke_manager._active.values()
     assert sorted(s.id for s in invocation._handler._child.configuration) == ["here"]
+
+
+def test_a_document_that_ends_cancels_its_sessions() -> None:
+    model = read(
+        doc(
+            f'<state id="s">{TOGGLE}<transition event="stop" target="end"/></state>'
+            '<final id="end"/>'
+        )
+    )
+    assert walk(model, ["goThere", "stop"]) == ["s{s.1=here}", "s{s.1=there}", "end"]
+    assert model.states["end"].final

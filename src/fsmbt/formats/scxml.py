@@ -21,13 +21,14 @@ event, and events SCXML would read otherwise are refused (docs/formats/scxml.md)
 Refused with ``UnsupportedError`` (element, line, feature): ``cond`` other than that guard,
 ``<history>``, wildcard and prefix-matching event descriptors (``done.state`` ones included), targetless transitions, transitions with several targets,
 ``type="internal"``, behaviour-changing executable content (``<raise>``, ``<send>``,
-``<assign>``, ``<script>``, ``<if>``, ``<foreach>``, ``<cancel>``, ``<invoke>``), XInclude,
+``<assign>``, ``<script>``, ``<if>``, ``<foreach>``, ``<cancel>``, ``<invoke>``),
 eventless transitions of compound states, transitions into a nested state that is not its
 parent's initial state, transitions leaving a ``<parallel>`` region. Warned (``ctx.warn``):
 ``<log>``, ``<datamodel>``/``<data>``, ``<donedata>``, foreign-namespace elements, and a
 transition dropped by document-order conflict resolution.
 
-Everything is iterative over the element tree; complexity O(n + T·d) for n elements,
+XInclude is expanded before reading (``fsmbt.formats.scxml_include``). Everything is iterative
+over the element tree; complexity O(n + T·d) for n elements,
 T transitions and nesting depth d.
 """
 

@@ -391,8 +391,14 @@ def finish(interp: _Interpreter, run: _Run) -> None:
     """W3C ``exitInterpreter`` of an invoked session that reached a top-level final state:
     ``onexit`` in exit order (their ``#_parent`` sends go out), its own sessions cancelled,
     then ``done.invoke`` for the parent. The configuration is dropped (a finished child is one
-    state)."""
-    if run.running or not interp.doc.session.invoked or not run.config:
+    state). A top-level document that ends just cancels its sessions (nothing it does after
+    is observable)."""
+    if run.running:
+        return
+    if not interp.doc.session.invoked:
+        run.sessions.clear()
+        return
+    if not run.config:
         return
     for s in sorted(run.config, key=interp.order.__getitem__, reverse=True):
         interp.perform(interp.s[s].onexit, run)

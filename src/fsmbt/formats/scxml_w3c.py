@@ -6,7 +6,8 @@ that has a finite reading: ``<history>`` (shallow and deep), ``cond`` guards, ``
 ``<send>`` without delay, ignored executable content (``<log>``, ``<assign>`` to a variable no
 guard reads), wildcard and prefix event descriptors, ``done.state`` on atomic states, entry
 into a non-initial nested state, targetless and ``type="internal"`` transitions, several
-targets, eventless transitions of compound states. Rules:
+targets, eventless transitions of compound states, ``<invoke>`` of SCXML sessions (their
+configurations are part of each state: ``fsmbt.formats.scxml_invoke``). Rules:
 
 - The interpreter follows the W3C SCXML 1.0 algorithm (appendix D): transition selection per
   atomic state in document order, innermost first; conflicts resolved by exit sets; exit in
