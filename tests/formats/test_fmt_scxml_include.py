@@ -188,6 +188,17 @@ def test_limits_and_hostile_xml_hold_for_included_files(tmp_path: Path) -> None:
             api.load(big)
     finally:
         limits.use(previous)
+    # repeated inclusion doubles per level: the expanded total is bounded, not only each file
+    for n in range(12):
+        inner = f'<xi:include href="d{n + 1}.scxml"/>' * 2 if n < 11 else ""
+        write(tmp_path, f"d{n}.scxml", f'<state {NS} {XI} id="d{n}">{inner}</state>')
+    double = write(tmp_path, "Main.scxml", MAIN.format(href="d0.scxml").replace("Sub1", "d0", 1))
+    previous = limits.use(limits.current().with_changes(max_input_bytes=100_000))
+    try:
+        with pytest.raises(InputError, match="each inclusion counted"):
+            api.load(double)
+    finally:
+        limits.use(previous)
     write(
         tmp_path,
         "evil.scxml",

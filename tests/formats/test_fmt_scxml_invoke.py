@@ -345,6 +345,19 @@ def test_src_files_are_confined_and_cycles_refused(tmp_path: Path) -> None:
         api.load(missing)
 
 
+def test_repeated_invocation_of_files_is_bounded_in_all(tmp_path: Path) -> None:
+    for n in range(12):  # each level invokes the next twice: 2**11 documents to read
+        body = "".join(f'<state id="s{k}"><invoke src="i{n + 1}.scxml"/></state>' for k in range(2))
+        write = body if n < 11 else '<state id="leaf"/>'
+        (tmp_path / f"i{n}.scxml").write_text(doc(f'<parallel id="p">{write}</parallel>'))
+    previous = limits.use(limits.current().with_changes(max_input_bytes=50_000))
+    try:
+        with pytest.raises(InputError, match="each <invoke> counted"):
+            api.load(tmp_path / "i0.scxml")
+    finally:
+        limits.use(previous)
+
+
 def test_error_in_an_invoked_file_names_that_file(tmp_path: Path) -> None:
     (tmp_path / "child.scxml").write_text(doc('<state id="a">\n<script>x()</script></state>'))
     main = tmp_path / "main.scxml"

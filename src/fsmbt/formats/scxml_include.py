@@ -15,6 +15,8 @@ Rules (docs/security.md, rule 4 - the same confinement as BehaviorTree.CPP inclu
   or a fragment are unsupported as well. A missing or unreadable file is replaced by the
   content of ``<xi:fallback>`` when the include has one (XInclude 1.0, 4.4), else an
   ``InputError``; a refused path never falls back.
+- The document and all its inclusions together (a file included twice counts twice) stay
+  within ``limits.max_input_bytes``: repeated inclusion cannot blow the document up.
 - The fragment's root element takes the place of the ``<xi:include>``. Elements of the
   fragment in no namespace are taken into the including element's namespace (SCXML
   fragments are usually written without ``xmlns``; XInclude would leave them in no namespace,
@@ -48,6 +50,7 @@ class Included:
     """What the expansion did: which line of the main file brought in which file."""
 
     files: dict[int, str] = field(default_factory=dict)  # include line -> included file
+    size: int = 0  # characters of the document and of every inclusion (each one counted)
 
     def describe(self, line: int | None) -> str:
         """`` (content included from 'x.scxml')`` for a line that holds an include, else ``""``."""
@@ -188,7 +191,7 @@ def parse_document(text: str, ctx: ReadContext) -> tuple[etree._Element, Include
         UnsupportedError: ``parse="text"``, ``xpointer``, a URL.
     """
     root = parse_xml(text, ctx.display_name)
-    included = Included()
+    included = Included(size=len(text))
     if next(root.iter(f"{{{XINCLUDE_NS}}}*"), None) is None:
         return root, included
     if namespace(root) == XINCLUDE_NS:
@@ -292,6 +295,19 @@ def _expand_one(
             element=name,
         )
         return [c for c in fallbacks[0] if isinstance(c.tag, str)], None
+    included.size += len(text)
+    budget = limits.current().max_input_bytes
+    if included.size > budget:  # a file included many times (a, twice b, twice c...) grows
+        raise InputError(
+            limits.exceeded(
+                f"the document with its inclusions ({included.size}+ characters, each "
+                "inclusion counted)",
+                "max_input_bytes",
+                budget,
+            ),
+            location=where,
+            element=name,
+        )
     fragment = parse_xml(text, str(resolved))
     holder = element.getparent()
     target_ns = namespace(holder) if holder is not None else None

@@ -32,7 +32,8 @@ other than ``In()`` in an invoked document, data passed (``<param>``, ``namelist
 whose data is read exactly (``data=exact``; otherwise the child's data model is ignored, so is
 the data). Nested invocations chain at most ``limits.max_include_depth`` documents, and a file
 that invokes itself (directly or not) is an error: the nesting is bounded, so the recursion
-over sessions below is too.
+over sessions below is too. The ``src`` files read for one document (each ``<invoke>``
+counted) stay within ``limits.max_input_bytes`` in all.
 
 Costs: a child multiplies the reachable configurations by its own (bounded by
 ``limits.max_states`` for the whole product); delivering one event costs a macro step of
@@ -41,7 +42,7 @@ the receiving session.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -76,6 +77,9 @@ class Session:
     invoked: bool = False
     chain: tuple[Path, ...] = ()
     depth: int = 0
+    #: characters of ``src`` files read so far in this read, shared by all sessions (a file
+    #: invoking another twice, which invokes another twice... must not blow up)
+    read_chars: list[int] = field(default_factory=lambda: [0])
 
 
 @dataclass
@@ -248,17 +252,30 @@ def _child_document(
                 location=ctx.location(content.sourceline),
                 element="<content>",
             )
-        session = Session(True, doc.session.chain, doc.session.depth + 1)
+        session = Session(True, doc.session.chain, doc.session.depth + 1, doc.session.read_chars)
         return make_doc("", ctx, element=documents[0], session=session)
     base = Path(ctx.path) if ctx.path is not None else None
     resolved = scxml_include.resolve_confined(ctx, base, src, "<invoke src>", where, "<invoke>")
     chain = doc.session.chain or ((base.resolve(),) if base is not None else ())
     scxml_include.check_chain(chain, resolved, "<invoke src>", where)
     text = scxml_include.read_confined(resolved, src, "invoked file", where, "<invoke>")
+    doc.session.read_chars[0] += len(text)
+    budget = limits.current().max_input_bytes
+    if doc.session.read_chars[0] > budget:
+        raise InputError(
+            limits.exceeded(
+                f"the invoked files ({doc.session.read_chars[0]}+ characters, each <invoke> "
+                "counted)",
+                "max_input_bytes",
+                budget,
+            ),
+            location=where,
+            element="<invoke>",
+        )
     options = dict(ctx.options)
     options["include_root"] = str(scxml_include.confinement_root(ctx))
     child_ctx = ReadContext(resolved, options, ctx.warnings)
-    session = Session(True, (*chain, resolved), doc.session.depth + 1)
+    session = Session(True, (*chain, resolved), doc.session.depth + 1, doc.session.read_chars)
     return make_doc(text, child_ctx, session=session)
 
 
