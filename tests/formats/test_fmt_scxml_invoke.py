@@ -476,3 +476,26 @@ def test_a_document_that_ends_cancels_its_sessions() -> None:
     )
     assert walk(model, ["goThere", "stop"]) == ["s{s.1=here}", "s{s.1=there}", "end"]
     assert model.states["end"].final
+
+
+def test_deep_nesting_is_bounded_without_recursion_errors() -> None:
+    from fsmbt.formats.scxml_invoke import MAX_SESSION_DEPTH
+
+    def nested(levels: int) -> str:
+        body = (
+            '<state id="x"><transition event="flip" target="y"/></state>'
+            '<state id="y"><transition event="flip" target="x"/></state>'
+        )
+        for i in range(levels):
+            invoke = child(body, f'id="k{i}" autoforward="true"')
+            body = f'<state id="m{i}">{invoke}</state>'
+        return doc(body)
+
+    previous = limits.use(limits.current().with_changes(max_include_depth=10_000))
+    try:
+        deepest = read(nested(MAX_SESSION_DEPTH))
+        assert len(deepest.states) == 2  # 'flip' is forwarded down every level
+        with pytest.raises(InputError, match=f"bound of {MAX_SESSION_DEPTH} nested sessions"):
+            read(nested(MAX_SESSION_DEPTH + 1))
+    finally:
+        limits.use(previous)

@@ -30,7 +30,8 @@ its own stability, before the sender goes on; the environment waits for every se
 idle. Refused: ``typeexpr``, ``srcexpr``, ``idlocation``, ``<content expr>``, ``cond`` guards
 other than ``In()`` in an invoked document, data passed (``<param>``, ``namelist``) to a child
 whose data is read exactly (``data=exact``; otherwise the child's data model is ignored, so is
-the data). Nested invocations chain at most ``limits.max_include_depth`` documents, and a file
+the data). Nested invocations chain at most ``limits.max_include_depth`` documents (and never more than
+``MAX_SESSION_DEPTH``), and a file
 that invokes itself (directly or not) is an error: the nesting is bounded, so the recursion
 over sessions below is too. The ``src`` files read for one document (each ``<invoke>``
 counted) stay within ``limits.max_input_bytes`` in all.
@@ -67,6 +68,9 @@ SCXML_TYPES = frozenset(
 )
 #: What a child puts in its outbox when it ends (the parent turns it into done.invoke.<id>).
 DONE = "\x00done"
+#: Sessions nest at most this deep whatever ``max_include_depth`` says: running them recurses
+#: once per level (a few frames each), far below Python's recursion limit.
+MAX_SESSION_DEPTH = 48
 _TAG = "\x00"  # parent-queue entries from a child: "\x00<invokeid>\x00<serial>\x00<event>"
 
 
@@ -153,11 +157,14 @@ def read_invoke(
             element="<invoke>",
         )
     depth = limits.current().max_include_depth
-    if doc.session.depth + 1 > depth:
+    if doc.session.depth + 1 > min(depth, MAX_SESSION_DEPTH):
         raise InputError(
             limits.exceeded(
                 f"{doc.session.depth + 1} nested <invoke> documents", "max_include_depth", depth
-            ),
+            )
+            if depth <= MAX_SESSION_DEPTH
+            else f"{doc.session.depth + 1} nested <invoke> documents exceed fsmbt's bound of "
+            f"{MAX_SESSION_DEPTH} nested sessions",
             location=where,
             element="<invoke>",
         )
