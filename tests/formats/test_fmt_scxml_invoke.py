@@ -22,6 +22,7 @@ from fsmbt import api, limits
 from fsmbt.formats import loads
 from fsmbt.model.errors import InputError, UnsupportedError
 from fsmbt.model.fsm import FSM
+from fsmbt.verify.nusmv.binary import find_nusmv
 
 NS = 'xmlns="http://www.w3.org/2005/07/scxml"'
 
@@ -114,6 +115,11 @@ def test_child_events_reach_the_parent_queue_before_the_environment_speaks() -> 
     # poke again: the child ends; its final state's onexit (exitInterpreter) sends bye before
     # done.invoke.c: s3 --bye--> s4 --done.invoke.c--> t
     assert walk(model, ["poke", "poke"]) == ["s/s2{c=idle}", "s/s3{c=busy}", "t"]
+    # FSM -> BT of the session system is proved equivalent (native checker and NuSMV)
+    result = api.convert_model(model)
+    assert api.verify_models(model, result.model, "native").equivalent
+    if find_nusmv() is not None:
+        assert api.verify_models(model, result.model, "nusmv").equivalent
 
 
 def test_state_exited_in_the_macro_step_that_entered_it_invokes_nothing() -> None:
