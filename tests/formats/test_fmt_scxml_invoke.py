@@ -13,6 +13,7 @@ from __future__ import annotations
 import contextlib
 import io
 import os
+import re
 import time
 from pathlib import Path
 
@@ -256,7 +257,7 @@ def test_nested_sessions_and_the_state_bound() -> None:
     ],
 )
 def test_what_has_no_finite_reading_is_refused_with_its_line(invoke: str, message: str) -> None:
-    with pytest.raises(UnsupportedError, match=__import__("re").escape(message)) as info:
+    with pytest.raises(UnsupportedError, match=re.escape(message)) as info:
         read(doc(f'<state id="s">\n{invoke}\n</state>'))
     assert info.value.location is not None and info.value.location.line == 3
 
@@ -290,7 +291,7 @@ def test_what_has_no_finite_reading_is_refused_with_its_line(invoke: str, messag
     ],
 )
 def test_malformed_invokes_are_input_errors(body: str, message: str) -> None:
-    with pytest.raises(InputError, match=__import__("re").escape(message)):
+    with pytest.raises(InputError, match=re.escape(message)):
         read(doc(body))
 
 
