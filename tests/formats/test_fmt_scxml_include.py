@@ -237,3 +237,29 @@ def test_unsupported_forms_and_errors_in_included_content(tmp_path: Path) -> Non
         loads(text, "scxml")
     with pytest.raises(InputError, match="outside an <xi:include>"):
         loads(f'<scxml {NS} {XI} version="1.0"><state id="a"/><xi:fallback/></scxml>', "scxml")
+
+
+def test_invoke_src_in_included_content_resolves_against_the_fragment(tmp_path: Path) -> None:
+    kid = f'<scxml {NS} version="1.0"><state id="k0"><transition event="go" target="k1"/>'
+    write(tmp_path, "parts/kid.scxml", kid + '</state><state id="k1"/></scxml>')
+    write(
+        tmp_path,
+        "parts/frag.scxml",
+        f'<state {NS} id="Sub1"><invoke id="kid" src="kid.scxml" autoforward="true"/>'
+        '<transition event="Event2" target="Sub2"/></state>',
+    )
+    main = write(tmp_path, "Main.scxml", MAIN.format(href="parts/frag.scxml"))
+    assert configurations(model_of(main), ["go", "Event2"]) == [
+        "Test2/Sub1{kid=k0}",
+        "Test2/Sub1{kid=k1}",
+        "Test3",
+    ]
+    # an error in the invoked file is located there, not at the include
+    write(
+        tmp_path, "parts/kid.scxml", kid.replace("<state", "\n<state") + "<script/></state></scxml>"
+    )
+    with pytest.raises(UnsupportedError, match="<script>") as info:
+        api.load(main)
+    assert info.value.location is not None
+    assert str(info.value.location.file).endswith("kid.scxml")
+    assert "included from" not in str(info.value)

@@ -21,6 +21,9 @@ Rules (docs/security.md, rule 4 - the same confinement as BehaviorTree.CPP inclu
   fragment in no namespace are taken into the including element's namespace (SCXML
   fragments are usually written without ``xmlns``; XInclude would leave them in no namespace,
   where an SCXML reader ignores them) - warned once per included file.
+- References inside an included fragment (``<invoke src>``) resolve against the fragment's
+  file (XInclude's base-URI fix-up, kept in ``Included.bases`` rather than as ``xml:base``
+  attributes, which the readers would keep as state attributes).
 - Elements that came from an included file carry the line of the ``<xi:include>`` that
   brought them in (error messages name the including file; a warning names the included
   file, and ``describe`` says which file a line's content came from).
@@ -51,6 +54,18 @@ class Included:
 
     files: dict[int, str] = field(default_factory=dict)  # include line -> included file
     size: int = 0  # characters of the document and of every inclusion (each one counted)
+    #: the root element of each included fragment -> its file (XInclude's base URI fix-up:
+    #: references inside, e.g. ``<invoke src>``, resolve against that file)
+    bases: dict[etree._Element, Path] = field(default_factory=dict)
+
+    def base_of(self, element: etree._Element) -> Path | None:
+        """The file ``element`` came from, when it came from an included file."""
+        node: etree._Element | None = element
+        while node is not None:
+            if node in self.bases:
+                return self.bases[node]
+            node = node.getparent()
+        return None
 
     def describe(self, line: int | None) -> str:
         """`` (content included from 'x.scxml')`` for a line that holds an include, else ``""``."""
@@ -217,6 +232,8 @@ def parse_document(text: str, ctx: ReadContext) -> tuple[etree._Element, Include
         for offset, new in enumerate(replacement):
             parent.insert(position + offset, new)
         inner_base = source or base
+        if source is not None:
+            included.bases.update((new, source) for new in replacement)
         inner_chain = (*chain, source) if source else chain
         pending = []
         for new in replacement:
@@ -342,9 +359,12 @@ def annotate(error: InputError, text: str, ctx: ReadContext) -> InputError:
     Returns:
         ``error`` (its message extended in place when it applies).
     """
-    line = error.location.line if error.location is not None else None
-    if line is None or XINCLUDE_NS not in text:
+    location = error.location
+    if location is None or location.line is None or XINCLUDE_NS not in text:
         return error
+    line = location.line
+    if location.file != ctx.display_name:
+        return error  # (an error in an invoked file is located in that file)
     try:
         _root, included = parse_document(text, ReadContext(ctx.path, dict(ctx.options)))
     except InputError:

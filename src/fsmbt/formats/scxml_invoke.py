@@ -84,6 +84,8 @@ class Session:
     #: characters of ``src`` files read so far in this read, shared by all sessions (a file
     #: invoking another twice, which invokes another twice... must not blow up)
     read_chars: list[int] = field(default_factory=lambda: [0])
+    #: what XInclude brought into the document an inline child is part of (its base files)
+    included: scxml_include.Included | None = None
 
 
 @dataclass
@@ -259,11 +261,14 @@ def _child_document(
                 location=ctx.location(content.sourceline),
                 element="<content>",
             )
-        session = Session(True, doc.session.chain, doc.session.depth + 1, doc.session.read_chars)
+        session = Session(
+            True, doc.session.chain, doc.session.depth + 1, doc.session.read_chars, doc.included
+        )
         return make_doc("", ctx, element=documents[0], session=session)
-    base = Path(ctx.path) if ctx.path is not None else None
+    # relative to the file the <invoke> is written in: an included fragment's, else the document's
+    base = doc.included.base_of(element) or (Path(ctx.path) if ctx.path is not None else None)
     resolved = scxml_include.resolve_confined(ctx, base, src, "<invoke src>", where, "<invoke>")
-    chain = doc.session.chain or ((base.resolve(),) if base is not None else ())
+    chain = doc.session.chain or ((Path(ctx.path).resolve(),) if ctx.path is not None else ())
     scxml_include.check_chain(chain, resolved, "<invoke src>", where)
     text = scxml_include.read_confined(resolved, src, "invoked file", where, "<invoke>")
     doc.session.read_chars[0] += len(text)

@@ -153,7 +153,10 @@ class _Doc:
         self.invocations: dict[str, scxml_invoke.Invocation] = {}
         self.session_targets: list[tuple[str, int | None]] = []
         self.abstract_time = "time" in abstractions(ctx.options.get("abstract"))
-        root = scxml_include.parse_document(text, ctx)[0] if element is None else element
+        if element is None:
+            root, self.included = scxml_include.parse_document(text, ctx)
+        else:  # an inline invoked document: part of its parent's (included) tree
+            root, self.included = element, self.session.included or scxml_include.Included()
         self.ns = namespace(root)
         self.root_name = root.get("name", "fsm")
         self.root_attrs = {
