@@ -250,8 +250,10 @@ def replay(
 
 
 def configuration_of(state: str) -> str:
-    """fsmbt's flat name without the history values (``a/a1#h=x`` -> ``a/a1``)."""
-    return state.split("#", 1)[0]
+    """fsmbt's flat name without the history values (``a/a1#h=x`` -> ``a/a1``) and the
+    configurations of invoked sessions (``s{s.1=here}`` -> ``s``; the engine's configuration
+    is the parent's only)."""
+    return state.split("#", 1)[0].split("{", 1)[0]
 
 
 def event_of(symbol: str) -> str:

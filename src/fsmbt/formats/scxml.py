@@ -21,13 +21,14 @@ event, and events SCXML would read otherwise are refused (docs/formats/scxml.md)
 Refused with ``UnsupportedError`` (element, line, feature): ``cond`` other than that guard,
 ``<history>``, wildcard and prefix-matching event descriptors (``done.state`` ones included), targetless transitions, transitions with several targets,
 ``type="internal"``, behaviour-changing executable content (``<raise>``, ``<send>``,
-``<assign>``, ``<script>``, ``<if>``, ``<foreach>``, ``<cancel>``, ``<invoke>``), XInclude,
+``<assign>``, ``<script>``, ``<if>``, ``<foreach>``, ``<cancel>``, ``<invoke>``),
 eventless transitions of compound states, transitions into a nested state that is not its
 parent's initial state, transitions leaving a ``<parallel>`` region. Warned (``ctx.warn``):
 ``<log>``, ``<datamodel>``/``<data>``, ``<donedata>``, foreign-namespace elements, and a
 transition dropped by document-order conflict resolution.
 
-Everything is iterative over the element tree; complexity O(n + T·d) for n elements,
+XInclude is expanded before reading (``fsmbt.formats.scxml_include``). Everything is iterative
+over the element tree; complexity O(n + T·d) for n elements,
 T transitions and nesting depth d.
 """
 
@@ -38,9 +39,10 @@ from dataclasses import dataclass, field
 
 from lxml import etree
 
+from fsmbt.formats import scxml_include
 from fsmbt.formats.registry import Format, ReadContext, register
 from fsmbt.formats.scxml_w3c import read_scxml_w3c
-from fsmbt.formats.xml_safe import local_name, namespace, parse_xml, root_tag
+from fsmbt.formats.xml_safe import local_name, namespace, root_tag
 from fsmbt.model import Model
 from fsmbt.model.errors import InputError, SourceLocation, UnsupportedError
 from fsmbt.model.fsm import FSM, State, Transition
@@ -114,7 +116,7 @@ class _Reader:
 
     # structure ----------------------------------------------------------------------------------
     def read(self, text: str) -> FSM:
-        root = parse_xml(text, self.ctx.display_name)
+        root, _included = scxml_include.parse_document(text, self.ctx)
         self.ns = namespace(root)
         if self.ns == LEGACY_NS:
             raise UnsupportedError(
@@ -650,6 +652,13 @@ def read_scxml(text: str, ctx: ReadContext) -> FSM:
     """The hierarchical model of the document; a document the structural reader refuses for a
     feature with a finite reading is read by running the W3C algorithm instead (a flat model,
     ``fsmbt.formats.scxml_w3c``; docs/formats/scxml.md)."""
+    try:
+        return _read_either(text, ctx)
+    except InputError as exc:  # UnsupportedError too: name the file included content came from
+        raise scxml_include.annotate(exc, text, ctx) from None
+
+
+def _read_either(text: str, ctx: ReadContext) -> FSM:
     kept = len(ctx.warnings)
     try:
         return _Reader(ctx).read(text)

@@ -6,7 +6,8 @@ that has a finite reading: ``<history>`` (shallow and deep), ``cond`` guards, ``
 ``<send>`` without delay, ignored executable content (``<log>``, ``<assign>`` to a variable no
 guard reads), wildcard and prefix event descriptors, ``done.state`` on atomic states, entry
 into a non-initial nested state, targetless and ``type="internal"`` transitions, several
-targets, eventless transitions of compound states. Rules:
+targets, eventless transitions of compound states, ``<invoke>`` of SCXML sessions (their
+configurations are part of each state: ``fsmbt.formats.scxml_invoke``). Rules:
 
 - The interpreter follows the W3C SCXML 1.0 algorithm (appendix D): transition selection per
   atomic state in document order, innermost first; conflicts resolved by exit sets; exit in
@@ -37,9 +38,9 @@ from itertools import product
 from lxml import etree
 
 from fsmbt import limits
-from fsmbt.formats import scxml_expr
+from fsmbt.formats import scxml_expr, scxml_include, scxml_invoke
 from fsmbt.formats.registry import ReadContext
-from fsmbt.formats.xml_safe import local_name, namespace, parse_xml
+from fsmbt.formats.xml_safe import local_name, namespace
 from fsmbt.model.errors import InputError, UnsupportedError
 from fsmbt.model.fsm import FSM, State
 
@@ -113,6 +114,7 @@ class _S:
     transitions: list[_T] = field(default_factory=list)
     onentry: list[Action] = field(default_factory=list)
     onexit: list[Action] = field(default_factory=list)
+    invokes: list[scxml_invoke.Invocation] = field(default_factory=list)
 
 
 def abstractions(value: object) -> set[str]:
@@ -138,10 +140,23 @@ def _matches(descriptor: str, event: str) -> bool:
 class _Doc:
     """The document's states and transitions (read with an explicit stack)."""
 
-    def __init__(self, text: str, ctx: ReadContext) -> None:
+    def __init__(
+        self,
+        text: str,
+        ctx: ReadContext,
+        element: etree._Element | None = None,
+        session: scxml_invoke.Session | None = None,
+    ) -> None:
+        """Read ``text`` (or, for an invoked document, its ``<scxml>`` ``element``)."""
         self.ctx = ctx
+        self.session = session or scxml_invoke.Session()
+        self.invocations: dict[str, scxml_invoke.Invocation] = {}
+        self.session_targets: list[tuple[str, int | None]] = []
         self.abstract_time = "time" in abstractions(ctx.options.get("abstract"))
-        root = parse_xml(text, ctx.display_name)
+        if element is None:
+            root, self.included = scxml_include.parse_document(text, ctx)
+        else:  # an inline invoked document: part of its parent's (included) tree
+            root, self.included = element, self.session.included or scxml_include.Included()
         self.ns = namespace(root)
         self.root_name = root.get("name", "fsm")
         self.root_attrs = {
@@ -248,6 +263,7 @@ class _Doc:
                     node.initial = first[:1]
         if not self.states[0].initial:
             raise InputError("the document has no state", location=ctx.location(root.sourceline))
+        scxml_invoke.check_targets(self)
         self.decide_data_mode()
 
     def tag(self, element: etree._Element) -> str | None:
@@ -297,7 +313,7 @@ class _Doc:
         elif tag == "donedata":
             self.ctx.warn("<donedata> ignored", line=element.sourceline, element="<donedata>")
         elif tag == "invoke":
-            raise self.refuse(element, "unsupported: <invoke> (external services)")
+            scxml_invoke.read_invoke(self, element, node, _Doc, _Interpreter)
         elif tag == "script":
             raise self.refuse(element, "unsupported: <script>")
         else:
@@ -429,6 +445,9 @@ class _Doc:
             return ("external", name)
         if target == "#_internal":
             return ("internal", name)
+        routed = scxml_invoke.send_target(self, target, name, item.sourceline)
+        if routed is not None:
+            return routed
         raise self.refuse(item, f"unsupported: <send> to target '{target}' (another session)")
 
     def ids(self, text: str, element: etree._Element) -> list[int]:
@@ -579,6 +598,11 @@ class _Run:
     valuation: dict[int, bool] = field(default_factory=dict)  # the environment's guard values
     data: dict[str, scxml_expr.Value] = field(default_factory=dict)  # exact data mode
     read: set[int] = field(default_factory=set)  # guards read so far
+    # invoked sessions (fsmbt.formats.scxml_invoke)
+    sessions: dict[str, scxml_invoke.Child] = field(default_factory=dict)
+    to_invoke: list[int] = field(default_factory=list)  # states entered in this macro step
+    outbox: list[str] = field(default_factory=list)  # events for the parent session
+    serial: int = 0
 
 
 class _Interpreter:
@@ -745,6 +769,9 @@ class _Interpreter:
                         break
                 continue
             kind, name = action
+            if kind == "parent" or kind.startswith("session:"):
+                scxml_invoke.route(run, self.doc.session.invoked, kind, name)
+                continue
             if kind == "assign":
                 if self.doc.data_mode:
                     self.assign(int(name), run)
@@ -792,6 +819,7 @@ class _Interpreter:
                 run.history[h] = frozenset(value)
         for s in ordered:
             self.perform(self.s[s].onexit, run)
+            scxml_invoke.on_exit(run, self.s[s])
             run.config.discard(s)
         for t in enabled:
             self.perform(t.actions, run)
@@ -850,6 +878,7 @@ class _Interpreter:
                 continue
             run.config.add(s)
             node = self.s[s]
+            scxml_invoke.on_enter(run, node)
             self.perform(node.onentry, run)
             if s in default_entry:
                 self.perform(node.initial_actions, run)
@@ -910,18 +939,26 @@ class _Interpreter:
                 run,
             )
         else:
-            enabled = self.select(run, event, valuation, read)
-            if enabled:
-                self.microstep(enabled, run)
+            self.take_external(run, event)
         self.stabilise(run, valuation, read)
+        scxml_invoke.start_pending(self, run)
         for _ in range(MAX_MICROSTEPS):
             if not run.external or not run.running:
+                scxml_invoke.finish(self, run)
                 return
-            enabled = self.select(run, run.external.popleft(), valuation, read)
-            if enabled:
-                self.microstep(enabled, run)
+            self.take_external(run, run.external.popleft())
             self.stabilise(run, valuation, read)
+            scxml_invoke.start_pending(self, run)
         raise InputError("events the machine sends itself never run out")
+
+    def take_external(self, run: _Run, item: str) -> None:
+        """One external event: finalize and autoforward (W3C main loop), then its transitions."""
+        event = scxml_invoke.before_external(self, run, item)
+        if event is None:
+            return
+        enabled = self.select(run, event, run.valuation, run.read)
+        if enabled:
+            self.microstep(enabled, run)
 
     # -- naming ---------------------------------------------------------------------------------
     def name(
@@ -986,6 +1023,10 @@ def _symbols(doc: _Doc, interp: _Interpreter) -> list[tuple[str, str, dict[int, 
                     events.setdefault(d, None)
             generated.update(_event_names(t.actions))
         generated.update(_event_names([*node.onentry, *node.onexit, *node.initial_actions]))
+    forwarded, from_children = scxml_invoke.session_events(doc)
+    for name in sorted(forwarded):
+        events.setdefault(name, None)
+    generated.update(from_children)
     if not events and any("*" in t.events for n in doc.states for t in n.transitions):
         events["event"] = None
     all_t = [t for n in doc.states for t in n.transitions]
@@ -1064,12 +1105,13 @@ def read_scxml_w3c(text: str, ctx: ReadContext) -> FSM:
         tuple[tuple[int, frozenset[int]], ...],
         bool,
         tuple[tuple[str, scxml_expr.Value], ...],
+        tuple[object, ...],  # invoked sessions (scxml_invoke.sessions_key)
     ]
 
     def key_of(run: _Run) -> Key:
         hist = tuple(sorted(run.history.items())) if has_history else ()
         data = tuple(sorted(run.data.items())) if doc.data_mode else ()
-        return (frozenset(run.config), hist, run.running, data)
+        return (frozenset(run.config), hist, run.running, data, scxml_invoke.sessions_key(run))
 
     names: dict[Key, str] = {}
     queue: deque[Key] = deque()
@@ -1078,9 +1120,11 @@ def read_scxml_w3c(text: str, ctx: ReadContext) -> FSM:
         if key not in names:
             if len(names) >= max_states:
                 raise InputError(f"more than {max_states} reachable configurations")
-            name = interp.name(key[0], key[1], key[3])
+            suffix, child_actions = scxml_invoke.describe(doc, key[4])
+            name = interp.name(key[0], key[1], key[3]) + suffix
+            action = "+".join(a for a in [interp.action(key[0]), *child_actions] if a) or None
             names[key] = name
-            flat.add_state(State(name, action=interp.action(key[0]), final=not key[2]))
+            flat.add_state(State(name, action=action, final=not key[2]))
             queue.append(key)
         return names[key]
 
@@ -1092,6 +1136,7 @@ def read_scxml_w3c(text: str, ctx: ReadContext) -> FSM:
         source = names[key]
         for symbol, event, valuation in symbols:
             run = _Run(set(key[0]), dict(key[1]), data=dict(key[3]))
+            scxml_invoke.restore(doc, run, key[4])
             interp.process(run, event, valuation, set())
             if run.moved:
                 flat.add_transition(source, symbol, visit(key_of(run)))
