@@ -187,7 +187,11 @@ def test_structural_refusals_are_read_by_the_w3c_algorithm(body: str, feature: s
     "body, feature",
     [
         ('<state id="s"><onentry><send event="x" delay="1s"/></onentry></state>', "delay"),
-        ('<state id="s"><onentry><script>x = 1</script></onentry></state>', "<script>"),
+        (
+            '<state id="s"><onentry><script>x = 1</script></onentry>'
+            '<transition event="e" cond="x" target="s"/></state>',
+            "<script>",
+        ),
         (
             '<state id="s"><onentry><foreach array="a" item="i"><raise event="x"/></foreach>'
             "</onentry></state>",
@@ -204,7 +208,7 @@ def test_structural_refusals_are_read_by_the_w3c_algorithm(body: str, feature: s
             '<state id="s"><onentry><send event="x" target="#_scxml_other"/></onentry></state>',
             "target",
         ),
-        ('<state id="s"><onentry><send eventexpr="\'x\'"/></onentry></state>', "eventexpr"),
+        ('<state id="s"><onentry><send eventexpr="f()"/></onentry></state>', "eventexpr"),
     ],
 )
 def test_remaining_features_are_refused_with_their_line(body: str, feature: str) -> None:
