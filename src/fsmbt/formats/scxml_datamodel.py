@@ -84,7 +84,8 @@ class DataPlan:
 
     dialect: scxml_expr.Dialect | None
     tracked: set[str] = field(default_factory=set)
-    relevant: list[str] = field(default_factory=list)  # declaration order: the state names
+    relevant: list[str] = field(default_factory=list)  # declaration order
+    varying: list[str] = field(default_factory=list)  # relevant ones some assignment changes
     computed: dict[int, scxml_expr.Expr] = field(default_factory=dict)  # guard index -> expr
     assigns: dict[int, scxml_expr.Expr] = field(default_factory=dict)  # to relevant variables
     sends: dict[int, scxml_expr.Expr] = field(default_factory=dict)  # exact eventexprs
@@ -95,8 +96,9 @@ class DataPlan:
 
     @property
     def has_data(self) -> bool:
-        """Whether explored states carry data values."""
-        return bool(self.relevant)
+        """Whether explored states carry data values (the varying relevant variables: a
+        constant one is the same in every state and is left out of the names)."""
+        return bool(self.varying)
 
 
 class Refusal(Exception):
@@ -269,6 +271,8 @@ def plan(
         )
     result.relevant = _relevant(data, assignments, result, parsed, used)
     relevant = set(result.relevant)
+    changed = {a.location for a in assignments}
+    result.varying = [name for name in result.relevant if name in changed]
     for index, a in enumerate(assignments):
         if a.location in relevant:
             expr = parsed.get(a.expr or "")

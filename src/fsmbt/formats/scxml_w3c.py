@@ -306,7 +306,9 @@ class _Doc:
                         len(data) > 0 or bool((data.text or "").strip()) or "src" in data.attrib
                     )
                     self.data.append(
-                        Declared(data.get("id") or "", data.get("expr"), has_content, data.sourceline)
+                        Declared(
+                            data.get("id") or "", data.get("expr"), has_content, data.sourceline
+                        )
                     )
         elif tag == "donedata":
             self.ctx.warn("<donedata> ignored", line=element.sourceline, element="<donedata>")
@@ -328,8 +330,10 @@ class _Doc:
             if not isinstance(item.tag, str):
                 continue
             tag = self.tag(item)
-            if tag is None and namespace(item) in scxml_datamodel.COMMONS_NS and (
-                local_name(item) == "var"
+            if (
+                tag is None
+                and namespace(item) in scxml_datamodel.COMMONS_NS
+                and (local_name(item) == "var")
             ):
                 out.append(self.commons_var(item))
             elif tag is None:
@@ -585,16 +589,22 @@ class _Doc:
         for index in sorted(plan.dropped_sends):
             send = self.send_exprs[index]
             self.ctx.warn(
-                f"<send eventexpr=\"{send.text}\"> dropped: no event descriptor can match the "
+                f'<send eventexpr="{send.text}"> dropped: no event descriptor can match the '
                 "event it sends",
                 line=send.line,
                 element="<send>",
             )
-        if plan.has_data:
+        if plan.relevant:
+            constant = [n for n in plan.relevant if n not in plan.varying]
             self.ctx.warn(
-                "the data model is read exactly: the values of "
-                + ", ".join(plan.relevant)
-                + " are part of each state"
+                "the data model is read exactly (conds over it are computed): "
+                + (
+                    f"the values of {', '.join(plan.varying)} are part of each state"
+                    if plan.varying
+                    else ""
+                )
+                + ("; " if plan.varying and constant else "")
+                + (f"{', '.join(constant)} never change(s)" if constant else "")
             )
         elif self.data:
             self.ctx.warn(
@@ -618,9 +628,7 @@ class _Doc:
             changed = False
             descriptors = [d for t, on in zip(transitions, live) if on for d in t.events]
             for n, t in enumerate(transitions):
-                if not live[n] and any(
-                    self.matters(a, descriptors) for a in _flatten(t.actions)
-                ):
+                if not live[n] and any(self.matters(a, descriptors) for a in _flatten(t.actions)):
                     live[n] = changed = True
         return sorted({d for t, on in zip(transitions, live) if on for d in t.events})
 
@@ -1258,7 +1266,7 @@ def read_scxml_w3c(text: str, ctx: ReadContext) -> FSM:
 
     def key_of(run: _Run) -> Key:
         hist = tuple(sorted(run.history.items())) if has_history else ()
-        data = tuple((n, run.data[n]) for n in doc.plan.relevant)
+        data = tuple((n, run.data[n]) for n in doc.plan.varying)
         return (frozenset(run.config), hist, run.running, data)
 
     names: dict[Key, str] = {}
@@ -1288,7 +1296,7 @@ def read_scxml_w3c(text: str, ctx: ReadContext) -> FSM:
             continue
         source = names[key]
         for symbol, event, valuation in symbols:
-            run = _Run(set(key[0]), dict(key[1]), data=dict(key[3]))
+            run = _Run(set(key[0]), dict(key[1]), data={**doc.plan.initial, **dict(key[3])})
             interp.process(run, event, valuation, set())
             if run.moved:
                 flat.add_transition(source, symbol, visit(key_of(run)))
