@@ -146,10 +146,10 @@ def literal_prefix(text: str) -> str | None:
         operand = _PREFIX_OPERAND.match(text, position)
         if operand is None:
             return None
-        position = operand.end()
-        position = _skip_postfix(text, position, end)
-        if position is None:
+        after = _skip_postfix(text, operand.end(), end)
+        if after is None:
             return None
+        position = after
     return prefix
 
 
@@ -412,19 +412,17 @@ def _relevant(
     computed = [e for i, e in result.computed.items() if i in used]
     for expr in [*computed, *result.sends.values()]:
         wanted |= expr.names & result.tracked
-    changed = True
-    while changed:
-        changed = False
+    size = -1
+    while size != len(wanted):  # grows monotonically within the tracked variables
+        size = len(wanted)
         for a in assignments:
-            expr = parsed.get(a.expr or "")
-            if a.location in wanted and expr is not None and not expr.names <= wanted:
-                wanted |= expr.names & result.tracked
-                changed = True
+            found = parsed.get(a.expr or "")
+            if a.location in wanted and found is not None:
+                wanted |= found.names & result.tracked
         for declared in data:
-            expr = parsed.get(declared.expr or "")
-            if declared.name in wanted and expr is not None and not expr.names <= wanted:
-                wanted |= expr.names
-                changed = True
+            found = parsed.get(declared.expr or "")
+            if declared.name in wanted and found is not None:
+                wanted |= found.names & result.tracked
     order: list[str] = []
     for declared in data:
         if declared.name in wanted and declared.name not in order:
