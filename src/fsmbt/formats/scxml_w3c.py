@@ -3,8 +3,10 @@
 
 Used when the structural reader (``fsmbt.formats.scxml``) refuses a document for a feature
 that has a finite reading: ``<history>`` (shallow and deep), ``cond`` guards, ``<raise>`` and
-``<send>`` without delay, ignored executable content (``<log>``, ``<assign>`` to a variable no
-guard reads), wildcard and prefix event descriptors, ``done.state`` on atomic states, entry
+``<send>`` without delay (``eventexpr`` included when computable or unobservable), the finite
+data model (``fsmbt.formats.scxml_datamodel``), ``<script>`` that cannot affect control flow,
+ignored executable content (``<log>``, ``<assign>`` to a variable no cond reads), wildcard and
+prefix event descriptors, ``done.state`` on atomic states, entry
 into a non-initial nested state, targetless and ``type="internal"`` transitions, several
 targets, eventless transitions of compound states. Rules:
 
@@ -16,8 +18,11 @@ targets, eventless transitions of compound states. Rules:
 - ``<send>`` without ``target`` goes to the external queue, ``target="#_internal"`` to the
   internal one. Events the machine sends itself are processed, in order, before the next
   environment event (the environment waits for the machine to be idle).
-- An input symbol is an event together with the truth of the guards it may read, in document
-  order: ``e[g1,!g2]`` (guard ``gN`` is the N-th distinct ``cond`` text; the mapping is in the
+- Variables control flow reads are part of the explored state (``a/a1#x=1``, after the
+  history values); conds over them are computed (docs/formats/scxml.md, "Data read exactly").
+  An ``error.execution`` skips the rest of its block and is raised on the internal queue.
+- Any other guard is an input: an input symbol is an event together with the truth of the
+  guards it may read, in document order: ``e[g1,!g2]`` (guard ``gN`` is the N-th distinct ``cond`` text; the mapping is in the
   model's ``attrs`` and in a warning). The environment chooses the guards' values with the
   event; they hold for the whole macro step. ``In('id')`` is evaluated exactly.
 - A flat state is a configuration (named as ``fsmbt.model.flatten`` names them: ``a/a1``,
