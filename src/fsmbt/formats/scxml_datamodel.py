@@ -36,7 +36,7 @@ from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 
 from fsmbt.formats import scxml_expr
-from fsmbt.model.errors import Hint, InputError
+from fsmbt.model.errors import InputError
 
 #: Apache Commons SCXML's namespace of custom actions (``<cs:var>``), both spellings in use.
 COMMONS_NS = frozenset({"http://commons.apache.org/scxml", "https://commons.apache.org/scxml"})
@@ -44,6 +44,7 @@ ERROR_EXECUTION = "error.execution"
 _IDENT = re.compile(r"[A-Za-z_$][\w$]*")
 _PREFIX_OPERAND = re.compile(r"""\s*(?:'[^']*'|"[^"]*"|[A-Za-z_$][\w$]*|\d+(?:\.\d+)?)""")
 _STRING = re.compile(r"""\s*('[^']*'|"[^"]*")""")
+_MEMBER = re.compile(r"\.\s*[A-Za-z_$][\w$]*")
 
 
 class StateLimitError(InputError):
@@ -159,7 +160,7 @@ def _skip_postfix(text: str, position: int, end: int) -> int | None:
         rest = text[position:end].lstrip()
         position = end - len(rest)
         if rest.startswith("."):
-            found = re.compile(r"\.\s*[A-Za-z_$][\w$]*").match(text, position)
+            found = _MEMBER.match(text, position)
             if found is None:
                 return None
             position = found.end()
@@ -445,6 +446,5 @@ def limit_error(
         hint = f"; the variable '{name}' took {len(seen[name])} distinct values (is it unbounded?)"
     return StateLimitError(
         f"more than {limit} reachable configurations and data values{hint} "
-        f"(limit {limit_name}; raise it with {env_name})",
-        hints=(Hint.MAX_STATES,),
+        f"(limit {limit_name}; raise it with {env_name})"
     )

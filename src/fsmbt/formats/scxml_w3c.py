@@ -1204,8 +1204,14 @@ def _symbols(doc: _Doc, interp: _Interpreter) -> list[tuple[str, str, dict[int, 
         return out
 
     internal = guards_of(sorted(generated), True) | doc.branch_guards
-    if doc.plan.sends:  # computed event names: any transition's guard may be read
-        internal |= guards_of(sorted(events), False)
+    if doc.plan.sends:  # computed event names: any transition's input guard may be read
+        internal |= {
+            int(t.cond[1])
+            for t in all_t
+            if t.cond is not None
+            and t.cond[0] == "guard"
+            and int(t.cond[1]) not in doc.plan.computed
+        }
     symbols: list[tuple[str, str, dict[int, bool]]] = []  # sorted below
     for event in events:
         relevant = sorted(guards_of([event], False) | internal)
