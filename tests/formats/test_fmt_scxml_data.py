@@ -347,3 +347,13 @@ def test_microwave_cooks_until_the_timer_reaches_the_cook_time() -> None:
     assert seen[1] == "on/cooking#door_closed=true;timer=0"
     assert seen[-1] == "off#door_closed=true;timer=5"  # timer >= cook_time (5): off
     assert walk(model, ["turn.on", "door.open", "time"])[-1] == "on/idle#door_closed=false;timer=0"
+
+
+def test_assign_to_a_member_of_a_guard_variable_is_refused() -> None:
+    body = """
+  <datamodel><data id="x" expr="0"/></datamodel>
+  <state id="s"><transition event="e" target="s"><assign location="x.y" expr="1"/>
+    </transition><transition event="f" cond="x.y == 1" target="s"/></state>"""
+    with pytest.raises(UnsupportedError, match="member location 'x.y'") as info:
+        loads(doc(body), "scxml")
+    assert "line 3" in str(info.value)

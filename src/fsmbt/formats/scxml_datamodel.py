@@ -232,7 +232,7 @@ def plan(
         if index in guard_exprs or index not in used:
             continue
         for name in _IDENT.findall(text):
-            changes = [a for a in assignments if a.location == name]
+            changes = [a for a in assignments if _root(a.location) == name]
             if not changes:
                 continue
             if name not in result.tracked:
@@ -320,6 +320,8 @@ def _why_untracked(
     if name not in result.declared:
         return changes[0], "of a variable no <data> declares"
     for a in changes:
+        if a.location.strip() != name:
+            return a, f"to the member location '{a.location}'"
         expr = _parse(a.expr, dialect, parsed)
         if expr is None:
             return a, f"of an expression outside fsmbt's subset ('{a.expr}')"
@@ -381,13 +383,20 @@ def _tracked(
     while changed:
         changed = False
         for a in assignments:
-            if a.location not in tracked:
+            root = _root(a.location)
+            if root not in tracked:
                 continue
             expr = _parse(a.expr, dialect, parsed)
-            if expr is None or not expr.names <= tracked:
-                tracked.discard(a.location)
+            if a.location != root or expr is None or not expr.names <= tracked:
+                tracked.discard(root)  # a member location (``x.y``) changes ``x`` too
                 changed = True
     return tracked
+
+
+def _root(location: str) -> str:
+    """The variable a location names (``x`` of ``x.y[0]``)."""
+    found = _IDENT.match(location.strip())
+    return found.group(0) if found else location
 
 
 def _event_name_last(expr: scxml_expr.Expr) -> bool:

@@ -453,6 +453,15 @@ def text_of(value: Value) -> str:
     return str(value)
 
 
+def shown(value: Value) -> str:
+    """A value as a state name shows it: ``text_of``, or Python's ``repr`` where ECMAScript
+    would write an exponent (never an error)."""
+    try:
+        return text_of(value)
+    except OutsideSubset:
+        return repr(value)
+
+
 def truthy(value: Value) -> bool:
     """The truth of a value (the same in the three dialects for the subset's values)."""
     if value is UNDEFINED or value is None:

@@ -367,7 +367,7 @@ class _Doc:
                 out.append(("assign", str(len(self.assign_exprs) - 1)))
             elif tag == "script":
                 self.scripts.append(item.sourceline)
-                out.append(("script", str(item.sourceline)))
+                out.append(("script", str(item.sourceline or 0)))
             elif tag == "if":
                 out.extend(self.if_block(item))
             else:
@@ -961,7 +961,13 @@ class _Interpreter:
         value = self.value(expr, run, line)
         if value is _FAILED:
             return None
-        name = scxml_expr.text_of(value)  # type: ignore[arg-type]
+        try:
+            name = scxml_expr.text_of(value)  # type: ignore[arg-type]
+        except scxml_expr.ExpressionError as exc:
+            raise UnsupportedError(
+                f"unsupported: <send eventexpr=\"{expr.text}\">: {exc}, line {line}",
+                location=self.doc.ctx.location(line),
+            ) from None
         if scxml_expr.EVENT_NAME in expr.names and any(
             d.startswith(name + ".") for d in self.descriptors
         ):
@@ -1163,7 +1169,7 @@ class _Interpreter:
                 parts.append(f"{self.s[h].name}={inner}")
             text += "#" + ";".join(parts)
         if data:
-            values = ";".join(f"{k}={scxml_expr.text_of(v)}" for k, v in data)
+            values = ";".join(f"{k}={scxml_expr.shown(v)}" for k, v in data)
             text += ("#" if not history else ";") + values
         return text
 
