@@ -357,3 +357,27 @@ def test_assign_to_a_member_of_a_guard_variable_is_refused() -> None:
     with pytest.raises(UnsupportedError, match="member location 'x.y'") as info:
         loads(doc(body), "scxml")
     assert "line 3" in str(info.value)
+
+
+def test_send_data_reading_event_before_any_event_fails_and_skips_the_send() -> None:
+    body = """
+  <state id="s"><onentry><send event="go"><param name="p" expr="_event.data"/></send>
+    </onentry><transition event="go" target="sent"/>
+    <transition event="error.execution" target="failed"/></state>
+  <state id="failed"/><state id="sent"><transition event="again" target="s2"/></state>
+  <state id="s2"><onentry><send event="go"><param name="p" expr="_event.data"/></send>
+    </onentry><transition event="go" target="sent"/></state>"""
+    model, _ = read(doc(body))
+    assert walk(model, [])[0] == "failed"  # W3C: _event is unbound, the send is not performed
+
+
+def test_send_data_that_may_fail_before_an_event_that_matters_is_refused() -> None:
+    body = """
+  <state id="s"><transition event="e" target="s">
+    <send event="go"><param name="p" expr="compute(1)"/></send></transition>
+    <transition event="go" target="t"/></state><state id="t"/>"""
+    with pytest.raises(UnsupportedError, match="<param>/<content> of <send>") as info:
+        loads(doc(body), "scxml")
+    assert "line 3" in str(info.value)
+    unread = body.replace('<transition event="go" target="t"/>', "")  # nothing takes 'go'
+    assert walk(read(doc(unread))[0], ["e"]) == ["s", "s"]

@@ -262,6 +262,13 @@ W3C_PROBES = {
   </state>
   <state id="u"><transition event="back" target="s"/></state>
   <state id="v"><transition event="back" target="s"/></state>""",
+    "error.execution: _event read before any event skips the send and the rest": """
+  <state id="s"><onentry><send eventexpr="'x.' + _event.name"/><raise event="r"/></onentry>
+    <transition event="error.execution" target="failed"/><transition event="r" target="ran"/>
+    <transition event="x" target="ran"/></state>
+  <state id="failed"><transition event="back" target="t"/></state><state id="ran"/>
+  <state id="t"><onentry><send event="y"><param name="p" expr="_event.data"/></send></onentry>
+    <transition event="y" target="u"/></state><state id="u"/>""",
     "if branches raise by guard; log and unread assign ignored": """
   <datamodel><data id="flag" expr="False"/><data id="count" expr="0"/></datamodel>
   <state id="s"><transition event="go" target="t"><log expr="'go'"/>

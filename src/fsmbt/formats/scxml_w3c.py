@@ -73,7 +73,8 @@ class _If:
 #: ("raise" | "internal" | "external", event name), ("internal_expr" | "external_expr", index
 #: of a ``<send eventexpr>``), ("assign", index), ("script", line), or an ``<if>``.
 Action = tuple[str, str] | _If
-_NO_EVENT = frozenset({"assign", "script", "internal_expr", "external_expr"})
+_NO_EVENT = frozenset({"assign", "script", "internal_expr", "external_expr", "params"})
+_EVENT_FIELD = re.compile(r"\s*_event\.[A-Za-z_$][\w$]*\s*$")
 
 
 def _event_names(actions: list[Action]) -> list[str]:
@@ -353,7 +354,7 @@ class _Doc:
             elif tag == "send":
                 sent = self.send(item)
                 if sent is not None:
-                    out.append(sent)
+                    out.extend([*self.send_data(item), sent])
             elif tag == "cancel" and self.abstract_time:
                 self.ctx.warn(
                     "<cancel> ignored under the abstraction 'time' (a timer's event "
@@ -440,6 +441,44 @@ class _Doc:
                 item, f"unsupported: <{local_name(item)}> without a literal event name (eventexpr)"
             )
         return event
+
+    def send_data(self, item: etree._Element) -> list[Action]:
+        """The data a ``<send>`` evaluates before sending (``<param>``, ``<content expr>``,
+        ``namelist``), as a ``("params", "line:unsafe:reads_event")`` action before it: its
+        values are event data fsmbt does not model, but its failure (W3C: ``error.execution``,
+        the send and the rest of the block skipped) is. ``unsafe``: an expression fsmbt cannot
+        vouch for (checked like a ``<script>``); ``reads_event``: reads ``_event``, which fails
+        before the first event (checked while exploring)."""
+        texts = [
+            child.get("expr") or child.get("location") or ""
+            for child in item
+            if isinstance(child.tag, str) and self.tag(child) in ("param", "content")
+        ]
+        texts = [t for t in texts if t.strip()]
+        texts.extend((item.get("namelist") or "").split())
+        if not texts:
+            return []
+        self.ctx.warn(
+            "<param>/<content> of <send> not evaluated (event data fsmbt does not model)",
+            line=item.sourceline,
+            element="<send>",
+        )
+        unsafe = reads_event = False
+        for text in texts:
+            if _EVENT_FIELD.match(text):
+                reads_event = True
+                continue
+            try:
+                expr = scxml_expr.parse(text)
+            except scxml_expr.ExpressionError:
+                unsafe = True
+                continue
+            reads_event |= scxml_expr.EVENT_NAME in expr.names
+            declared = {d.name for d in self.data}
+            unsafe |= not expr.names - {scxml_expr.EVENT_NAME} <= declared
+        if not unsafe and not reads_event:
+            return []
+        return [("params", f"{item.sourceline or 0}:{int(unsafe)}:{int(reads_event)}")]
 
     def send(self, item: etree._Element) -> Action | None:
         delay = (item.get("delay") or "").strip()
@@ -653,11 +692,23 @@ class _Doc:
         kind, value = action
         if kind == "assign":
             return int(value) in self.plan.assigns
-        if kind == "script":
+        if kind in ("script", "params"):
             return False
         if kind.endswith("_expr"):
-            return int(value) in self.plan.sends
+            return int(value) in self.plan.sends and self.send_may_match(int(value), descriptors)
         return any(scxml_datamodel.matches(d, value) for d in descriptors) or not events
+
+    def send_may_match(self, index: int, descriptors: list[str]) -> bool:
+        """Whether an exact ``eventexpr`` may send an event one of ``descriptors`` matches."""
+        text = self.send_exprs[index].text
+        prefix = scxml_datamodel.literal_prefix(text)
+        if prefix is not None:
+            return scxml_datamodel.may_match_prefix(descriptors, prefix)
+        expr = self.plan.sends[index]
+        if len(expr.postfix) == 1 and expr.postfix[0][0] == "value":
+            name = scxml_expr.shown(expr.postfix[0][1])  # type: ignore[arg-type]
+            return any(scxml_datamodel.matches(d, name) for d in descriptors)
+        return True
 
     def may_fail(self, action: Action) -> bool:
         """Whether an ignored action may fail (W3C: ``error.execution``, the rest of its
@@ -668,6 +719,8 @@ class _Doc:
         kind, value = action
         if kind == "script":
             return True
+        if kind == "params":
+            return value.split(":")[1] == "1"
         if kind != "assign" or int(value) in self.plan.assigns:
             return False
         a = self.assign_exprs[int(value)]
@@ -718,6 +771,8 @@ class _Doc:
             kind, value = first_failing
             if kind == "script":
                 what, line = "<script>", int(value)
+            elif kind == "params":
+                what, line = "<param>/<content> of <send>", int(value.split(":")[0])
             else:
                 a = self.assign_exprs[int(value)]
                 what, line = f"<assign> to '{a.location}'", a.line or 0
@@ -934,6 +989,11 @@ class _Interpreter:
             kind, name = action
             if kind == "script":
                 continue
+            if kind == "params":
+                if name.endswith(":1") and run.event is None:  # _event before any event
+                    run.internal.append(scxml_datamodel.ERROR_EXECUTION)
+                    return
+                continue
             if kind == "assign":
                 index = int(name)
                 if index in plan.assigns:
@@ -965,7 +1025,7 @@ class _Interpreter:
             name = scxml_expr.text_of(value)  # type: ignore[arg-type]
         except scxml_expr.ExpressionError as exc:
             raise UnsupportedError(
-                f"unsupported: <send eventexpr=\"{expr.text}\">: {exc}, line {line}",
+                f'unsupported: <send eventexpr="{expr.text}">: {exc}, line {line}',
                 location=self.doc.ctx.location(line),
             ) from None
         if scxml_expr.EVENT_NAME in expr.names and any(
