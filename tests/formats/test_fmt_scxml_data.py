@@ -381,3 +381,16 @@ def test_send_data_that_may_fail_before_an_event_that_matters_is_refused() -> No
     assert "line 3" in str(info.value)
     unread = body.replace('<transition event="go" target="t"/>', "")  # nothing takes 'go'
     assert walk(read(doc(unread))[0], ["e"]) == ["s", "s"]
+
+
+def test_an_inert_wildcard_transition_does_not_make_a_script_matter() -> None:
+    body = """
+  <state id="s"><onentry><script>log.everything()</script></onentry>
+    <transition event="go" target="t"/>
+    <transition event="*"><log expr="'seen'"/></transition></state><state id="t"/>"""
+    model, warnings = read(doc(body))  # the '*' transition is targetless and has no effect
+    assert walk(model, ["go"]) == ["s", "t"]
+    assert any("<script> ignored" in w for w in warnings)
+    live = body.replace("<log expr=\"'seen'\"/>", '<raise event="go"/>')
+    with pytest.raises(UnsupportedError, match="error.execution"):
+        loads(doc(live), "scxml")

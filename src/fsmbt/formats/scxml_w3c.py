@@ -67,7 +67,7 @@ class _If:
     """``<if>`` with effects: the first branch whose guard holds (``None``: ``<else>``)."""
 
     branches: list[tuple[int | None, list[Action]]]
-    effectless: bool = False  # only assignments: matters with exact data only
+    effectless: bool = False  # no event, no assignment a cond reads: skipped (decided after the plan)
 
 
 #: ("raise" | "internal" | "external", event name), ("internal_expr" | "external_expr", index
@@ -266,7 +266,7 @@ class _Doc:
                     node.initial = first[:1]
         if not self.states[0].initial:
             raise InputError("the document has no state", location=ctx.location(root.sourceline))
-        self.decide_data_mode()
+        self.decide_data()
 
     def tag(self, element: etree._Element) -> str | None:
         if namespace(element) == XINCLUDE_NS:
@@ -575,7 +575,7 @@ class _Doc:
             self.branch_guards.add(index)
         return index
 
-    def decide_data_mode(self) -> None:
+    def decide_data(self) -> None:
         """The data plan (``fsmbt.formats.scxml_datamodel``: tracked variables, computed conds,
         exact event expressions), the warnings for what it ignores, and the ``<script>`` and
         failing-content checks (docs/formats/scxml.md, "Data read exactly")."""
@@ -656,8 +656,9 @@ class _Doc:
                 line=self.data[0].line,
                 element="<datamodel>",
             )
-        self.check_scripts(descriptors)
-        self.check_failures(blocks, self.live_descriptors())
+        live = self.live_descriptors()  # an error.execution only live transitions take matters
+        self.check_scripts(live)
+        self.check_failures(blocks, live)
 
     def live_descriptors(self) -> list[str]:
         """The descriptors of the transitions that can change something (least fixpoint): a
