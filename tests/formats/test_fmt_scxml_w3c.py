@@ -271,11 +271,14 @@ COUNTER = """
   <final id="done"/>"""
 
 
-def test_exact_data_is_opt_in_and_computes_guards() -> None:
-    model = read_scxml(doc(COUNTER), ReadContext(options={"data": "exact"}))
+def test_data_is_read_exactly_by_default_and_guards_are_computed() -> None:
+    model = loads(doc(COUNTER), "scxml")
     assert walk(model, ["tick", "tick", "tick"]) == ["s#n=0", "s#n=1", "s#n=2", "done#n=2"]
-    guarded = loads(doc(COUNTER.replace('<assign location="n" expr="n + 1"/>', "")), "scxml")
-    assert sorted(guarded.events()) == ["tick[!g1]", "tick[g1]"]  # default: guards as inputs
+    assert sorted(model.events()) == ["tick"]  # no guard is an input any more
+    constant = doc(COUNTER.replace('<assign location="n" expr="n + 1"/>', ""))
+    assert walk(loads(constant, "scxml"), ["tick", "tick"]) == ["s", "s", "s"]  # n constant
+    guarded = read_scxml(constant, ReadContext(options={"data": "inputs"}))
+    assert sorted(guarded.events()) == ["tick[!g1]", "tick[g1]"]  # the old reading, opt-in
 
 
 @pytest.mark.parametrize(

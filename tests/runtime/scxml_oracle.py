@@ -22,6 +22,7 @@ import contextlib
 import functools
 import io
 import random
+import re
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
@@ -115,12 +116,57 @@ class Document:
         return "".join(out)
 
 
+#: python-statemachine 3.2.2 splits an ``event`` list on single spaces: an attribute with two
+#: blanks in a row (a list written across lines: XML turns each line break into a blank) gets
+#: an empty descriptor that matches every event. W3C splits on any whitespace, so the engine
+#: gets the document with each event list's blanks collapsed (the same document to W3C).
+EVENT_LIST_BLANKS = "engine reads an event list with two blanks in a row as matching every event"
+_EVENT_ATTRIBUTE = re.compile(r"""(\sevent\s*=\s*)(["'])(.*?)\2""", re.S)
+
+
+def engine_text(text: str) -> str:
+    """``text`` with every ``event`` list's whitespace collapsed (``EVENT_LIST_BLANKS``)."""
+    return _EVENT_ATTRIBUTE.sub(
+        lambda m: m.group(1) + m.group(2) + " ".join(m.group(3).split()) + m.group(2), text
+    )
+
+
+_ECMASCRIPT_WORDS = {
+    "true": "True",
+    "false": "False",
+    "===": "==",
+    "!==": "!=",
+    "&amp;&amp;": " and ",
+    "||": " or ",
+}
+_EXPRESSION_ATTRIBUTE = re.compile(r"""(\s(?:cond|expr)\s*=\s*)(["'])(.*?)\2""", re.S)
+_ECMASCRIPT_TOKEN = re.compile(r"===|!==|&amp;&amp;|\|\||\btrue\b|\bfalse\b")
+
+
+def python_spelled(text: str) -> str | None:
+    """An ``ecmascript`` document with its expressions spelled for the engine's Python data
+    model (``true`` -> ``True``, ``===`` -> ``==``, ``&&`` -> ``and``), else ``None``. The
+    engine evaluates expressions in Python; on the subset fsmbt computes (numbers, booleans,
+    strings compared with their own kind) the two spellings have the same values, and fsmbt
+    reads the copy with its Python dialect."""
+    if not re.search(r"""datamodel\s*=\s*["']ecmascript["']""", text):
+        return None
+    body = _EXPRESSION_ATTRIBUTE.sub(
+        lambda m: m.group(1)
+        + m.group(2)
+        + _ECMASCRIPT_TOKEN.sub(lambda t: _ECMASCRIPT_WORDS[t.group(0)], m.group(3))
+        + m.group(2),
+        text,
+    )
+    return re.sub(r"""datamodel\s*=\s*["']ecmascript["']""", 'datamodel="python"', body)
+
+
 @functools.lru_cache(maxsize=8)
 def _compiled(text: str) -> tuple[Document, type[StateChart]]:
     """The document's tree and the engine's class (built once per text: the sequences of one
     model share it, each gets a fresh instance)."""
     with contextlib.redirect_stdout(io.StringIO()):
-        return Document.parse(text), load(text, format="scxml")
+        return Document.parse(text), load(engine_text(text), format="scxml")
 
 
 class Engine:
@@ -128,9 +174,9 @@ class Engine:
 
     def __init__(self, text: str) -> None:
         self.doc, chart = _compiled(text)
-        if "<assign" in text:  # ASSIGN_SHARED_CLASS: a fresh class for each instance
+        if any(word in text for word in ("<assign", "<data", "_event")):  # ASSIGN_SHARED_CLASS
             with contextlib.redirect_stdout(io.StringIO()):
-                chart = load(text, format="scxml")
+                chart = load(engine_text(text), format="scxml")
         with contextlib.redirect_stdout(io.StringIO()):  # the engine prints <log> content
             self.machine = chart()
 
@@ -189,9 +235,11 @@ def random_events(
 
 
 #: python-statemachine 3.2.2: in the second and later instances of one class loaded from a
-#: document, an ``<assign>`` whose expression reads a ``<data>`` variable fails and the rest of
-#: its block (a ``<raise>`` after it) is skipped; the first instance runs it as W3C says.
-#: ``Engine`` therefore loads a fresh class per instance for documents with ``<assign>``.
+#: document, reading a ``<data>`` variable fails: an ``<assign>`` reading one fails and the
+#: rest of its block (a ``<raise>`` after it) is skipped, a ``cond`` reading one is false; the
+#: first instance runs both as W3C says; likewise ``_event`` stays bound from one instance to
+#: the next. ``Engine`` therefore loads a fresh class per instance for documents with
+#: ``<assign>``, ``<data>`` or ``_event``.
 ASSIGN_SHARED_CLASS = "engine skips a block after <assign> in a reused class"
 
 #: The engine's known departure from the W3C algorithm that a replay meets (see

@@ -201,7 +201,7 @@ def read_invoke(
             f"('{child_doc.guards[0]}'; only In() is read there)",
         )
     if data_passed:
-        if child_doc.data_mode:
+        if child_doc.plan.relevant:  # control flow there reads its data
             raise doc.refuse(
                 element, "unsupported: <param>/namelist passing data to an exactly read session"
             )

@@ -3,8 +3,10 @@
 
 Used when the structural reader (``fsmbt.formats.scxml``) refuses a document for a feature
 that has a finite reading: ``<history>`` (shallow and deep), ``cond`` guards, ``<raise>`` and
-``<send>`` without delay, ignored executable content (``<log>``, ``<assign>`` to a variable no
-guard reads), wildcard and prefix event descriptors, ``done.state`` on atomic states, entry
+``<send>`` without delay (``eventexpr`` included when computable or unobservable), the finite
+data model (``fsmbt.formats.scxml_datamodel``), ``<script>`` that cannot affect control flow,
+ignored executable content (``<log>``, ``<assign>`` to a variable no cond reads), wildcard and
+prefix event descriptors, ``done.state`` on atomic states, entry
 into a non-initial nested state, targetless and ``type="internal"`` transitions, several
 targets, eventless transitions of compound states, ``<invoke>`` of SCXML sessions (their
 configurations are part of each state: ``fsmbt.formats.scxml_invoke``). Rules:
@@ -17,8 +19,11 @@ configurations are part of each state: ``fsmbt.formats.scxml_invoke``). Rules:
 - ``<send>`` without ``target`` goes to the external queue, ``target="#_internal"`` to the
   internal one. Events the machine sends itself are processed, in order, before the next
   environment event (the environment waits for the machine to be idle).
-- An input symbol is an event together with the truth of the guards it may read, in document
-  order: ``e[g1,!g2]`` (guard ``gN`` is the N-th distinct ``cond`` text; the mapping is in the
+- Variables control flow reads are part of the explored state (``a/a1#x=1``, after the
+  history values); conds over them are computed (docs/formats/scxml.md, "Data read exactly").
+  An ``error.execution`` skips the rest of its block and is raised on the internal queue.
+- Any other guard is an input: an input symbol is an event together with the truth of the
+  guards it may read, in document order: ``e[g1,!g2]`` (guard ``gN`` is the N-th distinct ``cond`` text; the mapping is in the
   model's ``attrs`` and in a warning). The environment chooses the guards' values with the
   event; they hold for the whole macro step. ``In('id')`` is evaluated exactly.
 - A flat state is a configuration (named as ``fsmbt.model.flatten`` names them: ``a/a1``,
@@ -38,8 +43,9 @@ from itertools import product
 from lxml import etree
 
 from fsmbt import limits
-from fsmbt.formats import scxml_expr, scxml_include, scxml_invoke
+from fsmbt.formats import scxml_datamodel, scxml_expr, scxml_include, scxml_invoke
 from fsmbt.formats.registry import ReadContext
+from fsmbt.formats.scxml_datamodel import Assignment, Declared, SendExpr
 from fsmbt.formats.xml_safe import local_name, namespace
 from fsmbt.model.errors import InputError, UnsupportedError
 from fsmbt.model.fsm import FSM, State
@@ -53,8 +59,6 @@ STATE_TAGS = frozenset({"state", "parallel", "final", "history"})
 MAX_GUARDS_PER_EVENT = 6
 #: Micro steps in one macro step, and events a machine may queue for itself.
 MAX_MICROSTEPS = 10_000
-#: Exact data: a number's magnitude (a string's length) past this is "without bound".
-MAX_DATA_MAGNITUDE = 10_000
 _IN = re.compile(r"""\s*In\(\s*(?:'([^']+)'|"([^"]+)")\s*\)\s*$""")
 _IDENT = re.compile(r"[A-Za-z_$][\w$]*")
 
@@ -64,11 +68,14 @@ class _If:
     """``<if>`` with effects: the first branch whose guard holds (``None``: ``<else>``)."""
 
     branches: list[tuple[int | None, list[Action]]]
-    effectless: bool = False  # only assignments: matters with exact data only
+    effectless: bool = False  # no event, no assignment a cond reads: skipped (decided after the plan)
 
 
-#: ("raise" | "internal" | "external", event name), or an ``<if>``.
+#: ("raise" | "internal" | "external", event name), ("internal_expr" | "external_expr", index
+#: of a ``<send eventexpr>``), ("assign", index), ("script", line), or an ``<if>``.
 Action = tuple[str, str] | _If
+_NO_EVENT = frozenset({"assign", "script", "internal_expr", "external_expr", "params"})
+_EVENT_FIELD = re.compile(r"\s*_event\.[A-Za-z_$][\w$]*\s*$")
 
 
 def _event_names(actions: list[Action]) -> list[str]:
@@ -80,8 +87,21 @@ def _event_names(actions: list[Action]) -> list[str]:
         if isinstance(action, _If):
             for _guard, inner in action.branches:
                 stack.extend(inner)
-        elif action[0] != "assign":
+        elif action[0] not in _NO_EVENT:
             out.append(action[1])
+    return out
+
+
+def _flatten(actions: list[Action]) -> list[Action]:
+    """Every action of a block, ``<if>`` branches included, in document order."""
+    out: list[Action] = []
+    stack: list[Action] = list(reversed(actions))
+    while stack:
+        action = stack.pop()
+        out.append(action)
+        if isinstance(action, _If):
+            for _guard, inner in reversed(action.branches):
+                stack.extend(reversed(inner))
     return out
 
 
@@ -170,18 +190,16 @@ class _Doc:
         self.states: list[_S] = []
         self.by_id: dict[str, int] = {}
         self.guards: list[str] = []
-        self.data: list[tuple[str, str | None, bool, int | None]] = []
-        self.assign_exprs: list[tuple[str, str | None, int | None]] = []
-        self.data_mode = False
-        self.data_reason = ""
-        self.parsed_guards: list[scxml_expr.Expr] = []
-        self.parsed_assigns: list[scxml_expr.Expr] = []
-        self.initial_data: dict[str, scxml_expr.Value] = {}
+        self.guard_lines: dict[int, int | None] = {}
+        self.dialect = scxml_expr.dialect_of(root.get("datamodel"))
+        self.data: list[Declared] = []
+        self.assign_exprs: list[Assignment] = []
+        self.send_exprs: list[SendExpr] = []
+        self.scripts: list[int | None] = []
+        self.ifs: list[tuple[_If, list[int], int | None]] = []  # (if, its guards, line)
+        self.plan = scxml_datamodel.DataPlan(self.dialect)
         self.branch_guards: set[int] = set()  # read by <if> branches, whatever the event
-        self.data_only_guards: set[int] = set()  # of <if>s that only assign
         self.transition_guards: set[int] = set()
-        self.effectless_ifs: list[int | None] = []
-        self.assigned: list[tuple[str, int | None]] = []
         pending: list[tuple[int, etree._Element, str]] = []  # (state, element, target text)
         initial_text: dict[int, tuple[str, etree._Element]] = {}
         stack: list[tuple[etree._Element, int | None]] = [(root, None)]
@@ -264,7 +282,7 @@ class _Doc:
         if not self.states[0].initial:
             raise InputError("the document has no state", location=ctx.location(root.sourceline))
         scxml_invoke.check_targets(self)
-        self.decide_data_mode()
+        self.decide_data()
 
     def tag(self, element: etree._Element) -> str | None:
         if namespace(element) == XINCLUDE_NS:
@@ -306,16 +324,20 @@ class _Doc:
         elif tag == "datamodel":
             for data in element:
                 if isinstance(data.tag, str) and self.tag(data) == "data":
-                    has_content = len(data) > 0 or bool((data.text or "").strip())
+                    has_content = (
+                        len(data) > 0 or bool((data.text or "").strip()) or "src" in data.attrib
+                    )
                     self.data.append(
-                        (data.get("id") or "", data.get("expr"), has_content, data.sourceline)
+                        Declared(
+                            data.get("id") or "", data.get("expr"), has_content, data.sourceline
+                        )
                     )
         elif tag == "donedata":
             self.ctx.warn("<donedata> ignored", line=element.sourceline, element="<donedata>")
         elif tag == "invoke":
             scxml_invoke.read_invoke(self, element, node, _Doc, _Interpreter)
         elif tag == "script":
-            raise self.refuse(element, "unsupported: <script>")
+            self.scripts.append(element.sourceline)
         else:
             raise InputError(
                 f"unknown SCXML element <{tag}> in <{node.kind}>",
@@ -330,7 +352,13 @@ class _Doc:
             if not isinstance(item.tag, str):
                 continue
             tag = self.tag(item)
-            if tag is None:
+            if (
+                tag is None
+                and namespace(item) in scxml_datamodel.COMMONS_NS
+                and (local_name(item) == "var")
+            ):
+                out.append(self.commons_var(item))
+            elif tag is None:
                 self.ctx.warn(
                     f"element of another namespace ignored: <{local_name(item)}>",
                     line=item.sourceline,
@@ -342,7 +370,7 @@ class _Doc:
             elif tag == "send":
                 sent = self.send(item)
                 if sent is not None:
-                    out.append(sent)
+                    out.extend([*self.send_data(item), sent])
             elif tag == "cancel" and self.abstract_time:
                 self.ctx.warn(
                     "<cancel> ignored under the abstraction 'time' (a timer's event "
@@ -351,15 +379,16 @@ class _Doc:
                     element="<cancel>",
                 )
             elif tag == "assign":
-                location = item.get("location") or ""
-                self.assigned.append((location, item.sourceline))
-                self.assign_exprs.append((location, item.get("expr"), item.sourceline))
+                location = (item.get("location") or "").strip()
+                self.assign_exprs.append(Assignment(location, item.get("expr"), item.sourceline))
                 out.append(("assign", str(len(self.assign_exprs) - 1)))
+            elif tag == "script":
+                self.scripts.append(item.sourceline)
+                out.append(("script", str(item.sourceline or 0)))
             elif tag == "if":
                 out.extend(self.if_block(item))
             else:
                 feature = {
-                    "script": "<script>",
                     "elseif": "<elseif> outside <if>",
                     "else": "<else> outside <if>",
                     "foreach": "<foreach>",
@@ -367,6 +396,20 @@ class _Doc:
                 }.get(tag, f"<{tag}>")
                 raise self.refuse(item, f"unsupported: {feature}")
         return out
+
+    def commons_var(self, item: etree._Element) -> Action:
+        """Apache Commons SCXML's ``<cs:var name expr>``: declares ``name`` and assigns it
+        (read as one global variable: Commons keeps it in the state's context, which is the
+        same as long as no two states declare one name; docs/formats/scxml.md)."""
+        name = (item.get("name") or "").strip()
+        if not name:
+            raise InputError(
+                "<var> needs a name", location=self.ctx.location(item.sourceline), element="<var>"
+            )
+        if name not in {d.name for d in self.data}:
+            self.data.append(Declared(name, None, False, item.sourceline))
+        self.assign_exprs.append(Assignment(name, item.get("expr"), item.sourceline, True))
+        return ("assign", str(len(self.assign_exprs) - 1))
 
     def if_block(self, item: etree._Element) -> list[Action]:
         """``<if>``/``<elseif>``/``<else>``: branches chosen by guards (inputs of the
@@ -396,16 +439,16 @@ class _Doc:
                 "<if> ignored: its branches are empty", line=item.sourceline, element="<if>"
             )
             return []
-        effectless = not _event_names([a for branch in wrapper_actions for a in branch])
         guarded: list[tuple[int | None, list[Action]]] = []
-        for (cond, _origin), effects in zip(branches, wrapper_actions):
-            index = None if cond is None else self.guard(cond, item, internal=not effectless)
-            if index is not None and effectless:
-                self.data_only_guards.add(index)
+        indices: list[int] = []
+        for (cond, origin), effects in zip(branches, wrapper_actions):
+            index = None if cond is None else self.guard(cond, origin, internal=False)
+            if index is not None:
+                indices.append(index)
             guarded.append((index, effects))
-        if effectless:
-            self.effectless_ifs.append(item.sourceline)
-        return [_If(guarded, effectless)]
+        block = _If(guarded)
+        self.ifs.append((block, indices, item.sourceline))
+        return [block]
 
     def event_name(self, item: etree._Element) -> str:
         event = item.get("event")
@@ -414,6 +457,44 @@ class _Doc:
                 item, f"unsupported: <{local_name(item)}> without a literal event name (eventexpr)"
             )
         return event
+
+    def send_data(self, item: etree._Element) -> list[Action]:
+        """The data a ``<send>`` evaluates before sending (``<param>``, ``<content expr>``,
+        ``namelist``), as a ``("params", "line:unsafe:reads_event")`` action before it: its
+        values are event data fsmbt does not model, but its failure (W3C: ``error.execution``,
+        the send and the rest of the block skipped) is. ``unsafe``: an expression fsmbt cannot
+        vouch for (checked like a ``<script>``); ``reads_event``: reads ``_event``, which fails
+        before the first event (checked while exploring)."""
+        texts = [
+            child.get("expr") or child.get("location") or ""
+            for child in item
+            if isinstance(child.tag, str) and self.tag(child) in ("param", "content")
+        ]
+        texts = [t for t in texts if t.strip()]
+        texts.extend((item.get("namelist") or "").split())
+        if not texts:
+            return []
+        self.ctx.warn(
+            "<param>/<content> of <send> not evaluated (event data fsmbt does not model)",
+            line=item.sourceline,
+            element="<send>",
+        )
+        unsafe = reads_event = False
+        for text in texts:
+            if _EVENT_FIELD.match(text):
+                reads_event = True
+                continue
+            try:
+                expr = scxml_expr.parse(text)
+            except scxml_expr.ExpressionError:
+                unsafe = True
+                continue
+            reads_event |= scxml_expr.EVENT_NAME in expr.names
+            declared = {d.name for d in self.data}
+            unsafe |= not expr.names - {scxml_expr.EVENT_NAME} <= declared
+        if not unsafe and not reads_event:
+            return []
+        return [("params", f"{item.sourceline or 0}:{int(unsafe)}:{int(reads_event)}")]
 
     def send(self, item: etree._Element) -> Action | None:
         delay = (item.get("delay") or "").strip()
@@ -440,6 +521,13 @@ class _Doc:
         if kind not in (None, "http://www.w3.org/TR/scxml/#SCXMLEventProcessor", "scxml"):
             raise self.refuse(item, f"unsupported: <send> of type '{kind}'")
         target = item.get("target")
+        if target not in (None, "#_internal"):
+            raise self.refuse(item, f"unsupported: <send> to target '{target}' (another session)")
+        queue = "external" if target is None else "internal"
+        expression = item.get("eventexpr")
+        if expression is not None and item.get("event") is None:
+            self.send_exprs.append(SendExpr(expression, item.sourceline))
+            return (f"{queue}_expr", str(len(self.send_exprs) - 1))
         name = self.event_name(item)
         if target is None:
             return ("external", name)
@@ -500,89 +588,225 @@ class _Doc:
         text = " ".join(cond_text.split())
         if text not in self.guards:
             self.guards.append(text)
+            self.guard_lines[len(self.guards) - 1] = element.sourceline
         index = self.guards.index(text)
         if internal:
             self.branch_guards.add(index)
         return index
 
-    def decide_data_mode(self) -> None:
-        """Exact data (every guard, assignment and initial value in the small expression
-        language, every variable declared) or guards as inputs of the environment."""
-        declared = {name for name, _expr, _content, _line in self.data}
-        try:
-            if self.ctx.options.get("data") != "exact":
-                raise scxml_expr.ExpressionError("exact data is opt-in (reader option data=exact)")
-            guards = [scxml_expr.parse(text) for text in self.guards]
-            assigns = []
-            for location, expr, _line in self.assign_exprs:
-                if location not in declared or expr is None:
-                    raise scxml_expr.ExpressionError(f"assignment to '{location}'")
-                assigns.append(scxml_expr.parse(expr))
-            initial: dict[str, scxml_expr.Value] = {}
-            for name, expr, has_content, _line in self.data:
-                if has_content:
-                    raise scxml_expr.ExpressionError(f"<data id='{name}'> with content")
-                value = scxml_expr.parse(expr) if expr is not None else None
-                if value is not None and value.names:
-                    raise scxml_expr.ExpressionError("initial value reads a variable")
-                initial[name] = (
-                    None if value is None else scxml_expr.evaluate(value, {}, lambda _s: False)
+    def decide_data(self) -> None:
+        """The data plan (``fsmbt.formats.scxml_datamodel``: tracked variables, computed conds,
+        exact event expressions), the warnings for what it ignores, and the ``<script>`` and
+        failing-content checks (docs/formats/scxml.md, "Data read exactly")."""
+        descriptors = sorted({d for n in self.states for t in n.transitions for d in t.events})
+        dialect = None if self.ctx.options.get("data") == "inputs" else self.dialect
+        used: set[int] = set(self.transition_guards)
+        while True:  # an <if> with effects makes its conds used: they may make more relevant
+            try:
+                plan = scxml_datamodel.plan(
+                    dialect,
+                    self.data,
+                    self.assign_exprs,
+                    self.guards,
+                    self.send_exprs,
+                    descriptors,
+                    used,
                 )
-            if any(not e.names <= declared for e in [*guards, *assigns]):
-                raise scxml_expr.ExpressionError("reads an undeclared name")
-        except scxml_expr.ExpressionError as exc:
-            self.data_mode, self.data_reason = False, str(exc)
-            for line in self.effectless_ifs:
-                self.ctx.warn(
-                    "<if> ignored: no branch raises or sends an event", line=line, element="<if>"
+            except scxml_datamodel.Refusal as refusal:
+                message = refusal.message
+                if refusal.line is not None and f"line {refusal.line}" not in message:
+                    message += f", line {refusal.line}"
+                location = self.ctx.location(refusal.line)
+                raise UnsupportedError(message, location=location) from None
+            self.plan = plan
+            grown = set(used)
+            for block, indices, _line in self.ifs:
+                inner = _flatten([a for _g, branch in block.branches for a in branch])
+                block.effectless = not any(
+                    self.matters(a, descriptors, events=False) for a in inner
                 )
-            for location, _expr, line in self.assign_exprs:
+                if not block.effectless:
+                    grown.update(indices)
+            if grown == used:
+                break
+            used = grown
+        blocks = self.blocks()
+        for block, indices, line in self.ifs:
+            if block.effectless:
                 self.ctx.warn(
-                    f"<assign> to '{location}' ignored (no guard reads it)",
+                    "<if> ignored: no branch raises or sends an event, or changes a variable a "
+                    "cond reads",
                     line=line,
-                    element="<assign>",
+                    element="<if>",
                 )
-            if self.data:
+            else:
+                self.branch_guards.update(g for g in indices if g not in plan.computed)
+        for index, a in enumerate(self.assign_exprs):
+            if index not in plan.assigns:
+                what = "<var>" if a.declares else "<assign>"
                 self.ctx.warn(
-                    f"<datamodel> ignored (guards are inputs of the environment: {exc})",
-                    line=self.data[0][3],
-                    element="<datamodel>",
+                    f"{what} to '{a.location}' ignored (no cond reads it)",
+                    line=a.line,
+                    element=what,
                 )
-            self.check_assignments()
-            return
-        self.data_mode = bool(self.data)
-        self.parsed_guards, self.parsed_assigns, self.initial_data = guards, assigns, initial
-        if not self.data_mode:
-            for line in self.effectless_ifs:
-                self.ctx.warn(
-                    "<if> ignored: no branch raises or sends an event", line=line, element="<if>"
-                )
-            for location, _expr, line in self.assign_exprs:
-                self.ctx.warn(
-                    f"<assign> to '{location}' ignored (no guard reads it)",
-                    line=line,
-                    element="<assign>",
-                )
-            self.check_assignments()
-        else:
+        for index in sorted(plan.dropped_sends):
+            send = self.send_exprs[index]
             self.ctx.warn(
-                "the data model is read exactly (every guard and assignment is in "
-                "fsmbt's expression language): its values are part of each state"
+                f'<send eventexpr="{send.text}"> dropped: no event descriptor can match the '
+                "event it sends",
+                line=send.line,
+                element="<send>",
+            )
+        if plan.relevant:
+            constant = [n for n in plan.relevant if n not in plan.varying]
+            self.ctx.warn(
+                "the data model is read exactly (conds over it are computed): "
+                + (
+                    f"the values of {', '.join(plan.varying)} are part of each state"
+                    if plan.varying
+                    else ""
+                )
+                + ("; " if plan.varying and constant else "")
+                + (f"{', '.join(constant)} never change(s)" if constant else "")
+            )
+        elif self.data:
+            self.ctx.warn(
+                "<datamodel> ignored (no cond or event expression reads a variable that changes)",
+                line=self.data[0].line,
+                element="<datamodel>",
+            )
+        live = self.live_descriptors()  # an error.execution only live transitions take matters
+        self.check_scripts(live)
+        self.check_failures(blocks, live)
+
+    def live_descriptors(self) -> list[str]:
+        """The descriptors of the transitions that can change something (least fixpoint): a
+        transition with targets, or one whose content matters (an event a live transition
+        matches, an exact computed event, an assignment a cond reads). An event no live
+        transition matches is inert: taking a targetless transition without effects, or not,
+        is the same run (its exit set is empty, so it preempts nothing)."""
+        transitions = [t for n in self.states for t in n.transitions]
+        live = [bool(t.targets) for t in transitions]
+        changed = True
+        while changed:
+            changed = False
+            descriptors = [d for t, on in zip(transitions, live) if on for d in t.events]
+            for n, t in enumerate(transitions):
+                if not live[n] and any(self.matters(a, descriptors) for a in _flatten(t.actions)):
+                    live[n] = changed = True
+        return sorted({d for t, on in zip(transitions, live) if on for d in t.events})
+
+    def blocks(self) -> list[list[Action]]:
+        """Every block of executable content (W3C: an error skips the rest of its block)."""
+        out: list[list[Action]] = []
+        for node in self.states:
+            out.extend([node.onentry, node.onexit, node.initial_actions])
+            out.extend(t.actions for t in node.transitions)
+        return [block for block in out if block]
+
+    def matters(self, action: Action, descriptors: list[str], *, events: bool = True) -> bool:
+        """Whether ``action`` can change what the machine does: an event some descriptor
+        matches, an exact computed event, an assignment to a variable a cond reads."""
+        if isinstance(action, _If):
+            return False  # its branches are walked on their own
+        kind, value = action
+        if kind == "assign":
+            return int(value) in self.plan.assigns
+        if kind in ("script", "params"):
+            return False
+        if kind.endswith("_expr"):
+            return int(value) in self.plan.sends and self.send_may_match(int(value), descriptors)
+        return any(scxml_datamodel.matches(d, value) for d in descriptors) or not events
+
+    def send_may_match(self, index: int, descriptors: list[str]) -> bool:
+        """Whether an exact ``eventexpr`` may send an event one of ``descriptors`` matches."""
+        text = self.send_exprs[index].text
+        prefix = scxml_datamodel.literal_prefix(text)
+        if prefix is not None:
+            return scxml_datamodel.may_match_prefix(descriptors, prefix)
+        expr = self.plan.sends[index]
+        if len(expr.postfix) == 1 and expr.postfix[0][0] == "value":
+            name = scxml_expr.shown(expr.postfix[0][1])  # type: ignore[arg-type]
+            return any(scxml_datamodel.matches(d, name) for d in descriptors)
+        return True
+
+    def may_fail(self, action: Action) -> bool:
+        """Whether an ignored action may fail (W3C: ``error.execution``, the rest of its
+        block skipped): a ``<script>``, an ``<assign>`` fsmbt does not evaluate whose location
+        or expression it cannot vouch for."""
+        if isinstance(action, _If):
+            return False
+        kind, value = action
+        if kind == "script":
+            return True
+        if kind == "params":
+            return value.split(":")[1] == "1"
+        if kind != "assign" or int(value) in self.plan.assigns:
+            return False
+        a = self.assign_exprs[int(value)]
+        dialect = self.plan.dialect
+        if dialect is None or a.location not in self.plan.declared or a.expr is None:
+            return True
+        try:
+            expr = scxml_expr.parse(a.expr, dialect)
+        except scxml_expr.ExpressionError:
+            return True
+        return not dialect.undeclared_is_null and not expr.names <= self.plan.declared
+
+    def check_scripts(self, descriptors: list[str]) -> None:
+        if not self.scripts:
+            return
+        reason = self.plan.reads_data
+        if reason is None and scxml_datamodel.matches_error_execution(descriptors):
+            reason = "a transition takes error.execution, which a failing script raises"
+        line = self.scripts[0]
+        if reason is not None:
+            raise UnsupportedError(
+                f"unsupported: <script> ({reason}), line {line}",
+                location=self.ctx.location(line),
+                element="<script>",
+            )
+        for line in self.scripts:
+            self.ctx.warn(
+                "<script> ignored: it cannot affect control flow (no cond or event "
+                "expression reads the data model, no transition takes error.execution)",
+                line=line,
+                element="<script>",
             )
 
-    def check_assignments(self) -> None:
-        read: set[str] = set()
-        for index, text in enumerate(self.guards):
-            if index in self.transition_guards or index in self.branch_guards:
-                read.update(_IDENT.findall(text))
-        for location, line in self.assigned:
-            root_name = _IDENT.match(location)
-            if root_name and root_name.group(0) in read:
-                raise UnsupportedError(
-                    f"unsupported: <assign> to '{location}', which a guard reads, line {line}",
-                    location=self.ctx.location(line),
-                    element="<assign>",
-                )
+    def check_failures(self, blocks: list[list[Action]], descriptors: list[str]) -> None:
+        failing = scxml_datamodel.matches_error_execution(descriptors)
+        for block in blocks:
+            first_failing: Action | None = None
+            for action in _flatten(block):
+                if first_failing is None and self.may_fail(action):
+                    first_failing = action
+                    if failing:
+                        break
+                elif first_failing is not None and self.matters(action, descriptors):
+                    break
+            else:
+                continue
+            assert first_failing is not None and not isinstance(first_failing, _If)
+            kind, value = first_failing
+            if kind == "script":
+                what, line = "<script>", int(value)
+            elif kind == "params":
+                what, line = "<param>/<content> of <send>", int(value.split(":")[0])
+            else:
+                a = self.assign_exprs[int(value)]
+                what, line = f"<assign> to '{a.location}'", a.line or 0
+            effect = (
+                "a transition takes error.execution"
+                if failing
+                else "a failure would skip what follows it in its block"
+            )
+            raise UnsupportedError(
+                f"unsupported: {what} that fsmbt does not evaluate may fail ({effect}), "
+                f"line {line}",
+                location=self.ctx.location(line),
+                element=what.split(" ")[0],
+            )
 
 
 @dataclass
@@ -596,13 +820,18 @@ class _Run:
     running: bool = True
     moved: bool = False
     valuation: dict[int, bool] = field(default_factory=dict)  # the environment's guard values
-    data: dict[str, scxml_expr.Value] = field(default_factory=dict)  # exact data mode
+    data: dict[str, scxml_expr.Value] = field(default_factory=dict)  # the relevant variables
     read: set[int] = field(default_factory=set)  # guards read so far
     # invoked sessions (fsmbt.formats.scxml_invoke)
     sessions: dict[str, scxml_invoke.Child] = field(default_factory=dict)
     to_invoke: list[int] = field(default_factory=list)  # states entered in this macro step
     outbox: list[str] = field(default_factory=list)  # events for the parent session
     serial: int = 0
+    event: str | None = None  # _event.name: the event being processed (None: none yet)
+
+
+#: A value that could not be computed: ``error.execution`` was raised.
+_FAILED = object()
 
 
 class _Interpreter:
@@ -610,6 +839,7 @@ class _Interpreter:
         self.doc = doc
         self.s = doc.states
         self.order = doc.order
+        self.descriptors = sorted({d for n in doc.states for t in n.transitions for d in t.events})
         self.ancestors: list[list[int]] = []
         for node in self.s:
             chain, parent = [], node.parent
@@ -663,21 +893,32 @@ class _Interpreter:
     def guard_holds(
         self, index: int, run: _Run, valuation: dict[int, bool], read: set[int]
     ) -> bool:
-        """A guard's value: computed from the data (exact mode; an error is false, W3C
-        5.9.1) or the environment's choice."""
-        if self.doc.data_mode:
-            try:
-                return scxml_expr.truthy(
-                    scxml_expr.evaluate(
-                        self.doc.parsed_guards[index],
-                        run.data,
-                        lambda state_id: self.doc.by_id.get(state_id, -1) in run.config,
-                    )
-                )
-            except scxml_expr.ExpressionError:
-                return False
-        read.add(index)
-        return valuation.get(index, False)
+        """A guard's value: computed from the data when the plan computes it (an
+        ``error.execution`` is false, W3C 5.9.1), else the environment's choice."""
+        expr = self.doc.plan.computed.get(index)
+        if expr is None:
+            read.add(index)
+            return valuation.get(index, False)
+        value = self.value(expr, run, self.doc.guard_lines.get(index))
+        return value is not _FAILED and scxml_expr.truthy(value)  # type: ignore[arg-type]
+
+    def value(self, expr: scxml_expr.Expr, run: _Run, line: int | None) -> object:
+        """``expr``'s value in ``run``; ``_FAILED`` after raising ``error.execution``."""
+        try:
+            return scxml_expr.evaluate(
+                expr,
+                run.data,
+                lambda state_id: self.doc.by_id.get(state_id, -1) in run.config,
+                run.event,
+            )
+        except scxml_expr.ExecutionError:
+            run.internal.append(scxml_datamodel.ERROR_EXECUTION)
+            return _FAILED
+        except scxml_expr.ExpressionError as exc:
+            raise UnsupportedError(
+                f"unsupported: '{expr.text}': {exc}, line {line}",
+                location=self.doc.ctx.location(line),
+            ) from None
 
     def select(
         self, run: _Run, event: str | None, valuation: dict[int, bool], read: set[int]
@@ -757,11 +998,13 @@ class _Interpreter:
 
     # -- micro step -----------------------------------------------------------------------------
     def perform(self, actions: list[Action], run: _Run) -> None:
+        """Run a block of executable content; an ``error.execution`` skips the rest of it."""
+        plan = self.doc.plan
         stack = list(reversed(actions))
         while stack:
             action = stack.pop()
             if isinstance(action, _If):
-                if action.effectless and not self.doc.data_mode:
+                if action.effectless:
                     continue
                 for guard, inner in action.branches:
                     if guard is None or self.guard_holds(guard, run, run.valuation, run.read):
@@ -772,35 +1015,57 @@ class _Interpreter:
             if kind == "parent" or kind.startswith("session:"):
                 scxml_invoke.route(run, self.doc.session.invoked, kind, name)
                 continue
+            if kind == "script":
+                continue
+            if kind == "params":
+                if name.endswith(":1") and run.event is None:  # _event before any event
+                    run.internal.append(scxml_datamodel.ERROR_EXECUTION)
+                    return
+                continue
             if kind == "assign":
-                if self.doc.data_mode:
-                    self.assign(int(name), run)
+                index = int(name)
+                if index in plan.assigns:
+                    a = self.doc.assign_exprs[index]
+                    value = self.value(plan.assigns[index], run, a.line)
+                    if value is _FAILED:
+                        return
+                    run.data[a.location] = value  # type: ignore[assignment]
+                continue
+            if kind.endswith("_expr"):
+                index = int(name)
+                if index in plan.dropped_sends:
+                    continue
+                event = self.sent_event(index, run)
+                if event is None:
+                    return
+                (run.external if kind == "external_expr" else run.internal).append(event)
                 continue
             (run.external if kind == "external" else run.internal).append(name)
 
-    def assign(self, index: int, run: _Run) -> None:
-        location = self.doc.assign_exprs[index][0]
+    def sent_event(self, index: int, run: _Run) -> str | None:
+        """The event name a ``<send eventexpr>`` computes (``None``: ``error.execution``)."""
+        expr = self.doc.plan.sends[index]
+        line = self.doc.send_exprs[index].line
+        value = self.value(expr, run, line)
+        if value is _FAILED:
+            return None
         try:
-            value = scxml_expr.evaluate(
-                self.doc.parsed_assigns[index],
-                run.data,
-                lambda state_id: self.doc.by_id.get(state_id, -1) in run.config,
-            )
+            name = scxml_expr.text_of(value)  # type: ignore[arg-type]
         except scxml_expr.ExpressionError as exc:
             raise UnsupportedError(
-                f"unsupported: {exc} (error.execution), line {self.doc.assign_exprs[index][2]}"
+                f'unsupported: <send eventexpr="{expr.text}">: {exc}, line {line}',
+                location=self.doc.ctx.location(line),
             ) from None
-        if (
-            isinstance(value, (int, float))
-            and abs(value) > MAX_DATA_MAGNITUDE
-            or isinstance(value, str)
-            and len(value) > MAX_DATA_MAGNITUDE
+        if scxml_expr.EVENT_NAME in expr.names and any(
+            d.startswith(name + ".") for d in self.descriptors
         ):
             raise UnsupportedError(
-                f"unsupported: '{location}' grows without bound (past "
-                f"{MAX_DATA_MAGNITUDE}), line {self.doc.assign_exprs[index][2]}"
+                f"unsupported: <send eventexpr=\"{expr.text}\"> sends '{name}', and a longer "
+                "event name for which fsmbt's event stands would send an event another "
+                f"descriptor matches, line {line}",
+                location=self.doc.ctx.location(line),
             )
-        run.data[location] = value
+        return name
 
     def microstep(self, enabled: list[_T], run: _Run) -> None:
         run.moved = True
@@ -911,7 +1176,8 @@ class _Interpreter:
             if not enabled:
                 if not run.internal:
                     return
-                enabled = self.select(run, run.internal.popleft(), valuation, read)
+                run.event = run.internal.popleft()
+                enabled = self.select(run, run.event, valuation, read)
             if enabled:
                 self.microstep(enabled, run)
         raise InputError(
@@ -956,6 +1222,7 @@ class _Interpreter:
         event = scxml_invoke.before_external(self, run, item)
         if event is None:
             return
+        run.event = event  # _event.name while its transitions run
         enabled = self.select(run, event, run.valuation, run.read)
         if enabled:
             self.microstep(enabled, run)
@@ -999,7 +1266,7 @@ class _Interpreter:
                 parts.append(f"{self.s[h].name}={inner}")
             text += "#" + ";".join(parts)
         if data:
-            values = ";".join(f"{k}={scxml_expr.text_of(v)}" for k, v in data)
+            values = ";".join(f"{k}={scxml_expr.shown(v)}" for k, v in data)
             text += ("#" if not history else ";") + values
         return text
 
@@ -1034,7 +1301,7 @@ def _symbols(doc: _Doc, interp: _Interpreter) -> list[tuple[str, str, dict[int, 
     def guards_of(names: list[str], eventless: bool) -> set[int]:
         out: set[int] = set()
         for t in all_t:
-            if t.cond is None or t.cond[0] != "guard":
+            if t.cond is None or t.cond[0] != "guard" or int(t.cond[1]) in doc.plan.computed:
                 continue
             hit = (eventless and not t.events) or any(
                 _matches(d, e) for d in t.events for e in names
@@ -1044,11 +1311,14 @@ def _symbols(doc: _Doc, interp: _Interpreter) -> list[tuple[str, str, dict[int, 
         return out
 
     internal = guards_of(sorted(generated), True) | doc.branch_guards
-    if doc.data_mode:  # guards are computed from the data, not chosen
-        return sorted(
-            ((event, event, {}) for event in events),
-            key=lambda item: (-item[1].count("."), item[0]),
-        )
+    if doc.plan.sends:  # computed event names: any transition's input guard may be read
+        internal |= {
+            int(t.cond[1])
+            for t in all_t
+            if t.cond is not None
+            and t.cond[0] == "guard"
+            and int(t.cond[1]) not in doc.plan.computed
+        }
     symbols: list[tuple[str, str, dict[int, bool]]] = []  # sorted below
     for event in events:
         relevant = sorted(guards_of([event], False) | internal)
@@ -1089,9 +1359,11 @@ def read_scxml_w3c(text: str, ctx: ReadContext) -> FSM:
     has_history = any(s.kind == "history" for s in doc.states)
     flat = FSM(name=doc.root_name, attrs=dict(doc.root_attrs))
     for n, guard in enumerate(doc.guards):
+        if n in doc.plan.computed:
+            continue
         flat.attrs[f"{{{FSMBT_NS}}}guard.g{n + 1}"] = guard
         ctx.warn(f"guard g{n + 1} is an input of the environment: {guard}")
-    start = _Run(set(), {}, data=dict(doc.initial_data))
+    start = _Run(set(), {}, data=dict(doc.plan.initial))
     read: set[int] = set()
     interp.process(start, None, {}, read)
     if read:
@@ -1099,7 +1371,10 @@ def read_scxml_w3c(text: str, ctx: ReadContext) -> FSM:
             "unsupported: a cond guard read before the first event "
             f"(g{min(read) + 1}: {doc.guards[min(read)]})"
         )
-    max_states = limits.current().max_states
+    bounds = limits.current()
+    max_states = bounds.max_states
+    if doc.plan.has_data:  # configurations x valuations: an exploration like a conversion's
+        max_states = min(max_states, bounds.conversion_max_states)
     Key = tuple[
         frozenset[int],
         tuple[tuple[int, frozenset[int]], ...],
@@ -1110,7 +1385,7 @@ def read_scxml_w3c(text: str, ctx: ReadContext) -> FSM:
 
     def key_of(run: _Run) -> Key:
         hist = tuple(sorted(run.history.items())) if has_history else ()
-        data = tuple(sorted(run.data.items())) if doc.data_mode else ()
+        data = tuple((n, run.data[n]) for n in doc.plan.varying)
         return (frozenset(run.config), hist, run.running, data, scxml_invoke.sessions_key(run))
 
     names: dict[Key, str] = {}
@@ -1119,6 +1394,13 @@ def read_scxml_w3c(text: str, ctx: ReadContext) -> FSM:
     def visit(key: Key) -> str:
         if key not in names:
             if len(names) >= max_states:
+                if doc.plan.has_data:
+                    raise scxml_datamodel.limit_error(
+                        max_states,
+                        "conversion_max_states",
+                        limits.env_name("conversion_max_states"),
+                        (dict(seen[3]) for seen in names),
+                    )
                 raise InputError(f"more than {max_states} reachable configurations")
             suffix, child_actions = scxml_invoke.describe(doc, key[4])
             name = interp.name(key[0], key[1], key[3]) + suffix
@@ -1135,7 +1417,7 @@ def read_scxml_w3c(text: str, ctx: ReadContext) -> FSM:
             continue
         source = names[key]
         for symbol, event, valuation in symbols:
-            run = _Run(set(key[0]), dict(key[1]), data=dict(key[3]))
+            run = _Run(set(key[0]), dict(key[1]), data={**doc.plan.initial, **dict(key[3])})
             scxml_invoke.restore(doc, run, key[4])
             interp.process(run, event, valuation, set())
             if run.moved:
