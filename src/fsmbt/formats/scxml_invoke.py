@@ -375,7 +375,7 @@ def start_pending(interp: _Interpreter, run: _Run) -> None:
         return
     for index in pending:
         for inv in interp.s[index].invokes:
-            child_run = type(run)(set(), {}, data=dict(inv.doc.initial_data))
+            child_run = type(run)(set(), {}, data=dict(inv.doc.plan.initial))
             run.serial += 1
             child = Child(inv, child_run, run.serial)
             run.sessions[inv.invokeid] = child

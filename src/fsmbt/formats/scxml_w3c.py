@@ -521,11 +521,13 @@ class _Doc:
         if kind not in (None, "http://www.w3.org/TR/scxml/#SCXMLEventProcessor", "scxml"):
             raise self.refuse(item, f"unsupported: <send> of type '{kind}'")
         target = item.get("target")
-        if target not in (None, "#_internal"):
-            raise self.refuse(item, f"unsupported: <send> to target '{target}' (another session)")
-        queue = "external" if target is None else "internal"
         expression = item.get("eventexpr")
         if expression is not None and item.get("event") is None:
+            if target not in (None, "#_internal"):
+                raise self.refuse(
+                    item, f"unsupported: <send eventexpr> to target '{target}' (another session)"
+                )
+            queue = "external" if target is None else "internal"
             self.send_exprs.append(SendExpr(expression, item.sourceline))
             return (f"{queue}_expr", str(len(self.send_exprs) - 1))
         name = self.event_name(item)
