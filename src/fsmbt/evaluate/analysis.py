@@ -259,7 +259,9 @@ def nusmv_table(table_rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
     return out
 
 
-def nusmv_sample_rows(table_rows: list[dict[str, Any]], entries: list[Entry]) -> list[dict[str, Any]]:
+def nusmv_sample_rows(
+    table_rows: list[dict[str, Any]], entries: list[Entry]
+) -> list[dict[str, Any]]:
     """Which models NuSMV checked, each with its size and the verdict per method."""
     by_id = {e.id: e for e in entries}
     found: dict[str, dict[str, Any]] = {}
@@ -342,7 +344,9 @@ def headline(
         flat = " / ".join(
             "error" if c["flat_distance"] is None else f"{c['flat_distance']:.0f}" for c in chosen
         )
-        return f"{written} as written (k = {', '.join(str(c['k']) for c in chosen)}); {flat} flattened"
+        return (
+            f"{written} as written (k = {', '.join(str(c['k']) for c in chosen)}); {flat} flattened"
+        )
     chosen_costs = [c for c in costs if matches(c["method"], key[1])]
     found_costs = [c for c in chosen_costs if "text" not in c]
     if not found_costs:

@@ -42,7 +42,12 @@ PAPER_NUMBERS: tuple[tuple[str, str, str, tuple[str, ...]], ...] = (
     ("conversion accuracy, rule-based engine", NOT_RECORDED, "Tables I/VI", ("accuracy", "rules")),
     ("conversion accuracy, BSD", NOT_RECORDED, "Tables I/VI", ("accuracy", "bsd")),
     ("conversion accuracy, CHDS", NOT_RECORDED, "Tables I/VI", ("accuracy", "chds")),
-    ("graphical elements, BT->FSM, LLMDUCF", "4M+2k+1", "Table IV", ("elements", "bt->fsm", "rules")),
+    (
+        "graphical elements, BT->FSM, LLMDUCF",
+        "4M+2k+1",
+        "Table IV",
+        ("elements", "bt->fsm", "rules"),
+    ),
     ("graphical elements, BT->FSM, BSD", "≈36M", "Table IV", ("elements", "bt->fsm", "bsd")),
     ("graphical elements, BT->FSM, CHDS", "≈36M", "Table IV", ("elements", "bt->fsm", "chds")),
     ("graphical elements, FSM->BT, LLMDUCF", "≈7M−1", "Table IX", ("elements", "fsm->bt", "rules")),

@@ -587,7 +587,7 @@ def _markdown(
         "",
         f"NuSMV (with the native checker: `both`, they must agree) checks a stated sample, "
         f"not every model: it is 100x–5 000x slower than the native checker and the ratio "
-        f"grows with size (docs/nusmv.md, \"Cost\"); the native checker covers every model. "
+        f'grows with size (docs/nusmv.md, "Cost"); the native checker covers every model. '
         f"The sample: the examples {', '.join(NUSMV_EXAMPLES)} (present here: "
         f"{', '.join(examples_in) or 'none'}), then {len(generated_in)} generated models drawn "
         f"with the seed from those of at most {NUSMV_MAX_STATES} states (FSM) / "
@@ -639,7 +639,7 @@ def _markdown(
     parts += [
         "## The paper's headline numbers next to ours",
         "",
-        f"Ours: measured in this run. \"{NOT_RECORDED}\": the paper reports the figure but "
+        f'Ours: measured in this run. "{NOT_RECORDED}": the paper reports the figure but '
         "its value is not in the repository (no number is invented).",
         "",
         _md_table(
