@@ -34,10 +34,15 @@ count_rows() {
 import sqlite3, sys
 try:
     with sqlite3.connect(sys.argv[1]) as db:
-        rows, keys = db.execute("SELECT COUNT(*), COUNT(DISTINCT key) FROM results").fetchone()
+        # finished rows only: a job handed out when the kill came has a 'pending' claim row
+        rows, keys = db.execute(
+            "SELECT COUNT(*), COUNT(DISTINCT key) FROM results"
+            " WHERE state = 'done' AND NOT COALESCE(retry, 0)"
+        ).fetchone()
+        pending = db.execute("SELECT COUNT(*) FROM results WHERE state = 'pending'").fetchone()[0]
 except sqlite3.Error:
-    rows, keys = 0, 0
-print(rows, keys)
+    rows, keys, pending = 0, 0, 0
+print(rows, keys, pending)
 EOF
 }
 
@@ -55,35 +60,41 @@ else
 fi
 wait "$first" 2>/dev/null || true
 killed_at=$(now)
-read -r rows_at_kill keys_at_kill < <(count_rows)
+read -r rows_at_kill keys_at_kill pending_at_kill < <(count_rows)
 echo "part 1: killed=$killed after $("$PY" -c "print(round($killed_at - $started, 1))") s;" \
-    "rows stored $rows_at_kill, distinct keys $keys_at_kill"
+    "finished rows stored $rows_at_kill, distinct keys $keys_at_kill;" \
+    "claimed but unfinished (pending) $pending_at_kill"
 
 resumed=$(now)
 nice -n 10 "$PY" -m fsmbt.cli evaluate -o "$OUT" --corpus "$CORPUS" --quiet \
     | tee "$OUT.part2.log"
 finished=$(now)
-read -r rows keys < <(count_rows)
+read -r rows keys pending < <(count_rows)
 
 status=0
 "$PY" - "$OUT" "$started" "$killed_at" "$resumed" "$finished" "$rows_at_kill" "$rows" "$keys" \
-    "$killed" <<'EOF' || status=$?
+    "$killed" "$pending" <<'EOF' || status=$?
 import json, sys
 from pathlib import Path
 out = Path(sys.argv[1])
 started, killed_at, resumed, finished = map(float, sys.argv[2:6])
-rows_at_kill, rows, keys, killed = map(int, sys.argv[6:10])
+rows_at_kill, rows, keys, killed, pending = map(int, sys.argv[6:11])
 runs = [json.loads(line) for line in (out / "runs.jsonl").read_text().splitlines() if line]
 last = runs[-1]
 run = json.loads((out / "run.json").read_text())
-ok = rows == keys == last["jobs"] == last["after"] and last["before"] == rows_at_kill
+ok = (
+    rows == keys == last["jobs"] == last["after"]
+    and last["before"] == rows_at_kill
+    and pending == 0
+)
 print(f"models {run['models']}, jobs {last['jobs']}")
 print(f"kills {killed}, resumes {killed}, completed invocations logged {len(runs)}")
 print(f"part 1 (killed): {killed_at - started:.1f} s, {rows_at_kill} rows stored")
 print(f"part 2 (resumed): found {last['before']}, ran {last['ran']}, stored after {last['after']};"
       f" batch {last['seconds']:.1f} s, with the report {finished - resumed:.1f} s")
 print(f"total wall time {finished - started:.1f} s")
-print(f"rows {rows} == jobs {last['jobs']} == distinct keys {keys}: {'yes' if ok else 'NO'}")
+print(f"rows {rows} == jobs {last['jobs']} == distinct keys {keys}, {pending} pending left,"
+      f" resume found exactly the rows stored at the kill: {'yes' if ok else 'NO'}")
 sys.exit(0 if ok else 1)
 EOF
 if [ "${DOCS_PLOTS:-0}" = "1" ]; then

@@ -282,7 +282,8 @@ def nusmv_sample_rows(
                 ),
             },
         )
-        row[r["method"]] = r["status"]
+        # a NuSMV encoder refusal is stored as bad_input (the reasons column names it)
+        row[r["method"]] = "not encodable" if r["status"] == "bad_input" else r["status"]
         row[f"{r['method']}_seconds"] = r["timings"].get("verify")
     return sorted(found.values(), key=lambda row: (row["source"] != "example", row["model"]))
 
