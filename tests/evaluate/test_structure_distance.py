@@ -17,6 +17,7 @@ from fsmbt.metrics import graph_edit_distance
 from fsmbt.metrics.edit_distance import fsm_graph, label_lower_bound
 from fsmbt.metrics.structure_distance import (
     anchored_matching,
+    branch_lower_bound,
     mapping_cost,
     structure_edit_distance,
     structure_graph,
@@ -79,6 +80,8 @@ def test_bounds_bracket_networkx_exact_ged_on_small_machines() -> None:
         (machine(2), machine(3)),
         (machine(2), machine(2, extra=True)),
         (machine(3), machine(2)),
+        (machine(2), machine(3, extra=True)),
+        (machine(2), machine(2, sub_name="Fallback")),
     ]
     for first, second in pairs:
         a, b = structure_graph(first), structure_graph(second)
@@ -86,18 +89,21 @@ def test_bounds_bracket_networkx_exact_ged_on_small_machines() -> None:
         exact = nx.graph_edit_distance(a, b, node_match=same, edge_match=same, timeout=30)
         d = structure_edit_distance(first, second, timeout=10)
         assert d.lower_bound is not None and d.lower_bound <= exact <= d.value
+        assert branch_lower_bound(a, b) <= exact and label_lower_bound(a, b) <= exact
         if d.exact:
             assert d.value == exact
 
 
 def test_lower_bound_never_exceeds_any_edit_script() -> None:
     a, b = structure_graph(machine(3)), structure_graph(machine(4, extra=True))
-    lower = label_lower_bound(a, b)
+    lower = max(label_lower_bound(a, b), branch_lower_bound(a, b))
+    assert branch_lower_bound(a, a) == 0
     right = list(b.nodes)
     chooser = random.Random(7)
-    for _ in range(50):
-        chooser.shuffle(right)
-        assert mapping_cost(a, b, dict(zip(a.nodes, right))) >= lower
+    for size in range(0, len(right), 3):  # partial matchings too: the rest deleted/inserted
+        for _ in range(10):
+            chooser.shuffle(right)
+            assert mapping_cost(a, b, dict(zip(list(a.nodes)[:size], right))) >= lower
     assert mapping_cost(a, b, anchored_matching(a, b)) >= lower
 
 
