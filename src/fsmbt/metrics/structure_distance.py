@@ -1,7 +1,8 @@
 """Graph edit distance of two FSMs *as written*: every level of the hierarchy, not flattened.
 
-This is the edit a modeller makes to the produced machine (docs/evaluation.md, "Edit
-distances"): the states, sub-FSMs and transitions to add, delete or change.
+This is the edit a modeller makes to the produced machine (docs/evaluation.md, "Why the
+methods differ as written and coincide flattened"): the states, sub-FSMs and transitions to
+add, delete or change.
 
 The graph (``structure_graph``):
 - a node per state of every level, its id the path of state names from the top machine, its
@@ -17,7 +18,7 @@ The graph (``structure_graph``):
 Unit costs (insert, delete, relabel a node or an edge: 1).
 
 The value (``structure_edit_distance``): exact graph edit distance is NP-hard and these graphs
-have 30-150 nodes, so the figure is bracketed:
+have tens of nodes (12-62 on the paper's add-behaviour cases), so the figure is bracketed:
 - an upper bound: the cost of one explicit edit script, the node matching ``anchored_matching``
   builds level by level (same label first, then by shared descendants), then across levels
   (a state moved into a new sub-FSM keeps its match), then leftover nodes of the same kind,
@@ -28,7 +29,8 @@ have 30-150 nodes, so the figure is bracketed:
 - ``networkx.optimize_edit_paths`` searching below the upper bound until ``timeout``.
 The value is exact when the bounds meet or the search finishes; otherwise it is the upper
 bound and ``lower_bound`` says how far the truth can be below it.
-Cost: O(N + T) to build, O(N^2) for the matching, plus the bounded search (``timeout``).
+Cost: O(N + T) to build, O(N^3) at most for the matching and the branch bound, then the
+local search and the networkx search, both stopped by ``timeout``.
 No recursion: explicit stacks.
 """
 
