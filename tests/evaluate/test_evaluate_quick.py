@@ -18,7 +18,14 @@ from fsmbt.cli import main
 from fsmbt.evaluate import EvaluationSettings, evaluate
 from fsmbt.evaluate.analysis import FORMULA_BAND
 from fsmbt.evaluate.dataset import build
-from fsmbt.evaluate.plan import NOT_RUN
+from fsmbt.evaluate.paper import NOT_RECORDED, paper_edit
+from fsmbt.evaluate.plan import (
+    NOT_RUN,
+    NUSMV_EXAMPLES,
+    NUSMV_MAX_NODES,
+    NUSMV_MAX_STATES,
+    nusmv_models,
+)
 from fsmbt.evaluate.stats import fit_slope, wilson
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
@@ -86,6 +93,52 @@ def test_consistency_and_manifest(report: Path) -> None:
     manifest = json.loads((report / "dataset/manifest.json").read_text())["models"]
     assert all(len(m["sha256"]) == 64 for m in manifest)
     assert len(tables["edit_distances"]) == 18
+
+
+def test_every_table_sets_the_paper_beside_ours(report: Path) -> None:
+    markdown = (report / "report.md").read_text()
+    sections = markdown.split("\n## ")[1:]
+    tables = [s for s in sections if not s.startswith("Dataset")]
+    assert len(tables) == 9
+    for section in tables:
+        assert "paper" in section.lower(), section.splitlines()[0]
+    heads = json.loads((report / "tables.json").read_text())["paper"]
+    assert all(h["ours"] for h in heads)
+    accuracy = [h for h in heads if h["source"] == "Tables I/VI"]
+    assert len(accuracy) == 4 and all(h["paper"] == NOT_RECORDED for h in accuracy)
+    assert accuracy[0]["ours"] == NOT_RUN  # the LLM: no endpoint in the tests
+    assert accuracy[1]["ours"].startswith("rules 100.0 %")
+    edits = [h for h in heads if h["figure"].startswith("edit distance")]
+    assert len(edits) == 6 and all("as written" in h["ours"] for h in edits)
+
+
+def test_edit_rows_give_both_distances_and_the_paper(report: Path) -> None:
+    rows = json.loads((report / "tables.json").read_text())["edit_distances"]
+    for row in rows:
+        assert row["verified"] == "EQUIVALENT", row
+        assert row["paper"] == paper_edit(row["scenario"], row["case"], row["method"], row["k"])
+        assert row["lower_bound"] <= row["distance"]
+        assert row["flat_distance"] is not None
+        if row["method"] == "bsd":
+            assert row["k"] == row["k_base"] == 0  # BSD's result is flat
+    by = {(r["case"], r["method"]): r for r in rows}
+    # the measure as written separates the methods; flattened they coincide
+    safe = "Safe-Move-To behaviour"
+    assert by[(safe, "rules")]["lower_bound"] > by[(safe, "bsd")]["distance"]
+    assert by[(safe, "chds")]["lower_bound"] > by[(safe, "bsd")]["distance"]
+    assert len({by[(safe, m)]["flat_distance"] for m in ("rules", "bsd", "chds")}) == 1
+
+
+def test_nusmv_sample_names_the_examples(tmp_path: Path) -> None:
+    entries = build(tmp_path, seed=0, count=4, examples=EXAMPLES, corpus=None)
+    chosen = nusmv_models(entries, seed=0, count=3)
+    assert [e.id for e in chosen[:2]] == list(NUSMV_EXAMPLES)
+    assert len(chosen) == 5 and all(e.source == "generated" for e in chosen[2:])
+    for e in chosen[2:]:
+        limit = e.size["states"] <= NUSMV_MAX_STATES if e.kind == "fsm" else None
+        assert limit if limit is not None else e.size["nodes"] <= NUSMV_MAX_NODES
+    assert chosen == nusmv_models(entries, seed=0, count=3)
+    assert nusmv_models(entries, seed=0, count=0) == []
 
 
 def test_resume_runs_nothing_again(report: Path) -> None:

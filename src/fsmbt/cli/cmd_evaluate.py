@@ -34,7 +34,12 @@ def register(app: typer.Typer) -> None:
             "--count",
             help="generated models per scenario and kind (default 200, 10 with --quick)",
         ),
-        nusmv: int = typer.Option(30, "--nusmv", help="models NuSMV also checks (0: none)"),
+        nusmv: int = typer.Option(
+            30,
+            "--nusmv",
+            help="generated models NuSMV also checks, besides the robot BT and predator FSM "
+            "examples (0: no NuSMV at all)",
+        ),
         workers: int = typer.Option(2, "--workers", help="worker processes"),
         executor: str = typer.Option("local", "--executor", help="local or ray"),
         ray_address: str | None = typer.Option(None, "--ray-address"),

@@ -257,3 +257,109 @@ def nusmv_table(table_rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
             }
         )
     return out
+
+
+def nusmv_sample_rows(
+    table_rows: list[dict[str, Any]], entries: list[Entry]
+) -> list[dict[str, Any]]:
+    """Which models NuSMV checked, each with its size and the verdict per method."""
+    by_id = {e.id: e for e in entries}
+    found: dict[str, dict[str, Any]] = {}
+    for r in table_rows:
+        if r["verifier"] != "both" or r["method"] not in RULE_ENGINES:
+            continue
+        entry = by_id[r["model"]]
+        row = found.setdefault(
+            entry.id,
+            {
+                "model": entry.id,
+                "source": entry.source,
+                "kind": entry.kind,
+                "size": (
+                    f"{entry.size.get('states', 0)} states"
+                    if entry.kind == "fsm"
+                    else f"{entry.size.get('nodes', 0)} nodes"
+                ),
+            },
+        )
+        # a NuSMV encoder refusal is stored as bad_input (the reasons column names it)
+        row[r["method"]] = "not encodable" if r["status"] == "bad_input" else r["status"]
+        row[f"{r['method']}_seconds"] = r["timings"].get("verify")
+    return sorted(found.values(), key=lambda row: (row["source"] != "example", row["model"]))
+
+
+def _edit_cell(row: dict[str, Any]) -> str:
+    if row["distance"] is None:
+        return "error"
+    return f"{'' if row['exact'] else '≤'}{row['distance']:.0f}"
+
+
+def headline(
+    key: tuple[str, ...],
+    acc: list[dict[str, Any]],
+    formulas: list[dict[str, Any]],
+    case_rows: list[dict[str, Any]],
+    costs: list[dict[str, Any]],
+) -> str:
+    """Our figure for one of the paper's headline numbers (``paper.PAPER_NUMBERS``' keys).
+
+    Args:
+        key: ``("accuracy", method)``, ``("elements", direction, method)``,
+            ``("edit", scenario, method)``, ``("time", method)`` or ``("tokens", method)``;
+            ``llm`` stands for every ``llm[model]`` label.
+        acc: the accuracy table.
+        formulas: the element-fit table.
+        case_rows: the edit-distance rows.
+        costs: the cost table.
+
+    Returns:
+        The figure as text, ``NOT_RUN`` when the method did not run.
+    """
+
+    def matches(method: str, wanted: str) -> bool:
+        return method == wanted or (wanted == "llm" and method.startswith(("llm[", "nllm[")))
+
+    what = key[0]
+    if what == "accuracy":
+        chosen = [r for r in acc if matches(r["method"], key[1]) and r["group"] == "all"]
+        found = [r for r in chosen if "text" not in r and r["produced"]]
+        if not found:
+            return NOT_RUN
+        return "; ".join(
+            f"{r['method']} {_pct(r['accuracy'])} ({r['equivalent']}/{r['produced']}, "
+            f"Wilson [{_pct(r['wilson_low'])}, {_pct(r['wilson_high'])}])"
+            for r in found
+        )
+    if what == "elements":
+        fit = next(
+            (f for f in formulas if f["direction"] == key[1] and f["method"] == key[2]), None
+        )
+        if fit is None:
+            return NOT_RUN
+        return f"{fit['fitted_slope']:.2f}M{fit['intercept']:+.1f} (fit over {fit['n']})"
+    if what == "edit":
+        chosen = [c for c in case_rows if c["scenario"] == key[1] and c["method"] == key[2]]
+        if not chosen:
+            return NOT_RUN
+        written = " / ".join(_edit_cell(c) for c in chosen)
+        flat = " / ".join(
+            "error" if c["flat_distance"] is None else f"{c['flat_distance']:.0f}" for c in chosen
+        )
+        return (
+            f"{written} as written (k = {', '.join(str(c['k']) for c in chosen)}); {flat} flattened"
+        )
+    chosen_costs = [c for c in costs if matches(c["method"], key[1])]
+    found_costs = [c for c in chosen_costs if "text" not in c]
+    if not found_costs:
+        return NOT_RUN
+    if what == "time":
+        return "; ".join(
+            f"{c['method']} median {1000 * c['convert_median_s']:.1f} ms "
+            f"(p95 {1000 * c['convert_p95_s']:.1f} ms)"
+            for c in found_costs
+        )
+    return "; ".join(f"{c['method']} {c['tokens']}" for c in found_costs)
+
+
+def _pct(value: float | None) -> str:
+    return "–" if value is None else f"{100 * value:.1f} %"

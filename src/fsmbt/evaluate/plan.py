@@ -2,9 +2,13 @@
 
 Rules:
 - ``rules``, ``bsd`` and ``chds`` run on every readable model, verified by the native checker.
-- NuSMV verifies a stated sample: ``nusmv_sample`` models drawn with the run's seed from the
-  readable generated ones of at most ``NUSMV_MAX_STATES`` states / ``NUSMV_MAX_NODES`` nodes, each converted by the three rule engines and checked with
-  ``both`` (native and NuSMV must agree; a disagreement is an ``error`` row naming it).
+- NuSMV verifies a stated sample (``nusmv_models``): the examples named in ``NUSMV_EXAMPLES``
+  (the robot BT of the paper, ~1 s per engine, and the predator FSM), then ``nusmv_sample``
+  models drawn with the run's seed from the readable generated ones of at most
+  ``NUSMV_MAX_STATES`` states / ``NUSMV_MAX_NODES`` nodes; each converted by the three rule
+  engines and checked with ``both`` (native and NuSMV must agree; a disagreement is an
+  ``error`` row naming it). Why a sample: NuSMV is 100x-5 000x slower than the native checker
+  and the ratio grows with size (docs/nusmv.md, "Cost"); the native checker covers every model.
 - ``llm``, ``nllm`` and the SCP ablations (``llm`` without one SCP module each: the paper's
   Tables II/VII) run only when an OpenAI-compatible endpoint is configured
   (``fsmbt.llm.config.resolve_settings``), once per ``--llm-model``. Otherwise every table
@@ -96,10 +100,33 @@ NUSMV_MAX_STATES = 10
 NUSMV_MAX_NODES = 30
 
 
+#: Examples always in the NuSMV sample when ``nusmv_sample`` > 0 and they are in the dataset.
+NUSMV_EXAMPLES = ("example_robot_bt.xml", "example_predator_fsm.csv")
+
+
 def _small(entry: Entry) -> bool:
     if entry.kind == "fsm":
         return entry.size.get("states", 0) <= NUSMV_MAX_STATES
     return entry.size.get("nodes", 0) <= NUSMV_MAX_NODES
+
+
+def nusmv_models(entries: list[Entry], *, seed: int, count: int) -> list[Entry]:
+    """The models NuSMV also checks (see the module text).
+
+    Args:
+        entries: the dataset.
+        seed: the run's seed.
+        count: how many generated models to draw (0: no NuSMV at all).
+
+    Returns:
+        The ``NUSMV_EXAMPLES`` present and readable, then ``count`` drawn generated models.
+    """
+    if count <= 0:
+        return []
+    readable = [e for e in entries if e.readable]
+    examples = [e for name in NUSMV_EXAMPLES for e in readable if e.id == name]
+    pool = [e for e in readable if e.source == "generated" and _small(e)]
+    return examples + random.Random(f"nusmv:{seed}").sample(pool, min(count, len(pool)))
 
 
 def plan(
@@ -121,8 +148,7 @@ def plan(
     planned = [
         _job(e, outdir, engine, engine, "native", {}) for engine in RULE_ENGINES for e in entries
     ]
-    pool = [e for e in readable if e.source == "generated" and _small(e)]
-    sample = random.Random(f"nusmv:{seed}").sample(pool, min(nusmv_sample, len(pool)))
+    sample = nusmv_models(readable, seed=seed, count=nusmv_sample)
     planned += [
         _job(e, outdir, engine, engine, "both", {}) for engine in RULE_ENGINES for e in sample
     ]
