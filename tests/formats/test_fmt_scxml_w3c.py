@@ -308,3 +308,24 @@ def test_expressions_outside_the_language_do_not_parse(text: str) -> None:
 
     with pytest.raises(ExpressionError):
         parse(text)
+
+
+#: Also run by python-statemachine in tests/runtime/test_rt_scxml_reader_oracle.py.
+INVALID_TARGET = """
+  <state id="s"><transition event="go" target="t"/></state>
+  <state id="t">
+    <onentry><send target="_internal" event="sent"/><raise event="after"/></onentry>
+    <transition event="sent" target="got_it"/><transition event="after" target="went_on"/>
+    <transition event="error.execution" target="failed"/></state>
+  <state id="got_it"/><state id="went_on"/><state id="failed"/>"""
+
+
+def test_an_invalid_send_target_raises_error_execution_and_ends_its_block() -> None:
+    """W3C 6.2.4: a target that is neither special (``#_...``) nor a URI places
+    error.execution on the internal queue; the send sends nothing and the rest of the
+    ``<onentry>`` is skipped (so neither 'sent' nor 'after' happens)."""
+    ctx = ReadContext()
+    model = read_scxml(doc(INVALID_TARGET), ctx)
+    assert walk(model, ["go"]) == ["s", "failed"]
+    assert any("not a valid target" in w for w in ctx.warnings)
+

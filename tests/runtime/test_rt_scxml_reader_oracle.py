@@ -396,3 +396,22 @@ def test_departure_assign_fails_in_a_second_instance_of_one_loaded_class() -> No
     state, _ = fsmbt.start()
     assert fsmbt.step(state, "go")[0] == "n"
     assert Engine(text).configuration() == "s"
+
+
+def test_an_invalid_send_target_raises_error_execution_in_both() -> None:
+    """``<send target="_internal">`` (an older draft's spelling of ``#_internal``): W3C 6.2.4
+    and the engine raise error.execution and skip the rest of the block; so does fsmbt."""
+    text = (
+        '<scxml xmlns="http://www.w3.org/2005/07/scxml" version="1.0">'
+        '<state id="s"><transition event="go" target="t"/></state>'
+        '<state id="t"><onentry><send target="_internal" event="sent"/>'
+        '<raise event="after"/></onentry>'
+        '<transition event="sent" target="got_it"/><transition event="after" target="went_on"/>'
+        '<transition event="error.execution" target="failed"/></state>'
+        '<state id="got_it"/><state id="went_on"/><state id="failed"/></scxml>'
+    )
+    engine = Engine(text)
+    engine.send("go")
+    machine = FSMMachine(loads(text, "scxml"))
+    state, _ = machine.step(machine.start()[0], "go")
+    assert engine.configuration() == state == "failed"

@@ -74,7 +74,9 @@ class _If:
 #: ("raise" | "internal" | "external", event name), ("internal_expr" | "external_expr", index
 #: of a ``<send eventexpr>``), ("assign", index), ("script", line), or an ``<if>``.
 Action = tuple[str, str] | _If
-_NO_EVENT = frozenset({"assign", "script", "internal_expr", "external_expr", "params"})
+_NO_EVENT = frozenset(
+    {"assign", "script", "internal_expr", "external_expr", "params", "invalid_target"}
+)
 _EVENT_FIELD = re.compile(r"\s*_event\.[A-Za-z_$][\w$]*\s*$")
 
 
@@ -538,6 +540,17 @@ class _Doc:
         routed = scxml_invoke.send_target(self, target, name, item.sourceline)
         if routed is not None:
             return routed
+        if not target.startswith("#") and ":" not in target:
+            # neither a special target (#_...) nor a URI: W3C 6.2.4 says an invalid target
+            # places error.execution on the internal queue (python-statemachine agrees)
+            self.ctx.warn(
+                f"<send target='{target}'> is not a valid target (W3C: '#_internal', "
+                "'#_parent', '#_<invokeid>' or a URI): read as W3C says, it raises "
+                f"error.execution and sends nothing ('{target}' is an older draft's spelling?)",
+                line=item.sourceline,
+                element="<send>",
+            )
+            return ("invalid_target", str(item.sourceline or 0))
         raise self.refuse(item, f"unsupported: <send> to target '{target}' (another session)")
 
     def ids(self, text: str, element: etree._Element) -> list[int]:
@@ -716,6 +729,8 @@ class _Doc:
             return int(value) in self.plan.assigns
         if kind in ("script", "params"):
             return False
+        if kind == "invalid_target":  # it raises error.execution
+            return scxml_datamodel.matches_error_execution(descriptors) or not events
         if kind.endswith("_expr"):
             return int(value) in self.plan.sends and self.send_may_match(int(value), descriptors)
         return any(scxml_datamodel.matches(d, value) for d in descriptors) or not events
@@ -1019,6 +1034,9 @@ class _Interpreter:
                 continue
             if kind == "script":
                 continue
+            if kind == "invalid_target":  # W3C 6.2.4: error.execution, the block ends
+                run.internal.append(scxml_datamodel.ERROR_EXECUTION)
+                return
             if kind == "params":
                 if name.endswith(":1") and run.event is None:  # _event before any event
                     run.internal.append(scxml_datamodel.ERROR_EXECUTION)
