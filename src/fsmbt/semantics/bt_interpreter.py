@@ -1298,7 +1298,8 @@ class BTInterpreter:
         """LoopInt / LoopBool / LoopDouble / LoopString (loop_node.h, docs/semantics.md).
 
         ``params = (if_empty, length)``. A literal queue of ``length`` elements is reloaded when
-        the node is ticked while IDLE; its memory is how many elements are left. ``length = -1``
+        the node is ticked while IDLE; its memory is how many elements are left and whether the
+        child returned RUNNING on its last tick (``child_running_``). ``length = -1``
         (a {blackboard} queue, an abstraction): the gate, the last child, says whether the
         queue still has an element. An element is popped only while the child is not RUNNING;
         no element left returns ``if_empty`` without setting RUNNING (a SKIPPED result leaves
@@ -1306,22 +1307,21 @@ class BTInterpreter:
         if_empty, length = node.params
         child = node.children[0]
         pc = frame[1]
+        left, child_running = self._mem(w, node)
         if pc == 0:
-            child_running = w.st.get(child, IDLE) == RUNNING
+            if w.st.get(node.id, IDLE) == IDLE:
+                left, child_running = length, False  # the static queue is copied afresh
             if length < 0:
                 if child_running:
                     w.st[node.id] = RUNNING
                     return ("call", child, (node.id, 2))
                 return ("call", node.children[-1], (node.id, 1))
-            (left,) = self._mem(w, node)
-            if w.st.get(node.id, IDLE) == IDLE:
-                left = length  # the static queue is copied afresh
             if not child_running:
                 if left == 0:
-                    self._set_mem(w, node, (0,))
+                    self._set_mem(w, node, (0, False))
                     return ("ret", if_empty)
                 left -= 1  # pop_front, written to the 'value' port
-            self._set_mem(w, node, (left,))
+            self._set_mem(w, node, (left, child_running))
             w.st[node.id] = RUNNING
             return ("call", child, (node.id, 2))
         if pc == 1:  # the gate answered: does the blackboard queue have an element?
@@ -1329,7 +1329,11 @@ class BTInterpreter:
             if result == SUCCESS:
                 w.st[node.id] = RUNNING
                 return ("call", child, (node.id, 2))
+            self._set_mem(w, node, (0, False))
             return ("ret", if_empty)
+        # child_running_ is the node's own flag, not the child's stored status: a child that
+        # returned SKIPPED keeps its old (possibly RUNNING) status but clears the flag
+        self._set_mem(w, node, (max(left, 0), result == RUNNING))
         if result in (SUCCESS, FAILURE):
             self._reset_child(w, child, hook)
         return ("ret", FAILURE if result == FAILURE else RUNNING)

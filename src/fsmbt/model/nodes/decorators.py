@@ -200,8 +200,8 @@ LOOPS = tuple(
             "it and returns RUNNING (the next value on the next tick, no wake-up), FAILURE "
             "resets it and returns FAILURE, RUNNING and SKIPPED return RUNNING",
             halt="halts the child; the queue is reloaded on the next start",
-            memory=("left_in_queue",),
-            default_memory=(0,),
+            memory=("left_in_queue", "child_running"),
+            default_memory=(0, False),
             halt_resets_memory=True,
             blackboard_based=True,
             rejection="its queue is read from the blackboard",
