@@ -138,16 +138,14 @@ def test_sem_real_parallel_nusmv_agrees_with_the_native_checker(
         f'<root BTCPP_format="4"><BehaviorTree ID="Main">{xml}</BehaviorTree></root>',
         encoding="utf-8",
     )
-    outcome = api.convert_file(
-        path, verify_engine="both", options={"nodes": [str(STARDUST)]}
-    )
+    outcome = api.convert_file(path, verify_engine="both", options={"nodes": [str(STARDUST)]})
     assert outcome.equivalent is True, outcome.verdict
 
 
 # -- robocup2020 ActivationSequence, hans-ros-supervisor Negation ------------------------------
 def test_sem_activation_sequence_is_a_sequence() -> None:
     doc = doc_of(
-        '<ActivationSequence><NavigateToEntrance/><AskPerson/></ActivationSequence>',
+        "<ActivationSequence><NavigateToEntrance/><AskPerson/></ActivationSequence>",
         nodes=[ROBOCUP],
     )
     trace = run(
