@@ -336,6 +336,7 @@ LOOP_TREES = [
 ]
 
 
+@pytest.mark.nusmv
 @pytest.mark.parametrize("xml", LOOP_TREES)
 @pytest.mark.parametrize("loop", [False, True])
 def test_sem_loop_nusmv_agrees_with_the_native_checker(
@@ -350,3 +351,68 @@ def test_sem_loop_nusmv_agrees_with_the_native_checker(
         path, verify_engine="both", loop=loop, options={"abstract": ["blackboard"]}
     )
     assert outcome.equivalent is True, outcome.verdict
+
+
+#: What the NuSMV encoding encodes (no Parallel, Repeat, Retry, RunOnce, no internal leaves
+#: under KeepRunningUntilFailure; docs/semantics.md §10 "NuSMV"), plus the Loop family and
+#: stardust's RealParallel.
+_SMV_CONTROLS = (
+    "Sequence",
+    "ReactiveSequence",
+    "SequenceWithMemory",
+    "Fallback",
+    "ReactiveFallback",
+    "IfThenElse",
+    "WhileDoElse",
+    "stardust.RealParallel",
+)
+_SMV_DECORATORS = ("Inverter", "ForceSuccess", "ForceFailure", "LoopInt", "LoopInt")
+
+
+def _smv_tree(seed: int) -> BTDocument:
+    rng = random.Random(seed)
+    doc = random_tree(
+        rng,
+        controls=_SMV_CONTROLS,
+        decorators=_SMV_DECORATORS,
+        leaves=("Action", "Condition"),
+        max_nodes=7,
+    )
+    for _tree, node in doc.nodes():
+        if node.type == "LoopInt":
+            node.attrs = {
+                "queue": rng.choice(_QUEUES[:4]),
+                "if_empty": rng.choice(["SUCCESS", "FAILURE"]),
+            }
+    return doc
+
+
+@pytest.mark.slow
+@pytest.mark.nusmv
+def test_sem_loop_and_real_parallel_nusmv_agrees_on_random_trees(nusmv_binary) -> None:
+    """The NuSMV encoding against the native checker on random trees holding Loop nodes and
+    RealParallel: ``verify_models(engine="both")`` raises ``EngineDisagreement`` when the two
+    checkers differ; every tree the rules engine converts must be EQUIVALENT for both."""
+    from fsmbt import limits
+    from fsmbt.verify.nusmv.runner import NuSMVLimitError
+
+    compared = 0
+    previous = limits.use(limits.current().with_changes(nusmv_max_seconds=8))
+    try:
+        for seed in range(40):
+            doc = _smv_tree(seed)
+            if not any(n.type in ("LoopInt", "stardust.RealParallel") for _t, n in doc.nodes()):
+                continue
+            try:
+                result = api.convert_model(doc)
+            except UnsupportedError:
+                continue  # a shape the converter does not express (counted below)
+            try:
+                report = api.verify_models(doc, result.model, engine="both")
+            except NuSMVLimitError:
+                continue  # too large for NuSMV in 8 s (counted below)
+            assert report.equivalent, (seed, report)
+            compared += 1
+    finally:
+        limits.use(previous)
+    assert compared >= 10, compared

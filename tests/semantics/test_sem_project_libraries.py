@@ -127,6 +127,7 @@ def nusmv_binary():
     return path
 
 
+@pytest.mark.nusmv
 @pytest.mark.parametrize("xml", REAL_PARALLEL_TREES)
 def test_sem_real_parallel_nusmv_agrees_with_the_native_checker(
     xml: str, tmp_path, nusmv_binary
