@@ -203,8 +203,8 @@ def _loop_params(node: BTNode, ctype: str, literal: bool) -> tuple[int, int]:
     if canonical_type(node.type) != ctype:
         raise UnsupportedError(
             f"{node.type} (read as {ctype}) has a literal queue {raw!r}: how many elements it "
-            f"holds depends on the element type's own convertFromString; give the queue as a "
-            f"{{blackboard}} entry (with --abstract blackboard) or use {ctype} itself",
+            "holds depends on the element type's own convertFromString; give the queue as a "
+            f"{{blackboard}} entry (an abstraction) or use {ctype} itself",
             **_where(node),
         )
     elements = _queue_elements(raw)
@@ -331,8 +331,11 @@ class CompiledTree:
         spec = node_semantics(ctype)
         # a kind that is an abstraction only for a {blackboard} port (the Loop family's
         # queue) is exact, and needs no option, when that port is a literal
-        exact_here = spec is not None and spec.abstract_port is not None
-        exact_here = exact_here and spec is not None and not spec.abstracted_for(node.attrs)
+        exact_here = (
+            spec is not None
+            and spec.abstract_port is not None
+            and not spec.abstracted_for(node.attrs)
+        )
         if (
             spec is not None
             and spec.requires is not None
