@@ -6,8 +6,9 @@ of the corpus (``FSMBT_CORPUS``, default ``../shared/corpus``): BehaviorTree.CPP
 
 - ``plain``: no options, as a new user types ``fsmbt convert FILE -o OUT``;
 - ``profiles``: ``--nodes nav2,moveit_pro`` (the project node libraries; their gating
-  controllers are abstractions, named in the verdict) and, for Nav2 trees, Nav2's model file
-  as ``--node-models``;
+  controllers are abstractions, named in the verdict), the node-library files of
+  examples/node_libraries/ for the trees of their projects (``options_for``) and, for Nav2
+  trees, Nav2's model file as ``--node-models``;
 - ``abstract``: ``profiles`` plus ``--abstract time,blackboard``.
 
 Files under ``_malformed/`` or ``_legacy_draft/`` are negative inputs: they must be refused
@@ -79,10 +80,33 @@ def corpus_files(root: Path) -> list[tuple[Path, str, str]]:
     return found
 
 
-def options_for(setting: str, source: str, root: Path) -> dict[str, object]:
+#: Project node-library files (examples/node_libraries/, docs/semantics.md "Project nodes"):
+#: by corpus source folder, and by the file-name prefix of the project a tree comes from.
+NODE_LIBRARIES = Path(__file__).resolve().parents[1] / "examples" / "node_libraries"
+LIBRARIES_BY_SOURCE = {"bt/btcpp_tutorials": ("btcpp_tutorials.yaml",)}
+LIBRARIES_BY_PREFIX = {
+    "IntelligentRoboticsLabs_robocup2020_": ("robocup2020.yaml",),
+    "julienbayle_stardust_": ("stardust.yaml",),
+    "kmi-robots_hans-ros-supervisor_": ("hans_ros_supervisor.yaml",),
+}
+
+
+def library_files(source: str, path: Path | None) -> list[str]:
+    """The node-library files a user of the file's project would pass with ``--nodes``."""
+    names = list(LIBRARIES_BY_SOURCE.get(source, ()))
+    if path is not None:
+        for prefix, files in LIBRARIES_BY_PREFIX.items():
+            if path.name.startswith(prefix):
+                names += files
+    return [str(NODE_LIBRARIES / name) for name in names]
+
+
+def options_for(
+    setting: str, source: str, root: Path, path: Path | None = None
+) -> dict[str, object]:
     if setting == "plain":
         return {}
-    options: dict[str, object] = {"nodes": ["nav2", "moveit_pro"]}
+    options: dict[str, object] = {"nodes": ["nav2", "moveit_pro", *library_files(source, path)]}
     if source == "bt/nav2":
         options["node_models"] = [str(root / "bt" / "nav2" / "models" / "nav2_tree_nodes.xml")]
     if setting == "abstract":
@@ -121,7 +145,13 @@ def run_one(path: Path, source: str, kind: str, setting: str, root: Path, budget
         signal.alarm(budget)
     started = time.perf_counter()
     try:
-        outcome = api.convert_file(path, options=options_for(setting, source, root))
+        try:
+            outcome = api.convert_file(path, options=options_for(setting, source, root, path))
+        finally:
+            # the alarm is off before any handler below runs (a run ending at the budget
+            # must not raise _OverBudget from inside a handler)
+            if budget:
+                signal.alarm(0)
         ok = outcome.equivalent is True
         reason = "" if ok else f"verdict {outcome.verdict}"
     except _OverBudget:
@@ -130,9 +160,6 @@ def run_one(path: Path, source: str, kind: str, setting: str, root: Path, budget
         ok, reason = False, reason_of(exc)
     except Exception as exc:  # noqa: BLE001 - a crash is a finding: count it, never hide it
         ok, reason = False, f"CRASH {type(exc).__name__}: {reason_of(exc)}"
-    finally:
-        if budget:
-            signal.alarm(0)
     row = Row(path, source, kind, negative, ok, reason)
     row.seconds = time.perf_counter() - started
     return row

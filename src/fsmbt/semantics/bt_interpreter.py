@@ -34,6 +34,7 @@ stack depth d.
 
 from __future__ import annotations
 
+import re
 from collections.abc import Callable, Hashable
 from dataclasses import dataclass, field
 from typing import Any, Final
@@ -158,6 +159,65 @@ def _status_param(node: BTNode, port: str | None, default: str) -> int:
     return int(NodeStatus[text])
 
 
+#: How BehaviorTree.CPP 4.8 reads one element of a literal Loop queue (convertFromString<T>):
+#: int: std::from_chars (a leading '-' and digits; the rest is ignored; int32 bounds), double:
+#: std::stod (leading spaces, then a number, inf or nan), bool: the six spellings it accepts.
+_INT_ELEMENT = re.compile(r"-?\d+")
+_DOUBLE_ELEMENT = re.compile(r"\s*[+-]?(\d|\.\d|inf|nan)", re.IGNORECASE)
+_BOOL_ELEMENTS = frozenset({"0", "1", "true", "TRUE", "True", "false", "FALSE", "False"})
+
+
+def _queue_elements(text: str) -> list[str]:
+    """BehaviorTree.CPP's ``splitString(queue, ';')``: "" has no element, a trailing ';'
+    adds none, ";;" in the middle adds an empty one."""
+    parts: list[str] = []
+    pos = 0
+    while pos < len(text):
+        end = text.find(";", pos)
+        end = len(text) if end < 0 else end
+        parts.append(text[pos:end])
+        pos = end + 1
+    return parts
+
+
+def _element_ok(ctype: str, element: str) -> bool:
+    if ctype == "LoopInt":
+        match = _INT_ELEMENT.match(element)
+        return match is not None and -(2**31) <= int(match.group()) < 2**31
+    if ctype == "LoopDouble":
+        return _DOUBLE_ELEMENT.match(element) is not None
+    if ctype == "LoopBool":
+        return element in _BOOL_ELEMENTS
+    return True  # LoopString: any text
+
+
+def _loop_params(node: BTNode, ctype: str, literal: bool) -> tuple[int, int]:
+    """``(if_empty status, queue length)`` of a Loop node; length ``-1``: a {blackboard}
+    queue (an abstraction, its gate says whether an element is left)."""
+    if_empty = _status_param(node, "if_empty", "SUCCESS")
+    raw = node.attrs.get("queue")
+    if raw is None:
+        raise InputError(f"{ctype}: missing port 'queue'", **_where(node))
+    if not literal:
+        return (if_empty, -1)
+    if canonical_type(node.type) != ctype:
+        raise UnsupportedError(
+            f"{node.type} (read as {ctype}) has a literal queue {raw!r}: how many elements it "
+            "holds depends on the element type's own convertFromString; give the queue as a "
+            f"{{blackboard}} entry (an abstraction) or use {ctype} itself",
+            **_where(node),
+        )
+    elements = _queue_elements(raw)
+    for element in elements:
+        if not _element_ok(ctype, element):
+            raise InputError(
+                f"{ctype}: queue element {element!r} of {raw!r} is not a valid "
+                f"{ctype[4:].lower()} (BehaviorTree.CPP refuses to build the tree)",
+                **_where(node),
+            )
+    return (if_empty, len(elements))
+
+
 #: The type of the synthetic gate leaves (never a registered kind, so always an env leaf).
 GATE_TYPE = "_fsmbt_gate"
 
@@ -168,8 +228,8 @@ def _gate_leaf(node: BTNode, ctype: str) -> BTNode | None:
     if node.semantics is None:
         return None
     spec = node_semantics(ctype)
-    if spec is None or spec.gate is None:
-        return None
+    if spec is None or spec.gate is None or not spec.abstracted_for(node.attrs):
+        return None  # (a Loop over a literal queue is exact: no gate)
     return BTNode(
         GATE_TYPE, NodeKind.CONDITION, f"{node.label}.{spec.gate.word}", location=node.location
     )
@@ -269,7 +329,19 @@ class CompiledTree:
                     f"pre-condition '{attr}' depends on the blackboard", **_where(node)
                 )
         spec = node_semantics(ctype)
-        if spec is not None and spec.requires is not None and node.semantics is None:
+        # a kind that is an abstraction only for a {blackboard} port (the Loop family's
+        # queue) is exact, and needs no option, when that port is a literal
+        exact_here = (
+            spec is not None
+            and spec.abstract_port is not None
+            and not spec.abstracted_for(node.attrs)
+        )
+        if (
+            spec is not None
+            and spec.requires is not None
+            and node.semantics is None
+            and not exact_here
+        ):
             why = spec.rejection or (
                 f"a {spec.library} node whose control flow reads data fsmbt "
                 "does not model (a clock, the robot pose, a goal or a "
@@ -281,7 +353,7 @@ class CompiledTree:
                 **_where(node),
             )
         reason = tables.rejected.get(ctype)
-        if reason is not None and node.semantics is None:
+        if reason is not None and node.semantics is None and not exact_here:
             raise UnsupportedError(f"{ctype}: {reason}", **_where(node))
         kids = list(node.children)
         params: tuple[Any, ...] = ()
@@ -335,6 +407,8 @@ class CompiledTree:
                 params = (_bool_param(node, "then_skip", True),)
             elif ctype == "RepeatUnlessFailureEachTick":
                 params = (_int_param(node, "num_cycles", -1),)
+            elif spec is not None and spec.handler == "loop_queue":
+                params = _loop_params(node, ctype, exact_here)
             elif spec is not None and spec.gate is not None:
                 params = (_status_param(node, spec.closed_port, spec.gate.closed),)
             return ctype, kind, params, internal, kids
@@ -1220,6 +1294,78 @@ class BTInterpreter:
             return ("ret", RUNNING)
         self._reset_child(w, child, hook)
         return ("ret", stop if result == stop else RUNNING)
+
+    def _t_loop_queue(
+        self, w: _Work, node: CompiledNode, frame: Frame, result: int | None, hook: HaltHook | None
+    ) -> TickAction:
+        """LoopInt / LoopBool / LoopDouble / LoopString (loop_node.h, docs/semantics.md).
+
+        ``params = (if_empty, length)``. A literal queue of ``length`` elements is reloaded when
+        the node is ticked while IDLE; its memory is how many elements are left and whether the
+        child returned RUNNING on its last tick (``child_running_``). ``length = -1``
+        (a {blackboard} queue, an abstraction): the gate, the last child, says whether the
+        queue still has an element. An element is popped only while the child is not RUNNING;
+        no element left returns ``if_empty`` without setting RUNNING (a SKIPPED result leaves
+        the stored status as it was, as ``executeTick`` does)."""
+        if_empty, length = node.params
+        child = node.children[0]
+        pc = frame[1]
+        left, child_running = self._mem(w, node)
+        if pc == 0:
+            if w.st.get(node.id, IDLE) == IDLE:
+                left, child_running = length, False  # the static queue is copied afresh
+            if length < 0:
+                if child_running:
+                    w.st[node.id] = RUNNING
+                    return ("call", child, (node.id, 2))
+                return ("call", node.children[-1], (node.id, 1))
+            if not child_running:
+                if left == 0:
+                    self._set_mem(w, node, (0, False))
+                    return ("ret", if_empty)
+                left -= 1  # pop_front, written to the 'value' port
+            self._set_mem(w, node, (left, child_running))
+            w.st[node.id] = RUNNING
+            return ("call", child, (node.id, 2))
+        if pc == 1:  # the gate answered: does the blackboard queue have an element?
+            w.st.pop(node.children[-1], None)
+            if result == SUCCESS:
+                w.st[node.id] = RUNNING
+                return ("call", child, (node.id, 2))
+            self._set_mem(w, node, (0, False))
+            return ("ret", if_empty)
+        # child_running_ is the node's own flag, not the child's stored status: a child that
+        # returned SKIPPED keeps its old (possibly RUNNING) status but clears the flag
+        self._set_mem(w, node, (max(left, 0), result == RUNNING))
+        if result in (SUCCESS, FAILURE):
+            self._reset_child(w, child, hook)
+        return ("ret", FAILURE if result == FAILURE else RUNNING)
+
+    def _t_real_parallel(
+        self, w: _Work, node: CompiledNode, frame: Frame, result: int | None, hook: HaltHook | None
+    ) -> TickAction:
+        """julienbayle/stardust RealParallel (docs/semantics.md, "Project nodes"): every child
+        is ticked on every tick, in order, and never reset by the node (only its halt resets
+        them); any RUNNING child: RUNNING, else any FAILURE: FAILURE, else SUCCESS. A SKIPPED
+        child makes the project's node throw."""
+        if frame[1] == 0:
+            w.st[node.id] = RUNNING
+            return ("call", node.children[0], (node.id, 1, 0, False, False))
+        i, running, failed = frame[2], frame[3], frame[4]
+        if result == RUNNING:
+            running = True
+        elif result == FAILURE:
+            failed = True
+        elif result != SUCCESS:
+            raise BTRuntimeError(
+                "RealParallel: a child returned SKIPPED (the node throws on any status but "
+                "SUCCESS, FAILURE and RUNNING)",
+                element=node.label,
+            )
+        i += 1
+        if i < len(node.children):
+            return ("call", node.children[i], (node.id, 1, i, running, failed))
+        return ("ret", RUNNING if running else FAILURE if failed else SUCCESS)
 
 
 # -- a plain runner: the interpreter driven by an environment callback -------------------------

@@ -184,6 +184,9 @@ WAIT_VALUE_UPDATE = register(
         source="updated_decorator.cpp",
     )
 )
+#: BehaviorTree.CPP 4.8 LoopNode<T> (loop_node.h), registered as LoopInt, LoopBool, LoopDouble
+#: and LoopString. A literal queue ("1;2;3") is copied when the node starts (IDLE): its rules
+#: are exact, one element per tick. A {blackboard} queue is the environment's: an abstraction.
 LOOPS = tuple(
     register(
         NodeSemantics(
@@ -191,10 +194,26 @@ LOOPS = tuple(
             _D,
             Family.BLACKBOARD_LOOP,
             1,
-            tick=f"pops {value.lower()} values from a blackboard queue and ticks the child once per value",
+            tick="when not RUNNING it reloads its queue; while the child is not RUNNING it pops "
+            f"the next {value.lower()} value to 'value' and ticks the child; an empty queue "
+            "returns if_empty (default SUCCESS) without ticking it; the child's SUCCESS resets "
+            "it and returns RUNNING (the next value on the next tick, no wake-up), FAILURE "
+            "resets it and returns FAILURE, RUNNING and SKIPPED return RUNNING",
+            halt="halts the child; the queue is reloaded on the next start",
+            memory=("left_in_queue", "child_running"),
+            default_memory=(0, False),
+            halt_resets_memory=True,
             blackboard_based=True,
-            nusmv_refusal="its loop reads a blackboard queue",
+            rejection="its queue is read from the blackboard",
+            handler="loop_queue",
+            nusmv="loop_queue",
             ports=("queue", "value", "if_empty"),
+            requires="blackboard",
+            abstraction=f"Loop{value}: whether its blackboard queue still has an element is an "
+            "environment input, asked while its child is not running (no element: if_empty)",
+            gate=Gate("more", closed="SUCCESS"),
+            closed_port="if_empty",
+            abstract_port="queue",
             source="loop_node.h",
         )
     )

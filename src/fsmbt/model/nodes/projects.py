@@ -289,3 +289,25 @@ BLACKBOARD_CHECKS = tuple(
     )
     for value in ("String", "Int", "Double")
 )
+
+# -- project controls read from their sources, enabled by a node-library file -------------------
+# Their bare names (``RealParallel``) are a project's own registrations, which another project
+# may define differently, so the registered kind is qualified by the project and a node-library
+# file maps the bare name to it (examples/node_libraries/, docs/semantics.md "Project nodes").
+REAL_PARALLEL = register(
+    NodeSemantics(
+        "stardust.RealParallel",
+        _C,
+        Family.PARALLEL,
+        None,
+        tick="ticks every child on every tick, in order, whatever they returned before (a "
+        "completed child is not reset, so a completed action keeps its status); any RUNNING "
+        "child: RUNNING, else any FAILURE: FAILURE, else SUCCESS",
+        halt="halts the RUNNING children and resets every child's status",
+        handler="real_parallel",
+        nusmv="real_parallel",
+        library="julienbayle/stardust",
+        source="julienbayle/stardust@f680da70 ros/src/sd_behavior/src/control_nodes.cpp "
+        "(RealParallelNode::tick)",
+    )
+)

@@ -25,7 +25,7 @@ Costs: lookups are dict reads, O(1); the derived sets are built once, O(K) for K
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator, Mapping
 from contextlib import contextmanager
 from dataclasses import dataclass
 from enum import Enum
@@ -128,6 +128,9 @@ class NodeSemantics:
             abstraction (``None``: modelled exactly).
         gate: the abstraction's environment input (``Gate``), ``None`` for exact kinds.
         closed_port: a port that overrides ``gate.closed`` (``Precondition``'s ``else``).
+        abstract_port: the kind is an abstraction only when this port reads the blackboard
+            (``{key}``); with a literal value its rules are exact and need no option (the Loop
+            family's ``queue``: docs/semantics.md, "LoopInt, LoopBool, LoopDouble, LoopString").
     """
 
     name: str
@@ -161,6 +164,7 @@ class NodeSemantics:
     abstraction: str | None = None
     gate: Gate | None = None
     closed_port: str | None = None
+    abstract_port: str | None = None
 
     @property
     def type(self) -> str:
@@ -182,6 +186,22 @@ class NodeSemantics:
             and not self.asynchronous
         )
 
+    def abstracted_for(self, attrs: Mapping[str, str]) -> bool:
+        """Whether a node of this kind with these attributes is modelled as an abstraction.
+
+        Args:
+            attrs: the node's XML attributes (its ports).
+
+        Returns:
+            ``True`` for a kind with an ``abstraction``, unless its ``abstract_port`` holds a
+            literal value (then the node's rules are exact).
+        """
+        if self.abstraction is None:
+            return False
+        if self.abstract_port is None:
+            return True
+        return is_blackboard_reference(attrs.get(self.abstract_port, ""))
+
     def allows_children(self, count: int) -> bool:
         """Whether a node of this kind may have ``count`` children in a file."""
         if self.child_counts is not None:
@@ -189,6 +209,14 @@ class NodeSemantics:
         if self.children is None:
             return count >= 1
         return count == self.children
+
+
+def is_blackboard_reference(text: str) -> bool:
+    """A port value that names a blackboard entry (``{key}``), as BehaviorTree.CPP's
+    ``isBlackboardPointer`` reads it: surrounding spaces ignored, at least one character
+    between the braces."""
+    text = text.strip(" ")
+    return len(text) >= 3 and text.startswith("{") and text.endswith("}")
 
 
 _NODES: dict[str, NodeSemantics] = {}
@@ -293,6 +321,7 @@ __all__ = [
     "Gate",
     "PROFILES",
     "enabling_option",
+    "is_blackboard_reference",
     "NodeSemantics",
     "aliases",
     "all_nodes",

@@ -34,6 +34,7 @@ from fsmbt.semantics.lebt.leaves import (
     state_on_start,
 )
 from fsmbt.semantics.lebt.spec import BB_EVENT, BB_STATE, GUARD_TYPE, NO_EVENT, STATE_TYPE
+from fsmbt.semantics.nodes import all_nodes
 from fsmbt.semantics.status import LeafOutcome, NodeStatus
 
 ACTION_ID = "FsmbtAction"
@@ -46,6 +47,10 @@ _STATUS: dict[str, Any] = {
 #: The engine's status as ours, and by name (the interpreter's ``TickRecord`` spelling).
 _NODE_STATUS = {getattr(btpy.NodeStatus, status.name): status for status in NodeStatus}
 _NAME_OF = {engine: status.name for engine, status in _NODE_STATUS.items()}
+
+#: The Loop family: written with their literal queue and if_empty (a {blackboard} queue is an
+#: abstraction the engine cannot run).
+_LOOPS = frozenset(n.name for n in all_nodes() if n.handler == "loop_queue")
 
 #: How a leaf is written: (registration ID, extra attributes) for a compiled leaf.
 LeafWriter = Callable[[CompiledNode], tuple[str, dict[str, str]]]
@@ -94,6 +99,10 @@ def compiled_to_xml(tree: CompiledTree, leaf_writer: LeafWriter = _default_leaf)
             attrs["num_attempts"] = str(node.params[0])
         elif node.type == "RunOnce":
             attrs["then_skip"] = "true" if node.params[0] else "false"
+        elif node.type in _LOOPS and node.params[1] >= 0:  # a literal queue (exact)
+            attrs["queue"] = node.source.attrs["queue"]
+            attrs["if_empty"] = NodeStatus(node.params[0]).name
+            attrs["value"] = "{" + f"loop_value_{nid}" + "}"
         el = etree.SubElement(parent_el, node.type, attrib=attrs)
         for child in reversed(node.children):
             work.append((child, el))

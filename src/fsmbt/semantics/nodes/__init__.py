@@ -143,7 +143,9 @@ def abstractions_used(doc: object) -> list[str]:
         if node.semantics is None:
             continue
         spec = node_semantics(node.semantics)
-        if spec is not None and spec.abstraction is not None:
+        if spec is not None and spec.abstracted_for(node.attrs):
+            # (a Loop over a literal queue is exact: not an abstraction)
+            assert spec.abstraction is not None
             sentence = spec.abstraction
             if node.semantics != node.type:
                 sentence = f"{node.type} (as {sentence})"

@@ -62,6 +62,10 @@ GATE_RULES = {
     for n in all_nodes()
     if n.nusmv in ("gated", "timeout", "sleep", "for_each", "pass_through", "pass_through_keep")
 }
+#: The Loop family (docs/semantics.md, "LoopInt, LoopBool, LoopDouble, LoopString").
+LOOP_RULES = frozenset(n.name for n in all_nodes() if n.nusmv == "loop_queue")
+#: julienbayle/stardust RealParallel (docs/semantics.md, "Project nodes").
+REAL_PARALLEL_RULES = frozenset(n.name for n in all_nodes() if n.nusmv == "real_parallel")
 SUPPORTED = NUSMV_ENCODED
 #: type -> why the encoding refuses it
 NOT_ENCODED = {n.name: n.nusmv_refusal for n in all_nodes() if n.nusmv_refusal is not None}
@@ -217,6 +221,12 @@ class BTCore:
                 continue
             if t in MEMORY_RULES:
                 self._memory_rules(x, MEMORY_RULES[t], here, called, resets)
+                continue
+            if t in LOOP_RULES:
+                self._loop_rules(x, here, called, resets)
+                continue
+            if t in REAL_PARALLEL_RULES:
+                self._real_parallel_rules(x, here, called)
                 continue
             if t in SEQ_LIKE:
                 is_fb, wakes, memory = SEQ_LIKE[t]
@@ -390,6 +400,84 @@ class BTCore:
         if gate_rule.reset_on_done:
             resets[c].append(f"{from_child} & (res = S | res = F)")
         self.ret(from_child, x.id, passed)
+
+    def _loop_rules(
+        self, x: CompiledNode, here: str, called: str, resets: dict[int, list[str]]
+    ) -> None:
+        """LoopInt & co (loop_node.h). ``params = (if_empty, length)``: a literal queue keeps
+        ``lq`` (elements left, reloaded when the node is ticked while IDLE); a {blackboard}
+        queue (``length = -1``) asks its gate, the last child, whether an element is left.
+        Either way an element is taken only while the child is not RUNNING."""
+        if_empty, length = x.params
+        empty_status = NodeStatus(if_empty).name
+        if empty_status not in ST:
+            raise UnsupportedError(
+                f"the NuSMV encoding does not support {x.type} returning {empty_status} on an "
+                "empty queue (SKIPPED is not encoded); use --engine native",
+                location=x.source.location,
+                element=f"<{x.type}> '{x.label}'",
+            )
+        empty = ST[empty_status]
+        kids = list(x.children)
+        c = kids[0]
+        back = f"{here} & res != NONE"
+        from_child = f"{back} & lidx = 0"
+        resumed = f"{called} & {self.st(c)} = R"
+        if length < 0:
+            gate = kids[-1]
+            from_gate = f"{back} & lidx = {len(kids) - 1}"
+            resets[gate].append(from_gate)
+            self.rule(self.st(x.id), resumed, "R")
+            self.call(resumed, c)
+            self.call(called, gate)
+            opened = f"{from_gate} & res = S"
+            self.rule(self.st(x.id), opened, "R")
+            self.call(opened, c)
+            self.ret(from_gate, x.id, empty)
+        else:
+            left = self.memory("lq", x.id, length)
+            fresh = f"{called} & {self.st(x.id)} = I"
+            if length == 0:
+                self.ret(fresh, x.id, empty)
+            else:
+                self.rule(left, fresh, str(length - 1))
+                self.rule(self.st(x.id), fresh, "R")
+                self.call(fresh, c)
+            self.rule(left, resumed, left)  # a RUNNING child: nothing is popped
+            self.rule(self.st(x.id), resumed, "R")
+            self.call(resumed, c)
+            more = f"{called} & {left} > 0"
+            self.rule(left, more, f"case {left} > 0 : {left} - 1; TRUE : 0; esac")
+            self.rule(self.st(x.id), more, "R")
+            self.call(more, c)
+            self.ret(called, x.id, empty)
+        self.ret(f"{from_child} & res = R", x.id, "R")
+        resets[c].append(f"{from_child} & res != R")
+        self.ret(f"{from_child} & res = F", x.id, "F")
+        self.ret(from_child, x.id, "R")
+
+    def _real_parallel_rules(self, x: CompiledNode, here: str, called: str) -> None:
+        """stardust RealParallel: every child ticked in order on every tick, none reset;
+        ``pr``/``pf`` remember within the tick whether a child was RUNNING / failed."""
+        kids = list(x.children)
+        back = f"{here} & res != NONE"
+        ran = self.memory("pr", x.id, 1)
+        failed = self.memory("pf", x.id, 1)
+        self.rule(self.st(x.id), called, "R")
+        self.rule(ran, called, "0")
+        self.rule(failed, called, "0")
+        self.call(called, kids[0])
+        for i in range(len(kids)):
+            at = f"{back} & lidx = {i}"
+            if i + 1 < len(kids):
+                self.rule(ran, f"{at} & res = R", "1")
+                self.rule(failed, f"{at} & res = F", "1")
+                self.call(at, kids[i + 1])
+                continue
+            self.rule(ran, at, "0")
+            self.rule(failed, at, "0")
+            status = f"case {ran} = 1 | res = R : R; {failed} = 1 | res = F : F; TRUE : S; esac"
+            self.ret(at, x.id, status)
 
     def _memory_rules(
         self, x: CompiledNode, rule: str, here: str, called: str, resets: dict[int, list[str]]
