@@ -26,6 +26,8 @@ Complexity: O(S + T) time and memory for S states and T transitions (after flatt
 
 from __future__ import annotations
 
+from collections.abc import Callable, Iterable, Sequence
+
 from fsmbt.convert.perf import without_gc_pauses
 from fsmbt.convert.result import ConversionResult
 from fsmbt.convert.structure import LebtStructure, analyse
@@ -140,38 +142,131 @@ def build_lebt(fsm: FSM, structure: LebtStructure) -> BTNode:
     return _build(fsm, structure)[0]
 
 
-def _build(fsm: FSM, structure: LebtStructure) -> tuple[BTNode, int, int]:
-    """The LEBT root, its node count and depth (counted while building: no second walk).
+def _needs_escape(texts: Iterable[str]) -> bool:
+    """Whether any text holds a character ``escape`` rewrites (one scan of their concatenation)."""
+    joined = "".join(texts)
+    return "\\" in joined or ";" in joined or "/" in joined
 
-    A selector on level ``L`` holds its guard and body on ``L + 1``; a body Sequence holds the
-    state leaf and the child selectors on ``L + 2``. O(S + T).
+
+def _escaped_texts(fsm: FSM, structure: LebtStructure) -> tuple[list[str], Callable[[str], str]]:
+    """The escaped name of every state (and, last, of the start pseudo-state) by index, and
+    the event escaper: the identity when no name and no event needs escaping (the usual case,
+    found by one scan), else ``escape`` once per distinct event."""
+    sources = [*structure.names, structure.start]
+    events = (event for i in structure.reachable_ids for event in structure.exit_events[i])
+    if not _needs_escape(sources) and not _needs_escape(events) and not _needs_escape(
+        [fsm.initial_event or ""]
+    ):
+        return sources, str
+    known: dict[str, str] = {}
+
+    def esc_event(text: str) -> str:
+        done = known.get(text)
+        if done is None:
+            done = known[text] = escape(text)
+        return done
+
+    return [escape(name) for name in sources], esc_event
+
+
+def _build(fsm: FSM, structure: LebtStructure) -> tuple[BTNode, int, int]:
+    """The LEBT root, its node count and depth.
+
+    Built in two passes over the states in declaration order - the order their objects lie in
+    memory - rather than in tree order (a random order for a random machine): pass 1 makes each
+    placed state's guard, state leaf, selector and body; pass 2 hangs each body's child
+    selectors below it (a list look-up by index). The tree is the same as the tree-order
+    construction of docs/conversion.md step 5. A selector on level ``L`` holds its guard and
+    body on ``L + 1``; a body Sequence holds the state leaf and the child selectors on
+    ``L + 2``: the depth is found by a walk over the integer child lists. O(S + T).
     """
-    writer = LebtLeafWriter(fsm, structure)
-    root = BTNode(type="Sequence", kind=NodeKind.CONTROL, name=ROOT_NAME)
-    nodes, depth = 1, 1
-    pending: list[tuple[str, BTNode, int]] = []
-    for state in structure.roots:
-        selector, body = writer.selector(state)
-        root.children.append(selector)
-        if body is None:
-            nodes += 3
-            depth = max(depth, 3)
+    names = structure.names
+    states = list(fsm.states.values())
+    if len(states) != len(names):
+        raise ValueError("the structure was not analysed from this FSM")
+    esc_names, esc_event = _escaped_texts(fsm, structure)
+    child_ids = structure.child_ids
+    guard_ids = structure.guard_ids
+    exit_events = structure.exit_events
+    control, condition, action = NodeKind.CONTROL, NodeKind.CONDITION, NodeKind.ACTION
+    selectors: list[BTNode | None] = [None] * len(names)
+    bodies: list[tuple[BTNode, Sequence[int]]] = []
+    nodes = 1
+    placed = bytearray(len(names))
+    for root_id in structure.root_ids:
+        placed[root_id] = 1
+    for below in child_ids:
+        for child in below:
+            placed[child] = 1
+    for i in structure.reachable_ids:
+        if not placed[i]:
+            continue  # reached only through a transition that never fires: no predecessor
+        name = names[i]
+        state = states[i]
+        if esc_event is str:
+            pairs = ";".join([f"{esc_names[s]}/{event}" for s, event in guard_ids[i]])
+            exits = ";".join(exit_events[i])
         else:
+            pairs = ";".join([f"{esc_names[s]}/{esc_event(event)}" for s, event in guard_ids[i]])
+            exits = ";".join([esc_event(event) for event in exit_events[i]])
+        guard = BTNode(
+            type=GUARD_TYPE,
+            kind=condition,
+            name=f"Enter_{name}",
+            attrs={"target": name, "pairs": pairs},
+        )
+        leaf = BTNode(
+            type=STATE_TYPE,
+            kind=action,
+            name=name,
+            attrs={
+                "state": name,
+                "action": state.action or "",
+                "final": "true" if state.final else "false",
+                "exits": exits,
+            },
+        )
+        below = child_ids[i]
+        if below:
+            shape = "chain" if len(below) == 1 else "branch"
+            body = BTNode(type="Sequence", kind=control, name=f"{name}_{shape}", children=[leaf])
+            bodies.append((body, below))
+            selectors[i] = BTNode(
+                type="Fallback", kind=control, name=f"{name}_selector", children=[guard, body]
+            )
             nodes += 4
-            pending.append((state, body, 3))
-    while pending:
-        state, body, level = pending.pop()
-        depth = max(depth, level + 1)  # the state leaf below the body
-        for child in structure.children[state]:
-            selector, child_body = writer.selector(child)
-            body.children.append(selector)
-            if child_body is None:
-                nodes += 3
-                depth = max(depth, level + 2)
-            else:
-                nodes += 4
-                pending.append((child, child_body, level + 2))
-    return root, nodes, depth
+        else:
+            selectors[i] = BTNode(
+                type="Fallback", kind=control, name=f"{name}_selector", children=[guard, leaf]
+            )
+            nodes += 3
+    for body, below in bodies:
+        body.children.extend([selectors[child] for child in below])  # type: ignore[misc]
+    root = BTNode(
+        type="Sequence",
+        kind=control,
+        name=ROOT_NAME,
+        children=[selectors[i] for i in structure.root_ids],  # type: ignore[misc]
+    )
+    return root, nodes, _lebt_depth(structure)
+
+
+def _lebt_depth(structure: LebtStructure) -> int:
+    """Levels of the LEBT (root = 1) from the structure alone: a root selector is on level 2;
+    a state with successors below it has its leaf two levels under its selector, and its
+    successors' selectors two levels under its own; a state without, its leaf one level under."""
+    depth = 1
+    child_ids = structure.child_ids
+    stack = [(root, 2) for root in structure.root_ids]
+    while stack:
+        state, level = stack.pop()
+        below = child_ids[state]
+        if below:
+            depth = max(depth, level + 2)
+            stack.extend([(child, level + 2) for child in below])
+        else:
+            depth = max(depth, level + 1)
+    return depth
 
 
 def tree_depth(root: BTNode) -> int:
@@ -208,13 +303,13 @@ def fsm_to_lebt(fsm: FSM, *, style: str = "paper", **_options: object) -> Conver
     root, node_count, depth = _build(flat, structure)
     doc = BTDocument.single(root)
     doc.node_models.update(lebt_node_models())
-    below = [len(children) for children in structure.children.values()]
+    below = [len(structure.child_ids[i]) for i in structure.reachable_ids]
     stats = {
-        "states": len(structure.predecessors),
-        "transitions": sum(len(v) for v in structure.exits.values()),
+        "states": len(structure.reachable_ids),
+        "transitions": sum(len(structure.exit_events[i]) for i in structure.reachable_ids),
         "entry": structure.entry,
-        "loop_states": len(structure.loop_states),
-        "root_subtrees": len(structure.roots),
+        "loop_states": len(structure.loop_ids),
+        "root_subtrees": len(structure.root_ids),
         "chains": below.count(1),
         "branches": sum(1 for count in below if count >= 2),
         "unreachable_dropped": len(structure.unreachable),
