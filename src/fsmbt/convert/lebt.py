@@ -169,6 +169,35 @@ def _escaped_texts(fsm: FSM, structure: LebtStructure) -> tuple[list[str], Calla
     return [escape(name) for name in sources], esc_event
 
 
+def _guard_pair_texts(
+    structure: LebtStructure, esc_names: list[str], esc_event: Callable[[str], str]
+) -> list[list[str] | None]:
+    """Per state, its guard's ``source/event`` texts (escaped), made in source order - where
+    the source's name and its events are at hand - and dealt out to the targets: the start
+    pair first for the entry state, then by source in declaration order and by the source's
+    transitions (``LebtStructure.guard_ids``'s order)."""
+    texts: list[list[str] | None] = [None] * len(structure.names)
+    texts[structure.entry_id] = [
+        f"{esc_names[structure.start_id]}/{esc_event(structure.initial_event)}"
+    ]
+    kept_targets = structure.kept_targets
+    exit_events = structure.exit_events
+    plain = esc_event is str
+    for source in structure.reachable_ids:
+        targets = kept_targets[source]
+        if not targets:
+            continue
+        prefix = esc_names[source] + "/"
+        events = exit_events[source] if plain else [esc_event(e) for e in exit_events[source]]
+        for target, event in zip(targets, events):
+            known = texts[target]
+            if known is None:
+                texts[target] = [prefix + event]
+            else:
+                known.append(prefix + event)
+    return texts
+
+
 def _build(fsm: FSM, structure: LebtStructure) -> tuple[BTNode, int, int]:
     """The LEBT root, its node count and depth.
 
@@ -186,8 +215,8 @@ def _build(fsm: FSM, structure: LebtStructure) -> tuple[BTNode, int, int]:
         raise ValueError("the structure was not analysed from this FSM")
     esc_names, esc_event = _escaped_texts(fsm, structure)
     child_ids = structure.child_ids
-    guard_ids = structure.guard_ids
     exit_events = structure.exit_events
+    pair_texts = _guard_pair_texts(structure, esc_names, esc_event)
     control, condition, action = NodeKind.CONTROL, NodeKind.CONDITION, NodeKind.ACTION
     selectors: list[BTNode | None] = [None] * len(names)
     bodies: list[tuple[BTNode, Sequence[int]]] = []
@@ -198,16 +227,16 @@ def _build(fsm: FSM, structure: LebtStructure) -> tuple[BTNode, int, int]:
     for below in child_ids:
         for child in below:
             placed[child] = 1
+    plain = esc_event is str
     for i in structure.reachable_ids:
         if not placed[i]:
             continue  # reached only through a transition that never fires: no predecessor
         name = names[i]
         state = states[i]
-        if esc_event is str:
-            pairs = ";".join([f"{esc_names[s]}/{event}" for s, event in guard_ids[i]])
+        pairs = ";".join(pair_texts[i] or ())
+        if plain:
             exits = ";".join(exit_events[i])
         else:
-            pairs = ";".join([f"{esc_names[s]}/{esc_event(event)}" for s, event in guard_ids[i]])
             exits = ";".join([esc_event(event) for event in exit_events[i]])
         guard = BTNode(
             type=GUARD_TYPE,

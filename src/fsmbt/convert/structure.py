@@ -33,9 +33,10 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
+from typing import NoReturn
 
 from fsmbt.model.errors import InputError, UnsupportedError
-from fsmbt.model.fsm import FSM
+from fsmbt.model.fsm import FSM, Transition
 from fsmbt.semantics.lebt.spec import DEFAULT_START, NO_EVENT
 
 #: Shared empty per-state list (no successor linked below / no pair / no exit): most states of
@@ -61,9 +62,10 @@ class LebtStructure:
         loop_ids: The loop states (in-degree >= 2), in declaration order.
         child_ids: Per state, the successors of in-degree 1 linked below it, in the order of
             its outgoing transitions (empty for unreachable states).
-        guard_ids: Per state, the (source index or ``start_id``, event) pairs entering it, in
-            the order of the sources' declaration and then of their transitions.
+        kept_targets: Per state, the targets of the transitions that can fire out of it (the
+            first per event), parallel to ``exit_events``.
         exit_events: Per state, the events with a transition out of it (first one per event).
+        initial_event: The event of the start pseudo-state's transition (``NO_EVENT``: none).
         unreachable: The states dropped, by name.
     """
 
@@ -74,8 +76,9 @@ class LebtStructure:
     root_ids: list[int]
     loop_ids: list[int]
     child_ids: list[Sequence[int]]
-    guard_ids: list[Sequence[tuple[int, str]]]
+    kept_targets: list[Sequence[int]]
     exit_events: list[Sequence[str]]
+    initial_event: str
     unreachable: list[str] = field(default_factory=list)
 
     @property
@@ -106,12 +109,24 @@ class LebtStructure:
         names = self.names
         return {names[i]: [names[c] for c in self.child_ids[i]] for i in self.reachable_ids}
 
+    def guard_ids(self) -> list[list[tuple[int, str]]]:
+        """Per state, the (source index or ``start_id``, event) pairs entering it: the start
+        pair first for the entry state, then by source in declaration order and by the
+        source's transitions. O(S + T)."""
+        pairs: list[list[tuple[int, str]]] = [[] for _ in self.names]
+        pairs[self.entry_id].append((self.start_id, self.initial_event))
+        for source in self.reachable_ids:
+            for target, event in zip(self.kept_targets[source], self.exit_events[source]):
+                pairs[target].append((source, event))
+        return pairs
+
     @cached_property
     def guard_pairs(self) -> dict[str, list[tuple[str, str]]]:
-        """Reachable state -> the (source, event) pairs entering it."""
+        """Reachable state -> the (source, event) pairs entering it (``guard_ids`` by name)."""
         sources = [*self.names, self.start]
+        by_index = self.guard_ids()
         return {
-            self.names[i]: [(sources[s], event) for s, event in self.guard_ids[i]]
+            self.names[i]: [(sources[s], event) for s, event in by_index[i]]
             for i in self.reachable_ids
         }
 
@@ -141,51 +156,63 @@ class LebtStructure:
         return "leaf" if count == 0 else "chain" if count == 1 else "branch"
 
 
-def _out_edges(fsm: FSM, index: dict[str, int]) -> list[list[tuple[int, str]] | None]:
-    """Per state, its transitions as (target index, event), final states' dropped; the
+def _out_edges(
+    fsm: FSM, index: dict[str, int]
+) -> tuple[list[list[int] | None], list[list[str] | None]]:
+    """Per state, the targets and the events of its transitions (two parallel lists, in
+    declaration order; ``None`` for none), final states' transitions dropped. Raises the
     located errors for an unknown state, an eventless and an empty-event transition."""
     finals = [state.final for state in fsm.states.values()]
-    out: list[list[tuple[int, str]] | None] = [None] * len(finals)
+    out_targets: list[list[int] | None] = [None] * len(finals)
+    out_events: list[list[str] | None] = [None] * len(finals)
     for t in fsm.transitions:
         source = index.get(t.source)
         target = index.get(t.target)
-        if source is None or target is None:
-            missing = t.source if source is None else t.target
-            raise InputError(
-                f"transition refers to unknown state '{missing}'",
-                element=fsm.name,
-                location=t.location,
-            )
         event = t.event
-        if event is None:
-            raise InputError(
-                "eventless transition in a flat FSM; flatten it first",
-                element=t.source,
-                location=t.location,
-            )
-        if event == NO_EVENT:
-            raise UnsupportedError(
-                "an empty event name cannot be told from 'no event'",
-                element=t.source,
-                location=t.location,
-            )
+        if source is None or target is None or not event:
+            _refuse(fsm, t, source is None)
+        assert source is not None and target is not None and event is not None
         if finals[source]:
             continue  # never fires
-        edges = out[source]
-        if edges is None:
-            out[source] = [(target, event)]
+        targets = out_targets[source]
+        if targets is None:
+            out_targets[source] = [target]
+            out_events[source] = [event]
         else:
-            edges.append((target, event))
-    return out
+            targets.append(target)
+            out_events[source].append(event)  # type: ignore[union-attr]
+    return out_targets, out_events
 
 
-def _reached(entry: int, out: list[list[tuple[int, str]] | None]) -> bytearray:
+def _refuse(fsm: FSM, t: Transition, source_unknown: bool) -> NoReturn:
+    """The located error for a transition ``analyse`` cannot take."""
+    if t.source not in fsm.states or t.target not in fsm.states:
+        missing = t.source if source_unknown else t.target
+        raise InputError(
+            f"transition refers to unknown state '{missing}'",
+            element=fsm.name,
+            location=t.location,
+        )
+    if t.event is None:
+        raise InputError(
+            "eventless transition in a flat FSM; flatten it first",
+            element=t.source,
+            location=t.location,
+        )
+    raise UnsupportedError(
+        "an empty event name cannot be told from 'no event'",
+        element=t.source,
+        location=t.location,
+    )
+
+
+def _reached(entry: int, out_targets: list[list[int] | None]) -> bytearray:
     """Breadth-first reachability from ``entry``: flag 1 per reached state."""
-    seen = bytearray(len(out))
+    seen = bytearray(len(out_targets))
     seen[entry] = 1
     queue = [entry]
     for state in queue:  # the list grows while it is read: a queue without pops
-        for target, _event in out[state] or _NONE:
+        for target in out_targets[state] or _NONE:
             if not seen[target]:
                 seen[target] = 1
                 queue.append(target)
@@ -218,40 +245,31 @@ def analyse(fsm: FSM) -> LebtStructure:
     names = list(fsm.states)
     count = len(names)
     index = {name: position for position, name in enumerate(names)}
-    out = _out_edges(fsm, index)
+    out_targets, out_events = _out_edges(fsm, index)
     entry = index[fsm.initial]
-    seen = _reached(entry, out)
+    seen = _reached(entry, out_targets)
     reachable = [i for i in range(count) if seen[i]]
     unreachable = [names[i] for i in range(count) if not seen[i]]
 
-    # kept edges (first per (source, event)): guard pairs, exits, distinct-predecessor marks
-    guard_ids: list[Sequence[tuple[int, str]]] = [_NONE] * count
+    # kept edges (the first per (source, event)) and the distinct-predecessor marks
+    kept_targets: list[Sequence[int]] = [_NONE] * count
     exit_events: list[Sequence[str]] = [_NONE] * count
     pred_mark = [_NO_PRED] * count  # _NO_PRED, the only predecessor's index, or _MANY_PREDS
-    start_id = count
-    initial_event = fsm.initial_event if fsm.initial_event is not None else NO_EVENT
-    guard_ids[entry] = [(start_id, initial_event)]
-    pred_mark[entry] = start_id
+    pred_mark[entry] = count  # the start pseudo-state
     for source in reachable:
-        edges = out[source]
-        if edges is None:
+        targets = out_targets[source]
+        if targets is None:
             continue
-        if len(edges) == 1:
-            events: Sequence[str] = [edges[0][1]]
-            kept: Sequence[tuple[int, str]] = edges
-        else:
+        events = out_events[source]
+        assert events is not None
+        if len(events) > 1 and len(set(events)) < len(events):
             firsts: dict[str, int] = {}
-            for target, event in edges:
+            for target, event in zip(targets, events):
                 firsts.setdefault(event, target)
-            events = list(firsts)
-            kept = [(target, event) for event, target in firsts.items()]
+            events, targets = list(firsts), list(firsts.values())
         exit_events[source] = events
-        for target, event in kept:
-            pairs = guard_ids[target]
-            if pairs:
-                pairs.append((source, event))  # type: ignore[attr-defined]
-            else:
-                guard_ids[target] = [(source, event)]
+        kept_targets[source] = targets
+        for target in targets:
             mark = pred_mark[target]
             if mark == _NO_PRED:
                 pred_mark[target] = source
@@ -266,7 +284,7 @@ def analyse(fsm: FSM) -> LebtStructure:
     child_ids: list[Sequence[int]] = [_NONE] * count
     for source in reachable:
         below: list[int] | None = None
-        for target, _event in out[source] or _NONE:
+        for target in out_targets[source] or _NONE:  # every transition, in order
             if placed[target] or pred_mark[target] != source:
                 continue
             placed[target] = 1
@@ -283,7 +301,8 @@ def analyse(fsm: FSM) -> LebtStructure:
         root_ids,
         loop_ids,
         child_ids,
-        guard_ids,
+        kept_targets,
         exit_events,
+        fsm.initial_event if fsm.initial_event is not None else NO_EVENT,
         unreachable,
     )
