@@ -171,15 +171,16 @@ def _escaped_texts(fsm: FSM, structure: LebtStructure) -> tuple[list[str], Calla
 
 def _guard_pair_texts(
     structure: LebtStructure, esc_names: list[str], esc_event: Callable[[str], str]
-) -> list[list[str] | None]:
-    """Per state, its guard's ``source/event`` texts (escaped), made in source order - where
+) -> list[str | list[str] | None]:
+    """Per state, its guard's ``source/event`` texts (escaped; one text alone, not in a list,
+    since most states have one entering pair), made in source order - where
     the source's name and its events are at hand - and dealt out to the targets: the start
     pair first for the entry state, then by source in declaration order and by the source's
     transitions (``LebtStructure.guard_ids``'s order)."""
-    texts: list[list[str] | None] = [None] * len(structure.names)
-    texts[structure.entry_id] = [
+    texts: list[str | list[str] | None] = [None] * len(structure.names)
+    texts[structure.entry_id] = (
         f"{esc_names[structure.start_id]}/{esc_event(structure.initial_event)}"
-    ]
+    )
     kept_targets = structure.kept_targets
     exit_events = structure.exit_events
     plain = esc_event is str
@@ -192,9 +193,11 @@ def _guard_pair_texts(
         for target, event in zip(targets, events):
             known = texts[target]
             if known is None:
-                texts[target] = [prefix + event]
+                texts[target] = prefix + event
+            elif type(known) is str:
+                texts[target] = [known, prefix + event]
             else:
-                known.append(prefix + event)
+                known.append(prefix + event)  # type: ignore[union-attr]
     return texts
 
 
@@ -233,7 +236,8 @@ def _build(fsm: FSM, structure: LebtStructure) -> tuple[BTNode, int, int]:
             continue  # reached only through a transition that never fires: no predecessor
         name = names[i]
         state = states[i]
-        pairs = ";".join(pair_texts[i] or ())
+        texts = pair_texts[i]
+        pairs = texts if type(texts) is str else ";".join(texts or ())  # type: ignore[arg-type]
         if plain:
             exits = ";".join(exit_events[i])
         else:
