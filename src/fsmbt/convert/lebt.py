@@ -148,14 +148,14 @@ def _needs_escape(texts: Iterable[str]) -> bool:
     return "\\" in joined or ";" in joined or "/" in joined
 
 
-def _escaped_texts(fsm: FSM, structure: LebtStructure) -> tuple[list[str], Callable[[str], str]]:
+def _escaped_texts(structure: LebtStructure) -> tuple[list[str], Callable[[str], str]]:
     """The escaped name of every state (and, last, of the start pseudo-state) by index, and
     the event escaper: the identity when no name and no event needs escaping (the usual case,
     found by one scan), else ``escape`` once per distinct event."""
     sources = [*structure.names, structure.start]
     events = (event for i in structure.reachable_ids for event in structure.exit_events[i])
-    if not _needs_escape(sources) and not _needs_escape(events) and not _needs_escape(
-        [fsm.initial_event or ""]
+    if not (
+        _needs_escape(sources) or _needs_escape(events) or _needs_escape([structure.initial_event])
     ):
         return sources, str
     known: dict[str, str] = {}
@@ -216,7 +216,7 @@ def _build(fsm: FSM, structure: LebtStructure) -> tuple[BTNode, int, int]:
     states = list(fsm.states.values())
     if len(states) != len(names):
         raise ValueError("the structure was not analysed from this FSM")
-    esc_names, esc_event = _escaped_texts(fsm, structure)
+    esc_names, esc_event = _escaped_texts(structure)
     child_ids = structure.child_ids
     exit_events = structure.exit_events
     pair_texts = _guard_pair_texts(structure, esc_names, esc_event)
