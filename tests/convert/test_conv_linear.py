@@ -164,3 +164,12 @@ def test_promotion_on_exit_loses_no_garbage_and_respects_frozen_objects() -> Non
         assert gc.get_freeze_count() == frozen  # the caller's frozen objects stay frozen
     finally:
         gc.unfreeze()
+
+
+def test_the_builders_positional_node_fields_are_btnodes_field_order() -> None:
+    from dataclasses import fields
+
+    from fsmbt.convert.lebt import NODE_FIELDS
+    from fsmbt.model.bt import BTNode
+
+    assert tuple(f.name for f in fields(BTNode))[: len(NODE_FIELDS)] == NODE_FIELDS
