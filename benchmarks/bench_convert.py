@@ -9,8 +9,9 @@
    released after the clock is read, so its deallocation is not counted.
 2. Where the FSM -> BT time goes at 1 000 / 10 000 / 100 000 states: structure analysis and tree
    building (collector off, as in the conversion), the young-generation collector passes that
-   the promotion of ``convert/perf.py`` saves, memory (tracemalloc peak, objects tracked by the
-   collector in the result, per state) and, separately, the native checker's cost.
+   the promotion of ``convert/perf.py`` saves, the kernel's share (fresh memory pages), memory
+   (tracemalloc peak, objects tracked by the collector in the result, per state) and,
+   separately, the native checker's and the BehaviorTree.CPP XML writer's cost.
 3. BT -> HFSM for random BTs of 100 ... 100 000 nodes and a 100 000-node deep BT (alternating
    Sequence/Fallback, so compression cannot shorten it).
 
@@ -24,6 +25,7 @@ Run: .venv/bin/python benchmarks/bench_convert.py [--quick] [--fsm-only]
 from __future__ import annotations
 
 import gc
+import resource
 import sys
 import time
 import tracemalloc
@@ -34,6 +36,7 @@ from fsmbt.convert import perf
 from fsmbt.convert.bt_to_hfsm import bt_to_hfsm
 from fsmbt.convert.lebt import _build
 from fsmbt.convert.structure import analyse
+from fsmbt.formats import dumps
 from fsmbt.generate import random_bt, random_fsm
 from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.bt_nodes import NodeKind
@@ -147,29 +150,48 @@ def _phase_row(fsm: FSM) -> str:
     t_check = time.process_time() - started
     if not report.equivalent:
         raise SystemExit(f"the checker refutes the LEBT of a {n}-state machine")
+    _, t_write = best_of(lambda: dumps(result, "btcpp"), max(1, repeats // 3))
     peak, tracked = _memory(fsm)
+    system, faults = _kernel_share(fsm, repeats)
     return (
         f"{n:>7} {t_analyse / n * 1e6:>8.2f} {t_build / n * 1e6:>8.2f} "
-        f"{t_convert / n * 1e6:>8.2f} {t_plain / n * 1e6:>9.2f} {t_young / n * 1e6:>7.2f} "
-        f"{t_check / n * 1e6:>9.1f} {peak:>7.0f}B {tracked:>8.1f}"
+        f"{t_convert / n * 1e6:>8.2f} {system / n * 1e6:>6.2f} {faults / n:>7.3f} "
+        f"{t_plain / n * 1e6:>9.2f} {t_young / n * 1e6:>7.2f} "
+        f"{t_check / n * 1e6:>9.1f} {t_write / n * 1e6:>7.2f} {peak:>7.0f}B {tracked:>8.1f}"
     )
+
+
+def _kernel_share(fsm: FSM, repeats: int) -> tuple[float, float]:
+    """Kernel (system) CPU seconds and minor page faults of one conversion, averaged over
+    ``repeats`` runs: the part of its CPU time spent by the kernel handing out fresh memory
+    pages."""
+    system = faults = 0.0
+    for _ in range(repeats):
+        before = resource.getrusage(resource.RUSAGE_SELF)
+        result = convert_model(fsm)
+        after = resource.getrusage(resource.RUSAGE_SELF)
+        del result
+        system += after.ru_stime - before.ru_stime
+        faults += after.ru_minflt - before.ru_minflt
+    return system / repeats, faults / repeats
 
 
 def part_phases(sizes: list[int]) -> None:
     print()
     print("FSM -> BT, random machines: us per state (CPU); memory per state")
     print(
-        f"{'states':>7} {'analyse':>8} {'build':>8} {'convert':>8} {'no-promo':>9} "
-        f"{'young':>7} {'checker':>9} {'peak':>8} {'tracked':>8}"
+        f"{'states':>7} {'analyse':>8} {'build':>8} {'convert':>8} {'sys':>6} {'faults':>7} "
+        f"{'no-promo':>9} {'young':>7} {'checker':>9} {'write':>7} {'peak':>8} {'tracked':>8}"
     )
     for n in sizes:
         print(_phase_row(fsm_for("random", n)))
     print(
-        "analyse/build: collector off; convert: the whole call; no-promo: the whole call "
-        "without the promotion on exit;\nyoung: the young-generation passes over a fresh "
-        "result the promotion saves; checker: native verify_models (not part of convert);\n"
-        "peak: tracemalloc peak of one conversion; tracked: collector-tracked objects in the "
-        "result"
+        "analyse/build: collector off; convert: the whole call, of which sys: kernel time "
+        "(faults: minor page faults per state,\nfresh memory pages); no-promo: the whole call "
+        "without the promotion on exit; young: the young-generation passes\nover a fresh "
+        "result the promotion saves; checker: native verify_models, write: btcpp XML text "
+        "(neither is part of convert);\npeak: tracemalloc peak of one conversion; tracked: "
+        "collector-tracked objects in the result"
     )
 
 
