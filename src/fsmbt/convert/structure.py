@@ -19,7 +19,7 @@ Representation: a state is its position in ``fsm.states`` (declaration order), `
 (= the number of states) stands for the start pseudo-state. The analysis works on integer
 indices, flat lists and byte flags - one name -> index look-up per transition endpoint, then no
 string-keyed dictionary at all - so that at 100 000 states it does not spend its time on random
-probes into dictionaries of 100 000 string keys (measured: docs/conversion.md, 'Cost'). The
+probes into dictionaries of 100 000 string keys (docs/conversion.md, 'Cost of FSM -> BT'). The
 per-state lists are visited in declaration order, i.e. in the order the FSM's objects lie in
 memory. Name-keyed views (``roots``, ``children``, ``guard_pairs``, ``exits``,
 ``predecessors``) are built on first use, for callers that want names (the hierarchical builder
