@@ -13,8 +13,9 @@ so two things cost time that grows faster than the work while the model grows:
   object allocated while the collector was off is still "young", so that one pass traverses the
   whole result (about 7 objects tracked by the collector per FSM state), and the
   middle-generation pass a little later traverses it again. At 100 000 states the result does
-  not fit in the processor's caches and this pass alone cost 4-6 us per state, more than the
-  whole conversion of a small machine (figures: ``benchmarks/bench_convert.py``). On exit,
+  not fit in the processor's caches and these passes cost more per state than the whole
+  conversion (``benchmarks/bench_convert.py``, figures in docs/conversion.md, 'Cost of
+  FSM -> BT'). On exit,
   ``gc_paused`` therefore moves the young objects straight into the oldest generation with
   ``gc.freeze()`` + ``gc.unfreeze()`` - two O(1) list splices, no traversal - which is where
   two passes would have put the long-lived result anyway.
