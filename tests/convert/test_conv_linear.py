@@ -69,7 +69,7 @@ def _definition(fsm: FSM) -> dict[str, object]:
 def _awkward(seed: int) -> FSM:
     """A generated machine plus what the generator never makes: a second transition on the
     same event (nondeterministic: the first wins), transitions out of a final state, an
-    unreachable pair of states, a self-loop on the entry state."""
+    unreachable cycle of two states leading into the machine, a self-loop on the entry state."""
     fsm = random_fsm(seed, scenario=("basic", "robot", "game")[seed % 3], max_states=25)
     names = list(fsm.states)
     fsm.add_transition(names[0], "again", names[0])
@@ -82,12 +82,27 @@ def _awkward(seed: int) -> FSM:
     fsm.add_state(State("Island2"))
     fsm.add_transition("Island1", "hop", "Island2")
     fsm.add_transition("Island2", "hop", names[len(names) // 2])
+    fsm.add_transition("Island2", "back", "Island1")  # an unreachable cycle
     return fsm
+
+
+def _declared_backwards(fsm: FSM) -> FSM:
+    """The same machine with its states declared in reverse order (the initial state kept):
+    states are entered from states declared after them, which the reachability pass's
+    sequential shortcut cannot take, so the breadth-first search runs."""
+    flipped = FSM(name=fsm.name, start_name=fsm.start_name, initial_event=fsm.initial_event)
+    for state in reversed(list(fsm.states.values())):
+        flipped.add_state(state)
+    flipped.initial = fsm.initial
+    flipped.transitions = list(fsm.transitions)
+    return flipped
 
 
 @pytest.mark.parametrize("seed", range(120))
 def test_index_based_analysis_equals_the_definitions(seed: int) -> None:
     fsm = _awkward(seed) if seed % 2 else random_fsm(seed, max_states=40)
+    if seed % 3 == 0:
+        fsm = _declared_backwards(fsm)
     structure = analyse(fsm)
     expected = _definition(fsm)
     for field, value in expected.items():

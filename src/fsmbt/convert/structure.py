@@ -207,8 +207,30 @@ def _refuse(fsm: FSM, t: Transition, source_unknown: bool) -> NoReturn:
 
 
 def _reached(entry: int, out_targets: list[list[int] | None]) -> bytearray:
-    """Breadth-first reachability from ``entry``: flag 1 per reached state."""
-    seen = bytearray(len(out_targets))
+    """Flag 1 per state reachable from ``entry``.
+
+    First a sequential pass for the usual case, a machine declared roughly in the order it
+    runs: take the order "entry first, then declaration order"; if every other state has a
+    transition from a state before it in that order, every state is reachable (by induction
+    along the order) - checked without visiting the states in graph order, which at 100 000
+    states of a random machine is a cache miss per state. Otherwise, breadth-first search.
+    """
+    count = len(out_targets)
+    seen = bytearray(count)
+    seen[entry] = 1
+    for source, targets in enumerate(out_targets):
+        if targets is None:
+            continue
+        if source == entry:
+            for target in targets:
+                seen[target] = 1
+        else:
+            for target in targets:
+                if target > source:
+                    seen[target] = 1
+    if seen.count(0) == 0:
+        return seen
+    seen = bytearray(count)
     seen[entry] = 1
     queue = [entry]
     for state in queue:  # the list grows while it is read: a queue without pops
