@@ -25,8 +25,8 @@ How it is built (``_build``; the tree is the one the steps above define): the no
 state are made in declaration order - the order the FSM's objects lie in memory - and the
 selectors are then hung below their predecessor's body by index; guard texts are made in source
 order and dealt out to their targets; escaping is skipped when one scan finds nothing to
-escape; nodes are constructed with positional fields. Each of these was measured to matter at
-100 000 states (docs/conversion.md, 'Cost of FSM -> BT').
+escape; nodes are constructed with positional fields (docs/conversion.md, 'Benchmark' and
+'Cost of FSM -> BT').
 
 Complexity: O(S + T) time and memory for S states and T transitions (after flattening); about
 1.5 KB and 7 collector-tracked objects per state in the result.
@@ -50,10 +50,9 @@ STYLES = ("paper",)
 ROOT_NAME = "LEBT"
 SEQUENCE, FALLBACK = "Sequence", "Fallback"
 
-#: The leading ``BTNode`` fields in order: the builder passes them by position, because a
-#: dataclass ``__init__`` called with keywords costs about twice as much per call in CPython
-#: 3.11 (measured: 0.66 vs 0.37 us per node at 100 000 nodes) and the LEBT makes 3-4 nodes per
-#: state. ``tests/convert/test_conv_linear.py`` asserts the order.
+#: The leading ``BTNode`` fields in order: the builder passes them by position, because the
+#: generated dataclass ``__init__`` is slower to call with keywords and the LEBT makes 3-4 nodes
+#: per state. ``tests/convert/test_conv_linear.py`` asserts the order.
 NODE_FIELDS = ("type", "kind", "name", "attrs", "children")
 
 
