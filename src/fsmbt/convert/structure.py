@@ -15,8 +15,8 @@ never fire), then states the initial state cannot reach are dropped with a warni
 run, so no behaviour depends on them) before degrees are counted. Of several transitions leaving
 one state on the same event only the first counts (as ``FSMMachine`` runs it).
 
-Representation: a state is its position in ``fsm.states`` (declaration order), ``START_ID``
-(= the number of states) stands for the start pseudo-state. The analysis works on integer
+Representation: a state is its position in ``fsm.states`` (declaration order);
+``LebtStructure.start_id`` (= the number of states) stands for the start pseudo-state. The analysis works on integer
 indices, flat lists and byte flags - one name -> index look-up per transition endpoint, then no
 string-keyed dictionary at all - so that at 100 000 states it does not spend its time on random
 probes into dictionaries of 100 000 string keys (docs/conversion.md, 'Cost of FSM -> BT'). The
@@ -39,9 +39,9 @@ from fsmbt.model.errors import InputError, UnsupportedError
 from fsmbt.model.fsm import FSM, Transition
 from fsmbt.semantics.lebt.spec import DEFAULT_START, NO_EVENT
 
-#: Shared empty per-state list (no successor linked below / no pair / no exit): most states of
-#: a large machine have no successor linked below them, and one list each would cost memory and
-#: collector time for nothing. Never appended to.
+#: Shared empty per-state list (no successor linked below / no kept transition / no exit): many
+#: states have none, and one empty list each would cost memory and collector time for nothing.
+#: Never appended to.
 _NONE: tuple[()] = ()
 
 # pred_mark values besides a state index: no predecessor yet, several distinct predecessors
