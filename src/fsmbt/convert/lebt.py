@@ -10,8 +10,8 @@ Steps (``docs/conversion.md`` has the worked A-J example):
    ``LebtGuard`` holding every (source, event) pair entering ``s`` (the start pseudo-state's
    initialisation pair included for the entry state); ``body(s)`` is the ``LebtState`` leaf of
    ``s`` alone when no ordinary state hangs below ``s``, else ``Sequence(leaf(s), selector(c1),
-   ..., selector(ck))`` - a chain for k = 1, a branch for k >= 2 - built recursively (with an
-   explicit stack: a 100 000-state chain is 200 000 levels deep).
+   ..., selector(ck))`` - a chain for k = 1, a branch for k >= 2 - nested without recursion
+   (a 100 000-state chain is a 200 000-level tree).
 
 Leaves are named for people: the guard of ``C`` is ``Enter_C``, the state leaf is ``C``; the
 selector is ``C_selector`` and the body ``C_chain`` / ``C_branch``. The document declares
@@ -21,10 +21,20 @@ Only the paper's structure is offered: a "compact" style (a chain as one flat Se
 what the tree returns when an event leaves the chain (the flat Sequence fails where the nested
 Fallbacks succeed), so it is not macro-step equivalent under the LEBT protocol and is refused.
 
-Complexity: O(S + T) time and memory for S states and T transitions (after flattening).
+How it is built (``_build``; the tree is the one the steps above define): the nodes of each
+state are made in declaration order - the order the FSM's objects lie in memory - and the
+selectors are then hung below their predecessor's body by index; guard texts are made in source
+order and dealt out to their targets; escaping is skipped when one scan finds nothing to
+escape; nodes are constructed with positional fields (docs/conversion.md, 'Benchmark' and
+'Cost of FSM -> BT').
+
+Complexity: O(S + T) time and memory for S states and T transitions (after flattening); about
+1.5 KB and 7 collector-tracked objects per state in the result.
 """
 
 from __future__ import annotations
+
+from collections.abc import Callable, Iterable
 
 from fsmbt.convert.perf import without_gc_pauses
 from fsmbt.convert.result import ConversionResult
@@ -38,6 +48,12 @@ from fsmbt.semantics.lebt.spec import GUARD_TYPE, STATE_TYPE, escape
 
 STYLES = ("paper",)
 ROOT_NAME = "LEBT"
+SEQUENCE, FALLBACK = "Sequence", "Fallback"
+
+#: The leading ``BTNode`` fields in order: the builder passes them by position, because the
+#: generated dataclass ``__init__`` is slower to call with keywords and the LEBT makes 3-4 nodes
+#: per state. ``tests/convert/test_conv_linear.py`` asserts the order.
+NODE_FIELDS = ("type", "kind", "name", "attrs", "children")
 
 
 def lebt_node_models() -> dict[str, NodeModel]:
@@ -140,38 +156,158 @@ def build_lebt(fsm: FSM, structure: LebtStructure) -> BTNode:
     return _build(fsm, structure)[0]
 
 
-def _build(fsm: FSM, structure: LebtStructure) -> tuple[BTNode, int, int]:
-    """The LEBT root, its node count and depth (counted while building: no second walk).
+def _needs_escape(texts: Iterable[str]) -> bool:
+    """Whether any text holds a character ``escape`` rewrites (one scan of their concatenation)."""
+    joined = "".join(texts)
+    return "\\" in joined or ";" in joined or "/" in joined
 
-    A selector on level ``L`` holds its guard and body on ``L + 1``; a body Sequence holds the
-    state leaf and the child selectors on ``L + 2``. O(S + T).
-    """
-    writer = LebtLeafWriter(fsm, structure)
-    root = BTNode(type="Sequence", kind=NodeKind.CONTROL, name=ROOT_NAME)
-    nodes, depth = 1, 1
-    pending: list[tuple[str, BTNode, int]] = []
-    for state in structure.roots:
-        selector, body = writer.selector(state)
-        root.children.append(selector)
-        if body is None:
-            nodes += 3
-            depth = max(depth, 3)
-        else:
-            nodes += 4
-            pending.append((state, body, 3))
-    while pending:
-        state, body, level = pending.pop()
-        depth = max(depth, level + 1)  # the state leaf below the body
-        for child in structure.children[state]:
-            selector, child_body = writer.selector(child)
-            body.children.append(selector)
-            if child_body is None:
-                nodes += 3
-                depth = max(depth, level + 2)
+
+def _escaped_texts(structure: LebtStructure) -> tuple[list[str], Callable[[str], str]]:
+    """The escaped name of every state (and, last, of the start pseudo-state) by index, and
+    the event escaper: the identity when no name and no event needs escaping (the usual case,
+    found by one scan), else ``escape`` once per distinct event."""
+    sources = [*structure.names, structure.start]
+    events = (event for i in structure.reachable_ids for event in structure.exit_events[i])
+    if not (
+        _needs_escape(sources) or _needs_escape(events) or _needs_escape([structure.initial_event])
+    ):
+        return sources, str
+    known: dict[str, str] = {}
+
+    def esc_event(text: str) -> str:
+        done = known.get(text)
+        if done is None:
+            done = known[text] = escape(text)
+        return done
+
+    return [escape(name) for name in sources], esc_event
+
+
+def _guard_pair_texts(
+    structure: LebtStructure, esc_names: list[str], esc_event: Callable[[str], str]
+) -> list[str | list[str] | None]:
+    """Per state, its guard's ``source/event`` texts (escaped; one text alone, not in a list,
+    since most states have one entering pair), made in source order - where
+    the source's name and its events are at hand - and dealt out to the targets: the start
+    pair first for the entry state, then by source in declaration order and by the source's
+    transitions (``LebtStructure.guard_ids``'s order)."""
+    texts: list[str | list[str] | None] = [None] * len(structure.names)
+    texts[structure.entry_id] = (
+        f"{esc_names[structure.start_id]}/{esc_event(structure.initial_event)}"
+    )
+    kept_targets = structure.kept_targets
+    exit_events = structure.exit_events
+    plain = esc_event is str
+    for source in structure.reachable_ids:
+        targets = kept_targets[source]
+        if not targets:
+            continue
+        prefix = esc_names[source] + "/"
+        events = exit_events[source] if plain else [esc_event(e) for e in exit_events[source]]
+        for target, event in zip(targets, events):
+            known = texts[target]
+            if known is None:
+                texts[target] = prefix + event
+            elif type(known) is str:
+                texts[target] = [known, prefix + event]
             else:
-                nodes += 4
-                pending.append((child, child_body, level + 2))
-    return root, nodes, depth
+                known.append(prefix + event)  # type: ignore[union-attr]
+    return texts
+
+
+def _build(fsm: FSM, structure: LebtStructure) -> tuple[BTNode, int, int]:
+    """The LEBT root, its node count and depth.
+
+    Built in two passes over the states in declaration order - the order their objects lie in
+    memory - rather than in tree order (a random order for a random machine): pass 1 makes each
+    placed state's guard, state leaf, selector and body; pass 2 hangs each body's child
+    selectors below it (a list look-up by index). The tree is the same as the tree-order
+    construction of docs/conversion.md step 5. A selector on level ``L`` holds its guard and
+    body on ``L + 1``; a body Sequence holds the state leaf and the child selectors on
+    ``L + 2``: the depth is found by a walk over the integer child lists. O(S + T).
+    """
+    names = structure.names
+    states = list(fsm.states.values())
+    if len(states) != len(names):
+        raise ValueError("the structure was not analysed from this FSM")
+    esc_names, esc_event = _escaped_texts(structure)
+    child_ids = structure.child_ids
+    exit_events = structure.exit_events
+    pair_texts = _guard_pair_texts(structure, esc_names, esc_event)
+    control, condition, action = NodeKind.CONTROL, NodeKind.CONDITION, NodeKind.ACTION
+    selectors: list[BTNode | None] = [None] * len(names)
+    nodes = 1
+    placed = bytearray(len(names))
+    for root_id in structure.root_ids:
+        placed[root_id] = 1
+    for below in child_ids:
+        for child in below:
+            placed[child] = 1
+    plain = esc_event is str
+    for i in structure.reachable_ids:
+        if not placed[i]:
+            continue  # reached only through a transition that never fires: no predecessor
+        name = names[i]
+        state = states[i]
+        texts = pair_texts[i]
+        pairs = texts if type(texts) is str else ";".join(texts or ())  # type: ignore[arg-type]
+        if plain:
+            exits = ";".join(exit_events[i])
+        else:
+            exits = ";".join([esc_event(event) for event in exit_events[i]])
+        # positional (type, kind, name, attrs, children): see NODE_FIELDS
+        guard = BTNode(GUARD_TYPE, condition, f"Enter_{name}", {"target": name, "pairs": pairs})
+        leaf = BTNode(
+            STATE_TYPE,
+            action,
+            name,
+            {
+                "state": name,
+                "action": state.action or "",
+                "final": "true" if state.final else "false",
+                "exits": exits,
+            },
+        )
+        below = child_ids[i]
+        if below:
+            shape = "_chain" if len(below) == 1 else "_branch"
+            body = BTNode(SEQUENCE, control, name + shape, {}, [leaf])
+            selectors[i] = BTNode(FALLBACK, control, name + "_selector", {}, [guard, body])
+            nodes += 4
+        else:
+            selectors[i] = BTNode(FALLBACK, control, name + "_selector", {}, [guard, leaf])
+            nodes += 3
+    for i in structure.reachable_ids:  # pass 2: hang the child selectors below each body
+        below = child_ids[i]
+        if below:
+            body = selectors[i].children[1]  # type: ignore[union-attr]
+            body.children.extend([selectors[child] for child in below])  # type: ignore[misc]
+    root = BTNode(
+        type="Sequence",
+        kind=control,
+        name=ROOT_NAME,
+        children=[selectors[i] for i in structure.root_ids],  # type: ignore[misc]
+    )
+    return root, nodes, _lebt_depth(structure)
+
+
+def _lebt_depth(structure: LebtStructure) -> int:
+    """Levels of the LEBT (root = 1) from the structure alone, level by level over the integer
+    child lists (no per-node tuples): root selectors are on level 2 and the selectors hung
+    below a state's body two levels under its own, so with ``k`` levels of selectors the
+    deepest ones are on level ``2k`` and - having nothing below - their leaves on ``2k + 1``."""
+    child_ids = structure.child_ids
+    frontier: list[int] = list(structure.root_ids)
+    levels = 0
+    while frontier:
+        levels += 1
+        below: list[int] = []
+        for state in frontier:
+            children = child_ids[state]
+            if children:
+                below.extend(children)
+        frontier = below
+    return 2 * levels + 1
 
 
 def tree_depth(root: BTNode) -> int:
@@ -208,13 +344,13 @@ def fsm_to_lebt(fsm: FSM, *, style: str = "paper", **_options: object) -> Conver
     root, node_count, depth = _build(flat, structure)
     doc = BTDocument.single(root)
     doc.node_models.update(lebt_node_models())
-    below = [len(children) for children in structure.children.values()]
+    below = [len(structure.child_ids[i]) for i in structure.reachable_ids]
     stats = {
-        "states": len(structure.predecessors),
-        "transitions": sum(len(v) for v in structure.exits.values()),
+        "states": len(structure.reachable_ids),
+        "transitions": sum(len(structure.exit_events[i]) for i in structure.reachable_ids),
         "entry": structure.entry,
-        "loop_states": len(structure.loop_states),
-        "root_subtrees": len(structure.roots),
+        "loop_states": len(structure.loop_ids),
+        "root_subtrees": len(structure.root_ids),
         "chains": below.count(1),
         "branches": sum(1 for count in below if count >= 2),
         "unreachable_dropped": len(structure.unreachable),
