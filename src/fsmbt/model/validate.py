@@ -396,7 +396,11 @@ class _BtValidator:
                 self.add("error", "SubTree node without an ID naming the tree", node, where())
             elif target not in self.doc.trees:
                 severity: Severity = "warning" if self.doc.includes else "error"
-                hint = " (it may come from an included file)" if self.doc.includes else ""
+                hint = (
+                    " (it may come from an included file)"
+                    if self.doc.includes
+                    else " (a tree of another file: name it with --trees PATH)"
+                )
                 self.add(
                     severity, f"SubTree references missing tree '{target}'{hint}", node, where()
                 )

@@ -299,7 +299,11 @@ class CompiledTree:
             ctype = "SubTree"
             target = node.attrs.get("ID")
             if not target or target not in self.doc.trees:
-                raise InputError(f"SubTree refers to unknown tree {target!r}", **_where(node))
+                raise InputError(
+                    f"SubTree refers to unknown tree {target!r} (a tree of another file: name "
+                    "that file or its folder with --trees PATH)",
+                    **_where(node),
+                )
             if target in chain:
                 raise UnsupportedError(
                     f"SubTree '{target}' includes itself (recursion)", **_where(node)
