@@ -441,6 +441,12 @@ class _Loader:
         if spec is not None:
             if spec.kind is NodeKind.SUBTREE and not attrs.get("ID"):
                 raise InputError("<SubTree> without ID", location=where, element=tag)
+            if spec.kind is NodeKind.CONTROL and n_children == 0 and spec.allows_children(0):
+                self.ctx.warnings.append(
+                    f"{where}: {tag}: without children it follows its own rule "
+                    f"({spec.source}), but BehaviorTree.CPP 4.8.2's loader refuses a control "
+                    "node without children"
+                )
             return BTNode(type_name, spec.kind, name, attrs, location=where)
         seen = ports_seen.setdefault(type_name, {})
         for key in attrs:

@@ -364,7 +364,15 @@ class _BtValidator:
                 where(),
             )
         if node.kind is NodeKind.CONTROL:
-            if count == 0:
+            if count == 0 and spec is not None and spec.allows_children(0):
+                self.add(
+                    "warning",
+                    f"'{node.type}' without children: its own rule ({spec.source}) is modelled, "
+                    "but BehaviorTree.CPP 4.8.2's loader refuses a control node without children",
+                    node,
+                    where(),
+                )
+            elif count == 0:
                 self.add("error", f"control node '{node.type}' has no children", node, where())
             elif spec is not None and spec.children is not None and count != spec.children:
                 self.add(
