@@ -225,3 +225,32 @@ def test_corpus_multi_file_trees_convert() -> None:
     child = CORPUS / "bt" / "btcpp" / "trees" / "child" / "child_include_parent.xml"
     outcome = api.convert_file(child, options={"include_root": str(child.parents[1])})
     assert outcome.equivalent is True
+
+
+def test_batch_passes_trees_and_include_root_to_the_reader(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import json
+
+    from fsmbt.cli import main
+
+    (tmp_path / "in" / "sub").mkdir(parents=True)
+    (tmp_path / "lib").mkdir()
+    tree_file(tmp_path / "lib" / "s.xml", "Sub", "<Grasp/>")
+    tree_file(tmp_path / "in" / "common.xml", "C", "<Go/>")
+    main_file(tmp_path / "in" / "sub", "Sub")
+    tree_file(
+        tmp_path / "in" / "sub" / "child.xml",
+        "Child",
+        '<Sequence><SubTree ID="C"/><Stop/></Sequence>',
+        extra='<include path="../common.xml"/>',
+    )
+    inputs = [str(tmp_path / "in" / "sub" / n) for n in ("main.xml", "child.xml")]
+    args = ["batch", *inputs, "-o", str(tmp_path / "out"), "--quiet", "--json", "-j", "1"]
+    assert main(args) == 2  # without the options: one dangling SubTree, one include refused
+    capsys.readouterr()
+    extra = ["--trees", str(tmp_path / "lib"), "--include-root", str(tmp_path / "in")]
+    args2 = ["batch", *inputs, "-o", str(tmp_path / "out2"), "--quiet", "--json", "-j", "1"]
+    assert main([*args2, *extra]) == 0
+    rows = json.loads(capsys.readouterr().out)["results"]
+    assert sorted(r["status"] for r in rows) == ["equivalent", "equivalent"]
