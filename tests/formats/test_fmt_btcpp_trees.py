@@ -254,3 +254,17 @@ def test_batch_passes_trees_and_include_root_to_the_reader(
     assert main([*args2, *extra]) == 0
     rows = json.loads(capsys.readouterr().out)["results"]
     assert sorted(r["status"] for r in rows) == ["equivalent", "equivalent"]
+
+
+def test_a_found_file_does_not_replace_the_files_own_trees(tmp_path: Path) -> None:
+    main = main_file(tmp_path, "Sub")
+    (tmp_path / "other.xml").write_text(
+        '<root BTCPP_format="4"><BehaviorTree ID="Main"><Decoy/></BehaviorTree>'
+        '<BehaviorTree ID="Sub"><Grasp/></BehaviorTree></root>',
+        encoding="utf-8",
+    )
+    warnings: list[str] = []
+    doc = read_model(main, warnings=warnings)
+    assert doc.trees["Main"].root is not None and doc.trees["Main"].root.type == "Sequence"
+    assert set(doc.trees) == {"Main", "Sub"}
+    assert any("'Main'" in w and "not taken" in w for w in warnings)

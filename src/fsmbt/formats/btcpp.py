@@ -324,6 +324,13 @@ class _Loader:
             for child in _elements(f.root):
                 if child.tag == "BehaviorTree":
                     tree = self.tree(child, f, ports_seen, implied)
+                    if tree.id in doc.trees and f.extra:
+                        # a file read for another of its trees: the reader's own tree wins
+                        self.ctx.warnings.append(
+                            f"{tree.location}: tree '{tree.id}' of {f.path} is not taken: "
+                            f"{doc.trees[tree.id].location} defines it already"
+                        )
+                        continue
                     if tree.id in doc.trees:
                         raise InputError(
                             f"duplicate BehaviorTree ID '{tree.id}'",
