@@ -402,6 +402,15 @@ class _BtValidator:
             target = node.subtree_id
             if not target:
                 self.add("error", "SubTree node without an ID naming the tree", node, where())
+            elif builtin_spec(target) is not None and target not in self.doc.trees:
+                # xml_parsing.cpp VerifyXML: a SubTree ID must not be a registered node's name
+                self.add(
+                    "error",
+                    f"SubTree ID '{target}' is the name of a built-in node; BehaviorTree.CPP "
+                    "refuses it",
+                    node,
+                    where(),
+                )
             elif target not in self.doc.trees:
                 severity: Severity = "warning" if self.doc.includes else "error"
                 hint = (
