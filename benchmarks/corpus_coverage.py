@@ -11,6 +11,17 @@ of the corpus (``FSMBT_CORPUS``, default ``../shared/corpus``): BehaviorTree.CPP
   trees, Nav2's model file as ``--node-models``;
 - ``abstract``: ``profiles`` plus ``--abstract time,blackboard``.
 
+For the profiles and abstract settings the BehaviorTree.CPP test files (``bt/btcpp``) are read
+with ``include_root`` = their source folder (``--include-root``: BT.CPP's test set includes
+``../parent_no_include.xml`` from a subfolder). SubTrees naming trees of other files are found
+by the reader's folder lookup (docs/formats/btcpp.md), as for a user.
+
+Every BehaviorTree.CPP file is also loaded by BehaviorTree.CPP 4.8.2 itself (behaviortreepy;
+``btcpp_loads.py``: every unknown node registered as a dummy of its declared kind): the files the
+real engine refuses to load are counted in their own column and listed with the engine's
+message, and the BT figure is printed twice - over all well-formed files, and over the files
+BehaviorTree.CPP itself loads.
+
 Files under ``_malformed/`` or ``_legacy_draft/`` are negative inputs: they must be refused
 (counted apart). A file "converts" when the result is EQUIVALENT. For the others the first
 blocker (the error's message, with node names and locations cut out) is tallied.
@@ -33,8 +44,11 @@ from collections import Counter
 from dataclasses import dataclass
 from pathlib import Path
 
-from fsmbt import api
-from fsmbt.model.errors import InputError
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import btcpp_loads  # noqa: E402 - the sibling script, importable when run from anywhere
+
+from fsmbt import api  # noqa: E402
+from fsmbt.model.errors import InputError  # noqa: E402
 
 SETTINGS = ("plain", "profiles", "abstract")
 NEGATIVE_DIRS = ("_malformed", "_legacy_draft")
@@ -49,6 +63,7 @@ class Row:
     ok: bool
     reason: str
     seconds: float = 0.0
+    btcpp_refusal: str | None = None  # BehaviorTree.CPP 4.8.2's own refusal (bt files)
 
 
 def corpus_root() -> Path:
@@ -109,6 +124,8 @@ def options_for(
     options: dict[str, object] = {"nodes": ["nav2", "moveit_pro", *library_files(source, path)]}
     if source == "bt/nav2":
         options["node_models"] = [str(root / "bt" / "nav2" / "models" / "nav2_tree_nodes.xml")]
+    if source == "bt/btcpp":
+        options["include_root"] = str(root / source)
     if setting == "abstract":
         options["abstract"] = ["time", "blackboard"]
     return options
@@ -162,6 +179,10 @@ def run_one(path: Path, source: str, kind: str, setting: str, root: Path, budget
         ok, reason = False, f"CRASH {type(exc).__name__}: {reason_of(exc)}"
     row = Row(path, source, kind, negative, ok, reason)
     row.seconds = time.perf_counter() - started
+    if kind == "bt" and not negative and btcpp_loads.available():
+        row.btcpp_refusal = btcpp_loads.refusal(
+            path, root / source, options_for(setting, source, root)
+        )
     return row
 
 
@@ -209,12 +230,20 @@ def main() -> int:
         by_source: dict[str, list[Row]] = {}
         for r in positive:
             by_source.setdefault(r.source, []).append(r)
+        checked = btcpp_loads.available()
         print(
             table(
                 "by source (well-formed files)",
-                ["source", "files", "convert+verify"],
+                ["source", "files", "convert+verify", "refused by BehaviorTree.CPP itself"],
                 [
-                    [s, len(rs), share(sum(r.ok for r in rs), len(rs))]
+                    [
+                        s,
+                        len(rs),
+                        share(sum(r.ok for r in rs), len(rs)),
+                        sum(r.btcpp_refusal is not None for r in rs)
+                        if checked and s.startswith("bt/")
+                        else "-",
+                    ]
                     for s, rs in sorted(by_source.items())
                 ],
                 args.markdown,
@@ -229,12 +258,39 @@ def main() -> int:
                 args.markdown,
             )
         )
+        bt_rows = [r for r in positive if r.kind == "bt"]
+        refused_by_engine = [r for r in bt_rows if r.btcpp_refusal is not None]
+        if bt_rows and checked:
+            print(
+                table(
+                    "refused by BehaviorTree.CPP itself (4.8.2, unknown nodes as dummies)",
+                    ["file", "fsmbt", "BehaviorTree.CPP's message"],
+                    [
+                        [
+                            r.path.relative_to(root),
+                            "converts" if r.ok else "refuses",
+                            (r.btcpp_refusal or "")[:120],
+                        ]
+                        for r in refused_by_engine
+                    ],
+                    args.markdown,
+                )
+            )
+        elif bt_rows:
+            print("refused by BehaviorTree.CPP itself: not checked (behaviortreepy missing)")
         for kind in ("bt", "scxml", "smach", "flexbe"):
             mine = [r for r in positive if r.kind == kind]
             if mine:
                 print(
                     f"{kind}: {share(sum(r.ok for r in mine), len(mine))} well-formed files "
                     "convert and verify"
+                )
+            if kind == "bt" and mine and checked:
+                loadable = [r for r in mine if r.btcpp_refusal is None]
+                print(
+                    f"bt: {share(sum(r.ok for r in loadable), len(loadable))} of the files "
+                    f"BehaviorTree.CPP itself loads convert and verify ({len(refused_by_engine)} "
+                    "refused by BehaviorTree.CPP itself)"
                 )
         negatives = [r for r in rows if r.negative]
         refused = sum(not r.ok and not r.reason.startswith("CRASH") for r in negatives)

@@ -205,7 +205,9 @@ def load(
         fmt: its format's name; detected from the content, then the extension, when ``None``.
         options: reader options: for BehaviorTree.CPP files ``node_models`` (TreeNodesModel
             files), ``nodes`` (node profiles ``nav2``/``moveit_pro`` and YAML/JSON node files)
-            and ``abstract`` (``time``, ``blackboard``); docs/semantics.md §10.
+            and ``abstract`` (``time``, ``blackboard``); docs/semantics.md §10; ``trees``
+            (files or folders whose trees SubTrees may name) and ``include_root`` (the folder
+            ``<include>`` s may resolve in); docs/formats/btcpp.md.
 
     Returns:
         The ``Loaded`` model with the reader's warnings.
@@ -294,12 +296,12 @@ def load_for_engine(
 
 
 #: Options meant for the readers, not the engines (they travel in the same ``options`` dict).
-READER_OPTIONS = ("node_models", "nodes", "abstract", "data")
+READER_OPTIONS = ("node_models", "nodes", "abstract", "data", "trees", "include_root")
 
 
 def _reader_options(options: dict[str, object]) -> dict[str, object] | None:
-    """The options a reader understands (``node_models``, ``nodes``, ``abstract``, ``data``),
-    out of the engine options."""
+    """The options a reader understands (``node_models``, ``nodes``, ``abstract``, ``data``,
+    ``trees``, ``include_root``), out of the engine options."""
     picked = {key: options[key] for key in READER_OPTIONS if key in options}
     return picked or None
 

@@ -40,6 +40,9 @@ class Limits:
         max_nodes: most nodes (all trees) a read BT document may have. ``FSMBT_MAX_NODES``.
         max_include_depth: longest chain of BehaviorTree.CPP ``<include>`` files.
             ``FSMBT_MAX_INCLUDE_DEPTH``.
+        max_tree_files: most ``.xml`` files one BehaviorTree.CPP read opens to find the trees
+            its SubTrees name (a ``--trees`` folder, or the lookup in the file's own folder).
+            ``FSMBT_MAX_TREE_FILES``.
         checker_max_states: reachable states the native checker explores per machine and in the
             product before it stops. ``FSMBT_MAX_CHECKER_STATES``.
         conversion_max_states: reachable states BT -> FSM conversion explores for one region of
@@ -60,6 +63,7 @@ class Limits:
     max_states: int = 1_000_000
     max_nodes: int = 2_000_000
     max_include_depth: int = 64
+    max_tree_files: int = 1_000
     checker_max_states: int = 2_000_000
     conversion_max_states: int = 200_000
     checker_max_seconds: float = 600.0

@@ -147,6 +147,14 @@ def test_good_bt_has_no_issue() -> None:
             "error: SubTree references missing tree 'Gone'",
         ),
         (
+            BTNode("SubTree", NodeKind.SUBTREE, attrs={"ID": "SubTree"}),
+            "error: SubTree ID 'SubTree' is the name of a built-in node",
+        ),
+        (
+            BTNode("ManualSelector", NodeKind.CONTROL),
+            "warning: 'ManualSelector' without children",
+        ),
+        (
             BTNode("Delay", NodeKind.DECORATOR, children=[leaf("a")]),
             "warning: time-based node 'Delay'",
         ),

@@ -41,7 +41,12 @@ from fsmbt.batch.result import (
     TIMEOUT,
 )
 from fsmbt.cli.hints import CLI_WORDING
-from fsmbt.cli.options import node_models_option, reader_options
+from fsmbt.cli.options import (
+    include_root_option,
+    node_models_option,
+    reader_options,
+    trees_option,
+)
 from fsmbt.llm.config import PROVIDERS
 from fsmbt.model.errors import HINT_TEXT, InputError, SourceLocation
 
@@ -263,6 +268,8 @@ def register(app: typer.Typer) -> None:
             False, "--report", help="print the summary of OUTDIR's store again; runs nothing"
         ),
         node_models: list[Path] = node_models_option(),
+        trees: list[Path] = trees_option(),
+        include_root: Path | None = include_root_option(),
         hierarchy: Literal["subtrees", "flatten"] = typer.Option(
             "subtrees", "--hierarchy", help="FSM->BT of a hierarchical FSM: subtrees or flatten"
         ),
@@ -312,7 +319,9 @@ def register(app: typer.Typer) -> None:
                 "is a file; -o names the output folder", location=SourceLocation(str(outdir))
             )
         outdir.mkdir(parents=True, exist_ok=True)
-        options: dict[str, Any] = dict(reader_options(node_models) or {})
+        options: dict[str, Any] = dict(
+            reader_options(node_models, None, None, trees, include_root) or {}
+        )
         options.update(style=style, loop=loop, hierarchy=hierarchy)
         if source_format:
             options["source_format"] = source_format

@@ -21,12 +21,14 @@ from fsmbt import api
 from fsmbt.cli.options import (
     abstract_option,
     apply_engine_caps,
+    include_root_option,
     max_states_option,
     node_models_option,
     nodes_option,
     nusmv_memory_option,
     reader_options,
     timeout_option,
+    trees_option,
 )
 from fsmbt.cli.progress import StageProgress, format_timings
 from fsmbt.cli.wording import checked_counts, conversion_summary
@@ -78,6 +80,8 @@ def register(app: typer.Typer) -> None:
         max_states: int | None = max_states_option(),
         nodes: list[str] = nodes_option(),
         abstract: list[str] = abstract_option(),
+        trees: list[Path] = trees_option(),
+        include_root: Path | None = include_root_option(),
         hierarchy: Literal["subtrees", "flatten"] = typer.Option(
             "subtrees",
             "--hierarchy",
@@ -95,7 +99,9 @@ def register(app: typer.Typer) -> None:
         """Convert an FSM into a behavior tree or a behavior tree into a hierarchical FSM, and
         prove the result equivalent."""
         apply_engine_caps(timeout, nusmv_memory)
-        options: dict[str, object] = dict(reader_options(node_models, nodes, abstract) or {})
+        options: dict[str, object] = dict(
+            reader_options(node_models, nodes, abstract, trees, include_root) or {}
+        )
         if engine in api.LLM_ENGINES:
             options.update(llm_base_url=llm_base_url, llm_model=llm_model)
         with StageProgress(quiet=quiet, label=source.name) as progress:

@@ -13,9 +13,11 @@ from rich.table import Table
 from fsmbt import api
 from fsmbt.cli.options import (
     abstract_option,
+    include_root_option,
     node_models_option,
     nodes_option,
     reader_options,
+    trees_option,
 )
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.stats import BTStats, FSMStats, model_stats
@@ -36,6 +38,8 @@ def register(app: typer.Typer) -> None:
         node_models: list[Path] = node_models_option(),
         nodes: list[str] = nodes_option(),
         abstract: list[str] = abstract_option(),
+        trees: list[Path] = trees_option(),
+        include_root: Path | None = include_root_option(),
         as_json: bool = typer.Option(False, "--json", help="Print the figures as JSON."),
     ) -> None:
         """Structure at a glance: states, events, entry/loop states; BT nodes, depth, breadth.
@@ -44,7 +48,11 @@ def register(app: typer.Typer) -> None:
         loop states of the LEBT structure (docs/conversion.md), hierarchy. BT: nodes by kind and type, depth, breadth,
         leaves, trees and SubTree references.
         """
-        loaded = api.load(model, from_format, options=reader_options(node_models, nodes, abstract))
+        loaded = api.load(
+            model,
+            from_format,
+            options=reader_options(node_models, nodes, abstract, trees, include_root),
+        )
         stats = model_stats(loaded.model)
         undeclared = (
             undeclared_leaf_types(loaded.model) if isinstance(loaded.model, BTDocument) else None

@@ -14,9 +14,11 @@ from rich.table import Table
 from fsmbt import api
 from fsmbt.cli.options import (
     abstract_option,
+    include_root_option,
     node_models_option,
     nodes_option,
     reader_options,
+    trees_option,
 )
 from fsmbt.metrics import edit_distance, elements
 from fsmbt.model.errors import InputError
@@ -35,6 +37,8 @@ def register(app: typer.Typer) -> None:
         node_models: list[Path] = node_models_option(),
         nodes: list[str] = nodes_option(),
         abstract: list[str] = abstract_option(),
+        trees: list[Path] = trees_option(),
+        include_root: Path | None = include_root_option(),
         timeout: float = typer.Option(
             5.0, "--timeout", min=0.01, help="Seconds for the FSM graph edit distance search."
         ),
@@ -43,13 +47,17 @@ def register(app: typer.Typer) -> None:
         """Graphical and active elements, depth, node counts by type, sub-FSMs; with OTHER the
         tree edit distance (BTs) or graph edit distance (FSMs, an upper bound when cut)."""
         first = api.load(
-            model, from_format, options=reader_options(node_models, nodes, abstract)
+            model,
+            from_format,
+            options=reader_options(node_models, nodes, abstract, trees, include_root),
         ).model
         figures = {"file": str(model), **elements(first).to_dict()}
         report: dict[str, object] = {"model": figures}
         if other is not None:
             second = api.load(
-                other, from_format, options=reader_options(node_models, nodes, abstract)
+                other,
+                from_format,
+                options=reader_options(node_models, nodes, abstract, trees, include_root),
             ).model
             report["other"] = {"file": str(other), **elements(second).to_dict()}
             try:

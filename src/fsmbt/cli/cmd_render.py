@@ -11,9 +11,11 @@ from fsmbt import api
 from fsmbt.cli import EXIT_INTERNAL, fail
 from fsmbt.cli.options import (
     abstract_option,
+    include_root_option,
     node_models_option,
     nodes_option,
     reader_options,
+    trees_option,
 )
 from fsmbt.render import DEFAULT_MAX_NODES, GraphvizError, render_model
 
@@ -40,6 +42,8 @@ def register(app: typer.Typer) -> None:
         node_models: list[Path] = node_models_option(),
         nodes: list[str] = nodes_option(),
         abstract: list[str] = abstract_option(),
+        trees: list[Path] = trees_option(),
+        include_root: Path | None = include_root_option(),
         force: bool = typer.Option(False, "--force", help="Overwrite OUTPUT if it exists."),
         expand_subtrees: bool = typer.Option(
             False,
@@ -65,7 +69,9 @@ def register(app: typer.Typer) -> None:
     ) -> None:
         """Draw MODEL: FSMs as state diagrams, behavior trees top-down with the usual symbols."""
         loaded = api.load(
-            model, from_format, options=reader_options(node_models, nodes, abstract)
+            model,
+            from_format,
+            options=reader_options(node_models, nodes, abstract, trees, include_root),
         ).model
         notes: list[str] = []
         try:

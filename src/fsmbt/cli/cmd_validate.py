@@ -20,9 +20,11 @@ from fsmbt import api
 from fsmbt.cli import EXIT_BAD_INPUT, EXIT_OK
 from fsmbt.cli.options import (
     abstract_option,
+    include_root_option,
     node_models_option,
     nodes_option,
     reader_options,
+    trees_option,
 )
 from fsmbt.model.errors import SourceLocation
 from fsmbt.model.validate import Issue, validate
@@ -38,13 +40,19 @@ def register(app: typer.Typer) -> None:
         node_models: list[Path] = node_models_option(),
         nodes: list[str] = nodes_option(),
         abstract: list[str] = abstract_option(),
+        trees: list[Path] = trees_option(),
+        include_root: Path | None = include_root_option(),
         as_json: bool = typer.Option(False, "--json", help="Print the issues as JSON."),
         strict: bool = typer.Option(False, "--strict", help="Treat warnings as errors."),
     ) -> None:
         """Check a model: unknown nodes, wrong child counts, missing SubTrees, unknown or
         duplicate states, nondeterminism, empty models; warn about unreachable states,
         dead ends not marked final and parts fsmbt cannot model exactly."""
-        loaded = api.load(model, from_format, options=reader_options(node_models, nodes, abstract))
+        loaded = api.load(
+            model,
+            from_format,
+            options=reader_options(node_models, nodes, abstract, trees, include_root),
+        )
         # reader warnings already start with their location; model issues get the file name
         issues = [Issue("warning", w) for w in loaded.warnings]
         issues += [_with_file(i, model) for i in validate(loaded.model)]

@@ -17,12 +17,14 @@ from fsmbt import api
 from fsmbt.cli.options import (
     abstract_option,
     apply_engine_caps,
+    include_root_option,
     max_states_option,
     node_models_option,
     nodes_option,
     nusmv_memory_option,
     reader_options,
     timeout_option,
+    trees_option,
 )
 from fsmbt.cli.progress import StageProgress
 from fsmbt.verify import EngineDisagreement
@@ -44,6 +46,8 @@ def register(app: typer.Typer) -> None:
         max_states: int | None = max_states_option(),
         nodes: list[str] = nodes_option(),
         abstract: list[str] = abstract_option(),
+        trees: list[Path] = trees_option(),
+        include_root: Path | None = include_root_option(),
         engine: str = typer.Option(
             "native", "--engine", help="native, nusmv, or both (both must agree)."
         ),
@@ -75,7 +79,7 @@ def register(app: typer.Typer) -> None:
                     source_format=from_format,
                     converted_format=from_format2,
                     max_states=max_states,
-                    options=reader_options(node_models, nodes, abstract),
+                    options=reader_options(node_models, nodes, abstract, trees, include_root),
                     on_stage=progress,
                 )
         except EngineDisagreement as exc:

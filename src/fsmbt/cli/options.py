@@ -26,6 +26,32 @@ ABSTRACT_HELP = (
 )
 
 
+#: ``--trees PATH`` (repeatable): files (or folders of .xml files) whose ``<BehaviorTree>`` s the
+#: SubTrees may name, as BehaviorTree.CPP's ``registerBehaviorTreeFromFile`` (docs/cli.md).
+TREES_HELP = (
+    "a BehaviorTree.CPP file, or a folder of them, whose trees SubTrees may refer to (as "
+    "registerBehaviorTreeFromFile); repeatable. Without it, a SubTree ID found nowhere else is "
+    "looked up in the other .xml files of the referencing file's folder"
+)
+#: ``--include-root DIR``: ``<include path>`` may resolve anywhere under DIR (docs/security.md).
+INCLUDE_ROOT_HELP = (
+    "BehaviorTree.CPP <include path=...> may resolve anywhere under DIR (default: the folder "
+    "of the file read, and its subfolders)"
+)
+
+
+def trees_option() -> list[Path]:
+    """The ``--trees`` option (a fresh ``typer.Option`` per command)."""
+    return typer.Option([], "--trees", help=TREES_HELP)  # type: ignore[no-any-return]
+
+
+def include_root_option() -> Path | None:
+    """The ``--include-root`` option (a fresh ``typer.Option`` per command)."""
+    return typer.Option(  # type: ignore[no-any-return]
+        None, "--include-root", help=INCLUDE_ROOT_HELP, file_okay=False
+    )
+
+
 def node_models_option() -> list[Path]:
     """The ``--node-models`` option (a fresh ``typer.Option`` per command)."""
     return typer.Option([], "--node-models", help=NODE_MODELS_HELP, exists=False)  # type: ignore[no-any-return]
@@ -45,6 +71,8 @@ def reader_options(
     node_models: list[Path] | None,
     nodes: list[str] | None = None,
     abstract: list[str] | None = None,
+    trees: list[Path] | None = None,
+    include_root: Path | None = None,
 ) -> dict[str, object] | None:
     """The reader options for ``fsmbt.api.load`` from the shared CLI options.
 
@@ -52,6 +80,8 @@ def reader_options(
         node_models: ``--node-models`` files.
         nodes: ``--nodes`` profiles and files.
         abstract: ``--abstract`` families.
+        trees: ``--trees`` files and folders.
+        include_root: ``--include-root`` folder.
 
     Returns:
         The options dict, or ``None`` when none was given.
@@ -63,6 +93,10 @@ def reader_options(
         options["nodes"] = list(nodes)
     if abstract:
         options["abstract"] = list(abstract)
+    if trees:
+        options["trees"] = [str(path) for path in trees]
+    if include_root is not None:
+        options["include_root"] = str(include_root)
     return options or None
 
 

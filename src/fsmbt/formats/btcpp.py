@@ -27,6 +27,7 @@ from pathlib import Path
 from lxml import etree
 
 from fsmbt import limits
+from fsmbt.formats import btcpp_trees
 from fsmbt.formats.registry import Format, ReadContext, decode, read_bounded, register
 from fsmbt.formats.xml_safe import parse_xml, root_tag
 from fsmbt.model import Model
@@ -66,6 +67,8 @@ class _File:
     path: str
     root: etree._Element
     version: str
+    source: Path | None = None  # the file read (resolved), None for text
+    extra: bool = False  # read to resolve a SubTree (btcpp_trees), not given or included
 
 
 @dataclass
@@ -77,7 +80,9 @@ class _Loader:
     external: dict[str, NodeModel] = field(default_factory=dict)  # options["node_models"]
 
     # files and includes ------------------------------------------------------------------------
-    def load(self, text: str, path: Path | None, chain: tuple[Path, ...]) -> None:
+    def load(
+        self, text: str, path: Path | None, chain: tuple[Path, ...], *, extra: bool = False
+    ) -> None:
         name = str(path) if path is not None else self.ctx.display_name
         root = parse_xml(text, name)
         if root.tag != "root":
@@ -92,13 +97,20 @@ class _Loader:
                 location=SourceLocation(name, root.sourceline),
                 element="root",
             )
-        self.files.append(_File(name, root, version))
+        source = path.resolve() if path is not None else None
+        self.files.append(_File(name, root, version, source, extra))
         for child in _elements(root):
             if child.tag == "include":
-                self.include(child, path, name, chain)
+                self.include(child, path, name, chain, extra=extra)
 
     def include(
-        self, element: etree._Element, path: Path | None, name: str, chain: tuple[Path, ...]
+        self,
+        element: etree._Element,
+        path: Path | None,
+        name: str,
+        chain: tuple[Path, ...],
+        *,
+        extra: bool = False,
     ) -> None:
         where = SourceLocation(name, element.sourceline)
         if element.get("ros_pkg") is not None:
@@ -133,7 +145,7 @@ class _Loader:
             raise InputError(
                 f"include '{target}' resolves to {resolved}, outside the folder of "
                 f"the file read ({top_folder}); refused (allow a wider folder "
-                "with the include_root option)",
+                "with --include-root DIR, reader option include_root)",
                 location=where,
                 element="include",
             )
@@ -166,7 +178,100 @@ class _Loader:
                 location=where,
                 element="include",
             ) from None
-        self.load(decode(text, str(resolved)), resolved, (*chain, resolved))
+        self.load(decode(text, str(resolved)), resolved, (*chain, resolved), extra=extra)
+
+    # trees in other files (fsmbt.formats.btcpp_trees) -----------------------------------------
+    def resolve_subtrees(self) -> None:
+        """Load the files that define the trees the SubTrees name and no loaded file defines:
+        from the ``trees`` option, else from the referencing file's own folder."""
+        option = self.ctx.options.get(btcpp_trees.TREES_OPTION)
+        named = btcpp_trees.index_option(option) if option else None
+        folders: dict[Path, btcpp_trees.TreeIndex] = {}
+        defined: set[str] = set()
+        pending: list[tuple[str, _File, etree._Element]] = []
+        scanned = 0
+        while True:
+            for f in self.files[scanned:]:
+                defined.update(btcpp_trees.tree_ids(f.root))
+                pending.extend((tree_id, f, el) for tree_id, el in _subtree_refs(f.root))
+            scanned = len(self.files)
+            pending = [p for p in pending if p[0] not in defined]
+            if not pending:
+                return
+            tree_id, f, element = pending[0]
+            where = SourceLocation(f.path, element.sourceline)
+            if named is not None:
+                index, looked = named, f"the {btcpp_trees.TREES_FLAG} files"
+            elif f.source is not None:
+                folder = f.source.parent
+                if folder not in folders:
+                    folders[folder] = btcpp_trees.index_folder(folder)
+                index, looked = folders[folder], f"the other .xml files of its folder {folder}"
+            else:
+                index, looked = btcpp_trees.TreeIndex(), "any other file (the input is a text)"
+            found = index.defined.get(tree_id, [])
+            if not found:
+                # left dangling: validation and the interpreter refuse it, naming --trees
+                skipped = (
+                    f" ({len(index.skipped)} unreadable, skipped: {', '.join(index.skipped[:3])})"
+                    if index.skipped
+                    else ""
+                )
+                self.ctx.warnings.append(
+                    f"{where}: SubTree '{tree_id}': no tree with that ID in the file, its "
+                    f"includes or {looked}{skipped}; name the file (or folder) that defines it "
+                    f"with {btcpp_trees.TREES_FLAG} PATH (reader option trees)"
+                )
+                defined.add(tree_id)
+                continue
+            if len(found) > 1:
+                raise InputError(
+                    f"SubTree refers to tree '{tree_id}', defined in {found[0]} and in "
+                    f"{found[1]}; refused (name the one meant with {btcpp_trees.TREES_FLAG})",
+                    location=where,
+                    element="SubTree",
+                )
+            target = found[0]
+            if named is None:
+                self.ctx.warnings.append(
+                    f"{where}: SubTree '{tree_id}' is taken from {target}, another file of the "
+                    f"folder (name it with {btcpp_trees.TREES_FLAG} to make this explicit)"
+                )
+            if target in self.loaded:  # loaded, yet without that ID: a stale index
+                raise InputError(
+                    f"SubTree refers to tree '{tree_id}', which {target} no longer defines",
+                    location=where,
+                    element="SubTree",
+                )
+            self.loaded.add(target)
+            try:
+                data = read_bounded(target)
+            except OSError as exc:
+                raise InputError(
+                    f"cannot read {target} (it defines tree '{tree_id}'): {exc.strerror}",
+                    location=where,
+                    element="SubTree",
+                ) from None
+            self.load(decode(data, str(target)), target, (target,), extra=True)
+
+    def prune_extra_trees(self, doc: BTDocument) -> None:
+        """Keep, of the trees read from other files, only those the file's own trees reach."""
+        extra = {f.path for f in self.files if f.extra}
+        if not extra:
+            return
+        reached = [
+            t.id for t in doc.trees.values() if t.location is None or t.location.file not in extra
+        ]
+        seen = set(reached)
+        while reached:
+            root = doc.trees[reached.pop()].root
+            for node in root.walk() if root is not None else ():
+                target = node.subtree_id
+                if target is not None and target in doc.trees and target not in seen:
+                    seen.add(target)
+                    reached.append(target)
+        for tree_id in [t for t in doc.trees if t not in seen]:
+            del doc.trees[tree_id]
 
     def load_external_models(self) -> None:
         option = self.ctx.options.get("node_models") or []
@@ -199,7 +304,7 @@ class _Loader:
             for k, v in main.root.attrib.items()
             if k not in ("BTCPP_format", "main_tree_to_execute")
         }
-        doc.includes = [f.path for f in self.files[1:]]
+        doc.includes = [f.path for f in self.files[1:]]  # includes and other tree files
         for f in self.files:
             for child in _elements(f.root):
                 if child.tag == "TreeNodesModel":
@@ -219,6 +324,13 @@ class _Loader:
             for child in _elements(f.root):
                 if child.tag == "BehaviorTree":
                     tree = self.tree(child, f, ports_seen, implied)
+                    if tree.id in doc.trees and f.extra:
+                        # a file read for another of its trees: the reader's own tree wins
+                        self.ctx.warnings.append(
+                            f"{tree.location}: tree '{tree.id}' of {f.path} is not taken: "
+                            f"{doc.trees[tree.id].location} defines it already"
+                        )
+                        continue
                     if tree.id in doc.trees:
                         raise InputError(
                             f"duplicate BehaviorTree ID '{tree.id}'",
@@ -336,6 +448,12 @@ class _Loader:
         if spec is not None:
             if spec.kind is NodeKind.SUBTREE and not attrs.get("ID"):
                 raise InputError("<SubTree> without ID", location=where, element=tag)
+            if spec.kind is NodeKind.CONTROL and n_children == 0 and spec.allows_children(0):
+                self.ctx.warnings.append(
+                    f"{where}: {tag}: without children it follows its own rule "
+                    f"({spec.source}), but BehaviorTree.CPP 4.8.2's loader refuses a control "
+                    "node without children"
+                )
             return BTNode(type_name, spec.kind, name, attrs, location=where)
         seen = ports_seen.setdefault(type_name, {})
         for key in attrs:
@@ -357,6 +475,22 @@ class _Loader:
             return BTNode(type_name, kind, name, attrs, kind_declared=False, location=where)
         implied.setdefault(type_name, kind)
         return BTNode(type_name, kind, name, attrs, location=where)
+
+
+def _subtree_refs(root: etree._Element) -> list[tuple[str, etree._Element]]:
+    """``(tree ID, element)`` of every SubTree reference inside the file's ``<BehaviorTree>`` s
+    (not the ``<SubTree>`` declarations of a ``<TreeNodesModel>``); lxml iterates, no
+    recursion."""
+    refs = []
+    for tree in _elements(root):
+        if tree.tag != "BehaviorTree":
+            continue
+        for element in tree.iter():
+            if isinstance(element.tag, str) and canonical_type(element.tag) == "SubTree":
+                tree_id = element.get("ID")
+                if tree_id:
+                    refs.append((tree_id, element))
+    return refs
 
 
 def _elements(element: etree._Element) -> list[etree._Element]:
@@ -416,7 +550,9 @@ def read_btcpp(text: str, ctx: ReadContext) -> BTDocument:
     if path is not None:
         loader.loaded.add(path)
     loader.load(text, ctx.path, (path,) if path is not None else ())
+    loader.resolve_subtrees()
     doc = loader.document()
+    loader.prune_extra_trees(doc)
     # --nodes / --abstract (fsmbt.model.nodes.library): project kinds, aliases, abstractions
     library = build_library(ctx.options.get("nodes"), ctx.options.get("abstract"))
 

@@ -364,7 +364,15 @@ class _BtValidator:
                 where(),
             )
         if node.kind is NodeKind.CONTROL:
-            if count == 0:
+            if count == 0 and spec is not None and spec.allows_children(0):
+                self.add(
+                    "warning",
+                    f"'{node.type}' without children: its own rule ({spec.source}) is modelled, "
+                    "but BehaviorTree.CPP 4.8.2's loader refuses a control node without children",
+                    node,
+                    where(),
+                )
+            elif count == 0:
                 self.add("error", f"control node '{node.type}' has no children", node, where())
             elif spec is not None and spec.children is not None and count != spec.children:
                 self.add(
@@ -394,9 +402,22 @@ class _BtValidator:
             target = node.subtree_id
             if not target:
                 self.add("error", "SubTree node without an ID naming the tree", node, where())
+            elif builtin_spec(target) is not None and target not in self.doc.trees:
+                # xml_parsing.cpp VerifyXML: a SubTree ID must not be a registered node's name
+                self.add(
+                    "error",
+                    f"SubTree ID '{target}' is the name of a built-in node; BehaviorTree.CPP "
+                    "refuses it",
+                    node,
+                    where(),
+                )
             elif target not in self.doc.trees:
                 severity: Severity = "warning" if self.doc.includes else "error"
-                hint = " (it may come from an included file)" if self.doc.includes else ""
+                hint = (
+                    " (it may come from an included file)"
+                    if self.doc.includes
+                    else " (a tree of another file: name it with --trees PATH)"
+                )
                 self.add(
                     severity, f"SubTree references missing tree '{target}'{hint}", node, where()
                 )

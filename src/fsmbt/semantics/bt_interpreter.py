@@ -235,6 +235,34 @@ def _gate_leaf(node: BTNode, ctype: str) -> BTNode | None:
     )
 
 
+#: The person's picks of a ManualSelector besides its children (manual_node.cpp: S, F, R keys).
+MANUAL_STATUSES: tuple[int, ...] = (SUCCESS, FAILURE, RUNNING)
+
+
+def manual_choices(n_children: int, repeat_last: bool) -> int:
+    """How many picks a ManualSelector offers: its children and the three statuses; with
+    ``repeat_last_selection`` the children only (a status picked there makes BehaviorTree.CPP
+    4.8.2 index past its children on the next tick; docs/semantics.md); without children the
+    three statuses."""
+    if n_children == 0:
+        return len(MANUAL_STATUSES)
+    return n_children if repeat_last else n_children + len(MANUAL_STATUSES)
+
+
+def _choice_leaves(node: BTNode, n_children: int, repeat_last: bool) -> list[BTNode]:
+    """The conditions that ask the person for a ManualSelector's pick, one per pick but the
+    last (docs/semantics.md, "ManualSelector"): ``pick_<i>`` (child i, 1-based as the terminal
+    UI numbers them), ``pick_SUCCESS``, ``pick_FAILURE``; the first that answers SUCCESS is the
+    pick, none means the last pick (RUNNING, or the last child with repeat_last_selection)."""
+    words = [f"pick_{i + 1}" for i in range(n_children)]
+    if n_children == 0 or not repeat_last:
+        words += [f"pick_{NodeStatus(s).name}" for s in MANUAL_STATUSES]
+    return [
+        BTNode(GATE_TYPE, NodeKind.CONDITION, f"{node.label}.{word}", location=node.location)
+        for word in words[: manual_choices(n_children, repeat_last) - 1]
+    ]
+
+
 def _threshold(value: int, count: int) -> int:
     """BehaviorTree.CPP's reading of a Parallel threshold: negative means "all but"."""
     return max(count + value + 1, 0) if value < 0 else value
@@ -279,6 +307,8 @@ class CompiledTree:
             gate = _gate_leaf(node, ctype)
             if gate is not None:
                 kids = [*kids, gate]  # the gate is the last child (docs/semantics.md §10)
+            if ctype == "ManualSelector":  # the person's pick: conditions after the children
+                kids = [*kids, *_choice_leaves(node, *params)]
             if ctype == "SubTree":
                 target = node.attrs["ID"]
                 kids = [self.doc.trees[target].root]  # type: ignore[list-item]
@@ -371,7 +401,11 @@ class CompiledTree:
             ctype = "SubTree"
             target = node.attrs.get("ID")
             if not target or target not in self.doc.trees:
-                raise InputError(f"SubTree refers to unknown tree {target!r}", **_where(node))
+                raise InputError(
+                    f"SubTree refers to unknown tree {target!r} (a tree of another file: name "
+                    "that file or its folder with --trees PATH)",
+                    **_where(node),
+                )
             if target in chain:
                 raise UnsupportedError(
                     f"SubTree '{target}' includes itself (recursion)", **_where(node)
@@ -418,10 +452,10 @@ class CompiledTree:
                     f"control type '{node.type}' is not supported (custom or unknown semantics)",
                     **_where(node),
                 )
-            if not kids:
+            spec = node_semantics(ctype)
+            if not kids and (spec is None or not spec.allows_children(0)):
                 raise InputError(f"control node {ctype} has no children", **_where(node))
             n = len(kids)
-            spec = node_semantics(ctype)
             counts = spec.child_counts if spec is not None else None
             if counts is not None and n not in counts:
                 allowed = " or ".join(str(c) for c in counts)
@@ -438,6 +472,8 @@ class CompiledTree:
                 params = (_int_param(node, "number_of_retries", 1),)
             elif ctype == "RoundRobin":
                 params = (_bool_param(node, "wrap_around", False),)
+            elif ctype == "ManualSelector":
+                params = (n, _bool_param(node, "repeat_last_selection", False))
             elif ctype == "ParallelAll":
                 fail = _int_param(node, "max_failures", 1)
                 if n < _threshold(fail, n):
@@ -1019,6 +1055,43 @@ class BTInterpreter:
         return ("ret", result)
 
     # -- project kinds and abstractions (docs/semantics.md §10) ---------------------------------
+    def _t_manual_selector(
+        self, w: _Work, node: CompiledNode, frame: Frame, result: int | None, hook: HaltHook | None
+    ) -> TickAction:
+        """ManualSelector (manual_node.cpp): the person's pick is asked through the choice
+        conditions after the children (``_choice_leaves``), the first SUCCESS wins; a picked
+        child's status is returned; nothing else is halted or reset."""
+        n, repeat_last = node.params
+        choices = node.children[n:]
+        pc = frame[1]
+        if pc == 0:
+            (previous,) = self._mem(w, node)
+            if n and repeat_last and previous >= 0:
+                return ("call", node.children[previous], (node.id, 2))
+            if n:
+                w.st[node.id] = RUNNING  # setStatus(RUNNING) before selectChild()
+            if not choices:  # one child under repeat_last_selection: the only pick
+                pick = 0
+            else:
+                return ("call", choices[0], (node.id, 1, 0))
+        elif pc == 1:
+            asked = frame[2]
+            w.st.pop(choices[asked], None)  # a choice keeps no status: asked afresh each time
+            if result == SUCCESS:
+                pick = asked
+            elif asked + 1 < len(choices):
+                return ("call", choices[asked + 1], (node.id, 1, asked + 1))
+            else:
+                pick = len(choices)  # none said yes: the last pick
+        else:  # pc == 2: the picked child returned
+            assert result is not None
+            return ("ret", result)
+        if pick < n:
+            if repeat_last:
+                self._set_mem(w, node, (pick,))
+            return ("call", node.children[pick], (node.id, 2))
+        return ("ret", MANUAL_STATUSES[pick - n])
+
     def _t_pipeline(
         self, w: _Work, node: CompiledNode, frame: Frame, result: int | None, hook: HaltHook | None
     ) -> TickAction:

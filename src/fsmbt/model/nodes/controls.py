@@ -212,9 +212,19 @@ MANUAL_SELECTOR = register(
         _C,
         Family.MANUAL,
         None,
-        tick="asks a person (a terminal UI) which child to run",
-        rejection="it asks a person which child to run",
-        nusmv_refusal="it asks a person which child to run",
+        tick="a person picks, on every tick, a child to tick or a status to return (SUCCESS, "
+        "FAILURE, RUNNING); the node returns the picked child's status; a child left RUNNING by "
+        "an earlier pick is not halted. With repeat_last_selection the first pick (a child) is "
+        "ticked again on every later tick without asking. Without children the person picks a "
+        "status. The pick is an environment input: chained choice conditions "
+        "'<label>.pick_<i>', '<label>.pick_SUCCESS', '<label>.pick_FAILURE' (docs/semantics.md)",
+        halt="halts its RUNNING children; keeps the repeated selection",
+        min_children=0,
+        memory=("previously_executed_idx",),
+        default_memory=(-1,),
+        handler="manual_selector",
+        nusmv="manual_selector",
+        ports=("repeat_last_selection",),
         source="manual_node.cpp",
     )
 )

@@ -93,7 +93,8 @@ class NodeSemantics:
         name: the BehaviorTree.CPP v4 type name (the XML tag).
         kind: control, decorator, action, condition or subtree.
         family: see ``Family``.
-        children: exact child count in the file; ``None`` = one or more.
+        children: exact child count in the file; ``None`` = ``min_children`` or more.
+        min_children: the fewest children when ``children`` is ``None`` (1; ManualSelector 0).
         child_counts: the allowed counts when only some are (``IfThenElse``: ``(2, 3)``).
         tick: what one tick does (a summary of the BehaviorTree.CPP source; docs/semantics.md
             has the full rule).
@@ -140,6 +141,7 @@ class NodeSemantics:
     tick: str
     halt: str = "sets its status to IDLE"
     child_counts: tuple[int, ...] | None = None
+    min_children: int = 1
     memory: tuple[str, ...] = ()
     default_memory: tuple[object, ...] | None = None
     halt_resets_memory: bool = False
@@ -207,7 +209,7 @@ class NodeSemantics:
         if self.child_counts is not None:
             return count in self.child_counts
         if self.children is None:
-            return count >= 1
+            return count >= self.min_children
         return count == self.children
 
 

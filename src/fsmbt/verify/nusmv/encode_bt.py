@@ -66,6 +66,8 @@ GATE_RULES = {
 LOOP_RULES = frozenset(n.name for n in all_nodes() if n.nusmv == "loop_queue")
 #: julienbayle/stardust RealParallel (docs/semantics.md, "Project nodes").
 REAL_PARALLEL_RULES = frozenset(n.name for n in all_nodes() if n.nusmv == "real_parallel")
+#: Kinds whose pick is an environment input asked through choice conditions (ManualSelector).
+MANUAL_RULES = frozenset(n.name for n in all_nodes() if n.nusmv == "manual_selector")
 SUPPORTED = NUSMV_ENCODED
 #: type -> why the encoding refuses it
 NOT_ENCODED = {n.name: n.nusmv_refusal for n in all_nodes() if n.nusmv_refusal is not None}
@@ -133,6 +135,8 @@ class BTCore:
         self.init: dict[str, str] = {}
         #: memory variables of project kinds (index, counters): reset to 0 by a halt
         self.memory_vars: list[tuple[str, int]] = []
+        #: memory variables a halt keeps (ManualSelector's repeated selection)
+        self.kept_vars: list[str] = []
 
     # -- naming ----------------------------------------------------------------------------
     def n(self, nid: int) -> str:
@@ -171,6 +175,7 @@ class BTCore:
             if self.is_seq_like(x.id):
                 out += [f"idx_{x.id}", f"prev_{x.id}"]
         out += [var for var, _nid in self.memory_vars]
+        out += self.kept_vars
         return out
 
     def memory(self, name: str, nid: int, top: int) -> str:
@@ -227,6 +232,9 @@ class BTCore:
                 continue
             if t in REAL_PARALLEL_RULES:
                 self._real_parallel_rules(x, here, called)
+                continue
+            if t in MANUAL_RULES:
+                self._manual_rules(x, here, called, resets)
                 continue
             if t in SEQ_LIKE:
                 is_fb, wakes, memory = SEQ_LIKE[t]
@@ -326,6 +334,54 @@ class BTCore:
             self.rules.setdefault(var, []).insert(0, (f"hlt_{nid}", "0"))
         for x in self.nodes:
             self.rules.setdefault(self.st(x.id), []).insert(0, (f"clr_{x.id}", "I"))
+
+    def _manual_rules(
+        self, x: CompiledNode, here: str, called: str, resets: dict[int, list[str]]
+    ) -> None:
+        """ManualSelector (docs/semantics.md, "ManualSelector"): the choice conditions after
+        the ``n`` children are asked in order, the first SUCCESS is the pick, none means the last
+        pick; a picked child's status is returned; with ``repeat_last_selection`` the first pick
+        is kept in ``sel_<id>`` (0: none yet, i + 1: child i), which a halt does not reset."""
+        n, repeat_last = x.params
+        kids, choices = list(x.children[:n]), list(x.children[n:])
+        back = f"{here} & res != NONE"
+        sel = f"sel_{x.id}"
+        choosing = called
+        if n and repeat_last:
+            self.var_types[sel] = f"0..{max(n, 1)}"
+            self.init[sel] = "0"
+            self.kept_vars.append(sel)
+            for i, c in enumerate(kids):
+                self.call(f"{called} & {sel} = {i + 1}", c)
+            choosing = f"{called} & {sel} = 0"
+        if n:
+            self.rule(self.st(x.id), choosing, "R")
+
+        def pick(cond: str, index: int) -> None:
+            if index < n:
+                if repeat_last:
+                    self.rule(sel, cond, str(index + 1))
+                self.call(cond, kids[index])
+            else:
+                self.ret(cond, x.id, ("S", "F", "R")[index - n])
+
+        if choices:
+            self.call(choosing, choices[0])
+        else:  # one child under repeat_last_selection: the only pick
+            pick(choosing, 0)
+        for j, choice in enumerate(choices):
+            answered = f"{back} & lidx = {n + j}"
+            resets[choice].append(answered)  # a choice keeps no status
+            pick(f"{answered} & res = S", j)
+            if j + 1 < len(choices):
+                self.call(f"{answered} & res != S", choices[j + 1])
+            else:
+                pick(f"{answered} & res != S", len(choices))
+        self.ret(
+            f"{back} & lidx < {max(n, 1)}" if n else "FALSE",
+            x.id,
+            "case res = S : S; res = F : F; TRUE : R; esac",
+        )
 
     def _gate_rules(
         self, x: CompiledNode, rule: str, here: str, called: str, resets: dict[int, list[str]]
