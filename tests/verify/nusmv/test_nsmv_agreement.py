@@ -11,6 +11,9 @@ Four groups, one test each, so a failure names the group:
   rules engine converts (BT XML -> HFSM, SCXML -> BT);
 - abstractions: hand-built trees over the project kinds and abstractions the encoding covers
   (docs/semantics.md §10), both loop modes, with mutants;
+- built-ins: hand-built trees over Repeat, RetryUntilSuccessful, RunOnce, Parallel and
+  ParallelAll (both loop modes) with the generic mutants and parameter mutants (a count, a
+  threshold changed), against the conversion and tree against tree;
 - mutation suite: every mutant of every family of tests/verify/test_ver_mutations.py, mutated on
   the same side as there, plus the unmutated pairs.
 
@@ -53,6 +56,7 @@ MUTATED = 4  # generated pairs whose mutants are checked too (the hand-built one
 SHOWN = 5  # disagreements printed in full
 CONTROLS = ("Sequence", "Fallback", "ReactiveSequence", "ReactiveFallback", "SequenceWithMemory")
 DECORATORS = ("Inverter", "ForceSuccess", "ForceFailure", "KeepRunningUntilFailure")
+LOOPS = {"Repeat": "num_cycles", "RetryUntilSuccessful": "num_attempts"}
 Model = FSM | BTDocument
 
 
@@ -214,6 +218,21 @@ def _convert(label: str, model: Model, *, loop: bool = False) -> Pair | Rejected
     return Pair(label, model, result, loop, conversion=True)
 
 
+def _valid(model: Model) -> bool:
+    """Whether a mutant is still a tree BehaviorTree.CPP would load (dropping a child can leave
+    a Parallel with a threshold above its child count)."""
+    from fsmbt.model.errors import InputError
+    from fsmbt.semantics.bt_interpreter import CompiledTree
+
+    if not isinstance(model, BTDocument):
+        return True
+    try:
+        CompiledTree(model)
+    except InputError:
+        return False
+    return True
+
+
 def _with_mutants(pair: Pair, bt_side: int, fsm_side: int) -> Iterator[Pair]:
     """The pair and the first ``bt_side`` mutants of its BT side and ``fsm_side`` of its FSM
     side, each put back in its place (as the original agreement test drew them)."""
@@ -221,7 +240,7 @@ def _with_mutants(pair: Pair, bt_side: int, fsm_side: int) -> Iterator[Pair]:
     for side in ("source", "result"):
         model = getattr(pair, side)
         count = bt_side if isinstance(model, BTDocument) else fsm_side
-        for m in mutants(model, per_operator=1)[:count]:
+        for m in [m for m in mutants(model, per_operator=1) if _valid(m.model)][:count]:
             kind = "bt" if isinstance(model, BTDocument) else "fsm"
             swapped = (m.model, pair.result) if side == "source" else (pair.source, m.model)
             yield Pair(f"{pair.label}/{kind}-{m.operator}", *swapped, pair.loop)
@@ -237,6 +256,16 @@ def _node(kind: str, *children: BTNode) -> BTNode:
     return BTNode(kind, node_kind, children=list(children))
 
 
+def _built_in(kind: str, *children: BTNode, **attrs: str) -> BTNode:
+    """A built-in node with its ports (the registry says whether it is a control or a
+    decorator)."""
+    from fsmbt.semantics.nodes import node_semantics
+
+    spec = node_semantics(kind)
+    assert spec is not None
+    return BTNode(kind, spec.kind, attrs=dict(attrs), children=list(children))
+
+
 def _random_bt(rng: random.Random, leaves: int) -> BTDocument:
     counter = iter(range(1000))
 
@@ -244,12 +273,29 @@ def _random_bt(rng: random.Random, leaves: int) -> BTDocument:
         if budget <= 1 or depth > 3:
             name = f"l{next(counter)}"
             return _leaf(name, rng.random() < 0.4)
-        if rng.random() < 0.2:
+        draw = rng.random()
+        if draw < 0.15:
             return _node(rng.choice(DECORATORS[:3]), build(budget, depth + 1))
+        if draw < 0.25:  # a loop (finite or endless) or a RunOnce that keeps its result
+            kind = rng.choice([*LOOPS, "RunOnce"])
+            port, value = LOOPS.get(kind, "then_skip"), "false"
+            if kind in LOOPS:
+                value = str(rng.choice([1, 2, 3, -1]))
+            return _built_in(kind, build(budget, depth + 1), **{port: value})
         parts = rng.randint(2, min(3, budget))
         sizes = [budget // parts] * parts
         sizes[0] += budget - sum(sizes)
-        return _node(rng.choice(CONTROLS), *(build(s, depth + 1) for s in sizes))
+        children = [build(s, depth + 1) for s in sizes]
+        if draw < 0.35:  # a parallel, its thresholds drawn among the valid ones
+            valid = [v for v in range(-parts - 1, parts + 1) if v < 0 or v <= parts]
+            if rng.random() < 0.5:
+                return _built_in("ParallelAll", *children, max_failures=str(rng.choice(valid)))
+            counts = {
+                "success_count": str(rng.choice(valid)),
+                "failure_count": str(rng.choice(valid)),
+            }
+            return _built_in("Parallel", *children, **counts)
+        return _node(rng.choice(CONTROLS), *children)
 
     return BTDocument.single(build(leaves, 0))
 
@@ -391,6 +437,133 @@ def abstraction_pairs() -> Iterator[Pair | Rejected]:
                 yield item
 
 
+# -- built-ins: loops, RunOnce, parallels ------------------------------------------------------
+def _builtin_trees() -> list[BTDocument]:
+    """Every built-in the encoding covers through ``builtin_rules`` (docs/nusmv.md), in the
+    places that exercise its memory: a halt by a reactive parent, a wake-up, a re-tick."""
+    seq = _node
+    trees = [
+        _built_in("Repeat", seq("Sequence", _leaf("c", True), _leaf("a")), num_cycles="2"),
+        seq("Sequence", _built_in("Repeat", _leaf("a"), num_cycles="3"), _leaf("b", True)),
+        seq("Fallback", _built_in("Repeat", _leaf("a"), num_cycles="-1"), _leaf("b")),
+        _node(
+            "ReactiveSequence",
+            _leaf("c", True),
+            _built_in("Repeat", seq("Sequence", _leaf("a"), _leaf("b")), num_cycles="2"),
+        ),
+        _built_in("RetryUntilSuccessful", _leaf("a"), num_attempts="2"),
+        seq(
+            "Fallback",
+            _built_in(
+                "RetryUntilSuccessful",
+                seq("Sequence", _leaf("c", True), _leaf("a")),
+                num_attempts="-1",
+            ),
+            _leaf("b"),
+        ),
+        _node(
+            "ReactiveFallback",
+            _leaf("c", True),
+            _built_in(
+                "RetryUntilSuccessful",
+                seq("AsyncSequence", _leaf("a"), _leaf("b")),
+                num_attempts="3",
+            ),
+        ),
+        seq("Sequence", _built_in("RunOnce", _leaf("a"), then_skip="false"), _leaf("b")),
+        _node(
+            "ReactiveSequence",
+            _leaf("c", True),
+            _built_in("RunOnce", seq("Sequence", _leaf("a"), _leaf("b")), then_skip="false"),
+        ),
+        _built_in(
+            "Parallel",
+            _leaf("a"),
+            _leaf("b"),
+            _leaf("c", True),
+            success_count="2",
+            failure_count="1",
+        ),
+        _built_in(
+            "Parallel",
+            _leaf("a"),
+            seq("Sequence", _leaf("b"), _leaf("d")),
+            _leaf("c", True),
+            success_count="-1",
+            failure_count="-2",
+        ),
+        _node(
+            "ReactiveSequence",
+            _leaf("c", True),
+            _built_in("Parallel", _leaf("a"), _leaf("b"), success_count="1", failure_count="-1"),
+        ),
+        _built_in("ParallelAll", _leaf("a"), _leaf("b"), _leaf("c", True), max_failures="1"),
+        _built_in(
+            "Repeat",
+            _built_in("ParallelAll", _leaf("a"), _leaf("b"), _leaf("d"), max_failures="2"),
+            num_cycles="2",
+        ),
+    ]
+    return [BTDocument.single(t) for t in trees]
+
+
+#: port -> how a parameter mutant changes it (a count one lower, a threshold moved by one)
+PARAM_MUTATIONS = {
+    "num_cycles": lambda v: "1" if v == "-1" else str(int(v) - 1),
+    "num_attempts": lambda v: "1" if v == "-1" else str(int(v) - 1),
+    "then_skip": lambda v: v,  # then_skip=true is refused: not a mutant here
+    "success_count": lambda v: (
+        str(int(v) - 1) if int(v) > 1 or int(v) < -1 else "-1" if v == "1" else "1"
+    ),
+    "failure_count": lambda v: (
+        str(int(v) - 1) if int(v) > 1 or int(v) < -1 else "-1" if v == "1" else "1"
+    ),
+    "max_failures": lambda v: str(int(v) + 1) if 0 < int(v) < 3 else "1",
+}
+
+
+def _param_mutants(doc: BTDocument) -> Iterator[tuple[str, BTDocument]]:
+    """Copies of ``doc`` with one port of one built-in changed (``PARAM_MUTATIONS``)."""
+    import copy
+
+    count = 0
+    while True:
+        mutant = copy.deepcopy(doc)
+        ports = []
+        stack = [mutant.main.root]
+        while stack:
+            node = stack.pop()
+            if node is None:
+                continue
+            ports += [(node, port) for port in node.attrs if port in PARAM_MUTATIONS]
+            stack.extend(node.children)
+        if count >= len(ports):
+            return
+        node, port = ports[count]
+        count += 1
+        old = node.attrs[port]
+        node.attrs[port] = PARAM_MUTATIONS[port](old)
+        if node.attrs[port] != old:
+            yield f"{node.type}.{port}={node.attrs[port]}", mutant
+
+
+def builtin_pairs() -> Iterator[Pair | Rejected]:
+    """The trees above, both loop modes: the conversion with its generic mutants, and each
+    parameter mutant against the conversion and (without loop) against the tree itself."""
+    for i, doc in enumerate(_builtin_trees()):
+        for loop in (False, True):
+            label = f"builtin{i}-loop{int(loop)}"
+            item = _convert(label, doc, loop=loop)
+            if isinstance(item, Pair):
+                yield from _with_mutants(item, bt_side=2, fsm_side=1)
+                for name, mutant in _param_mutants(doc):
+                    yield Pair(f"{label}/param-{name}", mutant, item.result, loop)
+                    if not loop:  # tree against tree: two micro-step machines, the dearest
+                        yield Pair(f"{label}/param-{name}/bt-bt", doc, mutant, loop)
+            elif item is not None:
+                yield item
+
+
 # -- examples and corpus -------------------------------------------------------------------------
 def _read(path: Path, notes: Counter[str]) -> Model | None:
     from fsmbt.formats.registry import read_model
@@ -467,6 +640,16 @@ def test_agreement_generated(nusmv_binary):
 def test_agreement_abstractions(nusmv_binary):
     group = run_group("abstractions", abstraction_pairs())
     assert_agreement(group, min_agreed=2 * len(_abstraction_trees()))
+
+
+def test_agreement_builtins(nusmv_binary):
+    group = run_group("built-ins", builtin_pairs())
+    assert_agreement(group, min_agreed=2 * len(_builtin_trees()))
+    agreed = " ".join(o.pair.label for o in group.of("agreed"))
+    for kind in ("Repeat", "RetryUntilSuccessful", "Parallel", "ParallelAll"):
+        assert f"param-{kind}." in agreed, kind  # each kind's parameter mutants compared
+    # the parameter mutants really differ: both engines find failing verdicts on them
+    assert any(not all(o.native.values()) for o in group.of("agreed") if "/param-" in o.pair.label)
 
 
 def test_agreement_examples(nusmv_binary):
