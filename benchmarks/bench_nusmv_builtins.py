@@ -65,7 +65,7 @@ def main() -> None:
     args = parser.parse_args()
     corpus = Path(os.environ.get("FSMBT_CORPUS", REPO.parent / "shared" / "corpus"))
     total = 0.0
-    print(f"{'model':<58}{'built-ins':<34}{'states':>7}{'CPU s':>8}{'wall s':>8}  verdicts")
+    print(f"{'model':<66} {'built-ins':<37}{'states':>7}{'CPU s':>8}{'wall s':>8}  verdicts")
     for path in models(corpus):
         try:
             doc = read_model(path)
@@ -79,7 +79,7 @@ def main() -> None:
         states = max(stats["source_states"], stats["result_states"])
         kinds = ",".join(built_ins(doc))
         if states > args.max_states:
-            print(f"{name:<58}{kinds:<34}{states:>7}  above --max-states: not run")
+            print(f"{name:<66} {kinds:<37}{states:>7}  above --max-states: not run")
             continue
         cpu, wall = cpu_of_children(), time.perf_counter()
         smv = check(doc, result, timeout=args.timeout)
@@ -87,7 +87,7 @@ def main() -> None:
         total += cpu
         native = verify(doc, result).equivalent
         print(
-            f"{name:<58}{kinds:<34}{states:>7}{cpu:>8.1f}{wall:>8.1f}  "
+            f"{name:<66} {kinds:<37}{states:>7}{cpu:>8.1f}{wall:>8.1f}  "
             f"nusmv equivalent={smv.equivalent}, native equivalent={native}"
         )
     print(f"NuSMV CPU seconds in total: {total:.1f}")
