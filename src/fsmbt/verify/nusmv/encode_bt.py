@@ -17,8 +17,9 @@ The tick rules of BehaviorTree.CPP v4 are transition relations over per-node var
 
 Which kinds are encoded and by which rule is the node registry's ``nusmv`` field, and why a
 kind is refused its ``nusmv_refusal`` (``fsmbt.semantics.nodes``, docs/semantics.md "Node
-registry"). Leaf requests are where the environment answers: in a leaf-execution machine they are the
-stable states that take an input (success/failure/running); the LEBT encoding
+registry"); the built-in loops and parallels (Repeat, RetryUntilSuccessful, RunOnce,
+Parallel, ParallelAll) have their rules in ``builtin_rules``. Leaf requests are where the
+environment answers: in a leaf-execution machine they are the stable states that take an input (success/failure/running); the LEBT encoding
 (``encode_lebt``) answers them from its blackboard instead. Supported node types are listed in
 ``SUPPORTED`` (derived from the registry); anything else raises ``UnsupportedError`` (docs/nusmv.md says why).
 Size: O(N · d) SMV text for N nodes of depth d.
