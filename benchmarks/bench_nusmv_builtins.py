@@ -5,9 +5,12 @@ its conversion, checked by both engines.
 Prints, per pair: the built-ins it holds, the native machines' states, NuSMV's CPU seconds
 (``RUSAGE_CHILDREN``: the figure that does not depend on the machine's load) and wall seconds,
 and both verdicts; then the CPU total. Pairs above ``--max-states`` native states are listed
-and not given to NuSMV (the agreement test's bound). Prints figures only; nothing is asserted.
+and not given to NuSMV (the agreement test's bound). ``--counts 10,20,40`` also sweeps the
+count of ``Repeat(a, num_cycles=L)`` checked against itself (each count value is a state for
+both engines): how NuSMV's time grows with L. Prints figures only; nothing is asserted.
 
-Run: ``FSMBT_CORPUS=... .venv/bin/python benchmarks/bench_nusmv_builtins.py [--max-states 100]``.
+Run: ``FSMBT_CORPUS=... .venv/bin/python benchmarks/bench_nusmv_builtins.py [--max-states 100]
+[--counts 10,20,40] [--timeout 600]``.
 """
 
 from __future__ import annotations
@@ -20,10 +23,12 @@ from pathlib import Path
 
 from fsmbt.convert.engines import converter_for
 from fsmbt.formats.registry import read_model
-from fsmbt.model.bt import BTDocument
+from fsmbt.model.bt import BTDocument, BTNode
+from fsmbt.model.bt_nodes import NodeKind
 from fsmbt.model.errors import FsmbtError
 from fsmbt.verify import verify
 from fsmbt.verify.nusmv import check
+from fsmbt.verify.nusmv.runner import NuSMVLimitError
 
 REPO = Path(__file__).resolve().parents[1]
 KINDS = frozenset({"Repeat", "RetryUntilSuccessful", "RunOnce", "Parallel", "ParallelAll"})
@@ -58,10 +63,30 @@ def cpu_of_children() -> float:
     return usage.ru_utime + usage.ru_stime
 
 
+def count_sweep(counts: list[int], timeout: float) -> None:
+    """NuSMV on ``Repeat(a, num_cycles=L)`` against itself, for each L."""
+    print(f"\n{'num_cycles':>10}{'native states':>15}{'NuSMV CPU s':>13}{'wall s':>9}")
+    for count in counts:
+        leaf = BTNode("a", NodeKind.ACTION, name="a")
+        repeat = BTNode("Repeat", NodeKind.DECORATOR, attrs={"num_cycles": str(count)})
+        repeat.children.append(leaf)
+        doc = BTDocument.single(repeat)
+        states = verify(doc, doc).stats["source_states"]
+        cpu, wall = cpu_of_children(), time.perf_counter()
+        try:
+            check(doc, doc, timeout=timeout)
+            figure = ""
+        except NuSMVLimitError:
+            figure = f"  past the {timeout:.0f} s cap"
+        cpu, wall = cpu_of_children() - cpu, time.perf_counter() - wall
+        print(f"{count:>10}{states:>15}{cpu:>13.1f}{wall:>9.1f}{figure}")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--max-states", type=int, default=100)
     parser.add_argument("--timeout", type=float, default=600.0)
+    parser.add_argument("--counts", default="", help="e.g. 10,20,40: the Repeat count sweep")
     args = parser.parse_args()
     corpus = Path(os.environ.get("FSMBT_CORPUS", REPO.parent / "shared" / "corpus"))
     total = 0.0
@@ -91,6 +116,8 @@ def main() -> None:
             f"nusmv equivalent={smv.equivalent}, native equivalent={native}"
         )
     print(f"NuSMV CPU seconds in total: {total:.1f}")
+    if args.counts:
+        count_sweep([int(c) for c in args.counts.split(",")], args.timeout)
 
 
 if __name__ == "__main__":
