@@ -52,16 +52,81 @@ def _leaf(name: str, kind: NodeKind = NodeKind.ACTION) -> BTNode:
     return BTNode(name, kind, name=name)
 
 
-@pytest.mark.parametrize("node_type", ["Parallel", "Repeat", "RunOnce", "ParallelAll"])
-def test_unencodable_nodes_are_rejected_with_the_node_named(node_type):
-    attrs = {"num_cycles": "2"} if node_type == "Repeat" else {}
-    kind = NodeKind.DECORATOR if node_type in ("Repeat", "RunOnce") else NodeKind.CONTROL
-    kids = (
-        [_leaf("a")] if kind is NodeKind.DECORATOR else [_leaf("a", NodeKind.CONDITION), _leaf("b")]
+def _dec(kind: str, child: BTNode, **attrs: str) -> BTNode:
+    return BTNode(kind, NodeKind.DECORATOR, name=kind, attrs=attrs, children=[child])
+
+
+def _internal(kind: str = "AlwaysSuccess") -> BTNode:
+    return BTNode(kind, NodeKind.ACTION)
+
+
+@pytest.mark.parametrize(
+    ("root", "loop", "reason"),
+    [
+        # SKIPPED is not a status of the encoding: the node and the port are named
+        (_dec("RunOnce", _leaf("a")), False, r"RunOnce with then_skip=true"),
+        (_dec("RunOnce", _leaf("a"), then_skip="true"), False, r"RunOnce with then_skip=true"),
+        # ticks that end without any leaf: the native leaf machine reports LIVELOCK
+        (_dec("Repeat", _internal(), num_cycles="-1"), False, "livelock"),
+        (
+            _dec("RetryUntilSuccessful", _internal("AlwaysFailure"), num_attempts="-1"),
+            False,
+            "livelock",
+        ),
+        (_dec("RunOnce", _leaf("a"), then_skip="false"), True, "livelock"),
+        (_dec("Repeat", _leaf("a"), num_cycles="0"), True, "livelock"),
+    ],
+)
+def test_refused_trees_name_the_cause(root, loop, reason):
+    doc = BTDocument.single(root)
+    with pytest.raises(UnsupportedError, match=reason) as caught:
+        build_model(doc, doc, loop=loop)
+    assert "native" in str(caught.value)  # the way out is named
+
+
+def _smv_vars(root: BTNode, *, loop: bool = False) -> dict[str, str]:
+    doc = BTDocument.single(root)
+    text = build_model(doc, doc, loop=loop)[0].split("MODULE result")[0]
+    text = text.split("\nVAR\n")[1].split("\nDEFINE\n")[0]
+    return dict(re.findall(r"^\s+(\w+) : ([^;]+);", text, flags=re.M))
+
+
+def test_loop_counters_are_bounded_and_absent_for_endless_loops():
+    finite = _smv_vars(_dec("Repeat", _leaf("a"), num_cycles="4"))
+    assert finite["lc_0"] == "0..3" and "prev_0" in finite
+    retry = _smv_vars(_dec("RetryUntilSuccessful", _leaf("a"), num_attempts="3"))
+    assert retry["lc_0"] == "0..2"
+    endless = _smv_vars(_dec("Repeat", _leaf("a"), num_cycles="-1"))
+    assert not any(name.startswith("lc_") for name in endless) and "prev_0" in endless
+
+
+def test_parallel_memory_is_read_from_the_children_statuses():
+    """No completed-set or counter variable: the DEFINEs count the children's statuses."""
+    par = BTNode(
+        "Parallel",
+        NodeKind.CONTROL,
+        attrs={"success_count": "2", "failure_count": "1"},
+        children=[_leaf("a"), _leaf("b"), _leaf("c")],
     )
-    doc = BTDocument.single(BTNode(node_type, kind, name="N", attrs=attrs, children=kids))
-    with pytest.raises(UnsupportedError, match=node_type):
-        build_model(doc, doc)
+    doc = BTDocument.single(par)
+    text = build_model(doc, doc)[0].split("MODULE result")[0]
+    assert "psc_0 := (toint(st_1 = zS) + toint(st_2 = zS) + toint(st_3 = zS))" in text
+    assert set(_smv_vars(par)) == {"cur", "res", "lidx", "wake", "bres"} | {
+        f"st_{i}" for i in range(4)
+    }
+
+
+def test_run_once_result_survives_a_halt():
+    """RunOnce's memory is not reset by the halt closure (v4: the node stays 'already run')."""
+    root = BTNode(
+        "ReactiveSequence",
+        NodeKind.CONTROL,
+        children=[_leaf("c", NodeKind.CONDITION), _dec("RunOnce", _leaf("a"), then_skip="false")],
+    )
+    doc = BTDocument.single(root)
+    text = build_model(doc, doc)[0].split("MODULE result")[0]
+    rules = text.split("next(ro_2) := case")[1].split("esac;")[0]
+    assert "hlt_2" not in rules and "res = zS : 1" in rules.replace("case ", "")
 
 
 def test_counterexample_replays_to_a_difference(nusmv_binary):

@@ -12,7 +12,6 @@ from fsmbt.model.nodes.registry import Family, NodeSemantics, register
 
 _C = NodeKind.CONTROL
 _SEQ_MEMORY = ("current_child_idx", "skipped_count")
-_PARALLEL_REFUSAL = "several children run at once (completed-set memory)"
 
 SEQUENCE = register(
     NodeSemantics(
@@ -150,7 +149,7 @@ PARALLEL = register(
         default_memory=(frozenset(), 0, 0),
         halt_resets_memory=True,
         handler="parallel",
-        nusmv_refusal=_PARALLEL_REFUSAL,
+        nusmv="parallel",
         ports=("success_count", "failure_count"),
         source="parallel_node.cpp",
     )
@@ -168,7 +167,7 @@ PARALLEL_ALL = register(
         default_memory=(frozenset(), 0),
         halt_resets_memory=True,
         handler="parallel_all",
-        nusmv_refusal=_PARALLEL_REFUSAL,
+        nusmv="parallel_all",
         ports=("max_failures",),
         source="parallel_all_node.cpp",
     )

@@ -84,7 +84,7 @@ REPEAT = register(
         halt_resets_memory=True,
         wakes_up=True,
         handler="repeat",
-        nusmv_refusal="its cycle counter is not encoded",
+        nusmv="repeat",
         ports=("num_cycles",),
         source="repeat_node.cpp",
     )
@@ -103,7 +103,7 @@ RETRY_UNTIL_SUCCESSFUL = register(
         halt_resets_memory=True,
         wakes_up=True,
         handler="retry",
-        nusmv_refusal="its attempt counter is not encoded",
+        nusmv="retry",
         ports=("num_attempts",),
         aliases=("RetryUntilSuccesful",),
         source="retry_node.cpp",
@@ -121,7 +121,7 @@ RUN_ONCE = register(
         memory=("already_ticked", "returned_status"),
         default_memory=(False, 0),
         handler="run_once",
-        nusmv_refusal="SKIPPED statuses are not encoded",
+        nusmv="run_once",
         ports=("then_skip",),
         source="run_once_node.h",
     )

@@ -17,8 +17,9 @@ The tick rules of BehaviorTree.CPP v4 are transition relations over per-node var
 
 Which kinds are encoded and by which rule is the node registry's ``nusmv`` field, and why a
 kind is refused its ``nusmv_refusal`` (``fsmbt.semantics.nodes``, docs/semantics.md "Node
-registry"). Leaf requests are where the environment answers: in a leaf-execution machine they are the
-stable states that take an input (success/failure/running); the LEBT encoding
+registry"); the built-in loops and parallels (Repeat, RetryUntilSuccessful, RunOnce,
+Parallel, ParallelAll) have their rules in ``builtin_rules``. Leaf requests are where the
+environment answers: in a leaf-execution machine they are the stable states that take an input (success/failure/running); the LEBT encoding
 (``encode_lebt``) answers them from its blackboard instead. Supported node types are listed in
 ``SUPPORTED`` (derived from the registry); anything else raises ``UnsupportedError`` (docs/nusmv.md says why).
 Size: O(N · d) SMV text for N nodes of depth d.
@@ -36,6 +37,7 @@ from fsmbt.model.errors import Hint, UnsupportedError
 from fsmbt.semantics.bt_interpreter import CompiledNode, CompiledTree
 from fsmbt.semantics.nodes import NUSMV_ENCODED, all_nodes, node_semantics
 from fsmbt.semantics.status import LeafOutcome, NodeStatus, RootResult
+from fsmbt.verify.nusmv import builtin_rules
 from fsmbt.verify.nusmv.smv import Symbols, any_of, case
 
 if TYPE_CHECKING:
@@ -56,6 +58,8 @@ MEMORY_RULES = {
     if n.nusmv
     in ("pipeline", "recovery", "round_robin", "repeat_each_tick", "if_then_else", "while_do_else")
 }
+#: Built-in loops and parallels (``builtin_rules``): rule name.
+BUILTIN_RULES = {n.name: n.nusmv for n in all_nodes() if n.nusmv in builtin_rules.RULES}
 #: Abstractions and wrappers whose only state is statuses (docs/semantics.md §10): rule name.
 GATE_RULES = {
     n.name: n.nusmv
@@ -98,6 +102,7 @@ class BTCore:
         self.info: list[NodeInfo] = []
         has_internal = False
         has_keep_running = False
+        has_endless_loop = False
         for node in self.nodes:
             if node.kind in (NodeKind.ACTION, NodeKind.CONDITION):
                 internal = None
@@ -119,12 +124,20 @@ class BTCore:
             has_keep_running |= (
                 node.type in SIMPLE_DECORATORS and spec is not None and spec.result_map is None
             )
+            rule = BUILTIN_RULES.get(node.type)
+            # so can Repeat/Retry with -1; a RunOnce that has run, or a loop that never ticks
+            # its child (a count <= 0 other than -1), answers without any leaf
+            limit = node.params[0] if rule in builtin_rules.LOOPS else None
+            has_endless_loop |= limit == -1
+            has_internal |= rule == "run_once" or (limit is not None and -1 != limit <= 0)
             self.info.append(NodeInfo(node, False, None))
-        if has_internal and (loop or has_keep_running):
+        if has_internal and (loop or has_keep_running or has_endless_loop):
             raise UnsupportedError(
                 "the NuSMV encoding does not model ticks that end without any leaf "
-                "(AlwaysSuccess/AlwaysFailure & co with loop or KeepRunningUntilFailure: the "
-                "engine could livelock)",
+                "(AlwaysSuccess/AlwaysFailure & co, a RunOnce or a zero-count Repeat/"
+                "RetryUntilSuccessful, with loop, "
+                "KeepRunningUntilFailure or an endless Repeat/RetryUntilSuccessful: the engine "
+                "could livelock)",
                 element=self.nodes[0].label,
                 hints=(Hint.NATIVE_VERIFIER,),
             )
@@ -135,7 +148,7 @@ class BTCore:
         self.init: dict[str, str] = {}
         #: memory variables of project kinds (index, counters): reset to 0 by a halt
         self.memory_vars: list[tuple[str, int]] = []
-        #: memory variables a halt keeps (ManualSelector's repeated selection)
+        #: memory variables a halt keeps (ManualSelector's repeated selection, RunOnce's result)
         self.kept_vars: list[str] = []
 
     # -- naming ----------------------------------------------------------------------------
@@ -151,6 +164,11 @@ class BTCore:
     def is_seq_like(self, nid: int) -> bool:
         return self.nodes[nid].type in SEQ_LIKE
 
+    def has_prev(self, nid: int) -> bool:
+        """Whether ``nid``'s frame keeps ``prev_n``, its child's status when called (the
+        wake-up test of the sequences and of Repeat/RetryUntilSuccessful)."""
+        return self.is_seq_like(nid) or BUILTIN_RULES.get(self.nodes[nid].type) in builtin_rules.LOOPS
+
     # -- declarations ----------------------------------------------------------------------
     def declare(self, cur_extra: list[str], init_cur: str) -> None:
         cur_values = [self.n(x.id) for x in self.nodes] + cur_extra
@@ -165,6 +183,7 @@ class BTCore:
             if self.is_seq_like(x.id):
                 self.var_types[f"idx_{x.id}"] = f"0..{max(len(x.children) - 1, 1)}"
                 self.init[f"idx_{x.id}"] = "0"
+            if self.has_prev(x.id):
                 self.var_types[f"prev_{x.id}"] = STATUS_ENUM
                 self.init[f"prev_{x.id}"] = "I"
 
@@ -173,17 +192,23 @@ class BTCore:
         for x in self.nodes:
             out.append(self.st(x.id))
             if self.is_seq_like(x.id):
-                out += [f"idx_{x.id}", f"prev_{x.id}"]
+                out.append(f"idx_{x.id}")
+            if self.has_prev(x.id):
+                out.append(f"prev_{x.id}")
         out += [var for var, _nid in self.memory_vars]
         out += self.kept_vars
         return out
 
-    def memory(self, name: str, nid: int, top: int) -> str:
-        """Declare a memory variable ``0..top`` of node ``nid`` (reset by its halt)."""
+    def memory(self, name: str, nid: int, top: int, *, reset_by_halt: bool = True) -> str:
+        """Declare a memory variable ``0..top`` of node ``nid`` (reset by its halt unless
+        ``reset_by_halt`` is false)."""
         var = f"{name}_{nid}"
         self.var_types[var] = f"0..{max(top, 1)}"
         self.init[var] = "0"
-        self.memory_vars.append((var, nid))
+        if reset_by_halt:
+            self.memory_vars.append((var, nid))
+        else:
+            self.kept_vars.append(var)
         return var
 
     # -- the rules -------------------------------------------------------------------------
@@ -200,7 +225,7 @@ class BTCore:
         self.rule("cur", cond, self.n(node.parent) if node.parent is not None else "TOP")
         self.rule("res", cond, status)
         self.rule("lidx", cond, str(node.index))
-        if self.is_seq_like(nid):
+        if self.has_prev(nid):
             self.rule(f"prev_{nid}", cond, "I")
 
     def build(self) -> None:
@@ -235,6 +260,9 @@ class BTCore:
                 continue
             if t in MANUAL_RULES:
                 self._manual_rules(x, here, called, resets)
+                continue
+            if t in BUILTIN_RULES:
+                builtin_rules.add_rules(self, x, BUILTIN_RULES[t], here, called, resets)
                 continue
             if t in SEQ_LIKE:
                 is_fb, wakes, memory = SEQ_LIKE[t]
