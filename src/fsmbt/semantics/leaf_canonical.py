@@ -6,58 +6,108 @@ status a finished child keeps until its parent resets it, the RUNNING status of 
 action, the RUNNING status of a reactive node whose halt only clears statuses. Two snapshots
 that differ only there have the same future, but the checker counts them as two states; on
 reactive trees that multiplies the leaf-execution machine (``benchmarks/bench_reactive.py``: a
-102-node ReactiveSequence/ReactiveFallback tree has 1 820 faithful states and 71 canonical ones).
+102-node ReactiveSequence/ReactiveFallback tree has 1 820 faithful states and 71 canonical ones),
+and on Nav2's trees (PipelineSequence, RecoveryNode, RoundRobin, RateController) it made the
+explored machines two to three times larger than needed.
 
 The canonical class (``is_canonical_class``; read from the node registry, no node list here):
-every node of the compiled tree is ticked by the ``sequence`` rule (Sequence and Fallback,
-plain, WithMemory or Async) or the ``reactive`` rule (ReactiveSequence/ReactiveFallback), is a
-status-mapping decorator (``result_map``: Inverter, ForceSuccess, ForceFailure), a transparent
-SubTree, an internal leaf or an environment leaf. In this class no node ever returns SKIPPED
-(only RunOnce and all-skipped composites do), so a wake-up never survives to a leaf request and
-a sequence's skipped counter is always 0.
+every control is ticked by a rule of ``CANONICAL_RULES`` (the ``sequence`` rule: Sequence and
+Fallback, plain, WithMemory or Async; ``reactive``; Nav2's ``pipeline``, ``recovery`` and
+``round_robin``), every decorator by a rule of ``CANONICAL_DECORATOR_RULES`` (status maps and
+KeepRunningUntilFailure, Repeat, RetryUntilSuccessful, the gated abstractions whose closed gate
+does not return SKIPPED, GoalUpdater, Groot's Root), plus transparent SubTrees, internal leaves
+and environment leaves. No node of the class ever returns SKIPPED (only RunOnce and the
+SKIPPED-gates do, and composites only when every child did), so a sequence's skipped counter is
+always 0.
+
+Who reads a stored status (every read in ``bt_interpreter``): a leaf action's own tick (SUCCESS
+or FAILURE is returned without asking; IDLE and RUNNING both ask the environment), a gated
+node's own tick when ``free_when_idle`` (IDLE or not), the parent's frame ``prev`` (the wake-up
+test of asynchronous / WithMemory sequences, Repeat and Retry: IDLE or not), a gated parent's
+child-RUNNING tests, and every ``haltChild`` (RUNNING or not). The rule tables below say, per
+node, which of these apply (``_Tables``).
 
 ``canonical(snapshot)`` applies four erasures (the proof that each keeps the future is
 docs/semantics.md §4a):
 
-1. every SUCCESS/FAILURE status is dropped: in the class, a parent resets a finished child
-   before it ticks that child again, so a finished status is never read;
-2. a frame's ``prev`` (the child's status before the call) is set to IDLE unless the frame's
-   node is asynchronous or WithMemory - the only rule that reads it (the wake-up test);
-3. a RUNNING status is kept only when it can still be read: its node's parent reads ``prev``,
-   or the node keeps memory that its ``halt()`` resets (a plain Sequence's running index), or a
-   child's RUNNING status is kept (halting this node must reach that child). Otherwise the
-   status is only ever read by a ``halt()`` whose whole effect is to clear it;
+1. a SUCCESS/FAILURE status is dropped when its node's parent resets a finished child before
+   ticking it again (every rule of the class except ``pipeline``, GoalUpdater's and the gates
+   with ``reset_on_done=False``), or when no reader tells it from IDLE (the node is not an
+   environment action nor a ``free_when_idle`` gate, and its parent does not read ``prev``);
+2. a frame's ``prev`` is set to IDLE unless the frame's node reads it (asynchronous or
+   WithMemory sequences; Repeat/Retry frames are kept whole);
+3. a RUNNING status is kept only when it can still be read: the parent reads ``prev`` or tests
+   the child's RUNNING status (gates), the node's own rule tells RUNNING from IDLE (a
+   ``free_when_idle`` gate), the node keeps memory that its ``halt()`` resets, or a child's
+   status is kept (halting this node would clear it). Otherwise the status is only ever read by
+   a ``halt()`` whose whole effect is to clear erased statuses;
 4. the status of every node on the stack (the path from the root to the requested leaf) is
    dropped: each gets its status again from ``executeTick`` when it returns, and nothing reads
-   it before (a halt only reaches children that are not on the stack).
+   it before (no rule reads its own status after its first step; a halt only reaches children
+   that are not on the stack).
 
-Memories are kept as they are (a WithMemory index, a running child index: both are read).
+Memories are kept as they are (a WithMemory index, a pipeline's furthest child, a recovery's
+retry count, a round robin's position: all are read).
 
 Costs: ``canonical`` is O(k + d) for k stored statuses and stack depth d (one reverse pass over
-the RUNNING nodes, ids are pre-order so children come after parents); building the tables is
+the stored statuses, ids are pre-order so children come after parents); building the tables is
 O(N).
 """
 
 from __future__ import annotations
 
 from fsmbt.model.kinds import NodeKind
-from fsmbt.semantics.bt_interpreter import IDLE, RUNNING, CompiledTree, Snapshot
-from fsmbt.semantics.nodes import runtime_tables
+from fsmbt.model.nodes.registry import Gate
+from fsmbt.semantics.bt_interpreter import (
+    IDLE,
+    RUNNING,
+    SKIPPED,
+    CompiledNode,
+    CompiledTree,
+    Snapshot,
+)
+from fsmbt.semantics.nodes import node_semantics, runtime_tables
 
-#: The interpreter's tick rules whose nodes may be in the canonical class (with the status
-#: maps, SubTree and leaves): the registry names each kind's rule (``NodeSemantics.handler``).
-CANONICAL_RULES: frozenset[str] = frozenset({"sequence", "reactive"})
+#: The interpreter's control rules whose nodes may be in the canonical class (the registry
+#: names each kind's rule, ``NodeSemantics.handler``).
+CANONICAL_RULES: frozenset[str] = frozenset(
+    {"sequence", "reactive", "pipeline", "recovery", "round_robin"}
+)
+#: The decorator rules of the class (``gated`` only when the closed gate is not SKIPPED).
+CANONICAL_DECORATOR_RULES: frozenset[str] = frozenset(
+    {"simple_decorator", "repeat", "retry", "gated", "pass_through", "pass_through_keep"}
+)
+#: Rules that never reset a finished child before ticking it again: PipelineSequence re-ticks
+#: every child from the first on each tick, GoalUpdater passes its child's status on. The
+#: ``gated`` rule is decided by the gate's ``reset_on_done``.
+KEEPING_RULES: frozenset[str] = frozenset({"pipeline", "pass_through_keep"})
+#: Decorator rules whose frame holds the child's status before the call and read it (wake-up).
+PREV_READING_DECORATORS: frozenset[str] = frozenset({"repeat", "retry"})
+
+
+def _gate_of(node: CompiledNode) -> Gate | None:
+    spec = node_semantics(node.type)
+    return spec.gate if spec is not None else None
+
+
+def _gate_closed_skipped(node: CompiledNode) -> bool:
+    """A gated node whose closed gate returns SKIPPED (its ``closed`` port or the registry's
+    default): outside the class."""
+    return bool(node.params) and node.params[0] == SKIPPED
 
 
 def is_canonical_class(tree: CompiledTree) -> bool:
     """Whether every node of ``tree`` is in the canonical class (module docstring). O(N)."""
     tables = runtime_tables()
     for node in tree.nodes:
+        handler = tables.handlers.get(node.type)
         if node.kind is NodeKind.CONTROL:
-            if tables.handlers.get(node.type) not in CANONICAL_RULES:
+            if handler not in CANONICAL_RULES:
                 return False
         elif node.kind is NodeKind.DECORATOR:
-            if node.type not in tables.result_maps:
+            if handler not in CANONICAL_DECORATOR_RULES:
+                return False
+            if handler == "gated" and _gate_closed_skipped(node):
                 return False
         elif node.kind is NodeKind.SUBTREE:
             if node.type != "SubTree" or len(node.children) != 1:
@@ -67,25 +117,66 @@ def is_canonical_class(tree: CompiledTree) -> bool:
     return True
 
 
-class Canonicalizer:
-    """The erasures of the module docstring for one compiled tree of the canonical class."""
+class _Tables:
+    """Per node of one compiled tree, which readers of its status exist (module docstring)."""
 
     def __init__(self, tree: CompiledTree) -> None:
         tables = runtime_tables()
         flags = tables.sequence_flags
         nodes = tree.nodes
-        #: reads_prev[n]: n's tick rule reads its child's status before the call (wake-up test).
+        handler = [tables.handlers.get(node.type) for node in nodes]
+        gates = [_gate_of(node) if handler[i] == "gated" else None for i, node in enumerate(nodes)]
+        #: reads_prev[n]: n's frame holds its child's status before the call and reads it.
         self.reads_prev = [
-            node.type in flags and (flags[node.type][1] or flags[node.type][2]) for node in nodes
+            (node.type in flags and (flags[node.type][1] or flags[node.type][2]))
+            or handler[i] in PREV_READING_DECORATORS
+            for i, node in enumerate(nodes)
         ]
         #: sequence_frame[n]: n's frames are (id, pc, prev) of the ``sequence`` rule.
         self.sequence_frame = [node.type in flags for node in nodes]
         #: halt_resets[n]: n's halt() forgets its memory.
         self.halt_resets = [node.type in tables.halt_resets_memory for node in nodes]
-        self.parent_reads_prev = [
-            node.parent is not None and self.reads_prev[node.parent] for node in nodes
+        #: keeps_finished[n]: n may tick a finished child again without resetting it.
+        keeps_finished = [
+            handler[i] in KEEPING_RULES or (gate is not None and not gate.reset_on_done)
+            for i, gate in enumerate(gates)
         ]
+        #: reads_child_running[n]: n's rule tests its child's RUNNING status (gates).
+        reads_child_running = [
+            gate is not None and (gate.free_when_running or gate.halt_on_closed) for gate in gates
+        ]
+        #: reads_own_idle[n]: n's own tick tells IDLE from the other statuses.
+        reads_own_idle = [gate is not None and gate.free_when_idle for gate in gates]
         self.parent = [node.parent if node.parent is not None else -1 for node in nodes]
+        self.sf_dead: list[bool] = []
+        self.running_read: list[bool] = []
+        for i, node in enumerate(nodes):
+            p = node.parent
+            if p is None:  # the root: its result is reset by the tick's end
+                self.sf_dead.append(True)
+                self.running_read.append(reads_own_idle[i])
+                continue
+            reads_own_sf = node.is_env_leaf and node.kind is NodeKind.ACTION
+            self.sf_dead.append(
+                not keeps_finished[p]
+                or not (reads_own_sf or reads_own_idle[i] or self.reads_prev[p])
+            )
+            self.running_read.append(
+                self.reads_prev[p] or reads_child_running[p] or reads_own_idle[i]
+            )
+
+
+class Canonicalizer:
+    """The erasures of the module docstring for one compiled tree of the canonical class."""
+
+    def __init__(self, tree: CompiledTree) -> None:
+        t = _Tables(tree)
+        self.reads_prev = t.reads_prev
+        self.sequence_frame = t.sequence_frame
+        self.halt_resets = t.halt_resets
+        self.parent = t.parent
+        self.sf_dead = t.sf_dead
+        self.running_read = t.running_read
 
     def canonical(self, snap: Snapshot) -> Snapshot:
         """``snap`` with every status and frame local that cannot be read erased.
@@ -98,31 +189,36 @@ class Canonicalizer:
             The canonical snapshot; equal for snapshots with the same future.
         """
         statuses, memories, frames, wake = snap
-        running = [nid for nid, status in statuses if status == RUNNING]
-        kept: set[int] = set()
-        if running:
+        kept: list[tuple[int, int]] = []
+        if statuses:
             with_memory = {nid for nid, _ in memories}
-            parent_reads_prev, halt_resets, parent = (
-                self.parent_reads_prev,
+            sf_dead, running_read, halt_resets, parent = (
+                self.sf_dead,
+                self.running_read,
                 self.halt_resets,
                 self.parent,
             )
             # Reverse pre-order: every child is decided before its parent, and a kept child
             # marks its parent (rule 3) through ``needed``.
             needed: set[int] = set()
-            for nid in reversed(running):
-                if (
-                    nid in needed
-                    or parent_reads_prev[nid]
-                    or (halt_resets[nid] and nid in with_memory)
-                ):
-                    kept.add(nid)
+            for nid, status in reversed(statuses):
+                if status == RUNNING:
+                    keep = (
+                        nid in needed
+                        or running_read[nid]
+                        or (halt_resets[nid] and nid in with_memory)
+                    )
+                else:  # SUCCESS / FAILURE (SKIPPED is never stored, IDLE never listed)
+                    keep = not sf_dead[nid]
+                if keep:
+                    kept.append((nid, status))
                     needed.add(parent[nid])
-        # Rule 4: the nodes on the stack (the path to the requested leaf) get their status from
-        # ``executeTick``'s epilogue when they return, before anything can read it.
-        for frame in frames:
-            kept.discard(frame[0])
-        new_statuses = tuple((nid, RUNNING) for nid in running if nid in kept)
+            # Rule 4: the nodes on the stack (the path to the requested leaf) get their status
+            # from ``executeTick``'s epilogue when they return, before anything can read it.
+            if frames and kept:
+                on_stack = {frame[0] for frame in frames}
+                kept = [item for item in kept if item[0] not in on_stack]
+            kept.reverse()
         sequence_frame, reads_prev = self.sequence_frame, self.reads_prev
         new_frames = tuple(
             (frame[0], frame[1], IDLE)
@@ -130,4 +226,4 @@ class Canonicalizer:
             else frame
             for frame in frames
         )
-        return (new_statuses, memories, new_frames, wake)
+        return (tuple(kept), memories, new_frames, wake)
