@@ -126,14 +126,30 @@ class _Tables:
         nodes = tree.nodes
         handler = [tables.handlers.get(node.type) for node in nodes]
         gates = [_gate_of(node) if handler[i] == "gated" else None for i, node in enumerate(nodes)]
-        #: reads_prev[n]: n's frame holds its child's status before the call and reads it.
+        #: reads_prev[n]: n's frame holds its child's status before the call and reads it:
+        #: asynchronous / WithMemory sequences, and Repeat/Retry when a child's completion can
+        #: loop again in the same activation (num_cycles / num_attempts -1 or at least 2).
         self.reads_prev = [
             (node.type in flags and (flags[node.type][1] or flags[node.type][2]))
-            or handler[i] in PREV_READING_DECORATORS
+            or (handler[i] in PREV_READING_DECORATORS and _loops_again(node))
             for i, node in enumerate(nodes)
         ]
-        #: sequence_frame[n]: n's frames are (id, pc, prev) of the ``sequence`` rule.
+        #: sequence_frame[n]: n's frames are (id, pc, prev) of the ``sequence`` rule;
+        #: prev_frame[n]: n's frames hold ``prev`` at index 2 (the sequence and loop rules).
         self.sequence_frame = [node.type in flags for node in nodes]
+        self.prev_frame = [
+            self.sequence_frame[i] or handler[i] in PREV_READING_DECORATORS
+            for i in range(len(nodes))
+        ]
+        #: last_child[n]: n is the last child of a ``sequence``-rule parent, whose wake-up test
+        #: (``idx < n`` after the child) is never true for it: its ``prev`` is not read.
+        last_child = [
+            node.parent is not None
+            and self.sequence_frame[node.parent]
+            and node.index == len(nodes[node.parent].children) - 1
+            for node in nodes
+        ]
+        self.last_child = last_child
         #: halt_resets[n]: n's halt() forgets its memory.
         self.halt_resets = [node.type in tables.halt_resets_memory for node in nodes]
         #: keeps_finished[n]: n may tick a finished child again without resetting it.
@@ -150,20 +166,37 @@ class _Tables:
         self.parent = [node.parent if node.parent is not None else -1 for node in nodes]
         self.sf_dead: list[bool] = []
         self.running_read: list[bool] = []
+        #: sf_as_running[n]: a stored SUCCESS/FAILURE of n reads as RUNNING (rule 1b).
+        self.sf_as_running: list[bool] = []
         for i, node in enumerate(nodes):
             p = node.parent
             if p is None:  # the root: its result is reset by the tick's end
                 self.sf_dead.append(True)
                 self.running_read.append(reads_own_idle[i])
+                self.sf_as_running.append(False)
                 continue
+            parent_reads_prev = self.reads_prev[p] and not last_child[i]
             reads_own_sf = node.is_env_leaf and node.kind is NodeKind.ACTION
             self.sf_dead.append(
                 not keeps_finished[p]
-                or not (reads_own_sf or reads_own_idle[i] or self.reads_prev[p])
+                or not (reads_own_sf or reads_own_idle[i] or parent_reads_prev)
             )
             self.running_read.append(
-                self.reads_prev[p] or reads_child_running[p] or reads_own_idle[i]
+                parent_reads_prev or reads_child_running[p] or reads_own_idle[i]
             )
+            self.sf_as_running.append(
+                reads_own_idle[i]
+                and not reads_child_running[p]
+                and node.params[:1] == (RUNNING,)  # its closed gate returns RUNNING
+                and node.type not in tables.halt_resets_memory
+            )
+
+
+def _loops_again(node: CompiledNode) -> bool:
+    """Repeat/Retry: a child's completion may be followed by another cycle in the same
+    activation, so the wake-up test reads the child's status before the call."""
+    (limit,) = node.params
+    return bool(limit == -1 or limit >= 2)
 
 
 class Canonicalizer:
@@ -172,11 +205,13 @@ class Canonicalizer:
     def __init__(self, tree: CompiledTree) -> None:
         t = _Tables(tree)
         self.reads_prev = t.reads_prev
-        self.sequence_frame = t.sequence_frame
+        self.prev_frame = t.prev_frame
+        self.last_child = t.last_child
         self.halt_resets = t.halt_resets
         self.parent = t.parent
         self.sf_dead = t.sf_dead
         self.running_read = t.running_read
+        self.sf_as_running = t.sf_as_running
 
     def canonical(self, snap: Snapshot) -> Snapshot:
         """``snap`` with every status and frame local that cannot be read erased.
@@ -192,16 +227,19 @@ class Canonicalizer:
         kept: list[tuple[int, int]] = []
         if statuses:
             with_memory = {nid for nid, _ in memories}
-            sf_dead, running_read, halt_resets, parent = (
+            sf_dead, running_read, halt_resets, parent, sf_as_running = (
                 self.sf_dead,
                 self.running_read,
                 self.halt_resets,
                 self.parent,
+                self.sf_as_running,
             )
             # Reverse pre-order: every child is decided before its parent, and a kept child
             # marks its parent (rule 3) through ``needed``.
             needed: set[int] = set()
             for nid, status in reversed(statuses):
+                if status != RUNNING and sf_as_running[nid] and nid not in needed:
+                    status = RUNNING  # rule 1b: no reader tells the two apart
                 if status == RUNNING:
                     keep = (
                         nid in needed
@@ -219,11 +257,13 @@ class Canonicalizer:
                 on_stack = {frame[0] for frame in frames}
                 kept = [item for item in kept if item[0] not in on_stack]
             kept.reverse()
-        sequence_frame, reads_prev = self.sequence_frame, self.reads_prev
-        new_frames = tuple(
-            (frame[0], frame[1], IDLE)
-            if len(frame) == 3 and sequence_frame[frame[0]] and not reads_prev[frame[0]]
-            else frame
-            for frame in frames
-        )
-        return (tuple(kept), memories, new_frames, wake)
+        # Rule 2: a frame's ``prev`` is erased when its node does not read it, or when the
+        # child it called (the next frame's node) is the last child of a sequence.
+        prev_frame, reads_prev, last_child = self.prev_frame, self.reads_prev, self.last_child
+        new_frames = list(frames)
+        for k, frame in enumerate(frames):
+            if len(frame) == 3 and prev_frame[frame[0]] and frame[2] != IDLE:
+                callee = frames[k + 1][0] if k + 1 < len(frames) else -1
+                if not reads_prev[frame[0]] or (callee >= 0 and last_child[callee]):
+                    new_frames[k] = (frame[0], frame[1], IDLE)
+        return (tuple(kept), memories, tuple(new_frames), wake)
