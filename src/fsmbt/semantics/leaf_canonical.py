@@ -56,12 +56,15 @@ O(N).
 
 from __future__ import annotations
 
+from typing import Any
+
 from fsmbt.model.kinds import NodeKind
 from fsmbt.model.nodes.registry import Gate
 from fsmbt.semantics.bt_interpreter import (
     IDLE,
     RUNNING,
     SKIPPED,
+    SUCCESS,
     CompiledNode,
     CompiledTree,
     Snapshot,
@@ -212,6 +215,18 @@ class Canonicalizer:
         self.sf_dead = t.sf_dead
         self.running_read = t.running_read
         self.sf_as_running = t.sf_as_running
+        tables = runtime_tables()
+        #: pipeline id -> for each child, whether it is an environment Action (whose stored
+        #: SUCCESS is returned again without asking: it can never return RUNNING, rule 5).
+        self.pipelines: dict[int, tuple[bool, ...]] = {
+            node.id: tuple(
+                tree.nodes[c].is_env_leaf and tree.nodes[c].kind is NodeKind.ACTION
+                for c in node.children
+            )
+            for node in tree.nodes
+            if tables.handlers.get(node.type) == "pipeline"
+        }
+        self.children = [node.children for node in tree.nodes]
 
     def canonical(self, snap: Snapshot) -> Snapshot:
         """``snap`` with every status and frame local that cannot be read erased.
@@ -224,6 +239,8 @@ class Canonicalizer:
             The canonical snapshot; equal for snapshots with the same future.
         """
         statuses, memories, frames, wake = snap
+        if self.pipelines and memories:
+            memories = self._pipeline_memories(statuses, memories, frames)
         kept: list[tuple[int, int]] = []
         if statuses:
             with_memory = {nid for nid, _ in memories}
@@ -267,3 +284,36 @@ class Canonicalizer:
                 if not reads_prev[frame[0]] or (callee >= 0 and last_child[callee]):
                     new_frames[k] = (frame[0], frame[1], IDLE)
         return (tuple(kept), memories, tuple(new_frames), wake)
+
+    def _pipeline_memories(
+        self,
+        statuses: tuple[tuple[int, int], ...],
+        memories: tuple[tuple[int, tuple[Any, ...]], ...],
+        frames: tuple[tuple[Any, ...], ...],
+    ) -> tuple[tuple[int, tuple[Any, ...]], ...]:
+        """Rule 5: a pipeline's furthest index ``last`` is only compared with the index of a
+        child that returned RUNNING; a child that is an Action holding SUCCESS returns SUCCESS
+        until the pipeline resets it (and its memory with it), so ``last`` moves down past
+        such children without changing any comparison."""
+        changed = False
+        done: dict[int, int] | None = None
+        new: list[tuple[int, tuple[Any, ...]]] = []
+        for nid, memory in memories:
+            actions = self.pipelines.get(nid)
+            if actions is not None and memory[0]:
+                if done is None:
+                    done = dict(statuses)
+                    on_stack = {frame[0] for frame in frames}
+                    for item in on_stack:
+                        done.pop(item, None)
+                last: int = memory[0]
+                children = self.children[nid]
+                while last > 0 and actions[last - 1] and done.get(children[last - 1]) == SUCCESS:
+                    last -= 1
+                if last != memory[0]:
+                    changed = True
+                    if last == 0:
+                        continue  # the default memory is not stored
+                    memory = (last,)
+            new.append((nid, memory))
+        return tuple(new) if changed else memories
