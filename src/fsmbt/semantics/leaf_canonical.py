@@ -169,14 +169,28 @@ class _Tables:
         self.parent = [node.parent if node.parent is not None else -1 for node in nodes]
         self.sf_dead: list[bool] = []
         self.running_read: list[bool] = []
-        #: sf_as_running[n]: a stored SUCCESS/FAILURE of n reads as RUNNING (rule 1b).
+        #: sf_as_running[n]: a stored SUCCESS/FAILURE of n reads as RUNNING (rule 1c).
         self.sf_as_running: list[bool] = []
+        #: weak_running[n]: n's RUNNING is read statically only by its gate parent's RUNNING
+        #: test (R4); pairs_idle[g]: g is a gate whose RUNNING over such a RUNNING child reads
+        #: as IDLE over IDLE (rule 3b: both tick the child without asking the gate).
+        self.weak_running: list[bool] = []
+        self.pairs_idle: list[bool] = []
+        frees_running = [
+            reads_own_idle[i]
+            and gate is not None
+            and gate.free_when_running
+            and nodes[i].type not in tables.halt_resets_memory
+            for i, gate in enumerate(gates)
+        ]
         for i, node in enumerate(nodes):
             p = node.parent
             if p is None:  # the root: its result is reset by the tick's end
                 self.sf_dead.append(True)
                 self.running_read.append(reads_own_idle[i])
                 self.sf_as_running.append(False)
+                self.weak_running.append(False)
+                self.pairs_idle.append(frees_running[i])
                 continue
             parent_reads_prev = self.reads_prev[p] and not last_child[i]
             reads_own_sf = node.is_env_leaf and node.kind is NodeKind.ACTION
@@ -192,6 +206,12 @@ class _Tables:
                 and not reads_child_running[p]
                 and node.params[:1] == (RUNNING,)  # its closed gate returns RUNNING
                 and node.type not in tables.halt_resets_memory
+            )
+            self.weak_running.append(
+                reads_child_running[p] and not parent_reads_prev and not reads_own_idle[i]
+            )
+            self.pairs_idle.append(
+                frees_running[i] and not parent_reads_prev and not reads_child_running[p]
             )
 
 
@@ -215,6 +235,8 @@ class Canonicalizer:
         self.sf_dead = t.sf_dead
         self.running_read = t.running_read
         self.sf_as_running = t.sf_as_running
+        self.weak_running = t.weak_running
+        self.pairs_idle = t.pairs_idle
         tables = runtime_tables()
         #: pipeline id -> for each child, whether it is an environment Action (whose stored
         #: SUCCESS is returned again without asking: it can never return RUNNING, rule 5).
@@ -251,18 +273,22 @@ class Canonicalizer:
                 self.parent,
                 self.sf_as_running,
             )
+            weak_running, pairs_idle = self.weak_running, self.pairs_idle
             # Reverse pre-order: every child is decided before its parent, and a kept child
             # marks its parent (rule 3) through ``needed``.
             needed: set[int] = set()
+            weak: set[int] = set()  # gates whose only kept child is a weak RUNNING one
             for nid, status in reversed(statuses):
                 if status != RUNNING and sf_as_running[nid] and nid not in needed:
-                    status = RUNNING  # rule 1b: no reader tells the two apart
+                    status = RUNNING  # rule 1c: no reader tells the two apart
                 if status == RUNNING:
-                    keep = (
-                        nid in needed
-                        or running_read[nid]
-                        or (halt_resets[nid] and nid in with_memory)
-                    )
+                    if nid in weak and pairs_idle[nid]:
+                        kept.pop()  # rule 3b: the child's RUNNING goes too (it was the last kept)
+                        continue
+                    memory = halt_resets[nid] and nid in with_memory
+                    keep = nid in needed or running_read[nid] or memory
+                    if keep and weak_running[nid] and not memory and nid not in needed:
+                        weak.add(parent[nid])
                 else:  # SUCCESS / FAILURE (SKIPPED is never stored, IDLE never listed)
                     keep = not sf_dead[nid]
                 if keep:
