@@ -27,24 +27,31 @@ test of asynchronous / WithMemory sequences, Repeat and Retry: IDLE or not), a g
 child-RUNNING tests, and every ``haltChild`` (RUNNING or not). The rule tables below say, per
 node, which of these apply (``_Tables``).
 
-``canonical(snapshot)`` applies four erasures (the proof that each keeps the future is
+``canonical(snapshot)`` applies five rewrites (the proof that each keeps the future is
 docs/semantics.md §4a):
 
 1. a SUCCESS/FAILURE status is dropped when its node's parent resets a finished child before
    ticking it again (every rule of the class except ``pipeline``, GoalUpdater's and the gates
    with ``reset_on_done=False``), or when no reader tells it from IDLE (the node is not an
    environment action nor a ``free_when_idle`` gate, and its parent does not read ``prev``);
+   a ``free_when_idle`` gate's SUCCESS/FAILURE reads as RUNNING when nothing below it is kept
+   and its parent does not test its RUNNING status (1c);
 2. a frame's ``prev`` is set to IDLE unless the frame's node reads it (asynchronous or
-   WithMemory sequences; Repeat/Retry frames are kept whole);
+   WithMemory sequences, Repeat/Retry that may loop again), or when the child it called is
+   the sequence's last child (the wake-up test needs more children to go);
 3. a RUNNING status is kept only when it can still be read: the parent reads ``prev`` or tests
    the child's RUNNING status (gates), the node's own rule tells RUNNING from IDLE (a
    ``free_when_idle`` gate), the node keeps memory that its ``halt()`` resets, or a child's
    status is kept (halting this node would clear it). Otherwise the status is only ever read by
-   a ``halt()`` whose whole effect is to clear erased statuses;
+   a ``halt()`` whose whole effect is to clear erased statuses. (3b) A free-running gate
+   RUNNING over a child kept only for the gate's own RUNNING test ticks that child without
+   asking either way: both statuses go;
 4. the status of every node on the stack (the path from the root to the requested leaf) is
    dropped: each gets its status again from ``executeTick`` when it returns, and nothing reads
    it before (no rule reads its own status after its first step; a halt only reaches children
-   that are not on the stack).
+   that are not on the stack);
+5. a PipelineSequence's furthest index moves down past children that are Actions holding
+   SUCCESS: they return SUCCESS until the pipeline resets them, and its memory with them.
 
 Memories are kept as they are (a WithMemory index, a pipeline's furthest child, a recovery's
 retry count, a round robin's position: all are read).
