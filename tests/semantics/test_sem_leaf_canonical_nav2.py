@@ -276,7 +276,7 @@ ISSUE_12 = (
 
 @pytest.mark.skipif(not CORPUS.is_dir(), reason="the corpus is not present (FSMBT_CORPUS)")
 @pytest.mark.parametrize("name", ISSUE_12)
-def test_issue_12_trees_canonical_and_smaller(name: str) -> None:
+def test_issue_12_trees_take_the_canonical_path_and_agree(name: str) -> None:
     """The two Nav2 trees of issue 12 take the canonical path and agree with the faithful
     machine on random walks (state counts and the full product proof: benchmarks/bench_nav2.py)."""
     from fsmbt import api
