@@ -8,7 +8,7 @@ that differ only there have the same future, but the checker counts them as two 
 reactive trees that multiplies the leaf-execution machine (``benchmarks/bench_reactive.py``: a
 102-node ReactiveSequence/ReactiveFallback tree has 1 820 faithful states and 71 canonical ones),
 and on Nav2's trees (PipelineSequence, RecoveryNode, RoundRobin, RateController) it made the
-explored machines two to three times larger than needed.
+explored machines two to six times larger than needed (``benchmarks/bench_nav2.py``).
 
 The canonical class (``is_canonical_class``; read from the node registry, no node list here):
 every control is ticked by a rule of ``CANONICAL_RULES`` (the ``sequence`` rule: Sequence and
