@@ -28,10 +28,18 @@ from fsmbt.verify.mutations import mutants
 from fsmbt.verify.pairing import machines_for
 from support.random_trees import bt_documents, random_tree
 
-#: The class, from the registry: controls ticked by the canonical rules, status maps, SubTree.
+#: The class, from the registry: controls ticked by the canonical rules that take any number of
+#: children (the generator draws 1-4; RecoveryNode's two are drawn in
+#: test_sem_leaf_canonical_nav2.py, with the decorators of the widened class), status maps,
+#: SubTree.
 CLASS_CONTROLS = tuple(
     sorted(
-        n.name for n in all_nodes() if n.kind is NodeKind.CONTROL and n.handler in CANONICAL_RULES
+        n.name
+        for n in all_nodes()
+        if n.kind is NodeKind.CONTROL
+        and n.handler in CANONICAL_RULES
+        and n.children is None
+        and n.child_counts is None
     )
 )
 CLASS_DECORATORS = tuple(sorted(n.name for n in all_nodes() if n.result_map is not None)) + (

@@ -692,6 +692,9 @@ class _Writer:
     taken: set[str] = field(default_factory=set)
     composite_ids: set[str] = field(default_factory=set)
     composite_prefixes: set[str] = field(default_factory=set)  # proper dot-prefixes of those
+    #: id(machine) -> source state -> its transitions in document order (built on first use,
+    #: so writing a state costs its own transitions, not the machine's: O(T) in all)
+    outgoing: dict[int, dict[str, list[Transition]]] = field(default_factory=dict)
 
     def prepare(self) -> None:
         machines = [self.top]  # pre-order without recursion (FSM.walk recurses)
@@ -847,8 +850,14 @@ class _Writer:
                 element.set("initial", self.ids[(id(region), region.initial)])
         for key, value in state.attrs.items():
             element.set(key, value)
-        for t in machine.transitions:
-            if t.source != state.name or id(t) in self.skip_transitions:
+        by_source = self.outgoing.get(id(machine))
+        if by_source is None:
+            by_source = {}
+            for t in machine.transitions:
+                by_source.setdefault(t.source, []).append(t)
+            self.outgoing[id(machine)] = by_source
+        for t in by_source.get(state.name, ()):
+            if id(t) in self.skip_transitions:
                 continue
             self.transition_element(element, machine, state, state_id, t)
         return element

@@ -26,8 +26,9 @@ statuses and inputs are the interpreter's (tests/semantics/test_sem_leaf_fast.py
 lockstep). ``generic=True`` forces the interpreter; ``fast`` says which path was taken.
 
 Canonical states: a tree of the canonical class (``leaf_canonical.is_canonical_class``: the
-Sequence/Fallback families - plain, reactive, WithMemory, Async -, status maps, SubTrees and
-leaves) that is not plain runs on the interpreter, but every state is passed through
+Sequence/Fallback families - plain, reactive, WithMemory, Async -, Nav2's PipelineSequence,
+RecoveryNode, RoundRobin and gated controllers, status maps, Repeat/Retry, SubTrees and leaves)
+that is not plain runs on the interpreter, but every state is passed through
 ``leaf_canonical.Canonicalizer.canonical``: statuses and frame locals that are reset before they
 are read are erased, so engine snapshots with the same future are one state (docs/semantics.md
 §4a; tests/semantics/test_sem_leaf_canonical.py checks it in lockstep against the faithful

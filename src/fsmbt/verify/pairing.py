@@ -154,9 +154,19 @@ def lebt_guard_events(doc: BTDocument) -> list[str]:
 
 
 def machines_for(
-    source: FSM | BTDocument, result: FSM | BTDocument, *, loop: bool = False
+    source: FSM | BTDocument,
+    result: FSM | BTDocument,
+    *,
+    loop: bool = False,
+    faithful: bool = False,
 ) -> tuple[Machine[Any], Machine[Any], str]:
-    """The (source machine, result machine, mode) for a pair of models."""
+    """The (source machine, result machine, mode) for a pair of models.
+
+    ``faithful``: BT sides in leaf-execution mode use the faithful interpreter
+    (``LeafMachine(generic=True)``) instead of the static table or canonical states, whose
+    merged states can change the state-based reachability property of a failing pair
+    (docs/verification.md); every other property and the verdict are the same.
+    """
     if isinstance(source, FSM) and isinstance(result, FSM):
         alphabet = _union(source.events(), result.events(), *sub_machine_events(source, result))
         return (
@@ -180,11 +190,19 @@ def machines_for(
     if isinstance(source, BTDocument) and isinstance(result, FSM):
         from fsmbt.semantics.leaf_machine import LeafMachine
 
-        return LeafMachine(source, loop=loop), FSMLeafMachine(result, loop=loop), LEAF_EXECUTION
+        return (
+            LeafMachine(source, loop=loop, generic=faithful),
+            FSMLeafMachine(result, loop=loop),
+            LEAF_EXECUTION,
+        )
     if isinstance(source, BTDocument) and isinstance(result, BTDocument):
         from fsmbt.semantics.leaf_machine import LeafMachine
 
-        return LeafMachine(source, loop=loop), LeafMachine(result, loop=loop), LEAF_EXECUTION
+        return (
+            LeafMachine(source, loop=loop, generic=faithful),
+            LeafMachine(result, loop=loop, generic=faithful),
+            LEAF_EXECUTION,
+        )
     raise InputError(f"cannot compare a {type(source).__name__} with a {type(result).__name__}")
 
 
