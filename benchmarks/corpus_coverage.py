@@ -7,7 +7,7 @@ of the corpus (``FSMBT_CORPUS``, default ``../shared/corpus``): BehaviorTree.CPP
 - ``plain``: no options, as a new user types ``fsmbt convert FILE -o OUT``;
 - ``profiles``: ``--nodes nav2,moveit_pro`` (the project node libraries; their gating
   controllers are abstractions, named in the verdict), the node-library files of
-  examples/node_libraries/ for the trees of their projects (``options_for``) and, for Nav2
+  node_libraries/ for the trees of their projects (``options_for``) and, for Nav2
   trees, Nav2's model file as ``--node-models``;
 - ``abstract``: ``profiles`` plus ``--abstract time,blackboard``.
 
@@ -96,9 +96,9 @@ def corpus_files(root: Path) -> list[tuple[Path, str, str]]:
     return found
 
 
-#: Project node-library files (examples/node_libraries/, docs/semantics.md "Project nodes"):
+#: Project node-library files (node_libraries/, docs/semantics.md "Project nodes"):
 #: by corpus source folder, and by the file-name prefix of the project a tree comes from.
-NODE_LIBRARIES = Path(__file__).resolve().parents[1] / "examples" / "node_libraries"
+NODE_LIBRARIES = Path(__file__).resolve().parents[1] / "node_libraries"
 LIBRARIES_BY_SOURCE = {"bt/btcpp_tutorials": ("btcpp_tutorials.yaml",)}
 LIBRARIES_BY_PREFIX = {
     "IntelligentRoboticsLabs_robocup2020_": ("robocup2020.yaml",),

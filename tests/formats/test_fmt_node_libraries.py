@@ -1,4 +1,4 @@
-"""The node-library files of examples/node_libraries/ (``--nodes FILE``; docs/semantics.md
+"""The node-library files of node_libraries/ (``--nodes FILE``; docs/semantics.md
 "Project nodes"): each one loads, names registered kinds, cites the source it was read from,
 and makes its project's corpus trees (files written by other people, ``FSMBT_CORPUS``) convert
 and verify; without it those trees are refused, naming the node."""
@@ -18,7 +18,7 @@ from fsmbt.model.nodes import node_semantics
 from fsmbt.model.nodes.library import build_library
 from fsmbt.semantics.bt_interpreter import CompiledTree
 
-LIBRARIES = Path(__file__).resolve().parents[2] / "examples" / "node_libraries"
+LIBRARIES = Path(__file__).resolve().parents[2] / "node_libraries"
 CORPUS = Path(os.environ.get("FSMBT_CORPUS", Path(__file__).resolve().parents[3] / "shared/corpus"))
 BT = CORPUS / "bt"
 _COMMIT = re.compile(r"@?\b[0-9a-f]{7,40}\b")

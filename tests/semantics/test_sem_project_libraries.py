@@ -1,5 +1,5 @@
 """Project nodes read from their projects' sources and given by the node-library files in
-examples/node_libraries/ (docs/semantics.md "Project nodes"): stardust's RealParallel (a kind
+node_libraries/ (docs/semantics.md "Project nodes"): stardust's RealParallel (a kind
 of its own, ``stardust.RealParallel``), robocup2020's ActivationSequence (a Sequence) and
 hans-ros-supervisor's Negation (BehaviorTree.CPP's old name of Inverter). Each rule against a
 hand-made trace, and the NuSMV encoding of RealParallel against the native checker."""
@@ -15,7 +15,7 @@ from fsmbt import api
 from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.semantics.bt_interpreter import BTRunner, BTRuntimeError
 
-LIBRARIES = Path(__file__).resolve().parents[2] / "examples" / "node_libraries"
+LIBRARIES = Path(__file__).resolve().parents[2] / "node_libraries"
 STARDUST = LIBRARIES / "stardust.yaml"
 ROBOCUP = LIBRARIES / "robocup2020.yaml"
 HANS = LIBRARIES / "hans_ros_supervisor.yaml"

@@ -293,7 +293,7 @@ BLACKBOARD_CHECKS = tuple(
 # -- project controls read from their sources, enabled by a node-library file -------------------
 # Their bare names (``RealParallel``) are a project's own registrations, which another project
 # may define differently, so the registered kind is qualified by the project and a node-library
-# file maps the bare name to it (examples/node_libraries/, docs/semantics.md "Project nodes").
+# file maps the bare name to it (node_libraries/, docs/semantics.md "Project nodes").
 REAL_PARALLEL = register(
     NodeSemantics(
         "stardust.RealParallel",
