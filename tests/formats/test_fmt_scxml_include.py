@@ -256,8 +256,10 @@ def test_invoke_src_in_included_content_resolves_against_the_fragment(tmp_path: 
     ]
     # an error in the invoked file is located there, not at the include
     write(
-        tmp_path, "parts/kid.scxml", kid.replace("<state", "\n<state")
-        + '<onentry><foreach array="a" item="i"/></onentry></state><state id="k1"/></scxml>'
+        tmp_path,
+        "parts/kid.scxml",
+        kid.replace("<state", "\n<state")
+        + '<onentry><foreach array="a" item="i"/></onentry></state><state id="k1"/></scxml>',
     )
     with pytest.raises(UnsupportedError, match="<foreach>") as info:
         api.load(main)

@@ -366,7 +366,9 @@ def test_repeated_invocation_of_files_is_bounded_in_all(tmp_path: Path) -> None:
 
 
 def test_error_in_an_invoked_file_names_that_file(tmp_path: Path) -> None:
-    (tmp_path / "child.scxml").write_text(doc('<state id="a">\n<onentry><foreach array="a" item="i"/></onentry></state>'))
+    (tmp_path / "child.scxml").write_text(
+        doc('<state id="a">\n<onentry><foreach array="a" item="i"/></onentry></state>')
+    )
     main = tmp_path / "main.scxml"
     main.write_text(doc('<state id="s"><invoke src="child.scxml"/></state>'))
     with pytest.raises(UnsupportedError) as info:

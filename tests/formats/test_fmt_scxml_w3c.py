@@ -328,4 +328,3 @@ def test_an_invalid_send_target_raises_error_execution_and_ends_its_block() -> N
     model = read_scxml(doc(INVALID_TARGET), ctx)
     assert walk(model, ["go"]) == ["s", "failed"]
     assert any("not a valid target" in w for w in ctx.warnings)
-

@@ -152,10 +152,12 @@ def python_spelled(text: str) -> str | None:
     if not re.search(r"""datamodel\s*=\s*["']ecmascript["']""", text):
         return None
     body = _EXPRESSION_ATTRIBUTE.sub(
-        lambda m: m.group(1)
-        + m.group(2)
-        + _ECMASCRIPT_TOKEN.sub(lambda t: _ECMASCRIPT_WORDS[t.group(0)], m.group(3))
-        + m.group(2),
+        lambda m: (
+            m.group(1)
+            + m.group(2)
+            + _ECMASCRIPT_TOKEN.sub(lambda t: _ECMASCRIPT_WORDS[t.group(0)], m.group(3))
+            + m.group(2)
+        ),
         text,
     )
     return re.sub(r"""datamodel\s*=\s*["']ecmascript["']""", 'datamodel="python"', body)

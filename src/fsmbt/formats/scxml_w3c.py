@@ -68,7 +68,9 @@ class _If:
     """``<if>`` with effects: the first branch whose guard holds (``None``: ``<else>``)."""
 
     branches: list[tuple[int | None, list[Action]]]
-    effectless: bool = False  # no event, no assignment a cond reads: skipped (decided after the plan)
+    effectless: bool = (
+        False  # no event, no assignment a cond reads: skipped (decided after the plan)
+    )
 
 
 #: ("raise" | "internal" | "external", event name), ("internal_expr" | "external_expr", index

@@ -167,7 +167,9 @@ class BTCore:
     def has_prev(self, nid: int) -> bool:
         """Whether ``nid``'s frame keeps ``prev_n``, its child's status when called (the
         wake-up test of the sequences and of Repeat/RetryUntilSuccessful)."""
-        return self.is_seq_like(nid) or BUILTIN_RULES.get(self.nodes[nid].type) in builtin_rules.LOOPS
+        return (
+            self.is_seq_like(nid) or BUILTIN_RULES.get(self.nodes[nid].type) in builtin_rules.LOOPS
+        )
 
     # -- declarations ----------------------------------------------------------------------
     def declare(self, cur_extra: list[str], init_cur: str) -> None:
