@@ -48,6 +48,9 @@ class Limits:
         conversion_max_states: reachable states BT -> FSM conversion explores for one region of
             a reactive or stateful subtree (docs/conversion.md), with or without verification.
             ``FSMBT_MAX_CONVERSION_STATES``.
+        max_data_values: most distinct values one SCXML data-model variable may take while
+            its document is explored (an unbounded counter stops here, in about a second,
+            instead of filling ``conversion_max_states``). ``FSMBT_MAX_DATA_VALUES``.
         checker_max_seconds: wall seconds the native checker may run. ``FSMBT_MAX_CHECKER_SECONDS``.
         nusmv_max_seconds: wall seconds one NuSMV run may take. ``FSMBT_MAX_NUSMV_SECONDS``.
         nusmv_max_memory_mb: address space of the NuSMV process (``RLIMIT_AS``), MiB.
@@ -66,6 +69,7 @@ class Limits:
     max_tree_files: int = 1_000
     checker_max_states: int = 2_000_000
     conversion_max_states: int = 200_000
+    max_data_values: int = 10_000
     checker_max_seconds: float = 600.0
     nusmv_max_seconds: float = 300.0
     nusmv_max_memory_mb: int = 4096

@@ -1412,9 +1412,19 @@ def read_scxml_w3c(text: str, ctx: ReadContext) -> FSM:
 
     names: dict[Key, str] = {}
     queue: deque[Key] = deque()
+    values: dict[str, set[scxml_expr.Value]] = {n: set() for n in doc.plan.varying}
 
     def visit(key: Key) -> str:
         if key not in names:
+            for var, value in key[3]:  # an unbounded variable stops long before max_states
+                taken = values[var]
+                taken.add(value)
+                if len(taken) > bounds.max_data_values:
+                    raise scxml_datamodel.StateLimitError(
+                        f"the variable '{var}' took more than {bounds.max_data_values} "
+                        "distinct values (is it unbounded?) (limit max_data_values; raise it "
+                        f"with {limits.env_name('max_data_values')})"
+                    )
             if len(names) >= max_states:
                 if doc.plan.has_data:
                     raise scxml_datamodel.limit_error(
