@@ -49,7 +49,7 @@ class Limits:
             a reactive or stateful subtree (docs/conversion.md), with or without verification.
             ``FSMBT_MAX_CONVERSION_STATES``.
         max_data_values: most distinct values one SCXML data-model variable may take while
-            its document is explored (an unbounded counter stops here, in about a second,
+            its document is explored (an unbounded counter stops here, in a fraction of a second,
             instead of filling ``conversion_max_states``). ``FSMBT_MAX_DATA_VALUES``.
         checker_max_seconds: wall seconds the native checker may run. ``FSMBT_MAX_CHECKER_SECONDS``.
         nusmv_max_seconds: wall seconds one NuSMV run may take. ``FSMBT_MAX_NUSMV_SECONDS``.
@@ -69,7 +69,7 @@ class Limits:
     max_tree_files: int = 1_000
     checker_max_states: int = 2_000_000
     conversion_max_states: int = 200_000
-    max_data_values: int = 10_000
+    max_data_values: int = 1_000
     checker_max_seconds: float = 600.0
     nusmv_max_seconds: float = 300.0
     nusmv_max_memory_mb: int = 4096
