@@ -328,3 +328,26 @@ def test_an_invalid_send_target_raises_error_execution_and_ends_its_block() -> N
     model = read_scxml(doc(INVALID_TARGET), ctx)
     assert walk(model, ["go"]) == ["s", "failed"]
     assert any("not a valid target" in w for w in ctx.warnings)
+
+
+@pytest.mark.parametrize(
+    "body, named",
+    [
+        (  # an initial that names an ancestor (the fuzzer's hang: entry re-entered it forever)
+            '<state id="b" initial="h"><history id="h" type="deep"><transition target="b1"/>'
+            '</history><state id="b1" initial="b"><state id="x"/></state>'
+            '<transition event="go" target="b"/></state>',
+            "state 'b1': its initial 'b'",
+        ),
+        (  # a history whose default transition leaves its parent
+            '<state id="a"><transition event="go" target="h"/></state>'
+            '<state id="p" initial="p1"><history id="h"><transition target="a"/></history>'
+            '<state id="p1"/></state>',
+            "history 'h': its default transition target 'a'",
+        ),
+    ],
+)
+def test_default_targets_outside_their_state_are_errors_not_hangs(body: str, named: str) -> None:
+    with pytest.raises(InputError, match=named) as info:
+        loads(doc(body), "scxml")
+    assert "not a descendant" in str(info.value) and info.value.location is not None

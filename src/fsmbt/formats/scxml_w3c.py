@@ -285,8 +285,36 @@ class _Doc:
                     node.initial = first[:1]
         if not self.states[0].initial:
             raise InputError("the document has no state", location=ctx.location(root.sourceline))
+        self.check_default_targets()
         scxml_invoke.check_targets(self)
         self.decide_data()
+
+    def check_default_targets(self) -> None:
+        """W3C 3.3 and 3.10: a state's initial states, and a history's default transition
+        targets, are proper descendants of the state (of the history's parent). Anything else
+        would make entry re-enter an ancestor forever, so it is an error naming the state."""
+        for node in self.states:
+            if node.kind == "history":
+                owner = node.parent if node.parent is not None else 0
+                targets = [t for tr in node.transitions for t in tr.targets]
+                what = f"history '{node.id}': its default transition target"
+            else:
+                owner, targets, what = (
+                    node.index,
+                    list(node.initial),
+                    f"state '{node.id}': its initial",
+                )
+            for target in targets:
+                up = self.states[target].parent
+                while up is not None and up != owner:
+                    up = self.states[up].parent
+                if up is None and owner != 0:
+                    raise InputError(
+                        f"{what} '{self.states[target].id}' is not a descendant of "
+                        f"'{self.states[owner].id}' (W3C: it must be one)",
+                        location=self.ctx.location(node.line),
+                        element=f"<{node.kind}> '{node.id}'",
+                    )
 
     def tag(self, element: etree._Element) -> str | None:
         if namespace(element) == XINCLUDE_NS:
