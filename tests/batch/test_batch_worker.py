@@ -117,6 +117,21 @@ def test_the_state_limit_is_a_limit_row(tmp_path: Path) -> None:
     assert "5" in (result.error_message or "")
 
 
+def test_a_reader_s_limit_is_a_limit_row_too(tmp_path: Path) -> None:
+    """An unbounded SCXML variable stops the reader with its own ``StateLimitError`` (a
+    ``LimitError``, fsmbt.model.errors): recorded as over a limit, not as malformed input."""
+    path = tmp_path / "counter.scxml"
+    path.write_text(
+        '<scxml xmlns="http://www.w3.org/2005/07/scxml" version="1.0" datamodel="ecmascript">'
+        '<datamodel><data id="n" expr="0"/></datamodel>'
+        '<state id="s"><transition event="tick" target="s"><assign location="n" expr="n + 1"/>'
+        '</transition><transition event="stop" cond="n == 3" target="s"/></state></scxml>'
+    )
+    result = run_job(Job(str(path), str(tmp_path / "out.xml")))
+    assert result.status == "limit", (result.status, result.error_message)
+    assert "'n'" in (result.error_message or "")
+
+
 def test_the_time_limit_is_a_timeout_row(tmp_path: Path) -> None:
     result = run_job(Job(str(_big_fsm(tmp_path)), None, options={"timeout_s": 0.001}))
     assert result.status == "timeout" and result.error_class == "JobTimeout"

@@ -8,7 +8,7 @@ each exception becomes a status (``fsmbt.batch.result``):
 =========================================  ==============
 ``DestinationExists``                      refused (retryable: ``--force`` replaces it)
 ``UnsupportedError``                       refused
-``StateLimitError`` (``max_states``)       limit
+``LimitError`` (a bound of fsmbt.limits)   limit
 the per-model time limit                   timeout
 ``LLMUnavailableError``                    error (retryable: run again on resume)
 other ``InputError``, deep or huge input   bad_input
@@ -53,10 +53,10 @@ from fsmbt.batch.result import (
     TIMEOUT,
     JobResult,
 )
-from fsmbt.model.errors import InputError, UnsupportedError
+from fsmbt.model.errors import InputError, LimitError, UnsupportedError
 from fsmbt.model.fsm import FSM
 from fsmbt.model.stats import model_stats
-from fsmbt.verify.native import DEFAULT_MAX_STATES, StateLimitError
+from fsmbt.verify.native import DEFAULT_MAX_STATES
 
 #: The options ``run_job`` hands to ``fsmbt.api`` as keyword arguments, not engine options.
 PIPELINE_OPTIONS = (
@@ -115,7 +115,7 @@ def _classify(error: BaseException) -> tuple[str, bool]:
     retry = name in RETRYABLE_ERRORS
     if isinstance(error, JobTimeout):
         return TIMEOUT, False
-    if isinstance(error, StateLimitError):
+    if isinstance(error, LimitError):
         return LIMIT, False
     if isinstance(error, api.DestinationExists):
         return REFUSED, True

@@ -36,7 +36,7 @@ from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 
 from fsmbt.formats import scxml_expr
-from fsmbt.model.errors import InputError
+from fsmbt.model.errors import LimitError
 
 #: Apache Commons SCXML's namespace of custom actions (``<cs:var>``), both spellings in use.
 COMMONS_NS = frozenset({"http://commons.apache.org/scxml", "https://commons.apache.org/scxml"})
@@ -47,7 +47,7 @@ _STRING = re.compile(r"""\s*('[^']*'|"[^"]*")""")
 _MEMBER = re.compile(r"\.\s*[A-Za-z_$][\w$]*")
 
 
-class StateLimitError(InputError):
+class StateLimitError(LimitError):
     """The configurations times data valuations pass the state limit (an unbounded variable)."""
 
 

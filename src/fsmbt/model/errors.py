@@ -138,6 +138,13 @@ class InputError(FsmbtError):
     """The input cannot be read or is not a valid model (CLI exit code 2)."""
 
 
+class LimitError(InputError):
+    """The model is too large for a bound in force (``fsmbt.limits``): reachable states,
+    distinct data values, the checker's time. Not malformed input: raising the limit may let
+    it through. Every explorer's ``StateLimitError`` is one, so callers (the batch runner) tell
+    all of them apart with one class."""
+
+
 class UnsupportedError(InputError):
     """The input is valid in its own format but uses a feature fsmbt cannot honour."""
 

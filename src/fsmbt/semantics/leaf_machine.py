@@ -49,7 +49,7 @@ if TYPE_CHECKING:
     import networkx as nx
 
 from fsmbt.model.bt import BTDocument, BTNode
-from fsmbt.model.errors import InputError
+from fsmbt.model.errors import LimitError
 from fsmbt.semantics.bt_interpreter import (
     OUTCOME_TO_STATUS,
     BTInterpreter,
@@ -220,7 +220,7 @@ class LeafMachine:
 S = TypeVar("S", bound=Hashable)
 
 
-class StateLimitError(InputError):
+class StateLimitError(LimitError):
     """Exploration stopped: the machine has more reachable states than allowed."""
 
 

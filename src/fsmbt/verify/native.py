@@ -43,7 +43,7 @@ from typing import Any
 
 from fsmbt import limits
 from fsmbt.limits import Limits
-from fsmbt.model.errors import Hint, InputError
+from fsmbt.model.errors import Hint, InputError, LimitError
 from fsmbt.semantics.machine import RUNNING, Machine
 from fsmbt.verify.report import (
     COMPLETENESS,
@@ -62,11 +62,12 @@ from fsmbt.verify.report import (
 DEFAULT_MAX_STATES = Limits.checker_max_states
 
 
-class StateLimitError(InputError):
+class StateLimitError(LimitError):
     """A machine or the product has more reachable states than ``max_states`` allows.
 
-    An ``InputError`` (callers that only know that class still see bad input); the batch
-    runner tells it apart to record the model as over the state limit, not as malformed.
+    A ``LimitError`` and so an ``InputError`` (callers that only know that class still see bad
+    input); the batch runner tells every ``LimitError`` apart to record the model as over a
+    limit, not as malformed.
     """
 
 
