@@ -17,42 +17,21 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from fsmbt import api
-from fsmbt.model.bt import BTDocument, BTNode
+from fsmbt.model.bt import BTDocument
 from fsmbt.model.bt_nodes import NodeKind
 from fsmbt.model.errors import InputError, UnsupportedError
 from fsmbt.semantics.bt_interpreter import BTLivelock, BTRunner, BTRuntimeError, CompiledTree
 from fsmbt.semantics.nodes import abstractions_used
+from support import bt_traces
+from support.bt_traces import Script, doc_of
 from support.random_trees import ALL_DECORATORS, OutcomeScript, random_tree
-
-
-def doc_of(xml: str, **options: object) -> BTDocument:
-    text = f'<root BTCPP_format="4"><BehaviorTree ID="Main">{xml}</BehaviorTree></root>'
-    model = api.load_text(text, "btcpp", options=dict(options) or None).model
-    assert isinstance(model, BTDocument)
-    return model
-
-
-class Script:
-    """The environment: each leaf label answers from its own queue of outcomes."""
-
-    def __init__(self, answers: dict[str, Iterable[str]]) -> None:
-        self.answers = {label: list(outs) for label, outs in answers.items()}
-
-    def __call__(self, node: BTNode, path: str) -> str:
-        queue = self.answers.get(node.label)
-        assert queue, f"unexpected tick of {node.label}"
-        return queue.pop(0)
 
 
 def run(
     doc: BTDocument, answers: dict[str, Iterable[str]], ticks: int
 ) -> list[tuple[list[str], str]]:
-    runner = BTRunner(doc, Script(answers), exactly_once=False)
-    out = []
-    for _ in range(ticks):
-        record = runner.tick_once()
-        out.append(([label for label, _path, _outcome in record.leaves], record.result))
-    return out
+    """The Loop traces run in tickOnce mode (a RUNNING child is not re-ticked in the tick)."""
+    return bt_traces.run(doc, answers, ticks, exactly_once=False)
 
 
 # -- literal queues: exact ---------------------------------------------------------------------

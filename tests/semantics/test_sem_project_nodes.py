@@ -4,44 +4,13 @@ every tick, with the environment's answers scripted per leaf label."""
 
 from __future__ import annotations
 
-from collections.abc import Iterable
-
 import pytest
 
 from fsmbt import api
-from fsmbt.model.bt import BTDocument, BTNode
+from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import InputError, UnsupportedError
 from fsmbt.semantics.bt_interpreter import BTRunner
-
-
-def doc_of(xml: str, **options: object) -> BTDocument:
-    text = f'<root BTCPP_format="4"><BehaviorTree ID="Main">{xml}</BehaviorTree></root>'
-    model = api.load_text(text, "btcpp", options=dict(options) or None).model
-    assert isinstance(model, BTDocument)
-    return model
-
-
-class Script:
-    """The environment: each leaf label answers from its own queue of outcomes."""
-
-    def __init__(self, answers: dict[str, Iterable[str]]) -> None:
-        self.answers = {label: list(outs) for label, outs in answers.items()}
-
-    def __call__(self, node: BTNode, path: str) -> str:
-        queue = self.answers.get(node.label)
-        assert queue, f"unexpected tick of {node.label}"
-        return queue.pop(0)
-
-
-def run(
-    doc: BTDocument, answers: dict[str, Iterable[str]], ticks: int
-) -> list[tuple[list[str], str]]:
-    runner = BTRunner(doc, Script(answers))
-    out = []
-    for _ in range(ticks):
-        record = runner.tick_once()
-        out.append(([label for label, _path, _outcome in record.leaves], record.result))
-    return out
+from support.bt_traces import Script, doc_of, run
 
 
 def test_sem_pipeline_sequence_reticks_earlier_children() -> None:
