@@ -16,16 +16,14 @@ import random
 import pytest
 from hypothesis import given, settings
 
-from fsmbt.convert.bt_to_hfsm import bt_to_hfsm
 from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.bt_nodes import NodeKind
 from fsmbt.model.errors import UnsupportedError
 from fsmbt.semantics.leaf_canonical import CANONICAL_RULES, is_canonical_class
-from fsmbt.semantics.leaf_machine import LeafMachine, RootResult, explore
+from fsmbt.semantics.leaf_machine import LeafMachine, explore
 from fsmbt.semantics.nodes import all_nodes
 from fsmbt.verify import native
-from fsmbt.verify.mutations import mutants
-from fsmbt.verify.pairing import machines_for
+from support.canonical_checks import lockstep, proved_equivalent, same_verdicts_against_hfsm
 from support.random_trees import bt_documents, random_tree
 
 #: The class, from the registry: controls ticked by the canonical rules that take any number of
@@ -46,7 +44,6 @@ CLASS_DECORATORS = tuple(sorted(n.name for n in all_nodes() if n.result_map is n
     "SubTree",
 )
 CLASS_LEAVES = ("Action", "Condition", "Action", "Condition", "AlwaysSuccess", "AlwaysFailure")
-WALK_STEPS = 80
 
 
 def class_tree(
@@ -72,30 +69,6 @@ def test_the_class_holds_reactive_memory_and_async_kinds() -> None:
     assert "Parallel" not in CLASS_CONTROLS and "Inverter" in CLASS_DECORATORS
 
 
-def lockstep(doc: BTDocument, loop: bool, rng: random.Random) -> None:
-    canon = LeafMachine(doc, loop=loop)
-    faithful = LeafMachine(doc, loop=loop, generic=True)
-    assert canon.canonical and not faithful.canonical
-    c_state, c_out = canon.start()
-    f_state, f_out = faithful.start()
-    assert c_out == f_out
-    for _ in range(WALK_STEPS):
-        assert canon.status(c_state) == faithful.status(f_state)
-        assert canon.describe(c_state) == faithful.describe(f_state)
-        inputs = tuple(canon.inputs(c_state))
-        assert inputs == tuple(faithful.inputs(f_state))
-        if not inputs:
-            assert isinstance(c_state, RootResult) and c_state == f_state
-            c_state, c_out = canon.start()
-            f_state, f_out = faithful.start()
-            assert c_out == f_out
-            continue
-        symbol = rng.choice(inputs)
-        c_state, c_out = canon.step(c_state, symbol)
-        f_state, f_out = faithful.step(f_state, symbol)
-        assert c_out == f_out, (symbol, c_out, f_out)
-
-
 @pytest.mark.parametrize("loop", [False, True])
 def test_canonical_and_faithful_agree_in_lockstep(loop: bool) -> None:
     rng = random.Random(4321 + loop)
@@ -108,16 +81,8 @@ def test_canonical_and_faithful_agree_in_lockstep(loop: bool) -> None:
 @pytest.mark.parametrize("loop", [False, True])
 def test_checker_proves_canonical_equivalent_to_faithful(loop: bool) -> None:
     """Every input sequence, not a sample: the product of the two machines is explored."""
-    smaller = 0
     docs = canonical_documents(160)
-    for doc in docs:
-        canon = LeafMachine(doc, loop=loop)
-        faithful = LeafMachine(doc, loop=loop, generic=True)
-        report = native.check(faithful, canon, mode="lockstep")
-        assert report.equivalent, report.verdicts()
-        n_canon, n_faithful = len(explore(canon)), len(explore(faithful))
-        assert n_canon <= n_faithful
-        smaller += n_canon < n_faithful
+    smaller = sum(proved_equivalent(doc, loop) for doc in docs)
     assert smaller > len(docs) // 8  # the reduction does merge states
 
 
@@ -142,25 +107,11 @@ def test_checker_verdict_same_on_both_machines() -> None:
     for seed in range(300, 340):
         # environment leaves only: the HFSM of an all-internal branch is an eventless cycle
         doc = class_tree(seed, max_nodes=24, leaves=("Action", "Condition"))
-        canon = LeafMachine(doc)
-        if not canon.canonical:
+        if not LeafMachine(doc).canonical:
             continue
-        try:
-            hfsm = bt_to_hfsm(doc).model
-        except UnsupportedError:
-            continue
-        targets = [hfsm] + [
-            m.model for m in mutants(hfsm, seed=rng.randrange(1000), per_operator=1)
-        ]
-        for target in targets:
-            _src, result, _mode = machines_for(doc, target)
-            on_canon = native.check(LeafMachine(doc), result, mode="lockstep").equivalent
-            on_faithful = native.check(
-                LeafMachine(doc, generic=True), result, mode="lockstep"
-            ).equivalent
-            assert on_canon == on_faithful
-            checked += 1
-            caught += not on_canon
+        pairs, failing = same_verdicts_against_hfsm(doc, rng)
+        checked += pairs
+        caught += failing
     assert checked >= 40 and caught > 0
 
 

@@ -19,20 +19,17 @@ from pathlib import Path
 
 import pytest
 
-from fsmbt.convert.bt_to_hfsm import bt_to_hfsm
 from fsmbt.model.bt import BehaviorTree, BTDocument, BTNode
 from fsmbt.model.bt_nodes import NodeKind
-from fsmbt.model.errors import UnsupportedError
 from fsmbt.semantics.leaf_canonical import (
     CANONICAL_DECORATOR_RULES,
     CANONICAL_RULES,
     is_canonical_class,
 )
-from fsmbt.semantics.leaf_machine import LeafMachine, RootResult, explore
+from fsmbt.semantics.leaf_machine import LeafMachine
 from fsmbt.semantics.nodes import all_nodes
 from fsmbt.verify import native
-from fsmbt.verify.mutations import mutants
-from fsmbt.verify.pairing import machines_for
+from support.canonical_checks import lockstep, proved_equivalent, same_verdicts_against_hfsm
 
 #: Controls of the class, from the registry (the rule decides, not a list here).
 CONTROLS = tuple(
@@ -51,7 +48,6 @@ DECORATORS = tuple(
     )
 )
 NAV2 = ("PipelineSequence", "RecoveryNode", "RoundRobin", "RateController")
-WALK_STEPS = 80
 
 
 def test_the_class_holds_nav2_kinds() -> None:
@@ -135,30 +131,6 @@ def nav2_documents(count: int, **kwargs: object) -> list[BTDocument]:
     return docs
 
 
-def lockstep(doc: BTDocument, loop: bool, rng: random.Random) -> None:
-    canon = LeafMachine(doc, loop=loop)
-    faithful = LeafMachine(doc, loop=loop, generic=True)
-    assert canon.canonical and not faithful.canonical
-    c_state, c_out = canon.start()
-    f_state, f_out = faithful.start()
-    assert c_out == f_out
-    for _ in range(WALK_STEPS):
-        assert canon.status(c_state) == faithful.status(f_state)
-        assert canon.describe(c_state) == faithful.describe(f_state)
-        inputs = tuple(canon.inputs(c_state))
-        assert inputs == tuple(faithful.inputs(f_state))
-        if not inputs:
-            assert isinstance(c_state, RootResult) and c_state == f_state
-            c_state, c_out = canon.start()
-            f_state, f_out = faithful.start()
-            assert c_out == f_out
-            continue
-        symbol = rng.choice(inputs)
-        c_state, c_out = canon.step(c_state, symbol)
-        f_state, f_out = faithful.step(f_state, symbol)
-        assert c_out == f_out, (symbol, c_out, f_out)
-
-
 @pytest.mark.parametrize("loop", [False, True])
 def test_nav2_canonical_and_faithful_agree_in_lockstep(loop: bool) -> None:
     rng = random.Random(99 + loop)
@@ -171,16 +143,8 @@ def test_nav2_canonical_and_faithful_agree_in_lockstep(loop: bool) -> None:
 @pytest.mark.parametrize("loop", [False, True])
 def test_checker_proves_nav2_canonical_equivalent_to_faithful(loop: bool) -> None:
     """Every input sequence, not a sample: the product of the two machines is explored."""
-    smaller = 0
     docs = nav2_documents(220)
-    for doc in docs:
-        canon = LeafMachine(doc, loop=loop)
-        faithful = LeafMachine(doc, loop=loop, generic=True)
-        report = native.check(faithful, canon, mode="lockstep")
-        assert report.equivalent, report.verdicts()
-        n_canon, n_faithful = len(explore(canon)), len(explore(faithful))
-        assert n_canon <= n_faithful
-        smaller += n_canon < n_faithful
+    smaller = sum(proved_equivalent(doc, loop) for doc in docs)
     assert smaller > len(docs) // 4  # the reduction does merge states on these kinds
 
 
@@ -197,22 +161,9 @@ def test_checker_verdict_same_on_both_machines() -> None:
     rng = random.Random(11)
     checked = caught = 0
     for doc in nav2_documents(80, max_nodes=20, leaves=("Action", "Condition")):
-        try:
-            hfsm = bt_to_hfsm(doc).model
-        except UnsupportedError:
-            continue
-        targets = [hfsm] + [
-            m.model for m in mutants(hfsm, seed=rng.randrange(1000), per_operator=1)
-        ]
-        for target in targets:
-            _src, result, _mode = machines_for(doc, target)
-            on_canon = native.check(LeafMachine(doc), result, mode="lockstep").equivalent
-            on_faithful = native.check(
-                LeafMachine(doc, generic=True), result, mode="lockstep"
-            ).equivalent
-            assert on_canon == on_faithful
-            checked += 1
-            caught += not on_canon
+        pairs, failing = same_verdicts_against_hfsm(doc, rng)
+        checked += pairs
+        caught += failing
     assert checked >= 40 and caught > 0
 
 
