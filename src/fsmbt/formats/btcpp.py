@@ -20,7 +20,6 @@ Complexity: O(n) in the number of elements.
 from __future__ import annotations
 
 import re
-from collections.abc import Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -275,14 +274,7 @@ class _Loader:
 
     def load_external_models(self) -> None:
         option = self.ctx.options.get("node_models") or []
-        if isinstance(option, (str, Path)):
-            paths: list[object] = [option]
-        elif isinstance(option, Iterable):
-            paths = list(option)
-        else:
-            raise InputError("the node_models option must be a path or a list of paths")
-        for item in paths:
-            model_path = Path(str(item))
+        for model_path in btcpp_trees.option_paths(option, "node_models"):
             try:
                 data = read_bounded(model_path)
             except OSError as exc:

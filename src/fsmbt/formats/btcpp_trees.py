@@ -112,17 +112,18 @@ def _xml_files(folder: Path, what: str) -> list[Path]:
     return found
 
 
-def option_paths(option: object) -> list[Path]:
-    """The ``trees`` option as paths (a path, or a list of paths).
+def option_paths(option: object, name: str = TREES_OPTION) -> list[Path]:
+    """A reader option that names files (``trees``, ``node_models``) as paths: a path, or a
+    list of paths.
 
     Raises:
-        InputError: the option is neither.
+        InputError: the option is neither (the message names the option ``name``).
     """
     if isinstance(option, (str, Path)):
         return [Path(option)]
     if isinstance(option, Iterable):
         return [Path(str(item)) for item in option]
-    raise InputError(f"the {TREES_OPTION} option must be a path or a list of paths")
+    raise InputError(f"the {name} option must be a path or a list of paths")
 
 
 def index_option(option: object) -> TreeIndex:
