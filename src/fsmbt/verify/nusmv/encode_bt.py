@@ -450,15 +450,7 @@ class BTCore:
             return
         spec = node_semantics(x.type)
         assert spec is not None and spec.gate is not None
-        closed_status = NodeStatus(x.params[0]).name
-        if closed_status not in ST or closed_status == NodeStatus.IDLE.name:
-            raise UnsupportedError(
-                f"the NuSMV encoding does not support {x.type} returning {closed_status} "
-                "(SKIPPED is not encoded); use --engine native",
-                location=x.source.location,
-                element=f"<{x.type}> '{x.label}'",
-            )
-        closed = ST[closed_status]
+        closed = self._returned_status(x, x.params[0], "")
         if rule == "for_each":
             self.call(f"{called} & {self.st(c)} = R", c)
             self.call(called, gate)
@@ -487,6 +479,19 @@ class BTCore:
             resets[c].append(f"{from_child} & (res = S | res = F)")
         self.ret(from_child, x.id, passed)
 
+    def _returned_status(self, x: CompiledNode, value: int, when: str) -> str:
+        """The SMV constant of a status node ``x`` returns by parameter (``value``); IDLE and
+        SKIPPED are not statuses a node returns in the encoding, so they are refused."""
+        status = NodeStatus(value).name
+        if status not in ST or status == NodeStatus.IDLE.name:
+            raise UnsupportedError(
+                f"the NuSMV encoding does not support {x.type} returning {status}{when} "
+                "(SKIPPED is not encoded); use --engine native",
+                location=x.source.location,
+                element=f"<{x.type}> '{x.label}'",
+            )
+        return ST[status]
+
     def _loop_rules(
         self, x: CompiledNode, here: str, called: str, resets: dict[int, list[str]]
     ) -> None:
@@ -495,15 +500,7 @@ class BTCore:
         queue (``length = -1``) asks its gate, the last child, whether an element is left.
         Either way an element is taken only while the child is not RUNNING."""
         if_empty, length = x.params
-        empty_status = NodeStatus(if_empty).name
-        if empty_status not in ST:
-            raise UnsupportedError(
-                f"the NuSMV encoding does not support {x.type} returning {empty_status} on an "
-                "empty queue (SKIPPED is not encoded); use --engine native",
-                location=x.source.location,
-                element=f"<{x.type}> '{x.label}'",
-            )
-        empty = ST[empty_status]
+        empty = self._returned_status(x, if_empty, " on an empty queue")
         kids = list(x.children)
         c = kids[0]
         back = f"{here} & res != NONE"
