@@ -16,11 +16,12 @@ from fsmbt.generate import random_bt
 from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.bt_nodes import NodeKind
 from fsmbt.semantics.leaf_fast import is_plain_tree
-from fsmbt.semantics.leaf_machine import LeafMachine, RootResult
+from fsmbt.semantics.leaf_machine import LeafMachine
 from fsmbt.verify import native
 from fsmbt.verify.mutations import mutants
 from fsmbt.verify.pairing import machines_for
 from fsmbt.verify.report import REACHABILITY
+from support.canonical_checks import walk_alike
 from support.random_trees import random_tree
 
 PLAIN_SEEDS = range(200)
@@ -47,24 +48,7 @@ def lockstep(doc: BTDocument, loop: bool, rng: random.Random) -> None:
     fast = LeafMachine(doc, loop=loop)
     slow = LeafMachine(doc, loop=loop, generic=True)
     assert fast.fast and not slow.fast
-    fast_state, fast_out = fast.start()
-    slow_state, slow_out = slow.start()
-    assert fast_out == slow_out
-    for _ in range(WALK_STEPS):
-        assert fast.status(fast_state) == slow.status(slow_state)
-        assert fast.describe(fast_state) == slow.describe(slow_state)
-        inputs = tuple(fast.inputs(fast_state))
-        assert inputs == tuple(slow.inputs(slow_state))
-        if not inputs:  # terminal: both are RootResult; start over
-            assert isinstance(fast_state, RootResult) and fast_state == slow_state
-            fast_state, fast_out = fast.start()
-            slow_state, slow_out = slow.start()
-            assert fast_out == slow_out
-            continue
-        symbol = rng.choice(inputs)
-        fast_state, fast_out = fast.step(fast_state, symbol)
-        slow_state, slow_out = slow.step(slow_state, symbol)
-        assert fast_out == slow_out, (symbol, fast_out, slow_out)
+    walk_alike(fast, slow, rng, WALK_STEPS)
 
 
 @pytest.mark.parametrize("loop", [False, True])

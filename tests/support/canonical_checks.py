@@ -1,6 +1,6 @@
-"""The three checks that a canonical leaf-execution machine (docs/semantics.md §4a) behaves as
-the faithful interpreter does, shared by the tests of each widening of the canonical class:
-a lockstep random walk, a full proof by the native checker, and the same verdict against a
+"""The checks that a reduced leaf-execution machine (the canonical states of docs/semantics.md
+§4a, the static fast path) behaves as the faithful interpreter does, shared by their tests: a
+lockstep random walk, a full proof by the native checker, and the same verdict against a
 converted HFSM and its mutants."""
 
 from __future__ import annotations
@@ -18,30 +18,38 @@ from fsmbt.verify.pairing import machines_for
 WALK_STEPS = 80
 
 
+def walk_alike(
+    reduced: LeafMachine, faithful: LeafMachine, rng: random.Random, steps: int = WALK_STEPS
+) -> None:
+    """Walk a reduced machine (canonical or fast path) and the faithful one on the same random
+    inputs: same outputs, statuses, descriptions and offered inputs after every step
+    (restarting both after a root result)."""
+    r_state, r_out = reduced.start()
+    f_state, f_out = faithful.start()
+    assert r_out == f_out
+    for _ in range(steps):
+        assert reduced.status(r_state) == faithful.status(f_state)
+        assert reduced.describe(r_state) == faithful.describe(f_state)
+        inputs = tuple(reduced.inputs(r_state))
+        assert inputs == tuple(faithful.inputs(f_state))
+        if not inputs:
+            assert isinstance(r_state, RootResult) and r_state == f_state
+            r_state, r_out = reduced.start()
+            f_state, f_out = faithful.start()
+            assert r_out == f_out
+            continue
+        symbol = rng.choice(inputs)
+        r_state, r_out = reduced.step(r_state, symbol)
+        f_state, f_out = faithful.step(f_state, symbol)
+        assert r_out == f_out, (symbol, r_out, f_out)
+
+
 def lockstep(doc: BTDocument, loop: bool, rng: random.Random, steps: int = WALK_STEPS) -> None:
-    """Walk both machines on the same random inputs: same outputs, statuses, descriptions and
-    offered inputs after every step (restarting both after a root result)."""
+    """``walk_alike`` on ``doc``'s canonical machine and its faithful one."""
     canon = LeafMachine(doc, loop=loop)
     faithful = LeafMachine(doc, loop=loop, generic=True)
     assert canon.canonical and not faithful.canonical
-    c_state, c_out = canon.start()
-    f_state, f_out = faithful.start()
-    assert c_out == f_out
-    for _ in range(steps):
-        assert canon.status(c_state) == faithful.status(f_state)
-        assert canon.describe(c_state) == faithful.describe(f_state)
-        inputs = tuple(canon.inputs(c_state))
-        assert inputs == tuple(faithful.inputs(f_state))
-        if not inputs:
-            assert isinstance(c_state, RootResult) and c_state == f_state
-            c_state, c_out = canon.start()
-            f_state, f_out = faithful.start()
-            assert c_out == f_out
-            continue
-        symbol = rng.choice(inputs)
-        c_state, c_out = canon.step(c_state, symbol)
-        f_state, f_out = faithful.step(f_state, symbol)
-        assert c_out == f_out, (symbol, c_out, f_out)
+    walk_alike(canon, faithful, rng, steps)
 
 
 def proved_equivalent(doc: BTDocument, loop: bool) -> bool:
