@@ -139,7 +139,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--minimal", action="store_true", help="count the minimal machine")
     parser.add_argument("--limit", type=int, default=300, help="seconds per step")
     args = parser.parse_args(argv)
-    root = Path(os.environ.get("FSMBT_CORPUS", "/work/shared/corpus")) / "bt" / "nav2"
+    repo = Path(__file__).resolve().parents[1]
+    root = Path(os.environ.get("FSMBT_CORPUS", repo / ".." / "shared" / "corpus")) / "bt" / "nav2"
     files: list[Path] = list(args.files)
     if not files:
         if not root.is_dir():

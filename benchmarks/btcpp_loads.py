@@ -161,6 +161,8 @@ def refusal(path: Path, source_root: Path, options: dict[str, object]) -> str | 
         The engine's message (first line), or ``None`` when ``createTree`` succeeds.
     """
     assert btpy is not None
+    # resolved, so included files (resolved by fsmbt) compare with it: ``a/../b`` is ``b``
+    path, source_root = path.resolve(), source_root.resolve()
     parsed: dict[Path, etree._ElementTree] = {}
     for p in sorted(source_root.rglob("*.xml")):
         try:

@@ -4,7 +4,6 @@ existing outputs, a missing output folder, and the corpus's malformed files as r
 from __future__ import annotations
 
 import json
-import os
 from pathlib import Path
 
 import pytest
@@ -12,6 +11,7 @@ import pytest
 from fsmbt import api
 from fsmbt.cli import main
 from fsmbt.cli.cmd_batch import exit_code
+from support.corpus import CORPUS
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 #: the example models (not the README, not the runnable run_*.py programs)
@@ -20,7 +20,6 @@ EXAMPLE_MODELS = sorted(
     for p in EXAMPLES.iterdir()
     if p.is_file() and p.name != "README.md" and not p.name.startswith("run_")
 )
-CORPUS = Path(os.environ.get("FSMBT_CORPUS", "/nonexistent"))
 
 
 def test_examples_convert_into_a_new_nested_folder_and_report_again(
@@ -88,7 +87,7 @@ def test_exit_codes() -> None:
         assert exit_code(["equivalent", failed]) == 2
 
 
-@pytest.mark.skipif(not CORPUS.is_dir(), reason="FSMBT_CORPUS is not set")
+@pytest.mark.skipif(not CORPUS.is_dir(), reason=f"corpus not found at {CORPUS} (set FSMBT_CORPUS)")
 def test_the_corpus_malformed_files_are_rows_not_a_crash(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

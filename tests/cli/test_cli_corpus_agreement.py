@@ -6,7 +6,6 @@ Skips only when the corpus folder is absent (FSMBT_CORPUS)."""
 from __future__ import annotations
 
 import json
-import os
 from pathlib import Path
 
 import pytest
@@ -14,10 +13,7 @@ import pytest
 from fsmbt import api
 from fsmbt.cli import main
 from fsmbt.model.errors import InputError
-
-CORPUS = Path(
-    os.environ.get("FSMBT_CORPUS", Path(__file__).resolve().parents[2] / ".." / "shared" / "corpus")
-)
+from support.corpus import CORPUS
 
 
 def _bt_files() -> list[Path]:

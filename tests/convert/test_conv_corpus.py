@@ -3,7 +3,6 @@
 
 from __future__ import annotations
 
-import os
 from collections import Counter
 from pathlib import Path
 
@@ -13,10 +12,8 @@ from fsmbt.convert import convert
 from fsmbt.formats import read_model
 from fsmbt.model.errors import InputError
 from support.conv_helpers import check
+from support.corpus import CORPUS
 
-CORPUS = Path(
-    os.environ.get("FSMBT_CORPUS", Path(__file__).resolve().parents[3] / "shared" / "corpus")
-)
 MAX_CHECK_STATES = 200_000
 
 

@@ -4,7 +4,6 @@ tree mirrors the hierarchy."""
 
 from __future__ import annotations
 
-import os
 from pathlib import Path
 
 import pytest
@@ -16,9 +15,9 @@ from fsmbt.model.errors import InputError
 from fsmbt.model.fsm import FSM
 from support.conv_helpers import check
 from support.conv_hfsm_gen import random_hfsm
+from support.corpus import CORPUS
 
 REPO = Path(__file__).resolve().parents[2]
-CORPUS = Path(os.environ.get("FSMBT_CORPUS", REPO.parent / "shared" / "corpus"))
 
 
 def _composites(fsm: FSM) -> list[str]:

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import os
 import time
 from pathlib import Path
 
@@ -14,10 +13,7 @@ from fsmbt.formats.xml_safe import parse_xml, root_tag
 from fsmbt.limits import current as current_limits
 from fsmbt.model import BTDocument, BTNode, NodeKind
 from fsmbt.model.errors import InputError, UnsupportedError
-
-CORPUS = Path(
-    os.environ.get("FSMBT_CORPUS", Path(__file__).resolve().parents[2] / ".." / "shared" / "corpus")
-)
+from support.corpus import CORPUS
 
 
 def corpus(rel: str) -> Path:

@@ -3,7 +3,6 @@ with every unknown node registered as a dummy of its declared kind (docs/corpus.
 
 from __future__ import annotations
 
-import os
 import sys
 from pathlib import Path
 
@@ -13,9 +12,7 @@ pytest.importorskip("behaviortreepy")
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))
 import btcpp_loads  # noqa: E402
 
-CORPUS = Path(
-    os.environ.get("FSMBT_CORPUS", Path(__file__).resolve().parents[2] / ".." / "shared" / "corpus")
-)
+from support.corpus import CORPUS
 
 
 def write(folder: Path, name: str, text: str) -> Path:

@@ -14,10 +14,8 @@ from fsmbt import api, limits
 from fsmbt.formats import read_model
 from fsmbt.model.errors import InputError
 from fsmbt.semantics.bt_interpreter import BTInterpreter
+from support.corpus import CORPUS
 
-CORPUS = Path(
-    os.environ.get("FSMBT_CORPUS", Path(__file__).resolve().parents[2] / ".." / "shared" / "corpus")
-)
 SRC = Path(__file__).resolve().parents[2] / "src"
 
 

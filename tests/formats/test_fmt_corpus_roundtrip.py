@@ -9,7 +9,6 @@ included files, so the re-read document equals the original with ``format_versio
 from __future__ import annotations
 
 import dataclasses
-import os
 from collections import Counter
 from pathlib import Path
 
@@ -18,10 +17,8 @@ import pytest
 from fsmbt.formats import dumps, loads, read_model
 from fsmbt.model import BTDocument
 from fsmbt.model.errors import InputError, UnsupportedError
+from support.corpus import CORPUS
 
-CORPUS = Path(
-    os.environ.get("FSMBT_CORPUS", Path(__file__).resolve().parents[2] / ".." / "shared" / "corpus")
-)
 NAV2_MODELS = CORPUS / "bt" / "nav2" / "models" / "nav2_tree_nodes.xml"
 
 #: Floors: a regression that makes more files fail lowers these counts and fails the test.

@@ -5,7 +5,6 @@ and verify; without it those trees are refused, naming the node."""
 
 from __future__ import annotations
 
-import os
 import re
 from pathlib import Path
 
@@ -17,9 +16,9 @@ from fsmbt.model.errors import InputError, UnsupportedError
 from fsmbt.model.nodes import node_semantics
 from fsmbt.model.nodes.library import build_library
 from fsmbt.semantics.bt_interpreter import CompiledTree
+from support.corpus import CORPUS
 
 LIBRARIES = Path(__file__).resolve().parents[2] / "node_libraries"
-CORPUS = Path(os.environ.get("FSMBT_CORPUS", Path(__file__).resolve().parents[3] / "shared/corpus"))
 BT = CORPUS / "bt"
 _COMMIT = re.compile(r"@?\b[0-9a-f]{7,40}\b")
 

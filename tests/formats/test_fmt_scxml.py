@@ -3,9 +3,7 @@
 from __future__ import annotations
 
 import json
-import os
 import re
-from pathlib import Path
 
 import pytest
 
@@ -16,10 +14,8 @@ from fsmbt.formats.scxml_w3c import representative_event
 from fsmbt.model import FSM, State
 from fsmbt.model.errors import InputError, UnsupportedError
 from fsmbt.semantics.machine import FSMMachine
+from support.corpus import CORPUS
 
-CORPUS = Path(
-    os.environ.get("FSMBT_CORPUS", Path(__file__).resolve().parents[2] / ".." / "shared" / "corpus")
-)
 NS = 'xmlns="http://www.w3.org/2005/07/scxml"'
 
 

@@ -4,7 +4,6 @@ cannot affect control flow, the state limit on unbounded variables, the dialects
 
 from __future__ import annotations
 
-import os
 from pathlib import Path
 
 import pytest
@@ -27,9 +26,9 @@ from fsmbt.formats.scxml_expr import (
 from fsmbt.model.errors import UnsupportedError
 from fsmbt.model.fsm import FSM
 from fsmbt.semantics.machine import FSMMachine
+from support.corpus import CORPUS
 
 REPO = Path(__file__).resolve().parents[2]
-CORPUS = Path(os.environ.get("FSMBT_CORPUS", REPO.parent / "shared" / "corpus"))
 NS = 'xmlns="http://www.w3.org/2005/07/scxml"'
 
 

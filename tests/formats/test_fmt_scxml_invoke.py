@@ -24,6 +24,7 @@ from fsmbt.formats import loads
 from fsmbt.model.errors import InputError, UnsupportedError
 from fsmbt.model.fsm import FSM
 from fsmbt.verify.nusmv.binary import find_nusmv
+from support.corpus import CORPUS
 
 NS = 'xmlns="http://www.w3.org/2005/07/scxml"'
 
@@ -379,10 +380,9 @@ def test_error_in_an_invoked_file_names_that_file(tmp_path: Path) -> None:
 
 
 def test_corpus_qt_invoke_example_converts_and_verifies(tmp_path: Path) -> None:
-    corpus = os.environ.get("FSMBT_CORPUS")
-    if not corpus:
-        pytest.skip("FSMBT_CORPUS is not set")
-    path = Path(corpus) / "fsm" / "qt_scxml_examples" / "invoke.scxml"
+    path = CORPUS / "fsm" / "qt_scxml_examples" / "invoke.scxml"
+    if not path.is_file():
+        pytest.skip(f"corpus not found at {CORPUS} (set FSMBT_CORPUS)")
     outcome = api.convert_file(path, tmp_path / "bt.xml")
     assert outcome.equivalent is True
     model = api.load(path).model

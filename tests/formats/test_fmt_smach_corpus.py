@@ -7,7 +7,6 @@ when the folder is absent. A file that stops reading fails here with the reader'
 
 from __future__ import annotations
 
-import os
 from pathlib import Path
 
 import pytest
@@ -17,10 +16,8 @@ from fsmbt.formats import loads, read_model
 from fsmbt.formats._smach_write import write_smach
 from fsmbt.model.fsm import FSM
 from fsmbt.verify import verify
+from support.corpus import CORPUS
 
-CORPUS = Path(
-    os.environ.get("FSMBT_CORPUS", Path(__file__).resolve().parents[2] / ".." / "shared" / "corpus")
-)
 FSM_DIR = CORPUS / "fsm"
 SMACH_FILES = sorted([*FSM_DIR.glob("smach_tutorials/*.py"), *FSM_DIR.glob("smach_tests/*.py")])
 FLEXBE_FILES = sorted(FSM_DIR.glob("flexbe_turtlesim_demo/*_sm.py"))

@@ -27,10 +27,10 @@ from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import UnsupportedError
 from fsmbt.model.fsm import FSM
 from fsmbt.verify import verify
+from support.corpus import CORPUS
 
 ROOT = Path(__file__).resolve().parents[2]
 EXAMPLES = ROOT / "examples"
-CORPUS = Path(os.environ.get("FSMBT_CORPUS", ROOT / ".." / "shared" / "corpus"))
 needs_corpus = pytest.mark.skipif(not (CORPUS / "fsm").exists(), reason="corpus not present")
 
 
@@ -48,6 +48,7 @@ def cli(*args: str) -> subprocess.CompletedProcess[str]:
 
 SMACH_SOURCE = """\
 import smach
+from support.corpus import CORPUS
 
 class Foo(smach.State):
     def __init__(self):

@@ -35,9 +35,9 @@ from fsmbt.semantics.engines.btcpp_engine import BTCppLebtRunner
 from fsmbt.semantics.engines.pytrees_engine import PyTreesLebtRunner
 from fsmbt.semantics.machine import FINAL, FSMMachine
 from support.conv_hfsm_gen import random_hfsm
+from support.corpus import CORPUS
 
 REPO = Path(__file__).resolve().parents[2]
-CORPUS = Path(os.environ.get("FSMBT_CORPUS", REPO.parent / "shared" / "corpus"))
 SEQUENCES = 20
 LENGTH = 20
 GENERATED_FSMS = 200

@@ -32,9 +32,9 @@ from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import FsmbtError, UnsupportedError
 from fsmbt.model.fsm import FSM
 from fsmbt.semantics.machine import FSMMachine
+from support.corpus import CORPUS
 
 REPO = Path(__file__).resolve().parents[2]
-CORPUS = Path(os.environ.get("FSMBT_CORPUS", REPO.parent / "shared" / "corpus"))
 GENERATED = int(os.environ.get("FSMBT_SCXML_BTS", "300"))
 SEQUENCES = int(os.environ.get("FSMBT_SCXML_SEQUENCES", "5"))
 LENGTH = int(os.environ.get("FSMBT_SCXML_LENGTH", "30"))

@@ -27,9 +27,9 @@ from fsmbt.formats import loads, read_model
 from fsmbt.model.errors import FsmbtError
 from fsmbt.model.fsm import FSM
 from fsmbt.semantics.machine import FSMMachine
+from support.corpus import CORPUS
 
 REPO = Path(__file__).resolve().parents[2]
-CORPUS = Path(os.environ.get("FSMBT_CORPUS", REPO.parent / "shared" / "corpus"))
 SEQUENCES = int(os.environ.get("FSMBT_SCXML_READER_SEQUENCES", "20"))
 LENGTH = int(os.environ.get("FSMBT_SCXML_LENGTH", "20"))
 SEED = int(os.environ.get("FSMBT_SCXML_SEED", "11"))

@@ -13,9 +13,7 @@ the same way when the corpus is present.
 
 from __future__ import annotations
 
-import os
 import random
-from pathlib import Path
 
 import pytest
 
@@ -30,6 +28,7 @@ from fsmbt.semantics.leaf_machine import LeafMachine
 from fsmbt.semantics.nodes import all_nodes
 from fsmbt.verify import native
 from support.canonical_checks import lockstep, proved_equivalent, same_verdicts_against_hfsm
+from support.corpus import CORPUS
 
 #: Controls of the class, from the registry (the rule decides, not a list here).
 CONTROLS = tuple(
@@ -218,22 +217,25 @@ def test_trees_outside_the_class_stay_faithful() -> None:
     assert not machine.canonical and not is_canonical_class(machine.tree)
 
 
-CORPUS = Path(os.environ.get("FSMBT_CORPUS", "/work/shared/corpus")) / "bt" / "nav2"
+NAV2_TREES = CORPUS / "bt" / "nav2"
 ISSUE_12 = (
     "navigate_to_pose_w_replanning_goal_patience_and_recovery.xml",
     "navigate_w_routing_global_planning_and_control_w_recovery.xml",
 )
 
 
-@pytest.mark.skipif(not CORPUS.is_dir(), reason="the corpus is not present (FSMBT_CORPUS)")
+@pytest.mark.skipif(not NAV2_TREES.is_dir(), reason="the corpus is not present (FSMBT_CORPUS)")
 @pytest.mark.parametrize("name", ISSUE_12)
 def test_issue_12_trees_take_the_canonical_path_and_agree(name: str) -> None:
     """The two Nav2 trees of issue 12 take the canonical path and agree with the faithful
     machine on random walks (state counts and the full product proof: benchmarks/bench_nav2.py)."""
     from fsmbt import api
 
-    options = {"nodes": ["nav2"], "node_models": [str(CORPUS / "models" / "nav2_tree_nodes.xml")]}
-    doc = api.load(CORPUS / name, options=options).model
+    options = {
+        "nodes": ["nav2"],
+        "node_models": [str(NAV2_TREES / "models" / "nav2_tree_nodes.xml")],
+    }
+    doc = api.load(NAV2_TREES / name, options=options).model
     assert isinstance(doc, BTDocument)
     canon = LeafMachine(doc)
     assert canon.canonical

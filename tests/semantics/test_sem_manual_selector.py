@@ -9,9 +9,6 @@ and the corpus example end to end.
 
 from __future__ import annotations
 
-import os
-from pathlib import Path
-
 import pytest
 
 from fsmbt import api
@@ -28,10 +25,7 @@ from fsmbt.semantics.bt_interpreter import (
     TickDone,
 )
 from fsmbt.verify.nusmv.binary import find_nusmv
-
-CORPUS = Path(
-    os.environ.get("FSMBT_CORPUS", Path(__file__).resolve().parents[2] / ".." / "shared" / "corpus")
-)
+from support.corpus import CORPUS
 
 
 def act(name: str) -> BTNode:

@@ -223,7 +223,9 @@ def parse_document(text: str, ctx: ReadContext) -> tuple[etree._Element, Include
     while stack:
         element, base, chain, main_line = stack.pop()
         line = main_line if main_line is not None else element.sourceline
-        where = SourceLocation(str(base) if base else ctx.display_name, element.sourceline)
+        # the user's own file is named as they gave it; an included one by its resolved path
+        named = ctx.display_name if base is None or base == top_path else str(base)
+        where = SourceLocation(named, element.sourceline)
         replacement, source = _expand_one(element, base, chain, where, ctx, included, line)
         parent = element.getparent()
         assert parent is not None  # the root is never an include (refused above)

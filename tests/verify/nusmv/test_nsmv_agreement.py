@@ -50,9 +50,9 @@ from fsmbt.verify.native import check as native_check
 from fsmbt.verify.nusmv import check
 from fsmbt.verify.nusmv.runner import NuSMVError
 from fsmbt.verify.pairing import machines_for
+from support.corpus import CORPUS
 
 REPO = Path(__file__).resolve().parents[3]
-CORPUS = Path(os.environ.get("FSMBT_CORPUS", REPO.parent / "shared" / "corpus"))
 PAIRS = int(os.environ.get("FSMBT_NUSMV_PAIRS", "300"))
 TIMEOUT_S = 600  # a hang guard, not a speed target: workers share 2 cores with pytest-xdist
 WORKERS = os.cpu_count() or 2
