@@ -3,9 +3,13 @@
 Rules (docs/batch.md, "Resume"):
 
 - A job whose key has a finished, non-retryable row in the store is skipped, except a
-  ``timeout`` or ``limit`` row when this run's limit is larger than the one it hit.
+  ``timeout`` or ``limit`` row when this run's limit is larger than the one it hit, and a row
+  one of whose other files (``JobResult.dependencies``: an included file, a SubTree or node
+  file, an invoked machine) has changed, appeared or gone since (the key hashes the input
+  only: which other files a model needs is known once it is read).
 - Before a job is handed out its output is checked: when it exists, replacing it was not asked
-  for and it is not this batch's own (no ``pending`` claim in the store), the row says
+  for and it is not this batch's own (no ``pending`` claim in the store, and not the file a
+  finished row of this job wrote, unchanged since: ``stats["output_hash"]``), the row says
   ``refused`` (``DestinationExists``) and nothing runs. Otherwise the job is claimed in the
   store and runs allowed to replace its output, which from then on can only be its own work
   (an earlier attempt, a worker that died, a driver that was killed after the write).
@@ -27,7 +31,7 @@ from pathlib import Path
 from typing import Any, Literal
 
 from fsmbt import api
-from fsmbt.batch.jobs import LIMIT_OPTIONS, Job, public_options
+from fsmbt.batch.jobs import LIMIT_OPTIONS, Job, content_hash, public_options
 from fsmbt.batch.result import LIMIT, REFUSED, TIMEOUT, JobResult
 from fsmbt.batch.store import ResultStore
 from fsmbt.model.errors import InputError, SourceLocation
@@ -58,12 +62,21 @@ def needs_run(store: ResultStore | None, job: Job) -> bool:
     if store is None or not store.done(job.key):
         return True
     previous = store.get(job.key)
-    if previous is None:
+    if previous is None or changed_dependency(previous) is not None:
         return True
     hit = {TIMEOUT: "timeout_s", LIMIT: "max_states"}.get(previous.status)
     if hit is None:
         return False
     return _limit_value(job.options, hit) > _limit_value(previous.options, hit)
+
+
+def changed_dependency(previous: JobResult) -> str | None:
+    """The first of a stored row's other files whose content is not what the row was made
+    from (see the module text), or ``None``: one hash per dependency, in the recorded order."""
+    for path, digest in previous.dependencies.items():
+        if content_hash(path) != digest:
+            return path
+    return None
 
 
 def refused_destination(job: Job) -> JobResult:
@@ -104,12 +117,24 @@ def remove_stale_temporaries(output: Path) -> int:
     return removed
 
 
+def _own_output(store: ResultStore, job: Job) -> bool:
+    """Whether the file at ``job.output`` is, byte for byte, what this batch wrote there for
+    this job (a finished row re-run after a larger limit or a changed dependency replaces its
+    own output; a file someone changed since is theirs)."""
+    previous = store.get(job.key)
+    if previous is None or previous.output is None or job.output is None:
+        return False
+    if Path(previous.output) != Path(job.output):
+        return False
+    return previous.stats.get("output_hash") == content_hash(job.output)
+
+
 def _prepare(store: ResultStore | None, job: Job) -> Job | JobResult:
     """The job as it runs (allowed to replace its own output), or the refusal row."""
     if job.output is None or job.overwrite:
         return job
     output = Path(job.output)
-    ours = store is not None and store.pending_output(job.key)
+    ours = store is not None and (store.pending_output(job.key) or _own_output(store, job))
     if ours:
         remove_stale_temporaries(output)
     if output.exists() and not ours:

@@ -113,7 +113,9 @@ def public_options(options: dict[str, Any]) -> dict[str, Any]:
 def content_hash(path: str | Path) -> str:
     """SHA-256 of a file's first ``max_input_bytes`` + 1 bytes and its size, in hex.
 
-    A path that is not a regular file (missing, a folder, a FIFO, a device) is never opened:
+    A folder's hash is of its sorted listing (names only: a reader that scanned it for files
+    depends on which files are there; their contents, when read, are dependencies of their
+    own). Another path that is not a regular file (missing, a FIFO, a device) is never opened:
     its hash is of its name and what it is, so the worker's row reports the problem.
     """
     digest = hashlib.sha256()
@@ -121,6 +123,13 @@ def content_hash(path: str | Path) -> str:
         info = os.stat(path)
     except OSError as exc:
         digest.update(f"missing:{path}:{exc.errno}".encode())
+        return digest.hexdigest()
+    if stat.S_ISDIR(info.st_mode):  # a folder a reader scanned: its listing is its content
+        try:
+            names = sorted(os.listdir(path))
+        except OSError as exc:
+            names = [f"unlistable:{exc.errno}"]
+        digest.update(f"folder:{path}:".encode() + "\0".join(names).encode(errors="replace"))
         return digest.hexdigest()
     if not stat.S_ISREG(info.st_mode):
         digest.update(f"special:{path}:{stat.S_IFMT(info.st_mode)}".encode())

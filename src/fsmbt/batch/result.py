@@ -60,6 +60,9 @@ class JobResult:
         attempts: how many times a worker started this job (more than one after a death).
         retry: a resumed batch runs this row again (see the module text).
         finished_at: seconds since the epoch when the row was stored.
+        dependencies: the other files the model was made of (includes, SubTree and node
+            files, invoked machines; missing ones too) -> their ``content_hash`` when the job
+            ran; a resumed batch runs the row again when one of them changed.
     """
 
     key: str
@@ -78,6 +81,7 @@ class JobResult:
     attempts: int = 1
     retry: bool = False
     finished_at: float = 0.0
+    dependencies: dict[str, str] = field(default_factory=dict)
 
     @property
     def seconds(self) -> float:

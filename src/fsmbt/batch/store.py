@@ -28,7 +28,8 @@ from typing import Any
 from fsmbt.batch.jobs import Job, public_options
 from fsmbt.batch.result import STATUSES, JobResult
 
-SCHEMA_VERSION = 1
+#: 2: the ``dependencies`` column (a store of version 1 gets it, empty, when opened).
+SCHEMA_VERSION = 2
 #: The store's file name in the output folder.
 STORE_NAME = "fsmbt-batch.sqlite"
 
@@ -49,8 +50,9 @@ _COLUMNS = (
     "attempts",
     "retry",
     "finished_at",
+    "dependencies",
 )
-_JSON_COLUMNS = ("properties", "timings", "stats", "options")
+_JSON_COLUMNS = ("properties", "timings", "stats", "options", "dependencies")
 
 _CREATE = """
 CREATE TABLE IF NOT EXISTS results (
@@ -70,7 +72,8 @@ CREATE TABLE IF NOT EXISTS results (
     options TEXT,
     attempts INTEGER,
     retry INTEGER,
-    finished_at REAL
+    finished_at REAL,
+    dependencies TEXT
 );
 CREATE TABLE IF NOT EXISTS meta (name TEXT PRIMARY KEY, value TEXT);
 """
@@ -94,8 +97,11 @@ class ResultStore:
         self._db.execute("PRAGMA journal_mode=WAL")
         self._db.execute("PRAGMA synchronous=NORMAL")  # durable across a process crash
         self._db.executescript(_CREATE)
+        columns = {row[1] for row in self._db.execute("PRAGMA table_info(results)")}
+        if "dependencies" not in columns:  # a version 1 store: its rows have no dependencies
+            self._db.execute("ALTER TABLE results ADD COLUMN dependencies TEXT")
         self._db.execute(
-            "INSERT OR IGNORE INTO meta VALUES ('schema_version', ?)", (str(SCHEMA_VERSION),)
+            "INSERT OR REPLACE INTO meta VALUES ('schema_version', ?)", (str(SCHEMA_VERSION),)
         )
 
     # -- writing (the driver only) --------------------------------------------------------

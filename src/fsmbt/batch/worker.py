@@ -39,7 +39,7 @@ from types import FrameType
 from typing import Any
 
 from fsmbt import api
-from fsmbt.batch.jobs import Job, public_options
+from fsmbt.batch.jobs import Job, content_hash, public_options
 from fsmbt.batch.ratelimit import MinuteRateLimit, RateLimitedClient
 from fsmbt.batch.result import (
     BAD_INPUT,
@@ -54,6 +54,7 @@ from fsmbt.batch.result import (
     JobResult,
 )
 from fsmbt.model.errors import InputError, LimitError, UnsupportedError
+from fsmbt.model.files import recording_reads
 from fsmbt.model.fsm import FSM
 from fsmbt.model.stats import model_stats
 from fsmbt.verify.native import DEFAULT_MAX_STATES
@@ -210,6 +211,16 @@ def warm_up() -> None:
         pass
 
 
+def _dependencies(job: Job, reads: list[Path]) -> dict[str, str]:
+    """The files other than the input that the job asked for -> their content hash now
+    (``JobResult.dependencies``; the output is written, never read, so it is not one)."""
+    try:
+        own = Path(job.input).resolve()
+    except (OSError, RuntimeError):
+        own = Path(job.input).absolute()
+    return {str(path): content_hash(path) for path in reads if path != own}
+
+
 def run_job(job: Job) -> JobResult:
     """Convert and verify one input; every problem becomes the row's status.
 
@@ -231,8 +242,11 @@ def run_job(job: Job) -> JobResult:
     )
     options = {k: v for k, v in job.options.items()}
     try:
-        with time_limit(job.options.get("timeout_s")):
-            outcome = _pipeline(job, options, timings)
+        with time_limit(job.options.get("timeout_s")), recording_reads() as reads:
+            try:
+                outcome = _pipeline(job, options, timings)
+            finally:
+                result.dependencies = _dependencies(job, reads)
             stats: dict[str, Any] = {
                 "conversion": outcome.conversion.stats,
                 "direction": outcome.conversion.direction,
@@ -265,4 +279,6 @@ def run_job(job: Job) -> JobResult:
         result.properties = outcome.report.verdicts()
     if outcome.written and outcome.output is not None:
         result.output = str(Path(outcome.output))
+        # what the batch wrote: a re-run may replace this file only while it is still this
+        result.stats["output_hash"] = content_hash(result.output)
     return result

@@ -55,8 +55,9 @@ from fsmbt.formats._pysm_analyze import (
     analyze,
 )
 from fsmbt.formats._pysm_source import parse_source
-from fsmbt.formats.registry import ReadContext, decode, read_bounded
+from fsmbt.formats.registry import ReadContext, decode
 from fsmbt.model.errors import InputError, SourceLocation, UnsupportedError
+from fsmbt.model.files import note_read, read_bounded
 from fsmbt.model.flatten import flatten
 from fsmbt.model.fsm import FSM, State
 
@@ -187,18 +188,21 @@ class Builder:
             )
         folder = here.path.parent
         module_file = folder / f"{ref.module.rsplit('.', 1)[-1]}.py" if ref.module else None
+        if module_file is not None:
+            note_read(module_file)  # a dependency even when it is missing
         candidates = [module_file] if module_file is not None and module_file.is_file() else []
         if not candidates:
             marker = f"class {ref.cls}("
+            note_read(folder)  # the class may be defined in a file added later
             for path in sorted(folder.glob("*.py")):
                 try:
                     if (
                         path.stat().st_size <= limits.current().max_input_bytes
-                        and marker in path.read_text(encoding="utf-8", errors="replace")
+                        and marker in read_bounded(path).decode("utf-8", errors="replace")
                     ):
                         candidates.append(path)
                         break
-                except OSError:
+                except (OSError, InputError):  # unreadable, or not a regular file: not it
                     continue
         if not candidates:
             expected = module_file or folder / "<module>.py"

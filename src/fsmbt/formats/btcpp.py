@@ -27,12 +27,13 @@ from lxml import etree
 
 from fsmbt import limits
 from fsmbt.formats import btcpp_trees
-from fsmbt.formats.registry import Format, ReadContext, decode, read_bounded, register
+from fsmbt.formats.registry import Format, ReadContext, decode, register
 from fsmbt.formats.xml_safe import parse_xml, root_tag
 from fsmbt.model import Model
 from fsmbt.model.bt import BehaviorTree, BTDocument, BTNode, NodeModel, PortModel
 from fsmbt.model.bt_nodes import NodeKind, builtin_spec, canonical_type
 from fsmbt.model.errors import InputError, SourceLocation, UnsupportedError
+from fsmbt.model.files import note_read, read_bounded
 from fsmbt.model.nodes.library import apply_library, build_library
 
 #: Tags of Groot's explicit style and of ``<TreeNodesModel>`` entries, with the kind they declare.
@@ -165,6 +166,7 @@ class _Loader:
         if resolved in self.loaded:
             return  # included twice (diamond): BehaviorTree.CPP registers it once
         self.loaded.add(resolved)
+        note_read(resolved)  # a dependency even when it is missing
         try:
             if not resolved.is_file():  # a FIFO or a device could block or never end
                 raise InputError(

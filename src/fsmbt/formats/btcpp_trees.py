@@ -30,9 +30,10 @@ from pathlib import Path
 from lxml import etree
 
 from fsmbt import limits
-from fsmbt.formats.registry import decode, read_bounded
+from fsmbt.formats.registry import decode
 from fsmbt.formats.xml_safe import parse_xml
 from fsmbt.model.errors import InputError, SourceLocation
+from fsmbt.model.files import note_read, read_bounded
 
 #: The option a caller names extra tree files with (``--trees``).
 TREES_OPTION = "trees"
@@ -96,6 +97,7 @@ def _xml_files(folder: Path, what: str) -> list[Path]:
     """
     cap = limits.current().max_tree_files
     top = folder.resolve()
+    note_read(folder)  # a file added to the folder later may define a tree that is missing now
     found: list[Path] = []
     for entry in sorted(folder.iterdir()):
         if entry.suffix.lower() != ".xml":
@@ -141,6 +143,7 @@ def index_option(option: object) -> TreeIndex:
         elif given.exists():
             paths = [given.resolve()]
         else:
+            note_read(given)
             raise InputError(
                 f"{TREES_FLAG}: no such file or folder", location=SourceLocation(str(given))
             )

@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING
 
 from fsmbt import limits
 from fsmbt.model.errors import Hint, InputError, SourceLocation
+from fsmbt.model.files import read_bounded
 
 if TYPE_CHECKING:
     from fsmbt.model import Model
@@ -332,30 +333,6 @@ def check_model_size(model: Model, location: SourceLocation) -> None:
                 location=location,
             )
         nodes.extend(node.children)
-
-
-def read_bounded(path: Path) -> bytes:
-    """A regular file's bytes, refused past ``max_input_bytes`` (checked before and while
-    reading: the file may grow after ``stat``). Raises ``InputError`` (located) or ``OSError``."""
-    limit = limits.current().max_input_bytes
-    location = SourceLocation(str(path))
-    size = path.stat().st_size
-    if size > limit:
-        raise InputError(
-            limits.exceeded(f"the file's {size} bytes", "max_input_bytes", limit), location=location
-        )
-    if path.is_dir():
-        raise InputError("is a directory, not a model file", location=location)
-    if not path.is_file():  # a FIFO or a device (/dev/zero) could block or never end
-        raise InputError("is not a regular file", location=location)
-    with path.open("rb") as stream:
-        data = stream.read(limit + 1)
-    if len(data) > limit:
-        raise InputError(
-            limits.exceeded(f"the file's {len(data)}+ bytes", "max_input_bytes", limit),
-            location=location,
-        )
-    return data
 
 
 def read_text(path: str | Path) -> str:

@@ -39,9 +39,10 @@ from pathlib import Path
 from lxml import etree
 
 from fsmbt import limits
-from fsmbt.formats.registry import ReadContext, decode, read_bounded
+from fsmbt.formats.registry import ReadContext, decode
 from fsmbt.formats.xml_safe import local_name, namespace, parse_xml
 from fsmbt.model.errors import InputError, SourceLocation, UnsupportedError
+from fsmbt.model.files import note_read, read_bounded
 
 XINCLUDE_NS = "http://www.w3.org/2001/XInclude"
 _INCLUDE = f"{{{XINCLUDE_NS}}}include"
@@ -156,6 +157,7 @@ def read_confined(path: Path, href: str, what: str, where: SourceLocation, eleme
     Raises:
         InputError: not a regular file, too large, unreadable, undecodable.
     """
+    note_read(path)  # a dependency even when it is missing
     try:
         if not path.is_file():  # a FIFO or a device could block or never end
             raise InputError(

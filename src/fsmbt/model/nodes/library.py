@@ -35,6 +35,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from fsmbt.model.errors import InputError, SourceLocation
+from fsmbt.model.files import read_bounded
 from fsmbt.model.kinds import NodeKind
 from fsmbt.model.nodes.registry import ABSTRACTIONS, PROFILES, all_nodes, node_semantics
 
@@ -123,7 +124,7 @@ def _read_file(path: Path, library: NodeLibrary) -> list[str]:
     """Read one node file into ``library``; returns the profiles it asks for."""
     where = SourceLocation(str(path))
     try:
-        text = path.read_text(encoding="utf-8")
+        text = read_bounded(path).decode("utf-8")
     except (OSError, UnicodeDecodeError) as exc:
         raise InputError(f"cannot read node file: {exc}", location=where) from None
     try:
