@@ -87,3 +87,71 @@ def test_count_variables() -> None:
         "ASSIGN init(a) := TRUE;\n"
     )
     assert count_variables(text) == 3
+
+
+# A model NuSMV needs minutes for: the reachable states of a 2**20 counter, one per iteration.
+_ENDLESS = """MODULE main
+VAR x : 0..1048575;
+ASSIGN init(x) := 0; next(x) := (x + 1) mod 1048576;
+SPEC AG (x != 1048575 -> EX TRUE)
+"""
+_PARENT = """
+import sys
+from fsmbt.verify.nusmv.runner import run_nusmv
+run_nusmv(sys.stdin.read(), 1, timeout=600)
+"""
+
+
+def _children(pid: int) -> list[int]:
+    found = []
+    for stat_file in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat_file.read_text().rsplit(")", 1)[1].split()
+        except (OSError, IndexError):
+            continue
+        if int(fields[1]) == pid:
+            found.append(int(stat_file.parent.name))
+    return found
+
+
+@pytest.mark.skipif(not Path("/proc").is_dir(), reason="needs Linux /proc")
+def test_nusmv_dies_with_the_process_that_started_it(nusmv_binary, monkeypatch) -> None:
+    """A run killed with SIGKILL (a batch worker, a CLI run) leaves no NuSMV behind."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    monkeypatch.setenv("FSMBT_NUSMV", str(nusmv_binary))
+    parent = subprocess.Popen([sys.executable, "-c", _PARENT], stdin=subprocess.PIPE, text=True)
+    assert parent.stdin is not None
+    parent.stdin.write(_ENDLESS)
+    parent.stdin.close()
+    deadline = time.monotonic() + 60
+    children: list[int] = []
+    while not children and time.monotonic() < deadline:
+        time.sleep(0.1)
+        children = _children(parent.pid)
+    assert children, "NuSMV did not start"
+    (nusmv,) = children
+    assert "NuSMV" in Path(f"/proc/{nusmv}/cmdline").read_text(errors="replace")
+    os.kill(parent.pid, signal.SIGKILL)
+    parent.wait()
+    deadline = time.monotonic() + 10
+    while Path(f"/proc/{nusmv}").exists() and time.monotonic() < deadline:
+        state = Path(f"/proc/{nusmv}/stat").read_text(errors="replace").rsplit(")", 1)[-1].split()
+        if state and state[0] == "Z":  # dead, waiting for init to reap it
+            break
+        time.sleep(0.1)
+    alive = (
+        Path(f"/proc/{nusmv}").exists()
+        and "Z"
+        not in Path(f"/proc/{nusmv}/stat")
+        .read_text(errors="replace")
+        .rsplit(")", 1)[-1]
+        .split()[:1]
+    )
+    if alive:
+        os.kill(nusmv, signal.SIGKILL)
+    assert not alive, "NuSMV outlived the process that started it"
