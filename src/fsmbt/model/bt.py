@@ -14,7 +14,7 @@ from fsmbt.model.bt_nodes import NodeKind, builtin_spec
 from fsmbt.model.errors import SourceLocation
 
 
-@dataclass(eq=False, repr=False)
+@dataclass(eq=False, repr=False, slots=True)
 class BTNode:
     """One node. ``type`` is the v4 registration ID (``Sequence``, ``Inverter``, ``MoveTo``...).
 
