@@ -60,7 +60,8 @@ class LebtStructure:
         start: The start pseudo-state's name.
         names: Every state of the FSM in declaration order (reachable or not); index = position.
         entry_id: The entry state's index.
-        reachable_ids: The reachable states' indices, ascending (declaration order).
+        reachable_ids: The reachable states' indices, ascending (declaration order); a
+            ``range`` when every state is reachable (no integer object per state).
         root_ids: The entry state, then the loop states, in declaration order.
         loop_ids: The loop states (in-degree >= 2), in declaration order.
         kept_sources: The source of every transition that can fire (out of a reachable,
@@ -82,7 +83,7 @@ class LebtStructure:
     start: str
     names: list[str]
     entry_id: int
-    reachable_ids: list[int]
+    reachable_ids: Sequence[int]
     root_ids: list[int]
     loop_ids: list[int]
     kept_sources: Sequence[int]
@@ -330,8 +331,9 @@ def analyse(fsm: FSM) -> LebtStructure:
     entry = index[fsm.initial]
     del index
     seen = _reached(entry, count, sources, targets)
+    reachable: Sequence[int]
     if seen.count(0) == 0:
-        reachable = list(range(count))
+        reachable = range(count)
         unreachable: list[str] = []
     else:
         reachable = [i for i in range(count) if seen[i]]
