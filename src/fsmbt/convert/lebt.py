@@ -260,6 +260,8 @@ def _build(fsm: FSM, structure: LebtStructure) -> tuple[BTNode, int, int]:
     selectors: list[BTNode | None] = [None] * len(names)
     bodies: list[list[BTNode] | None] = [None] * len(names)  # each body Sequence's children
     nodes = 1
+    # a body's list is made at its final length - the leaf, then one slot per child selector,
+    # filled in pass 2 - so no list grows (and none is over-allocated)
     for i in structure.reachable_ids:
         if not placed[i]:
             continue  # reached only through a transition that never fires: no predecessor
@@ -282,16 +284,23 @@ def _build(fsm: FSM, structure: LebtStructure) -> tuple[BTNode, int, int]:
         )
         below = child_counts[i]
         if below:
-            shape = "_chain" if below == 1 else "_branch"
-            body = BTNode(SEQUENCE, control, name + shape, {}, [leaf])
+            if below == 1:
+                body = BTNode(SEQUENCE, control, name + "_chain", {}, [leaf, None])  # type: ignore[list-item]
+            else:
+                body = BTNode(SEQUENCE, control, name + "_branch", {}, [leaf, *[None] * below])  # type: ignore[list-item]
             bodies[i] = body.children
             selectors[i] = BTNode(FALLBACK, control, name + "_selector", {}, [guard, body])
             nodes += 4
         else:
             selectors[i] = BTNode(FALLBACK, control, name + "_selector", {}, [guard, leaf])
             nodes += 3
+    previous, slot = -1, 0
     for parent, child in zip(structure.child_sources, structure.child_targets):  # pass 2
-        bodies[parent].append(selectors[child])  # type: ignore[union-attr,arg-type]
+        if parent != previous:
+            previous, slot = parent, 1  # the links of one parent are consecutive
+        else:
+            slot += 1
+        bodies[parent][slot] = selectors[child]  # type: ignore[index,assignment]
     root = BTNode(
         type="Sequence",
         kind=control,
