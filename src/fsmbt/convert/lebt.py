@@ -268,9 +268,9 @@ def _build(fsm: FSM, structure: LebtStructure) -> tuple[BTNode, int, int]:
         name = names[i]
         state = states[i]
         # positional (type, kind, name, attrs, children): see NODE_FIELDS
-        guard = BTNode(
-            GUARD_TYPE, condition, f"Enter_{name}", {"target": name, "pairs": _joined(pair_texts[i])}
-        )
+        pairs = _joined(pair_texts[i])
+        pair_texts[i] = None  # released here, while hot, not by a random-order sweep at the end
+        guard = BTNode(GUARD_TYPE, condition, f"Enter_{name}", {"target": name, "pairs": pairs})
         leaf = BTNode(
             STATE_TYPE,
             action,
