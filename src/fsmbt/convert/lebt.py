@@ -23,13 +23,14 @@ Fallbacks succeed), so it is not macro-step equivalent under the LEBT protocol a
 
 How it is built (``_build``; the tree is the one the steps above define): the nodes of each
 state are made in declaration order - the order the FSM's objects lie in memory - and the
-selectors are then hung below their predecessor's body by index; guard texts are made in source
-order and dealt out to their targets; escaping is skipped when one scan finds nothing to
-escape; nodes are constructed with positional fields (docs/conversion.md, 'Benchmark' and
-'Cost of FSM -> BT').
+selectors are then hung below their predecessor's body, walking the structure's flat link
+arrays; a body's child list is made at its final length; guard texts are made in source order
+and dealt out to their targets, exit texts in source order; escaping is skipped when one scan
+finds nothing to escape; nodes are constructed with positional fields (docs/conversion.md,
+'Benchmark' and 'Cost of FSM -> BT').
 
 Complexity: O(S + T) time and memory for S states and T transitions (after flattening); about
-1.5 KB and 7 collector-tracked objects per state in the result.
+1.3 KB and 7 collector-tracked objects per state in the result.
 """
 
 from __future__ import annotations

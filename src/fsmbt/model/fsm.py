@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 from fsmbt.model.errors import SourceLocation
 
 
-@dataclass
+@dataclass(slots=True)
 class State:
     """One state of an FSM, possibly composite (one region) or parallel (several).
 
@@ -58,7 +58,7 @@ class State:
         return not self.regions
 
 
-@dataclass
+@dataclass(slots=True)
 class Transition:
     """``source --event--> target``; ``event=None`` is a completion (eventless) transition.
 
