@@ -11,6 +11,9 @@ transition whose ``event`` is ``None`` is a completion transition: from a compos
 when the sub-FSM reaches a final state (``exit`` names which one; ``None`` = any); from an atomic
 state it fires as soon as the state is entered. ``fsmbt.model.flatten`` gives the plain FSM every
 check works on.
+
+``State`` and ``Transition`` are slotted dataclasses (one allocation each, fields read without a
+dictionary: a converter reads every one of them); they have their fields and no others.
 """
 
 from __future__ import annotations
