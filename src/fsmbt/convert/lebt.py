@@ -36,7 +36,7 @@ Complexity: O(S + T) time and memory for S states and T transitions (after flatt
 from __future__ import annotations
 
 from array import array
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Sequence
 
 from fsmbt.convert.perf import without_gc_pauses
 from fsmbt.convert.result import ConversionResult
@@ -186,7 +186,9 @@ def _escaped_texts(structure: LebtStructure) -> tuple[list[str], Callable[[str],
     return [escape(name) for name in sources], esc_event
 
 
-def _gathered(count: int, keys: Iterable[int], texts: Iterable[str]) -> list[str | list[str] | None]:
+def _gathered(
+    count: int, keys: Iterable[int], texts: Iterable[str]
+) -> list[str | list[str] | None]:
     """Per index, the texts given for it in order: one text alone (most states have one),
     several in a list, None for none."""
     gathered: list[str | list[str] | None] = [None] * count
@@ -207,21 +209,22 @@ def _joined(texts: str | list[str] | None) -> str:
 
 
 def _guard_pair_texts(
-    structure: LebtStructure, esc_names: list[str], esc_event: Callable[[str], str]
+    structure: LebtStructure,
+    esc_names: list[str],
+    esc_event: Callable[[str], str],
+    esc_events: Sequence[str],
 ) -> list[str | list[str] | None]:
     """Per state, its guard's ``source/event`` texts (escaped; see ``_gathered``), made in
     source order - where the source's name and its events are at hand - and dealt out to the
     targets: the start pair first for the entry state, then by source in declaration order
-    and by the source's transitions (``LebtStructure.guard_ids``'s order)."""
+    and by the source's transitions (``LebtStructure.guard_ids``'s order). ``esc_events``:
+    ``kept_events`` escaped."""
     texts: list[str | list[str] | None] = [None] * len(structure.names)
     texts[structure.entry_id] = (
         f"{esc_names[structure.start_id]}/{esc_event(structure.initial_event)}"
     )
-    events = structure.kept_events
-    if esc_event is not str:
-        events = [esc_event(event) for event in events]
     previous, prefix = -1, ""
-    for source, target, event in zip(structure.kept_sources, structure.kept_targets, events):
+    for source, target, event in zip(structure.kept_sources, structure.kept_targets, esc_events):
         if source != previous:
             previous, prefix = source, esc_names[source] + "/"
         known = texts[target]
@@ -252,10 +255,10 @@ def _build(fsm: FSM, structure: LebtStructure) -> tuple[BTNode, int, int]:
     esc_names, esc_event = _escaped_texts(structure)
     child_counts = structure.child_counts
     placed = structure.placed
-    pair_texts = _guard_pair_texts(structure, esc_names, esc_event)
     events = structure.kept_events
     if esc_event is not str:
         events = [esc_event(event) for event in events]
+    pair_texts = _guard_pair_texts(structure, esc_names, esc_event, events)
     exit_texts = _gathered(len(names), structure.kept_sources, events)
     control, condition, action = NodeKind.CONTROL, NodeKind.CONDITION, NodeKind.ACTION
     selectors: list[BTNode | None] = [None] * len(names)
