@@ -1,7 +1,8 @@
 """The linear-time FSM -> BT path (issue 19): the index-based analysis gives what the
 definitions of docs/conversion.md ('FSM -> BT: the loop-execution BT') give, written here
 plainly on names; a 2 000-state generated machine's LEBT is proven equivalent by the native
-checker; the collector promotion of ``convert/perf.py`` loses nothing."""
+checker; the collector promotion of ``convert/perf.py`` loses nothing; the flat edge arrays
+give the same LEBT however the transitions of the sources are interleaved in the file."""
 
 from __future__ import annotations
 
@@ -15,6 +16,7 @@ from fsmbt.convert.compress import tree_depth
 from fsmbt.convert.perf import gc_paused
 from fsmbt.convert.structure import analyse
 from fsmbt.generate import random_fsm
+from fsmbt.model.bt import BTNode
 from fsmbt.model.fsm import FSM, State
 from fsmbt.semantics.lebt.spec import DEFAULT_START, GUARD_TYPE, NO_EVENT, GuardSpec
 
@@ -188,3 +190,32 @@ def test_the_builders_positional_node_fields_are_btnodes_field_order() -> None:
     from fsmbt.model.bt import BTNode
 
     assert tuple(f.name for f in fields(BTNode))[: len(NODE_FIELDS)] == NODE_FIELDS
+
+
+def _sources_listed_backwards(fsm: FSM) -> FSM:
+    """The same machine with its transitions listed by source in reverse declaration order,
+    each source's own transitions kept in their order (so the LEBT must not change): the
+    analysis cannot take them as they come and sorts them by source."""
+    order = {name: position for position, name in enumerate(fsm.states)}
+    listed = FSM(name=fsm.name, start_name=fsm.start_name, initial_event=fsm.initial_event)
+    for state in fsm.states.values():
+        listed.add_state(state)
+    listed.initial = fsm.initial
+    listed.transitions = sorted(fsm.transitions, key=lambda t: -order[t.source])  # stable
+    return listed
+
+
+@pytest.mark.parametrize("seed", range(40))
+def test_the_lebt_does_not_depend_on_how_the_sources_transitions_are_interleaved(
+    seed: int,
+) -> None:
+    fsm = _awkward(seed) if seed % 2 else random_fsm(seed, max_states=60)
+    grouped = convert_model(fsm, hierarchy="flatten")
+    backwards = convert_model(_sources_listed_backwards(fsm), hierarchy="flatten")
+    assert backwards.model.main.root == grouped.model.main.root
+    assert backwards.stats == grouped.stats
+    structure = analyse(_sources_listed_backwards(fsm))
+    assert list(structure.kept_sources) == sorted(structure.kept_sources)
+    nodes = list(grouped.model.main.root.walk())
+    assert all(isinstance(child, BTNode) for node in nodes for child in node.children)
+    assert grouped.stats["nodes"] == len(nodes)

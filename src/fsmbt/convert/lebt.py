@@ -23,18 +23,20 @@ Fallbacks succeed), so it is not macro-step equivalent under the LEBT protocol a
 
 How it is built (``_build``; the tree is the one the steps above define): the nodes of each
 state are made in declaration order - the order the FSM's objects lie in memory - and the
-selectors are then hung below their predecessor's body by index; guard texts are made in source
-order and dealt out to their targets; escaping is skipped when one scan finds nothing to
-escape; nodes are constructed with positional fields (docs/conversion.md, 'Benchmark' and
-'Cost of FSM -> BT').
+selectors are then hung below their predecessor's body, walking the structure's flat link
+arrays; a body's child list is made at its final length; guard texts are made in source order
+and dealt out to their targets, exit texts in source order; escaping is skipped when one scan
+finds nothing to escape; nodes are constructed with positional fields (docs/conversion.md,
+'Benchmark' and 'Cost of FSM -> BT').
 
 Complexity: O(S + T) time and memory for S states and T transitions (after flattening); about
-1.5 KB and 7 collector-tracked objects per state in the result.
+1.3 KB and 7 collector-tracked objects per state in the result.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable
+from array import array
+from collections.abc import Callable, Iterable, Sequence
 
 from fsmbt.convert.perf import without_gc_pauses
 from fsmbt.convert.result import ConversionResult
@@ -167,9 +169,10 @@ def _escaped_texts(structure: LebtStructure) -> tuple[list[str], Callable[[str],
     the event escaper: the identity when no name and no event needs escaping (the usual case,
     found by one scan), else ``escape`` once per distinct event."""
     sources = [*structure.names, structure.start]
-    events = (event for i in structure.reachable_ids for event in structure.exit_events[i])
     if not (
-        _needs_escape(sources) or _needs_escape(events) or _needs_escape([structure.initial_event])
+        _needs_escape(sources)
+        or _needs_escape(structure.kept_events)
+        or _needs_escape([structure.initial_event])
     ):
         return sources, str
     known: dict[str, str] = {}
@@ -183,35 +186,54 @@ def _escaped_texts(structure: LebtStructure) -> tuple[list[str], Callable[[str],
     return [escape(name) for name in sources], esc_event
 
 
-def _guard_pair_texts(
-    structure: LebtStructure, esc_names: list[str], esc_event: Callable[[str], str]
+def _gathered(
+    count: int, keys: Iterable[int], texts: Iterable[str]
 ) -> list[str | list[str] | None]:
-    """Per state, its guard's ``source/event`` texts (escaped; one text alone, not in a list,
-    since most states have one entering pair), made in source order - where
-    the source's name and its events are at hand - and dealt out to the targets: the start
-    pair first for the entry state, then by source in declaration order and by the source's
-    transitions (``LebtStructure.guard_ids``'s order)."""
+    """Per index, the texts given for it in order: one text alone (most states have one),
+    several in a list, None for none."""
+    gathered: list[str | list[str] | None] = [None] * count
+    for key, text in zip(keys, texts):
+        known = gathered[key]
+        if known is None:
+            gathered[key] = text
+        elif type(known) is str:
+            gathered[key] = [known, text]
+        else:
+            known.append(text)  # type: ignore[union-attr]
+    return gathered
+
+
+def _joined(texts: str | list[str] | None) -> str:
+    """``;``-joined ``_gathered`` texts ("" for none)."""
+    return texts if type(texts) is str else ";".join(texts or ())  # type: ignore[arg-type]
+
+
+def _guard_pair_texts(
+    structure: LebtStructure,
+    esc_names: list[str],
+    esc_event: Callable[[str], str],
+    esc_events: Sequence[str],
+) -> list[str | list[str] | None]:
+    """Per state, its guard's ``source/event`` texts (escaped; see ``_gathered``), made in
+    source order - where the source's name and its events are at hand - and dealt out to the
+    targets: the start pair first for the entry state, then by source in declaration order
+    and by the source's transitions (``LebtStructure.guard_ids``'s order). ``esc_events``:
+    ``kept_events`` escaped."""
     texts: list[str | list[str] | None] = [None] * len(structure.names)
     texts[structure.entry_id] = (
         f"{esc_names[structure.start_id]}/{esc_event(structure.initial_event)}"
     )
-    kept_targets = structure.kept_targets
-    exit_events = structure.exit_events
-    plain = esc_event is str
-    for source in structure.reachable_ids:
-        targets = kept_targets[source]
-        if not targets:
-            continue
-        prefix = esc_names[source] + "/"
-        events = exit_events[source] if plain else [esc_event(e) for e in exit_events[source]]
-        for target, event in zip(targets, events):
-            known = texts[target]
-            if known is None:
-                texts[target] = prefix + event
-            elif type(known) is str:
-                texts[target] = [known, prefix + event]
-            else:
-                known.append(prefix + event)  # type: ignore[union-attr]
+    previous, prefix = -1, ""
+    for source, target, event in zip(structure.kept_sources, structure.kept_targets, esc_events):
+        if source != previous:
+            previous, prefix = source, esc_names[source] + "/"
+        known = texts[target]
+        if known is None:
+            texts[target] = prefix + event
+        elif type(known) is str:
+            texts[target] = [known, prefix + event]
+        else:
+            known.append(prefix + event)  # type: ignore[union-attr]
     return texts
 
 
@@ -220,42 +242,38 @@ def _build(fsm: FSM, structure: LebtStructure) -> tuple[BTNode, int, int]:
 
     Built in two passes over the states in declaration order - the order their objects lie in
     memory - rather than in tree order (a random order for a random machine): pass 1 makes each
-    placed state's guard, state leaf, selector and body; pass 2 hangs each body's child
-    selectors below it (a list look-up by index). The tree is the same as the tree-order
-    construction of docs/conversion.md step 5. A selector on level ``L`` holds its guard and
-    body on ``L + 1``; a body Sequence holds the state leaf and the child selectors on
-    ``L + 2``: the depth is found by a walk over the integer child lists. O(S + T).
+    placed state's guard, state leaf, selector and body; pass 2 hangs each link's child
+    selector below its predecessor's body (flat lists, by index). The tree is the same as the
+    tree-order construction of docs/conversion.md step 5. A selector on level ``L`` holds its
+    guard and body on ``L + 1``; a body Sequence holds the state leaf and the child selectors
+    on ``L + 2``: the depth is found by a walk over the links. O(S + T).
     """
     names = structure.names
     states = list(fsm.states.values())
     if len(states) != len(names):
         raise ValueError("the structure was not analysed from this FSM")
     esc_names, esc_event = _escaped_texts(structure)
-    child_ids = structure.child_ids
-    exit_events = structure.exit_events
-    pair_texts = _guard_pair_texts(structure, esc_names, esc_event)
+    child_counts = structure.child_counts
+    placed = structure.placed
+    events = structure.kept_events
+    if esc_event is not str:
+        events = [esc_event(event) for event in events]
+    pair_texts = _guard_pair_texts(structure, esc_names, esc_event, events)
+    exit_texts = _gathered(len(names), structure.kept_sources, events)
     control, condition, action = NodeKind.CONTROL, NodeKind.CONDITION, NodeKind.ACTION
     selectors: list[BTNode | None] = [None] * len(names)
+    bodies: list[list[BTNode] | None] = [None] * len(names)  # each body Sequence's children
     nodes = 1
-    placed = bytearray(len(names))
-    for root_id in structure.root_ids:
-        placed[root_id] = 1
-    for below in child_ids:
-        for child in below:
-            placed[child] = 1
-    plain = esc_event is str
+    # a body's list is made at its final length - the leaf, then one slot per child selector,
+    # filled in pass 2 - so no list grows (and none is over-allocated)
     for i in structure.reachable_ids:
         if not placed[i]:
             continue  # reached only through a transition that never fires: no predecessor
         name = names[i]
         state = states[i]
-        texts = pair_texts[i]
-        pairs = texts if type(texts) is str else ";".join(texts or ())  # type: ignore[arg-type]
-        if plain:
-            exits = ";".join(exit_events[i])
-        else:
-            exits = ";".join([esc_event(event) for event in exit_events[i]])
         # positional (type, kind, name, attrs, children): see NODE_FIELDS
+        pairs = _joined(pair_texts[i])
+        pair_texts[i] = None  # released here, while hot, not by a random-order sweep at the end
         guard = BTNode(GUARD_TYPE, condition, f"Enter_{name}", {"target": name, "pairs": pairs})
         leaf = BTNode(
             STATE_TYPE,
@@ -265,23 +283,28 @@ def _build(fsm: FSM, structure: LebtStructure) -> tuple[BTNode, int, int]:
                 "state": name,
                 "action": state.action or "",
                 "final": "true" if state.final else "false",
-                "exits": exits,
+                "exits": _joined(exit_texts[i]),
             },
         )
-        below = child_ids[i]
+        below = child_counts[i]
         if below:
-            shape = "_chain" if len(below) == 1 else "_branch"
-            body = BTNode(SEQUENCE, control, name + shape, {}, [leaf])
+            if below == 1:
+                body = BTNode(SEQUENCE, control, name + "_chain", {}, [leaf, None])  # type: ignore[list-item]
+            else:
+                body = BTNode(SEQUENCE, control, name + "_branch", {}, [leaf, *[None] * below])  # type: ignore[list-item]
+            bodies[i] = body.children
             selectors[i] = BTNode(FALLBACK, control, name + "_selector", {}, [guard, body])
             nodes += 4
         else:
             selectors[i] = BTNode(FALLBACK, control, name + "_selector", {}, [guard, leaf])
             nodes += 3
-    for i in structure.reachable_ids:  # pass 2: hang the child selectors below each body
-        below = child_ids[i]
-        if below:
-            body = selectors[i].children[1]  # type: ignore[union-attr]
-            body.children.extend([selectors[child] for child in below])  # type: ignore[misc]
+    previous, slot = -1, 0
+    for parent, child in zip(structure.child_sources, structure.child_targets):  # pass 2
+        if parent != previous:
+            previous, slot = parent, 1  # the links of one parent are consecutive
+        else:
+            slot += 1
+        bodies[parent][slot] = selectors[child]  # type: ignore[index,assignment]
     root = BTNode(
         type="Sequence",
         kind=control,
@@ -292,20 +315,28 @@ def _build(fsm: FSM, structure: LebtStructure) -> tuple[BTNode, int, int]:
 
 
 def _lebt_depth(structure: LebtStructure) -> int:
-    """Levels of the LEBT (root = 1) from the structure alone, level by level over the integer
-    child lists (no per-node tuples): root selectors are on level 2 and the selectors hung
-    below a state's body two levels under its own, so with ``k`` levels of selectors the
-    deepest ones are on level ``2k`` and - having nothing below - their leaves on ``2k + 1``."""
-    child_ids = structure.child_ids
+    """Levels of the LEBT (root = 1) from the structure alone, level by level over the flat
+    link lists (each state's links found by offset, no per-state lists): root selectors are on
+    level 2 and the selectors hung below a state's body two levels under its own, so with
+    ``k`` levels of selectors the deepest ones are on level ``2k`` and - having nothing below
+    - their leaves on ``2k + 1``."""
+    counts = structure.child_counts
+    first = array("l", [0]) * (len(counts) + 1)  # where each state's links start
+    total = 0
+    for state, count in enumerate(counts):
+        first[state] = total
+        total += count
+    child_targets = structure.child_targets
     frontier: list[int] = list(structure.root_ids)
     levels = 0
     while frontier:
         levels += 1
         below: list[int] = []
         for state in frontier:
-            children = child_ids[state]
-            if children:
-                below.extend(children)
+            count = counts[state]
+            if count:
+                start = first[state]
+                below.extend(child_targets[start : start + count])
         frontier = below
     return 2 * levels + 1
 
@@ -344,15 +375,15 @@ def fsm_to_lebt(fsm: FSM, *, style: str = "paper", **_options: object) -> Conver
     root, node_count, depth = _build(flat, structure)
     doc = BTDocument.single(root)
     doc.node_models.update(lebt_node_models())
-    below = [len(structure.child_ids[i]) for i in structure.reachable_ids]
+    counts = structure.child_counts
     stats = {
         "states": len(structure.reachable_ids),
-        "transitions": sum(len(structure.exit_events[i]) for i in structure.reachable_ids),
+        "transitions": len(structure.kept_sources),
         "entry": structure.entry,
         "loop_states": len(structure.loop_ids),
         "root_subtrees": len(structure.root_ids),
-        "chains": below.count(1),
-        "branches": sum(1 for count in below if count >= 2),
+        "chains": counts.count(1),
+        "branches": len(counts) - counts.count(0) - counts.count(1),
         "unreachable_dropped": len(structure.unreachable),
         "flattened": flat is not fsm,
         "nodes": node_count,

@@ -16,33 +16,36 @@ run, so no behaviour depends on them) before degrees are counted. Of several tra
 one state on the same event only the first counts (as ``FSMMachine`` runs it).
 
 Representation: a state is its position in ``fsm.states`` (declaration order);
-``LebtStructure.start_id`` (= the number of states) stands for the start pseudo-state. The analysis works on integer
-indices, flat lists and byte flags - one name -> index look-up per transition endpoint, then no
-string-keyed dictionary at all - so that at 100 000 states it does not spend its time on random
-probes into dictionaries of 100 000 string keys (docs/conversion.md, 'Cost of FSM -> BT'). The
-per-state lists are visited in declaration order, i.e. in the order the FSM's objects lie in
-memory. Name-keyed views (``roots``, ``children``, ``guard_pairs``, ``exits``,
-``predecessors``) are built on first use, for callers that want names (the hierarchical builder
+``LebtStructure.start_id`` (= the number of states) stands for the start pseudo-state. Edges are
+flat parallel sequences - source indices, target indices (``array('l')``: machine integers, no
+object per entry) and events - grouped by source in declaration order, each source's edges in
+transition order (the order files usually give them in; otherwise one stable sort by source).
+There is no list per state and no string-keyed dictionary after the one name -> index look-up
+per transition endpoint. This is about memory, not operation counts: at 100 000 states a
+random machine's transitions point at random states, and every step that follows a transition
+touches memory far from the last one; on flat arrays of machine integers (hundreds of KB) that
+is a cache hit, on a list per state and an integer object per entry (megabytes spread over the
+heap) it was a cache miss (docs/conversion.md, 'Cost of FSM -> BT'). Name-keyed views
+(``roots``, ``children``, ``guard_pairs``, ``exits``, ``predecessors``) and per-state lists
+(``child_ids``) are built on first use, for callers that want them (the hierarchical builder
 ``fsmbt.convert.hfsm_to_bt``, tests).
 
-Complexity: O(S + T) time and memory for S states and T transitions, no recursion.
+Complexity: O(S + T) time and memory for S states and T transitions (O(T log T) for the sort
+when the transitions are not grouped by source in declaration order), no recursion.
 """
 
 from __future__ import annotations
 
+from array import array
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
+from itertools import compress
 from typing import NoReturn
 
 from fsmbt.model.errors import InputError, UnsupportedError
 from fsmbt.model.fsm import FSM, Transition
 from fsmbt.semantics.lebt.spec import DEFAULT_START, NO_EVENT
-
-#: Shared empty per-state list (no successor linked below / no kept transition / no exit): many
-#: states have none, and one empty list each would cost memory and collector time for nothing.
-#: Never appended to.
-_NONE: tuple[()] = ()
 
 # pred_mark values besides a state index: no predecessor yet, several distinct predecessors
 _NO_PRED = -1
@@ -57,14 +60,22 @@ class LebtStructure:
         start: The start pseudo-state's name.
         names: Every state of the FSM in declaration order (reachable or not); index = position.
         entry_id: The entry state's index.
-        reachable_ids: The reachable states' indices, ascending (declaration order).
+        reachable_ids: The reachable states' indices, ascending (declaration order); a
+            ``range`` when every state is reachable (no integer object per state).
         root_ids: The entry state, then the loop states, in declaration order.
         loop_ids: The loop states (in-degree >= 2), in declaration order.
-        child_ids: Per state, the successors of in-degree 1 linked below it, in the order of
-            its outgoing transitions (empty for unreachable states).
-        kept_targets: Per state, the targets of the transitions that can fire out of it (the
-            first per event), parallel to ``exit_events``.
-        exit_events: Per state, the events with a transition out of it (first one per event).
+        kept_sources: The source of every transition that can fire (out of a reachable,
+            non-final state, the first per (source, event)), grouped by source in declaration
+            order, each source's in transition order.
+        kept_targets: Their targets, parallel to ``kept_sources``.
+        kept_events: Their events, parallel to ``kept_sources``.
+        child_sources: Per link "state of in-degree 1 below its only predecessor", the
+            predecessor, grouped by predecessor in declaration order.
+        child_targets: The linked state, parallel (per predecessor in the order of its
+            outgoing transitions).
+        child_counts: Per state, how many states are linked below it.
+        placed: Per state, 1 when it is a root or linked below its predecessor (a reachable
+            state entered only by transitions that never fire is neither).
         initial_event: The event of the start pseudo-state's transition (``NO_EVENT``: none).
         unreachable: The states dropped, by name.
     """
@@ -72,12 +83,16 @@ class LebtStructure:
     start: str
     names: list[str]
     entry_id: int
-    reachable_ids: list[int]
+    reachable_ids: Sequence[int]
     root_ids: list[int]
     loop_ids: list[int]
-    child_ids: list[Sequence[int]]
-    kept_targets: list[Sequence[int]]
-    exit_events: list[Sequence[str]]
+    kept_sources: Sequence[int]
+    kept_targets: Sequence[int]
+    kept_events: Sequence[str]
+    child_sources: Sequence[int]
+    child_targets: Sequence[int]
+    child_counts: Sequence[int]
+    placed: bytearray
     initial_event: str
     unreachable: list[str] = field(default_factory=list)
 
@@ -91,6 +106,23 @@ class LebtStructure:
     def entry(self) -> str:
         """The entry state's name."""
         return self.names[self.entry_id]
+
+    # -- per-state lists, built on first use (O(S + T) each) ---------------------------------
+    @cached_property
+    def child_ids(self) -> list[list[int]]:
+        """Per state, the states linked below it, in the order of its outgoing transitions."""
+        below: list[list[int]] = [[] for _ in self.names]
+        for source, child in zip(self.child_sources, self.child_targets):
+            below[source].append(child)
+        return below
+
+    @cached_property
+    def exit_events(self) -> list[list[str]]:
+        """Per state, the events of its transitions that can fire, in transition order."""
+        events: list[list[str]] = [[] for _ in self.names]
+        for source, event in zip(self.kept_sources, self.kept_events):
+            events[source].append(event)
+        return events
 
     # -- name-keyed views, built on first use (O(S + T) each) --------------------------------
     @cached_property
@@ -106,8 +138,8 @@ class LebtStructure:
     @cached_property
     def children(self) -> dict[str, list[str]]:
         """Reachable state -> successors of in-degree 1 linked below it."""
-        names = self.names
-        return {names[i]: [names[c] for c in self.child_ids[i]] for i in self.reachable_ids}
+        names, below = self.names, self.child_ids
+        return {names[i]: [names[c] for c in below[i]] for i in self.reachable_ids}
 
     def guard_ids(self) -> list[list[tuple[int, str]]]:
         """Per state, the (source index or ``start_id``, event) pairs entering it: the start
@@ -115,9 +147,8 @@ class LebtStructure:
         source's transitions. O(S + T)."""
         pairs: list[list[tuple[int, str]]] = [[] for _ in self.names]
         pairs[self.entry_id].append((self.start_id, self.initial_event))
-        for source in self.reachable_ids:
-            for target, event in zip(self.kept_targets[source], self.exit_events[source]):
-                pairs[target].append((source, event))
+        for source, target, event in zip(self.kept_sources, self.kept_targets, self.kept_events):
+            pairs[target].append((source, event))
         return pairs
 
     @cached_property
@@ -133,7 +164,8 @@ class LebtStructure:
     @cached_property
     def exits(self) -> dict[str, list[str]]:
         """Reachable state -> the events with a transition out of it."""
-        return {self.names[i]: list(self.exit_events[i]) for i in self.reachable_ids}
+        events = self.exit_events
+        return {self.names[i]: events[i] for i in self.reachable_ids}
 
     @cached_property
     def predecessors(self) -> dict[str, list[str]]:
@@ -156,15 +188,18 @@ class LebtStructure:
         return "leaf" if count == 0 else "chain" if count == 1 else "branch"
 
 
-def _out_edges(
-    fsm: FSM, index: dict[str, int]
-) -> tuple[list[list[int] | None], list[list[str] | None]]:
-    """Per state, the targets and the events of its transitions (two parallel lists, in
-    declaration order; ``None`` for none), final states' transitions dropped. Raises the
-    located errors for an unknown state, an eventless and an empty-event transition."""
-    finals = [state.final for state in fsm.states.values()]
-    out_targets: list[list[int] | None] = [None] * len(finals)
-    out_events: list[list[str] | None] = [None] * len(finals)
+def _edges(fsm: FSM, index: dict[str, int]) -> tuple[array[int], array[int], list[str]]:
+    """Every transition out of a non-final state as three parallel flat sequences - source
+    indices, target indices, events - grouped by source in declaration order, each source's
+    in transition order (a stable sort when the FSM does not list them so). Raises the located
+    errors for an unknown state, an eventless and an empty-event transition."""
+    finals = bytearray(state.final for state in fsm.states.values())
+    sources: array[int] = array("l")
+    targets: array[int] = array("l")
+    events: list[str] = []
+    add_source, add_target, add_event = sources.append, targets.append, events.append
+    grouped = True
+    last = 0
     for t in fsm.transitions:
         source = index.get(t.source)
         target = index.get(t.target)
@@ -174,14 +209,18 @@ def _out_edges(
         assert source is not None and target is not None and event is not None
         if finals[source]:
             continue  # never fires
-        targets = out_targets[source]
-        if targets is None:
-            out_targets[source] = [target]
-            out_events[source] = [event]
-        else:
-            targets.append(target)
-            out_events[source].append(event)  # type: ignore[union-attr]
-    return out_targets, out_events
+        if source < last:
+            grouped = False
+        last = source
+        add_source(source)
+        add_target(target)
+        add_event(event)
+    if not grouped:
+        order = sorted(range(len(sources)), key=sources.__getitem__)  # stable
+        sources = array("l", [sources[k] for k in order])
+        targets = array("l", [targets[k] for k in order])
+        events = [events[k] for k in order]
+    return sources, targets, events
 
 
 def _refuse(fsm: FSM, t: Transition, source_unknown: bool) -> NoReturn:
@@ -206,8 +245,8 @@ def _refuse(fsm: FSM, t: Transition, source_unknown: bool) -> NoReturn:
     )
 
 
-def _reached(entry: int, out_targets: list[list[int] | None]) -> bytearray:
-    """Flag 1 per state reachable from ``entry``.
+def _reached(entry: int, count: int, sources: array[int], targets: array[int]) -> bytearray:
+    """Flag 1 per state reachable from ``entry`` over the edges (grouped by source).
 
     First a sequential pass for the usual case, a machine declared roughly in the order it
     runs: take the order "entry first, then declaration order"; if every other state has a
@@ -215,30 +254,51 @@ def _reached(entry: int, out_targets: list[list[int] | None]) -> bytearray:
     along the order) - checked without visiting the states in graph order, which at 100 000
     states of a random machine is a cache miss per state. Otherwise, breadth-first search.
     """
-    count = len(out_targets)
     seen = bytearray(count)
     seen[entry] = 1
-    for source, targets in enumerate(out_targets):
-        if targets is None:
-            continue
-        if source == entry:
-            for target in targets:
-                seen[target] = 1
-        else:
-            for target in targets:
-                if target > source:
-                    seen[target] = 1
+    for source, target in zip(sources, targets):
+        if target > source or source == entry:
+            seen[target] = 1
     if seen.count(0) == 0:
         return seen
+    first = [0] * (count + 1)  # first[s]: where source s's edges start (grouped by source)
+    for source in sources:
+        first[source + 1] += 1
+    for state in range(count):
+        first[state + 1] += first[state]
     seen = bytearray(count)
     seen[entry] = 1
     queue = [entry]
     for state in queue:  # the list grows while it is read: a queue without pops
-        for target in out_targets[state] or _NONE:
+        for target in targets[first[state] : first[state + 1]]:
             if not seen[target]:
                 seen[target] = 1
                 queue.append(target)
     return seen
+
+
+def _kept_flags(sources: array[int], events: list[str], seen: bytearray) -> bytearray | None:
+    """Per edge, 1 when it can fire: its source is reachable and it is its source's first
+    edge on its event. ``None`` when every edge can (the usual case: no copy is made)."""
+    flags: bytearray | None = None
+    previous = -1
+    first_event = ""
+    group: set[str] | None = None  # the events seen so far from a source with >= 2 edges
+    for k, (source, event) in enumerate(zip(sources, events)):
+        if source != previous:
+            previous, first_event, group = source, event, None
+            if seen[source]:
+                continue
+        elif seen[source]:
+            if group is None:
+                group = {first_event}
+            if event not in group:
+                group.add(event)
+                continue
+        if flags is None:
+            flags = bytearray(b"\x01") * len(sources)
+        flags[k] = 0
+    return flags
 
 
 def analyse(fsm: FSM) -> LebtStructure:
@@ -267,54 +327,50 @@ def analyse(fsm: FSM) -> LebtStructure:
     names = list(fsm.states)
     count = len(names)
     index = {name: position for position, name in enumerate(names)}
-    out_targets, out_events = _out_edges(fsm, index)
+    sources, targets, events = _edges(fsm, index)
     entry = index[fsm.initial]
-    seen = _reached(entry, out_targets)
-    reachable = [i for i in range(count) if seen[i]]
-    unreachable = [names[i] for i in range(count) if not seen[i]]
+    del index
+    seen = _reached(entry, count, sources, targets)
+    reachable: Sequence[int]
+    if seen.count(0) == 0:
+        reachable = range(count)
+        unreachable: list[str] = []
+    else:
+        reachable = [i for i in range(count) if seen[i]]
+        unreachable = [names[i] for i in range(count) if not seen[i]]
 
-    # kept edges (the first per (source, event)) and the distinct-predecessor marks
-    kept_targets: list[Sequence[int]] = [_NONE] * count
-    exit_events: list[Sequence[str]] = [_NONE] * count
-    pred_mark = [_NO_PRED] * count  # _NO_PRED, the only predecessor's index, or _MANY_PREDS
+    # the edges that can fire, and the distinct-predecessor marks they give
+    flags = _kept_flags(sources, events, seen)
+    if flags is None:
+        kept_sources, kept_targets, kept_events = sources, targets, events
+    else:
+        kept_sources = array("l", compress(sources, flags))
+        kept_targets = array("l", compress(targets, flags))
+        kept_events = list(compress(events, flags))
+    pred_mark = array("l", [_NO_PRED]) * count  # _NO_PRED, the only predecessor, _MANY_PREDS
     pred_mark[entry] = count  # the start pseudo-state
-    for source in reachable:
-        targets = out_targets[source]
-        if targets is None:
-            continue
-        events = out_events[source]
-        assert events is not None
-        if len(events) > 1 and len(set(events)) < len(events):
-            firsts: dict[str, int] = {}
-            for target, event in zip(targets, events):
-                firsts.setdefault(event, target)
-            events, targets = list(firsts), list(firsts.values())
-        exit_events[source] = events
-        kept_targets[source] = targets
-        for target in targets:
-            mark = pred_mark[target]
-            if mark == _NO_PRED:
-                pred_mark[target] = source
-            elif mark != source:
-                pred_mark[target] = _MANY_PREDS
+    for source, target in zip(kept_sources, kept_targets):
+        mark = pred_mark[target]
+        if mark == _NO_PRED:
+            pred_mark[target] = source
+        elif mark != source:
+            pred_mark[target] = _MANY_PREDS
 
     loop_ids = [i for i in reachable if pred_mark[i] == _MANY_PREDS]
     root_ids = [entry] + [i for i in loop_ids if i != entry]
     placed = bytearray(count)  # a root, or linked below its only predecessor (at most once)
     for root in root_ids:
         placed[root] = 1
-    child_ids: list[Sequence[int]] = [_NONE] * count
-    for source in reachable:
-        below: list[int] | None = None
-        for target in out_targets[source] or _NONE:  # every transition, in order
-            if placed[target] or pred_mark[target] != source:
-                continue
-            placed[target] = 1
-            if below is None:
-                below = [target]
-                child_ids[source] = below
-            else:
-                below.append(target)
+    child_sources: array[int] = array("l")
+    child_targets: array[int] = array("l")
+    child_counts = array("l", [0]) * count
+    for source, target in zip(sources, targets):  # every transition, in order
+        if placed[target] or pred_mark[target] != source:
+            continue  # (only a reachable source is a predecessor: no check of ``seen``)
+        placed[target] = 1
+        child_sources.append(source)
+        child_targets.append(target)
+        child_counts[source] += 1
     return LebtStructure(
         start,
         names,
@@ -322,9 +378,13 @@ def analyse(fsm: FSM) -> LebtStructure:
         reachable,
         root_ids,
         loop_ids,
-        child_ids,
+        kept_sources,
         kept_targets,
-        exit_events,
+        kept_events,
+        child_sources,
+        child_targets,
+        child_counts,
+        placed,
         fsm.initial_event if fsm.initial_event is not None else NO_EVENT,
         unreachable,
     )

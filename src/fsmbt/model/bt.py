@@ -3,6 +3,10 @@
 A ``BTDocument`` is what one file (plus its includes) holds: several ``BehaviorTree`` s, the one to
 execute, and the ``TreeNodesModel`` declarations. Attributes and ports stay on the nodes in order,
 so reading and writing a file loses nothing.
+
+``BTNode`` is a slotted dataclass (one allocation of 96 bytes per node, fields read without a
+dictionary: a converted tree holds 3-4 nodes per FSM state); a node has its fields and no
+others - setting any other attribute raises ``AttributeError``.
 """
 
 from __future__ import annotations
@@ -14,7 +18,7 @@ from fsmbt.model.bt_nodes import NodeKind, builtin_spec
 from fsmbt.model.errors import SourceLocation
 
 
-@dataclass(eq=False, repr=False)
+@dataclass(eq=False, repr=False, slots=True)
 class BTNode:
     """One node. ``type`` is the v4 registration ID (``Sequence``, ``Inverter``, ``MoveTo``...).
 

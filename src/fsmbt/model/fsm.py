@@ -11,6 +11,9 @@ transition whose ``event`` is ``None`` is a completion transition: from a compos
 when the sub-FSM reaches a final state (``exit`` names which one; ``None`` = any); from an atomic
 state it fires as soon as the state is entered. ``fsmbt.model.flatten`` gives the plain FSM every
 check works on.
+
+``State`` and ``Transition`` are slotted dataclasses (one allocation each, fields read without a
+dictionary: a converter reads every one of them); they have their fields and no others.
 """
 
 from __future__ import annotations
@@ -21,7 +24,7 @@ from dataclasses import dataclass, field
 from fsmbt.model.errors import SourceLocation
 
 
-@dataclass
+@dataclass(slots=True)
 class State:
     """One state of an FSM, possibly composite (one region) or parallel (several).
 
@@ -58,7 +61,7 @@ class State:
         return not self.regions
 
 
-@dataclass
+@dataclass(slots=True)
 class Transition:
     """``source --event--> target``; ``event=None`` is a completion (eventless) transition.
 
