@@ -121,7 +121,9 @@ def test_time_limit_answers_and_frees_the_worker():
     from fsmbt.formats import dumps
     from fsmbt.generate.generator import random_fsm
 
-    big = dumps(random_fsm(seed="web-timeout", n_states=3000, max_states=3000), "scxml")
+    # 20 000 states: about 12 s to read, convert and verify on the 2-core CI machine, 4x the
+    # limit, so a faster machine still hits it (3 000 states took 0.6 s: rendering decided)
+    big = dumps(random_fsm(seed="web-timeout", n_states=20_000, max_states=20_000), "scxml")
     settings = WebSettings.default(workers=1, timeout_s=3, max_body_bytes=8 * 1024 * 1024)
     with TestClient(create_app(settings)) as slow:
         _refused(slow.post("/api/convert", json={"text": big}), 503, "command line")
