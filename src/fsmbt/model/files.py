@@ -10,11 +10,13 @@ opened here, so two rules hold for all of them in one place:
   (the file may grow after ``stat``). Past the bound: an ``InputError`` naming the file.
 - **Recorded**: inside ``recording_reads()`` every path asked for - read or not (a missing
   file is a dependency too: creating it changes the result), and every folder a reader scans
-  for files (``note_read``) - is noted, resolved, in the order of first request. The batch runner keeps them with each row and re-runs a row when one of
-  them changed (docs/batch.md, "Resume").
+  for files (``note_read``) - is noted, resolved, in the order of first request. The batch
+  runner keeps them with each row and re-runs a row when one of them changed (docs/batch.md,
+  "Resume").
 
 It lives at the bottom of the layers because ``model/nodes`` (node library files) reads files
-as well as ``formats/``. Costs: one ``stat`` and one read per file; recording is a list append.
+as well as ``formats/``. Costs: one ``stat`` and one read per file; recording is a set look-up
+and a list append.
 """
 
 from __future__ import annotations
@@ -27,7 +29,10 @@ from pathlib import Path
 from fsmbt import limits
 from fsmbt.model.errors import InputError, SourceLocation
 
-_RECORDING: ContextVar[list[Path] | None] = ContextVar("fsmbt_reads", default=None)
+#: The paths of the innermost ``recording_reads`` block, and the same as a set (each once).
+_RECORDING: ContextVar[tuple[list[Path], set[Path]] | None] = ContextVar(
+    "fsmbt_reads", default=None
+)
 
 
 @contextmanager
@@ -39,7 +44,7 @@ def recording_reads() -> Iterator[list[Path]]:
         complete when the block ends. Blocks nest: an inner block records for itself only.
     """
     paths: list[Path] = []
-    token = _RECORDING.set(paths)
+    token = _RECORDING.set((paths, set()))
     try:
         yield paths
     finally:
@@ -49,14 +54,16 @@ def recording_reads() -> Iterator[list[Path]]:
 def note_read(path: Path) -> None:
     """Record ``path`` as asked for (inside ``recording_reads``; else nothing): a file a reader
     is about to check and read, or a folder whose listing it scans for files."""
-    paths = _RECORDING.get()
-    if paths is None:
+    recording = _RECORDING.get()
+    if recording is None:
         return
+    paths, seen = recording
     try:
         resolved = path.resolve()
     except (OSError, RuntimeError):  # a symlink loop: keep the name as given
         resolved = path.absolute()
-    if resolved not in paths:
+    if resolved not in seen:
+        seen.add(resolved)
         paths.append(resolved)
 
 
