@@ -13,49 +13,19 @@ from collections import Counter
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from fsmbt.semantics.bt_interpreter import BTLivelock, BTRunner, BTRuntimeError
-from fsmbt.semantics.engines.btcpp_engine import BTCppRunner
+from support.btcpp_lockstep import matches_btcpp
 from support.random_trees import ALL_NODE_TYPES, OutcomeScript, random_tree
 
-TICKS = 8
 SEEDS = st.integers(min_value=0, max_value=2**31 - 1)
 SETTINGS = settings(
     max_examples=500, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow]
 )
 
 
-def _run_interpreter(doc, script, exactly_once):
-    runner = BTRunner(doc, script, exactly_once=exactly_once, max_leaf_ticks_per_tick=200)
-    records, error = [], None
-    try:
-        for _ in range(TICKS):
-            records.append(runner.tick_once())
-    except BTLivelock:
-        return None, None
-    except BTRuntimeError as exc:
-        if "does not end" in str(exc):
-            return None, None
-        error = exc
-    return records, error
-
-
 def _compare(seed: int, exactly_once: bool) -> bool:
     """True when compared (False: tickOnce would not return, nothing to compare)."""
     doc = random_tree(random.Random(seed), max_nodes=16)
-    script = OutcomeScript(seed)
-    ours, error = _run_interpreter(doc, script, exactly_once)
-    if ours is None:
-        return False
-    engine = BTCppRunner(doc, script.fresh(), exactly_once=exactly_once)
-    theirs, engine_error = [], None
-    try:
-        for _ in range(len(ours) + (1 if error else 0)):
-            theirs.append(engine.tick_once())
-    except Exception as exc:  # noqa: BLE001 - BehaviorTree.CPP's logic_error
-        engine_error = exc
-    assert (error is None) == (engine_error is None), (seed, error, engine_error, engine.xml)
-    assert theirs[: len(ours)] == ours, (seed, engine.xml)
-    return True
+    return matches_btcpp(doc, OutcomeScript(seed), exactly_once, seed)
 
 
 @SETTINGS

@@ -20,10 +20,11 @@ from fsmbt import api
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.bt_nodes import NodeKind
 from fsmbt.model.errors import InputError, UnsupportedError
-from fsmbt.semantics.bt_interpreter import BTLivelock, BTRunner, BTRuntimeError, CompiledTree
+from fsmbt.semantics.bt_interpreter import CompiledTree
 from fsmbt.semantics.nodes import abstractions_used
 from support import bt_traces
 from support.bt_traces import Script, doc_of
+from support.btcpp_lockstep import matches_btcpp
 from support.random_trees import ALL_DECORATORS, OutcomeScript, random_tree
 
 
@@ -197,7 +198,6 @@ def test_sem_loop_user_type_via_a_node_library(tmp_path) -> None:
 
 
 # -- against BehaviorTree.CPP ----------------------------------------------------------------
-TICKS = 8
 SETTINGS = settings(
     max_examples=300, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow]
 )
@@ -224,41 +224,11 @@ def _loop_tree(seed: int) -> BTDocument:
     return doc
 
 
-def _interpreter_trace(doc: BTDocument, script: OutcomeScript, exactly_once: bool):
-    runner = BTRunner(doc, script, exactly_once=exactly_once, max_leaf_ticks_per_tick=200)
-    records, error = [], None
-    try:
-        for _ in range(TICKS):
-            records.append(runner.tick_once())
-    except BTLivelock:
-        return None, None
-    except BTRuntimeError as exc:
-        if "does not end" in str(exc):
-            return None, None
-        error = exc
-    return records, error
-
-
 def _compare(seed: int, exactly_once: bool) -> bool:
-    from fsmbt.semantics.engines.btcpp_engine import BTCppRunner
-
     doc = _loop_tree(seed)
     if not any(n.type.startswith("Loop") for _t, n in doc.nodes()):
         return False
-    script = OutcomeScript(seed)
-    ours, error = _interpreter_trace(doc, script, exactly_once)
-    if ours is None:
-        return False
-    engine = BTCppRunner(doc, script.fresh(), exactly_once=exactly_once)
-    theirs, engine_error = [], None
-    try:
-        for _ in range(len(ours) + (1 if error else 0)):
-            theirs.append(engine.tick_once())
-    except Exception as exc:  # noqa: BLE001 - BehaviorTree.CPP's logic_error
-        engine_error = exc
-    assert (error is None) == (engine_error is None), (seed, error, engine_error, engine.xml)
-    assert theirs[: len(ours)] == ours, (seed, engine.xml)
-    return True
+    return matches_btcpp(doc, OutcomeScript(seed), exactly_once, seed)
 
 
 @SETTINGS
