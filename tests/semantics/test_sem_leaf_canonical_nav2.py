@@ -17,7 +17,7 @@ import random
 
 import pytest
 
-from fsmbt.model.bt import BehaviorTree, BTDocument, BTNode
+from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.bt_nodes import NodeKind
 from fsmbt.semantics.leaf_canonical import (
     CANONICAL_DECORATOR_RULES,
@@ -29,6 +29,7 @@ from fsmbt.semantics.nodes import all_nodes
 from fsmbt.verify import native
 from support.canonical_checks import lockstep, proved_equivalent, same_verdicts_against_hfsm
 from support.corpus import CORPUS
+from support.random_trees import LEAVES, TreeGenerator
 
 #: Controls of the class, from the registry (the rule decides, not a list here).
 CONTROLS = tuple(
@@ -55,32 +56,16 @@ def test_the_class_holds_nav2_kinds() -> None:
     assert "SkipUnlessUpdated" not in DECORATORS and "Parallel" not in CONTROLS
 
 
-class _Gen:
+class _Nav2Generator(TreeGenerator):
     """Random trees over the class; Nav2's kinds are drawn twice as often (small, depth ≤ 5)."""
 
-    def __init__(self, rng: random.Random, max_nodes: int, leaves: tuple[str, ...]) -> None:
-        self.rng = rng
-        self.max_nodes = max_nodes
-        self.leaves = leaves
-        self.count = 0
-        self.subtrees: dict[str, BTNode] = {}
-
-    def leaf(self) -> BTNode:
-        self.count += 1
-        kind = self.rng.choice(self.leaves)
-        if kind == "Action":
-            return BTNode(f"Act{self.count % 3}", NodeKind.ACTION, name=f"a{self.count}")
-        if kind == "Condition":
-            return BTNode(f"Cond{self.count % 3}", NodeKind.CONDITION, name=f"c{self.count}")
-        return BTNode(kind, NodeKind.ACTION)
-
     def node(self, depth: int) -> BTNode:
-        self.count += 1
+        self.counter += 1
         rng = self.rng
-        if depth >= 5 or self.count >= self.max_nodes or rng.random() < 0.28:
+        if depth >= 5 or self.counter >= self.max_nodes or rng.random() < 0.28:
             return self.leaf()
         if rng.random() < 0.35:
-            kind = rng.choice(DECORATORS + ("SubTree", "RateController"))
+            kind = rng.choice(self.decorators)
             child = self.node(depth + 1)
             if kind == "SubTree":
                 sub_id = f"Sub{len(self.subtrees)}"
@@ -96,7 +81,7 @@ class _Gen:
             return BTNode(
                 kind, NodeKind.DECORATOR, attrs=attrs, children=[child], semantics=semantics
             )
-        kind = rng.choice(CONTROLS + NAV2[:3])
+        kind = rng.choice(self.controls)
         count = 2 if kind == "RecoveryNode" else rng.randint(1, 4)
         children = [self.node(depth + 1) for _ in range(count)]
         attrs = {}
@@ -107,15 +92,10 @@ class _Gen:
         return BTNode(kind, NodeKind.CONTROL, attrs=attrs, children=children)
 
 
-LEAVES = ("Action", "Condition", "Action", "Condition", "AlwaysSuccess", "AlwaysFailure")
-
-
 def nav2_tree(seed: int, max_nodes: int = 16, leaves: tuple[str, ...] = LEAVES) -> BTDocument:
-    gen = _Gen(random.Random(seed), max_nodes, leaves)
-    doc = BTDocument.single(gen.node(0))
-    for sub_id, root in gen.subtrees.items():
-        doc.trees[sub_id] = BehaviorTree(sub_id, root)
-    return doc
+    controls = CONTROLS + NAV2[:3]
+    decorators = DECORATORS + ("SubTree", "RateController")
+    return _Nav2Generator(random.Random(seed), controls, decorators, leaves, max_nodes).document()
 
 
 def nav2_documents(count: int, **kwargs: object) -> list[BTDocument]:

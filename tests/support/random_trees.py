@@ -54,8 +54,15 @@ PYTREES_DECORATORS = ("Inverter", "ForceSuccess", "ForceFailure")
 ALL_NODE_TYPES = ALL_CONTROLS + ALL_DECORATORS + ALL_LEAVES
 
 
+#: The leaf kinds drawn by default (Action and Condition twice as often as the constants).
+LEAVES = ("Action", "Condition", "Action", "Condition", "AlwaysSuccess", "AlwaysFailure")
+
+
 @dataclass
-class _Gen:
+class TreeGenerator:
+    """Grows one random tree (``document``) from the kinds it is given; a generator for another
+    node class subclasses it and overrides ``node`` (tests/semantics/test_sem_leaf_canonical_nav2)."""
+
     rng: random.Random
     controls: Sequence[str]
     decorators: Sequence[str]
@@ -113,29 +120,24 @@ class _Gen:
             )
         return BTNode(t, NodeKind.CONTROL, attrs=attrs, children=children)
 
+    def document(self) -> BTDocument:
+        """The main tree grown from the root, plus one tree per SubTree occurrence."""
+        doc = BTDocument.single(self.node(0))
+        for sub_id, sub_root in self.subtrees.items():
+            doc.trees[sub_id] = BehaviorTree(sub_id, sub_root)
+        return doc
+
 
 def random_tree(
     rng: random.Random,
     *,
     controls: Sequence[str] = ALL_CONTROLS,
     decorators: Sequence[str] = ALL_DECORATORS,
-    leaves: Sequence[str] = (
-        "Action",
-        "Condition",
-        "Action",
-        "Condition",
-        "AlwaysSuccess",
-        "AlwaysFailure",
-    ),
+    leaves: Sequence[str] = LEAVES,
     max_nodes: int = 14,
 ) -> BTDocument:
     """A random document (main tree ``MainTree`` plus one tree per SubTree occurrence)."""
-    gen = _Gen(rng, controls, decorators, leaves, max_nodes)
-    root = gen.node(0)
-    doc = BTDocument.single(root)
-    for sub_id, sub_root in gen.subtrees.items():
-        doc.trees[sub_id] = BehaviorTree(sub_id, sub_root)
-    return doc
+    return TreeGenerator(rng, controls, decorators, leaves, max_nodes).document()
 
 
 def bt_documents(**kwargs):
