@@ -57,7 +57,7 @@ from fsmbt.formats._pysm_analyze import (
 from fsmbt.formats._pysm_source import parse_source
 from fsmbt.formats.registry import ReadContext, decode
 from fsmbt.model.errors import InputError, SourceLocation, UnsupportedError
-from fsmbt.model.files import note_read, read_bounded
+from fsmbt.model.files import note_read, read_bounded, read_located
 from fsmbt.model.flatten import flatten
 from fsmbt.model.fsm import FSM, State
 
@@ -235,13 +235,7 @@ class Builder:
     def load(self, path: Path) -> _Source:
         if path in self.loaded:
             return self.loaded[path]
-        try:
-            data = read_bounded(path)
-        except OSError as exc:
-            raise InputError(
-                f"cannot read: {exc.strerror}", location=SourceLocation(str(path))
-            ) from None
-        text = decode(data, str(path))
+        text = decode(read_located(path), str(path))
         tree = parse_source(text, str(path))
         analysis = analyze(text, tree, str(path))
         source = _Source(path, str(path), analysis)

@@ -33,7 +33,7 @@ from fsmbt.model import Model
 from fsmbt.model.bt import BehaviorTree, BTDocument, BTNode, NodeModel, PortModel
 from fsmbt.model.bt_nodes import NodeKind, builtin_spec, canonical_type
 from fsmbt.model.errors import InputError, SourceLocation, UnsupportedError
-from fsmbt.model.files import note_read, read_bounded
+from fsmbt.model.files import note_read, read_located
 from fsmbt.model.nodes.library import apply_library, build_library
 
 #: Tags of Groot's explicit style and of ``<TreeNodesModel>`` entries, with the kind they declare.
@@ -167,18 +167,13 @@ class _Loader:
             return  # included twice (diamond): BehaviorTree.CPP registers it once
         self.loaded.add(resolved)
         note_read(resolved)  # a dependency even when it is missing
-        try:
-            if not resolved.is_file():  # a FIFO or a device could block or never end
-                raise InputError(
-                    f"included '{target}' is not a regular file", location=where, element="include"
-                )
-            text = read_bounded(resolved)
-        except OSError as exc:
+        if not resolved.is_file():  # a FIFO or a device could block or never end
             raise InputError(
-                f"cannot read included file '{target}' ({resolved}): {exc.strerror}",
-                location=where,
-                element="include",
-            ) from None
+                f"included '{target}' is not a regular file", location=where, element="include"
+            )
+        text = read_located(
+            resolved, f"included file '{target}' ({resolved})", location=where, element="include"
+        )
         self.load(decode(text, str(resolved)), resolved, (*chain, resolved), extra=extra)
 
     # trees in other files (fsmbt.formats.btcpp_trees) -----------------------------------------
@@ -245,14 +240,9 @@ class _Loader:
                     element="SubTree",
                 )
             self.loaded.add(target)
-            try:
-                data = read_bounded(target)
-            except OSError as exc:
-                raise InputError(
-                    f"cannot read {target} (it defines tree '{tree_id}'): {exc.strerror}",
-                    location=where,
-                    element="SubTree",
-                ) from None
+            data = read_located(
+                target, f"{target} (it defines tree '{tree_id}')", location=where, element="SubTree"
+            )
             self.load(decode(data, str(target)), target, (target,), extra=True)
 
     def prune_extra_trees(self, doc: BTDocument) -> None:
@@ -277,13 +267,7 @@ class _Loader:
     def load_external_models(self) -> None:
         option = self.ctx.options.get("node_models") or []
         for model_path in btcpp_trees.option_paths(option, "node_models"):
-            try:
-                data = read_bounded(model_path)
-            except OSError as exc:
-                raise InputError(
-                    f"cannot read node model file: {exc.strerror}",
-                    location=SourceLocation(str(model_path)),
-                ) from None
+            data = read_located(model_path, "node model file")
             root = parse_xml(decode(data, str(model_path)), str(model_path))
             for models in root.iter("TreeNodesModel"):
                 for model in _read_models(models, str(model_path)):

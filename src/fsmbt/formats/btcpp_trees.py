@@ -33,7 +33,7 @@ from fsmbt import limits
 from fsmbt.formats.registry import decode
 from fsmbt.formats.xml_safe import parse_xml
 from fsmbt.model.errors import InputError, SourceLocation
-from fsmbt.model.files import note_read, read_bounded
+from fsmbt.model.files import note_read, read_bounded, read_located
 
 #: The option a caller names extra tree files with (``--trees``).
 TREES_OPTION = "trees"
@@ -73,14 +73,20 @@ def tree_ids(root: etree._Element) -> list[str]:
     return [i for i in ids if i]
 
 
-def read_root(path: Path) -> etree._Element:
+def read_root(path: Path, what: str | None = None) -> etree._Element:
     """A BehaviorTree.CPP file's ``<root>``, read under every input limit.
+
+    Args:
+        path: the file.
+        what: what the file is to the user (``--trees file``): the file system's refusal is
+            then the ``InputError`` "cannot read WHAT: REASON"; ``None``: it is the ``OSError``.
 
     Raises:
         InputError: unreadable, too big, not XML, or its root is not ``<root>`` (located).
-        OSError: the file system refused to open it.
+        OSError: the file system refused to open it (``what`` is ``None``).
     """
-    root = parse_xml(decode(read_bounded(path), str(path)), str(path))
+    data = read_bounded(path) if what is None else read_located(path, what)
+    root = parse_xml(decode(data, str(path)), str(path))
     if root.tag != "root":
         raise InputError(
             f"not a BehaviorTree.CPP file: root element is <{str(root.tag)}>, expected <root>",
@@ -157,14 +163,7 @@ def index_option(option: object) -> TreeIndex:
                     ),
                     location=SourceLocation(str(given)),
                 )
-            try:
-                root = read_root(path)
-            except OSError as exc:
-                raise InputError(
-                    f"cannot read {TREES_FLAG} file: {exc.strerror}",
-                    location=SourceLocation(str(path)),
-                ) from None
-            index.add(path, tree_ids(root))
+            index.add(path, tree_ids(read_root(path, f"{TREES_FLAG} file")))
     return index
 
 

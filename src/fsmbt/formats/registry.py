@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING
 
 from fsmbt import limits
 from fsmbt.model.errors import Hint, InputError, SourceLocation
-from fsmbt.model.files import read_bounded
+from fsmbt.model.files import read_located
 
 if TYPE_CHECKING:
     from fsmbt.model import Model
@@ -342,13 +342,7 @@ def read_text(path: str | Path) -> str:
         InputError: a folder, a device or FIFO, a file over the limit, unreadable bytes.
     """
     path = Path(path)
-    try:
-        data = read_bounded(path)
-    except OSError as exc:
-        raise InputError(
-            f"cannot read: {exc.strerror}", location=SourceLocation(str(path))
-        ) from None
-    return decode(data, str(path))
+    return decode(read_located(path), str(path))
 
 
 def read_model(

@@ -42,7 +42,7 @@ from fsmbt import limits
 from fsmbt.formats.registry import ReadContext, decode
 from fsmbt.formats.xml_safe import local_name, namespace, parse_xml
 from fsmbt.model.errors import InputError, SourceLocation, UnsupportedError
-from fsmbt.model.files import note_read, read_bounded
+from fsmbt.model.files import note_read, read_located
 
 XINCLUDE_NS = "http://www.w3.org/2001/XInclude"
 _INCLUDE = f"{{{XINCLUDE_NS}}}include"
@@ -158,22 +158,15 @@ def read_confined(path: Path, href: str, what: str, where: SourceLocation, eleme
         InputError: not a regular file, too large, unreadable, undecodable.
     """
     note_read(path)  # a dependency even when it is missing
-    try:
-        if not path.is_file():  # a FIFO or a device could block or never end
-            raise InputError(
-                f"{what} '{href}' ({path}) is not a regular file"
-                if path.exists()
-                else f"{what} '{href}' ({path}) does not exist",
-                location=where,
-                element=element,
-            )
-        data = read_bounded(path)
-    except OSError as exc:
+    if not path.is_file():  # a FIFO or a device could block or never end
         raise InputError(
-            f"cannot read {what} '{href}' ({path}): {exc.strerror}",
+            f"{what} '{href}' ({path}) is not a regular file"
+            if path.exists()
+            else f"{what} '{href}' ({path}) does not exist",
             location=where,
             element=element,
-        ) from None
+        )
+    data = read_located(path, f"{what} '{href}' ({path})", location=where, element=element)
     return decode(data, str(path))
 
 

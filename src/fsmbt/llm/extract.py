@@ -22,7 +22,6 @@ from fsmbt.formats.registry import (
     formats,
     get_format,
     loads,
-    read_bounded,
 )
 from fsmbt.llm.client import LLMClient, Message
 from fsmbt.llm.config import LLMUnavailableError
@@ -38,6 +37,7 @@ from fsmbt.llm.parsing import AnswerError, extract_json
 from fsmbt.llm.prompts import DEFAULT_VERSION, extraction_messages, feedback_message
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import FsmbtError, Hint, InputError, SourceLocation
+from fsmbt.model.files import read_bounded
 from fsmbt.model.fsm import FSM
 
 Model = FSM | BTDocument

@@ -67,6 +67,30 @@ def note_read(path: Path) -> None:
         paths.append(resolved)
 
 
+def read_located(
+    path: Path,
+    what: str = "",
+    *,
+    location: SourceLocation | None = None,
+    element: str | None = None,
+) -> bytes:
+    """``read_bounded``, where the file system's refusal (an ``OSError``) is the located
+    ``InputError`` "cannot read WHAT: REASON" - at ``location`` (the reference to the file,
+    e.g. an ``<include>``), else at the file itself.
+
+    Raises:
+        InputError: as ``read_bounded``, or the file cannot be opened or read.
+    """
+    try:
+        return read_bounded(path)
+    except OSError as exc:
+        raise InputError(
+            f"cannot read {what}: {exc.strerror}" if what else f"cannot read: {exc.strerror}",
+            location=location or SourceLocation(str(path)),
+            element=element,
+        ) from None
+
+
 def read_bounded(path: Path) -> bytes:
     """A regular file's bytes, refused past ``max_input_bytes`` (see the module text).
 
