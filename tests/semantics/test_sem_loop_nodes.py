@@ -263,16 +263,6 @@ def test_sem_loop_hand_trace_matches_btcpp() -> None:
 
 
 # -- NuSMV encoding ----------------------------------------------------------------------------
-@pytest.fixture(scope="module")
-def nusmv_binary():
-    from fsmbt.verify.nusmv.binary import find_nusmv
-
-    path = find_nusmv()
-    if path is None:
-        pytest.skip("NuSMV is not available (FSMBT_NUSMV, scripts/build_nusmv.sh)")
-    return path
-
-
 LOOP_TREES = [
     '<Sequence><LoopDouble queue="1;2;3" value="{n}"><Action ID="P"/></LoopDouble>'
     '<Action ID="Done"/></Sequence>',

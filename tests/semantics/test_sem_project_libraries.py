@@ -87,16 +87,6 @@ REAL_PARALLEL_TREES = [
 ]
 
 
-@pytest.fixture(scope="module")
-def nusmv_binary():
-    from fsmbt.verify.nusmv.binary import find_nusmv
-
-    path = find_nusmv()
-    if path is None:
-        pytest.skip("NuSMV is not available (FSMBT_NUSMV, scripts/build_nusmv.sh)")
-    return path
-
-
 @pytest.mark.nusmv
 @pytest.mark.parametrize("xml", REAL_PARALLEL_TREES)
 def test_sem_real_parallel_nusmv_agrees_with_the_native_checker(

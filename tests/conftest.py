@@ -1,7 +1,6 @@
-"""Session fixture: a NuSMV binary, built by scripts/build_nusmv.sh when missing.
-
-The agreement test imports the mutation suite's families from ``support.mutation_families``
-(tests/support, importable through ``pythonpath`` in pyproject.toml) instead of copying them."""
+"""Session fixtures shared by every test folder: ``nusmv_binary``, the NuSMV binary, built by
+scripts/build_nusmv.sh when missing (the NuSMV agreement, CLI and encoding tests of
+tests/verify/nusmv, and the semantics tests that encode their node families for NuSMV)."""
 
 from __future__ import annotations
 
