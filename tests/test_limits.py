@@ -227,3 +227,14 @@ def test_include_root_option_widens_the_confinement(tmp_path: Path) -> None:
     with pytest.raises(InputError, match="outside the folder of the file read"):
         read_model(child)
     assert set(read_model(child, options={"include_root": str(tmp_path)}).trees) == {"C", "S"}
+
+
+def test_changed_holds_for_its_block_only_even_when_the_block_raises() -> None:
+    before = limits.current()
+    with limits.changed(max_states=7) as inside:
+        assert limits.current() is inside and inside.max_states == 7
+        assert inside.max_nodes == before.max_nodes
+    assert limits.current() is before
+    with pytest.raises(RuntimeError), limits.changed(max_nodes=3):
+        raise RuntimeError("the block failed")
+    assert limits.current() is before

@@ -7,7 +7,7 @@ limit and how to raise it - never a hang, a crash or an exhausted machine.
 Each limit has a default here, an environment variable ``FSMBT_MAX_<NAME>`` (read when
 :func:`current` is first called after :func:`reset`, i.e. once per process by default) and a
 programmatic override: ``limits.current().with_changes(max_states=10)`` gives a copy, and
-:func:`use` installs a copy for the process (a CLI flag is one ``use(current().with_changes(...))``
+:func:`use` installs a copy for the process (:func:`changed`: for one ``with`` block) (a CLI flag is one ``use(current().with_changes(...))``
 line). Readers call ``current()`` at each read, so an override applies to the next read.
 
 This module imports nothing from fsmbt: ``model/`` and ``formats/`` use it without pulling in
@@ -18,6 +18,8 @@ from __future__ import annotations
 
 import dataclasses
 import os
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, fields
 
 ENV_PREFIX = "FSMBT_"
@@ -140,6 +142,23 @@ def use(limits: Limits) -> Limits:
     previous = current()
     _current = limits
     return previous
+
+
+@contextmanager
+def changed(**changes: int | float) -> Iterator[Limits]:
+    """Within the block, the limits in force with ``changes`` (``max_states=10``); after it,
+    the ones before, whatever the block raised - for a script or a test that needs other
+    bounds for one call.
+
+    Yields:
+        The limits in force inside the block.
+    """
+    inside = current().with_changes(**changes)
+    previous = use(inside)
+    try:
+        yield inside
+    finally:
+        use(previous)
 
 
 def reset() -> None:

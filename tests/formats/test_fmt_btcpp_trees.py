@@ -92,25 +92,17 @@ def test_folder_lookup_is_bounded_by_max_tree_files(tmp_path: Path) -> None:
     main = main_file(tmp_path, "Sub")
     for i in range(4):
         tree_file(tmp_path / f"t{i}.xml", f"T{i}", "<A/>")
-    previous = limits.use(limits.current().with_changes(max_tree_files=3))
-    try:
+    with limits.changed(max_tree_files=3):
         with pytest.raises(InputError, match="FSMBT_MAX_TREE_FILES"):
             read_model(main)
-    finally:
-        limits.use(previous)
 
 
 def test_folder_lookup_obeys_the_size_limit(tmp_path: Path) -> None:
     main = main_file(tmp_path, "Sub")
     big = tree_file(tmp_path / "big.xml", "Sub", "<A/>" + " " * 5000)
-    previous = limits.use(
-        limits.current().with_changes(max_input_bytes=len(main.read_bytes()) + 50)
-    )
-    try:
+    with limits.changed(max_input_bytes=len(main.read_bytes()) + 50):
         warnings: list[str] = []
         doc = read_model(main, warnings=warnings)
-    finally:
-        limits.use(previous)
     assert "Sub" not in doc.trees and big.name in " ".join(warnings)
 
 

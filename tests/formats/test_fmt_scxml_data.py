@@ -103,12 +103,9 @@ def test_an_unbounded_variable_ends_in_the_state_limit_naming_it() -> None:
   <state id="s"><transition event="tick" target="s"><assign location="n" expr="n + 1"/>
     </transition><transition event="stop" cond="n == 3" target="end"/></state>
   <final id="end"/>"""
-    previous = limits.use(limits.current().with_changes(conversion_max_states=50))
-    try:
+    with limits.changed(conversion_max_states=50):
         with pytest.raises(StateLimitError, match=r"the variable 'n' took \d+ distinct values"):
             loads(doc(body), "scxml")
-    finally:
-        limits.use(previous)
 
 
 def test_an_unbounded_variable_stops_at_its_value_limit_before_the_state_limit() -> None:
@@ -119,13 +116,10 @@ def test_an_unbounded_variable_stops_at_its_value_limit_before_the_state_limit()
   <state id="s"><transition event="tick" target="s"><assign location="n" expr="n + 1"/>
     </transition><transition event="stop" cond="n == 3" target="end"/></state>
   <final id="end"/>"""
-    previous = limits.use(limits.current().with_changes(max_data_values=40))
-    try:
+    with limits.changed(max_data_values=40):
         with pytest.raises(StateLimitError, match=r"'n' took more than 40 distinct values") as info:
             loads(doc(body), "scxml")
         assert "FSMBT_MAX_DATA_VALUES" in str(info.value)
-    finally:
-        limits.use(previous)
 
 
 def test_assign_of_an_expression_outside_the_subset_to_a_guard_variable_is_refused() -> None:

@@ -174,31 +174,22 @@ def test_limits_and_hostile_xml_hold_for_included_files(tmp_path: Path) -> None:
         inner = f'<xi:include href="chain{n + 1}.scxml"/>' if n < 3 else ""
         write(tmp_path, f"chain{n}.scxml", f'<state {NS} {XI} id="c{n}">{inner}</state>')
     main = write(tmp_path, "Main.scxml", MAIN.format(href="chain0.scxml").replace("Sub1", "c0", 1))
-    previous = limits.use(limits.current().with_changes(max_include_depth=3))
-    try:
+    with limits.changed(max_include_depth=3):
         with pytest.raises(InputError, match="FSMBT_MAX_INCLUDE_DEPTH"):
             api.load(main)
-    finally:
-        limits.use(previous)
     write(tmp_path, "big.scxml", FRAGMENT + " " * 5000)
     big = write(tmp_path, "Main.scxml", MAIN.format(href="big.scxml"))
-    previous = limits.use(limits.current().with_changes(max_input_bytes=len(big.read_text()) + 10))
-    try:
+    with limits.changed(max_input_bytes=len(big.read_text()) + 10):
         with pytest.raises(InputError, match="FSMBT_MAX_INPUT_BYTES"):
             api.load(big)
-    finally:
-        limits.use(previous)
     # repeated inclusion doubles per level: the expanded total is bounded, not only each file
     for n in range(12):
         inner = f'<xi:include href="d{n + 1}.scxml"/>' * 2 if n < 11 else ""
         write(tmp_path, f"d{n}.scxml", f'<state {NS} {XI} id="d{n}">{inner}</state>')
     double = write(tmp_path, "Main.scxml", MAIN.format(href="d0.scxml").replace("Sub1", "d0", 1))
-    previous = limits.use(limits.current().with_changes(max_input_bytes=100_000))
-    try:
+    with limits.changed(max_input_bytes=100_000):
         with pytest.raises(InputError, match="each inclusion counted"):
             api.load(double)
-    finally:
-        limits.use(previous)
     write(
         tmp_path,
         "evil.scxml",

@@ -222,18 +222,12 @@ def test_nested_sessions_and_the_state_bound() -> None:
     outer = child(f'<state id="m">{inner}</state>', 'id="k" autoforward="true"')
     model = read(doc(f'<state id="s">{outer}</state>'))
     assert walk(model, ["flip", "flip"]) == ["s{k=m{g=x}}", "s{k=m{g=y}}", "s{k=m{g=x}}"]
-    previous = limits.use(limits.current().with_changes(max_states=1))
-    try:
+    with limits.changed(max_states=1):
         with pytest.raises(InputError, match="more than 1 reachable"):
             read(doc(f'<state id="s">{outer}</state>'))
-    finally:
-        limits.use(previous)
-    previous = limits.use(limits.current().with_changes(max_include_depth=1))
-    try:
+    with limits.changed(max_include_depth=1):
         with pytest.raises(InputError, match="FSMBT_MAX_INCLUDE_DEPTH"):
             read(doc(f'<state id="s">{outer}</state>'))
-    finally:
-        limits.use(previous)
 
 
 @pytest.mark.parametrize(
@@ -358,12 +352,9 @@ def test_repeated_invocation_of_files_is_bounded_in_all(tmp_path: Path) -> None:
         body = "".join(f'<state id="s{k}"><invoke src="i{n + 1}.scxml"/></state>' for k in range(2))
         write = body if n < 11 else '<state id="leaf"/>'
         (tmp_path / f"i{n}.scxml").write_text(doc(f'<parallel id="p">{write}</parallel>'))
-    previous = limits.use(limits.current().with_changes(max_input_bytes=50_000))
-    try:
+    with limits.changed(max_input_bytes=50_000):
         with pytest.raises(InputError, match="each <invoke> counted"):
             api.load(tmp_path / "i0.scxml")
-    finally:
-        limits.use(previous)
 
 
 def test_error_in_an_invoked_file_names_that_file(tmp_path: Path) -> None:
@@ -501,11 +492,8 @@ def test_deep_nesting_is_bounded_without_recursion_errors() -> None:
             body = f'<state id="m{i}">{invoke}</state>'
         return doc(body)
 
-    previous = limits.use(limits.current().with_changes(max_include_depth=10_000))
-    try:
+    with limits.changed(max_include_depth=10_000):
         deepest = read(nested(MAX_SESSION_DEPTH))
         assert len(deepest.states) == 2  # 'flip' is forwarded down every level
         with pytest.raises(InputError, match=f"bound of {MAX_SESSION_DEPTH} nested sessions"):
             read(nested(MAX_SESSION_DEPTH + 1))
-    finally:
-        limits.use(previous)

@@ -125,13 +125,10 @@ def test_ten_megabytes_of_text_is_cut_off_at_the_limit_and_retried(
 
 
 def test_the_response_limit_is_the_one_in_fsmbt_limits(bt: BTDocument, tmp_path: Path) -> None:
-    previous = limits.use(limits.current().with_changes(llm_max_response_bytes=200))
-    try:
+    with limits.changed(llm_max_response_bytes=200):
         with ScriptedServer([{"content": GOOD}]) as server:
             with pytest.raises(LLMUnavailableError, match="exceeded 200 bytes"):
                 convert_with_llm(bt, client_for(server, tmp_path, max_retries=0))
-    finally:
-        limits.use(previous)
 
 
 def test_truncated_json_body_is_a_failed_attempt(bt: BTDocument, tmp_path: Path) -> None:

@@ -336,8 +336,7 @@ def test_sem_loop_and_real_parallel_nusmv_agrees_on_random_trees(nusmv_binary) -
     from fsmbt.verify.nusmv.runner import NuSMVLimitError
 
     compared = 0
-    previous = limits.use(limits.current().with_changes(nusmv_max_seconds=8))
-    try:
+    with limits.changed(nusmv_max_seconds=8):
         for seed in range(40):
             doc = _smv_tree(seed)
             if not any(n.type in ("LoopInt", "stardust.RealParallel") for _t, n in doc.nodes()):
@@ -352,6 +351,4 @@ def test_sem_loop_and_real_parallel_nusmv_agrees_on_random_trees(nusmv_binary) -
                 continue  # too large for NuSMV in 8 s (counted below)
             assert report.equivalent, (seed, report)
             compared += 1
-    finally:
-        limits.use(previous)
     assert compared >= 10, compared

@@ -40,12 +40,9 @@ def test_memory_cap_is_a_clear_limit_error(nusmv_binary, paper_model, monkeypatc
 def test_time_cap_is_a_clear_limit_error(nusmv_binary, paper_model, monkeypatch) -> None:
     monkeypatch.setenv("FSMBT_NUSMV", str(nusmv_binary))
     text, names = paper_model
-    previous = limits.use(limits.current().with_changes(nusmv_max_seconds=0.001))
-    try:
+    with limits.changed(nusmv_max_seconds=0.001):
         with pytest.raises(NuSMVLimitError) as caught:
             run_nusmv(text, len(names))
-    finally:
-        limits.use(previous)
     assert caught.value.resource == "time"
     assert "NuSMV ran out of time" in str(caught.value)
 
