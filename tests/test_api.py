@@ -64,7 +64,8 @@ def test_existing_destination_is_refused_before_any_work(
     def must_not_run(*args: object, **kwargs: object) -> None:
         raise AssertionError("the conversion ran although the destination is refused")
 
-    monkeypatch.setattr(api, "load_for_engine", must_not_run)
+    monkeypatch.setattr(api, "load", must_not_run)
+    monkeypatch.setattr(api, "load_for_llm", must_not_run)
     with pytest.raises(api.DestinationExists) as caught:
         api.convert_file(PAPER_FSM, out)
     assert "taken.xml" in str(caught.value)
@@ -143,7 +144,7 @@ def test_verify_files_reads_both_and_reports(tmp_path: Path) -> None:
 
 def test_llm_engine_input_read_by_a_parser_keeps_its_format_and_warnings() -> None:
     # hybrid asks the LLM only when no parser reads the file: here the paper's XML reader does
-    options: dict[str, object] = {}
-    loaded = api.load_for_engine(PAPER_FSM, "hybrid", options=options)
+    loaded, client = api.load_for_llm(PAPER_FSM, api.ConvertRequest(engine="hybrid"))
+    assert client is None
     assert loaded.format == "paper-xml" and not loaded.extracted_by_llm
     assert loaded.warnings == api.load(PAPER_FSM).warnings
