@@ -3,6 +3,7 @@
 from pathlib import Path
 
 import pytest
+from pydantic import ValidationError
 
 from fsmbt import api, limits
 from fsmbt.api_types import ConvertRequest, ReadOptions, convert_request, verify_request
@@ -37,7 +38,7 @@ def test_requests_are_values() -> None:
     request = ConvertRequest(engine="bsd")
     changed = convert_request(request, loop=True)
     assert (request.loop, changed.loop, changed.engine) == (False, True, "bsd")
-    with pytest.raises(Exception):
+    with pytest.raises(ValidationError, match="frozen"):
         request.loop = True  # type: ignore[misc]
 
 
