@@ -148,3 +148,21 @@ def test_llm_engine_input_read_by_a_parser_keeps_its_format_and_warnings() -> No
     assert client is None
     assert loaded.format == "paper-xml" and not loaded.extracted_by_llm
     assert loaded.warnings == api.load(PAPER_FSM).warnings
+
+
+def test_written_results_honour_the_umask_and_keep_a_replaced_files_mode(tmp_path: Path) -> None:
+    import os
+    import stat
+
+    previous = os.umask(0o022)
+    try:
+        fresh = api.write_text("x", tmp_path / "fresh.txt")
+        assert stat.S_IMODE(fresh.stat().st_mode) == 0o644
+        kept = tmp_path / "kept.txt"
+        kept.write_text("old", encoding="utf-8")
+        kept.chmod(0o640)
+        api.write_text("new", kept, overwrite=True)
+        assert stat.S_IMODE(kept.stat().st_mode) == 0o640
+        assert kept.read_text(encoding="utf-8") == "new"
+    finally:
+        os.umask(previous)

@@ -28,8 +28,8 @@ def test_unknown_or_mistyped_options_are_named() -> None:
         convert_request(verifyengine="nusmv")
     with pytest.raises(InputError, match="verify_engine"):
         convert_request(verify_engine="z3")
-    with pytest.raises(InputError, match="abstract"):
-        convert_request(options={"abstract": "weather"})
+    with pytest.raises(InputError, match="hierarchy"):
+        convert_request(hierarchy="nested")
     with pytest.raises(InputError, match="max_states"):
         verify_request(max_states=0)
 

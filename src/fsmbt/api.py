@@ -52,6 +52,8 @@ from fsmbt.api_types import (
 from fsmbt.convert import ConversionResult, convert
 from fsmbt.formats import detect_format, dumps, get_format, loads
 from fsmbt.formats.registry import format_for_path, read_text
+from fsmbt.formats.translate import Translation
+from fsmbt.formats.translate import translate as translate_model
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import Hint, InputError, SourceLocation, UnsupportedError
 from fsmbt.model.fsm import FSM
@@ -535,10 +537,37 @@ def write(
     return write_text(dumps(model, chosen), path, overwrite=overwrite)
 
 
+def _file_mode(path: Path) -> int:
+    """The mode ``path`` keeps when replaced, else ``0o666`` less the umask."""
+    try:
+        return path.stat().st_mode & 0o7777
+    except OSError:
+        return 0o666 & ~_umask()
+
+
+def _umask() -> int:
+    """The process's umask, read without changing it where the system says it (Linux's
+    ``/proc/self/status``: setting and restoring it races with other threads' file creation)."""
+    try:
+        with open("/proc/self/status", encoding="ascii") as status:
+            for line in status:
+                if line.startswith("Umask:"):
+                    return int(line.split()[1], 8)
+    except (OSError, ValueError, IndexError):
+        pass
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
+
+
 def write_text(text: str, path: str | Path, *, overwrite: bool = False) -> Path:
     """Write a text atomically: a temporary file in the same folder, then a rename.
 
-    A reader never sees half a file, and a crash mid-write leaves the old file (or none).
+    A reader never sees half a file, and a crash mid-write leaves the old file (or none). The
+    file gets the mode a plain ``open`` would give it: a replaced file keeps its own mode, a new
+    one ``0o666`` less the process's umask (a temporary file is created ``0o600``; without this,
+    results would be unreadable to the user's group although ``render`` and ``translate``
+    outputs were not).
 
     Args:
         text: what to write (UTF-8).
@@ -561,6 +590,7 @@ def write_text(text: str, path: str | Path, *, overwrite: bool = False) -> Path:
             with os.fdopen(handle, "w", encoding="utf-8", newline="") as stream:
                 stream.write(text)
                 stream.flush()
+                os.fchmod(stream.fileno(), _file_mode(path))
                 os.fsync(stream.fileno())
             if not overwrite and path.exists():  # appeared while we wrote: keep it
                 raise DestinationExists(SourceLocation(str(path)))
@@ -787,6 +817,71 @@ def verify_files(
     return first, second, report
 
 
+def translate(
+    source: str | Path,
+    output: str | Path | None = None,
+    *,
+    to: str | None = None,
+    read: ReadOptions | None = None,
+    flatten: bool = False,
+    overwrite: bool = False,
+    verify_request: VerifyRequest | None = None,
+) -> tuple[Loaded, Translation, Report | None]:
+    """The same model in another format, every loss named, proven to mean the same.
+
+    Read (``load``) -> write in the target format and read it back (``fsmbt.formats.translate``)
+    -> prove the read-back equivalent to the source (``verify_models``; a loss that changes
+    behaviour is an ``UnsupportedError`` and nothing is written) -> write atomically, after
+    the destination was checked before any work.
+
+    Args:
+        source: the input file.
+        output: where to write (``None``: only return the text).
+        to: the target format (default: from ``output``'s extension and the model's kind).
+        read: how the input is read (format, reader options).
+        flatten: write a hierarchical FSM as its flat machine (named as a loss).
+        overwrite: an existing ``output`` may be replaced.
+        verify_request: the checker and its limits (default: native).
+
+    Returns:
+        The source as read, the ``Translation`` (text, losses, ``verified``) and the
+        equivalence report (``None`` when the target cannot be read back).
+
+    Raises:
+        InputError, UnsupportedError: unreadable input, an unknown target, a refused
+        destination, or a translation that changes the model's behaviour (located).
+    """
+    read = read or ReadOptions()
+    destination = check_destination(output, overwrite=overwrite) if output is not None else None
+    loaded = load(source, read.format, options=read)
+    target = to
+    if target is None and destination is not None:
+        guessed = format_for_path(destination, writing=True, kind=loaded.kind)
+        target = guessed.name if guessed is not None else None
+    if target is None:
+        where = f" (from '{destination.name}')" if destination is not None else ""
+        raise InputError(f"cannot tell the target format; name it with --to{where}")
+    result = translate_model(loaded.model, target, flatten=flatten, source_format=loaded.format)
+    result.warnings = list(loaded.warnings)
+    report: Report | None = None
+    if result.read_back is not None and result.checked is not None:
+        request = verify_request or VerifyRequest()
+        report = verify_models(
+            result.checked, result.read_back, request.engine, max_states=request.max_states
+        )
+        if not report.equivalent:
+            failed = [name for name, prop in report.properties.items() if not prop.holds]
+            details = "; ".join(f"{name}: {report.properties[name].detail}" for name in failed)
+            raise UnsupportedError(
+                f"translating to {result.target_format} changes the model's behaviour "
+                f"({details}); nothing written"
+            )
+        result.verified = True
+    if destination is not None:
+        write_text(result.text, destination, overwrite=overwrite)
+    return loaded, result, report
+
+
 __all__ = [
     "ConvertRequest",
     "ReadOptions",
@@ -815,6 +910,7 @@ __all__ = [
     "verdict_word",
     "verify_either_order",
     "verify_files",
+    "translate",
     "verify_models",
     "write",
     "write_text",

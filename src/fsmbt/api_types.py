@@ -32,10 +32,18 @@ from fsmbt.model.errors import InputError
 VerifyEngine = Literal["native", "nusmv", "both"]
 #: FSM -> BT of a hierarchical FSM: one SubTree per composite state, or the flattened machine.
 Hierarchy = Literal["subtrees", "flatten"]
-#: Abstraction families a reader may model as environment inputs (docs/semantics.md §10).
-ABSTRACTION_FAMILIES = ("time", "blackboard")
 #: The reader option names (``ReadOptions`` fields that readers receive in their context).
-READER_FIELDS = ("node_models", "nodes", "abstract", "data", "trees", "include_root")
+READER_FIELDS = (
+    "node_models",
+    "nodes",
+    "abstract",
+    "data",
+    "trees",
+    "include_root",
+    "machine",
+    "behaviour",
+    "initial",
+)
 
 
 def _as_list(value: object) -> object:
@@ -83,22 +91,18 @@ class ReadOptions(_Request):
     include_root: str | None = Field(
         default=None, description="the folder <include path> may resolve anywhere under"
     )
+    machine: str | None = Field(
+        default=None, description="SMACH: which top-level container to read"
+    )
+    behaviour: str | None = Field(default=None, description="FlexBE: which Behavior class to read")
+    initial: str | None = Field(
+        default=None, description="tables: the initial state (default: the first row's source)"
+    )
 
     @field_validator("node_models", "nodes", "abstract", "trees", mode="before")
     @classmethod
     def _listify(cls, value: object) -> object:
         return _as_list(value)
-
-    @field_validator("abstract")
-    @classmethod
-    def _known_families(cls, value: list[str]) -> list[str]:
-        unknown = [family for family in value if family not in ABSTRACTION_FAMILIES]
-        if unknown:
-            raise ValueError(
-                f"unknown abstraction family {', '.join(unknown)} "
-                f"(known: {', '.join(ABSTRACTION_FAMILIES)})"
-            )
-        return value
 
     def reader_options(self) -> dict[str, object] | None:
         """The options the readers take (``fsmbt.formats`` ``ReadContext.options``), or
@@ -213,6 +217,19 @@ def option_error(error: ValidationError) -> InputError:
     return InputError(f"invalid option(s): {'; '.join(parts)}")
 
 
+def read_options(options: ReadOptions | None = None, **fields: Any) -> ReadOptions:
+    """``options`` with ``fields`` changed, or new options from ``fields`` (validated).
+
+    Raises:
+        InputError: an unknown reader option or a value of the wrong type (every one named).
+    """
+    try:
+        base = options.model_dump() if options is not None else {}
+        return ReadOptions(**{**base, **fields})
+    except ValidationError as error:
+        raise option_error(error) from None
+
+
 def convert_request(request: ConvertRequest | None = None, **fields: Any) -> ConvertRequest:
     """``request`` with ``fields`` changed, or a new request from ``fields`` (validated).
 
@@ -254,7 +271,6 @@ def verify_request(request: VerifyRequest | None = None, **fields: Any) -> Verif
 
 
 __all__ = [
-    "ABSTRACTION_FAMILIES",
     "READER_FIELDS",
     "ConvertRequest",
     "Hierarchy",
@@ -264,5 +280,6 @@ __all__ = [
     "checker_limit",
     "convert_request",
     "option_error",
+    "read_options",
     "verify_request",
 ]

@@ -23,8 +23,9 @@ from pathlib import Path
 import pytest
 from lxml import etree
 
+from fsmbt import api
 from fsmbt.convert.engines import converter_for
-from fsmbt.formats import dumps, read_model
+from fsmbt.formats import dumps
 from fsmbt.generate import random_fsm
 from fsmbt.model.errors import FsmbtError, InputError, UnsupportedError
 from fsmbt.model.fsm import FSM
@@ -102,7 +103,7 @@ def example_fsms() -> list[tuple[str, FSM]]:
     out = []
     for path in sorted((REPO / "examples").iterdir()):
         try:
-            model = read_model(path)
+            model = api.load(path).model
         except FsmbtError:
             continue
         if isinstance(model, FSM):
@@ -152,7 +153,7 @@ def test_the_runtime_reports_what_the_callables_did() -> None:
     }
     for engine in ENGINES:
         calls.clear()
-        runner = load_tree(tree_of(read_model(DOOR)), actions, engine=engine)
+        runner = load_tree(tree_of(api.load(DOOR).model), actions, engine=engine)
         assert not runner.started and runner.start() == ("Closed",) and calls == ["Closed"]
         assert runner.state == "Operating/Closed"
         assert runner.post("fully_open") == () and calls == ["Closed"]  # ignored event
@@ -171,7 +172,7 @@ DOOR_ACTIONS = {
 
 
 def door_tree() -> str:
-    return tree_of(read_model(DOOR))
+    return tree_of(api.load(DOOR).model)
 
 
 def test_missing_callable_is_a_load_error_naming_the_action() -> None:

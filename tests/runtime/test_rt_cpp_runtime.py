@@ -10,9 +10,10 @@ from pathlib import Path
 
 import pytest
 
+from fsmbt import api
 from fsmbt.cli import main
 from fsmbt.convert import convert
-from fsmbt.formats import dumps, read_model
+from fsmbt.formats import dumps
 from fsmbt.runtime import cpp as cpp_runtime
 from fsmbt.runtime.cpp import DriverSession, library_prefix
 
@@ -55,7 +56,7 @@ def _tree(tmp_path: Path, leaf: str = GOOD_LEAF, name: str = "tree.xml") -> Path
 
 def _door_tree(tmp_path: Path) -> Path:
     path = tmp_path / "door_bt.xml"
-    path.write_text(dumps(convert(read_model(DOOR)).model, "btcpp"), encoding="utf-8")
+    path.write_text(dumps(convert(api.load(DOOR).model).model, "btcpp"), encoding="utf-8")
     return path
 
 

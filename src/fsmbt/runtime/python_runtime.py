@@ -38,11 +38,12 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping
 from pathlib import Path
 
-from fsmbt.formats import loads, read_model
+from fsmbt import api
+from fsmbt.formats import loads
 from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.bt_nodes import NodeKind
 from fsmbt.model.errors import InputError
-from fsmbt.semantics.bt_interpreter import CompiledTree
+from fsmbt.semantics.execution import lebt_engine_run
 from fsmbt.semantics.lebt.driver import EngineLebtRun
 from fsmbt.semantics.lebt.spec import GUARD_TYPE, STATE_TYPE
 from fsmbt.semantics.nodes import PLAIN_CONTROLS
@@ -84,9 +85,8 @@ class TreeRunner:
         if engine not in ENGINES:
             raise InputError(f"unknown engine '{engine}' (known: {', '.join(ENGINES)})")
         check_lebt_nodes(doc)
-        tree = CompiledTree(doc)
         self.engine = engine
-        self._run = _engine_runner(engine, tree)
+        self._run = lebt_engine_run(doc, engine)
         self.used_actions = _check_actions(self._run, actions, allow_unused=allow_unused)
         self._actions = dict(actions)
         self._started = False
@@ -166,7 +166,7 @@ def load_tree(
     if isinstance(source, str) and source.lstrip("\ufeff \t\r\n").startswith("<"):
         model = loads(source, "btcpp")
     else:
-        model = read_model(Path(source))
+        model = api.load(Path(source)).model
     if not isinstance(model, BTDocument):
         raise InputError(
             "not a behavior tree: the runtime runs converted trees "
@@ -199,17 +199,6 @@ def check_lebt_nodes(doc: BTDocument) -> None:
                     element=f"<{node.type}> '{node.label}'",
                 )
             stack.extend(reversed(node.children))
-
-
-def _engine_runner(engine: str, tree: CompiledTree) -> EngineLebtRun:
-    """The engine adapter of fsmbt's differential tests, on the compiled tree."""
-    if engine == "btcpp":
-        from fsmbt.semantics.engines.btcpp_engine import BTCppLebtRunner
-
-        return BTCppLebtRunner(tree)
-    from fsmbt.semantics.engines.pytrees_engine import PyTreesLebtRunner
-
-    return PyTreesLebtRunner(tree)
 
 
 def _check_actions(
