@@ -104,7 +104,7 @@ def test_action_and_hook_definitions() -> None:
     assert any("action_diff.sh" in step.get("run", "") for step in action["runs"]["steps"])
     hooks = yaml.safe_load((ROOT / ".pre-commit-hooks.yaml").read_text(encoding="utf-8"))
     [hook] = hooks
-    assert hook["entry"].split()[:2] == ["fsmbt", "diff-changes"]
+    assert hook["entry"].split()[:2] == ["fsmbt", "review"]
 
 
 def test_pre_commit_command_on_the_working_tree(

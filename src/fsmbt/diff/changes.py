@@ -1,6 +1,6 @@
 """Diff every model file that changed between two git revisions (docs/diff.md, 'Pull requests
 and pre-commit'): what the GitHub Action (``action.yml``) and the pre-commit hook
-(``.pre-commit-hooks.yaml``) run through ``fsmbt diff-changes``.
+(``.pre-commit-hooks.yaml``) run through ``fsmbt review``.
 
 Rules: the changed files are ``git diff --name-status BASE [HEAD]`` (without HEAD: the working
 tree, which is what pre-commit checks), kept when their name matches one of ``patterns``

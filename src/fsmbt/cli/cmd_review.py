@@ -1,4 +1,4 @@
-"""``fsmbt diff-changes BASE [HEAD]``: diff every model file changed between two git revisions
+"""``fsmbt review BASE [HEAD]``: diff every model file changed between two git revisions
 (or BASE and the working tree); what the GitHub Action and the pre-commit hook run.
 
 Exit 0 no behaviour changed, 1 some behaviour changed (only with ``--fail-on-change``; else 0),
@@ -18,8 +18,8 @@ EXIT_BAD = 2
 
 
 def register(app: typer.Typer) -> None:
-    @app.command("diff-changes")
-    def diff_changes_command(
+    @app.command("review")
+    def review_command(
         base: str = typer.Argument(..., help="The base revision (e.g. origin/main, HEAD)."),
         head: str | None = typer.Argument(None, help="The head revision (default: working tree)."),
         repo: Path = typer.Option(Path("."), "--repo", help="The git repository."),
