@@ -153,3 +153,22 @@ def test_bad_input(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["diff", str(out), str(ROBOT)]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "cannot pair" in err[0]
+
+
+def test_fsm_against_its_converted_tree(tmp_path: Path) -> None:
+    """A BT against the FSM it must implement, in either order: the verdict is the verifier's
+    and every witness is confirmed on the machines."""
+    fsm = api.load(EXAMPLES / "paper_fsm.xml").model
+    bt_path = tmp_path / "paper_bt.xml"
+    assert main(["convert", str(EXAMPLES / "paper_fsm.xml"), "-o", str(bt_path)]) == 0
+    bt = api.load(bt_path).model
+    assert diff.diff_models(fsm, bt).same
+    differing = 0
+    for mutant in mutants(bt, seed=1, per_operator=1):
+        report = diff.diff_models(fsm, mutant.model)
+        assert report.same == verify(fsm, mutant.model).equivalent, mutant.description
+        assert report.script is None  # two kinds: no edit script
+        assert diff.diff_models(mutant.model, fsm).same == report.same
+        _confirm(fsm, mutant.model, report)
+        differing += not report.same
+    assert differing >= 2
