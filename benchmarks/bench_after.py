@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import argparse
 import copy
+import os
 import statistics
 import sys
 import tempfile
@@ -173,6 +174,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--models", type=int, default=200)
     parser.add_argument("--events", type=int, default=1_000_000)
     args = parser.parse_args(argv)
+    cores = os.cpu_count()
+    load = ", ".join(f"{x:.1f}" for x in os.getloadavg())
+    print(f"(machine: {cores} cores, load average {load} at the start)\n")
     if args.part in ("diff", "all"):
         print("## diff\n")
         part_diff()

@@ -1,5 +1,5 @@
 """Replay a recorded execution through a model's semantics (docs/conform.md, 'The replay';
-docs/semantics.md, 'The leaf-execution machine').
+docs/semantics.md §4 'The leaf-execution machine' and §4b, whose rules this implements).
 
 The model is read as its leaf-execution machine with the root ticked again after it returns
 (``loop``): a BT as ``LeafMachine`` (the faithful interpreter), an FSM as ``FSMLeafMachine``
@@ -51,6 +51,7 @@ from fsmbt.conform.log import (
 )
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.bt_nodes import NodeKind
+from fsmbt.model.errors import InputError, SourceLocation
 from fsmbt.model.fsm import FSM
 from fsmbt.semantics.bt_interpreter import CompiledNode
 from fsmbt.semantics.leaf_machine import LeafMachine
@@ -177,8 +178,6 @@ class Replayer:
         Raises:
             InputError: no leaf in common (located at the log).
         """
-        from fsmbt.model.errors import InputError, SourceLocation
-
         leaves = [n for n in log.nodes.values() if n.leaf]
         if isinstance(self.model, BTDocument):
             known = sum(1 for n in leaves if self.map_node(n) is not None)

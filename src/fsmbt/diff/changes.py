@@ -164,7 +164,8 @@ def diff_changes(
                     max_groups=max_groups,
                 )
             except FsmbtError as exc:
-                item.error = str(exc).replace(tmp, "")
+                message = str(exc).replace(f"{tmp}/old/", f"{base}:")
+                item.error = message.replace(f"{tmp}/new/", f"{head}:")
     return changes
 
 
