@@ -48,6 +48,7 @@ def repo(tmp_path: Path) -> Path:
     (repo / "models" / "robot.xml").write_text(text.replace(*SWAP), encoding="utf-8")
     shutil.copy(ROOT / "examples" / "prey_bt.xml", repo / "models" / "prey.xml")
     (repo / "README.txt").write_text("still not a model\n")
+    (repo / "package.xml").write_text('<?xml version="1.0"?>\n<package format="3"/>\n')
     _git(repo, "add", "-A")
     _git(repo, "commit", "-q", "-m", "second: swap two children of a Fallback")
     return repo
@@ -84,6 +85,7 @@ def test_action_script_posts_the_markdown(repo: Path, tmp_path: Path) -> None:
     assert "**moved** node `Dock`" in comment
     assert "models/prey.xml" in comment and "paper.xml" not in comment  # unchanged: not listed
     assert "README" not in comment
+    assert "`package.xml` (not a model)" in comment and "package.xml: not a model" in done.stdout
     assert (tmp_path / "github_output").read_text() == f"markdown={tmp_path / 'comment.md'}\n"
     failing = _run_action(repo, tmp_path, FSMBT_FAIL_ON_CHANGE="true")
     assert failing.returncode == 1

@@ -7,7 +7,8 @@ tree, which is what pre-commit checks), kept when their name matches one of ``pa
 (``fnmatch``, default ``DEFAULT_PATTERNS``). A modified or renamed file is diffed against its
 BASE version (read with ``git show``, written into a temporary folder under the same name so the
 format is detected as usual); an added file is only read (a model that does not load is a bad
-input); a deleted file is listed. git is run without a shell, with a fixed argument list; paths
+input); a deleted file is listed; a matching file no reader recognises by its content (a ROS
+``package.xml``, a launch file) is listed as "not a model". git is run without a shell, with a fixed argument list; paths
 come from git itself. SubTree files that a tree names are read from the same revision only when
 they sit beside it in the temporary folder (a limitation stated in docs/diff.md).
 
@@ -26,6 +27,7 @@ from fsmbt import api
 from fsmbt.diff.behaviour import DEFAULT_MAX_GROUPS
 from fsmbt.diff.compare import diff_models
 from fsmbt.diff.report import DiffReport, to_markdown
+from fsmbt.formats.registry import formats
 from fsmbt.model.errors import FsmbtError, InputError
 
 #: Files treated as models when no pattern is given.
@@ -150,6 +152,9 @@ def diff_changes(
                 continue
             try:
                 new_file = _version(root, head, new_path, Path(tmp) / "new")
+                if not looks_like_a_model(new_file):
+                    item.status = "not a model"
+                    continue
                 if status == "added":
                     api.load(new_file)
                     continue
@@ -167,6 +172,16 @@ def diff_changes(
                 message = str(exc).replace(f"{tmp}/old/", f"{base}:")
                 item.error = message.replace(f"{tmp}/new/", f"{head}:")
     return changes
+
+
+def looks_like_a_model(path: Path) -> bool:
+    """Whether some reader recognises the file's content (a ROS ``package.xml`` or a launch
+    file matches ``*.xml`` but is no model: it is listed, not refused)."""
+    try:
+        text = path.read_bytes()[:65536].decode("utf-8", errors="replace")
+    except OSError:
+        return True  # the reader will say why it cannot be read
+    return any(f.read is not None and f.sniff is not None and f.sniff(text) for f in formats())
 
 
 def _version(repo: Path, rev: str | None, path: str, folder: Path) -> Path:
