@@ -103,3 +103,45 @@ def test_bad_input(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     shutil.copy(ROBOT, full / "x.xml")
     assert main(["testgen", str(ROBOT), "--tree", str(ROBOT), "-o", str(full)]) == 2
     assert "not empty" in capsys.readouterr().err
+
+
+def test_generated_gtest_file_builds_and_tells_trees_apart(
+    fsm_spec: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The GoogleTest file, built with the CMakeLists.txt written beside it against the
+    BehaviorTree.CPP 4.8.2 scripts/setup.sh built: every case passes on the tree, some fail on
+    the tree with two children of a Fallback swapped (given as the program's argument)."""
+    from fsmbt.cache import cache_root
+
+    prefix = cache_root() / "btcpp-4.8.2"
+    if shutil.which("cmake") is None or not Path("/usr/include/gtest/gtest.h").exists():
+        pytest.fail("cmake and libgtest-dev are installed by scripts/setup.sh")
+    assert (prefix / "lib").is_dir(), "scripts/setup.sh builds BehaviorTree.CPP into the cache"
+    out = tmp_path / "suite"
+    assert main(["testgen", str(fsm_spec), "--tree", str(ROBOT), "-o", str(out), "--no-score"]) == 0
+    cases = int(re.search(r"suite: (\d+) cases", capsys.readouterr().out).group(1))  # type: ignore[union-attr]
+    build = tmp_path / "build"
+    for command in (
+        [
+            "cmake",
+            "-S",
+            str(out),
+            "-B",
+            str(build),
+            f"-DCMAKE_PREFIX_PATH={prefix}",
+            "-DCMAKE_BUILD_TYPE=Debug",
+        ],
+        ["cmake", "--build", str(build)],
+    ):
+        done = subprocess.run(command, capture_output=True, text=True, timeout=600, check=False)
+        assert done.returncode == 0, done.stdout[-2000:] + done.stderr[-2000:]
+    program = build / "test_behaviour_btcpp"
+    passed = subprocess.run([program], capture_output=True, text=True, timeout=120, check=False)
+    assert passed.returncode == 0 and f"[  PASSED  ] {cases} tests." in passed.stdout
+    swapped = tmp_path / "swapped.xml"
+    swapped.write_text(ROBOT.read_text(encoding="utf-8").replace(*SWAP), encoding="utf-8")
+    failed = subprocess.run(
+        [program, str(swapped)], capture_output=True, text=True, timeout=120, check=False
+    )
+    assert failed.returncode == 1 and "FAILED TEST" in failed.stdout
+    assert "the tree ticks Dock, expected RobotAtInspection" in failed.stdout

@@ -34,7 +34,14 @@ def register(app: typer.Typer) -> None:
         if not isinstance(loaded_tree.model, BTDocument):
             raise InputError("--tree must be a behavior tree", location=SourceLocation(str(tree)))
         suite = testgen.generate(loaded_spec.model)
-        files = testgen.write_suite(output, suite, tree=tree, spec_name=spec.name, overwrite=force)
+        files = testgen.write_suite(
+            output,
+            suite,
+            tree=tree,
+            spec_name=spec.name,
+            overwrite=force,
+            tree_model=loaded_tree.model,
+        )
         print(
             f"suite: {len(suite.cases)} cases, {suite.steps} scripted leaf ticks; "
             f"covers {suite.covered}/{suite.targets} transitions of {spec.name}"

@@ -1,6 +1,7 @@
 """Write a generated suite as files (docs/testgen.md, 'The files'): the tree under test copied
-beside the tests, the cases as JSON, and one pytest file that runs every case on py_trees and on
-BehaviorTree.CPP 4.8.2 through behaviortreepy.
+beside the tests, the cases as JSON, one pytest file that runs every case on py_trees and on
+BehaviorTree.CPP 4.8.2 through behaviortreepy, and a GoogleTest file with its CMakeLists.txt
+that runs them in BehaviorTree.CPP linked as a C++ library (``cpp.py``).
 
 The pytest file reads behaviour only: it loads the tree with fsmbt's reader, builds it in each
 engine with every leaf scripted by the case (``fsmbt.testgen.runner.run_case``) and asserts the
@@ -14,8 +15,10 @@ import json
 import shutil
 from pathlib import Path
 
+from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import InputError, SourceLocation
 from fsmbt.testgen.cases import Suite
+from fsmbt.testgen.cpp import CMAKE_FILE, CPP_FILE, cmake_text, cpp_text
 
 TEST_FILE = "test_behaviour.py"
 CASES_FILE = "cases.json"
@@ -65,9 +68,16 @@ def test_behaviortree_cpp(case):
 
 
 def write_suite(
-    folder: Path, suite: Suite, *, tree: Path, spec_name: str, overwrite: bool = False
+    folder: Path,
+    suite: Suite,
+    *,
+    tree: Path,
+    spec_name: str,
+    overwrite: bool = False,
+    tree_model: BTDocument | None = None,
 ) -> list[Path]:
-    """Write the suite into ``folder``; returns the files written.
+    """Write the suite into ``folder``; returns the files written. With ``tree_model`` (the
+    tree, read), also the GoogleTest file and its CMakeLists.txt (``fsmbt.testgen.cpp``).
 
     Raises:
         InputError: ``folder`` is a non-empty folder (without ``overwrite``) or a file.
@@ -98,6 +108,16 @@ def write_suite(
             ),
             encoding="utf-8",
         )
+        written = [folder / tree_file, cases, test]
+        if tree_model is not None:
+            source = folder / CPP_FILE
+            source.write_text(
+                cpp_text(tree_model, suite, tree_name=tree.name, spec_name=spec_name),
+                encoding="utf-8",
+            )
+            cmake = folder / CMAKE_FILE
+            cmake.write_text(cmake_text(tree_file), encoding="utf-8")
+            written += [source, cmake]
     except OSError as exc:
         raise InputError(f"cannot write the suite: {exc.strerror}", location=location) from None
-    return [folder / tree_file, cases, test]
+    return written
