@@ -11,6 +11,9 @@ from fsmbt.cli.options import READ_FLAGS
 
 #: The commands that read a user's model file.
 READING_COMMANDS = (
+    "diff",
+    "conform",
+    "testgen",
     "convert",
     "verify",
     "info",

@@ -13,26 +13,25 @@ from pathlib import Path
 import typer
 
 from fsmbt import conform
-from fsmbt.cli.options import node_models_option, nodes_option, reader_options, trees_option
+from fsmbt.api_types import ReadOptions
+from fsmbt.cli.options import reads_models
 
 
 def register(app: typer.Typer) -> None:
     @app.command("conform")
+    @reads_models
     def conform_command(
         model: Path = typer.Argument(..., help="The model (BT, or FSM through leaf <-> state)."),
         logs: list[Path] = typer.Argument(
             ..., help="BehaviorTree.CPP .btlog files or fsmbt py_trees traces (.jsonl)."
         ),
         as_json: bool = typer.Option(False, "--json", help="Print the result as JSON."),
-        node_models: list[Path] = node_models_option(),
-        nodes: list[str] = nodes_option(),
-        trees: list[Path] = trees_option(),
+        *,
+        read: ReadOptions,
     ) -> None:
         """Replay every transition of each log through the model's semantics; report the
         first deviation of each log and the coverage the logs reached."""
-        report = conform.conform_files(
-            model, list(logs), options=reader_options(node_models, nodes, [], trees, None)
-        )
+        report = conform.conform_files(model, list(logs), options=read)
         if as_json:
             print(json.dumps(_as_dict(report), indent=2))
         else:

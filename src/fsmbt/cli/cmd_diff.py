@@ -12,7 +12,8 @@ from pathlib import Path
 import typer
 
 from fsmbt import api, diff
-from fsmbt.cli.options import node_models_option, nodes_option, reader_options, trees_option
+from fsmbt.api_types import ReadOptions
+from fsmbt.cli.options import reads_models
 
 EXIT_SAME = 0
 EXIT_DIFFERENT = 1
@@ -20,6 +21,7 @@ EXIT_DIFFERENT = 1
 
 def register(app: typer.Typer) -> None:
     @app.command("diff")
+    @reads_models
     def diff_command(
         old: Path = typer.Argument(..., help="The old model (FSM or BT)."),
         new: Path = typer.Argument(..., help="The new model (FSM or BT)."),
@@ -36,9 +38,8 @@ def register(app: typer.Typer) -> None:
         loop: bool = typer.Option(
             False, "--loop", help="BT side: tick the root again after it returns."
         ),
-        node_models: list[Path] = node_models_option(),
-        nodes: list[str] = nodes_option(),
-        trees: list[Path] = trees_option(),
+        *,
+        read: ReadOptions,
     ) -> None:
         """Every way NEW behaves differently from OLD (grouped by where the runs part, each
         with a shortest witness) and the structural edits (added, removed, moved, re-typed)."""
@@ -50,7 +51,7 @@ def register(app: typer.Typer) -> None:
             new,
             max_groups=max_groups,
             loop=loop,
-            options=reader_options(node_models, nodes, [], trees, None),
+            options=read,
         )
         if picture is not None:
             diff.write_diff_picture(first.model, second.model, report, picture, overwrite=force)

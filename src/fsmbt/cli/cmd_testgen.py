@@ -12,12 +12,15 @@ from pathlib import Path
 import typer
 
 from fsmbt import api, testgen
+from fsmbt.api_types import ReadOptions
+from fsmbt.cli.options import reads_models
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import InputError, SourceLocation
 
 
 def register(app: typer.Typer) -> None:
     @app.command("testgen")
+    @reads_models
     def testgen_command(
         spec: Path = typer.Argument(..., help="The specification (FSM or BT)."),
         tree: Path = typer.Option(..., "--tree", help="The behavior tree under test."),
@@ -26,11 +29,13 @@ def register(app: typer.Typer) -> None:
         score: bool = typer.Option(
             True, "--score/--no-score", help="Compute the mutation score (mutants of TREE)."
         ),
+        *,
+        read: ReadOptions,
     ) -> None:
         """Generate input sequences covering every transition of SPEC, with the expected
         observations, as pytest files running TREE on py_trees and BehaviorTree.CPP."""
-        loaded_spec = api.load(spec)
-        loaded_tree = api.load(tree)
+        loaded_spec = api.load(spec, options=read)
+        loaded_tree = api.load(tree, options=read.model_copy(update={"format": None}))
         if not isinstance(loaded_tree.model, BTDocument):
             raise InputError("--tree must be a behavior tree", location=SourceLocation(str(tree)))
         suite = testgen.generate(loaded_spec.model)

@@ -72,7 +72,10 @@ def conform(model: api.Model, logs: list[RecordedLog], *, name: str = "model") -
 
 
 def conform_files(
-    model: str | Path, logs: list[str | Path], *, options: dict[str, object] | None = None
+    model: str | Path,
+    logs: list[str | Path],
+    *,
+    options: dict[str, object] | api.ReadOptions | None = None,
 ) -> ConformReport:
     """Read the model and the logs, then ``conform``.
 

@@ -55,7 +55,7 @@ from fsmbt.model.errors import InputError, SourceLocation
 from fsmbt.model.fsm import FSM
 from fsmbt.semantics.bt_interpreter import CompiledNode
 from fsmbt.semantics.leaf_machine import LeafMachine
-from fsmbt.verify.pairing import FSMLeafMachine
+from fsmbt.semantics.machine import FSMLeafMachine
 
 RESULTS = ("SUCCESS", "FAILURE")
 #: RUNNING re-ticks assumed in a row before the replay calls the next leaf a deviation.

@@ -43,7 +43,7 @@ def diff_files(
     *,
     max_groups: int = DEFAULT_MAX_GROUPS,
     loop: bool = False,
-    options: dict[str, object] | None = None,
+    options: dict[str, object] | api.ReadOptions | None = None,
 ) -> tuple[api.Loaded, api.Loaded, DiffReport]:
     """Read two model files and diff them; returns both loaded models and the report.
 

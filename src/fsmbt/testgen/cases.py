@@ -33,7 +33,7 @@ from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import LimitError
 from fsmbt.model.fsm import FSM
 from fsmbt.semantics.leaf_machine import LeafMachine
-from fsmbt.verify.pairing import FSMLeafMachine
+from fsmbt.semantics.machine import FSMLeafMachine
 
 RESULTS = ("SUCCESS", "FAILURE")
 #: States of the specification's machine explored at most.
