@@ -15,7 +15,9 @@ For every leaf type of the tree (``leaves.leaf_kinds``):
 Control nodes: those py_trees runs with BehaviorTree.CPP v4's meaning
 (``fsmbt.semantics.engines.pytrees_engine.SUPPORTED_TYPES``: Sequence, ReactiveSequence,
 Fallback, ReactiveFallback, Inverter, ForceSuccess, ForceFailure, AlwaysSuccess,
-AlwaysFailure, SubTree). Any other node is refused with its name and line (py_trees has no
+AlwaysFailure, SubTree) and BehaviorTree.CPP's ``RetryUntilSuccessful`` and ``Repeat``, which
+``generated/bases.py`` defines with v4's rules (a tick is BehaviorTree.CPP's
+``tickExactlyOnce()``: no wake-up re-tick). Any other node is refused with its name and line (py_trees has no
 node with the same semantics; the C++ skeleton runs every BehaviorTree.CPP built-in).
 
 Cost: O(nodes after SubTree expansion) to render.
@@ -41,7 +43,11 @@ _COMPOSITES = {
     "ForceFailure": "py_trees.decorators.SuccessIsFailure({name}, child={kids})",
     "AlwaysSuccess": "py_trees.behaviours.Success({name})",
     "AlwaysFailure": "py_trees.behaviours.Failure({name})",
+    "RetryUntilSuccessful": "RetryUntilSuccessful({name}, {kids}, {limit})",
+    "Repeat": "Repeat({name}, {kids}, {limit})",
 }
+#: The loop decorators of generated/bases.py (BehaviorTree.CPP's rules, not py_trees' own).
+LOOPS = frozenset({"RetryUntilSuccessful", "Repeat"})
 
 
 def user_file(leaf: LeafKind) -> str:
@@ -75,20 +81,22 @@ def tree_statements(doc: BTDocument, leaves: list[LeafKind]) -> tuple[list[str],
             lines.append(f"{var} = {leaf.class_name}({name}, **{params!r})")
             continue
         template = _COMPOSITES.get(node.type)
-        if template is None or node.type not in SUPPORTED_TYPES:
+        if template is None or (node.type not in SUPPORTED_TYPES and node.type not in LOOPS):
             if node.type == "SubTree":
                 lines.append(f"{var} = n{node.children[0]}  # SubTree {source.attrs.get('ID')}")
                 continue
             raise InputError(
                 f"<{node.type}> has no py_trees equivalent with BehaviorTree.CPP's meaning (the "
                 "Python skeleton runs Sequence, Fallback, their reactive forms, Inverter, "
-                "ForceSuccess, ForceFailure, AlwaysSuccess, AlwaysFailure, SubTree); the C++ "
+                "ForceSuccess, ForceFailure, RetryUntilSuccessful, Repeat, AlwaysSuccess, "
+                "AlwaysFailure, SubTree); the C++ "
                 "skeleton (fsmbt runtime cpp DIR MODEL) runs every built-in",
                 location=source.location,
                 element=f"<{source.type}> '{source.label}'",
             )
         kids = ", ".join(f"n{c}" for c in node.children)
-        lines.append(f"{var} = " + template.format(name=name, kids=kids))
+        limit = node.params[0] if node.type in LOOPS else None
+        lines.append(f"{var} = " + template.format(name=name, kids=kids, limit=limit))
     return lines, "n0"
 
 
