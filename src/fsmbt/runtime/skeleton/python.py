@@ -63,6 +63,16 @@ def tree_statements(doc: BTDocument, leaves: list[LeafKind]) -> tuple[list[str],
     """
     by_type = {leaf.type: leaf for leaf in leaves}
     compiled = CompiledTree(doc)
+    for node in compiled.nodes:  # document order: the first offending node is named
+        source = node.source
+        leaf = by_type.get(source.type) if node.is_env_leaf else None
+        if leaf is not None and leaf.ros is not None:
+            raise InputError(
+                f"<{source.type}> is a ROS 2 {leaf.ros.kind} leaf: the Python skeleton "
+                "has no ROS client (use fsmbt runtime cpp DIR MODEL: behaviortree_ros2)",
+                location=source.location,
+                element=f"<{source.type}> '{source.label}'",
+            )
     lines: list[str] = []
     for node in reversed(compiled.nodes):
         var = f"n{node.id}"
@@ -70,13 +80,6 @@ def tree_statements(doc: BTDocument, leaves: list[LeafKind]) -> tuple[list[str],
         source = node.source
         if node.is_env_leaf and source.type in by_type:
             leaf = by_type[source.type]
-            if leaf.ros is not None:
-                raise InputError(
-                    f"<{source.type}> is a ROS 2 {leaf.ros.kind} leaf: the Python skeleton "
-                    "has no ROS client (use fsmbt runtime cpp DIR MODEL: behaviortree_ros2)",
-                    location=source.location,
-                    element=f"<{source.type}> '{source.label}'",
-                )
             params = {k: v for k, v in source.attrs.items() if not k.startswith("_")}
             lines.append(f"{var} = {leaf.class_name}({name}, **{params!r})")
             continue
