@@ -234,6 +234,9 @@ def test_example_skeleton_builds_and_runs_with_labels_and_parameters(tmp_path: P
     assert "Grasp 'GRASP' started force=10.0 object_pose={pose}" in lines
     assert "Place 'PLACE' started location=bin" in lines
     assert lines[-1] == "tick 4: SUCCESS"
+    snippet, printed = _documented("runtime.md")
+    assert "fsmbt runtime cpp out/pick_place_cpp examples/pick_place_bt.xml" in snippet
+    assert "pick_place_bt --period-ms 0" in snippet and run.stdout == printed
     # the same tree with a port the classes do not declare: a load error, exit 1, one line
     broken = tmp_path / "broken.xml"
     broken.write_text(
@@ -242,3 +245,16 @@ def test_example_skeleton_builds_and_runs_with_labels_and_parameters(tmp_path: P
     refused = subprocess.run([str(binary), str(broken)], capture_output=True, text=True, timeout=60)
     assert refused.returncode == 1 and "place" in refused.stderr
     assert read_model(project / "tree.xml")  # the copied tree reads back
+
+
+def _documented(page: str) -> tuple[str, str]:
+    """The migration section's shell snippet and the output it shows (docs/<page>)."""
+    import re
+
+    doc = (REPO / "docs" / page).read_text(encoding="utf-8")
+    section = doc.split("## The migration path", 1)[1]
+    blocks = re.findall(r"```(\w+)\n(.*?)```", section, re.S)
+    return (
+        next(body for lang, body in blocks if lang == "sh"),
+        next(body for lang, body in blocks if lang == "text"),
+    )

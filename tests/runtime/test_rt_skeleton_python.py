@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import os
 import random
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -186,3 +187,10 @@ def test_example_python_skeleton_runs_with_labels_and_parameters(tmp_path: Path)
     assert "Place 'PLACE' started location=bin" in lines
     assert lines[-1] == "tick 4: SUCCESS"
     assert read_model(project / "tree.xml")
+    doc = (REPO / "docs" / "runtime-python.md").read_text(encoding="utf-8")
+    section = doc.split("## The migration path", 1)[1]
+    blocks = re.findall(r"```(\w+)\n(.*?)```", section, re.S)
+    snippet = next(body for lang, body in blocks if lang == "sh")
+    assert "fsmbt runtime python out/pick_place_py examples/pick_place_bt.xml" in snippet
+    assert "main.py --period 0" in snippet
+    assert run.stdout == next(body for lang, body in blocks if lang == "text")
