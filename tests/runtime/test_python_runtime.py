@@ -30,6 +30,7 @@ from fsmbt.model.errors import FsmbtError, InputError, UnsupportedError
 from fsmbt.model.fsm import FSM
 from fsmbt.runtime.python_runtime import ENGINES, TreeRunner, load_tree, write_files
 from fsmbt.semantics.machine import FINAL, FSMMachine
+from support import hand_lebt
 
 REPO = Path(__file__).resolve().parents[2]
 FSMS = int(os.environ.get("FSMBT_RUNTIME_FSMS", "60"))
@@ -346,10 +347,9 @@ def test_the_docs_snippet_runs_as_written(tmp_path: Path) -> None:
 
 # -- callbacks get the state's label and parameters; annotations checked at load -------------
 def test_callbacks_get_the_state_label_and_its_parameters() -> None:
-    from support import hand_lebt
-
+    seen: list[tuple[str, str, dict[str, str]]] = []
     for engine in ENGINES:
-        seen: list[tuple[str, str, dict[str, str]]] = []
+        seen.clear()
         actions = {
             "TimedCmdVelState": lambda state, params: seen.append(
                 ("TimedCmdVelState", state, params)
@@ -365,10 +365,8 @@ def test_callbacks_get_the_state_label_and_its_parameters() -> None:
         load_tree(hand_lebt.TREE, {"TimedCmdVelState": lambda state: None, "LogState": print})
 
 
-@pytest.mark.parametrize("case", [c[0] for c in __import__("support.hand_lebt").hand_lebt.BROKEN])
+@pytest.mark.parametrize("case", [c[0] for c in hand_lebt.BROKEN])
 def test_hand_broken_annotations_are_load_errors_naming_the_node(case: str) -> None:
-    from support import hand_lebt
-
     _, replaced, replacement, node, line = next(c for c in hand_lebt.BROKEN if c[0] == case)
     actions = {"TimedCmdVelState": lambda: None, "LogState": lambda: None}
     for engine in ENGINES:

@@ -15,6 +15,7 @@ from fsmbt.convert import convert
 from fsmbt.formats import dumps, read_model
 from fsmbt.runtime import cpp as cpp_runtime
 from fsmbt.runtime.cpp import DriverSession, library_prefix
+from support import hand_lebt
 
 REPO = Path(__file__).resolve().parents[2]
 DOOR = REPO / "examples" / "door_hfsm.scxml"
@@ -443,8 +444,6 @@ def test_nusmv_build_script_reuses_the_old_checkout_binary(tmp_path: Path) -> No
 def test_callbacks_get_the_state_label_and_its_parameters(driver: Path, tmp_path: Path) -> None:
     import json
 
-    from support import hand_lebt
-
     tree = tmp_path / "hand.xml"
     tree.write_text(hand_lebt.TREE, encoding="utf-8")
     run = _driver_call(driver, tree, "--entries", stdin="go\nstop\n")
@@ -457,12 +456,10 @@ def test_callbacks_get_the_state_label_and_its_parameters(driver: Path, tmp_path
     assert steps[-1]["terminated"] is True
 
 
-@pytest.mark.parametrize("case", [c[0] for c in __import__("support.hand_lebt").hand_lebt.BROKEN])
+@pytest.mark.parametrize("case", [c[0] for c in hand_lebt.BROKEN])
 def test_hand_broken_annotations_are_load_errors_naming_the_node(
     driver: Path, tmp_path: Path, case: str
 ) -> None:
-    from support import hand_lebt
-
     _, replaced, replacement, node, line = next(c for c in hand_lebt.BROKEN if c[0] == case)
     tree = tmp_path / "broken.xml"
     tree.write_text(hand_lebt.broken(replaced, replacement), encoding="utf-8")

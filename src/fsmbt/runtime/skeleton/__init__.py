@@ -52,7 +52,9 @@ def write_skeleton_for(
     leaves = leaf_kinds(doc)
     tree_text = dumps(doc, "btcpp")
     if language == "cpp":
-        files = cpp_files(doc, leaves, tree_text, source=source, project=project_name(Path(source).stem))
+        files = cpp_files(
+            doc, leaves, tree_text, source=source, project=project_name(Path(source).stem)
+        )
         users = {leaf.type: cpp_user_file(leaf) for leaf in leaves}
     else:
         files = python_files(doc, leaves, tree_text, source=source)
@@ -60,6 +62,8 @@ def write_skeleton_for(
     return write_files(directory, files, manifest(language, leaves), users, force=force)
 
 
-def write_skeleton(model: Path, directory: Path, language: str, *, force: bool = False) -> WriteReport:
+def write_skeleton(
+    model: Path, directory: Path, language: str, *, force: bool = False
+) -> WriteReport:
     """Read ``model`` and write its skeleton into ``directory`` (see ``write_skeleton_for``)."""
     return write_skeleton_for(load_tree(model), directory, language, source=model.name, force=force)

@@ -66,7 +66,9 @@ def manifest(language: str, leaves: list[LeafKind]) -> dict[str, object]:
     }
 
 
-def manifest_changes(old: dict[str, object], new: dict[str, object], user_files: dict[str, str]) -> list[str]:
+def manifest_changes(
+    old: dict[str, object], new: dict[str, object], user_files: dict[str, str]
+) -> list[str]:
     """One line per leaf type added, removed or whose kind, ROS type or ports changed."""
     old_leaves = old.get("leaves") if isinstance(old.get("leaves"), dict) else {}
     new_leaves = new["leaves"]
@@ -164,7 +166,8 @@ def write_files(
         if not f.user
         and f.path != "tree.xml"
         and (directory / f.path).is_file()
-        and GENERATED_MARKER not in (directory / f.path).read_text(encoding="utf-8", errors="replace")[:400]
+        and GENERATED_MARKER
+        not in (directory / f.path).read_text(encoding="utf-8", errors="replace")[:400]
     ]
     if foreign and not force:
         raise InputError(
