@@ -240,3 +240,35 @@ def test_model_text_is_escaped_in_generated_code(tmp_path: Path) -> None:
     write_skeleton(tree, tmp_path / "py", "python")
     compile((tmp_path / "py" / "generated" / "tree.py").read_text(), "tree.py", "exec")
     compile((tmp_path / "py" / "generated" / "bases.py").read_text(), "bases.py", "exec")
+
+
+def test_python_skeleton_refuses_a_control_py_trees_cannot_run(tmp_path: Path, capsys) -> None:
+    parallel = tmp_path / "parallel.xml"
+    parallel.write_text(
+        '<root BTCPP_format="4"><BehaviorTree ID="T"><Sequence>\n'
+        '<Parallel success_count="1" failure_count="1">\n<A name="a"/><B name="b"/></Parallel>\n'
+        "</Sequence></BehaviorTree></root>",
+        encoding="utf-8",
+    )
+    code, _, err = _cli(capsys, "runtime", "python", str(tmp_path / "py"), str(parallel))
+    assert code == 2 and "<Parallel>" in err and ":2:" in err, err
+    assert not (tmp_path / "py").exists()
+    # a Switch dispatch over an output port (the structured style's >2-outcome states)
+    switch = tmp_path / "switch.xml"
+    switch.write_text(
+        '<root BTCPP_format="4"><BehaviorTree ID="T"><Sequence>\n'
+        '<Look name="LOOK" result="{seen}"/>\n'
+        '<Switch2 variable="{seen}" case_1="cup" case_2="box">'
+        '<A name="c"/><A name="d"/><A name="e"/></Switch2>\n'
+        "</Sequence></BehaviorTree>"
+        '<TreeNodesModel><Action ID="Look"><output_port name="result"/></Action>'
+        "</TreeNodesModel></root>",
+        encoding="utf-8",
+    )
+    code, _, err = _cli(capsys, "runtime", "python", str(tmp_path / "py"), str(switch))
+    assert code == 2 and "Switch2" in err and ":3:" in err, err
+    for model in (parallel, switch):  # BehaviorTree.CPP runs every built-in
+        code, _, _ = _cli(capsys, "runtime", "cpp", str(tmp_path / model.stem), str(model))
+        assert code == 0
+    header = (tmp_path / "switch" / "generated" / "fsmbt_nodes.hpp").read_text()
+    assert 'BT::OutputPort<std::string>("result", "")' in header

@@ -40,7 +40,7 @@ UNION = """<root BTCPP_format="4" main_tree_to_execute="Main">
   <BehaviorTree ID="Main">
     <Sequence>
       <Act0 name="a0" speed="2"/><Act1 name="a1"/><Act2 name="a2" goal="{goal}"/>
-      <Cond0 name="c0"/><Cond1 name="c1"/><Cond2 name="c2"/>
+      <Cond0 name="c0"/><Cond1 name="c1"/><Cond2 name="c2"/><Look name="l" result="{seen}"/>
     </Sequence>
   </BehaviorTree>
   <TreeNodesModel>
@@ -49,6 +49,7 @@ UNION = """<root BTCPP_format="4" main_tree_to_execute="Main">
     <Condition ID="Cond0"/>
     <Condition ID="Cond1"/>
     <Condition ID="Cond2"/>
+    <Action ID="Look"><output_port name="result"/></Action>
   </TreeNodesModel>
 </root>
 """
@@ -64,7 +65,7 @@ SCRIPTED = r"""#pragma once
 #include <string>
 #include <vector>
 
-inline BT::NodeStatus scripted(const std::string& label)
+inline std::string scriptedWord(const std::string& label)
 {
   static std::map<std::string, std::vector<std::string>> plans = [] {
     std::map<std::string, std::vector<std::string>> read;
@@ -83,6 +84,12 @@ inline BT::NodeStatus scripted(const std::string& label)
   const std::vector<std::string>& plan = plans.at(label);
   const std::string& outcome = plan[next[label]++ % plan.size()];
   std::cout << "leaf " << label << " " << outcome << std::endl;
+  return outcome;
+}
+
+inline BT::NodeStatus scripted(const std::string& label)
+{
+  const std::string outcome = scriptedWord(label);
   return outcome == "success" ? BT::NodeStatus::SUCCESS :
          outcome == "failure" ? BT::NodeStatus::FAILURE : BT::NodeStatus::RUNNING;
 }
@@ -112,6 +119,41 @@ public:
   BT::NodeStatus tick() override {{ return scripted(label()); }}
 }};
 }}
+"""
+
+
+LOOK = """#pragma once
+#include "fsmbt_nodes.hpp"
+#include "scripted.hpp"
+namespace bt_nodes {
+// sets its output port to the next word of its script: what a >2-outcome state reports
+class Look : public generated::LookBase
+{
+public:
+  using generated::LookBase::LookBase;
+  BT::NodeStatus onStart() override
+  {
+    setOutput("result", scriptedWord(label()));
+    return BT::NodeStatus::SUCCESS;
+  }
+  BT::NodeStatus onRunning() override { return BT::NodeStatus::SUCCESS; }
+  void onHalted() override {}
+};
+}
+"""
+#: A state with three outcomes as the structured style may dispatch it: an output port read by
+#: a Switch (not in fsmbt's interpreter: the blackboard decides; the expected runs are Switch's
+#: rule, case_1 -> first child, case_2 -> second, anything else -> the last).
+SWITCH = """<root BTCPP_format="4" main_tree_to_execute="T">
+  <BehaviorTree ID="T">
+    <Sequence>
+      <Look name="l" result="{seen}"/>
+      <Switch2 variable="{seen}" case_1="cup" case_2="box">
+        <Act0 name="on_cup"/><Act1 name="on_box"/><Act2 name="otherwise"/>
+      </Switch2>
+    </Sequence>
+  </BehaviorTree>
+</root>
 """
 
 
@@ -175,6 +217,7 @@ def scripted_binary(tmp_path_factory) -> Path:
     for name in ("Act0", "Act1", "Act2", "Cond0", "Cond1", "Cond2"):
         text = (CONDITION if name.startswith("Cond") else ACTION).format(name=name)
         (project / "nodes" / f"{name.lower()}.hpp").write_text(text, encoding="utf-8")
+    (project / "nodes" / "look.hpp").write_text(LOOK, encoding="utf-8")
     binary, seconds = _build(project)
     print(f"\nscripted skeleton: compiled in {seconds:.1f} s (0.0 = cached)")
     return binary
@@ -258,3 +301,26 @@ def _documented(page: str) -> tuple[str, str]:
         next(body for lang, body in blocks if lang == "sh"),
         next(body for lang, body in blocks if lang == "text"),
     )
+
+
+@pytest.mark.parametrize(
+    ("seen", "branch"), [("cup", "on_cup"), ("box", "on_box"), ("mug", "otherwise")]
+)
+def test_an_output_port_dispatched_by_switch_runs_the_right_branch(
+    scripted_binary: Path, tmp_path: Path, seen: str, branch: str
+) -> None:
+    tree = tmp_path / "switch.xml"
+    tree.write_text(SWITCH, encoding="utf-8")
+    plans = {"l": [seen], "on_cup": ["success"], "on_box": ["failure"], "otherwise": ["success"]}
+    script = skeleton_script.write(tmp_path / "script.txt", plans)
+    run = subprocess.run(
+        [str(scripted_binary), str(tree), "--period-ms", "0", "--max-ticks", "3"],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        env={**os.environ, "FSMBT_SCRIPT": str(script)},
+    )
+    result = "FAILURE" if branch == "on_box" else "SUCCESS"
+    assert skeleton_script.parse_run(run.stdout) == [
+        ([("l", seen), (branch, plans[branch][0])], result)
+    ], run.stdout + run.stderr

@@ -73,6 +73,19 @@ def tree_statements(doc: BTDocument, leaves: list[LeafKind]) -> tuple[list[str],
                 location=source.location,
                 element=f"<{source.type}> '{source.label}'",
             )
+        runnable = node.type == "SubTree" or (
+            node.type in _COMPOSITES and (node.type in SUPPORTED_TYPES or node.type in LOOPS)
+        )
+        if leaf is None and not runnable:
+            raise InputError(
+                f"<{node.type}> has no py_trees equivalent with BehaviorTree.CPP's meaning (the "
+                "Python skeleton runs Sequence, Fallback, their reactive forms, Inverter, "
+                "ForceSuccess, ForceFailure, RetryUntilSuccessful, Repeat, AlwaysSuccess, "
+                "AlwaysFailure, SubTree); the C++ "
+                "skeleton (fsmbt runtime cpp DIR MODEL) runs every built-in",
+                location=source.location,
+                element=f"<{source.type}> '{source.label}'",
+            )
     lines: list[str] = []
     for node in reversed(compiled.nodes):
         var = f"n{node.id}"
@@ -83,20 +96,10 @@ def tree_statements(doc: BTDocument, leaves: list[LeafKind]) -> tuple[list[str],
             params = {k: v for k, v in source.attrs.items() if not k.startswith("_")}
             lines.append(f"{var} = {leaf.class_name}({name}, **{params!r})")
             continue
-        template = _COMPOSITES.get(node.type)
-        if template is None or (node.type not in SUPPORTED_TYPES and node.type not in LOOPS):
-            if node.type == "SubTree":
-                lines.append(f"{var} = n{node.children[0]}  # SubTree {source.attrs.get('ID')}")
-                continue
-            raise InputError(
-                f"<{node.type}> has no py_trees equivalent with BehaviorTree.CPP's meaning (the "
-                "Python skeleton runs Sequence, Fallback, their reactive forms, Inverter, "
-                "ForceSuccess, ForceFailure, RetryUntilSuccessful, Repeat, AlwaysSuccess, "
-                "AlwaysFailure, SubTree); the C++ "
-                "skeleton (fsmbt runtime cpp DIR MODEL) runs every built-in",
-                location=source.location,
-                element=f"<{source.type}> '{source.label}'",
-            )
+        if node.type == "SubTree":
+            lines.append(f"{var} = n{node.children[0]}  # SubTree {source.attrs.get('ID')}")
+            continue
+        template = _COMPOSITES[node.type]
         kids = ", ".join(f"n{c}" for c in node.children)
         limit = node.params[0] if node.type in LOOPS else None
         lines.append(f"{var} = " + template.format(name=name, kids=kids, limit=limit))
