@@ -272,3 +272,17 @@ def test_python_skeleton_refuses_a_control_py_trees_cannot_run(tmp_path: Path, c
         assert code == 0
     header = (tmp_path / "switch" / "generated" / "fsmbt_nodes.hpp").read_text()
     assert 'BT::OutputPort<std::string>("result", "")' in header
+
+
+def test_the_tree_in_the_folder_is_never_rewritten_from_itself(tmp_path: Path, capsys) -> None:
+    project = tmp_path / "mine"
+    project.mkdir()
+    own = project / "tree.xml"
+    own.write_text(EXAMPLE.read_text(encoding="utf-8"), encoding="utf-8")
+    code, _, _ = _cli(capsys, "runtime", "python", str(project), str(own))
+    assert code == 0 and own.read_text(encoding="utf-8") == EXAMPLE.read_text(encoding="utf-8")
+    other = tmp_path / "other"
+    other.mkdir()
+    (other / "tree.xml").write_text("<!-- my notes -->\n", encoding="utf-8")
+    code, _, err = _cli(capsys, "runtime", "cpp", str(other), str(EXAMPLE))
+    assert code == 2 and "tree.xml" in err  # not fsmbt's: kept without --force

@@ -180,10 +180,12 @@ def _require_build() -> None:
 
 
 def _build(project: Path) -> tuple[Path, float]:
-    """Configure and build ``project`` in a temp folder keyed by its sources' hash (reused)."""
+    """Configure and build ``project`` in a temp folder keyed by its sources' hash (reused; the
+    tree is read at run time, so it is not part of the key)."""
     digest = hashlib.sha256()
     for path in sorted(project.rglob("*")):
-        if path.is_file() and "build" not in path.relative_to(project).parts:
+        compiled = path.suffix in (".hpp", ".cpp") or path.name == "CMakeLists.txt"
+        if path.is_file() and compiled and "build" not in path.relative_to(project).parts:
             digest.update(str(path.relative_to(project)).encode() + b"\0" + path.read_bytes())
     build = Path(tempfile.gettempdir()) / f"fsmbt-skeleton-{digest.hexdigest()[:16]}"
     binary = build / "bin"
