@@ -21,8 +21,8 @@ from fsmbt.runtime.skeleton.cpp import user_file as cpp_user_file
 from fsmbt.runtime.skeleton.files import WriteReport, manifest, write_files
 from fsmbt.runtime.skeleton.leaves import LeafKind, leaf_kinds
 from fsmbt.runtime.skeleton.python import python_files
-from fsmbt.runtime.skeleton.render import one_line
 from fsmbt.runtime.skeleton.python import user_file as py_user_file
+from fsmbt.runtime.skeleton.render import one_line
 
 LANGUAGES = ("cpp", "python")
 
