@@ -31,6 +31,7 @@ from fsmbt.model.errors import FsmbtError, InputError, UnsupportedError
 from fsmbt.model.fsm import FSM
 from fsmbt.runtime.python_runtime import ENGINES, TreeRunner, load_tree, write_files
 from fsmbt.semantics.machine import FINAL, FSMMachine
+from support import hand_lebt
 
 REPO = Path(__file__).resolve().parents[2]
 FSMS = int(os.environ.get("FSMBT_RUNTIME_FSMS", "60"))
@@ -343,3 +344,34 @@ def test_the_docs_snippet_runs_as_written(tmp_path: Path) -> None:
         )
         assert done.returncode == 0, done.stderr
         assert done.stdout == shown, (engine, done.stdout)
+
+
+# -- callbacks get the state's label and parameters; annotations checked at load -------------
+def test_callbacks_get_the_state_label_and_its_parameters() -> None:
+    seen: list[tuple[str, str, dict[str, str]]] = []
+    for engine in ENGINES:
+        seen.clear()
+        actions = {
+            "TimedCmdVelState": lambda state, params: seen.append(
+                ("TimedCmdVelState", state, params)
+            ),
+            "LogState": lambda state, params: seen.append(("LogState", state, params)),
+        }
+        runner = load_tree(hand_lebt.TREE, actions, engine=engine)
+        assert runner.start() == ("TimedCmdVelState",)
+        assert runner.post("go") == ("TimedCmdVelState",)
+        assert runner.post("stop") == ("LogState",) and runner.terminated
+        assert seen == hand_lebt.ENTRIES, engine
+    with pytest.raises(InputError, match="must take \\(state, params\\) or no argument"):
+        load_tree(hand_lebt.TREE, {"TimedCmdVelState": lambda state: None, "LogState": print})
+
+
+@pytest.mark.parametrize("case", [c[0] for c in hand_lebt.BROKEN])
+def test_hand_broken_annotations_are_load_errors_naming_the_node(case: str) -> None:
+    _, replaced, replacement, node, line = next(c for c in hand_lebt.BROKEN if c[0] == case)
+    actions = {"TimedCmdVelState": lambda: None, "LogState": lambda: None}
+    for engine in ENGINES:
+        with pytest.raises(InputError) as info:
+            load_tree(hand_lebt.broken(replaced, replacement), actions, engine=engine)
+        assert f"'{node}'" in str(info.value), str(info.value)
+        assert info.value.location is not None and info.value.location.line == line
