@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 
 from fsmbt.formats import dumps, loads, read_model
-from fsmbt.formats.btcpp import ASSUMED_MARK
+from fsmbt.formats.btcpp.xml_format import ASSUMED_MARK
 from fsmbt.formats.xml_safe import parse_xml, root_tag
 from fsmbt.limits import current as current_limits
 from fsmbt.model import BTDocument, BTNode, NodeKind

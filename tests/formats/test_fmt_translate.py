@@ -16,7 +16,7 @@ from pathlib import Path
 import pytest
 
 from fsmbt.formats import Format, loads, read_model
-from fsmbt.formats.json_format import write_json
+from fsmbt.formats.schema.json_format import write_json
 from fsmbt.formats.translate import (
     differences_between,
     rename_events,

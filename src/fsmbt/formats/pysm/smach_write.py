@@ -493,8 +493,8 @@ class _Writer:
 
 def _product_matches(spec: dict[str, object], region: FSM) -> bool:
     """Does ``region`` equal the product the reader builds from ``spec``?"""
-    from fsmbt.formats._pysm_analyze import Child, Container, StateRef
-    from fsmbt.formats._pysm_build import Builder, _Source, _Work
+    from fsmbt.formats.pysm.analyze import Child, Container, StateRef
+    from fsmbt.formats.pysm.build import Builder, _Source, _Work
     from fsmbt.formats.registry import ReadContext
 
     container = Container("Concurrence", "concurrence", list(spec["outcomes"]), 0)  # type: ignore[call-overload]
@@ -503,7 +503,7 @@ def _product_matches(spec: dict[str, object], region: FSM) -> bool:
     for label, action, outcomes in spec["children"]:  # type: ignore[attr-defined]
         container.children.append(Child(label, StateRef(action, list(outcomes), 0), {}, 0))
     rebuilt = FSM(name=region.name)
-    from fsmbt.formats._pysm_analyze import Analysis
+    from fsmbt.formats.pysm.analyze import Analysis
 
     source = _Source(None, "<check>", Analysis([], {}, {}))
     try:

@@ -45,7 +45,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from fsmbt import limits
-from fsmbt.formats._pysm_analyze import (
+from fsmbt.formats.pysm.analyze import (
     MAX_UNROLLED_ITEMS,
     Analysis,
     Child,
@@ -54,7 +54,7 @@ from fsmbt.formats._pysm_analyze import (
     StateRef,
     analyze,
 )
-from fsmbt.formats._pysm_source import parse_source
+from fsmbt.formats.pysm.source import parse_source
 from fsmbt.formats.registry import ReadContext, decode
 from fsmbt.model.errors import InputError, SourceLocation, UnsupportedError
 from fsmbt.model.files import note_read, read_bounded, read_located

@@ -4,7 +4,7 @@
 What is read: ``<invoke>`` of type SCXML (no ``type``, ``scxml``,
 ``http://www.w3.org/TR/scxml/``, its ``#SCXMLEventProcessor`` form) whose document is inline
 (``<content><scxml>...</scxml></content>``) or a file (``src="child.scxml"``, resolved and
-confined like an XInclude, ``fsmbt.formats.scxml_include``). Other types (``vxml2``, http,
+confined like an XInclude, ``fsmbt.formats.scxml.include``). Other types (``vxml2``, http,
 ...) are external services: ``UnsupportedError`` with the line. Rules (W3C SCXML 1.0, 6.4 and
 appendix D):
 
@@ -50,13 +50,13 @@ from typing import TYPE_CHECKING, Any
 from lxml import etree
 
 from fsmbt import limits
-from fsmbt.formats import scxml_include
 from fsmbt.formats.registry import ReadContext
+from fsmbt.formats.scxml import include as scxml_include
 from fsmbt.formats.xml_safe import local_name, namespace
 from fsmbt.model.errors import InputError, UnsupportedError
 
 if TYPE_CHECKING:
-    from fsmbt.formats.scxml_w3c import _S, _Doc, _Interpreter, _Run
+    from fsmbt.formats.scxml.w3c import _S, _Doc, _Interpreter, _Run
 
 SCXML_TYPES = frozenset(
     {
@@ -124,8 +124,8 @@ def read_invoke(
         doc: The document being read (the parent).
         element: The ``<invoke>`` element.
         node: The state holding it.
-        make_doc: The document reader class (``scxml_w3c._Doc``).
-        make_interp: The interpreter class (``scxml_w3c._Interpreter``).
+        make_doc: The document reader class (``scxml.w3c._Doc``).
+        make_interp: The interpreter class (``scxml.w3c._Interpreter``).
 
     Returns:
         The invocation; it is also recorded in ``doc.invocations`` and ``node.invokes``.
