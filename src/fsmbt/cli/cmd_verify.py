@@ -27,8 +27,8 @@ from fsmbt.cli.options import (
     trees_option,
 )
 from fsmbt.cli.progress import StageProgress
-from fsmbt.verify import EngineDisagreement
 from fsmbt.cli.render_report import print_report
+from fsmbt.verify import EngineDisagreement
 
 EXIT_EQUIVALENT = 0
 EXIT_NOT_EQUIVALENT = 1
