@@ -37,6 +37,7 @@ from __future__ import annotations
 
 import re
 from collections import deque
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from itertools import product
 
@@ -370,7 +371,9 @@ class _Doc:
         elif tag == "donedata":
             self.ctx.warn("<donedata> ignored", line=element.sourceline, element="<donedata>")
         elif tag == "invoke":
-            scxml_invoke.read_invoke(self, element, node, _Doc, _Interpreter)
+            source = scxml_invoke.read_invoke(self, element, node)
+            child = _Doc(source.text, source.ctx, element=source.element, session=source.session)
+            scxml_invoke.add_invocation(self, element, node, source, child, _Interpreter(child))
         elif tag == "script":
             self.scripts.append(element.sourceline)
         else:
@@ -879,6 +882,15 @@ class _Run:
     serial: int = 0
     event: str | None = None  # _event.name: the event being processed (None: none yet)
 
+    def spawn(
+        self,
+        config: set[int],
+        history: dict[int, frozenset[int]],
+        data: dict[str, scxml_expr.Value],
+    ) -> _Run:
+        """A fresh run for a child session (``scxml_invoke.Run``)."""
+        return _Run(config, history, data=data)
+
 
 #: A value that could not be computed: ``error.execution`` was raised.
 _FAILED = object()
@@ -1047,7 +1059,7 @@ class _Interpreter:
         return {s for s in run.config if domain is not None and self.descendant(s, domain)}
 
     # -- micro step -----------------------------------------------------------------------------
-    def perform(self, actions: list[Action], run: _Run) -> None:
+    def perform(self, actions: Sequence[Action], run: _Run) -> None:
         """Run a block of executable content; an ``error.execution`` skips the rest of it."""
         plan = self.doc.plan
         stack = list(reversed(actions))
