@@ -731,3 +731,16 @@ def build_fsm(
     ):
         fsm.start_name, fsm.initial_event = start["name"], start["event"]
     return fsm
+
+
+def build_concurrence(container: Container, name: str) -> FSM:
+    """The product FSM the reader builds from one ``Concurrence`` container, alone (the SMACH
+    writer checks that a region it writes reads back as itself).
+
+    Raises:
+        InputError: the container is refused, as reading it would be.
+    """
+    fsm = FSM(name=name)
+    source = _Source(None, "<check>", Analysis([], {}, {}))
+    Builder(ReadContext(), source).concurrence(_Work(container, fsm, name, source, ()))
+    return fsm
