@@ -25,7 +25,7 @@
 #
 # Environment:
 #   FSMBT_CACHE   cache root (default ${XDG_CACHE_HOME:-$HOME/.cache}/fsmbt)
-#   PYTHON        python used for `pip download` (default <repo>/.venv/bin/python or python3)
+#   PYTHON        python used for `pip download` (default <checkout>/.venv/bin/python or python3)
 #   JOBS          parallel build jobs (default 2)
 #   FORCE=1       rebuild the library and the driver
 #   CXX           C++ compiler (default g++, else c++, else clang++)
@@ -33,10 +33,12 @@ set -euo pipefail
 
 BTCPP_VERSION="4.8.2"
 BTPY_VERSION="0.1.4"
-REPO_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+# the fsmbt package this script ships in; the checkout, when run from one (scripts/)
+PKG_DIR="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+CHECKOUT="${FSMBT_CHECKOUT:-}"
 CACHE_ROOT="${FSMBT_CACHE:-${XDG_CACHE_HOME:-$HOME/.cache}/fsmbt}"
 PREFIX="$CACHE_ROOT/btcpp-$BTCPP_VERSION"
-CPP_DIR="$REPO_ROOT/src/fsmbt/runtime/cpp"
+CPP_DIR="$PKG_DIR/runtime/cpp"
 DRIVER_SRC="$CPP_DIR/driver/fsmbt_lebt_driver.cpp"
 HEADER="$CPP_DIR/include/fsmbt/lebt.hpp"
 DRIVER="$PREFIX/bin/fsmbt_lebt_driver"
@@ -65,7 +67,7 @@ GENERATOR=()
 command -v ninja >/dev/null 2>&1 && GENERATOR=(-G Ninja)
 
 if [ -z "${PYTHON:-}" ]; then
-    if [ -x "$REPO_ROOT/.venv/bin/python" ]; then PYTHON="$REPO_ROOT/.venv/bin/python"; else PYTHON="python3"; fi
+    if [ -n "$CHECKOUT" ] && [ -x "$CHECKOUT/.venv/bin/python" ]; then PYTHON="$CHECKOUT/.venv/bin/python"; else PYTHON="python3"; fi
 fi
 
 WORK="$(mktemp -d "${TMPDIR:-/tmp}/fsmbt-btcpp-build.XXXXXX")"

@@ -11,17 +11,18 @@
 # Environment:
 #   FSMBT_CACHE         cache root (default ${XDG_CACHE_HOME:-$HOME/.cache}/fsmbt)
 #   FSMBT_NUSMV_PREFIX  install prefix (default <cache root>/nusmv-2.5.4)
-#   PYTHON              python used for `pip download` (default <repo>/.venv/bin/python or python3)
+#   PYTHON              python used for `pip download` (default <checkout>/.venv/bin/python or python3)
 #   JOBS                parallel make jobs (default: nproc)
 #   FORCE=1             rebuild even when a working binary exists
 set -euo pipefail
 
 PYNUSMV_VERSION="1.0rc8"
 NUSMV_VERSION="2.5.4"
-REPO_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+# the checkout, when run from one (scripts/build_nusmv.sh sets it)
+CHECKOUT="${FSMBT_CHECKOUT:-}"
 CACHE_ROOT="${FSMBT_CACHE:-${XDG_CACHE_HOME:-$HOME/.cache}/fsmbt}"
 PREFIX="${FSMBT_NUSMV_PREFIX:-$CACHE_ROOT/nusmv-$NUSMV_VERSION}"
-LEGACY_BIN="$REPO_ROOT/.cache/nusmv/bin/NuSMV"
+LEGACY_BIN="${CHECKOUT:-/nonexistent}/.cache/nusmv/bin/NuSMV"
 BIN="$PREFIX/bin/NuSMV"
 JOBS="${JOBS:-$(nproc 2>/dev/null || echo 2)}"
 
@@ -48,7 +49,7 @@ if [ "${FORCE:-0}" != "1" ] && binary_works "$LEGACY_BIN"; then
 fi
 
 if [ -z "${PYTHON:-}" ]; then
-    if [ -x "$REPO_ROOT/.venv/bin/python" ]; then PYTHON="$REPO_ROOT/.venv/bin/python"; else PYTHON="python3"; fi
+    if [ -n "$CHECKOUT" ] && [ -x "$CHECKOUT/.venv/bin/python" ]; then PYTHON="$CHECKOUT/.venv/bin/python"; else PYTHON="python3"; fi
 fi
 
 # --- build dependencies (Debian) ---------------------------------------------------------------
