@@ -60,6 +60,7 @@ need = [
     "runtime/cpp/include/fsmbt/lebt.hpp", "runtime/cpp/driver/fsmbt_lebt_driver.cpp",
     "install/build_nusmv.sh", "install/build_btcpp.sh",
     "llm/templates/fsm_to_bt.v1.md", "sim/models/prey_bt.xml", "sim/models/predator_fsm.scxml",
+    "evaluate/templates/report.md.j2",
 ]
 missing = [n for n in need if not (root / n).is_file()]
 if missing:
