@@ -152,7 +152,7 @@ def translate(
 def _writer_losses(target: str, model: Model) -> list[str] | None:
     """The writer's own list of losses, for writers that keep one (else ``None``)."""
     if target == "smach" and isinstance(model, FSM):
-        from fsmbt.formats._smach_write import smach_losses
+        from fsmbt.formats.pysm.smach_write import smach_losses
 
         return smach_losses(model)
     return None

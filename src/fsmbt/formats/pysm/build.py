@@ -45,7 +45,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from fsmbt import limits
-from fsmbt.formats._pysm_analyze import (
+from fsmbt.formats.pysm.analyze import (
     MAX_UNROLLED_ITEMS,
     Analysis,
     Child,
@@ -54,7 +54,7 @@ from fsmbt.formats._pysm_analyze import (
     StateRef,
     analyze,
 )
-from fsmbt.formats._pysm_source import parse_source
+from fsmbt.formats.pysm.source import parse_source
 from fsmbt.formats.registry import ReadContext, decode
 from fsmbt.model.errors import InputError, SourceLocation, UnsupportedError
 from fsmbt.model.files import note_read, read_bounded, read_located
@@ -730,4 +730,17 @@ def build_fsm(
         and isinstance(start.get("event"), str)
     ):
         fsm.start_name, fsm.initial_event = start["name"], start["event"]
+    return fsm
+
+
+def build_concurrence(container: Container, name: str) -> FSM:
+    """The product FSM the reader builds from one ``Concurrence`` container, alone (the SMACH
+    writer checks that a region it writes reads back as itself).
+
+    Raises:
+        InputError: the container is refused, as reading it would be.
+    """
+    fsm = FSM(name=name)
+    source = _Source(None, "<check>", Analysis([], {}, {}))
+    Builder(ReadContext(), source).concurrence(_Work(container, fsm, name, source, ()))
     return fsm

@@ -27,7 +27,7 @@ import ast
 from collections import ChainMap
 from dataclasses import dataclass, field
 
-from fsmbt.formats._pysm_source import NotStatic, last_name, literal, source_text
+from fsmbt.formats.pysm.source import NotStatic, last_name, literal, source_text
 from fsmbt.model.errors import InputError, SourceLocation, UnsupportedError
 
 SMACH_CONTAINERS = {

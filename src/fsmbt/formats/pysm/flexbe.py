@@ -7,7 +7,7 @@ returns: ``OperatableStateMachine`` (and ``PriorityContainer``, read as a plain 
 satisfied condition ending it), states added with ``OperatableStateMachine.add(label, state,
 transitions=..., autonomy=..., remapping=...)`` inside ``with`` blocks, and embedded
 behaviours (``self.use_behavior(Class, ...)``) read from their own file beside this one. Rules
-and refusals are those of ``fsmbt.formats._pysm_build``; autonomy levels are kept as the
+and refusals are those of ``fsmbt.formats.pysm.build``; autonomy levels are kept as the
 ``autonomy`` attribute of each transition, userdata remapping is not part of the model.
 
 Option ``behaviour`` (``ReadContext.options``) picks a Behavior class when a file has several.
@@ -18,10 +18,10 @@ from __future__ import annotations
 
 import re
 
-from fsmbt.formats._pysm_analyze import Analysis, Container
-from fsmbt.formats._pysm_build import build_fsm
+from fsmbt.formats.pysm.analyze import Analysis, Container
+from fsmbt.formats.pysm.build import build_fsm
+from fsmbt.formats.pysm.smach import choose_machine
 from fsmbt.formats.registry import Format, ReadContext, register
-from fsmbt.formats.smach import choose_machine
 from fsmbt.model.errors import InputError
 from fsmbt.model.fsm import FSM
 

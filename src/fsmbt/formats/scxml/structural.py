@@ -27,7 +27,7 @@ parent's initial state, transitions leaving a ``<parallel>`` region. Warned (``c
 ``<log>``, ``<datamodel>``/``<data>``, ``<donedata>``, foreign-namespace elements, and a
 transition dropped by document-order conflict resolution.
 
-XInclude is expanded before reading (``fsmbt.formats.scxml_include``). Everything is iterative
+XInclude is expanded before reading (``fsmbt.formats.scxml.include``). Everything is iterative
 over the element tree; complexity O(n + T·d) for n elements,
 T transitions and nesting depth d.
 """
@@ -39,9 +39,9 @@ from dataclasses import dataclass, field
 
 from lxml import etree
 
-from fsmbt.formats import scxml_include
 from fsmbt.formats.registry import Format, ReadContext, register
-from fsmbt.formats.scxml_w3c import read_scxml_w3c
+from fsmbt.formats.scxml import include as scxml_include
+from fsmbt.formats.scxml.w3c import read_scxml_w3c
 from fsmbt.formats.xml_safe import local_name, namespace, root_tag
 from fsmbt.model import Model
 from fsmbt.model.errors import InputError, SourceLocation, UnsupportedError
@@ -651,7 +651,7 @@ class _Reader:
 def read_scxml(text: str, ctx: ReadContext) -> FSM:
     """The hierarchical model of the document; a document the structural reader refuses for a
     feature with a finite reading is read by running the W3C algorithm instead (a flat model,
-    ``fsmbt.formats.scxml_w3c``; docs/formats/scxml.md)."""
+    ``fsmbt.formats.scxml.w3c``; docs/formats/scxml.md)."""
     try:
         return _read_either(text, ctx)
     except InputError as exc:  # UnsupportedError too: name the file included content came from

@@ -493,23 +493,16 @@ class _Writer:
 
 def _product_matches(spec: dict[str, object], region: FSM) -> bool:
     """Does ``region`` equal the product the reader builds from ``spec``?"""
-    from fsmbt.formats._pysm_analyze import Child, Container, StateRef
-    from fsmbt.formats._pysm_build import Builder, _Source, _Work
-    from fsmbt.formats.registry import ReadContext
+    from fsmbt.formats.pysm.analyze import Child, Container, StateRef
+    from fsmbt.formats.pysm.build import build_concurrence
 
     container = Container("Concurrence", "concurrence", list(spec["outcomes"]), 0)  # type: ignore[call-overload]
     container.default_outcome = spec["default"]  # type: ignore[assignment]
     container.outcome_map = [(o, dict(m)) for o, m in spec["outcome_map"]]  # type: ignore[attr-defined]
     for label, action, outcomes in spec["children"]:  # type: ignore[attr-defined]
         container.children.append(Child(label, StateRef(action, list(outcomes), 0), {}, 0))
-    rebuilt = FSM(name=region.name)
-    from fsmbt.formats._pysm_analyze import Analysis
-
-    source = _Source(None, "<check>", Analysis([], {}, {}))
     try:
-        Builder(ReadContext(), source).concurrence(
-            _Work(container, rebuilt, region.name, source, ())
-        )
+        rebuilt = build_concurrence(container, region.name)
     except InputError:
         return False
     return (
