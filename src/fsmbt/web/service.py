@@ -244,16 +244,20 @@ def convert(request: dict[str, Any]) -> dict[str, Any]:
     """
     loaded = _load(request)
     options = request.get("options") or {}
-    loop = bool(options.get("loop", False))
     hierarchy = str(options.get("hierarchy") or "subtrees")
     if hierarchy not in HIERARCHIES:
         raise InputError(
             f"unknown hierarchy option '{hierarchy}' (one of: {', '.join(HIERARCHIES)})"
         )
-    to = request.get("to") or None
-    outcome = api.convert_loaded(
-        loaded, to=to, engine=str(request.get("engine") or "rules"), loop=loop, hierarchy=hierarchy
-    )
+    fields: dict[str, Any] = {
+        "engine": str(request.get("engine") or "rules"),
+        "to": request.get("to") or None,
+        "loop": bool(options.get("loop", False)),
+        "hierarchy": hierarchy,
+    }
+    if request.get("style"):
+        fields["style"] = request["style"]
+    outcome = api.convert_loaded(loaded, None, api.convert_request(**fields))
     report = outcome.report
     pictures = {"source": _picture(loaded.model), "result": _picture(outcome.result)}
     kind = api.model_kind(outcome.result)
