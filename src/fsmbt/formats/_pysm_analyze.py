@@ -69,6 +69,7 @@ class StateRef:
     outcomes: list[str] | None
     line: int
     callback: str | None = None
+    opaque_behaviour: bool = False  # an embedded behaviour whose file was not found
 
 
 @dataclass
