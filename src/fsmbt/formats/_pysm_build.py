@@ -38,6 +38,7 @@ costs the product of (1 + outcomes) over its children, capped at ``MAX_PRODUCT_S
 
 from __future__ import annotations
 
+import ast
 import json
 from collections import deque
 from collections.abc import Callable
@@ -49,14 +50,17 @@ from fsmbt.formats._pysm_analyze import (
     MAX_UNROLLED_ITEMS,
     Analysis,
     Child,
+    ClassResolver,
     Container,
     Embedded,
     StateRef,
     analyze,
 )
 from fsmbt.formats._pysm_find import find_module_file
+from fsmbt.formats._pysm_params import ClassDecl, class_declaration
 from fsmbt.formats._pysm_source import parse_python
 from fsmbt.formats.registry import ReadContext, decode
+from fsmbt.model import state_info
 from fsmbt.model.errors import InputError, SourceLocation, UnsupportedError
 from fsmbt.model.files import note_read, read_bounded, read_located
 from fsmbt.model.flatten import flatten
@@ -100,11 +104,49 @@ class _Work:
 
 
 @dataclass
+class ClassFiles:
+    """State classes of other modules, found through imports in the ROS package layout
+    (``fsmbt.formats._pysm_find``) and read statically, each file once."""
+
+    files: dict[Path, dict[str, ClassDecl]] = field(default_factory=dict)
+
+    def resolver(self, importer: Path | None) -> ClassResolver | None:
+        """The class resolver for a file's imports (``None`` for a text with no file)."""
+        if importer is None:
+            return None
+
+        def resolve(module: str, name: str) -> ClassDecl | None:
+            path = find_module_file(importer, module)
+            if path is None:
+                return None
+            return self.classes(path.resolve()).get(name)
+
+        return resolve
+
+    def classes(self, path: Path) -> dict[str, ClassDecl]:
+        """The top-level classes of one module file (empty when it cannot be read)."""
+        if path not in self.files:
+            try:
+                text = decode(read_located(path), str(path))
+                _, tree, _ = parse_python(text, str(path))
+            except InputError:  # a state module fsmbt cannot read: its classes stay unknown
+                self.files[path] = {}
+                return {}
+            self.files[path] = {
+                stmt.name: class_declaration(stmt)
+                for stmt in tree.body
+                if isinstance(stmt, ast.ClassDef)
+            }
+        return self.files[path]
+
+
+@dataclass
 class Builder:
     """Builds the FSM of one root container (and whatever it nests)."""
 
     ctx: ReadContext
     main: _Source
+    classes: ClassFiles = field(default_factory=ClassFiles)
     loaded: dict[Path, _Source] = field(default_factory=dict)
     owners: dict[int, State] = field(default_factory=dict)  # id(region FSM) -> its state
 
@@ -158,10 +200,20 @@ class Builder:
             attrs = {A_CLASS: "CBState"} if state.callback else {}
             if state.opaque_behaviour:
                 attrs = {A_BEHAVIOUR: state.cls, A_OPAQUE: "true"}
+            attrs.update(leaf_info(state, child))
+            undeclared = work.source.analysis.extension.get("undeclared_outcomes")
+            if isinstance(undeclared, list) and sub_path in undeclared:
+                attrs.pop(state_info.OUTCOMES, None)  # stub outcomes fsmbt wrote, not declared
             return (State(label, action=action, attrs=attrs, location=where), state.outcomes, None)
         if isinstance(state, Container):
             region = FSM(name=label)
-            composite = State(label, action=None, regions=[region], location=where)
+            composite = State(
+                label,
+                action=None,
+                regions=[region],
+                location=where,
+                attrs=container_info(state, child),
+            )
             self.owners[id(region)] = composite
             return (
                 composite,
@@ -172,7 +224,11 @@ class Builder:
         root, source = found
         region = FSM(name=label)
         composite = State(
-            label, action=None, regions=[region], location=where, attrs={A_BEHAVIOUR: state.cls}
+            label,
+            action=None,
+            regions=[region],
+            location=where,
+            attrs={A_BEHAVIOUR: state.cls, **container_info(root, child)},
         )
         self.owners[id(region)] = composite
         chain = (*work.chain, str(source.path))
@@ -274,7 +330,7 @@ class Builder:
             return self.loaded[path]
         text = decode(read_located(path), str(path))
         text, tree, notes = parse_python(text, str(path))
-        analysis = analyze(text, tree, str(path))
+        analysis = analyze(text, tree, str(path), self.classes.resolver(path))
         source = _Source(path, str(path), analysis)
         if notes:
             self.warn(source, None, python2_warning(notes))
@@ -561,10 +617,17 @@ class Builder:
                     "combination of child outcomes gives",
                 )
         refs = [c.state for c in container.children if isinstance(c.state, StateRef)]
-        if not leaves:
-            return
         owner = self.owner_state(work)
         attrs = owner.attrs if owner is not None else fsm.attrs
+        children_info = {
+            c.label: leaf_info(c.state, c)
+            for c in container.children
+            if isinstance(c.state, StateRef) and leaf_info(c.state, c)
+        }
+        if children_info:
+            attrs[state_info.CHILD_STATES] = json.dumps(children_info)
+        if not leaves:
+            return
         attrs.update(
             {
                 A_CONTAINER: container.cls,
@@ -748,6 +811,34 @@ def _shares_outcomes(outcomes: list[list[str]]) -> bool:
     return False
 
 
+def leaf_info(ref: StateRef, child: Child) -> dict[str, str]:
+    """A leaf state's ``state_info`` entries: declared outcomes, parameters, userdata keys,
+    remapping, ROS interface, editor position (docs/formats/smach.md)."""
+    config = ref.config
+    return state_info.encode(
+        outcomes=ref.declared,
+        params=config.params,
+        expression_params=config.expressions,
+        inputs=config.inputs,
+        outputs=config.outputs,
+        remap=child.remapping,
+        at=child.position,
+        ros=config.ros,
+    )
+
+
+def container_info(container: Container, child: Child | None) -> dict[str, str]:
+    """A container's ``state_info`` entries: its userdata keys and initial values, and (as a
+    child) its remapping and editor position."""
+    return state_info.encode(
+        inputs=container.inputs,
+        outputs=container.outputs,
+        userdata=container.userdata,
+        remap=child.remapping if child is not None else None,
+        at=child.position if child is not None else None,
+    )
+
+
 def is_strict(ctx: ReadContext) -> bool:
     """Reader option ``strict`` (``fsmbt convert --strict``, ``-O strict=1``): refuse what
     would otherwise be read as an opaque approximation with a warning."""
@@ -775,9 +866,11 @@ def build_fsm(
         The hierarchical FSM.
     """
     text, tree, notes = parse_python(text, ctx.display_name)
-    analysis = analyze(text, tree, ctx.display_name)
-    main = _Source(ctx.path.resolve() if ctx.path is not None else None, ctx.display_name, analysis)
-    builder = Builder(ctx, main)
+    classes = ClassFiles()
+    path = ctx.path.resolve() if ctx.path is not None else None
+    analysis = analyze(text, tree, ctx.display_name, classes.resolver(path))
+    main = _Source(path, ctx.display_name, analysis)
+    builder = Builder(ctx, main, classes)
     if notes:
         builder.warn(main, None, python2_warning(notes))
     for line, message in analysis.warnings:
@@ -787,6 +880,7 @@ def build_fsm(
     if isinstance(extension.get("name"), str):
         name = str(extension["name"])
     fsm = builder.build(root, name)
+    fsm.attrs.update(container_info(root, None))
     start = extension.get("start")
     if (
         isinstance(start, dict)
