@@ -9,7 +9,9 @@ Rules:
   keeps one (SMACH: ``smach_losses``), else every difference between the model and the model
   read back from the written text (states, transitions, attributes, nodes, the BT format
   version ...), ignoring only the order of FSM states and transitions, which no format keeps
-  the same way and no semantics reads.
+  the same way and no semantics reads. The states' annotations (parameters, userdata keys,
+  remappings, positions, autonomy levels: ``fsmbt.formats.annotations``) are named by kind,
+  one line each, with the states that lose them.
 - A loss that changes meaning is an error, not a warning: when the target has a reader, the
   model read back is checked against the source with the checker the caller passes
   (``fsmbt.verify.verify``; this module sits below verify in the package layers and does not
@@ -30,6 +32,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from fsmbt.formats.annotations import annotation_losses
 from fsmbt.formats.registry import (
     ReadContext,
     format_for_path,
@@ -157,7 +160,9 @@ def translate(
         _check_meaning(checked, back, target.name, check)
         result.verified = True
     if own_losses is None:
-        losses.extend(differences_between(written, back))
+        named, written_rest, back_rest = annotation_losses(written, back, target.name)
+        losses.extend(named)
+        losses.extend(differences_between(written_rest, back_rest))
     return result
 
 
