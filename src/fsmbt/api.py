@@ -296,12 +296,12 @@ def load_for_engine(
 
 
 #: Options meant for the readers, not the engines (they travel in the same ``options`` dict).
-READER_OPTIONS = ("node_models", "nodes", "abstract", "data", "trees", "include_root")
+READER_OPTIONS = ("node_models", "nodes", "abstract", "data", "trees", "include_root", "strict")
 
 
 def _reader_options(options: dict[str, object]) -> dict[str, object] | None:
     """The options a reader understands (``node_models``, ``nodes``, ``abstract``, ``data``,
-    ``trees``, ``include_root``), out of the engine options."""
+    ``trees``, ``include_root``, ``strict``), out of the engine options."""
     picked = {key: options[key] for key in READER_OPTIONS if key in options}
     return picked or None
 

@@ -95,6 +95,12 @@ def register(app: typer.Typer) -> None:
         llm_model: str | None = typer.Option(None, "--llm-model", help="LLM engines: model name"),
         timeout: float | None = timeout_option(),
         nusmv_memory: int | None = nusmv_memory_option(),
+        strict: bool = typer.Option(
+            False,
+            "--strict",
+            help="refuse what the reader would otherwise read as an approximation with a "
+            "warning (FlexBE: an embedded behaviour whose file is not found)",
+        ),
     ) -> None:
         """Convert an FSM into a behavior tree or a behavior tree into a hierarchical FSM, and
         prove the result equivalent."""
@@ -102,6 +108,8 @@ def register(app: typer.Typer) -> None:
         options: dict[str, object] = dict(
             reader_options(node_models, nodes, abstract, trees, include_root) or {}
         )
+        if strict:
+            options["strict"] = True
         if engine in api.LLM_ENGINES:
             options.update(llm_base_url=llm_base_url, llm_model=llm_model)
         with StageProgress(quiet=quiet, label=source.name) as progress:
