@@ -648,7 +648,7 @@ def _arguments(state: State) -> str:
     """The stub state's constructor arguments: its parameters as keywords (``*`` / ``**``
     expression parameters as unpacking)."""
     expressions = set(state_info.expression_parameters(state))
-    parts = []
+    parts: list[str] = []
     for name, value in state_info.parameters(state).items():
         source = _python_value(value, name in expressions)
         if name == "*":

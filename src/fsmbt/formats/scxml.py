@@ -35,7 +35,6 @@ T transitions and nesting depth d.
 from __future__ import annotations
 
 import re
-from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 from lxml import etree
@@ -80,11 +79,12 @@ def annotation_attribute(key: str) -> str:
     return key
 
 
-def annotations_in(attrib: Mapping[str, str], known: frozenset[str]) -> dict[str, str]:
+def annotations_in(attrib: etree._Attrib, known: frozenset[str]) -> dict[str, str]:
     """An element's other attributes as ``attrs``: fsmbt-namespaced annotations by their key."""
     out: dict[str, str] = {}
     prefix = f"{{{FSMBT_NS}}}"
-    for key, value in attrib.items():
+    for raw_key, raw_value in attrib.items():
+        key, value = str(raw_key), str(raw_value)
         if key in known:
             continue
         local = key[len(prefix) :] if key.startswith(prefix) else None
