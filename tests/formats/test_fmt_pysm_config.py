@@ -190,8 +190,10 @@ def test_smach_ros_states_and_positional_parameters() -> None:
     assert state_info.userdata_values(model) == {"speed": "0.25"}
     # SMACH keeps the parameters and keys; the ROS interfaces are named as losses
     result = translate(model, "smach", check=verify)
-    assert any("ROS action state (move_base_msgs/msg/MoveBaseAction" in x for x in result.losses)
-    assert any("ROS service state (std_srvs/srv/Empty on '/clear')" in x for x in result.losses)
+    (ros_loss,) = [x for x in result.losses if "ROS action/service state(s)" in x]
+    assert ros_loss.startswith("2 ROS action/service state(s) written as stub state classes")
+    assert "'MOVE' (action move_base_msgs/msg/MoveBaseAction on 'move_base')" in ros_loss
+    assert "'CLEAR' (service std_srvs/srv/Empty on '/clear')" in ros_loss
     assert "Wait(seconds=2.5, label=name_var)" in result.text
 
 
@@ -291,3 +293,51 @@ def test_ros1_workspace_lookup_in_the_packages_the_imports_name(tmp_path: Path) 
     assert state_info.parameters(work) == {"count": "3", "speed": "0.5"}
     assert state_info.position(work) == (30, 40)
     assert not any("opaque" in w for w in warnings)
+
+
+CORPUS_FILES = sorted(
+    [
+        *(CORPUS / "fsm").glob("smach_tutorials/*.py"),
+        *(CORPUS / "fsm").glob("smach_tests/*.py"),
+        *(CORPUS / "fsm").glob("flexbe_turtlesim_demo/*_sm.py"),
+    ]
+)
+
+
+def _annotated(model: FSM) -> dict[str, set[str]]:
+    """Annotation kind -> paths of the states carrying it (the top machine as "")."""
+    out: dict[str, set[str]] = {}
+    for key in state_info.KEYS:
+        if key in model.attrs:
+            out.setdefault(key, set()).add("")
+    for path, _machine, state in model.walk():
+        for key in state.attrs:
+            if key in state_info.KEYS:
+                out.setdefault(key, set()).add(path)
+    return out
+
+
+@needs_corpus
+@pytest.mark.parametrize("path", CORPUS_FILES, ids=lambda p: f"{p.parent.name}/{p.name}")
+def test_every_corpus_annotation_is_carried_or_named(path: Path) -> None:
+    model = read_model(path)
+    assert isinstance(model, FSM)
+    annotated = _annotated(model)
+    # fsmbt JSON and SCXML carry every annotation: read back, the same states hold the same
+    for target in ("json", "scxml"):
+        result = translate(model, target)
+        back = loads(result.text, target)
+        if target == "json":
+            assert result.losses == [] and differences_between(model, back) == []
+        else:
+            renamed = any("not SCXML ids" in line for line in result.losses)
+            if not renamed:
+                assert _annotated(back) == annotated, target
+            assert not any("have no place" in line for line in result.losses)
+    # Mermaid (flattened where it must be) has no place: each kind present is named once
+    hierarchical = model.is_hierarchical
+    lost = translate(model, "mermaid", flatten=hierarchical).losses
+    for key in annotated:
+        what = state_info.DESCRIPTIONS[key]
+        named = [line for line in lost if line.startswith(f"{what} of ")]
+        assert len(named) == 1, (key, lost)

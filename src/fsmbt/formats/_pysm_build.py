@@ -619,11 +619,17 @@ class Builder:
         refs = [c.state for c in container.children if isinstance(c.state, StateRef)]
         owner = self.owner_state(work)
         attrs = owner.attrs if owner is not None else fsm.attrs
-        children_info = {
-            c.label: leaf_info(c.state, c)
-            for c in container.children
-            if isinstance(c.state, StateRef) and leaf_info(c.state, c)
-        }
+        undeclared = work.source.analysis.extension.get("undeclared_outcomes")
+        children_info: dict[str, dict[str, str]] = {}
+        for c in container.children:
+            if not isinstance(c.state, StateRef):
+                continue
+            info = leaf_info(c.state, c)
+            child_path = f"{work.path}/{c.label}" if work.path else c.label
+            if isinstance(undeclared, list) and child_path in undeclared:
+                info.pop(state_info.OUTCOMES, None)  # stub outcomes fsmbt wrote
+            if info:
+                children_info[c.label] = info
         if children_info:
             attrs[state_info.CHILD_STATES] = json.dumps(children_info)
         if not leaves:

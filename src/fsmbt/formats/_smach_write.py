@@ -196,6 +196,7 @@ class _Writer:
         ] = []
         self.undeclared: list[str] = []  # states whose declared outcomes the model did not know
         self.positioned = 0  # states with an editor position (a loss)
+        self.ros_states: list[str] = []  # generic ROS states written as stubs (a loss)
         self.final_actions: dict[str, dict[str, str | None]] = {}
         self.lines: list[str] = []
         self.counter = 0
@@ -283,6 +284,13 @@ class _Writer:
                     "the model; a SMACH container outcome runs nothing (kept in "
                     "__fsmbt__)"
                 )
+        if self.ros_states:
+            shown = ", ".join(self.ros_states[:5])
+            more = f" and {len(self.ros_states) - 5} more" if len(self.ros_states) > 5 else ""
+            self.losses.append(
+                f"{len(self.ros_states)} ROS action/service state(s) written as stub state "
+                f"classes (the interface is not called): {shown}{more}"
+            )
         if self.positioned:
             self.losses.append(
                 f"editor positions of {self.positioned} state(s) have no place in SMACH; dropped"
@@ -301,12 +309,12 @@ class _Writer:
             self.positioned += 1
         ros = state_info.ros_interface(state)
         if ros is not None:
-            self.losses.append(
-                f"state {where} was a ROS {ros[0]} state ({ros[1]}"
-                + (f" on '{ros[2]}'" if ros[2] else "")
-                + "); written as a stub state class"
+            self.ros_states.append(
+                f"{where} ({ros[0]} {ros[1]}" + (f" on '{ros[2]}'" if ros[2] else "") + ")"
             )
-        if state.attrs.get(state_info.CHILD_STATES):
+        if state.attrs.get(state_info.CHILD_STATES) and (
+            state.attrs.get(A_CONTAINER) != "Concurrence"
+        ):
             self.losses.append(
                 f"the configuration of the concurrent children of {where} (their parameters, "
                 "userdata keys and remappings) has no place in the StateMachine written; dropped"
@@ -431,7 +439,7 @@ class _Writer:
                 region = state.regions[0]
                 concurrence = self.concurrence(state, region)
                 if concurrence is not None:
-                    sub_var = self.emit_concurrence(state, concurrence, level, lines)
+                    sub_var = self.emit_concurrence(state, concurrence, level, lines, sub_path)
                     lines.append(
                         f"{pad}smach.StateMachine.add({_py(state.name)}, {sub_var}, "
                         f"transitions={_py(transitions)}{_remapping(state)})"
@@ -562,28 +570,54 @@ class _Writer:
         if not _product_matches(spec, region):
             self.losses.append(
                 f"Concurrence '{state.name}' was changed after reading; written "
-                "as the StateMachine of its combinations"
+                "as the StateMachine of its combinations (its children's configuration "
+                "dropped)"
             )
             return None
         return spec
 
     def emit_concurrence(
-        self, state: State, spec: dict[str, object], level: int, lines: list[str]
+        self, state: State, spec: dict[str, object], level: int, lines: list[str], path: str
     ) -> str:
+        """The ``Concurrence`` read back unchanged, with its own keys and userdata and each
+        child's parameters, keys and remapping (``state_info.CHILD_STATES``)."""
         var = f"cc_{self.counter}"
         self.counter += 1
         pad = "    " * level
         outcome_map: dict[str, dict[str, str]] = {}
         for outcome, required in spec["outcome_map"]:  # type: ignore[attr-defined]
             outcome_map[outcome] = required
+        keys = "".join(
+            f", {name}={_py(found)}"
+            for name, found in (
+                ("input_keys", state_info.input_keys(state)),
+                ("output_keys", state_info.output_keys(state)),
+            )
+            if found
+        )
         lines.append(
             f"{pad}{var} = smach.Concurrence(outcomes={_py(spec['outcomes'])}, "
-            f"default_outcome={_py(spec['default'])}, outcome_map={_py(outcome_map)})"
+            f"default_outcome={_py(spec['default'])}, outcome_map={_py(outcome_map)}{keys})"
         )
+        for key, value in state_info.userdata_values(state).items():
+            target = f"{var}.userdata.{key}" if _is_identifier(key) else f"{var}.userdata[{key!r}]"
+            lines.append(f"{pad}{target} = {_python_value(value, False)}")
         lines.append(f"{pad}with {var}:")
+        children = state_info.child_states(state)
         for label, action, outcomes in spec["children"]:  # type: ignore[attr-defined]
-            cls = self.state_class(action, tuple(outcomes))
-            lines.append(f"{pad}    smach.Concurrence.add({_py(label)}, {cls}())")
+            child = State(label, action=action, attrs=children.get(label, {}))
+            cls = self.state_class(
+                action,
+                tuple(outcomes),
+                tuple(state_info.input_keys(child)),
+                tuple(state_info.output_keys(child)),
+            )
+            if state_info.declared_outcomes(child) is None:
+                self.undeclared.append(f"{path}/{label}" if path else label)
+            lines.append(
+                f"{pad}    smach.Concurrence.add({_py(label)}, {cls}({_arguments(child)})"
+                f"{_remapping(child)})"
+            )
         return var
 
 

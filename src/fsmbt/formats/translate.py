@@ -107,6 +107,7 @@ def translate(
             f"flattened: {len(written.states)} flat states replace the composite, "
             "parallel and transient states"
         )
+        losses.extend(annotation_losses(model, written, "the flattened machine")[0])
     checked = model  # what the read-back must equal in behaviour (events renamed, if any)
     if target.name == "scxml" and isinstance(written, FSM):
         events = scxml_event_renames(written)
