@@ -13,7 +13,12 @@ What is understood (docs/formats/smach.md, docs/formats/flexbe.md):
   ``CBState`` (outcomes from ``@cb_interface``), a container, or a FlexBE
   ``self.use_behavior(Class, ...)`` (an embedded behaviour);
 - literal values (labels, outcome lists, transition dicts) may come through names bound to
-  literals earlier in the same function or module.
+  literals earlier in the same function or module;
+- what a state is configured with (``fsmbt.formats._pysm_params``: constructor arguments,
+  the userdata keys its class declares - in the file, or through ``resolver`` in the file its
+  import names -, the ROS interface of SMACH's generic states), the ``remapping=`` and the
+  FlexBE editor's ``# x:.. y:..`` position of each ``add``, a container's keys and its
+  ``c.userdata.k = v`` values: kept as annotations, never deciding which states exist.
 Everything else that touches a container - a label or transitions computed at run time, an
 ``add`` in a loop or under a condition, a callback deciding outcomes - is ``UnsupportedError``
 with its line. Statements are walked with an explicit stack; nothing is executed.

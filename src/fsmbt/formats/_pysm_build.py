@@ -29,8 +29,15 @@ Mapping rules:
   ``MAX_UNROLLED_ITEMS``) is unrolled, one copy of the contained state per item; with items
   computed at run time, the number of items is an environment choice after each loop outcome
   (events ``<label>.next`` / ``<label>.exhausted``), named in a warning.
-- An embedded FlexBE behaviour is read from its own file beside the including one (module
-  name of its import, else any ``*.py`` there defining the class) and nested as a composite.
+- An embedded FlexBE behaviour is read from the file its import names, looked up in its own
+  ROS package (``fsmbt.formats._pysm_find``; docs/formats/flexbe.md "Embedded behaviours"),
+  and nested as a composite; not found, it is one opaque state whose outcomes are those its
+  transitions name (a warning; reader option ``strict`` refuses).
+- ConcurrencyContainer / Concurrence product states get names no other state has
+  (``_product_name``).
+- What each state was configured with (parameters, declared outcomes, userdata keys,
+  remapping, ROS interface, editor position) goes into ``State.attrs`` through
+  ``fsmbt.model.state_info`` (``leaf_info``, ``container_info``); it never changes the machine.
 
 Everything is built with an explicit work stack. Costs: O(S + T) per machine; a concurrence
 costs the product of (1 + outcomes) over its children, capped at ``MAX_PRODUCT_STATES``.
