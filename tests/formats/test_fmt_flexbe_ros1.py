@@ -242,3 +242,42 @@ def test_convert_strict_refuses_an_embedded_behaviour_not_found(tmp_path: Path) 
     strict = _cli("convert", str(source), "-o", str(tmp_path / "o2.xml"), "--strict", cwd=tmp_path)
     assert strict.returncode == 2
     assert f"{source}:8" in strict.stderr and "strict reading refuses" in strict.stderr
+
+
+def test_mangled_python2_sources_fail_only_with_located_input_errors() -> None:
+    """Seeded mutations of the ROS 1 file (quotes, backticks, tabs, brackets, keywords): the
+    normaliser and the reader end in a model or a located ``InputError``/``UnsupportedError``,
+    never another exception."""
+    import random
+
+    from fsmbt.model.errors import FsmbtError
+
+    rng = random.Random(26)
+    outcomes = {"read": 0, "refused": 0}
+    pieces = list("`'\"\t ,()[]{}:<>\\\n#") + [
+        "print ",
+        "exec ",
+        "except ",
+        "raise ",
+        "ur",
+        "0",
+        "L",
+    ]
+    for _ in range(150):
+        text = list(ROS1)
+        for _ in range(rng.randint(1, 6)):
+            where = rng.randrange(len(text))
+            choice = rng.random()
+            if choice < 0.4:
+                text.insert(where, rng.choice(pieces))
+            elif choice < 0.7:
+                del text[where]
+            else:
+                text[where] = rng.choice(pieces)
+        try:
+            loads("".join(text), "flexbe")
+            outcomes["read"] += 1
+        except FsmbtError as exc:
+            outcomes["refused"] += 1
+            assert exc.location is not None and str(exc).startswith("<input>")
+    assert outcomes["read"] > 0 and outcomes["refused"] > 0, outcomes
