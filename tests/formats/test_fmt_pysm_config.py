@@ -131,11 +131,28 @@ def test_flexbe_demo_to_smach_writes_parameters_and_names_the_rest() -> None:
     assert result.verified
     assert "TimedCmdVelState(target_time=3.99, velocity=0.5, rotation_rate=0.0" in result.text
     assert "severity=Logger.REPORT_HINT" in result.text  # an expression, written as itself
-    assert any("editor positions of" in line for line in result.losses)
+    assert "            # x:130 y:43\n" in result.text  # the editor's position comment
     assert any("autonomy" in line for line in result.losses)
+    assert any(
+        "embedded the FlexBE behaviour 'TurtlesimInputStateBehaviorSM'" in line
+        for line in result.losses
+    )
     back = loads(result.text, "smach")
     forward = back.states["EightMove"].regions[0].states["Forward0"]
     assert state_info.parameters(forward)["velocity"] == "0.5"
+    assert state_info.position(forward) == (130, 43)
+    # every parameter, key, remapping and position read back as it was
+    before = {p: s.attrs for p, _m, s in model.walk()}
+    after = {p: s.attrs for p, _m, s in back.walk()}
+    for key in (
+        state_info.PARAMETERS,
+        state_info.EXPRESSION_PARAMETERS,
+        state_info.REMAPPING,
+        state_info.POSITION,
+    ):
+        assert {p: a[key] for p, a in before.items() if key in a} == {
+            p: a[key] for p, a in after.items() if key in a
+        }, key
 
 
 SMACH_ROS = """\

@@ -195,7 +195,6 @@ class _Writer:
             tuple[str, tuple[str, ...], str | None, tuple[str, ...], tuple[str, ...]]
         ] = []
         self.undeclared: list[str] = []  # states whose declared outcomes the model did not know
-        self.positioned = 0  # states with an editor position (a loss)
         self.ros_states: list[str] = []  # generic ROS states written as stubs (a loss)
         self.final_actions: dict[str, dict[str, str | None]] = {}
         self.lines: list[str] = []
@@ -291,10 +290,6 @@ class _Writer:
                 f"{len(self.ros_states)} ROS action/service state(s) written as stub state "
                 f"classes (the interface is not called): {shown}{more}"
             )
-        if self.positioned:
-            self.losses.append(
-                f"editor positions of {self.positioned} state(s) have no place in SMACH; dropped"
-            )
         _push_down(self.fsm)
         if self.fsm.start_name is not None and self.fsm.initial_event is not None:
             self.losses.append(
@@ -305,8 +300,6 @@ class _Writer:
 
     def info_losses(self, where: str, state: State) -> None:
         """What SMACH cannot hold of a state's ``state_info`` (the rest is written)."""
-        if state_info.position(state) is not None:
-            self.positioned += 1
         ros = state_info.ros_interface(state)
         if ros is not None:
             self.ros_states.append(
@@ -318,6 +311,13 @@ class _Writer:
             self.losses.append(
                 f"the configuration of the concurrent children of {where} (their parameters, "
                 "userdata keys and remappings) has no place in the StateMachine written; dropped"
+            )
+        behaviour = state.attrs.get("flexbe.behaviour")
+        if behaviour is not None:
+            self.losses.append(
+                f"state {where} embedded the FlexBE behaviour '{behaviour}'; written as "
+                + ("a stub state class" if state.is_atomic else "a nested StateMachine")
+                + " (the behaviour's name dropped)"
             )
         odd = [n for n in state_info.parameters(state) if n not in ("*", "**")]
         odd = [n for n in odd if not _is_identifier(n)]
@@ -440,6 +440,7 @@ class _Writer:
                 concurrence = self.concurrence(state, region)
                 if concurrence is not None:
                     sub_var = self.emit_concurrence(state, concurrence, level, lines, sub_path)
+                    lines.extend(_position_comment(state, pad))
                     lines.append(
                         f"{pad}smach.StateMachine.add({_py(state.name)}, {sub_var}, "
                         f"transitions={_py(transitions)}{_remapping(state)})"
@@ -448,6 +449,7 @@ class _Writer:
                 sub_var = self.new_container(region, sub_path, level, lines, state)
                 after_lines = [
                     *self.initial_line(region, sub_var, level),
+                    *_position_comment(state, pad),
                     f"{pad}smach.StateMachine.add({_py(state.name)}, {sub_var}, "
                     f"transitions={_py(transitions)}{_remapping(state)})",
                 ]
@@ -470,6 +472,7 @@ class _Writer:
             )
             if state_info.declared_outcomes(state) is None:
                 self.undeclared.append(f"{path}/{state.name}" if path else state.name)
+            lines.extend(_position_comment(state, pad))
             lines.append(
                 f"{pad}smach.StateMachine.add({_py(state.name)}, {cls}({_arguments(state)}), "
                 f"transitions={_py(transitions)}{_remapping(state)})"
@@ -614,6 +617,7 @@ class _Writer:
             )
             if state_info.declared_outcomes(child) is None:
                 self.undeclared.append(f"{path}/{label}" if path else label)
+            lines.extend(_position_comment(child, pad + "    "))
             lines.append(
                 f"{pad}    smach.Concurrence.add({_py(label)}, {cls}({_arguments(child)})"
                 f"{_remapping(child)})"
@@ -692,6 +696,13 @@ def _arguments(state: State) -> str:
         elif _is_identifier(name):
             parts.append(f"{name}={source}")
     return ", ".join(parts)
+
+
+def _position_comment(state: State, pad: str) -> list[str]:
+    """The FlexBE editor's ``# x:.. y:..`` comment above the ``add`` (read back as the
+    state's position, docs/formats/flexbe.md)."""
+    at = state_info.position(state)
+    return [f"{pad}# x:{at[0]} y:{at[1]}"] if at is not None else []
 
 
 def _remapping(state: State) -> str:
