@@ -43,6 +43,7 @@ READER_FIELDS = (
     "machine",
     "behaviour",
     "initial",
+    "strict",
 )
 
 
@@ -97,6 +98,11 @@ class ReadOptions(_Request):
     behaviour: str | None = Field(default=None, description="FlexBE: which Behavior class to read")
     initial: str | None = Field(
         default=None, description="tables: the initial state (default: the first row's source)"
+    )
+    strict: bool = Field(
+        default=False,
+        description="refuse what a reader would otherwise read as an approximation with a "
+        "warning (FlexBE: an embedded behaviour whose file is not found)",
     )
 
     @field_validator("node_models", "nodes", "abstract", "trees", mode="before")
