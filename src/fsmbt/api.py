@@ -51,6 +51,7 @@ from fsmbt.model.fsm import FSM
 from fsmbt.model.validate import Issue
 from fsmbt.semantics.blockers import Blocker
 from fsmbt.semantics.blockers import conversion_blockers as blockers_of
+from fsmbt.semantics.outcome_rules import OutcomeRules
 from fsmbt.verify import Report, verify
 from fsmbt.verify.native import StateLimitError
 from fsmbt.verify.orient import orient, rules_text
@@ -63,6 +64,9 @@ DEFAULT_FSM_FORMAT = "scxml"  # BT -> FSM: nested states survive
 DEFAULT_BT_FORMAT = "btcpp"  # FSM -> BT: BehaviorTree.CPP v4 XML with TreeNodesModel
 #: Engines that ask a language model (they read prose and pictures through LLM extraction).
 LLM_ENGINES = ("llm", "nllm", "hybrid")
+#: Formats whose events are the states' outcomes (docs/semantics.md §11): ``--style auto``
+#: gives their machines the structured tree.
+OUTCOME_FORMATS = ("smach", "flexbe", "yasmin")
 
 #: The verdict words every layer prints and stores.
 EQUIVALENT = "EQUIVALENT"
@@ -313,7 +317,7 @@ def convert_model(
     model: Model,
     engine: str = "rules",
     *,
-    style: str = "paper",
+    style: str = "auto",
     loop: bool = False,
     hierarchy: str | None = None,
     **options: object,
@@ -323,7 +327,8 @@ def convert_model(
     Args:
         model: the source model; its kind decides the direction.
         engine: the engine's name (``rules``, ``bsd``, ``chds``, ``llm``, ...).
-        style: the output structure style the engine offers (``paper`` by default).
+        style: the output structure style: ``auto`` (default: ``structured`` for an
+            outcome-driven machine, else ``lebt``), ``structured``, ``lebt`` (``paper``).
         loop: BT -> FSM: the root is ticked again after it returns.
         hierarchy: FSM -> BT with ``rules``: ``subtrees`` (one SubTree per composite state) or
             ``flatten``; ``None`` leaves the engine's default.
@@ -374,6 +379,11 @@ def _checker_limit(max_states: int | None) -> int:
     return max_states if max_states is not None else limits.current().checker_max_states
 
 
+def _outcome_option(options: dict[str, object]) -> str | None:
+    value = options.get("outcomes")
+    return str(value) if value else None
+
+
 def verify_models(
     source: Model,
     result: Model,
@@ -381,6 +391,8 @@ def verify_models(
     *,
     loop: bool = False,
     max_states: int | None = None,
+    outcomes: str | None = None,
+    outcome_driven: bool = False,
 ) -> Report:
     """Check that ``result`` behaves exactly like ``source`` (the five properties).
 
@@ -391,6 +403,9 @@ def verify_models(
         loop: the BT side's root is ticked again after it returns.
         max_states: the native checker's state limit (``None``: ``fsmbt.limits.current()``'s
             ``checker_max_states``).
+        outcomes: an FSM and its structured tree: the outcome rules (``"arrived=success"``,
+            docs/semantics.md §11); ``None``: the default names.
+        outcome_driven: the FSM's events are outcomes (a SMACH/FlexBE/YASMIN source).
 
     Returns:
         The ``Report``: verdict, five properties, shortest counterexamples.
@@ -399,7 +414,15 @@ def verify_models(
         EngineDisagreement: ``both`` and the engines disagree (a bug in one of them).
         InputError, UnsupportedError: the pair cannot be compared.
     """
-    report = verify(source, result, engine=engine, loop=loop, max_states=_checker_limit(max_states))
+    report = verify(
+        source,
+        result,
+        engine=engine,
+        loop=loop,
+        max_states=_checker_limit(max_states),
+        outcomes=OutcomeRules.from_option(outcomes),
+        outcome_driven=outcome_driven,
+    )
     _name_abstractions(report, source, result)
     return readable(report, source, result)
 
@@ -631,7 +654,7 @@ def convert_file(
     to: str | None = None,
     source_format: str | None = None,
     engine: str = "rules",
-    style: str = "paper",
+    style: str = "auto",
     loop: bool = False,
     hierarchy: str = "subtrees",
     verify: bool = True,
@@ -706,7 +729,7 @@ def convert_loaded(
     *,
     to: str | None = None,
     engine: str = "rules",
-    style: str = "paper",
+    style: str = "auto",
     loop: bool = False,
     hierarchy: str = "subtrees",
     verify: bool = True,
@@ -742,6 +765,8 @@ def convert_loaded(
     _refuse_blockers(loaded.model)
     with _timed(timings, "convert", on_stage):
         engine_options = {k: v for k, v in options.items() if k not in READER_OPTIONS}
+        if engine == "rules" and loaded.format in OUTCOME_FORMATS:
+            engine_options["outcome_driven"] = True  # the format's events are outcomes
         if max_states is not None:
             engine_options.setdefault("max_states", max_states)
         conversion = convert_model(
@@ -752,8 +777,15 @@ def convert_loaded(
     report: Report | None = None
     if verify:
         with _timed(timings, "verify", on_stage):
+            structured = conversion.stats.get("style") == "structured"
             report = verify_models(
-                loaded.model, conversion.model, verify_engine, loop=loop, max_states=max_states
+                loaded.model,
+                conversion.model,
+                verify_engine,
+                loop=loop,
+                max_states=max_states,
+                outcomes=_outcome_option(options) if structured else None,
+                outcome_driven=structured,
             )
     outcome = Outcome(loaded, conversion, report, fmt, text, output=destination)
     if destination is not None and (report is None or report.equivalent or keep_not_equivalent):

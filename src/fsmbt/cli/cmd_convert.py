@@ -56,7 +56,17 @@ def register(app: typer.Typer) -> None:
         ),
         source_format: str | None = typer.Option(None, "--from", help="input format"),
         engine: str = typer.Option("rules", "--engine", help="rules, or a registered engine"),
-        style: str = typer.Option("paper", "--style", help="output structure style"),
+        style: str = typer.Option(
+            "auto",
+            "--style",
+            help="FSM->BT: auto (structured for SMACH/FlexBE/YASMIN and machines that declare "
+            "outcomes, else lebt), structured, lebt (paper is lebt)",
+        ),
+        outcomes: str | None = typer.Option(
+            None,
+            "--outcomes",
+            help="structured style: outcome statuses, e.g. arrived=success,lost=failure",
+        ),
         loop: bool = typer.Option(
             False,
             "--loop",
@@ -102,6 +112,8 @@ def register(app: typer.Typer) -> None:
         options: dict[str, object] = dict(
             reader_options(node_models, nodes, abstract, trees, include_root) or {}
         )
+        if outcomes:
+            options["outcomes"] = outcomes
         if engine in api.LLM_ENGINES:
             options.update(llm_base_url=llm_base_url, llm_model=llm_model)
         with StageProgress(quiet=quiet, label=source.name) as progress:

@@ -64,9 +64,8 @@ class OutcomeFSMMachine:
         while True:
             if (region_path, target) in seen:
                 raise OutcomeError(
-                    f"state '{target}': containers enter and leave each other forever without "
-                    "running a state",
-                    element=target,
+                    "containers enter and leave each other forever without running a state",
+                    element=f"state '{target}'",
                 )
             seen.add((region_path, target))
             region = self.view.regions[region_path]

@@ -68,12 +68,12 @@ def parse_outcomes_option(text: str | None) -> dict[str, str]:
         name, status = name.strip(), status.strip().lower()
         if not sep or not name or status not in STATUSES:
             raise OutcomeError(
-                f"--outcomes: '{item}' is not OUTCOME=success or OUTCOME=failure",
+                f"'{item}' is not OUTCOME=success or OUTCOME=failure",
                 element="--outcomes",
             )
         if mapping.get(name, status) != status:
             raise OutcomeError(
-                f"--outcomes: outcome '{name}' is mapped to both success and failure",
+                f"outcome '{name}' is mapped to both success and failure",
                 element="--outcomes",
             )
         mapping[name] = status

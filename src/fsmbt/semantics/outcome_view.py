@@ -149,9 +149,9 @@ def read_outcome_view(fsm: FSM, rules: OutcomeRules | None = None) -> OutcomeVie
     rules = rules or OutcomeRules()
     if fsm.initial_event is not None:
         raise OutcomeError(
-            f"machine '{fsm.name}': the start waits for the external event "
+            f"the start waits for the external event "
             f"'{fsm.initial_event}' (an event-driven machine, not an outcome-driven one)",
-            element=fsm.name,
+            element=f"machine '{fsm.name}'",
         )
     regions: dict[str, Region] = {}
     order_choices: list[str] = []
@@ -167,16 +167,15 @@ def read_outcome_view(fsm: FSM, rules: OutcomeRules | None = None) -> OutcomeVie
         region = Region(path, machine, owner)
         regions[path] = region
         if machine.initial is None or machine.initial not in machine.states:
-            raise OutcomeError(f"machine '{path or fsm.name}' has no initial state", element=path)
+            raise OutcomeError("no initial state", element=f"machine '{path or fsm.name}'")
         for name, state in machine.states.items():
             where = f"{path}/{name}" if path else name
             if state.final:
                 continue
             if state.is_parallel:
                 raise OutcomeError(
-                    f"state '{where}': a Concurrence (parallel regions) has no structured "
-                    "form in this version",
-                    element=where,
+                    f"a Concurrence (parallel regions) has no structured form in this version",
+                    element=f"state '{where}'",
                     location=state.location,
                 )
             outgoing = machine.outgoing(name)
@@ -244,24 +243,23 @@ def _leaf_unit(
     for t in outgoing:
         if t.event is None:
             raise OutcomeError(
-                f"state '{where}': a completion transition to '{t.target}' (an atomic "
+                f"a completion transition to '{t.target}' (an atomic "
                 "outcome-driven state leaves only on one of its outcomes)",
-                element=where,
+                element=f"state '{where}'",
                 location=t.location or state.location,
             )
         if declared is not None and t.event not in declared:
             raise OutcomeError(
-                f"state '{where}': event '{t.event}' is not one of its declared outcomes "
+                f"event '{t.event}' is not one of its declared outcomes "
                 f"({', '.join(declared) or 'none'}): the machine mixes external events and "
                 "outcomes",
-                element=where,
+                element=f"state '{where}'",
                 location=t.location or state.location,
             )
         if t.event == RUNNING_INPUT:
             raise OutcomeError(
-                f"state '{where}': an outcome named '{RUNNING_INPUT}' cannot be told from a "
-                "running leaf",
-                element=where,
+                f"an outcome named '{RUNNING_INPUT}' cannot be told from a running leaf",
+                element=f"state '{where}'",
             )
         if t.event not in targets:
             targets[t.event] = t.target
@@ -272,8 +270,8 @@ def _leaf_unit(
     kept = [o for o in order if o not in halted]
     if not kept and not halted:
         raise OutcomeError(
-            f"state '{where}': no outcome leaves it (an outcome-driven state must return one)",
-            element=where,
+            f"no outcome leaves it (an outcome-driven state must return one)",
+            element=f"state '{where}'",
             location=state.location,
         )
     return Unit(
@@ -295,9 +293,9 @@ def _container_unit(
     for t in outgoing:
         if t.event is not None:
             raise OutcomeError(
-                f"state '{where}': the container handles event '{t.event}' (an event that "
+                f"the container handles event '{t.event}' (an event that "
                 "interrupts a running container is not an outcome)",
-                element=where,
+                element=f"state '{where}'",
                 location=t.location or state.location,
             )
         if t.exit is None:
@@ -306,9 +304,9 @@ def _container_unit(
             targets.setdefault(t.exit, t.target)
         else:
             raise OutcomeError(
-                f"state '{where}': a completion transition waits for '{t.exit}', which is no "
+                f"a completion transition waits for '{t.exit}', which is no "
                 "outcome of the container",
-                element=where,
+                element=f"state '{where}'",
                 location=t.location or state.location,
             )
     for final in finals:
