@@ -174,7 +174,7 @@ def read_outcome_view(fsm: FSM, rules: OutcomeRules | None = None) -> OutcomeVie
                 continue
             if state.is_parallel:
                 raise OutcomeError(
-                    f"a Concurrence (parallel regions) has no structured form in this version",
+                    "a Concurrence (parallel regions) has no structured form in this version",
                     element=f"state '{where}'",
                     location=state.location,
                 )
@@ -270,7 +270,7 @@ def _leaf_unit(
     kept = [o for o in order if o not in halted]
     if not kept and not halted:
         raise OutcomeError(
-            f"no outcome leaves it (an outcome-driven state must return one)",
+            "no outcome leaves it (an outcome-driven state must return one)",
             element=f"state '{where}'",
             location=state.location,
         )
