@@ -81,6 +81,8 @@ def structured_result(view: OutcomeView) -> ConversionResult:
         "style": STYLE,
         **counts,
         "flags": len(flagged) + len(flags),
+        "flag_forms": len(flagged),
+        "flag_loops": len(flags),
         "lebt_blocks": 0,
         "dispatches": sum(
             1 for r in view.regions.values() for u in r.units.values() if u.dispatch

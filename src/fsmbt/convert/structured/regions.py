@@ -29,6 +29,7 @@ for chains.
 
 from __future__ import annotations
 
+import re
 from collections.abc import Callable, Generator
 from typing import Any
 
@@ -55,6 +56,8 @@ Context = dict[str, Term]
 Request = tuple[str, Context, bool]
 Task = Generator[Request, Fragment, Fragment]
 _END = "\x00end"
+#: A flag value that is a literal as written (else the way out's index is used).
+_LITERAL = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 
 
 class Unstructured(Exception):
@@ -72,6 +75,7 @@ class RegionStructurer:
         self.emit = emit
         self.exits = exits
         self.emitted: set[str] = set()
+        self.order = {name: index for index, name in enumerate(self.units)}
         #: The blackboard flags the structuring needed (each named: where and why).
         self.flags: list[str] = []
         graph: nx.DiGraph[str] = nx.DiGraph()
@@ -143,34 +147,42 @@ class RegionStructurer:
         if not units and statuses == {SUCCESS}:
             inner = yield (head, {**ctx, head: Term(FAILURE)}, True)
             return decorator("RetryUntilSuccessful", as_node(inner), num_attempts="-1")
-        if not units and statuses == {SUCCESS, FAILURE} and all(ctx[t].pure for t in terminals):
-            return (yield from self._flag_loop(head, ctx, terminals))
         if len(units) == 1 and not terminals:
             (m,) = units
             inner = yield (head, {**ctx, head: Term(FAILURE), m: Term(SUCCESS)}, True)
             rest = yield (m, ctx, False)
             retry = decorator("RetryUntilSuccessful", as_node(inner), num_attempts="-1")
             return sequence(retry, as_node(rest))
-        raise Unstructured(
-            f"the loop through state '{head}' leaves it for several places with different results"
-        )
+        ordered = [t for x in sorted(body, key=self.order.__getitem__)
+                   for t in self.units[x].targets.values() if t in outs]  # fmt: skip
+        return (yield from self._flag_loop(head, ctx, list(dict.fromkeys(ordered))))
 
-    def _flag_loop(self, head: str, ctx: Context, terminals: list[str]) -> Task:
-        """A loop left with both results: ``Sequence(Script flag:='', Fallback(
-        KeepRunningUntilFailure(body), Switch(flag): 'done' -> AlwaysSuccess))`` where the
-        SUCCESS exits write ``flag:='done'`` and fail; one blackboard flag."""
+    def _flag_loop(self, head: str, ctx: Context, outs: list[str]) -> Task:
+        """A loop with several ways out: ``Sequence(Script flag:='', Fallback(
+        KeepRunningUntilFailure(body), Switch(flag) -> each way out))``. Inside the body the
+        loop head is SUCCESS (go round again) and every way out writes its name to the flag and
+        fails, except the pure FAILURE terminals (the usual abort), which fail as they are and
+        reach the Switch's default. One blackboard flag, named in the summary."""
         flag = f"loop_{type_id(head)}"
         inner_ctx = {**ctx, head: Term(SUCCESS)}
-        for t in terminals:
-            if ctx[t].status == SUCCESS:
-                inner_ctx[t] = Term(FAILURE, (flag, "done"))
+        named: list[tuple[str, str]] = []
+        for index, t in enumerate(outs):
+            if t in ctx and ctx[t].pure and ctx[t].status == FAILURE:
+                continue
+            value = t if _LITERAL.fullmatch(t) else f"exit{index}"
+            inner_ctx[t] = Term(FAILURE, (flag, value))
+            named.append((t, value))
         inner = yield (head, inner_ctx, True)
+        cases: list[tuple[str, BTNode]] = []
+        for t, value in named:
+            fragment = ctx[t] if t in ctx else (yield (t, ctx, False))
+            cases.append((value, as_node(fragment)))
         self.flags.append(
-            f"state '{self.units[head].path}': a loop left with both results (flag '{flag}')"
+            f"state '{self.units[head].path}': a loop with {len(outs)} ways out (flag '{flag}')"
         )
-        verdict = switch_chain(flag, [("done", always(True))], always(False))
         loop = decorator("KeepRunningUntilFailure", as_node(inner))
-        return control("Sequence", script(flag, ""), fallback(loop, verdict))
+        ways_out = switch_chain(flag, cases, always(False))
+        return control("Sequence", script(flag, ""), fallback(loop, ways_out))
 
     def _join(self, name: str, ctx: Context) -> Generator[Request, Fragment, Fragment | None]:
         region = self._reach(name, ctx)
@@ -182,7 +194,27 @@ class RegionStructurer:
             rest = yield (m, ctx, False)
             combine = sequence if status == SUCCESS else fallback
             return combine(as_node(inner), as_node(rest))
-        return None
+        m = self._join_point(name, region, ctx)
+        if m is None:
+            return None
+        # a join left early with SUCCESS: those ways out write a flag and fail instead
+        flag = f"join_{type_id(m)}"
+        inner_ctx = {**ctx, m: Term(SUCCESS)}
+        cases: list[tuple[str, BTNode]] = []
+        exits = self._exits_of(region, ctx)
+        for index, t in enumerate(t for t in ctx if t in exits):
+            if ctx[t].status == SUCCESS:
+                value = t if _LITERAL.fullmatch(t) else f"exit{index}"
+                inner_ctx[t] = Term(FAILURE, (flag, value))
+                cases.append((value, ctx[t].node()))
+        inner = yield (name, inner_ctx, True)
+        rest = yield (m, ctx, False)
+        self.flags.append(
+            f"state '{self.units[name].path}': ways out before the join at '{m}' (flag '{flag}')"
+        )
+        joined = sequence(as_node(inner), as_node(rest))
+        early = switch_chain(flag, cases, always(False))
+        return control("Sequence", script(flag, ""), fallback(joined, early))
 
     def _compose(self, unit: Unit, ctx: Context) -> Task:
         if unit.name in self.emitted:
@@ -257,15 +289,39 @@ class RegionStructurer:
                 todo.extend(self._open_targets(x, ctx))
         return False
 
-    def _post_dominator(self, name: str, region: set[str], ctx: Context, status: str) -> str | None:
-        """The unit every path from ``name`` passes before a terminal with ``status``."""
+    def _join_point(self, name: str, region: set[str], ctx: Context) -> str | None:
+        """The first unit (in declaration order) that two ways from ``name`` reach and that
+        splits the region in two: nothing before it is reached again after it."""
+        preds: dict[str, int] = {}
+        for x in region:
+            for t in set(self._open_targets(x, ctx)):
+                preds[t] = preds.get(t, 0) + 1
+        for m in sorted(region, key=self.order.__getitem__):
+            if m == name or preds.get(m, 0) < 2:
+                continue
+            before = self._reach(name, {**ctx, m: Term(SUCCESS)})
+            after = self._reach(m, ctx)
+            if m in before:
+                before.discard(m)
+            if not before & after and name not in after:
+                return m
+        return None
+
+    def _exits_of(self, region: set[str], ctx: Context) -> set[str]:
+        return {t for x in region for t in self.units[x].targets.values() if t in ctx}
+
+    def _post_dominator(
+        self, name: str, region: set[str], ctx: Context, status: str | None
+    ) -> str | None:
+        """The unit every path from ``name`` passes before a terminal with ``status``
+        (``None``: before any terminal)."""
         reverse: nx.DiGraph[str] = nx.DiGraph()
         reverse.add_node(_END)
         for x in region:
             for t in self.units[x].targets.values():
                 if t not in ctx:
                     reverse.add_edge(t, x)
-                elif ctx[t].status == status:
+                elif status is None or ctx[t].status == status:
                     reverse.add_edge(_END, x)
         if name not in reverse or not nx.has_path(reverse, _END, name):
             return None
