@@ -432,7 +432,7 @@ def _name_abstractions(report: Report, *models: Model) -> None:
     under (docs/semantics.md §10): the verdict holds under them, and says so."""
     from fsmbt.semantics.nodes import abstractions_used
 
-    found: dict[str, None] = {}
+    found: dict[str, None] = dict.fromkeys(report.stats.get("abstractions", []))
     for model in models:
         for sentence in abstractions_used(model):
             found.setdefault(sentence, None)

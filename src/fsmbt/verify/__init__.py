@@ -11,9 +11,10 @@ from __future__ import annotations
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import Hint, InputError, UnsupportedError
 from fsmbt.model.fsm import FSM
+from fsmbt.semantics.outcome_machine import OutcomeFSMMachine
 from fsmbt.semantics.outcome_rules import OutcomeRules
 from fsmbt.verify.native import DEFAULT_MAX_STATES, Replay, check, replay
-from fsmbt.verify.outcome_pairing import is_outcome_pair
+from fsmbt.verify.outcome_pairing import is_outcome_pair, outcome_abstractions
 from fsmbt.verify.pairing import FSMLeafMachine, machines_for
 from fsmbt.verify.report import PROPERTIES, PropertyResult, Report, TraceStep
 
@@ -89,6 +90,8 @@ def verify(
         source, result, loop=loop, outcomes=outcomes, outcome_driven=outcome_driven
     )
     native = check(source_machine, result_machine, max_states=max_states, mode=mode)
+    if isinstance(source_machine, OutcomeFSMMachine):
+        native.stats["abstractions"] = outcome_abstractions(source_machine.view)
     native.source = _model_name(source, native.source)
     native.result = _model_name(result, native.result)
     if engine == "native":

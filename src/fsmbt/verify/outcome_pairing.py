@@ -23,7 +23,7 @@ from fsmbt.semantics.lebt.spec import GUARD_TYPE, STATE_TYPE
 from fsmbt.semantics.outcome_blackboard import OutcomeLeafMachine
 from fsmbt.semantics.outcome_machine import OutcomeFSMMachine
 from fsmbt.semantics.outcome_rules import OutcomeRules
-from fsmbt.semantics.outcome_view import declares_outcomes, read_outcome_view
+from fsmbt.semantics.outcome_view import OutcomeView, declares_outcomes, read_outcome_view
 from fsmbt.semantics.state_variable_runtime import is_state_variable_bt
 
 OUTCOME_EXECUTION = "outcome-execution"
@@ -48,3 +48,16 @@ def outcome_machines(
     """
     view = read_outcome_view(source, rules)
     return OutcomeFSMMachine(view), OutcomeLeafMachine(result, view), OUTCOME_EXECUTION
+
+
+def outcome_abstractions(view: OutcomeView) -> list[str]:
+    """What a verdict of the outcome pairing holds under (docs/semantics.md §11), in words."""
+    sentences = [
+        "outcome-driven reading: each state's outcome is its leaf's status by the outcome "
+        "rules (docs/semantics.md §11); userdata values and FlexBE autonomy levels are not "
+        "modelled"
+    ]
+    if view.halts:
+        sentences.append(f"'preempted' is the tree being halted ({view.halts} outcome(s))")
+    sentences.extend(f"by declaration order: {choice}" for choice in view.order_choices)
+    return sentences

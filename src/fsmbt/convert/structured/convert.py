@@ -27,11 +27,6 @@ from fsmbt.semantics.outcome_rules import FAILURE, SUCCESS, OutcomeRules
 from fsmbt.semantics.outcome_view import OutcomeView, Region, Unit, read_outcome_view
 
 STYLE = "structured"
-#: What the verdict names as not proven (docs/semantics.md §11).
-ABSTRACTIONS = (
-    "outcome-driven reading: a state's leaf returns the status its outcome maps to "
-    "(docs/semantics.md §11); userdata values and FlexBE autonomy levels are not modelled",
-)
 
 
 def fsm_to_structured(
@@ -88,12 +83,12 @@ def structured_result(view: OutcomeView) -> ConversionResult:
             1 for r in view.regions.values() for u in r.units.values() if u.dispatch
         ),  # fmt: skip
         "halts": view.halts,
+        "order_choices": len(view.order_choices),
         "fully_structured": not flagged and not flags,
         "subtrees": len(trees) - 1,
     }
     stats["summary"] = summary(stats)
-    warnings = [
-        *view.order_choices,
+    warnings = [  # the order choices are named in the verdict (verify.outcome_pairing)
         *(f"flag form: {f}" for f in flagged),
         *(f"flag: {f}" for f in flags),
         *_concurrences(view),
