@@ -139,7 +139,7 @@ def _pipeline(job: Job, options: dict[str, Any], timings: dict[str, float]) -> a
     common: dict[str, Any] = {
         "to": pipeline.get("to"),
         "engine": job.engine,
-        "style": pipeline.get("style", "paper"),
+        "style": pipeline.get("style", "auto"),
         "loop": bool(pipeline.get("loop", False)),
         "hierarchy": pipeline.get("hierarchy", "subtrees"),
         "verify": verify,

@@ -244,7 +244,12 @@ def register(app: typer.Typer) -> None:
             None, "--from", help="input format (default: detected per file)"
         ),
         engine: str = typer.Option("rules", "--engine", help="rules, or a registered engine"),
-        style: str = typer.Option("paper", "--style", help="output structure style"),
+        style: str = typer.Option(
+            "auto",
+            "--style",
+            help="FSM->BT: auto (structured for outcome-driven machines, else lebt), "
+            "structured, lebt (paper is lebt)",
+        ),
         loop: bool = typer.Option(
             False,
             "--loop",

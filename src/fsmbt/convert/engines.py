@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import importlib
 from dataclasses import dataclass
+from typing import Any
 
 from fsmbt.convert.bt_to_hfsm import bt_to_hfsm
 from fsmbt.convert.hfsm_to_bt import fsm_to_bt
@@ -60,7 +61,7 @@ def rules_fsm_to_bt(
     style: str = AUTO,
     outcome_driven: bool = False,
     outcomes: str | None = None,
-    **options: object,
+    **options: Any,
 ) -> ConversionResult:
     """The rules engine's FSM -> BT: the structured tree for an outcome-driven machine, the
     LEBT otherwise (``fsmbt.convert.structured.style``: ``auto``, ``structured``, ``lebt``).
@@ -80,7 +81,7 @@ def rules_fsm_to_bt(
     return result
 
 
-def rules_bt_to_fsm(doc: BTDocument, *, style: str = AUTO, **options: object) -> ConversionResult:
+def rules_bt_to_fsm(doc: BTDocument, *, style: str = AUTO, **options: Any) -> ConversionResult:
     """The rules engine's BT -> FSM (one style; ``structured`` is an FSM -> BT style)."""
     if check_style(style) == STRUCTURED:
         raise InputError(

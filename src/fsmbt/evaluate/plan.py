@@ -77,6 +77,12 @@ def llm_method_names(models: list[str]) -> list[str]:
     return names
 
 
+def _style(engine: str) -> dict[str, Any]:
+    """``rules`` is the paper's LEBT shape (``--style lebt``) whatever the model: the
+    evaluation measures the paper's method (the structured style is not the paper's)."""
+    return {"style": "lebt"} if engine == "rules" else {}
+
+
 def _job(
     entry: Entry, outdir: Path, method: str, engine: str, verifier: str, options: dict[str, Any]
 ) -> Planned:
@@ -146,11 +152,15 @@ def plan(
     """
     readable = [e for e in entries if e.readable]
     planned = [
-        _job(e, outdir, engine, engine, "native", {}) for engine in RULE_ENGINES for e in entries
+        _job(e, outdir, engine, engine, "native", _style(engine))
+        for engine in RULE_ENGINES
+        for e in entries
     ]
     sample = nusmv_models(readable, seed=seed, count=nusmv_sample)
     planned += [
-        _job(e, outdir, engine, engine, "both", {}) for engine in RULE_ENGINES for e in sample
+        _job(e, outdir, engine, engine, "both", _style(engine))
+        for engine in RULE_ENGINES
+        for e in sample
     ]
     for model in llm_models:
         llm = {"llm_model": model}

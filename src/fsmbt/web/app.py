@@ -205,6 +205,7 @@ def create_app(settings: WebSettings | None = None) -> FastAPI:
         return {
             "engines": list(service.PLAIN_ENGINES) + _llm_engines(),
             "hierarchies": list(service.HIERARCHIES),
+            "styles": list(service.STYLES),
             "runtimes": service.runtime_kinds(),
         }
 

@@ -24,6 +24,11 @@ class Options(BaseModel):
         default=False, description="BT -> FSM: the root is ticked again after it returns"
     )
     hierarchy: str = Field(default="subtrees", description="FSM -> BT: `subtrees` or `flatten`")
+    style: str = Field(
+        default="auto",
+        description="FSM -> BT: `auto` (structured for outcome-driven machines, else lebt), "
+        "`structured` or `lebt`",
+    )
 
 
 class ConvertRequest(ModelText):
