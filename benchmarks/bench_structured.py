@@ -126,9 +126,9 @@ def main() -> None:
         measure(f"gen {seed}", random_outcome_fsm(seed, states=5 + seed % 16))
         for seed in range(count)
     ]
-    print("## Corpus SMACH/FlexBE files (nodes / depth; CPU ms, min of 3)\n")
+    print("### Corpus SMACH/FlexBE files (nodes / depth; CPU ms, min of 3)\n")
     table(corpus)
-    print("\n## Means (nodes / depth); share fully structured; flags and LEBT blocks per machine\n")
+    print("\n### Means (nodes / depth); share fully structured; flags and LEBT blocks per machine\n")
     print("| set | machines | structured | LEBT | BSD | fully structured | flags per machine | "
           "LEBT blocks | convert ms | proof ms |")  # fmt: skip
     print("|---|---|---|---|---|---|---|---|---|---|")
