@@ -54,7 +54,7 @@ from fsmbt.semantics.blockers import conversion_blockers as blockers_of
 from fsmbt.semantics.outcome_rules import OutcomeRules
 from fsmbt.verify import Report, verify
 from fsmbt.verify.native import StateLimitError
-from fsmbt.verify.orient import orient, rules_text
+from fsmbt.verify.orient import OUTCOME_RULE, orient, rules_text
 from fsmbt.verify.wording import readable
 
 Model = FSM | BTDocument
@@ -447,6 +447,7 @@ def verify_either_order(
     *,
     loop: bool = False,
     max_states: int | None = None,
+    outcome_driven: bool = False,
 ) -> Report:
     """Like ``verify_models``, for two models given in either order.
 
@@ -461,10 +462,15 @@ def verify_either_order(
         was tried and every rule there is.
         EngineDisagreement: ``both`` and the engines disagree.
     """
-    oriented = orient(first, second)
+    oriented = orient(first, second, outcome_driven=outcome_driven)
     try:
         report = verify_models(
-            oriented.source, oriented.result, engine, loop=loop, max_states=max_states
+            oriented.source,
+            oriented.result,
+            engine,
+            loop=loop,
+            max_states=max_states,
+            outcome_driven=oriented.rule == OUTCOME_RULE,
         )
     except (UnsupportedError, StateLimitError):
         raise  # a construct, or a size or time limit: not a pairing problem
@@ -837,8 +843,14 @@ def verify_files(
         _warn_lebt_ports(first)
         _warn_lebt_ports(second)
     with _timed(timings, "verify", on_stage):
+        outcome_driven = first.format in OUTCOME_FORMATS or second.format in OUTCOME_FORMATS
         report = verify_either_order(
-            first.model, second.model, engine, loop=loop, max_states=max_states
+            first.model,
+            second.model,
+            engine,
+            loop=loop,
+            max_states=max_states,
+            outcome_driven=outcome_driven,
         )
     return first, second, report
 

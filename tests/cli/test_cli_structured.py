@@ -82,3 +82,20 @@ def test_bad_style_input_is_one_line_exit_2(
     lines = capsys.readouterr().err.strip().splitlines()
     assert len(lines) == 1 and re.search(cause, lines[0]), lines
     assert not (tmp_path / "out.xml").exists()
+
+
+def test_verify_pairs_a_smach_file_with_its_structured_tree_in_either_order(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from fsmbt.cli import main
+
+    out = tmp_path / "delivery.xml"
+    assert main(["convert", str(DELIVERY), "-o", str(out)]) == 0
+    capsys.readouterr()
+    assert main(["verify", str(DELIVERY), str(out)]) == 0
+    assert main(["verify", str(out), str(DELIVERY)]) == 0
+    assert capsys.readouterr().out.count("outcome-execution") == 2
+    tree = out.read_text(encoding="utf-8")
+    wrong = tmp_path / "wrong.xml"
+    wrong.write_text(tree.replace('name="DRIVE"', 'name="HANDOVER_"', 1), encoding="utf-8")
+    assert main(["verify", str(DELIVERY), str(wrong)]) == 1
