@@ -32,8 +32,8 @@ from dataclasses import dataclass
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.fsm import FSM
 from fsmbt.semantics.lebt.spec import GUARD_TYPE, STATE_TYPE
-from fsmbt.semantics.outcome_view import declares_outcomes
 from fsmbt.semantics.state_variable_runtime import is_state_variable_bt
+from fsmbt.verify.outcome_pairing import is_outcome_pair
 
 Model = FSM | BTDocument
 
@@ -104,14 +104,14 @@ def orient(first: Model, second: Model, *, outcome_driven: bool = False) -> Orie
         rule = fsm_side_rule(second)
         if rule is not None:
             return Orientation(first, second, False, rule)
-        if outcome_driven or declares_outcomes(first):
+        if is_outcome_pair(first, second, outcome_driven=outcome_driven):
             return Orientation(first, second, False, OUTCOME_RULE)
         return Orientation(second, first, True, LEAF_EXECUTION_RULE)
     assert isinstance(first, BTDocument) and isinstance(second, FSM)
     rule = fsm_side_rule(first)
     if rule is not None:
         return Orientation(second, first, True, rule)
-    if outcome_driven or declares_outcomes(second):
+    if is_outcome_pair(second, first, outcome_driven=outcome_driven):
         return Orientation(second, first, True, OUTCOME_RULE)
     return Orientation(first, second, False, LEAF_EXECUTION_RULE)
 

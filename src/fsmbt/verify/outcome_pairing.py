@@ -12,12 +12,15 @@ the checker finds with a shortest trace.
 When the pairing applies (``is_outcome_pair``): the tree has no LEBT or state-variable leaves,
 and the FSM is outcome-driven - some state declares its outcomes, or the caller says so
 (``outcome_driven=True``: the conversion came from a SMACH/FlexBE/YASMIN file, whose events
-are outcomes by the format).
+are outcomes by the format), or the pair has a structured conversion's signature: the FSM has
+the outcome-driven shape, its events are not just leaf statuses (a BT -> FSM conversion's
+are), and every custom leaf of the tree is named after one of its states.
 """
 
 from __future__ import annotations
 
 from fsmbt.model.bt import BTDocument
+from fsmbt.model.errors import InputError
 from fsmbt.model.fsm import FSM
 from fsmbt.semantics.lebt.spec import GUARD_TYPE, STATE_TYPE
 from fsmbt.semantics.outcome_blackboard import OutcomeLeafMachine
@@ -25,6 +28,9 @@ from fsmbt.semantics.outcome_machine import OutcomeFSMMachine
 from fsmbt.semantics.outcome_rules import OutcomeRules
 from fsmbt.semantics.outcome_view import OutcomeView, declares_outcomes, read_outcome_view
 from fsmbt.semantics.state_variable_runtime import is_state_variable_bt
+from fsmbt.semantics.status import LeafOutcome
+
+LEAF_OUTCOMES = tuple(outcome.value for outcome in LeafOutcome)
 
 OUTCOME_EXECUTION = "outcome-execution"
 
@@ -35,7 +41,25 @@ def is_outcome_pair(source: FSM, result: BTDocument, *, outcome_driven: bool = F
         return False
     if is_state_variable_bt(result):
         return False
-    return outcome_driven or declares_outcomes(source)
+    return outcome_driven or declares_outcomes(source) or _structured_signature(source, result)
+
+
+def _structured_signature(source: FSM, result: BTDocument) -> bool:
+    events = {e for machine in source.machines() for e in machine.events()}
+    if events <= set(LEAF_OUTCOMES):
+        return False
+    leaves = {
+        node.name or node.type
+        for _tree, node in result.nodes()
+        if node.is_leaf and not node.is_builtin
+    }
+    if not leaves:
+        return False
+    try:
+        view = read_outcome_view(source)
+    except InputError:
+        return False
+    return leaves <= set(view.by_label)
 
 
 def outcome_machines(
