@@ -128,7 +128,9 @@ def main() -> None:
     ]
     print("### Corpus SMACH/FlexBE files (nodes / depth; CPU ms, min of 3)\n")
     table(corpus)
-    print("\n### Means (nodes / depth); share fully structured; flags and LEBT blocks per machine\n")
+    print(
+        "\n### Means (nodes / depth); share fully structured; flags and LEBT blocks per machine\n"
+    )
     print("| set | machines | structured | LEBT | BSD | fully structured | flags per machine | "
           "LEBT blocks | convert ms | proof ms |")  # fmt: skip
     print("|---|---|---|---|---|---|---|---|---|---|")
