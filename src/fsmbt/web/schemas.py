@@ -31,6 +31,11 @@ class Options(BaseModel):
         default=False, description="BT -> FSM: the root is ticked again after it returns"
     )
     hierarchy: str = Field(default="subtrees", description="FSM -> BT: `subtrees` or `flatten`")
+    style: str = Field(
+        default="auto",
+        description="FSM -> BT: `auto` (structured for outcome-driven machines, else lebt), "
+        "`structured` or `lebt`",
+    )
 
 
 class ConvertBody(ModelText):
@@ -38,9 +43,6 @@ class ConvertBody(ModelText):
 
     engine: str = Field(
         default="rules", description="rules, bsd, chds (LLM engines when configured)"
-    )
-    style: str | None = Field(
-        default=None, description="the engine's output style (default: the engine's)"
     )
     options: Options = Options()
     to: str | None = Field(default=None, description="the result's format (default: btcpp / scxml)")

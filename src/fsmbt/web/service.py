@@ -37,6 +37,8 @@ from fsmbt.verify.report import Report
 PLAIN_ENGINES = ("rules", "bsd", "chds")
 #: The options a request may set (nothing else reaches an engine: no endpoint, no key).
 HIERARCHIES = ("subtrees", "flatten")
+#: FSM -> BT styles (docs/conversion.md, "Styles"; ``paper`` is ``lebt``).
+STYLES = ("auto", "structured", "lebt")
 #: Download formats besides the registry's writers: pictures through Graphviz.
 PICTURE_FORMATS = ("svg", "png")
 #: The file name ending of each download format.
@@ -230,7 +232,7 @@ def convert(request: dict[str, Any]) -> dict[str, Any]:
     """Convert one model, verify the result, draw both.
 
     Args:
-        request: ``{"text", "filename"?, "format"?, "engine", "options": {"loop", "hierarchy"},
+        request: ``{"text", "filename"?, "format"?, "engine", "options": {"loop", "hierarchy", "style"},
             "to"?}``.
 
     Returns:
@@ -254,9 +256,8 @@ def convert(request: dict[str, Any]) -> dict[str, Any]:
         "to": request.get("to") or None,
         "loop": bool(options.get("loop", False)),
         "hierarchy": hierarchy,
+        "style": str(options.get("style") or "auto"),
     }
-    if request.get("style"):
-        fields["style"] = request["style"]
     outcome = api.convert_loaded(loaded, None, api.convert_request(**fields))
     report = outcome.report
     pictures = {"source": _picture(loaded.model), "result": _picture(outcome.result)}
@@ -272,6 +273,8 @@ def convert(request: dict[str, Any]) -> dict[str, Any]:
         "mode": report.mode if report is not None else None,
         "counterexample": _steps(report, loaded.model, outcome.result) if report else None,
         "warnings": outcome.warnings,
+        "style": outcome.conversion.stats.get("style"),
+        "summary": outcome.conversion.stats.get("summary"),
         "issues": _issues(loaded),
         "metrics": {"source": _metrics(loaded.model), "result": _metrics(outcome.result)},
         "svg": {"source": pictures["source"]["svg"], "result": pictures["result"]["svg"]},
