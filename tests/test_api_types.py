@@ -26,7 +26,7 @@ def test_flat_options_split_into_reader_and_engine_options() -> None:
 def test_unknown_or_mistyped_options_are_named() -> None:
     with pytest.raises(InputError, match="verifyengine"):
         convert_request(verifyengine="nusmv")
-    with pytest.raises(InputError, match="verify_engine"):
+    with pytest.raises(InputError, match="unknown verification engine 'z3'"):
         convert_request(verify_engine="z3")
     with pytest.raises(InputError, match="hierarchy"):
         convert_request(hierarchy="nested")

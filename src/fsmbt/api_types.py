@@ -223,12 +223,24 @@ class ConvertRequest(_Request):
         return checker_limit(self.max_states)
 
 
+#: What a fixed-choice field is called in messages, per request model.
+_NOUNS = {
+    "VerifyRequest": {"engine": "verification engine"},
+    "ConvertRequest": {"verify_engine": "verification engine", "hierarchy": "hierarchy"},
+}
+
+
 def option_error(error: ValidationError) -> InputError:
     """One ``InputError`` naming every invalid option of a request and why (exit 2 in the
     CLI, a 422 on the web page), instead of pydantic's multi-line report."""
     parts = []
     for problem in error.errors():
         where = ".".join(str(step) for step in problem.get("loc", ())) or "request"
+        if problem.get("type") == "literal_error":
+            noun = _NOUNS.get(error.title, {}).get(where, where.replace("_", " "))
+            expected = problem.get("ctx", {}).get("expected", "")
+            parts.append(f"unknown {noun} '{problem.get('input')}' (one of: {expected})")
+            continue
         parts.append(f"{where}: {problem.get('msg', 'invalid')}")
     return InputError(f"invalid option(s): {'; '.join(parts)}")
 

@@ -48,7 +48,16 @@ def test_no_verify_exploration_names_the_subtree_and_the_flag(
     out = tmp_path / "patrol.scxml"
     assert (
         main(
-            ["convert", str(reactive_bt), "--no-verify", "--max-states", "3", "-q", "-o", str(out)]
+            [
+                "convert",
+                str(reactive_bt),
+                "--no-verify",
+                "--max-states",
+                "3",
+                "--no-progress",
+                "-o",
+                str(out),
+            ]
         )
         == 2
     )
@@ -65,7 +74,10 @@ def test_raising_the_limit_converts_and_verifies(
     reactive_bt: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     out = tmp_path / "patrol.scxml"
-    assert main(["convert", str(reactive_bt), "--max-states", "5000", "-q", "-o", str(out)]) == 0
+    assert (
+        main(["convert", str(reactive_bt), "--max-states", "5000", "--no-progress", "-o", str(out)])
+        == 0
+    )
     assert "EQUIVALENT" in capsys.readouterr().out and out.exists()
 
 
@@ -73,17 +85,19 @@ def test_verify_state_limit_is_an_option(
     reactive_bt: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     out = tmp_path / "patrol.scxml"
-    assert main(["convert", str(reactive_bt), "-q", "-o", str(out)]) == 0
+    assert main(["convert", str(reactive_bt), "--no-progress", "-o", str(out)]) == 0
     capsys.readouterr()
-    assert main(["verify", str(reactive_bt), str(out), "--max-states", "4", "-q"]) == 2
+    assert main(["verify", str(reactive_bt), str(out), "--max-states", "4", "--no-progress"]) == 2
     err = capsys.readouterr().err
     assert "more than 4 reachable states" in err and "--max-states" in err
     assert "pairing rule" not in err  # a size limit is not a pairing problem
-    assert main(["verify", str(reactive_bt), str(out), "--max-states", "100000", "-q"]) == 0
+    assert (
+        main(["verify", str(reactive_bt), str(out), "--max-states", "100000", "--no-progress"]) == 0
+    )
 
 
 def test_max_states_must_be_positive(reactive_bt: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    assert main(["convert", str(reactive_bt), "--max-states", "0", "-q"]) == 2
+    assert main(["convert", str(reactive_bt), "--max-states", "0", "--no-progress"]) == 2
     assert "--max-states" in capsys.readouterr().err
 
 
@@ -121,7 +135,7 @@ def test_validate_collapses_repeated_not_declared_warnings(
     assert not [i for i in issues if "'Spin'" in i["message"] or "'Wait'" in i["message"]]
 
 
-@pytest.mark.parametrize("command", [["info"], ["convert", "-q", "--no-verify"]])
+@pytest.mark.parametrize("command", [["info"], ["convert", "--no-progress", "--no-verify"]])
 def test_info_and_convert_name_each_undeclared_type_once(
     command: list[str], undeclared_bt: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -138,7 +152,7 @@ def test_info_and_convert_name_each_undeclared_type_once(
 @pytest.fixture
 def paper_lebt(tmp_path: Path) -> Path:
     out = tmp_path / "paper_bt.xml"
-    assert main(["convert", str(EXAMPLES / "paper_fsm.xml"), "-q", "-o", str(out)]) == 0
+    assert main(["convert", str(EXAMPLES / "paper_fsm.xml"), "--no-progress", "-o", str(out)]) == 0
     return out
 
 
@@ -160,7 +174,7 @@ def test_honest_lebt_has_no_port_issue(
 ) -> None:
     capsys.readouterr()
     assert main(["validate", str(paper_lebt)]) == 0
-    assert main(["verify", str(EXAMPLES / "paper_fsm.xml"), str(paper_lebt), "-q"]) == 0
+    assert main(["verify", str(EXAMPLES / "paper_fsm.xml"), str(paper_lebt), "--no-progress"]) == 0
     assert "warning" not in capsys.readouterr().err
 
 
@@ -175,7 +189,7 @@ def test_wrong_guard_target_is_an_error_in_validate_and_a_warning_in_verify(
     assert f"{bad}:{line}:" in err and "LebtGuard 'Enter_B'" in err
     assert "target='C'" in err and "'B'" in err
     # the checkers read the pairs, not the target: the verdict stands, the user is told
-    assert main(["verify", str(EXAMPLES / "paper_fsm.xml"), str(bad), "-q"]) == 0
+    assert main(["verify", str(EXAMPLES / "paper_fsm.xml"), str(bad), "--no-progress"]) == 0
     captured = capsys.readouterr()
     assert "EQUIVALENT" in captured.out
     assert "warning:" in captured.err and "target='C'" in captured.err
@@ -197,7 +211,15 @@ def test_convert_summary_says_what_was_built(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     assert (
-        main(["convert", str(EXAMPLES / "robot_bt.xml"), "-q", "-o", str(tmp_path / "robot.scxml")])
+        main(
+            [
+                "convert",
+                str(EXAMPLES / "robot_bt.xml"),
+                "--no-progress",
+                "-o",
+                str(tmp_path / "robot.scxml"),
+            ]
+        )
         == 0
     )
     out = capsys.readouterr().out
@@ -215,7 +237,7 @@ def test_convert_json_keeps_its_keys(tmp_path: Path, capsys: pytest.CaptureFixtu
             [
                 "convert",
                 str(EXAMPLES / "robot_bt.xml"),
-                "-q",
+                "--no-progress",
                 "--json",
                 "-o",
                 str(tmp_path / "robot.scxml"),
@@ -232,13 +254,13 @@ def test_leaf_execution_counterexample_in_the_users_words(
 ) -> None:
     monkeypatch.setenv("COLUMNS", "250")  # rich tables do not wrap the words compared here
     hfsm = tmp_path / "robot.scxml"
-    assert main(["convert", str(EXAMPLES / "robot_bt.xml"), "-q", "-o", str(hfsm)]) == 0
+    assert main(["convert", str(EXAMPLES / "robot_bt.xml"), "--no-progress", "-o", str(hfsm)]) == 0
     wrong = tmp_path / "wrong.scxml"
     wrong.write_text(
         hfsm.read_text(encoding="utf-8").replace("MovetoCube2", "MovetoCubeX"), encoding="utf-8"
     )
     capsys.readouterr()
-    assert main(["verify", str(EXAMPLES / "robot_bt.xml"), str(wrong), "-q"]) == 1
+    assert main(["verify", str(EXAMPLES / "robot_bt.xml"), str(wrong), "--no-progress"]) == 1
     out = " ".join(capsys.readouterr().out.split())  # the table wraps; compare the words
     assert "NOT EQUIVALENT" in out
     assert "input 'failure'" not in out and "when the previous leaf returned FAILURE" in out
@@ -252,7 +274,7 @@ def test_one_step_counterexample_is_singular(
 ) -> None:
     bad = _edited(paper_lebt, 'state="A" action="A"', 'state="A" action="Z"')
     capsys.readouterr()
-    assert main(["verify", str(EXAMPLES / "paper_fsm.xml"), str(bad), "-q"]) == 1
+    assert main(["verify", str(EXAMPLES / "paper_fsm.xml"), str(bad), "--no-progress"]) == 1
     out = " ".join(capsys.readouterr().out.split())
     assert "shortest counterexample (1 input)" in out and "(1 inputs)" not in out
 
@@ -262,7 +284,7 @@ def test_prose_text_points_to_llm_extract(
 ) -> None:
     prose = tmp_path / "mission.txt"
     prose.write_text("The robot moves to the cube, picks it up and docks.\n", encoding="utf-8")
-    assert main(["convert", str(prose), "-q"]) == 2
+    assert main(["convert", str(prose), "--no-progress"]) == 2
     err = capsys.readouterr().err
     assert "mission.txt:1:" in err and "fsmbt llm extract" in err and "--engine llm" in err
 
@@ -370,7 +392,7 @@ def test_baseline_summaries_claim_only_what_they_built(
                 str(EXAMPLES / "paper_fsm.xml"),
                 "--engine",
                 engine,
-                "-q",
+                "--no-progress",
                 "--no-verify",
                 "-o",
                 str(tmp_path / "bt.xml"),

@@ -53,3 +53,16 @@ def test_version(capsys: pytest.CaptureFixture[str]) -> None:
 
     assert main(["--version"]) == 0
     assert capsys.readouterr().out.strip() == f"fsmbt {__version__}"
+
+
+def test_quiet_prints_only_the_verdict(tmp_path, capsys: pytest.CaptureFixture[str]) -> None:
+    from pathlib import Path
+
+    paper = Path(__file__).resolve().parents[2] / "examples" / "paper_fsm.xml"
+    out = tmp_path / "bt.xml"
+    assert main(["convert", str(paper), "-o", str(out), "-q", "--style", "lebt"]) == 0
+    assert capsys.readouterr().out.splitlines() == ["verdict: EQUIVALENT"]
+    assert main(["verify", str(paper), str(out), "-q"]) == 0
+    assert capsys.readouterr().out.splitlines() == ["verdict: EQUIVALENT"]
+    assert main(["verify", str(paper), str(out), "--no-progress"]) == 0
+    assert "product states" in capsys.readouterr().out  # the full report (a table)

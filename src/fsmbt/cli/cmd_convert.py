@@ -81,7 +81,15 @@ def register(app: typer.Typer) -> None:
             help="write the result even when it is not equivalent (default: not written)",
         ),
         as_json: bool = typer.Option(False, "--json", help="print a JSON summary on stdout"),
-        quiet: bool = typer.Option(False, "--quiet", "-q", help="no progress display on stderr"),
+        quiet: bool = typer.Option(
+            False,
+            "--quiet",
+            "-q",
+            help="no progress display, and of the summary only warnings and the verdict line",
+        ),
+        no_progress: bool = typer.Option(
+            False, "--no-progress", help="no progress display on stderr (the full summary stays)"
+        ),
         max_states: int | None = max_states_option(),
         hierarchy: Literal["subtrees", "flatten"] = typer.Option(
             "subtrees",
@@ -120,7 +128,7 @@ def register(app: typer.Typer) -> None:
             read=read,
             engine_options=engine_options,
         )
-        with StageProgress(quiet=quiet, label=source.name) as progress:
+        with StageProgress(quiet=quiet or no_progress, label=source.name) as progress:
             outcome = api.convert_file(source, output, request, on_stage=progress)
         summary = outcome.to_dict()
         if as_json:
@@ -130,12 +138,12 @@ def register(app: typer.Typer) -> None:
         else:
             if output is None:
                 sys.stdout.write(outcome.text)
-            _print_summary(outcome, to_stderr=output is None)
+            _print_summary(outcome, to_stderr=output is None, brief=quiet)
         if outcome.equivalent is False:
             raise typer.Exit(1)
 
 
-def _print_summary(outcome: api.Outcome, *, to_stderr: bool) -> None:
+def _print_summary(outcome: api.Outcome, *, to_stderr: bool, brief: bool = False) -> None:
     stream = sys.stderr if to_stderr else sys.stdout
     for warning in outcome.warnings:
         print(f"warning: {warning}", file=stream)
@@ -147,6 +155,10 @@ def _print_summary(outcome: api.Outcome, *, to_stderr: bool) -> None:
                 f"warning: {undeclared_summary(undeclared)}; declare them with --node-models FILE",
                 file=stream,
             )
+    if brief:
+        written = "" if outcome.output is None or outcome.written else " (not written)"
+        print(f"verdict: {outcome.verdict}{written}", file=stream)
+        return
     figures = conversion_summary(
         outcome.conversion.direction, outcome.conversion.stats, outcome.conversion.engine
     )

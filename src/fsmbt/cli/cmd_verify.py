@@ -38,7 +38,12 @@ def register(app: typer.Typer) -> None:
         source: Path = typer.Argument(..., help="The source model (FSM or BT)."),
         converted: Path = typer.Argument(..., help="The converted model to check against it."),
         as_json: bool = typer.Option(False, "--json", help="Print the report as JSON."),
-        quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress display on stderr."),
+        quiet: bool = typer.Option(
+            False, "--quiet", "-q", help="No progress display; print only the verdict line."
+        ),
+        no_progress: bool = typer.Option(
+            False, "--no-progress", help="No progress display on stderr (the full report stays)."
+        ),
         max_states: int | None = max_states_option(),
         engine: str = typer.Option(
             "native",
@@ -63,7 +68,7 @@ def register(app: typer.Typer) -> None:
         apply_engine_caps(timeout, nusmv_memory)
         try:
             with StageProgress(
-                quiet=quiet or as_json, label=f"{source.name} ~ {converted.name}"
+                quiet=quiet or no_progress or as_json, label=f"{source.name} ~ {converted.name}"
             ) as progress:
                 request = api.verify_request(
                     engine=engine, loop=loop, max_states=max_states, read=read
@@ -85,6 +90,8 @@ def register(app: typer.Typer) -> None:
             data["source_file"] = str(source)
             data["result_file"] = str(converted)
             print(json.dumps(data, indent=2, ensure_ascii=False))
+        elif quiet:
+            print(f"verdict: {api.verdict_word(report)}")
         else:
             print_report(report, Console())
             for sentence in report.stats.get("abstractions", []):
