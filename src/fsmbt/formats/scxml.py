@@ -43,7 +43,7 @@ from fsmbt.formats import scxml_include
 from fsmbt.formats.registry import Format, ReadContext, register
 from fsmbt.formats.scxml_w3c import read_scxml_w3c
 from fsmbt.formats.xml_safe import local_name, namespace, root_tag
-from fsmbt.model import Model
+from fsmbt.model import Model, fsm_data
 from fsmbt.model.errors import InputError, SourceLocation, UnsupportedError
 from fsmbt.model.fsm import FSM, State, Transition
 
@@ -798,7 +798,13 @@ class _Writer:
         elif fsm.initial is not None:
             root.set("initial", self.ids[(id(fsm), fsm.initial)])
         for key, value in fsm.attrs.items():
-            root.set(key, value)
+            if key != fsm_data.DATAMODEL:
+                root.set(key, value)
+        if fsm_data.has_data(fsm):  # docs/semantics.md, "Data in state machines"
+            root.set("datamodel", fsm_data.DIALECT)
+            block = etree.SubElement(root, _q("datamodel"))
+            for name, expr in fsm_data.parse_lines(fsm.attrs[fsm_data.DATAMODEL]):
+                etree.SubElement(block, _q("data"), id=name, expr=expr)
         if start is not None and fsm.initial is not None:
             element = etree.SubElement(root, _q("state"), id=start)
             element.set(F_START, "true")
@@ -849,7 +855,10 @@ class _Writer:
             if region.initial is not None:
                 element.set("initial", self.ids[(id(region), region.initial)])
         for key, value in state.attrs.items():
-            element.set(key, value)
+            if key == fsm_data.ONEXIT:
+                _assignments(etree.SubElement(element, _q("onexit")), value)
+            else:
+                element.set(key, value)
         by_source = self.outgoing.get(id(machine))
         if by_source is None:
             by_source = {}
@@ -878,7 +887,10 @@ class _Writer:
             raise InputError(f"transition to unknown state '{target}'", element=state.name)
         out.set("target", self.ids[key])
         for k, v in t.attrs.items():
-            out.set(k, v)
+            if k == fsm_data.ASSIGN:
+                _assignments(out, v)
+            else:
+                out.set(k, v)
 
     def final_id(self, state: State, exit_name: str) -> str:
         """The id of the final state a completion transition of ``state`` waits for."""
@@ -917,6 +929,12 @@ class _Writer:
                     wrapper.set("initial", self.ids[(id(region), region.initial)])
                 out.append((region, wrapper))
         return out
+
+
+def _assignments(parent: etree._Element, text: str) -> None:
+    """``<assign location expr>`` children for ``name=expr`` lines (``fsmbt.model.fsm_data``)."""
+    for name, expr in fsm_data.parse_lines(text):
+        etree.SubElement(parent, _q("assign"), location=name, expr=expr)
 
 
 def _in_predicate(state_id: str, source: str) -> str:
@@ -1018,6 +1036,16 @@ def write_scxml(model: Model) -> str:
 
 def _sniff(text: str) -> bool:
     return root_tag(text) == "scxml"
+
+
+def expand_data(fsm: FSM) -> FSM:
+    """The exact flat meaning of a machine with data (``fsmbt.model.fsm_data``): the machine
+    written as SCXML, read back by the W3C algorithm (every reachable configuration and
+    valuation; docs/semantics.md, "Data in state machines"). Cost: the W3C reading's."""
+    return read_scxml_w3c(write_scxml(fsm), ReadContext())
+
+
+fsm_data.register_expander(expand_data)
 
 
 register(
