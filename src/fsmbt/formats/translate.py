@@ -36,6 +36,7 @@ from fsmbt.formats.registry import (
     get_format,
     loads,
     read_model,
+    refuse_data_loss,
 )
 from fsmbt.model import Model
 from fsmbt.model.errors import InputError, SourceLocation, UnsupportedError
@@ -128,6 +129,7 @@ def translate(
                 f"{shown}{more}"
             )
     try:
+        refuse_data_loss(written, target.name)
         text = target.write(written)
     except UnsupportedError as exc:
         hint = ""
