@@ -14,6 +14,7 @@ from fsmbt.formats import dumps, loads
 from fsmbt.generate import random_bt
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import FsmbtError, UnsupportedError
+from fsmbt.model.flatten import flatten
 from fsmbt.model.fsm import FSM
 from fsmbt.model.fsm_data import ASSIGN, COND, DATAMODEL, has_data
 from support.conv_helpers import check
@@ -67,15 +68,18 @@ def test_nav2_default_tree_is_small_keeps_data_and_is_proven() -> None:
 
 
 def test_compact_scxml_reads_back_as_its_proven_meaning() -> None:
-    """The SCXML written is read back by fsmbt's W3C reader into the flat machine the checker
-    proved: equivalent to the BT and to the unrolled conversion."""
+    """The SCXML written reads back into the same model (written again byte for byte), and its
+    flat meaning - the W3C reading of the data model - is the machine the checker proved:
+    equivalent to the BT and to the unrolled conversion."""
     doc = nav2_default()
     text = dumps(bt_to_hfsm(doc).model, "scxml")
     assert "<datamodel>" in text and "<assign" in text and "cond=" in text
     back = loads(text, "scxml")
-    assert not has_data(back) and not back.is_hierarchical  # the flat expansion
-    assert check(doc, back).equivalent
-    assert api.verify_models(bt_to_hfsm(doc, unroll=True).model, back).equivalent
+    assert has_data(back) and back.is_hierarchical and dumps(back, "scxml") == text
+    flat = flatten(back)
+    assert not has_data(flat) and not flat.is_hierarchical
+    assert check(doc, flat).equivalent
+    assert api.verify_models(bt_to_hfsm(doc, unroll=True).model, flat).equivalent
 
 
 def test_corpus_and_generated_trees_within_the_bound_and_proven() -> None:

@@ -56,6 +56,9 @@ FSMBT_NS = "https://fsmbt.dev/ns/scxml"
 F_NAME, F_ACTION, F_START, F_EXIT, F_REGION = (
     f"{{{FSMBT_NS}}}{n}" for n in ("name", "action", "start", "exit", "region")
 )
+#: Root mark of a document whose data model fsmbt wrote from a model that keeps data
+#: (``fsmbt.model.fsm_data``): read back into the same model (guards, assignments, data).
+F_DATA = f"{{{FSMBT_NS}}}data"
 #: ``State.attrs`` mark of the transient final states that encode a transition leaving its parent.
 EXIT_MARK = f"{{{FSMBT_NS}}}exit-state"
 
@@ -94,6 +97,8 @@ class _Reader:
     descriptors: dict[str, int] = field(default_factory=dict)
     done_transitions: list[tuple[_Node, etree._Element, bool]] = field(default_factory=list)
     wrapper_ids: set[str] = field(default_factory=set)
+    data_ir: bool = False  # the document carries fsmbt's own data model (F_DATA)
+    top: FSM = field(default_factory=FSM)
 
     def where(self, element: etree._Element) -> SourceLocation:
         return self.ctx.location(element.sourceline)
@@ -135,10 +140,16 @@ class _Reader:
             raise InputError(
                 f"not an SCXML document: unknown namespace {self.ns}", location=self.where(root)
             )
+        self.data_ir = root.get(F_DATA) == "ir"
         top = FSM(
             name=root.get("name", "fsm"),
-            attrs={k: v for k, v in root.attrib.items() if k not in _SCXML_KEYS},
+            attrs={
+                k: v
+                for k, v in root.attrib.items()
+                if k not in _SCXML_KEYS and not (self.data_ir and k in (F_DATA, "datamodel"))
+            },
         )
+        self.top = top
         self.parent_of[id(top)] = None
         self.build(root, top)
         for node in self.order:
@@ -209,6 +220,10 @@ class _Reader:
         if F_ACTION in element.attrib:
             action = element.get(F_ACTION) or None
         attrs = {k: v for k, v in element.attrib.items() if k not in _STATE_KEYS}
+        if self.data_ir:
+            for block in self.children(element):
+                if self.tag(block) == "onexit" and self._assigned(block):
+                    attrs[fsm_data.ONEXIT] = self._assigned(block)
         state = State(
             name, action=action, final=tag == "final", attrs=attrs, location=self.where(element)
         )
@@ -280,6 +295,14 @@ class _Reader:
             return  # handled with the transitions / the initial state
         elif tag in ("onentry", "onexit", "donedata"):
             self.executable(element)
+        elif tag == "datamodel" and self.data_ir:  # fsmbt's own data (fsm_data)
+            self.top.attrs[fsm_data.DATAMODEL] = fsm_data.join_lines(
+                [
+                    (data.get("id") or "", data.get("expr") or "")
+                    for data in self.children(element)
+                    if self.tag(data) == "data"
+                ]
+            )
         elif tag == "datamodel":
             self.ctx.warn(
                 "<datamodel> ignored (no supported construct reads data)",
@@ -318,10 +341,22 @@ class _Reader:
                     line=item.sourceline,
                     element=f"<{tag}>",
                 )
+            elif tag == "assign" and self.data_ir and local_name(block) in ("onexit", "transition"):
+                continue  # fsmbt's own data: read into the model (``_assigned``)
             elif tag in ("param", "content") and local_name(block) == "donedata":
                 self.ctx.warn("<donedata> ignored", line=item.sourceline, element="<donedata>")
             else:
                 raise self.unsupported(item, f"<{tag}> (executable content that changes behaviour)")
+
+    def _assigned(self, block: etree._Element) -> str:
+        """The ``<assign>`` children of a block as ``name=expr`` lines (``fsm_data``)."""
+        return fsm_data.join_lines(
+            [
+                (item.get("location") or "", item.get("expr") or "")
+                for item in self.children(block)
+                if self.tag(item) == "assign"
+            ]
+        )
 
     def set_initial(self, container: etree._Element, machine: FSM) -> None:
         """The machine's initial state: ``initial`` attribute, ``<initial>``, or first child."""
@@ -376,7 +411,8 @@ class _Reader:
                         element="<transition>",
                     )
                     continue
-                seen.add(key)
+                if fsm_data.COND not in transition.attrs:  # a data guard lets later ones fire
+                    seen.add(key)
                 node.machine.transitions.append(transition)
 
     def transition(self, node: _Node, element: etree._Element) -> list[Transition]:
@@ -399,6 +435,10 @@ class _Reader:
                 element="<transition>",
             )
         attrs = {k: v for k, v in element.attrib.items() if k not in _TRANSITION_KEYS}
+        if self.data_ir and cond_exit is None and element.get("cond") is not None:
+            attrs[fsm_data.COND] = element.get("cond") or ""
+        if self.data_ir and self._assigned(element):
+            attrs[fsm_data.ASSIGN] = self._assigned(element)
         exit_name = self.exit_of(node, element, cond_exit)
         events = element.get("event")
         location = self.where(element)
@@ -443,6 +483,8 @@ class _Reader:
         if cond is None:
             return None
         match = _IN_FINAL.fullmatch(cond)
+        if match is None and self.data_ir:  # a data guard of fsmbt's own data model
+            return None
         events = (element.get("event") or "").split()
         own_done = f"done.state.{node.element.get('id')}"
         if match is None or events != [own_done] or local_name(node.element) != "state":
@@ -802,6 +844,7 @@ class _Writer:
                 root.set(key, value)
         if fsm_data.has_data(fsm):  # docs/semantics.md, "Data in state machines"
             root.set("datamodel", fsm_data.DIALECT)
+            root.set(F_DATA, "ir")
             block = etree.SubElement(root, _q("datamodel"))
             for name, expr in fsm_data.parse_lines(fsm.attrs[fsm_data.DATAMODEL]):
                 etree.SubElement(block, _q("data"), id=name, expr=expr)

@@ -38,6 +38,7 @@ import graphviz
 
 from fsmbt.model.errors import InputError
 from fsmbt.model.fsm import FSM, State
+from fsmbt.model.fsm_data import ASSIGN, COND, parse_lines
 from fsmbt.model.stats import fsm_stats
 from fsmbt.render.anchor_ids import START_ANCHOR, state_anchor
 from fsmbt.render.dot import (
@@ -62,6 +63,9 @@ LAYERED_MAX_STATES = 60
 LAYERED_MAX_ARROWS = 150
 #: At most this many event names per arrow label line.
 EVENTS_PER_LINE = 3
+#: Graphviz ``size``: a picture larger than this (inches) is scaled down to fit, so a PNG
+#: (96 dpi) stays within 4096 x 4096 pixels and an SVG within 4096 x 4096 px at 96 px/inch.
+MAX_PICTURE_INCHES = "42.6,42.6"
 
 
 @dataclass
@@ -217,6 +221,8 @@ def fsm_to_dot(
             "a force-directed layout (no clusters); fsmbt info lists its structure"
         )
     root = graphviz.Digraph(name=dot_id(fsm.name) if exchange else _safe_name(fsm.name))
+    if not exchange:  # at most 4096 x 4096 pixels at 96 dpi (scaled down, never up)
+        root.attr(size=MAX_PICTURE_INCHES)
     if layered:
         root.attr(rankdir="LR", compound="true", fontname=FONT, nodesep="0.35", ranksep="0.5")
     else:
@@ -468,13 +474,28 @@ def _endpoint(level: _Level, state: str, side: str) -> tuple[str, dict[str, str]
 
 def _event_label(level: _Level, t) -> str:
     if t.event is not None:
-        return t.event
+        return t.event + _data_label(t)
     if level.machine.states[t.source].is_atomic:
         return "ε"
     return f"done({t.exit})" if t.exit is not None else "done"
 
 
+def _data_label(t) -> str:
+    """A data guard and its updates (``fsmbt.model.fsm_data``) as UML writes them,
+    ``event [cond] / x := e``, one conjunct and one update per line (a picture stays narrow)."""
+    text = ""
+    if COND in t.attrs:
+        guard = t.attrs[COND].replace(" && ", " &&\n  ").replace(" || ", " ||\n  ")
+        text += f" [{guard}]"
+    updates = parse_lines(t.attrs.get(ASSIGN, ""))
+    if updates:
+        text += " /\n  " + "\n  ".join(f"{name} := {expr}" for name, expr in updates)
+    return text
+
+
 def _wrap(labels: list[str]) -> str:
+    if any("[" in label or " /" in label for label in labels):  # guards: one line each
+        return label_text(*(line for label in labels for line in label.split("\n")))
     lines = [
         ", ".join(labels[i : i + EVENTS_PER_LINE]) for i in range(0, len(labels), EVENTS_PER_LINE)
     ]
