@@ -31,6 +31,11 @@ express. The whole tree is explored instead when such a region can end in ``SKIP
 exists (its memory outlives the root's restart). The verdict for those parts then checks the
 assembly and the flattening; the node semantics come from the interpreter.
 
+By default (docs/conversion.md, "Compact conversion") such a region is not kept as its explored
+machine but as one state per leaf with the memory as data (``fsmbt.convert.bt_compact``;
+docs/semantics.md §6a): guards and assignments whose W3C meaning the checker proves equivalent
+to the region's leaf-execution machine. ``unroll=True`` keeps the explored machine.
+
 Complexity: O(N) for the structural part (explicit work lists, no recursion over the tree);
 explored regions cost O(S · 3) interpreter steps for their S reachable states.
 """
