@@ -92,7 +92,10 @@ def check_tree(
     except FsmbtError as exc:
         tally.refused[f"{type(exc).__name__}: {getattr(exc, 'message', str(exc))[:60]}"] += 1
         return
-    text = dumps(hfsm, "scxml")
+    written = dumps(hfsm, "scxml")
+    # a data model (the compact conversion) is written in ECMAScript; the engine evaluates
+    # Python: the same document with its expressions spelled for it (scxml_oracle)
+    text = python_spelled(written) or written
     Engine(text)  # loads in the engine at all (raises otherwise)
     machine = FSMMachine(hfsm)
     tally.models += 1

@@ -304,6 +304,14 @@ class _Compactor:
             specs[key] = spec
         return specs
 
+    def _undecided(self, items: list, reads: list[int], chosen: list[int]) -> set[Hashable]:
+        """The valuations of ``reads`` whose items have no one spec."""
+        project = _projector(reads)
+        groups: dict[Hashable, list] = {}
+        for item in items:
+            groups.setdefault(project(self.vec[item[0]]), []).append(item)
+        return {key for key, group in groups.items() if self._spec(group, chosen) is None}
+
     def decide(self, items, chosen: list[int]):
         """For one (leaf, input): the deciding variables and {outcome: valuations}. Greedy:
         add the variable that leaves the least uncertainty (conditional entropy) about what
@@ -316,11 +324,16 @@ class _Compactor:
             if specs is not None:
                 break
             project = _projector(reads)
-            rows = [(project(self.vec[it[0]]), self.vec[it[0]], signature[id(it)]) for it in items]
+            undecided = self._undecided(items, reads, chosen)
+            rows = [
+                (prefix, self.vec[it[0]], signature[id(it)])
+                for it in items
+                if (prefix := project(self.vec[it[0]])) in undecided
+            ]
             best, best_key = None, None
             for i in chosen:
-                if i in reads:
-                    continue
+                if i in reads or len({vs[i] for _p, vs, _s in rows}) < 2:
+                    continue  # a variable constant where it matters tells nothing apart
                 totals: dict[Hashable, int] = {}
                 counts: dict[tuple[Any, Any], int] = {}
                 for prefix, vs, sig in rows:
@@ -507,23 +520,24 @@ def _guard(
     terms = []
     for cube in cubes:
         if not cube:
-            return "true"
+            return "True"
         parts = [
             _one(names[k], encoders[k], sorted(cube[k], key=_order), wrap=len(cube) > 1)
             for k in sorted(cube)
         ]
-        terms.append(" && ".join(parts))
+        terms.append(" and ".join(parts))
     if len(terms) == 1:
         return terms[0]
-    return " || ".join(f"({t})" for t in terms)
+    return " or ".join(f"({t})" for t in terms)
 
 
 def _one(name: str, encode: Callable[[Any], str], values: list[Any], wrap: bool = False) -> str:
     if len(values) == 1:
         return f"{name} == {encode(values[0])}"
-    if all(_is_int(v) for v in values) and values == list(range(values[0], values[-1] + 1)):
-        return f"{name} >= {values[0]} && {name} <= {values[-1]}"
-    text = " || ".join(f"{name} == {encode(v)}" for v in values)
+    numbers = all(_is_int(v) and encode(v) == str(v) for v in values)  # written as numbers
+    if numbers and values == list(range(values[0], values[-1] + 1)):
+        return f"{name} >= {values[0]} and {name} <= {values[-1]}"
+    text = " or ".join(f"{name} == {encode(v)}" for v in values)
     return f"({text})" if wrap else text
 
 

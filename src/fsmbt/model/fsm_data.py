@@ -14,7 +14,9 @@ remembered statuses) as variables instead of states. The IR keeps them in the fo
   the transition is taken;
 - ``State.attrs[ONEXIT]``: updates run when the state is left (``<onexit><assign>``).
 
-Meaning (the only one): the W3C SCXML algorithm, with the ``ecmascript`` data model - the
+Meaning (the only one): the W3C SCXML algorithm, with the ``python`` data model (the one
+python-statemachine evaluates, so its engine runs the file as written; fsmbt's expression
+subset reads it exactly: ``==``, ``<=``, ``>=``, ``and``, ``or``, literals, ``x + 1``) - the
 transitions of a state on one event are tried in document order and the first whose guard holds
 is taken. A machine with data is never flattened by ``fsmbt.model.flatten``'s own rules (they
 know nothing of data): its flat meaning is the SCXML reader's exact expansion (configurations x
@@ -36,7 +38,7 @@ COND = "cond"
 ASSIGN = "fsmbt:assign"
 ONEXIT = "fsmbt:onexit"
 #: The data model dialect the expressions are written in.
-DIALECT = "ecmascript"
+DIALECT = "python"
 
 _expander: Callable[[FSM], FSM] | None = None
 

@@ -485,7 +485,9 @@ def _data_label(t) -> str:
     ``event [cond] / x := e``, one conjunct and one update per line (a picture stays narrow)."""
     text = ""
     if COND in t.attrs:
-        guard = t.attrs[COND].replace(" && ", " &&\n  ").replace(" || ", " ||\n  ")
+        guard = t.attrs[COND]
+        for word in (" and ", " or ", " && ", " || "):
+            guard = guard.replace(word, word.rstrip() + "\n  ")
         text += f" [{guard}]"
     updates = parse_lines(t.attrs.get(ASSIGN, ""))
     if updates:
