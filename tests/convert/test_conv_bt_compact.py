@@ -168,3 +168,24 @@ def test_formats_without_a_data_model_refuse_and_json_keeps_it() -> None:
     back = loads(dumps(hfsm, "json"), "json")
     assert has_data(back)
     assert api.verify_models(doc, back).equivalent
+
+
+def test_render_pages_one_level_per_picture_within_4096(tmp_path) -> None:  # noqa: ANN001
+    """``fsmbt render --pages``: the top machine (the region closed into a box) and the
+    region's own machine, each at most 4096 x 4096 pixels, guards on the arrows."""
+    import struct
+
+    from fsmbt.render import render_pages
+    from fsmbt.render.fsm_graph import fsm_to_dot
+
+    hfsm = bt_to_hfsm(nav2_default()).model
+    pages = render_pages(hfsm, tmp_path / "pages", fmt="png")
+    assert [p.name for p in pages] == ["top.png", "NavigateRecovery.png"]
+    for page in pages:
+        width, height = struct.unpack(">II", page.read_bytes()[16:24])
+        assert 0 < width <= 4096 and 0 < height <= 4096
+    region = fsm_to_dot(hfsm, level=0, composite="NavigateRecovery")
+    assert "NavigateRecovery_retry_count" in region  # the legend
+    assert "failure [v" in region and ":= v" in region  # a guard and an update on arrows
+    top = fsm_to_dot(hfsm, level=0)
+    assert "ProgressCheckerSelector" not in top  # the region is a closed box there
