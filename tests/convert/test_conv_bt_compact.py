@@ -4,6 +4,7 @@ through the W3C expansion of the data model (docs/conversion.md, "Compact conver
 from __future__ import annotations
 
 import random
+from pathlib import Path
 
 import pytest
 from lxml import etree
@@ -189,3 +190,26 @@ def test_render_pages_one_level_per_picture_within_4096(tmp_path) -> None:  # no
     assert "failure [v" in region and ":= v" in region  # a guard and an update on arrows
     top = fsm_to_dot(hfsm, level=0)
     assert "ProgressCheckerSelector" not in top  # the region is a closed box there
+
+
+def test_cli_convert_compact_unroll_and_pages(tmp_path, capsys) -> None:  # noqa: ANN001
+    """``fsmbt convert`` writes the data model by default and says what the proof checked;
+    ``--unroll`` writes the product; ``fsmbt render --pages`` draws one picture per level."""
+    from fsmbt.cli import main
+
+    example = Path(__file__).resolve().parents[2] / "examples" / "game_npc_bt.xml"
+    compact, unrolled = tmp_path / "npc.scxml", tmp_path / "npc_unrolled.scxml"
+    assert main(["convert", str(example), "-o", str(compact)]) == 0
+    shown = capsys.readouterr()
+    assert "checked through the data model" in shown.out + shown.err
+    assert main(["convert", str(example), "-o", str(unrolled), "--unroll"]) == 0
+    capsys.readouterr()
+    assert "<datamodel>" in compact.read_text() and "<datamodel>" not in unrolled.read_text()
+    small, big = (elements(loads(p.read_text(), "scxml")) for p in (compact, unrolled))
+    assert small < big
+    assert main(["render", str(compact), "--pages", str(tmp_path / "pages")]) == 0
+    assert (tmp_path / "pages" / "top.svg").exists()
+    assert len(list((tmp_path / "pages").glob("*.svg"))) >= 2
+    assert main(["convert", str(example), "-o", str(tmp_path / "npc.txt")]) == 2
+    shown = capsys.readouterr()
+    assert "no data model" in shown.out + shown.err
