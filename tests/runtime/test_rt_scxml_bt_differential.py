@@ -25,8 +25,9 @@ from pathlib import Path
 import pytest
 from scxml_oracle import PARALLEL_STOPS, Engine, Mismatch, Replay, python_spelled, replay
 
+from fsmbt import api
 from fsmbt.convert.bt_to_hfsm import bt_to_hfsm
-from fsmbt.formats import dumps, read_model
+from fsmbt.formats import dumps
 from fsmbt.generate import random_bt
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.bt_nodes import NodeKind
@@ -114,7 +115,7 @@ def check_tree(
 def test_reported_bug_robot_pick_failure_is_not_delivery() -> None:
     """Issue 11's report: after MovetoCube2 fails the engine must leave the pick unit by its
     FAILURE end (the BT fails), not go on to RobotatDelivery as if the pick had succeeded."""
-    doc = read_model(REPO / "examples" / "robot_bt.xml")
+    doc = api.load(REPO / "examples" / "robot_bt.xml").model
     hfsm = bt_to_hfsm(doc).model
     text = dumps(hfsm, "scxml")
     engine = Engine(text)
@@ -134,7 +135,7 @@ def test_examples() -> None:
     paths = sorted((REPO / "examples").glob("*_bt.xml"))
     assert paths
     for path in paths:
-        check_tree(tally, path.name, read_model(path), rng, 4 * SEQUENCES)
+        check_tree(tally, path.name, api.load(path).model, rng, 4 * SEQUENCES)
     print(tally.report())
     assert tally.models == len(paths) and not tally.mismatches, tally.mismatches[:5]
 
@@ -148,7 +149,7 @@ def test_corpus_bts() -> None:
     unreadable = 0
     for path in sorted(folder.rglob("*.xml")):
         try:
-            doc = read_model(path)
+            doc = api.load(path).model
         except FsmbtError:
             unreadable += 1
             continue
@@ -199,7 +200,7 @@ def test_mismatch_is_reported_on_a_wrong_model() -> None:
     """The oracle can fail: the robot SCXML against an HFSM whose pick unit's completion
     transitions are swapped disagrees with the engine (so zero mismatches above means
     something)."""
-    doc = read_model(REPO / "examples" / "robot_bt.xml")
+    doc = api.load(REPO / "examples" / "robot_bt.xml").model
     hfsm = bt_to_hfsm(doc).model
     text = dumps(hfsm, "scxml")
     for machine_fsm in [hfsm, *(s.regions[0] for s in hfsm.states.values() if s.regions)]:
@@ -330,14 +331,14 @@ def test_compact_runs_like_btcpp() -> None:
     with_data = 0
     trees: list[tuple[str, BTDocument]] = []
     for path in sorted((REPO / "examples").glob("*_bt.xml")):
-        trees.append((path.name, read_model(path)))
+        trees.append((path.name, api.load(path).model))
     folder = CORPUS / "bt"
     if folder.exists():
         for path in sorted(folder.rglob("*.xml")):
             if "models" in path.parts or any(p.startswith("_") for p in path.parts):
                 continue
             try:
-                doc = read_model(path, options=profile_options(path))
+                doc = api.load(path, options=profile_options(path)).model
             except FsmbtError:
                 continue
             if isinstance(doc, BTDocument):
@@ -368,7 +369,7 @@ def test_compact_lockstep_catches_a_wrong_guard() -> None:
     path = CORPUS / "bt" / "nav2" / "navigate_to_pose_w_replanning_and_recovery.xml"
     if not path.exists():
         pytest.skip(f"corpus not found at {CORPUS} (set FSMBT_CORPUS)")
-    doc = read_model(path, options=profile_options(path))
+    doc = api.load(path, options=profile_options(path)).model
     hfsm = bt_to_hfsm(doc).model
     guarded = [
         t

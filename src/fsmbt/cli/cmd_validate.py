@@ -17,14 +17,10 @@ from rich.markup import escape
 from rich.table import Table
 
 from fsmbt import api
+from fsmbt.api_types import ReadOptions
 from fsmbt.cli import EXIT_BAD_INPUT, EXIT_OK
 from fsmbt.cli.options import (
-    abstract_option,
-    include_root_option,
-    node_models_option,
-    nodes_option,
-    reader_options,
-    trees_option,
+    reads_models,
 )
 from fsmbt.model.errors import SourceLocation
 from fsmbt.model.validate import Issue, validate
@@ -32,26 +28,21 @@ from fsmbt.model.validate import Issue, validate
 
 def register(app: typer.Typer) -> None:
     @app.command("validate")
+    @reads_models
     def validate_command(
         model: Path = typer.Argument(..., help="Model file (FSM or BT, any format fsmbt reads)."),
-        from_format: str | None = typer.Option(
-            None, "--from", help="Input format (default: detected)."
-        ),
-        node_models: list[Path] = node_models_option(),
-        nodes: list[str] = nodes_option(),
-        abstract: list[str] = abstract_option(),
-        trees: list[Path] = trees_option(),
-        include_root: Path | None = include_root_option(),
         as_json: bool = typer.Option(False, "--json", help="Print the issues as JSON."),
         strict: bool = typer.Option(False, "--strict", help="Treat warnings as errors."),
+        *,
+        read: ReadOptions,
     ) -> None:
         """Check a model: unknown nodes, wrong child counts, missing SubTrees, unknown or
         duplicate states, nondeterminism, empty models; warn about unreachable states,
         dead ends not marked final and parts fsmbt cannot model exactly."""
         loaded = api.load(
             model,
-            from_format,
-            options=reader_options(node_models, nodes, abstract, trees, include_root),
+            read.format,
+            options=read,
         )
         # reader warnings already start with their location; model issues get the file name
         issues = [Issue("warning", w) for w in loaded.warnings]

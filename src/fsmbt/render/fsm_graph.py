@@ -33,6 +33,7 @@ walk (``render.dot.assemble``). Complexity O(S + T) for S states (every level) a
 from __future__ import annotations
 
 import re
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 
 import graphviz
@@ -67,6 +68,11 @@ EVENTS_PER_LINE = 3
 #: Graphviz ``size``: a picture larger than this (inches) is scaled down to fit, so a PNG
 #: (96 dpi) stays within 4096 x 4096 pixels and an SVG within 4096 x 4096 px at 96 px/inch.
 MAX_PICTURE_INCHES = "42.6,42.6"
+
+
+#: How a diff's removed states and transitions look: dashed and grey.
+GHOST_STATE_STYLE = {"shape": "circle", "style": "dashed", "color": "gray55", "fontcolor": "gray45"}
+GHOST_EDGE_STYLE = {"style": "dashed", "color": "gray55", "fontcolor": "gray45"}
 
 
 @dataclass
@@ -150,6 +156,9 @@ def fsm_to_dot(
     composite: str | None = None,
     notes: list[str] | None = None,
     anchors: bool = False,
+    marks: Mapping[str, Mapping[str, str]] | None = None,
+    ghosts: Sequence[str] = (),
+    ghost_edges: Sequence[tuple[str, str, str]] = (),
 ) -> str:
     """DOT source of ``fsm``.
 
@@ -165,6 +174,11 @@ def fsm_to_dot(
         notes: told what was left out of the picture and how to draw it.
         anchors: give every state an SVG id from its name (``fsmbt.render.anchors``): atomic
             and composite states ``s@Parent/child``, the top initial point ``start@``.
+        marks: extra Graphviz attributes per atomic state, keyed by its anchor id (whether or
+            not ``anchors`` is set): how a diff highlights changed states.
+        ghosts: states that are not in ``fsm`` (a diff's removed states), drawn dashed and grey.
+        ghost_edges: transitions that are not in ``fsm`` as ``(tail anchor, head anchor,
+            label)`` between drawn atomic states or ghosts (``s@`` + the ghost's name), dashed.
 
     Returns:
         The DOT source text.
@@ -237,6 +251,8 @@ def fsm_to_dot(
     edges: list[tuple[str, str, dict[str, str]]] = []
     clusters: list[tuple[graphviz.Digraph, graphviz.Digraph]] = []  # (cluster, parent), pre-order
 
+    marks = marks or {}
+    drawn: dict[str, str] = {}  # anchor id -> DOT node id of atomic states, for ghost edges
     level_cap = level  # the drawing loop below names each machine being drawn ``lv``
     top = _Level(fsm, root)
     depth_of: dict[int, int] = {id(top): 0}
@@ -269,8 +285,11 @@ def fsm_to_dot(
                 node_id = counter.state_id(lv, state.name)
                 lv.ids[state.name] = node_id
                 attrs = _state_attrs(state, title, compact=not layered)
+                anchor = state_anchor(lv.anchor + state.name)
+                drawn[anchor] = node_id
                 if anchors:
-                    attrs["id"] = state_anchor(lv.anchor + state.name)
+                    attrs["id"] = anchor
+                attrs.update(marks.get(anchor, {}))
                 lv.graph.node(node_id, **attrs)
                 continue
             if not layered:  # a box standing for the composite state, no cluster
@@ -338,6 +357,15 @@ def fsm_to_dot(
         lv.aliases = aliases
         _draw_initial(lv, edges, counter, is_top=lv is top, anchors=anchors)
         _draw_transitions(lv, edges, exact=exchange)
+    for name in ghosts:
+        ghost_id = counter.next("g")
+        drawn.setdefault(state_anchor(name), ghost_id)
+        root.node(ghost_id, label=label_text(name), **GHOST_STATE_STYLE)
+    for tail, head, text in ghost_edges:
+        if tail in drawn and head in drawn:
+            edges.append(
+                (drawn[tail], drawn[head], {"label": label_text(text), **GHOST_EDGE_STYLE})
+            )
 
     return assemble(root, clusters, [edge_line(tail, head, attrs) for tail, head, attrs in edges])
 
