@@ -16,7 +16,7 @@ from pathlib import Path
 from fsmbt import api
 from fsmbt.convert import convert
 from fsmbt.formats import loads
-from fsmbt.formats._smach_write import write_smach
+from fsmbt.formats.pysm.smach_write import write_smach
 from fsmbt.model.errors import FsmbtError
 from fsmbt.model.flatten import flatten
 from fsmbt.model.fsm import FSM

@@ -9,7 +9,7 @@ import pytest
 
 from fsmbt import api
 from fsmbt.formats import dumps, loads
-from fsmbt.formats.btcpp import ASSUMED_MARK
+from fsmbt.formats.btcpp.xml_format import ASSUMED_MARK
 from fsmbt.formats.xml_safe import parse_xml, root_tag
 from fsmbt.limits import current as current_limits
 from fsmbt.model import BTDocument, BTNode, NodeKind

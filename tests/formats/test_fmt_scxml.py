@@ -10,8 +10,8 @@ import pytest
 from fsmbt import api
 from fsmbt.formats import dumps, loads
 from fsmbt.formats.registry import ReadContext
-from fsmbt.formats.scxml import _Reader, read_scxml
-from fsmbt.formats.scxml_w3c import representative_event
+from fsmbt.formats.scxml.structural import _Reader, read_scxml
+from fsmbt.formats.scxml.w3c import representative_event
 from fsmbt.model import FSM, State
 from fsmbt.model.errors import InputError, UnsupportedError
 from fsmbt.semantics.machine import FSMMachine

@@ -14,7 +14,7 @@ import pytest
 from fsmbt import api
 from fsmbt.convert import convert
 from fsmbt.formats import loads
-from fsmbt.formats._smach_write import write_smach
+from fsmbt.formats.pysm.smach_write import write_smach
 from fsmbt.model.fsm import FSM
 from fsmbt.verify import verify
 from support.corpus import CORPUS

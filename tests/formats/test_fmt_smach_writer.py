@@ -20,7 +20,7 @@ import pytest
 from fsmbt import api
 from fsmbt.convert import convert
 from fsmbt.formats import loads
-from fsmbt.formats._smach_write import smach_losses, write_smach
+from fsmbt.formats.pysm.smach_write import smach_losses, write_smach
 from fsmbt.formats.translate import differences_between
 from fsmbt.generate.generator import random_bt, random_fsm
 from fsmbt.model.errors import InputError, UnsupportedError

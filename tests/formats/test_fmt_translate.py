@@ -17,7 +17,7 @@ import pytest
 
 from fsmbt import api
 from fsmbt.formats import Format, loads
-from fsmbt.formats.json_format import write_json
+from fsmbt.formats.schema.json_format import write_json
 from fsmbt.formats.translate import (
     differences_between,
     rename_events,

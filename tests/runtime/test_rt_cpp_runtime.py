@@ -362,7 +362,7 @@ def test_doctor_reports_the_cpp_runtime(tmp_path: Path, monkeypatch) -> None:
     names = {c.name: c for c in checks()}
     assert not names["C++ LEBT driver"].ok
     assert not names[f"BehaviorTree.CPP {cpp_runtime.BTCPP_VERSION} (C++)"].ok
-    assert "build_btcpp.sh" in names["C++ LEBT driver"].hint
+    assert "fsmbt doctor --install btcpp" in names["C++ LEBT driver"].hint
     assert main(["doctor"]) == 1
 
 
@@ -413,6 +413,12 @@ def test_nusmv_build_script_reuses_the_old_checkout_binary(tmp_path: Path) -> No
     repo = tmp_path / "repo"
     (repo / "scripts").mkdir(parents=True)
     shutil.copy2(REPO / "scripts" / "build_nusmv.sh", repo / "scripts" / "build_nusmv.sh")
+    # the checkout's script runs the one the package ships (src/fsmbt/install)
+    (repo / "src" / "fsmbt" / "install").mkdir(parents=True)
+    shutil.copy2(
+        REPO / "src" / "fsmbt" / "install" / "build_nusmv.sh",
+        repo / "src" / "fsmbt" / "install" / "build_nusmv.sh",
+    )
     legacy = repo / ".cache" / "nusmv" / "bin" / "NuSMV"
     legacy.parent.mkdir(parents=True)
     legacy.write_text("#!/bin/sh\necho 'usage: NuSMV -dcx ...'\n", encoding="utf-8")

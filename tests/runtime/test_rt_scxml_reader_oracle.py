@@ -182,7 +182,7 @@ PROBES = {
 
 
 #: Documents the structural reader refuses and fsmbt reads by running the W3C algorithm
-#: (``fsmbt.formats.scxml_w3c``, docs/formats/scxml.md): one per feature of issue 12 part 4.
+#: (``fsmbt.formats.scxml.w3c``, docs/formats/scxml.md): one per feature of issue 12 part 4.
 W3C_PROBES = {
     "shallow history restores the last child, not its descendants": """
   <state id="a" initial="a1"><history id="h"><transition target="a1"/></history>

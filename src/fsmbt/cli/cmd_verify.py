@@ -23,8 +23,8 @@ from fsmbt.cli.options import (
     timeout_option,
 )
 from fsmbt.cli.progress import StageProgress
+from fsmbt.cli.render_report import print_report
 from fsmbt.verify import EngineDisagreement
-from fsmbt.verify.render_report import print_report
 
 EXIT_EQUIVALENT = 0
 EXIT_NOT_EQUIVALENT = 1

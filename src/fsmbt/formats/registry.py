@@ -143,16 +143,29 @@ def get_format(name: str) -> Format:
         raise InputError(f"unknown format '{name}' (known: {known})") from None
 
 
+#: The modules of the built-in formats, each registering its format on import.
+BUILTIN_FORMAT_MODULES: tuple[str, ...] = (
+    "fsmbt.formats.paper.xml_format",
+    "fsmbt.formats.paper.text_format",
+    "fsmbt.formats.scxml.structural",
+    "fsmbt.formats.btcpp.xml_format",
+    "fsmbt.formats.pysm.smach",
+    "fsmbt.formats.pysm.flexbe",
+    "fsmbt.formats.schema.json_format",
+    "fsmbt.formats.schema.yaml_format",
+    "fsmbt.formats.tables.csv_format",
+    "fsmbt.formats.tables.markdown",
+    "fsmbt.formats.diagrams.dot",
+    "fsmbt.formats.diagrams.mermaid",
+)
+
+
 def _load_builtin_formats() -> None:
-    """Import every format module once so each registers itself."""
+    """Import every built-in format module once so each registers itself."""
     import importlib
-    import pkgutil
 
-    import fsmbt.formats as package
-
-    for info in pkgutil.iter_modules(package.__path__):
-        if info.name not in ("registry",) and not info.name.startswith("_"):
-            importlib.import_module(f"fsmbt.formats.{info.name}")
+    for name in BUILTIN_FORMAT_MODULES:
+        importlib.import_module(name)
 
 
 def format_for_path(path: Path, *, writing: bool = False, kind: str | None = None) -> Format | None:

@@ -65,7 +65,7 @@ def join_lines(pairs: list[tuple[str, str]]) -> str:
 
 def register_expander(expander: Callable[[FSM], FSM]) -> None:
     """Install the exact expansion of a machine with data into a flat FSM (the SCXML reader's
-    W3C reading of the machine written as SCXML; registered by ``fsmbt.formats.scxml``)."""
+    W3C reading of the machine written as SCXML; registered by ``fsmbt.formats.scxml.structural``)."""
     global _expander
     _expander = expander
 
@@ -81,7 +81,7 @@ def expand(fsm: FSM) -> FSM:
         UnsupportedError: no expander could be installed.
     """
     if _expander is None:
-        importlib.import_module("fsmbt.formats.scxml")
+        importlib.import_module("fsmbt.formats.scxml.structural")
     if _expander is None:
         raise UnsupportedError(
             "this state machine keeps data (an SCXML data model); reading it needs "

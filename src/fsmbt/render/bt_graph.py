@@ -18,7 +18,7 @@ below it, in a dashed cluster (a recursive reference is not expanded again). Bui
 explicit stack; complexity O(N) for N drawn nodes, refused beyond ``max_nodes``.
 
 This is also the DOT file format's BT writer (``fsmbt convert --to dot``, through
-``fsmbt.formats.dot``, with no size limit); BT DOT is write-only (docs/formats/dot.md).
+``fsmbt.formats.diagrams.dot``, with no size limit); BT DOT is write-only (docs/formats/dot.md).
 """
 
 from __future__ import annotations

@@ -18,12 +18,12 @@ A flat machine that large uses the force-directed ``sfdp`` layout (seconds for t
 states; dot's layered layout with edge labels needs minutes from about a hundred states).
 
 The same builder writes the DOT *file format* (``fsmbt convert --to dot``, registered by
-``fsmbt.formats.dot``) with ``exchange=True``: node ids are the state names (``Parent/child``
+``fsmbt.formats.diagrams.dot``) with ``exchange=True``: node ids are the state names (``Parent/child``
 paths inside composite states, ``Parent/0:child`` in parallel regions), each carrying an
 ``action`` attribute when its action differs from its name; every transition is its own edge
 labelled with its exact event (eventless: no label); the initial point is named after the start
 pseudo-state (else ``__start__``); the layered layout is always used and no size limit applies.
-That is what ``fsmbt.formats.dot``'s reader reads back (docs/formats/dot.md). Pictures also
+That is what ``fsmbt.formats.diagrams.dot``'s reader reads back (docs/formats/dot.md). Pictures also
 carry the ``action`` attribute (Graphviz ignores attributes it does not know).
 
 Built without recursion: clusters are created in pre-order and written out by one pre-order
@@ -55,7 +55,7 @@ from fsmbt.render.dot import (
 )
 
 #: The initial point's id in exchange DOT when the model names no start pseudo-state; the
-#: reader (``fsmbt.formats.dot``) takes a node of this name as the start marker.
+#: reader (``fsmbt.formats.diagrams.dot``) takes a node of this name as the start marker.
 START_NODE = "__start__"
 
 #: Nested clusters beyond this depth make dot slow and the picture unreadable.
@@ -166,7 +166,7 @@ def fsm_to_dot(
         fsm: the machine (flat or hierarchical).
         max_nodes: refuse (``TooLargeError``) more states than this (and more than five times
             as many transitions), and nesting deeper than ``MAX_NESTING``; ``None``: no limit.
-        exchange: write the DOT file format that ``fsmbt.formats.dot`` reads back (see the
+        exchange: write the DOT file format that ``fsmbt.formats.diagrams.dot`` reads back (see the
             module docstring) instead of the picture's DOT.
         level: draw composite states nested at most this deep as clusters (0: the top machine
             only, composites closed); default: all, or the deepest that fits (see above).
@@ -417,7 +417,7 @@ def _state_attrs(state: State, title: str, *, compact: bool = False) -> dict[str
     ):  # ``q3:Move`` already says it
         lines.append(f"/ {state.action}")
     attrs = {"label": label_text(*lines), "shape": "doublecircle" if state.final else "circle"}
-    if state.action != state.name:  # read back by fsmbt.formats.dot; Graphviz ignores it
+    if state.action != state.name:  # read back by fsmbt.formats.diagrams.dot; Graphviz ignores it
         attrs["action"] = dot_id(state.action or "")
     if compact:
         attrs.update(shape="ellipse", peripheries="2" if state.final else "1")

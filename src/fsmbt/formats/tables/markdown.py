@@ -3,7 +3,7 @@
 The reader takes the first pipe table whose header names ``source``, ``event`` and ``target``
 (text around it, headings and other tables before it are ignored, which lets a README hold the
 table). A ``|`` inside a cell is written ``\\|``; cells may be wrapped in backticks, which are
-removed. Rows and errors are numbered by the file's lines. Rules: ``table_csv`` module docstring
+removed. Rows and errors are numbered by the file's lines. Rules: ``tables.csv_format`` module docstring
 and docs/formats/tables.md.
 """
 
@@ -12,7 +12,7 @@ from __future__ import annotations
 import re
 
 from fsmbt.formats.registry import Format, ReadContext, register
-from fsmbt.formats.table_csv import TableRow, fsm_from_rows, is_header, rows_from_fsm
+from fsmbt.formats.tables.csv_format import TableRow, fsm_from_rows, is_header, rows_from_fsm
 from fsmbt.model import Model
 from fsmbt.model.errors import InputError
 

@@ -4,7 +4,7 @@
 What is read: ``<invoke>`` of type SCXML (no ``type``, ``scxml``,
 ``http://www.w3.org/TR/scxml/``, its ``#SCXMLEventProcessor`` form) whose document is inline
 (``<content><scxml>...</scxml></content>``) or a file (``src="child.scxml"``, resolved and
-confined like an XInclude, ``fsmbt.formats.scxml_include``). Other types (``vxml2``, http,
+confined like an XInclude, ``fsmbt.formats.scxml.include``). Other types (``vxml2``, http,
 ...) are external services: ``UnsupportedError`` with the line. Rules (W3C SCXML 1.0, 6.4 and
 appendix D):
 
@@ -43,20 +43,19 @@ the receiving session.
 
 from __future__ import annotations
 
+from collections import deque
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any, Protocol
 
 from lxml import etree
 
 from fsmbt import limits
-from fsmbt.formats import scxml_include
 from fsmbt.formats.registry import ReadContext
+from fsmbt.formats.scxml import include as scxml_include
 from fsmbt.formats.xml_safe import local_name, namespace
 from fsmbt.model.errors import InputError, UnsupportedError
-
-if TYPE_CHECKING:
-    from fsmbt.formats.scxml_w3c import _S, _Doc, _Interpreter, _Run
 
 SCXML_TYPES = frozenset(
     {
@@ -94,8 +93,8 @@ class Invocation:
 
     state: int
     invokeid: str
-    doc: _Doc
-    interp: _Interpreter
+    doc: Document
+    interp: Interpreter
     autoforward: bool
     finalize: list[Any]
     line: int | None
@@ -106,29 +105,130 @@ class Child:
     """A running child session of one run."""
 
     invocation: Invocation
-    run: _Run
+    run: Run
     serial: int
 
 
+# -- what this module reads of the W3C reader's objects (fsmbt.formats.scxml.w3c) ----------------
+# The reader imports this module, never the other way round: these protocols name what the
+# sessions use of a document, a state, an interpreter and a run.
+class StateNode(Protocol):
+    """A state of a document being read."""
+
+    @property
+    def index(self) -> int: ...
+    @property
+    def id(self) -> str: ...
+    @property
+    def kind(self) -> str: ...
+    @property
+    def invokes(self) -> list[Invocation]: ...
+    @property
+    def onentry(self) -> Sequence[Any]: ...
+    @property
+    def onexit(self) -> Sequence[Any]: ...
+    @property
+    def initial_actions(self) -> Sequence[Any]: ...
+    @property
+    def transitions(self) -> Sequence[Any]: ...
+
+
+class Document(Protocol):
+    """A document read by the W3C reader (the parent of an invocation, or a child)."""
+
+    @property
+    def ctx(self) -> ReadContext: ...
+    @property
+    def ns(self) -> str | None: ...
+    @property
+    def session(self) -> Session: ...
+    @property
+    def included(self) -> scxml_include.Included: ...
+    @property
+    def invocations(self) -> dict[str, Invocation]: ...
+    @property
+    def session_targets(self) -> list[tuple[str, int | None]]: ...
+    @property
+    def guards(self) -> list[str]: ...
+    @property
+    def plan(self) -> Any: ...
+    @property
+    def states(self) -> Sequence[StateNode]: ...
+    def tag(self, element: etree._Element) -> str | None: ...
+    def refuse(self, element: etree._Element, feature: str) -> UnsupportedError: ...
+    def actions(self, block: etree._Element | list[etree._Element]) -> list[Any]: ...
+
+
+class Run(Protocol):
+    """One session's run state (mutable)."""
+
+    config: set[int]
+    history: dict[int, frozenset[int]]
+    internal: deque[str]
+    external: deque[str]
+    running: bool
+    moved: bool
+    data: dict[str, Any]
+    sessions: dict[str, Child]
+    to_invoke: list[int]
+    outbox: list[str]
+    serial: int
+
+    def spawn(
+        self,
+        config: set[int],
+        history: dict[int, frozenset[int]],
+        data: dict[str, Any],
+    ) -> Run:
+        """A fresh run of the same kind (for a child session)."""
+        ...
+
+
+class Interpreter(Protocol):
+    """The W3C algorithm over one document."""
+
+    @property
+    def doc(self) -> Document: ...
+    @property
+    def s(self) -> Sequence[StateNode]: ...
+    @property
+    def order(self) -> dict[int, int]: ...
+    def process(
+        self, run: Any, event: str | None, valuation: dict[int, bool], read: set[int]
+    ) -> Any: ...
+    def perform(self, actions: Sequence[Any], run: Any) -> None: ...
+    def name(self, config: frozenset[int], history: Any, data: Any) -> str: ...
+    def action(self, config: frozenset[int]) -> str | None: ...
+
+
 # -- reading -------------------------------------------------------------------------------------
-def read_invoke(
-    doc: _Doc,
-    element: etree._Element,
-    node: _S,
-    make_doc: type[_Doc],
-    make_interp: type[_Interpreter],
-) -> Invocation:
-    """The invocation an ``<invoke>`` element of state ``node`` describes.
+@dataclass(frozen=True)
+class ChildSource:
+    """What the child document of one ``<invoke>`` is read from, checked (``read_invoke``).
+
+    The W3C reader reads ``text`` (or the inline ``element``) with ``ctx`` as a document of
+    ``session``, then hands it to ``add_invocation``.
+    """
+
+    text: str
+    ctx: ReadContext
+    element: etree._Element | None
+    session: Session
+    autoforward: bool
+    finalize: etree._Element | None
+    data_passed: bool
+
+
+def read_invoke(doc: Document, element: etree._Element, node: StateNode) -> ChildSource:
+    """Check an ``<invoke>`` element of state ``node`` and find its child document.
 
     Args:
         doc: The document being read (the parent).
         element: The ``<invoke>`` element.
         node: The state holding it.
-        make_doc: The document reader class (``scxml_w3c._Doc``).
-        make_interp: The interpreter class (``scxml_w3c._Interpreter``).
 
     Returns:
-        The invocation; it is also recorded in ``doc.invocations`` and ``node.invokes``.
+        Where the child document is (its text or inline element) and how it is invoked.
 
     Raises:
         UnsupportedError: an external service, computed attributes, guards in the child.
@@ -193,14 +293,45 @@ def read_invoke(
             location=where,
             element="<invoke>",
         )
-    child_doc = _child_document(doc, element, src, contents, make_doc)
+    text, child_ctx, inline, session = _child_document(doc, element, src, contents)
+    return ChildSource(
+        text,
+        child_ctx,
+        inline,
+        session,
+        autoforward == "true",
+        finalizes[0] if finalizes else None,
+        data_passed,
+    )
+
+
+def add_invocation(
+    doc: Document,
+    element: etree._Element,
+    node: StateNode,
+    source: ChildSource,
+    child_doc: Document,
+    child_interp: Interpreter,
+) -> Invocation:
+    """Record the invocation of ``child_doc`` (read from ``source``) by state ``node``.
+
+    Returns:
+        The invocation; it is also recorded in ``doc.invocations`` and ``node.invokes``.
+
+    Raises:
+        UnsupportedError: guards in the child, data passed to an exactly read session, a
+            ``<finalize>`` that raises or sends.
+        InputError: a duplicate invoke id.
+    """
+    ctx = doc.ctx
+    where = ctx.location(element.sourceline)
     if child_doc.guards:
         raise doc.refuse(
             element,
             "unsupported: a cond guard in an invoked document "
             f"('{child_doc.guards[0]}'; only In() is read there)",
         )
-    if data_passed:
+    if source.data_passed:
         if child_doc.plan.relevant:  # control flow there reads its data
             raise doc.refuse(
                 element, "unsupported: <param>/namelist passing data to an exactly read session"
@@ -210,10 +341,11 @@ def read_invoke(
             line=element.sourceline,
             element="<invoke>",
         )
-    finalize = doc.actions(finalizes[0]) if finalizes else []
+    finalize = doc.actions(source.finalize) if source.finalize is not None else []
     if sent_names(finalize, ("raise", "internal", "external", "parent", "session:")):
+        assert source.finalize is not None
         raise doc.refuse(
-            finalizes[0], "unsupported: <finalize> that raises or sends events (in the parent)"
+            source.finalize, "unsupported: <finalize> that raises or sends events (in the parent)"
         )
     invokeid = element.get("id") or f"{node.id}.{len(node.invokes) + 1}"
     if invokeid in doc.invocations:
@@ -222,8 +354,8 @@ def read_invoke(
         node.index,
         invokeid,
         child_doc,
-        make_interp(child_doc),
-        autoforward == "true",
+        child_interp,
+        source.autoforward,
         finalize,
         element.sourceline,
     )
@@ -238,12 +370,12 @@ def _is_url(src: str) -> bool:
 
 
 def _child_document(
-    doc: _Doc,
+    doc: Document,
     element: etree._Element,
     src: str | None,
     contents: list[etree._Element],
-    make_doc: type[_Doc],
-) -> _Doc:
+) -> tuple[str, ReadContext, etree._Element | None, Session]:
+    """(text, context, inline element, session) of the child document."""
     ctx = doc.ctx
     where = ctx.location(element.sourceline)
     if src is None:
@@ -264,7 +396,7 @@ def _child_document(
         session = Session(
             True, doc.session.chain, doc.session.depth + 1, doc.session.read_chars, doc.included
         )
-        return make_doc("", ctx, element=documents[0], session=session)
+        return "", ctx, documents[0], session
     # relative to the file the <invoke> is written in: an included fragment's, else the document's
     base = doc.included.base_of(element) or (Path(ctx.path) if ctx.path is not None else None)
     resolved = scxml_include.resolve_confined(ctx, base, src, "<invoke src>", where, "<invoke>")
@@ -288,10 +420,10 @@ def _child_document(
     options["include_root"] = str(scxml_include.confinement_root(ctx))
     child_ctx = ReadContext(resolved, options, ctx.warnings)
     session = Session(True, (*chain, resolved), doc.session.depth + 1, doc.session.read_chars)
-    return make_doc(text, child_ctx, session=session)
+    return text, child_ctx, None, session
 
 
-def send_target(doc: _Doc, target: str, name: str, line: int | None) -> tuple[str, str] | None:
+def send_target(doc: Document, target: str, name: str, line: int | None) -> tuple[str, str] | None:
     """The action of ``<send target=...>`` to another session of this system: ``#_parent`` or
     ``#_<invokeid>`` (checked once the document is read, ``check_targets``); ``None`` for
     another target."""
@@ -303,7 +435,7 @@ def send_target(doc: _Doc, target: str, name: str, line: int | None) -> tuple[st
     return None
 
 
-def check_targets(doc: _Doc) -> None:
+def check_targets(doc: Document) -> None:
     """Every ``#_<id>`` target names an ``<invoke>`` of the document (another session could
     be meant otherwise: refused as the reader refuses sends to other sessions)."""
     for invokeid, line in doc.session_targets:
@@ -331,7 +463,7 @@ def sent_names(actions: list[Any], kinds: tuple[str, ...]) -> list[str]:
     return out
 
 
-def session_events(doc: _Doc) -> tuple[set[str], set[str]]:
+def session_events(doc: Document) -> tuple[set[str], set[str]]:
     """(events the environment may send that an autoforwarded child reads, events children may
     send to ``doc``'s session) - for the input symbols of ``doc``."""
     forwarded: set[str] = set()
@@ -354,13 +486,13 @@ def session_events(doc: _Doc) -> tuple[set[str], set[str]]:
 
 
 # -- running -------------------------------------------------------------------------------------
-def on_enter(run: _Run, node: _S) -> None:
+def on_enter(run: Run, node: StateNode) -> None:
     """W3C ``enterStates``: a state with invocations is to be invoked."""
     if node.invokes:
         run.to_invoke.append(node.index)
 
 
-def on_exit(run: _Run, node: _S) -> None:
+def on_exit(run: Run, node: StateNode) -> None:
     """W3C ``exitStates``: not invoked if still pending; its sessions are cancelled."""
     if node.index in run.to_invoke:
         run.to_invoke.remove(node.index)
@@ -368,14 +500,14 @@ def on_exit(run: _Run, node: _S) -> None:
         run.sessions.pop(inv.invokeid, None)
 
 
-def start_pending(interp: _Interpreter, run: _Run) -> None:
+def start_pending(interp: Interpreter, run: Run) -> None:
     """End of a macro step: start the invocations of the states entered in it, in entry order."""
     pending, run.to_invoke = run.to_invoke, []
     if not run.running:
         return
     for index in pending:
         for inv in interp.s[index].invokes:
-            child_run = type(run)(set(), {}, data=dict(inv.doc.plan.initial))
+            child_run = run.spawn(set(), {}, dict(inv.doc.plan.initial))
             run.serial += 1
             child = Child(inv, child_run, run.serial)
             run.sessions[inv.invokeid] = child
@@ -384,7 +516,7 @@ def start_pending(interp: _Interpreter, run: _Run) -> None:
             _flush(run, child)
 
 
-def route(run: _Run, invoked: bool, kind: str, name: str) -> None:
+def route(run: Run, invoked: bool, kind: str, name: str) -> None:
     """``<send>`` to ``#_parent`` or ``#_<invokeid>`` (``error.communication`` if unreachable)."""
     if kind == "parent":
         if invoked:
@@ -399,7 +531,7 @@ def route(run: _Run, invoked: bool, kind: str, name: str) -> None:
     _deliver(run, child, name)
 
 
-def before_external(interp: _Interpreter, run: _Run, item: str) -> str | None:
+def before_external(interp: Interpreter, run: Run, item: str) -> str | None:
     """W3C main loop, an external event taken off the queue: ``<finalize>`` of the child it
     came from, then a copy to each autoforwarding child. ``None``: an event of a cancelled
     session, ignored."""
@@ -416,7 +548,7 @@ def before_external(interp: _Interpreter, run: _Run, item: str) -> str | None:
     return event
 
 
-def finish(interp: _Interpreter, run: _Run) -> None:
+def finish(interp: Interpreter, run: Run) -> None:
     """W3C ``exitInterpreter`` of an invoked session that reached a top-level final state:
     ``onexit`` in exit order (their ``#_parent`` sends go out), its own sessions cancelled,
     then ``done.invoke`` for the parent. The configuration is dropped (a finished child is one
@@ -439,7 +571,7 @@ def finish(interp: _Interpreter, run: _Run) -> None:
     run.outbox.append(DONE)
 
 
-def _deliver(run: _Run, child: Child, event: str) -> None:
+def _deliver(run: Run, child: Child, event: str) -> None:
     child.run.moved = False
     child.invocation.interp.process(child.run, event, {}, set())
     if child.run.moved:
@@ -447,7 +579,7 @@ def _deliver(run: _Run, child: Child, event: str) -> None:
     _flush(run, child)
 
 
-def _flush(run: _Run, child: Child) -> None:
+def _flush(run: Run, child: Child) -> None:
     """The child's events for its parent, onto the parent's external queue (tagged)."""
     invokeid = child.invocation.invokeid
     for event in child.run.outbox:
@@ -457,7 +589,7 @@ def _flush(run: _Run, child: Child) -> None:
 
 
 # -- the explored state --------------------------------------------------------------------------
-def sessions_key(run: _Run) -> tuple[Any, ...]:
+def sessions_key(run: Run) -> tuple[Any, ...]:
     """The running children of ``run`` (start order), each with its configuration, history,
     status, data and own children: part of the explored state."""
     out = []
@@ -478,18 +610,18 @@ def sessions_key(run: _Run) -> tuple[Any, ...]:
     return tuple(out)
 
 
-def restore(doc: _Doc, run: _Run, key: tuple[Any, ...]) -> None:
+def restore(doc: Document, run: Run, key: tuple[Any, ...]) -> None:
     """Rebuild ``run``'s children (``doc``'s sessions) from ``sessions_key`` output."""
     for invokeid, (config, history, running, data, inner) in key:
         inv = doc.invocations[invokeid]
-        crun = type(run)(set(config), dict(history), data=dict(data))
+        crun = run.spawn(set(config), dict(history), dict(data))
         crun.running = running
         restore(inv.doc, crun, inner)
         run.serial += 1
         run.sessions[invokeid] = Child(inv, crun, run.serial)
 
 
-def describe(doc: _Doc, key: tuple[Any, ...]) -> tuple[str, list[str]]:
+def describe(doc: Document, key: tuple[Any, ...]) -> tuple[str, list[str]]:
     """The name suffix ``{id=child configuration}`` of the children in ``key`` and their
     actions (``(done)`` for a finished child)."""
     parts: list[str] = []

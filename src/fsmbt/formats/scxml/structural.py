@@ -27,7 +27,7 @@ parent's initial state, transitions leaving a ``<parallel>`` region. Warned (``c
 ``<log>``, ``<datamodel>``/``<data>``, ``<donedata>``, foreign-namespace elements, and a
 transition dropped by document-order conflict resolution.
 
-XInclude is expanded before reading (``fsmbt.formats.scxml_include``). Everything is iterative
+XInclude is expanded before reading (``fsmbt.formats.scxml.include``). Everything is iterative
 over the element tree; complexity O(n + T·d) for n elements,
 T transitions and nesting depth d.
 """
@@ -39,11 +39,11 @@ from dataclasses import dataclass, field
 
 from lxml import etree
 
-from fsmbt.formats import scxml_include
 from fsmbt.formats.registry import Format, ReadContext, register
-from fsmbt.formats.scxml_w3c import read_scxml_w3c
+from fsmbt.formats.scxml import include as scxml_include
+from fsmbt.formats.scxml.w3c import read_scxml_w3c
 from fsmbt.formats.xml_safe import local_name, namespace, root_tag
-from fsmbt.model import Model, fsm_data
+from fsmbt.model import Model, fsm_data, state_info
 from fsmbt.model.errors import InputError, SourceLocation, UnsupportedError
 from fsmbt.model.fsm import FSM, State, Transition
 
@@ -68,6 +68,38 @@ UNSUPPORTED_CONTENT = frozenset(
 )
 WARNED_CONTENT = frozenset({"log"})
 _SCXML_KEYS = frozenset({"initial", "name", "version"})
+#: ``attrs`` keys a reader of outcome-driven states adds (``fsmbt.model.state_info``, FlexBE
+#: autonomy, SMACH/FlexBE container facts): written in the fsmbt namespace, so the SCXML stays
+#: valid (the W3C schema allows attributes of other namespaces) and reads back the same.
+_ANNOTATION_PREFIXES = ("flexbe.", "smach.", "userdata.", "params", "ros.", "children.")
+_ANNOTATION_KEYS = frozenset({*state_info.KEYS, "autonomy"})
+
+
+def annotation_attribute(key: str) -> str:
+    """The XML attribute an ``attrs`` key is written as (fsmbt-namespaced for annotations)."""
+    if key in _ANNOTATION_KEYS or key.startswith(_ANNOTATION_PREFIXES):
+        return f"{{{FSMBT_NS}}}{key}"
+    return key
+
+
+def annotations_in(attrib: etree._Attrib, known: frozenset[str]) -> dict[str, str]:
+    """An element's other attributes as ``attrs``: fsmbt-namespaced annotations by their key."""
+    out: dict[str, str] = {}
+    prefix = f"{{{FSMBT_NS}}}"
+    for raw_key, raw_value in attrib.items():
+        key, value = str(raw_key), str(raw_value)
+        if key in known:
+            continue
+        local = key[len(prefix) :] if key.startswith(prefix) else None
+        if local is not None and (
+            local in _ANNOTATION_KEYS or local.startswith(_ANNOTATION_PREFIXES)
+        ):
+            out[local] = value
+        else:
+            out[key] = value
+    return out
+
+
 _STATE_KEYS = frozenset({"id", "initial", F_NAME, F_ACTION, F_START, F_REGION})
 _TRANSITION_KEYS = frozenset({"event", "target", "cond", F_EXIT})
 #: The one guard read: ``In('id')`` / ``In("id")`` (W3C's predicate, in every data model).
@@ -145,8 +177,8 @@ class _Reader:
             name=root.get("name", "fsm"),
             attrs={
                 k: v
-                for k, v in root.attrib.items()
-                if k not in _SCXML_KEYS and not (self.data_ir and k in (F_DATA, "datamodel"))
+                for k, v in annotations_in(root.attrib, _SCXML_KEYS).items()
+                if not (self.data_ir and k in (F_DATA, "datamodel"))
             },
         )
         self.top = top
@@ -219,7 +251,7 @@ class _Reader:
         action: str | None = name if not nested else None
         if F_ACTION in element.attrib:
             action = element.get(F_ACTION) or None
-        attrs = {k: v for k, v in element.attrib.items() if k not in _STATE_KEYS}
+        attrs = annotations_in(element.attrib, _STATE_KEYS)
         if self.data_ir:
             for block in self.children(element):
                 if self.tag(block) == "onexit" and self._assigned(block):
@@ -434,7 +466,7 @@ class _Reader:
                 location=self.where(element),
                 element="<transition>",
             )
-        attrs = {k: v for k, v in element.attrib.items() if k not in _TRANSITION_KEYS}
+        attrs = annotations_in(element.attrib, _TRANSITION_KEYS)
         if self.data_ir and cond_exit is None and element.get("cond") is not None:
             attrs[fsm_data.COND] = element.get("cond") or ""
         if self.data_ir and self._assigned(element):
@@ -693,7 +725,7 @@ class _Reader:
 def read_scxml(text: str, ctx: ReadContext) -> FSM:
     """The hierarchical model of the document; a document the structural reader refuses for a
     feature with a finite reading is read by running the W3C algorithm instead (a flat model,
-    ``fsmbt.formats.scxml_w3c``; docs/formats/scxml.md)."""
+    ``fsmbt.formats.scxml.w3c``; docs/formats/scxml.md)."""
     try:
         return _read_either(text, ctx)
     except InputError as exc:  # UnsupportedError too: name the file included content came from
@@ -841,7 +873,7 @@ class _Writer:
             root.set("initial", self.ids[(id(fsm), fsm.initial)])
         for key, value in fsm.attrs.items():
             if key != fsm_data.DATAMODEL:
-                root.set(key, value)
+                root.set(annotation_attribute(key), value)
         if fsm_data.has_data(fsm):  # docs/semantics.md, "Data in state machines"
             root.set("datamodel", fsm_data.DIALECT)
             root.set(F_DATA, "ir")
@@ -901,7 +933,7 @@ class _Writer:
             if key == fsm_data.ONEXIT:
                 _assignments(etree.SubElement(element, _q("onexit")), value)
             else:
-                element.set(key, value)
+                element.set(annotation_attribute(key), value)
         by_source = self.outgoing.get(id(machine))
         if by_source is None:
             by_source = {}
@@ -933,7 +965,7 @@ class _Writer:
             if k == fsm_data.ASSIGN:
                 _assignments(out, v)
             else:
-                out.set(k, v)
+                out.set(annotation_attribute(k), v)
 
     def final_id(self, state: State, exit_name: str) -> str:
         """The id of the final state a completion transition of ``state`` waits for."""

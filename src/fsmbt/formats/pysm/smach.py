@@ -4,11 +4,11 @@ Reading is static: the source is parsed with ``ast`` and never imported or execu
 whose module-level code would have side effects is safe to read). Containers, ``add`` /
 ``add_auto`` in positional and keyword forms inside ``with`` blocks, ``Sequence``,
 ``Concurrence`` (outcome maps), ``Iterator``, ``set_initial_state``, nested containers; the
-mapping and the refusals are in ``fsmbt.formats._pysm_build``. When a file builds several
+mapping and the refusals are in ``fsmbt.formats.pysm.build``. When a file builds several
 top-level containers the first is read (option ``machine`` names another by its variable) and
 the others are named in a warning.
 
-Writing (``fsmbt.formats._smach_write``) produces a container module with one stub
+Writing (``fsmbt.formats.pysm.smach_write``) produces a container module with one stub
 ``smach.State`` class per action.
 
 Costs: O(n) in the size of the source.
@@ -18,9 +18,9 @@ from __future__ import annotations
 
 import re
 
-from fsmbt.formats._pysm_analyze import Analysis, Container
-from fsmbt.formats._pysm_build import build_fsm
-from fsmbt.formats._smach_write import write_smach
+from fsmbt.formats.pysm.analyze import Analysis, Container
+from fsmbt.formats.pysm.build import build_fsm
+from fsmbt.formats.pysm.smach_write import write_smach
 from fsmbt.formats.registry import Format, ReadContext, register
 from fsmbt.model.errors import InputError
 from fsmbt.model.fsm import FSM

@@ -4,7 +4,7 @@
 Rules (decided once per document, before exploring; ``plan``):
 
 - A *candidate* variable is declared by ``<data id>`` (its ``expr`` in the subset of
-  ``fsmbt.formats.scxml_expr``, reading earlier candidates only; no ``expr``: ``undefined``)
+  ``fsmbt.formats.scxml.expr``, reading earlier candidates only; no ``expr``: ``undefined``)
   or by Apache Commons SCXML's ``<cs:var name expr>`` (a declaration and an assignment).
 - A candidate is *tracked* when every ``<assign>`` to it (and every ``<cs:var>`` of it) has an
   expression in the subset reading tracked variables only (greatest fixpoint).
@@ -35,7 +35,7 @@ import re
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 
-from fsmbt.formats import scxml_expr
+from fsmbt.formats.scxml import expr as scxml_expr
 from fsmbt.model.errors import LimitError
 
 #: Apache Commons SCXML's namespace of custom actions (``<cs:var>``), both spellings in use.

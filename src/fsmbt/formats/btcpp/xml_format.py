@@ -26,7 +26,7 @@ from pathlib import Path
 from lxml import etree
 
 from fsmbt import limits
-from fsmbt.formats import btcpp_trees
+from fsmbt.formats.btcpp import trees as btcpp_trees
 from fsmbt.formats.registry import Format, ReadContext, decode, register
 from fsmbt.formats.xml_safe import parse_xml, root_tag
 from fsmbt.model import Model
@@ -68,7 +68,7 @@ class _File:
     root: etree._Element
     version: str
     source: Path | None = None  # the file read (resolved), None for text
-    extra: bool = False  # read to resolve a SubTree (btcpp_trees), not given or included
+    extra: bool = False  # read to resolve a SubTree (btcpp.trees), not given or included
 
 
 @dataclass
@@ -176,7 +176,7 @@ class _Loader:
         )
         self.load(decode(text, str(resolved)), resolved, (*chain, resolved), extra=extra)
 
-    # trees in other files (fsmbt.formats.btcpp_trees) -----------------------------------------
+    # trees in other files (fsmbt.formats.btcpp.trees) -----------------------------------------
     def resolve_subtrees(self) -> None:
         """Load the files that define the trees the SubTrees name and no loaded file defines:
         from the ``trees`` option, else from the referencing file's own folder."""

@@ -1,15 +1,15 @@
 """SCXML read by running the W3C algorithm: the flat FSM of the reachable configurations
 (docs/formats/scxml.md, "Documents read by the W3C algorithm").
 
-Used when the structural reader (``fsmbt.formats.scxml``) refuses a document for a feature
+Used when the structural reader (``fsmbt.formats.scxml.structural``) refuses a document for a feature
 that has a finite reading: ``<history>`` (shallow and deep), ``cond`` guards, ``<raise>`` and
 ``<send>`` without delay (``eventexpr`` included when computable or unobservable), the finite
-data model (``fsmbt.formats.scxml_datamodel``), ``<script>`` that cannot affect control flow,
+data model (``fsmbt.formats.scxml.datamodel``), ``<script>`` that cannot affect control flow,
 ignored executable content (``<log>``, ``<assign>`` to a variable no cond reads), wildcard and
 prefix event descriptors, ``done.state`` on atomic states, entry
 into a non-initial nested state, targetless and ``type="internal"`` transitions, several
 targets, eventless transitions of compound states, ``<invoke>`` of SCXML sessions (their
-configurations are part of each state: ``fsmbt.formats.scxml_invoke``). Rules:
+configurations are part of each state: ``fsmbt.formats.scxml.invoke``). Rules:
 
 - The interpreter follows the W3C SCXML 1.0 algorithm (appendix D): transition selection per
   atomic state in document order, innermost first; conflicts resolved by exit sets; exit in
@@ -37,15 +37,19 @@ from __future__ import annotations
 
 import re
 from collections import deque
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from itertools import product
 
 from lxml import etree
 
 from fsmbt import limits
-from fsmbt.formats import scxml_datamodel, scxml_expr, scxml_include, scxml_invoke
 from fsmbt.formats.registry import ReadContext
-from fsmbt.formats.scxml_datamodel import Assignment, Declared, SendExpr
+from fsmbt.formats.scxml import datamodel as scxml_datamodel
+from fsmbt.formats.scxml import expr as scxml_expr
+from fsmbt.formats.scxml import include as scxml_include
+from fsmbt.formats.scxml import invoke as scxml_invoke
+from fsmbt.formats.scxml.datamodel import Assignment, Declared, SendExpr
 from fsmbt.formats.xml_safe import local_name, namespace
 from fsmbt.model.errors import InputError, UnsupportedError
 from fsmbt.model.fsm import FSM, State
@@ -367,7 +371,9 @@ class _Doc:
         elif tag == "donedata":
             self.ctx.warn("<donedata> ignored", line=element.sourceline, element="<donedata>")
         elif tag == "invoke":
-            scxml_invoke.read_invoke(self, element, node, _Doc, _Interpreter)
+            source = scxml_invoke.read_invoke(self, element, node)
+            child = _Doc(source.text, source.ctx, element=source.element, session=source.session)
+            scxml_invoke.add_invocation(self, element, node, source, child, _Interpreter(child))
         elif tag == "script":
             self.scripts.append(element.sourceline)
         else:
@@ -640,7 +646,7 @@ class _Doc:
         return index
 
     def decide_data(self) -> None:
-        """The data plan (``fsmbt.formats.scxml_datamodel``: tracked variables, computed conds,
+        """The data plan (``fsmbt.formats.scxml.datamodel``: tracked variables, computed conds,
         exact event expressions), the warnings for what it ignores, and the ``<script>`` and
         failing-content checks (docs/formats/scxml.md, "Data read exactly")."""
         descriptors = sorted({d for n in self.states for t in n.transitions for d in t.events})
@@ -869,12 +875,21 @@ class _Run:
     valuation: dict[int, bool] = field(default_factory=dict)  # the environment's guard values
     data: dict[str, scxml_expr.Value] = field(default_factory=dict)  # the relevant variables
     read: set[int] = field(default_factory=set)  # guards read so far
-    # invoked sessions (fsmbt.formats.scxml_invoke)
+    # invoked sessions (fsmbt.formats.scxml.invoke)
     sessions: dict[str, scxml_invoke.Child] = field(default_factory=dict)
     to_invoke: list[int] = field(default_factory=list)  # states entered in this macro step
     outbox: list[str] = field(default_factory=list)  # events for the parent session
     serial: int = 0
     event: str | None = None  # _event.name: the event being processed (None: none yet)
+
+    def spawn(
+        self,
+        config: set[int],
+        history: dict[int, frozenset[int]],
+        data: dict[str, scxml_expr.Value],
+    ) -> _Run:
+        """A fresh run for a child session (``scxml_invoke.Run``)."""
+        return _Run(config, history, data=data)
 
 
 #: A value that could not be computed: ``error.execution`` was raised.
@@ -1063,7 +1078,7 @@ class _Interpreter:
         return {s for s in run.config if domain is not None and self.descendant(s, domain)}
 
     # -- micro step -----------------------------------------------------------------------------
-    def perform(self, actions: list[Action], run: _Run) -> None:
+    def perform(self, actions: Sequence[Action], run: _Run) -> None:
         """Run a block of executable content; an ``error.execution`` skips the rest of it."""
         plan = self.doc.plan
         stack = list(reversed(actions))
