@@ -9,7 +9,7 @@ remembered statuses) as variables instead of states. The IR keeps them in the fo
   (SCXML ``<datamodel><data id="name" expr="expr"/>``); its presence marks the machine as
   keeping data;
 - ``Transition.attrs[COND]``: the guard (SCXML ``cond``), an expression of
-  ``fsmbt.formats.scxml_expr`` over the variables;
+  ``fsmbt.formats.scxml.expr`` over the variables;
 - ``Transition.attrs[ASSIGN]``: the updates, one ``name=expr`` per line (``<assign>``), run when
   the transition is taken;
 - ``State.attrs[ONEXIT]``: updates run when the state is left (``<onexit><assign>``).
