@@ -416,7 +416,26 @@ def verify_models(
         outcome_driven=outcome_driven,
     )
     _name_abstractions(report, source, result)
+    _name_data_model(report, source, result)
     return readable(report, source, result)
+
+
+def _name_data_model(report: Report, *models: Model) -> None:
+    """Record in ``report.stats["data_model"]`` what was checked for a machine that keeps data
+    (``fsmbt.model.fsm_data``): its exact flat meaning, the W3C expansion of its SCXML
+    (docs/semantics.md, "Data in state machines")."""
+    from fsmbt.model.fsm_data import DATAMODEL, has_data, parse_lines
+
+    for model in models:
+        if isinstance(model, FSM) and has_data(model):
+            names = [name for name, _expr in parse_lines(model.attrs[DATAMODEL])]
+            states = sum(1 for _ in model.walk())
+            report.stats["data_model"] = (
+                f"the state machine '{model.name}' keeps {len(names)} variable(s) in guards and "
+                f"assignments; its {states} states were checked through their exact flat "
+                "meaning: the machine written as SCXML and expanded by the W3C algorithm "
+                "(every reachable configuration and valuation of the variables)"
+            )
 
 
 def _name_abstractions(report: Report, *models: Model) -> None:

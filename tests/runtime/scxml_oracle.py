@@ -300,10 +300,13 @@ def replay(
 
 
 def configuration_of(state: str) -> str:
-    """fsmbt's flat name without the history values (``a/a1#h=x`` -> ``a/a1``) and the
-    configurations of invoked sessions (``s{s.1=here}`` -> ``s``; the engine's configuration
+    """fsmbt's flat name without the history and data values (``a/a1#h=x`` -> ``a/a1``,
+    ``a/x#2#n=1`` -> ``a/x#2``) and the configurations of invoked sessions (``s{s.1=here}`` -> ``s``; the engine's configuration
     is the parent's only)."""
-    return state.split("#", 1)[0].split("{", 1)[0]
+    name = state.split("{", 1)[0]
+    while "#" in name and "=" in name.rsplit("#", 1)[1]:  # values, not a '#' of a state name
+        name = name.rsplit("#", 1)[0]
+    return name
 
 
 def event_of(symbol: str) -> str:

@@ -23,13 +23,14 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import pytest
-from scxml_oracle import PARALLEL_STOPS, Engine, Mismatch, Replay, replay
+from scxml_oracle import PARALLEL_STOPS, Engine, Mismatch, Replay, python_spelled, replay
 
 from fsmbt import api
 from fsmbt.convert.bt_to_hfsm import bt_to_hfsm
 from fsmbt.formats import dumps
 from fsmbt.generate import random_bt
 from fsmbt.model.bt import BTDocument
+from fsmbt.model.bt_nodes import NodeKind
 from fsmbt.model.errors import FsmbtError, UnsupportedError
 from fsmbt.model.fsm import FSM
 from fsmbt.semantics.machine import FSMMachine
@@ -92,7 +93,10 @@ def check_tree(
     except FsmbtError as exc:
         tally.refused[f"{type(exc).__name__}: {getattr(exc, 'message', str(exc))[:60]}"] += 1
         return
-    text = dumps(hfsm, "scxml")
+    written = dumps(hfsm, "scxml")
+    # a data model (the compact conversion) is written in ECMAScript; the engine evaluates
+    # Python: the same document with its expressions spelled for it (scxml_oracle)
+    text = python_spelled(written) or written
     Engine(text)  # loads in the engine at all (raises otherwise)
     machine = FSMMachine(hfsm)
     tally.models += 1
@@ -212,3 +216,181 @@ def test_mismatch_is_reported_on_a_wrong_model() -> None:
         if result.mismatch is not None:
             found.append(result.mismatch)
     assert found
+
+
+# -- the compact conversion (memory as data) against the tree in BehaviorTree.CPP ------------
+#: Trees whose regions explore past this many states are not converted here (the test stays
+#: fast; ``FSMBT_COMPACT_MAX_STATES=200000`` runs every corpus tree).
+COMPACT_MAX_STATES = int(os.environ.get("FSMBT_COMPACT_MAX_STATES", "2500"))
+COMPACT_SEQUENCES = int(os.environ.get("FSMBT_COMPACT_SEQUENCES", "3"))
+COMPACT_LEAF_STEPS = int(os.environ.get("FSMBT_COMPACT_STEPS", "60"))
+F_ACTION = "{https://fsmbt.dev/ns/scxml}action"
+
+
+@dataclass
+class Lockstep:
+    """The environment of one run: each leaf the tree ticks must be the leaf the SCXML engine
+    is in (the action of its active atomic state); the outcome, drawn at random, goes to both."""
+
+    engine: Engine
+    actions: dict[str, str]
+    rng: random.Random
+    steps: int = 0
+    mismatch: str | None = None
+
+    def active_leaf(self) -> str:
+        doc = self.engine.doc
+        active = {s.id for s in self.engine.machine.configuration}
+        atoms = [s for s in active if not doc.children.get(s)]
+        return "+".join(sorted(self.actions.get(s, doc.name[s]) for s in atoms))
+
+    def __call__(self, node, _path: str) -> str:  # noqa: ANN001 - the tree's BTNode
+        label = node.name or node.type
+        seen = self.active_leaf()
+        if self.mismatch is None and seen != label:
+            self.mismatch = f"leaf {self.steps}: tree ticks {label}, SCXML engine is in {seen}"
+        condition = node.kind is NodeKind.CONDITION
+        choices = ["success", "failure"] + ([] if condition else ["running"])
+        outcome = self.rng.choice(choices)
+        self.engine.send(outcome)
+        self.steps += 1
+        return outcome
+
+
+def _actions(text: str) -> dict[str, str]:
+    """State id -> its action (fsmbt:action, else its model name, else its id)."""
+    from lxml import etree
+
+    root = etree.fromstring(text.encode())
+    out = {}
+    for element in root.iter():
+        if isinstance(element.tag, str) and element.get("id") is not None:
+            name = element.get("{https://fsmbt.dev/ns/scxml}name", element.get("id"))
+            out[element.get("id")] = element.get(F_ACTION, name)
+    return out
+
+
+def run_compact(
+    doc: BTDocument, rng: random.Random, tally: Tally, label: str
+) -> tuple[str, bool] | None:
+    """Convert ``doc`` compactly, then run it ``COMPACT_SEQUENCES`` times in python-statemachine
+    and in BehaviorTree.CPP (fsmbt's interpreter when BehaviorTree.CPP has no such node: Nav2,
+    MoveIt Pro and gated nodes) with the same random leaf outcomes. Returns the engine used
+    and whether the SCXML has a data model (``None``: not converted)."""
+    from fsmbt.semantics.bt_interpreter import BTRunner
+    from fsmbt.semantics.engines.btcpp_engine import BTCppRunner
+
+    try:
+        hfsm = bt_to_hfsm(doc, max_states=COMPACT_MAX_STATES).model
+    except FsmbtError as exc:
+        tally.refused[f"{type(exc).__name__}: {getattr(exc, 'message', str(exc))[:50]}"] += 1
+        return None
+    text = dumps(hfsm, "scxml")
+    spelled = python_spelled(text) or text
+    actions = _actions(text)
+    tally.models += 1
+    used = "btcpp"
+    for _ in range(COMPACT_SEQUENCES):
+        engine = Engine(spelled)
+        env = Lockstep(engine, actions, rng)
+        try:
+            runner = BTCppRunner(doc, env)
+        except Exception:  # noqa: BLE001 - BehaviorTree.CPP does not know a node type
+            runner, used = BTRunner(doc, env), "interpreter"
+        tally.sequences += 1
+        result = "RUNNING"
+        while env.steps < COMPACT_LEAF_STEPS and env.mismatch is None:
+            before = env.steps
+            result = runner.tick_once().result
+            if result != "RUNNING" or env.steps == before:
+                break
+        tally.events += env.steps
+        if env.mismatch is None and result in ("SUCCESS", "FAILURE"):
+            end = env.active_leaf()
+            if not engine.terminated or end != result:
+                env.mismatch = f"tree returned {result}, engine in {end}"
+        elif env.mismatch is None and engine.terminated:
+            env.mismatch = f"engine terminated in {env.active_leaf()}, tree still {result}"
+        if env.mismatch is not None:
+            tally.mismatches.append(f"{label}: {env.mismatch}")
+    return used, "<datamodel>" in text
+
+
+def test_compact_runs_like_btcpp() -> None:
+    """Issue 24: the compact SCXML of every example and corpus BT (profile options, regions up
+    to ``COMPACT_MAX_STATES`` explored states) and of seeded extended trees runs in
+    python-statemachine, data model included, leaf for leaf and result for result as the tree
+    runs in BehaviorTree.CPP (behaviortreepy), or in fsmbt's interpreter for node types
+    BehaviorTree.CPP does not have (the interpreter is cross-checked against it in
+    tests/semantics)."""
+    from support.corpus import profile_options
+
+    tally = Tally("compact")
+    rng = random.Random(SEED)
+    engines: Counter[str] = Counter()
+    with_data = 0
+    trees: list[tuple[str, BTDocument]] = []
+    for path in sorted((REPO / "examples").glob("*_bt.xml")):
+        trees.append((path.name, api.load(path).model))
+    folder = CORPUS / "bt"
+    if folder.exists():
+        for path in sorted(folder.rglob("*.xml")):
+            if "models" in path.parts or any(p.startswith("_") for p in path.parts):
+                continue
+            try:
+                doc = api.load(path, options=profile_options(path)).model
+            except FsmbtError:
+                continue
+            if isinstance(doc, BTDocument):
+                trees.append((str(path.relative_to(CORPUS)), doc))
+    for index in range(40):
+        trees.append(
+            (
+                f"gen{index}",
+                random_bt(seed=SEED * 7_000 + index, depth=3, breadth=3, extended=True),
+            )
+        )
+    for label, doc in trees:
+        ran = run_compact(doc, rng, tally, label)
+        if ran is not None:
+            engines[ran[0]] += 1
+            with_data += ran[1]
+    print(tally.report() + f"; run against {dict(engines)}; {with_data} with a data model")
+    assert not tally.mismatches, tally.mismatches[:5]
+    assert engines["btcpp"] >= 20 and with_data >= 10
+    assert tally.models >= 0.8 * len(trees)
+
+
+def test_compact_lockstep_catches_a_wrong_guard() -> None:
+    """The lockstep can fail: the Nav2 default tree's compact SCXML with one retry guard
+    negated (a failing selector ends the run instead of recovering) disagrees with the tree."""
+    from support.corpus import profile_options
+
+    path = CORPUS / "bt" / "nav2" / "navigate_to_pose_w_replanning_and_recovery.xml"
+    if not path.exists():
+        pytest.skip(f"corpus not found at {CORPUS} (set FSMBT_CORPUS)")
+    doc = api.load(path, options=profile_options(path)).model
+    hfsm = bt_to_hfsm(doc).model
+    guarded = [
+        t
+        for m in hfsm.machines()
+        for t in m.transitions
+        if "retry_count ==" in t.attrs.get("cond", "")
+    ]
+    assert guarded
+    guarded[0].attrs["cond"] = f"!({guarded[0].attrs['cond']})"
+    text = dumps(hfsm, "scxml")
+    spelled = (python_spelled(text) or text).replace('cond="!(', 'cond="not (')
+    from fsmbt.semantics.bt_interpreter import BTRunner
+
+    rng = random.Random(SEED)
+    caught = 0
+    for _ in range(20):
+        env = Lockstep(Engine(spelled), _actions(text), rng)
+        runner = BTRunner(doc, env)
+        while env.steps < COMPACT_LEAF_STEPS and env.mismatch is None:
+            before = env.steps
+            if runner.tick_once().result != "RUNNING" or env.steps == before:
+                break
+        caught += env.mismatch is not None
+    assert caught

@@ -68,6 +68,12 @@ def register(app: typer.Typer) -> None:
             "--loop",
             help="BT->FSM: the root is ticked again after it returns (checked in loop mode)",
         ),
+        unroll: bool = typer.Option(
+            False,
+            "--unroll",
+            help="BT->FSM: keep the tree's memory (retry counts, running indices) as states "
+            "instead of SCXML data (a flat product, for tools without a data model)",
+        ),
         no_verify: bool = typer.Option(False, "--no-verify", help="skip the equivalence check"),
         verify_engine: str = typer.Option(
             "native",
@@ -113,6 +119,8 @@ def register(app: typer.Typer) -> None:
         engine_options: dict[str, object] = {}
         if engine in api.LLM_ENGINES:
             engine_options.update(llm_base_url=llm_base_url, llm_model=llm_model)
+        if unroll:
+            engine_options["unroll"] = True
         request = api.convert_request(
             to=to,
             engine=engine,
@@ -179,6 +187,8 @@ def _print_summary(outcome: api.Outcome, *, to_stderr: bool, brief: bool = False
         print(f"  checked {counts}", file=stream)
     for sentence in report.stats.get("abstractions", []):
         print(f"verified under the abstraction: {sentence}", file=stream)
+    if report.stats.get("data_model"):
+        print(f"checked through the data model: {report.stats['data_model']}", file=stream)
     for name, prop in report.properties.items():
         mark = "ok  " if prop.holds else "FAIL"
         print(f"  {mark} {name}: {prop.detail}", file=stream)

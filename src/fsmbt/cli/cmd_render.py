@@ -13,7 +13,8 @@ from fsmbt.cli import EXIT_INTERNAL, fail
 from fsmbt.cli.options import (
     reads_models,
 )
-from fsmbt.render import DEFAULT_MAX_NODES, GraphvizError, render_model
+from fsmbt.model.fsm import FSM
+from fsmbt.render import DEFAULT_MAX_NODES, GraphvizError, render_model, render_pages
 
 
 def _cli_words(note: str) -> str:
@@ -30,8 +31,12 @@ def register(app: typer.Typer) -> None:
     @reads_models
     def render_command(
         model: Path = typer.Argument(..., help="Model file (FSM or BT, any format fsmbt reads)."),
-        output: Path = typer.Option(
-            ..., "-o", "--output", help="Picture to write: .svg, .png, .pdf, or .dot (source)."
+        output: Path | None = typer.Option(
+            None,
+            "-o",
+            "--output",
+            help="Picture to write: .svg, .png, .pdf, or .dot (source); with --pages, its "
+            "suffix is the pictures' format (default .svg).",
         ),
         force: bool = typer.Option(False, "--force", help="Overwrite OUTPUT if it exists."),
         expand_subtrees: bool = typer.Option(
@@ -48,8 +53,16 @@ def register(app: typer.Typer) -> None:
         level: int | None = typer.Option(
             None,
             "--level",
+            "--depth",
             min=0,
-            help="FSM: open composite states down to this nesting level (0: top machine only).",
+            help="FSM: open composite states down to this nesting level (0: top machine "
+            "only, composites drawn as closed boxes).",
+        ),
+        pages: Path | None = typer.Option(
+            None,
+            "--pages",
+            help="FSM: write one picture per level into this folder: top.svg (composites "
+            "closed) and one per composite state, data guards on the arrows.",
         ),
         composite: str | None = typer.Option(
             None, "--composite", help="FSM: draw only this composite state (path A/B)."
@@ -65,6 +78,25 @@ def register(app: typer.Typer) -> None:
             options=read,
         ).model
         notes: list[str] = []
+        if pages is not None:
+            if not isinstance(loaded, FSM):
+                raise fail("--pages draws a state machine's levels; this is a behavior tree")
+            fmt = output.suffix.lstrip(".") if output is not None else "svg"
+            try:
+                drawn = render_pages(
+                    loaded,
+                    pages,
+                    fmt=fmt or "svg",
+                    overwrite=force,
+                    max_nodes=max_nodes,
+                    notes=notes,
+                )
+            except GraphvizError as exc:
+                raise fail(str(exc), EXIT_INTERNAL) from None
+            print(f"wrote {len(drawn)} pictures into {pages}: " + ", ".join(p.name for p in drawn))
+            return
+        if output is None:
+            raise fail("missing option -o/--output (or --pages DIR)")
         try:
             written = render_model(
                 loaded,

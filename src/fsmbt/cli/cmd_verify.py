@@ -96,6 +96,8 @@ def register(app: typer.Typer) -> None:
             print_report(report, Console())
             for sentence in report.stats.get("abstractions", []):
                 print(f"verified under the abstraction: {sentence}")
+            if report.stats.get("data_model"):
+                print(f"checked through the data model: {report.stats['data_model']}")
             if report.stats.get("swapped"):
                 print(
                     f"note: {converted} was read as the source and {source} as its "

@@ -31,6 +31,11 @@ express. The whole tree is explored instead when such a region can end in ``SKIP
 exists (its memory outlives the root's restart). The verdict for those parts then checks the
 assembly and the flattening; the node semantics come from the interpreter.
 
+By default (docs/conversion.md, "Compact conversion") such a region is not kept as its explored
+machine but as one state per leaf with the memory as data (``fsmbt.convert.bt_compact``;
+docs/semantics.md §6a): guards and assignments whose W3C meaning the checker proves equivalent
+to the region's leaf-execution machine. ``unroll=True`` keeps the explored machine.
+
 Complexity: O(N) for the structural part (explicit work lists, no recursion over the tree);
 explored regions cost O(S · 3) interpreter steps for their S reachable states.
 """
@@ -38,8 +43,10 @@ explored regions cost O(S · 3) interpreter steps for their S reachable states.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 from fsmbt import limits
+from fsmbt.convert.bt_compact import Namer, compact_region
 from fsmbt.convert.compress import inline_and_compress
 from fsmbt.convert.perf import without_gc_pauses
 from fsmbt.convert.result import ConversionResult
@@ -47,6 +54,8 @@ from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.bt_nodes import NodeKind
 from fsmbt.model.errors import Hint, InputError, UnsupportedError
 from fsmbt.model.fsm import FSM, State
+from fsmbt.model.fsm_data import DATAMODEL, ONEXIT, join_lines
+from fsmbt.semantics.leaf_machine import ExploredMachine, LeafMachine, StateLimitError, explore
 from fsmbt.semantics.nodes import (
     PLAIN_CONTROLS,
     RESULT_MAP_DECORATORS,
@@ -124,6 +133,10 @@ class _Builder:
     loop: bool = False
     max_states: int | None = None
     where: _Places | None = None
+    compact: bool = True
+    namer: Namer = field(default_factory=Namer)
+    variables: list[tuple[str, str]] = field(default_factory=list)
+    guarded: int = 0
 
     # -- naming ----------------------------------------------------------------------------
     @staticmethod
@@ -208,15 +221,25 @@ class _Builder:
 
     # -- explored regions --------------------------------------------------------------------
     def _explored_state(self, node: BTNode, cont: _Cont, machine: FSM) -> str:
-        sub, ends = explore_region(node, loop=False, max_states=self.max_states, where=self.where)
+        reset: list[tuple[str, str]] = []
+        if self.compact:
+            region = self.compact_region(node, loop=False, top=False)
+            sub, ends = region.fsm, region.ends
+            reset = region.variables
+        else:
+            sub, ends = explore_region(
+                node, loop=False, max_states=self.max_states, where=self.where
+            )
+            self.explored_states += len(sub.states)
         self.explored += 1
         self.machines += 1
-        self.explored_states += len(sub.states)
         unexpected = ends - set(ROOT_RESULTS)
         if unexpected:
             raise _NeedsWholeTree(", ".join(sorted(unexpected)))
         name = self._unique(machine, node.name or node.type)
-        machine.add_state(State(name, action=None, regions=[sub]))
+        state = machine.add_state(State(name, action=None, regions=[sub]))
+        if reset:  # leaving the region forgets its memory (docs/semantics.md, data)
+            state.attrs[ONEXIT] = join_lines(reset)
         # only the ends the region reaches: a completion transition waiting for a final state
         # the sub-machine does not have never fires (and SCXML cannot name that state)
         if SUCCESS in ends:
@@ -224,6 +247,23 @@ class _Builder:
         if FAILURE in ends:
             machine.add_transition(name, None, cont.failure, exit=FAILURE)
         return name
+
+    def compact_region(self, node: BTNode, *, loop: bool, top: bool):  # noqa: ANN201
+        """``node``'s region as one state per leaf with data (``bt_compact``); its variables
+        join the conversion's data model."""
+        machine, explored = _explore(node, loop=loop, max_states=self.max_states, where=self.where)
+        region = compact_region(
+            machine,
+            explored,
+            name=f"compact_{node.label}",
+            top=top,
+            namer=self.namer,
+            unique=self._unique,
+        )
+        self.explored_states += region.explored_states
+        self.guarded += region.guarded
+        self.variables.extend(region.variables)
+        return region
 
 
 class _NeedsWholeTree(Exception):
@@ -292,21 +332,9 @@ def explore_region(
         StateLimitError: more than ``max_states`` configurations; names the subtree (tree,
         node path, line) and carries ``Hint.MAX_STATES``.
     """
-    from fsmbt.semantics.leaf_machine import LeafMachine, RootResult, StateLimitError, explore
+    from fsmbt.semantics.leaf_machine import RootResult
 
-    limit = max_states if max_states is not None else limits.current().conversion_max_states
-    machine = LeafMachine(BTDocument.single(node), loop=loop)
-    try:
-        explored = explore(machine, max_states=limit)
-    except StateLimitError:
-        subtree = where.path(node) if where is not None else node.label
-        raise StateLimitError(
-            f"exploring this subtree (a {node.type} with memory or reactive children, "
-            f"converted as one composite state) reaches more than {limit} states",
-            element=subtree,
-            location=node.location,
-            hints=(Hint.MAX_STATES,),
-        ) from None
+    _machine, explored = _explore(node, loop=loop, max_states=max_states, where=where)
     fsm = FSM(name=f"explored_{node.label}")
     names: dict[object, str] = {}
     ends: set[str] = set()
@@ -348,6 +376,26 @@ def explore_region(
     return fsm, ends
 
 
+def _explore(
+    node: BTNode, *, loop: bool, max_states: int | None, where: _Places | None
+) -> tuple[LeafMachine, ExploredMachine[Any]]:
+    """The leaf machine of ``node``'s subtree and every state it reaches (bounded; a refusal
+    names the subtree)."""
+    limit = max_states if max_states is not None else limits.current().conversion_max_states
+    machine = LeafMachine(BTDocument.single(node), loop=loop)
+    try:
+        return machine, explore(machine, max_states=limit)
+    except StateLimitError:
+        subtree = where.path(node) if where is not None else node.label
+        raise StateLimitError(
+            f"exploring this subtree (a {node.type} with memory or reactive children, "
+            f"converted as one composite state) reaches more than {limit} states",
+            element=subtree,
+            location=node.location,
+            hints=(Hint.MAX_STATES,),
+        ) from None
+
+
 def _looped_result(
     fsm: FSM, explored, target: object, outputs: tuple[str, ...], ends: set[str], node: BTNode
 ) -> str:
@@ -375,6 +423,7 @@ def bt_to_hfsm(
     loop: bool = False,
     style: str = "paper",
     max_states: int | None = None,
+    unroll: bool = False,
     **_options: object,
 ) -> ConversionResult:
     """Convert a BT document into a hierarchical FSM whose flattening is the BT's
@@ -385,6 +434,8 @@ def bt_to_hfsm(
         loop: the root is ticked again after it returns.
         style: the output style (``paper``).
         max_states: most states explored per region (``None``: the limits in force).
+        unroll: keep every memory as states (a region = its explored leaf-execution
+            machine) instead of data (the default, ``bt_compact``; docs/conversion.md).
 
     Returns:
         The HFSM with the conversion's figures and warnings.
@@ -393,7 +444,7 @@ def bt_to_hfsm(
     compression = prepared.compression
     root = compression.root
     places = _Places(doc.main.id, root)
-    builder = _Builder(loop=loop, max_states=max_states, where=places)
+    builder = _Builder(loop=loop, max_states=max_states, where=places, compact=not unroll)
     opaque_nodes = _opaque_roots(root)
     whole_tree = loop and bool(opaque_nodes)
     hfsm: FSM | None = None
@@ -404,12 +455,19 @@ def bt_to_hfsm(
             builder.warnings.append(f"a region can end in {exc}: the whole tree is explored")
             whole_tree = True
     if whole_tree:
-        builder = _Builder(loop=loop, max_states=max_states, where=places)
-        hfsm, _ends = explore_region(root, loop=loop, top=True, max_states=max_states, where=places)
+        builder = _Builder(loop=loop, max_states=max_states, where=places, compact=not unroll)
+        if unroll:
+            hfsm, _ends = explore_region(
+                root, loop=loop, top=True, max_states=max_states, where=places
+            )
+            builder.explored_states = len(hfsm.states)
+        else:
+            hfsm = builder.compact_region(root, loop=loop, top=True).fsm
         builder.explored, builder.machines = 1, 1
-        builder.explored_states = len(hfsm.states)
     assert hfsm is not None
     hfsm.name = f"{doc.main.id}_hfsm"
+    if builder.variables:  # docs/semantics.md, "Data in state machines"
+        hfsm.attrs[DATAMODEL] = join_lines(builder.variables)
     stats = {
         "k": builder.machines,
         "units": builder.units,
@@ -420,5 +478,8 @@ def bt_to_hfsm(
         "merged_nodes": compression.merged,
         "leaves": prepared.leaves,
         "loop": loop,
+        "unroll": unroll,
+        "data_variables": len(builder.variables),
+        "guarded_transitions": builder.guarded,
     }
     return ConversionResult(hfsm, "rules", "bt->fsm", stats, builder.warnings)

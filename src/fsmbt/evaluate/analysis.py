@@ -21,6 +21,7 @@ from fsmbt.evaluate.plan import NOT_RUN, RULE_ENGINES, STRUCTURED, Planned
 from fsmbt.evaluate.stats import fit_slope, wilson
 from fsmbt.metrics import elements
 from fsmbt.metrics.formulas import bsd, chds, hfsm, lebt
+from fsmbt.model.fsm import FSM
 from fsmbt.verify import PROPERTIES
 
 GROUPS = ("basic", "robot", "game", "example", "corpus")
@@ -124,6 +125,11 @@ def consistency(
     return out
 
 
+def _mean(values: list[Any]) -> float | None:
+    kept = [float(v) for v in values if v is not None]
+    return statistics.fmean(kept) if kept else None
+
+
 def _paper_method(method: str) -> str:
     """The paper's method a method is measured beside: the structured style beside the LEBT
     formula (the paper has none for it)."""
@@ -147,7 +153,8 @@ def element_rows(table_rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
             continue
         if r["status"] not in ("equivalent", "not_equivalent") or not Path(r["output"]).exists():
             continue
-        result = elements(api.load(r["output"], "json").model)
+        loaded = api.load(r["output"], "json").model
+        result = elements(loaded)
         conversion = r["stats"].get("conversion", {})
         if r["kind"] == "fsm":
             direction = "fsm->bt"
@@ -158,6 +165,9 @@ def element_rows(table_rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
             m = int(r["size"].get("leaves", 0))
             t = 0
         k = result.sub_fsms
+        # SCXML <state>/<parallel>/<final> elements of an FSM result (docs/conversion.md,
+        # "Compact conversion"): its states at every level
+        states = sum(1 for _ in loaded.walk()) if isinstance(loaded, FSM) else None
         out.append(
             {
                 "model": r["model"],
@@ -169,6 +179,7 @@ def element_rows(table_rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
                 "graphical": result.graphical,
                 "active": result.active,
                 "ours": _prediction(direction, r["method"], m, k, t),
+                "state_elements": states,
                 "seconds": r["timings"].get("convert", 0.0),
                 "source_graphical": r["size"].get("graphical", 0),
             }
@@ -205,6 +216,8 @@ def formula_table(measured: list[dict[str, Any]]) -> list[dict[str, Any]]:
                 "max_abs_deviation_from_ours": max(abs(d) for d in deviations)
                 if deviations
                 else None,
+                "mean_state_elements": _mean([r["state_elements"] for r in chosen]),
+                "mean_formula": _mean([r["ours"] for r in chosen]),
                 "within_band": (sum(abs(d) <= FORMULA_BAND for d in deviations) / len(deviations))
                 if deviations
                 else None,

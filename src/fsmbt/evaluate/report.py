@@ -360,6 +360,7 @@ def markdown_report(
                 "fitted a (active)",
                 "mean dev. from ours",
                 "within band",
+                "FSM states (SCXML elements) / formula, mean",
             ],
             _formula_rows(formulas),
         ),
@@ -529,6 +530,9 @@ def _formula_rows(formulas: list[dict[str, Any]]) -> list[list[Any]]:
             f"{f['active_slope']:.2f} ± {f['active_slope_error']:.2f}",
             _pct(f["mean_deviation_from_ours"]),
             _pct(f["within_band"]),
+            "–"
+            if f.get("mean_state_elements") is None
+            else f"{f['mean_state_elements']:.1f} / {f['mean_formula']:.1f}",
         ]
         for f in formulas
     ]

@@ -15,8 +15,10 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from fsmbt import limits
-from fsmbt.model.errors import Hint, InputError, SourceLocation
+from fsmbt.model.errors import Hint, InputError, SourceLocation, UnsupportedError
 from fsmbt.model.files import read_located
+from fsmbt.model.fsm import FSM
+from fsmbt.model.fsm_data import DATAMODEL, has_data, parse_lines
 
 if TYPE_CHECKING:
     from fsmbt.model import Model
@@ -379,7 +381,29 @@ def dumps(model: Model, fmt: str) -> str:
         raise InputError(f"format '{chosen.name}' can be read but not written")
     if kind not in chosen.kinds:
         raise InputError(f"format '{chosen.name}' cannot hold a {kind.upper()}")
+    refuse_data_loss(model, chosen.name)
     return chosen.write(model)
+
+
+#: FSM formats that hold a data model (``fsmbt.model.fsm_data``): SCXML as ``<datamodel>``,
+#: JSON and YAML as the attributes they keep.
+DATA_FORMATS = frozenset({"scxml", "json", "yaml"})
+
+
+def refuse_data_loss(model: Model, fmt: str) -> None:
+    """A machine that keeps data written in a format without a data model would lose its
+    guards and updates, and with them its meaning: refused, naming what would be lost and the
+    ways out (docs/semantics.md, "Data in state machines")."""
+    if fmt in DATA_FORMATS or not isinstance(model, FSM) or not has_data(model):
+        return
+    names = [name for name, _expr in parse_lines(model.attrs[DATAMODEL])]
+    shown = ", ".join(names[:4]) + (f" and {len(names) - 4} more" if len(names) > 4 else "")
+    raise UnsupportedError(
+        f"{fmt} has no data model, and this state machine keeps {len(names)} variable(s) "
+        f"({shown}) in guards and assignments: write it as SCXML, JSON or YAML, translate "
+        "it with --flatten (its exact flat expansion), or convert with --unroll",
+        element=model.name,
+    )
 
 
 def _is_fsm(model: object) -> bool:

@@ -30,7 +30,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from fsmbt.formats.annotations import annotation_losses
-from fsmbt.formats.registry import ReadContext, get_format, loads
+from fsmbt.formats.registry import ReadContext, get_format, loads, refuse_data_loss
 from fsmbt.model import Model
 from fsmbt.model.errors import InputError, UnsupportedError
 from fsmbt.model.flatten import flatten as flatten_fsm
@@ -120,6 +120,7 @@ def translate(
                 f"{shown}{more}"
             )
     try:
+        refuse_data_loss(written, target.name)
         text = target.write(written)
     except UnsupportedError as exc:
         hint = ""

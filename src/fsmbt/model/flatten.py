@@ -28,6 +28,7 @@ import copy
 from collections import deque
 from dataclasses import dataclass
 
+from fsmbt.model import fsm_data
 from fsmbt.model.errors import InputError
 from fsmbt.model.fsm import FSM, State, Transition
 
@@ -246,9 +247,14 @@ def needs_flattening(fsm: FSM) -> bool:
         fsm: A machine.
 
     Returns:
-        True when it has a composite or parallel state, or a completion transition.
+        True when it has a composite or parallel state, a completion transition, or data
+        (``fsmbt.model.fsm_data``).
     """
-    return fsm.is_hierarchical or any(t.event is None for t in fsm.transitions)
+    return (
+        fsm_data.has_data(fsm)
+        or fsm.is_hierarchical
+        or any(t.event is None for t in fsm.transitions)
+    )
 
 
 def flatten(fsm: FSM, *, max_configurations: int = 1_000_000) -> FSM:
@@ -269,4 +275,6 @@ def flatten(fsm: FSM, *, max_configurations: int = 1_000_000) -> FSM:
     """
     if not needs_flattening(fsm):
         return copy.deepcopy(fsm)
+    if fsm_data.has_data(fsm):  # its meaning is the W3C reading (docs/semantics.md, data)
+        return fsm_data.expand(fsm)
     return _Flattener(fsm, max_configurations).run()

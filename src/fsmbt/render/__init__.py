@@ -25,7 +25,7 @@ from fsmbt.render.dot import (
     run_dot,
     write_picture,
 )
-from fsmbt.render.fsm_graph import fsm_to_dot
+from fsmbt.render.fsm_graph import composite_paths, fsm_to_dot
 
 
 def model_to_dot(
@@ -150,7 +150,39 @@ def render_model(
     return write_picture(source, path, overwrite=overwrite)
 
 
+def render_pages(
+    model: FSM,
+    directory: str | Path,
+    *,
+    fmt: str = "svg",
+    overwrite: bool = False,
+    max_nodes: int = DEFAULT_MAX_NODES,
+    notes: list[str] | None = None,
+) -> list[Path]:
+    """One picture per level of a hierarchical FSM: ``top.<fmt>`` (the top machine, every
+    composite closed into a box) and one per composite state, its own machine with the
+    composites inside it closed (``A.<fmt>``, ``A__B.<fmt>`` for ``A/B``); data guards and
+    updates label the arrows. Each picture is capped at 4096 x 4096 pixels.
+
+    Returns:
+        The pictures written, top first.
+    """
+    folder = Path(directory)
+    folder.mkdir(parents=True, exist_ok=True)
+    pages: list[tuple[str, str | None]] = [("top", None)]
+    pages += [(path.replace("/", "__"), path) for path in composite_paths(model)]
+    written: list[Path] = []
+    for stem, composite in pages:
+        safe = "".join(c if c.isalnum() or c in "-_." else "_" for c in stem)
+        path = folder / f"{safe}.{fmt}"
+        check_output(path, overwrite=overwrite)
+        source = fsm_to_dot(model, max_nodes=max_nodes, level=0, composite=composite, notes=notes)
+        written.append(write_picture(source, path, overwrite=overwrite))
+    return written
+
+
 __all__ = [
+    "render_pages",
     "model_to_dot",
     "svg_text",
     "trace_anchors",

@@ -32,6 +32,7 @@ walk (``render.dot.assemble``). Complexity O(S + T) for S states (every level) a
 
 from __future__ import annotations
 
+import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 
@@ -39,6 +40,7 @@ import graphviz
 
 from fsmbt.model.errors import InputError
 from fsmbt.model.fsm import FSM, State
+from fsmbt.model.fsm_data import ASSIGN, COND, parse_lines
 from fsmbt.model.stats import fsm_stats
 from fsmbt.render.anchor_ids import START_ANCHOR, state_anchor
 from fsmbt.render.dot import (
@@ -63,6 +65,9 @@ LAYERED_MAX_STATES = 60
 LAYERED_MAX_ARROWS = 150
 #: At most this many event names per arrow label line.
 EVENTS_PER_LINE = 3
+#: Graphviz ``size``: a picture larger than this (inches) is scaled down to fit, so a PNG
+#: (96 dpi) stays within 4096 x 4096 pixels and an SVG within 4096 x 4096 px at 96 px/inch.
+MAX_PICTURE_INCHES = "42.6,42.6"
 
 
 #: How a diff's removed states and transitions look: dashed and grey.
@@ -84,6 +89,7 @@ class _Level:
     entry: str | None = None  # large pictures: the composite state's box, drawn instead of a point
     path: str = ""  # exchange DOT: the node-id prefix of this level's states
     anchor: str = ""  # anchors: the composite-state path of this level ("Parent/"), no regions
+    aliases: dict[str, str] = field(default_factory=dict)  # data variable -> its short name
 
 
 def _find_composite(fsm: FSM, path: str) -> State:
@@ -231,6 +237,8 @@ def fsm_to_dot(
             "a force-directed layout (no clusters); fsmbt info lists its structure"
         )
     root = graphviz.Digraph(name=dot_id(fsm.name) if exchange else _safe_name(fsm.name))
+    if not exchange:  # at most 4096 x 4096 pixels at 96 dpi (scaled down, never up)
+        root.attr(size=MAX_PICTURE_INCHES)
     if layered:
         root.attr(rankdir="LR", compound="true", fontname=FONT, nodesep="0.35", ranksep="0.5")
     else:
@@ -341,7 +349,12 @@ def fsm_to_dot(
             depth_of.update((id(x), depth_of[id(lv)] + 1) for x in inner)
             pending.extend(reversed(inner))
 
+    aliases = {} if exchange else _aliases(fsm)
+    if aliases:  # the legend: short names keep the guards on the arrows short
+        lines = [f"{short} = {name}" for name, short in aliases.items()]
+        root.node("__data__", label=label_text("data", *lines), shape="note", fontsize="11")
     for lv in levels:
+        lv.aliases = aliases
         _draw_initial(lv, edges, counter, is_top=lv is top, anchors=anchors)
         _draw_transitions(lv, edges, exact=exchange)
     for name in ghosts:
@@ -496,13 +509,56 @@ def _endpoint(level: _Level, state: str, side: str) -> tuple[str, dict[str, str]
 
 def _event_label(level: _Level, t) -> str:
     if t.event is not None:
-        return t.event
+        return t.event + _data_label(t, level.aliases)
     if level.machine.states[t.source].is_atomic:
         return "ε"
     return f"done({t.exit})" if t.exit is not None else "done"
 
 
+_IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+_WORDS = frozenset({"and", "or", "not", "True", "False", "None", "In", "true", "false"})
+
+
+def _aliases(fsm: FSM) -> dict[str, str]:
+    """The data variables the drawn machines' guards and updates name, each with a short name
+    (``v1``, ``v2``, ... in order of first use) for the arrows; the legend gives the full one."""
+    found: dict[str, None] = {}
+    for machine in fsm.machines():
+        for t in machine.transitions:
+            texts = [t.attrs.get(COND, "")]
+            texts += [f"{n} {e}" for n, e in parse_lines(t.attrs.get(ASSIGN, ""))]
+            for text in texts:
+                for name in _IDENTIFIER.findall(re.sub(r"'[^']*'", "", text)):
+                    if name not in _WORDS:
+                        found.setdefault(name, None)
+    return {name: f"v{n}" for n, name in enumerate(found, 1)}
+
+
+def _short(text: str, aliases: dict[str, str]) -> str:
+    if not aliases:
+        return text
+    return _IDENTIFIER.sub(lambda m: aliases.get(m.group(0), m.group(0)), text)
+
+
+def _data_label(t, aliases: dict[str, str] | None = None) -> str:
+    """A data guard and its updates (``fsmbt.model.fsm_data``) as UML writes them,
+    ``event [cond] / x := e``, one conjunct and one update per line (a picture stays narrow)."""
+    text = ""
+    if COND in t.attrs:
+        guard = _short(t.attrs[COND], aliases or {})
+        for word in (" and ", " or ", " && ", " || "):
+            guard = guard.replace(word, word.rstrip() + "\n  ")
+        text += f" [{guard}]"
+    updates = parse_lines(t.attrs.get(ASSIGN, ""))
+    if updates:
+        shown = [(_short(n, aliases or {}), _short(e, aliases or {})) for n, e in updates]
+        text += " /\n  " + "\n  ".join(f"{name} := {expr}" for name, expr in shown)
+    return text
+
+
 def _wrap(labels: list[str]) -> str:
+    if any("[" in label or " /" in label for label in labels):  # guards: one line each
+        return label_text(*(line for label in labels for line in label.split("\n")))
     lines = [
         ", ".join(labels[i : i + EVENTS_PER_LINE]) for i in range(0, len(labels), EVENTS_PER_LINE)
     ]

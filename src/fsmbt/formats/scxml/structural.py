@@ -43,7 +43,7 @@ from fsmbt.formats.registry import Format, ReadContext, register
 from fsmbt.formats.scxml import include as scxml_include
 from fsmbt.formats.scxml.w3c import read_scxml_w3c
 from fsmbt.formats.xml_safe import local_name, namespace, root_tag
-from fsmbt.model import Model, state_info
+from fsmbt.model import Model, fsm_data, state_info
 from fsmbt.model.errors import InputError, SourceLocation, UnsupportedError
 from fsmbt.model.fsm import FSM, State, Transition
 
@@ -56,6 +56,9 @@ FSMBT_NS = "https://fsmbt.dev/ns/scxml"
 F_NAME, F_ACTION, F_START, F_EXIT, F_REGION = (
     f"{{{FSMBT_NS}}}{n}" for n in ("name", "action", "start", "exit", "region")
 )
+#: Root mark of a document whose data model fsmbt wrote from a model that keeps data
+#: (``fsmbt.model.fsm_data``): read back into the same model (guards, assignments, data).
+F_DATA = f"{{{FSMBT_NS}}}data"
 #: ``State.attrs`` mark of the transient final states that encode a transition leaving its parent.
 EXIT_MARK = f"{{{FSMBT_NS}}}exit-state"
 
@@ -126,6 +129,8 @@ class _Reader:
     descriptors: dict[str, int] = field(default_factory=dict)
     done_transitions: list[tuple[_Node, etree._Element, bool]] = field(default_factory=list)
     wrapper_ids: set[str] = field(default_factory=set)
+    data_ir: bool = False  # the document carries fsmbt's own data model (F_DATA)
+    top: FSM = field(default_factory=FSM)
 
     def where(self, element: etree._Element) -> SourceLocation:
         return self.ctx.location(element.sourceline)
@@ -167,10 +172,16 @@ class _Reader:
             raise InputError(
                 f"not an SCXML document: unknown namespace {self.ns}", location=self.where(root)
             )
+        self.data_ir = root.get(F_DATA) == "ir"
         top = FSM(
             name=root.get("name", "fsm"),
-            attrs=annotations_in(root.attrib, _SCXML_KEYS),
+            attrs={
+                k: v
+                for k, v in annotations_in(root.attrib, _SCXML_KEYS).items()
+                if not (self.data_ir and k in (F_DATA, "datamodel"))
+            },
         )
+        self.top = top
         self.parent_of[id(top)] = None
         self.build(root, top)
         for node in self.order:
@@ -241,6 +252,10 @@ class _Reader:
         if F_ACTION in element.attrib:
             action = element.get(F_ACTION) or None
         attrs = annotations_in(element.attrib, _STATE_KEYS)
+        if self.data_ir:
+            for block in self.children(element):
+                if self.tag(block) == "onexit" and self._assigned(block):
+                    attrs[fsm_data.ONEXIT] = self._assigned(block)
         state = State(
             name, action=action, final=tag == "final", attrs=attrs, location=self.where(element)
         )
@@ -312,6 +327,14 @@ class _Reader:
             return  # handled with the transitions / the initial state
         elif tag in ("onentry", "onexit", "donedata"):
             self.executable(element)
+        elif tag == "datamodel" and self.data_ir:  # fsmbt's own data (fsm_data)
+            self.top.attrs[fsm_data.DATAMODEL] = fsm_data.join_lines(
+                [
+                    (data.get("id") or "", data.get("expr") or "")
+                    for data in self.children(element)
+                    if self.tag(data) == "data"
+                ]
+            )
         elif tag == "datamodel":
             self.ctx.warn(
                 "<datamodel> ignored (no supported construct reads data)",
@@ -350,10 +373,22 @@ class _Reader:
                     line=item.sourceline,
                     element=f"<{tag}>",
                 )
+            elif tag == "assign" and self.data_ir and local_name(block) in ("onexit", "transition"):
+                continue  # fsmbt's own data: read into the model (``_assigned``)
             elif tag in ("param", "content") and local_name(block) == "donedata":
                 self.ctx.warn("<donedata> ignored", line=item.sourceline, element="<donedata>")
             else:
                 raise self.unsupported(item, f"<{tag}> (executable content that changes behaviour)")
+
+    def _assigned(self, block: etree._Element) -> str:
+        """The ``<assign>`` children of a block as ``name=expr`` lines (``fsm_data``)."""
+        return fsm_data.join_lines(
+            [
+                (item.get("location") or "", item.get("expr") or "")
+                for item in self.children(block)
+                if self.tag(item) == "assign"
+            ]
+        )
 
     def set_initial(self, container: etree._Element, machine: FSM) -> None:
         """The machine's initial state: ``initial`` attribute, ``<initial>``, or first child."""
@@ -408,7 +443,8 @@ class _Reader:
                         element="<transition>",
                     )
                     continue
-                seen.add(key)
+                if fsm_data.COND not in transition.attrs:  # a data guard lets later ones fire
+                    seen.add(key)
                 node.machine.transitions.append(transition)
 
     def transition(self, node: _Node, element: etree._Element) -> list[Transition]:
@@ -431,6 +467,10 @@ class _Reader:
                 element="<transition>",
             )
         attrs = annotations_in(element.attrib, _TRANSITION_KEYS)
+        if self.data_ir and cond_exit is None and element.get("cond") is not None:
+            attrs[fsm_data.COND] = element.get("cond") or ""
+        if self.data_ir and self._assigned(element):
+            attrs[fsm_data.ASSIGN] = self._assigned(element)
         exit_name = self.exit_of(node, element, cond_exit)
         events = element.get("event")
         location = self.where(element)
@@ -475,6 +515,8 @@ class _Reader:
         if cond is None:
             return None
         match = _IN_FINAL.fullmatch(cond)
+        if match is None and self.data_ir:  # a data guard of fsmbt's own data model
+            return None
         events = (element.get("event") or "").split()
         own_done = f"done.state.{node.element.get('id')}"
         if match is None or events != [own_done] or local_name(node.element) != "state":
@@ -830,7 +872,14 @@ class _Writer:
         elif fsm.initial is not None:
             root.set("initial", self.ids[(id(fsm), fsm.initial)])
         for key, value in fsm.attrs.items():
-            root.set(annotation_attribute(key), value)
+            if key != fsm_data.DATAMODEL:
+                root.set(annotation_attribute(key), value)
+        if fsm_data.has_data(fsm):  # docs/semantics.md, "Data in state machines"
+            root.set("datamodel", fsm_data.DIALECT)
+            root.set(F_DATA, "ir")
+            block = etree.SubElement(root, _q("datamodel"))
+            for name, expr in fsm_data.parse_lines(fsm.attrs[fsm_data.DATAMODEL]):
+                etree.SubElement(block, _q("data"), id=name, expr=expr)
         if start is not None and fsm.initial is not None:
             element = etree.SubElement(root, _q("state"), id=start)
             element.set(F_START, "true")
@@ -881,7 +930,10 @@ class _Writer:
             if region.initial is not None:
                 element.set("initial", self.ids[(id(region), region.initial)])
         for key, value in state.attrs.items():
-            element.set(annotation_attribute(key), value)
+            if key == fsm_data.ONEXIT:
+                _assignments(etree.SubElement(element, _q("onexit")), value)
+            else:
+                element.set(annotation_attribute(key), value)
         by_source = self.outgoing.get(id(machine))
         if by_source is None:
             by_source = {}
@@ -910,7 +962,10 @@ class _Writer:
             raise InputError(f"transition to unknown state '{target}'", element=state.name)
         out.set("target", self.ids[key])
         for k, v in t.attrs.items():
-            out.set(annotation_attribute(k), v)
+            if k == fsm_data.ASSIGN:
+                _assignments(out, v)
+            else:
+                out.set(annotation_attribute(k), v)
 
     def final_id(self, state: State, exit_name: str) -> str:
         """The id of the final state a completion transition of ``state`` waits for."""
@@ -949,6 +1004,12 @@ class _Writer:
                     wrapper.set("initial", self.ids[(id(region), region.initial)])
                 out.append((region, wrapper))
         return out
+
+
+def _assignments(parent: etree._Element, text: str) -> None:
+    """``<assign location expr>`` children for ``name=expr`` lines (``fsmbt.model.fsm_data``)."""
+    for name, expr in fsm_data.parse_lines(text):
+        etree.SubElement(parent, _q("assign"), location=name, expr=expr)
 
 
 def _in_predicate(state_id: str, source: str) -> str:
@@ -1050,6 +1111,16 @@ def write_scxml(model: Model) -> str:
 
 def _sniff(text: str) -> bool:
     return root_tag(text) == "scxml"
+
+
+def expand_data(fsm: FSM) -> FSM:
+    """The exact flat meaning of a machine with data (``fsmbt.model.fsm_data``): the machine
+    written as SCXML, read back by the W3C algorithm (every reachable configuration and
+    valuation; docs/semantics.md, "Data in state machines"). Cost: the W3C reading's."""
+    return read_scxml_w3c(write_scxml(fsm), ReadContext())
+
+
+fsm_data.register_expander(expand_data)
 
 
 register(

@@ -909,6 +909,11 @@ class _Interpreter:
                 chain.append(parent)
                 parent = self.s[parent].parent
             self.ancestors.append(chain)
+        #: values of pure expressions (no ``In()``, no ``_event``) by the values they read:
+        #: id(expr) -> the names read, and (id(expr), values) -> value (same result, computed
+        #: once: a guard is asked again in every configuration with the same data)
+        self.pure: dict[int, tuple[str, ...] | None] = {}
+        self.memo: dict[tuple[int, tuple[object, ...]], object] = {}
 
     # -- tree helpers ---------------------------------------------------------------------------
     def atomic(self, i: int) -> bool:
@@ -966,8 +971,19 @@ class _Interpreter:
 
     def value(self, expr: scxml_expr.Expr, run: _Run, line: int | None) -> object:
         """``expr``'s value in ``run``; ``_FAILED`` after raising ``error.execution``."""
+        reads = self.pure.get(id(expr), ())
+        if reads == ():
+            pure = scxml_expr.EVENT_NAME not in expr.names and all(
+                kind != "call" for kind, _item in expr.postfix
+            )
+            reads = self.pure[id(expr)] = tuple(sorted(expr.names)) if pure else None
+        key = None
+        if reads is not None and all(name in run.data for name in reads):
+            key = (id(expr), tuple((type(v), v) for v in (run.data[n] for n in reads)))
+            if key in self.memo:
+                return self.memo[key]
         try:
-            return scxml_expr.evaluate(
+            value = scxml_expr.evaluate(
                 expr,
                 run.data,
                 lambda state_id: self.doc.by_id.get(state_id, -1) in run.config,
@@ -981,6 +997,9 @@ class _Interpreter:
                 f"unsupported: '{expr.text}': {exc}, line {line}",
                 location=self.doc.ctx.location(line),
             ) from None
+        if key is not None:
+            self.memo[key] = value
+        return value
 
     def select(
         self, run: _Run, event: str | None, valuation: dict[int, bool], read: set[int]

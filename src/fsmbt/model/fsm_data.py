@@ -1,0 +1,91 @@
+"""Data kept by an FSM: the SCXML data model as the IR holds it (docs/semantics.md, "Data in
+state machines").
+
+A compact BT -> FSM conversion keeps a behavior tree's memory (retry counts, running indices,
+remembered statuses) as variables instead of states. The IR keeps them in the format-specific
+``attrs`` the model already has, under keys no format uses for anything else:
+
+- ``FSM.attrs[DATAMODEL]`` on the top machine: the declarations, one ``name=expr`` per line
+  (SCXML ``<datamodel><data id="name" expr="expr"/>``); its presence marks the machine as
+  keeping data;
+- ``Transition.attrs[COND]``: the guard (SCXML ``cond``), an expression of
+  ``fsmbt.formats.scxml.expr`` over the variables;
+- ``Transition.attrs[ASSIGN]``: the updates, one ``name=expr`` per line (``<assign>``), run when
+  the transition is taken;
+- ``State.attrs[ONEXIT]``: updates run when the state is left (``<onexit><assign>``).
+
+Meaning (the only one): the W3C SCXML algorithm, with the ``python`` data model (the one
+python-statemachine evaluates, so its engine runs the file as written; fsmbt's expression
+subset reads it exactly: ``==``, ``<=``, ``>=``, ``and``, ``or``, literals, ``x + 1``) - the
+transitions of a state on one event are tried in document order and the first whose guard holds
+is taken. A machine with data is never flattened by ``fsmbt.model.flatten``'s own rules (they
+know nothing of data): its flat meaning is the SCXML reader's exact expansion (configurations x
+variable values), which the formats layer registers here (``register_expander``), so the model
+layer needs no import from above. Cost of ``has_data``: O(1).
+"""
+
+from __future__ import annotations
+
+import importlib
+from collections.abc import Callable
+
+from fsmbt.model.errors import UnsupportedError
+from fsmbt.model.fsm import FSM
+
+#: Keys in ``attrs`` (they contain no character an XML attribute name may hold alone).
+DATAMODEL = "fsmbt:datamodel"
+COND = "cond"
+ASSIGN = "fsmbt:assign"
+ONEXIT = "fsmbt:onexit"
+#: The data model dialect the expressions are written in.
+DIALECT = "python"
+
+_expander: Callable[[FSM], FSM] | None = None
+
+
+def has_data(fsm: FSM) -> bool:
+    """Whether ``fsm`` (a top machine) declares data."""
+    return DATAMODEL in fsm.attrs
+
+
+def parse_lines(text: str) -> list[tuple[str, str]]:
+    """``name=expr`` lines as pairs (the name is everything before the first ``=``)."""
+    pairs: list[tuple[str, str]] = []
+    for line in text.splitlines():
+        if line.strip():
+            name, _, expr = line.partition("=")
+            pairs.append((name.strip(), expr.strip()))
+    return pairs
+
+
+def join_lines(pairs: list[tuple[str, str]]) -> str:
+    """The inverse of ``parse_lines``."""
+    return "\n".join(f"{name}={expr}" for name, expr in pairs)
+
+
+def register_expander(expander: Callable[[FSM], FSM]) -> None:
+    """Install the exact expansion of a machine with data into a flat FSM (the SCXML reader's
+    W3C reading of the machine written as SCXML; registered by ``fsmbt.formats.scxml.structural``)."""
+    global _expander
+    _expander = expander
+
+
+def expand(fsm: FSM) -> FSM:
+    """The flat FSM a machine with data means: every reachable (configuration, valuation).
+
+    The expander lives in the formats layer, above this one: when no caller has loaded it
+    yet, it is looked up by name (``importlib``, as the web page finds the runtimes), which
+    registers it.
+
+    Raises:
+        UnsupportedError: no expander could be installed.
+    """
+    if _expander is None:
+        importlib.import_module("fsmbt.formats.scxml.structural")
+    if _expander is None:
+        raise UnsupportedError(
+            "this state machine keeps data (an SCXML data model); reading it needs "
+            "fsmbt.formats, which was not loaded",
+            element=fsm.name,
+        )
+    return _expander(fsm)
