@@ -120,6 +120,8 @@ class Container:
     contained_line: int | None = None
     blocker: UnsupportedError | None = None  # raised only if this container is read
     labels: set[str] = field(default_factory=set)
+    # YASMIN OrthogonalState: JoinState barriers, each a list of (region label, state in it)
+    sync_groups: list[list[tuple[str, str]]] = field(default_factory=list)
 
     @property
     def name(self) -> str:
