@@ -17,7 +17,7 @@ import json
 from fsmbt.formats._pysm_analyze import Analysis, Container
 from fsmbt.formats._pysm_build import build_records
 from fsmbt.formats.registry import ReadContext
-from fsmbt.formats.yasmin.xml_read import A_CHILD_INFO, Records
+from fsmbt.formats.yasmin.xml_read import A_CHILD_INFO, NO_ACTION_CLASS, Records
 from fsmbt.model.fsm import FSM
 
 
@@ -34,11 +34,16 @@ def _attach(fsm: FSM, records: Records) -> None:
     work: list[tuple[FSM, Container]] = [(fsm, records.root)]
     while work:
         machine, container = work.pop()
+        for outcome, action in records.final_actions.get(id(container), {}).items():
+            if outcome in machine.states:
+                machine.states[outcome].action = action
         for child in container.children:
             state = machine.states.get(child.label)
             if state is None:
                 continue
             state.attrs.update(records.info.get(id(child), {}))
+            if state.action == NO_ACTION_CLASS:
+                state.action = None  # what fsmbt writes for a state that runs nothing
             inner = child.state
             if not isinstance(inner, Container) or not state.regions:
                 continue

@@ -11,7 +11,8 @@ each statement list walked with an explicit stack):
   class's ``super().__init__(outcomes=[...])`` when the class is in the file, else unknown);
 - ``x.add_state("NAME", state, transitions={...}, remappings={...},
   parameter_mappings={...})`` in positional or keyword form, ``x.set_start_state("NAME")``;
-- literal values may come through names bound to literals earlier.
+- literal values may come through names bound to literals earlier, and the outcome constants
+  of ``yasmin_ros.basic_outcomes`` (``SUCCEED`` is ``"succeeded"``...) imported by name.
 The machine is the first ``StateMachine`` that is not added to another. An ``add_state`` in a
 loop or under a condition, a computed name or transitions, and code that would run when the
 file is imported (a call at module level that is not one of the calls above, outside
@@ -49,6 +50,17 @@ _METADATA_METHODS = frozenset(
 )
 
 
+#: ``yasmin_ros.basic_outcomes``: the outcome constants YASMIN programs import by name.
+BASIC_OUTCOMES = {
+    "SUCCEED": "succeeded",
+    "ABORT": "aborted",
+    "FAIL": "failed",
+    "CANCEL": "canceled",
+    "TIMEOUT": "timeout",
+    "RETRY": "retry",
+}
+
+
 class _Reader:
     def __init__(self, text: str, ctx: ReadContext) -> None:
         self.ctx = ctx
@@ -83,6 +95,11 @@ class _Reader:
 
     # -- entry ----------------------------------------------------------------------------------
     def read(self) -> Records:
+        for node in ast.walk(self.tree):
+            if isinstance(node, ast.ImportFrom) and node.module == "yasmin_ros.basic_outcomes":
+                for alias in node.names:
+                    if alias.name in BASIC_OUTCOMES:
+                        self.env[alias.asname or alias.name] = BASIC_OUTCOMES[alias.name]
         self.collect_classes()
         self.check_import_time(self.tree.body)
         # statement lists in source order, depth first: (remaining statements, loop line)

@@ -26,7 +26,8 @@ construction (``_pysm_build``) makes the FSM. What the factory does, and so what
   of that ``sync_id`` waits there until all have arrived (``RegionBarrier``).
 - ``Param`` (with ``default_value``), ``Key``, ``Remap`` and ``ParamRemap`` are annotations
   (``model.state_info``: parameters, userdata keys, remapping); ``x``/``y`` and ``description``
-  are kept as ``yasmin.*`` attributes; ``<Text>`` blocks (editor notes) and the editor's
+  are kept as ``yasmin.*`` attributes; ``fsmbt_action`` on a ``FinalOutcome`` (written by fsmbt,
+  ignored by YASMIN) is the action of that final state; ``<Text>`` blocks (editor notes) and the editor's
   ``<Transition>`` under a ``<FinalOutcome>`` or the root, which the factory ignores, are
   ignored. Any other element is an ``InputError`` at its line, as is a missing required
   attribute.
@@ -84,6 +85,11 @@ A_KEYS = "yasmin.keys"
 A_INCLUDE = "yasmin.include"
 A_SYNC = "yasmin.sync_id"
 A_CHILD_INFO = "yasmin.children"
+#: The class fsmbt writes for a state that runs no action (read back as no action).
+NO_ACTION_CLASS = "fsmbt_states/NoAction"
+#: The ``FinalOutcome`` attribute fsmbt writes for the action of a final state (YASMIN runs no
+#: action on an outcome and ignores the attribute; fsmbt reads it back).
+A_FINAL_ACTION = "fsmbt_action"
 
 
 @dataclass
@@ -96,6 +102,8 @@ class Records:
     info: dict[int, dict[str, str]] = field(default_factory=dict)
     #: the root machine's own annotations
     root_info: dict[str, str] = field(default_factory=dict)
+    #: id(Container) -> {outcome: action} that fsmbt wrote on a ``FinalOutcome``
+    final_actions: dict[int, dict[str, str]] = field(default_factory=dict)
     warnings: list[tuple[int | None, str]] = field(default_factory=list)
 
 
@@ -119,7 +127,7 @@ class XmlReader:
     def __init__(self, ctx: ReadContext) -> None:
         self.ctx = ctx
         self.info: dict[int, dict[str, str]] = {}
-        self.warnings: list[str] = []
+        self.final_actions: dict[int, dict[str, str]] = {}
 
     # -- errors ---------------------------------------------------------------------------------
     def where(self, source: _File, element: etree._Element | None) -> SourceLocation:
@@ -151,6 +159,7 @@ class XmlReader:
         container = self.machine_record(source, root, root.get("name") or "StateMachine")
         self.fill(_Job(root, container, source))
         records = Records(container, root.get("name") or "StateMachine", self.info)
+        records.final_actions = self.final_actions
         records.root_info = self.annotations(source, root, "StateMachine")
         return records
 
@@ -203,10 +212,17 @@ class XmlReader:
                 )
         if not outcomes:
             raise self.error(source, element, f"state machine '{name}' declares no outcomes")
+        actions = {
+            f.get("name", ""): f.get(A_FINAL_ACTION, "")
+            for f in element
+            if _is(f, "FinalOutcome") and f.get(A_FINAL_ACTION)
+        }
         container = Container(
             cls="StateMachine", kind="sm", outcomes=outcomes, line=element.sourceline or 0
         )
         container.var = name
+        if actions:
+            self.final_actions[id(container)] = actions
         start = element.get("start_state")
         if start:
             container.initial = start

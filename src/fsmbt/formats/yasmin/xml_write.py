@@ -3,9 +3,10 @@
 Mapping (the inverse of the reader, so that what is written reads back as the same FSM):
 - the machine is the root ``<StateMachine outcomes start_state>``; its final states are its
   outcomes (``<FinalOutcome>``); every other atomic state is a ``<State>`` whose class is its
-  declared class (``state_info``) or else its action (else its name), with ``type``/``module``
-  as read (a Python state with no module gets ``module="fsmbt_states"``: the classes are the
-  user's to write);
+  declared class (``state_info``) or else its action, with ``type``/``module`` as read (a Python
+  state with no module gets ``module="fsmbt_states"``: the classes are the user's to write); a
+  state that runs no action gets the C++ class ``fsmbt_states/NoAction``, which the reader takes
+  back as no action;
 - an event ``s --e--> t`` is ``<Transition from="e" to="t"/>`` of ``s``: in YASMIN a state
   returns one of its outcomes, and the outcome picks the next state;
 - a composite state whose transitions are all completion transitions naming their exit is a
@@ -16,6 +17,8 @@ Mapping (the inverse of the reader, so that what is written reads back as the sa
   YASMIN reader or another outcome-driven reader through ``model.state_info``) become ``Param``,
   ``Key``, ``Remap``, ``ParamRemap``, ``x``/``y`` and ``description``; a machine read from an
   included file is written inline (its states are in the model; the include is a named loss).
+A final state's action is written as ``fsmbt_action`` on its ``<FinalOutcome>`` (YASMIN ignores
+it and runs nothing there: ``yasmin_losses`` names it).
 Refused (``UnsupportedError``, so ``translate --flatten`` can write the flat machine): a
 parallel state that was not read from a YASMIN container, a composite left on an event or by a
 completion transition without an exit, an eventless transition of an atomic state, a final
@@ -34,6 +37,7 @@ from fsmbt.formats._pysm_build import A_CHILDREN, A_DEFAULT, A_MAP
 from fsmbt.formats.yasmin.xml_read import (
     A_CHILD_INFO,
     A_DESCRIPTION,
+    A_FINAL_ACTION,
     A_KEYS,
     A_MODULE,
     A_PARAM_DECLS,
@@ -42,6 +46,7 @@ from fsmbt.formats.yasmin.xml_read import (
     A_SYNC,
     A_TAG,
     A_TYPE,
+    NO_ACTION_CLASS,
 )
 from fsmbt.model import Model, state_info
 from fsmbt.model.errors import UnsupportedError
@@ -49,6 +54,26 @@ from fsmbt.model.fsm import FSM, State
 
 #: The module written for Python states whose module is not known.
 DEFAULT_MODULE = "fsmbt_states"
+
+
+def yasmin_losses(model: Model) -> list[str]:
+    """What the YASMIN program itself cannot do that fsmbt keeps for its own reading."""
+    if not isinstance(model, FSM):
+        return []
+    finals = [
+        f"{machine.name}/{state.name}"
+        for machine in model.machines()
+        for state in machine.states.values()
+        if state.final and state.action is not None
+    ]
+    if not finals:
+        return []
+    return [
+        f"{len(finals)} final state(s) run an action ({', '.join(finals[:5])}"
+        + (" ..." if len(finals) > 5 else "")
+        + "): YASMIN runs none on reaching an outcome; kept as fsmbt_action on <FinalOutcome>, "
+        "which YASMIN ignores"
+    ]
 
 
 def write_yasmin(model: Model) -> str:
@@ -101,9 +126,15 @@ def _machine(
         final = etree.SubElement(element, "FinalOutcome")
         final.set("name", name)
         final_attrs = machine.states[name].attrs
+        action = machine.states[name].action
+        if action is not None:
+            final.set(A_FINAL_ACTION, action)
         if final_attrs.get(A_DESCRIPTION):
             final.set("description", final_attrs[A_DESCRIPTION])
         _position(final, final_attrs)
+    for transition in element.findall("Transition"):  # this machine's own exits, last
+        element.remove(transition)
+        element.append(transition)
     return pending
 
 
@@ -134,12 +165,15 @@ def _state(
         element.set("sync_id", state.attrs.get(A_SYNC, ""))
         outcomes = state_info.declared_outcomes(state) or ["joined"]
         element.set("outcome", outcomes[0])
+    elif state.action is None:
+        element.set("type", "cpp")
+        element.set("class", NO_ACTION_CLASS)
     else:
         kind = state.attrs.get(A_TYPE, "py")
         element.set("type", kind)
         if kind == "py":
             element.set("module", state.attrs.get(A_MODULE, DEFAULT_MODULE))
-        element.set("class", state_info.state_class(state) or state.name)
+        element.set("class", state.action)
     _annotate(element, state.attrs)
     _transitions(machine, state, element, completion=False)
     return None
