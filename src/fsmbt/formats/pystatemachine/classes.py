@@ -5,7 +5,7 @@ run. The machine is the first class deriving from ``StateMachine`` or ``StateCha
 ``machine`` names another). In its body:
 - ``x = State(...)`` is state ``x`` (``initial=True``: the initial state, else the first one
   declared; ``final=True``: final; ``name=`` / the first argument, ``value=``, ``enter=``,
-  ``exit=`` kept as ``pystatemachine.*`` attributes); its action is its id;
+  ``exit=`` kept as ``pystatemachine.*`` attributes); its action is its id (final ones too);
 - ``ev = <transitions>`` makes the transitions events ``ev``, where ``<transitions>`` joins with
   ``|``: ``a.to(b, ...)``, ``a.to.itself()``, ``b.from_(a, ...)``, ``b.from_.any()`` (every
   non-final state), optionally wrapped in ``Event(..., name=...)``; ``event="e1 e2"`` adds
@@ -217,7 +217,7 @@ class _Reader:
         final = _flag(call, "final")
         return State(
             target,
-            action=None if final else target,
+            action=target,
             final=final,
             attrs=attrs,
             location=self.where(call),
@@ -375,6 +375,10 @@ def write_pystatemachine(model: Model) -> str:
         "",
         f"class {cls}(StateMachine):",
         "    allow_event_without_transition = True",
+        "    # fsmbt's models may have states that end nowhere or that nothing reaches",
+        "    validate_trap_states = False",
+        "    validate_final_reachability = False",
+        "    validate_disconnected_states = False",
         "",
     ]
     for state in model.states.values():

@@ -5,7 +5,7 @@ Reading (rules):
   by a transition belongs to the machine whose transition names it, unless it is declared
   somewhere (state-machine-cat's ``extractUndeclaredStates``); names are global;
 - ``regular`` states are states (action: the ``entry/`` action of ``: ...``, else the name);
-  ``final`` states are final; a state with ``{ ... }`` is composite; a ``parallel`` state's inner
+  ``final`` states are final (action: their ``entry/`` action, else none); a state with ``{ ... }`` is composite; a ``parallel`` state's inner
   states are its regions (each composite);
 - the ``initial`` state of a machine is its start pseudo-state: its one transition names the
   initial state; with an event, that event is the machine's initial event;
@@ -143,9 +143,11 @@ class _Builder:
                         "as an annotation (fsmbt runs one action on entering a state)",
                         state.line,
                     )
+            if state.kind == "final":
+                action = action if state.actions is not None else None
             new = State(
                 state.name,
-                action=None if state.kind == "final" else action,
+                action=action,
                 final=state.kind == "final",
                 attrs=attrs,
                 location=self.loc(state.line),
@@ -289,7 +291,8 @@ def write_smcat(model: Model) -> str:
         for index, name in enumerate(declared):
             sep = ";" if index == len(declared) - 1 else ","
             if index == 0:
-                items.append(f"{pad}{_name(start)}{sep}")
+                typed = "" if type_from_name(start) == "initial" else " [type=initial]"
+                items.append(f"{pad}{_name(start)}{typed}{sep}")
                 continue
             state = machine.states[name]
             items.extend(_notes(state.attrs, pad))
@@ -297,7 +300,9 @@ def write_smcat(model: Model) -> str:
             attributes = _state_attributes(state)
             if attributes:
                 text += f" [{attributes}]"
-            if not state.final and not state.regions and state.action != state.name:
+            if state.final and state.action is not None:
+                text += f": {_quote('entry/ ' + state.action)}"
+            elif not state.final and not state.regions and state.action != state.name:
                 if state.action is None:
                     raise UnsupportedError(
                         f"state '{state.name}' runs no action; state-machine-cat's states "

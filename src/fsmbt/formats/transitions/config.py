@@ -13,7 +13,8 @@ Reading (pytransitions 0.9 semantics, as ``Machine(**config)`` / ``HierarchicalM
   (pytransitions raises ``MachineError`` unless ``ignore_invalid_triggers``: a warning names it);
   of several transitions on one trigger from one state pytransitions takes the first (no
   conditions here), and so does fsmbt: the later ones are dropped with a warning;
-- a state's action is its ``on_enter`` callbacks joined with ``+`` (else its name); ``on_exit``,
+- a state's action is its ``on_enter`` callbacks joined with ``+`` (else its name; a final
+  state's, else none); ``on_exit``,
   ``tags``, transitions' ``before``/``after``/``prepare`` are kept as ``transitions.*``
   attributes with a warning (fsmbt runs one action on entering a state);
 - the convenience triggers ``to_<state>`` that ``auto_transitions`` adds are not modelled (a
@@ -180,8 +181,9 @@ def _level(
         if on_enter:
             attrs[A_PREFIX + "on_enter"] = json.dumps(on_enter)
         final = bool(entry.get("final", False))
+        entered = "+".join(on_enter) or None
         state = State(
-            name, action=None if final else ("+".join(on_enter) or name), final=final, attrs=attrs
+            name, action=entered if final else (entered or name), final=final, attrs=attrs
         )
         children = entry.get("children", entry.get("states"))
         if children:
@@ -304,7 +306,7 @@ def write_transitions(model: Model) -> str:
             entry: dict[str, Any] = {"name": state.name}
             if state.final:
                 entry["final"] = True
-            if state.action is not None and state.action != state.name:
+            if state.action is not None and (state.final or state.action != state.name):
                 entry["on_enter"] = state.action.split("+")
             for key in ("on_exit", "tags"):
                 if A_PREFIX + key in state.attrs:
