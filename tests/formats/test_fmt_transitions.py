@@ -220,3 +220,14 @@ def test_missing_initial_is_pytransitions_own_initial_state() -> None:
     )
     assert isinstance(fsm, FSM) and fsm.initial == "initial"
     assert any("pytransitions adds the state 'initial'" in w for w in warnings)
+
+
+@pytest.mark.parametrize("fmt", ["transitions", "yasmin", "pystatemachine"])
+def test_content_sniffing_picks_the_new_writers_formats(fmt: str) -> None:
+    from fsmbt.formats.registry import detect_format
+
+    fsm = random_fsm(seed=4, max_states=6, start_event=False)
+    assert detect_format(dumps(fsm, fmt)).name == fmt
+    # and fsmbt's own JSON / YAML are still theirs
+    assert detect_format(dumps(fsm, "json")).name == "json"
+    assert detect_format(dumps(fsm, "yaml")).name == "yaml"

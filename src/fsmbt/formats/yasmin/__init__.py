@@ -49,7 +49,8 @@ register(
         write_yasmin,
         _sniff_xml,
         priority=30,
-        cannot_hold="guards and run-time conditions; states must name a class (stubs written)",
+        cannot_hold="parallel states not read from a concurrence, composites left on an event "
+        "(flatten first)",
     )
 )
 register(
