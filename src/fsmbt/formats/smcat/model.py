@@ -7,6 +7,7 @@ Reading (rules):
 - ``regular`` states are states (action: the ``entry/`` action of ``: ...``, else the name);
   ``final`` states are final (action: their ``entry/`` action, else none); a state with ``{ ... }`` is composite; a ``parallel`` state's inner
   states are its regions (each composite);
+- a ``parallel`` state's atomic inner state is a region holding just that state;
 - the ``initial`` state of a machine is its start pseudo-state: its one transition names the
   initial state; with an event, that event is the machine's initial event;
 - ``a => b: ev;`` is ``a --ev--> b``; without an event it is a completion transition, and the
@@ -165,14 +166,17 @@ class _Builder:
                     )
                 new.action = None
                 for region in state.machine.states:
-                    if region.machine is None:
-                        raise UnsupportedError(
-                            f"region '{region.name}' of parallel state '{state.name}' has no "
-                            "states",
-                            location=self.loc(region.line),
-                        )
                     sub = FSM(name=region.name)
                     new.regions.append(sub)
+                    if region.machine is None:  # an atomic region: that one state
+                        if region.kind != "regular":
+                            raise UnsupportedError(
+                                f"region '{region.name}' of parallel state '{state.name}' is "
+                                f"a {region.kind} state",
+                                location=self.loc(region.line),
+                            )
+                        sub.add_state(State(region.name, action=region.name))
+                        continue
                     pending.append((region.machine, sub, region))
             elif state.machine is not None:
                 new.action = None if state.actions is None else new.action
