@@ -186,3 +186,15 @@ def test_eventless_transition_is_a_completion_transition() -> None:
         ("b", "go", "c"),
     ]
     assert run_fsmbt(fsm, ["go"]) == ["b", "c"]
+
+
+def test_entry_callback_is_the_action_and_is_written_back() -> None:
+    fsm = loads(
+        HEADER + "    a = State(initial=True, enter='beep')\n    b = State()\n    go = a.to(b)\n",
+        "pystatemachine",
+    )
+    assert isinstance(fsm, FSM) and fsm.states["a"].action == "beep"
+    assert fsm.states["b"].action == "b"
+    text = dumps(fsm, "pystatemachine")
+    assert "enter='beep'" in text
+    assert api.verdict_word(api.verify_models(fsm, loads(text, "pystatemachine"))) == "EQUIVALENT"

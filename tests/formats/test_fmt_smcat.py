@@ -156,3 +156,19 @@ def test_the_extension_selects_the_format(tmp_path: Path) -> None:
     fsm = read_model(path)
     assert isinstance(fsm, FSM) and fsm.name == "m"
     assert [(t.source, t.event, t.target) for t in fsm.transitions] == [("a", "go", "b")]
+
+
+def test_parallel_state_regions_and_atomic_regions() -> None:
+    text = (
+        "p [type=parallel] {\n  a,\n  b {\n    b.initial, x, y;\n    b.initial => x;\n"
+        "    x => y: go;\n  };\n},\ndone [type=final];\ninitial => p;\np => done: stop;\n"
+    )
+    fsm = loads(text, "smcat")
+    assert isinstance(fsm, FSM)
+    regions = fsm.states["p"].regions
+    assert [sorted(r.states) for r in regions] == [["a"], ["x", "y"]]
+    assert regions[1].initial == "x"
+    result = api.convert_model(fsm)
+    assert api.verdict_word(api.verify_models(fsm, result.model)) == "EQUIVALENT"
+    with pytest.raises(UnsupportedError, match="parallel state 'p'"):
+        dumps(fsm, "smcat")

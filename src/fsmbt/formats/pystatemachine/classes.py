@@ -5,7 +5,8 @@ run. The machine is the first class deriving from ``StateMachine`` or ``StateCha
 ``machine`` names another). In its body:
 - ``x = State(...)`` is state ``x`` (``initial=True``: the initial state, else the first one
   declared; ``final=True``: final; ``name=`` / the first argument, ``value=``, ``enter=``,
-  ``exit=`` kept as ``pystatemachine.*`` attributes); its action is its id (final ones too);
+  ``exit=`` kept as ``pystatemachine.*`` attributes); its action is the one entry callback
+  ``enter="name"`` names, else its id (final ones too);
 - ``ev = <transitions>`` makes the transitions events ``ev``, where ``<transitions>`` joins with
   ``|``: ``a.to(b, ...)``, ``a.to.itself()``, ``b.from_(a, ...)``, ``b.from_.any()`` (every
   non-final state), optionally wrapped in ``Event(..., name=...)``; ``event="e1 e2"`` adds
@@ -20,7 +21,8 @@ Refused at their line: ``cond``/``unless``/``validators`` (guards), ``internal=T
 code that runs when the file is imported or the class is defined (a call that is not a
 declaration, at module level or in the class body): nothing is executed, ever.
 
-Writing produces the class (identifiers only; hierarchical machines are flattened first by
+Writing produces the class (a state whose action is not its id gets ``enter="action"``: the
+callback is the user's to write; identifiers only; hierarchical machines are flattened first by
 ``translate --flatten``). Costs: O(n) syntax nodes / O(S + T).
 """
 
@@ -215,9 +217,13 @@ class _Reader:
             else:
                 raise InputError(f"State() has no argument '{kw.arg}'", location=self.where(kw))
         final = _flag(call, "final")
+        enter = next((kw.value for kw in call.keywords if kw.arg == "enter"), None)
+        action = target
+        if isinstance(enter, ast.Constant) and isinstance(enter.value, str):
+            action = enter.value  # one named entry callback: the action it runs
         return State(
             target,
-            action=target,
+            action=action,
             final=final,
             attrs=attrs,
             location=self.where(call),
@@ -387,6 +393,13 @@ def write_pystatemachine(model: Model) -> str:
             flags.append("initial=True")
         if state.final:
             flags.append("final=True")
+        if state.action is not None and state.action != state.name:
+            if not state.action.isidentifier() or keyword.iskeyword(state.action):
+                raise UnsupportedError(
+                    f"state '{state.name}' runs '{state.action}', which is not a Python "
+                    "identifier a python-statemachine entry callback can be named"
+                )
+            flags.append(f"enter={state.action!r}")
         lines.append(f"    {state.name} = State({', '.join(flags)})")
     lines.append("")
     by_event: dict[str | None, list[str]] = {}
