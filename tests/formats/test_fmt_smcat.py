@@ -7,6 +7,7 @@ import json
 import shutil
 import subprocess
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -19,6 +20,9 @@ from fsmbt.model.fsm import FSM
 
 REPO = Path(__file__).resolve().parents[2]
 SMCAT = REPO / "tools" / "smcat" / "node_modules" / ".bin" / "smcat"
+PARSE_ALL = REPO / "tools" / "smcat" / "parse_all.mjs"
+#: state-machine-cat is installed (scripts/install_smcat.sh): the tests check every text they write
+PARSE_ALL_READY = SMCAT.exists() and shutil.which("node") is not None
 
 EXAMPLE = """# the door of a lab
 initial,
@@ -40,19 +44,66 @@ open => final: shutdown;
 """
 
 
-def _smcat_json(text: str, tmp: Path) -> dict[str, object]:
-    """What state-machine-cat itself parses ``text`` into (its JSON AST)."""
-    source = tmp / "m.smcat"
-    source.write_text(text, encoding="utf-8")
+def state_machine_cat(texts: list[str], tmp: Path) -> list[dict[str, Any]]:
+    """state-machine-cat's own parse of each text (one node process: tools/smcat/parse_all.mjs)."""
+    paths = []
+    for index, text in enumerate(texts):
+        path = tmp / f"written{index}.smcat"
+        path.write_text(text, encoding="utf-8")
+        paths.append(str(path))
     run = subprocess.run(
-        [str(SMCAT), "-I", "smcat", "-T", "json", str(source), "-o", "-"],
+        ["node", str(PARSE_ALL)],
+        input=json.dumps(paths),
         capture_output=True,
         text=True,
-        timeout=60,
+        timeout=120,
+        cwd=PARSE_ALL.parent,
     )
     assert run.returncode == 0, run.stderr
-    data: dict[str, object] = json.loads(run.stdout)
-    return data
+    results: list[dict[str, Any]] = json.loads(run.stdout)
+    return results
+
+
+def smcat_view(ast: dict[str, Any]) -> tuple[dict[str, str], set[tuple[str, str, str | None]]]:
+    """State types and transitions (from, to, event) of state-machine-cat's AST, all levels."""
+    kinds: dict[str, str] = {}
+    edges: set[tuple[str, str, str | None]] = set()
+    stack = [ast]
+    while stack:
+        machine = stack.pop()
+        for state in machine.get("states", []):
+            kinds[state["name"]] = state["type"]
+            if "statemachine" in state:
+                stack.append(state["statemachine"])
+        for t in machine.get("transitions", []):
+            edges.add((t["from"], t["to"], t.get("event")))
+    return kinds, edges
+
+
+def fsmbt_view(fsm: FSM) -> tuple[dict[str, str], set[tuple[str, str, str | None]]]:
+    kinds: dict[str, str] = {}
+    edges: set[tuple[str, str, str | None]] = set()
+    for machine in fsm.machines():
+        for state in machine.states.values():
+            kinds[state.name] = "final" if state.final else "regular"
+        edges |= {(t.source, t.target, t.event) for t in machine.transitions}
+    return kinds, edges
+
+
+def assert_state_machine_cat_reads_the_same(models: list[FSM], tmp: Path) -> None:
+    """Every text fsmbt writes for ``models`` is parsed by state-machine-cat into the same
+    states (types) and transitions (the initial pseudo-states aside)."""
+    texts = [dumps(model, "smcat") for model in models]
+    if not PARSE_ALL_READY:
+        return
+    for model, text, parsed in zip(models, texts, state_machine_cat(texts, tmp)):
+        assert parsed["ok"], (parsed.get("error"), text)
+        kinds, edges = smcat_view(parsed["ast"])
+        initials = {name for name, kind in kinds.items() if kind == "initial"}
+        assert len(initials) == len(list(model.machines())), text
+        ours_kinds, ours_edges = fsmbt_view(model)
+        assert {n: k for n, k in kinds.items() if n not in initials} == ours_kinds, text
+        assert {e for e in edges if e[0] not in initials} == ours_edges, text
 
 
 def test_reads_composite_initial_final_events_and_completion() -> None:
@@ -70,47 +121,49 @@ def test_reads_composite_initial_final_events_and_completion() -> None:
     assert any("its action 'beep' is kept as an annotation" in w for w in warnings)
 
 
-def test_round_trip_of_random_machines_is_equivalent() -> None:
-    for seed in range(25):
-        fsm = random_fsm(seed=seed, max_states=10)
+def test_round_trip_of_random_machines_is_equivalent(tmp_path: Path) -> None:
+    models = [random_fsm(seed=seed, max_states=10) for seed in range(25)]
+    for seed, fsm in enumerate(models):
         back = loads(dumps(fsm, "smcat"), "smcat")
         assert api.verdict_word(api.verify_models(fsm, back)) == "EQUIVALENT", seed
+    assert_state_machine_cat_reads_the_same(models, tmp_path)
 
 
-def test_round_trip_of_a_hierarchical_machine_is_equivalent() -> None:
+def test_round_trip_of_a_hierarchical_machine_is_equivalent(tmp_path: Path) -> None:
     fsm = loads(EXAMPLE, "smcat")
+    assert isinstance(fsm, FSM)
     result = translate(fsm, "smcat", check=api.verify_models)
     assert result.verified
     assert result.losses == []  # the transition action and the exit condition are kept
+    assert_state_machine_cat_reads_the_same([fsm], tmp_path)
 
 
 @pytest.mark.skipif(
-    not SMCAT.exists(), reason="state-machine-cat not installed (scripts/install_smcat.sh)"
+    not PARSE_ALL_READY, reason="state-machine-cat not installed (scripts/install_smcat.sh)"
 )
-def test_state_machine_cat_reads_every_file_fsmbt_writes(tmp_path: Path) -> None:
-    models: list[FSM] = [random_fsm(seed=s, max_states=8) for s in range(4)]
-    hierarchical = loads(EXAMPLE, "smcat")
-    assert isinstance(hierarchical, FSM)
-    models.append(hierarchical)
+def test_state_machine_cat_reads_awkward_names_as_fsmbt_means_them(tmp_path: Path) -> None:
     awkward = FSM(name="awkward")  # names state-machine-cat would misread unless written with care
     awkward.add_state("final_check")
     awkward.add_state("go home", action="drive")
+    awkward.add_state("initialize", action="boot")
     awkward.add_state("done", final=True, action="report")
     awkward.add_transition("final_check", "ok", "go home")
-    awkward.add_transition("go home", "arrived", "done")
-    models.append(awkward)
-    for model in models:
-        text = dumps(model, "smcat")
-        ast = _smcat_json(text, tmp_path)
-        states = ast["states"]
-        assert isinstance(states, list)
-        kinds = {s["name"]: s["type"] for s in states}
-        for state in model.states.values():
-            expected = "final" if state.final else "regular"
-            assert kinds[state.name] == expected, (state.name, text)
-        assert sum(kind == "initial" for kind in kinds.values()) == 1
-        back = loads(text, "smcat")
-        assert api.verdict_word(api.verify_models(model, back)) == "EQUIVALENT"
+    awkward.add_transition("go home", "arrived", "initialize")
+    awkward.add_transition("initialize", "booted", "done")
+    awkward.start_name, awkward.initial_event = "Start", "power"
+    assert_state_machine_cat_reads_the_same([awkward], tmp_path)
+    # and the smcat command line (what users run) parses it too
+    source = tmp_path / "awkward.smcat"
+    source.write_text(dumps(awkward, "smcat"), encoding="utf-8")
+    run = subprocess.run(
+        [str(SMCAT), "-T", "json", str(source), "-o", "-"],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert run.returncode == 0, run.stderr
+    back = loads(source.read_text(encoding="utf-8"), "smcat")
+    assert api.verdict_word(api.verify_models(awkward, back)) == "EQUIVALENT"
 
 
 @pytest.mark.parametrize(
