@@ -285,3 +285,34 @@ def test_yasmin_python_code_at_import_is_refused_and_not_run(tmp_path: Path) -> 
     )
     assert run.returncode == 2 and f"{path}:{line}" in run.stderr + run.stdout
     assert not marker.exists()
+
+
+ORTHOGONAL_PY = """from yasmin import JoinState, OrthogonalState, StateMachine
+from my_states import Work
+
+
+def build():
+    a = StateMachine(outcomes=["done"])
+    a.add_state("W1", Work(), transitions={"ok": "SYNC"})
+    a.add_state("SYNC", JoinState("mid", "joined"), transitions={"joined": "W2"})
+    a.add_state("W2", Work(), transitions={"ok": "done"})
+    b = StateMachine(outcomes=["done"])
+    b.add_state("SYNC", JoinState("mid"), transitions={"joined": "V"})
+    b.add_state("V", Work(), transitions={"ok": "done"})
+    ort = OrthogonalState("timeout", {"success": {"A": "done", "B": "done"}})
+    ort.add_region("A", a)
+    ort.add_region("B", b)
+    sm = StateMachine(outcomes=["success", "timeout"])
+    sm.add_state("PAR", ort, transitions={"success": "success", "timeout": "timeout"})
+    return sm
+"""
+
+
+def test_yasmin_python_orthogonal_state_with_a_barrier(tmp_path: Path) -> None:
+    fsm = read_model(_write(tmp_path, "ort.py", ORTHOGONAL_PY))
+    assert isinstance(fsm, FSM)
+    product = fsm.states["PAR"].regions[0]
+    joined = [t for t in product.transitions if (t.event or "").endswith("joined")]
+    assert [t.source.split(" ")[0] for t in joined] == ["A:SYNC,B:SYNC"]
+    assert all(t.target.startswith("A:W2,B:V") for t in joined)
+    assert api.verdict_word(api.verify_models(fsm, api.convert_model(fsm).model)) == "EQUIVALENT"

@@ -127,8 +127,31 @@ class _Reader:
                     f"state machine '{container.name}' has no states",
                     location=SourceLocation(self.name, container.line),
                 )
+        for container in self.containers:
+            if container.cls == "OrthogonalState":
+                self.barriers(container)
         records = Records(root, root.name, self.info)
         return records
+
+    def barriers(self, container: Container) -> None:
+        """JoinStates directly in the regions of an OrthogonalState, grouped by sync_id."""
+        groups: dict[str, list[tuple[str, str]]] = {}
+        for region in container.children:
+            if not isinstance(region.state, Container):
+                continue
+            for child in region.state.children:
+                state = child.state
+                if isinstance(state, StateRef) and state.cls == "JoinState":
+                    sync_id = self.info.get(id(state), {}).get(A_SYNC, "")
+                    groups.setdefault(sync_id, []).append((region.label, child.label))
+        for sync_id, members in groups.items():
+            if len(members) < 2:
+                raise InputError(
+                    f"JoinState sync_id '{sync_id}' of OrthogonalState '{container.name}' has "
+                    "fewer than 2 participants (YASMIN refuses it when it configures the state)",
+                    location=SourceLocation(self.name, container.line),
+                )
+            container.sync_groups.append(members)
 
     def collect_classes(self) -> None:
         """Outcomes of state classes defined in the file (``super().__init__(outcomes=...)``)."""
