@@ -31,6 +31,7 @@ from __future__ import annotations
 import ast
 import json
 import keyword
+import re
 
 from fsmbt.formats._pysm_source import NotStatic, last_name, literal, parse_source
 from fsmbt.formats.registry import ReadContext
@@ -370,9 +371,11 @@ def write_pystatemachine(model: Model) -> str:
     clash = set(model.states) & set(model.events())
     if clash:
         raise UnsupportedError(f"names used for a state and an event: {', '.join(sorted(clash))}")
-    cls = "".join(p[:1].upper() + p[1:] for p in model.name.replace("-", "_").split("_") if p)
-    if not cls.isidentifier() or keyword.iskeyword(cls):
-        cls = "Machine"
+    cls = model.name  # the class name is the machine's name, where Python allows it
+    if not cls.isidentifier() or keyword.iskeyword(cls) or cls in ("State", "StateMachine"):
+        cls = "".join(p[:1].upper() + p[1:] for p in re.split(r"[^A-Za-z0-9_]+", cls) if p)
+        if not cls.isidentifier() or keyword.iskeyword(cls) or cls in ("State", "StateMachine"):
+            cls = "Machine"
     lines = [
         '"""Written by fsmbt: the states and events of the model; the actions are yours."""',
         "",

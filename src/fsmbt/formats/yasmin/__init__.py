@@ -62,6 +62,6 @@ register(
         read_yasmin_python,
         None,
         _sniff_python,
-        priority=33,
+        priority=36,  # after SMACH and FlexBE: a .py file no import identifies stays theirs
     )
 )

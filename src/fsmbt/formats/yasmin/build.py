@@ -17,7 +17,7 @@ import json
 from fsmbt.formats._pysm_analyze import Analysis, Container
 from fsmbt.formats._pysm_build import build_records
 from fsmbt.formats.registry import ReadContext
-from fsmbt.formats.yasmin.xml_read import A_CHILD_INFO, NO_ACTION_CLASS, Records
+from fsmbt.formats.yasmin.xml_read import A_CHILD_INFO, NO_ACTION_CLASS, START_CLASS, Records
 from fsmbt.model.fsm import FSM
 
 
@@ -34,6 +34,7 @@ def _attach(fsm: FSM, records: Records) -> None:
     work: list[tuple[FSM, Container]] = [(fsm, records.root)]
     while work:
         machine, container = work.pop()
+        _start_state(machine)
         for outcome, action in records.final_actions.get(id(container), {}).items():
             if outcome in machine.states:
                 machine.states[outcome].action = action
@@ -53,3 +54,18 @@ def _attach(fsm: FSM, records: Records) -> None:
                 state.attrs[A_CHILD_INFO] = json.dumps(infos, sort_keys=True)
             else:
                 work.append((state.regions[0], inner))
+
+
+def _start_state(machine: FSM) -> None:
+    """fsmbt's start pseudo-state, written as a state of class ``fsmbt_states/Start`` with one
+    transition (its initial event), becomes the start pseudo-state again."""
+    start = machine.states.get(str(machine.initial))
+    if start is None or start.action != START_CLASS or start.regions:
+        return
+    leaving = machine.outgoing(start.name)
+    if len(leaving) != 1 or leaving[0].event is None:
+        return
+    machine.start_name, machine.initial_event = start.name, leaving[0].event
+    machine.initial = leaving[0].target
+    machine.transitions.remove(leaving[0])
+    del machine.states[start.name]

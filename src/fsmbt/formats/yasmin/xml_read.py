@@ -87,6 +87,8 @@ A_SYNC = "yasmin.sync_id"
 A_CHILD_INFO = "yasmin.children"
 #: The class fsmbt writes for a state that runs no action (read back as no action).
 NO_ACTION_CLASS = "fsmbt_states/NoAction"
+#: The class fsmbt writes for a start pseudo-state left on its initial event (read back as one).
+START_CLASS = "fsmbt_states/Start"
 #: The ``FinalOutcome`` attribute fsmbt writes for the action of a final state (YASMIN runs no
 #: action on an outcome and ignores the attribute; fsmbt reads it back).
 A_FINAL_ACTION = "fsmbt_action"

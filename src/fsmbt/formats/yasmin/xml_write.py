@@ -13,6 +13,8 @@ Mapping (the inverse of the reader, so that what is written reads back as the sa
   nested ``<StateMachine>`` whose outcomes are its final states, each exit a ``<Transition>``;
 - a composite read from a YASMIN ``Concurrence`` / ``OrthogonalState`` whose children are
   leaves is written back as that container with its outcome map;
+- a start pseudo-state left on an initial event is a state of class ``fsmbt_states/Start``
+  whose one transition is that event (read back as the start pseudo-state);
 - parameters, keys, remappings, positions and descriptions kept in ``State.attrs`` (by the
   YASMIN reader or another outcome-driven reader through ``model.state_info``) become ``Param``,
   ``Key``, ``Remap``, ``ParamRemap``, ``x``/``y`` and ``description``; a machine read from an
@@ -23,7 +25,7 @@ Refused (``UnsupportedError``, so ``translate --flatten`` can write the flat mac
 parallel state that was not read from a YASMIN container, a composite left on an event or by a
 completion transition without an exit, an eventless transition of an atomic state, a final
 state with outgoing transitions, a state named like an outcome of its machine. Everything else
-that differs when the text is read back (a start pseudo-state, an action that is not a class,
+that differs when the text is read back (an action that is not a class,
 ...) is named as a loss by ``translate``. Explicit work list. Costs: O(S + T).
 """
 
@@ -47,6 +49,7 @@ from fsmbt.formats.yasmin.xml_read import (
     A_TAG,
     A_TYPE,
     NO_ACTION_CLASS,
+    START_CLASS,
 )
 from fsmbt.model import Model, state_info
 from fsmbt.model.errors import UnsupportedError
@@ -110,6 +113,17 @@ def _machine(
     element.set("start_state", machine.initial)
     _annotate(element, attrs)
     pending: list[tuple[FSM, etree._Element, dict[str, str]]] = []
+    if machine.start_name is not None and machine.initial_event is not None:
+        if machine.start_name in machine.states:
+            raise UnsupportedError(f"start pseudo-state '{machine.start_name}' is also a state")
+        start = etree.SubElement(element, "State")
+        start.set("name", machine.start_name)
+        start.set("type", "cpp")
+        start.set("class", START_CLASS)
+        leave = etree.SubElement(start, "Transition")
+        leave.set("from", machine.initial_event)
+        leave.set("to", machine.initial)
+        element.set("start_state", machine.start_name)
     for state in machine.states.values():
         if state.final:
             if machine.outgoing(state.name):
