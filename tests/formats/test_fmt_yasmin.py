@@ -223,12 +223,17 @@ def test_what_yasmin_cannot_hold_is_named() -> None:
     fsm = FSM(name="m")
     fsm.add_state("A")
     fsm.add_state("B")
-    fsm.states["end"] = fsm.states["B"].__class__("end", final=True)
+    fsm.states["end"] = State("end", action="report", final=True)
     fsm.add_transition("A", "go", "B")
-    fsm.add_transition("B", "stop", "end")
+    fsm.add_transition("B", "stop", "end", attrs={"note": "by hand"})
     fsm.start_name, fsm.initial_event = "start", "power"
-    result = translate(fsm, "yasmin")
-    assert any("start" in loss or "initial_event" in loss for loss in result.losses), result.losses
+    result = translate(fsm, "yasmin", check=api.verify_models)
+    assert result.verified
+    back = loads(result.text, "yasmin")
+    assert isinstance(back, FSM)  # the start pseudo-state and its event come back
+    assert (back.start_name, back.initial_event, back.initial) == ("start", "power", "A")
+    assert any("YASMIN runs none on reaching an outcome" in x for x in result.losses)
+    assert any("note" in x and "is lost" in x for x in result.losses), result.losses
     parallel = FSM(name="p")
     parallel.add_state("P", regions=[FSM(name="r1"), FSM(name="r2")], action=None)
     parallel.states["end"] = fsm.states["end"]
