@@ -321,3 +321,29 @@ def test_yasmin_python_orthogonal_state_with_a_barrier(tmp_path: Path) -> None:
     assert [t.source.split(" ")[0] for t in joined] == ["A:SYNC,B:SYNC"]
     assert all(t.target.startswith("A:W2,B:V") for t in joined)
     assert api.verdict_word(api.verify_models(fsm, api.convert_model(fsm).model)) == "EQUIVALENT"
+
+
+def test_a_region_may_be_an_included_machine(tmp_path: Path) -> None:
+    _write(tmp_path, "inner.xml", INCLUDED)
+    main = _write(
+        tmp_path,
+        "main.xml",
+        '<StateMachine name="M" outcomes="ok" start_state="O">\n'
+        '  <OrthogonalState name="O" default_outcome="ok">\n'
+        '    <Region name="A" file_path="inner.xml"/>\n'
+        '    <Region name="B" outcomes="done" start_state="Y">\n'
+        '      <State name="Y" type="cpp" class="p/Y"><Transition from="y" to="done"/></State>\n'
+        "    </Region>\n"
+        '    <Transition from="ok" to="ok"/>\n'
+        "  </OrthogonalState>\n"
+        "</StateMachine>\n",
+    )
+    fsm = read_model(main)
+    assert isinstance(fsm, FSM)
+    product = fsm.states["O"].regions[0]
+    assert {(t.source, t.event, t.target) for t in product.transitions} == {
+        ("A:X,B:Y", "go", "A=end,B:Y"),
+        ("A:X,B:Y", "y", "A:X,B=done"),
+        ("A=end,B:Y", "y", "ok"),
+        ("A:X,B=done", "go", "ok"),
+    }

@@ -12,8 +12,8 @@ construction (``_pysm_build``) makes the FSM. What the factory does, and so what
   ``<Transition from to>`` children map its outcomes. The file does not list a state's outcomes:
   the ones its transitions name are kept, and an outcome left unmapped falls through to the
   container outcome of the same name (``StateMachine::execute_step``).
-- ``<StateMachine file_path=...>`` or ``<StateMachine package file_name>``: the machine of another
-  file. ``file_path`` is resolved relative to the including file and must stay in its folder (the
+- ``<StateMachine file_path=...>`` or ``<StateMachine package file_name>`` (a ``<Region>`` too):
+  the machine of another file. ``file_path`` is resolved relative to the including file and must stay in its folder (the
   factory refuses a path that leaves it); ``package`` is looked up as the factory does (the
   package's share folder, under ``AMENT_PREFIX_PATH``), then in an enclosing source folder of
   that name holding a ``package.xml``, then beside the including file (a warning names the file
@@ -475,19 +475,25 @@ class XmlReader:
             name = self.attr(job.source, element, "name")
             if any(c.label == name for c in children):
                 raise self.error(job.source, element, f"region '{name}' already exists")
-            container = self.machine_record(job.source, element, name)
+            target, sub_source, root = self.included(job.source, element)
+            body, body_source = (root, sub_source) if root is not None else (element, job.source)
+            container = self.machine_record(body_source, body, name)
             container.cls = "Region"
             child = Child(name, container, {}, element.sourceline or 0)
             info = self.annotations(job.source, element, "Region")
             info[state_info.CLASS] = "Region"
             info[A_TAG] = "Region"
+            if target is not None:
+                info[A_INCLUDE] = json.dumps(
+                    {k: v for k in ("file_path", "package", "file_name") if (v := element.get(k))}
+                )
             self.info[id(child)] = info
             children.append(child)
-            pending.append(_Job(element, container, job.source))
-            for state in element:
+            pending.append(_Job(body, container, body_source))
+            for state in body:
                 if _is(state, "JoinState"):
                     joins.setdefault(state.get("sync_id", ""), []).append(
-                        (name, self.attr(job.source, state, "name"))
+                        (name, self.attr(body_source, state, "name"))
                     )
         if not children:
             raise self.error(
