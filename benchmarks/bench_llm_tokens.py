@@ -16,7 +16,7 @@ import statistics
 import sys
 from pathlib import Path
 
-from fsmbt.formats.registry import read_model
+from fsmbt import api
 from fsmbt.generate.generator import random_bt, random_fsm
 from fsmbt.llm.pipeline import direction_for
 from fsmbt.llm.prompts import MODULES, PromptOptions, conversion_messages
@@ -63,7 +63,7 @@ def main() -> int:
         if path.suffix == ".md":
             continue
         try:
-            model = read_model(path)
+            model = api.load(path).model
         except FsmbtError as exc:
             print(f"{path.name:<38} (not read: {exc})")
             continue

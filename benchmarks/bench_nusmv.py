@@ -20,10 +20,10 @@ import statistics
 import time
 from pathlib import Path
 
+from fsmbt import api
 from fsmbt.convert.bt_to_hfsm import bt_to_hfsm
 from fsmbt.convert.engines import converter_for
 from fsmbt.convert.lebt import fsm_to_lebt
-from fsmbt.formats.registry import read_model
 from fsmbt.generate.generator import random_fsm
 from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.bt_nodes import NodeKind
@@ -158,7 +158,7 @@ def examples(repeat: int, timeout: float) -> None:
     print(f"\nexamples/ (size = source states or BT nodes)\n{HEADER}")
     for path in sorted(EXAMPLES.iterdir()):
         try:
-            model = read_model(path)
+            model = api.load(path).model
             converted = converter_for("rules", model)(model)
         except FsmbtError:
             continue  # not a model (README) or not convertible

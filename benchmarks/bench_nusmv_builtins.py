@@ -21,8 +21,8 @@ import resource
 import time
 from pathlib import Path
 
+from fsmbt import api
 from fsmbt.convert.engines import converter_for
-from fsmbt.formats.registry import read_model
 from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.bt_nodes import NodeKind
 from fsmbt.model.errors import FsmbtError
@@ -97,7 +97,7 @@ def main() -> None:
     print(f"{'model':<66} {'built-ins':<37}{'states':>7}{'CPU s':>8}{'wall s':>8}  verdicts")
     for path in models(corpus):
         try:
-            doc = read_model(path)
+            doc = api.load(path).model
             if not isinstance(doc, BTDocument) or not built_ins(doc):
                 continue
             result = converter_for("rules", doc)(doc).model

@@ -18,7 +18,7 @@ from pathlib import Path
 
 from fsmbt import api, limits
 from fsmbt.formats import loads
-from fsmbt.formats.scxml_datamodel import StateLimitError
+from fsmbt.formats.scxml.datamodel import StateLimitError
 
 FILES = [
     "w3c_scxml_examples/microwave-01.scxml",

@@ -1,4 +1,4 @@
-"""Cost of reading SCXML ``<invoke>`` (fsmbt.formats.scxml_invoke): a parallel state of N
+"""Cost of reading SCXML ``<invoke>`` (fsmbt.formats.scxml.invoke): a parallel state of N
 regions, each invoking an autoforwarded child that toggles on its own event, so the reachable
 configurations are 2**N (every child's state is part of the flat state). Prints, per N, the
 flat states and transitions found and the read time (best of 3).

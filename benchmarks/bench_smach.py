@@ -14,7 +14,7 @@ import argparse
 import time
 
 from fsmbt.formats import loads
-from fsmbt.formats._smach_write import write_smach
+from fsmbt.formats.pysm.smach_write import write_smach
 from fsmbt.generate.generator import random_fsm
 from fsmbt.verify import verify
 

@@ -13,9 +13,10 @@ import sys
 import time
 from pathlib import Path
 
+from fsmbt import api
 from fsmbt.convert import convert
-from fsmbt.formats import loads, read_model
-from fsmbt.formats._smach_write import write_smach
+from fsmbt.formats import loads
+from fsmbt.formats.pysm.smach_write import write_smach
 from fsmbt.model.errors import FsmbtError
 from fsmbt.model.flatten import flatten
 from fsmbt.model.fsm import FSM
@@ -48,7 +49,7 @@ def main() -> int:
         warnings: list[str] = []
         start = time.perf_counter()
         try:
-            model = read_model(path, warnings=warnings)
+            model = api.load(path, warnings=warnings).model
         except FsmbtError as exc:
             print(f"| {name} | no: {exc} | | | | | | |")
             continue

@@ -20,7 +20,6 @@ from collections import Counter
 from pathlib import Path
 
 from fsmbt import api
-from fsmbt.formats.registry import read_model
 from fsmbt.model.errors import InputError, UnsupportedError
 
 SMCAT = Path(__file__).resolve().parents[1] / "tools" / "smcat" / "node_modules" / ".bin" / "smcat"
@@ -60,7 +59,7 @@ def main() -> int:
         theirs = their_verdict(path)
         parsed += theirs
         try:
-            model = read_model(path)
+            model = api.load(path).model
         except UnsupportedError as exc:
             refusals[reason_of(exc)] += 1
             continue

@@ -17,78 +17,84 @@ import smach
 
 class WaitForOrder(smach.State):
     def __init__(self):
-        smach.State.__init__(self, outcomes=['order', 'shutdown'])
+        smach.State.__init__(self, outcomes=["order", "shutdown"])
 
     def execute(self, userdata):
-        return 'order'
+        return "order"
 
 
 class Dock(smach.State):
     def __init__(self):
-        smach.State.__init__(self, outcomes=['docked', 'blocked'])
+        smach.State.__init__(self, outcomes=["docked", "blocked"])
 
     def execute(self, userdata):
-        return 'docked'
+        return "docked"
 
 
 class Grip(smach.State):
     def __init__(self):
-        smach.State.__init__(self, outcomes=['gripped', 'slipped'])
+        smach.State.__init__(self, outcomes=["gripped", "slipped"])
 
     def execute(self, userdata):
-        return 'gripped'
+        return "gripped"
 
 
 class Drive(smach.State):
     def __init__(self):
-        smach.State.__init__(self, outcomes=['arrived', 'lost'])
+        smach.State.__init__(self, outcomes=["arrived", "lost"])
 
     def execute(self, userdata):
-        return 'arrived'
+        return "arrived"
 
 
 class Handover(smach.State):
     def __init__(self):
-        smach.State.__init__(self, outcomes=['done', 'refused'])
+        smach.State.__init__(self, outcomes=["done", "refused"])
 
     def execute(self, userdata):
-        return 'done'
+        return "done"
 
 
 class Charge(smach.State):
     def __init__(self):
-        smach.State.__init__(self, outcomes=['charged', 'aborted'])
+        smach.State.__init__(self, outcomes=["charged", "aborted"])
 
     def execute(self, userdata):
-        return 'charged'
+        return "charged"
 
 
 def build():
-    robot = smach.StateMachine(outcomes=['off', 'aborted'])
+    robot = smach.StateMachine(outcomes=["off", "aborted"])
     with robot:
-        smach.StateMachine.add('IDLE', WaitForOrder(),
-                               transitions={'order': 'LOAD', 'shutdown': 'off'})
+        smach.StateMachine.add(
+            "IDLE", WaitForOrder(), transitions={"order": "LOAD", "shutdown": "off"}
+        )
 
-        load = smach.Concurrence(outcomes=['loaded', 'not_loaded'],
-                                 default_outcome='not_loaded',
-                                 outcome_map={'loaded': {'DOCK': 'docked', 'GRIP': 'gripped'}})
+        load = smach.Concurrence(
+            outcomes=["loaded", "not_loaded"],
+            default_outcome="not_loaded",
+            outcome_map={"loaded": {"DOCK": "docked", "GRIP": "gripped"}},
+        )
         with load:
-            smach.Concurrence.add('DOCK', Dock())
-            smach.Concurrence.add('GRIP', Grip())
-        smach.StateMachine.add('LOAD', load,
-                               transitions={'loaded': 'DELIVER', 'not_loaded': 'IDLE'})
+            smach.Concurrence.add("DOCK", Dock())
+            smach.Concurrence.add("GRIP", Grip())
+        smach.StateMachine.add(
+            "LOAD", load, transitions={"loaded": "DELIVER", "not_loaded": "IDLE"}
+        )
 
-        deliver = smach.Sequence(outcomes=['delivered', 'failed'], connector_outcome='arrived')
+        deliver = smach.Sequence(outcomes=["delivered", "failed"], connector_outcome="arrived")
         with deliver:
-            smach.Sequence.add('DRIVE', Drive(), transitions={'lost': 'failed'})
-            smach.Sequence.add('HANDOVER', Handover(),
-                               transitions={'done': 'delivered', 'refused': 'failed'})
-        smach.StateMachine.add('DELIVER', deliver,
-                               transitions={'delivered': 'CHARGE', 'failed': 'IDLE'})
+            smach.Sequence.add("DRIVE", Drive(), transitions={"lost": "failed"})
+            smach.Sequence.add(
+                "HANDOVER", Handover(), transitions={"done": "delivered", "refused": "failed"}
+            )
+        smach.StateMachine.add(
+            "DELIVER", deliver, transitions={"delivered": "CHARGE", "failed": "IDLE"}
+        )
 
-        smach.StateMachine.add('CHARGE', Charge(), transitions={'charged': 'IDLE'})
+        smach.StateMachine.add("CHARGE", Charge(), transitions={"charged": "IDLE"})
     return robot
 
 
-if __name__ == '__main__':
+if __name__ == "__main__":
     build().execute()

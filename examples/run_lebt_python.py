@@ -11,18 +11,29 @@ from __future__ import annotations
 from collections.abc import Callable
 from pathlib import Path
 
+from fsmbt import api
 from fsmbt.convert.engines import converter_for
-from fsmbt.formats import dumps, read_model
+from fsmbt.formats import dumps
 from fsmbt.runtime.python_runtime import ENGINES, load_tree
 from fsmbt.semantics.machine import FSMMachine
 
 HERE = Path(__file__).resolve().parent
-EVENTS = ["eventSA", "eventAB", "eventBD", "eventDE", "eventEC", "eventCD", "eventXX",
-          "eventDE", "eventEG", "eventGH"]
+EVENTS = [
+    "eventSA",
+    "eventAB",
+    "eventBD",
+    "eventDE",
+    "eventEC",
+    "eventCD",
+    "eventXX",
+    "eventDE",
+    "eventEG",
+    "eventGH",
+]
 
 
 def main() -> None:
-    fsm = read_model(HERE / "paper_fsm.xml")
+    fsm = api.load(HERE / "paper_fsm.xml").model
     tree_xml = dumps(converter_for("rules", fsm)(fsm).model, "btcpp")  # = fsmbt convert
 
     machine = FSMMachine(fsm)
@@ -38,6 +49,7 @@ def main() -> None:
         def run() -> None:  # your robot's code goes here
             log.append(name)
             print(f"   running action {name}")
+
         return run
 
     actions = {name: action(name) for name in "ABCDEFGHIJ"}
@@ -49,8 +61,10 @@ def main() -> None:
             log.clear()
             print(f"-> {event}")
             runner.post(event)
-            print(f"   state {runner.state}, terminated {runner.terminated}; "
-                  f"FSM runs {list(fsm_outputs)}")
+            print(
+                f"   state {runner.state}, terminated {runner.terminated}; "
+                f"FSM runs {list(fsm_outputs)}"
+            )
             assert tuple(log) == fsm_outputs, (engine, event, log, fsm_outputs)
         assert runner.terminated
     print("both engines ran the FSM's actions")

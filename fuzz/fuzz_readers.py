@@ -6,7 +6,7 @@ Usage (from the repository root)::
         --timeout-per-input 2
 
 The rule every reader must keep: whatever bytes it is given, reading them (``decode`` then the
-format's reader, as ``fsmbt.formats.read_model`` does) ends in one of three ways only - a model,
+format's reader, as ``fsmbt.api.load`` does) ends in one of three ways only - a model,
 an ``InputError`` or an ``UnsupportedError`` (``fsmbt.model.errors``) whose message is one line
 and names the input (a location). Anything else is a *finding*:
 
@@ -113,8 +113,9 @@ def build_seeds(reader: str, out: Path, *, max_seed_bytes: int) -> int:
     Seeds: example and corpus files the reader claims (extension or content sniffing), and
     example, corpus and generated models written by the reader's own writer, when it has one.
     """
+    from fsmbt import api
     from fsmbt.formats import detect_format, dumps, get_format
-    from fsmbt.formats.registry import decode, read_model
+    from fsmbt.formats.registry import decode
     from fsmbt.generate import random_bt, random_fsm
     from fsmbt.model.errors import InputError
 
@@ -142,7 +143,7 @@ def build_seeds(reader: str, out: Path, *, max_seed_bytes: int) -> int:
         if claims:
             seeds[hashlib.sha1(data).hexdigest()] = data
         try:
-            models.append(read_model(path))
+            models.append(api.load(path).model)
         except InputError:
             pass
     for seed in range(12):

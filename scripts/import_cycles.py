@@ -4,10 +4,12 @@
 
 Reads every ``.py`` file with the stdlib ``ast`` (nothing is imported or run) and draws an edge
 ``a -> b`` for each ``import b`` / ``from b import x`` in module ``a`` (``from p import m`` with
-``m`` a module of the package is an edge to ``p.m``). Imports under ``if TYPE_CHECKING:`` are left
-out (they never run). Imports inside functions *are* counted, and marked ``(local)``: an import
-hidden in a function still ties the two modules together, it only postpones the cycle to run
-time; ``--module-level-only`` shows what Python's import machinery itself would trip over.
+``m`` a module of the package is an edge to ``p.m``). Imports inside functions *are* counted, and
+marked ``(local)``: an import hidden in a function still ties the two modules together, it only
+postpones the cycle to run time. Imports under ``if TYPE_CHECKING:`` are counted too, marked
+``(typing)``: a module that names another's types depends on it as much as one that calls it, and
+a cycle kept only for annotations is a cycle of design (issue 25). ``--module-level-only`` leaves
+both out and shows what Python's import machinery itself would trip over.
 Importing ``p.m`` also runs ``p/__init__.py``; like grimp, that implicit edge is not drawn.
 
 A cycle is a strongly connected component of more than one module (Tarjan's algorithm, written
@@ -30,6 +32,7 @@ class Edge:
     target: str
     line: int
     local: bool  # written inside a function
+    typing: bool = False  # under ``if TYPE_CHECKING:``
 
 
 def module_names(root: Path, package: str) -> dict[str, Path]:
@@ -53,12 +56,13 @@ def imports_of(name: str, path: Path, modules: dict[str, Path]) -> list[Edge]:
     tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
     is_package = path.name == "__init__.py"
     edges: list[Edge] = []
-    # (node, inside a function) pairs, walked with an explicit stack
-    stack: list[tuple[ast.AST, bool]] = [(tree, False)]
+    # (node, inside a function, under TYPE_CHECKING) triples, walked with an explicit stack
+    stack: list[tuple[ast.AST, bool, bool]] = [(tree, False, False)]
     while stack:
-        node, local = stack.pop()
+        node, local, typing = stack.pop()
         if isinstance(node, ast.If) and _is_type_checking(node.test):
-            stack.extend((child, local) for child in node.orelse)
+            stack.extend((child, local, True) for child in node.body)
+            stack.extend((child, local, typing) for child in node.orelse)
             continue
         targets: list[str] = []
         if isinstance(node, ast.Import):
@@ -76,9 +80,9 @@ def imports_of(name: str, path: Path, modules: dict[str, Path]) -> list[Edge]:
             while target and target not in modules:  # ``import a.b.c`` of a non-module c
                 target = target.rpartition(".")[0]
             if target and target != name:
-                edges.append(Edge(name, target, getattr(node, "lineno", 0), local))
+                edges.append(Edge(name, target, getattr(node, "lineno", 0), local, typing))
         inner = local or isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.Lambda))
-        stack.extend((child, inner) for child in ast.iter_child_nodes(node))
+        stack.extend((child, inner, typing) for child in ast.iter_child_nodes(node))
     return edges
 
 
@@ -133,11 +137,11 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--root", default="src", type=Path)
     parser.add_argument("--package", default="fsmbt")
     parser.add_argument("--module-level-only", action="store_true",
-                        help="leave out imports written inside functions")
+                        help="leave out imports inside functions and under TYPE_CHECKING")
     args = parser.parse_args(argv)
     modules = module_names(args.root, args.package)
     edges = [e for name, path in modules.items() for e in imports_of(name, path, modules)
-             if not (args.module_level_only and e.local)]
+             if not (args.module_level_only and (e.local or e.typing))]
     graph: dict[str, set[str]] = {name: set() for name in modules}
     for edge in edges:
         graph[edge.source].add(edge.target)
@@ -152,7 +156,7 @@ def main(argv: list[str] | None = None) -> int:
                            key=lambda e: (e.source, e.target, e.line)):
             where = f"{modules[edge.source].as_posix()}:{edge.line}"
             print(f"  {edge.source} -> {edge.target}  {where}"
-                  + ("  (local)" if edge.local else ""))
+                  + ("  (local)" if edge.local else "") + ("  (typing)" if edge.typing else ""))
     return 1 if cycles else 0
 
 

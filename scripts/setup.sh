@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Set up fsmbt on a fresh Debian machine (run as root or with sudo); safe to run again.
 #
-#   1. Graphviz's `dot` (Debian package graphviz) when it is missing  - for `fsmbt render`
+#   1. Graphviz's `dot` (Debian package graphviz) when it is missing  - for `fsmbt render`; and
+#      GoogleTest (Debian libgtest-dev) when missing - for the C++ files `fsmbt testgen` writes
 #   2. .venv with Python 3.11 (python3.11, or python3 when that is 3.11)
 #   3. the project and its pinned dependencies: pip install -e '.[test]' (pins live in
 #      pyproject.toml); skipped when pyproject.toml has not changed since the last install
@@ -57,6 +58,13 @@ if command -v dot >/dev/null 2>&1; then
     say "Graphviz: $(command -v dot)"
 else
     apt_install graphviz
+fi
+
+# GoogleTest: the C++ test files `fsmbt testgen` writes link it (docs/testgen.md)
+if [ -f /usr/include/gtest/gtest.h ]; then
+    say "GoogleTest: /usr/include/gtest"
+else
+    apt_install libgtest-dev
 fi
 
 # -- 2. Python 3.11 and the virtual environment -------------------------------------------------

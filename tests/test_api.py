@@ -64,7 +64,8 @@ def test_existing_destination_is_refused_before_any_work(
     def must_not_run(*args: object, **kwargs: object) -> None:
         raise AssertionError("the conversion ran although the destination is refused")
 
-    monkeypatch.setattr(api, "load_for_engine", must_not_run)
+    monkeypatch.setattr(api, "load", must_not_run)
+    monkeypatch.setattr(api, "load_for_llm", must_not_run)
     with pytest.raises(api.DestinationExists) as caught:
         api.convert_file(PAPER_FSM, out)
     assert "taken.xml" in str(caught.value)
@@ -143,7 +144,25 @@ def test_verify_files_reads_both_and_reports(tmp_path: Path) -> None:
 
 def test_llm_engine_input_read_by_a_parser_keeps_its_format_and_warnings() -> None:
     # hybrid asks the LLM only when no parser reads the file: here the paper's XML reader does
-    options: dict[str, object] = {}
-    loaded = api.load_for_engine(PAPER_FSM, "hybrid", options=options)
+    loaded, client = api.load_for_llm(PAPER_FSM, api.ConvertRequest(engine="hybrid"))
+    assert client is None
     assert loaded.format == "paper-xml" and not loaded.extracted_by_llm
     assert loaded.warnings == api.load(PAPER_FSM).warnings
+
+
+def test_written_results_honour_the_umask_and_keep_a_replaced_files_mode(tmp_path: Path) -> None:
+    import os
+    import stat
+
+    previous = os.umask(0o022)
+    try:
+        fresh = api.write_text("x", tmp_path / "fresh.txt")
+        assert stat.S_IMODE(fresh.stat().st_mode) == 0o644
+        kept = tmp_path / "kept.txt"
+        kept.write_text("old", encoding="utf-8")
+        kept.chmod(0o640)
+        api.write_text("new", kept, overwrite=True)
+        assert stat.S_IMODE(kept.stat().st_mode) == 0o640
+        assert kept.read_text(encoding="utf-8") == "new"
+    finally:
+        os.umask(previous)

@@ -10,8 +10,8 @@ from pathlib import Path
 
 import pytest
 
-from fsmbt import limits
-from fsmbt.formats import loads, read_model
+from fsmbt import api, limits
+from fsmbt.formats import loads
 from fsmbt.model.errors import InputError
 
 FSM_JSON = json.dumps(
@@ -92,7 +92,7 @@ def test_input_size_bounds_files_and_text(tmp_path: Path, override: None) -> Non
     path.write_text(FSM_JSON, encoding="utf-8")
     use(max_input_bytes=50)
     with pytest.raises(InputError, match=f"{path}.*bytes exceed.*limit of 50"):
-        read_model(path)
+        api.load(path)
     with pytest.raises(InputError, match="limit of 50"):
         loads(FSM_JSON, "json")
 
@@ -134,10 +134,10 @@ def test_include_chain_depth(tmp_path: Path, override: None) -> None:
             f'<root BTCPP_format="4" main_tree_to_execute="T0">{include}{body.format(n=n)}</root>',
             encoding="utf-8",
         )
-    assert read_model(tmp_path / "f0.xml")
+    assert api.load(tmp_path / "f0.xml").model
     use(max_include_depth=2)
     with pytest.raises(InputError, match="include chain of 3 files.*FSMBT_MAX_INCLUDE_DEPTH"):
-        read_model(tmp_path / "f0.xml")
+        api.load(tmp_path / "f0.xml")
 
 
 def test_includes_are_confined_to_the_read_files_folder(tmp_path: Path) -> None:
@@ -165,7 +165,7 @@ def test_includes_are_confined_to_the_read_files_folder(tmp_path: Path) -> None:
         "</BehaviorTree></root>",
         encoding="utf-8",
     )
-    assert set(read_model(main).trees) == {"M", "C", "S"}
+    assert set(api.load(main).model.trees) == {"M", "C", "S"}
     for target in ("../outside.xml", str(outside), "/etc/passwd", "/dev/zero"):
         main.write_text(
             f'<root BTCPP_format="4"><include path="{target}"/>'
@@ -173,7 +173,7 @@ def test_includes_are_confined_to_the_read_files_folder(tmp_path: Path) -> None:
             encoding="utf-8",
         )
         with pytest.raises(InputError, match="outside the folder of the file read"):
-            read_model(main)
+            api.load(main)
     (project / "link.xml").symlink_to(outside)
     main.write_text(
         '<root BTCPP_format="4"><include path="link.xml"/>'
@@ -181,7 +181,7 @@ def test_includes_are_confined_to_the_read_files_folder(tmp_path: Path) -> None:
         encoding="utf-8",
     )
     with pytest.raises(InputError, match="outside the folder"):
-        read_model(main)
+        api.load(main)
     fifo = project / "pipe.xml"
     import os
 
@@ -192,7 +192,7 @@ def test_includes_are_confined_to_the_read_files_folder(tmp_path: Path) -> None:
         encoding="utf-8",
     )
     with pytest.raises(InputError, match="not a regular file"):
-        read_model(main)
+        api.load(main)
 
 
 def test_limits_module_imports_nothing_from_fsmbt() -> None:
@@ -225,8 +225,8 @@ def test_include_root_option_widens_the_confinement(tmp_path: Path) -> None:
         encoding="utf-8",
     )
     with pytest.raises(InputError, match="outside the folder of the file read"):
-        read_model(child)
-    assert set(read_model(child, options={"include_root": str(tmp_path)}).trees) == {"C", "S"}
+        api.load(child)
+    assert set(api.load(child, options={"include_root": str(tmp_path)}).model.trees) == {"C", "S"}
 
 
 def test_changed_holds_for_its_block_only_even_when_the_block_raises() -> None:

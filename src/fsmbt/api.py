@@ -8,7 +8,7 @@ these functions and only parse options and print around them; none of them does 
 The steps, each a thin public function over the package that owns it:
 
 - ``load`` / ``load_text``: a file or a text into a model (``fsmbt.formats``), with the reader's
-  warnings and the format it was read as. ``load_for_engine`` reads through the LLM extraction
+  warnings and the format it was read as. ``load_for_llm`` reads through the LLM extraction
   step (``fsmbt.llm.extract``) when an LLM engine is asked for and no parser reads the input.
 - ``convert_model``: one engine's conversion (``fsmbt.convert``); the direction follows the
   model's kind.
@@ -41,10 +41,19 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from fsmbt import limits
+from fsmbt.api_types import (
+    ConvertRequest,
+    ReadOptions,
+    VerifyRequest,
+    checker_limit,
+    convert_request,
+    verify_request,
+)
 from fsmbt.convert import ConversionResult, convert
 from fsmbt.formats import detect_format, dumps, get_format, loads
 from fsmbt.formats.registry import format_for_path, read_text
+from fsmbt.formats.translate import Translation
+from fsmbt.formats.translate import translate as translate_model
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import Hint, InputError, SourceLocation, UnsupportedError
 from fsmbt.model.fsm import FSM
@@ -196,7 +205,10 @@ class DestinationExists(InputError):
 
 
 def load(
-    path: str | Path, fmt: str | None = None, *, options: dict[str, object] | None = None
+    path: str | Path,
+    fmt: str | None = None,
+    *,
+    options: dict[str, object] | ReadOptions | None = None,
 ) -> Loaded:
     """Read one model file.
 
@@ -216,6 +228,9 @@ def load(
         InputError: the file cannot be read or is not a valid model (located).
         UnsupportedError: the model uses something fsmbt cannot model exactly (located).
     """
+    if isinstance(options, ReadOptions):
+        fmt = fmt or options.format
+        options = options.reader_options()
     path = Path(path)
     text = read_text(path)
     chosen = get_format(fmt).name if fmt else detect_format(text, path).name
@@ -229,7 +244,7 @@ def load_text(
     fmt: str | None = None,
     *,
     filename: str | None = None,
-    options: dict[str, object] | None = None,
+    options: dict[str, object] | ReadOptions | None = None,
 ) -> Loaded:
     """Read one model from a text (a paste, an upload, an LLM answer).
 
@@ -246,6 +261,9 @@ def load_text(
     Raises:
         InputError, UnsupportedError: as for ``load``.
     """
+    if isinstance(options, ReadOptions):
+        fmt = fmt or options.format
+        options = options.reader_options()
     name = Path(Path(filename).name) if filename else None
     warnings: list[str] = []
     chosen = fmt or detect_format(text, name).name
@@ -253,57 +271,41 @@ def load_text(
     return Loaded(model, None, chosen, warnings)
 
 
-def load_for_engine(
-    path: str | Path, engine: str, fmt: str | None = None, *, options: dict[str, object]
-) -> Loaded:
-    """Read the source of a conversion; for the LLM engines through LLM extraction.
+def load_for_llm(source: str | Path, request: ConvertRequest) -> tuple[Loaded, object | None]:
+    """Read the source of an LLM engine's conversion, through LLM extraction where needed.
 
     The LLM engines (``llm``, ``nllm``, ``hybrid``) read prose, unknown notations and pictures
     by asking the model to extract them (``hybrid`` asks only when no parser reads the file).
-    The client and the input's provenance are recorded in ``options`` for the engine.
 
     Args:
-        path: the source file.
-        engine: the conversion engine that will run.
-        fmt: the source format, or ``None`` to detect it.
-        options: the engine options; updated in place for the LLM engines.
+        source: the source file.
+        request: the conversion (its engine, ``read.format``, ``engine_options`` with the
+            endpoint, and an ``llm_client`` when the caller made one).
 
     Returns:
-        The ``Loaded`` source.
+        The ``Loaded`` source and the client used (``None`` when none was needed); the caller
+        passes the client on explicitly (``request.llm_client``).
 
     Raises:
         InputError, UnsupportedError: unreadable input; ``LLMConfigError`` when an LLM engine
         has no endpoint configured.
     """
-    if engine not in LLM_ENGINES:
-        return load(path, fmt, options=_reader_options(options))
     from fsmbt.llm.engine import client_from_options
     from fsmbt.llm.extract import needs_llm, read_input
 
-    path = Path(path)
-    client = None
-    if engine != "hybrid" or needs_llm(path, fmt):
-        client = client_from_options(options)
-    regenerations = options.get("max_regenerations")
+    path = Path(source)
+    fmt = request.read.format
+    client = request.llm_client
+    if client is None and (request.engine != "hybrid" or needs_llm(path, fmt)):
+        client = client_from_options(dict(request.engine_options))
+    regenerations = request.engine_options.get("max_regenerations")
     loaded = read_input(
         path,
         fmt,
         client=client,
         max_regenerations=regenerations if isinstance(regenerations, int) else None,
     )
-    options.update(client=client, source_name=str(path), extracted_by_llm=loaded.extracted)
-    return Loaded(loaded.model, path, loaded.format, loaded.warnings, loaded.extracted)
-
-
-#: Options meant for the readers, not the engines (they travel in the same ``options`` dict).
-READER_OPTIONS = ("node_models", "nodes", "abstract", "data", "trees", "include_root")
-
-
-def _reader_options(options: dict[str, object]) -> dict[str, object] | None:
-    """The options a reader understands (``node_models``, ``nodes``, ``abstract``, ``data``,
-    ``trees``, ``include_root``), out of the engine options."""
-    picked = {key: options[key] for key in READER_OPTIONS if key in options}
-    return picked or None
+    return Loaded(loaded.model, path, loaded.format, loaded.warnings, loaded.extracted), client
 
 
 # -- convert and verify ----------------------------------------------------------------------
@@ -369,11 +371,6 @@ def _warn_lebt_ports(loaded: Loaded) -> None:
             loaded.warnings.append(text)
 
 
-def _checker_limit(max_states: int | None) -> int:
-    """The native checker's state limit: the one given, else the limits in force."""
-    return max_states if max_states is not None else limits.current().checker_max_states
-
-
 def verify_models(
     source: Model,
     result: Model,
@@ -399,7 +396,7 @@ def verify_models(
         EngineDisagreement: ``both`` and the engines disagree (a bug in one of them).
         InputError, UnsupportedError: the pair cannot be compared.
     """
-    report = verify(source, result, engine=engine, loop=loop, max_states=_checker_limit(max_states))
+    report = verify(source, result, engine=engine, loop=loop, max_states=checker_limit(max_states))
     _name_abstractions(report, source, result)
     return readable(report, source, result)
 
@@ -540,10 +537,37 @@ def write(
     return write_text(dumps(model, chosen), path, overwrite=overwrite)
 
 
+def _file_mode(path: Path) -> int:
+    """The mode ``path`` keeps when replaced, else ``0o666`` less the umask."""
+    try:
+        return path.stat().st_mode & 0o7777
+    except OSError:
+        return 0o666 & ~_umask()
+
+
+def _umask() -> int:
+    """The process's umask, read without changing it where the system says it (Linux's
+    ``/proc/self/status``: setting and restoring it races with other threads' file creation)."""
+    try:
+        with open("/proc/self/status", encoding="ascii") as status:
+            for line in status:
+                if line.startswith("Umask:"):
+                    return int(line.split()[1], 8)
+    except (OSError, ValueError, IndexError):
+        pass
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
+
+
 def write_text(text: str, path: str | Path, *, overwrite: bool = False) -> Path:
     """Write a text atomically: a temporary file in the same folder, then a rename.
 
-    A reader never sees half a file, and a crash mid-write leaves the old file (or none).
+    A reader never sees half a file, and a crash mid-write leaves the old file (or none). The
+    file gets the mode a plain ``open`` would give it: a replaced file keeps its own mode, a new
+    one ``0o666`` less the process's umask (a temporary file is created ``0o600``; without this,
+    results would be unreadable to the user's group although ``render`` and ``translate``
+    outputs were not).
 
     Args:
         text: what to write (UTF-8).
@@ -566,6 +590,7 @@ def write_text(text: str, path: str | Path, *, overwrite: bool = False) -> Path:
             with os.fdopen(handle, "w", encoding="utf-8", newline="") as stream:
                 stream.write(text)
                 stream.flush()
+                os.fchmod(stream.fileno(), _file_mode(path))
                 os.fsync(stream.fileno())
             if not overwrite and path.exists():  # appeared while we wrote: keep it
                 raise DestinationExists(SourceLocation(str(path)))
@@ -627,45 +652,25 @@ def _refuse_blockers(model: Model) -> None:
 def convert_file(
     source: str | Path,
     output: str | Path | None = None,
+    request: ConvertRequest | None = None,
     *,
-    to: str | None = None,
-    source_format: str | None = None,
-    engine: str = "rules",
-    style: str = "paper",
-    loop: bool = False,
-    hierarchy: str = "subtrees",
-    verify: bool = True,
-    verify_engine: str = "native",
-    max_states: int | None = None,
-    overwrite: bool = False,
-    keep_not_equivalent: bool = False,
-    options: dict[str, object] | None = None,
     on_stage: StageHook | None = None,
+    **fields: Any,
 ) -> Outcome:
     """Read, convert, verify and write one model file.
 
     The destination is checked first, so a refused output costs no conversion. The result is
     written only after verification, and only when it is equivalent (or not verified), unless
-    ``keep_not_equivalent``.
+    ``request.keep_not_equivalent``.
 
     Args:
         source: the source file.
         output: where to write the result; ``None`` keeps it in ``Outcome.text`` only.
-        to: the output format (default: from ``output``'s extension, else ``btcpp`` for a BT,
-            ``scxml`` for an FSM).
-        source_format: the source's format (default: detected).
-        engine: the conversion engine.
-        style: the engine's output structure style.
-        loop: BT -> FSM: the root is ticked again after it returns (checked in loop mode).
-        hierarchy: FSM -> BT of a hierarchical FSM: ``subtrees`` or ``flatten``.
-        verify: run the equivalence check.
-        verify_engine: ``native``, ``nusmv`` or ``both``.
-        max_states: the native checker's state limit (``None``: ``fsmbt.limits.current()``'s
-            ``checker_max_states``).
-        overwrite: an existing output file may be replaced.
-        keep_not_equivalent: write the result even when it is not equivalent.
-        options: further engine options (LLM endpoint and model, node models, ...).
+        request: what to do (``fsmbt.api_types.ConvertRequest``: engine, style, output format,
+            verification, reading); the defaults when ``None``.
         on_stage: told each step's name as it starts (for progress displays).
+        **fields: ``ConvertRequest`` fields given one by one (``engine="bsd"``), applied over
+            ``request``; validated the same way (an unknown name is an error).
 
     Returns:
         The ``Outcome``.
@@ -674,48 +679,33 @@ def convert_file(
         InputError, UnsupportedError: bad input or a refused destination (located);
         EngineDisagreement: ``verify_engine="both"`` and the engines disagree.
     """
-    options = dict(options or {})
+    request = convert_request(request, **fields)
     if output is not None:
-        check_destination(output, overwrite=overwrite)
+        check_destination(output, overwrite=request.overwrite)
     timings: dict[str, float] = {}
     with _timed(timings, "read", on_stage):
-        loaded = load_for_engine(source, engine, source_format, options=options)
-    outcome = convert_loaded(
-        loaded,
-        output,
-        to=to,
-        engine=engine,
-        style=style,
-        loop=loop,
-        hierarchy=hierarchy,
-        verify=verify,
-        verify_engine=verify_engine,
-        max_states=max_states,
-        overwrite=overwrite,
-        keep_not_equivalent=keep_not_equivalent,
-        options=options,
-        on_stage=on_stage,
-    )
+        loaded, request = _load_source(source, request)
+    outcome = convert_loaded(loaded, output, request, on_stage=on_stage)
     outcome.timings = {**timings, **outcome.timings}
     return outcome
+
+
+def _load_source(source: str | Path, request: ConvertRequest) -> tuple[Loaded, ConvertRequest]:
+    """Read the source of ``request``'s conversion; the LLM engines read through extraction
+    and get the client they made passed on explicitly in the returned request."""
+    if request.engine not in LLM_ENGINES:
+        return load(source, request.read.format, options=request.read.reader_options()), request
+    loaded, client = load_for_llm(source, request)
+    return loaded, request.model_copy(update={"llm_client": client})
 
 
 def convert_loaded(
     loaded: Loaded,
     output: str | Path | None = None,
+    request: ConvertRequest | None = None,
     *,
-    to: str | None = None,
-    engine: str = "rules",
-    style: str = "paper",
-    loop: bool = False,
-    hierarchy: str = "subtrees",
-    verify: bool = True,
-    verify_engine: str = "native",
-    max_states: int | None = None,
-    overwrite: bool = False,
-    keep_not_equivalent: bool = False,
-    options: dict[str, object] | None = None,
     on_stage: StageHook | None = None,
+    **fields: Any,
 ) -> Outcome:
     """Convert, verify and (optionally) write a model already read (a file, a text, an upload).
 
@@ -723,9 +713,8 @@ def convert_loaded(
     through here, so the web page and the batch runner convert exactly as the CLI does.
 
     Args:
-        loaded: the source, from ``load``, ``load_text`` or ``load_for_engine``.
-        output, to, engine, style, loop, hierarchy, verify, verify_engine, max_states,
-        overwrite, keep_not_equivalent, options, on_stage: as for ``convert_file``.
+        loaded: the source, from ``load``, ``load_text`` or ``load_for_llm``.
+        output, request, on_stage, fields: as for ``convert_file``.
 
     Returns:
         The ``Outcome`` (``timings`` without "read").
@@ -733,32 +722,49 @@ def convert_loaded(
     Raises:
         As ``convert_file``.
     """
-    options = dict(options or {})
+    request = convert_request(request, **fields)
     destination = Path(output) if output is not None else None
     if destination is not None:
-        check_destination(destination, overwrite=overwrite)
+        check_destination(destination, overwrite=request.overwrite)
     _warn_lebt_ports(loaded)
     timings: dict[str, float] = {}
     _refuse_blockers(loaded.model)
     with _timed(timings, "convert", on_stage):
-        engine_options = {k: v for k, v in options.items() if k not in READER_OPTIONS}
-        if max_states is not None:
-            engine_options.setdefault("max_states", max_states)
+        engine_options = dict(request.engine_options)
+        if request.llm_client is not None:
+            engine_options["client"] = request.llm_client
+        if loaded.extracted_by_llm or request.engine in LLM_ENGINES:
+            engine_options.setdefault("extracted_by_llm", loaded.extracted_by_llm)
+            if loaded.path is not None:
+                engine_options.setdefault("source_name", str(loaded.path))
+        if request.max_states is not None:
+            engine_options.setdefault("max_states", request.max_states)
         conversion = convert_model(
-            loaded.model, engine, style=style, loop=loop, hierarchy=hierarchy, **engine_options
+            loaded.model,
+            request.engine,
+            style=request.style,
+            loop=request.loop,
+            hierarchy=request.hierarchy,
+            **engine_options,
         )
-    fmt = output_format_for(model_kind(conversion.model), to=to, output=destination)
+    fmt = output_format_for(model_kind(conversion.model), to=request.to, output=destination)
     text = dumps(conversion.model, fmt)
     report: Report | None = None
-    if verify:
+    if request.verify:
         with _timed(timings, "verify", on_stage):
             report = verify_models(
-                loaded.model, conversion.model, verify_engine, loop=loop, max_states=max_states
+                loaded.model,
+                conversion.model,
+                request.verify_engine,
+                loop=request.loop,
+                max_states=request.max_states,
             )
     outcome = Outcome(loaded, conversion, report, fmt, text, output=destination)
-    if destination is not None and (report is None or report.equivalent or keep_not_equivalent):
+    if destination is not None and (
+        report is None or report.equivalent or request.keep_not_equivalent
+    ):
         with _timed(timings, "write", on_stage):
-            write_text(text, destination, overwrite=overwrite)
+            write_text(text, destination, overwrite=request.overwrite)
         outcome.written = True
     outcome.timings = timings
     return outcome
@@ -767,28 +773,22 @@ def convert_loaded(
 def verify_files(
     source: str | Path,
     converted: str | Path,
+    request: VerifyRequest | None = None,
     *,
-    engine: str = "native",
-    loop: bool = False,
-    source_format: str | None = None,
     converted_format: str | None = None,
-    max_states: int | None = None,
-    options: dict[str, object] | None = None,
     on_stage: StageHook | None = None,
+    **fields: Any,
 ) -> tuple[Loaded, Loaded, Report]:
     """Read two model files and check that the second behaves exactly like the first.
 
     Args:
         source: the source model's file.
         converted: the converted model's file.
-        engine: ``native``, ``nusmv`` or ``both``.
-        loop: the BT side's root is ticked again after it returns.
-        source_format: the first file's format (default: detected).
+        request: the checker, loop mode, state limit and reader options
+            (``fsmbt.api_types.VerifyRequest``; ``read.format`` is the first file's format).
         converted_format: the second file's format (default: detected).
-        max_states: the native checker's state limit (``None``: ``fsmbt.limits.current()``'s
-            ``checker_max_states``).
-        options: reader options (e.g. ``node_models``).
         on_stage: told each step's name as it starts ("read", "verify").
+        **fields: ``VerifyRequest`` fields given one by one, applied over ``request``.
 
     Returns:
         Both loaded models (as given) and the ``Report``; the pair is compared in the order
@@ -798,20 +798,94 @@ def verify_files(
         InputError, UnsupportedError: unreadable models or a pair that cannot be compared;
         EngineDisagreement: ``both`` and the engines disagree.
     """
+    request = verify_request(request, **fields)
+    options = request.read.reader_options()
     timings: dict[str, float] = {}
     with _timed(timings, "read", on_stage):
-        first = load(source, source_format, options=options)
+        first = load(source, request.read.format, options=options)
         second = load(converted, converted_format, options=options)
         _warn_lebt_ports(first)
         _warn_lebt_ports(second)
     with _timed(timings, "verify", on_stage):
         report = verify_either_order(
-            first.model, second.model, engine, loop=loop, max_states=max_states
+            first.model,
+            second.model,
+            request.engine,
+            loop=request.loop,
+            max_states=request.max_states,
         )
     return first, second, report
 
 
+def translate(
+    source: str | Path,
+    output: str | Path | None = None,
+    *,
+    to: str | None = None,
+    read: ReadOptions | None = None,
+    flatten: bool = False,
+    overwrite: bool = False,
+    verify_request: VerifyRequest | None = None,
+) -> tuple[Loaded, Translation, Report | None]:
+    """The same model in another format, every loss named, proven to mean the same.
+
+    Read (``load``) -> write in the target format and read it back (``fsmbt.formats.translate``)
+    -> prove the read-back equivalent to the source (``verify_models``; a loss that changes
+    behaviour is an ``UnsupportedError`` and nothing is written) -> write atomically, after
+    the destination was checked before any work.
+
+    Args:
+        source: the input file.
+        output: where to write (``None``: only return the text).
+        to: the target format (default: from ``output``'s extension and the model's kind).
+        read: how the input is read (format, reader options).
+        flatten: write a hierarchical FSM as its flat machine (named as a loss).
+        overwrite: an existing ``output`` may be replaced.
+        verify_request: the checker and its limits (default: native).
+
+    Returns:
+        The source as read, the ``Translation`` (text, losses, ``verified``) and the
+        equivalence report (``None`` when the target cannot be read back).
+
+    Raises:
+        InputError, UnsupportedError: unreadable input, an unknown target, a refused
+        destination, or a translation that changes the model's behaviour (located).
+    """
+    read = read or ReadOptions()
+    destination = check_destination(output, overwrite=overwrite) if output is not None else None
+    loaded = load(source, read.format, options=read)
+    target = to
+    if target is None and destination is not None:
+        guessed = format_for_path(destination, writing=True, kind=loaded.kind)
+        target = guessed.name if guessed is not None else None
+    if target is None:
+        where = f" (from '{destination.name}')" if destination is not None else ""
+        raise InputError(f"cannot tell the target format; name it with --to{where}")
+    result = translate_model(loaded.model, target, flatten=flatten, source_format=loaded.format)
+    result.warnings = list(loaded.warnings)
+    report: Report | None = None
+    if result.read_back is not None and result.checked is not None:
+        request = verify_request or VerifyRequest()
+        report = verify_models(
+            result.checked, result.read_back, request.engine, max_states=request.max_states
+        )
+        if not report.equivalent:
+            failed = [name for name, prop in report.properties.items() if not prop.holds]
+            details = "; ".join(f"{name}: {report.properties[name].detail}" for name in failed)
+            raise UnsupportedError(
+                f"translating to {result.target_format} changes the model's behaviour "
+                f"({details}); nothing written"
+            )
+        result.verified = True
+    if destination is not None:
+        write_text(result.text, destination, overwrite=overwrite)
+    return loaded, result, report
+
+
 __all__ = [
+    "ConvertRequest",
+    "ReadOptions",
+    "VerifyRequest",
     "DEFAULT_BT_FORMAT",
     "DEFAULT_FSM_FORMAT",
     "EQUIVALENT",
@@ -826,14 +900,17 @@ __all__ = [
     "convert_file",
     "convert_loaded",
     "convert_model",
+    "convert_request",
+    "verify_request",
     "load",
-    "load_for_engine",
+    "load_for_llm",
     "load_text",
     "model_kind",
     "output_format_for",
     "verdict_word",
     "verify_either_order",
     "verify_files",
+    "translate",
     "verify_models",
     "write",
     "write_text",

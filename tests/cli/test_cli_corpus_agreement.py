@@ -1,6 +1,7 @@
-"""``validate`` and ``convert`` agree on every well-formed corpus BT (issue 12 part 5): a file
-``validate`` passes (exit 0) is not refused by ``convert``, and a file ``convert`` refuses fails
-``validate`` (exit 2) with an error at the place convert names; ``info`` lists what would be refused.
+"""``validate`` and ``convert`` agree on every well-formed corpus BT (issue 12 part 5, issue 25):
+a file ``validate`` finds no error and no "cannot convert" warning in is not refused by
+``convert``, and a file ``convert`` refuses has an error or a ``cannot-convert`` /
+``unknown-semantics`` finding at the place convert names (an error with ``--strict``); ``info`` lists what would be refused.
 Skips only when the corpus folder is absent (FSMBT_CORPUS)."""
 
 from __future__ import annotations
@@ -25,6 +26,11 @@ def _bt_files() -> list[Path]:
     )
 
 
+def _refusal(issue: dict[str, object]) -> bool:
+    """An error, or a warning that conversion would refuse the model there."""
+    return issue["severity"] == "error" or issue["code"] in ("cannot-convert", "unknown-semantics")
+
+
 def test_validate_and_convert_agree_on_the_corpus(capsys: pytest.CaptureFixture[str]) -> None:
     files = _bt_files()
     if not files:
@@ -47,17 +53,21 @@ def test_validate_and_convert_agree_on_the_corpus(capsys: pytest.CaptureFixture[
         except InputError as exc:
             converts = False
             refused += 1
-            error_lines = {i["line"] for i in report["issues"] if i["severity"] == "error"}
+            error_lines = {i["line"] for i in report["issues"] if _refusal(i)}
             if exc.location is not None and exc.location.line not in error_lines:
                 disagreements.append(
                     f"{path.name}: convert refuses at {exc.location}, "
                     f"validate names no error there ({sorted(error_lines)})"
                 )
-        if (code == 0) != converts:
+        clean = code == 0 and not any(_refusal(i) for i in report["issues"])
+        if clean != converts:
             disagreements.append(
                 f"{path.name}: validate exit {code}, convert "
                 f"{'converts' if converts else 'refuses'}"
             )
+        if not converts:  # --strict makes the refusal an error
+            assert main(["validate", str(path), "--strict", "--json"]) == 2, path
+            capsys.readouterr()
     assert disagreements == []
     assert refused > 0  # the corpus has files conversion refuses: the check is not vacuous
 

@@ -13,8 +13,8 @@ from pathlib import Path
 import pytest
 from lxml import etree
 
+from fsmbt import api
 from fsmbt.cli import main
-from fsmbt.formats import read_model
 from fsmbt.formats.registry import format_for_path, formats
 from fsmbt.model import FSM, BTDocument, BTNode, NodeKind
 
@@ -52,7 +52,7 @@ def test_info_and_render_every_example(
     _need_reader(path)
     assert main(["info", str(path), "--json"]) == 0
     data = json.loads(capsys.readouterr().out)
-    model = read_model(path)
+    model = api.load(path).model
     assert data["kind"] == ("fsm" if isinstance(model, FSM) else "bt")
     if shutil.which("dot") is None:
         pytest.skip("Graphviz dot not installed")
@@ -117,7 +117,7 @@ ROBOT_CONDITIONS = {
 
 @pytest.mark.parametrize("name", ["paper_fsm.xml", "paper_fsm.json"])
 def test_paper_fsm_is_the_issues_fsm(name: str) -> None:
-    fsm = read_model(EXAMPLES / name)
+    fsm = api.load(EXAMPLES / name).model
     assert isinstance(fsm, FSM)
     pairs = {
         tuple(p.strip().split("→")) for group in PAPER_FSM.split(";") for p in group.split(",")
@@ -131,7 +131,7 @@ def test_paper_fsm_is_the_issues_fsm(name: str) -> None:
 
 
 def test_paper_fsm_xml_and_json_hold_the_same_model() -> None:
-    assert read_model(EXAMPLES / "paper_fsm.xml") == read_model(EXAMPLES / "paper_fsm.json")
+    assert api.load(EXAMPLES / "paper_fsm.xml").model == api.load(EXAMPLES / "paper_fsm.json").model
 
 
 def _parse_bracket(text: str) -> tuple:
@@ -163,7 +163,7 @@ def _shape(node: BTNode) -> tuple:
 
 
 def test_robot_bt_is_the_issues_tree() -> None:
-    doc = read_model(EXAMPLES / "robot_bt.xml")
+    doc = api.load(EXAMPLES / "robot_bt.xml").model
     assert isinstance(doc, BTDocument)
     assert _shape(doc.main.root) == _parse_bracket(ROBOT_BT)
     leaves = {n.type: n.kind for _, n in doc.nodes() if n.is_leaf}
@@ -199,7 +199,7 @@ def test_robot_bt_runs_in_behaviortree_cpp() -> None:
     path = EXAMPLES / "robot_bt.xml"
     status, ticked = _btcpp_run(path.read_text(encoding="utf-8"), *_declared(path))
     # every condition fails and every action succeeds: each Fallback runs its action
-    doc = read_model(path)
+    doc = api.load(path).model
     assert status.endswith("SUCCESS")
     assert ticked == [n.type for _, n in doc.nodes() if n.is_leaf]
 

@@ -6,9 +6,10 @@ from pathlib import Path
 
 import pytest
 
+from fsmbt import api
 from fsmbt.cli import main
 from fsmbt.cli.hints import CLI_WORDING
-from fsmbt.formats import loads, read_model, write_model
+from fsmbt.formats import loads
 from fsmbt.llm.config import LLMConfigError, resolve_settings
 from fsmbt.model import FSM, InputError, State
 from fsmbt.model.errors import HINT_TEXT, Hint
@@ -36,13 +37,13 @@ def test_library_errors_carry_hints_and_name_no_flag(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     target = tmp_path / "m.json"
-    write_model(small_fsm(), target)
+    api.write(small_fsm(), target)
     with pytest.raises(InputError) as exists:
-        write_model(small_fsm(), target)
+        api.write(small_fsm(), target)
     with pytest.raises(InputError) as unknown:
         loads("no reader knows this\n")
     with pytest.raises(InputError) as no_suffix:
-        write_model(small_fsm(), tmp_path / "m.unknown-suffix")
+        api.write(small_fsm(), tmp_path / "m.unknown-suffix")
     with pytest.raises(TooLargeError) as too_large:
         fsm_to_dot(small_fsm(), max_nodes=2)
     for name in ("FSMBT_LLM_BASE_URL", "FSMBT_LLM_MODEL", "FSMBT_LLM_CONFIG"):
@@ -98,7 +99,7 @@ def test_cli_prints_the_flag(tmp_path: Path, capsys: pytest.CaptureFixture[str])
 
 
 def test_wrapped_errors_keep_their_hints() -> None:
-    fsm = read_model(EXAMPLES / "paper_fsm.json")
+    fsm = api.load(EXAMPLES / "paper_fsm.json").model
     try:
         fsm_to_dot(fsm, max_nodes=1)
     except TooLargeError as exc:

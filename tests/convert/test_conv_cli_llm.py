@@ -83,12 +83,13 @@ def test_hybrid_on_a_parsed_file_asks_no_llm(tmp_path: Path) -> None:
 def test_llm_engine_gets_base_url_and_model(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
+    from fsmbt import api
     from fsmbt.convert import convert
-    from fsmbt.formats import dumps, read_model
+    from fsmbt.formats import dumps
 
     source = tmp_path / "door.json"
     source.write_text(json.dumps(FSM_JSON), encoding="utf-8")
-    answer = dumps(convert(read_model(source)).model, "btcpp")
+    answer = dumps(convert(api.load(source).model).model, "btcpp")
     with ScriptedServer([{"content": answer}]) as server:
         code = main(
             [

@@ -8,8 +8,8 @@ from pathlib import Path
 
 import pytest
 
+from fsmbt import api
 from fsmbt.convert import convert
-from fsmbt.formats import read_model
 from fsmbt.model.errors import InputError
 from support.conv_helpers import check
 from support.corpus import CORPUS
@@ -38,7 +38,7 @@ def test_corpus_converts_or_is_rejected_clearly() -> None:
     failures: list[str] = []
     for path in files:
         try:
-            model = read_model(path)
+            model = api.load(path).model
         except InputError:
             counts["unreadable"] += 1
             continue

@@ -8,9 +8,9 @@ from pathlib import Path
 
 import pytest
 
+from fsmbt import api
 from fsmbt.convert import convert
 from fsmbt.convert.hfsm_to_bt import fsm_to_subtree_bt
-from fsmbt.formats import read_model
 from fsmbt.model.errors import InputError
 from fsmbt.model.fsm import FSM
 from support.conv_helpers import check
@@ -29,7 +29,7 @@ def _subtree_refs(doc) -> list[str]:
 
 
 def test_door_example_has_one_tree_per_composite_and_is_equivalent() -> None:
-    fsm = read_model(REPO / "examples" / "door_hfsm.scxml")
+    fsm = api.load(REPO / "examples" / "door_hfsm.scxml").model
     result = convert(fsm)
     doc = result.model
     assert set(doc.trees) == {"MainTree", *_composites(fsm)}
@@ -39,7 +39,7 @@ def test_door_example_has_one_tree_per_composite_and_is_equivalent() -> None:
 
 
 def test_flatten_mode_gives_one_tree() -> None:
-    fsm = read_model(REPO / "examples" / "door_hfsm.scxml")
+    fsm = api.load(REPO / "examples" / "door_hfsm.scxml").model
     result = convert(fsm, hierarchy="flatten")
     assert list(result.model.trees) == ["MainTree"]
     assert check(fsm, result.model).equivalent
@@ -71,7 +71,7 @@ def test_corpus_hierarchical_scxml_converts_to_subtrees_equivalently() -> None:
     converted, failures = 0, []
     for path in files:
         try:
-            model = read_model(path)
+            model = api.load(path).model
         except InputError:
             continue
         if not isinstance(model, FSM) or not model.is_hierarchical:

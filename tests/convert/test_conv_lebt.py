@@ -116,19 +116,20 @@ def test_compact_style_is_refused() -> None:
 
 
 def test_cli_convert_verifies_writes_and_refuses_overwrite(tmp_path) -> None:
+    from fsmbt import api
     from fsmbt.cli import main
-    from fsmbt.formats import loads, write_model
+    from fsmbt.formats import loads
     from fsmbt.model.serialize import model_to_dict
     from support.conv_helpers import paper_robot_bt
 
     source = tmp_path / "aj.json"
-    write_model(paper_aj_fsm(), source)
+    api.write(paper_aj_fsm(), source)
     out = tmp_path / "aj.xml"
     assert main(["convert", str(source), "-o", str(out)]) == 0 and out.exists()
     assert main(["convert", str(source), "-o", str(out)]) == 2, "no overwrite without --force"
     assert main(["convert", str(source), "-o", str(out), "--force", "--json"]) == 0
     robot = tmp_path / "robot.json"
-    write_model(paper_robot_bt(), robot)
+    api.write(paper_robot_bt(), robot)
     text_out = tmp_path / "robot.txt"
     assert main(["convert", str(robot), "-o", str(text_out)]) == 0
     hfsm = convert(paper_robot_bt()).model

@@ -37,7 +37,7 @@ def report(tmp_path_factory: pytest.TempPathFactory) -> Path:
     settings = EvaluationSettings(
         output=out, quick=True, count=3, nusmv_sample=0, workers=1, corpus=None, examples=EXAMPLES
     )
-    evaluate(settings, progress=False)
+    evaluate(settings)
     return out
 
 
@@ -171,14 +171,25 @@ def test_resume_after_lost_rows_runs_exactly_those(tmp_path: Path) -> None:
     settings = EvaluationSettings(
         output=tmp_path, count=2, nusmv_sample=0, workers=2, corpus=None, examples=None
     )
-    first = evaluate(settings, report=False, progress=False)
+    first = evaluate(settings, report=False)
     assert first["before"] == 0 and first["ran"] == first["after"] == first["jobs"] == 36
     # a run killed mid-way: the rows it had not stored yet are missing
     with sqlite3.connect(tmp_path / "results.sqlite") as db:
         db.execute("DELETE FROM results WHERE rowid % 3 = 0")
         left = db.execute("SELECT COUNT(*) FROM results").fetchone()[0]
-    second = evaluate(settings, report=False, progress=False)
+    calls: list[tuple[str, int, int]] = []
+    second = evaluate(settings, report=False, on_progress=lambda *call: calls.append(call))
     assert second["before"] == left and second["ran"] == 36 - left and second["after"] == 36
+    # the progress hook: each method starts at what the store held and ends at its total
+    first_seen: dict[str, int] = {}
+    last: dict[str, tuple[int, int]] = {}
+    for label, done, total in calls:
+        first_seen.setdefault(label, done)
+        last[label] = (done, total)
+    assert sum(first_seen.values()) == left
+    assert all(done == total for done, total in last.values())
+    assert sum(total for _done, total in last.values()) == 36
+    assert len(calls) == len(last) + (36 - left)
     with sqlite3.connect(tmp_path / "results.sqlite") as db:
         assert db.execute("SELECT COUNT(*), COUNT(DISTINCT key) FROM results").fetchone() == (
             36,

@@ -7,8 +7,9 @@ from pathlib import Path
 
 import pytest
 
-from fsmbt.formats import dumps, loads, read_model
-from fsmbt.formats.btcpp import ASSUMED_MARK
+from fsmbt import api
+from fsmbt.formats import dumps, loads
+from fsmbt.formats.btcpp.xml_format import ASSUMED_MARK
 from fsmbt.formats.xml_safe import parse_xml, root_tag
 from fsmbt.limits import current as current_limits
 from fsmbt.model import BTDocument, BTNode, NodeKind
@@ -114,7 +115,7 @@ def test_writer_declares_custom_types_for_groot() -> None:
 
 def test_includes_resolve_relative_and_are_written_inline() -> None:
     path = corpus("bt/btcpp/trees/parent_include_child_include_parent.xml")
-    doc = read_model(path)
+    doc = api.load(path).model
     assert set(doc.trees) == {
         "ParentIncludeChildIncludeParent",
         "ChildIncludeParent",
@@ -138,7 +139,7 @@ def test_include_cycle_is_reported(tmp_path: Path) -> None:
         '<BehaviorTree ID="B"><AlwaysSuccess/></BehaviorTree></root>'
     )
     with pytest.raises(InputError, match="include cycle"):
-        read_model(tmp_path / "a.xml")
+        api.load(tmp_path / "a.xml")
 
 
 def test_missing_include_names_the_line(tmp_path: Path) -> None:
@@ -147,15 +148,15 @@ def test_missing_include_names_the_line(tmp_path: Path) -> None:
         '<BehaviorTree ID="A"><AlwaysSuccess/></BehaviorTree></root>'
     )
     with pytest.raises(InputError) as info:
-        read_model(tmp_path / "a.xml")
+        api.load(tmp_path / "a.xml")
     assert info.value.location is not None and info.value.location.line == 2
 
 
 def test_external_node_models_option_decides_leaf_kinds() -> None:
     models = corpus("bt/nav2/models/nav2_tree_nodes.xml")
     tree = corpus("bt/nav2/navigate_w_replanning_time.xml")
-    plain = read_model(tree)
-    informed = read_model(tree, options={"node_models": [str(models)]})
+    plain = api.load(tree).model
+    informed = api.load(tree, options={"node_models": [str(models)]}).model
     undeclared = [n for _, n in plain.nodes() if not n.kind_declared]
     assert undeclared, "without Nav2's model file some kinds are assumed"
     assert all(n.kind_declared for _, n in informed.nodes())

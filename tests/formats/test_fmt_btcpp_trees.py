@@ -11,7 +11,6 @@ from pathlib import Path
 import pytest
 
 from fsmbt import api, limits
-from fsmbt.formats import read_model
 from fsmbt.model.errors import InputError
 from fsmbt.semantics.bt_interpreter import BTInterpreter
 from support.corpus import CORPUS
@@ -41,7 +40,8 @@ def test_folder_lookup_finds_the_tree_and_warns_naming_the_file(tmp_path: Path) 
     other = tree_file(tmp_path / "other.xml", "Sub", "<Grasp/>")
     tree_file(tmp_path / "unrelated.xml", "Unused", "<Broken><A/><B/></Broken>")
     warnings: list[str] = []
-    doc = read_model(main, warnings=warnings)
+    loaded = api.load(main)
+    doc, warnings = loaded.model, loaded.warnings
     assert set(doc.trees) == {"Main", "Sub"}  # the unreached tree of the folder is not taken
     assert str(other) in " ".join(warnings) and "--trees" in " ".join(warnings)
     assert doc.trees["Sub"].root is not None and doc.trees["Sub"].root.type == "Grasp"
@@ -52,7 +52,7 @@ def test_folder_lookup_follows_references_of_the_found_file(tmp_path: Path) -> N
     main = main_file(tmp_path, "A")
     tree_file(tmp_path / "a.xml", "A", '<Sequence><SubTree ID="B"/><Go/></Sequence>')
     tree_file(tmp_path / "b.xml", "B", "<Stop/>")
-    assert set(read_model(main).trees) == {"Main", "A", "B"}
+    assert set(api.load(main).model.trees) == {"Main", "A", "B"}
 
 
 def test_folder_lookup_refuses_an_id_defined_twice_naming_both(tmp_path: Path) -> None:
@@ -60,7 +60,7 @@ def test_folder_lookup_refuses_an_id_defined_twice_naming_both(tmp_path: Path) -
     one = tree_file(tmp_path / "one.xml", "Sub", "<Grasp/>")
     two = tree_file(tmp_path / "two.xml", "Sub", "<Drop/>")
     with pytest.raises(InputError) as info:
-        read_model(main)
+        api.load(main)
     message = str(info.value)
     assert str(one) in message and str(two) in message and "main.xml:1" in message
 
@@ -71,7 +71,8 @@ def test_folder_lookup_never_leaves_the_folder(tmp_path: Path) -> None:
     tree_file(tmp_path / "outside.xml", "Sub", "<Grasp/>")  # the parent folder: not searched
     (tmp_path / "nested").mkdir()
     warnings: list[str] = []
-    doc = read_model(main, warnings=warnings)
+    loaded = api.load(main)
+    doc, warnings = loaded.model, loaded.warnings
     assert "Sub" not in doc.trees
     assert any("--trees" in w and "'Sub'" in w for w in warnings)
     with pytest.raises(InputError, match="unknown tree 'Sub'.*--trees"):
@@ -83,7 +84,7 @@ def test_folder_lookup_skips_unreadable_files_and_names_them(tmp_path: Path) -> 
     (tmp_path / "broken.xml").write_text("<root><BehaviorTree ID='Sub'>", encoding="utf-8")
     (tmp_path / "notbt.xml").write_text("<scxml/>", encoding="utf-8")
     warnings: list[str] = []
-    read_model(main, warnings=warnings)
+    warnings = api.load(main).warnings
     text = " ".join(warnings)
     assert "broken.xml" in text and "notbt.xml" in text and "2 unreadable" in text
 
@@ -94,7 +95,7 @@ def test_folder_lookup_is_bounded_by_max_tree_files(tmp_path: Path) -> None:
         tree_file(tmp_path / f"t{i}.xml", f"T{i}", "<A/>")
     with limits.changed(max_tree_files=3):
         with pytest.raises(InputError, match="FSMBT_MAX_TREE_FILES"):
-            read_model(main)
+            api.load(main)
 
 
 def test_folder_lookup_obeys_the_size_limit(tmp_path: Path) -> None:
@@ -102,7 +103,8 @@ def test_folder_lookup_obeys_the_size_limit(tmp_path: Path) -> None:
     big = tree_file(tmp_path / "big.xml", "Sub", "<A/>" + " " * 5000)
     with limits.changed(max_input_bytes=len(main.read_bytes()) + 50):
         warnings: list[str] = []
-        doc = read_model(main, warnings=warnings)
+        loaded = api.load(main)
+        doc, warnings = loaded.model, loaded.warnings
     assert "Sub" not in doc.trees and big.name in " ".join(warnings)
 
 
@@ -114,7 +116,8 @@ def test_folder_lookup_refuses_hostile_xml_as_unreadable(tmp_path: Path) -> None
         encoding="utf-8",
     )
     warnings: list[str] = []
-    doc = read_model(main, warnings=warnings)
+    loaded = api.load(main)
+    doc, warnings = loaded.model, loaded.warnings
     assert "Sub" not in doc.trees and "bomb.xml" in " ".join(warnings)
 
 
@@ -126,7 +129,8 @@ def test_trees_option_files_and_folders(tmp_path: Path) -> None:
     # a file in the main file's folder would be found, but --trees is given: only its files
     tree_file(tmp_path / "a_decoy.xml", "A", "<Decoy/>")
     warnings: list[str] = []
-    doc = read_model(main, options={"trees": [str(tmp_path / "lib"), str(b)]}, warnings=warnings)
+    loaded = api.load(main, options={"trees": [str(tmp_path / "lib"), str(b)]})
+    doc, warnings = loaded.model, loaded.warnings
     assert set(doc.trees) == {"Main", "A", "B"}
     assert doc.trees["A"].root is not None and doc.trees["A"].root.type == "Go"
     assert not any("taken from" in w for w in warnings)  # named by the caller: no warning
@@ -137,13 +141,13 @@ def test_trees_option_refuses_duplicates_and_missing_paths(tmp_path: Path) -> No
     one = tree_file(tmp_path / "x1.xml", "A", "<Go/>")
     two = tree_file(tmp_path / "x2.xml", "A", "<Stop/>")
     with pytest.raises(InputError) as info:
-        read_model(main, options={"trees": [str(one), str(two)]})
+        api.load(main, options={"trees": [str(one), str(two)]})
     assert str(one) in str(info.value) and str(two) in str(info.value)
     with pytest.raises(InputError, match="no such file"):
-        read_model(main, options={"trees": [str(tmp_path / "nope.xml")]})
+        api.load(main, options={"trees": [str(tmp_path / "nope.xml")]})
     (tmp_path / "junk.xml").write_text("not xml", encoding="utf-8")
     with pytest.raises(InputError, match="junk.xml"):
-        read_model(main, options={"trees": [str(tmp_path / "junk.xml")]})
+        api.load(main, options={"trees": [str(tmp_path / "junk.xml")]})
 
 
 def test_trees_option_for_text_input(tmp_path: Path) -> None:
@@ -162,10 +166,10 @@ def test_include_root_reaches_a_parent_folder_and_stays_bounded(tmp_path: Path) 
         extra='<include path="../parent.xml"/>',
     )
     with pytest.raises(InputError, match="--include-root"):
-        read_model(child)
-    assert set(read_model(child, options={"include_root": str(tmp_path)}).trees) == {"C", "P"}
+        api.load(child)
+    assert set(api.load(child, options={"include_root": str(tmp_path)}).model.trees) == {"C", "P"}
     with pytest.raises(InputError, match="outside the folder"):
-        read_model(child, options={"include_root": str(tmp_path / "child")})
+        api.load(child, options={"include_root": str(tmp_path / "child")})
 
 
 def _cli(*args: str) -> subprocess.CompletedProcess[str]:
@@ -254,7 +258,8 @@ def test_a_found_file_does_not_replace_the_files_own_trees(tmp_path: Path) -> No
         encoding="utf-8",
     )
     warnings: list[str] = []
-    doc = read_model(main, warnings=warnings)
+    loaded = api.load(main)
+    doc, warnings = loaded.model, loaded.warnings
     assert doc.trees["Main"].root is not None and doc.trees["Main"].root.type == "Sequence"
     assert set(doc.trees) == {"Main", "Sub"}
     assert any("'Main'" in w and "not taken" in w for w in warnings)

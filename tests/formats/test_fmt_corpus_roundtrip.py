@@ -14,7 +14,8 @@ from pathlib import Path
 
 import pytest
 
-from fsmbt.formats import dumps, loads, read_model
+from fsmbt import api
+from fsmbt.formats import dumps, loads
 from fsmbt.model import BTDocument
 from fsmbt.model.errors import InputError, UnsupportedError
 from support.corpus import CORPUS
@@ -42,7 +43,7 @@ def _classify(path: Path) -> tuple[str, str]:
     # are confined to the read file's folder unless the caller widens it (docs/security.md)
     options["include_root"] = str(CORPUS)
     try:
-        model = read_model(path, options=options)
+        model = api.load(path, options=options).model
     except UnsupportedError as exc:
         return "unsupported", str(exc)
     except InputError as exc:

@@ -11,8 +11,9 @@ from pathlib import Path
 
 import pytest
 
+from fsmbt import api
 from fsmbt.cli import main
-from fsmbt.formats import dumps, loads, read_model
+from fsmbt.formats import dumps, loads
 from fsmbt.model import FSM, State
 from fsmbt.render import bt_to_dot, fsm_to_dot
 
@@ -56,13 +57,13 @@ def test_odd_names_roundtrip_exactly_through_the_format_writer() -> None:
 
 
 def test_format_dot_of_a_bt_is_the_picture_dot() -> None:
-    doc = read_model(EXAMPLES / "robot_bt.xml")
+    doc = api.load(EXAMPLES / "robot_bt.xml").model
     assert dumps(doc, "dot") == bt_to_dot(doc)
 
 
 @pytest.mark.parametrize("name", ["paper_fsm.json", "turnstile.mmd", "door_hfsm.scxml"])
 def test_format_and_picture_draw_fsms_with_the_same_nodes_and_clusters(name: str) -> None:
-    fsm = read_model(EXAMPLES / name)
+    fsm = api.load(EXAMPLES / name).model
     written, drawn = dumps(fsm, "dot"), fsm_to_dot(fsm)
     assert shapes(written) == shapes(drawn)
     assert written.count("subgraph cluster_") == drawn.count("subgraph cluster_")

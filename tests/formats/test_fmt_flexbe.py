@@ -11,7 +11,8 @@ from pathlib import Path
 
 import pytest
 
-from fsmbt.formats import detect_format, loads, read_model
+from fsmbt import api
+from fsmbt.formats import detect_format, loads
 from fsmbt.model.errors import InputError, UnsupportedError
 from fsmbt.model.fsm import FSM
 from fsmbt.semantics.machine import FSMMachine
@@ -153,7 +154,7 @@ def test_embedded_behaviour_is_read_from_its_file_beside(tmp_path: Path) -> None
         behaviour(EMBEDDED, name="OuterSM", imports="from my_behaviors.inner_sm import InnerSM"),
         encoding="utf-8",
     )
-    model = read_model(outer)
+    model = api.load(outer).model
     inner = model.states["Inner"]
     assert inner.attrs["flexbe.behaviour"] == "InnerSM"
     assert edges(inner.regions[0]) == {
@@ -170,7 +171,7 @@ def test_missing_embedded_behaviour_names_the_file_expected(tmp_path: Path) -> N
         encoding="utf-8",
     )
     with pytest.raises(UnsupportedError) as caught:
-        read_model(outer)
+        api.load(outer)
     assert str(tmp_path / "inner_sm.py") in str(caught.value)
     assert caught.value.location is not None and caught.value.location.line is not None
     with pytest.raises(UnsupportedError, match="read this behaviour from its file"):
@@ -191,7 +192,7 @@ def test_behaviours_embedding_each_other_are_refused(tmp_path: Path) -> None:
         encoding="utf-8",
     )
     with pytest.raises(InputError, match="embeds itself"):
-        read_model(tmp_path / "a_sm.py")
+        api.load(tmp_path / "a_sm.py")
 
 
 def test_create_that_returns_nothing_readable_is_an_error() -> None:

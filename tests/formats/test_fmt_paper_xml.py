@@ -110,8 +110,8 @@ def test_hierarchical_fsm_cannot_be_written() -> None:
 
 
 def test_detected_by_root_element_in_xml_file(tmp_path) -> None:
-    from fsmbt.formats import read_model
+    from fsmbt import api
 
     path = tmp_path / "machine.xml"
     path.write_text(PAPER)
-    assert isinstance(read_model(path), FSM)
+    assert isinstance(api.load(path).model, FSM)

@@ -12,11 +12,18 @@ from pathlib import Path
 import pytest
 
 from fsmbt import api
-from fsmbt.formats.registry import dumps, loads, read_model
+from fsmbt.formats.registry import dumps, loads, read_text
 from fsmbt.generate.generator import random_fsm
+from fsmbt.model import Model
 from fsmbt.model.errors import InputError, UnsupportedError
 from fsmbt.model.flatten import flatten
 from fsmbt.model.fsm import FSM
+
+
+def read_model(path: Path, warnings: list[str] | None = None) -> Model:
+    """Read one file with the reader its content or extension selects (as ``api.load``)."""
+    return loads(read_text(path), path=Path(path), warnings=warnings)
+
 
 statemachine = pytest.importorskip("statemachine")
 

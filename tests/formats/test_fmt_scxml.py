@@ -7,10 +7,11 @@ import re
 
 import pytest
 
-from fsmbt.formats import dumps, loads, read_model
+from fsmbt import api
+from fsmbt.formats import dumps, loads
 from fsmbt.formats.registry import ReadContext
-from fsmbt.formats.scxml import _Reader, read_scxml
-from fsmbt.formats.scxml_w3c import representative_event
+from fsmbt.formats.scxml.structural import _Reader, read_scxml
+from fsmbt.formats.scxml.w3c import representative_event
 from fsmbt.model import FSM, State
 from fsmbt.model.errors import InputError, UnsupportedError
 from fsmbt.semantics.machine import FSMMachine
@@ -305,7 +306,7 @@ def test_scion_expected_configurations() -> None:
     checked, unsupported = [], []
     for spec_path in sorted(folder.glob("*.json")):
         try:
-            machine = FSMMachine(read_model(spec_path.with_suffix(".scxml")))
+            machine = FSMMachine(api.load(spec_path.with_suffix(".scxml")).model)
         except UnsupportedError:
             unsupported.append(spec_path.stem)
             continue
@@ -322,7 +323,7 @@ def test_scion_expected_configurations() -> None:
     assert len(checked) >= 24  # history, guards, prefix and wildcard descriptors included
     for name in DATA_TESTS:  # the data is read exactly: no guard is the environment's choice
         assert name in checked
-        model = read_model(folder / f"{name}.scxml")
+        model = api.load(folder / f"{name}.scxml").model
         assert not [event for event in model.events() if "[" in event], name
 
 

@@ -11,9 +11,8 @@ import pytest
 from fsmbt import api, limits
 from fsmbt.formats import loads
 from fsmbt.formats.registry import ReadContext
-from fsmbt.formats.scxml import read_scxml
-from fsmbt.formats.scxml_datamodel import StateLimitError, literal_prefix, may_match_prefix
-from fsmbt.formats.scxml_expr import (
+from fsmbt.formats.scxml.datamodel import StateLimitError, literal_prefix, may_match_prefix
+from fsmbt.formats.scxml.expr import (
     ECMASCRIPT,
     JEXL,
     PYTHON,
@@ -23,6 +22,7 @@ from fsmbt.formats.scxml_expr import (
     evaluate,
     parse,
 )
+from fsmbt.formats.scxml.structural import read_scxml
 from fsmbt.model.errors import UnsupportedError
 from fsmbt.model.fsm import FSM
 from fsmbt.semantics.machine import FSMMachine

@@ -1,4 +1,4 @@
-"""XInclude in SCXML (fsmbt.formats.scxml_include): the included document reads like the same
+"""XInclude in SCXML (fsmbt.formats.scxml.include): the included document reads like the same
 document written inline by hand (the model is compared, and the hand-inlined text is run by
 python-statemachine's SCXML engine, a W3C engine written by others), and every way out of the
 confinement rule of docs/security.md is refused with the include's line.

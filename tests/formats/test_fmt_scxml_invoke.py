@@ -1,4 +1,4 @@
-"""``<invoke>`` of SCXML sessions (fsmbt.formats.scxml_invoke): the expected configurations are
+"""``<invoke>`` of SCXML sessions (fsmbt.formats.scxml.invoke): the expected configurations are
 worked out by hand from the W3C SCXML 1.0 text (6.4 <invoke>, 6.2.4 send targets, appendix D:
 ``statesToInvoke``, ``exitStates`` cancelling, the main loop's finalize/autoforward step,
 ``exitInterpreter`` and ``done.invoke``), with fsmbt's schedule (docs/formats/scxml.md: an
@@ -480,7 +480,7 @@ def test_a_document_that_ends_cancels_its_sessions() -> None:
 
 
 def test_deep_nesting_is_bounded_without_recursion_errors() -> None:
-    from fsmbt.formats.scxml_invoke import MAX_SESSION_DEPTH
+    from fsmbt.formats.scxml.invoke import MAX_SESSION_DEPTH
 
     def nested(levels: int) -> str:
         body = (

@@ -1,4 +1,4 @@
-"""SCXML documents read by running the W3C algorithm (fsmbt.formats.scxml_w3c): history, guarded
+"""SCXML documents read by running the W3C algorithm (fsmbt.formats.scxml.w3c): history, guarded
 inputs, the internal and external queues, descriptors, refusals with lines, bounds. Expected
 configurations are worked out by hand from the W3C SCXML 1.0 algorithm (appendix D); the
 agreement with a W3C engine written by others is tests/runtime/test_rt_scxml_reader_oracle.py.
@@ -11,8 +11,8 @@ import pytest
 from fsmbt import api
 from fsmbt.formats import dumps, loads
 from fsmbt.formats.registry import ReadContext
-from fsmbt.formats.scxml import read_scxml
-from fsmbt.formats.scxml_w3c import MAX_GUARDS_PER_EVENT, representative_event
+from fsmbt.formats.scxml.structural import read_scxml
+from fsmbt.formats.scxml.w3c import MAX_GUARDS_PER_EVENT, representative_event
 from fsmbt.model.errors import InputError, UnsupportedError
 from fsmbt.model.fsm import FSM, State
 from fsmbt.semantics.machine import FINAL, FSMMachine
@@ -297,14 +297,14 @@ def test_data_is_read_exactly_by_default_and_guards_are_computed() -> None:
     ],
 )
 def test_expression_language(text: str, value: object) -> None:
-    from fsmbt.formats.scxml_expr import evaluate, parse
+    from fsmbt.formats.scxml.expr import evaluate, parse
 
     assert evaluate(parse(text), {"x": 3, "y": ""}, lambda state: state == "s") == value
 
 
 @pytest.mark.parametrize("text", ["a.b", "f(1, 2)", "1 +", "(1", "1)", "_event.data"])
 def test_expressions_outside_the_language_do_not_parse(text: str) -> None:
-    from fsmbt.formats.scxml_expr import ExpressionError, parse
+    from fsmbt.formats.scxml.expr import ExpressionError, parse
 
     with pytest.raises(ExpressionError):
         parse(text)

@@ -15,7 +15,8 @@ from pathlib import Path
 
 import pytest
 
-from fsmbt.formats import detect_format, loads, read_model
+from fsmbt import api
+from fsmbt.formats import detect_format, loads
 from fsmbt.model.errors import InputError, UnsupportedError
 from fsmbt.model.fsm import FSM
 from fsmbt.semantics.machine import FSMMachine
@@ -562,7 +563,7 @@ def test_code_in_the_file_is_never_executed(tmp_path: Path) -> None:
         """),
         encoding="utf-8",
     )
-    model = read_model(path)
+    model = api.load(path).model
     assert isinstance(model, FSM) and list(model.states) == ["F", "a"]
     assert not marker.exists()
 

@@ -11,9 +11,10 @@ from pathlib import Path
 
 import pytest
 
+from fsmbt import api
 from fsmbt.convert import convert
-from fsmbt.formats import loads, read_model
-from fsmbt.formats._smach_write import write_smach
+from fsmbt.formats import loads
+from fsmbt.formats.pysm.smach_write import write_smach
 from fsmbt.model.fsm import FSM
 from fsmbt.verify import verify
 from support.corpus import CORPUS
@@ -36,7 +37,7 @@ def test_the_corpus_has_the_files_the_readme_promises() -> None:
 
 @pytest.mark.parametrize("path", FILES, ids=_id)
 def test_corpus_file_reads_converts_and_verifies(path: Path) -> None:
-    model = read_model(path)
+    model = api.load(path).model
     assert isinstance(model, FSM) and model.states
     expected = "flexbe" if "flexbe" in path.parent.name else "smach"
     assert loads(path.read_text(encoding="utf-8"), path=path).name == model.name
@@ -50,15 +51,17 @@ def test_corpus_file_reads_converts_and_verifies(path: Path) -> None:
 
 @pytest.mark.parametrize("path", FILES, ids=_id)
 def test_corpus_file_round_trips_through_the_smach_writer(path: Path) -> None:
-    model = read_model(path)
+    model = api.load(path).model
     again = loads(write_smach(model), "smach")
     assert verify(model, again).equivalent
 
 
 def test_embedded_behaviours_are_nested_from_their_files() -> None:
-    demo = read_model(FSM_DIR / "flexbe_turtlesim_demo" / "flexbe_turtlesim_demo_sm.py")
+    demo = api.load(FSM_DIR / "flexbe_turtlesim_demo" / "flexbe_turtlesim_demo_sm.py").model
     embedded = demo.states["Turtlesim Input State Behavior"]
     assert embedded.attrs["flexbe.behaviour"] == "TurtlesimInputStateBehaviorSM"
-    alone = read_model(FSM_DIR / "flexbe_turtlesim_demo" / "turtlesim_input_state_behavior_sm.py")
+    alone = api.load(
+        FSM_DIR / "flexbe_turtlesim_demo" / "turtlesim_input_state_behavior_sm.py"
+    ).model
     assert embedded.regions[0].states.keys() == alone.states.keys()
     assert embedded.regions[0].transitions == alone.transitions

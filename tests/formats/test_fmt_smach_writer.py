@@ -17,9 +17,10 @@ from pathlib import Path
 
 import pytest
 
+from fsmbt import api
 from fsmbt.convert import convert
-from fsmbt.formats import loads, read_model
-from fsmbt.formats._smach_write import smach_losses, write_smach
+from fsmbt.formats import loads
+from fsmbt.formats.pysm.smach_write import smach_losses, write_smach
 from fsmbt.formats.translate import differences_between
 from fsmbt.generate.generator import random_bt, random_fsm
 from fsmbt.model.errors import InputError, UnsupportedError
@@ -45,7 +46,7 @@ def round_trip(model: FSM) -> FSM:
 
 @pytest.mark.parametrize("name", FSM_EXAMPLES)
 def test_examples_round_trip_to_an_equivalent_model(name: str) -> None:
-    model = read_model(EXAMPLES / name)
+    model = api.load(EXAMPLES / name).model
     assert isinstance(model, FSM)
     back = round_trip(model)
     assert verify(model, back).equivalent
@@ -129,7 +130,7 @@ def test_refusals_are_named() -> None:
     fsm.add_transition("A", None, "B")
     with pytest.raises(UnsupportedError, match="eventless transition"):
         write_smach(fsm)
-    bt = read_model(EXAMPLES / "robot_bt.xml")
+    bt = api.load(EXAMPLES / "robot_bt.xml").model
     with pytest.raises(InputError, match="not behavior trees"):
         write_smach(bt)
 
@@ -227,7 +228,7 @@ def test_written_module_builds_a_consistent_smach_machine(
     elif source.startswith("hfsm:"):
         model = convert(random_bt(int(source[5:]))).model
     else:
-        model = read_model(EXAMPLES / source)
+        model = api.load(EXAMPLES / source).model
     text = write_smach(model)
     monkeypatch.setitem(sys.modules, "smach", _recording_smach())
     namespace: dict = {"__name__": "written_by_fsmbt"}
@@ -275,16 +276,20 @@ def test_states_sharing_an_action_but_not_their_events_get_one_class_each() -> N
     assert differences_between(fsm, back) == []
 
 
-def test_a_transient_state_is_refused_but_translate_flatten_writes_it() -> None:
-    from fsmbt.formats.translate import translate
-
+def test_a_transient_state_is_refused_but_translate_flatten_writes_it(tmp_path: Path) -> None:
     fsm = FSM(name="transient")
     fsm.add_state("A")
     fsm.add_state("Pass")
     fsm.add_state("B", final=True)
     fsm.add_transition("A", "go", "Pass")
     fsm.add_transition("Pass", None, "B")
+    source = api.write(fsm, tmp_path / "transient.json")
     with pytest.raises(UnsupportedError, match="--flatten"):
-        translate(fsm, "smach", check=verify)
-    result = translate(fsm, "smach", flatten=True, check=verify)
-    assert result.verified and any(loss.startswith("flattened:") for loss in result.losses)
+        api.translate(source, to="smach")
+    _loaded, result, report = api.translate(source, to="smach", flatten=True)
+    assert (
+        result.verified
+        and report is not None
+        and report.equivalent
+        and any(loss.startswith("flattened:") for loss in result.losses)
+    )

@@ -355,14 +355,14 @@ def test_sniffing_bt_yaml_and_dot() -> None:
 
 def test_write_model_creates_missing_folders_and_never_overwrites(tmp_path: Path) -> None:
     """`fsmbt convert -o out/x.xml` on a fresh clone has no out/ yet."""
-    from fsmbt.formats.registry import write_model
+    from fsmbt import api
     from fsmbt.model.errors import InputError
     from fsmbt.model.fsm import FSM
 
     fsm = FSM()
     fsm.add_state("A")
     target = tmp_path / "new" / "deeper" / "model.json"
-    write_model(fsm, target)
+    api.write(fsm, target)
     assert target.read_text(encoding="utf-8").startswith("{")
     with pytest.raises(InputError, match="exists"):
-        write_model(fsm, target)
+        api.write(fsm, target)

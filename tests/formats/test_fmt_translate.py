@@ -15,8 +15,9 @@ from pathlib import Path
 
 import pytest
 
-from fsmbt.formats import Format, loads, read_model
-from fsmbt.formats.json_format import write_json
+from fsmbt import api
+from fsmbt.formats import Format, loads
+from fsmbt.formats.schema.json_format import write_json
 from fsmbt.formats.translate import (
     differences_between,
     rename_events,
@@ -74,7 +75,7 @@ def test_smach_to_scxml(tmp_path: Path) -> None:
     assert done.returncode == 0, done.stderr
     assert "(smach) ->" in done.stderr and "(scxml)" in done.stderr
     assert "verified equivalent" in done.stderr
-    model, back = read_model(source), read_model(out)
+    model, back = api.load(source).model, api.load(out).model
     assert differences_between(model, back) == []
     again = cli("translate", str(source), "-o", str(out))
     assert again.returncode == 2 and "--force" in again.stderr  # never overwritten silently
@@ -93,7 +94,7 @@ def test_smach_concurrence_to_scxml_names_what_scxml_cannot_say(tmp_path: Path) 
     assert 'event="done.state.CON"' in text and 'cond="In(' in text
     assert "ends differently by final state" not in done.stderr
     assert verify(
-        read_model(CORPUS / "fsm" / "smach_tutorials" / "concurrence2.py"), read_model(out)
+        api.load(CORPUS / "fsm" / "smach_tutorials" / "concurrence2.py").model, api.load(out)
     ).equivalent
 
 
@@ -107,7 +108,7 @@ def test_btcpp_v3_to_v4(tmp_path: Path) -> None:
     assert 'format_version: "3" becomes "4"' in done.stderr  # the change is named
     text = out.read_text(encoding="utf-8")
     assert 'BTCPP_format="4"' in text and "SequenceStar" not in text
-    before, after = read_model(source), read_model(out)
+    before, after = api.load(source).model, api.load(out).model
     assert isinstance(before, BTDocument) and isinstance(after, BTDocument)
     assert verify(before, after).equivalent
 
@@ -117,7 +118,9 @@ def test_scxml_to_mermaid(tmp_path: Path) -> None:
     done = cli("translate", str(EXAMPLES / "door_hfsm.scxml"), "-o", str(out))
     assert done.returncode == 0, done.stderr
     assert "\nstateDiagram-v2\n" in out.read_text(encoding="utf-8")
-    assert differences_between(read_model(EXAMPLES / "door_hfsm.scxml"), read_model(out)) == []
+    assert (
+        differences_between(api.load(EXAMPLES / "door_hfsm.scxml").model, api.load(out).model) == []
+    )
 
 
 def test_a_refusing_target_is_an_error_and_flatten_is_offered(tmp_path: Path) -> None:
@@ -130,7 +133,7 @@ def test_a_refusing_target_is_an_error_and_flatten_is_offered(tmp_path: Path) ->
     flat = cli("translate", str(source), "-o", str(out), "--flatten")
     assert flat.returncode == 0, flat.stderr
     assert "warning: paper-xml: flattened:" in flat.stderr
-    assert verify(read_model(source), read_model(out)).equivalent
+    assert verify(api.load(source).model, api.load(out).model).equivalent
 
 
 @needs_corpus
@@ -141,7 +144,7 @@ def test_flexbe_to_json(tmp_path: Path) -> None:
     assert done.returncode == 0, done.stderr
     assert "(flexbe) ->" in done.stderr
     assert "warning:" in done.stderr and "declares outcome 'failed'" in done.stderr  # reader's
-    model, back = read_model(source), read_model(out)
+    model, back = api.load(source).model, api.load(out).model
     assert isinstance(back, FSM) and differences_between(model, back) == []
 
 
@@ -172,7 +175,7 @@ def test_stdout_needs_a_target_format(tmp_path: Path) -> None:
     source.write_text(SMACH_SOURCE, encoding="utf-8")
     assert cli("translate", str(source)).returncode == 2
     done = cli("translate", str(source), "--to", "json")
-    assert done.returncode == 0 and loads(done.stdout, "json") == read_model(source)
+    assert done.returncode == 0 and loads(done.stdout, "json") == api.load(source).model
 
 
 def test_a_loss_that_changes_behaviour_is_refused(monkeypatch: pytest.MonkeyPatch) -> None:
@@ -203,10 +206,10 @@ def test_a_loss_that_changes_behaviour_is_refused(monkeypatch: pytest.MonkeyPatc
             drop_last_transition,
         ),
     )
-    model = read_model(EXAMPLES / "paper_fsm.xml")
     with pytest.raises(UnsupportedError, match="changes the model's behaviour"):
-        translate(model, "lossy-for-test", check=verify)
-    unchecked = translate(model, "lossy-for-test")  # no checker: structure only, named
+        api.translate(EXAMPLES / "paper_fsm.xml", to="lossy-for-test")
+    model = api.load(EXAMPLES / "paper_fsm.xml").model
+    unchecked = translate(model, "lossy-for-test")  # formats never verify: structure only
     assert not unchecked.verified
     assert any("transitions" in loss and "is lost" in loss for loss in unchecked.losses)
 
@@ -222,6 +225,6 @@ def test_labels_that_are_not_scxml_ids_are_renamed_and_named(tmp_path: Path) -> 
     assert 'id="Finished Eight-pattern"' not in text and 'id="Finished_Eight-pattern"' in text
     # the outcome 'done' would match every done.state.X event in SCXML: renamed, and named
     assert "'done' -> 'ev_done'" in done.stderr
-    source_model = read_model(source)
+    source_model = api.load(source).model
     renamed = rename_events(source_model, scxml_event_renames(source_model))
-    assert verify(renamed, read_model(out)).equivalent
+    assert verify(renamed, api.load(out).model).equivalent

@@ -145,10 +145,11 @@ def test_llm_convert_writes_only_a_verified_result(
     monkeypatch: pytest.MonkeyPatch,
     capsys: pytest.CaptureFixture[str],
 ) -> None:
+    from fsmbt import api
     from fsmbt.convert.engines import converter_for
-    from fsmbt.formats.registry import dumps, read_model
+    from fsmbt.formats import dumps
 
-    model = read_model(model_file)
+    model = api.load(model_file).model
     answer = dumps(converter_for("rules", model)(model).model, "btcpp")
     monkeypatch.setenv("FSMBT_LLM_API_KEY", "k")
     out = tmp_path / "door_bt.xml"
@@ -170,16 +171,16 @@ def test_llm_convert_writes_only_a_verified_result(
     assert "llm: verified equivalent" in capsys.readouterr().err
     from fsmbt.verify import verify
 
-    assert verify(model, read_model(out)).equivalent
+    assert verify(model, api.load(out).model).equivalent
 
 
 def test_hybrid_on_a_parsed_file_needs_no_endpoint(model_file: Path, tmp_path: Path) -> None:
     out = tmp_path / "door_bt.xml"
     assert main(["llm", "convert", str(model_file), "--engine", "hybrid", "-o", str(out)]) == 0
-    from fsmbt.formats.registry import read_model
+    from fsmbt import api
     from fsmbt.verify import verify
 
-    assert verify(read_model(model_file), read_model(out)).equivalent
+    assert verify(api.load(model_file).model, api.load(out).model).equivalent
 
 
 def test_hybrid_on_prose_asks_the_llm_only_to_extract(

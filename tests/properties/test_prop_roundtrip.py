@@ -19,6 +19,7 @@ from collections import Counter
 from hypothesis import given
 from hypothesis import strategies as st
 
+from fsmbt import api
 from fsmbt.formats import dumps, formats, loads
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import InputError
@@ -165,10 +166,8 @@ def test_hierarchical_models_from_reading_round_trip() -> None:
     """Hierarchical FSMs: the SCXML example (nested states) through every format holding it."""
     from pathlib import Path
 
-    from fsmbt.formats import read_model
-
     tally: Counter[str] = Counter()
-    example = read_model(Path(__file__).resolve().parents[2] / "examples" / "door_hfsm.scxml")
+    example = api.load(Path(__file__).resolve().parents[2] / "examples" / "door_hfsm.scxml").model
     assert isinstance(example, FSM) and example.is_hierarchical
 
     @BUDGET

@@ -10,8 +10,8 @@ from pathlib import Path
 
 import pytest
 
+from fsmbt import api
 from fsmbt.cli import main
-from fsmbt.formats import read_model
 from fsmbt.model import FSM, BehaviorTree, BTDocument, BTNode, NodeKind, State
 from fsmbt.render import TooLargeError, bt_to_dot, fsm_to_dot, render_model
 from fsmbt.render.bt_graph import CONTROL_SYMBOLS
@@ -101,7 +101,7 @@ def attrs_value(value: str | None) -> str:
 
 # -- FSM ----------------------------------------------------------------------------------------
 def paper_fsm() -> FSM:
-    return read_model(EXAMPLES / "paper_fsm.json")
+    return api.load(EXAMPLES / "paper_fsm.json").model
 
 
 def test_fsm_states_shapes_initial_arrow_and_labelled_transitions() -> None:
@@ -230,7 +230,7 @@ def _tree_from_model(node: BTNode) -> tuple:
 
 
 def test_robot_bt_is_drawn_top_down_with_the_tree_structure_and_symbols() -> None:
-    doc = read_model(EXAMPLES / "robot_bt.xml")
+    doc = api.load(EXAMPLES / "robot_bt.xml").model
     source = bt_to_dot(doc)
     dot = parse_dot(source)
     assert "rankdir=TB" in source and "ordering=out" in source
@@ -248,7 +248,7 @@ def test_robot_bt_is_drawn_top_down_with_the_tree_structure_and_symbols() -> Non
 
 
 def test_decorators_parallel_reactive_memory_and_subtrees() -> None:
-    doc = read_model(EXAMPLES / "game_npc_bt.xml")
+    doc = api.load(EXAMPLES / "game_npc_bt.xml").model
     dot = parse_dot(bt_to_dot(doc))
     firsts = {dot.label(n).split("\n")[0]: dot.nodes[n] for n in dot.nodes}
     assert firsts["¬"]["shape"] == "hexagon"
@@ -266,7 +266,7 @@ def test_decorators_parallel_reactive_memory_and_subtrees() -> None:
 
 
 def test_expanded_subtrees_hang_below_their_reference_in_a_cluster() -> None:
-    doc = read_model(EXAMPLES / "game_npc_bt.xml")
+    doc = api.load(EXAMPLES / "game_npc_bt.xml").model
     dot = parse_dot(bt_to_dot(doc, expand_subtrees=True))
     ref = next(n for n in dot.nodes if dot.label(n) == "SubTree Combat")
     (child,) = dot.children(ref)

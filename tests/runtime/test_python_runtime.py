@@ -23,13 +23,15 @@ from pathlib import Path
 import pytest
 from lxml import etree
 
+from fsmbt import api
 from fsmbt.convert.engines import converter_for
-from fsmbt.formats import dumps, read_model
+from fsmbt.formats import dumps
 from fsmbt.generate import random_fsm
 from fsmbt.model.errors import FsmbtError, InputError, UnsupportedError
 from fsmbt.model.fsm import FSM
 from fsmbt.runtime.python_runtime import ENGINES, TreeRunner, load_tree, write_files
 from fsmbt.semantics.machine import FINAL, FSMMachine
+from support import hand_lebt
 
 REPO = Path(__file__).resolve().parents[2]
 FSMS = int(os.environ.get("FSMBT_RUNTIME_FSMS", "60"))
@@ -102,7 +104,7 @@ def example_fsms() -> list[tuple[str, FSM]]:
     out = []
     for path in sorted((REPO / "examples").iterdir()):
         try:
-            model = read_model(path)
+            model = api.load(path).model
         except FsmbtError:
             continue
         if isinstance(model, FSM):
@@ -152,7 +154,7 @@ def test_the_runtime_reports_what_the_callables_did() -> None:
     }
     for engine in ENGINES:
         calls.clear()
-        runner = load_tree(tree_of(read_model(DOOR)), actions, engine=engine)
+        runner = load_tree(tree_of(api.load(DOOR).model), actions, engine=engine)
         assert not runner.started and runner.start() == ("Closed",) and calls == ["Closed"]
         assert runner.state == "Operating/Closed"
         assert runner.post("fully_open") == () and calls == ["Closed"]  # ignored event
@@ -171,7 +173,7 @@ DOOR_ACTIONS = {
 
 
 def door_tree() -> str:
-    return tree_of(read_model(DOOR))
+    return tree_of(api.load(DOOR).model)
 
 
 def test_missing_callable_is_a_load_error_naming_the_action() -> None:
@@ -342,3 +344,34 @@ def test_the_docs_snippet_runs_as_written(tmp_path: Path) -> None:
         )
         assert done.returncode == 0, done.stderr
         assert done.stdout == shown, (engine, done.stdout)
+
+
+# -- callbacks get the state's label and parameters; annotations checked at load -------------
+def test_callbacks_get_the_state_label_and_its_parameters() -> None:
+    seen: list[tuple[str, str, dict[str, str]]] = []
+    for engine in ENGINES:
+        seen.clear()
+        actions = {
+            "TimedCmdVelState": lambda state, params: seen.append(
+                ("TimedCmdVelState", state, params)
+            ),
+            "LogState": lambda state, params: seen.append(("LogState", state, params)),
+        }
+        runner = load_tree(hand_lebt.TREE, actions, engine=engine)
+        assert runner.start() == ("TimedCmdVelState",)
+        assert runner.post("go") == ("TimedCmdVelState",)
+        assert runner.post("stop") == ("LogState",) and runner.terminated
+        assert seen == hand_lebt.ENTRIES, engine
+    with pytest.raises(InputError, match="must take \\(state, params\\) or no argument"):
+        load_tree(hand_lebt.TREE, {"TimedCmdVelState": lambda state: None, "LogState": print})
+
+
+@pytest.mark.parametrize("case", [c[0] for c in hand_lebt.BROKEN])
+def test_hand_broken_annotations_are_load_errors_naming_the_node(case: str) -> None:
+    _, replaced, replacement, node, line = next(c for c in hand_lebt.BROKEN if c[0] == case)
+    actions = {"TimedCmdVelState": lambda: None, "LogState": lambda: None}
+    for engine in ENGINES:
+        with pytest.raises(InputError) as info:
+            load_tree(hand_lebt.broken(replaced, replacement), actions, engine=engine)
+        assert f"'{node}'" in str(info.value), str(info.value)
+        assert info.value.location is not None and info.value.location.line == line

@@ -10,11 +10,13 @@ from pathlib import Path
 
 import pytest
 
+from fsmbt import api
 from fsmbt.cli import main
 from fsmbt.convert import convert
-from fsmbt.formats import dumps, read_model
+from fsmbt.formats import dumps
 from fsmbt.runtime import cpp as cpp_runtime
 from fsmbt.runtime.cpp import DriverSession, library_prefix
+from support import hand_lebt
 
 REPO = Path(__file__).resolve().parents[2]
 DOOR = REPO / "examples" / "door_hfsm.scxml"
@@ -55,7 +57,7 @@ def _tree(tmp_path: Path, leaf: str = GOOD_LEAF, name: str = "tree.xml") -> Path
 
 def _door_tree(tmp_path: Path) -> Path:
     path = tmp_path / "door_bt.xml"
-    path.write_text(dumps(convert(read_model(DOOR)).model, "btcpp"), encoding="utf-8")
+    path.write_text(dumps(convert(api.load(DOOR).model).model, "btcpp"), encoding="utf-8")
     return path
 
 
@@ -360,7 +362,7 @@ def test_doctor_reports_the_cpp_runtime(tmp_path: Path, monkeypatch) -> None:
     names = {c.name: c for c in checks()}
     assert not names["C++ LEBT driver"].ok
     assert not names[f"BehaviorTree.CPP {cpp_runtime.BTCPP_VERSION} (C++)"].ok
-    assert "build_btcpp.sh" in names["C++ LEBT driver"].hint
+    assert "fsmbt doctor --install btcpp" in names["C++ LEBT driver"].hint
     assert main(["doctor"]) == 1
 
 
@@ -411,6 +413,12 @@ def test_nusmv_build_script_reuses_the_old_checkout_binary(tmp_path: Path) -> No
     repo = tmp_path / "repo"
     (repo / "scripts").mkdir(parents=True)
     shutil.copy2(REPO / "scripts" / "build_nusmv.sh", repo / "scripts" / "build_nusmv.sh")
+    # the checkout's script runs the one the package ships (src/fsmbt/install)
+    (repo / "src" / "fsmbt" / "install").mkdir(parents=True)
+    shutil.copy2(
+        REPO / "src" / "fsmbt" / "install" / "build_nusmv.sh",
+        repo / "src" / "fsmbt" / "install" / "build_nusmv.sh",
+    )
     legacy = repo / ".cache" / "nusmv" / "bin" / "NuSMV"
     legacy.parent.mkdir(parents=True)
     legacy.write_text("#!/bin/sh\necho 'usage: NuSMV -dcx ...'\n", encoding="utf-8")
@@ -437,3 +445,34 @@ def test_nusmv_build_script_reuses_the_old_checkout_binary(tmp_path: Path) -> No
         env=env,
     )
     assert second.returncode == 0 and f"already built: {cached}" in second.stdout
+
+
+# -- callbacks get label and parameters; hand-broken annotations are load errors ---------------
+def test_callbacks_get_the_state_label_and_its_parameters(driver: Path, tmp_path: Path) -> None:
+    import json
+
+    tree = tmp_path / "hand.xml"
+    tree.write_text(hand_lebt.TREE, encoding="utf-8")
+    run = _driver_call(driver, tree, "--entries", stdin="go\nstop\n")
+    assert run.returncode == 0, run.stderr
+    records = [json.loads(line) for line in run.stdout.splitlines()]
+    entered = [(r["entered"], r["params"]) for r in records if "entered" in r]
+    assert entered == [(state, params) for _, state, params in hand_lebt.ENTRIES]
+    steps = [r for r in records if "step" in r]
+    assert [s["actions"] for s in steps] == [[action] for action, _, _ in hand_lebt.ENTRIES]
+    assert steps[-1]["terminated"] is True
+
+
+@pytest.mark.parametrize("case", [c[0] for c in hand_lebt.BROKEN])
+def test_hand_broken_annotations_are_load_errors_naming_the_node(
+    driver: Path, tmp_path: Path, case: str
+) -> None:
+    _, replaced, replacement, node, line = next(c for c in hand_lebt.BROKEN if c[0] == case)
+    tree = tmp_path / "broken.xml"
+    tree.write_text(hand_lebt.broken(replaced, replacement), encoding="utf-8")
+    run = _driver_call(driver, tree, stdin="go\n")
+    assert run.returncode == 1 and run.stdout == ""
+    error = run.stderr.strip()
+    assert len(error.splitlines()) == 1 and f'name="{node}"' in error, error
+    if "params" not in case:  # BehaviorTree.CPP builds the node before the runner sees the XML
+        assert f"line {line}" in error, error

@@ -25,8 +25,9 @@ from pathlib import Path
 
 import pytest
 
+from fsmbt import api
 from fsmbt.convert import convert
-from fsmbt.formats import dumps, loads, read_model
+from fsmbt.formats import dumps, loads
 from fsmbt.generate import random_fsm
 from fsmbt.model.errors import InputError
 from fsmbt.model.fsm import FSM
@@ -147,7 +148,7 @@ def _example_fsms() -> list[tuple[str, FSM]]:
     found = []
     for path in sorted((REPO / "examples").iterdir()):
         try:
-            model = read_model(path)
+            model = api.load(path).model
         except InputError:
             continue
         if isinstance(model, FSM):
@@ -168,7 +169,7 @@ def _corpus_fsms() -> list[tuple[str, FSM]]:
         ):
             continue
         try:
-            model = read_model(path)
+            model = api.load(path).model
         except InputError:
             continue
         if isinstance(model, FSM):

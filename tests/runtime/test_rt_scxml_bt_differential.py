@@ -25,8 +25,9 @@ from pathlib import Path
 import pytest
 from scxml_oracle import PARALLEL_STOPS, Engine, Mismatch, Replay, replay
 
+from fsmbt import api
 from fsmbt.convert.bt_to_hfsm import bt_to_hfsm
-from fsmbt.formats import dumps, read_model
+from fsmbt.formats import dumps
 from fsmbt.generate import random_bt
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import FsmbtError, UnsupportedError
@@ -110,7 +111,7 @@ def check_tree(
 def test_reported_bug_robot_pick_failure_is_not_delivery() -> None:
     """Issue 11's report: after MovetoCube2 fails the engine must leave the pick unit by its
     FAILURE end (the BT fails), not go on to RobotatDelivery as if the pick had succeeded."""
-    doc = read_model(REPO / "examples" / "robot_bt.xml")
+    doc = api.load(REPO / "examples" / "robot_bt.xml").model
     hfsm = bt_to_hfsm(doc).model
     text = dumps(hfsm, "scxml")
     engine = Engine(text)
@@ -130,7 +131,7 @@ def test_examples() -> None:
     paths = sorted((REPO / "examples").glob("*_bt.xml"))
     assert paths
     for path in paths:
-        check_tree(tally, path.name, read_model(path), rng, 4 * SEQUENCES)
+        check_tree(tally, path.name, api.load(path).model, rng, 4 * SEQUENCES)
     print(tally.report())
     assert tally.models == len(paths) and not tally.mismatches, tally.mismatches[:5]
 
@@ -144,7 +145,7 @@ def test_corpus_bts() -> None:
     unreadable = 0
     for path in sorted(folder.rglob("*.xml")):
         try:
-            doc = read_model(path)
+            doc = api.load(path).model
         except FsmbtError:
             unreadable += 1
             continue
@@ -195,7 +196,7 @@ def test_mismatch_is_reported_on_a_wrong_model() -> None:
     """The oracle can fail: the robot SCXML against an HFSM whose pick unit's completion
     transitions are swapped disagrees with the engine (so zero mismatches above means
     something)."""
-    doc = read_model(REPO / "examples" / "robot_bt.xml")
+    doc = api.load(REPO / "examples" / "robot_bt.xml").model
     hfsm = bt_to_hfsm(doc).model
     text = dumps(hfsm, "scxml")
     for machine_fsm in [hfsm, *(s.regions[0] for s in hfsm.states.values() if s.regions)]:

@@ -23,7 +23,8 @@ from pathlib import Path
 import pytest
 from scxml_oracle import Engine, python_spelled, replay
 
-from fsmbt.formats import loads, read_model
+from fsmbt import api
+from fsmbt.formats import loads
 from fsmbt.model.errors import FsmbtError
 from fsmbt.model.fsm import FSM
 from fsmbt.semantics.machine import FSMMachine
@@ -85,7 +86,7 @@ def test_corpus_files_both_read_agree() -> None:
         for index, path in enumerate(paths):
             label = str(path.relative_to(CORPUS))
             try:
-                model = read_model(path)
+                model = api.load(path).model
             except FsmbtError:
                 fsmbt_refuses.append(label)
                 continue
@@ -181,7 +182,7 @@ PROBES = {
 
 
 #: Documents the structural reader refuses and fsmbt reads by running the W3C algorithm
-#: (``fsmbt.formats.scxml_w3c``, docs/formats/scxml.md): one per feature of issue 12 part 4.
+#: (``fsmbt.formats.scxml.w3c``, docs/formats/scxml.md): one per feature of issue 12 part 4.
 W3C_PROBES = {
     "shallow history restores the last child, not its descendants": """
   <state id="a" initial="a1"><history id="h"><transition target="a1"/></history>

@@ -8,9 +8,9 @@ import json
 import pytest
 
 import fsmbt.verify as verify_module
+from fsmbt import api
 from fsmbt.cli import main
 from fsmbt.convert.lebt import fsm_to_lebt
-from fsmbt.formats import write_model
 from fsmbt.verify.report import PROPERTIES
 from support.ver_models import PAPER_EDGES, paper_fsm
 
@@ -21,10 +21,10 @@ def files(tmp_path):
     mutated = copy.deepcopy(source)
     mutated.transitions[PAPER_EDGES.index("BC")].target = "D"
     paths = {
-        "source": write_model(source, tmp_path / "source.json"),
-        "copy": write_model(copy.deepcopy(source), tmp_path / "copy.json"),
-        "mutated": write_model(mutated, tmp_path / "mutated.json"),
-        "lebt": write_model(fsm_to_lebt(source).model, tmp_path / "lebt.json"),
+        "source": api.write(source, tmp_path / "source.json"),
+        "copy": api.write(copy.deepcopy(source), tmp_path / "copy.json"),
+        "mutated": api.write(mutated, tmp_path / "mutated.json"),
+        "lebt": api.write(fsm_to_lebt(source).model, tmp_path / "lebt.json"),
     }
     return {k: str(v) for k, v in paths.items()}
 

@@ -8,9 +8,8 @@ import copy
 
 import pytest
 
-from fsmbt import limits
+from fsmbt import api, limits
 from fsmbt.cli import EXIT_LIMIT, main
-from fsmbt.formats import write_model
 from fsmbt.generate.generator import random_fsm
 from fsmbt.verify.native import CheckerTimeLimitError, StateLimitError, check
 from fsmbt.verify.pairing import machines_for
@@ -54,8 +53,8 @@ def test_the_limit_in_force_applies_when_none_is_given(big_fsm, restore_limits):
 
 
 def test_cli_timeout_exits_4_naming_the_flag(big_fsm, tmp_path, capsys, restore_limits):
-    a = write_model(big_fsm, tmp_path / "a.json")
-    b = write_model(copy.deepcopy(big_fsm), tmp_path / "b.json")
+    a = api.write(big_fsm, tmp_path / "a.json")
+    b = api.write(copy.deepcopy(big_fsm), tmp_path / "b.json")
     code = main(["verify", str(a), str(b), "--timeout", "0.001"])
     err = capsys.readouterr().err.strip().splitlines()
     assert code == EXIT_LIMIT

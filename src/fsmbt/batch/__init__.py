@@ -1,7 +1,7 @@
 """``fsmbt batch``: many models at once, on local processes or on Ray, resumable, nothing lost.
 
 A layer above ``fsmbt.api``: every job calls the library's pipeline (``convert_file``, or
-``load_for_engine`` and ``convert_loaded`` for the LLM engines) and never redoes its work.
+``load_for_llm`` and ``convert_loaded`` for the LLM engines) and never redoes its work.
 
 - ``make_jobs`` (``jobs``): files, folders and globs to ``Job`` values, outputs mirrored.
 - ``run_job`` (``worker``): one job, every problem a row (``JobResult``, ``result``).

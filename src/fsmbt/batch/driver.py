@@ -31,11 +31,11 @@ from pathlib import Path
 from typing import Any, Literal
 
 from fsmbt import api
+from fsmbt.api_types import checker_limit
 from fsmbt.batch.jobs import LIMIT_OPTIONS, Job, content_hash, public_options
 from fsmbt.batch.result import LIMIT, REFUSED, TIMEOUT, JobResult
 from fsmbt.batch.store import ResultStore
 from fsmbt.model.errors import InputError, SourceLocation
-from fsmbt.verify.native import DEFAULT_MAX_STATES
 
 OnResult = Callable[[JobResult], None]
 #: LLM requests at once when nothing else is said.
@@ -45,7 +45,8 @@ DEFAULT_LLM_CONCURRENCY = 4
 def _limit_value(options: dict[str, Any], name: str) -> float:
     value = options.get(name)
     if value is None:
-        return float("inf") if name == "timeout_s" else float(DEFAULT_MAX_STATES)
+        # unset: the limits in force (FSMBT_MAX_CHECKER_STATES), the one the worker uses too
+        return float("inf") if name == "timeout_s" else float(checker_limit(None))
     return float(value)
 
 

@@ -1,7 +1,7 @@
 """One job in a worker: the library's pipeline for one input, every problem turned into a row.
 
 ``run_job`` calls ``fsmbt.api`` and nothing else does the work: ``convert_file`` for the
-parser-read engines, ``load_for_engine`` then ``convert_loaded`` for the LLM engines (so the
+parser-read engines, ``load_for_llm`` then ``convert_loaded`` for the LLM engines (so the
 client can be wrapped in the batch's per-minute limit). It never raises for a model's problem;
 each exception becomes a status (``fsmbt.batch.result``):
 
@@ -57,7 +57,6 @@ from fsmbt.model.errors import InputError, LimitError, UnsupportedError
 from fsmbt.model.files import recording_reads
 from fsmbt.model.fsm import FSM
 from fsmbt.model.stats import model_stats
-from fsmbt.verify.native import DEFAULT_MAX_STATES
 
 #: The options ``run_job`` hands to ``fsmbt.api`` as keyword arguments, not engine options.
 PIPELINE_OPTIONS = (
@@ -68,7 +67,6 @@ PIPELINE_OPTIONS = (
     "hierarchy",
     "max_states",
     "keep_not_equivalent",
-    "timeout_s",
 )
 
 
@@ -132,50 +130,40 @@ def _classify(error: BaseException) -> tuple[str, bool]:
 
 
 def _pipeline(job: Job, options: dict[str, Any], timings: dict[str, float]) -> api.Outcome:
-    """The library's pipeline for ``job`` (see the module text)."""
+    """The library's pipeline for ``job`` (see the module text).
+
+    The job's JSON options become one ``ConvertRequest``: the pipeline options by name, the
+    reader options (``nodes``, ``abstract``...) and engine options through the request's own
+    split, so the batch takes every option ``convert`` takes and validates it the same way.
+    A limit left unset is the limits in force (``FSMBT_MAX_CHECKER_STATES``...), as in ``convert``.
+    """
+    options.pop("timeout_s", None)
     pipeline = {name: options.pop(name) for name in PIPELINE_OPTIONS if name in options}
-    pipeline.pop("timeout_s", None)
     verify = job.verify_engine != "none"
-    common: dict[str, Any] = {
-        "to": pipeline.get("to"),
-        "engine": job.engine,
-        "style": pipeline.get("style", "paper"),
-        "loop": bool(pipeline.get("loop", False)),
-        "hierarchy": pipeline.get("hierarchy", "subtrees"),
-        "verify": verify,
-        "verify_engine": job.verify_engine if verify else "native",
-        "max_states": int(pipeline.get("max_states", DEFAULT_MAX_STATES)),
-        "overwrite": job.overwrite,
-        "keep_not_equivalent": bool(pipeline.get("keep_not_equivalent", False)),
-    }
+    request = api.convert_request(
+        engine=job.engine,
+        verify=verify,
+        verify_engine=job.verify_engine if verify else "native",
+        overwrite=job.overwrite,
+        options=options,
+        **pipeline,
+    )
     if job.engine not in api.LLM_ENGINES:
-        return api.convert_file(
-            job.input,
-            job.output,
-            source_format=pipeline.get("source_format"),
-            options=options,
-            **common,
-        )
+        return api.convert_file(job.input, job.output, request)
     if job.output is not None:
         api.check_destination(job.output, overwrite=job.overwrite)
     started = time.perf_counter()
-    if job.verify_engine != "none":
-        options.setdefault("verify_engine", job.verify_engine)
-    loaded = api.load_for_engine(
-        job.input, job.engine, pipeline.get("source_format"), options=options
-    )
+    loaded, client = api.load_for_llm(job.input, request)
     timings["read"] = time.perf_counter() - started
     per_minute = job.runtime.get("llm_rate_per_minute")
     rate_file = job.runtime.get("llm_rate_file")
     if per_minute and rate_file:
-        limit = MinuteRateLimit(rate_file, int(per_minute))
-        client = options.get("client")
         if client is None:
             from fsmbt.llm.engine import client_from_options
 
-            client = client_from_options(options)
-        options["client"] = RateLimitedClient(client, limit)
-    return api.convert_loaded(loaded, job.output, options=options, **common)
+            client = client_from_options(dict(request.engine_options))
+        client = RateLimitedClient(client, MinuteRateLimit(rate_file, int(per_minute)))
+    return api.convert_loaded(loaded, job.output, request, llm_client=client)
 
 
 #: A two-state FSM converted both ways by ``warm_up``.

@@ -42,8 +42,25 @@ def sub_app(help_text: str) -> typer.Typer:
     return typer.Typer(help=help_text, no_args_is_help=True, rich_markup_mode=None)
 
 
+def _print_version(asked: bool) -> None:
+    """``--version``: the package's version, then exit 0."""
+    if asked:
+        from fsmbt import __version__
+
+        print(f"fsmbt {__version__}")
+        raise typer.Exit(EXIT_OK)
+
+
 @app.callback()
-def _root() -> None:
+def _root(
+    version: bool = typer.Option(
+        False,
+        "--version",
+        is_eager=True,
+        callback=_print_version,
+        help="print fsmbt's version and exit",
+    ),
+) -> None:
     """Convert behavior models between FSMs and behavior trees, and prove the result equivalent."""
 
 

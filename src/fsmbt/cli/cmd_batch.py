@@ -29,6 +29,7 @@ from typing import Any, Literal
 import typer
 
 from fsmbt import api
+from fsmbt.api_types import ReadOptions
 from fsmbt.batch import STATUSES, STORE_NAME, JobResult, ResultStore, make_jobs, run_jobs
 from fsmbt.batch.result import (
     BAD_INPUT,
@@ -42,10 +43,7 @@ from fsmbt.batch.result import (
 )
 from fsmbt.cli.hints import CLI_WORDING
 from fsmbt.cli.options import (
-    include_root_option,
-    node_models_option,
-    reader_options,
-    trees_option,
+    reads_models,
 )
 from fsmbt.llm.config import PROVIDERS
 from fsmbt.model.errors import HINT_TEXT, InputError, SourceLocation
@@ -225,6 +223,7 @@ def _report(outdir: Path, as_json: bool, keys: list[str] | None = None) -> int:
 
 def register(app: typer.Typer) -> None:
     @app.command("batch")
+    @reads_models
     def batch_command(
         inputs: list[str] = typer.Argument(
             None, help="model files, folders (walked recursively) and glob patterns"
@@ -240,9 +239,6 @@ def register(app: typer.Typer) -> None:
             "--to",
             help="output format (default: btcpp for a BT result, scxml for an FSM result)",
         ),
-        source_format: str | None = typer.Option(
-            None, "--from", help="input format (default: detected per file)"
-        ),
         engine: str = typer.Option("rules", "--engine", help="rules, or a registered engine"),
         style: str = typer.Option("paper", "--style", help="output structure style"),
         loop: bool = typer.Option(
@@ -252,7 +248,10 @@ def register(app: typer.Typer) -> None:
         ),
         no_verify: bool = typer.Option(False, "--no-verify", help="skip the equivalence check"),
         verifier: Literal["native", "nusmv", "both"] = typer.Option(
-            "native", "--verifier", help="native, nusmv, or both (both must agree)"
+            "native",
+            "--verify-engine",
+            "--verifier",
+            help="native, nusmv, or both (both must agree)",
         ),
         force: bool = typer.Option(False, "--force", help="overwrite existing output files"),
         keep_failed: bool = typer.Option(
@@ -267,9 +266,6 @@ def register(app: typer.Typer) -> None:
         report: bool = typer.Option(
             False, "--report", help="print the summary of OUTDIR's store again; runs nothing"
         ),
-        node_models: list[Path] = node_models_option(),
-        trees: list[Path] = trees_option(),
-        include_root: Path | None = include_root_option(),
         hierarchy: Literal["subtrees", "flatten"] = typer.Option(
             "subtrees", "--hierarchy", help="FSM->BT of a hierarchical FSM: subtrees or flatten"
         ),
@@ -307,6 +303,8 @@ def register(app: typer.Typer) -> None:
         llm_rate: int | None = typer.Option(
             None, "--llm-rate", min=1, help="LLM engines: requests per minute, over all workers"
         ),
+        *,
+        read: ReadOptions,
     ) -> None:
         """Convert and verify many models (files, folders, globs) into OUTDIR; a second run
         skips what is done, a killed run resumes."""
@@ -319,12 +317,10 @@ def register(app: typer.Typer) -> None:
                 "is a file; -o names the output folder", location=SourceLocation(str(outdir))
             )
         outdir.mkdir(parents=True, exist_ok=True)
-        options: dict[str, Any] = dict(
-            reader_options(node_models, None, None, trees, include_root) or {}
-        )
+        options: dict[str, Any] = dict(read.reader_options() or {})
         options.update(style=style, loop=loop, hierarchy=hierarchy)
-        if source_format:
-            options["source_format"] = source_format
+        if read.format:
+            options["source_format"] = read.format
         if keep_failed:
             options["keep_not_equivalent"] = True
         if timeout is not None:

@@ -18,17 +18,13 @@ from typing import Literal
 import typer
 
 from fsmbt import api
+from fsmbt.api_types import ReadOptions
 from fsmbt.cli.options import (
-    abstract_option,
     apply_engine_caps,
-    include_root_option,
     max_states_option,
-    node_models_option,
-    nodes_option,
     nusmv_memory_option,
-    reader_options,
+    reads_models,
     timeout_option,
-    trees_option,
 )
 from fsmbt.cli.progress import StageProgress, format_timings
 from fsmbt.cli.wording import checked_counts, conversion_summary
@@ -43,6 +39,7 @@ PROVIDER_NAMES = ", ".join(sorted(PROVIDERS))
 
 def register(app: typer.Typer) -> None:
     @app.command("convert")
+    @reads_models
     def convert_command(
         source: Path = typer.Argument(..., help="the model to convert (FSM or BT)"),
         output: Path | None = typer.Option(
@@ -54,7 +51,6 @@ def register(app: typer.Typer) -> None:
             help="output format (default: from -o's "
             "extension, else btcpp for a BT, scxml for an FSM)",
         ),
-        source_format: str | None = typer.Option(None, "--from", help="input format"),
         engine: str = typer.Option("rules", "--engine", help="rules, or a registered engine"),
         style: str = typer.Option("paper", "--style", help="output structure style"),
         loop: bool = typer.Option(
@@ -76,12 +72,7 @@ def register(app: typer.Typer) -> None:
         ),
         as_json: bool = typer.Option(False, "--json", help="print a JSON summary on stdout"),
         quiet: bool = typer.Option(False, "--quiet", "-q", help="no progress display on stderr"),
-        node_models: list[Path] = node_models_option(),
         max_states: int | None = max_states_option(),
-        nodes: list[str] = nodes_option(),
-        abstract: list[str] = abstract_option(),
-        trees: list[Path] = trees_option(),
-        include_root: Path | None = include_root_option(),
         hierarchy: Literal["subtrees", "flatten"] = typer.Option(
             "subtrees",
             "--hierarchy",
@@ -95,33 +86,31 @@ def register(app: typer.Typer) -> None:
         llm_model: str | None = typer.Option(None, "--llm-model", help="LLM engines: model name"),
         timeout: float | None = timeout_option(),
         nusmv_memory: int | None = nusmv_memory_option(),
+        *,
+        read: ReadOptions,
     ) -> None:
         """Convert an FSM into a behavior tree or a behavior tree into a hierarchical FSM, and
         prove the result equivalent."""
         apply_engine_caps(timeout, nusmv_memory)
-        options: dict[str, object] = dict(
-            reader_options(node_models, nodes, abstract, trees, include_root) or {}
-        )
+        engine_options: dict[str, object] = {}
         if engine in api.LLM_ENGINES:
-            options.update(llm_base_url=llm_base_url, llm_model=llm_model)
+            engine_options.update(llm_base_url=llm_base_url, llm_model=llm_model)
+        request = api.convert_request(
+            to=to,
+            engine=engine,
+            style=style,
+            loop=loop,
+            hierarchy=hierarchy,
+            verify=not no_verify,
+            verify_engine=verify_engine,
+            overwrite=force,
+            max_states=max_states,
+            keep_not_equivalent=keep_failed,
+            read=read,
+            engine_options=engine_options,
+        )
         with StageProgress(quiet=quiet, label=source.name) as progress:
-            outcome = api.convert_file(
-                source,
-                output,
-                to=to,
-                source_format=source_format,
-                engine=engine,
-                style=style,
-                loop=loop,
-                hierarchy=hierarchy,
-                verify=not no_verify,
-                verify_engine=verify_engine,
-                overwrite=force,
-                max_states=max_states,
-                keep_not_equivalent=keep_failed,
-                options=options,
-                on_stage=progress,
-            )
+            outcome = api.convert_file(source, output, request, on_stage=progress)
         summary = outcome.to_dict()
         if as_json:
             if output is None:

@@ -1,22 +1,26 @@
-"""``fsmbt doctor``: what fsmbt's optional engines and tools need, found or not.
+"""``fsmbt doctor``: fsmbt's optional engines and tools, what each adds, found or not.
 
-Checks NuSMV (the second verification engine; path and version), Graphviz ``dot`` (pictures),
-behaviortreepy (BehaviorTree.CPP, the differential tests), py_trees, and the C++ runtime built
-by ``scripts/build_btcpp.sh`` (BehaviorTree.CPP's install prefix in the cache, the LEBT driver
-built from the current sources or not). Exit 0 when all are found, 1 otherwise; each missing one
-says how to get it.
+fsmbt reads, converts, verifies (its native checker) and writes models with nothing but its
+Python dependencies. The rest is optional: NuSMV (a second, independent verifier; path and
+version), Graphviz ``dot`` (pictures), behaviortreepy (BehaviorTree.CPP in-process), py_trees,
+and the C++ runtime (BehaviorTree.CPP 4.8.2 in the cache and the LEBT driver built from the
+current sources or not). Each line says what the tool adds and, when missing, how to get it;
+``--install nusmv|btcpp`` builds one into the cache with the build script shipped in the
+package (``fsmbt.install``). ``--json`` prints the same as JSON. Paths are printed whole (no
+table column cuts them). Exit 0 when all are found, 1 otherwise (``--install``: the build's own
+exit status when it fails).
 """
 
 from __future__ import annotations
 
 import importlib
+import json
 import shutil
 import subprocess
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
+from enum import Enum
 
 import typer
-from rich.console import Console
-from rich.table import Table
 
 
 @dataclass
@@ -25,15 +29,35 @@ class Check:
     ok: bool
     detail: str
     hint: str = ""
+    adds: str = ""  # what fsmbt can do with it
+
+
+class Installable(str, Enum):
+    nusmv = "nusmv"
+    btcpp = "btcpp"
+
+
+#: What each optional tool adds (by check name prefix).
+ADDS = {
+    "NuSMV": "a second, independent verifier (--verify-engine nusmv|both)",
+    "Graphviz dot": "SVG/PNG pictures (fsmbt render; DOT text needs nothing)",
+    "behaviortreepy": "BehaviorTree.CPP in-process: run converted BTs on the real engine",
+    "py_trees": "run converted BTs on py_trees (runtime, simulations)",
+    "BehaviorTree.CPP": "the C++ runtime's library (fsmbt runtime cpp, C++ differential checks)",
+    "C++ LEBT driver": "run converted BTs through the C++ LEBT runtime",
+}
 
 
 def _nusmv() -> Check:
-    from fsmbt.verify.nusmv.binary import BUILD_SCRIPT, ENV_VAR, find_nusmv, nusmv_version
+    from fsmbt.verify.nusmv.binary import ENV_VAR, cached_binary, find_nusmv, nusmv_version
 
     path = find_nusmv()
     if path is None:
         return Check(
-            "NuSMV", False, "not found", f"run {BUILD_SCRIPT.name} (scripts/) or set {ENV_VAR}"
+            "NuSMV",
+            False,
+            f"not found ({ENV_VAR}, PATH, the cache {cached_binary()})",
+            f"fsmbt doctor --install nusmv (needs gcc, make, flex, bison) or set {ENV_VAR}",
         )
     return Check("NuSMV", True, f"{nusmv_version(str(path))} at {path}")
 
@@ -73,7 +97,7 @@ def _cpp_runtime() -> list[Check]:
     from fsmbt.runtime.cpp import BTCPP_VERSION, library_prefix, status
 
     found = status()
-    hint = "run scripts/build_btcpp.sh (needs cmake and g++)"
+    hint = "fsmbt doctor --install btcpp (needs cmake and g++)"
     library = (
         Check(f"BehaviorTree.CPP {BTCPP_VERSION} (C++)", True, f"built at {found.library}")
         if found.library
@@ -93,26 +117,46 @@ def _cpp_runtime() -> list[Check]:
 
 
 def checks() -> list[Check]:
-    return [
+    found = [
         _nusmv(),
         _dot(),
         _module("behaviortreepy", "behaviortreepy", "behaviortreepy"),
         _module("py_trees", "py_trees", "py_trees"),
         *_cpp_runtime(),
     ]
+    for check in found:
+        check.adds = next((v for k, v in ADDS.items() if check.name.startswith(k)), "")
+    return found
 
 
 def register(app: typer.Typer) -> None:
     @app.command("doctor")
-    def doctor_command() -> None:
-        """Report the external tools fsmbt uses (NuSMV, Graphviz, behaviortreepy, py_trees, the
-        C++ runtime)."""
+    def doctor_command(
+        as_json: bool = typer.Option(False, "--json", help="Print the checks as JSON."),
+        install: Installable | None = typer.Option(
+            None,
+            "--install",
+            help="Build an optional engine into the cache (~/.cache/fsmbt): nusmv or btcpp.",
+        ),
+    ) -> None:
+        """Report the optional engines and tools fsmbt uses (NuSMV, Graphviz, behaviortreepy,
+        py_trees, the C++ runtime), what each adds and how to get it."""
+        if install is not None:
+            from fsmbt.install import install as build
+
+            code = build(install.value)
+            if code != 0:
+                raise typer.Exit(code)
         results = checks()
-        table = Table("tool", "status", "detail")
-        for c in results:
-            status = "[green]ok[/green]" if c.ok else "[red]missing[/red]"
-            detail = c.detail + (f" - {c.hint}" if c.hint else "")
-            table.add_row(c.name, status, detail)
-        Console().print(table)
+        if as_json:
+            print(json.dumps([asdict(c) for c in results], indent=2))
+        else:
+            width = max(len(c.name) for c in results)
+            for c in results:
+                status = "ok     " if c.ok else "missing"
+                print(f"{status}  {c.name:<{width}}  {c.detail}")
+                print(f"{'':9}{'':<{width}}  adds: {c.adds}")
+                if c.hint and not c.ok:
+                    print(f"{'':9}{'':<{width}}  get it: {c.hint}")
         if not all(c.ok for c in results):
             raise typer.Exit(1)

@@ -56,6 +56,7 @@ def register(app: typer.Typer) -> None:
         quiet: bool = typer.Option(False, "--quiet", help="no progress bars"),
     ) -> None:
         """Build the dataset, run every engine on every model, verify, and write the report."""
+        from fsmbt.cli.progress import MethodBars
         from fsmbt.evaluate import EvaluationSettings, evaluate
 
         chosen_corpus = corpus or Path(os.environ.get("FSMBT_CORPUS", "../shared/corpus"))
@@ -73,7 +74,8 @@ def register(app: typer.Typer) -> None:
             examples=examples,
             command="fsmbt " + " ".join(shlex.quote(a) for a in sys.argv[1:]),
         )
-        summary = evaluate(settings, report=not no_report, progress=not quiet)
+        with MethodBars(quiet=quiet) as bars:
+            summary = evaluate(settings, report=not no_report, on_progress=bars)
         print(
             f"dataset: {summary['models']} models; jobs: {summary['jobs']} "
             f"(stored before {summary['before']}, run now {summary['ran']}, "

@@ -11,13 +11,9 @@ from rich.markup import escape
 from rich.table import Table
 
 from fsmbt import api
+from fsmbt.api_types import ReadOptions
 from fsmbt.cli.options import (
-    abstract_option,
-    include_root_option,
-    node_models_option,
-    nodes_option,
-    reader_options,
-    trees_option,
+    reads_models,
 )
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.stats import BTStats, FSMStats, model_stats
@@ -30,17 +26,12 @@ MAX_LISTED = 12
 
 def register(app: typer.Typer) -> None:
     @app.command("info")
+    @reads_models
     def info_command(
         model: Path = typer.Argument(..., help="Model file (FSM or BT, any format fsmbt reads)."),
-        from_format: str | None = typer.Option(
-            None, "--from", help="Input format (default: detected)."
-        ),
-        node_models: list[Path] = node_models_option(),
-        nodes: list[str] = nodes_option(),
-        abstract: list[str] = abstract_option(),
-        trees: list[Path] = trees_option(),
-        include_root: Path | None = include_root_option(),
         as_json: bool = typer.Option(False, "--json", help="Print the figures as JSON."),
+        *,
+        read: ReadOptions,
     ) -> None:
         """Structure at a glance: states, events, entry/loop states; BT nodes, depth, breadth.
 
@@ -50,8 +41,8 @@ def register(app: typer.Typer) -> None:
         """
         loaded = api.load(
             model,
-            from_format,
-            options=reader_options(node_models, nodes, abstract, trees, include_root),
+            read.format,
+            options=read,
         )
         stats = model_stats(loaded.model)
         undeclared = (

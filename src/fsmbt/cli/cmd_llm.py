@@ -141,7 +141,8 @@ def register(app: typer.Typer) -> None:
         llm_log: str | None = log_opt,
     ) -> None:
         """Let the LLM write the model in INPUT as fsmbt JSON (validated like any input)."""
-        from fsmbt.formats import dumps, write_model
+        from fsmbt import api
+        from fsmbt.formats import dumps
         from fsmbt.llm.engine import client_from_options
         from fsmbt.llm.extract import read_input
 
@@ -152,7 +153,7 @@ def register(app: typer.Typer) -> None:
             input_path, "llm", client=client, kind=kind, max_regenerations=max_regenerations
         )
         if output is not None:
-            write_model(loaded.model, output, "json", overwrite=force)
+            api.write(loaded.model, output, "json", overwrite=force)
         else:
             print(dumps(loaded.model, "json"), end="")
 

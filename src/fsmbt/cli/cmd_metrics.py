@@ -12,13 +12,9 @@ from rich.markup import escape
 from rich.table import Table
 
 from fsmbt import api
+from fsmbt.api_types import ReadOptions
 from fsmbt.cli.options import (
-    abstract_option,
-    include_root_option,
-    node_models_option,
-    nodes_option,
-    reader_options,
-    trees_option,
+    reads_models,
 )
 from fsmbt.metrics import edit_distance, elements
 from fsmbt.model.errors import InputError
@@ -26,38 +22,33 @@ from fsmbt.model.errors import InputError
 
 def register(app: typer.Typer) -> None:
     @app.command("metrics")
+    @reads_models
     def metrics_command(
         model: Path = typer.Argument(..., help="Model file (FSM or BT)."),
         other: Path | None = typer.Argument(
             None, help="A second model of the same kind: adds the edit distance."
         ),
-        from_format: str | None = typer.Option(
-            None, "--from", help="Input format (default: detected)."
-        ),
-        node_models: list[Path] = node_models_option(),
-        nodes: list[str] = nodes_option(),
-        abstract: list[str] = abstract_option(),
-        trees: list[Path] = trees_option(),
-        include_root: Path | None = include_root_option(),
         timeout: float = typer.Option(
             5.0, "--timeout", min=0.01, help="Seconds for the FSM graph edit distance search."
         ),
         as_json: bool = typer.Option(False, "--json", help="Print the figures as JSON."),
+        *,
+        read: ReadOptions,
     ) -> None:
         """Graphical and active elements, depth, node counts by type, sub-FSMs; with OTHER the
         tree edit distance (BTs) or graph edit distance (FSMs, an upper bound when cut)."""
         first = api.load(
             model,
-            from_format,
-            options=reader_options(node_models, nodes, abstract, trees, include_root),
+            read.format,
+            options=read,
         ).model
         figures = {"file": str(model), **elements(first).to_dict()}
         report: dict[str, object] = {"model": figures}
         if other is not None:
             second = api.load(
                 other,
-                from_format,
-                options=reader_options(node_models, nodes, abstract, trees, include_root),
+                read.format,
+                options=read,
             ).model
             report["other"] = {"file": str(other), **elements(second).to_dict()}
             try:

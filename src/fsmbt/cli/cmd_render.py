@@ -8,14 +8,10 @@ from pathlib import Path
 import typer
 
 from fsmbt import api
+from fsmbt.api_types import ReadOptions
 from fsmbt.cli import EXIT_INTERNAL, fail
 from fsmbt.cli.options import (
-    abstract_option,
-    include_root_option,
-    node_models_option,
-    nodes_option,
-    reader_options,
-    trees_option,
+    reads_models,
 )
 from fsmbt.render import DEFAULT_MAX_NODES, GraphvizError, render_model
 
@@ -31,19 +27,12 @@ def _cli_words(note: str) -> str:
 
 def register(app: typer.Typer) -> None:
     @app.command("render")
+    @reads_models
     def render_command(
         model: Path = typer.Argument(..., help="Model file (FSM or BT, any format fsmbt reads)."),
         output: Path = typer.Option(
             ..., "-o", "--output", help="Picture to write: .svg, .png, .pdf, or .dot (source)."
         ),
-        from_format: str | None = typer.Option(
-            None, "--from", help="Input format (default: detected)."
-        ),
-        node_models: list[Path] = node_models_option(),
-        nodes: list[str] = nodes_option(),
-        abstract: list[str] = abstract_option(),
-        trees: list[Path] = trees_option(),
-        include_root: Path | None = include_root_option(),
         force: bool = typer.Option(False, "--force", help="Overwrite OUTPUT if it exists."),
         expand_subtrees: bool = typer.Option(
             False,
@@ -66,12 +55,14 @@ def register(app: typer.Typer) -> None:
             None, "--composite", help="FSM: draw only this composite state (path A/B)."
         ),
         tree: str | None = typer.Option(None, "--tree", help="BT: draw only this tree."),
+        *,
+        read: ReadOptions,
     ) -> None:
         """Draw MODEL: FSMs as state diagrams, behavior trees top-down with the usual symbols."""
         loaded = api.load(
             model,
-            from_format,
-            options=reader_options(node_models, nodes, abstract, trees, include_root),
+            read.format,
+            options=read,
         ).model
         notes: list[str] = []
         try:

@@ -14,11 +14,14 @@ from pathlib import Path
 
 import typer
 
+from fsmbt.api_types import ReadOptions
 from fsmbt.cli import EXIT_NOT_EQUIVALENT
+from fsmbt.cli.options import reads_models
 
 
 def register(app: typer.Typer) -> None:
     @app.command("simulate")
+    @reads_models
     def simulate_command(
         world: str = typer.Argument(..., help="robot or predator-prey."),
         model: Path = typer.Argument(..., help="The model (BT, FSM, or a conversion)."),
@@ -52,6 +55,8 @@ def register(app: typer.Typer) -> None:
             help="Episode (0-based) drawn in the pictures (default: the "
             "first divergent one, else the first).",
         ),
+        *,
+        read: ReadOptions,
     ) -> None:
         """Run MODEL and OTHER (or MODEL's conversion) in the same seeded world; compare the
         trajectories step by step."""
@@ -68,9 +73,9 @@ def register(app: typer.Typer) -> None:
                 raise fail(f"{output} exists and is not a directory")
             gif = api.check_destination(output / "simulation.gif", overwrite=force)
             png = api.check_destination(output / "trajectories.png", overwrite=force)
-        source = api.load(model).model
+        source = api.load(model, options=read).model
         if against is not None:
-            other = api.load(against).model
+            other = api.load(against, options=read.model_copy(update={"format": None})).model
             names = (model.name, against.name)
         else:
             other = api.convert_model(source, convert_engine).model

@@ -5,7 +5,7 @@ reads IN (``-O`` passes reader options, e.g. ``machine=NAME`` for SMACH), writes
 OUT in FMT (default: from OUT's extension; stdout when there is no ``-o``, then ``--to`` is
 needed). The reader's warnings and one ``warning:`` line per thing the target cannot hold go
 to stderr; a loss that changes the model's behaviour is an error (exit 2) and nothing is
-written. The logic is ``fsmbt.formats.translate``; this module parses options and prints.
+written. The logic is ``fsmbt.api.translate``; this module parses options and prints.
 Exit codes: 0 translated, 2 bad input or a refused translation.
 """
 
@@ -17,11 +17,14 @@ from pathlib import Path
 
 import typer
 
-from fsmbt.formats.translate import translate_file
+from fsmbt import api
+from fsmbt.api_types import ReadOptions, read_options
+from fsmbt.cli.options import reads_models
 
 
 def register(app: typer.Typer) -> None:
     @app.command("translate")
+    @reads_models
     def translate_command(
         source: Path = typer.Argument(..., help="the model to translate (any readable format)"),
         output: Path | None = typer.Option(
@@ -29,9 +32,6 @@ def register(app: typer.Typer) -> None:
         ),
         to: str | None = typer.Option(
             None, "--to", help="target format (default: from -o's extension)"
-        ),
-        source_format: str | None = typer.Option(
-            None, "--from", help="input format (default: detected)"
         ),
         force: bool = typer.Option(False, "--force", help="overwrite an existing output file"),
         flatten: bool = typer.Option(
@@ -48,6 +48,8 @@ def register(app: typer.Typer) -> None:
             "KEY=VALUE, e.g. machine=sm_top (SMACH: which "
             "top-level container), behaviour=MySM (FlexBE)",
         ),
+        *,
+        read: ReadOptions,
     ) -> None:
         """Write the same model in another format; name whatever the target cannot hold."""
         if output is None and to is None:
@@ -60,17 +62,10 @@ def register(app: typer.Typer) -> None:
                 print(f"error: --option takes KEY=VALUE, not {item!r}", file=sys.stderr)
                 raise typer.Exit(2)
             options[key.strip()] = value.strip()
-        from fsmbt.verify import verify
-
-        result = translate_file(
-            source,
-            to,
-            output,
-            source_format=source_format,
-            flatten=flatten,
-            overwrite=force,
-            options=options,
-            check=verify,
+        if options:
+            read = read_options(read, **options)
+        _loaded, result, _report = api.translate(
+            source, output, to=to, read=read, flatten=flatten, overwrite=force
         )
         summary = {
             "source": str(source),

@@ -14,21 +14,17 @@ import typer
 from rich.console import Console
 
 from fsmbt import api
+from fsmbt.api_types import ReadOptions
 from fsmbt.cli.options import (
-    abstract_option,
     apply_engine_caps,
-    include_root_option,
     max_states_option,
-    node_models_option,
-    nodes_option,
     nusmv_memory_option,
-    reader_options,
+    reads_models,
     timeout_option,
-    trees_option,
 )
 from fsmbt.cli.progress import StageProgress
+from fsmbt.cli.render_report import print_report
 from fsmbt.verify import EngineDisagreement
-from fsmbt.verify.render_report import print_report
 
 EXIT_EQUIVALENT = 0
 EXIT_NOT_EQUIVALENT = 1
@@ -37,31 +33,29 @@ EXIT_ENGINES_DISAGREE = 3
 
 def register(app: typer.Typer) -> None:
     @app.command("verify")
+    @reads_models
     def verify_command(
         source: Path = typer.Argument(..., help="The source model (FSM or BT)."),
         converted: Path = typer.Argument(..., help="The converted model to check against it."),
         as_json: bool = typer.Option(False, "--json", help="Print the report as JSON."),
         quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress display on stderr."),
-        node_models: list[Path] = node_models_option(),
         max_states: int | None = max_states_option(),
-        nodes: list[str] = nodes_option(),
-        abstract: list[str] = abstract_option(),
-        trees: list[Path] = trees_option(),
-        include_root: Path | None = include_root_option(),
         engine: str = typer.Option(
-            "native", "--engine", help="native, nusmv, or both (both must agree)."
+            "native",
+            "--verify-engine",
+            "--engine",
+            help="native, nusmv, or both (both must agree).",
         ),
         loop: bool = typer.Option(
             False, "--loop", help="BT side: tick the root again after it returns."
-        ),
-        from_format: str | None = typer.Option(
-            None, "--from", help="Format of SOURCE (default: detected)."
         ),
         from_format2: str | None = typer.Option(
             None, "--from2", help="Format of CONVERTED (default: detected)."
         ),
         timeout: float | None = timeout_option(),
         nusmv_memory: int | None = nusmv_memory_option(),
+        *,
+        read: ReadOptions,
     ) -> None:
         """Check the five properties (reachability, completeness, no additional behaviour,
         deadlock absence, termination consistency); on failure, show the shortest input
@@ -71,16 +65,11 @@ def register(app: typer.Typer) -> None:
             with StageProgress(
                 quiet=quiet or as_json, label=f"{source.name} ~ {converted.name}"
             ) as progress:
+                request = api.verify_request(
+                    engine=engine, loop=loop, max_states=max_states, read=read
+                )
                 first, second, report = api.verify_files(
-                    source,
-                    converted,
-                    engine=engine,
-                    loop=loop,
-                    source_format=from_format,
-                    converted_format=from_format2,
-                    max_states=max_states,
-                    options=reader_options(node_models, nodes, abstract, trees, include_root),
-                    on_stage=progress,
+                    source, converted, request, converted_format=from_format2, on_stage=progress
                 )
         except EngineDisagreement as exc:
             print(

@@ -2,7 +2,11 @@
 
 from __future__ import annotations
 
+import functools
+import inspect
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import typer
 
@@ -147,3 +151,96 @@ def apply_engine_caps(timeout: float | None, nusmv_memory: int | None) -> None:
         changes["nusmv_max_memory_mb"] = nusmv_memory
     if changes:
         limits.use(limits.current().with_changes(**changes))
+
+
+# -- the reader options, declared once for every command that reads a model -------------------
+
+#: ``--from FORMAT``: the input's format (detected from content and name when omitted).
+FROM_HELP = "input format (default: detected from the content, then the extension)"
+#: ``--data inputs``: SCXML conditions on data the file cannot compute are environment inputs.
+DATA_HELP = (
+    "SCXML: 'inputs' reads conditions on data the machine cannot compute as environment "
+    "inputs (docs/formats/scxml.md)"
+)
+
+#: The reader parameters ``reads_models`` adds: (name, annotation, a fresh typer.Option).
+_READ_PARAMETERS: tuple[tuple[str, Any, Callable[[], Any]], ...] = (
+    ("source_format", str | None, lambda: typer.Option(None, "--from", help=FROM_HELP)),
+    ("node_models", list[Path], node_models_option),
+    ("nodes", list[str], nodes_option),
+    ("abstract", list[str], abstract_option),
+    ("trees", list[Path], trees_option),
+    ("include_root", Path | None, include_root_option),
+    ("data", str | None, lambda: typer.Option(None, "--data", help=DATA_HELP)),
+    (
+        "machine",
+        str | None,
+        lambda: typer.Option(None, "--machine", help="SMACH: the top-level container to read"),
+    ),
+    (
+        "behaviour",
+        str | None,
+        lambda: typer.Option(None, "--behaviour", help="FlexBE: the Behavior class to read"),
+    ),
+    (
+        "initial",
+        str | None,
+        lambda: typer.Option(
+            None, "--initial", help="tables: the initial state (default: the first row's source)"
+        ),
+    ),
+)
+#: Every CLI flag of the reader options (the vocabulary test walks the commands for them).
+READ_FLAGS = (
+    "--from",
+    "--node-models",
+    "--nodes",
+    "--abstract",
+    "--trees",
+    "--include-root",
+    "--data",
+)
+
+
+def reads_models(command: Callable[..., Any]) -> Callable[..., Any]:
+    """Give a command every reader option, under one name each, as one ``read: ReadOptions``.
+
+    Why: each option a reader takes must be offered by every command that reads models, with
+    the same flag and meaning (issue "one vocabulary"). The command declares a parameter
+    ``read`` (a ``fsmbt.api_types.ReadOptions``) instead of the flags; this decorator puts the
+    flags into the signature typer reads and builds the validated ``ReadOptions`` (an invalid
+    value is the located ``InputError`` of ``fsmbt.api_types``: exit 2).
+    """
+    from fsmbt.api_types import convert_request
+
+    signature = inspect.signature(command, eval_str=True)
+    kept = [p for name, p in signature.parameters.items() if name != "read"]
+    added = [
+        inspect.Parameter(name, inspect.Parameter.KEYWORD_ONLY, default=make(), annotation=kind)
+        for name, kind, make in _READ_PARAMETERS
+    ]
+    names = [name for name, _kind, _make in _READ_PARAMETERS]
+
+    @functools.wraps(command)
+    def wrapper(**kwargs: Any) -> Any:
+        given = {name: kwargs.pop(name) for name in names}
+        fields: dict[str, Any] = {
+            key: [str(v) for v in value] if isinstance(value, list) else value
+            for key, value in given.items()
+            if key != "source_format" and value not in (None, [])
+        }
+        if isinstance(fields.get("include_root"), Path):
+            fields["include_root"] = str(fields["include_root"])
+        request = convert_request(source_format=given["source_format"], options=fields)
+        return command(read=request.read, **kwargs)
+
+    parameters = [
+        p.replace(kind=inspect.Parameter.KEYWORD_ONLY)
+        if p.kind is inspect.Parameter.POSITIONAL_OR_KEYWORD
+        else p
+        for p in kept
+    ] + added
+    wrapper.__signature__ = signature.replace(parameters=parameters)  # type: ignore[attr-defined]
+    wrapper.__annotations__ = {p.name: p.annotation for p in parameters}
+    del wrapper.__wrapped__  # typer must read the new signature, not the command's
+    return wrapper

@@ -17,6 +17,15 @@ import sys
 from types import TracebackType
 
 from rich.console import Console
+from rich.progress import (
+    BarColumn,
+    MofNCompleteColumn,
+    Progress,
+    TaskID,
+    TextColumn,
+    TimeElapsedColumn,
+    TimeRemainingColumn,
+)
 from rich.status import Status
 
 #: What each library step is called on screen.
@@ -64,3 +73,50 @@ class StageProgress:
 def format_timings(timings: dict[str, float]) -> str:
     """``read 0.01 s, convert 0.20 s, verify 1.52 s`` in the order the steps ran."""
     return ", ".join(f"{stage} {seconds:.2f} s" for stage, seconds in timings.items())
+
+
+class MethodBars:
+    """``fsmbt evaluate``'s per-method progress bars with ETA on stderr (a context manager).
+
+    It is the ``on_progress(label, done, total)`` hook of ``fsmbt.evaluate.evaluate``: the first
+    call for a label adds its bar (starting at what the results store already held), later
+    calls move it. Drawn only when stderr is a terminal and not ``--quiet``.
+    """
+
+    def __init__(self, *, quiet: bool = False) -> None:
+        self.enabled = not quiet and sys.stderr.isatty()
+        self._bars: Progress | None = None
+        self._tasks: dict[str, TaskID] = {}
+
+    def __call__(self, label: str, done: int, total: int) -> None:
+        if self._bars is None:
+            return
+        task = self._tasks.get(label)
+        if task is None:
+            self._tasks[label] = self._bars.add_task(label, total=total, completed=done)
+        else:
+            self._bars.update(task, completed=done, total=total)
+
+    def __enter__(self) -> MethodBars:
+        if self.enabled:
+            self._bars = Progress(
+                TextColumn("{task.description:>24}"),
+                BarColumn(),
+                MofNCompleteColumn(),
+                TimeElapsedColumn(),
+                TextColumn("ETA"),
+                TimeRemainingColumn(),
+                console=Console(stderr=True),
+            )
+            self._bars.start()
+        return self
+
+    def __exit__(
+        self,
+        kind: type[BaseException] | None,
+        error: BaseException | None,
+        trace: TracebackType | None,
+    ) -> None:
+        if self._bars is not None:
+            self._bars.stop()
+            self._bars = None

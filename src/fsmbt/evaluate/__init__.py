@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import json
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -65,14 +66,18 @@ def _log_invocation(path: Path, settings: EvaluationSettings, summary: dict[str,
 
 
 def evaluate(
-    settings: EvaluationSettings, *, report: bool = True, progress: bool = True
+    settings: EvaluationSettings,
+    *,
+    report: bool = True,
+    on_progress: Callable[[str, int, int], None] | None = None,
 ) -> dict[str, Any]:
     """Build the dataset, run and verify every method, write the report.
 
     Args:
         settings: the run's settings.
         report: write the report folder after the run.
-        progress: show the per-method progress bars (on a terminal only).
+        on_progress: ``on_progress(method, done, total)`` as results arrive
+            (``fsmbt.evaluate.execute.ProgressHook``), or ``None``.
 
     Returns:
         Counts: ``models``, ``jobs``, ``before`` / ``ran`` / ``after`` (stored rows), ``seconds``
@@ -102,7 +107,7 @@ def evaluate(
         workers=settings.workers,
         executor=settings.executor,
         ray_address=settings.ray_address,
-        progress=progress,
+        on_progress=on_progress,
     )
     summary: dict[str, Any] = {
         "models": len(entries),

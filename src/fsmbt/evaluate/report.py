@@ -5,7 +5,8 @@ file), ``plots/*.png|svg`` (accuracy bars with Wilson intervals, elements vs M w
 lines, time per model size), ``rows.csv`` / ``rows.json`` (every stored result),
 ``tables.json`` (every table), ``run.json`` (the exact command, versions, counts, seconds).
 Every number is computed from the store by ``analysis``; a method that did not run reads
-"not run: no endpoint". Cost: O(rows) plus the plots (a second each).
+"not run: no endpoint". ``report.md``'s prose and layout are the jinja2 template
+``templates/report.md.j2``; this module computes its tables' cells. Cost: O(rows) plus the plots (a second each).
 """
 
 from __future__ import annotations
@@ -20,6 +21,8 @@ import time
 from importlib import metadata
 from pathlib import Path
 from typing import Any
+
+from jinja2 import Environment, FileSystemLoader, StrictUndefined
 
 from fsmbt.evaluate import analysis, cases, inputs
 from fsmbt.evaluate.dataset import Entry
@@ -45,6 +48,15 @@ from fsmbt.evaluate.runner import BATCH_SOURCE, ResultStore
 from fsmbt.verify import PROPERTIES
 
 CONSISTENCY_MODELS = ("example_robot_bt.xml", "example_predator_fsm.csv")
+#: report.md's template (prose and layout); the tables arrive as Markdown text.
+_TEMPLATES = Environment(
+    loader=FileSystemLoader(Path(__file__).parent / "templates"),
+    autoescape=False,  # Markdown, not HTML (report.html escapes every cell itself)
+    trim_blocks=True,
+    lstrip_blocks=True,
+    keep_trailing_newline=True,
+    undefined=StrictUndefined,
+)
 VERSIONED = ("fsmbt", "networkx", "matplotlib", "lxml", "zss", "py-trees", "behaviortreepy")
 
 
@@ -271,7 +283,7 @@ def write_report(
                     "verify_s": r["timings"].get("verify"),
                 }
             )
-    markdown = _markdown(
+    markdown = markdown_report(
         run,
         entries,
         acc,
@@ -289,7 +301,7 @@ def write_report(
     return out / "report.md"
 
 
-def _markdown(
+def markdown_report(
     run: dict[str, Any],
     entries: list[Entry],
     acc: list[dict[str, Any]],
@@ -302,49 +314,160 @@ def _markdown(
     nusmv_models: list[dict[str, Any]],
     headlines: list[dict[str, str]],
 ) -> str:
-    parts = [
-        "# fsmbt evaluation report",
-        "",
-        f"Command: `{run['command']}` — {run['written_at']}; batch runner "
-        f"`{run['batch_runner']}`; {run['models']} models, {run['jobs']} jobs, "
-        f"{run['rows_stored']} rows stored; run {run['run_seconds']} s.",
-        "",
-        "Versions: " + ", ".join(f"{k} {v}" for k, v in run["versions"].items()),
-        "",
-        "Invocations of this report folder (a killed run resumes; rows are stored once per key):",
-        "",
-        _md_table(
+    """``report.md``: the tables' cells computed here, the prose and layout in the template
+    ``templates/report.md.j2``."""
+    sources: dict[str, int] = {}
+    for e in entries:
+        label = f"{e.source} {e.kind}" + ("" if e.readable else " (unreadable)")
+        sources[label] = sources.get(label, 0) + 1
+    examples_in = [m["model"] for m in nusmv_models if m["source"] == "example"]
+    generated_in = [m for m in nusmv_models if m["source"] == "generated"]
+    tables = {
+        "invocations": _md_table(
             ["finished", "stored before", "ran", "stored after", "jobs", "seconds"],
             [
                 [i["finished_at"], i["before"], i["ran"], i["after"], i["jobs"], i["seconds"]]
                 for i in run["invocations"]
             ],
         ),
-        "",
-        f"LLM methods (llm, nllm, SCP ablations): {run['llm_models']}.",
-        "",
-    ]
-    sources: dict[str, int] = {}
-    for e in entries:
-        label = f"{e.source} {e.kind}" + ("" if e.readable else " (unreadable)")
-        sources[label] = sources.get(label, 0) + 1
-    parts += [
-        "## Dataset",
-        "",
-        _md_table(["source / kind", "models"], [[k, v] for k, v in sorted(sources.items())]),
-        "",
-    ]
-    parts += [
-        "## Accuracy (Tables I/VI)",
-        "",
-        "Share of produced results the native checker proves equivalent; 95 % **Wilson** "
-        "score intervals. Refused = the engine names a construct it cannot convert "
-        "exactly; unreadable inputs are counted apart. Paper column: "
-        f"{NOT_RECORDED_TABLES['accuracy']}; those values are {NOT_RECORDED}, so none is "
-        "shown.",
-        "",
-    ]
-    body = []
+        "dataset": _md_table(
+            ["source / kind", "models"], [[k, v] for k, v in sorted(sources.items())]
+        ),
+        "accuracy": _md_table(
+            [
+                "method",
+                "group",
+                "equivalent/produced",
+                "accuracy",
+                "Wilson 95 %",
+                "not produced",
+                "paper",
+            ],
+            _accuracy_rows(acc),
+        ),
+        "consistency": _md_table(
+            ["model", "method", *PROPERTIES, "paper"], _consistency_rows(consistency)
+        ),
+        "formulas": _md_table(
+            [
+                "direction",
+                "method",
+                "n",
+                "paper",
+                "fitted a (graphical)",
+                "b",
+                "fitted a (active)",
+                "mean dev. from ours",
+                "within band",
+            ],
+            _formula_rows(formulas),
+        ),
+        "cases": _md_table(
+            [
+                "scenario",
+                "case",
+                "method",
+                "BT edit",
+                "FSM edit, as written",
+                "bounds",
+                "FSM edit, flattened",
+                "paper",
+                "k",
+                "Δ elements",
+                "verified",
+            ],
+            _case_rows(case_rows),
+        ),
+        "inputs": _md_table(
+            ["representation", "file", "method", "read by", "result", "paper"],
+            [
+                [
+                    r["representation"],
+                    r["file"],
+                    r["method"],
+                    r.get("reader", ""),
+                    r.get("text", ""),
+                    NOT_RECORDED,
+                ]
+                for r in representation
+            ],
+        ),
+        "cost": _md_table(
+            [
+                "method",
+                "n",
+                "convert median",
+                "convert p95",
+                "verify median",
+                "paper time",
+                "tokens",
+                "paper tokens",
+            ],
+            _cost_rows(costs),
+        ),
+        "nusmv": _md_table(
+            [
+                "method",
+                "sampled",
+                "both equivalent",
+                "not equivalent",
+                "not encodable / error",
+                "reasons",
+            ],
+            [
+                [
+                    n["method"],
+                    n["sampled"],
+                    n["both_equivalent"],
+                    n["not_equivalent"],
+                    n["not_encodable_or_error"],
+                    "; ".join(n["reasons"]),
+                ]
+                for n in nusmv
+            ],
+        ),
+        "nusmv_models": _md_table(
+            ["model", "source", "kind", "size", *RULE_ENGINES],
+            [
+                [
+                    m["model"],
+                    m["source"],
+                    m["kind"],
+                    m["size"],
+                    *[
+                        f"{m.get(e, '–')} ({m[e + '_seconds']:.1f} s)"
+                        if m.get(e + "_seconds") is not None
+                        else m.get(e, "–")
+                        for e in RULE_ENGINES
+                    ],
+                ]
+                for m in nusmv_models
+            ],
+        ),
+        "headlines": _md_table(
+            ["figure", "paper", "ours", "source"],
+            [[h["figure"], h["paper"], h["ours"], h["source"]] for h in headlines],
+        ),
+    }
+    return _TEMPLATES.get_template("report.md.j2").render(
+        run=run,
+        versions=", ".join(f"{k} {v}" for k, v in run["versions"].items()),
+        tables=tables,
+        not_run=NOT_RUN,
+        not_recorded=NOT_RECORDED,
+        not_recorded_tables=NOT_RECORDED_TABLES,
+        no_paper_figure=NO_PAPER_FIGURE,
+        formula_band=f"{analysis.FORMULA_BAND:.0%}",
+        nusmv_examples=", ".join(NUSMV_EXAMPLES),
+        examples_in=", ".join(examples_in) or "none",
+        generated_in=len(generated_in),
+        nusmv_max_states=NUSMV_MAX_STATES,
+        nusmv_max_nodes=NUSMV_MAX_NODES,
+    )
+
+
+def _accuracy_rows(acc: list[dict[str, Any]]) -> list[list[Any]]:
+    body: list[list[Any]] = []
     for row in acc:
         if "text" in row:
             if row["group"] == "all":
@@ -371,37 +494,11 @@ def _markdown(
                 paper_accuracy(row["method"]),
             ]
         )
-    parts += [
-        _md_table(
-            [
-                "method",
-                "group",
-                "equivalent/produced",
-                "accuracy",
-                "Wilson 95 %",
-                "not produced",
-                "paper",
-            ],
-            body,
-        ),
-        "",
-        "![accuracy](plots/accuracy.svg)",
-        "",
-    ]
-    parts += [
-        "## SCP ablations (Tables II/VII), retries (XII), version sensitivity (XI)",
-        "",
-        f"LLM only: {NOT_RUN}. Paper: {NOT_RECORDED_TABLES['ablation']}; {NOT_RECORDED}.",
-        "",
-    ]
-    parts += [
-        "## Behavioural consistency (Tables III/VIII)",
-        "",
-        f"Native checker's five properties. Paper: {NOT_RECORDED_TABLES['consistency']}; "
-        f"{NOT_RECORDED}.",
-        "",
-    ]
-    body = []
+    return body
+
+
+def _consistency_rows(consistency: list[dict[str, Any]]) -> list[list[Any]]:
+    body: list[list[Any]] = []
     for row in consistency:
         if "text" in row:
             body.append(
@@ -416,17 +513,11 @@ def _markdown(
                     NOT_RECORDED,
                 ]
             )
-    parts += [_md_table(["model", "method", *PROPERTIES, "paper"], body), ""]
-    parts += [
-        "## Graphical and active elements (Tables IV/IX)",
-        "",
-        "Least-squares fit `elements = a·M + b` over every produced result; `a ± "
-        "standard error` next to the paper's coefficient. Our exact formulas "
-        "(src/fsmbt/metrics/formulas.py): LEBT 7M−1, BSD 8M+1, CHDS 6T+6M+1 (FSM→BT); "
-        f"4M+2k+1 (BT→FSM). Band: share within ±{analysis.FORMULA_BAND:.0%} of ours.",
-        "",
-    ]
-    body = [
+    return body
+
+
+def _formula_rows(formulas: list[dict[str, Any]]) -> list[list[Any]]:
+    return [
         [
             f["direction"],
             f["method"],
@@ -440,39 +531,10 @@ def _markdown(
         ]
         for f in formulas
     ]
-    parts += [
-        _md_table(
-            [
-                "direction",
-                "method",
-                "n",
-                "paper",
-                "fitted a (graphical)",
-                "b",
-                "fitted a (active)",
-                "mean dev. from ours",
-                "within band",
-            ],
-            body,
-        ),
-        "",
-        "![elements](plots/elements.svg)",
-        "",
-    ]
-    parts += [
-        "## Edit distance when a behaviour is added (Tables V/X)",
-        "",
-        "Graph edit distance (unit costs) between the FSMs converted from the base and the "
-        "extended BT. **As written**: the hierarchical result, every state of every level a "
-        "node, containment and transition edges (what a modeller edits; the paper's "
-        "measure); `≤` = upper bound, the interval = [lower bound, upper bound] when the "
-        "optimum is not proven. **Flattened**: the same behaviour as one flat machine. "
-        "k = sub-FSMs of the base → extended result; Δ elements = growth of the result; "
-        "paper = Tables V/X (LLMDUCF beside rules), its k evaluated at our extended k; both "
-        "results verified by the native checker.",
-        "",
-    ]
-    body = [
+
+
+def _case_rows(case_rows: list[dict[str, Any]]) -> list[list[Any]]:
+    return [
         [
             c["scenario"],
             c["case"],
@@ -498,53 +560,10 @@ def _markdown(
         ]
         for c in case_rows
     ]
-    parts += [
-        _md_table(
-            [
-                "scenario",
-                "case",
-                "method",
-                "BT edit",
-                "FSM edit, as written",
-                "bounds",
-                "FSM edit, flattened",
-                "paper",
-                "k",
-                "Δ elements",
-                "verified",
-            ],
-            body,
-        ),
-        "",
-    ]
-    parts += [
-        "## Input representation (Table XIII)",
-        "",
-        f"Paper: {NOT_RECORDED_TABLES['inputs']}; {NOT_RECORDED}.",
-        "",
-    ]
-    body = [
-        [
-            r["representation"],
-            r["file"],
-            r["method"],
-            r.get("reader", ""),
-            r.get("text", ""),
-            NOT_RECORDED,
-        ]
-        for r in representation
-    ]
-    parts += [
-        _md_table(["representation", "file", "method", "read by", "result", "paper"], body),
-        "",
-    ]
-    parts += [
-        "## Cost per conversion",
-        "",
-        "Seconds from the job timings of this run; paper = its cost discussion (rules, LLM).",
-        "",
-    ]
-    body = []
+
+
+def _cost_rows(costs: list[dict[str, Any]]) -> list[list[Any]]:
+    body: list[list[Any]] = []
     for c in costs:
         paper_time, paper_tokens = paper_cost(c["method"])
         if "text" in c:
@@ -562,93 +581,7 @@ def _markdown(
                     paper_tokens,
                 ]
             )
-    parts += [
-        _md_table(
-            [
-                "method",
-                "n",
-                "convert median",
-                "convert p95",
-                "verify median",
-                "paper time",
-                "tokens",
-                "paper tokens",
-            ],
-            body,
-        ),
-        "",
-        "![time](plots/time.svg)",
-        "",
-    ]
-    examples_in = [m["model"] for m in nusmv_models if m["source"] == "example"]
-    generated_in = [m for m in nusmv_models if m["source"] == "generated"]
-    parts += [
-        "## NuSMV sample",
-        "",
-        f"NuSMV (with the native checker: `both`, they must agree) checks a stated sample, "
-        f"not every model: it is 100x–5 000x slower than the native checker and the ratio "
-        f'grows with size (docs/nusmv.md, "Cost"); the native checker covers every model. '
-        f"The sample: the examples {', '.join(NUSMV_EXAMPLES)} (present here: "
-        f"{', '.join(examples_in) or 'none'}), then {len(generated_in)} generated models drawn "
-        f"with the seed from those of at most {NUSMV_MAX_STATES} states (FSM) / "
-        f"{NUSMV_MAX_NODES} nodes (BT); each listed below. Paper: {NO_PAPER_FIGURE} "
-        f"(NuSMV is fsmbt's cross-check).",
-        "",
-        _md_table(
-            [
-                "method",
-                "sampled",
-                "both equivalent",
-                "not equivalent",
-                "not encodable / error",
-                "reasons",
-            ],
-            [
-                [
-                    n["method"],
-                    n["sampled"],
-                    n["both_equivalent"],
-                    n["not_equivalent"],
-                    n["not_encodable_or_error"],
-                    "; ".join(n["reasons"]),
-                ]
-                for n in nusmv
-            ],
-        ),
-        "",
-        _md_table(
-            ["model", "source", "kind", "size", *RULE_ENGINES],
-            [
-                [
-                    m["model"],
-                    m["source"],
-                    m["kind"],
-                    m["size"],
-                    *[
-                        f"{m.get(e, '–')} ({m[e + '_seconds']:.1f} s)"
-                        if m.get(e + "_seconds") is not None
-                        else m.get(e, "–")
-                        for e in RULE_ENGINES
-                    ],
-                ]
-                for m in nusmv_models
-            ],
-        ),
-        "",
-    ]
-    parts += [
-        "## The paper's headline numbers next to ours",
-        "",
-        f'Ours: measured in this run. "{NOT_RECORDED}": the paper reports the figure but '
-        "its value is not in the repository (no number is invented).",
-        "",
-        _md_table(
-            ["figure", "paper", "ours", "source"],
-            [[h["figure"], h["paper"], h["ours"], h["source"]] for h in headlines],
-        ),
-        "",
-    ]
-    return "\n".join(parts)
+    return body
 
 
 def _html(markdown: str, svgs: dict[str, str]) -> str:

@@ -8,9 +8,7 @@ from fsmbt.formats.registry import (
     formats,
     get_format,
     loads,
-    read_model,
     register,
-    write_model,
 )
 
 __all__ = [
@@ -21,7 +19,5 @@ __all__ = [
     "formats",
     "get_format",
     "loads",
-    "read_model",
     "register",
-    "write_model",
 ]

@@ -1,9 +1,10 @@
 """One registry of file formats: each format module registers a reader and/or writer here.
 
-Reading goes through ``read_model`` (file) or ``loads`` (text); both check size and encoding
-before any parser sees the bytes, pick the format from ``--from``, the extension or the content,
-and raise ``InputError`` with the file name on any problem. Writing never overwrites a file unless
-asked to.
+Reading goes through ``loads`` (a text; ``read_text`` reads a file safely first): the size and
+encoding are checked before any parser sees the bytes, the format is picked from ``--from``, the
+extension or the content, and any problem is an ``InputError`` with the file name. ``dumps``
+writes a text. Files are read and written only through ``fsmbt.api`` (``load``, ``write``,
+``translate``: the one front door, with the destination check and atomic writes).
 """
 
 from __future__ import annotations
@@ -140,16 +141,33 @@ def get_format(name: str) -> Format:
         raise InputError(f"unknown format '{name}' (known: {known})") from None
 
 
+#: The modules of the built-in formats, each registering its format on import.
+BUILTIN_FORMAT_MODULES: tuple[str, ...] = (
+    "fsmbt.formats.paper.xml_format",
+    "fsmbt.formats.paper.text_format",
+    "fsmbt.formats.scxml.structural",
+    "fsmbt.formats.btcpp.xml_format",
+    "fsmbt.formats.pysm.smach",
+    "fsmbt.formats.pysm.flexbe",
+    "fsmbt.formats.schema.json_format",
+    "fsmbt.formats.schema.yaml_format",
+    "fsmbt.formats.tables.csv_format",
+    "fsmbt.formats.tables.markdown",
+    "fsmbt.formats.diagrams.dot",
+    "fsmbt.formats.diagrams.mermaid",
+    "fsmbt.formats.yasmin",
+    "fsmbt.formats.smcat",
+    "fsmbt.formats.transitions",
+    "fsmbt.formats.pystatemachine",
+)
+
+
 def _load_builtin_formats() -> None:
-    """Import every format module once so each registers itself."""
+    """Import every built-in format module once so each registers itself."""
     import importlib
-    import pkgutil
 
-    import fsmbt.formats as package
-
-    for info in pkgutil.iter_modules(package.__path__):
-        if info.name not in ("registry",) and not info.name.startswith("_"):
-            importlib.import_module(f"fsmbt.formats.{info.name}")
+    for name in BUILTIN_FORMAT_MODULES:
+        importlib.import_module(name)
 
 
 def format_for_path(path: Path, *, writing: bool = False, kind: str | None = None) -> Format | None:
@@ -345,33 +363,6 @@ def read_text(path: str | Path) -> str:
     return decode(read_located(path), str(path))
 
 
-def read_model(
-    path: str | Path,
-    fmt: str | None = None,
-    options: dict[str, object] | None = None,
-    *,
-    warnings: list[str] | None = None,
-) -> Model:
-    """Read one model file: size and encoding checks, then the format's reader.
-
-    Args:
-        path: The file; a regular file within ``limits.current().max_input_bytes``.
-        fmt: A format name; ``None`` detects it from the content, then the extension.
-        options: Reader options.
-        warnings: When given, the reader's documented warnings are appended to it.
-
-    Returns:
-        The model (``FSM`` or ``BTDocument``).
-
-    Raises:
-        InputError: The file cannot be read, is too large, not a regular file, not text, or
-            the reader refuses it (located).
-        UnsupportedError: A construct fsmbt cannot model (located).
-    """
-    path = Path(path)
-    return loads(read_text(path), fmt, path=path, options=options, warnings=warnings)
-
-
 def dumps(model: Model, fmt: str) -> str:
     """A model as text in a format.
 
@@ -393,45 +384,6 @@ def dumps(model: Model, fmt: str) -> str:
     if kind not in chosen.kinds:
         raise InputError(f"format '{chosen.name}' cannot hold a {kind.upper()}")
     return chosen.write(model)
-
-
-def write_model(
-    model: Model, path: str | Path, fmt: str | None = None, *, overwrite: bool = False
-) -> Path:
-    """Write a model to a file; never replaces an existing file unless ``overwrite``.
-
-    Args:
-        model: An ``FSM`` or a ``BTDocument``.
-        path: The file to write; missing parent directories are created.
-        fmt: A format name; ``None`` takes it from the extension.
-        overwrite: Replace ``path`` if it exists.
-
-    Returns:
-        The path written.
-
-    Raises:
-        InputError: No format for the name, the file exists and ``overwrite`` is false, or
-            the file cannot be written (located).
-        UnsupportedError: The model uses something the format cannot express.
-    """
-    path = Path(path)
-    kind = "fsm" if _is_fsm(model) else "bt"
-    chosen = get_format(fmt) if fmt else format_for_path(path, writing=True, kind=kind)
-    if chosen is None:
-        raise InputError(
-            f"cannot tell the output format from '{path.name}'", hints=(Hint.OUTPUT_FORMAT,)
-        )
-    text = dumps(model, chosen.name)
-    if path.exists() and not overwrite:
-        raise InputError("exists", location=SourceLocation(str(path)), hints=(Hint.OVERWRITE,))
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        path.write_text(text, encoding="utf-8")
-    except OSError as exc:
-        raise InputError(
-            f"cannot write: {exc.strerror}", location=SourceLocation(str(path))
-        ) from None
-    return path
 
 
 def _is_fsm(model: object) -> bool:

@@ -11,13 +11,12 @@ Rules:
   version ...), ignoring only the order of FSM states and transitions, which no format keeps
   the same way and no semantics reads.
 - A loss that changes meaning is an error, not a warning: when the target has a reader, the
-  model read back is checked against the source with the checker the caller passes
-  (``fsmbt.verify.verify``; this module sits below verify in the package layers and does not
-  import it); not equivalent -> ``UnsupportedError`` naming the failed properties, and nothing
-  is written.
+  model read back is returned with the model it must equal (``read_back``, ``checked``), and
+  ``fsmbt.api.translate`` proves them equivalent before anything is written (not equivalent
+  -> ``UnsupportedError`` naming the failed properties). Formats read and write; they never
+  verify (the package layers forbid it).
 
-Costs: one write, one read and one equivalence check of the model (the check is the product
-exploration of docs/verification.md).
+Costs: one write and one read of the model.
 """
 
 from __future__ import annotations
@@ -25,20 +24,12 @@ from __future__ import annotations
 import copy
 import json
 import re
-from collections.abc import Callable
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any
 
-from fsmbt.formats.registry import (
-    ReadContext,
-    format_for_path,
-    get_format,
-    loads,
-    read_model,
-)
+from fsmbt.formats.registry import ReadContext, get_format, loads
 from fsmbt.model import Model
-from fsmbt.model.errors import InputError, SourceLocation, UnsupportedError
+from fsmbt.model.errors import InputError, UnsupportedError
 from fsmbt.model.flatten import flatten as flatten_fsm
 from fsmbt.model.flatten import needs_flattening
 from fsmbt.model.fsm import FSM
@@ -57,12 +48,11 @@ class Translation:
     target_format: str
     losses: list[str] = field(default_factory=list)  # what the target cannot hold
     warnings: list[str] = field(default_factory=list)  # the reader's warnings about the input
-    verified: bool = False  # the model read back was checked equivalent
-
-
-#: Checks two models equivalent: ``fsmbt.verify.verify`` (passed in by the caller: formats sit
-#: below verify in the package layers, so this module does not import it).
-Checker = Callable[[Model, Model], Any]
+    verified: bool = False  # the model read back was checked equivalent (by ``fsmbt.api``)
+    #: The model read back from ``text`` (``None``: the target cannot be read back).
+    read_back: Model | None = None
+    #: What the read-back must equal in behaviour: the source, with any renamed events.
+    checked: Model | None = None
 
 
 def translate(
@@ -71,7 +61,6 @@ def translate(
     *,
     flatten: bool = False,
     source_format: str | None = None,
-    check: Checker | None = None,
 ) -> Translation:
     """Write ``model`` in format ``to`` and name everything the format cannot hold.
 
@@ -80,11 +69,10 @@ def translate(
         to: the target format's name (``fsmbt formats`` lists them).
         flatten: write a hierarchical FSM as its flat machine (a named loss).
         source_format: the source format's name, for the report.
-        check: the equivalence checker (``fsmbt.verify.verify``); without it the model read
-            back is compared structurally only and ``verified`` stays False.
 
     Returns:
-        The translation (text, losses, whether the read-back was verified equivalent).
+        The translation: text, losses, the model read back and the model it must equal in
+        behaviour (``fsmbt.api.translate`` proves that; formats never verify).
 
     Raises:
         InputError / UnsupportedError: the target cannot hold the model, or what it loses
@@ -142,7 +130,7 @@ def translate(
     own_losses = _writer_losses(target.name, written)
     losses.extend(own_losses or [])
     losses.extend(_program_losses(target.name, written))
-    result = Translation(text, source_format, target.name, losses)
+    result = Translation(text, source_format, target.name, losses, checked=checked)
     if target.read is None:
         losses.append(f"{target.name} cannot be read back, so what it loses is not checked")
         return result
@@ -154,85 +142,18 @@ def translate(
             "loses is not checked"
         )
         return result
-    if check is not None:
-        _check_meaning(checked, back, target.name, check)
-        result.verified = True
+    if isinstance(checked, FSM) != isinstance(back, FSM):
+        raise InputError(f"{target.name} read back a different kind of model")
+    result.read_back = back
     if own_losses is None:
         losses.extend(differences_between(written, back))
     return result
 
 
-def translate_file(
-    source: str | Path,
-    to: str | None = None,
-    output: str | Path | None = None,
-    *,
-    source_format: str | None = None,
-    flatten: bool = False,
-    overwrite: bool = False,
-    options: dict[str, object] | None = None,
-    check: Checker | None = None,
-) -> Translation:
-    """Read ``source``, translate it, write ``output`` (never replacing it unless asked).
-
-    Args:
-        source: the input file.
-        to: the target format (default: from ``output``'s extension).
-        output: where to write (``None``: only return the text).
-        source_format: the input format (default: detected).
-        flatten: see ``translate``.
-        overwrite: replace an existing ``output``.
-        options: reader options (``ReadContext.options``).
-        check: see ``translate``.
-
-    Returns:
-        The translation; ``warnings`` holds the reader's warnings.
-    """
-    warnings: list[str] = []
-    model = read_model(source, source_format, options, warnings=warnings)
-    kind = "fsm" if isinstance(model, FSM) else "bt"
-    target = to
-    if target is None and output is not None:
-        guessed = format_for_path(Path(output), writing=True, kind=kind)
-        target = guessed.name if guessed is not None else None
-    if target is None:
-        raise InputError(
-            "cannot tell the target format; name it with --to"
-            + (f" (from '{Path(output).name}')" if output is not None else "")
-        )
-    chosen_source = source_format or _detected(source)
-    result = translate(model, target, flatten=flatten, source_format=chosen_source, check=check)
-    result.warnings = warnings
-    if output is not None:
-        path = Path(output)
-        if path.exists() and not overwrite:
-            raise InputError(
-                "exists; pass --force to overwrite it", location=SourceLocation(str(path))
-            )
-        try:
-            path.parent.mkdir(parents=True, exist_ok=True)
-            path.write_text(result.text, encoding="utf-8")
-        except OSError as exc:
-            raise InputError(
-                f"cannot write: {exc.strerror}", location=SourceLocation(str(path))
-            ) from None
-    return result
-
-
-def _detected(source: str | Path) -> str | None:
-    from fsmbt.formats.registry import decode, detect_format
-
-    path = Path(source)
-    try:
-        return detect_format(decode(path.read_bytes()[: 1 << 20], str(path)), path).name
-    except (InputError, OSError):
-        return None
-
-
 def _writer_losses(target: str, model: Model) -> list[str] | None:
     """The writer's own list of losses, for writers that keep one (else ``None``)."""
     if target == "smach" and isinstance(model, FSM):
-        from fsmbt.formats._smach_write import smach_losses
+        from fsmbt.formats.pysm.smach_write import smach_losses
 
         return smach_losses(model)
     return None
@@ -365,18 +286,6 @@ def scxml_safe_names(fsm: FSM) -> tuple[FSM, dict[str, str]]:
     return copy_, renamed
 
 
-def _check_meaning(model: Model, back: Model, target: str, verify: Checker) -> None:
-    if isinstance(model, FSM) != isinstance(back, FSM):
-        raise InputError(f"{target} read back a different kind of model")
-    report = verify(model, back)
-    if not report.equivalent:
-        failed = [name for name, prop in report.properties.items() if not prop.holds]
-        details = "; ".join(f"{name}: {report.properties[name].detail}" for name in failed)
-        raise UnsupportedError(
-            f"translating to {target} changes the model's behaviour ({details}); nothing written"
-        )
-
-
 # -- generic differences ------------------------------------------------------------------------
 def differences_between(before: Model, after: Model) -> list[str]:
     """Every difference between two models, one line each (order of FSM states and
@@ -444,4 +353,4 @@ def _short(value: Any) -> str:
     return text if len(text) <= 80 else text[:77] + "..."
 
 
-__all__ = ["Translation", "translate", "translate_file", "differences_between", "ReadContext"]
+__all__ = ["Translation", "translate", "differences_between", "ReadContext"]

@@ -10,11 +10,13 @@ conversion itself.
 from __future__ import annotations
 
 import json
-import sys
+import logging
 import time
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
+
+LOG = logging.getLogger("fsmbt.llm")
 
 #: Final verdicts a record can carry.
 EQUIVALENT = "equivalent"
@@ -78,7 +80,9 @@ def append_record(path: Path | None, record: ConversionRecord) -> None:
         with path.open("a", encoding="utf-8") as handle:
             handle.write(json.dumps(record.to_dict(), ensure_ascii=False) + "\n")
     except OSError as exc:
-        print(f"warning: cannot write the LLM log {path}: {exc.strerror}", file=sys.stderr)
+        # the library does not print (presentation is the CLI's): a logged warning, which
+        # Python shows on stderr when no handler is configured
+        LOG.warning("warning: cannot write the LLM log %s: %s", path, exc.strerror)
 
 
 def read_records(path: Path) -> list[dict[str, Any]]:

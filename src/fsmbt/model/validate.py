@@ -28,12 +28,14 @@ Severity = Literal["error", "warning"]
 @dataclass(frozen=True)
 class Issue:
     """One finding: ``location`` is file:line:col where the format has them; ``element`` names
-    the state, transition or node (with its path in the model)."""
+    the state, transition or node (with its path in the model); ``code`` names the check, stable
+    across versions (the list: docs/cli.md, "Diagnostics")."""
 
     severity: Severity
     message: str
     location: SourceLocation | None = None
     element: str | None = None
+    code: str = ""
 
     def __str__(self) -> str:
         prefix = f"{self.location}: " if self.location is not None else ""
@@ -44,6 +46,7 @@ class Issue:
         loc = self.location
         return {
             "severity": self.severity,
+            "code": self.code,
             "message": self.message,
             "element": self.element,
             "file": loc.file if loc else None,
@@ -82,6 +85,7 @@ def collapse_repeated_warnings(issues: list[Issue]) -> list[Issue]:
                     f"{issue.message} ({counts[issue.message]} nodes; the first is here)",
                     issue.location,
                     issue.element,
+                    code=issue.code,
                 )
             )
     return kept
@@ -112,13 +116,21 @@ class _FsmValidator:
         self.issues: list[Issue] = []
 
     def add(
-        self, severity: Severity, message: str, location: SourceLocation | None, element: str | None
+        self,
+        severity: Severity,
+        message: str,
+        location: SourceLocation | None,
+        element: str | None,
+        *,
+        code: str,
     ) -> None:
-        self.issues.append(Issue(severity, message, location, element))
+        self.issues.append(Issue(severity, message, location, element, code))
 
     def run(self, fsm: FSM) -> list[Issue]:
         if not fsm.states:
-            self.add("error", "the state machine has no states", None, fsm.name)
+            self.add(
+                "error", "the state machine has no states", None, fsm.name, code="fsm-no-states"
+            )
             return self.issues
         seen_at: dict[str, str] = {}  # state name -> path of its first occurrence
         # explicit stack of (machine, path prefix, an enclosing state has an event transition)
@@ -138,6 +150,7 @@ class _FsmValidator:
                         "would merge them",
                         state.location,
                         path,
+                        code="state-name-reused",
                     )
                 leaves = can_leave or any(t.event is not None for t in outgoing.get(state.name, ()))
                 for index, region in enumerate(state.regions):
@@ -147,6 +160,7 @@ class _FsmValidator:
                             "composite state has an empty sub-machine",
                             state.location,
                             path,
+                            code="empty-submachine",
                         )
                         continue
                     sub = f"{path}/" if state.is_composite else f"{path}/{index}:"
@@ -160,9 +174,15 @@ class _FsmValidator:
         where = prefix.rstrip("/") or machine.name
         states = machine.states
         if machine.initial is None:
-            self.add("error", "no initial state", None, where)
+            self.add("error", "no initial state", None, where, code="no-initial")
         elif machine.initial not in states:
-            self.add("error", f"initial state '{machine.initial}' is not a state", None, where)
+            self.add(
+                "error",
+                f"initial state '{machine.initial}' is not a state",
+                None,
+                where,
+                code="bad-initial",
+            )
         targets_by_key: dict[
             tuple[str, str | None, str | None], tuple[str, SourceLocation | None]
         ] = {}
@@ -175,6 +195,7 @@ class _FsmValidator:
                         f"transition {end} '{name}' is not a state at this level",
                         t.location,
                         label,
+                        code="unknown-state",
                     )
             key = (t.source, t.event, t.exit)
             earlier = targets_by_key.get(key)
@@ -188,9 +209,16 @@ class _FsmValidator:
                     f"'{earlier[0]}' and '{t.target}' on {event}",
                     t.location,
                     label,
+                    code="nondeterministic",
                 )
             else:
-                self.add("warning", "duplicate transition", t.location, label)
+                self.add(
+                    "warning",
+                    "duplicate transition",
+                    t.location,
+                    label,
+                    code="duplicate-transition",
+                )
             source = states.get(t.source)
             if source is not None and source.final:
                 self.add(
@@ -199,6 +227,7 @@ class _FsmValidator:
                     "state accepts no event",
                     t.location,
                     label,
+                    code="final-has-transition",
                 )
         for state in states.values():
             self.state(state, outgoing.get(state.name, []), prefix, can_leave)
@@ -213,6 +242,7 @@ class _FsmValidator:
                 "states run actions (the flat state's action is its sub-states')",
                 state.location,
                 path,
+                code="composite-action",
             )
         if state.is_atomic and not state.final and not outgoing and not can_leave:
             self.add(
@@ -220,6 +250,7 @@ class _FsmValidator:
                 "no way out and not marked final: the machine gets stuck here",
                 state.location,
                 path,
+                code="dead-end",
             )
         if state.is_atomic and state.action is not None and any(t.event is None for t in outgoing):
             self.add(
@@ -228,6 +259,7 @@ class _FsmValidator:
                 f"'{state.action}' is never observed",
                 state.location,
                 path,
+                code="transient-state",
             )
 
     def reachability(
@@ -250,6 +282,7 @@ class _FsmValidator:
                     "unreachable from the initial state",
                     state.location,
                     f"{prefix}{state.name}",
+                    code="unreachable",
                 )
 
 
@@ -278,13 +311,17 @@ class _BtValidator:
         self.doc = doc
         self.issues: list[Issue] = []
 
-    def add(self, severity: Severity, message: str, node: BTNode | None, element: str) -> None:
-        self.issues.append(Issue(severity, message, node.location if node else None, element))
+    def add(
+        self, severity: Severity, message: str, node: BTNode | None, element: str, *, code: str
+    ) -> None:
+        self.issues.append(Issue(severity, message, node.location if node else None, element, code))
 
     def run(self) -> list[Issue]:
         doc = self.doc
         if not doc.trees:
-            self.issues.append(Issue("error", "the document holds no behavior tree"))
+            self.issues.append(
+                Issue("error", "the document holds no behavior tree", code="no-tree")
+            )
             return self.issues
         if doc.main_tree is not None and doc.main_tree not in doc.trees:
             self.issues.append(
@@ -293,6 +330,7 @@ class _BtValidator:
                     f"main tree '{doc.main_tree}' is not defined (trees: {', '.join(doc.trees)})",
                     None,
                     doc.main_tree,
+                    code="unknown-main-tree",
                 )
             )
         elif doc.main_tree is None and len(doc.trees) > 1:
@@ -303,13 +341,20 @@ class _BtValidator:
                     f"{len(doc.trees)} trees and no main tree named; '{first}' is executed",
                     None,
                     first,
+                    code="no-main-tree",
                 )
             )
         references: dict[str, list[str]] = {tree_id: [] for tree_id in doc.trees}
         for tree in doc.trees.values():
             if tree.root is None:
                 self.issues.append(
-                    Issue("error", "the tree is empty", tree.location, f"tree '{tree.id}'")
+                    Issue(
+                        "error",
+                        "the tree is empty",
+                        tree.location,
+                        f"tree '{tree.id}'",
+                        code="empty-tree",
+                    )
                 )
                 continue
             self.tree(tree.id, tree.root, references[tree.id])
@@ -344,6 +389,7 @@ class _BtValidator:
                     f"in TreeNodesModel) with {count} child(ren)",
                     node,
                     where(),
+                    code="unknown-node",
                 )
                 return
             self.add(
@@ -352,6 +398,7 @@ class _BtValidator:
                 "Action (it may return RUNNING)",
                 node,
                 where(),
+                code="undeclared-leaf",
             )
         if spec is None and node.kind in (NodeKind.CONTROL, NodeKind.DECORATOR):
             # declared (TreeNodesModel or a <Control ID=..> / <Decorator ID=..> tag)
@@ -362,6 +409,7 @@ class _BtValidator:
                 "be converted or verified",
                 node,
                 where(),
+                code="unknown-semantics",
             )
         if node.kind is NodeKind.CONTROL:
             if count == 0 and spec is not None and spec.allows_children(0):
@@ -371,20 +419,32 @@ class _BtValidator:
                     "but BehaviorTree.CPP 4.8.2's loader refuses a control node without children",
                     node,
                     where(),
+                    code="childless-node",
                 )
             elif count == 0:
-                self.add("error", f"control node '{node.type}' has no children", node, where())
+                self.add(
+                    "error",
+                    f"control node '{node.type}' has no children",
+                    node,
+                    where(),
+                    code="no-children",
+                )
             elif spec is not None and spec.children is not None and count != spec.children:
                 self.add(
                     "error",
                     f"'{node.type}' needs exactly {spec.children} children, has {count}",
                     node,
                     where(),
+                    code="child-count",
                 )
             elif spec is not None and not spec.allows_children(count):
                 allowed = " or ".join(str(c) for c in spec.child_counts or ())
                 self.add(
-                    "error", f"'{node.type}' needs {allowed} children, has {count}", node, where()
+                    "error",
+                    f"'{node.type}' needs {allowed} children, has {count}",
+                    node,
+                    where(),
+                    code="child-count",
                 )
         elif node.kind is NodeKind.DECORATOR:
             if count != 1:
@@ -393,15 +453,26 @@ class _BtValidator:
                     f"decorator '{node.type}' needs exactly one child, has {count}",
                     node,
                     where(),
+                    code="child-count",
                 )
         elif node.kind is NodeKind.SUBTREE:
             if count:
                 self.add(
-                    "error", f"SubTree node has {count} child(ren); it takes none", node, where()
+                    "error",
+                    f"SubTree node has {count} child(ren); it takes none",
+                    node,
+                    where(),
+                    code="subtree-children",
                 )
             target = node.subtree_id
             if not target:
-                self.add("error", "SubTree node without an ID naming the tree", node, where())
+                self.add(
+                    "error",
+                    "SubTree node without an ID naming the tree",
+                    node,
+                    where(),
+                    code="subtree-no-id",
+                )
             elif builtin_spec(target) is not None and target not in self.doc.trees:
                 # xml_parsing.cpp VerifyXML: a SubTree ID must not be a registered node's name
                 self.add(
@@ -410,6 +481,7 @@ class _BtValidator:
                     "refuses it",
                     node,
                     where(),
+                    code="subtree-builtin-id",
                 )
             elif target not in self.doc.trees:
                 severity: Severity = "warning" if self.doc.includes else "error"
@@ -419,7 +491,11 @@ class _BtValidator:
                     else " (a tree of another file: name it with --trees PATH)"
                 )
                 self.add(
-                    severity, f"SubTree references missing tree '{target}'{hint}", node, where()
+                    severity,
+                    f"SubTree references missing tree '{target}'{hint}",
+                    node,
+                    where(),
+                    code="missing-subtree",
                 )
             else:
                 referenced.append(target)
@@ -430,6 +506,7 @@ class _BtValidator:
                 f"{kind} leaf '{node.type}' has {count} child(ren); leaves take none",
                 node,
                 where(),
+                code="leaf-children",
             )
         if spec is not None and spec.time_based:
             self.add(
@@ -438,6 +515,7 @@ class _BtValidator:
                 "timing is ignored when converting or verifying",
                 node,
                 where(),
+                code="time-based",
             )
 
     def cycles(self, references: dict[str, list[str]]) -> None:
@@ -470,6 +548,7 @@ class _BtValidator:
                                     "recursive SubTree: " + " -> ".join(cycle),
                                     tree.location,
                                     f"tree '{child}'",
+                                    code="recursive-subtree",
                                 )
                             )
                     elif not colour.get(child):

@@ -14,7 +14,7 @@ from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import InputError
 from fsmbt.model.fsm import FSM
 from fsmbt.render.anchor_ids import trace_anchors
-from fsmbt.render.bt_graph import bt_to_dot
+from fsmbt.render.bt_graph import Ghost, bt_to_dot
 from fsmbt.render.dot import (
     DEFAULT_MAX_NODES,
     DOT_TIMEOUT_S,
@@ -156,6 +156,7 @@ __all__ = [
     "trace_anchors",
     "fsm_to_dot",
     "bt_to_dot",
+    "Ghost",
     "render_model",
     "run_dot",
     "write_picture",

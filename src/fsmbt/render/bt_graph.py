@@ -18,12 +18,13 @@ below it, in a dashed cluster (a recursive reference is not expanded again). Bui
 explicit stack; complexity O(N) for N drawn nodes, refused beyond ``max_nodes``.
 
 This is also the DOT file format's BT writer (``fsmbt convert --to dot``, through
-``fsmbt.formats.dot``, with no size limit); BT DOT is write-only (docs/formats/dot.md).
+``fsmbt.formats.diagrams.dot``, with no size limit); BT DOT is write-only (docs/formats/dot.md).
 """
 
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Mapping, Sequence
 
 import graphviz
 
@@ -98,6 +99,8 @@ def bt_to_dot(
     tree: str | None = None,
     notes: list[str] | None = None,
     anchors: bool = False,
+    marks: Mapping[str, Mapping[str, str]] | None = None,
+    ghosts: Sequence[Ghost] = (),
 ) -> str:
     """DOT source of the picture of ``doc``.
 
@@ -110,6 +113,10 @@ def bt_to_dot(
         anchors: give every node an SVG id from its place (``fsmbt.render.anchor_ids``): the
             child-index path from the main root with ``expand_subtrees`` (the interpreter's
             path, docs/semantics.md), else the tree's id and the path inside that tree.
+        marks: extra Graphviz attributes per node, keyed by the node's anchor id (as above,
+            whether or not ``anchors`` is set): how a diff highlights changed nodes.
+        ghosts: nodes that are not in ``doc`` (a diff's removed nodes), drawn dashed and grey
+            under the node whose anchor they name (or alone).
 
     Returns:
         The DOT source text.
@@ -130,12 +137,31 @@ def bt_to_dot(
     root.attr("node", fontname=FONT, fontsize="11", height="0.4")
     root.attr("edge", arrowsize="0.6", color="gray25")
     builder = _Builder(doc, root, max_nodes, expand_subtrees, anchors)
+    builder.marks = marks or {}
     if expand_subtrees or tree is not None:
         main = doc.main
         builder.draw_tree(main.root, root, parent=None, path=(main.id,))
     else:
         _draw_all_trees(doc, root, builder, notes)
+    builder.draw_ghosts(ghosts)
     return builder.finish()
+
+
+@dataclasses.dataclass(frozen=True)
+class Ghost:
+    """A node drawn although it is not in the document (a diff's removed node).
+
+    Attributes:
+        label: its text.
+        parent: the anchor id of the drawn node it hangs under, or ``None`` (drawn alone).
+    """
+
+    label: str
+    parent: str | None = None
+
+
+#: How a ghost looks: dashed, grey, no fill.
+GHOST_STYLE = {"style": "dashed,rounded", "color": "gray55", "fontcolor": "gray45", "shape": "box"}
 
 
 def _draw_all_trees(
@@ -220,6 +246,8 @@ class _Builder:
         self.deepest = ""  # the deepest node id of the last tree drawn
         self.edges: list[tuple[str, str, dict[str, str]]] = []
         self.clusters: list[tuple[graphviz.Digraph, graphviz.Digraph]] = []  # pre-order
+        self.marks: Mapping[str, Mapping[str, str]] = {}
+        self.by_anchor: dict[str, str] = {}  # anchor id -> DOT node id, for ghosts
 
     def next_id(self, prefix: str) -> str:
         self.serial += 1
@@ -253,8 +281,11 @@ class _Builder:
             if level > deepest_level:
                 deepest_level, self.deepest = level, node_id
             attrs = node_attrs(node, recursive=node.subtree_id in trees)
+            anchor = node_anchor(where, None if self.expanding else trees[0])
+            self.by_anchor.setdefault(anchor, node_id)
             if self.anchors:
-                attrs["id"] = node_anchor(where, None if self.expanding else trees[0])
+                attrs["id"] = anchor
+            attrs.update(self.marks.get(anchor, {}))
             holder.node(node_id, **attrs)
             if parent_id is not None:
                 self.edges.append((parent_id, node_id, {}))
@@ -279,6 +310,14 @@ class _Builder:
                 (child, node_id, holder, trees, child_path(where, index), level + 1)
                 for index, child in reversed(list(enumerate(node.children)))
             )
+
+    def draw_ghosts(self, ghosts: Sequence[Ghost]) -> None:
+        for ghost in ghosts:
+            ghost_id = self.next_id("g")
+            self.root.node(ghost_id, label=label_text(ghost.label), **GHOST_STYLE)
+            parent = self.by_anchor.get(ghost.parent) if ghost.parent is not None else None
+            if parent is not None:
+                self.edges.append((parent, ghost_id, {"style": "dashed", "color": "gray55"}))
 
     def finish(self) -> str:
         return assemble(

@@ -18,12 +18,12 @@ A flat machine that large uses the force-directed ``sfdp`` layout (seconds for t
 states; dot's layered layout with edge labels needs minutes from about a hundred states).
 
 The same builder writes the DOT *file format* (``fsmbt convert --to dot``, registered by
-``fsmbt.formats.dot``) with ``exchange=True``: node ids are the state names (``Parent/child``
+``fsmbt.formats.diagrams.dot``) with ``exchange=True``: node ids are the state names (``Parent/child``
 paths inside composite states, ``Parent/0:child`` in parallel regions), each carrying an
 ``action`` attribute when its action differs from its name; every transition is its own edge
 labelled with its exact event (eventless: no label); the initial point is named after the start
 pseudo-state (else ``__start__``); the layered layout is always used and no size limit applies.
-That is what ``fsmbt.formats.dot``'s reader reads back (docs/formats/dot.md). Pictures also
+That is what ``fsmbt.formats.diagrams.dot``'s reader reads back (docs/formats/dot.md). Pictures also
 carry the ``action`` attribute (Graphviz ignores attributes it does not know).
 
 Built without recursion: clusters are created in pre-order and written out by one pre-order
@@ -32,6 +32,7 @@ walk (``render.dot.assemble``). Complexity O(S + T) for S states (every level) a
 
 from __future__ import annotations
 
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 
 import graphviz
@@ -52,7 +53,7 @@ from fsmbt.render.dot import (
 )
 
 #: The initial point's id in exchange DOT when the model names no start pseudo-state; the
-#: reader (``fsmbt.formats.dot``) takes a node of this name as the start marker.
+#: reader (``fsmbt.formats.diagrams.dot``) takes a node of this name as the start marker.
 START_NODE = "__start__"
 
 #: Nested clusters beyond this depth make dot slow and the picture unreadable.
@@ -62,6 +63,11 @@ LAYERED_MAX_STATES = 60
 LAYERED_MAX_ARROWS = 150
 #: At most this many event names per arrow label line.
 EVENTS_PER_LINE = 3
+
+
+#: How a diff's removed states and transitions look: dashed and grey.
+GHOST_STATE_STYLE = {"shape": "circle", "style": "dashed", "color": "gray55", "fontcolor": "gray45"}
+GHOST_EDGE_STYLE = {"style": "dashed", "color": "gray55", "fontcolor": "gray45"}
 
 
 @dataclass
@@ -144,6 +150,9 @@ def fsm_to_dot(
     composite: str | None = None,
     notes: list[str] | None = None,
     anchors: bool = False,
+    marks: Mapping[str, Mapping[str, str]] | None = None,
+    ghosts: Sequence[str] = (),
+    ghost_edges: Sequence[tuple[str, str, str]] = (),
 ) -> str:
     """DOT source of ``fsm``.
 
@@ -151,7 +160,7 @@ def fsm_to_dot(
         fsm: the machine (flat or hierarchical).
         max_nodes: refuse (``TooLargeError``) more states than this (and more than five times
             as many transitions), and nesting deeper than ``MAX_NESTING``; ``None``: no limit.
-        exchange: write the DOT file format that ``fsmbt.formats.dot`` reads back (see the
+        exchange: write the DOT file format that ``fsmbt.formats.diagrams.dot`` reads back (see the
             module docstring) instead of the picture's DOT.
         level: draw composite states nested at most this deep as clusters (0: the top machine
             only, composites closed); default: all, or the deepest that fits (see above).
@@ -159,6 +168,11 @@ def fsm_to_dot(
         notes: told what was left out of the picture and how to draw it.
         anchors: give every state an SVG id from its name (``fsmbt.render.anchors``): atomic
             and composite states ``s@Parent/child``, the top initial point ``start@``.
+        marks: extra Graphviz attributes per atomic state, keyed by its anchor id (whether or
+            not ``anchors`` is set): how a diff highlights changed states.
+        ghosts: states that are not in ``fsm`` (a diff's removed states), drawn dashed and grey.
+        ghost_edges: transitions that are not in ``fsm`` as ``(tail anchor, head anchor,
+            label)`` between drawn atomic states or ghosts (``s@`` + the ghost's name), dashed.
 
     Returns:
         The DOT source text.
@@ -229,6 +243,8 @@ def fsm_to_dot(
     edges: list[tuple[str, str, dict[str, str]]] = []
     clusters: list[tuple[graphviz.Digraph, graphviz.Digraph]] = []  # (cluster, parent), pre-order
 
+    marks = marks or {}
+    drawn: dict[str, str] = {}  # anchor id -> DOT node id of atomic states, for ghost edges
     level_cap = level  # the drawing loop below names each machine being drawn ``lv``
     top = _Level(fsm, root)
     depth_of: dict[int, int] = {id(top): 0}
@@ -261,8 +277,11 @@ def fsm_to_dot(
                 node_id = counter.state_id(lv, state.name)
                 lv.ids[state.name] = node_id
                 attrs = _state_attrs(state, title, compact=not layered)
+                anchor = state_anchor(lv.anchor + state.name)
+                drawn[anchor] = node_id
                 if anchors:
-                    attrs["id"] = state_anchor(lv.anchor + state.name)
+                    attrs["id"] = anchor
+                attrs.update(marks.get(anchor, {}))
                 lv.graph.node(node_id, **attrs)
                 continue
             if not layered:  # a box standing for the composite state, no cluster
@@ -325,6 +344,15 @@ def fsm_to_dot(
     for lv in levels:
         _draw_initial(lv, edges, counter, is_top=lv is top, anchors=anchors)
         _draw_transitions(lv, edges, exact=exchange)
+    for name in ghosts:
+        ghost_id = counter.next("g")
+        drawn.setdefault(state_anchor(name), ghost_id)
+        root.node(ghost_id, label=label_text(name), **GHOST_STATE_STYLE)
+    for tail, head, text in ghost_edges:
+        if tail in drawn and head in drawn:
+            edges.append(
+                (drawn[tail], drawn[head], {"label": label_text(text), **GHOST_EDGE_STYLE})
+            )
 
     return assemble(root, clusters, [edge_line(tail, head, attrs) for tail, head, attrs in edges])
 
@@ -376,7 +404,7 @@ def _state_attrs(state: State, title: str, *, compact: bool = False) -> dict[str
     ):  # ``q3:Move`` already says it
         lines.append(f"/ {state.action}")
     attrs = {"label": label_text(*lines), "shape": "doublecircle" if state.final else "circle"}
-    if state.action != state.name:  # read back by fsmbt.formats.dot; Graphviz ignores it
+    if state.action != state.name:  # read back by fsmbt.formats.diagrams.dot; Graphviz ignores it
         attrs["action"] = dot_id(state.action or "")
     if compact:
         attrs.update(shape="ellipse", peripheries="2" if state.final else "1")

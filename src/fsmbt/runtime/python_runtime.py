@@ -15,16 +15,24 @@ Rules:
   ``behaviortreepy``); both run the same leaf behaviours (``fsmbt.semantics.lebt.leaves``) and
   the macro step of docs/semantics.md: post the event, tick, tick once more when the root
   succeeded with the event still pending, drop an event no state takes.
-- An action is a callable taking no argument, looked up by the action name the ``LebtState``
-  leaf carries (its ``action`` port; by default the FSM state's name). It runs once per entry
-  into the state, as the FSM's entry action does, in entry order, after the engine's ticks of
-  that macro step (the tree's control flow never depends on an action). An exception raised
-  by an action propagates to the caller of ``start``/``post``.
+- An action is a callable looked up by the action name the ``LebtState`` leaf carries (its
+  ``action`` port; by default the FSM state's name, for SMACH/FlexBE states their class, so
+  several states share one). It is called ``action(state, params)``: the label of the state
+  entered and its parameters (the leaf's optional ``params`` port, ``name=value;...``, decoded
+  into a ``dict``; empty when none) - so one callable serves every ``TimedCmdVelState`` with
+  its own velocity. A callable that takes no argument is called without (the earlier
+  contract). It runs once per entry into the state, as the FSM's entry action does, in entry
+  order, after the engine's ticks of that macro step (the tree's control flow never depends on
+  an action). An exception raised by an action propagates to the caller of ``start``/``post``.
 - Checked when loading, never at tick time (``InputError`` naming the place): the file is a
   v4 tree fsmbt can read; every node is ``LebtGuard``, ``LebtState``, ``SubTree`` or the
   control nodes the LEBT uses (``Sequence``, ``Fallback``) - any other node is named with its
-  line; every action name the tree uses has a callable, and (unless ``allow_unused=True``) every
-  callable names an action of the tree (a typo is caught, not ignored).
+  line; the LEBT annotations agree with each other (``check_lebt_annotations``: a guard pair
+  naming an event its source state does not list as an exit, an exit no guard takes, a guard
+  whose ``target`` is not the state it enters, a pair whose source is no state besides the one
+  start pseudo-state, a malformed ``params`` port - hand edits that would otherwise stop the
+  machine silently at tick time); every action name the tree uses has a callable, and (unless
+  ``allow_unused=True``) every callable names an action of the tree (a typo is caught).
 - ``write_files`` writes a runnable example (a converted tree and a script) into a folder.
 
 Costs: loading is O(n) in the tree's nodes plus the engine's own build; a macro step costs one
@@ -35,16 +43,26 @@ imported or executed by fsmbt itself: only the callables you pass are called.
 
 from __future__ import annotations
 
+import inspect
 from collections.abc import Callable, Mapping
+from dataclasses import dataclass
 from pathlib import Path
 
-from fsmbt.formats import loads, read_model
+from fsmbt import api
+from fsmbt.formats import loads
 from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.bt_nodes import NodeKind
 from fsmbt.model.errors import InputError
-from fsmbt.semantics.bt_interpreter import CompiledTree
-from fsmbt.semantics.lebt.driver import EngineLebtRun
-from fsmbt.semantics.lebt.spec import GUARD_TYPE, STATE_TYPE
+from fsmbt.semantics.execution import lebt_engine_run
+from fsmbt.semantics.lebt.ports import lebt_port_issues
+from fsmbt.semantics.lebt.spec import (
+    GUARD_TYPE,
+    PARAMS_PORT,
+    STATE_TYPE,
+    GuardSpec,
+    StateSpec,
+    decode_params,
+)
 from fsmbt.semantics.nodes import PLAIN_CONTROLS
 
 #: The engines a tree can run on.
@@ -54,9 +72,21 @@ ENGINES = ("py_trees", "btcpp")
 LEBT_CONTROLS = PLAIN_CONTROLS
 LEBT_LEAVES = frozenset({GUARD_TYPE, STATE_TYPE})
 
-Action = Callable[[], object]
+#: ``action(state, params)`` (or ``action()``): see the module doc.
+Action = Callable[..., object]
+#: The action key the engines run instead of each state's action name (one per state leaf).
+_ENTRY_KEY = "fsmbt-entry-{}"
 
-__all__ = ["ENGINES", "TreeRunner", "load_tree", "write_files"]
+__all__ = ["ENGINES", "Entry", "TreeRunner", "check_lebt_annotations", "load_tree", "write_files"]
+
+
+@dataclass(frozen=True)
+class Entry:
+    """One state leaf's entry: the action it runs, the state's label, its parameters."""
+
+    action: str
+    state: str
+    params: dict[str, str]
 
 
 class TreeRunner:
@@ -74,21 +104,27 @@ class TreeRunner:
 
         Args:
             doc: the converted tree, as fsmbt read it.
-            actions: action name -> callable without arguments.
+            actions: action name -> ``callable(state, params)`` (or without arguments).
             engine: ``"py_trees"`` or ``"btcpp"``.
             allow_unused: accept callables whose name no state of the tree uses.
         Raises:
-            InputError: a node the LEBT does not use (with its line), an action without
-                callable, a callable without action, an unknown engine.
+            InputError: a node the LEBT does not use (with its line), contradicting LEBT
+                annotations (``check_lebt_annotations``), an action without callable, a
+                callable without action, an unknown engine.
         """
         if engine not in ENGINES:
             raise InputError(f"unknown engine '{engine}' (known: {', '.join(ENGINES)})")
         check_lebt_nodes(doc)
-        tree = CompiledTree(doc)
+        check_lebt_annotations(doc)
         self.engine = engine
-        self._run = _engine_runner(engine, tree)
-        self.used_actions = _check_actions(self._run, actions, allow_unused=allow_unused)
+        self._entries = _keyed_entries(doc)
+        try:  # the engines run one key per state leaf, so each call knows its state
+            self._run = lebt_engine_run(doc, engine)
+        finally:
+            _restore_actions(doc, self._entries)
+        self.used_actions = _check_actions(self._entries, actions, allow_unused=allow_unused)
         self._actions = dict(actions)
+        self._with_entry = {name: _takes_entry(name, action) for name, action in actions.items()}
         self._started = False
 
     @property
@@ -137,10 +173,16 @@ class TreeRunner:
             raise RuntimeError("call start() before posting events")
         return self._call(self._run.macro_step(event))
 
-    def _call(self, names: tuple[str, ...]) -> tuple[str, ...]:
-        for name in names:
-            self._actions[name]()
-        return names
+    def _call(self, keys: tuple[str, ...]) -> tuple[str, ...]:
+        names: list[str] = []
+        for key in keys:
+            entry = self._entries[key]
+            names.append(entry.action)
+            if self._with_entry[entry.action]:
+                self._actions[entry.action](entry.state, dict(entry.params))
+            else:
+                self._actions[entry.action]()
+        return tuple(names)
 
 
 def load_tree(
@@ -155,7 +197,7 @@ def load_tree(
     Args:
         source: the BehaviorTree.CPP XML text (a string starting with ``<``), or the path of
             the file (a ``Path``, or any other string).
-        actions: action name -> callable without arguments.
+        actions: action name -> ``callable(state, params)`` (or without arguments).
         engine: ``"py_trees"`` or ``"btcpp"``.
         allow_unused: accept callables whose name no state of the tree uses.
     Returns:
@@ -166,7 +208,7 @@ def load_tree(
     if isinstance(source, str) and source.lstrip("\ufeff \t\r\n").startswith("<"):
         model = loads(source, "btcpp")
     else:
-        model = read_model(Path(source))
+        model = api.load(Path(source)).model
     if not isinstance(model, BTDocument):
         raise InputError(
             "not a behavior tree: the runtime runs converted trees "
@@ -201,25 +243,123 @@ def check_lebt_nodes(doc: BTDocument) -> None:
             stack.extend(reversed(node.children))
 
 
-def _engine_runner(engine: str, tree: CompiledTree) -> EngineLebtRun:
-    """The engine adapter of fsmbt's differential tests, on the compiled tree."""
-    if engine == "btcpp":
-        from fsmbt.semantics.engines.btcpp_engine import BTCppLebtRunner
+def check_lebt_annotations(doc: BTDocument) -> None:
+    """Refuse an LEBT whose annotations contradict each other (docs/semantics.md section 5).
 
-        return BTCppLebtRunner(tree)
-    from fsmbt.semantics.engines.pytrees_engine import PyTreesLebtRunner
+    The checks of ``fsmbt.semantics.lebt.ports.lebt_port_issues`` (a guard pair whose event
+    is not among its source state's ``exits``, an exit no guard pair takes, a ``target`` that
+    is not the state the guard enters), plus: a pair whose source is neither a state nor the
+    start pseudo-state (an LEBT has one start; a second unknown source is a misspelt state),
+    and a malformed ``params`` port. Each would make the machine stop or ignore an event at
+    tick time without a word.
 
-    return PyTreesLebtRunner(tree)
+    Raises:
+        InputError: the first problem in document order, naming the leaf and its line.
+    """
+    issues = [issue for issue in lebt_port_issues(doc) if issue.severity == "error"]
+    if issues:
+        first = issues[0]
+        more = f" (and {len(issues) - 1} more)" if len(issues) > 1 else ""
+        raise InputError(
+            f"LEBT annotations disagree: {first.message}{more}",
+            location=first.location,
+            element=first.element,
+        )
+    states: set[str] = set()
+    guards: list[BTNode] = []
+    for tree in doc.trees.values():
+        for node in tree.root.walk() if tree.root is not None else ():
+            if node.type == STATE_TYPE:
+                states.add(StateSpec.from_attrs(node.attrs).state)
+                try:
+                    decode_params(node.attrs.get(PARAMS_PORT, ""))
+                except ValueError as exc:
+                    raise InputError(
+                        f"port '{PARAMS_PORT}': {exc}",
+                        location=node.location,
+                        element=f"<{STATE_TYPE}> '{node.label}'",
+                    ) from None
+            elif node.type == GUARD_TYPE:
+                guards.append(node)
+    starts: dict[str, BTNode] = {}
+    for guard in guards:
+        for source, _event in GuardSpec.from_attrs(guard.attrs).pairs:
+            if source not in states:
+                starts.setdefault(source, guard)
+    if len(starts) > 1:
+        # the start pseudo-state is the source of the initialisation pair (empty event) when
+        # there is one; every other unknown source names no state
+        initial = [
+            s
+            for s, g in starts.items()
+            if any(p == (s, "") for p in GuardSpec.from_attrs(g.attrs).pairs)
+        ]
+        start = initial[0] if initial else next(iter(starts))
+        source, guard = next((s, g) for s, g in starts.items() if s != start)
+        raise InputError(
+            f"LEBT annotations disagree: pair source '{source}' is no state of the tree (its "
+            f"states: {', '.join(sorted(states))}; the start pseudo-state is '{start}'), so "
+            "the transition never fires",
+            location=guard.location,
+            element=f"<{GUARD_TYPE}> '{guard.label}'",
+        )
+
+
+def _keyed_entries(doc: BTDocument) -> dict[str, Entry]:
+    """Give every state leaf with an action its own key in its ``action`` port (restored by
+    ``_restore_actions``); the key -> the entry it stands for."""
+    entries: dict[str, Entry] = {}
+    for tree in doc.trees.values():
+        for node in tree.root.walk() if tree.root is not None else ():
+            if node.type != STATE_TYPE:
+                continue
+            spec = StateSpec.from_attrs(node.attrs)
+            if spec.action is None:
+                continue
+            key = _ENTRY_KEY.format(len(entries))
+            params = decode_params(node.attrs.get(PARAMS_PORT, ""))
+            entries[key] = Entry(spec.action, spec.state, params)
+            node.attrs["action"] = key
+    return entries
+
+
+def _restore_actions(doc: BTDocument, entries: Mapping[str, Entry]) -> None:
+    for tree in doc.trees.values():
+        for node in tree.root.walk() if tree.root is not None else ():
+            entry = entries.get(node.attrs.get("action", "")) if node.type == STATE_TYPE else None
+            if entry is not None:
+                node.attrs["action"] = entry.action
+
+
+def _takes_entry(name: str, action: Action) -> bool:
+    """Whether ``action`` is called with (state, params) (True) or without arguments.
+
+    Raises:
+        InputError: it can be called neither way (e.g. it requires one argument).
+    """
+    try:
+        signature = inspect.signature(action)
+    except (TypeError, ValueError):  # a builtin without a signature: the documented contract
+        return True
+    for arguments, with_entry in ((("state", {}), True), ((), False)):
+        try:
+            signature.bind(*arguments)
+        except TypeError:
+            continue
+        return with_entry
+    raise InputError(
+        f"the callable for action '{name}' takes {signature}: it must take (state, params) "
+        "or no argument"
+    )
 
 
 def _check_actions(
-    run: EngineLebtRun, actions: Mapping[str, Action], *, allow_unused: bool
+    entries: Mapping[str, Entry], actions: Mapping[str, Action], *, allow_unused: bool
 ) -> frozenset[str]:
     """Every action of the tree has a callable (and every callable an action)."""
     used: dict[str, str] = {}  # action -> a state that runs it
-    for spec in run.leaves.states.values():
-        if spec.action is not None:
-            used.setdefault(spec.action, spec.state)
+    for entry in entries.values():
+        used.setdefault(entry.action, entry.state)
     missing = [name for name in used if name not in actions]
     if missing:
         shown = ", ".join(f"'{name}' (state '{used[name]}')" for name in missing)

@@ -3,7 +3,7 @@
 ``CompiledTree`` stops at the first node it cannot give a meaning to; a user fixing a file wants
 the whole list. ``conversion_blockers`` walks the main tree and every SubTree it reaches (explicit
 stack, each tree once per SubTree chain) and runs the same per-node check the compiler runs
-(``CompiledTree._check``), collecting each ``InputError`` / ``UnsupportedError`` with its
+(``CompiledTree.check_node``), collecting each ``InputError`` / ``UnsupportedError`` with its
 location. ``validate``, ``info``, ``render`` and ``convert`` all report this list, so they agree
 on what conversion refuses (docs/cli.md).
 
@@ -58,8 +58,7 @@ def conversion_blockers(doc: BTDocument) -> list[Blocker]:
         return [
             Blocker("the main behavior tree is empty", tree.location, f"tree '{tree.id}'", False)
         ]
-    checker = CompiledTree.__new__(CompiledTree)
-    checker.doc = doc
+    checker = CompiledTree.checker(doc)
     seen: set[tuple[str, tuple[str, ...]]] = set()
     stack: list[tuple[BTNode, tuple[str, ...]]] = [(tree.root, (tree.id,))]
     checked = 0
@@ -67,7 +66,7 @@ def conversion_blockers(doc: BTDocument) -> list[Blocker]:
         node, chain = stack.pop()
         checked += 1
         try:
-            ctype, _kind, _params, _internal, kids = checker._check(node, chain)
+            ctype, _kind, _params, _internal, kids = checker.check_node(node, chain)
         except InputError as exc:  # UnsupportedError is an InputError
             found.append(
                 Blocker(exc.message, exc.location, exc.element, isinstance(exc, UnsupportedError))

@@ -263,7 +263,7 @@ def _choice_leaves(node: BTNode, n_children: int, repeat_last: bool) -> list[BTN
     ]
 
 
-def _threshold(value: int, count: int) -> int:
+def parallel_threshold(value: int, count: int) -> int:
     """BehaviorTree.CPP's reading of a Parallel threshold: negative means "all but"."""
     return max(count + value + 1, 0) if value < 0 else value
 
@@ -346,6 +346,28 @@ class CompiledTree:
             cached = "/".join(reversed(parts))
             self._paths[nid] = cached
         return cached
+
+    @classmethod
+    def checker(cls, doc: BTDocument) -> CompiledTree:
+        """A tree of ``doc`` left uncompiled, to check its nodes one at a time with
+        ``check_node`` (``semantics/blockers.py`` lists every blocker, not only the first)."""
+        tree = cls.__new__(cls)
+        tree.doc = doc
+        return tree
+
+    def check_node(
+        self, node: BTNode, chain: tuple[str, ...]
+    ) -> tuple[str, NodeKind, tuple[Any, ...], int | None, list[BTNode]]:
+        """Check one node against the v4 rules (as compiling does) and read it.
+
+        Returns:
+            Its canonical type, kind, parameters, internal id (or ``None``) and children.
+
+        Raises:
+            InputError: the node is malformed; ``UnsupportedError`` for what cannot be
+                modelled exactly.
+        """
+        return self._check(node, chain)
 
     def _check(
         self, node: BTNode, chain: tuple[str, ...]
@@ -463,7 +485,7 @@ class CompiledTree:
             if ctype == "Parallel":
                 succ = _int_param(node, "success_count", -1)
                 fail = _int_param(node, "failure_count", 1)
-                if n < _threshold(succ, n) or n < _threshold(fail, n):
+                if n < parallel_threshold(succ, n) or n < parallel_threshold(fail, n):
                     raise InputError(
                         "Parallel threshold exceeds the number of children", **_where(node)
                     )
@@ -476,11 +498,11 @@ class CompiledTree:
                 params = (n, _bool_param(node, "repeat_last_selection", False))
             elif ctype == "ParallelAll":
                 fail = _int_param(node, "max_failures", 1)
-                if n < _threshold(fail, n):
+                if n < parallel_threshold(fail, n):
                     raise InputError(
                         "ParallelAll max_failures exceeds the number of children", **_where(node)
                     )
-                params = (_threshold(fail, n),)
+                params = (parallel_threshold(fail, n),)
             return ctype, kind, params, internal, kids
         raise UnsupportedError(f"node kind {kind} is not supported", **_where(node))
 
@@ -802,7 +824,7 @@ class BTInterpreter:
         """Parallel with success_count / failure_count (parallel_node.cpp)."""
         n = len(node.children)
         succ_param, fail_param = node.params
-        need_s, need_f = _threshold(succ_param, n), _threshold(fail_param, n)
+        need_s, need_f = parallel_threshold(succ_param, n), parallel_threshold(fail_param, n)
         completed, sc, fc = self._mem(w, node)
         if frame[1] == 0:
             w.st[node.id] = RUNNING

@@ -16,9 +16,10 @@ from __future__ import annotations
 from collections.abc import Hashable, Sequence
 from typing import Final, Protocol, TypeVar
 
+from fsmbt.model.errors import InputError
 from fsmbt.model.flatten import flatten, needs_flattening
 from fsmbt.model.fsm import FSM
-from fsmbt.semantics.status import MachineStatus
+from fsmbt.semantics.status import LeafOutcome, MachineStatus
 
 S = TypeVar("S", bound=Hashable)
 Outputs = tuple[str, ...]
@@ -121,3 +122,61 @@ class FSMMachine:
         """What entering the flat state ``name`` outputs: its action, if it has one."""
         action = self.fsm.states[name].action
         return (action,) if action is not None else ()
+
+
+#: The inputs of a leaf-execution machine: what a ticked leaf may return.
+LEAF_OUTCOMES: Final[tuple[str, ...]] = tuple(outcome.value for outcome in LeafOutcome)
+
+
+class FSMLeafMachine:
+    """An FSM (flattened if hierarchical) read as a BT's leaf-execution machine (docs/semantics.md,
+    'The leaf-execution machine').
+
+    A state is the leaf about to be ticked: entering it outputs its action (the leaf's label).
+    An outcome with no transition leaves the FSM where it is, so the same leaf is ticked again
+    and its label is output again (a converter may omit ``running`` self-loops). A final state
+    is the root's result: its action (``SUCCESS``/``FAILURE``) is output and the status is
+    ``"final"``, as ``LeafMachine`` does. With ``loop`` the root is ticked again at once: entering
+    a final state outputs its action and then the initial state's, and the machine is back in
+    the initial state (``LeafMachine(loop=True)`` outputs ``(result, first leaf)`` likewise).
+    The machine takes whatever outcomes the BT side offers.
+    """
+
+    follows_environment = True
+
+    def __init__(self, fsm: FSM, *, loop: bool = False) -> None:
+        self.inner = FSMMachine(fsm, alphabet=LEAF_OUTCOMES)
+        self.fsm = self.inner.fsm
+        self.name = self.fsm.name
+        self.loop = loop
+        if self.fsm.initial is None:
+            raise InputError("the state machine has no initial state", element=self.name)
+        self.initial: str = self.fsm.initial
+
+    def start(self) -> tuple[str, Outputs]:
+        # a leaf machine has no start event: the initial transition is taken at once
+        return self._enter(self.initial, ())
+
+    def inputs(self, state: str) -> Sequence[str]:
+        if self.fsm.states[state].final:
+            return ()
+        return LEAF_OUTCOMES
+
+    def step(self, state: str, symbol: str) -> tuple[str, Outputs]:
+        if self.fsm.states[state].final:
+            return state, ()
+        # no transition leaves ``target == state``: the same leaf is ticked again
+        target, _outputs = self.inner.step(state, symbol)
+        return self._enter(target, ())
+
+    def _enter(self, target: str, before: Outputs) -> tuple[str, Outputs]:
+        outputs = before + self.inner.entry_outputs(target)
+        if self.loop and self.fsm.states[target].final and target != self.initial:
+            return self.initial, outputs + self.inner.entry_outputs(self.initial)
+        return target, outputs
+
+    def status(self, state: str) -> str:
+        return FINAL if self.fsm.states[state].final else RUNNING
+
+    def describe(self, state: str) -> str:
+        return state

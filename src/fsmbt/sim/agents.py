@@ -31,15 +31,26 @@ from typing import Any, Protocol
 
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.bt_nodes import NodeKind
-from fsmbt.model.errors import InputError, UnsupportedError
+from fsmbt.model.errors import InputError
 from fsmbt.model.flatten import flatten, needs_flattening
 from fsmbt.model.fsm import FSM
+from fsmbt.semantics.execution import ENGINES as EXECUTION_ENGINES
+from fsmbt.semantics.execution import (
+    Flavour,
+    check_engine,
+    event_machine,
+    flavour_of,
+    leaf_machine,
+    lebt_engine_run,
+    tick_runner,
+)
 from fsmbt.semantics.machine import FINAL
 from fsmbt.semantics.status import LeafOutcome, RootResult
 from fsmbt.sim.world import EVENT_DRIVEN, World, check_names
 
 #: Engines a side can run on; ``fsmbt`` = fsmbt's own interpreter and machines.
-ENGINES = ("fsmbt", "btcpp", "py_trees", "python-statemachine")
+#: The engines a world can run a model on: ``fsmbt.semantics.execution``'s registry.
+ENGINES = tuple(EXECUTION_ENGINES)
 ROOT_RESULTS = frozenset(result.value for result in RootResult)
 LEAF_OUTCOMES = tuple(outcome.value for outcome in LeafOutcome)
 #: A step that ticks more leaves than this does not end (a tree that loops without RUNNING).
@@ -213,15 +224,8 @@ class EngineAsMachine:
 
 # -- what a model is -------------------------------------------------------------------------
 def bt_flavour(doc: BTDocument) -> str:
-    """``"lebt"`` (FSM -> BT by rules), ``"state-variable"`` (BSD/CHDS) or ``"plain"``."""
-    from fsmbt.semantics.lebt.spec import GUARD_TYPE, STATE_TYPE
-    from fsmbt.semantics.state_variable_runtime import is_state_variable_bt
-
-    if is_state_variable_bt(doc):
-        return "state-variable"
-    if any(node.type in (GUARD_TYPE, STATE_TYPE) for _tree, node in doc.nodes()):
-        return "lebt"
-    return "plain"
+    """``"lebt"``, ``"state-variable"`` or ``"plain"``: ``fsmbt.semantics.execution``'s answer."""
+    return str(flavour_of(doc))
 
 
 def model_names(model: FSM | BTDocument) -> list[str]:
@@ -248,21 +252,6 @@ def model_names(model: FSM | BTDocument) -> list[str]:
     return list(names)
 
 
-def engines_for(model: FSM | BTDocument) -> tuple[str, ...]:
-    """The engines a model can run on (``fsmbt`` always)."""
-    if isinstance(model, FSM):
-        return ("fsmbt", "python-statemachine")
-    flavour = bt_flavour(model)
-    if flavour == "state-variable":
-        return ("fsmbt",)
-    if flavour == "lebt":
-        return ("fsmbt", "btcpp", "py_trees")
-    from fsmbt.semantics.bt_interpreter import CompiledTree
-    from fsmbt.semantics.engines.pytrees_engine import supports
-
-    return ("fsmbt", "btcpp", "py_trees") if supports(CompiledTree(model)) else ("fsmbt", "btcpp")
-
-
 def build_agent(
     model: FSM | BTDocument, world: World, role: str, engine: str = "fsmbt", *, where: str = "model"
 ) -> LeafAgent | EventAgent:
@@ -272,7 +261,8 @@ def build_agent(
         model: the model.
         world: the world (its name table and events).
         role: the role the model plays.
-        engine: one of ``ENGINES`` that ``engines_for(model)`` lists.
+        engine: one of ``ENGINES`` that ``engines_for(model)`` lists
+            (``fsmbt.semantics.execution``).
         where: the model's name for messages.
 
     Returns:
@@ -286,12 +276,7 @@ def build_agent(
         raise InputError(
             f"the {world.name} world has no role '{role}' (roles: {', '.join(world.roles)})"
         )
-    if engine not in ENGINES:
-        raise InputError(f"unknown engine '{engine}' (known: {', '.join(ENGINES)})")
-    if engine not in engines_for(model):
-        raise UnsupportedError(
-            f"{where} cannot run on {engine} (it runs on: {', '.join(engines_for(model))})"
-        )
+    check_engine(model, engine, where)
     if (
         world.roles[role] == EVENT_DRIVEN
         and isinstance(model, BTDocument)
@@ -314,50 +299,20 @@ def _leaf_agent(model: FSM | BTDocument, engine: str) -> LeafAgent:
 
             text = SCXMLLeafMachine.document(model)
             return MachineLeafAgent(lambda: SCXMLLeafMachine(text, model), engine)
-        from fsmbt.verify.pairing import FSMLeafMachine
-
-        machine = FSMLeafMachine(model)
+        machine = leaf_machine(model)
         return MachineLeafAgent(lambda: machine, engine)
-    flavour = bt_flavour(model)
-    if flavour == "plain":
-        from fsmbt.semantics.bt_interpreter import BTRunner, CompiledTree
-
-        tree = CompiledTree(model)
-        if engine == "btcpp":
-            from fsmbt.semantics.engines.btcpp_engine import BTCppRunner
-
-            return BTTickAgent(lambda env: BTCppRunner(tree, env), engine)
-        if engine == "py_trees":
-            from fsmbt.semantics.engines.pytrees_engine import PyTreesRunner
-
-            return BTTickAgent(lambda env: PyTreesRunner(tree, env), engine)
-        return BTTickAgent(lambda env: BTRunner(tree, env), engine)
+    if flavour_of(model) is Flavour.PLAIN:
+        return BTTickAgent(tick_runner(model, engine), engine)
     make = _converted_machine(model, LEAF_OUTCOMES, engine)
     return MachineLeafAgent(make, engine)
 
 
 def _converted_machine(doc: BTDocument, alphabet: Sequence[str], engine: str) -> Callable[[], Any]:
     """A factory of the macro-step machine of a converted BT on ``engine``."""
-    if bt_flavour(doc) == "state-variable":
-        from fsmbt.semantics.state_variable_runtime import StateVariableMachine
-
-        sv = StateVariableMachine(doc, alphabet)
-        return lambda: sv
-    from fsmbt.semantics.bt_interpreter import CompiledTree
-
-    tree = CompiledTree(doc)
-    if engine == "btcpp":
-        from fsmbt.semantics.engines.btcpp_engine import BTCppLebtRunner
-
-        return lambda: EngineAsMachine(BTCppLebtRunner(tree))
-    if engine == "py_trees":
-        from fsmbt.semantics.engines.pytrees_engine import PyTreesLebtRunner
-
-        return lambda: EngineAsMachine(PyTreesLebtRunner(tree))
-    from fsmbt.semantics.lebt.machine import LEBTMachine
-
-    lebt = LEBTMachine(tree, alphabet)
-    return lambda: lebt
+    if engine in ("btcpp", "py_trees") and flavour_of(doc) is Flavour.LEBT:
+        return lambda: EngineAsMachine(lebt_engine_run(doc, engine))
+    machine = event_machine(doc, alphabet)
+    return lambda: machine
 
 
 def _event_agent(model: FSM | BTDocument, events: list[str], engine: str, where: str) -> EventAgent:
@@ -366,11 +321,9 @@ def _event_agent(model: FSM | BTDocument, events: list[str], engine: str, where:
             from fsmbt.sim.scxml_engine import SCXMLEventAgent
 
             return SCXMLEventAgent(model)
-        from fsmbt.semantics.machine import FSMMachine
-
-        alphabet = list(dict.fromkeys([*FSMMachine(model).alphabet, *events]))
-        return MachineEventAgent(FSMMachine(model, alphabet=alphabet), engine)
-    if bt_flavour(model) == "plain":
+        alphabet = list(dict.fromkeys([*model.events(), *events]))
+        return MachineEventAgent(event_machine(model, alphabet), engine)
+    if flavour_of(model) is Flavour.PLAIN:
         raise InputError(
             f"{where}: an event-driven role needs an FSM or a BT converted from one "
             "(LEBT, BSD, CHDS); this is a plain BT"

@@ -96,16 +96,22 @@ def document(model: FSM) -> str:
     return dumps(model, "scxml")
 
 
+#: Charts by SCXML text: python-statemachine reads a document once, every run reuses it.
+_CHARTS: dict[str, _Chart] = {}
+
+
+def _chart(text: str) -> _Chart:
+    chart = _CHARTS.get(text)
+    if chart is None:
+        chart = _CHARTS[text] = _Chart(text)
+    return chart
+
+
 class SCXMLLeafMachine:
     """An FSM on python-statemachine read as a leaf-execution machine (one instance per run)."""
 
-    _charts: dict[str, _Chart] = {}
-
     def __init__(self, text: str, model: FSM | None = None) -> None:
-        chart = self._charts.get(text)
-        if chart is None:
-            chart = self._charts[text] = _Chart(text)
-        self.instance = _Instance(chart)
+        self.instance = _Instance(_chart(text))
 
     @staticmethod
     def document(model: FSM) -> str:
@@ -137,10 +143,7 @@ class SCXMLEventAgent:
         self.instance: _Instance | None = None
 
     def start(self) -> None:
-        chart = SCXMLLeafMachine._charts.get(self.text)
-        if chart is None:
-            chart = SCXMLLeafMachine._charts[self.text] = _Chart(self.text)
-        self.instance = _Instance(chart)
+        self.instance = _Instance(_chart(self.text))
         self.action = self.instance.action()
 
     def post(self, event: str) -> None:

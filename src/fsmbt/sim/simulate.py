@@ -26,7 +26,8 @@ from importlib import resources
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import InputError
 from fsmbt.model.fsm import FSM
-from fsmbt.sim.agents import ENGINES, engines_for, model_names
+from fsmbt.semantics.execution import engines_for
+from fsmbt.sim.agents import ENGINES, model_names
 from fsmbt.sim.run import Comparison, Side, compare, worlds
 from fsmbt.sim.world import World
 

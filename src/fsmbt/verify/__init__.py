@@ -11,8 +11,9 @@ from __future__ import annotations
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import Hint, InputError
 from fsmbt.model.fsm import FSM
+from fsmbt.semantics.machine import FSMLeafMachine
 from fsmbt.verify.native import DEFAULT_MAX_STATES, Replay, check, replay
-from fsmbt.verify.pairing import FSMLeafMachine, machines_for
+from fsmbt.verify.pairing import machines_for
 from fsmbt.verify.report import PROPERTIES, PropertyResult, Report, TraceStep
 
 ENGINES = ("native", "nusmv", "both")

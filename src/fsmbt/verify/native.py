@@ -397,11 +397,15 @@ class _Product:
         self.edges = 0
         self.first: dict[str, _Violation] = {}
         self.counts: dict[str, int] = {name: 0 for name in PROPERTIES}
+        #: every violation in breadth-first order, when ``frontier`` asked for them all
+        self.every: list[tuple[str, _Violation]] | None = None
         self._input_diffs: dict[tuple[int, int], tuple[list[str], list[str]]] = {}
 
     def violate(self, name: str, violation: _Violation) -> None:
         self.counts[name] += 1
         self.first.setdefault(name, violation)
+        if self.every is not None:
+            self.every.append((name, violation))
 
     def pair(self, s: int, r: int, parent: int, symbol: str | None) -> int:
         key = s * self.width + r
@@ -649,6 +653,103 @@ def _check(
         "seconds": round(finished - started, 6),
     }
     return report
+
+
+@dataclass(frozen=True)
+class FrontierPoint:
+    """One place where the two machines part: a faithful product pair and what breaks there.
+
+    Attributes:
+        property: the property the point violates (one of ``PROPERTIES``, never reachability).
+        source_state, result_state: the two machines' states in the pair (both reached on one
+            shortest input sequence on which they agreed at every step).
+        symbol: the input on which they part, ``None`` when the pair itself differs (the
+            start, or one side stuck).
+        detail: the checker's sentence for it.
+        witness: a shortest input sequence from the start that shows the difference (the path
+            to the pair, ``symbol``, and for a stuck side the live side's way to act).
+    """
+
+    property: str
+    source_state: Hashable
+    result_state: Hashable
+    symbol: str | None
+    detail: str
+    witness: tuple[str, ...]
+
+
+@dataclass
+class Frontier:
+    """Every distinguishing frontier point of two machines, in breadth-first order."""
+
+    points: list[FrontierPoint]
+    stats: dict[str, Any]
+
+
+def frontier(
+    source: Machine[Any],
+    result: Machine[Any],
+    *,
+    max_states: int = DEFAULT_MAX_STATES,
+    max_seconds: float | None = None,
+) -> Frontier:
+    """All the points where ``source`` and ``result`` part, each with a shortest witness.
+
+    The same product as ``check`` (one kernel): it explores agreeing steps only, so every
+    violation it meets is a *frontier* point - the first step on some run where the two
+    differ. ``check`` keeps the first point per property; this keeps them all, in
+    breadth-first order (so the first point of any group of points is a shortest one). The
+    reachability property is a consequence of the others (a state only reached after the runs
+    part) and adds no point. A point where two properties fail on the same step is listed once.
+    Costs: as ``check``, plus O(depth) per point for its witness.
+
+    Raises:
+        StateLimitError: past ``max_states`` (``CheckerTimeLimitError`` past ``max_seconds``).
+    """
+    seconds = limits.current().checker_max_seconds if max_seconds is None else max_seconds
+    collecting = gc.isenabled()
+    gc.disable()
+    try:
+        started = time.perf_counter()
+        deadline = _Deadline(seconds)
+        outputs = _Interner()
+        src = _Explored(source, outputs, max_states, "source", deadline)
+        res = _Explored(result, outputs, max_states, "result", deadline)
+        product = _Product(src, res, max_states, deadline)
+        product.every = []
+        product.run()
+        seen: set[tuple[int, str | None]] = set()
+        points: list[FrontierPoint] = []
+        for name, violation in product.every:
+            key = (violation.pair, violation.symbol)
+            if key in seen:
+                continue
+            seen.add(key)
+            witness = product.path_to(violation.pair)
+            if violation.symbol is not None:
+                witness.append(violation.symbol)
+            witness.extend(violation.extension)
+            points.append(
+                FrontierPoint(
+                    name,
+                    src.states[product.pair_s[violation.pair]],
+                    res.states[product.pair_r[violation.pair]],
+                    violation.symbol,
+                    violation.detail,
+                    tuple(witness),
+                )
+            )
+        stats = {
+            "source_states": len(src.states),
+            "result_states": len(res.states),
+            "product_states": len(product.pair_s),
+            "product_edges": product.edges,
+            "seconds": round(time.perf_counter() - started, 6),
+        }
+        return Frontier(points, stats)
+    finally:
+        if collecting:
+            gc.enable()
 
 
 def _reachability(

@@ -28,8 +28,7 @@ from dataclasses import dataclass
 
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.fsm import FSM
-from fsmbt.semantics.lebt.spec import GUARD_TYPE, STATE_TYPE
-from fsmbt.semantics.state_variable_runtime import is_state_variable_bt
+from fsmbt.semantics.execution import Flavour, flavour_of
 
 Model = FSM | BTDocument
 
@@ -59,18 +58,14 @@ class Orientation:
     rule: str
 
 
-def is_lebt(doc: BTDocument) -> bool:
-    """True when any leaf of ``doc`` is a loop-execution leaf (LebtGuard / LebtState)."""
-    return any(node.type in (GUARD_TYPE, STATE_TYPE) for _tree, node in doc.nodes())
+#: The macro-step rule by which an FSM is compared with a BT of each flavour (the rest: leaf
+#: execution). ``fsmbt.semantics.execution.flavour_of`` says what a BT is.
+_MACRO_STEP_RULES = {Flavour.LEBT: LEBT_RULE, Flavour.STATE_VARIABLE: STATE_VARIABLE_RULE}
 
 
 def fsm_side_rule(doc: BTDocument) -> str | None:
     """The macro-step rule a BT is compared with an FSM by, or ``None`` (leaf execution)."""
-    if is_lebt(doc):
-        return LEBT_RULE
-    if is_state_variable_bt(doc):
-        return STATE_VARIABLE_RULE
-    return None
+    return _MACRO_STEP_RULES.get(flavour_of(doc))
 
 
 def orient(first: Model, second: Model) -> Orientation:

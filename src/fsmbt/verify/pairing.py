@@ -16,68 +16,16 @@ from typing import Any
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import InputError
 from fsmbt.model.fsm import FSM
+from fsmbt.semantics.execution import Flavour, flavour_of, leaf_machine
 from fsmbt.semantics.lebt.machine import LEBTMachine
 from fsmbt.semantics.lebt.spec import GUARD_TYPE, GuardSpec
-from fsmbt.semantics.machine import FINAL, RUNNING, FSMMachine, Machine, Outputs
-from fsmbt.semantics.status import LeafOutcome
+from fsmbt.semantics.machine import (
+    FSMMachine,
+    Machine,
+)
 
 MACRO_STEP = "macro-step"
 LEAF_EXECUTION = "leaf-execution"
-LEAF_OUTCOMES = tuple(outcome.value for outcome in LeafOutcome)
-
-
-class FSMLeafMachine:
-    """An FSM (flattened if hierarchical) read as a BT's leaf-execution machine (docs/semantics.md,
-    'The leaf-execution machine').
-
-    A state is the leaf about to be ticked: entering it outputs its action (the leaf's label).
-    An outcome with no transition leaves the FSM where it is, so the same leaf is ticked again
-    and its label is output again (a converter may omit ``running`` self-loops). A final state
-    is the root's result: its action (``SUCCESS``/``FAILURE``) is output and the status is
-    ``"final"``, as ``LeafMachine`` does. With ``loop`` the root is ticked again at once: entering
-    a final state outputs its action and then the initial state's, and the machine is back in
-    the initial state (``LeafMachine(loop=True)`` outputs ``(result, first leaf)`` likewise).
-    The machine takes whatever outcomes the BT side offers.
-    """
-
-    follows_environment = True
-
-    def __init__(self, fsm: FSM, *, loop: bool = False) -> None:
-        self.inner = FSMMachine(fsm, alphabet=LEAF_OUTCOMES)
-        self.fsm = self.inner.fsm
-        self.name = self.fsm.name
-        self.loop = loop
-        if self.fsm.initial is None:
-            raise InputError("the state machine has no initial state", element=self.name)
-        self.initial: str = self.fsm.initial
-
-    def start(self) -> tuple[str, Outputs]:
-        # a leaf machine has no start event: the initial transition is taken at once
-        return self._enter(self.initial, ())
-
-    def inputs(self, state: str) -> Sequence[str]:
-        if self.fsm.states[state].final:
-            return ()
-        return LEAF_OUTCOMES
-
-    def step(self, state: str, symbol: str) -> tuple[str, Outputs]:
-        if self.fsm.states[state].final:
-            return state, ()
-        # no transition leaves ``target == state``: the same leaf is ticked again
-        target, _outputs = self.inner.step(state, symbol)
-        return self._enter(target, ())
-
-    def _enter(self, target: str, before: Outputs) -> tuple[str, Outputs]:
-        outputs = before + self.inner.entry_outputs(target)
-        if self.loop and self.fsm.states[target].final and target != self.initial:
-            return self.initial, outputs + self.inner.entry_outputs(self.initial)
-        return target, outputs
-
-    def status(self, state: str) -> str:
-        return FINAL if self.fsm.states[state].final else RUNNING
-
-    def describe(self, state: str) -> str:
-        return state
 
 
 class LEBTWithActiveInputs:
@@ -175,32 +123,19 @@ def machines_for(
             MACRO_STEP,
         )
     if isinstance(source, FSM) and isinstance(result, BTDocument):
-        from fsmbt.semantics.state_variable_runtime import (
-            is_state_variable_bt,
-            machines_for_state_variable,
-        )
+        from fsmbt.semantics.state_variable_runtime import machines_for_state_variable
 
-        if is_state_variable_bt(result):  # the baselines' state-variable leaves (BSD, CHDS)
+        if flavour_of(result) is Flavour.STATE_VARIABLE:  # the baselines' leaves (BSD, CHDS)
             return (*machines_for_state_variable(source, result), MACRO_STEP)
 
         source_machine = FSMMachine(source)
         alphabet = _union(source_machine.alphabet, lebt_guard_events(result))
         source_machine = FSMMachine(source, alphabet=alphabet)
         return source_machine, LEBTWithActiveInputs(LEBTMachine(result, alphabet)), MACRO_STEP
-    if isinstance(source, BTDocument) and isinstance(result, FSM):
-        from fsmbt.semantics.leaf_machine import LeafMachine
-
+    if isinstance(source, BTDocument):  # leaf execution against an FSM or another BT
         return (
-            LeafMachine(source, loop=loop, generic=faithful),
-            FSMLeafMachine(result, loop=loop),
-            LEAF_EXECUTION,
-        )
-    if isinstance(source, BTDocument) and isinstance(result, BTDocument):
-        from fsmbt.semantics.leaf_machine import LeafMachine
-
-        return (
-            LeafMachine(source, loop=loop, generic=faithful),
-            LeafMachine(result, loop=loop, generic=faithful),
+            leaf_machine(source, loop=loop, generic=faithful),
+            leaf_machine(result, loop=loop, generic=faithful),
             LEAF_EXECUTION,
         )
     raise InputError(f"cannot compare a {type(source).__name__} with a {type(result).__name__}")

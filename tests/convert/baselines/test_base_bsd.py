@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from fsmbt.formats import read_model
+from fsmbt import api
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import UnsupportedError
 from fsmbt.semantics import state_variable_runtime as sv
@@ -37,7 +37,7 @@ def test_bsd_generated_bts_all_equivalent():
 
 
 def test_bsd_paper_fsm_shape_and_verdict():
-    fsm = read_model(EXAMPLES / "paper_fsm.json")
+    fsm = api.load(EXAMPLES / "paper_fsm.json").model
     result = convert("bsd", fsm)
     root = result.model.main.root
     assert root.type == "ReactiveFallback"
@@ -54,7 +54,7 @@ def test_bsd_paper_fsm_shape_and_verdict():
 def test_bsd_element_count_is_8m_plus_1_without_start_event():
     from fsmbt.metrics import elements
 
-    fsm = read_model(EXAMPLES / "paper_fsm.json")
+    fsm = api.load(EXAMPLES / "paper_fsm.json").model
     fsm.start_name = fsm.initial_event = None
     result = convert("bsd", fsm)
     assert elements(result.model).graphical == 8 * len(fsm.states) + 1
@@ -62,7 +62,7 @@ def test_bsd_element_count_is_8m_plus_1_without_start_event():
 
 
 def test_bsd_robot_bt():
-    bt = read_model(EXAMPLES / "robot_bt.xml")
+    bt = api.load(EXAMPLES / "robot_bt.xml").model
     result = convert("bsd", bt)
     fsm = result.model
     assert not fsm.is_hierarchical
@@ -73,7 +73,7 @@ def test_bsd_robot_bt():
 
 def test_bsd_broken_tree_is_caught_with_a_counterexample():
     """The runtime is not vacuous: redirect one transition and the checker must object."""
-    fsm = read_model(EXAMPLES / "paper_fsm.json")
+    fsm = api.load(EXAMPLES / "paper_fsm.json").model
     doc = convert("bsd", fsm).model
     transition = doc.main.root.children[1].children[2]  # A's transition leaf
     transition.attrs["transitions"] = transition.attrs["transitions"].replace("/B", "/C")
@@ -130,5 +130,5 @@ def test_bsd_cli_convert_engine(tmp_path):
     )
     assert proc.returncode == 0, proc.stderr
     assert "EQUIVALENT" in proc.stdout
-    written = read_model(out)  # the XML round trip keeps the state-variable leaves
-    assert verify(read_model(EXAMPLES / "paper_fsm.json"), written).equivalent
+    written = api.load(out).model  # the XML round trip keeps the state-variable leaves
+    assert verify(api.load(EXAMPLES / "paper_fsm.json").model, written).equivalent

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from fsmbt.formats import read_model
+from fsmbt import api
 from fsmbt.model.bt import BTDocument
 from fsmbt.semantics import state_variable_runtime as sv
 from fsmbt.verify import verify
@@ -31,7 +31,7 @@ def test_chds_generated_bts_all_equivalent():
 
 
 def test_chds_paper_fsm_one_switch_per_transition():
-    fsm = read_model(EXAMPLES / "paper_fsm.json")
+    fsm = api.load(EXAMPLES / "paper_fsm.json").model
     result = convert("chds", fsm)
     root = result.model.main.root
     switches = [c for c in root.children if c.children[0].type == sv.GUARD]
@@ -43,7 +43,7 @@ def test_chds_paper_fsm_one_switch_per_transition():
 
 
 def test_chds_robot_bt_one_sub_fsm_per_control_node():
-    bt = read_model(EXAMPLES / "robot_bt.xml")
+    bt = api.load(EXAMPLES / "robot_bt.xml").model
     result = convert("chds", bt)
     controls = sum(1 for _t, n in bt.nodes() if n.kind.value == "Control")
     assert result.model.is_hierarchical
@@ -75,7 +75,7 @@ def test_chds_plain_node_under_reactive_is_not_equivalent_by_construction():
 
 
 def test_chds_broken_mode_is_caught():
-    fsm = read_model(EXAMPLES / "paper_fsm.json")
+    fsm = api.load(EXAMPLES / "paper_fsm.json").model
     doc = convert("chds", fsm).model
     mode = next(c for c in doc.main.root.children if c.children[0].type == sv.IS_STATE)
     mode.children[1].attrs["final"] = "true"  # A would terminate at once

@@ -595,10 +595,10 @@ def builtin_pairs() -> Iterator[Pair | Rejected]:
 
 # -- examples and corpus -------------------------------------------------------------------------
 def _read(path: Path, notes: Counter[str]) -> Model | None:
-    from fsmbt.formats.registry import read_model
+    from fsmbt import api
 
     try:
-        return read_model(path)
+        return api.load(path).model
     except FsmbtError:
         notes["unreadable"] += 1
         return None

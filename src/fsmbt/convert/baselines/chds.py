@@ -148,7 +148,7 @@ class _Builder:
                 stack.append((child, reactive, chain))
 
     @staticmethod
-    def _unique(fsm: FSM, base: str) -> str:
+    def unique_name(fsm: FSM, base: str) -> str:
         name, n = base, 2
         while name in fsm.states:
             name, n = f"{base}#{n}", n + 1
@@ -164,9 +164,9 @@ class _Builder:
         fsm.initial = None
         return fsm
 
-    def _leaf(self, node: BTNode, machine: FSM, cont: Cont, restart: str | None) -> str:
+    def leaf_state(self, node: BTNode, machine: FSM, cont: Cont, restart: str | None) -> str:
         """An atomic state for a leaf; ``running`` goes to ``restart`` (None = itself)."""
-        name = self._unique(machine, leaf_label(node))
+        name = self.unique_name(machine, leaf_label(node))
         machine.add_state(State(name, action=leaf_label(node)))
         machine.add_transition(name, EV_SUCCESS, cont.success)
         machine.add_transition(name, EV_FAILURE, cont.failure)
@@ -193,9 +193,9 @@ def _fill(builder: _Builder, node: BTNode, machine: FSM, work: list[tuple[BTNode
             restart = None
             if owner is not None and child.kind is NodeKind.ACTION:
                 restart = first_entry_placeholder if restart_here else RESTART
-            entry = builder._leaf(child, machine, cont, restart)
+            entry = builder.leaf_state(child, machine, cont, restart)
         else:
-            name = builder._unique(machine, child.name or child.type)
+            name = builder.unique_name(machine, child.name or child.type)
             sub = builder.new_machine(name, child, top=False)
             machine.add_state(State(name, action=None, regions=[sub]))
             machine.add_transition(name, None, cont.success, exit=SUCCESS)
@@ -240,8 +240,8 @@ def _top_entry(builder: _Builder, root: BTNode, top: FSM, work: list[tuple[BTNod
         cont = rewire(node, cont)
         node = node.children[0]
     if node.is_leaf:
-        return builder._leaf(node, top, cont, None)
-    name = builder._unique(top, node.name or node.type)
+        return builder.leaf_state(node, top, cont, None)
+    name = builder.unique_name(top, node.name or node.type)
     sub = builder.new_machine(name, node, top=False)
     top.add_state(State(name, action=None, regions=[sub]))
     top.add_transition(name, None, cont.success, exit=SUCCESS)

@@ -1,6 +1,6 @@
 """python-statemachine classes, read statically, and written (docs/formats/pystatemachine.md).
 
-Reading parses the file with ``ast`` (``_pysm_source.parse_source``): nothing is imported or
+Reading parses the file with ``ast`` (``pysm.source.parse_source``): nothing is imported or
 run. The machine is the first class deriving from ``StateMachine`` or ``StateChart`` (option
 ``machine`` names another). In its body:
 - ``x = State(...)`` is state ``x`` (``initial=True``: the initial state, else the first one
@@ -33,7 +33,7 @@ import json
 import keyword
 import re
 
-from fsmbt.formats._pysm_source import NotStatic, last_name, literal, parse_source
+from fsmbt.formats.pysm.source import NotStatic, last_name, literal, parse_source
 from fsmbt.formats.registry import ReadContext
 from fsmbt.model import Model
 from fsmbt.model.errors import InputError, SourceLocation, UnsupportedError

@@ -34,7 +34,7 @@ import json
 from typing import Any
 
 from fsmbt.formats.registry import ReadContext
-from fsmbt.formats.yaml_format import load_yaml
+from fsmbt.formats.schema.yaml_format import load_yaml
 from fsmbt.model import Model
 from fsmbt.model.errors import InputError, UnsupportedError
 from fsmbt.model.fsm import FSM, State

@@ -1,6 +1,6 @@
 """YASMIN container records -> fsmbt's hierarchical FSM, with each state's declarations.
 
-The shape is the SMACH reader's (``_pysm_build.build_records``: one state per state, events are
+The shape is the SMACH reader's (``pysm.build.build_records``: one state per state, events are
 outcomes, containers are composite states left by completion transitions ``exit=<outcome>``,
 one final state per container outcome, a concurrence or orthogonal state as the product of its
 children). This module then stores what each state was declared with (``model.state_info``:
@@ -14,8 +14,8 @@ from __future__ import annotations
 
 import json
 
-from fsmbt.formats._pysm_analyze import Analysis, Container
-from fsmbt.formats._pysm_build import build_records
+from fsmbt.formats.pysm.analyze import Analysis, Container
+from fsmbt.formats.pysm.build import build_records
 from fsmbt.formats.registry import ReadContext
 from fsmbt.formats.yasmin.xml_read import A_CHILD_INFO, NO_ACTION_CLASS, START_CLASS, Records
 from fsmbt.model.fsm import FSM

@@ -1,6 +1,6 @@
 """YASMIN Python state machines, read statically (docs/formats/yasmin.md, 'Python').
 
-The file is parsed with ``ast`` (``_pysm_source.parse_source``) and never imported or run. What
+The file is parsed with ``ast`` (``pysm.source.parse_source``) and never imported or run. What
 is understood, in the order the statements are written (module level and every function body,
 each statement list walked with an explicit stack):
 
@@ -25,8 +25,8 @@ import ast
 import json
 from collections.abc import Iterator
 
-from fsmbt.formats._pysm_analyze import Child, Container, StateRef
-from fsmbt.formats._pysm_source import NotStatic, last_name, literal, parse_source
+from fsmbt.formats.pysm.analyze import Child, Container, StateRef
+from fsmbt.formats.pysm.source import NotStatic, last_name, literal, parse_source
 from fsmbt.formats.registry import ReadContext
 from fsmbt.formats.yasmin.xml_read import A_SYNC, A_TAG, Records
 from fsmbt.model import state_info

@@ -1,8 +1,8 @@
 """YASMIN factory XML -> container records (docs/formats/yasmin.md).
 
 ``yasmin_factory`` (YASMIN 6.x) builds a state machine from XML; this module reads the same
-elements into the container records the SMACH reader builds (``_pysm_analyze``), so that one
-construction (``_pysm_build``) makes the FSM. What the factory does, and so what is read:
+elements into the container records the SMACH reader builds (``pysm.analyze``), so that one
+construction (``pysm.build``) makes the FSM. What the factory does, and so what is read:
 
 - ``<StateMachine outcomes start_state>`` and ``<Region>`` (inside ``<OrthogonalState>``): a
   machine; its states are the ``State``, ``StateMachine``, ``Concurrence``, ``OrthogonalState``
@@ -46,7 +46,7 @@ from pathlib import Path
 
 from lxml import etree
 
-from fsmbt.formats._pysm_analyze import Child, Container, StateRef
+from fsmbt.formats.pysm.analyze import Child, Container, StateRef
 from fsmbt.formats.registry import ReadContext, decode
 from fsmbt.formats.xml_safe import local_name, parse_xml
 from fsmbt.model import state_info

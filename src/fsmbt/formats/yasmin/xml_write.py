@@ -35,7 +35,7 @@ import json
 
 from lxml import etree
 
-from fsmbt.formats._pysm_build import A_CHILDREN, A_DEFAULT, A_MAP
+from fsmbt.formats.pysm.build import A_CHILDREN, A_DEFAULT, A_MAP
 from fsmbt.formats.yasmin.xml_read import (
     A_CHILD_INFO,
     A_DESCRIPTION,

@@ -30,6 +30,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from fsmbt.cache import cache_root
+from fsmbt.install import build_script as install_script
 from fsmbt.model.errors import FsmbtError
 
 BTCPP_VERSION = "4.8.2"
@@ -51,16 +52,10 @@ class CppRuntimeError(FsmbtError):
     """The C++ driver is missing, stale, or failed on a tree."""
 
 
-def _repo_root() -> Path | None:
-    """The checkout holding this package (for the build script), if there is one."""
-    root = PACKAGE_DIR.parents[3]
-    return root if (root / "scripts" / "build_btcpp.sh").is_file() else None
-
-
-def build_script() -> Path | None:
-    """``scripts/build_btcpp.sh`` of the checkout, or ``None`` for an installed package."""
-    root = _repo_root()
-    return None if root is None else root / "scripts" / "build_btcpp.sh"
+def build_script() -> Path:
+    """The build script of BehaviorTree.CPP and the driver, shipped in the package
+    (``fsmbt doctor --install btcpp`` runs it; a checkout's ``scripts/build_btcpp.sh`` too)."""
+    return install_script("btcpp")
 
 
 def library_prefix() -> Path:
@@ -126,9 +121,10 @@ def require_driver() -> Path:
     """The driver, or a ``CppRuntimeError`` that says how to build it."""
     path = find_driver()
     if path is None:
-        script = build_script()
-        how = f"run {script}" if script else "run scripts/build_btcpp.sh from an fsmbt checkout"
-        raise CppRuntimeError(f"the C++ LEBT driver is not built ({status().problem}); {how}")
+        raise CppRuntimeError(
+            f"the C++ LEBT driver is not built ({status().problem}); "
+            "run fsmbt doctor --install btcpp (needs cmake and g++)"
+        )
     return path
 
 

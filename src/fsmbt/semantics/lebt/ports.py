@@ -102,6 +102,7 @@ def lebt_port_issues(doc: BTDocument) -> list[Issue]:
                     "enters (a LebtState or SubTree, alone or first in a chain)",
                     guard.node.location,
                     where,
+                    code="lebt-port",
                 )
             )
         elif guard.spec.target != name:
@@ -115,6 +116,7 @@ def lebt_port_issues(doc: BTDocument) -> list[Issue]:
                     "state the guard enters",
                     guard.node.location,
                     where,
+                    code="lebt-port",
                 )
             )
         for source, event in guard.spec.pairs:
@@ -128,6 +130,7 @@ def lebt_port_issues(doc: BTDocument) -> list[Issue]:
                         "never fires",
                         guard.node.location,
                         where,
+                        code="lebt-port",
                     )
                 )
     left: set[tuple[str, str]] = {pair for guard in guards for pair in guard.spec.pairs}
@@ -141,6 +144,7 @@ def lebt_port_issues(doc: BTDocument) -> list[Issue]:
                         f"has the pair '{name}/{event}'",
                         node.location,
                         f"{STATE_TYPE} '{node.label}'",
+                        code="lebt-port",
                     )
                 )
     return issues

@@ -9,6 +9,9 @@ the runtimes (interpreter, fast path, BehaviorTree.CPP, py_trees) that run them.
 - ``LebtState`` (a stateful Action): ports ``state``, ``action`` (empty = none), ``final``
   (``true``/``false``) and ``exits``, the events that have a transition out of the state,
   separated by ``;``.
+  An optional ``params`` port holds the state's parameters for the runtimes' callbacks
+  (``name=value`` items separated by ``;``; ``encode_params``): what the state was configured
+  with (FlexBE's ``TimedCmdVelState(velocity=...)``), never read by the checkers.
 Names with ``;``, ``/`` or ``\\`` are escaped with a backslash.
 Blackboard keys: ``state`` (starts at the start pseudo-state) and ``event`` (empty = none).
 
@@ -27,6 +30,8 @@ BB_STATE = "state"
 BB_EVENT = "event"
 NO_EVENT = ""
 DEFAULT_START = "__start__"
+#: The optional port of ``LebtState`` holding the state's parameters (runtimes only).
+PARAMS_PORT = "params"
 
 
 def escape(text: str) -> str:
@@ -65,6 +70,25 @@ def decode_pairs(text: str) -> list[tuple[str, str]]:
             raise ValueError(f"malformed pair {item!r}: expected 'a/b'")
         pairs.append((unescape(pieces[0]), unescape(pieces[1])))
     return pairs
+
+
+def encode_params(params: dict[str, str]) -> str:
+    """``name=value`` items joined by ``;`` (``;``, ``/`` and ``\\`` escaped; a name has no
+    ``=``): the ``params`` port of a state leaf."""
+    return ";".join(f"{escape(name)}={escape(value)}" for name, value in params.items())
+
+
+def decode_params(text: str) -> dict[str, str]:
+    """The inverse of ``encode_params``; raises ``ValueError`` on an item without ``=``."""
+    params: dict[str, str] = {}
+    if not text:
+        return params
+    for item in _split_keeping_escapes(text, ";"):
+        name, sep, value = item.partition("=")
+        if not sep or not name:
+            raise ValueError(f"malformed parameter {item!r}: expected 'name=value'")
+        params[unescape(name)] = unescape(value)
+    return params
 
 
 def _split_keeping_escapes(text: str, separator: str) -> list[str]:

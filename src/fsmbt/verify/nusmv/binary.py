@@ -15,11 +15,13 @@ from functools import lru_cache
 from pathlib import Path
 
 from fsmbt.cache import cache_root
+from fsmbt.install import build_script
 from fsmbt.model.errors import FsmbtError
 
 ENV_VAR = "FSMBT_NUSMV"
 _REPO_ROOT = Path(__file__).resolve().parents[4]
-BUILD_SCRIPT = _REPO_ROOT / "scripts" / "build_nusmv.sh"
+#: The build script, shipped in the package (``fsmbt doctor --install nusmv`` runs it)
+BUILD_SCRIPT = build_script("nusmv")
 NUSMV_VERSION = "2.5.4"
 LEGACY_BINARY = _REPO_ROOT / ".cache" / "nusmv" / "bin" / "NuSMV"
 
@@ -68,7 +70,9 @@ def require_nusmv() -> Path:
             if env
             else f"not on PATH and not built at {cached_binary()}"
         )
-        raise NuSMVNotFound(f"NuSMV not found ({hint}); run {BUILD_SCRIPT} or set {ENV_VAR}")
+        raise NuSMVNotFound(
+            f"NuSMV not found ({hint}); run fsmbt doctor --install nusmv or set {ENV_VAR}"
+        )
     return path
 
 

@@ -32,14 +32,39 @@ O(1) for the decorators; one variable of log2(L) bits per finite loop, 2 bits pe
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import Protocol
 
 from fsmbt.model.errors import Hint, UnsupportedError
-from fsmbt.semantics.bt_interpreter import CompiledNode, _threshold
+from fsmbt.semantics.bt_interpreter import CompiledNode, parallel_threshold
 from fsmbt.verify.nusmv.smv import all_of
 
-if TYPE_CHECKING:
-    from fsmbt.verify.nusmv.encode_bt import BTCore
+
+class BTCore(Protocol):
+    """What these rules write into: the BT encoder (``encode_bt.BTCore``), which imports this
+    module (so this one names the encoder's methods it calls, not the encoder)."""
+
+    defines: list[tuple[str, str]]
+
+    def st(self, nid: int) -> str:
+        """The status variable of node ``nid``."""
+        ...
+
+    def rule(self, var: str, cond: str, value: str) -> None:
+        """Add ``cond -> var := value``."""
+        ...
+
+    def memory(self, name: str, nid: int, top: int, *, reset_by_halt: bool = True) -> str:
+        """Declare a memory variable ``0..top`` of node ``nid``; its name."""
+        ...
+
+    def call(self, cond: str, child: int) -> None:
+        """The current node calls ``child``."""
+        ...
+
+    def ret(self, cond: str, nid: int, status: str) -> None:
+        """``nid`` returns ``status`` to its parent."""
+        ...
+
 
 #: The rule names (the node registry's ``nusmv`` field) this module encodes.
 RULES = ("repeat", "retry", "run_once", "parallel", "parallel_all")
@@ -136,7 +161,7 @@ def _parallel(
     core.defines += [(sc, f"({successes})"), (fc, f"({failures})")]
     if rule == "parallel":
         succ_param, fail_param = x.params
-        need_s, need_f = _threshold(succ_param, n), _threshold(fail_param, n)
+        need_s, need_f = parallel_threshold(succ_param, n), parallel_threshold(fail_param, n)
         won = f"{sc} >= {need_s}"
         lost = f"!({won}) & ({n} - {fc} < {need_s} | {fc} = {need_f})"
         checks = [(won, "S"), (lost, "F")]  # run after every child's return, success first

@@ -2,7 +2,7 @@
 // fsmbt/lebt.hpp, reading events from stdin and printing what each macro step did.
 //
 //   fsmbt_lebt_driver TREE.xml [--start NAME] [--register A,B,...] [--table] [--bench R]
-//                              [--tick once|exactly-once|auto]
+//                              [--tick once|exactly-once|auto] [--entries]
 //   fsmbt_lebt_driver --version
 //
 // Input (stdin): one event name per line (a trailing '\r' is dropped; empty lines are skipped).
@@ -21,6 +21,8 @@
 //                    records its call); without it every action gets a recording fallback. An
 //                    action of the tree missing from LIST is a load-time error.
 //   --tick MODE      how the root is ticked (fsmbt::lebt::TickMode; default auto)
+//   --entries        every action callback prints the state and parameters it received, one
+//                    JSON line {"entered":STATE,"params":{...}} before its step's line
 //   --table          run the same FSM as a plain transition table read off the tree's guards and
 //                    states (no behavior tree ticks): the baseline of benchmarks/bench_runtime.py
 //   --bench R        read all of stdin first, replay it R times without printing steps, then print
@@ -199,6 +201,7 @@ struct Arguments
   std::optional<std::string> start;
   std::optional<std::vector<std::string>> registered;
   bool table = false;
+  bool entries = false;
   long bench = 0;
   fsmbt::lebt::TickMode tick = fsmbt::lebt::TickMode::Auto;
 };
@@ -207,7 +210,7 @@ struct Arguments
 {
   std::fprintf(stderr,
                "error: %s\nusage: fsmbt_lebt_driver TREE.xml [--start NAME] [--register A,B] "
-               "[--table] [--bench R] [--tick once|exactly-once|auto] | --version\n",
+               "[--table] [--entries] [--bench R] [--tick once|exactly-once|auto] | --version\n",
                problem.c_str());
   std::exit(2);
 }
@@ -265,6 +268,10 @@ Arguments parse(int argc, char** argv)
     else if(arg == "--table")
     {
       args.table = true;
+    }
+    else if(arg == "--entries")
+    {
+      args.entries = true;
     }
     else if(arg == "--bench")
     {
@@ -431,16 +438,33 @@ int main(int argc, char** argv)
   try
   {
     fsmbt::lebt::ActionRegistry actions;
+    // --entries: each callback prints what it received, {"entered":STATE,"params":{...}}
+    auto callback = [entries = args.entries](const std::string& state,
+                                             const fsmbt::lebt::Parameters& params) {
+      if(!entries)
+      {
+        return;
+      }
+      std::string line = "{\"entered\":" + jsonString(state) + ",\"params\":{";
+      bool first = true;
+      for(const auto& [name, value] : params)
+      {
+        line += (first ? "" : ",") + jsonString(name) + ":" + jsonString(value);
+        first = false;
+      }
+      line += "}}\n";
+      std::fputs(line.c_str(), stdout);
+    };
     if(args.registered)
     {
       for(const std::string& name : *args.registered)
       {
-        actions.add(name, [](const std::string&) {});
+        actions.add(name, callback);
       }
     }
     else
     {
-      actions.addFallback([](const std::string&) {});
+      actions.addFallback(callback);
     }
     fsmbt::lebt::Options options;
     options.start = args.start;

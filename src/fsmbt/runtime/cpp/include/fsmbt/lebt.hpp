@@ -11,8 +11,10 @@
 //  - LebtGuard (a Condition; ports `target`, `pairs`): FAILURE when (state, event) is one of its
 //    `source/event` pairs (the transition fires), else SUCCESS. `Start/` (empty event) is the
 //    initialisation pair.
-//  - LebtState (a stateful Action; ports `state`, `action`, `final`, `exits`): onStart runs the
-//    state's action (the user's callback registered under the action's name; once per entry),
+//  - LebtState (a stateful Action; ports `state`, `action`, `final`, `exits` and the optional
+//    `params`, `name=value;...`): onStart runs the state's action (the user's callback
+//    registered under the action's name, called with the state's label and parameters; once
+//    per entry),
 //    sets `state`, clears `event`, returns RUNNING (SUCCESS when final). onRunning: SUCCESS when
 //    the pending event has a transition out of the state (the event is kept), else the event is
 //    dropped and the leaf stays RUNNING; RUNNING when no event is pending.
@@ -34,8 +36,11 @@
 //
 // Load-time errors (fsmbt::lebt::LebtError, derived from std::runtime_error): a leaf the runtime
 // does not define (BehaviorTree.CPP's "Error at line N: -> Node not recognized: X"), a port that
-// is a blackboard reference or malformed, and an action name with no registered callback - all
-// raised by the LebtRunner constructor, never at tick time.
+// is a blackboard reference or malformed, an action name with no registered callback, and LEBT
+// annotations that contradict each other (a guard pair whose event is not an exit of its source
+// state, an exit no guard pair takes, a pair source that is neither a state nor the start
+// pseudo-state: hand edits that would otherwise stop the machine silently) - all raised by the
+// LebtRunner constructor, never at tick time, naming the node and its line.
 //
 // Cost: a guard tick is two hash look-ups, a state tick one. A macro step ticks from the root
 // down to the running leaf (BehaviorTree.CPP resumes each Sequence at its running child, but every
@@ -68,6 +73,7 @@
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <type_traits>
 #include <unordered_map>
 #include <unordered_set>
 #include <utility>
@@ -202,26 +208,85 @@ inline std::vector<std::string> decodeExits(std::string_view text)
   return exits;
 }
 
-/// User code run when a state is entered: receives the (flat) name of the state entered.
-using ActionCallback = std::function<void(const std::string& state)>;
+/// A state's parameters (its `params` port): name -> literal value text.
+using Parameters = std::map<std::string, std::string>;
+
+/// The parameters of a state's `params` port (`name=value` items separated by `;`, escaped as
+/// fsmbt.semantics.lebt.spec.encode_params does); throws std::invalid_argument on an item
+/// without `=`.
+inline Parameters decodeParams(std::string_view text)
+{
+  Parameters params;
+  if(text.empty())
+  {
+    return params;
+  }
+  for(const std::string& item : detail::splitKeepingEscapes(text, ';'))
+  {
+    std::size_t eq = std::string::npos;
+    for(std::size_t i = 0; i < item.size(); ++i)
+    {
+      if(item[i] == '\\')
+      {
+        ++i;
+      }
+      else if(item[i] == '=')
+      {
+        eq = i;
+        break;
+      }
+    }
+    if(eq == std::string::npos || eq == 0)
+    {
+      throw std::invalid_argument("malformed parameter '" + item + "': expected 'name=value'");
+    }
+    params[detail::unescape(item.substr(0, eq))] = detail::unescape(item.substr(eq + 1));
+  }
+  return params;
+}
+
+/// User code run when a state is entered: receives the (flat) name of the state entered and
+/// its parameters.
+using ActionCallback = std::function<void(const std::string& state, const Parameters& params)>;
 
 /// The user's actions, by the action name the tree's `LebtState` leaves carry.
 class ActionRegistry
 {
 public:
   /// Register `callback` for `action` (replaces an earlier registration of the same name).
-  ActionRegistry& add(const std::string& action, ActionCallback callback)
+  /// `callback` takes (state, params), or the state only (the earlier signature).
+  template <typename Callback>
+  ActionRegistry& add(const std::string& action, Callback callback)
   {
-    callbacks_[action] = std::move(callback);
+    callbacks_[action] = wrap(std::move(callback));
     return *this;
   }
 
   /// Run `callback` for every action that has no callback of its own (a logger, a test
   /// recorder). Without it, an unregistered action is a load-time error.
-  ActionRegistry& addFallback(ActionCallback callback)
+  template <typename Callback>
+  ActionRegistry& addFallback(Callback callback)
   {
-    fallback_ = std::move(callback);
+    fallback_ = wrap(std::move(callback));
     return *this;
+  }
+
+  /// A callback taking (state) or (state, params) as an ActionCallback.
+  template <typename Callback>
+  static ActionCallback wrap(Callback callback)
+  {
+    if constexpr(std::is_invocable_v<Callback&, const std::string&, const Parameters&>)
+    {
+      return ActionCallback(std::move(callback));
+    }
+    else
+    {
+      static_assert(std::is_invocable_v<Callback&, const std::string&>,
+                    "an action callback takes (const std::string& state, const "
+                    "fsmbt::lebt::Parameters& params) or (const std::string& state)");
+      return [callback = std::move(callback)](const std::string& state,
+                                              const Parameters&) mutable { callback(state); };
+    }
   }
 
   /// The callback that runs for `action`, or nullptr.
@@ -329,6 +394,15 @@ public:
     {
       exits_.insert(std::move(exit));
     }
+    try
+    {
+      params_ = decodeParams(detail::literalPort(config, name, kStateType, "params"));
+    }
+    catch(const std::invalid_argument& exc)
+    {
+      throw LebtError(std::string("<LebtState name=\"") + name + "\"> (" + config.path +
+                      "): port 'params': " + exc.what());
+    }
   }
 
   static BT::PortsList providedPorts()
@@ -336,12 +410,15 @@ public:
     return { BT::InputPort<std::string>("state", "the FSM state"),
              BT::InputPort<std::string>("action", "the state's action (empty = none)"),
              BT::InputPort<std::string>("final", "true when the state is final"),
-             BT::InputPort<std::string>("exits", "events leaving the state, ';'-separated") };
+             BT::InputPort<std::string>("exits", "events leaving the state, ';'-separated"),
+             BT::InputPort<std::string>("params", "the state's parameters, name=value;...") };
   }
 
   const std::string& stateName() const { return state_; }
   const std::string& actionName() const { return action_; }
   bool isFinal() const { return final_; }
+  const std::unordered_set<std::string>& exits() const { return exits_; }
+  const Parameters& parameters() const { return params_; }
 
   /// Bind the user's callback (done by LebtRunner at load time; nullptr = no action).
   void bind(const ActionCallback* callback) { callback_ = callback; }
@@ -355,7 +432,7 @@ protected:
       context_->actions_run.push_back(action_);
       if(callback_ != nullptr)
       {
-        (*callback_)(state_);
+        (*callback_)(state_, params_);
       }
     }
     context_->state = state_;
@@ -385,6 +462,7 @@ private:
   std::string action_;
   bool final_ = false;
   std::unordered_set<std::string> exits_;
+  Parameters params_;
   const ActionCallback* callback_ = nullptr;
 };
 
@@ -479,6 +557,7 @@ public:
         }
       }
     }
+    checkAnnotations(xml_text);
     context_->state = start_;
     exactly_once_ = options.tick == TickMode::ExactlyOnce ||
                     (options.tick == TickMode::Auto && never_wakes_up_);
@@ -690,6 +769,61 @@ private:
     }
   }
 
+  /// The LEBT annotations agree (docs/semantics.md section 5): every guard pair leaving a
+  /// state names one of its exits, every exit is taken by some pair, and every pair source that
+  /// is no state is the start pseudo-state. Throws LebtError naming the first leaf that does
+  /// not, with its line.
+  void checkAnnotations(const std::string& xml_text) const
+  {
+    std::unordered_map<std::string, const LebtState*> states;
+    for(const LebtState* leaf : state_leaves_)
+    {
+      states.emplace(leaf->stateName(), leaf);
+    }
+    auto where = [&](const BT::TreeNode* node, const char* type) {
+      const int line = lineOf(xml_text, type, node->name());
+      return std::string("<") + type + " name=\"" + node->name() + "\"> (" + node->fullPath() +
+             (line > 0 ? ", line " + std::to_string(line) : "") + ")";
+    };
+    std::set<std::pair<std::string, std::string>> taken;
+    for(const LebtGuard* guard : guards_)
+    {
+      for(const auto& [source, event] : guard->pairs())
+      {
+        taken.emplace(source, event);
+        auto state = states.find(source);
+        if(state == states.end())
+        {
+          if(source != start_)
+          {
+            throw LebtError(where(guard, kGuardType) + ": LEBT annotations disagree: pair '" +
+                            source + "/" + event + "': '" + source +
+                            "' is no state of the tree and not the start pseudo-state '" +
+                            start_ + "', so the transition never fires");
+          }
+        }
+        else if(!event.empty() && state->second->exits().count(event) == 0)
+        {
+          throw LebtError(where(guard, kGuardType) + ": LEBT annotations disagree: pair '" +
+                          source + "/" + event + "': state '" + source + "' does not list '" +
+                          event + "' in its exits port, so this transition never fires");
+        }
+      }
+    }
+    for(const LebtState* leaf : state_leaves_)
+    {
+      for(const std::string& exit : leaf->exits())
+      {
+        if(taken.count({ leaf->stateName(), exit }) == 0)
+        {
+          throw LebtError(where(leaf, kStateType) + ": LEBT annotations disagree: exits port " +
+                          "lists '" + exit + "' but no LebtGuard has the pair '" +
+                          leaf->stateName() + "/" + exit + "'");
+        }
+      }
+    }
+  }
+
   std::string inferStart() const
   {
     std::unordered_set<std::string> names;
@@ -706,6 +840,25 @@ private:
         {
           sources.insert(pair.first);
         }
+      }
+    }
+    if(sources.size() > 1)
+    {
+      // a misspelt state among them: the start is the source of the initialisation pair
+      std::set<std::string> initial;
+      for(const LebtGuard* guard : guards_)
+      {
+        for(const auto& pair : guard->pairs())
+        {
+          if(pair.second.empty() && sources.count(pair.first) != 0)
+          {
+            initial.insert(pair.first);
+          }
+        }
+      }
+      if(initial.size() == 1)
+      {
+        return *initial.begin();
       }
     }
     return sources.size() == 1 ? *sources.begin() : std::string(kDefaultStart);

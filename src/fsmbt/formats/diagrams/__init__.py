@@ -1,0 +1,1 @@
+"""Diagram languages: Graphviz DOT and Mermaid."""

@@ -1,0 +1,1 @@
+"""The paper's FSM formats: its XML and its text notation."""

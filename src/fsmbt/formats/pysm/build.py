@@ -1,0 +1,811 @@
+"""SMACH / FlexBE container records -> fsmbt's hierarchical FSM (docs/formats/smach.md).
+
+Mapping rules:
+- A ``StateMachine`` / ``Sequence`` / ``OperatableStateMachine`` / ``PriorityContainer`` is a
+  machine: one state per ``add`` (label = state name, action = the state's class; a container
+  or embedded behaviour is a composite state with no action of its own), one final state per
+  container outcome, the first added state initial unless ``set_initial_state`` names another.
+- Events are outcomes: ``transitions={o: t}`` of a leaf state is ``label --o--> t``; of a
+  composite state a completion transition ``exit=o`` (it fires when the inner machine ends in
+  its final state ``o``). An outcome left unmapped or mapped to ``None`` falls through to the
+  container outcome of the same name, as SMACH does; when there is none that is the run-time
+  error SMACH raises, reported here as ``InputError`` with the line. A target that is neither a
+  label nor a container outcome, an outcome the state does not declare, or a ``Concurrence``
+  outcome map naming an unknown child is an ``InputError`` too. A container outcome no
+  transition reaches is a warning.
+- ``Sequence`` links each state's connector outcome to the next added state unless mapped;
+  ``add_auto`` links its connector outcomes to the next added state (overriding, as SMACH's
+  code does).
+- ``Concurrence`` / ``ConcurrencyContainer`` is a composite state whose inner machine is the
+  product of its children (a leaf child is its state plus one final state per outcome; a
+  container child its flattened machine): a state per combination of child positions, one
+  event per child event (qualified ``LABEL.event`` when two children share an event name, so
+  each child's input stays independent). SMACH: when all children are done, the last matching
+  entry of ``outcome_map`` (else ``default_outcome``) ends it; FlexBE: after each child step
+  the first satisfied condition ends it (children not finished are stopped). Entering it runs
+  every child's first action (``A+B``); a later product state runs only what the child that
+  moved starts (product states are split by that action).
+- ``Iterator`` with a static item list (literal list/tuple, ``range`` of integers, at most
+  ``MAX_UNROLLED_ITEMS``) is unrolled, one copy of the contained state per item; with items
+  computed at run time, the number of items is an environment choice after each loop outcome
+  (events ``<label>.next`` / ``<label>.exhausted``), named in a warning.
+- An embedded FlexBE behaviour is read from its own file beside the including one (module
+  name of its import, else any ``*.py`` there defining the class) and nested as a composite.
+
+Everything is built with an explicit work stack. Costs: O(S + T) per machine; a concurrence
+costs the product of (1 + outcomes) over its children, capped at ``MAX_PRODUCT_STATES``.
+"""
+
+from __future__ import annotations
+
+import json
+from collections import deque
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from fsmbt import limits
+from fsmbt.formats.pysm.analyze import (
+    MAX_UNROLLED_ITEMS,
+    Analysis,
+    Child,
+    Container,
+    Embedded,
+    StateRef,
+    analyze,
+)
+from fsmbt.formats.pysm.source import parse_source
+from fsmbt.formats.registry import ReadContext, decode
+from fsmbt.model.errors import InputError, SourceLocation, UnsupportedError
+from fsmbt.model.files import note_read, read_bounded, read_located
+from fsmbt.model.flatten import flatten
+from fsmbt.model.fsm import FSM, State, Transition
+
+MAX_PRODUCT_STATES = 20_000
+#: Where a concurrence child is: ``(False, flat state)`` while it runs, ``(True, outcome)`` done.
+Position = tuple[bool, str]
+#: A product state: every child's position, and the action that entering it runs.
+Key = tuple[tuple[Position, ...], str | None]
+#: ``State.attrs`` keys the SMACH writer reads back (docs/formats/smach.md).
+A_CLASS = "class"
+A_CONTAINER = "smach.container"
+A_CHILDREN = "smach.children"
+A_MAP = "smach.outcome_map"
+A_DEFAULT = "smach.default_outcome"
+A_BEHAVIOUR = "flexbe.behaviour"
+
+
+@dataclass
+class _Source:
+    """One analysed file (the main one or an embedded behaviour's)."""
+
+    path: Path | None
+    name: str
+    analysis: Analysis
+
+
+@dataclass
+class _Work:
+    container: Container
+    machine: FSM
+    label: str
+    source: _Source
+    chain: tuple[str, ...]  # behaviour files on the way here (cycle check)
+    path: str = ""  # label path from the file's top container ("" = top, "A/B")
+    phase: int = 0  # concurrences: 0 = build the container children first, 1 = the product
+    child_machines: dict[str, FSM] = field(default_factory=dict)
+
+
+@dataclass
+class Builder:
+    """Builds the FSM of one root container (and whatever it nests)."""
+
+    ctx: ReadContext
+    main: _Source
+    loaded: dict[Path, _Source] = field(default_factory=dict)
+    owners: dict[int, State] = field(default_factory=dict)  # id(region FSM) -> its state
+
+    def warn(self, source: _Source, line: int | None, message: str) -> None:
+        self.ctx.warnings.append(f"{SourceLocation(source.name, line)}: {message}")
+
+    def loc(self, source: _Source, line: int | None) -> SourceLocation:
+        return SourceLocation(source.name, line)
+
+    def build(self, root: Container, name: str) -> FSM:
+        top = FSM(name=name)
+        stack = [_Work(root, top, name, self.main, (), "")]
+        while stack:
+            work = stack.pop()
+            if work.container.blocker is not None:
+                raise work.container.blocker
+            kind = work.container.kind
+            if kind in ("concurrence", "flexbe-concurrency"):
+                if work.phase == 0:
+                    pending = self.concurrence_children(work)
+                    if pending:
+                        work.phase = 1
+                        stack.append(work)
+                        stack.extend(pending)
+                        continue
+                self.concurrence(work)
+            elif kind == "iterator":
+                stack.extend(self.iterator(work))
+            else:
+                stack.extend(self.machine(work))
+        return top
+
+    # -- children -----------------------------------------------------------------------------
+    def child_state(
+        self, work: _Work, child: Child, name: str | None = None
+    ) -> tuple[State, list[str] | None, _Work | None]:
+        """The state for ``child``, its outcomes (None = unknown), and the work to fill it."""
+        label = name or child.label
+        where = self.loc(work.source, child.line)
+        state = child.state
+        sub_path = f"{work.path}/{label}" if work.path else label
+        if isinstance(state, StateRef):
+            actions = work.source.analysis.extension.get("actions")
+            action: str | None = state.cls
+            if isinstance(actions, dict) and state.cls in actions:
+                mapped = actions[state.cls]
+                action = mapped if isinstance(mapped, str) else None
+            attrs = {A_CLASS: "CBState"} if state.callback else {}
+            return (State(label, action=action, attrs=attrs, location=where), state.outcomes, None)
+        if isinstance(state, Container):
+            region = FSM(name=label)
+            composite = State(label, action=None, regions=[region], location=where)
+            self.owners[id(region)] = composite
+            return (
+                composite,
+                list(state.outcomes),
+                _Work(state, region, label, work.source, work.chain, sub_path),
+            )
+        root, source = self.embedded(work, state, child)
+        region = FSM(name=label)
+        composite = State(
+            label, action=None, regions=[region], location=where, attrs={A_BEHAVIOUR: state.cls}
+        )
+        self.owners[id(region)] = composite
+        chain = (*work.chain, str(source.path))
+        return composite, list(root.outcomes), _Work(root, region, label, source, chain, "")
+
+    def embedded(self, work: _Work, ref: Embedded, child: Child) -> tuple[Container, _Source]:
+        here = work.source
+        found = here.analysis.behaviours.get(ref.cls)
+        if ref.cls in here.analysis.behaviours:
+            if found is None:
+                raise UnsupportedError(
+                    f"embedded behaviour '{ref.cls}': its create() does not "
+                    "return a state machine fsmbt can read",
+                    location=self.loc(here, child.line),
+                )
+            return found, here
+        if here.path is None:
+            raise UnsupportedError(
+                f"embedded behaviour '{ref.cls}' is defined in another file; read this "
+                "behaviour from its file so the embedded one can be found beside it",
+                location=self.loc(here, child.line),
+            )
+        folder = here.path.parent
+        module_file = folder / f"{ref.module.rsplit('.', 1)[-1]}.py" if ref.module else None
+        if module_file is not None:
+            note_read(module_file)  # a dependency even when it is missing
+        candidates = [module_file] if module_file is not None and module_file.is_file() else []
+        if not candidates:
+            marker = f"class {ref.cls}("
+            note_read(folder)  # the class may be defined in a file added later
+            for path in sorted(folder.glob("*.py")):
+                try:
+                    if (
+                        path.stat().st_size <= limits.current().max_input_bytes
+                        and marker in read_bounded(path).decode("utf-8", errors="replace")
+                    ):
+                        candidates.append(path)
+                        break
+                except (OSError, InputError):  # unreadable, or not a regular file: not it
+                    continue
+        if not candidates:
+            expected = module_file or folder / "<module>.py"
+            raise UnsupportedError(
+                f"embedded behaviour '{ref.cls}' not found: expected its file {expected} "
+                "beside this one (FlexBE behaviours embed others by class; give the embedded "
+                "behaviour's file in the same folder)",
+                location=self.loc(here, child.line),
+            )
+        path = candidates[0].resolve()
+        if str(path) in work.chain or path == (
+            self.main.path.resolve() if self.main.path else None
+        ):
+            raise InputError(
+                f"embedded behaviour '{ref.cls}' ({path.name}) embeds itself "
+                "(directly or through others)",
+                location=self.loc(here, child.line),
+            )
+        source = self.load(path)
+        root = source.analysis.behaviours.get(ref.cls)
+        if root is None:
+            raise UnsupportedError(
+                f"embedded behaviour '{ref.cls}': {path.name} has no "
+                f"Behavior class '{ref.cls}' whose create() returns a state "
+                "machine",
+                location=self.loc(here, child.line),
+            )
+        return root, source
+
+    def load(self, path: Path) -> _Source:
+        if path in self.loaded:
+            return self.loaded[path]
+        text = decode(read_located(path), str(path))
+        tree = parse_source(text, str(path))
+        analysis = analyze(text, tree, str(path))
+        source = _Source(path, str(path), analysis)
+        for line, message in analysis.warnings:
+            self.warn(source, line, message)
+        self.loaded[path] = source
+        return source
+
+    # -- state machines -----------------------------------------------------------------------
+    def machine(self, work: _Work) -> list[_Work]:
+        container, fsm = work.container, work.machine
+        children = container.children
+        if not children:
+            raise InputError(
+                f"container '{container.name}' has no states (SMACH's consistency check fails)",
+                location=self.loc(work.source, container.line),
+            )
+        labels = {c.label for c in children}
+        for outcome in container.outcomes:
+            if outcome in labels:
+                raise UnsupportedError(
+                    f"container outcome '{outcome}' is also a state label in '{container.name}'",
+                    location=self.loc(work.source, container.line),
+                )
+        pending: list[_Work] = []
+        outcomes_of: dict[str, list[str] | None] = {}
+        for child in children:
+            state, outcomes, sub = self.child_state(work, child)
+            fsm.states[state.name] = state
+            outcomes_of[child.label] = outcomes
+            if sub is not None:
+                pending.append(sub)
+        finals = work.source.analysis.extension.get("final_actions")
+        final_actions = finals.get(work.path, {}) if isinstance(finals, dict) else {}
+        for outcome in container.outcomes:
+            action = final_actions.get(outcome) if isinstance(final_actions, dict) else None
+            fsm.states[outcome] = State(
+                outcome,
+                action=action if isinstance(action, str) else None,
+                final=True,
+                location=self.loc(work.source, container.line),
+            )
+        initial = container.initial or children[0].label
+        if initial not in labels:
+            raise InputError(
+                f"set_initial_state names '{initial}', not a state of '{container.name}'",
+                location=self.loc(work.source, container.initial_line),
+            )
+        fsm.initial = initial
+        transitions = self.linked_transitions(container)
+        reached: set[str] = set()
+        for child, mapping in zip(children, transitions):
+            self.add_transitions(work, child, mapping, outcomes_of[child.label], labels, reached)
+        for outcome in container.outcomes:
+            if outcome not in reached:
+                self.warn(
+                    work.source,
+                    container.line,
+                    f"container '{container.name}' declares outcome '{outcome}' that no "
+                    "transition reaches",
+                )
+        return pending
+
+    def linked_transitions(self, container: Container) -> list[dict[str, str | None]]:
+        """Each child's transitions after Sequence / add_auto linking."""
+        out = [dict(c.transitions) for c in container.children]
+        for index, child in enumerate(container.children[:-1]):
+            following = container.children[index + 1].label
+            if container.kind == "sequence" and container.connector is not None:
+                if out[index].get(container.connector) is None:
+                    out[index][container.connector] = following
+            for connector in child.connectors:
+                out[index][connector] = following
+        return out
+
+    def add_transitions(
+        self,
+        work: _Work,
+        child: Child,
+        mapping: dict[str, str | None],
+        outcomes: list[str] | None,
+        labels: set[str],
+        reached: set[str],
+    ) -> None:
+        container, fsm = work.container, work.machine
+        where = self.loc(work.source, child.line)
+        if outcomes is not None:
+            for outcome in mapping:
+                if outcome not in outcomes:
+                    raise InputError(
+                        f"state '{child.label}' maps outcome '{outcome}' it does "
+                        f"not have (its outcomes: {', '.join(outcomes)}); SMACH "
+                        "raises InvalidTransitionError",
+                        location=where,
+                    )
+            for connector in child.connectors:
+                if connector not in outcomes:
+                    raise InputError(
+                        f"add_auto connector outcome '{connector}' is not an "
+                        f"outcome of '{child.label}'",
+                        location=where,
+                    )
+        every = list(mapping) + [o for o in (outcomes or []) if o not in mapping]
+        composite = not isinstance(child.state, StateRef)
+        for outcome in every:
+            target = mapping.get(outcome)
+            if target is None:
+                if outcome not in container.outcomes:
+                    raise InputError(
+                        f"outcome '{outcome}' of state '{child.label}' is mapped to nothing: no "
+                        f"transition and no container outcome '{outcome}' in "
+                        f"'{container.name}' (SMACH's consistency check fails at run time)",
+                        location=where,
+                    )
+                target = outcome
+            elif target not in labels and target not in container.outcomes:
+                raise InputError(
+                    f"outcome '{outcome}' of state '{child.label}' goes to "
+                    f"'{target}', which is neither a state of '{container.name}' "
+                    "nor one of its outcomes",
+                    location=where,
+                )
+            if target in container.outcomes and target not in labels:
+                reached.add(target)
+            attrs = {"autonomy": child.autonomy[outcome]} if outcome in child.autonomy else {}
+            if composite:
+                fsm.add_transition(
+                    child.label, None, target, exit=outcome, attrs=attrs, location=where
+                )
+            else:
+                fsm.add_transition(child.label, outcome, target, attrs=attrs, location=where)
+
+    # -- concurrence --------------------------------------------------------------------------
+    def concurrence_children(self, work: _Work) -> list[_Work]:
+        """Phase 0 of a concurrence: the machines of its container children, built first."""
+        pending: list[_Work] = []
+        for child in work.container.children:
+            if isinstance(child.state, Container) and child.state.kind == "priority":
+                self.warn(
+                    work.source,
+                    child.line,
+                    f"PriorityContainer '{child.label}' inside a concurrency container: "
+                    "FlexBE pauses its siblings while it runs; read without that "
+                    "priority (siblings may return meanwhile)",
+                )
+            if not isinstance(child.state, StateRef):
+                state, _, sub = self.child_state(work, child)
+                work.child_machines[child.label] = state.regions[0]
+                if sub is not None:
+                    pending.append(sub)
+        return pending
+
+    def child_machine(self, work: _Work, child: Child, what: str, smach: bool) -> FSM:
+        """A child as a flat machine whose final states are its outcomes."""
+        container = work.container
+        if not isinstance(child.state, StateRef):
+            flat = flatten(work.child_machines[child.label])
+            if flat.initial is None or flat.start_name is not None:
+                raise UnsupportedError(
+                    f"{what} child '{child.label}' has no plain initial state",
+                    location=self.loc(work.source, child.line),
+                )
+            return flat
+        known = child.state.outcomes
+        if not smach and child.transitions:
+            known = list(dict.fromkeys([*(known or []), *child.transitions]))
+        if known is None:
+            from_map = [m[child.label] for _, m in container.outcome_map if child.label in m]
+            if not from_map:
+                raise UnsupportedError(
+                    f"outcomes of {what} child '{child.label}' (class {child.state.cls}) are "
+                    "unknown: its class is not in the file and no outcome map names it",
+                    location=self.loc(work.source, child.line),
+                )
+            known = list(dict.fromkeys(from_map))
+            self.warn(
+                work.source,
+                child.line,
+                f"outcomes of '{child.label}' (class "
+                f"{child.state.cls}, defined elsewhere) read from the outcome map: "
+                f"{', '.join(known)}",
+            )
+        leaf = FSM(name=child.label)
+        leaf.add_state(State(child.label, action=child.state.cls))
+        for outcome in known:
+            leaf.add_state(State(outcome, action=None, final=True))
+            leaf.add_transition(child.label, outcome, outcome)
+        return leaf
+
+    def concurrence(self, work: _Work) -> None:
+        """Phase 1: the product of the children's machines (see the module docstring)."""
+        container, fsm = work.container, work.machine
+        smach = container.kind == "concurrence"
+        what = "Concurrence" if smach else "ConcurrencyContainer"
+        where = self.loc(work.source, container.line)
+        if not container.children:
+            raise InputError(f"{what} '{container.name}' has no states", location=where)
+        labels = [c.label for c in container.children]
+        machines = [self.child_machine(work, c, what, smach) for c in container.children]
+        leaves = all(isinstance(c.state, StateRef) for c in container.children)
+        outcomes = [[s.name for s in m.states.values() if s.final] for m in machines]
+        self.check_outcome_map(work, what, labels, outcomes)
+        for outcome in container.outcomes:
+            fsm.states[outcome] = State(outcome, action=None, final=True, location=where)
+        shared = _shares_outcomes([m.events() for m in machines])
+        tables = [m.transition_map() for m in machines]
+        start_positions = tuple((False, str(m.initial)) for m in machines)
+        start_action = (
+            "+".join(
+                a for a in (m.states[str(m.initial)].action for m in machines) if a is not None
+            )
+            or None
+        )
+        names: dict[Key, str] = {}
+        queue: deque[Key] = deque()
+
+        def part(label: str, position: Position, machine: FSM) -> str:
+            done, name = position
+            if done:
+                return f"{label}={name}"
+            return label if name == machine.initial and name == label else f"{label}:{name}"
+
+        def visit(key: Key) -> str:
+            if key not in names:
+                if len(names) >= MAX_PRODUCT_STATES:
+                    raise UnsupportedError(
+                        f"{what} '{container.name}' has more than "
+                        f"{MAX_PRODUCT_STATES} combinations of child states",
+                        location=where,
+                    )
+                positions, action = key
+                name = ",".join(
+                    part(lab, pos, m) for lab, pos, m in zip(labels, positions, machines)
+                )
+                if key != (start_positions, start_action) and (
+                    action is not None or key[0] == start_positions
+                ):  # a child looping back to its first state runs only its own action
+                    name = f"{name} ({action or 'no action'})"
+                if name in fsm.states:
+                    raise UnsupportedError(
+                        f"{what} '{container.name}': state name '{name}' clashes with an outcome",
+                        location=where,
+                    )
+                names[key] = name
+                fsm.states[name] = State(name, action=action, location=where)
+                queue.append(key)
+            return names[key]
+
+        barriers: dict[tuple[int, str], list[tuple[int, str]]] = {}
+        for members in container.sync_groups:
+            parties = [(labels.index(label), state) for label, state in members]
+            for party in parties:
+                barriers[party] = parties
+        fsm.initial = visit((start_positions, start_action))
+        stuck: list[str] = []
+        reached: set[str] = set()
+        while queue:
+            key = queue.popleft()
+            positions = key[0]
+            source = names[key]
+            for index, (done, current) in enumerate(positions):
+                if done:
+                    continue
+                group = barriers.get((index, current))
+                for event, transition in tables[index].get(current, {}).items():
+                    if event is None:
+                        continue
+                    target_state = machines[index].states[transition.target]
+                    action = None if target_state.final else target_state.action
+                    if group is not None:
+                        passed = self.barrier(group, index, positions, tables, machines)
+                        if passed is None:
+                            continue  # not every party has arrived (or another one leads)
+                        after, action = passed
+                    else:
+                        moved: Position = (target_state.final, transition.target)
+                        after = positions[:index] + (moved,) + positions[index + 1 :]
+                    combo = tuple(name if is_done else None for is_done, name in after)
+                    qualified = f"{labels[index]}.{event}" if shared else event
+                    decided = self.decide(container, smach, labels, combo)
+                    if decided is not None:
+                        reached.add(decided)
+                        fsm.add_transition(source, qualified, decided)
+                        continue
+                    target = visit((after, action))
+                    fsm.add_transition(source, qualified, target)
+                    if all(is_done for is_done, _ in after):
+                        stuck.append(target)
+        for name in dict.fromkeys(stuck):
+            self.warn(
+                work.source,
+                container.line,
+                f"{what} '{container.name}': when its children end as '{name}' no "
+                "condition holds, so FlexBE waits there forever",
+            )
+        for outcome in container.outcomes:
+            if outcome not in reached:
+                self.warn(
+                    work.source,
+                    container.line,
+                    f"{what} '{container.name}' declares outcome '{outcome}' that no "
+                    "combination of child outcomes gives",
+                )
+        refs = [c.state for c in container.children if isinstance(c.state, StateRef)]
+        if not leaves:
+            return
+        owner = self.owner_state(work)
+        attrs = owner.attrs if owner is not None else fsm.attrs
+        attrs.update(
+            {
+                A_CONTAINER: container.cls,
+                A_CHILDREN: json.dumps(
+                    [[lab, r.cls, outs] for lab, r, outs in zip(labels, refs, outcomes)]
+                ),
+                A_MAP: json.dumps(container.outcome_map),
+            }
+        )
+        if container.default_outcome is not None:
+            attrs[A_DEFAULT] = container.default_outcome
+
+    def barrier(
+        self,
+        group: list[tuple[int, str]],
+        index: int,
+        positions: tuple[Position, ...],
+        tables: list[dict[str, dict[str | None, Transition]]],
+        machines: list[FSM],
+    ) -> tuple[tuple[Position, ...], str | None] | None:
+        """A YASMIN JoinState barrier: every party leaves at once, when every one has arrived.
+
+        ``group`` lists (child index, join state) of one ``sync_id``; the step is taken from
+        its first party only (one product transition per crossing). ``None`` while a party is
+        elsewhere: a region that ends without reaching its join leaves the others waiting, as
+        YASMIN's ``RegionBarrier`` does (docs/formats/yasmin.md). Returns the positions after
+        the crossing and the actions the parties start (``+``-joined).
+        """
+        if group[0][0] != index:
+            return None
+        moved = list(positions)
+        actions: list[str] = []
+        for child, state in group:
+            if positions[child] != (False, state):
+                return None
+            steps = [t for e, t in tables[child].get(state, {}).items() if e is not None]
+            if not steps:
+                return None
+            target = machines[child].states[steps[0].target]
+            moved[child] = (target.final, target.name)
+            if not target.final and target.action is not None:
+                actions.append(target.action)
+        return tuple(moved), "+".join(actions) or None
+
+    def owner_state(self, work: _Work) -> State | None:
+        return self.owners.get(id(work.machine))
+
+    def decide(
+        self, container: Container, smach: bool, labels: list[str], combo: tuple[str | None, ...]
+    ) -> str | None:
+        """The container outcome once ``combo`` is reached, or ``None`` while it runs on."""
+        done = dict(zip(labels, combo))
+        if smach:
+            if any(o is None for o in combo):
+                return None
+            outcome = container.default_outcome
+            for candidate, required in container.outcome_map:
+                if all(done.get(label) == o for label, o in required.items()):
+                    outcome = candidate  # SMACH lets the last matching entry win
+            return outcome
+        for candidate, required in container.outcome_map:
+            if all(done.get(label) == o for label, o in required.items()):
+                return candidate
+        return None
+
+    def check_outcome_map(
+        self, work: _Work, what: str, labels: list[str], outcomes: list[list[str]]
+    ) -> None:
+        container = work.container
+        where = self.loc(work.source, container.line)
+        if (
+            container.default_outcome is not None
+            and container.default_outcome not in container.outcomes
+        ):
+            raise InputError(
+                f"{what} default_outcome '{container.default_outcome}' is not one "
+                f"of its outcomes ({', '.join(container.outcomes)})",
+                location=where,
+            )
+        by_label = dict(zip(labels, outcomes))
+        for outcome, required in container.outcome_map:
+            if outcome not in container.outcomes:
+                raise InputError(
+                    f"{what} maps to '{outcome}', not one of its outcomes "
+                    f"({', '.join(container.outcomes)})",
+                    location=where,
+                )
+            for label, child_outcome in required.items():
+                if label not in by_label:
+                    raise InputError(
+                        f"{what} outcome map names '{label}', not a child "
+                        f"({', '.join(labels)}); SMACH fails at run time",
+                        location=where,
+                    )
+                if child_outcome not in by_label[label]:
+                    self.warn(
+                        work.source,
+                        container.line,
+                        f"{what} outcome map expects '{label}' to return "
+                        f"'{child_outcome}', which it never does",
+                    )
+
+    # -- iterator -----------------------------------------------------------------------------
+    def iterator(self, work: _Work) -> list[_Work]:
+        container, fsm = work.container, work.machine
+        where = self.loc(work.source, container.line)
+        if not container.children:
+            raise InputError(
+                f"Iterator '{container.name}' has no contained state "
+                "(Iterator.set_contained_state)",
+                location=where,
+            )
+        child = container.children[0]
+        state0, outcomes, _ = self.child_state(work, child)
+        if outcomes is None:
+            raise UnsupportedError(
+                f"outcomes of the Iterator's state '{child.label}' are "
+                "unknown (its class is not in the file)",
+                location=self.loc(work.source, child.line),
+            )
+        if container.break_outcomes:
+            loop = [o for o in outcomes if o not in container.break_outcomes]
+        else:
+            loop = list(container.loop_outcomes)
+        ending = [o for o in outcomes if o not in loop]
+
+        def final_of(outcome: str) -> str:
+            mapped = container.final_outcome_map.get(outcome, outcome)
+            if mapped not in container.outcomes:
+                raise InputError(
+                    f"Iterator '{container.name}' ends with '{mapped}' (from "
+                    f"'{outcome}'), not one of its outcomes",
+                    location=where,
+                )
+            return mapped
+
+        for outcome in container.outcomes:
+            fsm.states[outcome] = State(outcome, action=None, final=True, location=where)
+        exhausted = final_of(container.exhausted_outcome)
+        pending: list[_Work] = []
+        composite = not isinstance(child.state, StateRef)
+        static = container.items is not None and container.items <= MAX_UNROLLED_ITEMS
+
+        def add(source: str, outcome: str, target: str) -> None:
+            if composite:
+                fsm.add_transition(source, None, target, exit=outcome, location=state0.location)
+            else:
+                fsm.add_transition(source, outcome, target, location=state0.location)
+
+        if static:
+            count = container.items or 0
+            copies = (
+                [f"{child.label}#{i + 1}" for i in range(count)] if count != 1 else [child.label]
+            )
+            for index, name in enumerate(copies):
+                state, _, sub = self.child_state(work, child, name)
+                fsm.states[name] = state
+                if sub is not None:
+                    pending.append(sub)
+                following = copies[index + 1] if index + 1 < count else exhausted
+                for outcome in loop:
+                    add(name, outcome, following)
+                for outcome in ending:
+                    add(name, outcome, final_of(outcome))
+            fsm.initial = copies[0] if copies else exhausted
+            return pending
+        state, _, sub = self.child_state(work, child)
+        fsm.states[state.name] = state
+        if sub is not None:
+            pending.append(sub)
+        choice = f"{work.label}.next?"
+        fsm.states[choice] = State(choice, action=None, location=where)
+        for outcome in loop:
+            add(state.name, outcome, choice)
+        for outcome in ending:
+            add(state.name, outcome, final_of(outcome))
+        fsm.add_transition(choice, f"{work.label}.next", state.name, location=where)
+        fsm.add_transition(choice, f"{work.label}.exhausted", exhausted, location=where)
+        fsm.initial = state.name
+        self.warn(
+            work.source,
+            container.line,
+            f"Iterator '{work.label}': its items ({container.items_text or 'it'}) are "
+            "known only at run time; read with their number as an environment choice "
+            f"after each loop outcome (events '{work.label}.next' / "
+            f"'{work.label}.exhausted'; an empty item list is not modelled)",
+        )
+        return pending
+
+
+def _shares_outcomes(outcomes: list[list[str]]) -> bool:
+    seen: set[str] = set()
+    for outs in outcomes:
+        if seen & set(outs):
+            return True
+        seen |= set(outs)
+    return False
+
+
+def build_fsm(
+    text: str,
+    ctx: ReadContext,
+    choose_root: Callable[[Analysis, ReadContext], tuple[Container, str]],
+) -> FSM:
+    """Parse, analyse and build (the shared path of the SMACH and FlexBE readers).
+
+    Args:
+        text: the Python source (never executed).
+        ctx: the read context (file, options, warnings).
+        choose_root: picks the container that is the model, and its name.
+
+    Returns:
+        The hierarchical FSM.
+    """
+    tree = parse_source(text, ctx.display_name)
+    analysis = analyze(text, tree, ctx.display_name)
+    main = _Source(ctx.path.resolve() if ctx.path is not None else None, ctx.display_name, analysis)
+    builder = Builder(ctx, main)
+    for line, message in analysis.warnings:
+        builder.warn(main, line, message)
+    root, name = choose_root(analysis, ctx)
+    extension = analysis.extension
+    if isinstance(extension.get("name"), str):
+        name = str(extension["name"])
+    fsm = builder.build(root, name)
+    start = extension.get("start")
+    if (
+        isinstance(start, dict)
+        and isinstance(start.get("name"), str)
+        and isinstance(start.get("event"), str)
+    ):
+        fsm.start_name, fsm.initial_event = start["name"], start["event"]
+    return fsm
+
+
+def build_records(root: Container, name: str, ctx: ReadContext, analysis: Analysis) -> FSM:
+    """The FSM of container records another reader made (YASMIN XML and Python).
+
+    Args:
+        root: the top container (its children already filled in).
+        name: the machine's name.
+        ctx: the read context (file, warnings).
+        analysis: what the reader found (its warnings are recorded, located in ``ctx``'s file).
+
+    Returns:
+        The hierarchical FSM, built by the same rules as SMACH's (module docstring).
+    """
+    main = _Source(ctx.path.resolve() if ctx.path is not None else None, ctx.display_name, analysis)
+    builder = Builder(ctx, main)
+    for line, message in analysis.warnings:
+        builder.warn(main, line, message)
+    return builder.build(root, name)
+
+
+def build_concurrence(container: Container, name: str) -> FSM:
+    """The product FSM the reader builds from one ``Concurrence`` container, alone (the SMACH
+    writer checks that a region it writes reads back as itself).
+
+    Raises:
+        InputError: the container is refused, as reading it would be.
+    """
+    fsm = FSM(name=name)
+    source = _Source(None, "<check>", Analysis([], {}, {}))
+    Builder(ReadContext(), source).concurrence(_Work(container, fsm, name, source, ()))
+    return fsm

@@ -1,0 +1,1 @@
+"""fsmbt's own schema (docs/formats/json.md), as JSON and as YAML."""

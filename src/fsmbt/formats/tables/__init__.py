@@ -1,0 +1,1 @@
+"""FSMs as transition tables: CSV and Markdown."""

@@ -1,0 +1,101 @@
+"""The pipeline's endpoints: inspect, convert, verify, export, the runtime files. Each parses its
+body (``bodies``) and runs one library call in a worker process (``service``, ``workers``) under
+the server's time limit (docs/web.md)."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from fastapi import APIRouter, Request
+from fastapi.responses import Response
+
+from fsmbt.web import service
+from fsmbt.web.bodies import body_doc, model_body, pair_body
+from fsmbt.web.errors import ApiError
+from fsmbt.web.routes_reference import llm_engines
+from fsmbt.web.schemas import ConvertRequest, ExportRequest, ModelText, VerifyRequest
+from fsmbt.web.workers import Busy, WorkerCrashed, WorkTimeout
+
+router = APIRouter()
+
+
+async def work(request: Request, function: Any, argument: Any) -> Any:
+    """``function(argument)`` in a worker; its refusal as a 400, time and load limits as 503."""
+    timeout_s = request.app.state.settings.timeout_s
+    try:
+        status, value = await request.app.state.workers.run(function, argument)
+    except WorkTimeout:
+        raise ApiError(
+            503,
+            f"took longer than {timeout_s:g} s, the page's limit; "
+            "the model is too large for the page: use the command line "
+            "(fsmbt convert / fsmbt verify)",
+        ) from None
+    except Busy:
+        raise ApiError(
+            503, "the server is busy (too many requests waiting); try again shortly"
+        ) from None
+    except WorkerCrashed:
+        raise ApiError(500, "internal error (logged on the server)") from None
+    if status == "error":
+        raise ApiError(400, value["error"], value["where"])
+    return value
+
+
+@router.post(
+    "/api/inspect", summary="Read and validate one model", openapi_extra=body_doc(ModelText)
+)
+async def inspect(request: Request) -> Any:
+    body = await model_body(request)
+    return await work(request, service.inspect, body)
+
+
+@router.post(
+    "/api/convert",
+    summary="Convert a model, verify the result, draw both",
+    openapi_extra=body_doc(ConvertRequest),
+)
+async def convert(request: Request) -> Any:
+    body = await model_body(request)
+    engine = str(body.get("engine") or "rules")
+    if engine not in service.PLAIN_ENGINES and engine not in llm_engines():
+        known = ", ".join([*service.PLAIN_ENGINES, *llm_engines()])
+        raise ApiError(400, f"engine '{engine}' is not offered here (offered: {known})", "engine")
+    return await work(request, service.convert, body)
+
+
+@router.post(
+    "/api/verify",
+    summary="Check two models against each other",
+    openapi_extra=body_doc(VerifyRequest),
+)
+async def verify(request: Request) -> Any:
+    body = await pair_body(request)
+    return await work(request, service.verify, body)
+
+
+@router.post(
+    "/api/export",
+    summary="A model in another format (download)",
+    openapi_extra=body_doc(ExportRequest),
+)
+async def export(request: Request) -> Response:
+    body = await model_body(request)
+    data, name, media = await work(request, service.export, body)
+    return Response(
+        data,
+        media_type=media,
+        headers={"content-disposition": f'attachment; filename="{name}"'},
+    )
+
+
+@router.get("/api/runtime/{kind}", summary="The runtime files (zip) for converted trees")
+async def runtime(request: Request, kind: str) -> Response:
+    if kind not in ("cpp", "python"):
+        raise ApiError(404, f"no runtime '{kind}' (cpp or python)", "kind")
+    data, name = await work(request, service.runtime_zip, kind)
+    return Response(
+        data,
+        media_type="application/zip",
+        headers={"content-disposition": f'attachment; filename="{name}"'},
+    )
