@@ -5,22 +5,3 @@ The notation behaviour-model studies publish their extracted machines in; state-
 it to and from fsmbt's hierarchical FSM. Detected by the ``.smcat`` extension only (the text has
 no marker a sniffer could trust).
 """
-
-from __future__ import annotations
-
-from fsmbt.formats.registry import Format, register
-from fsmbt.formats.smcat.model import read_smcat, write_smcat
-
-register(
-    Format(
-        "smcat",
-        (".smcat",),
-        frozenset({"fsm"}),
-        "state-machine-cat notation (read and write; rendered by the smcat tool)",
-        read_smcat,
-        write_smcat,
-        None,
-        priority=60,
-        cannot_hold="parallel states, guards, history and choice pseudo-states",
-    )
-)
