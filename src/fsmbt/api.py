@@ -60,9 +60,10 @@ from fsmbt.model.fsm import FSM
 from fsmbt.model.validate import Issue
 from fsmbt.semantics.blockers import Blocker
 from fsmbt.semantics.blockers import conversion_blockers as blockers_of
+from fsmbt.semantics.outcome_rules import OutcomeRules
 from fsmbt.verify import Report, verify
 from fsmbt.verify.native import StateLimitError
-from fsmbt.verify.orient import orient, rules_text
+from fsmbt.verify.orient import OUTCOME_RULE, orient, rules_text
 from fsmbt.verify.wording import readable
 
 Model = FSM | BTDocument
@@ -72,6 +73,9 @@ DEFAULT_FSM_FORMAT = "scxml"  # BT -> FSM: nested states survive
 DEFAULT_BT_FORMAT = "btcpp"  # FSM -> BT: BehaviorTree.CPP v4 XML with TreeNodesModel
 #: Engines that ask a language model (they read prose and pictures through LLM extraction).
 LLM_ENGINES = ("llm", "nllm", "hybrid")
+#: Formats whose events are the states' outcomes (docs/semantics.md §11): ``--style auto``
+#: gives their machines the structured tree.
+OUTCOME_FORMATS = ("smach", "flexbe", "yasmin")
 
 #: The verdict words every layer prints and stores.
 EQUIVALENT = "EQUIVALENT"
@@ -315,7 +319,7 @@ def convert_model(
     model: Model,
     engine: str = "rules",
     *,
-    style: str = "paper",
+    style: str = "auto",
     loop: bool = False,
     hierarchy: str | None = None,
     **options: object,
@@ -325,7 +329,8 @@ def convert_model(
     Args:
         model: the source model; its kind decides the direction.
         engine: the engine's name (``rules``, ``bsd``, ``chds``, ``llm``, ...).
-        style: the output structure style the engine offers (``paper`` by default).
+        style: the output structure style: ``auto`` (default: ``structured`` for an
+            outcome-driven machine, else ``lebt``), ``structured``, ``lebt`` (``paper``).
         loop: BT -> FSM: the root is ticked again after it returns.
         hierarchy: FSM -> BT with ``rules``: ``subtrees`` (one SubTree per composite state) or
             ``flatten``; ``None`` leaves the engine's default.
@@ -378,6 +383,8 @@ def verify_models(
     *,
     loop: bool = False,
     max_states: int | None = None,
+    outcomes: str | None = None,
+    outcome_driven: bool = False,
 ) -> Report:
     """Check that ``result`` behaves exactly like ``source`` (the five properties).
 
@@ -388,6 +395,9 @@ def verify_models(
         loop: the BT side's root is ticked again after it returns.
         max_states: the native checker's state limit (``None``: ``fsmbt.limits.current()``'s
             ``checker_max_states``).
+        outcomes: an FSM and its structured tree: the outcome rules (``"arrived=success"``,
+            docs/semantics.md §11); ``None``: the default names.
+        outcome_driven: the FSM's events are outcomes (a SMACH/FlexBE/YASMIN source).
 
     Returns:
         The ``Report``: verdict, five properties, shortest counterexamples.
@@ -396,7 +406,15 @@ def verify_models(
         EngineDisagreement: ``both`` and the engines disagree (a bug in one of them).
         InputError, UnsupportedError: the pair cannot be compared.
     """
-    report = verify(source, result, engine=engine, loop=loop, max_states=checker_limit(max_states))
+    report = verify(
+        source,
+        result,
+        engine=engine,
+        loop=loop,
+        max_states=checker_limit(max_states),
+        outcomes=OutcomeRules.from_option(outcomes),
+        outcome_driven=outcome_driven,
+    )
     _name_abstractions(report, source, result)
     return readable(report, source, result)
 
@@ -406,7 +424,7 @@ def _name_abstractions(report: Report, *models: Model) -> None:
     under (docs/semantics.md §10): the verdict holds under them, and says so."""
     from fsmbt.semantics.nodes import abstractions_used
 
-    found: dict[str, None] = {}
+    found: dict[str, None] = dict.fromkeys(report.stats.get("abstractions", []))
     for model in models:
         for sentence in abstractions_used(model):
             found.setdefault(sentence, None)
@@ -421,6 +439,7 @@ def verify_either_order(
     *,
     loop: bool = False,
     max_states: int | None = None,
+    outcome_driven: bool = False,
 ) -> Report:
     """Like ``verify_models``, for two models given in either order.
 
@@ -435,10 +454,15 @@ def verify_either_order(
         was tried and every rule there is.
         EngineDisagreement: ``both`` and the engines disagree.
     """
-    oriented = orient(first, second)
+    oriented = orient(first, second, outcome_driven=outcome_driven)
     try:
         report = verify_models(
-            oriented.source, oriented.result, engine, loop=loop, max_states=max_states
+            oriented.source,
+            oriented.result,
+            engine,
+            loop=loop,
+            max_states=max_states,
+            outcome_driven=oriented.rule == OUTCOME_RULE,
         )
     except (UnsupportedError, StateLimitError):
         raise  # a construct, or a size or time limit: not a pairing problem
@@ -739,6 +763,10 @@ def convert_loaded(
                 engine_options.setdefault("source_name", str(loaded.path))
         if request.max_states is not None:
             engine_options.setdefault("max_states", request.max_states)
+        if request.engine == "rules" and loaded.format in OUTCOME_FORMATS:
+            engine_options["outcome_driven"] = True  # the format's events are outcomes
+        if request.outcomes:
+            engine_options["outcomes"] = request.outcomes
         conversion = convert_model(
             loaded.model,
             request.engine,
@@ -752,12 +780,15 @@ def convert_loaded(
     report: Report | None = None
     if request.verify:
         with _timed(timings, "verify", on_stage):
+            structured = conversion.stats.get("style") == "structured"
             report = verify_models(
                 loaded.model,
                 conversion.model,
                 request.verify_engine,
                 loop=request.loop,
                 max_states=request.max_states,
+                outcomes=request.outcomes if structured else None,
+                outcome_driven=structured,
             )
     outcome = Outcome(loaded, conversion, report, fmt, text, output=destination)
     if destination is not None and (
@@ -807,12 +838,14 @@ def verify_files(
         _warn_lebt_ports(first)
         _warn_lebt_ports(second)
     with _timed(timings, "verify", on_stage):
+        outcome_driven = first.format in OUTCOME_FORMATS or second.format in OUTCOME_FORMATS
         report = verify_either_order(
             first.model,
             second.model,
             request.engine,
             loop=request.loop,
             max_states=request.max_states,
+            outcome_driven=outcome_driven,
         )
     return first, second, report
 

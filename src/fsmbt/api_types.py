@@ -43,6 +43,7 @@ READER_FIELDS = (
     "machine",
     "behaviour",
     "initial",
+    "strict",
 )
 
 
@@ -98,6 +99,11 @@ class ReadOptions(_Request):
     initial: str | None = Field(
         default=None, description="tables: the initial state (default: the first row's source)"
     )
+    strict: bool = Field(
+        default=False,
+        description="refuse what a reader would otherwise read as an approximation with a "
+        "warning (FlexBE: an embedded behaviour whose file is not found)",
+    )
 
     @field_validator("node_models", "nodes", "abstract", "trees", mode="before")
     @classmethod
@@ -139,7 +145,15 @@ class ConvertRequest(_Request):
     """One conversion: engine, style, output, verification, reading."""
 
     engine: str = Field(default="rules", description="rules, bsd, chds (llm, nllm, hybrid)")
-    style: str = Field(default="paper", description="the engine's output structure style")
+    style: str = Field(
+        default="auto",
+        description="FSM -> BT: auto (structured for outcome-driven machines, else lebt), "
+        "structured, lebt (paper)",
+    )
+    outcomes: str | None = Field(
+        default=None,
+        description="structured style: outcome statuses, e.g. arrived=success,lost=failure",
+    )
     loop: bool = Field(default=False, description="BT -> FSM: the root is ticked again")
     hierarchy: Hierarchy = Field(
         default="subtrees", description="FSM -> BT of an HFSM: subtrees or flatten"
@@ -189,6 +203,8 @@ class ConvertRequest(_Request):
                 read_fields[key] = value
             elif key == "client":
                 fields["llm_client"] = value
+            elif key == "outcomes":
+                fields["outcomes"] = value
             else:
                 engine_options[key] = value
         fields["read"] = read_fields

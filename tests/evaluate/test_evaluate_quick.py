@@ -72,6 +72,14 @@ def test_rules_and_baselines_fully_verified(report: Path) -> None:
             assert row == {"method": row["method"], "group": row["group"], "text": NOT_RUN}
 
 
+def test_structured_is_a_method_of_its_own_on_the_smach_example(report: Path) -> None:
+    tables = json.loads((report / "tables.json").read_text())
+    (row,) = [r for r in tables["accuracy"] if r["method"] == "structured" and r["group"] == "all"]
+    assert row["produced"] >= 1 and row["equivalent"] == row["produced"], row
+    formulas = [f for f in tables["formulas"] if f["method"] == "structured"]
+    assert formulas and all("LEBT, beside" in f["paper_formula"] for f in formulas)
+
+
 def test_elements_within_band_of_formulas(report: Path) -> None:
     rows = json.loads((report / "rows.json").read_text())
     generated_fsm = {r["model"] for r in rows if r["source"] == "generated" and r["kind"] == "fsm"}

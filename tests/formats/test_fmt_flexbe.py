@@ -164,18 +164,37 @@ def test_embedded_behaviour_is_read_from_its_file_beside(tmp_path: Path) -> None
     assert ("Inner", None, "failed", "failed") in edges(model)
 
 
-def test_missing_embedded_behaviour_names_the_file_expected(tmp_path: Path) -> None:
+def test_missing_embedded_behaviour_is_an_opaque_state_or_refused_when_strict(
+    tmp_path: Path,
+) -> None:
     outer = tmp_path / "outer_sm.py"
     outer.write_text(
         behaviour(EMBEDDED, name="OuterSM", imports="from my_behaviors.inner_sm import InnerSM"),
         encoding="utf-8",
     )
-    with pytest.raises(UnsupportedError) as caught:
-        api.load(outer)
-    assert str(tmp_path / "inner_sm.py") in str(caught.value)
+    warnings: list[str] = []
+    loaded = api.load(outer)
+    model = loaded.model
+    warnings.extend(loaded.warnings)
+    inner = model.states["Inner"]
+    assert inner.is_atomic and inner.action == "InnerSM"
+    assert inner.attrs["flexbe.opaque"] == "true"
+    # its outcomes are those its transitions name, each leading where the behaviour says
+    assert {(t.event, t.target) for t in model.transitions if t.source == "Inner"} == {
+        ("finished", "finished"),
+        ("failed", "failed"),
+    }
+    assert any(
+        "embedded behaviour 'InnerSM' not found (module my_behaviors.inner_sm" in w
+        and "opaque state 'Inner'" in w
+        for w in warnings
+    )
+    with pytest.raises(UnsupportedError, match="my_behaviors.inner_sm") as caught:
+        api.load(outer, options={"strict": True})
     assert caught.value.location is not None and caught.value.location.line is not None
-    with pytest.raises(UnsupportedError, match="read this behaviour from its file"):
-        loads(outer.read_text(encoding="utf-8"), "flexbe")
+    warnings = []
+    loads(outer.read_text(encoding="utf-8"), "flexbe", warnings=warnings)
+    assert any("read from a text, not a file" in w for w in warnings)
 
 
 def test_behaviours_embedding_each_other_are_refused(tmp_path: Path) -> None:

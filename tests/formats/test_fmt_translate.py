@@ -94,7 +94,7 @@ def test_smach_concurrence_to_scxml_names_what_scxml_cannot_say(tmp_path: Path) 
     assert 'event="done.state.CON"' in text and 'cond="In(' in text
     assert "ends differently by final state" not in done.stderr
     assert verify(
-        api.load(CORPUS / "fsm" / "smach_tutorials" / "concurrence2.py").model, api.load(out)
+        api.load(CORPUS / "fsm" / "smach_tutorials" / "concurrence2.py").model, api.load(out).model
     ).equivalent
 
 

@@ -100,7 +100,7 @@ def _engine_runs(make, sequences: list[list[str]]) -> list[list[Observation]]:
 def _compare(label: str, fsm: FSM, tmp: Path, driver: Path, tally: Tally) -> None:
     """Convert ``fsm``, run every runtime on the same sequences, record differences."""
     try:
-        result = convert(fsm)
+        result = convert(fsm, style="lebt")  # the LEBT runtimes run LEBTs (SMACH: not structured)
     except InputError as exc:  # UnsupportedError included: e.g. an eventless cycle
         tally.refused.append(f"{label}: {exc}")
         return

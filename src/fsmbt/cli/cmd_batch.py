@@ -240,7 +240,12 @@ def register(app: typer.Typer) -> None:
             help="output format (default: btcpp for a BT result, scxml for an FSM result)",
         ),
         engine: str = typer.Option("rules", "--engine", help="rules, or a registered engine"),
-        style: str = typer.Option("paper", "--style", help="output structure style"),
+        style: str = typer.Option(
+            "auto",
+            "--style",
+            help="FSM->BT: auto (structured for outcome-driven machines, else lebt), "
+            "structured, lebt (paper is lebt)",
+        ),
         loop: bool = typer.Option(
             False,
             "--loop",

@@ -52,7 +52,17 @@ def register(app: typer.Typer) -> None:
             "extension, else btcpp for a BT, scxml for an FSM)",
         ),
         engine: str = typer.Option("rules", "--engine", help="rules, or a registered engine"),
-        style: str = typer.Option("paper", "--style", help="output structure style"),
+        style: str = typer.Option(
+            "auto",
+            "--style",
+            help="FSM->BT: auto (structured for SMACH/FlexBE/YASMIN and machines that declare "
+            "outcomes, else lebt), structured, lebt (paper is lebt)",
+        ),
+        outcomes: str | None = typer.Option(
+            None,
+            "--outcomes",
+            help="structured style: outcome statuses, e.g. arrived=success,lost=failure",
+        ),
         loop: bool = typer.Option(
             False,
             "--loop",
@@ -106,6 +116,7 @@ def register(app: typer.Typer) -> None:
             overwrite=force,
             max_states=max_states,
             keep_not_equivalent=keep_failed,
+            outcomes=outcomes,
             read=read,
             engine_options=engine_options,
         )

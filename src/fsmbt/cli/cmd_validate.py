@@ -60,9 +60,6 @@ def register(app: typer.Typer) -> None:
             "(SARIF 2.1.0, for GitHub code scanning); table (a rich table).",
         ),
         as_json_flag: bool = typer.Option(False, "--json", help="Same as --format json."),
-        strict: bool = typer.Option(
-            False, "--strict", help="Treat warnings (cannot-convert included) as errors."
-        ),
         *,
         read: ReadOptions,
     ) -> None:
@@ -70,6 +67,7 @@ def register(app: typer.Typer) -> None:
         duplicate states, nondeterminism, empty models; warn about unreachable states,
         dead ends not marked final and parts fsmbt cannot convert yet."""
         chosen = OutputFormat.json if as_json_flag else output_format
+        strict = read.strict  # warnings (cannot-convert included) are errors
         loaded = api.load(
             model,
             read.format,

@@ -183,6 +183,16 @@ _READ_PARAMETERS: tuple[tuple[str, Any, Callable[[], Any]], ...] = (
         lambda: typer.Option(None, "--behaviour", help="FlexBE: the Behavior class to read"),
     ),
     (
+        "strict",
+        bool,
+        lambda: typer.Option(
+            False,
+            "--strict",
+            help="refuse what a reader would read as an approximation with a warning (FlexBE: "
+            "an embedded behaviour whose file is not found); validate: warnings are errors",
+        ),
+    ),
+    (
         "initial",
         str | None,
         lambda: typer.Option(
@@ -227,7 +237,7 @@ def reads_models(command: Callable[..., Any]) -> Callable[..., Any]:
         fields: dict[str, Any] = {
             key: [str(v) for v in value] if isinstance(value, list) else value
             for key, value in given.items()
-            if key != "source_format" and value not in (None, [])
+            if key != "source_format" and value not in (None, [], False)
         }
         if isinstance(fields.get("include_root"), Path):
             fields["include_root"] = str(fields["include_root"])

@@ -136,6 +136,8 @@ def conversion_summary(direction: str, stats: Mapping[str, object], engine: str 
     """
     used: set[str] = set()
     parts: list[str] = []
+    if stats.get("style") == "structured":
+        return f"{stats['summary']}; {stats['nodes']} nodes, depth {stats['depth']}"
     if direction == "fsm->bt" and "states" in stats:
         parts = _fsm_to_bt(stats, engine, used)
     elif direction == "bt->fsm" and ("leaves" in stats or "k" in stats):

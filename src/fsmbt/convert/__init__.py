@@ -14,14 +14,14 @@ from fsmbt.model.fsm import FSM
 
 
 def convert(
-    model: FSM | BTDocument, *, engine: str = "rules", style: str = "paper", **options: object
+    model: FSM | BTDocument, *, engine: str = "rules", style: str = "auto", **options: object
 ) -> ConversionResult:
     """Convert an FSM into a BT or a BT into a (hierarchical) FSM with ``engine``.
 
     Args:
         model: The source model; its kind picks the direction.
         engine: A registered engine name (``rules``, ``bsd``, ``chds``, ``llm``, ...).
-        style: The engine's output style (``paper`` for the rules engine).
+        style: The engine's output style (rules engine: ``auto``, ``structured``, ``lebt``/``paper``).
         **options: Passed to the engine (e.g. ``loop=True`` for BT -> FSM,
             ``hierarchy="flatten"`` for FSM -> BT).
 

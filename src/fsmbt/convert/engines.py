@@ -13,13 +13,17 @@ from __future__ import annotations
 
 import importlib
 from dataclasses import dataclass
+from typing import Any
 
 from fsmbt.convert.bt_to_hfsm import bt_to_hfsm
 from fsmbt.convert.hfsm_to_bt import fsm_to_bt
-from fsmbt.convert.result import Converter, Model
+from fsmbt.convert.result import ConversionResult, Converter, Model
+from fsmbt.convert.structured import structured_result
+from fsmbt.convert.structured.style import AUTO, STRUCTURED, check_style, resolve_style
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import InputError, UnsupportedError
 from fsmbt.model.fsm import FSM
+from fsmbt.semantics.outcome_rules import OutcomeRules
 
 
 @dataclass(frozen=True)
@@ -51,14 +55,53 @@ def register_engine(
     return engine
 
 
+def rules_fsm_to_bt(
+    fsm: FSM,
+    *,
+    style: str = AUTO,
+    outcome_driven: bool = False,
+    outcomes: str | None = None,
+    **options: Any,
+) -> ConversionResult:
+    """The rules engine's FSM -> BT: the structured tree for an outcome-driven machine, the
+    LEBT otherwise (``fsmbt.convert.structured.style``: ``auto``, ``structured``, ``lebt``).
+
+    Raises:
+        InputError: an unknown style; OutcomeError: ``structured`` on an event-driven machine,
+        or a malformed outcome-driven one (state and cause named).
+    """
+    rules = OutcomeRules.from_option(outcomes)
+    chosen, view = resolve_style(style, fsm, outcome_driven=outcome_driven, rules=rules)
+    if view is not None:
+        result = structured_result(view)
+        result.engine = "rules"
+        return result
+    result = fsm_to_bt(fsm, style="paper", **options)
+    result.stats.setdefault("style", chosen)
+    return result
+
+
+def rules_bt_to_fsm(doc: BTDocument, *, style: str = AUTO, **options: Any) -> ConversionResult:
+    """The rules engine's BT -> FSM (one style; ``structured`` is an FSM -> BT style)."""
+    if check_style(style) == STRUCTURED:
+        raise InputError(
+            "--style structured converts outcome-driven state machines into behavior trees; "
+            "this input is a behavior tree",
+            element="--style",
+        )
+    return bt_to_hfsm(doc, style="paper", **options)
+
+
 def _register_rules() -> None:
-    """The default engine: LEBT for FSM -> BT (a SubTree per composite state of a hierarchical
-    FSM, option ``hierarchy``), hierarchical conversion units for BT -> FSM."""
+    """The default engine: the structured tree (outcome-driven machines) or the LEBT for
+    FSM -> BT (a SubTree per composite state of a hierarchical FSM, option ``hierarchy``),
+    hierarchical conversion units for BT -> FSM."""
     register_engine(
         "rules",
-        fsm_to_bt,
-        bt_to_hfsm,
-        "the paper's algorithms done exactly (LEBT; depth compression + units)",
+        rules_fsm_to_bt,
+        rules_bt_to_fsm,
+        "the paper's algorithms done exactly (LEBT; depth compression + units), and the "
+        "structured style for outcome-driven machines",
     )
 
 

@@ -17,7 +17,7 @@ from typing import Any, cast
 from fsmbt import api
 from fsmbt.evaluate.dataset import Entry
 from fsmbt.evaluate.paper import PAPER_FORMULAS, PAPER_SLOPES
-from fsmbt.evaluate.plan import NOT_RUN, RULE_ENGINES, Planned
+from fsmbt.evaluate.plan import NOT_RUN, RULE_ENGINES, STRUCTURED, Planned
 from fsmbt.evaluate.stats import fit_slope, wilson
 from fsmbt.metrics import elements
 from fsmbt.metrics.formulas import bsd, chds, hfsm, lebt
@@ -74,7 +74,7 @@ def accuracy(table_rows: list[dict[str, Any]], methods: list[str]) -> list[dict[
                 and r["verifier"] == "native"
                 and (group == "all" or r["group"] == group)
             ]
-            if method not in RULE_ENGINES and not chosen:
+            if method not in (*RULE_ENGINES, STRUCTURED) and not chosen:
                 out.append({"method": method, "group": group, "text": NOT_RUN})
                 continue
             produced = [r for r in chosen if r["status"] in ("equivalent", "not_equivalent")]
@@ -124,7 +124,14 @@ def consistency(
     return out
 
 
+def _paper_method(method: str) -> str:
+    """The paper's method a method is measured beside: the structured style beside the LEBT
+    formula (the paper has none for it)."""
+    return "rules" if method == STRUCTURED else method
+
+
 def _prediction(direction: str, method: str, m: int, k: int, t: int) -> int:
+    method = _paper_method(method)
     if direction == "fsm->bt":
         return {"rules": lebt(m), "bsd": bsd(m), "chds": chds(m, t)}[method]
     return hfsm(m, k) if method != "bsd" else hfsm(m, 0)
@@ -134,7 +141,9 @@ def element_rows(table_rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
     """Graphical and active elements of every produced rule-engine result, with M and k."""
     out = []
     for r in table_rows:
-        if r["method"] not in RULE_ENGINES or r["verifier"] != "native" or not r["output"]:
+        if r["method"] not in (*RULE_ENGINES, STRUCTURED) or r["verifier"] != "native":
+            continue
+        if not r["output"]:
             continue
         if r["status"] not in ("equivalent", "not_equivalent") or not Path(r["output"]).exists():
             continue
@@ -184,8 +193,9 @@ def formula_table(measured: list[dict[str, Any]]) -> list[dict[str, Any]]:
                 "direction": direction,
                 "method": method,
                 "n": len(chosen),
-                "paper_formula": PAPER_FORMULAS[(direction, method)],
-                "paper_slope": PAPER_SLOPES[(direction, method)],
+                "paper_formula": PAPER_FORMULAS[(direction, _paper_method(method))]
+                + (" (LEBT, beside)" if method == STRUCTURED else ""),
+                "paper_slope": PAPER_SLOPES[(direction, _paper_method(method))],
                 "fitted_slope": slope,
                 "slope_error": error,
                 "intercept": intercept,
@@ -215,7 +225,8 @@ def cost(table_rows: list[dict[str, Any]], methods: list[str]) -> list[dict[str,
             and r["status"] in ("equivalent", "not_equivalent")
         ]
         if not chosen:
-            out.append({"method": method, "text": NOT_RUN})
+            text = "no model of its kind" if method == STRUCTURED else NOT_RUN
+            out.append({"method": method, "text": text})
             continue
         convert = sorted(r["timings"].get("convert", 0.0) for r in chosen)
         verify = sorted(r["timings"].get("verify", 0.0) for r in chosen)

@@ -32,6 +32,9 @@ from fsmbt.evaluate.dataset import Entry
 from fsmbt.evaluate.runner import Job
 
 RULE_ENGINES = ("rules", "bsd", "chds")
+#: The rules engine's structured style, a method of its own on outcome-driven machines (the
+#: SMACH/FlexBE/YASMIN files: Python sources); not the paper's, so not in ``RULE_ENGINES``.
+STRUCTURED = "structured"
 LLM_METHODS = ("llm", "nllm")
 #: The SCP modules of each direction (fsmbt.llm.prompts.MODULES), one ablation each.
 ABLATIONS = ("structure_recognition", "lebt_mapping", "depth_compression", "hierarchical_rules")
@@ -75,6 +78,17 @@ def llm_method_names(models: list[str]) -> list[str]:
         names += [f"llm[{model}]", f"nllm[{model}]"]
         names += [f"llm-no-{module}[{model}]" for module in ABLATIONS]
     return names
+
+
+def outcome_driven(entry: Entry) -> bool:
+    """An FSM read from a Python source (SMACH, FlexBE, YASMIN): its events are outcomes."""
+    return entry.kind == "fsm" and entry.path.endswith(".py")
+
+
+def _style(engine: str) -> dict[str, Any]:
+    """``rules`` is the paper's LEBT shape (``--style lebt``) whatever the model: the
+    evaluation measures the paper's method (the structured style is not the paper's)."""
+    return {"style": "lebt"} if engine == "rules" else {}
 
 
 def _job(
@@ -146,11 +160,20 @@ def plan(
     """
     readable = [e for e in entries if e.readable]
     planned = [
-        _job(e, outdir, engine, engine, "native", {}) for engine in RULE_ENGINES for e in entries
+        _job(e, outdir, engine, engine, "native", _style(engine))
+        for engine in RULE_ENGINES
+        for e in entries
+    ]
+    planned += [
+        _job(e, outdir, STRUCTURED, "rules", "native", {"style": STRUCTURED})
+        for e in readable
+        if outcome_driven(e)
     ]
     sample = nusmv_models(readable, seed=seed, count=nusmv_sample)
     planned += [
-        _job(e, outdir, engine, engine, "both", {}) for engine in RULE_ENGINES for e in sample
+        _job(e, outdir, engine, engine, "both", _style(engine))
+        for engine in RULE_ENGINES
+        for e in sample
     ]
     for model in llm_models:
         llm = {"llm_model": model}

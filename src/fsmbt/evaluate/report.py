@@ -41,6 +41,7 @@ from fsmbt.evaluate.plan import (
     NUSMV_MAX_NODES,
     NUSMV_MAX_STATES,
     RULE_ENGINES,
+    STRUCTURED,
     Planned,
     llm_method_names,
 )
@@ -190,14 +191,14 @@ def write_report(
             close()
     table_rows = analysis.rows(planned, stored, entries)
     llm_methods = llm_method_names(llm_models) if llm_models else llm_method_names(["default"])
-    methods = [*RULE_ENGINES, *llm_methods]
+    methods = [*RULE_ENGINES, STRUCTURED, *llm_methods]
     acc = analysis.accuracy(table_rows, methods)
     consistency = analysis.consistency(
         table_rows, [*RULE_ENGINES, *llm_methods[:2]], CONSISTENCY_MODELS
     )
     measured = analysis.element_rows(table_rows)
     formulas = analysis.formula_table(measured)
-    costs = analysis.cost(table_rows, [*RULE_ENGINES, *llm_methods[:2]])
+    costs = analysis.cost(table_rows, [*RULE_ENGINES, STRUCTURED, *llm_methods[:2]])
     nusmv = analysis.nusmv_table(table_rows)
     nusmv_models = analysis.nusmv_sample_rows(table_rows, entries)
     examples = settings.examples or Path("examples")

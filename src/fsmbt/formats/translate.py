@@ -9,7 +9,9 @@ Rules:
   keeps one (SMACH: ``smach_losses``), else every difference between the model and the model
   read back from the written text (states, transitions, attributes, nodes, the BT format
   version ...), ignoring only the order of FSM states and transitions, which no format keeps
-  the same way and no semantics reads.
+  the same way and no semantics reads. The states' annotations (parameters, userdata keys,
+  remappings, positions, autonomy levels: ``fsmbt.formats.annotations``) are named by kind,
+  one line each, with the states that lose them.
 - A loss that changes meaning is an error, not a warning: when the target has a reader, the
   model read back is returned with the model it must equal (``read_back``, ``checked``), and
   ``fsmbt.api.translate`` proves them equivalent before anything is written (not equivalent
@@ -27,6 +29,7 @@ import re
 from dataclasses import dataclass, field
 from typing import Any
 
+from fsmbt.formats.annotations import annotation_losses
 from fsmbt.formats.registry import ReadContext, get_format, loads
 from fsmbt.model import Model
 from fsmbt.model.errors import InputError, UnsupportedError
@@ -92,6 +95,7 @@ def translate(
             f"flattened: {len(written.states)} flat states replace the composite, "
             "parallel and transient states"
         )
+        losses.extend(annotation_losses(model, written, "the flattened machine")[0])
     checked = model  # what the read-back must equal in behaviour (events renamed, if any)
     if target.name == "scxml" and isinstance(written, FSM):
         events = scxml_event_renames(written)
@@ -146,7 +150,9 @@ def translate(
         raise InputError(f"{target.name} read back a different kind of model")
     result.read_back = back
     if own_losses is None:
-        losses.extend(differences_between(written, back))
+        named, written_rest, back_rest = annotation_losses(written, back, target.name)
+        losses.extend(named)
+        losses.extend(differences_between(written_rest, back_rest))
     return result
 
 

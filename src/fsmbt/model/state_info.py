@@ -21,7 +21,7 @@ from __future__ import annotations
 import json
 from collections.abc import Mapping
 
-from fsmbt.model.fsm import State
+from fsmbt.model.fsm import FSM, State
 
 #: The state's class, i.e. its action type (``DetectObject``; ``SimpleActionState``...).
 CLASS = "class"
@@ -44,9 +44,51 @@ ROS_INTERFACE = "ros.interface"
 ROS_KIND = "ros.kind"
 #: The ROS action or service name the state talks to (``/move_base``), when literal.
 ROS_NAME = "ros.name"
+#: JSON object on a composite state (or, for the top machine, ``FSM.attrs``): userdata key ->
+#: the literal text of the value the container sets before it runs (``sm.userdata.home = ...``).
+USERDATA = "userdata.values"
+#: JSON ``[x, y]``: where the FlexBE editor draws the state (``# x:120 y:40`` above its ``add``).
+POSITION = "position"
+#: JSON object on a concurrency composite: child label -> that leaf child's own entries (the
+#: children of a concurrence are not states of the model, which holds their product).
+CHILD_STATES = "children.states"
+
+#: Every key above: the annotations a reader of outcome-driven states adds to ``attrs``
+#: (writers that have no place for them name them as losses, docs/cli.md "translate").
+KEYS = (
+    CLASS,
+    OUTCOMES,
+    PARAMETERS,
+    EXPRESSION_PARAMETERS,
+    INPUT_KEYS,
+    OUTPUT_KEYS,
+    REMAPPING,
+    ROS_INTERFACE,
+    ROS_KIND,
+    ROS_NAME,
+    USERDATA,
+    POSITION,
+    CHILD_STATES,
+)
+#: What each key is, in words, for loss messages.
+DESCRIPTIONS = {
+    CLASS: "state class",
+    OUTCOMES: "declared outcomes",
+    PARAMETERS: "parameters",
+    EXPRESSION_PARAMETERS: "expression parameters",
+    INPUT_KEYS: "input userdata keys",
+    OUTPUT_KEYS: "output userdata keys",
+    REMAPPING: "userdata remappings",
+    ROS_INTERFACE: "ROS interface types",
+    ROS_KIND: "ROS interface kinds",
+    ROS_NAME: "ROS interface names",
+    USERDATA: "userdata initial values",
+    POSITION: "editor positions",
+    CHILD_STATES: "concurrent children's configuration",
+}
 
 
-def _json(state: State, key: str) -> object:
+def _json(state: State | FSM, key: str) -> object:
     text = state.attrs.get(key)
     if text is None:
         return None
@@ -83,13 +125,13 @@ def expression_parameters(state: State) -> list[str]:
     return [str(v) for v in value] if isinstance(value, list) else []
 
 
-def input_keys(state: State) -> list[str]:
+def input_keys(state: State | FSM) -> list[str]:
     """The userdata keys the state reads."""
     value = _json(state, INPUT_KEYS)
     return [str(v) for v in value] if isinstance(value, list) else []
 
 
-def output_keys(state: State) -> list[str]:
+def output_keys(state: State | FSM) -> list[str]:
     """The userdata keys the state writes."""
     value = _json(state, OUTPUT_KEYS)
     return [str(v) for v in value] if isinstance(value, list) else []
@@ -101,6 +143,38 @@ def remapping(state: State) -> dict[str, str]:
     if isinstance(value, dict):
         return {str(k): str(v) for k, v in value.items()}
     return {}
+
+
+def userdata_values(holder: State | FSM) -> dict[str, str]:
+    """Userdata key -> initial value text a container sets (a composite state or the top FSM)."""
+    value = _json(holder, USERDATA)
+    if isinstance(value, dict):
+        return {str(k): str(v) for k, v in value.items()}
+    return {}
+
+
+def position(state: State) -> tuple[int, int] | None:
+    """Where the FlexBE editor drew the state, or ``None``."""
+    value = _json(state, POSITION)
+    if (
+        isinstance(value, list)
+        and len(value) == 2
+        and all(isinstance(v, int) and not isinstance(v, bool) for v in value)
+    ):
+        return value[0], value[1]
+    return None
+
+
+def child_states(state: State) -> dict[str, dict[str, str]]:
+    """A concurrency composite's leaf children: label -> their own ``attrs`` entries."""
+    value = _json(state, CHILD_STATES)
+    if not isinstance(value, dict):
+        return {}
+    return {
+        str(label): {str(k): str(v) for k, v in entries.items()}
+        for label, entries in value.items()
+        if isinstance(entries, dict)
+    }
 
 
 def ros_interface(state: State) -> tuple[str, str, str | None] | None:
@@ -120,8 +194,13 @@ def encode(
     inputs: list[str] | None = None,
     outputs: list[str] | None = None,
     remap: Mapping[str, str] | None = None,
+    userdata: Mapping[str, str] | None = None,
+    at: tuple[int, int] | None = None,
+    ros: tuple[str, str, str | None] | None = None,
 ) -> dict[str, str]:
-    """The ``State.attrs`` entries for what a reader found (fields left ``None`` are omitted)."""
+    """The ``State.attrs`` entries for what a reader found (fields left ``None`` are omitted).
+
+    ``ros`` is ``(kind, interface type, name or None)``; ``at`` the editor position."""
     attrs: dict[str, str] = {}
     if outcomes is not None:
         attrs[OUTCOMES] = json.dumps(list(outcomes))
@@ -135,4 +214,12 @@ def encode(
         attrs[OUTPUT_KEYS] = json.dumps(list(outputs))
     if remap:
         attrs[REMAPPING] = json.dumps(dict(remap))
+    if userdata:
+        attrs[USERDATA] = json.dumps(dict(userdata))
+    if at is not None:
+        attrs[POSITION] = json.dumps([at[0], at[1]])
+    if ros is not None:
+        attrs[ROS_KIND], attrs[ROS_INTERFACE] = ros[0], ros[1]
+        if ros[2] is not None:
+            attrs[ROS_NAME] = ros[2]
     return attrs

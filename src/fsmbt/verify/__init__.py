@@ -9,10 +9,13 @@ verdict differs, since then one of them is wrong.
 from __future__ import annotations
 
 from fsmbt.model.bt import BTDocument
-from fsmbt.model.errors import Hint, InputError
+from fsmbt.model.errors import Hint, InputError, UnsupportedError
 from fsmbt.model.fsm import FSM
 from fsmbt.semantics.machine import FSMLeafMachine
+from fsmbt.semantics.outcome_machine import OutcomeFSMMachine
+from fsmbt.semantics.outcome_rules import OutcomeRules
 from fsmbt.verify.native import DEFAULT_MAX_STATES, Replay, check, replay
+from fsmbt.verify.outcome_pairing import is_outcome_pair, outcome_abstractions
 from fsmbt.verify.pairing import machines_for
 from fsmbt.verify.report import PROPERTIES, PropertyResult, Report, TraceStep
 
@@ -44,6 +47,8 @@ def verify(
     engine: str = "native",
     loop: bool = False,
     max_states: int = DEFAULT_MAX_STATES,
+    outcomes: OutcomeRules | None = None,
+    outcome_driven: bool = False,
 ) -> Report:
     """Check that ``result`` behaves exactly like ``source`` (see ``fsmbt.verify.pairing``).
 
@@ -53,6 +58,8 @@ def verify(
         engine: ``native`` (explicit-state product), ``nusmv``, or ``both`` (must agree).
         loop: BT source: the root is ticked again after it finishes (leaf-execution mode).
         max_states: Bound on the states the native checker explores per machine.
+        outcomes: FSM source, structured BT result: the outcome rules (docs/semantics.md §11).
+        outcome_driven: the FSM's events are outcomes even where no state declares them.
 
     Returns:
         The report: the verdict and the five properties, each with a shortest
@@ -67,10 +74,25 @@ def verify(
     """
     if engine not in ENGINES:
         raise InputError(f"unknown verification engine '{engine}' (known: {', '.join(ENGINES)})")
+    if (
+        engine != "native"
+        and isinstance(source, FSM)
+        and isinstance(result, BTDocument)
+        and is_outcome_pair(source, result, outcome_driven=outcome_driven)
+    ):
+        raise UnsupportedError(
+            "NuSMV does not encode the outcome pairing of a structured tree (its Switch and "
+            "Script blackboard model)",
+            hints=(Hint.NATIVE_VERIFIER,),
+        )
     if engine == "nusmv":
         return _nusmv(source, result, loop)
-    source_machine, result_machine, mode = machines_for(source, result, loop=loop)
+    source_machine, result_machine, mode = machines_for(
+        source, result, loop=loop, outcomes=outcomes, outcome_driven=outcome_driven
+    )
     native = check(source_machine, result_machine, max_states=max_states, mode=mode)
+    if isinstance(source_machine, OutcomeFSMMachine):
+        native.stats["abstractions"] = outcome_abstractions(source_machine.view)
     native.source = _model_name(source, native.source)
     native.result = _model_name(result, native.result)
     if engine == "native":

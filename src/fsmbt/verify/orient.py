@@ -12,6 +12,9 @@ rule                                        when
 FSM ~ loop-execution BT (macro steps)       one side is an FSM, the other a BT whose leaves are
                                             LebtGuard / LebtState
 FSM ~ state-variable BT (macro steps)       the BT's leaves are the baselines' Sv* leaves
+FSM ~ structured BT (outcome execution)     an outcome-driven FSM (its format's events are
+                                            outcomes, or a state declares them) and any other
+                                            BT (docs/semantics.md §11)
 BT ~ FSM (leaf execution)                   any other BT against an FSM: the FSM is read as the
                                             BT's leaf-execution machine
 FSM ~ FSM (macro steps)                     two FSMs, in the given order
@@ -29,16 +32,25 @@ from dataclasses import dataclass
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.fsm import FSM
 from fsmbt.semantics.execution import Flavour, flavour_of
+from fsmbt.verify.outcome_pairing import is_outcome_pair
 
 Model = FSM | BTDocument
 
 LEBT_RULE = "FSM ~ loop-execution BT (macro steps)"
 STATE_VARIABLE_RULE = "FSM ~ state-variable BT (macro steps)"
+OUTCOME_RULE = "FSM ~ structured BT (outcome execution)"
 LEAF_EXECUTION_RULE = "BT ~ FSM (leaf execution)"
 FSM_FSM_RULE = "FSM ~ FSM (macro steps)"
 BT_BT_RULE = "BT ~ BT (leaf execution)"
 #: Every pairing rule, in the order they are tried (named in errors).
-PAIRING_RULES = (LEBT_RULE, STATE_VARIABLE_RULE, LEAF_EXECUTION_RULE, FSM_FSM_RULE, BT_BT_RULE)
+PAIRING_RULES = (
+    LEBT_RULE,
+    STATE_VARIABLE_RULE,
+    OUTCOME_RULE,
+    LEAF_EXECUTION_RULE,
+    FSM_FSM_RULE,
+    BT_BT_RULE,
+)
 
 
 @dataclass(frozen=True)
@@ -68,12 +80,13 @@ def fsm_side_rule(doc: BTDocument) -> str | None:
     return _MACRO_STEP_RULES.get(flavour_of(doc))
 
 
-def orient(first: Model, second: Model) -> Orientation:
+def orient(first: Model, second: Model, *, outcome_driven: bool = False) -> Orientation:
     """Put two models in the order a pairing rule exists for.
 
     Args:
         first: the model given first.
         second: the model given second.
+        outcome_driven: the FSM's events are outcomes (read from SMACH, FlexBE or YASMIN).
 
     Returns:
         The ``Orientation``: source, result, whether they were swapped, and the rule.
@@ -86,11 +99,15 @@ def orient(first: Model, second: Model) -> Orientation:
         rule = fsm_side_rule(second)
         if rule is not None:
             return Orientation(first, second, False, rule)
+        if is_outcome_pair(first, second, outcome_driven=outcome_driven):
+            return Orientation(first, second, False, OUTCOME_RULE)
         return Orientation(second, first, True, LEAF_EXECUTION_RULE)
     assert isinstance(first, BTDocument) and isinstance(second, FSM)
     rule = fsm_side_rule(first)
     if rule is not None:
         return Orientation(second, first, True, rule)
+    if is_outcome_pair(second, first, outcome_driven=outcome_driven):
+        return Orientation(second, first, True, OUTCOME_RULE)
     return Orientation(first, second, False, LEAF_EXECUTION_RULE)
 
 

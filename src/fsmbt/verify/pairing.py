@@ -4,6 +4,8 @@
   the LEBT protocol (docs/semantics.md); inputs are events (the FSM's, then any the LEBT's guards name).
 - BT source, FSM result (leaf execution): the BT's leaf-execution machine against the FSM read as
   one (``FSMLeafMachine``): a state is the leaf about to be ticked, inputs are leaf outcomes.
+- FSM source, structured BT result (outcome execution): both leaf-execution machines over the
+  source states' outcomes (``fsmbt.verify.outcome_pairing``, docs/semantics.md §11).
 - FSM vs FSM: both macro-step machines over the union of their events.
 - BT vs BT: both leaf-execution machines.
 """
@@ -19,10 +21,9 @@ from fsmbt.model.fsm import FSM
 from fsmbt.semantics.execution import Flavour, flavour_of, leaf_machine
 from fsmbt.semantics.lebt.machine import LEBTMachine
 from fsmbt.semantics.lebt.spec import GUARD_TYPE, GuardSpec
-from fsmbt.semantics.machine import (
-    FSMMachine,
-    Machine,
-)
+from fsmbt.semantics.machine import FSMMachine, Machine
+from fsmbt.semantics.outcome_rules import OutcomeRules
+from fsmbt.verify.outcome_pairing import is_outcome_pair, outcome_machines
 
 MACRO_STEP = "macro-step"
 LEAF_EXECUTION = "leaf-execution"
@@ -107,8 +108,15 @@ def machines_for(
     *,
     loop: bool = False,
     faithful: bool = False,
+    outcomes: OutcomeRules | None = None,
+    outcome_driven: bool = False,
 ) -> tuple[Machine[Any], Machine[Any], str]:
     """The (source machine, result machine, mode) for a pair of models.
+
+    An outcome-driven FSM and a tree without LEBT or state-variable leaves (a structured
+    conversion) are compared by the outcome pairing (``fsmbt.verify.outcome_pairing``) under
+    ``outcomes`` (the outcome rules; ``None``: the defaults); ``outcome_driven`` says the FSM's
+    events are outcomes although no state declares them (a SMACH/FlexBE/YASMIN file).
 
     ``faithful``: BT sides in leaf-execution mode use the faithful interpreter
     (``LeafMachine(generic=True)``) instead of the static table or canonical states, whose
@@ -127,6 +135,8 @@ def machines_for(
 
         if flavour_of(result) is Flavour.STATE_VARIABLE:  # the baselines' leaves (BSD, CHDS)
             return (*machines_for_state_variable(source, result), MACRO_STEP)
+        if is_outcome_pair(source, result, outcome_driven=outcome_driven):
+            return outcome_machines(source, result, outcomes)
 
         source_machine = FSMMachine(source)
         alphabet = _union(source_machine.alphabet, lebt_guard_events(result))

@@ -8,6 +8,7 @@ import json
 from typing import Any
 
 from fastapi import Request
+from pydantic import BaseModel, ValidationError
 
 from fsmbt.web.errors import ApiError, TooLarge
 
@@ -70,8 +71,28 @@ def _content_type(request: Request) -> str:
     return request.headers.get("content-type", "").split(";")[0].strip().lower()
 
 
-async def model_body(request: Request) -> dict[str, Any]:
-    """One model from JSON or multipart (field ``file``, or ``text``; ``options`` as JSON)."""
+def parsed(body: dict[str, Any], schema: type[BaseModel]) -> dict[str, Any]:
+    """``body`` parsed by its schema (``fsmbt.web.schemas``): the schema is the validation; the
+    first problem is a 400 naming the field. Returns the validated fields (defaults filled)."""
+    try:
+        return schema.model_validate(body).model_dump()
+    except ValidationError as error:
+        problem = error.errors()[0]
+        field = ".".join(str(step) for step in problem.get("loc", ()))
+        if problem.get("type") == "string_type":
+            message = f"'{field}' must be a string"
+        elif problem.get("type") in ("model_type", "dict_type"):
+            message = f"'{field}' must be an object"
+        elif problem.get("type") == "missing":
+            message = f"'{field}' is missing"
+        else:
+            message = f"'{field}': {problem.get('msg', 'invalid')}"
+        raise ApiError(400, message, field or None) from None
+
+
+async def model_body(request: Request, schema: type[BaseModel]) -> dict[str, Any]:
+    """One model from JSON or multipart (field ``file``, or ``text``; ``options`` as JSON),
+    parsed by ``schema``."""
     kind = _content_type(request)
     if kind == "application/json":
         body = _json_object(await request.body())
@@ -97,10 +118,10 @@ async def model_body(request: Request) -> dict[str, Any]:
             "application/json or multipart/form-data",
         )
     _check_fields(body)
-    return body
+    return parsed(body, schema)
 
 
-async def pair_body(request: Request) -> dict[str, Any]:
+async def pair_body(request: Request, schema: type[BaseModel]) -> dict[str, Any]:
     """Two models from JSON (``first``, ``second``) or multipart (files ``first``, ``second``)."""
     kind = _content_type(request)
     if kind == "application/json":
@@ -126,22 +147,21 @@ async def pair_body(request: Request) -> dict[str, Any]:
     for side in ("first", "second"):
         if isinstance(body.get(side), dict):
             _check_fields(body[side], prefix=f"{side}.")
-    return body
+    if not (isinstance(body.get("first"), dict) and isinstance(body.get("second"), dict)):
+        return body  # the service names the missing model ("two models")
+    return parsed(body, schema)
 
 
 def _check_fields(body: dict[str, Any], prefix: str = "") -> None:
-    """Types of the fields a model request has; a file name is a name, never a path."""
-    for key in ("text", "filename", "format", "engine", "to", "name"):
-        value = body.get(key)
-        if value is not None and not isinstance(value, str):
-            raise ApiError(400, f"'{prefix}{key}' must be a string", prefix + key)
+    """A file name is a name, never a path (the types are the schema's: ``parsed``)."""
     name = body.get("filename")
-    if name and ("/" in name or "\\" in name or name in (".", "..") or "\x00" in name):
+    if (
+        isinstance(name, str)
+        and name
+        and ("/" in name or "\\" in name or name in (".", "..") or "\x00" in name)
+    ):
         raise ApiError(
             400,
             "'filename' must be a file name, not a path (the server reads no files; send the text)",
             prefix + "filename",
         )
-    options = body.get("options")
-    if options is not None and not isinstance(options, dict):
-        raise ApiError(400, f"'{prefix}options' must be an object", prefix + "options")

@@ -13,7 +13,7 @@ from fsmbt.web import service
 from fsmbt.web.bodies import body_doc, model_body, pair_body
 from fsmbt.web.errors import ApiError
 from fsmbt.web.routes_reference import llm_engines
-from fsmbt.web.schemas import ConvertRequest, ExportRequest, ModelText, VerifyRequest
+from fsmbt.web.schemas import ConvertBody, ExportBody, ModelText, VerifyBody
 from fsmbt.web.workers import Busy, WorkerCrashed, WorkTimeout
 
 router = APIRouter()
@@ -46,17 +46,17 @@ async def work(request: Request, function: Any, argument: Any) -> Any:
     "/api/inspect", summary="Read and validate one model", openapi_extra=body_doc(ModelText)
 )
 async def inspect(request: Request) -> Any:
-    body = await model_body(request)
+    body = await model_body(request, ModelText)
     return await work(request, service.inspect, body)
 
 
 @router.post(
     "/api/convert",
     summary="Convert a model, verify the result, draw both",
-    openapi_extra=body_doc(ConvertRequest),
+    openapi_extra=body_doc(ConvertBody),
 )
 async def convert(request: Request) -> Any:
-    body = await model_body(request)
+    body = await model_body(request, ConvertBody)
     engine = str(body.get("engine") or "rules")
     if engine not in service.PLAIN_ENGINES and engine not in llm_engines():
         known = ", ".join([*service.PLAIN_ENGINES, *llm_engines()])
@@ -67,20 +67,20 @@ async def convert(request: Request) -> Any:
 @router.post(
     "/api/verify",
     summary="Check two models against each other",
-    openapi_extra=body_doc(VerifyRequest),
+    openapi_extra=body_doc(VerifyBody),
 )
 async def verify(request: Request) -> Any:
-    body = await pair_body(request)
+    body = await pair_body(request, VerifyBody)
     return await work(request, service.verify, body)
 
 
 @router.post(
     "/api/export",
     summary="A model in another format (download)",
-    openapi_extra=body_doc(ExportRequest),
+    openapi_extra=body_doc(ExportBody),
 )
 async def export(request: Request) -> Response:
-    body = await model_body(request)
+    body = await model_body(request, ExportBody)
     data, name, media = await work(request, service.export, body)
     return Response(
         data,

@@ -41,6 +41,7 @@ async def get_engines() -> dict[str, Any]:
     return {
         "engines": list(service.PLAIN_ENGINES) + llm_engines(),
         "hierarchies": list(service.HIERARCHIES),
+        "styles": list(service.STYLES),
         "runtimes": service.runtime_kinds(),
     }
 

@@ -1,16 +1,21 @@
-"""The request bodies of the JSON API, for the OpenAPI page (``/docs``).
+"""The request bodies of the JSON API: their validation and their OpenAPI text (``/docs``).
 
-The routes read bodies by hand (the same fields come as JSON or as a multipart upload), so these
-models document the fields; ``fsmbt.web.app`` checks the types of what arrives.
+The routes read a body as JSON or as a multipart upload (``fsmbt.web.bodies``) and parse it into
+one of these models, which *are* the validation: a field of the wrong type is a 400 naming it.
+The pipeline options then become the library's typed request (``fsmbt.api_types``) in
+``fsmbt.web.service``, so the web page converts with the same options, checked the same way,
+as the command line.
 """
 
 from __future__ import annotations
 
-from pydantic import BaseModel, Field
+from pydantic import BaseModel, ConfigDict, Field
 
 
 class ModelText(BaseModel):
     """One model as text."""
+
+    model_config = ConfigDict(extra="ignore")
 
     text: str = Field(description="the model's text (multipart: the uploaded `file`)")
     filename: str | None = Field(default=None, description="a file name, for format detection only")
@@ -20,13 +25,20 @@ class ModelText(BaseModel):
 class Options(BaseModel):
     """Conversion options."""
 
+    model_config = ConfigDict(extra="ignore")
+
     loop: bool = Field(
         default=False, description="BT -> FSM: the root is ticked again after it returns"
     )
     hierarchy: str = Field(default="subtrees", description="FSM -> BT: `subtrees` or `flatten`")
+    style: str = Field(
+        default="auto",
+        description="FSM -> BT: `auto` (structured for outcome-driven machines, else lebt), "
+        "`structured` or `lebt`",
+    )
 
 
-class ConvertRequest(ModelText):
+class ConvertBody(ModelText):
     """A conversion."""
 
     engine: str = Field(
@@ -36,15 +48,17 @@ class ConvertRequest(ModelText):
     to: str | None = Field(default=None, description="the result's format (default: btcpp / scxml)")
 
 
-class VerifyRequest(BaseModel):
+class VerifyBody(BaseModel):
     """Two models to compare, in either order."""
+
+    model_config = ConfigDict(extra="ignore")
 
     first: ModelText
     second: ModelText
     options: Options = Options()
 
 
-class ExportRequest(ModelText):
+class ExportBody(ModelText):
     """A model to download in another format."""
 
     to: str = Field(description="a format name from /api/formats (svg and png: pictures)")

@@ -37,6 +37,8 @@ from fsmbt.verify.report import Report
 PLAIN_ENGINES = ("rules", "bsd", "chds")
 #: The options a request may set (nothing else reaches an engine: no endpoint, no key).
 HIERARCHIES = ("subtrees", "flatten")
+#: FSM -> BT styles (docs/conversion.md, "Styles"; ``paper`` is ``lebt``).
+STYLES = ("auto", "structured", "lebt")
 #: Download formats besides the registry's writers: pictures through Graphviz.
 PICTURE_FORMATS = ("svg", "png")
 #: The file name ending of each download format.
@@ -230,7 +232,7 @@ def convert(request: dict[str, Any]) -> dict[str, Any]:
     """Convert one model, verify the result, draw both.
 
     Args:
-        request: ``{"text", "filename"?, "format"?, "engine", "options": {"loop", "hierarchy"},
+        request: ``{"text", "filename"?, "format"?, "engine", "options": {"loop", "hierarchy", "style"},
             "to"?}``.
 
     Returns:
@@ -244,16 +246,19 @@ def convert(request: dict[str, Any]) -> dict[str, Any]:
     """
     loaded = _load(request)
     options = request.get("options") or {}
-    loop = bool(options.get("loop", False))
     hierarchy = str(options.get("hierarchy") or "subtrees")
     if hierarchy not in HIERARCHIES:
         raise InputError(
             f"unknown hierarchy option '{hierarchy}' (one of: {', '.join(HIERARCHIES)})"
         )
-    to = request.get("to") or None
-    outcome = api.convert_loaded(
-        loaded, to=to, engine=str(request.get("engine") or "rules"), loop=loop, hierarchy=hierarchy
-    )
+    fields: dict[str, Any] = {
+        "engine": str(request.get("engine") or "rules"),
+        "to": request.get("to") or None,
+        "loop": bool(options.get("loop", False)),
+        "hierarchy": hierarchy,
+        "style": str(options.get("style") or "auto"),
+    }
+    outcome = api.convert_loaded(loaded, None, api.convert_request(**fields))
     report = outcome.report
     pictures = {"source": _picture(loaded.model), "result": _picture(outcome.result)}
     kind = api.model_kind(outcome.result)
@@ -268,6 +273,8 @@ def convert(request: dict[str, Any]) -> dict[str, Any]:
         "mode": report.mode if report is not None else None,
         "counterexample": _steps(report, loaded.model, outcome.result) if report else None,
         "warnings": outcome.warnings,
+        "style": outcome.conversion.stats.get("style"),
+        "summary": outcome.conversion.stats.get("summary"),
         "issues": _issues(loaded),
         "metrics": {"source": _metrics(loaded.model), "result": _metrics(outcome.result)},
         "svg": {"source": pictures["source"]["svg"], "result": pictures["result"]["svg"]},

@@ -13,7 +13,12 @@ What is understood (docs/formats/smach.md, docs/formats/flexbe.md):
   ``CBState`` (outcomes from ``@cb_interface``), a container, or a FlexBE
   ``self.use_behavior(Class, ...)`` (an embedded behaviour);
 - literal values (labels, outcome lists, transition dicts) may come through names bound to
-  literals earlier in the same function or module.
+  literals earlier in the same function or module;
+- what a state is configured with (``fsmbt.formats.pysm.params``: constructor arguments,
+  the userdata keys its class declares - in the file, or through ``resolver`` in the file its
+  import names -, the ROS interface of SMACH's generic states), the ``remapping=`` and the
+  FlexBE editor's ``# x:.. y:..`` position of each ``add``, a container's keys and its
+  ``c.userdata.k = v`` values: kept as annotations, never deciding which states exist.
 Everything else that touches a container - a label or transitions computed at run time, an
 ``add`` in a loop or under a condition, a callback deciding outcomes - is ``UnsupportedError``
 with its line. Statements are walked with an explicit stack; nothing is executed.
@@ -24,9 +29,19 @@ Costs: O(n) in the number of syntax nodes.
 from __future__ import annotations
 
 import ast
+import re
 from collections import ChainMap
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
+from fsmbt.formats.pysm.params import (
+    ClassDecl,
+    Configured,
+    class_declaration,
+    configure,
+    render,
+    string_list,
+)
 from fsmbt.formats.pysm.source import NotStatic, last_name, literal, source_text
 from fsmbt.model.errors import InputError, SourceLocation, UnsupportedError
 
@@ -69,6 +84,9 @@ class StateRef:
     outcomes: list[str] | None
     line: int
     callback: str | None = None
+    opaque_behaviour: bool = False  # an embedded behaviour whose file was not found
+    config: Configured = field(default_factory=Configured)  # parameters, keys, ROS interface
+    declared: list[str] | None = None  # outcomes its class declares (file or package)
 
 
 @dataclass
@@ -90,6 +108,8 @@ class Child:
     line: int
     autonomy: dict[str, str] = field(default_factory=dict)
     connectors: list[str] = field(default_factory=list)  # add_auto
+    remapping: dict[str, str] = field(default_factory=dict)  # the state's key -> container's
+    position: tuple[int, int] | None = None  # FlexBE editor's ``# x:.. y:..`` above the add
 
 
 @dataclass
@@ -120,6 +140,9 @@ class Container:
     contained_line: int | None = None
     blocker: UnsupportedError | None = None  # raised only if this container is read
     labels: set[str] = field(default_factory=set)
+    inputs: list[str] = field(default_factory=list)  # input_keys
+    outputs: list[str] = field(default_factory=list)  # output_keys
+    userdata: dict[str, str] = field(default_factory=dict)  # ``c.userdata.k = v``: k -> text
     # YASMIN OrthogonalState: JoinState barriers, each a list of (region label, state in it)
     sync_groups: list[list[tuple[str, str]]] = field(default_factory=list)
 
@@ -149,13 +172,24 @@ class _Ctx:
     self_container: Container | None
 
 
+#: Finds a state class imported from another module: ``(module path, class name)`` -> what
+#: its ``__init__`` declares, or ``None`` (the builder looks in the ROS package, never runs it).
+ClassResolver = Callable[[str, str], ClassDecl | None]
+_POSITION = re.compile(r"#\s*x:\s*(-?\d+)\s+y:\s*(-?\d+)\s*$")
+
+
 class Analyzer:
     """Walks one module; ``run`` gives the containers it builds."""
 
-    def __init__(self, text: str, tree: ast.Module, name: str) -> None:
+    def __init__(
+        self, text: str, tree: ast.Module, name: str, resolver: ClassResolver | None = None
+    ) -> None:
         self.text = text
         self.tree = tree
         self.name = name
+        self.resolver = resolver
+        self.lines = text.splitlines()
+        self.class_decls: dict[str, ClassDecl] = {}
         self.containers: list[Container] = []
         self.behaviours: dict[str, Container | None] = {}
         self.imports: dict[str, str] = {}
@@ -223,6 +257,7 @@ class Analyzer:
                     self.imports[alias.asname or alias.name.split(".")[0]] = alias.name
             elif isinstance(node, ast.ClassDef):
                 self.class_defs.setdefault(node.name, node)
+                self.class_decls.setdefault(node.name, class_declaration(node))
                 self.class_bases[node.name] = [b for b in (last_name(x) for x in node.bases) if b]
                 outcomes = self.init_outcomes(node)
                 if outcomes is not None:
@@ -403,7 +438,8 @@ class Analyzer:
         if isinstance(stmt, ast.Assign):
             value = self.expression(stmt.value, ctx, stmt)
             for target in stmt.targets:
-                self.bind(target, value, ctx, stmt.value)
+                if not self.userdata_assignment(target, stmt.value, ctx):
+                    self.bind(target, value, ctx, stmt.value)
             return []
         if isinstance(stmt, ast.AnnAssign) and stmt.value is not None:
             self.bind(stmt.target, self.expression(stmt.value, ctx, stmt), ctx, stmt.value)
@@ -436,6 +472,27 @@ class Analyzer:
                 ctx.env[key] = _UNKNOWN  # its value depends on which branch / iteration ran
             return
         ctx.env[key] = value
+
+    def userdata_assignment(self, target: ast.expr, value: ast.expr, ctx: _Ctx) -> bool:
+        """``c.userdata.key = v`` / ``c.userdata['key'] = v`` on a container: the key's initial
+        value (its literal text, or the expression's source) is kept on the container."""
+        if isinstance(target, ast.Attribute):
+            holder, key = target.value, target.attr
+        elif (
+            isinstance(target, ast.Subscript)
+            and isinstance(target.slice, ast.Constant)
+            and isinstance(target.slice.value, str)
+        ):
+            holder, key = target.value, target.slice.value
+        else:
+            return False
+        if not (isinstance(holder, ast.Attribute) and holder.attr == "userdata"):
+            return False
+        container = self.value_of(holder.value, ctx)
+        if not isinstance(container, Container):
+            return False
+        container.userdata[key] = render(value, self.text, lambda n: self.lookup_literal(n, ctx))[0]
+        return True
 
     def lookup(self, name: str, ctx: _Ctx) -> object:
         return ctx.env[name]
@@ -514,6 +571,8 @@ class Analyzer:
         args = self.bind_args(call, _CONSTRUCTOR_PARAMS[self.aliases.get(cls, cls)])
         outcomes = self.string_list(args.get("outcomes"), ctx, call, "the container's outcomes")
         container = Container(self.aliases.get(cls, cls), kind, outcomes, call.lineno)
+        container.inputs = string_list(args.get("input_keys"), None) or []
+        container.outputs = string_list(args.get("output_keys"), None) or []
         if kind == "sequence":
             container.connector = self.string(
                 args.get("connector_outcome"), ctx, call, "the connector outcome"
@@ -818,6 +877,23 @@ class Analyzer:
                 )
             transitions = {str(k): (v if v != "" else None) for k, v in value.items()}
         child = Child(label, state, transitions, call.lineno)
+        remapping = args.get("remapping")
+        if remapping is not None:
+            try:
+                found_map = literal(remapping, lambda n: self.lookup_literal(n, ctx))
+            except NotStatic:
+                found_map = None
+            if isinstance(found_map, dict):
+                child.remapping = {str(k): str(v) for k, v in found_map.items()}
+            elif not (isinstance(remapping, ast.Constant) and remapping.value is None):
+                self.warnings.append(
+                    (
+                        call.lineno,
+                        f"the remapping of '{label}' is computed at run time "
+                        f"('{source_text(self.text, remapping, 60)}'); not read",
+                    )
+                )
+        child.position = self.position_above(call.lineno)
         autonomy = args.get("autonomy")
         if autonomy is not None:
             try:
@@ -841,6 +917,15 @@ class Analyzer:
         container.children.append(child)
         container.labels.add(label)
         return state
+
+    def position_above(self, line: int) -> tuple[int, int] | None:
+        """The FlexBE editor's ``# x:120 y:40`` comment on the line above an ``add``."""
+        index = line - 2
+        if 0 <= index < len(self.lines):
+            match = _POSITION.search(self.lines[index])
+            if match is not None:
+                return int(match.group(1)), int(match.group(2))
+        return None
 
     def set_contained(self, container: Container, call: ast.Call, ctx: _Ctx) -> object:
         if container.kind != "iterator":
@@ -944,7 +1029,49 @@ class Analyzer:
                     elif outcomes is not None:
                         outcomes = list(dict.fromkeys([*outcomes, *extra]))
         display = callback if original == "CBState" and callback else original
-        return StateRef(display, outcomes, call.lineno, callback=callback)
+        decl = self.declaration_of(cls)
+        config = configure(
+            call,
+            original,
+            self.text,
+            lambda n: self.lookup_literal(n, ctx),
+            decl.arguments if decl is not None else None,
+            self.imports,
+        )
+        if decl is not None:
+            config.inputs = list(dict.fromkeys([*(decl.inputs or []), *(config.inputs or [])]))
+            config.outputs = list(dict.fromkeys([*(decl.outputs or []), *(config.outputs or [])]))
+        declared = outcomes
+        if declared is None and decl is not None:
+            declared = decl.outcomes
+        return StateRef(
+            display, outcomes, call.lineno, callback=callback, config=config, declared=declared
+        )
+
+    def declaration_of(self, cls: str) -> ClassDecl | None:
+        """What the state class declares: in this file (through its in-file bases), else in the
+        file its import names (through the resolver), else ``None``."""
+        seen: set[str] = set()
+        current: str | None = cls
+        merged: ClassDecl | None = None
+        while current is not None and current not in seen and current in self.class_decls:
+            seen.add(current)
+            decl = self.class_decls[current]
+            if merged is None:
+                merged = ClassDecl(decl.outcomes, decl.inputs, decl.outputs, list(decl.arguments))
+            else:
+                merged.outcomes = merged.outcomes or decl.outcomes
+                merged.inputs = merged.inputs or decl.inputs
+                merged.outputs = merged.outputs or decl.outputs
+            bases = self.class_bases.get(current, [])
+            current = bases[0] if bases else None
+        if merged is not None:
+            return merged
+        path = self.imports.get(cls)
+        if self.resolver is None or path is None or "." not in path:
+            return None
+        module, _, name = path.rpartition(".")
+        return self.resolver(module, name)
 
     def callback_interface(self, node: ast.expr) -> list[str] | None:
         if isinstance(node, ast.Call) and last_name(node.func) in ("CBInterface", "cb_interface"):
@@ -1042,6 +1169,9 @@ def _static_count(node: ast.expr, lookup) -> int | None:  # type: ignore[no-unty
     return None
 
 
-def analyze(text: str, tree: ast.Module, name: str) -> Analysis:
-    """The containers ``tree`` builds (see the module docstring)."""
-    return Analyzer(text, tree, name).run()
+def analyze(
+    text: str, tree: ast.Module, name: str, resolver: ClassResolver | None = None
+) -> Analysis:
+    """The containers ``tree`` builds (see the module docstring); ``resolver`` finds state
+    classes imported from other files (none: only this file's classes are known)."""
+    return Analyzer(text, tree, name, resolver).run()

@@ -29,8 +29,15 @@ Mapping rules:
   ``MAX_UNROLLED_ITEMS``) is unrolled, one copy of the contained state per item; with items
   computed at run time, the number of items is an environment choice after each loop outcome
   (events ``<label>.next`` / ``<label>.exhausted``), named in a warning.
-- An embedded FlexBE behaviour is read from its own file beside the including one (module
-  name of its import, else any ``*.py`` there defining the class) and nested as a composite.
+- An embedded FlexBE behaviour is read from the file its import names, looked up in its own
+  ROS package (``fsmbt.formats.pysm.find``; docs/formats/flexbe.md "Embedded behaviours"),
+  and nested as a composite; not found, it is one opaque state whose outcomes are those its
+  transitions name (a warning; reader option ``strict`` refuses).
+- ConcurrencyContainer / Concurrence product states get names no other state has
+  (``_product_name``).
+- What each state was configured with (parameters, declared outcomes, userdata keys,
+  remapping, ROS interface, editor position) goes into ``State.attrs`` through
+  ``fsmbt.model.state_info`` (``leaf_info``, ``container_info``); it never changes the machine.
 
 Everything is built with an explicit work stack. Costs: O(S + T) per machine; a concurrence
 costs the product of (1 + outcomes) over its children, capped at ``MAX_PRODUCT_STATES``.
@@ -38,6 +45,7 @@ costs the product of (1 + outcomes) over its children, capped at ``MAX_PRODUCT_S
 
 from __future__ import annotations
 
+import ast
 import json
 from collections import deque
 from collections.abc import Callable
@@ -49,13 +57,17 @@ from fsmbt.formats.pysm.analyze import (
     MAX_UNROLLED_ITEMS,
     Analysis,
     Child,
+    ClassResolver,
     Container,
     Embedded,
     StateRef,
     analyze,
 )
-from fsmbt.formats.pysm.source import parse_source
+from fsmbt.formats.pysm.find import find_module_file
+from fsmbt.formats.pysm.params import ClassDecl, class_declaration
+from fsmbt.formats.pysm.source import parse_python
 from fsmbt.formats.registry import ReadContext, decode
+from fsmbt.model import state_info
 from fsmbt.model.errors import InputError, SourceLocation, UnsupportedError
 from fsmbt.model.files import note_read, read_bounded, read_located
 from fsmbt.model.flatten import flatten
@@ -73,6 +85,8 @@ A_CHILDREN = "smach.children"
 A_MAP = "smach.outcome_map"
 A_DEFAULT = "smach.default_outcome"
 A_BEHAVIOUR = "flexbe.behaviour"
+#: An embedded behaviour whose file was not found, read as one state (docs/formats/flexbe.md).
+A_OPAQUE = "flexbe.opaque"
 
 
 @dataclass
@@ -97,11 +111,49 @@ class _Work:
 
 
 @dataclass
+class ClassFiles:
+    """State classes of other modules, found through imports in the ROS package layout
+    (``fsmbt.formats.pysm.find``) and read statically, each file once."""
+
+    files: dict[Path, dict[str, ClassDecl]] = field(default_factory=dict)
+
+    def resolver(self, importer: Path | None) -> ClassResolver | None:
+        """The class resolver for a file's imports (``None`` for a text with no file)."""
+        if importer is None:
+            return None
+
+        def resolve(module: str, name: str) -> ClassDecl | None:
+            path = find_module_file(importer, module)
+            if path is None:
+                return None
+            return self.classes(path.resolve()).get(name)
+
+        return resolve
+
+    def classes(self, path: Path) -> dict[str, ClassDecl]:
+        """The top-level classes of one module file (empty when it cannot be read)."""
+        if path not in self.files:
+            try:
+                text = decode(read_located(path), str(path))
+                _, tree, _ = parse_python(text, str(path))
+            except InputError:  # a state module fsmbt cannot read: its classes stay unknown
+                self.files[path] = {}
+                return {}
+            self.files[path] = {
+                stmt.name: class_declaration(stmt)
+                for stmt in tree.body
+                if isinstance(stmt, ast.ClassDef)
+            }
+        return self.files[path]
+
+
+@dataclass
 class Builder:
     """Builds the FSM of one root container (and whatever it nests)."""
 
     ctx: ReadContext
     main: _Source
+    classes: ClassFiles = field(default_factory=ClassFiles)
     loaded: dict[Path, _Source] = field(default_factory=dict)
     owners: dict[int, State] = field(default_factory=dict)  # id(region FSM) -> its state
 
@@ -143,6 +195,9 @@ class Builder:
         where = self.loc(work.source, child.line)
         state = child.state
         sub_path = f"{work.path}/{label}" if work.path else label
+        found = self.embedded(work, state, child) if isinstance(state, Embedded) else None
+        if isinstance(state, Embedded) and found is None:
+            state = child.state = self.opaque(work, state, child)
         if isinstance(state, StateRef):
             actions = work.source.analysis.extension.get("actions")
             action: str | None = state.cls
@@ -150,26 +205,47 @@ class Builder:
                 mapped = actions[state.cls]
                 action = mapped if isinstance(mapped, str) else None
             attrs = {A_CLASS: "CBState"} if state.callback else {}
+            if state.opaque_behaviour:
+                attrs = {A_BEHAVIOUR: state.cls, A_OPAQUE: "true"}
+            attrs.update(leaf_info(state, child))
+            undeclared = work.source.analysis.extension.get("undeclared_outcomes")
+            if isinstance(undeclared, list) and sub_path in undeclared:
+                attrs.pop(state_info.OUTCOMES, None)  # stub outcomes fsmbt wrote, not declared
             return (State(label, action=action, attrs=attrs, location=where), state.outcomes, None)
         if isinstance(state, Container):
             region = FSM(name=label)
-            composite = State(label, action=None, regions=[region], location=where)
+            composite = State(
+                label,
+                action=None,
+                regions=[region],
+                location=where,
+                attrs=container_info(state, child),
+            )
             self.owners[id(region)] = composite
             return (
                 composite,
                 list(state.outcomes),
                 _Work(state, region, label, work.source, work.chain, sub_path),
             )
-        root, source = self.embedded(work, state, child)
+        assert found is not None
+        root, source = found
         region = FSM(name=label)
         composite = State(
-            label, action=None, regions=[region], location=where, attrs={A_BEHAVIOUR: state.cls}
+            label,
+            action=None,
+            regions=[region],
+            location=where,
+            attrs={A_BEHAVIOUR: state.cls, **container_info(root, child)},
         )
         self.owners[id(region)] = composite
         chain = (*work.chain, str(source.path))
         return composite, list(root.outcomes), _Work(root, region, label, source, chain, "")
 
-    def embedded(self, work: _Work, ref: Embedded, child: Child) -> tuple[Container, _Source]:
+    def embedded(
+        self, work: _Work, ref: Embedded, child: Child
+    ) -> tuple[Container, _Source] | None:
+        """The embedded behaviour's machine and file; ``None`` when its file is not found
+        (the caller reads the state as opaque, or refuses under option ``strict``)."""
         here = work.source
         found = here.analysis.behaviours.get(ref.cls)
         if ref.cls in here.analysis.behaviours:
@@ -181,38 +257,13 @@ class Builder:
                 )
             return found, here
         if here.path is None:
-            raise UnsupportedError(
-                f"embedded behaviour '{ref.cls}' is defined in another file; read this "
-                "behaviour from its file so the embedded one can be found beside it",
-                location=self.loc(here, child.line),
-            )
-        folder = here.path.parent
-        module_file = folder / f"{ref.module.rsplit('.', 1)[-1]}.py" if ref.module else None
-        if module_file is not None:
-            note_read(module_file)  # a dependency even when it is missing
-        candidates = [module_file] if module_file is not None and module_file.is_file() else []
-        if not candidates:
-            marker = f"class {ref.cls}("
-            note_read(folder)  # the class may be defined in a file added later
-            for path in sorted(folder.glob("*.py")):
-                try:
-                    if (
-                        path.stat().st_size <= limits.current().max_input_bytes
-                        and marker in read_bounded(path).decode("utf-8", errors="replace")
-                    ):
-                        candidates.append(path)
-                        break
-                except (OSError, InputError):  # unreadable, or not a regular file: not it
-                    continue
-        if not candidates:
-            expected = module_file or folder / "<module>.py"
-            raise UnsupportedError(
-                f"embedded behaviour '{ref.cls}' not found: expected its file {expected} "
-                "beside this one (FlexBE behaviours embed others by class; give the embedded "
-                "behaviour's file in the same folder)",
-                location=self.loc(here, child.line),
-            )
-        path = candidates[0].resolve()
+            return None  # a text with no file: nothing to look beside
+        path = find_module_file(here.path, ref.module)
+        if path is None and ref.module is None:
+            path = self.class_beside(here, ref.cls)
+        if path is None:
+            return None
+        path = path.resolve()
         if str(path) in work.chain or path == (
             self.main.path.resolve() if self.main.path else None
         ):
@@ -232,13 +283,64 @@ class Builder:
             )
         return root, source
 
+    def class_beside(self, here: _Source, cls: str) -> Path | None:
+        """A ``*.py`` beside ``here`` defining ``cls``, for a class with no import to follow
+        (same folder = same package); the file chosen is named in a warning."""
+        assert here.path is not None
+        folder = here.path.parent
+        marker = f"class {cls}("
+        note_read(folder)  # the class may be defined in a file added later
+        for path in sorted(folder.glob("*.py")):
+            try:
+                if path.stat().st_size <= limits.current().max_input_bytes and marker in (
+                    read_bounded(path).decode("utf-8", errors="replace")
+                ):
+                    self.warn(
+                        here,
+                        None,
+                        f"embedded behaviour '{cls}' is not imported; read from {path.name}, "
+                        "the file beside this one that defines it",
+                    )
+                    return path
+            except (OSError, InputError):  # unreadable, or not a regular file: not it
+                continue
+        return None
+
+    def opaque(self, work: _Work, ref: Embedded, child: Child) -> StateRef:
+        """An embedded behaviour whose file is not found, as one state whose outcomes are the
+        ones its transitions name (a warning), or ``UnsupportedError`` under option
+        ``strict`` (docs/formats/flexbe.md, "Embedded behaviours")."""
+        where = self.loc(work.source, child.line)
+        if work.source.path is None:
+            looked = "read from a text, not a file, so no other file is looked at"
+        else:
+            wanted = f"module {ref.module}" if ref.module else "no import names its module"
+            looked = f"{wanted}; looked in its own package and beside this file"
+        if is_strict(self.ctx):
+            raise UnsupportedError(
+                f"embedded behaviour '{ref.cls}' not found ({looked}); strict reading "
+                "refuses an opaque state",
+                location=where,
+            )
+        outcomes = list(child.transitions)
+        self.warn(
+            work.source,
+            child.line,
+            f"embedded behaviour '{ref.cls}' not found ({looked}): read as one opaque "
+            f"state '{child.label}' whose outcomes are those its transitions name "
+            f"({', '.join(outcomes) or 'none'}); --strict refuses instead",
+        )
+        return StateRef(ref.cls, outcomes, ref.line, opaque_behaviour=True)
+
     def load(self, path: Path) -> _Source:
         if path in self.loaded:
             return self.loaded[path]
         text = decode(read_located(path), str(path))
-        tree = parse_source(text, str(path))
-        analysis = analyze(text, tree, str(path))
+        text, tree, notes = parse_python(text, str(path))
+        analysis = analyze(text, tree, str(path), self.classes.resolver(path))
         source = _Source(path, str(path), analysis)
+        if notes:
+            self.warn(source, None, python2_warning(notes))
         for line, message in analysis.warnings:
             self.warn(source, line, message)
         self.loaded[path] = source
@@ -470,15 +572,9 @@ class Builder:
                 name = ",".join(
                     part(lab, pos, m) for lab, pos, m in zip(labels, positions, machines)
                 )
-                if key != (start_positions, start_action) and (
-                    action is not None or key[0] == start_positions
-                ):  # a child looping back to its first state runs only its own action
-                    name = f"{name} ({action or 'no action'})"
-                if name in fsm.states:
-                    raise UnsupportedError(
-                        f"{what} '{container.name}': state name '{name}' clashes with an outcome",
-                        location=where,
-                    )
+                if key[0] != start_positions and action is not None:
+                    name = f"{name} ({action})"
+                name = _product_name(name, action, key[0] == start_positions, fsm)
                 names[key] = name
                 fsm.states[name] = State(name, action=action, location=where)
                 queue.append(key)
@@ -540,10 +636,23 @@ class Builder:
                     "combination of child outcomes gives",
                 )
         refs = [c.state for c in container.children if isinstance(c.state, StateRef)]
-        if not leaves:
-            return
         owner = self.owner_state(work)
         attrs = owner.attrs if owner is not None else fsm.attrs
+        undeclared = work.source.analysis.extension.get("undeclared_outcomes")
+        children_info: dict[str, dict[str, str]] = {}
+        for c in container.children:
+            if not isinstance(c.state, StateRef):
+                continue
+            info = leaf_info(c.state, c)
+            child_path = f"{work.path}/{c.label}" if work.path else c.label
+            if isinstance(undeclared, list) and child_path in undeclared:
+                info.pop(state_info.OUTCOMES, None)  # stub outcomes fsmbt wrote
+            if info:
+                children_info[c.label] = info
+        if children_info:
+            attrs[state_info.CHILD_STATES] = json.dumps(children_info)
+        if not leaves:
+            return
         attrs.update(
             {
                 A_CONTAINER: container.cls,
@@ -734,6 +843,22 @@ class Builder:
         return pending
 
 
+def _product_name(name: str, action: str | None, at_start: bool, fsm: FSM) -> str:
+    """A product state's name that no other state of ``fsm`` has (outcomes included).
+
+    Two product states can print alike - the children back at their first states with another
+    action running than at the start, or a name equal to a container outcome - so a taken name
+    gets the action it runs, then ``#2``, ``#3`` ... (docs/formats/flexbe.md).
+    """
+    if name not in fsm.states:
+        return name
+    base = f"{name} ({action})" if at_start and action is not None else name
+    candidate, index = base, 2
+    while candidate in fsm.states:
+        candidate, index = f"{base} #{index}", index + 1
+    return candidate
+
+
 def _shares_outcomes(outcomes: list[list[str]]) -> bool:
     seen: set[str] = set()
     for outs in outcomes:
@@ -741,6 +866,45 @@ def _shares_outcomes(outcomes: list[list[str]]) -> bool:
             return True
         seen |= set(outs)
     return False
+
+
+def leaf_info(ref: StateRef, child: Child) -> dict[str, str]:
+    """A leaf state's ``state_info`` entries: declared outcomes, parameters, userdata keys,
+    remapping, ROS interface, editor position (docs/formats/smach.md)."""
+    config = ref.config
+    return state_info.encode(
+        outcomes=ref.declared,
+        params=config.params,
+        expression_params=config.expressions,
+        inputs=config.inputs,
+        outputs=config.outputs,
+        remap=child.remapping,
+        at=child.position,
+        ros=config.ros,
+    )
+
+
+def container_info(container: Container, child: Child | None) -> dict[str, str]:
+    """A container's ``state_info`` entries: its userdata keys and initial values, and (as a
+    child) its remapping and editor position."""
+    return state_info.encode(
+        inputs=container.inputs,
+        outputs=container.outputs,
+        userdata=container.userdata,
+        remap=child.remapping if child is not None else None,
+        at=child.position if child is not None else None,
+    )
+
+
+def is_strict(ctx: ReadContext) -> bool:
+    """Reader option ``strict`` (``fsmbt convert --strict``, ``-O strict=1``): refuse what
+    would otherwise be read as an opaque approximation with a warning."""
+    return ctx.options.get("strict") not in (None, False, "", "0", "false", "no")
+
+
+def python2_warning(notes: list[str]) -> str:
+    """The one warning for a file read as Python 2 (docs/formats/flexbe.md)."""
+    return "read as Python 2 source (nothing run): " + "; ".join(notes)
 
 
 def build_fsm(
@@ -758,10 +922,14 @@ def build_fsm(
     Returns:
         The hierarchical FSM.
     """
-    tree = parse_source(text, ctx.display_name)
-    analysis = analyze(text, tree, ctx.display_name)
-    main = _Source(ctx.path.resolve() if ctx.path is not None else None, ctx.display_name, analysis)
-    builder = Builder(ctx, main)
+    text, tree, notes = parse_python(text, ctx.display_name)
+    classes = ClassFiles()
+    path = ctx.path.resolve() if ctx.path is not None else None
+    analysis = analyze(text, tree, ctx.display_name, classes.resolver(path))
+    main = _Source(path, ctx.display_name, analysis)
+    builder = Builder(ctx, main, classes)
+    if notes:
+        builder.warn(main, None, python2_warning(notes))
     for line, message in analysis.warnings:
         builder.warn(main, line, message)
     root, name = choose_root(analysis, ctx)
@@ -769,6 +937,7 @@ def build_fsm(
     if isinstance(extension.get("name"), str):
         name = str(extension["name"])
     fsm = builder.build(root, name)
+    fsm.attrs.update(container_info(root, None))
     start = extension.get("start")
     if (
         isinstance(start, dict)

@@ -6,9 +6,12 @@ returns: ``OperatableStateMachine`` (and ``PriorityContainer``, read as a plain 
 ``ConcurrencyContainer`` with its ``conditions`` (a product of its leaf children, the first
 satisfied condition ending it), states added with ``OperatableStateMachine.add(label, state,
 transitions=..., autonomy=..., remapping=...)`` inside ``with`` blocks, and embedded
-behaviours (``self.use_behavior(Class, ...)``) read from their own file beside this one. Rules
-and refusals are those of ``fsmbt.formats.pysm.build``; autonomy levels are kept as the
-``autonomy`` attribute of each transition, userdata remapping is not part of the model.
+behaviours (``self.use_behavior(Class, ...)``) read from their file in their own ROS package
+(an opaque state with a warning when it is not found). Python 2 era files (ROS 1) are read
+through a token-level normaliser (``fsmbt.formats.pysm.py2``), never run. Rules and refusals
+are those of ``fsmbt.formats.pysm.build``; autonomy levels are kept as the ``autonomy``
+attribute of each transition; parameters, userdata keys, remappings and editor positions as
+``fsmbt.model.state_info`` annotations of the states (they do not change the machine).
 
 Option ``behaviour`` (``ReadContext.options``) picks a Behavior class when a file has several.
 Costs: O(n) in the size of the source (plus the embedded files).

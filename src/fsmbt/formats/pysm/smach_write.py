@@ -31,13 +31,14 @@ transitions and nesting depth D (pushed-down transitions are copied into each le
 
 from __future__ import annotations
 
+import ast
 import copy
 import json
 import keyword
 import re
 from dataclasses import dataclass, field
 
-from fsmbt.model import Model
+from fsmbt.model import Model, state_info
 from fsmbt.model.errors import InputError, UnsupportedError
 from fsmbt.model.flatten import flatten
 from fsmbt.model.fsm import FSM, State, Transition
@@ -48,6 +49,19 @@ A_CHILDREN = "smach.children"
 A_MAP = "smach.outcome_map"
 A_DEFAULT = "smach.default_outcome"
 _READER_ATTRS = frozenset({"class", A_CONTAINER, A_CHILDREN, A_MAP, A_DEFAULT, "flexbe.behaviour"})
+#: ``state_info`` entries the SMACH program holds itself (constructor keyword arguments, the stub
+#: class's outcomes and userdata keys, ``remapping=``, a container's keys and ``userdata``).
+_WRITTEN_INFO = frozenset(
+    {
+        state_info.OUTCOMES,
+        state_info.PARAMETERS,
+        state_info.EXPRESSION_PARAMETERS,
+        state_info.INPUT_KEYS,
+        state_info.OUTPUT_KEYS,
+        state_info.REMAPPING,
+        state_info.USERDATA,
+    }
+)
 
 
 @dataclass
@@ -173,9 +187,15 @@ class _Writer:
     def __init__(self, fsm: FSM) -> None:
         self.fsm = fsm
         self.losses: list[str] = []
-        self.classes: dict[tuple[str | None, tuple[str, ...]], str] = {}
+        self.classes: dict[
+            tuple[str | None, tuple[str, ...], tuple[str, ...], tuple[str, ...]], str
+        ] = {}
         self.class_actions: dict[str, str | None] = {}
-        self.class_order: list[tuple[str, tuple[str, ...], str | None]] = []
+        self.class_order: list[
+            tuple[str, tuple[str, ...], str | None, tuple[str, ...], tuple[str, ...]]
+        ] = []
+        self.undeclared: list[str] = []  # states whose declared outcomes the model did not know
+        self.ros_states: list[str] = []  # generic ROS states written as stubs (a loss)
         self.final_actions: dict[str, dict[str, str | None]] = {}
         self.lines: list[str] = []
         self.counter = 0
@@ -188,7 +208,7 @@ class _Writer:
         return Written("\n".join([*header, *body]) + "\n", self.losses)
 
     def prepare(self) -> None:
-        top_attrs = {k for k in self.fsm.attrs if k not in _READER_ATTRS}
+        top_attrs = {k for k in self.fsm.attrs if k not in _READER_ATTRS | _WRITTEN_INFO}
         if top_attrs:
             self.losses.append(
                 f"model attributes {', '.join(sorted(top_attrs))} have no place in SMACH; dropped"
@@ -220,7 +240,12 @@ class _Writer:
                         f"state {where} was a CBState calling "
                         f"'{state.action}'; written as a stub state class"
                     )
-                extra = {k: v for k, v in state.attrs.items() if k not in _READER_ATTRS}
+                self.info_losses(where, state)
+                extra = {
+                    k: v
+                    for k, v in state.attrs.items()
+                    if k not in _READER_ATTRS | _WRITTEN_INFO and k not in state_info.KEYS
+                }
                 if extra:
                     self.losses.append(
                         f"state {where}: attributes {', '.join(extra)} have no "
@@ -258,6 +283,13 @@ class _Writer:
                     "the model; a SMACH container outcome runs nothing (kept in "
                     "__fsmbt__)"
                 )
+        if self.ros_states:
+            shown = ", ".join(self.ros_states[:5])
+            more = f" and {len(self.ros_states) - 5} more" if len(self.ros_states) > 5 else ""
+            self.losses.append(
+                f"{len(self.ros_states)} ROS action/service state(s) written as stub state "
+                f"classes (the interface is not called): {shown}{more}"
+            )
         _push_down(self.fsm)
         if self.fsm.start_name is not None and self.fsm.initial_event is not None:
             self.losses.append(
@@ -266,8 +298,50 @@ class _Writer:
                 "SMACH starts at once (kept in __fsmbt__)"
             )
 
-    def state_class(self, action: str | None, outcomes: tuple[str, ...]) -> str:
-        key = (action, outcomes)
+    def info_losses(self, where: str, state: State) -> None:
+        """What SMACH cannot hold of a state's ``state_info`` (the rest is written)."""
+        ros = state_info.ros_interface(state)
+        if ros is not None:
+            self.ros_states.append(
+                f"{where} ({ros[0]} {ros[1]}" + (f" on '{ros[2]}'" if ros[2] else "") + ")"
+            )
+        if state.attrs.get(state_info.CHILD_STATES) and (
+            state.attrs.get(A_CONTAINER) != "Concurrence"
+        ):
+            self.losses.append(
+                f"the configuration of the concurrent children of {where} (their parameters, "
+                "userdata keys and remappings) has no place in the StateMachine written; dropped"
+            )
+        behaviour = state.attrs.get("flexbe.behaviour")
+        if behaviour is not None:
+            self.losses.append(
+                f"state {where} embedded the FlexBE behaviour '{behaviour}'; written as "
+                + ("a stub state class" if state.is_atomic else "a nested StateMachine")
+                + " (the behaviour's name dropped)"
+            )
+        odd = [n for n in state_info.parameters(state) if n not in ("*", "**")]
+        odd = [n for n in odd if not _is_identifier(n)]
+        if odd:
+            self.losses.append(
+                f"state {where}: parameter(s) {', '.join(odd)} are not Python names; dropped"
+            )
+        if state_info.CLASS in state.attrs and state.attrs[state_info.CLASS] not in (
+            "CBState",
+            state.action,
+        ):
+            self.losses.append(
+                f"state {where}: class '{state.attrs[state_info.CLASS]}' differs from its "
+                "action; written as a stub class named after the action"
+            )
+
+    def state_class(
+        self,
+        action: str | None,
+        outcomes: tuple[str, ...],
+        inputs: tuple[str, ...] = (),
+        outputs: tuple[str, ...] = (),
+    ) -> str:
+        key = (action, outcomes, inputs, outputs)
         if key not in self.classes:
             base = _identifier(action) if action is not None else "NoAction"
             name, index = base, 2
@@ -275,7 +349,7 @@ class _Writer:
                 name, index = f"{base}_{index}", index + 1
             self.classes[key] = name
             self.class_actions[name] = action
-            self.class_order.append((name, outcomes, action))
+            self.class_order.append((name, outcomes, action, inputs, outputs))
         return self.classes[key]
 
     def header(self) -> list[str]:
@@ -300,9 +374,14 @@ class _Writer:
             extension["final_actions"] = finals
         if self.fsm.start_name is not None and self.fsm.initial_event is not None:
             extension["start"] = {"name": self.fsm.start_name, "event": self.fsm.initial_event}
+        if self.undeclared:
+            extension["undeclared_outcomes"] = self.undeclared
         lines.append("__fsmbt__ = " + _py(extension))
         lines.append("")
-        for name, outcomes, action in self.class_order:
+        for name, outcomes, action, inputs, outputs in self.class_order:
+            keys = (f", input_keys={_py(list(inputs))}" if inputs else "") + (
+                f", output_keys={_py(list(outputs))}" if outputs else ""
+            )
             lines += [
                 "",
                 f"class {name}(smach.State):",
@@ -310,8 +389,9 @@ class _Writer:
                 if action is not None
                 else '    """Runs nothing."""',
                 "",
-                "    def __init__(self):",
-                f"        smach.State.__init__(self, outcomes={_py(list(outcomes))})",
+                "    def __init__(self, **parameters):",
+                f"        smach.State.__init__(self, outcomes={_py(list(outcomes))}{keys})",
+                "        self.parameters = parameters",
                 "",
                 "    def execute(self, userdata):",
                 f"        raise NotImplementedError({_py(f'{name}: return one of ' + ', '.join(outcomes))})",
@@ -333,7 +413,7 @@ class _Writer:
     def emit_machine(self, top: FSM, top_path: str, indent: int, lines: list[str]) -> str:
         """Emit ``top`` and every nested machine (explicit stack); returns the top's variable."""
         # frames: (machine, path, var, indent, remaining states, pending add line after sub)
-        first_var = self.new_container(top, top_path, indent, lines)
+        first_var = self.new_container(top, top_path, indent, lines, top)
         stack: list[tuple[FSM, str, str, int, list[State], list[str] | None]] = [
             (
                 top,
@@ -359,17 +439,19 @@ class _Writer:
                 region = state.regions[0]
                 concurrence = self.concurrence(state, region)
                 if concurrence is not None:
-                    sub_var = self.emit_concurrence(state, concurrence, level, lines)
+                    sub_var = self.emit_concurrence(state, concurrence, level, lines, sub_path)
+                    lines.extend(_position_comment(state, pad))
                     lines.append(
                         f"{pad}smach.StateMachine.add({_py(state.name)}, {sub_var}, "
-                        f"transitions={_py(transitions)})"
+                        f"transitions={_py(transitions)}{_remapping(state)})"
                     )
                     continue
-                sub_var = self.new_container(region, sub_path, level, lines)
+                sub_var = self.new_container(region, sub_path, level, lines, state)
                 after_lines = [
                     *self.initial_line(region, sub_var, level),
+                    *_position_comment(state, pad),
                     f"{pad}smach.StateMachine.add({_py(state.name)}, {sub_var}, "
-                    f"transitions={_py(transitions)})",
+                    f"transitions={_py(transitions)}{_remapping(state)})",
                 ]
                 stack.append(
                     (
@@ -382,14 +464,26 @@ class _Writer:
                     )
                 )
                 continue
-            cls = self.state_class(state.action, tuple(transitions))
+            cls = self.state_class(
+                state.action,
+                tuple(transitions),
+                tuple(state_info.input_keys(state)),
+                tuple(state_info.output_keys(state)),
+            )
+            if state_info.declared_outcomes(state) is None:
+                self.undeclared.append(f"{path}/{state.name}" if path else state.name)
+            lines.extend(_position_comment(state, pad))
             lines.append(
-                f"{pad}smach.StateMachine.add({_py(state.name)}, {cls}(), "
-                f"transitions={_py(transitions)})"
+                f"{pad}smach.StateMachine.add({_py(state.name)}, {cls}({_arguments(state)}), "
+                f"transitions={_py(transitions)}{_remapping(state)})"
             )
         return first_var
 
-    def new_container(self, machine: FSM, path: str, level: int, lines: list[str]) -> str:
+    def new_container(
+        self, machine: FSM, path: str, level: int, lines: list[str], holder: State | FSM
+    ) -> str:
+        """``smach.StateMachine(...)`` for ``machine`` with the userdata keys and initial
+        values of ``holder`` (its composite state, or the top FSM), then ``with``."""
         finals = [s for s in machine.states.values() if s.final]
         if machine.initial is None or machine.states.get(machine.initial) is None:
             raise InputError(
@@ -404,7 +498,20 @@ class _Writer:
         var = f"sm_{self.counter}"
         self.counter += 1
         pad = "    " * level
-        lines.append(f"{pad}{var} = smach.StateMachine(outcomes={_py([s.name for s in finals])})")
+        keys = "".join(
+            f", {name}={_py(found)}"
+            for name, found in (
+                ("input_keys", state_info.input_keys(holder)),
+                ("output_keys", state_info.output_keys(holder)),
+            )
+            if found
+        )
+        lines.append(
+            f"{pad}{var} = smach.StateMachine(outcomes={_py([s.name for s in finals])}{keys})"
+        )
+        for key, value in state_info.userdata_values(holder).items():
+            target = f"{var}.userdata.{key}" if _is_identifier(key) else f"{var}.userdata[{key!r}]"
+            lines.append(f"{pad}{target} = {_python_value(value, False)}")
         lines.append(f"{pad}with {var}:")
         return var
 
@@ -466,28 +573,55 @@ class _Writer:
         if not _product_matches(spec, region):
             self.losses.append(
                 f"Concurrence '{state.name}' was changed after reading; written "
-                "as the StateMachine of its combinations"
+                "as the StateMachine of its combinations (its children's configuration "
+                "dropped)"
             )
             return None
         return spec
 
     def emit_concurrence(
-        self, state: State, spec: dict[str, object], level: int, lines: list[str]
+        self, state: State, spec: dict[str, object], level: int, lines: list[str], path: str
     ) -> str:
+        """The ``Concurrence`` read back unchanged, with its own keys and userdata and each
+        child's parameters, keys and remapping (``state_info.CHILD_STATES``)."""
         var = f"cc_{self.counter}"
         self.counter += 1
         pad = "    " * level
         outcome_map: dict[str, dict[str, str]] = {}
         for outcome, required in spec["outcome_map"]:  # type: ignore[attr-defined]
             outcome_map[outcome] = required
+        keys = "".join(
+            f", {name}={_py(found)}"
+            for name, found in (
+                ("input_keys", state_info.input_keys(state)),
+                ("output_keys", state_info.output_keys(state)),
+            )
+            if found
+        )
         lines.append(
             f"{pad}{var} = smach.Concurrence(outcomes={_py(spec['outcomes'])}, "
-            f"default_outcome={_py(spec['default'])}, outcome_map={_py(outcome_map)})"
+            f"default_outcome={_py(spec['default'])}, outcome_map={_py(outcome_map)}{keys})"
         )
+        for key, value in state_info.userdata_values(state).items():
+            target = f"{var}.userdata.{key}" if _is_identifier(key) else f"{var}.userdata[{key!r}]"
+            lines.append(f"{pad}{target} = {_python_value(value, False)}")
         lines.append(f"{pad}with {var}:")
+        children = state_info.child_states(state)
         for label, action, outcomes in spec["children"]:  # type: ignore[attr-defined]
-            cls = self.state_class(action, tuple(outcomes))
-            lines.append(f"{pad}    smach.Concurrence.add({_py(label)}, {cls}())")
+            child = State(label, action=action, attrs=children.get(label, {}))
+            cls = self.state_class(
+                action,
+                tuple(outcomes),
+                tuple(state_info.input_keys(child)),
+                tuple(state_info.output_keys(child)),
+            )
+            if state_info.declared_outcomes(child) is None:
+                self.undeclared.append(f"{path}/{label}" if path else label)
+            lines.extend(_position_comment(child, pad + "    "))
+            lines.append(
+                f"{pad}    smach.Concurrence.add({_py(label)}, {cls}({_arguments(child)})"
+                f"{_remapping(child)})"
+            )
         return var
 
 
@@ -516,6 +650,57 @@ def _product_matches(spec: dict[str, object], region: FSM) -> bool:
         and [(t.source, t.event, t.target) for t in rebuilt.transitions]
         == [(t.source, t.event, t.target) for t in region.transitions]
     )
+
+
+def _is_identifier(name: str) -> bool:
+    return name.isidentifier() and not keyword.iskeyword(name)
+
+
+def _python_value(text: str, expression: bool) -> str:
+    """A parameter's Python source: an expression's own text (when it parses as one), a JSON
+    number / boolean / null / list / dict as that Python literal, any other text a string
+    (reading it back gives the same text, docs/formats/smach.md)."""
+    if expression:
+        try:
+            ast.parse(text, mode="eval")
+            return text
+        except (SyntaxError, ValueError, RecursionError, MemoryError):
+            return repr(text)
+    try:
+        value = json.loads(text)
+    except ValueError:
+        return repr(text)
+    if isinstance(value, str) or json.dumps(value) != text:
+        return repr(text)
+    return repr(value)
+
+
+def _arguments(state: State) -> str:
+    """The stub state's constructor arguments: its parameters as keywords (``*`` / ``**``
+    expression parameters as unpacking)."""
+    expressions = set(state_info.expression_parameters(state))
+    parts: list[str] = []
+    for name, value in state_info.parameters(state).items():
+        source = _python_value(value, name in expressions)
+        if name == "*":
+            parts.insert(0, f"*{source}")
+        elif name == "**":
+            parts.append(f"**{source}")
+        elif _is_identifier(name):
+            parts.append(f"{name}={source}")
+    return ", ".join(parts)
+
+
+def _position_comment(state: State, pad: str) -> list[str]:
+    """The FlexBE editor's ``# x:.. y:..`` comment above the ``add`` (read back as the
+    state's position, docs/formats/flexbe.md)."""
+    at = state_info.position(state)
+    return [f"{pad}# x:{at[0]} y:{at[1]}"] if at is not None else []
+
+
+def _remapping(state: State) -> str:
+    remap = state_info.remapping(state)
+    return f", remapping={_py(remap)}" if remap else ""
 
 
 def _py(value: object) -> str:

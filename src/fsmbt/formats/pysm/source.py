@@ -20,6 +20,7 @@ from __future__ import annotations
 import ast
 from collections.abc import Callable
 
+from fsmbt.formats.pysm.py2 import NotNormalisable, normalise
 from fsmbt.model.errors import InputError, SourceLocation
 
 #: A behaviour file larger than this is not a state machine someone wrote by hand or by editor.
@@ -45,7 +46,29 @@ def parse_source(text: str, name: str) -> ast.Module:
         name: the file name for error locations.
 
     Returns:
-        The parsed module (not executed).
+        The parsed module (not executed); see ``parse_python`` for Python 2 sources.
+    """
+    return parse_python(text, name)[1]
+
+
+def parse_python(text: str, name: str) -> tuple[str, ast.Module, list[str]]:
+    """The module's syntax tree, read as Python 3 and else as Python 2 (never executed).
+
+    A text Python 3's parser refuses is normalised by ``fsmbt.formats.pysm.py2`` (ROS 1 era
+    files: ``print x``, ``except X, e``, mixed tabs ...) and parsed again; the text the tree
+    was parsed from is returned, since the tree's columns refer to it.
+
+    Args:
+        text: the Python source.
+        name: the file name for error locations.
+
+    Returns:
+        ``(text parsed, tree, notes)``: notes name each Python 2 form rewritten (empty for a
+        Python 3 text).
+
+    Raises:
+        InputError: neither reading parses (the first error, located), or the source is too
+            large or too deep.
     """
     if len(text.encode("utf-8", "surrogatepass")) > MAX_SOURCE_BYTES:
         raise InputError(
@@ -53,11 +76,33 @@ def parse_source(text: str, name: str) -> ast.Module:
             location=SourceLocation(name),
         )
     try:
-        tree = ast.parse(text, filename=name, mode="exec")
+        return text, _parse(text, name), []
     except SyntaxError as exc:
-        raise InputError(
-            f"Python syntax error: {exc.msg}", location=SourceLocation(name, exc.lineno, exc.offset)
-        ) from None
+        first = exc
+    try:
+        normalised = normalise(text)
+    except NotNormalisable:
+        raise _syntax_error(first, name) from None
+    try:
+        tree = _parse(normalised.text, name)
+    except SyntaxError as again:
+        worse = (again.lineno or 0) > (first.lineno or 0)
+        raise _syntax_error(again if worse else first, name) from None
+    return normalised.text, tree, normalised.notes
+
+
+def _syntax_error(exc: SyntaxError, name: str) -> InputError:
+    return InputError(
+        f"Python syntax error: {exc.msg}", location=SourceLocation(name, exc.lineno, exc.offset)
+    )
+
+
+def _parse(text: str, name: str) -> ast.Module:
+    """``ast.parse`` with the parser's own failures (other than syntax) as ``InputError``."""
+    try:
+        tree = ast.parse(text, filename=name, mode="exec")
+    except SyntaxError:
+        raise
     except (RecursionError, MemoryError):
         raise InputError(
             "Python source nested too deeply for the parser (an expression or "

@@ -43,7 +43,7 @@ from fsmbt.formats.registry import Format, ReadContext, register
 from fsmbt.formats.scxml import include as scxml_include
 from fsmbt.formats.scxml.w3c import read_scxml_w3c
 from fsmbt.formats.xml_safe import local_name, namespace, root_tag
-from fsmbt.model import Model
+from fsmbt.model import Model, state_info
 from fsmbt.model.errors import InputError, SourceLocation, UnsupportedError
 from fsmbt.model.fsm import FSM, State, Transition
 
@@ -65,6 +65,38 @@ UNSUPPORTED_CONTENT = frozenset(
 )
 WARNED_CONTENT = frozenset({"log"})
 _SCXML_KEYS = frozenset({"initial", "name", "version"})
+#: ``attrs`` keys a reader of outcome-driven states adds (``fsmbt.model.state_info``, FlexBE
+#: autonomy, SMACH/FlexBE container facts): written in the fsmbt namespace, so the SCXML stays
+#: valid (the W3C schema allows attributes of other namespaces) and reads back the same.
+_ANNOTATION_PREFIXES = ("flexbe.", "smach.", "userdata.", "params", "ros.", "children.")
+_ANNOTATION_KEYS = frozenset({*state_info.KEYS, "autonomy"})
+
+
+def annotation_attribute(key: str) -> str:
+    """The XML attribute an ``attrs`` key is written as (fsmbt-namespaced for annotations)."""
+    if key in _ANNOTATION_KEYS or key.startswith(_ANNOTATION_PREFIXES):
+        return f"{{{FSMBT_NS}}}{key}"
+    return key
+
+
+def annotations_in(attrib: etree._Attrib, known: frozenset[str]) -> dict[str, str]:
+    """An element's other attributes as ``attrs``: fsmbt-namespaced annotations by their key."""
+    out: dict[str, str] = {}
+    prefix = f"{{{FSMBT_NS}}}"
+    for raw_key, raw_value in attrib.items():
+        key, value = str(raw_key), str(raw_value)
+        if key in known:
+            continue
+        local = key[len(prefix) :] if key.startswith(prefix) else None
+        if local is not None and (
+            local in _ANNOTATION_KEYS or local.startswith(_ANNOTATION_PREFIXES)
+        ):
+            out[local] = value
+        else:
+            out[key] = value
+    return out
+
+
 _STATE_KEYS = frozenset({"id", "initial", F_NAME, F_ACTION, F_START, F_REGION})
 _TRANSITION_KEYS = frozenset({"event", "target", "cond", F_EXIT})
 #: The one guard read: ``In('id')`` / ``In("id")`` (W3C's predicate, in every data model).
@@ -137,7 +169,7 @@ class _Reader:
             )
         top = FSM(
             name=root.get("name", "fsm"),
-            attrs={k: v for k, v in root.attrib.items() if k not in _SCXML_KEYS},
+            attrs=annotations_in(root.attrib, _SCXML_KEYS),
         )
         self.parent_of[id(top)] = None
         self.build(root, top)
@@ -208,7 +240,7 @@ class _Reader:
         action: str | None = name if not nested else None
         if F_ACTION in element.attrib:
             action = element.get(F_ACTION) or None
-        attrs = {k: v for k, v in element.attrib.items() if k not in _STATE_KEYS}
+        attrs = annotations_in(element.attrib, _STATE_KEYS)
         state = State(
             name, action=action, final=tag == "final", attrs=attrs, location=self.where(element)
         )
@@ -398,7 +430,7 @@ class _Reader:
                 location=self.where(element),
                 element="<transition>",
             )
-        attrs = {k: v for k, v in element.attrib.items() if k not in _TRANSITION_KEYS}
+        attrs = annotations_in(element.attrib, _TRANSITION_KEYS)
         exit_name = self.exit_of(node, element, cond_exit)
         events = element.get("event")
         location = self.where(element)
@@ -798,7 +830,7 @@ class _Writer:
         elif fsm.initial is not None:
             root.set("initial", self.ids[(id(fsm), fsm.initial)])
         for key, value in fsm.attrs.items():
-            root.set(key, value)
+            root.set(annotation_attribute(key), value)
         if start is not None and fsm.initial is not None:
             element = etree.SubElement(root, _q("state"), id=start)
             element.set(F_START, "true")
@@ -849,7 +881,7 @@ class _Writer:
             if region.initial is not None:
                 element.set("initial", self.ids[(id(region), region.initial)])
         for key, value in state.attrs.items():
-            element.set(key, value)
+            element.set(annotation_attribute(key), value)
         by_source = self.outgoing.get(id(machine))
         if by_source is None:
             by_source = {}
@@ -878,7 +910,7 @@ class _Writer:
             raise InputError(f"transition to unknown state '{target}'", element=state.name)
         out.set("target", self.ids[key])
         for k, v in t.attrs.items():
-            out.set(k, v)
+            out.set(annotation_attribute(k), v)
 
     def final_id(self, state: State, exit_name: str) -> str:
         """The id of the final state a completion transition of ``state`` waits for."""

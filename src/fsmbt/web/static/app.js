@@ -135,6 +135,7 @@ async function loadChoices() {
   for (const f of formats.filter((f) => f.read)) $("format").append(el("option", { value: f.name }, f.name));
   for (const name of engines.engines) $("engine").append(el("option", { value: name }, name));
   for (const name of engines.hierarchies) $("hierarchy").append(el("option", { value: name }, name));
+  for (const name of engines.styles || []) $("style").append(el("option", { value: name }, name));
   for (const ex of examples) $("example").append(el("option", { value: ex.name }, `${ex.name} (${ex.format})`));
 }
 
@@ -285,7 +286,7 @@ async function convert() {
   try {
     const body = sourceRequest();
     body.engine = $("engine").value || "rules";
-    body.options = { loop: $("loop").checked, hierarchy: $("hierarchy").value || "subtrees" };
+    body.options = { loop: $("loop").checked, hierarchy: $("hierarchy").value || "subtrees", style: $("style").value || "auto" };
     const data = await api("/api/convert", body);
     state.convert = data;
     render(box, data);

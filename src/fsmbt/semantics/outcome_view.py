@@ -1,0 +1,344 @@
+"""An FSM read as an outcome-driven machine (docs/semantics.md, "11. Outcome-driven machines").
+
+SMACH, FlexBE and YASMIN machines are read (``fsmbt.formats``) into FSMs whose events are the
+states' outcomes: a state ``S`` that returned ``o`` takes ``S --o--> T``; a container is a
+composite state whose completion transitions ``exit=o`` say where each container outcome goes,
+with one final state per container outcome. This module checks that a machine has exactly that
+shape and gives every state a ``Unit``: its outcomes in declaration order (those a transition
+names; ``preempted`` ones that halt the machine removed, ``outcome_rules`` rule 4), their
+targets and statuses, and whether a leaf needs a dispatch on its outcome.
+
+Rules (each violation is an ``OutcomeError`` naming the state and the cause, exit 2):
+- no parallel state (a Concurrence has no structured form in this version);
+- the machine needs no start event; an atomic state has no completion transition and at
+  least one outcome; a composite state leaves only by completion transitions;
+- when a state declares its outcomes (``fsmbt.model.state_info``), every event of its
+  transitions is one of them (else the machine mixes external events and outcomes);
+- every final state a container reaches has a completion transition in the parent.
+
+A unit is *binary* when, grouping its outcomes by status, each group has one target (or all
+outcomes share one target); else it is a *dispatch* unit: its leaf (or SubTree) writes the
+outcome to the blackboard entry ``key`` and a ``Switch`` reads it.
+
+Everything is computed with explicit work lists, O(states + transitions).
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+
+from fsmbt.model import state_info
+from fsmbt.model.fsm import FSM, State
+from fsmbt.semantics.outcome_rules import (
+    FAILURE,
+    HALT_OUTCOME,
+    SUCCESS,
+    OutcomeError,
+    OutcomeRules,
+)
+
+#: The leaf outcome a running state gives (not an outcome of the source machine).
+RUNNING_INPUT = "running"
+
+
+@dataclass
+class Unit:
+    """One non-final state of a region: a leaf (atomic state) or a container (composite)."""
+
+    path: str
+    name: str
+    state: State
+    container: bool
+    outcomes: tuple[str, ...]
+    targets: dict[str, str]
+    status: dict[str, str | None]
+    halted: tuple[str, ...]
+    order_choice: bool
+    label: str = ""
+    key: str = ""
+
+    @property
+    def dispatch(self) -> bool:
+        """Whether the outcome must be written to the blackboard and dispatched on."""
+        if len(set(self.targets.values())) <= 1:
+            return False
+        if any(self.status[o] is None for o in self.outcomes):
+            return True
+        for status in (SUCCESS, FAILURE):
+            group = {self.targets[o] for o in self.outcomes if self.status[o] == status}
+            if len(group) > 1:
+                return True
+        return False
+
+    def target_of(self, status: str) -> str | None:
+        """The one target of the outcomes with ``status`` (binary units), else ``None``."""
+        for o in self.outcomes:
+            if self.status[o] == status:
+                return self.targets[o]
+        return None
+
+
+@dataclass
+class Region:
+    """One machine (the top level or a container's region) with its units and exits."""
+
+    path: str
+    machine: FSM
+    owner: Unit | None
+    units: dict[str, Unit] = field(default_factory=dict)
+    exits: list[str] = field(default_factory=list)
+    exit_status: dict[str, str | None] = field(default_factory=dict)
+    pc_key: str = ""
+
+    @property
+    def initial(self) -> str:
+        assert self.machine.initial is not None
+        return self.machine.initial
+
+
+@dataclass
+class OutcomeView:
+    """Every region and unit of an outcome-driven machine, and the rules it was read under."""
+
+    fsm: FSM
+    rules: OutcomeRules
+    regions: dict[str, Region]
+    by_label: dict[str, Unit]
+    order_choices: list[str]
+    halts: int
+
+    @property
+    def top(self) -> Region:
+        return self.regions[""]
+
+    def root_result(self, exit_name: str) -> str:
+        """The root's result (``SUCCESS``/``FAILURE``) when the machine ends in ``exit_name``;
+        a top-level outcome with no status ends it with SUCCESS (named in the verdict)."""
+        status = self.top.exit_status.get(exit_name)
+        return "FAILURE" if status == FAILURE else "SUCCESS"
+
+    def leaf_units(self) -> list[Unit]:
+        return [u for region in self.regions.values() for u in region.units.values()
+                if not u.container]  # fmt: skip
+
+
+def declares_outcomes(fsm: FSM) -> bool:
+    """Whether some state declares its outcomes (a reader of an outcome-driven format)."""
+    return any(
+        state_info.declared_outcomes(state) is not None
+        for _path, _machine, state in fsm.walk()
+        if state.is_atomic and not state.final
+    )
+
+
+_NOT_KEY = re.compile(r"[^A-Za-z0-9_]+")
+
+
+def _sanitize(text: str) -> str:
+    out = _NOT_KEY.sub("_", text).strip("_") or "state"
+    return out if not out[0].isdigit() else f"s_{out}"
+
+
+def read_outcome_view(fsm: FSM, rules: OutcomeRules | None = None) -> OutcomeView:
+    """Check ``fsm`` is outcome-driven and read its units (see the module docstring).
+
+    Raises:
+        OutcomeError: the first violation, naming the state's path and the cause.
+    """
+    rules = rules or OutcomeRules()
+    if fsm.initial_event is not None:
+        raise OutcomeError(
+            f"the start waits for the external event "
+            f"'{fsm.initial_event}' (an event-driven machine, not an outcome-driven one)",
+            element=f"machine '{fsm.name}'",
+        )
+    regions: dict[str, Region] = {}
+    order_choices: list[str] = []
+    halts = 0
+    # work list: (region path, machine, owner unit, halting finals of this machine)
+    work: list[tuple[str, FSM, Unit | None, frozenset[str]]] = []
+    top_halting = frozenset(
+        {HALT_OUTCOME} if HALT_OUTCOME in fsm.states and fsm.states[HALT_OUTCOME].final else ()
+    )
+    work.append(("", fsm, None, top_halting))
+    while work:
+        path, machine, owner, halting = work.pop()
+        region = Region(path, machine, owner)
+        regions[path] = region
+        if machine.initial is None or machine.initial not in machine.states:
+            raise OutcomeError("no initial state", element=f"machine '{path or fsm.name}'")
+        for name, state in machine.states.items():
+            where = f"{path}/{name}" if path else name
+            if state.final:
+                continue
+            if state.is_parallel:
+                raise OutcomeError(
+                    "a Concurrence (parallel regions) has no structured form in this version",
+                    element=f"state '{where}'",
+                    location=state.location,
+                )
+            outgoing = machine.outgoing(name)
+            if state.is_composite:
+                unit, inner_halting = _container_unit(where, name, state, outgoing, halting)
+                work.append((where, state.regions[0], unit, inner_halting))
+            else:
+                unit = _leaf_unit(where, name, state, outgoing, halting)
+            halts += len(unit.halted)
+            region.units[name] = unit
+        reached = {t for u in region.units.values() for t in u.targets.values()}
+        reached.add(region.initial)
+        region.exits = [n for n, s in machine.states.items() if s.final and n in reached]
+    # statuses: a container's exits have the statuses of the container's outcomes
+    for region in regions.values():
+        for unit in region.units.values():
+            if unit.container:
+                inner = regions[unit.path]
+                unit.outcomes = tuple(o for o in inner.exits if o in unit.targets)
+                unit.targets = {o: unit.targets[o] for o in unit.outcomes}
+            unit.status, unit.order_choice = rules.statuses(list(unit.outcomes))
+            if unit.dispatch and len(set(unit.targets.values())) == 2:
+                # two places to go: a binary leaf, whatever the names (docs/semantics.md §11)
+                first = unit.targets[unit.outcomes[0]]
+                unit.status = {
+                    o: SUCCESS if unit.targets[o] == first else FAILURE for o in unit.outcomes
+                }
+                unit.order_choice = False
+                order_choices.append(
+                    f"{unit.path}: the outcomes leading to '{first}' read as SUCCESS, the "
+                    "others as FAILURE (two places to go)"
+                )
+            if not unit.dispatch:  # one place to go whatever the status: say SUCCESS
+                unit.status = {o: s or SUCCESS for o, s in unit.status.items()}
+            if unit.order_choice:
+                first, second = unit.outcomes
+                order_choices.append(
+                    f"{unit.path}: '{first}' read as SUCCESS, '{second}' as FAILURE "
+                    "(first declared outcome)"
+                )
+    top = regions[""]
+    top.exit_status, top_choice = rules.statuses(top.exits)
+    if top_choice:
+        order_choices.append(
+            f"{fsm.name}: outcome '{top.exits[0]}' read as SUCCESS, '{top.exits[1]}' as FAILURE"
+        )
+    for path, region in regions.items():
+        if region.owner is not None:
+            region.exit_status = {e: region.owner.status.get(e) for e in region.exits}
+        region.pc_key = "pc" if not path else f"pc_{_sanitize(path)}"
+    by_label = _assign_labels(regions)
+    return OutcomeView(fsm, rules, regions, by_label, order_choices, halts)
+
+
+def _leaf_unit(
+    where: str,
+    name: str,
+    state: State,
+    outgoing: list,  # type: ignore[type-arg]
+    halting: frozenset[str],
+) -> Unit:
+    declared = state_info.declared_outcomes(state)
+    order: list[str] = []
+    targets: dict[str, str] = {}
+    for t in outgoing:
+        if t.event is None:
+            raise OutcomeError(
+                f"a completion transition to '{t.target}' (an atomic "
+                "outcome-driven state leaves only on one of its outcomes)",
+                element=f"state '{where}'",
+                location=t.location or state.location,
+            )
+        if declared is not None and t.event not in declared:
+            raise OutcomeError(
+                f"event '{t.event}' is not one of its declared outcomes "
+                f"({', '.join(declared) or 'none'}): the machine mixes external events and "
+                "outcomes",
+                element=f"state '{where}'",
+                location=t.location or state.location,
+            )
+        if t.event == RUNNING_INPUT:
+            raise OutcomeError(
+                f"an outcome named '{RUNNING_INPUT}' cannot be told from a running leaf",
+                element=f"state '{where}'",
+            )
+        if t.event not in targets:
+            targets[t.event] = t.target
+            order.append(t.event)
+    if declared is not None:
+        order = [o for o in declared if o in targets] + [o for o in order if o not in declared]
+    halted = tuple(o for o in order if o == HALT_OUTCOME and targets[o] in halting)
+    kept = [o for o in order if o not in halted]
+    if not kept and not halted:
+        raise OutcomeError(
+            "no outcome leaves it (an outcome-driven state must return one)",
+            element=f"state '{where}'",
+            location=state.location,
+        )
+    return Unit(
+        where, name, state, False, tuple(kept), {o: targets[o] for o in kept}, {}, halted, False
+    )
+
+
+def _container_unit(
+    where: str,
+    name: str,
+    state: State,
+    outgoing: list,  # type: ignore[type-arg]
+    halting: frozenset[str],
+) -> tuple[Unit, frozenset[str]]:
+    inner = state.regions[0]
+    finals = [n for n, s in inner.states.items() if s.final]
+    targets: dict[str, str] = {}
+    any_target: str | None = None
+    for t in outgoing:
+        if t.event is not None:
+            raise OutcomeError(
+                f"the container handles event '{t.event}' (an event that "
+                "interrupts a running container is not an outcome)",
+                element=f"state '{where}'",
+                location=t.location or state.location,
+            )
+        if t.exit is None:
+            any_target = any_target or t.target
+        elif t.exit in inner.states and inner.states[t.exit].final:
+            targets.setdefault(t.exit, t.target)
+        else:
+            raise OutcomeError(
+                f"a completion transition waits for '{t.exit}', which is no "
+                "outcome of the container",
+                element=f"state '{where}'",
+                location=t.location or state.location,
+            )
+    for final in finals:
+        if final not in targets and any_target is not None:
+            targets[final] = any_target
+    inner_halting = frozenset(f for f in finals if f in targets and targets[f] in halting)
+    halted = tuple(f for f in finals if f == HALT_OUTCOME and f in inner_halting)
+    kept = [f for f in finals if f in targets and f not in halted]
+    unit = Unit(
+        where, name, state, True, tuple(kept), {o: targets[o] for o in kept}, {}, halted, False
+    )
+    return unit, inner_halting
+
+
+def _assign_labels(regions: dict[str, Region]) -> dict[str, Unit]:
+    """Labels: the state's name, or its path where two units share a name; blackboard keys
+    ``<label>_outcome`` made unique."""
+    counts: dict[str, int] = {}
+    for region in regions.values():
+        for unit in region.units.values():
+            counts[unit.name] = counts.get(unit.name, 0) + 1
+    by_label: dict[str, Unit] = {}
+    keys: set[str] = set()
+    for region in regions.values():
+        for unit in region.units.values():
+            unit.label = unit.name if counts[unit.name] == 1 else unit.path
+            by_label[unit.label] = unit
+            key = f"{_sanitize(unit.label)}_outcome"
+            suffix = 2
+            while key in keys:
+                key = f"{_sanitize(unit.label)}_outcome{suffix}"
+                suffix += 1
+            keys.add(key)
+            unit.key = key
+    return by_label
