@@ -2,7 +2,7 @@
 
 Runs ``fsmbt.api.convert_file`` (rules engine, native checker, nothing written) over every file
 of the corpus (``FSMBT_CORPUS``, default ``../shared/corpus``): BehaviorTree.CPP XML under
-``bt/``, SCXML, SMACH and FlexBE under ``fsm/``. Each file is tried in three settings:
+``bt/``, SCXML, SMACH, FlexBE and YASMIN (``fsm/yasmin/*.xml``) under ``fsm/``. Each file is tried in three settings:
 
 - ``plain``: no options, as a new user types ``fsmbt convert FILE -o OUT``;
 - ``profiles``: ``--nodes nav2,moveit_pro`` (the project node libraries; their gating
@@ -52,6 +52,7 @@ from fsmbt import api  # noqa: E402
 from fsmbt.model.errors import InputError  # noqa: E402
 
 SETTINGS = ("plain", "profiles", "abstract")
+KINDS = ("bt", "scxml", "smach", "flexbe", "yasmin")
 NEGATIVE_DIRS = ("_malformed", "_legacy_draft")
 
 
@@ -59,7 +60,7 @@ NEGATIVE_DIRS = ("_malformed", "_legacy_draft")
 class Row:
     path: Path
     source: str  # "bt/nav2", "fsm/scion_tests", ...
-    kind: str  # "bt", "scxml", "smach", "flexbe"
+    kind: str  # "bt", "scxml", "smach", "flexbe", "yasmin"
     negative: bool
     ok: bool
     reason: str
@@ -87,6 +88,8 @@ def corpus_files(root: Path) -> list[tuple[Path, str, str]]:
         source = "/".join(rel.parts[:2])
         if path.suffix == ".xml" and rel.parts[0] == "bt":
             found.append((path, source, "bt"))
+        elif path.suffix == ".xml" and rel.parts[:2] == ("fsm", "yasmin"):
+            found.append((path, source, "yasmin"))
         elif path.suffix == ".scxml":
             found.append((path, source, "scxml"))
         elif path.suffix == ".py" and "flexbe" in rel.parts[1]:
@@ -211,7 +214,7 @@ def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--setting", choices=SETTINGS, action="append")
     parser.add_argument("--markdown", action="store_true")
-    parser.add_argument("--kind", choices=("bt", "scxml", "smach", "flexbe"), action="append")
+    parser.add_argument("--kind", choices=KINDS, action="append")
     parser.add_argument(
         "--budget",
         type=int,
@@ -279,7 +282,7 @@ def main() -> int:
             )
         elif bt_rows:
             print("refused by BehaviorTree.CPP itself: not checked (behaviortreepy missing)")
-        for kind in ("bt", "scxml", "smach", "flexbe"):
+        for kind in KINDS:
             mine = [r for r in positive if r.kind == kind]
             if mine:
                 print(

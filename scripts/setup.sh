@@ -10,6 +10,8 @@
 #   5. the C++ runtime: BehaviorTree.CPP 4.8.2 and the LEBT driver, built by scripts/build_btcpp.sh
 #      into the machine's cache (once per machine); a machine without cmake/g++ gets one line
 #      saying what is missing and the rest of the setup still succeeds
+#   6. state-machine-cat from npm (pinned in tools/smcat) by scripts/install_smcat.sh; skipped
+#      when npm is missing or FSMBT_SKIP_SMCAT=1
 #
 # Environment: PYTHON=/path/to/python3.11 picks the interpreter; FSMBT_SKIP_NUSMV=1 skips step 4;
 # FSMBT_SKIP_BTCPP=1 skips step 5; FSMBT_CACHE moves the build cache of steps 4 and 5.
@@ -123,5 +125,8 @@ elif [ -x scripts/build_btcpp.sh ]; then
         die "scripts/build_btcpp.sh failed"
     fi
 fi
+
+# -- 6. state-machine-cat (npm, pinned): the tests check written .smcat files with it -----------
+bash scripts/install_smcat.sh
 
 say "ready: $VENV/bin/fsmbt"

@@ -93,8 +93,11 @@ def round_trip_formats(model: FSM | BTDocument) -> list[str]:
 
 #: Writers that may rewrite a model's structure while keeping its behaviour (documented in
 #: docs/formats/smach.md: a composite state's event transitions are pushed onto its inner
-#: states, outcomes become final states): read back, such a model must be proven equivalent.
-BEHAVIOUR_PRESERVING = {"smach"}
+#: states, outcomes become final states), or whose readers add what the notation declares
+#: (YASMIN: each state's class and outcomes; pytransitions: on_enter) or have no place for the
+#: machine's name (state-machine-cat, a python-statemachine class name that is not one):
+#: read back, such a model must be proven equivalent.
+BEHAVIOUR_PRESERVING = {"smach", "yasmin", "smcat", "transitions", "pystatemachine"}
 
 
 def check_round_trips(model: FSM | BTDocument, tally: Counter[str]) -> None:

@@ -13,9 +13,10 @@ def register(app: typer.Typer) -> None:
     @app.command("formats")
     def formats_command() -> None:
         """List the file formats, what they hold, and whether fsmbt reads and writes them."""
-        table = Table(
-            "format", "extensions", "models", "read", "write", "cannot hold", "description"
-        )
+        table = Table("format", "extensions", "models", "read", "write")
+        # wide enough for its header on an 80-column terminal, next to long extension lists
+        table.add_column("cannot hold", min_width=len("cannot hold"))
+        table.add_column("description")
         for fmt in formats():
             table.add_row(
                 fmt.name,

@@ -157,6 +157,10 @@ BUILTIN_FORMAT_MODULES: tuple[str, ...] = (
     "fsmbt.formats.tables.markdown",
     "fsmbt.formats.diagrams.dot",
     "fsmbt.formats.diagrams.mermaid",
+    "fsmbt.formats.yasmin.formats",
+    "fsmbt.formats.smcat.smcat_format",
+    "fsmbt.formats.transitions.config_format",
+    "fsmbt.formats.pystatemachine.class_format",
 )
 
 

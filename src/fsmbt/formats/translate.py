@@ -134,6 +134,7 @@ def translate(
         ) from None
     own_losses = _writer_losses(target.name, written)
     losses.extend(own_losses or [])
+    losses.extend(_program_losses(target.name, written))
     result = Translation(text, source_format, target.name, losses, checked=checked)
     if target.read is None:
         losses.append(f"{target.name} cannot be read back, so what it loses is not checked")
@@ -163,6 +164,16 @@ def _writer_losses(target: str, model: Model) -> list[str] | None:
 
         return smach_losses(model)
     return None
+
+
+def _program_losses(target: str, model: Model) -> list[str]:
+    """What the target program cannot do although the written file keeps it for fsmbt (the
+    read-back comparison cannot see these)."""
+    if target == "yasmin":
+        from fsmbt.formats.yasmin.xml_write import yasmin_losses
+
+        return yasmin_losses(model)
+    return []
 
 
 _NCNAME = re.compile(r"[A-Za-z_][A-Za-z0-9_.\-]*\Z")

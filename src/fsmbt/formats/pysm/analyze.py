@@ -143,6 +143,8 @@ class Container:
     inputs: list[str] = field(default_factory=list)  # input_keys
     outputs: list[str] = field(default_factory=list)  # output_keys
     userdata: dict[str, str] = field(default_factory=dict)  # ``c.userdata.k = v``: k -> text
+    # YASMIN OrthogonalState: JoinState barriers, each a list of (region label, state in it)
+    sync_groups: list[list[tuple[str, str]]] = field(default_factory=list)
 
     @property
     def name(self) -> str:

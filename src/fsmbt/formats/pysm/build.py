@@ -71,7 +71,7 @@ from fsmbt.model import state_info
 from fsmbt.model.errors import InputError, SourceLocation, UnsupportedError
 from fsmbt.model.files import note_read, read_bounded, read_located
 from fsmbt.model.flatten import flatten
-from fsmbt.model.fsm import FSM, State
+from fsmbt.model.fsm import FSM, State, Transition
 
 MAX_PRODUCT_STATES = 20_000
 #: Where a concurrence child is: ``(False, flat state)`` while it runs, ``(True, outcome)`` done.
@@ -580,6 +580,11 @@ class Builder:
                 queue.append(key)
             return names[key]
 
+        barriers: dict[tuple[int, str], list[tuple[int, str]]] = {}
+        for members in container.sync_groups:
+            parties = [(labels.index(label), state) for label, state in members]
+            for party in parties:
+                barriers[party] = parties
         fsm.initial = visit((start_positions, start_action))
         stuck: list[str] = []
         reached: set[str] = set()
@@ -590,12 +595,20 @@ class Builder:
             for index, (done, current) in enumerate(positions):
                 if done:
                     continue
+                group = barriers.get((index, current))
                 for event, transition in tables[index].get(current, {}).items():
                     if event is None:
                         continue
                     target_state = machines[index].states[transition.target]
-                    moved: Position = (target_state.final, transition.target)
-                    after = positions[:index] + (moved,) + positions[index + 1 :]
+                    action = None if target_state.final else target_state.action
+                    if group is not None:
+                        passed = self.barrier(group, index, positions, tables, machines)
+                        if passed is None:
+                            continue  # not every party has arrived (or another one leads)
+                        after, action = passed
+                    else:
+                        moved: Position = (target_state.final, transition.target)
+                        after = positions[:index] + (moved,) + positions[index + 1 :]
                     combo = tuple(name if is_done else None for is_done, name in after)
                     qualified = f"{labels[index]}.{event}" if shared else event
                     decided = self.decide(container, smach, labels, combo)
@@ -603,7 +616,6 @@ class Builder:
                         reached.add(decided)
                         fsm.add_transition(source, qualified, decided)
                         continue
-                    action = None if target_state.final else target_state.action
                     target = visit((after, action))
                     fsm.add_transition(source, qualified, target)
                     if all(is_done for is_done, _ in after):
@@ -652,6 +664,38 @@ class Builder:
         )
         if container.default_outcome is not None:
             attrs[A_DEFAULT] = container.default_outcome
+
+    def barrier(
+        self,
+        group: list[tuple[int, str]],
+        index: int,
+        positions: tuple[Position, ...],
+        tables: list[dict[str, dict[str | None, Transition]]],
+        machines: list[FSM],
+    ) -> tuple[tuple[Position, ...], str | None] | None:
+        """A YASMIN JoinState barrier: every party leaves at once, when every one has arrived.
+
+        ``group`` lists (child index, join state) of one ``sync_id``; the step is taken from
+        its first party only (one product transition per crossing). ``None`` while a party is
+        elsewhere: a region that ends without reaching its join leaves the others waiting, as
+        YASMIN's ``RegionBarrier`` does (docs/formats/yasmin.md). Returns the positions after
+        the crossing and the actions the parties start (``+``-joined).
+        """
+        if group[0][0] != index:
+            return None
+        moved = list(positions)
+        actions: list[str] = []
+        for child, state in group:
+            if positions[child] != (False, state):
+                return None
+            steps = [t for e, t in tables[child].get(state, {}).items() if e is not None]
+            if not steps:
+                return None
+            target = machines[child].states[steps[0].target]
+            moved[child] = (target.final, target.name)
+            if not target.final and target.action is not None:
+                actions.append(target.action)
+        return tuple(moved), "+".join(actions) or None
 
     def owner_state(self, work: _Work) -> State | None:
         return self.owners.get(id(work.machine))
@@ -902,6 +946,25 @@ def build_fsm(
     ):
         fsm.start_name, fsm.initial_event = start["name"], start["event"]
     return fsm
+
+
+def build_records(root: Container, name: str, ctx: ReadContext, analysis: Analysis) -> FSM:
+    """The FSM of container records another reader made (YASMIN XML and Python).
+
+    Args:
+        root: the top container (its children already filled in).
+        name: the machine's name.
+        ctx: the read context (file, warnings).
+        analysis: what the reader found (its warnings are recorded, located in ``ctx``'s file).
+
+    Returns:
+        The hierarchical FSM, built by the same rules as SMACH's (module docstring).
+    """
+    main = _Source(ctx.path.resolve() if ctx.path is not None else None, ctx.display_name, analysis)
+    builder = Builder(ctx, main)
+    for line, message in analysis.warnings:
+        builder.warn(main, line, message)
+    return builder.build(root, name)
 
 
 def build_concurrence(container: Container, name: str) -> FSM:
