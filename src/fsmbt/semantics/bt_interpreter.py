@@ -7,8 +7,9 @@ a *frame* ``(node id, pc, locals...)`` on an explicit stack; ticking a child pus
 child's return pops it and resumes the parent at ``pc``. No Python recursion is used anywhere
 (trees may be 100 000 deep): compiling, ticking and halting all use explicit stacks.
 
-Which node kinds exist, which tick rule (``_t_<handler>``) runs each, their memory at rest,
-which ``halt()`` forgets it and which kinds are refused and why come from the node registry
+Which node kinds exist, which family tick rule runs each (``fsmbt.semantics.families``: one
+module per node family, bound into one dispatch dict here, docs/semantics.md §9a), their
+memory at rest, which ``halt()`` forgets it and which kinds are refused and why come from the node registry
 (``fsmbt.semantics.nodes.runtime_tables()``, docs/semantics.md "Node registry"); statuses are
 ``fsmbt.semantics.status.NodeStatus`` values (plain-int aliases below, for the hot loops).
 
