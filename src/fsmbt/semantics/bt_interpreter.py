@@ -7,8 +7,9 @@ a *frame* ``(node id, pc, locals...)`` on an explicit stack; ticking a child pus
 child's return pops it and resumes the parent at ``pc``. No Python recursion is used anywhere
 (trees may be 100 000 deep): compiling, ticking and halting all use explicit stacks.
 
-Which node kinds exist, which tick rule (``_t_<handler>``) runs each, their memory at rest,
-which ``halt()`` forgets it and which kinds are refused and why come from the node registry
+Which node kinds exist, which family tick rule runs each (``fsmbt.semantics.families``: one
+module per node family, bound into one dispatch dict here, docs/semantics.md §9a), their
+memory at rest, which ``halt()`` forgets it and which kinds are refused and why come from the node registry
 (``fsmbt.semantics.nodes.runtime_tables()``, docs/semantics.md "Node registry"); statuses are
 ``fsmbt.semantics.status.NodeStatus`` values (plain-int aliases below, for the hot loops).
 
@@ -34,26 +35,38 @@ stack depth d.
 
 from __future__ import annotations
 
-import re
 from collections.abc import Callable, Hashable
-from dataclasses import dataclass, field
+from dataclasses import dataclass
+from types import MethodType
 from typing import Any, Final
 
 from fsmbt.limits import Limits
 from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.errors import InputError, UnsupportedError
 from fsmbt.model.kinds import NodeKind
+from fsmbt.semantics.compiled import FAILURE as FAILURE
+from fsmbt.semantics.compiled import GATE_TYPE as GATE_TYPE
+from fsmbt.semantics.compiled import IDLE as IDLE
+from fsmbt.semantics.compiled import RUNNING as RUNNING
+from fsmbt.semantics.compiled import SKIPPED as SKIPPED
+from fsmbt.semantics.compiled import SUCCESS as SUCCESS
+from fsmbt.semantics.compiled import BTRuntimeError as BTRuntimeError
+from fsmbt.semantics.compiled import CompiledNode as CompiledNode
+from fsmbt.semantics.compiled import Frame as Frame
+from fsmbt.semantics.compiled import HaltHook as HaltHook
+from fsmbt.semantics.compiled import Snapshot as Snapshot
+from fsmbt.semantics.compiled import TickAction as TickAction
+from fsmbt.semantics.compiled import Work as Work
+from fsmbt.semantics.families.manual import MANUAL_STATUSES as MANUAL_STATUSES
+from fsmbt.semantics.families.manual import manual_choices as manual_choices
+from fsmbt.semantics.families.parallel import parallel_threshold as parallel_threshold
+from fsmbt.semantics.families.ports import status_param, where
+from fsmbt.semantics.families.registry import rule as family_rule
+from fsmbt.semantics.families.registry import rules as family_rules
 from fsmbt.semantics.nodes import canonical_type, enabling_option, node_semantics, runtime_tables
 from fsmbt.semantics.status import LeafOutcome, NodeStatus
 
-# -- statuses (fsmbt.semantics.status; docs/semantics.md "Statuses") ---------------------------
-# Plain-int aliases of NodeStatus for the hot loops: snapshots hold them, and an int hashes
-# three times faster than an IntEnum member (equal values, equal hashes).
-IDLE: Final[int] = NodeStatus.IDLE.value
-RUNNING: Final[int] = NodeStatus.RUNNING.value
-SUCCESS: Final[int] = NodeStatus.SUCCESS.value
-FAILURE: Final[int] = NodeStatus.FAILURE.value
-SKIPPED: Final[int] = NodeStatus.SKIPPED.value
+# -- statuses: plain-int aliases of NodeStatus for the hot loops (``fsmbt.semantics.compiled``)
 STATUS_NAMES: tuple[str, ...] = tuple(status.name for status in NodeStatus)
 #: Leaf outcomes as the environment / the leaf machine's inputs name them (plain ``str``).
 OUTCOME_SUCCESS: Final[str] = LeafOutcome.SUCCESS.value
@@ -73,153 +86,9 @@ MAX_COMPILED_NODES = Limits.max_nodes
 PRECONDITION_ATTRS = ("_skipIf", "_failureIf", "_successIf", "_while")
 
 
-class BTRuntimeError(InputError):
-    """The tree does something BehaviorTree.CPP would throw on (e.g. a child returns IDLE)."""
-
-
 class BTLivelock(BTRuntimeError):
     """``tickOnce`` would re-tick the root forever without ticking an environment leaf (e.g.
     ``Repeat num_cycles=-1`` over ``AlwaysSuccess``): the real engine hangs."""
-
-
-@dataclass(frozen=True)
-class CompiledNode:
-    """One node after SubTree expansion; ``id`` is its pre-order index."""
-
-    id: int
-    type: str
-    kind: NodeKind
-    children: tuple[int, ...]
-    label: str
-    parent: int | None
-    index: int  # position among the parent's children
-    source: BTNode = field(compare=False, repr=False)
-    params: tuple[Any, ...] = ()
-    internal_status: int | None = None  # for internal built-in leaves
-    tree: CompiledTree | None = field(default=None, compare=False, repr=False)
-
-    @property
-    def path(self) -> str:
-        """Child indices from the root joined by ``/`` (``""`` for the root); a SubTree node
-        has its tree's root as child 0. Computed on demand: O(depth)."""
-        assert self.tree is not None
-        return self.tree.path_of(self.id)
-
-    @property
-    def is_env_leaf(self) -> bool:
-        """A leaf whose outcome the environment decides (observable in traces)."""
-        return self.kind in (NodeKind.ACTION, NodeKind.CONDITION) and self.internal_status is None
-
-    @property
-    def is_condition(self) -> bool:
-        return self.kind is NodeKind.CONDITION
-
-
-def _where(node: BTNode) -> dict[str, Any]:
-    return {"location": node.location, "element": f"<{node.type}> '{node.label}'"}
-
-
-def _int_param(node: BTNode, port: str, default: int | None) -> int:
-    raw = node.attrs.get(port)
-    if raw is None:
-        if default is None:
-            raise InputError(f"missing port '{port}'", **_where(node))
-        return default
-    text = raw.strip()
-    if text.startswith("{") and text.endswith("}"):
-        raise UnsupportedError(f"port '{port}' reads the blackboard ({text})", **_where(node))
-    try:
-        return int(text)
-    except ValueError:
-        raise InputError(f"port '{port}' is not an integer: {raw!r}", **_where(node)) from None
-
-
-def _bool_param(node: BTNode, port: str, default: bool) -> bool:
-    raw = node.attrs.get(port)
-    if raw is None:
-        return default
-    text = raw.strip().lower()
-    if text in ("true", "1"):
-        return True
-    if text in ("false", "0"):
-        return False
-    if text.startswith("{"):
-        raise UnsupportedError(f"port '{port}' reads the blackboard ({raw})", **_where(node))
-    raise InputError(f"port '{port}' is not a boolean: {raw!r}", **_where(node))
-
-
-def _status_param(node: BTNode, port: str | None, default: str) -> int:
-    """A port naming the status a node returns (``Precondition``'s ``else``...)."""
-    raw = node.attrs.get(port) if port is not None else None
-    text = (raw if raw is not None else default).strip()
-    if text.startswith("{"):
-        raise UnsupportedError(f"port '{port}' reads the blackboard ({text})", **_where(node))
-    if text not in ("SUCCESS", "FAILURE", "RUNNING", "SKIPPED"):
-        raise InputError(f"port '{port}' is not a status: {raw!r}", **_where(node))
-    return int(NodeStatus[text])
-
-
-#: How BehaviorTree.CPP 4.8 reads one element of a literal Loop queue (convertFromString<T>):
-#: int: std::from_chars (a leading '-' and digits; the rest is ignored; int32 bounds), double:
-#: std::stod (leading spaces, then a number, inf or nan), bool: the six spellings it accepts.
-_INT_ELEMENT = re.compile(r"-?\d+")
-_DOUBLE_ELEMENT = re.compile(r"\s*[+-]?(\d|\.\d|inf|nan)", re.IGNORECASE)
-_BOOL_ELEMENTS = frozenset({"0", "1", "true", "TRUE", "True", "false", "FALSE", "False"})
-
-
-def _queue_elements(text: str) -> list[str]:
-    """BehaviorTree.CPP's ``splitString(queue, ';')``: "" has no element, a trailing ';'
-    adds none, ";;" in the middle adds an empty one."""
-    parts: list[str] = []
-    pos = 0
-    while pos < len(text):
-        end = text.find(";", pos)
-        end = len(text) if end < 0 else end
-        parts.append(text[pos:end])
-        pos = end + 1
-    return parts
-
-
-def _element_ok(ctype: str, element: str) -> bool:
-    if ctype == "LoopInt":
-        match = _INT_ELEMENT.match(element)
-        return match is not None and -(2**31) <= int(match.group()) < 2**31
-    if ctype == "LoopDouble":
-        return _DOUBLE_ELEMENT.match(element) is not None
-    if ctype == "LoopBool":
-        return element in _BOOL_ELEMENTS
-    return True  # LoopString: any text
-
-
-def _loop_params(node: BTNode, ctype: str, literal: bool) -> tuple[int, int]:
-    """``(if_empty status, queue length)`` of a Loop node; length ``-1``: a {blackboard}
-    queue (an abstraction, its gate says whether an element is left)."""
-    if_empty = _status_param(node, "if_empty", "SUCCESS")
-    raw = node.attrs.get("queue")
-    if raw is None:
-        raise InputError(f"{ctype}: missing port 'queue'", **_where(node))
-    if not literal:
-        return (if_empty, -1)
-    if canonical_type(node.type) != ctype:
-        raise UnsupportedError(
-            f"{node.type} (read as {ctype}) has a literal queue {raw!r}: how many elements it "
-            "holds depends on the element type's own convertFromString; give the queue as a "
-            f"{{blackboard}} entry (an abstraction) or use {ctype} itself",
-            **_where(node),
-        )
-    elements = _queue_elements(raw)
-    for element in elements:
-        if not _element_ok(ctype, element):
-            raise InputError(
-                f"{ctype}: queue element {element!r} of {raw!r} is not a valid "
-                f"{ctype[4:].lower()} (BehaviorTree.CPP refuses to build the tree)",
-                **_where(node),
-            )
-    return (if_empty, len(elements))
-
-
-#: The type of the synthetic gate leaves (never a registered kind, so always an env leaf).
-GATE_TYPE = "_fsmbt_gate"
 
 
 def _gate_leaf(node: BTNode, ctype: str) -> BTNode | None:
@@ -233,39 +102,6 @@ def _gate_leaf(node: BTNode, ctype: str) -> BTNode | None:
     return BTNode(
         GATE_TYPE, NodeKind.CONDITION, f"{node.label}.{spec.gate.word}", location=node.location
     )
-
-
-#: The person's picks of a ManualSelector besides its children (manual_node.cpp: S, F, R keys).
-MANUAL_STATUSES: tuple[int, ...] = (SUCCESS, FAILURE, RUNNING)
-
-
-def manual_choices(n_children: int, repeat_last: bool) -> int:
-    """How many picks a ManualSelector offers: its children and the three statuses; with
-    ``repeat_last_selection`` the children only (a status picked there makes BehaviorTree.CPP
-    4.8.2 index past its children on the next tick; docs/semantics.md); without children the
-    three statuses."""
-    if n_children == 0:
-        return len(MANUAL_STATUSES)
-    return n_children if repeat_last else n_children + len(MANUAL_STATUSES)
-
-
-def _choice_leaves(node: BTNode, n_children: int, repeat_last: bool) -> list[BTNode]:
-    """The conditions that ask the person for a ManualSelector's pick, one per pick but the
-    last (docs/semantics.md, "ManualSelector"): ``pick_<i>`` (child i, 1-based as the terminal
-    UI numbers them), ``pick_SUCCESS``, ``pick_FAILURE``; the first that answers SUCCESS is the
-    pick, none means the last pick (RUNNING, or the last child with repeat_last_selection)."""
-    words = [f"pick_{i + 1}" for i in range(n_children)]
-    if n_children == 0 or not repeat_last:
-        words += [f"pick_{NodeStatus(s).name}" for s in MANUAL_STATUSES]
-    return [
-        BTNode(GATE_TYPE, NodeKind.CONDITION, f"{node.label}.{word}", location=node.location)
-        for word in words[: manual_choices(n_children, repeat_last) - 1]
-    ]
-
-
-def parallel_threshold(value: int, count: int) -> int:
-    """BehaviorTree.CPP's reading of a Parallel threshold: negative means "all but"."""
-    return max(count + value + 1, 0) if value < 0 else value
 
 
 class CompiledTree:
@@ -286,6 +122,12 @@ class CompiledTree:
                 location=tree.location,
                 element=f"BehaviorTree '{tree.id}'",
             )
+        tables = runtime_tables()
+        extra_children = {
+            kind: found.extra_children
+            for kind, handler in tables.handlers.items()
+            if (found := family_rule(handler)) is not None and found.extra_children is not None
+        }
         children_of: dict[int, list[int]] = {}
         raw: list[tuple[BTNode, str, int | None, int, tuple[Any, ...], int | None, NodeKind]] = []
         stack: list[tuple[BTNode, int | None, int, tuple[str, ...]]] = [
@@ -307,8 +149,9 @@ class CompiledTree:
             gate = _gate_leaf(node, ctype)
             if gate is not None:
                 kids = [*kids, gate]  # the gate is the last child (docs/semantics.md §10)
-            if ctype == "ManualSelector":  # the person's pick: conditions after the children
-                kids = [*kids, *_choice_leaves(node, *params)]
+            extra = extra_children.get(ctype)
+            if extra is not None:  # e.g. ManualSelector's picks: conditions after the children
+                kids = [*kids, *extra(node, params)]
             if ctype == "SubTree":
                 target = node.attrs["ID"]
                 kids = [self.doc.trees[target].root]  # type: ignore[list-item]
@@ -378,7 +221,7 @@ class CompiledTree:
         for attr in PRECONDITION_ATTRS:
             if attr in node.attrs:
                 raise UnsupportedError(
-                    f"pre-condition '{attr}' depends on the blackboard", **_where(node)
+                    f"pre-condition '{attr}' depends on the blackboard", **where(node)
                 )
         spec = node_semantics(ctype)
         # a kind that is an abstraction only for a {blackboard} port (the Loop family's
@@ -402,11 +245,11 @@ class CompiledTree:
             raise UnsupportedError(
                 f"{ctype}: {why}; enable it with {enabling_option(spec.requires)} (an "
                 f"abstraction: {spec.abstraction})",
-                **_where(node),
+                **where(node),
             )
         reason = tables.rejected.get(ctype)
         if reason is not None and node.semantics is None and not exact_here:
-            raise UnsupportedError(f"{ctype}: {reason}", **_where(node))
+            raise UnsupportedError(f"{ctype}: {reason}", **where(node))
         kids = list(node.children)
         params: tuple[Any, ...] = ()
         internal: int | None = None
@@ -416,7 +259,7 @@ class CompiledTree:
                 kind = NodeKind.CONDITION
             elif spec.gate is not None and kind in (NodeKind.ACTION, NodeKind.CONDITION):
                 if kids:
-                    raise InputError("a leaf node has children", **_where(node))
+                    raise InputError("a leaf node has children", **where(node))
                 return ctype, NodeKind.DECORATOR, params, internal, kids  # Sleep: gate only
         if kind is NodeKind.SUBTREE or ctype == "SubTree":
             kind = NodeKind.SUBTREE
@@ -426,85 +269,72 @@ class CompiledTree:
                 raise InputError(
                     f"SubTree refers to unknown tree {target!r} (a tree of another file: name "
                     "that file or its folder with --trees PATH)",
-                    **_where(node),
+                    **where(node),
                 )
             if target in chain:
                 raise UnsupportedError(
-                    f"SubTree '{target}' includes itself (recursion)", **_where(node)
+                    f"SubTree '{target}' includes itself (recursion)", **where(node)
                 )
             if self.doc.trees[target].root is None:
-                raise InputError(f"SubTree '{target}' is empty", **_where(node))
+                raise InputError(f"SubTree '{target}' is empty", **where(node))
             return ctype, kind, params, internal, []
         if kind in (NodeKind.ACTION, NodeKind.CONDITION):
             if kids:
-                raise InputError("a leaf node has children", **_where(node))
+                raise InputError("a leaf node has children", **where(node))
             if ctype in tables.internal_leaves:
                 internal = tables.internal_leaves[ctype]
             elif spec is not None and spec.handler == "env_condition" and node.semantics:
                 pass  # an abstraction: a condition the environment answers
             elif spec is not None:
-                raise UnsupportedError(f"built-in leaf {ctype} is not supported", **_where(node))
+                raise UnsupportedError(f"built-in leaf {ctype} is not supported", **where(node))
             return ctype, kind, params, internal, kids
         if kind is NodeKind.DECORATOR:
             if ctype not in tables.decorators:
                 raise UnsupportedError(
                     f"decorator type '{node.type}' is not supported (custom or unknown semantics)",
-                    **_where(node),
+                    **where(node),
                 )
             if len(kids) != 1:
                 raise InputError(
-                    f"decorator {ctype} needs exactly one child, has {len(kids)}", **_where(node)
+                    f"decorator {ctype} needs exactly one child, has {len(kids)}", **where(node)
                 )
-            if ctype == "Repeat":
-                params = (_int_param(node, "num_cycles", None),)
-            elif ctype == "RetryUntilSuccessful":
-                params = (_int_param(node, "num_attempts", None),)
-            elif ctype == "RunOnce":
-                params = (_bool_param(node, "then_skip", True),)
-            elif ctype == "RepeatUnlessFailureEachTick":
-                params = (_int_param(node, "num_cycles", -1),)
-            elif spec is not None and spec.handler == "loop_queue":
-                params = _loop_params(node, ctype, exact_here)
-            elif spec is not None and spec.gate is not None:
-                params = (_status_param(node, spec.closed_port, spec.gate.closed),)
+            params = self._family_params(node, ctype, exact_here)
+            if not params and spec is not None and spec.gate is not None:
+                params = (status_param(node, spec.closed_port, spec.gate.closed),)
             return ctype, kind, params, internal, kids
         if kind is NodeKind.CONTROL:
             if ctype not in tables.controls:
                 raise UnsupportedError(
                     f"control type '{node.type}' is not supported (custom or unknown semantics)",
-                    **_where(node),
+                    **where(node),
                 )
             spec = node_semantics(ctype)
             if not kids and (spec is None or not spec.allows_children(0)):
-                raise InputError(f"control node {ctype} has no children", **_where(node))
+                raise InputError(f"control node {ctype} has no children", **where(node))
             n = len(kids)
             counts = spec.child_counts if spec is not None else None
             if counts is not None and n not in counts:
                 allowed = " or ".join(str(c) for c in counts)
-                raise InputError(f"{ctype} needs {allowed} children, has {n}", **_where(node))
-            if ctype == "Parallel":
-                succ = _int_param(node, "success_count", -1)
-                fail = _int_param(node, "failure_count", 1)
-                if n < parallel_threshold(succ, n) or n < parallel_threshold(fail, n):
-                    raise InputError(
-                        "Parallel threshold exceeds the number of children", **_where(node)
-                    )
-                params = (succ, fail)
-            elif ctype == "RecoveryNode":
-                params = (_int_param(node, "number_of_retries", 1),)
-            elif ctype == "RoundRobin":
-                params = (_bool_param(node, "wrap_around", False),)
-            elif ctype == "ManualSelector":
-                params = (n, _bool_param(node, "repeat_last_selection", False))
-            elif ctype == "ParallelAll":
-                fail = _int_param(node, "max_failures", 1)
-                if n < parallel_threshold(fail, n):
-                    raise InputError(
-                        "ParallelAll max_failures exceeds the number of children", **_where(node)
-                    )
-                params = (parallel_threshold(fail, n),)
+                raise InputError(f"{ctype} needs {allowed} children, has {n}", **where(node))
+            params = self._family_params(node, ctype, exact_here)
             return ctype, kind, params, internal, kids
-        raise UnsupportedError(f"node kind {kind} is not supported", **_where(node))
+        raise UnsupportedError(f"node kind {kind} is not supported", **where(node))
+
+    @staticmethod
+    def _family_params(node: BTNode, ctype: str, exact: bool) -> tuple[Any, ...]:
+        """The node's ports read and checked by its family (``FamilyRule.params``; ``()`` for
+        a family without ports; docs/semantics.md "Node families")."""
+        handler = runtime_tables().handlers[ctype]
+        found = family_rule(handler)
+        if found is None:
+            raise UnsupportedError(
+                f"{ctype}: its tick rule {handler!r} is not registered "
+                "(fsmbt.semantics.families.registry.register_rule)",
+                **where(node),
+            )
+        if found.params is None:
+            return ()
+        return found.params(node, ctype, exact)
 
     @property
     def root(self) -> CompiledNode:
@@ -512,16 +342,6 @@ class CompiledTree:
 
 
 # -- run-time configuration ------------------------------------------------------------------
-#: A snapshot: (statuses, memories, frames, wake-up pending). Hashable; equal snapshots behave
-#: the same for every future input.
-Snapshot = tuple[
-    tuple[tuple[int, int], ...],
-    tuple[tuple[int, tuple[Any, ...]], ...],
-    tuple[tuple[Any, ...], ...],
-    bool,
-]
-
-
 @dataclass(frozen=True)
 class LeafRequest:
     """The interpreter is about to tick an environment leaf; ``prev`` is its status (IDLE =
@@ -538,34 +358,8 @@ class TickDone:
     status: int
 
 
-HaltHook = Callable[[CompiledNode], None]
-#: A frame on the interpreter's stack: (node id, pc, locals...).
-Frame = tuple[Any, ...]
-#: What a tick rule does next: ("call", child id, new frame) or ("ret", status).
-TickAction = tuple[Any, ...]
-#: A node kind's tick rule (``BTInterpreter._t_<handler>``).
-TickRule = Callable[["_Work", CompiledNode, Frame, "int | None", "HaltHook | None"], TickAction]
-
-
-class _Work:
-    """The mutable working copy of a snapshot."""
-
-    __slots__ = ("st", "mem", "frames", "wake")
-
-    def __init__(self, snap: Snapshot) -> None:
-        self.st: dict[int, int] = dict(snap[0])
-        self.mem: dict[int, tuple[Any, ...]] = dict(snap[1])
-        self.frames: list[tuple[Any, ...]] = list(snap[2])
-        self.wake: bool = snap[3]
-
-    def snapshot(self) -> Snapshot:
-        return (
-            tuple(sorted(self.st.items())),
-            tuple(sorted(self.mem.items())),
-            tuple(self.frames),
-            self.wake,
-        )
-
+#: A node kind's tick rule bound to an interpreter (a family's ``FamilyRule.tick``).
+TickRule = Callable[[Work, CompiledNode, Frame, "int | None", "HaltHook | None"], TickAction]
 
 EMPTY_SNAPSHOT: Snapshot = ((), (), (), False)
 
@@ -590,14 +384,19 @@ class BTInterpreter:
         self.exactly_once = exactly_once
         # Dispatch data from the node registry (docs/semantics.md "Node registry").
         tables = runtime_tables()
+        # Each kind's tick rule is its family's function bound to this interpreter
+        # (``fsmbt.semantics.families``): one dict read and one bound-method call per node tick.
+        rules = family_rules()
         self._tick: dict[str, TickRule] = {
-            kind: getattr(self, f"_t_{handler}") for kind, handler in tables.handlers.items()
+            kind: MethodType(rules[handler].tick, self)
+            for kind, handler in tables.handlers.items()
+            if handler in rules
         }
         self._default_mem = tables.default_memory
         self._halt_resets = tables.halt_resets_memory
-        self._seq_flags = tables.sequence_flags
-        self._reactive_fallbacks = tables.reactive_fallbacks
-        self._result_maps = tables.result_maps
+        self.seq_flags = tables.sequence_flags
+        self.reactive_fallbacks = tables.reactive_fallbacks
+        self.result_maps = tables.result_maps
 
     # -- public driving API --------------------------------------------------------------
     def initial(self) -> Snapshot:
@@ -617,7 +416,7 @@ class BTInterpreter:
         ``outcome`` answers the ``LeafRequest`` the snapshot stopped at (``None`` right after
         ``begin_tick``). ``halt_hook`` is called for every RUNNING action that gets halted.
         """
-        w = _Work(snap)
+        w = Work(snap)
         result: int | None = None
         seen_reticks: set[Snapshot] = set()
         if outcome is not None:
@@ -683,12 +482,12 @@ class BTInterpreter:
 
     def halt_tree(self, snap: Snapshot, halt_hook: HaltHook | None = None) -> Snapshot:
         """``Tree::haltTree``: halt the root (between ticks)."""
-        w = _Work(snap)
+        w = Work(snap)
         self._halt(w, 0, halt_hook)
         return w.snapshot()
 
     # -- helpers shared by node types -------------------------------------------------------
-    def _returned(self, w: _Work, nid: int, status: int) -> int:
+    def _returned(self, w: Work, nid: int, status: int) -> int:
         """``executeTick``'s epilogue: store the status unless SKIPPED."""
         if status == IDLE:
             raise BTRuntimeError("a node returned IDLE", element=self.nodes[nid].label)
@@ -696,28 +495,28 @@ class BTInterpreter:
             w.st[nid] = status
         return status
 
-    def _mem(self, w: _Work, node: CompiledNode) -> tuple[Any, ...]:
+    def mem(self, w: Work, node: CompiledNode) -> tuple[Any, ...]:
         return w.mem.get(node.id, self._default_mem[node.type])
 
-    def _set_mem(self, w: _Work, node: CompiledNode, value: tuple[Any, ...]) -> None:
+    def set_mem(self, w: Work, node: CompiledNode, value: tuple[Any, ...]) -> None:
         if value == self._default_mem[node.type]:
             w.mem.pop(node.id, None)
         else:
             w.mem[node.id] = value
 
-    def _reset_child(self, w: _Work, child: int, hook: HaltHook | None) -> None:
+    def reset_child(self, w: Work, child: int, hook: HaltHook | None) -> None:
         """``ControlNode::haltChild`` / ``DecoratorNode::resetChild``."""
         if w.st.get(child, IDLE) == RUNNING:
             self._halt(w, child, hook)
         w.st.pop(child, None)
 
-    def _reset_children(
-        self, w: _Work, node: CompiledNode, hook: HaltHook | None, first: int = 0
+    def reset_children(
+        self, w: Work, node: CompiledNode, hook: HaltHook | None, first: int = 0
     ) -> None:
         for child in node.children[first:]:
-            self._reset_child(w, child, hook)
+            self.reset_child(w, child, hook)
 
-    def _halt(self, w: _Work, nid: int, hook: HaltHook | None) -> None:
+    def _halt(self, w: Work, nid: int, hook: HaltHook | None) -> None:
         """``haltNode()``: per-type ``halt()``, halting RUNNING descendants (explicit stack,
         pre-order, as the recursive C++ does)."""
         stack = [nid]
@@ -741,726 +540,6 @@ class BTInterpreter:
                     w.st.pop(child, None)
             w.st.pop(x.id, None)
             # running children reset their own status when popped (after their halt)
-
-    # -- node types: each returns ("call", child, new_frame) or ("ret", status) ---------------
-    def _t_sequence(
-        self, w: _Work, node: CompiledNode, frame: Frame, result: int | None, hook: HaltHook | None
-    ) -> TickAction:
-        """Sequence / Fallback / Async* / SequenceWithMemory (sequence_node.cpp & co)."""
-        is_fallback, asynch, with_memory = self._seq_flags[node.type]
-        stop, go_on = (SUCCESS, FAILURE) if is_fallback else (FAILURE, SUCCESS)
-        idx, skipped = self._mem(w, node)
-        n = len(node.children)
-        if frame[1] == 0:
-            if w.st.get(node.id, IDLE) == IDLE:  # !isStatusActive(status())
-                skipped = 0
-            w.st[node.id] = RUNNING
-        else:
-            prev = frame[2]
-            if result == RUNNING:
-                self._set_mem(w, node, (idx, skipped))
-                return ("ret", RUNNING)
-            if result == stop:
-                if with_memory:
-                    self._reset_children(w, node, hook, first=idx)
-                else:
-                    self._reset_children(w, node, hook)
-                    idx = 0
-                self._set_mem(w, node, (idx, skipped))
-                return ("ret", stop)
-            if result == go_on:
-                idx += 1
-                if (asynch or with_memory) and prev == IDLE and idx < n:
-                    w.wake = True
-                    self._set_mem(w, node, (idx, skipped))
-                    return ("ret", RUNNING)
-            elif result == SKIPPED:
-                idx += 1
-                skipped += 1
-            else:
-                raise BTRuntimeError("a child returned IDLE", element=node.label)
-        if idx < n:
-            child = node.children[idx]
-            self._set_mem(w, node, (idx, skipped))
-            return ("call", child, (node.id, 1, w.st.get(child, IDLE)))
-        all_skipped = skipped == n
-        self._reset_children(w, node, hook)
-        self._set_mem(w, node, (0, 0))
-        return ("ret", SKIPPED if all_skipped else go_on)
-
-    def _t_reactive(
-        self, w: _Work, node: CompiledNode, frame: Frame, result: int | None, hook: HaltHook | None
-    ) -> TickAction:
-        """ReactiveSequence / ReactiveFallback (reactive_sequence.cpp, reactive_fallback.cpp)."""
-        is_fallback = node.type in self._reactive_fallbacks
-        stop, go_on = (SUCCESS, FAILURE) if is_fallback else (FAILURE, SUCCESS)
-        if frame[1] == 0:
-            w.st[node.id] = RUNNING
-            index, all_skipped = 0, True
-        else:
-            index, all_skipped = frame[2], frame[3]
-            all_skipped = all_skipped and result == SKIPPED
-            if result == RUNNING:
-                for i, child in enumerate(node.children):
-                    if i != index:
-                        self._reset_child(w, child, hook)
-                return ("ret", RUNNING)
-            if result == stop:
-                self._reset_children(w, node, hook)
-                return ("ret", stop)
-            if result == SKIPPED:
-                self._reset_child(w, node.children[index], hook)
-            elif result != go_on:
-                raise BTRuntimeError("a child returned IDLE", element=node.label)
-            index += 1
-        if index < len(node.children):
-            return ("call", node.children[index], (node.id, 1, index, all_skipped))
-        self._reset_children(w, node, hook)
-        return ("ret", SKIPPED if all_skipped else go_on)
-
-    def _t_parallel(
-        self, w: _Work, node: CompiledNode, frame: Frame, result: int | None, hook: HaltHook | None
-    ) -> TickAction:
-        """Parallel with success_count / failure_count (parallel_node.cpp)."""
-        n = len(node.children)
-        succ_param, fail_param = node.params
-        need_s, need_f = parallel_threshold(succ_param, n), parallel_threshold(fail_param, n)
-        completed, sc, fc = self._mem(w, node)
-        if frame[1] == 0:
-            w.st[node.id] = RUNNING
-            i, skipped = 0, 0
-            checked = False
-        else:
-            i, skipped = frame[2], frame[3]
-            if result == SKIPPED:
-                skipped += 1
-            elif result == SUCCESS:
-                completed, sc = completed | {i}, sc + 1
-            elif result == FAILURE:
-                completed, fc = completed | {i}, fc + 1
-            elif result != RUNNING:
-                raise BTRuntimeError("a child returned IDLE", element=node.label)
-            checked = True  # the child at i was ticked: run the checks for i below
-        while i < n:
-            if not checked and i not in completed:
-                self._set_mem(w, node, (completed, sc, fc))
-                return ("call", node.children[i], (node.id, 1, i, skipped))
-            checked = False
-            if sc >= need_s or (succ_param < 0 and sc + skipped >= need_s):
-                self._set_mem(w, node, (frozenset(), 0, 0))
-                self._reset_children(w, node, hook)
-                return ("ret", SUCCESS)
-            if (n - fc) < need_s or fc == need_f:
-                self._set_mem(w, node, (frozenset(), 0, 0))
-                self._reset_children(w, node, hook)
-                return ("ret", FAILURE)
-            i += 1
-        self._set_mem(w, node, (completed, sc, fc))
-        return ("ret", SKIPPED if skipped == n else RUNNING)
-
-    def _t_parallel_all(
-        self, w: _Work, node: CompiledNode, frame: Frame, result: int | None, hook: HaltHook | None
-    ) -> TickAction:
-        """ParallelAll with max_failures (parallel_all_node.cpp)."""
-        n = len(node.children)
-        (need_f,) = node.params
-        completed, fc = self._mem(w, node)
-        if frame[1] == 0:
-            w.st[node.id] = RUNNING
-            i, skipped = 0, 0
-        else:
-            i, skipped = frame[2], frame[3]
-            if result == SUCCESS:
-                completed = completed | {i}
-            elif result == FAILURE:
-                completed, fc = completed | {i}, fc + 1
-            elif result == SKIPPED:
-                skipped += 1
-            elif result != RUNNING:
-                raise BTRuntimeError("a child returned IDLE", element=node.label)
-            i += 1
-        while i < n and i in completed:
-            i += 1
-        if i < n:
-            self._set_mem(w, node, (completed, fc))
-            return ("call", node.children[i], (node.id, 1, i, skipped))
-        if skipped == n:
-            self._set_mem(w, node, (completed, fc))
-            return ("ret", SKIPPED)
-        if skipped + len(completed) >= n:
-            self._reset_children(w, node, hook)  # haltChildren()
-            status = FAILURE if fc >= need_f else SUCCESS
-            self._set_mem(w, node, (frozenset(), 0))
-            return ("ret", status)
-        self._set_mem(w, node, (completed, fc))
-        return ("ret", RUNNING)
-
-    def _t_if_then_else(
-        self, w: _Work, node: CompiledNode, frame: Frame, result: int | None, hook: HaltHook | None
-    ) -> TickAction:
-        """IfThenElse (if_then_else_node.cpp): the condition is not re-evaluated while a branch
-        runs."""
-        (child_idx,) = self._mem(w, node)
-        n = len(node.children)
-        pc = frame[1]
-        if pc == 0:
-            w.st[node.id] = RUNNING
-            if child_idx == 0:
-                return ("call", node.children[0], (node.id, 1))
-        elif pc == 1:
-            if result == RUNNING:
-                return ("ret", RUNNING)
-            if result == SUCCESS:
-                child_idx = 1
-            elif result == FAILURE:
-                if n == 3:
-                    child_idx = 2
-                else:
-                    return ("ret", FAILURE)
-            else:
-                raise BTRuntimeError(
-                    "IfThenElse: the condition was skipped (BehaviorTree.CPP throws a logic_error)",
-                    element=node.label,
-                )
-            self._set_mem(w, node, (child_idx,))
-        else:  # pc == 2: the branch returned
-            if result == RUNNING:
-                return ("ret", RUNNING)
-            self._reset_children(w, node, hook)
-            self._set_mem(w, node, (0,))
-            return ("ret", result)
-        return ("call", node.children[child_idx], (node.id, 2))
-
-    def _t_while_do_else(
-        self, w: _Work, node: CompiledNode, frame: Frame, result: int | None, hook: HaltHook | None
-    ) -> TickAction:
-        """WhileDoElse (while_do_else_node.cpp): the condition is re-evaluated every tick."""
-        n = len(node.children)
-        pc = frame[1]
-        if pc == 0:
-            w.st[node.id] = RUNNING
-            return ("call", node.children[0], (node.id, 1))
-        if pc == 1:
-            if result == RUNNING:
-                return ("ret", RUNNING)
-            if result == SUCCESS:
-                if n == 3:
-                    self._reset_child(w, node.children[2], hook)
-                return ("call", node.children[1], (node.id, 2))
-            if result == FAILURE:
-                if n == 3:
-                    self._reset_child(w, node.children[1], hook)
-                    return ("call", node.children[2], (node.id, 2))
-                status = FAILURE
-            else:
-                raise BTRuntimeError(
-                    "WhileDoElse: the condition was skipped (the node would return IDLE)",
-                    element=node.label,
-                )
-        else:
-            assert result is not None  # pc == 2: the branch returned
-            status = result
-        if status == RUNNING:
-            return ("ret", RUNNING)
-        self._reset_children(w, node, hook)
-        return ("ret", status)
-
-    def _t_simple_decorator(
-        self, w: _Work, node: CompiledNode, frame: Frame, result: int | None, hook: HaltHook | None
-    ) -> TickAction:
-        """Inverter, ForceSuccess, ForceFailure, KeepRunningUntilFailure."""
-        child = node.children[0]
-        if frame[1] == 0:
-            w.st[node.id] = RUNNING
-            return ("call", child, (node.id, 1))
-        mapped = self._result_maps.get(node.type)
-        if mapped is None:  # KeepRunningUntilFailure
-            if result == FAILURE:
-                self._reset_child(w, child, hook)
-                return ("ret", FAILURE)
-            if result == SUCCESS:
-                self._reset_child(w, child, hook)
-                return ("ret", RUNNING)
-            return ("ret", RUNNING)  # RUNNING, or `return status()` (RUNNING) when skipped
-        if result in (RUNNING, SKIPPED):
-            return ("ret", result)
-        self._reset_child(w, child, hook)
-        return ("ret", mapped[0] if result == SUCCESS else mapped[1])
-
-    def _t_repeat(
-        self, w: _Work, node: CompiledNode, frame: Frame, result: int | None, hook: HaltHook | None
-    ) -> TickAction:
-        """Repeat num_cycles (repeat_node.cpp); -1 repeats forever."""
-        return self._loop_decorator(w, node, frame, result, hook, again_on=SUCCESS)
-
-    def _t_retry(
-        self, w: _Work, node: CompiledNode, frame: Frame, result: int | None, hook: HaltHook | None
-    ) -> TickAction:
-        """RetryUntilSuccessful num_attempts (retry_node.cpp); -1 retries forever."""
-        return self._loop_decorator(w, node, frame, result, hook, again_on=FAILURE)
-
-    def _loop_decorator(
-        self,
-        w: _Work,
-        node: CompiledNode,
-        frame: Frame,
-        result: int | None,
-        hook: HaltHook | None,
-        *,
-        again_on: int,
-    ) -> TickAction:
-        """Repeat and RetryUntilSuccessful are mirror images in BehaviorTree.CPP: the child is
-        ticked again while it returns ``again_on``, at most ``node.params[0]`` times (-1: no
-        bound); the other result ends the loop at once. A loop that goes on in the same tick
-        after a synchronous child asks for a wake-up and returns RUNNING, as v4 does."""
-        (limit,) = node.params
-        (count,) = self._mem(w, node)
-        child = node.children[0]
-        stop_on = FAILURE if again_on == SUCCESS else SUCCESS
-        if frame[1] == 0:
-            w.st[node.id] = RUNNING
-            do_loop = count < limit or limit == -1
-        else:
-            prev = frame[2]
-            if result == again_on:
-                # with -1 the count is never read: keep it 0 so states stay finite
-                count = count + 1 if limit != -1 else 0
-                do_loop = count < limit or limit == -1
-                self._reset_child(w, child, hook)
-                if prev == IDLE and do_loop:
-                    w.wake = True
-                    self._set_mem(w, node, (count,))
-                    return ("ret", RUNNING)
-            elif result == stop_on:
-                self._set_mem(w, node, (0,))
-                self._reset_child(w, child, hook)
-                return ("ret", stop_on)
-            elif result == RUNNING:
-                return ("ret", RUNNING)
-            elif result == SKIPPED:
-                self._reset_child(w, child, hook)
-                return ("ret", SKIPPED)
-            else:
-                raise BTRuntimeError("a child returned IDLE", element=node.label)
-        if do_loop:
-            self._set_mem(w, node, (count,))
-            return ("call", child, (node.id, 1, w.st.get(child, IDLE)))
-        self._set_mem(w, node, (0,))
-        return ("ret", again_on)
-
-    def _t_run_once(
-        self, w: _Work, node: CompiledNode, frame: Frame, result: int | None, hook: HaltHook | None
-    ) -> TickAction:
-        """RunOnce then_skip (run_once_node.h): memory survives halts."""
-        (then_skip,) = node.params
-        ticked, returned = self._mem(w, node)
-        if frame[1] == 0:
-            if ticked:
-                return ("ret", SKIPPED if then_skip else returned)
-            w.st[node.id] = RUNNING
-            return ("call", node.children[0], (node.id, 1))
-        if result in (SUCCESS, FAILURE):
-            self._set_mem(w, node, (True, result))
-            self._reset_child(w, node.children[0], hook)
-        return ("ret", result)
-
-    def _t_subtree(
-        self, w: _Work, node: CompiledNode, frame: Frame, result: int | None, hook: HaltHook | None
-    ) -> TickAction:
-        """SubTree (subtree_node.cpp): a transparent decorator; port remapping is irrelevant."""
-        if frame[1] == 0:
-            if w.st.get(node.id, IDLE) == IDLE:
-                w.st[node.id] = RUNNING
-            return ("call", node.children[0], (node.id, 1))
-        if result in (SUCCESS, FAILURE):
-            self._reset_child(w, node.children[0], hook)
-        return ("ret", result)
-
-    # -- project kinds and abstractions (docs/semantics.md §10) ---------------------------------
-    def _t_manual_selector(
-        self, w: _Work, node: CompiledNode, frame: Frame, result: int | None, hook: HaltHook | None
-    ) -> TickAction:
-        """ManualSelector (manual_node.cpp): the person's pick is asked through the choice
-        conditions after the children (``_choice_leaves``), the first SUCCESS wins; a picked
-        child's status is returned; nothing else is halted or reset."""
-        n, repeat_last = node.params
-        choices = node.children[n:]
-        pc = frame[1]
-        if pc == 0:
-            (previous,) = self._mem(w, node)
-            if n and repeat_last and previous >= 0:
-                return ("call", node.children[previous], (node.id, 2))
-            if n:
-                w.st[node.id] = RUNNING  # setStatus(RUNNING) before selectChild()
-            if not choices:  # one child under repeat_last_selection: the only pick
-                pick = 0
-            else:
-                return ("call", choices[0], (node.id, 1, 0))
-        elif pc == 1:
-            asked = frame[2]
-            w.st.pop(choices[asked], None)  # a choice keeps no status: asked afresh each time
-            if result == SUCCESS:
-                pick = asked
-            elif asked + 1 < len(choices):
-                return ("call", choices[asked + 1], (node.id, 1, asked + 1))
-            else:
-                pick = len(choices)  # none said yes: the last pick
-        else:  # pc == 2: the picked child returned
-            assert result is not None
-            return ("ret", result)
-        if pick < n:
-            if repeat_last:
-                self._set_mem(w, node, (pick,))
-            return ("call", node.children[pick], (node.id, 2))
-        return ("ret", MANUAL_STATUSES[pick - n])
-
-    def _t_pipeline(
-        self, w: _Work, node: CompiledNode, frame: Frame, result: int | None, hook: HaltHook | None
-    ) -> TickAction:
-        """Nav2 PipelineSequence (pipeline_sequence.cpp)."""
-        (last,) = self._mem(w, node)
-        n = len(node.children)
-        if frame[1] == 0:
-            w.st[node.id] = RUNNING
-            i, skipped = 0, 0
-        else:
-            i, skipped = frame[2], frame[3]
-            if result == FAILURE:
-                self._reset_children(w, node, hook)
-                self._set_mem(w, node, (0,))
-                return ("ret", FAILURE)
-            if result == SKIPPED:
-                skipped += 1
-            elif result == RUNNING:
-                if i >= last:
-                    self._set_mem(w, node, (i,))
-                    return ("ret", RUNNING)
-            elif result != SUCCESS:
-                raise BTRuntimeError("a child returned IDLE", element=node.label)
-            i += 1
-        if i < n:
-            return ("call", node.children[i], (node.id, 1, i, skipped))
-        self._reset_children(w, node, hook)
-        self._set_mem(w, node, (0,))
-        return ("ret", SKIPPED if skipped == n else SUCCESS)
-
-    def _t_recovery(
-        self, w: _Work, node: CompiledNode, frame: Frame, result: int | None, hook: HaltHook | None
-    ) -> TickAction:
-        """Nav2 RecoveryNode (recovery_node.cpp): main child 0, recovery child 1."""
-        (retries,) = node.params
-        idx, tries = self._mem(w, node)
-        main, recovery = node.children
-        if frame[1] == 0:
-            w.st[node.id] = RUNNING
-        elif idx == 0:
-            if result == RUNNING:
-                return ("ret", RUNNING)
-            if result in (SUCCESS, SKIPPED):
-                self._reset_children(w, node, hook)  # haltChild(1), then halt()
-                self._set_mem(w, node, (0, 0))
-                return ("ret", result)
-            if result != FAILURE:
-                raise BTRuntimeError("a child returned IDLE", element=node.label)
-            if tries >= retries:
-                self._reset_children(w, node, hook)
-                self._set_mem(w, node, (0, 0))
-                return ("ret", FAILURE)
-            self._reset_child(w, main, hook)
-            idx = 1
-        else:
-            if result == RUNNING:
-                return ("ret", RUNNING)
-            if result == SKIPPED:  # no recovery possible; not a retry
-                self._reset_child(w, recovery, hook)
-                self._set_mem(w, node, (0, tries))
-                return ("ret", FAILURE)
-            if result == FAILURE:
-                self._reset_children(w, node, hook)
-                self._set_mem(w, node, (0, 0))
-                return ("ret", FAILURE)
-            if result != SUCCESS:
-                raise BTRuntimeError("a child returned IDLE", element=node.label)
-            self._reset_child(w, recovery, hook)
-            idx, tries = 0, tries + 1
-        if tries <= retries:
-            self._set_mem(w, node, (idx, tries))
-            return ("call", node.children[idx], (node.id, 1))
-        self._reset_children(w, node, hook)
-        self._set_mem(w, node, (0, 0))
-        return ("ret", FAILURE)
-
-    def _t_round_robin(
-        self, w: _Work, node: CompiledNode, frame: Frame, result: int | None, hook: HaltHook | None
-    ) -> TickAction:
-        """Nav2 RoundRobin (round_robin_node.cpp), with its ``wrap_around`` port."""
-        (wrap,) = node.params
-        n = len(node.children)
-        idx, failed = self._mem(w, node)
-        ended = False
-        if frame[1] == 0:
-            w.st[node.id] = RUNNING
-            skipped = 0
-        else:
-            skipped = frame[2]
-            if result not in (SUCCESS, FAILURE, RUNNING, SKIPPED):
-                raise BTRuntimeError("a child returned IDLE", element=node.label)
-            if result != RUNNING:
-                idx += 1
-                if idx == n:
-                    if wrap:
-                        idx = 0
-                    else:  # the end of the list: counted, then the loop stops
-                        skipped += result == SKIPPED
-                        failed += result == FAILURE
-                        ended = True
-            if not ended:
-                if result == SUCCESS:
-                    self._reset_children(w, node, hook)
-                    self._set_mem(w, node, (idx, 0))
-                    return ("ret", SUCCESS)
-                if result == RUNNING:
-                    self._set_mem(w, node, (idx, failed))
-                    return ("ret", RUNNING)
-                if result == FAILURE:
-                    failed += 1
-                else:
-                    skipped += 1
-        if not ended and failed + skipped < n:
-            self._set_mem(w, node, (idx, failed))
-            return ("call", node.children[idx], (node.id, 1, skipped))
-        self._reset_children(w, node, hook)
-        self._set_mem(w, node, (0, 0))
-        return ("ret", SKIPPED if skipped == n else FAILURE)
-
-    def _t_repeat_each_tick(
-        self, w: _Work, node: CompiledNode, frame: Frame, result: int | None, hook: HaltHook | None
-    ) -> TickAction:
-        """MoveIt Pro RepeatUnlessFailureEachTick: one cycle per tick, no wake-up."""
-        (limit,) = node.params
-        (count,) = self._mem(w, node)
-        child = node.children[0]
-        if frame[1] == 0:
-            w.st[node.id] = RUNNING
-            return ("call", child, (node.id, 1))
-        if result == RUNNING:
-            return ("ret", RUNNING)
-        self._reset_child(w, child, hook)
-        if result == SUCCESS:
-            if limit != -1:  # with -1 the count is never read: keep it 0 (finite states)
-                count += 1
-                if count >= limit:
-                    self._set_mem(w, node, (0,))
-                    return ("ret", SUCCESS)
-            self._set_mem(w, node, (count,))
-            return ("ret", RUNNING)
-        if result == FAILURE:
-            self._set_mem(w, node, (0,))
-            return ("ret", FAILURE)
-        return ("ret", SKIPPED)
-
-    def _t_single_trigger(
-        self, w: _Work, node: CompiledNode, frame: Frame, result: int | None, hook: HaltHook | None
-    ) -> TickAction:
-        """Nav2 SingleTrigger: the child runs to completion once per activation."""
-        child = node.children[0]
-        if frame[1] == 0:
-            (triggered,) = self._mem(w, node)
-            if w.st.get(node.id, IDLE) == IDLE:
-                triggered = False
-                self._set_mem(w, node, (False,))
-            w.st[node.id] = RUNNING
-            if triggered:
-                return ("ret", FAILURE)
-            return ("call", child, (node.id, 1))
-        if result in (SUCCESS, FAILURE):
-            self._set_mem(w, node, (True,))
-        return ("ret", result)
-
-    def _t_pass_through(
-        self, w: _Work, node: CompiledNode, frame: Frame, result: int | None, hook: HaltHook | None
-    ) -> TickAction:
-        """A transparent wrapper (Groot 1 ``Root``): the child's status, child reset when done."""
-        if frame[1] == 0:
-            w.st[node.id] = RUNNING
-            return ("call", node.children[0], (node.id, 1))
-        if result in (SUCCESS, FAILURE):
-            self._reset_child(w, node.children[0], hook)
-        return ("ret", result)
-
-    def _t_pass_through_keep(
-        self, w: _Work, node: CompiledNode, frame: Frame, result: int | None, hook: HaltHook | None
-    ) -> TickAction:
-        """Nav2 GoalUpdater: ``return child_node_->executeTick()`` (the child is not reset)."""
-        if frame[1] == 0:
-            w.st[node.id] = RUNNING
-            return ("call", node.children[0], (node.id, 1))
-        return ("ret", result)
-
-    def _gate_of(self, node: CompiledNode) -> Any:
-        spec = node_semantics(node.type)
-        assert spec is not None and spec.gate is not None
-        return spec.gate
-
-    def _t_gated(
-        self, w: _Work, node: CompiledNode, frame: Frame, result: int | None, hook: HaltHook | None
-    ) -> TickAction:
-        """An abstraction whose gate (the last child, a condition the environment answers)
-        decides whether the child is ticked: Nav2's controllers, Delay, Precondition,
-        BlackboardCheck* (docs/semantics.md §10)."""
-        gate_rule = self._gate_of(node)
-        child, gate = node.children[0], node.children[-1]
-        (closed,) = node.params
-        pc = frame[1]
-        if pc == 0:
-            prev = w.st.get(node.id, IDLE)
-            w.st[node.id] = RUNNING
-            child_status = w.st.get(child, IDLE)
-            if (gate_rule.free_when_idle and prev == IDLE) or (
-                gate_rule.free_when_running and child_status == RUNNING
-            ):
-                return ("call", child, (node.id, 2))
-            return ("call", gate, (node.id, 1))
-        if pc == 1:
-            w.st.pop(gate, None)  # a gate keeps no status: it is asked afresh each time
-            if result == SUCCESS:
-                return ("call", child, (node.id, 2))
-            if gate_rule.halt_on_closed and w.st.get(child, IDLE) == RUNNING:
-                self._reset_child(w, child, hook)
-            return ("ret", closed)
-        if gate_rule.reset_on_done and result in (SUCCESS, FAILURE):
-            self._reset_child(w, child, hook)
-        return ("ret", result)
-
-    def _t_timeout(
-        self, w: _Work, node: CompiledNode, frame: Frame, result: int | None, hook: HaltHook | None
-    ) -> TickAction:
-        """Timeout as an abstraction: the timer (the gate) may fire on any tick after the
-        first; fired, the child is halted and the node returns FAILURE."""
-        child, gate = node.children[0], node.children[-1]
-        pc = frame[1]
-        if pc == 0:
-            started = w.st.get(node.id, IDLE) == RUNNING
-            w.st[node.id] = RUNNING
-            if not started:
-                return ("call", child, (node.id, 2))
-            return ("call", gate, (node.id, 1))
-        if pc == 1:
-            w.st.pop(gate, None)
-            if result == SUCCESS:  # fired
-                self._reset_child(w, child, hook)
-                return ("ret", FAILURE)
-            return ("call", child, (node.id, 2))
-        if result in (SUCCESS, FAILURE):
-            self._reset_child(w, child, hook)
-        return ("ret", result)
-
-    def _t_sleep(
-        self, w: _Work, node: CompiledNode, frame: Frame, result: int | None, hook: HaltHook | None
-    ) -> TickAction:
-        """Sleep as an abstraction: RUNNING until the timer (the gate) says the time is up."""
-        gate = node.children[-1]
-        if frame[1] == 0:
-            w.st[node.id] = RUNNING
-            return ("call", gate, (node.id, 1))
-        w.st.pop(gate, None)
-        return ("ret", SUCCESS if result == SUCCESS else RUNNING)
-
-    def _t_for_each(
-        self, w: _Work, node: CompiledNode, frame: Frame, result: int | None, hook: HaltHook | None
-    ) -> TickAction:
-        """MoveIt Pro ForEach / ForEachUntilSuccess as an abstraction: the gate says whether
-        the vector has another element; one element per tick."""
-        (no_more,) = node.params
-        stop = FAILURE if no_more == SUCCESS else SUCCESS
-        child, gate = node.children[0], node.children[-1]
-        pc = frame[1]
-        if pc == 0:
-            w.st[node.id] = RUNNING
-            if w.st.get(child, IDLE) == RUNNING:
-                return ("call", child, (node.id, 2))
-            return ("call", gate, (node.id, 1))
-        if pc == 1:
-            w.st.pop(gate, None)
-            if result == SUCCESS:
-                return ("call", child, (node.id, 2))
-            return ("ret", no_more)
-        if result == RUNNING:
-            return ("ret", RUNNING)
-        self._reset_child(w, child, hook)
-        return ("ret", stop if result == stop else RUNNING)
-
-    def _t_loop_queue(
-        self, w: _Work, node: CompiledNode, frame: Frame, result: int | None, hook: HaltHook | None
-    ) -> TickAction:
-        """LoopInt / LoopBool / LoopDouble / LoopString (loop_node.h, docs/semantics.md).
-
-        ``params = (if_empty, length)``. A literal queue of ``length`` elements is reloaded when
-        the node is ticked while IDLE; its memory is how many elements are left and whether the
-        child returned RUNNING on its last tick (``child_running_``). ``length = -1``
-        (a {blackboard} queue, an abstraction): the gate, the last child, says whether the
-        queue still has an element. An element is popped only while the child is not RUNNING;
-        no element left returns ``if_empty`` without setting RUNNING (a SKIPPED result leaves
-        the stored status as it was, as ``executeTick`` does)."""
-        if_empty, length = node.params
-        child = node.children[0]
-        pc = frame[1]
-        left, child_running = self._mem(w, node)
-        if pc == 0:
-            if w.st.get(node.id, IDLE) == IDLE:
-                left, child_running = length, False  # the static queue is copied afresh
-            if length < 0:
-                if child_running:
-                    w.st[node.id] = RUNNING
-                    return ("call", child, (node.id, 2))
-                return ("call", node.children[-1], (node.id, 1))
-            if not child_running:
-                if left == 0:
-                    self._set_mem(w, node, (0, False))
-                    return ("ret", if_empty)
-                left -= 1  # pop_front, written to the 'value' port
-            self._set_mem(w, node, (left, child_running))
-            w.st[node.id] = RUNNING
-            return ("call", child, (node.id, 2))
-        if pc == 1:  # the gate answered: does the blackboard queue have an element?
-            w.st.pop(node.children[-1], None)
-            if result == SUCCESS:
-                w.st[node.id] = RUNNING
-                return ("call", child, (node.id, 2))
-            self._set_mem(w, node, (0, False))
-            return ("ret", if_empty)
-        # child_running_ is the node's own flag, not the child's stored status: a child that
-        # returned SKIPPED keeps its old (possibly RUNNING) status but clears the flag
-        self._set_mem(w, node, (max(left, 0), result == RUNNING))
-        if result in (SUCCESS, FAILURE):
-            self._reset_child(w, child, hook)
-        return ("ret", FAILURE if result == FAILURE else RUNNING)
-
-    def _t_real_parallel(
-        self, w: _Work, node: CompiledNode, frame: Frame, result: int | None, hook: HaltHook | None
-    ) -> TickAction:
-        """julienbayle/stardust RealParallel (docs/semantics.md, "Project nodes"): every child
-        is ticked on every tick, in order, and never reset by the node (only its halt resets
-        them); any RUNNING child: RUNNING, else any FAILURE: FAILURE, else SUCCESS. A SKIPPED
-        child makes the project's node throw."""
-        if frame[1] == 0:
-            w.st[node.id] = RUNNING
-            return ("call", node.children[0], (node.id, 1, 0, False, False))
-        i, running, failed = frame[2], frame[3], frame[4]
-        if result == RUNNING:
-            running = True
-        elif result == FAILURE:
-            failed = True
-        elif result != SUCCESS:
-            raise BTRuntimeError(
-                "RealParallel: a child returned SKIPPED (the node throws on any status but "
-                "SUCCESS, FAILURE and RUNNING)",
-                element=node.label,
-            )
-        i += 1
-        if i < len(node.children):
-            return ("call", node.children[i], (node.id, 1, i, running, failed))
-        return ("ret", RUNNING if running else FAILURE if failed else SUCCESS)
 
 
 # -- a plain runner: the interpreter driven by an environment callback -------------------------

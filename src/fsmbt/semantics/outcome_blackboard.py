@@ -192,19 +192,19 @@ class OutcomeInterpreter(BTInterpreter):
         if frame[1] == 0:
             value = _blackboard(w).get(key)
             match = cases.index(value) if value in cases else len(cases)
-            (running,) = self._mem(w, node)
+            (running,) = self.mem(w, node)
             if running != -1 and running != match:
-                self._reset_child(w, node.children[running], hook)
+                self.reset_child(w, node.children[running], hook)
             return ("call", node.children[match], (node.id, 1, match))
         match = frame[2]
         if result == SKIPPED:
-            self._set_mem(w, node, (-1,))
+            self.set_mem(w, node, (-1,))
             return ("ret", SKIPPED)
         if result == RUNNING:
-            self._set_mem(w, node, (match,))
+            self.set_mem(w, node, (match,))
             return ("ret", RUNNING)
-        self._reset_children(w, node, hook)
-        self._set_mem(w, node, (-1,))
+        self.reset_children(w, node, hook)
+        self.set_mem(w, node, (-1,))
         return ("ret", result)
 
     def _t_bb_script(

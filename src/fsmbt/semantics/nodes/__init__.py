@@ -54,7 +54,8 @@ class RuntimeTables:
     """What the interpreter dispatches on, derived from the registry (see the module docstring).
 
     Attributes:
-        handlers: kind -> name of its tick rule (``_t_<name>`` in the interpreter).
+        handlers: kind -> name of its tick rule (a ``FamilyRule`` in
+            ``fsmbt.semantics.families.registry``).
         controls: control kinds with a tick rule.
         decorators: decorator kinds with a tick rule.
         internal_leaves: internal leaf kind -> the status it always returns.

@@ -28,6 +28,7 @@ Size: O(N · d) SMV text for N nodes of depth d.
 from __future__ import annotations
 
 import re
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -37,7 +38,9 @@ from fsmbt.model.errors import Hint, UnsupportedError
 from fsmbt.semantics.bt_interpreter import CompiledNode, CompiledTree
 from fsmbt.semantics.nodes import NUSMV_ENCODED, all_nodes, node_semantics
 from fsmbt.semantics.status import LeafOutcome, NodeStatus, RootResult
-from fsmbt.verify.nusmv import builtin_rules
+from fsmbt.verify.nusmv.families import builtin_rules
+from fsmbt.verify.nusmv.families.contract import NusmvRule, Resets
+from fsmbt.verify.nusmv.families.registry import nusmv_rules
 from fsmbt.verify.nusmv.smv import Symbols, any_of, case
 
 if TYPE_CHECKING:
@@ -86,6 +89,7 @@ class NodeInfo:
     node: CompiledNode
     env_leaf: bool
     internal: str | None  # "S"/"F" for AlwaysSuccess & co
+    rule: str | None = None  # the kind's NuSMV rule name (the registry's ``nusmv`` field)
 
 
 class BTCore:
@@ -99,6 +103,33 @@ class BTCore:
         self.tree = doc if isinstance(doc, CompiledTree) else CompiledTree(doc)
         self.nodes = self.tree.nodes
         self.loop = loop
+        # One table from NuSMV rule name to the rule (docs/semantics.md "Node families"): the
+        # families' rules registered by name, then the ones this encoder writes itself.
+        self.dispatch: dict[str, Callable[[CompiledNode, str, str, Resets], None]] = {
+            name: self._registered(rule) for name, rule in nusmv_rules().items()
+        }
+        self.dispatch.update(
+            sequence=self._sequence_rules,
+            reactive=self._reactive_rules,
+            simple_decorator=self._one_child_rules,
+            subtree=self._one_child_rules,
+            loop_queue=self._loop_rules,
+            real_parallel=lambda x, here, called, resets: self._real_parallel_rules(
+                x, here, called
+            ),
+            manual_selector=self._manual_rules,
+        )
+        for name in ("gated", "timeout", "sleep", "for_each", "pass_through", "pass_through_keep"):
+            self.dispatch[name] = self._with_name(self._gate_rules, name)
+        for name in (
+            "pipeline",
+            "recovery",
+            "round_robin",
+            "repeat_each_tick",
+            "if_then_else",
+            "while_do_else",
+        ):
+            self.dispatch[name] = self._with_name(self._memory_rules, name)
         self.info: list[NodeInfo] = []
         has_internal = False
         has_keep_running = False
@@ -111,7 +142,8 @@ class BTCore:
                     has_internal = True
                 self.info.append(NodeInfo(node, internal is None, internal))
                 continue
-            if node.type not in SUPPORTED:
+            spec = node_semantics(node.type)
+            if spec is None or spec.nusmv is None or spec.nusmv not in self.dispatch:
                 reason = NOT_ENCODED.get(node.type, "not encoded")
                 raise UnsupportedError(
                     f"the NuSMV encoding does not support {node.type} ({reason})",
@@ -119,7 +151,6 @@ class BTCore:
                     element=f"<{node.type}> '{node.label}'",
                     hints=(Hint.NATIVE_VERIFIER,),
                 )
-            spec = node_semantics(node.type)
             # a simple decorator without a result map (KeepRunningUntilFailure) can tick forever
             has_keep_running |= (
                 node.type in SIMPLE_DECORATORS and spec is not None and spec.result_map is None
@@ -130,7 +161,7 @@ class BTCore:
             limit = node.params[0] if rule in builtin_rules.LOOPS else None
             has_endless_loop |= limit == -1
             has_internal |= rule == "run_once" or (limit is not None and -1 != limit <= 0)
-            self.info.append(NodeInfo(node, False, None))
+            self.info.append(NodeInfo(node, False, None, spec.nusmv))
         if has_internal and (loop or has_keep_running or has_endless_loop):
             raise UnsupportedError(
                 "the NuSMV encoding does not model ticks that end without any leaf "
@@ -245,113 +276,8 @@ class BTCore:
                     stale = f"{called} & ({self.st(x.id)} = S | {self.st(x.id)} = F)"
                     self.ret(stale, x.id, f"case {self.st(x.id)} = S : S; TRUE : F; esac")
                 continue  # leaf requests: answered by the machine encoding
-            kids = list(x.children)
-            k = len(kids)
-            t = x.type
-            if t in GATE_RULES:
-                self._gate_rules(x, GATE_RULES[t], here, called, resets)
-                continue
-            if t in MEMORY_RULES:
-                self._memory_rules(x, MEMORY_RULES[t], here, called, resets)
-                continue
-            if t in LOOP_RULES:
-                self._loop_rules(x, here, called, resets)
-                continue
-            if t in REAL_PARALLEL_RULES:
-                self._real_parallel_rules(x, here, called)
-                continue
-            if t in MANUAL_RULES:
-                self._manual_rules(x, here, called, resets)
-                continue
-            if t in BUILTIN_RULES:
-                builtin_rules.add_rules(self, x, BUILTIN_RULES[t], here, called, resets)
-                continue
-            if t in SEQ_LIKE:
-                is_fb, wakes, memory = SEQ_LIKE[t]
-                stop, go_on = ("S", "F") if is_fb else ("F", "S")
-                idx = f"idx_{x.id}"
-                self.rule(self.st(x.id), called, "R")
-                for i, c in enumerate(kids):
-                    cond = f"{called} & {idx} = {i}"
-                    self.call(cond, c)
-                    self.rule(f"prev_{x.id}", cond, self.st(c))
-                back = f"{here} & res != NONE"
-                self.ret(f"{back} & res = R", x.id, "R")
-                stopped = f"{back} & res = {stop}"
-                if memory:
-                    for i, c in enumerate(kids):
-                        resets[c].append(f"{stopped} & {idx} <= {i}")
-                else:
-                    for c in kids:
-                        resets[c].append(stopped)
-                    self.rule(idx, stopped, "0")
-                self.ret(stopped, x.id, stop)
-                went = f"{back} & res = {go_on}"
-                for i in range(k):
-                    cond = f"{went} & {idx} = {i}"
-                    if i + 1 < k:
-                        if wakes:
-                            woke = f"{cond} & prev_{x.id} = I"
-                            self.rule("wake", woke, "TRUE")
-                            self.rule(idx, woke, str(i + 1))
-                            self.ret(woke, x.id, "R")
-                            cond = f"{cond} & prev_{x.id} != I"
-                        self.rule(idx, cond, str(i + 1))
-                        self.call(cond, kids[i + 1])
-                        self.rule(f"prev_{x.id}", cond, self.st(kids[i + 1]))
-                    else:
-                        for c in kids:
-                            resets[c].append(cond)
-                        self.rule(idx, cond, "0")
-                        self.ret(cond, x.id, go_on)
-            elif t in REACTIVE:
-                is_fb = REACTIVE[t]
-                stop, go_on = ("S", "F") if is_fb else ("F", "S")
-                self.rule(self.st(x.id), called, "R")
-                self.call(called, kids[0])
-                back = f"{here} & res != NONE"
-                running = f"{back} & res = R"
-                for i, c in enumerate(kids):
-                    resets[c].append(f"{running} & lidx != {i}")
-                self.ret(running, x.id, "R")
-                stopped = f"{back} & res = {stop}"
-                for c in kids:
-                    resets[c].append(stopped)
-                self.ret(stopped, x.id, stop)
-                for i in range(k):
-                    cond = f"{back} & res = {go_on} & lidx = {i}"
-                    if i + 1 < k:
-                        self.call(cond, kids[i + 1])
-                    else:
-                        for c in kids:
-                            resets[c].append(cond)
-                        self.ret(cond, x.id, go_on)
-            else:  # one child: simple decorators and SubTree
-                c = kids[0]
-                spec = node_semantics(t)
-                assert spec is not None
-                result_map = spec.result_map
-                if spec.kind is NodeKind.SUBTREE:
-                    self.rule(self.st(x.id), f"{called} & {self.st(x.id)} = I", "R")
-                else:
-                    self.rule(self.st(x.id), called, "R")
-                self.call(called, c)
-                back = f"{here} & res != NONE"
-                done = f"{back} & (res = S | res = F)"
-                if result_map is None and spec.kind is not NodeKind.SUBTREE:
-                    # KeepRunningUntilFailure
-                    resets[c].append(done)
-                    self.ret(f"{back} & res = F", x.id, "F")
-                    self.ret(f"{back} & res != F", x.id, "R")
-                    continue
-                self.ret(f"{back} & res = R", x.id, "R")
-                resets[c].append(done)
-                # the child's S / F as the node returns them (a SubTree passes them on)
-                on_s, on_f = (
-                    (ST[result_map[0]], ST[result_map[1]]) if result_map is not None else (_S, _F)
-                )
-                mapped = on_s if on_s == on_f else f"case res = S : {on_s}; TRUE : {on_f}; esac"
-                self.ret(done, x.id, mapped)
+            assert info.rule is not None
+            self.dispatch[info.rule](x, here, called, resets)
         # halt closure (pre-order ids: a parent's defines come before its children's)
         for x in self.nodes:
             parent_halt = f"hlt_{x.parent}" if x.parent is not None else "FALSE"
@@ -364,6 +290,123 @@ class BTCore:
             self.rules.setdefault(var, []).insert(0, (f"hlt_{nid}", "0"))
         for x in self.nodes:
             self.rules.setdefault(self.st(x.id), []).insert(0, (f"clr_{x.id}", "I"))
+
+    def _registered(self, rule: NusmvRule) -> Callable[[CompiledNode, str, str, Resets], None]:
+        """A registered family rule bound to this encoder."""
+
+        def encode(x: CompiledNode, here: str, called: str, resets: Resets) -> None:
+            rule(self, x, here, called, resets)
+
+        return encode
+
+    @staticmethod
+    def _with_name(
+        method: Callable[[CompiledNode, str, str, str, Resets], None], name: str
+    ) -> Callable[[CompiledNode, str, str, Resets], None]:
+        """One of this encoder's rules that serves several names, for ``name``."""
+
+        def encode(x: CompiledNode, here: str, called: str, resets: Resets) -> None:
+            method(x, name, here, called, resets)
+
+        return encode
+
+    def _sequence_rules(self, x: CompiledNode, here: str, called: str, resets: Resets) -> None:
+        """Sequence, Fallback, Async*, SequenceWithMemory (``families.sequence``)."""
+        kids = list(x.children)
+        k = len(kids)
+        t = x.type
+        is_fb, wakes, memory = SEQ_LIKE[t]
+        stop, go_on = ("S", "F") if is_fb else ("F", "S")
+        idx = f"idx_{x.id}"
+        self.rule(self.st(x.id), called, "R")
+        for i, c in enumerate(kids):
+            cond = f"{called} & {idx} = {i}"
+            self.call(cond, c)
+            self.rule(f"prev_{x.id}", cond, self.st(c))
+        back = f"{here} & res != NONE"
+        self.ret(f"{back} & res = R", x.id, "R")
+        stopped = f"{back} & res = {stop}"
+        if memory:
+            for i, c in enumerate(kids):
+                resets[c].append(f"{stopped} & {idx} <= {i}")
+        else:
+            for c in kids:
+                resets[c].append(stopped)
+            self.rule(idx, stopped, "0")
+        self.ret(stopped, x.id, stop)
+        went = f"{back} & res = {go_on}"
+        for i in range(k):
+            cond = f"{went} & {idx} = {i}"
+            if i + 1 < k:
+                if wakes:
+                    woke = f"{cond} & prev_{x.id} = I"
+                    self.rule("wake", woke, "TRUE")
+                    self.rule(idx, woke, str(i + 1))
+                    self.ret(woke, x.id, "R")
+                    cond = f"{cond} & prev_{x.id} != I"
+                self.rule(idx, cond, str(i + 1))
+                self.call(cond, kids[i + 1])
+                self.rule(f"prev_{x.id}", cond, self.st(kids[i + 1]))
+            else:
+                for c in kids:
+                    resets[c].append(cond)
+                self.rule(idx, cond, "0")
+                self.ret(cond, x.id, go_on)
+
+    def _reactive_rules(self, x: CompiledNode, here: str, called: str, resets: Resets) -> None:
+        """ReactiveSequence, ReactiveFallback (``families.reactive``)."""
+        kids = list(x.children)
+        k = len(kids)
+        t = x.type
+        is_fb = REACTIVE[t]
+        stop, go_on = ("S", "F") if is_fb else ("F", "S")
+        self.rule(self.st(x.id), called, "R")
+        self.call(called, kids[0])
+        back = f"{here} & res != NONE"
+        running = f"{back} & res = R"
+        for i, c in enumerate(kids):
+            resets[c].append(f"{running} & lidx != {i}")
+        self.ret(running, x.id, "R")
+        stopped = f"{back} & res = {stop}"
+        for c in kids:
+            resets[c].append(stopped)
+        self.ret(stopped, x.id, stop)
+        for i in range(k):
+            cond = f"{back} & res = {go_on} & lidx = {i}"
+            if i + 1 < k:
+                self.call(cond, kids[i + 1])
+            else:
+                for c in kids:
+                    resets[c].append(cond)
+                self.ret(cond, x.id, go_on)
+
+    def _one_child_rules(self, x: CompiledNode, here: str, called: str, resets: Resets) -> None:
+        """Status-map decorators and SubTree (``families.status_map``, ``.wrappers``)."""
+        kids = list(x.children)
+        t = x.type
+        c = kids[0]
+        spec = node_semantics(t)
+        assert spec is not None
+        result_map = spec.result_map
+        if spec.kind is NodeKind.SUBTREE:
+            self.rule(self.st(x.id), f"{called} & {self.st(x.id)} = I", "R")
+        else:
+            self.rule(self.st(x.id), called, "R")
+        self.call(called, c)
+        back = f"{here} & res != NONE"
+        done = f"{back} & (res = S | res = F)"
+        if result_map is None and spec.kind is not NodeKind.SUBTREE:
+            # KeepRunningUntilFailure
+            resets[c].append(done)
+            self.ret(f"{back} & res = F", x.id, "F")
+            self.ret(f"{back} & res != F", x.id, "R")
+            return
+        self.ret(f"{back} & res = R", x.id, "R")
+        resets[c].append(done)
+        # the child's S / F as the node returns them (a SubTree passes them on)
+        on_s, on_f = (ST[result_map[0]], ST[result_map[1]]) if result_map is not None else (_S, _F)
+        mapped = on_s if on_s == on_f else f"case res = S : {on_s}; TRUE : {on_f}; esac"
+        self.ret(done, x.id, mapped)
 
     def _manual_rules(
         self, x: CompiledNode, here: str, called: str, resets: dict[int, list[str]]

@@ -2,7 +2,7 @@
 Parallel and ParallelAll (docs/semantics.md, "Decorators" and "Control nodes"; docs/nusmv.md).
 
 Each function adds one node's rules to a ``BTCore`` (``encode_bt``), as the interpreter's
-``_t_repeat`` / ``_t_retry`` / ``_t_run_once`` / ``_t_parallel`` / ``_t_parallel_all`` do them
+rules in ``fsmbt.semantics.families.loops``, ``.once`` and ``.parallel`` do them
 (BehaviorTree.CPP 4.8), in the same micro-step style: ``called`` is the node ticked with no
 result yet, ``back`` a child's return (``res``; ``lidx`` says which child), ``resets[c]``
 collects the conditions under which child ``c`` is reset (halted when RUNNING).
@@ -32,46 +32,16 @@ O(1) for the decorators; one variable of log2(L) bits per finite loop, 2 bits pe
 
 from __future__ import annotations
 
-from typing import Protocol
-
 from fsmbt.model.errors import Hint, UnsupportedError
-from fsmbt.semantics.bt_interpreter import CompiledNode, parallel_threshold
+from fsmbt.semantics.compiled import CompiledNode
+from fsmbt.semantics.families.parallel import parallel_threshold
+from fsmbt.verify.nusmv.families.contract import BTCore, NusmvRule, Resets
 from fsmbt.verify.nusmv.smv import all_of
-
-
-class BTCore(Protocol):
-    """What these rules write into: the BT encoder (``encode_bt.BTCore``), which imports this
-    module (so this one names the encoder's methods it calls, not the encoder)."""
-
-    defines: list[tuple[str, str]]
-
-    def st(self, nid: int) -> str:
-        """The status variable of node ``nid``."""
-        ...
-
-    def rule(self, var: str, cond: str, value: str) -> None:
-        """Add ``cond -> var := value``."""
-        ...
-
-    def memory(self, name: str, nid: int, top: int, *, reset_by_halt: bool = True) -> str:
-        """Declare a memory variable ``0..top`` of node ``nid``; its name."""
-        ...
-
-    def call(self, cond: str, child: int) -> None:
-        """The current node calls ``child``."""
-        ...
-
-    def ret(self, cond: str, nid: int, status: str) -> None:
-        """``nid`` returns ``status`` to its parent."""
-        ...
-
 
 #: The rule names (the node registry's ``nusmv`` field) this module encodes.
 RULES = ("repeat", "retry", "run_once", "parallel", "parallel_all")
 #: Loop rule -> (the result that repeats the child, the one that ends the loop)
 LOOPS = {"repeat": ("S", "F"), "retry": ("F", "S")}
-
-Resets = dict[int, list[str]]
 
 
 def add_rules(
@@ -88,7 +58,7 @@ def add_rules(
 
 
 def _loop(core: BTCore, x: CompiledNode, rule: str, called: str, back: str, resets: Resets) -> None:
-    """Repeat / RetryUntilSuccessful (docs/semantics.md "Decorators"; ``_loop_decorator``)."""
+    """Repeat / RetryUntilSuccessful (docs/semantics.md "Decorators"; ``loops.loop_decorator``)."""
     (limit,) = x.params
     again, stop = LOOPS[rule]
     c = x.children[0]
@@ -123,7 +93,7 @@ def _loop(core: BTCore, x: CompiledNode, rule: str, called: str, back: str, rese
 
 
 def _run_once(core: BTCore, x: CompiledNode, called: str, back: str, resets: Resets) -> None:
-    """RunOnce (docs/semantics.md "Decorators"; ``_t_run_once``); its memory survives halts."""
+    """RunOnce (docs/semantics.md "Decorators"; ``once.tick_run_once``); its memory survives halts."""
     (then_skip,) = x.params
     if then_skip:
         raise UnsupportedError(
@@ -151,7 +121,7 @@ def _parallel(
     core: BTCore, x: CompiledNode, rule: str, called: str, back: str, resets: Resets
 ) -> None:
     """Parallel (success/failure thresholds) and ParallelAll (max_failures): docs/semantics.md
-    "Control nodes"; ``_t_parallel`` / ``_t_parallel_all``."""
+    "Control nodes"; ``parallel.tick_parallel`` / ``tick_parallel_all``."""
     kids = list(x.children)
     n = len(kids)
     done = [f"({core.st(c)} = S | {core.st(c)} = F)" for c in kids]
@@ -206,3 +176,16 @@ def _parallel(
     verdicts(called)  # (only once every child completed)
     core.rule(core.st(x.id), called, "R")
     first_open(called, 0)
+
+
+def _named(rule: str) -> NusmvRule:
+    """``add_rules`` for one rule name, in the registry's calling convention."""
+
+    def encode(core: BTCore, x: CompiledNode, here: str, called: str, resets: Resets) -> None:
+        add_rules(core, x, rule, here, called, resets)
+
+    return encode
+
+
+#: These rules by name, as ``fsmbt.verify.nusmv.families.registry`` registers them.
+RULE_TABLE: dict[str, NusmvRule] = {name: _named(name) for name in RULES}

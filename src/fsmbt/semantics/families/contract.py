@@ -1,0 +1,76 @@
+"""The contract between the interpreter and a node family (docs/semantics.md, "Node families").
+
+A family module exports ``RULES: dict[str, FamilyRule]``, keyed by the ``handler`` name its
+kinds declare in ``fsmbt.model.nodes``. Each ``FamilyRule`` has:
+
+- ``tick(ip, w, node, frame, result, hook) -> TickAction``: one step of the node's ``tick()``
+  written as a resumable state machine (``bt_interpreter``'s module docstring). ``frame[1]`` is
+  the pc (0: the node is ticked; otherwise a child just returned ``result``). The rule returns
+  ``("call", child, new_frame)`` to tick a child and be resumed with ``new_frame``, or
+  ``("ret", status)``. It reads and writes statuses in ``w.st``, its memory through
+  ``ip.mem``/``ip.set_mem`` (stored only when it differs from the declared memory at rest), sets
+  ``w.wake`` for the tree's wake-up signal, and resets children with ``ip.reset_child`` /
+  ``ip.reset_children`` (``haltChild``: a RUNNING child is halted first).
+- ``params(node, ctype, exact) -> tuple``: read the node's ports into ``CompiledNode.params``
+  and check what BehaviorTree.CPP checks when it builds the tree (``InputError`` for a malformed
+  node, ``UnsupportedError`` for what fsmbt cannot model exactly); ``None``: no ports. ``exact``
+  is False when the kind is used as an abstraction (docs/semantics.md §10).
+- ``extra_children(node, params) -> list[BTNode]``: synthetic condition leaves added after the
+  node's children at compile time (ManualSelector's picks); ``None``: none.
+
+``halt()`` is not a function: every node's halt halts its RUNNING children and resets their
+statuses (``bt_interpreter._halt``), and whether it also forgets its memory is the declared
+``halt_resets_memory`` - data, read once into a set, so halting stays a set lookup per node.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any, Protocol
+
+from fsmbt.model.bt import BTNode
+from fsmbt.semantics.compiled import CompiledNode, Frame, HaltHook, TickAction, Work
+
+
+class Interp(Protocol):
+    """What a tick rule may use of the interpreter (``bt_interpreter.BTInterpreter``)."""
+
+    #: sequence kinds -> (is a fallback, asynchronous, with memory), from the declarations
+    seq_flags: dict[str, tuple[bool, bool, bool]]
+    #: reactive kinds of the fallback family
+    reactive_fallbacks: frozenset[str]
+    #: status-mapping decorator -> the statuses its child's SUCCESS/FAILURE become
+    result_maps: dict[str, tuple[int, int]]
+
+    def mem(self, w: Work, node: CompiledNode) -> tuple[Any, ...]:
+        """The node's memory (its declared memory at rest when none is stored)."""
+        ...
+
+    def set_mem(self, w: Work, node: CompiledNode, value: tuple[Any, ...]) -> None:
+        """Store the node's memory (dropped when equal to the memory at rest)."""
+        ...
+
+    def reset_child(self, w: Work, child: int, hook: HaltHook | None) -> None:
+        """``ControlNode::haltChild``: halt ``child`` if RUNNING, then reset its status."""
+        ...
+
+    def reset_children(
+        self, w: Work, node: CompiledNode, hook: HaltHook | None, first: int = 0
+    ) -> None:
+        """``resetChildren()`` from child ``first`` on."""
+        ...
+
+
+TickFn = Callable[[Interp, Work, CompiledNode, Frame, "int | None", "HaltHook | None"], TickAction]
+ParamsFn = Callable[[BTNode, str, bool], tuple[Any, ...]]
+ExtraChildrenFn = Callable[[BTNode, tuple[Any, ...]], list[BTNode]]
+
+
+@dataclass(frozen=True)
+class FamilyRule:
+    """One handler's behaviour (the module docstring says what each part does)."""
+
+    tick: TickFn
+    params: ParamsFn | None = None
+    extra_children: ExtraChildrenFn | None = None
