@@ -4,7 +4,10 @@ Runs ``fsmbt.api.convert_file`` (rules engine, native checker, nothing written) 
 of the corpus (``FSMBT_CORPUS``, default ``../shared/corpus``): BehaviorTree.CPP XML under
 ``bt/``, SCXML, SMACH and FlexBE under ``fsm/``. Each file is tried in three settings:
 
-- ``plain``: no options, as a new user types ``fsmbt convert FILE -o OUT``;
+- ``no_profiles``: ``--no-profiles`` only: nothing fsmbt would find by itself is applied
+  (the figure before issue 26);
+- ``plain``: no options, as a new user types ``fsmbt convert FILE -o OUT`` (the profiles and
+  node-model files fsmbt finds by itself are applied: docs/semantics.md §10);
 - ``profiles``: ``--nodes nav2,moveit_pro`` (the project node libraries; their gating
   controllers are abstractions, named in the verdict), the node-library files of
   node_libraries/ for the trees of their projects (``options_for``) and, for Nav2
@@ -51,7 +54,7 @@ import btcpp_loads  # noqa: E402 - the sibling script, importable when run from 
 from fsmbt import api  # noqa: E402
 from fsmbt.model.errors import InputError  # noqa: E402
 
-SETTINGS = ("plain", "profiles", "abstract")
+SETTINGS = ("no_profiles", "plain", "profiles", "abstract")
 NEGATIVE_DIRS = ("_malformed", "_legacy_draft")
 
 
@@ -120,6 +123,8 @@ def library_files(source: str, path: Path | None) -> list[str]:
 def options_for(
     setting: str, source: str, root: Path, path: Path | None = None
 ) -> dict[str, object]:
+    if setting == "no_profiles":
+        return {"no_profiles": True}
     if setting == "plain":
         return {}
     options: dict[str, object] = {"nodes": ["nav2", "moveit_pro", *library_files(source, path)]}

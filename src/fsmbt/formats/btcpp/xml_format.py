@@ -26,6 +26,7 @@ from pathlib import Path
 from lxml import etree
 
 from fsmbt import limits
+from fsmbt.formats.btcpp import profiles as btcpp_profiles
 from fsmbt.formats.btcpp import trees as btcpp_trees
 from fsmbt.formats.registry import Format, ReadContext, decode, register
 from fsmbt.formats.xml_safe import parse_xml, root_tag
@@ -35,6 +36,7 @@ from fsmbt.model.bt_nodes import NodeKind, builtin_spec, canonical_type
 from fsmbt.model.errors import InputError, SourceLocation, UnsupportedError
 from fsmbt.model.files import note_read, read_located
 from fsmbt.model.nodes.library import apply_library, build_library
+from fsmbt.model.nodes.registry import node_semantics
 
 #: Tags of Groot's explicit style and of ``<TreeNodesModel>`` entries, with the kind they declare.
 EXPLICIT_TAGS: dict[str, NodeKind] = {
@@ -529,16 +531,63 @@ def read_btcpp(text: str, ctx: ReadContext) -> BTDocument:
         loader.loaded.add(path)
     loader.load(text, ctx.path, (path,) if path is not None else ())
     loader.resolve_subtrees()
+    given_nodes = [str(n) for n in _as_list(ctx.options.get("nodes"))]
+    found = None
+    if not ctx.options.get("no_profiles"):
+        found = _find_profiles(loader, ctx, given_nodes)
     doc = loader.document()
     loader.prune_extra_trees(doc)
     # --nodes / --abstract (fsmbt.model.nodes.library): project kinds, aliases, abstractions
-    library = build_library(ctx.options.get("nodes"), ctx.options.get("abstract"))
+    nodes = given_nodes + (found.profiles + found.libraries if found is not None else [])
+    library = build_library(nodes, ctx.options.get("abstract"))
 
     def warn(message: str, location: SourceLocation | None) -> None:
         ctx.warnings.append(f"{location}: {message}" if location is not None else message)
 
     apply_library(doc, library, warn)
+    if found is not None:
+        abstractions: dict[str, list[str]] = {}
+        for _tree, node in doc.nodes():
+            spec = node_semantics(node.semantics) if node.semantics else None
+            if spec is None or spec.abstraction is None:
+                continue
+            origin = library.sources.get(node.type) or spec.requires or ""
+            names = abstractions.setdefault(origin, [])
+            if node.type not in names:
+                names.append(node.type)
+        ctx.warnings.extend(btcpp_profiles.notes(found, abstractions, ctx.display_name))
     return doc
+
+
+def _as_list(value: object) -> list[object]:
+    if value is None:
+        return []
+    if isinstance(value, (str, Path)):
+        return [part.strip() for part in str(value).split(",") if part.strip()]
+    return list(value)  # type: ignore[call-overload]
+
+
+def _find_profiles(
+    loader: _Loader, ctx: ReadContext, given_nodes: list[str]
+) -> btcpp_profiles.Found:
+    """Profiles and node models found by themselves (``fsmbt.formats.btcpp.profiles``); the
+    found declarations join the external models after the user's ``--node-models``."""
+    declared: set[str] = set()
+    for f in loader.files:
+        for child in _elements(f.root):
+            if child.tag == "TreeNodesModel":
+                declared |= {m.type for m in _read_models(child, f.path)}
+    found = btcpp_profiles.discover(
+        ctx.path,
+        [(f.path, f.root) for f in loader.files],
+        declared,
+        given_nodes,
+        set(loader.external),
+    )
+    ctx.warnings.extend(found.warnings)
+    for type_name, (model, _source) in found.models.items():
+        loader.external.setdefault(type_name, model)
+    return found
 
 
 # -- writing -------------------------------------------------------------------------------------
