@@ -155,8 +155,8 @@ def test_missing_include_names_the_line(tmp_path: Path) -> None:
 def test_external_node_models_option_decides_leaf_kinds() -> None:
     models = corpus("bt/nav2/models/nav2_tree_nodes.xml")
     tree = corpus("bt/nav2/navigate_w_replanning_time.xml")
-    plain = api.load(tree).model
-    informed = api.load(tree, options={"node_models": [str(models)]}).model
+    plain = api.load(tree, options={"no_profiles": True}).model
+    informed = api.load(tree, options={"node_models": [str(models)], "no_profiles": True}).model
     undeclared = [n for _, n in plain.nodes() if not n.kind_declared]
     assert undeclared, "without Nav2's model file some kinds are assumed"
     assert all(n.kind_declared for _, n in informed.nodes())
