@@ -75,6 +75,7 @@ class Found:
 
     profiles: list[str] = field(default_factory=list)
     libraries: list[str] = field(default_factory=list)
+    library_hits: dict[str, list[str]] = field(default_factory=dict)
     models: dict[str, tuple[NodeModel, str]] = field(default_factory=dict)
     model_files: dict[str, list[str]] = field(default_factory=dict)
     warnings: list[str] = field(default_factory=list)
@@ -96,8 +97,10 @@ def used_types(files: Iterable[tuple[str, etree._Element]]) -> dict[str, Usage]:
                 if not type_id:
                     continue
                 type_name = canonical_type(type_id)
-                if builtin_spec(type_name) is not None or type_name == "SubTree":
-                    continue
+                spec = builtin_spec(type_name)
+                project_kind = spec is not None and spec.library in PROJECT_PROFILES
+                if (spec is not None and not project_kind) or type_name == "SubTree":
+                    continue  # BehaviorTree.CPP's own kinds say nothing about a project
                 usage = used.setdefault(type_name, Usage(f"{name}:{element.sourceline}"))
                 for key in element.attrib:
                     if key not in _NOT_PORTS and not key.startswith("_"):
@@ -244,11 +247,14 @@ def discover(
                 continue
             kind, ports = leaf
             model = NodeModel(type_name, kind, [PortModel(p) for p in ports])
-            if _fits(type_name, usage, model, "the Nav2 profile (Nav2's nav2_tree_nodes.xml)", found):
+            if _fits(
+                type_name, usage, model, "the Nav2 profile (Nav2's nav2_tree_nodes.xml)", found
+            ):
                 found.models[type_name] = (model, "the Nav2 profile")
     for library_path, hits in _bundled_libraries(used, known | set(found.models)):
         if library_path not in given_nodes:
             found.libraries.append(library_path)
+            found.library_hits[library_path] = hits
     return found
 
 
@@ -265,8 +271,11 @@ def notes(found: Found, abstractions: dict[str, list[str]], display: str) -> lis
         if gated:
             parts.append(f"{', '.join(gated)} as environment inputs")
         if profile == "nav2" and leaves:
-            parts.append(f"{len(leaves)} Nav2 leaves declared ({', '.join(leaves[:4])}"
-                         + (", ..." if len(leaves) > 4 else "") + ")")
+            parts.append(
+                f"{len(leaves)} Nav2 leaves declared ({', '.join(leaves[:4])}"
+                + (", ..." if len(leaves) > 4 else "")
+                + ")"
+            )
         detail = "; ".join(parts) or "its exact node kinds"
         lines.append(f"{display}: read with the {title} profile: {detail}{refuse}")
     for model_file, types in found.model_files.items():
@@ -278,7 +287,7 @@ def notes(found: Found, abstractions: dict[str, list[str]], display: str) -> lis
         gated = abstractions.get(library, [])
         detail = f": {', '.join(gated)} as environment inputs" if gated else ""
         lines.append(
-            f"{display}: read with the node library {Path(library).name} (its custom nodes are "
-            f"used here){detail}{refuse}"
+            f"{display}: read with the node library {library} (its "
+            f"{', '.join(found.library_hits.get(library, []))} used here){detail}{refuse}"
         )
     return lines
