@@ -163,3 +163,23 @@ def test_corpus_sample_converts_with_no_option_as_with_the_profiles() -> None:
     # the sample holds a tree the profiles matter for (refused without them)
     nav2 = [p for p in sample if p.relative_to(BT).parts[0] == "nav2"]
     assert nav2 and not _ok(nav2[0], {"no_profiles": True}) and _ok(nav2[0], {})
+
+
+def test_comments_with_double_hyphens_read_as_tinyxml2_reads_them() -> None:
+    """BehaviorTree.CPP (tinyxml2) loads ``<!------->`` and ``<!-- a -- b -->``; libxml2
+    refuses them. fsmbt reads them with one warning, lines unchanged; the entity check still
+    refuses entities; the other XML formats stay strict."""
+    text = (
+        '<root BTCPP_format="4">\n<!------->\n<!-- a -- b -->\n<BehaviorTree ID="T">\n'
+        "<Sequence><A/><B/></Sequence>\n</BehaviorTree>\n</root>\n"
+    )
+    loaded = api.load_text(text, "btcpp")
+    assert any("2 comment(s) hold '--'" in w for w in loaded.warnings)
+    assert [n.location.line for _, n in loaded.model.nodes()] == [5, 5, 5]  # type: ignore[attr-defined, union-attr]
+    with pytest.raises(InputError, match="[Cc]omment"):
+        from fsmbt.formats.xml_safe import parse_xml
+
+        parse_xml("<x><!-- a -- b --></x>", "x.xml")  # strict without notes
+    bomb = '<!DOCTYPE r [<!ENTITY a "x">]>\n' + text
+    with pytest.raises(InputError, match="entities"):
+        api.load_text(bomb, "btcpp")

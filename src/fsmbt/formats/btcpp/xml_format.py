@@ -86,7 +86,7 @@ class _Loader:
         self, text: str, path: Path | None, chain: tuple[Path, ...], *, extra: bool = False
     ) -> None:
         name = str(path) if path is not None else self.ctx.display_name
-        root = parse_xml(text, name)
+        root = parse_xml(text, name, self.ctx.warnings)
         if root.tag != "root":
             raise InputError(
                 f"not a BehaviorTree.CPP file: root element is <{str(root.tag)}>, expected <root>",
