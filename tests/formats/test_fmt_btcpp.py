@@ -9,7 +9,7 @@ import pytest
 
 from fsmbt import api
 from fsmbt.formats import dumps, loads
-from fsmbt.formats.btcpp.xml_format import ASSUMED_MARK
+from fsmbt.formats.btcpp.xml_format import ASSUMED_DESCRIPTION
 from fsmbt.formats.xml_safe import parse_xml, root_tag
 from fsmbt.limits import current as current_limits
 from fsmbt.model import BTDocument, BTNode, NodeKind
@@ -95,7 +95,7 @@ def test_undeclared_types_are_assumed_and_stay_assumed() -> None:
     assert (leaf.kind, leaf.kind_declared) == (NodeKind.ACTION, False)
     assert (wrap.kind, wrap.kind_declared) == (NodeKind.DECORATOR, False)
     text = dumps(doc, "btcpp")
-    assert ASSUMED_MARK in text and 'ID="Pipeline"' in text  # Groot2 still learns the type
+    assert ASSUMED_DESCRIPTION in text and 'ID="Pipeline"' in text  # Groot2 still learns the type
     assert loads(text, "btcpp") == doc
 
 

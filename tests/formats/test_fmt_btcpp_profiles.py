@@ -180,6 +180,12 @@ def test_comments_with_double_hyphens_read_as_tinyxml2_reads_them() -> None:
         from fsmbt.formats.xml_safe import parse_xml
 
         parse_xml("<x><!-- a -- b --></x>", "x.xml")  # strict without notes
+    behaviortreepy = pytest.importorskip("behaviortreepy")  # BehaviorTree.CPP 4.8.2 itself
+    factory = behaviortreepy.BehaviorTreeFactory()
+    factory.register_simple_action("A", lambda _node: behaviortreepy.NodeStatus.SUCCESS)
+    factory.register_simple_action("B", lambda _node: behaviortreepy.NodeStatus.SUCCESS)
+    factory.register_behavior_tree_from_text(text)
+    assert "T" in factory.registered_behavior_trees()
     bomb = '<!DOCTYPE r [<!ENTITY a "x">]>\n' + text
     with pytest.raises(InputError, match="entities"):
         api.load_text(bomb, "btcpp")

@@ -35,12 +35,14 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 from dataclasses import dataclass, field
+from functools import lru_cache
 from pathlib import Path
 
 from lxml import etree
 
 from fsmbt.model.bt import NodeModel, PortModel
 from fsmbt.model.bt_nodes import builtin_spec, canonical_type
+from fsmbt.model.errors import InputError
 from fsmbt.model.kinds import NodeKind
 from fsmbt.model.nodes.library import build_library
 from fsmbt.model.nodes.nav2_leaves import nav2_leaf
@@ -183,16 +185,28 @@ def _fits(type_name: str, usage: Usage, model: NodeModel, source: str, found: Fo
     return True
 
 
+@lru_cache(maxsize=1)
+def _bundled_custom_types() -> tuple[tuple[str, frozenset[str]], ...]:
+    """(library file, its custom control/decorator types) of each bundled library, read once
+    per process (fsmbt's own files; one the input limits refuse is passed over)."""
+    out: list[tuple[str, frozenset[str]]] = []
+    if not BUNDLED_LIBRARIES.is_dir():
+        return ()
+    for path in sorted(BUNDLED_LIBRARIES.glob("*.yaml")):
+        try:
+            library = build_library([str(path)])
+        except InputError:
+            continue
+        out.append((str(path), frozenset(library.aliases) | frozenset(library.semantics)))
+    return tuple(out)
+
+
 def _bundled_libraries(used: dict[str, Usage], known: set[str]) -> list[tuple[str, list[str]]]:
     out: list[tuple[str, list[str]]] = []
-    if not BUNDLED_LIBRARIES.is_dir():
-        return out
-    for path in sorted(BUNDLED_LIBRARIES.glob("*.yaml")):
-        library = build_library([str(path)])
-        custom = set(library.aliases) | set(library.semantics)
+    for path, custom in _bundled_custom_types():
         hits = sorted(t for t in custom if t in used and t not in known)
         if hits:
-            out.append((str(path), hits))
+            out.append((path, hits))
     return out
 
 
@@ -220,7 +234,8 @@ def discover(
     by_profile: dict[str, list[str]] = {}
     for type_name in used:
         profile = _project_of(type_name)
-        if profile is not None and type_name not in declared:
+        leaf = nav2_leaf(type_name) is not None
+        if profile is not None and not (leaf and type_name in declared):
             by_profile.setdefault(profile, []).append(type_name)
     found.profiles = [p for p in by_profile if p not in given_nodes]
     # node-model files beside the file or in its package, nearest first
@@ -251,7 +266,7 @@ def discover(
                 type_name, usage, model, "the Nav2 profile (Nav2's nav2_tree_nodes.xml)", found
             ):
                 found.models[type_name] = (model, "the Nav2 profile")
-    for library_path, hits in _bundled_libraries(used, known | set(found.models)):
+    for library_path, hits in _bundled_libraries(used, set()):
         if library_path not in given_nodes:
             found.libraries.append(library_path)
             found.library_hits[library_path] = hits
