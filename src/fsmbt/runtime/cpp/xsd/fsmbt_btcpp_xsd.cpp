@@ -63,6 +63,14 @@ int main(int argc, char** argv)
         else
           manifest.ports.insert(BT::InputPort<std::string>(name));
       }
+      // a declaration under a built-in's name (hans-ros-supervisor's v3 Sleep action):
+      // BehaviorTree.CPP 4.8.2 cannot register it (a built-in cannot be removed), so the
+      // built-in's own schema stays, said on stderr
+      if(factory.builtinNodes().count(id) != 0)
+      {
+        std::cerr << "fsmbt_btcpp_xsd: " << id << " is a built-in; its declaration is not used\n";
+        continue;
+      }
       factory.registerBuilder(manifest, [](const std::string&, const BT::NodeConfig&)
                               -> std::unique_ptr<BT::TreeNode> { return nullptr; });
     }
