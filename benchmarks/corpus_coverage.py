@@ -212,6 +212,25 @@ def share(ok: int, total: int) -> str:
     return f"{ok}/{total} ({100.0 * ok / total:.1f} %)" if total else "0/0"
 
 
+def _comment_only(path: Path) -> bool:
+    """The file is refused by the strict XML parse and read by the BehaviorTree.CPP reader's
+    comment leniency (``xml_safe.parse_xml`` with notes)."""
+    from fsmbt.formats.xml_safe import parse_xml
+
+    text = path.read_text(encoding="utf-8", errors="replace")
+    try:
+        parse_xml(text, str(path))
+        return False
+    except InputError:
+        pass
+    notes: list[str] = []
+    try:
+        parse_xml(text, str(path), notes)
+    except InputError:
+        return False
+    return bool(notes)
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--setting", choices=SETTINGS, action="append")
@@ -300,7 +319,13 @@ def main() -> int:
                 )
         negatives = [r for r in rows if r.negative]
         refused = sum(not r.ok and not r.reason.startswith("CRASH") for r in negatives)
-        print(f"negative inputs refused with an error: {refused}/{len(negatives)}")
+        lenient = [r for r in negatives if r.kind == "bt" and _comment_only(r.path)]
+        print(
+            f"negative inputs refused with an error: {refused}/{len(negatives)}; "
+            f"{len(lenient)} BT file(s) among them are malformed only by '--' inside "
+            "comments, which BehaviorTree.CPP's tinyxml2 loads: read with a warning "
+            "(docs/formats/btcpp.md)"
+        )
         slowest = max(rows, key=lambda r: r.seconds)
         print(
             f"time: {sum(r.seconds for r in rows):.1f} s in all, slowest "

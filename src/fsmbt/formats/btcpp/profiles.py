@@ -234,8 +234,8 @@ def discover(
     by_profile: dict[str, list[str]] = {}
     for type_name in used:
         profile = _project_of(type_name)
-        leaf = nav2_leaf(type_name) is not None
-        if profile is not None and not (leaf and type_name in declared):
+        is_leaf = nav2_leaf(type_name) is not None
+        if profile is not None and not (is_leaf and type_name in declared):
             by_profile.setdefault(profile, []).append(type_name)
     found.profiles = [p for p in by_profile if p not in given_nodes]
     # node-model files beside the file or in its package, nearest first
