@@ -189,3 +189,27 @@ def test_comments_with_double_hyphens_read_as_tinyxml2_reads_them() -> None:
     bomb = '<!DOCTYPE r [<!ENTITY a "x">]>\n' + text
     with pytest.raises(InputError, match="entities"):
         api.load_text(bomb, "btcpp")
+
+
+def test_translate_of_a_declared_v4_file_keeps_it_byte_for_byte(tmp_path: Path) -> None:
+    """Nothing to change (v4, main tree named, every custom node declared): the translation
+    writes the user's bytes - comments, attribute order, spacing; a file with an undeclared
+    node is rewritten (its declaration added)."""
+    text = (
+        "<?xml version='1.0'?>\n<!-- mine -->\n"
+        '<root main_tree_to_execute="T"  BTCPP_format="4">\n'
+        '  <BehaviorTree ID="T">\n    <Sequence name="s">\n'
+        '      <Go  target="{t}"  speed="1"/>\n'
+        "    </Sequence>\n  </BehaviorTree>\n"
+        '  <TreeNodesModel><Action ID="Go"><input_port name="speed"/>'
+        '<input_port name="target"/></Action></TreeNodesModel>\n</root>\n'
+    )
+    source = tmp_path / "mine.xml"
+    source.write_text(text, encoding="utf-8")
+    _loaded, result, report = api.translate(source, to="btcpp")
+    assert result.text == text and report is not None and report.equivalent
+    undeclared = tmp_path / "undeclared.xml"
+    undeclared.write_text(text.replace('<Action ID="Go">', '<Action ID="Other">'), "utf-8")
+    _loaded, rewritten, _report = api.translate(undeclared, to="btcpp")
+    assert rewritten.text != undeclared.read_text(encoding="utf-8")
+    assert 'ID="Go"' in rewritten.text
