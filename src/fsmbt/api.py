@@ -915,6 +915,13 @@ def translate(
         raise InputError(f"cannot tell the target format; name it with --to{where}")
     result = translate_model(loaded.model, target, flatten=flatten, source_format=loaded.format)
     result.warnings = list(loaded.warnings)
+    if loaded.format == target == "btcpp" and not result.losses and loaded.path is not None:
+        # a v4 file that already declares every node is written unchanged, byte for byte
+        from fsmbt.formats.btcpp.xml_format import kept_as_written
+
+        original = loaded.path.read_text(encoding="utf-8")
+        if kept_as_written(original, loaded.model):  # type: ignore[arg-type]
+            result.text = original
     report: Report | None = None
     if result.read_back is not None and result.checked is not None:
         request = verify_request or VerifyRequest()

@@ -44,6 +44,7 @@ READER_FIELDS = (
     "behaviour",
     "initial",
     "strict",
+    "no_profiles",
 )
 
 
@@ -103,6 +104,12 @@ class ReadOptions(_Request):
         default=False,
         description="refuse what a reader would otherwise read as an approximation with a "
         "warning (FlexBE: an embedded behaviour whose file is not found)",
+    )
+
+    no_profiles: bool = Field(
+        default=False,
+        description="do not apply the node profiles and node-model files fsmbt finds by itself "
+        "(a known project's nodes, a *_tree_nodes.xml beside the file: docs/semantics.md §10)",
     )
 
     @field_validator("node_models", "nodes", "abstract", "trees", mode="before")

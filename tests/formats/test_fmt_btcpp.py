@@ -9,7 +9,7 @@ import pytest
 
 from fsmbt import api
 from fsmbt.formats import dumps, loads
-from fsmbt.formats.btcpp.xml_format import ASSUMED_MARK
+from fsmbt.formats.btcpp.xml_format import ASSUMED_DESCRIPTION
 from fsmbt.formats.xml_safe import parse_xml, root_tag
 from fsmbt.limits import current as current_limits
 from fsmbt.model import BTDocument, BTNode, NodeKind
@@ -95,7 +95,7 @@ def test_undeclared_types_are_assumed_and_stay_assumed() -> None:
     assert (leaf.kind, leaf.kind_declared) == (NodeKind.ACTION, False)
     assert (wrap.kind, wrap.kind_declared) == (NodeKind.DECORATOR, False)
     text = dumps(doc, "btcpp")
-    assert ASSUMED_MARK in text and 'ID="Pipeline"' in text  # Groot2 still learns the type
+    assert ASSUMED_DESCRIPTION in text and 'ID="Pipeline"' in text  # Groot2 still learns the type
     assert loads(text, "btcpp") == doc
 
 
@@ -155,8 +155,8 @@ def test_missing_include_names_the_line(tmp_path: Path) -> None:
 def test_external_node_models_option_decides_leaf_kinds() -> None:
     models = corpus("bt/nav2/models/nav2_tree_nodes.xml")
     tree = corpus("bt/nav2/navigate_w_replanning_time.xml")
-    plain = api.load(tree).model
-    informed = api.load(tree, options={"node_models": [str(models)]}).model
+    plain = api.load(tree, options={"no_profiles": True}).model
+    informed = api.load(tree, options={"node_models": [str(models)], "no_profiles": True}).model
     undeclared = [n for _, n in plain.nodes() if not n.kind_declared]
     assert undeclared, "without Nav2's model file some kinds are assumed"
     assert all(n.kind_declared for _, n in informed.nodes())

@@ -480,7 +480,7 @@ def test_parallel_region_of_several_states_round_trips_through_its_wrapper() -> 
         loads(scxml('<state id="s" fsmbt:region="true"/>', FSMBT), "scxml")
 
 
-def test_in_guard_quotes_an_id_holding_a_quote() -> None:
+def test_a_state_name_holding_a_quote_gets_an_ncname_id() -> None:
     region = FSM(name="u")
     region.add_state("w")
     region.add_state(State("it's done", action=None, final=True))
@@ -490,5 +490,20 @@ def test_in_guard_quotes_an_id_holding_a_quote() -> None:
     fsm.add_state("t")
     fsm.add_transition("u", None, "t", exit="it's done")
     text = dumps(fsm, "scxml")
-    assert 'cond="In(&quot;it\'s_done&quot;)"' in text and 'fsmbt:name="it\'s done"' in text
+    # the id is an NCName (no quote, no space), the model name kept in fsmbt:name
+    assert "cond=\"In('it_s_done')\"" in text and 'fsmbt:name="it\'s done"' in text
+    assert loads(text, "scxml") == fsm
+
+
+def test_written_state_ids_are_ncnames() -> None:
+    """W3C SCXML ids are NCNames: ``q0:Check`` (an explored state's name) and ``1st step`` are
+    written with NCName ids, their names kept in ``fsmbt:name``; the machine reads back equal."""
+    fsm = FSM()
+    fsm.add_state("q0:Check")
+    fsm.add_state("1st step")
+    fsm.add_transition("q0:Check", "go", "1st step")
+    text = dumps(fsm, "scxml")
+    ids = re.findall(r'<(?:state|final)[^>]* id="([^"]*)"', text)
+    assert ids and all(re.fullmatch(r"[A-Za-z_][\w.-]*", i) for i in ids), ids
+    assert 'id="q0_Check"' in text and 'id="_1st_step"' in text
     assert loads(text, "scxml") == fsm

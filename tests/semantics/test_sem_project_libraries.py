@@ -74,9 +74,22 @@ def test_sem_real_parallel_keeps_the_users_type_name() -> None:
 
 
 def test_sem_real_parallel_without_its_library_is_refused() -> None:
-    doc = doc_of('<RealParallel><Action ID="A"/></RealParallel>')
+    doc = doc_of('<RealParallel><Action ID="A"/></RealParallel>', no_profiles=True)
     with pytest.raises(Exception, match="RealParallel' is not supported"):
         run(doc, {"A": ["success"]}, 1)
+
+
+def test_sem_real_parallel_finds_its_bundled_library_by_itself() -> None:
+    """With no option the bundled stardust.yaml applies (docs/semantics.md §10, "Profiles found
+    by themselves") and one line says so."""
+    text = (
+        '<root BTCPP_format="4"><BehaviorTree ID="Main"><RealParallel><Action ID="A"/>'
+        "</RealParallel></BehaviorTree></root>"
+    )
+    loaded = api.load_text(text, "btcpp")
+    root = loaded.model.main.root  # type: ignore[union-attr]
+    assert root is not None and root.semantics == "stardust.RealParallel"
+    assert any("stardust.yaml" in w and "RealParallel used here" in w for w in loaded.warnings)
 
 
 REAL_PARALLEL_TREES = [

@@ -193,6 +193,16 @@ _READ_PARAMETERS: tuple[tuple[str, Any, Callable[[], Any]], ...] = (
         ),
     ),
     (
+        "no_profiles",
+        bool,
+        lambda: typer.Option(
+            False,
+            "--no-profiles",
+            help="BT: do not apply the profiles fsmbt finds by itself (a known project's "
+            "nodes, a *_tree_nodes.xml beside the file or in its package)",
+        ),
+    ),
+    (
         "initial",
         str | None,
         lambda: typer.Option(
@@ -209,6 +219,8 @@ READ_FLAGS = (
     "--trees",
     "--include-root",
     "--data",
+    "--strict",
+    "--no-profiles",
 )
 
 

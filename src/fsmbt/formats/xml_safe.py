@@ -15,6 +15,15 @@ libxml2 (under lxml) stops at 2 048 levels even with ``huge_tree``; documents de
 are parsed by the standard library's expat (C, not recursive) feeding lxml's ``TreeBuilder``, so
 callers always get an lxml element tree whose elements carry ``sourceline``. Comments and
 processing instructions are dropped. Complexity: O(n) in the size of the text.
+
+Leniency (only for a caller that passes ``notes``: the BehaviorTree.CPP reader, docs/formats/
+btcpp.md "What BehaviorTree.CPP reads"): tinyxml2, BehaviorTree.CPP's parser, ends a comment at
+the first ``-->`` and accepts ``--`` inside it (``<!------->``, ``<!-- a -- b -->``), which XML
+1.0 forbids and libxml2 refuses ("Double hyphen within comment"). When the strict parse fails so
+and the text has such comments, their bodies are blanked (same length, newlines kept, so every
+line and column stays right: comments are dropped anyway) and the text parsed again, one note
+saying so. The security rules above are unchanged: the entity check runs first on the original
+text, and the second parse uses the same hardened parser.
 """
 
 from __future__ import annotations
@@ -64,12 +73,54 @@ def namespace(element: etree._Element) -> str | None:
     return etree.QName(element).namespace
 
 
-def parse_xml(text: str, source: str | None = None) -> etree._Element:
+#: A comment as tinyxml2 reads it: from ``<!--`` to the first ``-->``.
+_TINYXML_COMMENT = re.compile(r"<!--(?P<body>.*?)-->", re.S)
+
+
+def _blank_hyphen_comments(text: str) -> tuple[str, int]:
+    """Comments whose body XML 1.0 forbids (``--`` inside, or ``-`` last) blanked: the text
+    and how many were."""
+    count = 0
+
+    def blank(match: re.Match[str]) -> str:
+        nonlocal count
+        body = match.group("body")
+        if "--" not in body and not body.endswith("-"):
+            return match.group(0)
+        count += 1
+        return "<!--" + re.sub(r"[^\n]", " ", body) + "-->"
+
+    return _TINYXML_COMMENT.sub(blank, text), count
+
+
+def parse_xml(
+    text: str, source: str | None = None, notes: list[str] | None = None
+) -> etree._Element:
     """Parse ``text`` safely and return the root element (see the module docstring).
 
-    ``source`` is the file name used in error messages.
+    ``source`` is the file name used in error messages. ``notes``: read comments as tinyxml2
+    does (the module docstring's "Leniency"), each leniency used appended as one located line.
     """
     _refuse_entity_declarations(text, source)
+    if notes is None:
+        return _parse_strict(text, source)
+    try:
+        return _parse_strict(text, source)
+    except InputError as exc:
+        if "comment" not in str(exc).lower():
+            raise
+        lenient, count = _blank_hyphen_comments(text)
+        if not count:
+            raise
+        root = _parse_strict(lenient, source)
+        notes.append(
+            f"{source}: {count} comment(s) hold '--' (XML 1.0 forbids it; read as "
+            "BehaviorTree.CPP's tinyxml2 reads them, to the first '-->')"
+        )
+        return root
+
+
+def _parse_strict(text: str, source: str | None) -> etree._Element:
     data = text.encode("utf-8")
     parser = etree.XMLParser(
         resolve_entities=False,

@@ -26,6 +26,7 @@ from pathlib import Path
 from lxml import etree
 
 from fsmbt import limits
+from fsmbt.formats.btcpp import profiles as btcpp_profiles
 from fsmbt.formats.btcpp import trees as btcpp_trees
 from fsmbt.formats.registry import Format, ReadContext, decode, register
 from fsmbt.formats.xml_safe import parse_xml, root_tag
@@ -35,6 +36,7 @@ from fsmbt.model.bt_nodes import NodeKind, builtin_spec, canonical_type
 from fsmbt.model.errors import InputError, SourceLocation, UnsupportedError
 from fsmbt.model.files import note_read, read_located
 from fsmbt.model.nodes.library import apply_library, build_library
+from fsmbt.model.nodes.registry import node_semantics
 
 #: Tags of Groot's explicit style and of ``<TreeNodesModel>`` entries, with the kind they declare.
 EXPLICIT_TAGS: dict[str, NodeKind] = {
@@ -54,6 +56,9 @@ PORT_ELEMENT = {"input": "input_port", "output": "output_port", "inout": "inout_
 #: Written on ``<TreeNodesModel>`` entries fsmbt had to assume (kind not declared anywhere); the
 #: reader does not take such an entry as a declaration, so the assumption survives a round trip.
 ASSUMED_MARK = "_fsmbt_assumed"
+#: How the writer marks such an entry: a ``<description>`` (the one child BehaviorTree.CPP's XSD
+#: allows besides ports; an attribute would break it). ``ASSUMED_MARK="true"`` is read too.
+ASSUMED_DESCRIPTION = "fsmbt: kind assumed, declared nowhere (it may be a Condition)"
 #: ``NodeModel.attrs`` key holding a model entry's non-port children (Groot2 metadata) as XML.
 EXTRA_XML_KEY = "_fsmbt_extra_xml"
 #: Deeper trees are written without indentation (indentation alone would be O(depth²) bytes).
@@ -84,7 +89,7 @@ class _Loader:
         self, text: str, path: Path | None, chain: tuple[Path, ...], *, extra: bool = False
     ) -> None:
         name = str(path) if path is not None else self.ctx.display_name
-        root = parse_xml(text, name)
+        root = parse_xml(text, name, self.ctx.warnings)
         if root.tag != "root":
             raise InputError(
                 f"not a BehaviorTree.CPP file: root element is <{str(root.tag)}>, expected <root>",
@@ -432,6 +437,13 @@ class _Loader:
                     f"({spec.source}), but BehaviorTree.CPP 4.8.2's loader refuses a control "
                     "node without children"
                 )
+            if not _factory_builtin(type_name) and spec.kind is not NodeKind.SUBTREE:
+                # a project's kind (Nav2's PipelineSequence): declared in the document's models
+                # with its ports, as every node BehaviorTree.CPP's factory does not hold
+                seen = ports_seen.setdefault(type_name, dict.fromkeys(spec.ports))
+                for key in attrs:
+                    seen.setdefault(key, None)
+                implied.setdefault(type_name, spec.kind)
             return BTNode(type_name, spec.kind, name, attrs, location=where)
         seen = ports_seen.setdefault(type_name, {})
         for key in attrs:
@@ -499,6 +511,9 @@ def _read_models(element: etree._Element, source: str) -> list[NodeModel]:
         extra: list[str] = []
         for child in _elements(entry):
             direction = PORT_TAGS.get(str(child.tag))
+            if child.tag == "description" and (child.text or "").strip() == ASSUMED_DESCRIPTION:
+                attrs[ASSUMED_MARK] = "true"
+                continue
             if direction is None:
                 extra.append(etree.tostring(child, encoding="unicode", with_tail=False))
                 continue
@@ -529,16 +544,110 @@ def read_btcpp(text: str, ctx: ReadContext) -> BTDocument:
         loader.loaded.add(path)
     loader.load(text, ctx.path, (path,) if path is not None else ())
     loader.resolve_subtrees()
+    given_nodes = [str(n) for n in _as_list(ctx.options.get("nodes"))]
+    found = None
+    if not ctx.options.get("no_profiles"):
+        found = _find_profiles(loader, ctx, given_nodes)
     doc = loader.document()
     loader.prune_extra_trees(doc)
     # --nodes / --abstract (fsmbt.model.nodes.library): project kinds, aliases, abstractions
-    library = build_library(ctx.options.get("nodes"), ctx.options.get("abstract"))
+    nodes = given_nodes + (found.profiles + found.libraries if found is not None else [])
+    library = build_library(nodes, ctx.options.get("abstract"))
 
     def warn(message: str, location: SourceLocation | None) -> None:
         ctx.warnings.append(f"{location}: {message}" if location is not None else message)
 
     apply_library(doc, library, warn)
+    _declare_library_kinds(doc)
+    if found is not None:
+        abstractions: dict[str, list[str]] = {}
+        for _tree, node in doc.nodes():
+            spec = node_semantics(node.semantics) if node.semantics else None
+            if spec is None or spec.abstraction is None:
+                continue
+            origin = library.sources.get(node.type) or spec.requires or ""
+            names = abstractions.setdefault(origin, [])
+            if node.type not in names:
+                names.append(node.type)
+        ctx.warnings.extend(btcpp_profiles.notes(found, abstractions, ctx.display_name))
     return doc
+
+
+def _declare_library_kinds(doc: BTDocument) -> None:
+    """Kinds a node library declared (``kind: action``, an alias's target kind) join the
+    document's models with the ports the nodes use, as the writer declares them: a written
+    file read again is the same document (docs/formats/btcpp.md)."""
+    added: set[str] = set()
+    for _tree, node in doc.nodes():
+        if (
+            not node.kind_declared
+            or node.kind is NodeKind.SUBTREE
+            or _factory_builtin(node.type)
+            or (node.type in doc.node_models and node.type not in added)
+        ):
+            continue
+        if node.type not in doc.node_models:
+            doc.node_models[node.type] = NodeModel(node.type, node.kind, [])
+            added.add(node.type)
+        entry = doc.node_models[node.type]
+        known = {p.name for p in entry.ports}
+        entry.ports.extend(PortModel(k) for k in node.attrs if k not in known)
+
+
+def _as_list(value: object) -> list[object]:
+    if value is None:
+        return []
+    if isinstance(value, (str, Path)):
+        return [part.strip() for part in str(value).split(",") if part.strip()]
+    return list(value)  # type: ignore[call-overload]
+
+
+def _find_profiles(
+    loader: _Loader, ctx: ReadContext, given_nodes: list[str]
+) -> btcpp_profiles.Found:
+    """Profiles and node models found by themselves (``fsmbt.formats.btcpp.profiles``); the
+    found declarations join the external models after the user's ``--node-models``."""
+    declared: set[str] = set()
+    for f in loader.files:
+        for child in _elements(f.root):
+            if child.tag == "TreeNodesModel":
+                declared |= {m.type for m in _read_models(child, f.path)}
+    found = btcpp_profiles.discover(
+        ctx.path,
+        [(f.path, f.root) for f in loader.files],
+        declared,
+        given_nodes,
+        set(loader.external),
+    )
+    ctx.warnings.extend(found.warnings)
+    for type_name, (model, _source) in found.models.items():
+        loader.external.setdefault(type_name, model)
+    return found
+
+
+def kept_as_written(text: str, doc: BTDocument) -> bool:
+    """Whether ``text``, the file ``doc`` was read from, is already what the writer must give:
+    a self-contained v4 file (``BTCPP_format="4"``, no ``<include>``), its main tree named,
+    every node BehaviorTree.CPP's factory does not hold declared in its own
+    ``<TreeNodesModel>`` and no kind assumed. A BT.CPP -> BT.CPP translation of such a file
+    writes it byte for byte (comments, attribute order, formatting kept: nothing changed);
+    docs/formats/btcpp.md "What is written"."""
+    if doc.format_version != "4" or doc.includes:
+        return False
+    root = parse_xml(text, "<source>", [])
+    if root.get("BTCPP_format") != "4" or (
+        root.get("main_tree_to_execute") is None and len(doc.trees) != 1
+    ):
+        return False
+    declared: set[str] = set()
+    for models in root.iter("TreeNodesModel"):
+        declared |= {m.type for m in _read_models(models, "<source>")}
+    for _tree, node in doc.nodes():
+        if node.kind is NodeKind.SUBTREE or _factory_builtin(node.type):
+            continue
+        if not node.kind_declared or node.type not in declared:
+            return False
+    return True
 
 
 # -- writing -------------------------------------------------------------------------------------
@@ -598,13 +707,15 @@ def _write_models(root: etree._Element, doc: BTDocument) -> None:
     assumed: dict[str, NodeModel] = {}
     added: set[str] = set()
     for _tree, node in doc.nodes():
-        if node.is_builtin or node.kind is NodeKind.SUBTREE:
+        if _factory_builtin(node.type) or node.kind is NodeKind.SUBTREE:
             continue
         if node.type in doc.node_models or (node.kind_declared and node.type in assumed):
             continue
         target = models if node.kind_declared else assumed
         if node.type not in target:
-            target[node.type] = NodeModel(node.type, node.kind)
+            spec = builtin_spec(node.type)
+            ports = [PortModel(p) for p in spec.ports] if spec is not None else []
+            target[node.type] = NodeModel(node.type, node.kind, ports)
             added.add(node.type)
         elif node.type not in added:
             continue
@@ -618,7 +729,26 @@ def _write_models(root: etree._Element, doc: BTDocument) -> None:
         _model_element(container, model)
     for model in assumed.values():
         if model.type not in models:
-            _model_element(container, model).set(ASSUMED_MARK, "true")
+            etree.SubElement(
+                _model_element(container, model), "description"
+            ).text = ASSUMED_DESCRIPTION
+
+
+#: Registered BehaviorTree.CPP kinds a 4.8.2 ``BehaviorTreeFactory`` does not hold: v3's
+#: blackboard checks (removed in v4) and ManualSelector (registered only with ncurses).
+_NOT_IN_FACTORY = frozenset(
+    {"BlackboardCheckDouble", "BlackboardCheckInt", "BlackboardCheckString", "ManualSelector"}
+)
+
+
+def _factory_builtin(type_name: str) -> bool:
+    """A node BehaviorTree.CPP 4.8.2's factory knows without a declaration; every other node
+    (a project's ``PipelineSequence``, a user's leaf) is declared in ``<TreeNodesModel>`` with
+    its ports, so BehaviorTree.CPP's XSD and Groot2 know it (docs/formats/btcpp.md)."""
+    spec = builtin_spec(type_name)
+    return (
+        spec is not None and spec.library == "BehaviorTree.CPP" and spec.name not in _NOT_IN_FACTORY
+    )
 
 
 def _model_element(parent: etree._Element, model: NodeModel) -> etree._Element:

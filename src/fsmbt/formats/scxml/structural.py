@@ -809,10 +809,11 @@ class _Writer:
 
         The id of a compound/parallel state (it raises ``done.state.<id>``) is never a
         dot-prefix of another one's, nor has one as a dot-prefix: SCXML's event matching takes
-        ``done.state.a`` for ``done.state.a.b`` too. Such ids get ``_`` for ``.``; whitespace
-        becomes ``_`` (the model name is kept in ``fsmbt:name``).
+        ``done.state.a`` for ``done.state.a.b`` too. Such ids get ``_`` for ``.``; a character
+        an NCName cannot hold becomes ``_`` (``ncname``; the model name is kept in
+        ``fsmbt:name``).
         """
-        name = re.sub(r"\s+", "_", name)  # an id is one token (targets are lists of ids)
+        name = ncname(name)  # an id is one token (targets are lists of ids), an NCName
         unique = f"{prefix}.{name}" if shared or name in self.taken else name
         while unique in self.taken or (composite and self.dot_related(unique)):
             unique = unique.replace(".", "_") if composite and "." in unique else unique + "_"
@@ -1010,6 +1011,20 @@ def _assignments(parent: etree._Element, text: str) -> None:
     """``<assign location expr>`` children for ``name=expr`` lines (``fsmbt.model.fsm_data``)."""
     for name, expr in fsm_data.parse_lines(text):
         etree.SubElement(parent, _q("assign"), location=name, expr=expr)
+
+
+_NOT_NCNAME = re.compile(r"[^\w.\-\u00B7\u0300-\u036F\u203F-\u2040]")
+
+
+def ncname(name: str) -> str:
+    """``name`` as an XML NCName, the type of SCXML's ``id`` (W3C SCXML §3.14, XML Namespaces
+    §3): every character an NCName cannot hold (``:``, whitespace, punctuation) becomes ``_``,
+    and a first character that cannot start one (a digit, ``-``, ``.``) gets a ``_`` before it.
+    docs/formats/scxml.md "What fsmbt writes"."""
+    out = _NOT_NCNAME.sub("_", name) or "_"
+    if not (out[0].isalpha() or out[0] == "_"):
+        out = "_" + out
+    return out
 
 
 def _in_predicate(state_id: str, source: str) -> str:

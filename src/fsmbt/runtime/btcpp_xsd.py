@@ -1,0 +1,125 @@
+"""BehaviorTree.CPP's own XSD for a written file, and the check of the file against it.
+
+Why: a BT file fsmbt writes must be one BehaviorTree.CPP 4.8.2 and Groot2 accept. The schema is
+not ours: ``BT::writeTreeXSD`` generates it from a factory holding BehaviorTree.CPP's built-ins
+plus the nodes the file's own ``<TreeNodesModel>`` declares (with their ports).
+``cpp/xsd/fsmbt_btcpp_xsd.cpp`` is that factory: a tiny program compiled against the cached
+BehaviorTree.CPP build (``fsmbt doctor --install btcpp``), cached as
+``bin/fsmbt_btcpp_xsd-<sha256 of its source, 16 hex>`` next to the driver, so a changed source
+is rebuilt and a stale binary is never used. docs/formats/btcpp.md ("Checked against
+BehaviorTree.CPP's XSD") lists what that XSD cannot express.
+
+Costs: the first call compiles the program (about 10 s on one core); each check runs it once
+per distinct ``<TreeNodesModel>`` (memoised) and validates with lxml in O(file size).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import shutil
+import subprocess
+from functools import lru_cache
+from pathlib import Path
+
+from lxml import etree
+
+from fsmbt.runtime.cpp import PACKAGE_DIR, CppRuntimeError, library_built, library_prefix
+
+XSD_SOURCE = PACKAGE_DIR / "xsd" / "fsmbt_btcpp_xsd.cpp"
+_KINDS = ("Action", "Condition", "Control", "Decorator")
+_DIRECTIONS = {"input_port": "input", "output_port": "output", "inout_port": "inout"}
+
+
+def program_path() -> Path:
+    """Where the program built from this package's source is (may not exist)."""
+    digest = hashlib.sha256(XSD_SOURCE.read_bytes()).hexdigest()[:16]
+    return library_prefix() / "bin" / f"fsmbt_btcpp_xsd-{digest}"
+
+
+def find_program(*, build: bool = True) -> Path | None:
+    """The program, compiled first when ``build`` and the library is there; ``None`` when the
+    library is not built or no C++ compiler is found."""
+    path = program_path()
+    if path.is_file() and os.access(path, os.X_OK):
+        return path
+    if not build or not library_built():
+        return None
+    compiler = os.environ.get("CXX") or shutil.which("g++") or shutil.which("clang++")
+    if compiler is None:
+        return None
+    prefix = library_prefix()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    partial = path.with_name(f"{path.name}.{os.getpid()}.tmp")
+    done = subprocess.run(
+        [compiler, "-std=c++17", "-O1", "-o", str(partial), str(XSD_SOURCE)]
+        + [f"-I{prefix / 'include'}", f"-L{prefix / 'lib'}", f"-Wl,-rpath,{prefix / 'lib'}"]
+        + ["-lbehaviortree_cpp", "-lpthread", "-ldl"],
+        capture_output=True,
+        text=True,
+        timeout=600,
+        check=False,
+    )
+    if done.returncode != 0:
+        partial.unlink(missing_ok=True)
+        raise CppRuntimeError(f"cannot compile {XSD_SOURCE.name}: {done.stderr.strip()[:400]}")
+    partial.replace(path)  # atomic: a concurrent build writes the same bytes
+    return path
+
+
+def declarations(root: etree._Element) -> str:
+    """The program's input for a file's ``<TreeNodesModel>``: ``KIND ID dir:port...`` lines."""
+    lines: list[str] = []
+    for container in root.iter("TreeNodesModel"):
+        for entry in container:
+            if not isinstance(entry.tag, str) or entry.tag not in _KINDS or not entry.get("ID"):
+                continue
+            ports = [
+                f"{_DIRECTIONS[str(p.tag)]}:{p.get('name')}"
+                for p in entry
+                if isinstance(p.tag, str) and p.tag in _DIRECTIONS and p.get("name")
+            ]
+            lines.append(" ".join([str(entry.tag), str(entry.get("ID")), *ports]))
+    return "\n".join(lines) + "\n"
+
+
+@lru_cache(maxsize=256)
+def _schema(program: str, declared: str) -> etree.XMLSchema:
+    done = subprocess.run(
+        [program], input=declared, capture_output=True, text=True, timeout=60, check=False
+    )
+    if done.returncode != 0:
+        raise CppRuntimeError(f"fsmbt_btcpp_xsd failed: {done.stderr.strip()[:400]}")
+    return etree.XMLSchema(etree.fromstring(done.stdout.encode("utf-8")))
+
+
+def tree_xsd(text: str) -> str:
+    """The XSD BehaviorTree.CPP generates for the built-ins plus ``text``'s declared nodes."""
+    program = find_program()
+    if program is None:
+        raise CppRuntimeError("BehaviorTree.CPP is not built: run fsmbt doctor --install btcpp")
+    root = etree.fromstring(text.encode("utf-8"))
+    done = subprocess.run(
+        [str(program)],
+        input=declarations(root),
+        capture_output=True,
+        text=True,
+        timeout=60,
+        check=False,
+    )
+    if done.returncode != 0:
+        raise CppRuntimeError(f"fsmbt_btcpp_xsd failed: {done.stderr.strip()[:400]}")
+    return done.stdout
+
+
+def xsd_errors(text: str) -> list[str]:
+    """Where ``text`` (a BehaviorTree.CPP file) breaks BehaviorTree.CPP's XSD for it:
+    ``line: message`` each, ``[]`` when it validates."""
+    program = find_program()
+    if program is None:
+        raise CppRuntimeError("BehaviorTree.CPP is not built: run fsmbt doctor --install btcpp")
+    document = etree.fromstring(text.encode("utf-8"))
+    schema = _schema(str(program), declarations(document))
+    if schema.validate(document):
+        return []
+    return [f"{error.line}: {error.message}" for error in schema.error_log]
