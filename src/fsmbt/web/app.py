@@ -49,7 +49,12 @@ def create_app(settings: WebSettings | None = None) -> FastAPI:
 
     @asynccontextmanager
     async def lifespan(app: FastAPI) -> AsyncIterator[None]:
-        app.state.workers = Workers(settings.workers, settings.timeout_s)
+        app.state.workers = Workers(
+            settings.workers,
+            settings.timeout_s,
+            max_waiting=settings.max_waiting,
+            cpu_seconds=settings.cpu_limit_s,
+        )
         yield
         app.state.workers.close()
 
@@ -61,7 +66,7 @@ def create_app(settings: WebSettings | None = None) -> FastAPI:
         "prove the result equivalent (docs/web.md).",
     )
     app.state.settings = settings
-    app.add_middleware(BodyLimit, limit=settings.max_body_bytes)
+    app.add_middleware(BodyLimit, limit=settings.max_body_bytes, drain_cap=settings.drain_cap_bytes)
     app.mount("/static", StaticFiles(directory=HERE / "static"), name="static")
     install_handlers(app)
     app.include_router(routes_reference.router)

@@ -14,26 +14,40 @@ from fsmbt.web.bodies import body_doc, model_body, pair_body
 from fsmbt.web.errors import ApiError
 from fsmbt.web.routes_reference import llm_engines
 from fsmbt.web.schemas import ConvertBody, ExportBody, ModelText, VerifyBody
-from fsmbt.web.workers import Busy, WorkerCrashed, WorkTimeout
+from fsmbt.web.workers import Busy, CpuTimeout, WorkerCrashed, WorkTimeout
 
 router = APIRouter()
+#: Seconds a refused-as-busy client is asked to wait (``Retry-After``).
+RETRY_AFTER_S = 2
 
 
 async def work(request: Request, function: Any, argument: Any) -> Any:
-    """``function(argument)`` in a worker; its refusal as a 400, time and load limits as 503."""
-    timeout_s = request.app.state.settings.timeout_s
+    """``function(argument)`` in a worker; its refusal as a 400; the wall-time limit as 408, the
+    CPU-time limit as 422 (each naming the limit), too many waiting requests as 503 with
+    ``Retry-After`` (docs/web.md, 'Limits')."""
+    settings = request.app.state.settings
     try:
         status, value = await request.app.state.workers.run(function, argument)
     except WorkTimeout:
         raise ApiError(
-            503,
-            f"took longer than {timeout_s:g} s, the page's limit; "
+            408,
+            f"over the wall-time limit of {settings.timeout_s:g} s per request (--timeout); "
+            "the model is too large for the page: use the command line "
+            "(fsmbt convert / fsmbt verify)",
+        ) from None
+    except CpuTimeout:
+        raise ApiError(
+            422,
+            f"over the CPU-time limit of {settings.cpu_limit_s:g} s per request (--cpu-limit); "
             "the model is too large for the page: use the command line "
             "(fsmbt convert / fsmbt verify)",
         ) from None
     except Busy:
         raise ApiError(
-            503, "the server is busy (too many requests waiting); try again shortly"
+            503,
+            "the server is busy (too many requests waiting for a worker, --max-waiting); "
+            "try again shortly",
+            headers={"retry-after": str(RETRY_AFTER_S)},
         ) from None
     except WorkerCrashed:
         raise ApiError(500, "internal error (logged on the server)") from None
