@@ -17,6 +17,7 @@ from pathlib import Path
 
 import typer
 
+from fsmbt.web.answers import DEFAULT_CACHE_BYTES
 from fsmbt.web.settings import (
     DEFAULT_CPU_LIMIT_S,
     DEFAULT_MAX_BODY_BYTES,
@@ -92,6 +93,15 @@ def register(app: typer.Typer) -> None:
             min=1.0,
             help="CPU seconds one conversion or verification may use (422 past it)",
         ),
+        cache_bytes: int = typer.Option(
+            DEFAULT_CACHE_BYTES,
+            "--cache-bytes",
+            min=0,
+            help="memory bound of the answer cache, bytes (0: no cache)",
+        ),
+        cache_dir: Path | None = typer.Option(
+            None, "--cache-dir", help="also keep cached answers in this folder"
+        ),
         max_waiting: int = typer.Option(
             DEFAULT_MAX_WAITING,
             "--max-waiting",
@@ -116,6 +126,8 @@ def register(app: typer.Typer) -> None:
             "timeout_s": timeout,
             "cpu_limit_s": cpu_limit,
             "max_waiting": max_waiting,
+            "cache_bytes": cache_bytes,
+            "cache_dir": cache_dir,
             "workers": workers,
             "reports_dir": reports,
         }

@@ -28,6 +28,7 @@ from fastapi import FastAPI
 from fastapi.staticfiles import StaticFiles
 
 from fsmbt.web import routes_pipeline, routes_reference, routes_reports
+from fsmbt.web.answers import AnswerCache
 from fsmbt.web.errors import BodyLimit, install_handlers
 from fsmbt.web.settings import WebSettings
 from fsmbt.web.workers import Workers
@@ -66,6 +67,9 @@ def create_app(settings: WebSettings | None = None) -> FastAPI:
         "prove the result equivalent (docs/web.md).",
     )
     app.state.settings = settings
+    app.state.cache = (
+        AnswerCache(settings.cache_bytes, settings.cache_dir) if settings.cache_bytes > 0 else None
+    )
     app.add_middleware(BodyLimit, limit=settings.max_body_bytes, drain_cap=settings.drain_cap_bytes)
     app.mount("/static", StaticFiles(directory=HERE / "static"), name="static")
     install_handlers(app)

@@ -1,6 +1,7 @@
 """The pipeline's endpoints: inspect, convert, verify, export, the runtime files. Each parses its
 body (``bodies``) and runs one library call in a worker process (``service``, ``workers``) under
-the server's time limit (docs/web.md)."""
+the server's time limits (docs/web.md), unless the same request's answer is in the
+content-addressed cache (``answers``)."""
 
 from __future__ import annotations
 
@@ -10,6 +11,7 @@ from fastapi import APIRouter, Request
 from fastapi.responses import Response
 
 from fsmbt.web import service
+from fsmbt.web.answers import request_key
 from fsmbt.web.bodies import body_doc, model_body, pair_body
 from fsmbt.web.errors import ApiError
 from fsmbt.web.routes_reference import llm_engines
@@ -26,8 +28,15 @@ async def work(request: Request, function: Any, argument: Any) -> Any:
     CPU-time limit as 422 (each naming the limit), too many waiting requests as 503 with
     ``Retry-After`` (docs/web.md, 'Limits')."""
     settings = request.app.state.settings
+    cache = request.app.state.cache
+    key = request_key(getattr(function, "__name__", str(function)), argument)
+    answer = cache.get(key) if cache is not None else None
     try:
-        status, value = await request.app.state.workers.run(function, argument)
+        if answer is None:
+            answer = await request.app.state.workers.run(function, argument)
+            if cache is not None:
+                cache.put(key, answer)
+        status, value = answer
     except WorkTimeout:
         raise ApiError(
             408,

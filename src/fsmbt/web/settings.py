@@ -11,6 +11,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import fsmbt
+from fsmbt.web.answers import DEFAULT_CACHE_BYTES
 from fsmbt.web.errors import DEFAULT_DRAIN_CAP_BYTES
 
 #: Largest request body accepted (bytes).
@@ -41,6 +42,8 @@ class WebSettings:
         timeout_s: the wall-time limit of one conversion or verification (408 past it).
         cpu_limit_s: the CPU-time limit of one conversion or verification (422 past it).
         max_waiting: requests that may wait for a worker (503 with ``Retry-After`` beyond).
+        cache_bytes: the in-memory bound of the answer cache (0: no cache; ``answers``).
+        cache_dir: where the answer cache is also kept on disk (``None``: memory only).
         drain_cap_bytes: an over-limit body is read and dropped up to this size so the client
             gets its 413 (``errors.BodyLimit``); past it the connection is closed.
         workers: worker processes.
@@ -54,6 +57,8 @@ class WebSettings:
     cpu_limit_s: float = DEFAULT_CPU_LIMIT_S
     max_waiting: int = DEFAULT_MAX_WAITING
     drain_cap_bytes: int = DEFAULT_DRAIN_CAP_BYTES
+    cache_bytes: int = DEFAULT_CACHE_BYTES
+    cache_dir: Path | None = None
     workers: int = DEFAULT_WORKERS
     examples_dir: Path | None = None
     reports_dir: Path | None = None
