@@ -5,6 +5,7 @@ content-addressed cache (``answers``)."""
 
 from __future__ import annotations
 
+import json
 from typing import Any
 
 from fastapi import APIRouter, Request
@@ -23,20 +24,22 @@ router = APIRouter()
 RETRY_AFTER_S = 2
 
 
-async def work(request: Request, function: Any, argument: Any) -> Any:
+async def work(request: Request, function: Any, argument: Any, encode: bool = False) -> Any:
     """``function(argument)`` in a worker; its refusal as a 400; the wall-time limit as 408, the
     CPU-time limit as 422 (each naming the limit), too many waiting requests as 503 with
     ``Retry-After`` (docs/web.md, 'Limits')."""
     settings = request.app.state.settings
     cache = request.app.state.cache
-    key = request_key(getattr(function, "__name__", str(function)), argument)
-    answer = cache.get(key) if cache is not None else None
+    name = getattr(function, "__name__", str(function))
+    key = request_key(f"{name}.json" if encode else name, argument)
+    answer: tuple[str, Any] | None = cache.get(key) if cache is not None else None
     try:
         if answer is None:
             answer = await request.app.state.workers.run(function, argument)
+            if encode and answer[0] == "ok":
+                answer = ("ok", encoded(answer[1]))
             if cache is not None:
                 cache.put(key, answer)
-        status, value = answer
     except WorkTimeout:
         raise ApiError(
             408,
@@ -60,9 +63,25 @@ async def work(request: Request, function: Any, argument: Any) -> Any:
         ) from None
     except WorkerCrashed:
         raise ApiError(500, "internal error (logged on the server)") from None
+    status: str = answer[0]
+    value: Any = answer[1]
     if status == "error":
         raise ApiError(400, value["error"], value["where"])
     return value
+
+
+async def json_work(request: Request, function: Any, argument: Any) -> Response:
+    """``work`` for a call answering a JSON object: the answer is encoded once (as FastAPI's
+    ``JSONResponse`` would) and the encoded bytes are what the cache keeps, so a repeated
+    request costs a lookup, not a new serialisation of both pictures."""
+    value = await work(request, function, argument, encode=True)
+    return Response(value, media_type="application/json")
+
+
+def encoded(value: Any) -> bytes:
+    return json.dumps(
+        value, ensure_ascii=False, allow_nan=False, indent=None, separators=(",", ":")
+    ).encode("utf-8")
 
 
 @router.post(
@@ -70,7 +89,7 @@ async def work(request: Request, function: Any, argument: Any) -> Any:
 )
 async def inspect(request: Request) -> Any:
     body = await model_body(request, ModelText)
-    return await work(request, service.inspect, body)
+    return await json_work(request, service.inspect, body)
 
 
 @router.post(
@@ -84,7 +103,7 @@ async def convert(request: Request) -> Any:
     if engine not in service.PLAIN_ENGINES and engine not in llm_engines():
         known = ", ".join([*service.PLAIN_ENGINES, *llm_engines()])
         raise ApiError(400, f"engine '{engine}' is not offered here (offered: {known})", "engine")
-    return await work(request, service.convert, body)
+    return await json_work(request, service.convert, body)
 
 
 @router.post(
@@ -94,7 +113,7 @@ async def convert(request: Request) -> Any:
 )
 async def verify(request: Request) -> Any:
     body = await pair_body(request, VerifyBody)
-    return await work(request, service.verify, body)
+    return await json_work(request, service.verify, body)
 
 
 @router.post(
