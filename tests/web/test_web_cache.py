@@ -58,3 +58,16 @@ def test_a_repeated_request_is_answered_from_the_cache():
         assert (cache.hits, cache.misses) == (1, 1)
         looped = client.post("/api/convert", json={"text": PAPER, "options": {"loop": True}})
         assert looped.status_code == 200 and cache.misses == 2
+
+
+def test_every_answer_carries_the_security_headers():
+    from fsmbt.web.headers import SECURITY_HEADERS
+
+    with TestClient(create_app(WebSettings.default(workers=1, max_body_bytes=2048))) as client:
+        for answer in (
+            client.get("/"),
+            client.get("/api/formats"),
+            client.post("/api/convert", json={"text": "x" * 4096}),  # the 413
+        ):
+            for name, value in SECURITY_HEADERS:
+                assert answer.headers.get(name.decode()) == value.decode(), answer.status_code

@@ -30,6 +30,7 @@ from fastapi.staticfiles import StaticFiles
 from fsmbt.web import routes_pipeline, routes_reference, routes_reports
 from fsmbt.web.answers import AnswerCache
 from fsmbt.web.errors import BodyLimit, install_handlers
+from fsmbt.web.headers import SecurityHeaders
 from fsmbt.web.settings import WebSettings
 from fsmbt.web.workers import Workers
 
@@ -71,6 +72,7 @@ def create_app(settings: WebSettings | None = None) -> FastAPI:
         AnswerCache(settings.cache_bytes, settings.cache_dir) if settings.cache_bytes > 0 else None
     )
     app.add_middleware(BodyLimit, limit=settings.max_body_bytes, drain_cap=settings.drain_cap_bytes)
+    app.add_middleware(SecurityHeaders)  # outermost: the 413s carry them too
     app.mount("/static", StaticFiles(directory=HERE / "static"), name="static")
     install_handlers(app)
     app.include_router(routes_reference.router)
