@@ -1,7 +1,8 @@
 """Load test of the web page's API on loopback (issue 16): many concurrent conversions.
 
     .venv/bin/python benchmarks/bench_web.py [--requests 200] [--concurrency 200]
-        [--workers 2] [--deadline 600] [--url http://127.0.0.1:PORT]
+        [--workers 2] [--deadline 600] [--url http://127.0.0.1:PORT] [--warm]
+        [--distinct STATES]
 
 Starts ``fsmbt serve`` as a subprocess on a free 127.0.0.1 port (unless ``--url`` names a
 running one), then sends ``--requests`` ``POST /api/convert`` requests cycling over the example
@@ -9,13 +10,17 @@ models (JSON bodies), at most ``--concurrency`` at once, through one ``httpx.Asy
 run is bounded: each request has a client timeout and the whole run ``--deadline`` seconds.
 Prints the count, errors (any answer but 200 with a verdict, or a transport failure: must be
 0), throughput and the latency percentiles (p50, p95, max) measured here, per request from send
-to full answer. Exit 1 when any request failed.
+to full answer, and the load average (the machine may be shared). ``--warm`` sends each example
+once first (the server's answer cache is then warm, docs/web.md 'Cache'); ``--distinct 30``
+sends a different generated 30-state FSM in every request instead. Exit 1 when any request
+failed.
 """
 
 from __future__ import annotations
 
 import argparse
 import asyncio
+import os
 import statistics
 import sys
 import time
@@ -44,13 +49,45 @@ def percentile(values: list[float], fraction: float) -> float:
     return ordered[index]
 
 
-async def load(
-    url: str, requests: int, concurrency: int, deadline: float, timeout: float
-) -> dict[str, object]:
-    bodies = [
+def example_bodies() -> list[dict[str, str]]:
+    return [
         {"text": (REPO / "examples" / name).read_text(encoding="utf-8"), "filename": name}
         for name in EXAMPLES
     ]
+
+
+def distinct_bodies(count: int, states: int) -> list[dict[str, str]]:
+    """``count`` different generated ``states``-state FSMs (SCXML): no cache can help."""
+    from fsmbt.formats import dumps
+    from fsmbt.generate.generator import random_fsm
+
+    return [
+        {
+            "text": dumps(
+                random_fsm(seed=f"bench-web-{index}", n_states=states, max_states=states),
+                "scxml",
+            ),
+            "filename": f"m{index}.scxml",
+        }
+        for index in range(count)
+    ]
+
+
+async def warm(url: str, bodies: list[dict[str, str]], timeout: float) -> None:
+    """Send each body once (fills the server's answer cache)."""
+    async with httpx.AsyncClient(base_url=url, timeout=timeout) as client:
+        for body in bodies:
+            await client.post("/api/convert", json=body)
+
+
+async def load(
+    url: str,
+    requests: int,
+    concurrency: int,
+    deadline: float,
+    timeout: float,
+    bodies: list[dict[str, str]],
+) -> dict[str, object]:
     latencies: list[float] = []
     errors: list[str] = []
     gate = asyncio.Semaphore(concurrency)
@@ -117,18 +154,42 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--deadline", type=float, default=600.0, help="seconds for the whole run")
     parser.add_argument("--timeout", type=float, default=300.0, help="seconds per request")
     parser.add_argument("--url", help="a running server instead of starting one")
+    parser.add_argument(
+        "--warm", action="store_true", help="send each example once before timing (cache warm)"
+    )
+    parser.add_argument(
+        "--distinct",
+        type=int,
+        default=0,
+        metavar="STATES",
+        help="every request a different generated FSM of STATES states (no cache hit)",
+    )
+    parser.add_argument(
+        "--no-cache", action="store_true", help="start the server with --cache-bytes 0 (before)"
+    )
     args = parser.parse_args(argv)
+    bodies = distinct_bodies(args.requests, args.distinct) if args.distinct else example_bodies()
 
     def run(url: str) -> int:
+        if args.warm:
+            asyncio.run(warm(url, bodies, args.timeout))
         result = asyncio.run(
-            load(url, args.requests, args.concurrency, args.deadline, args.timeout)
+            load(url, args.requests, args.concurrency, args.deadline, args.timeout, bodies)
+        )
+        load1, load5, _ = os.getloadavg()
+        mode = f"distinct {args.distinct}-state models" if args.distinct else "examples"
+        cache = "off" if args.no_cache else ("warm" if args.warm else "cold")
+        print(f"mode: {mode}, cache {cache}")
+        print(
+            f"load average at the end: {load1:.2f} (1 min), {load5:.2f} (5 min), {os.cpu_count()} cores"
         )
         return report(result, args.concurrency)
 
     if args.url:
         return run(args.url)
     # the per-conversion limit stays the default; queued requests wait outside it
-    with running_server("--workers", str(args.workers)) as url:
+    extra = ("--cache-bytes", "0") if args.no_cache else ()
+    with running_server("--workers", str(args.workers), *extra) as url:
         print(f"server: {url} ({args.workers} worker processes)")
         return run(url)
 

@@ -62,9 +62,29 @@ def running_server(*args: str, ready_seconds: float = 60.0) -> Iterator[str]:
                 time.sleep(0.2)
         yield url
     finally:
-        process.terminate()
+        stop_leaving_nothing(process)
+
+
+def stop_leaving_nothing(process: subprocess.Popen[str], seconds: float = 15.0) -> list[int]:
+    """SIGTERM ``process``, wait, then SIGKILL whatever of it and its descendants is still
+    alive, so a test never leaves a worker behind. Returns the pids that had to be killed
+    (the stop tests assert it is empty; fixtures just clean up)."""
+    import psutil
+
+    try:
+        descendants = psutil.Process(process.pid).children(recursive=True)
+    except psutil.NoSuchProcess:
+        descendants = []
+    process.terminate()
+    try:
+        process.wait(timeout=seconds)
+    except subprocess.TimeoutExpired:
+        process.kill()
+        process.wait()
+    _, alive = psutil.wait_procs(descendants, timeout=1.0)
+    for child in alive:
         try:
-            process.wait(timeout=15)
-        except subprocess.TimeoutExpired:
-            process.kill()
-            process.wait()
+            child.kill()
+        except psutil.NoSuchProcess:
+            pass
+    return [child.pid for child in alive]

@@ -1,4 +1,4 @@
-"""Hostile requests: each is a clean 4xx (or 503 for the time limit) with a one-line cause, and
+"""Hostile requests: each is a clean 4xx (408 / 422 for the wall / CPU limits) with a one-line cause, and
 the server keeps answering afterwards."""
 
 from __future__ import annotations
@@ -117,17 +117,38 @@ def test_bad_fields(client):
     _refused(client.post("/api/verify", json={"first": {"text": PAPER}}), 400, "two models")
 
 
-def test_time_limit_answers_and_frees_the_worker():
+@pytest.fixture(scope="module")
+def big_model() -> str:
     from fsmbt.formats import dumps
     from fsmbt.generate.generator import random_fsm
 
     # 20 000 states: about 12 s to read, convert and verify on the 2-core CI machine, 4x the
     # limit, so a faster machine still hits it (3 000 states took 0.6 s: rendering decided)
-    big = dumps(random_fsm(seed="web-timeout", n_states=20_000, max_states=20_000), "scxml")
-    settings = WebSettings.default(workers=1, timeout_s=3, max_body_bytes=8 * 1024 * 1024)
+    return dumps(random_fsm(seed="web-timeout", n_states=20_000, max_states=20_000), "scxml")
+
+
+def test_time_limit_answers_408_naming_it_and_frees_the_worker(big_model):
+    settings = WebSettings.default(
+        workers=1, timeout_s=3, cpu_limit_s=600, max_body_bytes=8 * 1024 * 1024
+    )
     with TestClient(create_app(settings)) as slow:
-        _refused(slow.post("/api/convert", json={"text": big}), 503, "command line")
+        _refused(
+            slow.post("/api/convert", json={"text": big_model}),
+            408,
+            "wall-time limit of 3 s",
+            "command line",
+        )
         # the stuck worker was replaced: the next request is served within the limit
+        answer = slow.post("/api/convert", json={"text": PAPER})
+        assert answer.status_code == 200 and answer.json()["verdict"] == "EQUIVALENT"
+
+
+def test_cpu_limit_answers_422_naming_it_and_the_worker_serves_on(big_model):
+    settings = WebSettings.default(
+        workers=1, timeout_s=120, cpu_limit_s=1, max_body_bytes=8 * 1024 * 1024
+    )
+    with TestClient(create_app(settings)) as slow:
+        _refused(slow.post("/api/convert", json={"text": big_model}), 422, "CPU-time limit of 1 s")
         answer = slow.post("/api/convert", json={"text": PAPER})
         assert answer.status_code == 200 and answer.json()["verdict"] == "EQUIVALENT"
 

@@ -14,6 +14,11 @@ Rules:
   where ``SIGALRM`` cannot reach) gets a ``timeout`` row; the pool's processes are killed and
   the other jobs go back to the queue without losing an attempt.
 
+- Stop (SIGINT, or SIGTERM turned into one by ``fsmbt.cli.stopping``): the workers ignore
+  SIGINT (the driver decides); the driver gives the jobs that are out ``STOP_GRACE_S`` to
+  finish and stores those results, then kills the workers. Jobs still out stay ``pending`` in
+  the store (interrupted): the next run resumes them. Nothing outlives the driver.
+
 Costs: one process start per worker (and per ``max_tasks_per_child`` jobs); one pickled job and
 result per input.
 """
@@ -28,6 +33,7 @@ from collections import deque
 from collections.abc import Callable, Iterable
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
+from pathlib import Path
 
 from fsmbt.batch.jobs import Job, public_options
 from fsmbt.batch.result import ERROR, TIMEOUT, JobResult
@@ -35,6 +41,8 @@ from fsmbt.batch.worker import run_job, warm_up
 
 #: Seconds a job may run past twice its time limit before the watchdog kills its worker.
 WATCHDOG_GRACE_S = 30.0
+#: Seconds the jobs that are out get to finish when the run is stopped (SIGINT / SIGTERM).
+STOP_GRACE_S = 3.0
 #: Jobs a worker process runs before it is replaced.
 MAX_TASKS_PER_CHILD = 500
 
@@ -74,6 +82,38 @@ def overran(job: Job, seconds: float) -> JobResult:
     )
 
 
+def descendants(pid: int) -> list[int]:
+    """The processes started under ``pid`` (a worker's NuSMV or C++ child), read from Linux's
+    ``/proc/PID/task/TID/children``; empty where that does not exist. An explicit work list,
+    children before grandchildren. Read before the kill, so none is left orphaned."""
+    found: list[int] = []
+    todo = [pid]
+    while todo:
+        current = todo.pop()
+        tasks = Path(f"/proc/{current}/task")
+        try:
+            entries = list(tasks.iterdir())
+        except OSError:
+            continue
+        for task in entries:
+            try:
+                children = (task / "children").read_text().split()
+            except OSError:
+                continue
+            for child in children:
+                if child.isdigit():
+                    found.append(int(child))
+                    todo.append(int(child))
+    return found
+
+
+def _start_worker() -> None:
+    """Worker start: ignore SIGINT (Ctrl-C reaches the whole process group; the driver stops
+    the workers itself), then warm up."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    warm_up()
+
+
 def _hard_deadline(job: Job) -> float | None:
     limit = job.options.get("timeout_s")
     return 2.0 * float(limit) + WATCHDOG_GRACE_S if limit else None
@@ -107,7 +147,7 @@ class LocalExecutor:
             max_workers=self.workers,
             mp_context=self._context,
             max_tasks_per_child=self.max_tasks_per_child,
-            initializer=warm_up,
+            initializer=_start_worker,
         )
 
     def _pool_pids(self) -> list[int]:
@@ -120,9 +160,10 @@ class LocalExecutor:
         return pids
 
     def _kill(self, pool: ProcessPoolExecutor) -> None:
-        for pid in self._pool_pids():
+        pids = self._pool_pids()
+        for victim in [*pids, *(child for worker in pids for child in descendants(worker))]:
             try:
-                os.kill(pid, signal.SIGKILL)
+                os.kill(victim, signal.SIGKILL)
             except ProcessLookupError:
                 pass
         pool.shutdown(wait=True, cancel_futures=True)
@@ -182,8 +223,34 @@ class LocalExecutor:
                     pool = self._pool()
                 else:
                     self._pool_pids()
+        except BaseException:
+            self._stop(pool, out, deliver)
+            raise
         finally:
             pool.shutdown(wait=True, cancel_futures=True)
+
+    def _stop(
+        self,
+        pool: ProcessPoolExecutor,
+        out: dict[Future[JobResult], tuple[Job, int, float]],
+        deliver: Deliver,
+    ) -> None:
+        """The run is stopped: store what finishes within ``STOP_GRACE_S``, kill the workers.
+        A second signal during the grace ends the grace, not the cleanup."""
+        try:
+            finished, _ = wait(list(out), timeout=STOP_GRACE_S)
+            for future in finished:
+                job, attempts, _started = out.pop(future)
+                try:
+                    result = future.result()
+                except BaseException:  # noqa: BLE001 - a broken pool: the row stays pending
+                    continue
+                result.attempts = attempts
+                deliver(result)
+        except BaseException:  # noqa: BLE001 - a second Ctrl-C: go straight to the kill
+            pass
+        finally:
+            self._kill(pool)
 
     def _requeue(
         self, queue: deque[tuple[Job, int]], deliver: Deliver, job: Job, attempts: int

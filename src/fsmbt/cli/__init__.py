@@ -14,6 +14,7 @@ import sys
 
 import typer
 
+from fsmbt.cli import stopping
 from fsmbt.cli.hints import cli_message
 from fsmbt.model.errors import FsmbtError
 
@@ -96,12 +97,21 @@ def _is_engine_limit(exc: FsmbtError) -> bool:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Entry point: run the app, turning every error into one line and an exit code."""
+    """Entry point: run the app, turning every error into one line and an exit code; SIGTERM
+    and SIGINT are a requested stop (exit 0, ``fsmbt.cli.stopping``)."""
     _register_commands()
+    with stopping.installed():
+        return _run(argv)
+
+
+def _run(argv: list[str] | None) -> int:
     debug = os.environ.get("FSMBT_DEBUG") == "1"
     try:
         # without standalone mode click returns a raised typer.Exit's code instead of exiting
         code = app(args=argv, standalone_mode=False)
+        if code == 130 and stopping.stop_was_requested():  # typer's code for an interruption
+            print("fsmbt: stopped on request", file=sys.stderr)
+            return EXIT_OK
     except FsmbtError as exc:
         if debug:
             raise
@@ -117,7 +127,8 @@ def main(argv: list[str] | None = None) -> int:
         )
         return EXIT_BAD_INPUT
     except KeyboardInterrupt:
-        return 130
+        print("fsmbt: stopped on request", file=sys.stderr)
+        return EXIT_OK
     except BrokenPipeError:
         # the reader went away (``fsmbt llm prompt x | head``): what it wanted, it got
         _silence_stdout()
@@ -128,7 +139,10 @@ def main(argv: list[str] | None = None) -> int:
             _silence_stdout()
             return EXIT_OK
         raise exc
-    except typer.Abort:
+    except typer.Abort as exc:
+        if stopping.requested_stop(exc):
+            print("fsmbt: stopped on request", file=sys.stderr)
+            return EXIT_OK
         return 130
     except Exception as exc:  # noqa: BLE001 - the last line of defence: never a traceback
         if hasattr(exc, "show") and hasattr(exc, "exit_code"):  # click's usage errors

@@ -9,12 +9,22 @@ and batch stores under DIR, read-only. Exit 2 on a bad option (missing folder, b
 from __future__ import annotations
 
 import ipaddress
+import signal
 import sys
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 import typer
 
-from fsmbt.web.settings import DEFAULT_MAX_BODY_BYTES, DEFAULT_TIMEOUT_S, DEFAULT_WORKERS
+from fsmbt.web.answers import DEFAULT_CACHE_BYTES
+from fsmbt.web.settings import (
+    DEFAULT_CPU_LIMIT_S,
+    DEFAULT_MAX_BODY_BYTES,
+    DEFAULT_MAX_WAITING,
+    DEFAULT_TIMEOUT_S,
+    DEFAULT_WORKERS,
+)
 
 
 def is_loopback(host: str) -> bool:
@@ -25,6 +35,31 @@ def is_loopback(host: str) -> bool:
         return ipaddress.ip_address(host).is_loopback
     except ValueError:
         return False
+
+
+#: Seconds in-flight requests get to finish after SIGTERM / SIGINT before they are cancelled;
+#: the workers then get the rest of the 5 s stop budget (``Workers.close``).
+GRACE_S = 2
+
+
+@contextmanager
+def requested_stop_exits_zero() -> Iterator[None]:
+    """While the server runs, SIGTERM and SIGINT are a requested stop: uvicorn stops accepting,
+    lets in-flight requests finish (``GRACE_S``), the app's shutdown stops the workers, and
+    uvicorn re-raises the signal into the handlers found here, which only note it, so the
+    command returns normally and exits 0 (docs/web.md, 'Stopping')."""
+    stopped: list[int] = []
+    previous = {
+        sig: signal.signal(sig, lambda number, _frame: stopped.append(number))
+        for sig in (signal.SIGTERM, signal.SIGINT)
+    }
+    try:
+        yield
+    finally:
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+        if stopped:
+            print("fsmbt serve: stopped", file=sys.stderr)
 
 
 def register(app: typer.Typer) -> None:
@@ -50,7 +85,28 @@ def register(app: typer.Typer) -> None:
             DEFAULT_TIMEOUT_S,
             "--timeout",
             min=0.1,
-            help="seconds one conversion or verification may take",
+            help="wall seconds one conversion or verification may take (408 past it)",
+        ),
+        cpu_limit: float = typer.Option(
+            DEFAULT_CPU_LIMIT_S,
+            "--cpu-limit",
+            min=1.0,
+            help="CPU seconds one conversion or verification may use (422 past it)",
+        ),
+        cache_bytes: int = typer.Option(
+            DEFAULT_CACHE_BYTES,
+            "--cache-bytes",
+            min=0,
+            help="memory bound of the answer cache, bytes (0: no cache)",
+        ),
+        cache_dir: Path | None = typer.Option(
+            None, "--cache-dir", help="also keep cached answers in this folder"
+        ),
+        max_waiting: int = typer.Option(
+            DEFAULT_MAX_WAITING,
+            "--max-waiting",
+            min=1,
+            help="requests that may wait for a worker (503 with Retry-After beyond)",
         ),
         workers: int = typer.Option(
             DEFAULT_WORKERS, "--workers", min=1, max=64, help="worker processes for conversions"
@@ -68,6 +124,10 @@ def register(app: typer.Typer) -> None:
         changes: dict[str, object] = {
             "max_body_bytes": max_body,
             "timeout_s": timeout,
+            "cpu_limit_s": cpu_limit,
+            "max_waiting": max_waiting,
+            "cache_bytes": cache_bytes,
+            "cache_dir": cache_dir,
             "workers": workers,
             "reports_dir": reports,
         }
@@ -84,7 +144,19 @@ def register(app: typer.Typer) -> None:
         print(
             f"fsmbt web page on http://{host}:{port}/  (API documentation: /docs)", file=sys.stderr
         )
+        server = uvicorn.Server(
+            uvicorn.Config(
+                create_app(settings),
+                host=host,
+                port=port,
+                log_level="warning",
+                timeout_graceful_shutdown=GRACE_S,
+            )
+        )
         try:
-            uvicorn.run(create_app(settings), host=host, port=port, log_level="warning")
+            with requested_stop_exits_zero():
+                server.run()
         except OSError as exc:
             raise fail(f"cannot listen on {host}:{port}: {exc.strerror or exc}") from None
+        except SystemExit:  # uvicorn's own exit when the port cannot be bound
+            raise fail(f"cannot listen on {host}:{port} (address in use or not allowed)") from None

@@ -28,7 +28,9 @@ from fastapi import FastAPI
 from fastapi.staticfiles import StaticFiles
 
 from fsmbt.web import routes_pipeline, routes_reference, routes_reports
+from fsmbt.web.answers import AnswerCache
 from fsmbt.web.errors import BodyLimit, install_handlers
+from fsmbt.web.headers import SecurityHeaders
 from fsmbt.web.settings import WebSettings
 from fsmbt.web.workers import Workers
 
@@ -49,7 +51,12 @@ def create_app(settings: WebSettings | None = None) -> FastAPI:
 
     @asynccontextmanager
     async def lifespan(app: FastAPI) -> AsyncIterator[None]:
-        app.state.workers = Workers(settings.workers, settings.timeout_s)
+        app.state.workers = Workers(
+            settings.workers,
+            settings.timeout_s,
+            max_waiting=settings.max_waiting,
+            cpu_seconds=settings.cpu_limit_s,
+        )
         yield
         app.state.workers.close()
 
@@ -61,7 +68,11 @@ def create_app(settings: WebSettings | None = None) -> FastAPI:
         "prove the result equivalent (docs/web.md).",
     )
     app.state.settings = settings
-    app.add_middleware(BodyLimit, limit=settings.max_body_bytes)
+    app.state.cache = (
+        AnswerCache(settings.cache_bytes, settings.cache_dir) if settings.cache_bytes > 0 else None
+    )
+    app.add_middleware(BodyLimit, limit=settings.max_body_bytes, drain_cap=settings.drain_cap_bytes)
+    app.add_middleware(SecurityHeaders)  # outermost: the 413s carry them too
     app.mount("/static", StaticFiles(directory=HERE / "static"), name="static")
     install_handlers(app)
     app.include_router(routes_reference.router)

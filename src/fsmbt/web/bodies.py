@@ -4,6 +4,7 @@ and the OpenAPI text of a body read by hand (``body_doc``)."""
 
 from __future__ import annotations
 
+import copy
 import json
 from typing import Any
 
@@ -13,9 +14,33 @@ from pydantic import BaseModel, ValidationError
 from fsmbt.web.errors import ApiError, TooLarge
 
 
+def inlined_schema(model: Any) -> dict[str, Any]:
+    """``model``'s JSON schema with its ``$defs`` written in place: embedded in an operation,
+    ``#/$defs/...`` would point at the OpenAPI document's root, where nothing is (schema
+    fuzzers could not resolve it). An explicit work list over the (server-made, acyclic)
+    schema; every ``{"$ref": "#/$defs/X", ...}`` becomes X's definition merged with the
+    other keys."""
+    schema: dict[str, Any] = model.model_json_schema()
+    defs: dict[str, Any] = schema.pop("$defs", {})
+    todo: list[Any] = [schema]
+    while todo:
+        node = todo.pop()
+        children = node.values() if isinstance(node, dict) else node
+        for child in list(children):
+            if isinstance(child, dict):
+                reference = child.get("$ref", "")
+                if isinstance(reference, str) and reference.startswith("#/$defs/"):
+                    child.pop("$ref")
+                    child.update(copy.deepcopy(defs[reference.removeprefix("#/$defs/")]))
+                todo.append(child)
+            elif isinstance(child, list):
+                todo.append(child)
+    return schema
+
+
 def body_doc(model: Any) -> dict[str, Any]:
     """OpenAPI text for a body read by hand (JSON, or the same fields as multipart)."""
-    schema = model.model_json_schema()
+    schema = inlined_schema(model)
     return {
         "requestBody": {
             "required": True,

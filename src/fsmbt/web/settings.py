@@ -11,11 +11,17 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import fsmbt
+from fsmbt.web.answers import DEFAULT_CACHE_BYTES
+from fsmbt.web.errors import DEFAULT_DRAIN_CAP_BYTES
 
 #: Largest request body accepted (bytes).
 DEFAULT_MAX_BODY_BYTES = 2 * 1024 * 1024
 #: Wall seconds one conversion or verification may take in a worker.
 DEFAULT_TIMEOUT_S = 30.0
+#: CPU seconds one conversion or verification may use in a worker.
+DEFAULT_CPU_LIMIT_S = 20.0
+#: Requests that may wait for a worker before new ones get 503 (well above a burst of 200).
+DEFAULT_MAX_WAITING = 1000
 #: Worker processes.
 DEFAULT_WORKERS = 2
 
@@ -33,7 +39,13 @@ class WebSettings:
 
     Attributes:
         max_body_bytes: requests with a larger body are refused with 413.
-        timeout_s: the wall-time limit of one conversion or verification.
+        timeout_s: the wall-time limit of one conversion or verification (408 past it).
+        cpu_limit_s: the CPU-time limit of one conversion or verification (422 past it).
+        max_waiting: requests that may wait for a worker (503 with ``Retry-After`` beyond).
+        cache_bytes: the in-memory bound of the answer cache (0: no cache; ``answers``).
+        cache_dir: where the answer cache is also kept on disk (``None``: memory only).
+        drain_cap_bytes: an over-limit body is read and dropped up to this size so the client
+            gets its 413 (``errors.BodyLimit``); past it the connection is closed.
         workers: worker processes.
         examples_dir: the folder whose model files the page offers as examples (``None``: none).
         reports_dir: the folder of evaluation reports and batch stores browsed read-only
@@ -42,6 +54,11 @@ class WebSettings:
 
     max_body_bytes: int = DEFAULT_MAX_BODY_BYTES
     timeout_s: float = DEFAULT_TIMEOUT_S
+    cpu_limit_s: float = DEFAULT_CPU_LIMIT_S
+    max_waiting: int = DEFAULT_MAX_WAITING
+    drain_cap_bytes: int = DEFAULT_DRAIN_CAP_BYTES
+    cache_bytes: int = DEFAULT_CACHE_BYTES
+    cache_dir: Path | None = None
     workers: int = DEFAULT_WORKERS
     examples_dir: Path | None = None
     reports_dir: Path | None = None

@@ -403,12 +403,14 @@ document.addEventListener("DOMContentLoaded", async () => {
   $("verify").addEventListener("click", verify);
   try {
     await loadChoices();
-    // ?example=NAME opens the page on that example (README: one command to start on one)
+    // ?example=NAME opens the page on that example and converts it on arrival (README: one
+    // command to start on one; the answer usually comes from the server's cache)
     const wanted = new URLSearchParams(location.search).get("example");
     if (wanted) {
       const data = await api(`/api/examples/${encodeURIComponent(wanted)}`);
       $("example").value = wanted;
       setSource(data.text, data.name);
+      await convert();
     }
   } catch (err) { showError($("convert-error"), err); }
   document.body.dataset.ready = "1";
