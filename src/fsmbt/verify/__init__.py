@@ -8,13 +8,16 @@ verdict differs, since then one of them is wrong.
 
 from __future__ import annotations
 
+from fsmbt import __version__
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import Hint, InputError
 from fsmbt.model.fsm import FSM
 from fsmbt.semantics.machine import FSMLeafMachine
-from fsmbt.verify.native import DEFAULT_MAX_STATES, Replay, check, replay
+from fsmbt.verify import certificate
+from fsmbt.verify.method import describe_method, nusmv_engine
+from fsmbt.verify.native import DEFAULT_MAX_STATES, Replay, check, check_witnessed, replay
 from fsmbt.verify.pairing import machines_for
-from fsmbt.verify.report import PROPERTIES, PropertyResult, Report, TraceStep
+from fsmbt.verify.report import PROPERTIES, SYMBOLIC, PropertyResult, Report, TraceStep
 
 ENGINES = ("native", "nusmv", "both")
 
@@ -68,9 +71,13 @@ def verify(
     if engine not in ENGINES:
         raise InputError(f"unknown verification engine '{engine}' (known: {', '.join(ENGINES)})")
     if engine == "nusmv":
-        return _nusmv(source, result, loop)
+        report = _nusmv(source, result, loop)
+        report.method = SYMBOLIC
+        report.engines = nusmv_engine()
+        return report
+    sink = certificate.active_sink()
     source_machine, result_machine, mode = machines_for(source, result, loop=loop)
-    native = check(source_machine, result_machine, max_states=max_states, mode=mode)
+    native = _native(source_machine, result_machine, max_states, mode, sink, loop, False)
     native.source = _model_name(source, native.source)
     native.result = _model_name(result, native.result)
     if engine == "native":
@@ -83,14 +90,39 @@ def verify(
         source_machine, result_machine, mode = machines_for(
             source, result, loop=loop, faithful=True
         )
-        faithful = check(source_machine, result_machine, max_states=max_states, mode=mode)
+        faithful = _native(source_machine, result_machine, max_states, mode, sink, loop, True)
         faithful.source, faithful.result = native.source, native.result
         native = faithful
     if native.verdicts() != other.verdicts():
         raise EngineDisagreement(native, other)
     native.engine = "native+nusmv"
+    native.method = f"{native.method}+{SYMBOLIC}"
+    native.engines.update(nusmv_engine())
     native.stats["nusmv"] = dict(other.stats)
     return native
+
+
+def _native(
+    source_machine: object,
+    result_machine: object,
+    max_states: int,
+    mode: str,
+    sink: certificate.WitnessSink | None,
+    loop: bool,
+    faithful: bool,
+) -> Report:
+    """The native check, its method and abstractions named; its witness left in ``sink``."""
+    report, witness = check_witnessed(
+        source_machine,  # type: ignore[arg-type]
+        result_machine,  # type: ignore[arg-type]
+        max_states=max_states,
+        mode=mode,
+    )
+    report.method, report.abstractions = describe_method(source_machine, result_machine)
+    report.engines = {"fsmbt native checker": __version__}
+    if sink is not None:
+        sink.witness, sink.loop, sink.faithful = witness, loop, faithful
+    return report
 
 
 def _reachability_only(native: Report, other: Report) -> bool:
