@@ -71,7 +71,7 @@ def verify(
     if engine not in ENGINES:
         raise InputError(f"unknown verification engine '{engine}' (known: {', '.join(ENGINES)})")
     if engine == "nusmv":
-        report = _nusmv(source, result, loop)
+        report = _nusmv(source, result, loop, fallback=False)
         report.method = SYMBOLIC
         report.engines = nusmv_engine()
         return report
@@ -82,7 +82,14 @@ def verify(
     native.result = _model_name(result, native.result)
     if engine == "native":
         return native
-    other = _nusmv(source, result, loop)
+    try:
+        other = _nusmv(source, result, loop)
+    except NuSMVGaveUp as exc:
+        # NuSMV's time or memory cap: the native verdict stands, and the report says NuSMV
+        # could not confirm it (docs/verification.md, "What a verdict says").
+        native.engines.update(nusmv_engine())
+        native.stats["nusmv_limit"] = str(exc)
+        return native
     if _reachability_only(native, other):
         # Reachability compares states: a leaf machine on reduced states (docs/semantics.md
         # §4a) may merge a state reached only outside the agreeing pairs with one reached in
@@ -132,7 +139,13 @@ def _reachability_only(native: Report, other: Report) -> bool:
     return differing == {"reachability"} and not native.equivalent
 
 
-def _nusmv(source: FSM | BTDocument, result: FSM | BTDocument, loop: bool) -> Report:
+class NuSMVGaveUp(RuntimeError):
+    """NuSMV reached its time or memory cap (``fsmbt.limits``) on a pair."""
+
+
+def _nusmv(
+    source: FSM | BTDocument, result: FSM | BTDocument, loop: bool, *, fallback: bool = True
+) -> Report:
     try:
         from fsmbt.verify import nusmv
     except ImportError as exc:
@@ -148,6 +161,10 @@ def _nusmv(source: FSM | BTDocument, result: FSM | BTDocument, loop: bool) -> Re
     try:
         report: Report = checker(source, result, loop=loop)
         return report
+    except nusmv.NuSMVLimitError as exc:
+        if fallback:
+            raise NuSMVGaveUp(str(exc)) from None
+        raise
     except FileNotFoundError as exc:
         raise InputError(
             f"the NuSMV binary is not installed ({exc}); scripts/setup.sh builds it",
