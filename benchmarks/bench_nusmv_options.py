@@ -31,10 +31,10 @@ from fsmbt.verify import nusmv, verify  # noqa: E402
 from fsmbt.verify.nusmv.runner import NuSMVLimitError, run_nusmv  # noqa: E402
 
 
-def _timed(run) -> str:  # type: ignore[no-untyped-def]
+def _timed(run, *args, **kwargs) -> str:  # type: ignore[no-untyped-def]
     started = time.perf_counter()
     try:
-        run()
+        run(*args, **kwargs)
     except NuSMVLimitError:
         return "-"
     return f"{time.perf_counter() - started:.2f}"
@@ -60,9 +60,9 @@ def main(argv: list[str] | None = None) -> int:
             text, names, context = nusmv.build_model(source, result)
             order = context[-1]
             cells = [
-                _timed(lambda: nusmv.check(source, result, implied_reachability=False)),
-                _timed(lambda: run_nusmv(text, len(names), order=order, options=["-coi"])),
-                _timed(lambda: run_nusmv(text, len(names), order=order, options=["-dynamic"])),
+                _timed(nusmv.check, source, result, implied_reachability=False),
+                _timed(run_nusmv, text, len(names), order=order, options=["-coi"]),
+                _timed(run_nusmv, text, len(names), order=order, options=["-dynamic"]),
             ]
             agree = "-"
             started = time.perf_counter()
