@@ -66,8 +66,9 @@ def test_arguments_in_either_order(files, tmp_path):
         lambda d: d["relation"].pop(),  # relation no longer closed
         lambda d: d["machines"]["source"]["states"][2].__setitem__(1, "final"),  # status
         lambda d: d["machines"]["result"]["edges"][2].pop(),  # an explored input left out
+        lambda d: d.__setitem__("method", "symbolic"),  # a method the pair was not proven by
     ],
-    ids=["edge-target", "edge-outputs", "relation", "status", "missing-edge"],
+    ids=["edge-target", "edge-outputs", "relation", "status", "missing-edge", "method"],
 )
 def test_a_tampered_certificate_is_refused(files, tmp_path, capsys, tamper):
     cert = tmp_path / "c.json"

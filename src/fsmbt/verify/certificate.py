@@ -49,6 +49,7 @@ from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import InputError
 from fsmbt.model.fsm import FSM
 from fsmbt.semantics.machine import Machine
+from fsmbt.verify.method import describe_method
 from fsmbt.verify.native import Witness, replay
 from fsmbt.verify.pairing import machines_for
 from fsmbt.verify.report import Report
@@ -199,6 +200,12 @@ def check(
     if mode != data.get("mode"):
         raise CertificateError(
             f"the certificate is for mode {data.get('mode')}, the pair is {mode}"
+        )
+    method = describe_method(source_machine, result_machine)[0]
+    claimed = str(data.get("method", ""))
+    if claimed.split("+")[0] != method:
+        raise CertificateError(
+            f"the certificate claims method {claimed!r}, the machines are checked by {method!r}"
         )
     checked = Checked(
         equivalent=bool(data.get("equivalent")),
