@@ -3,16 +3,21 @@
 ``verify(source, result)`` gives a ``Report``: the verdict and the five properties, each with a
 shortest counterexample when it fails. Two engines: ``native`` (explicit-state product, the
 default) and ``nusmv``; ``both`` runs the two and raises ``EngineDisagreement`` if any property
-verdict differs, since then one of them is wrong.
+verdict differs, since then one of them is wrong; when NuSMV reaches its time or memory cap, ``both``
+returns the native verdict with ``stats["nusmv_limit"]`` saying so. Every report names its
+``method``, ``engines`` and ``abstractions`` (``fsmbt.verify.method``); inside
+``certificate.collecting()`` the native check's witness is kept for a certificate.
 """
 
 from __future__ import annotations
+
+from typing import Any
 
 from fsmbt import __version__
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import Hint, InputError
 from fsmbt.model.fsm import FSM
-from fsmbt.semantics.machine import FSMLeafMachine
+from fsmbt.semantics.machine import FSMLeafMachine, Machine
 from fsmbt.verify import certificate
 from fsmbt.verify.method import describe_method, nusmv_engine
 from fsmbt.verify.native import DEFAULT_MAX_STATES, Replay, check, check_witnessed, replay
@@ -67,6 +72,8 @@ def verify(
             reachable states.
         UnsupportedError: A construct the chosen engine does not model (located).
         EngineDisagreement: With ``both``, the engines differ on some property.
+        NuSMVLimitError: With ``nusmv``, NuSMV reached its cap (with ``both`` the native
+            verdict is returned instead, ``stats["nusmv_limit"]`` naming the cap).
     """
     if engine not in ENGINES:
         raise InputError(f"unknown verification engine '{engine}' (known: {', '.join(ENGINES)})")
@@ -110,8 +117,8 @@ def verify(
 
 
 def _native(
-    source_machine: object,
-    result_machine: object,
+    source_machine: Machine[Any],
+    result_machine: Machine[Any],
     max_states: int,
     mode: str,
     sink: certificate.WitnessSink | None,
@@ -120,10 +127,7 @@ def _native(
 ) -> Report:
     """The native check, its method and abstractions named; its witness left in ``sink``."""
     report, witness = check_witnessed(
-        source_machine,  # type: ignore[arg-type]
-        result_machine,  # type: ignore[arg-type]
-        max_states=max_states,
-        mode=mode,
+        source_machine, result_machine, max_states=max_states, mode=mode
     )
     report.method, report.abstractions = describe_method(source_machine, result_machine)
     report.engines = {"fsmbt native checker": __version__}
