@@ -10,7 +10,10 @@ under a control, 40 % conditions; every control then re-typed, seeded):
 - ``reactive-plain``: each control reactive or plain at random (plain nodes under reactive ones
   keep a running index: canonical states, ``leaf_canonical``);
 - ``memory``: SequenceWithMemory / Fallback (the WithMemory index is real, readable memory);
-- ``mixed``: each control drawn from all five kinds.
+- ``mixed``: each control drawn from all five kinds;
+- ``decorated``: ``mixed``, then a fifth of the leaves under a decorator (Inverter, ForceSuccess,
+  ForceFailure, RetryUntilSuccessful 2, Repeat 2) and a tenth of the controls made Parallel
+  (success_count 1, failure_count 1): the random family of issue 27.
 Each tree is checked against its HFSM (``bt_to_hfsm``, not timed); ``time`` is the whole
 ``check`` (both machines explored, then the product). A row that stops prints why (the time limit,
 or the state limit: WithMemory indices are real memory, so a tree with k of them may have a
@@ -34,6 +37,8 @@ from bench_checker import random_tree  # noqa: E402
 
 from fsmbt.convert.bt_to_hfsm import bt_to_hfsm  # noqa: E402
 from fsmbt.model import BTDocument  # noqa: E402
+from fsmbt.model.bt import BTNode  # noqa: E402
+from fsmbt.model.bt_nodes import NodeKind  # noqa: E402
 from fsmbt.semantics.leaf_machine import LeafMachine, StateLimitError, explore  # noqa: E402
 from fsmbt.verify.native import check  # noqa: E402
 from fsmbt.verify.pairing import machines_for  # noqa: E402
@@ -50,7 +55,21 @@ FAMILIES: dict[str, dict[str, tuple[str, ...]]] = {
         "Sequence": ("Sequence", "ReactiveSequence", "SequenceWithMemory"),
         "Fallback": ("Fallback", "ReactiveFallback"),
     },
+    # ``mixed``, then decorators over leaves and Parallel nodes (see ``decorate``)
+    "decorated": {
+        "Sequence": ("Sequence", "ReactiveSequence", "SequenceWithMemory"),
+        "Fallback": ("Fallback", "ReactiveFallback"),
+    },
 }
+
+#: The ``decorated`` family's decorators (type, ports), each over a leaf with probability 0.2.
+DECORATORS: tuple[tuple[str, dict[str, str]], ...] = (
+    ("Inverter", {}),
+    ("ForceSuccess", {}),
+    ("ForceFailure", {}),
+    ("RetryUntilSuccessful", {"num_attempts": "2"}),
+    ("Repeat", {"num_cycles": "2"}),
+)
 
 
 def family_tree(family: str, leaves: int, seed: int) -> BTDocument:
@@ -64,7 +83,28 @@ def family_tree(family: str, leaves: int, seed: int) -> BTDocument:
         if node.type in table:
             node.type = rng.choice(table[node.type])
         stack.extend(node.children)
+    if family == "decorated":
+        decorate(doc, rng)
     return doc
+
+
+def decorate(doc: BTDocument, rng: random.Random) -> None:
+    """Wrap each leaf in one of ``DECORATORS`` with probability 0.2, and make each control a
+    ``Parallel`` (success_count 1, failure_count 1) with probability 0.1 (iterative)."""
+    stack = [doc.main.root]
+    while stack:
+        node = stack.pop()
+        if node.kind is NodeKind.CONTROL and rng.random() < 0.1:
+            node.type = "Parallel"
+            node.attrs = {"success_count": "1", "failure_count": "1"}
+        for index, child in enumerate(node.children):
+            if child.is_leaf and rng.random() < 0.2:
+                kind, ports = rng.choice(DECORATORS)
+                node.children[index] = BTNode(
+                    kind, NodeKind.DECORATOR, attrs=dict(ports), children=[child]
+                )
+            else:
+                stack.append(child)
 
 
 def node_count(doc: BTDocument) -> int:

@@ -349,6 +349,8 @@ def test_sem_loop_and_real_parallel_nusmv_agrees_on_random_trees(nusmv_binary) -
                 report = api.verify_models(doc, result.model, engine="both")
             except NuSMVLimitError:
                 continue  # too large for NuSMV in 8 s (counted below)
+            if "nusmv_limit" in report.stats:
+                continue  # NuSMV gave up: only the native verdict (not a comparison)
             assert report.equivalent, (seed, report)
             compared += 1
     assert compared >= 10, compared

@@ -19,6 +19,7 @@ import typer
 
 from fsmbt import api
 from fsmbt.api_types import ReadOptions
+from fsmbt.cli.certificates import certificate_option, write_certificate
 from fsmbt.cli.options import (
     apply_engine_caps,
     max_states_option,
@@ -30,8 +31,10 @@ from fsmbt.cli.progress import StageProgress, format_timings
 from fsmbt.cli.wording import checked_counts, conversion_summary
 from fsmbt.llm.config import PROVIDERS
 from fsmbt.model.bt import BTDocument
+from fsmbt.model.errors import InputError
 from fsmbt.model.undeclared import summary as undeclared_summary
 from fsmbt.model.undeclared import undeclared_leaf_types
+from fsmbt.verify import certificate
 from fsmbt.verify.report import Report
 
 PROVIDER_NAMES = ", ".join(sorted(PROVIDERS))
@@ -110,6 +113,7 @@ def register(app: typer.Typer) -> None:
         llm_model: str | None = typer.Option(None, "--llm-model", help="LLM engines: model name"),
         timeout: float | None = timeout_option(),
         nusmv_memory: int | None = nusmv_memory_option(),
+        certificate_file: Path | None = certificate_option(),
         *,
         read: ReadOptions,
     ) -> None:
@@ -136,8 +140,20 @@ def register(app: typer.Typer) -> None:
             read=read,
             engine_options=engine_options,
         )
+        if certificate_file is not None and no_verify:
+            raise InputError("--certificate needs the equivalence check (drop --no-verify)")
         with StageProgress(quiet=quiet or no_progress, label=source.name) as progress:
-            outcome = api.convert_file(source, output, request, on_stage=progress)
+            with certificate.collecting() as sink:
+                outcome = api.convert_file(source, output, request, on_stage=progress)
+        if certificate_file is not None and outcome.report is not None:
+            write_certificate(
+                certificate_file,
+                sink,
+                outcome.report,
+                source.read_bytes(),
+                outcome.text.encode("utf-8"),
+                to_stderr=output is None or as_json,
+            )
         summary = outcome.to_dict()
         if as_json:
             if output is None:
@@ -182,6 +198,11 @@ def _print_summary(outcome: api.Outcome, *, to_stderr: bool, brief: bool = False
         print("verification skipped (--no-verify)", file=stream)
         return
     print(f"verdict: {outcome.verdict}", file=stream)
+    if report.method:
+        engines = ", ".join(f"{name} {version}" for name, version in report.engines.items())
+        print(f"  proven by: {report.method} ({engines})", file=stream)
+        for sentence in report.abstractions:
+            print(f"  under the abstraction: {sentence}", file=stream)
     counts = checked_counts(report.stats)
     if counts:
         print(f"  checked {counts}", file=stream)

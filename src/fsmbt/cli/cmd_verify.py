@@ -15,6 +15,7 @@ from rich.console import Console
 
 from fsmbt import api
 from fsmbt.api_types import ReadOptions
+from fsmbt.cli.certificates import certificate_option, write_certificate
 from fsmbt.cli.options import (
     apply_engine_caps,
     max_states_option,
@@ -24,7 +25,7 @@ from fsmbt.cli.options import (
 )
 from fsmbt.cli.progress import StageProgress
 from fsmbt.cli.render_report import print_report
-from fsmbt.verify import EngineDisagreement
+from fsmbt.verify import EngineDisagreement, certificate
 
 EXIT_EQUIVALENT = 0
 EXIT_NOT_EQUIVALENT = 1
@@ -59,6 +60,7 @@ def register(app: typer.Typer) -> None:
         ),
         timeout: float | None = timeout_option(),
         nusmv_memory: int | None = nusmv_memory_option(),
+        certificate_file: Path | None = certificate_option(),
         *,
         read: ReadOptions,
     ) -> None:
@@ -73,9 +75,14 @@ def register(app: typer.Typer) -> None:
                 request = api.verify_request(
                     engine=engine, loop=loop, max_states=max_states, read=read
                 )
-                first, second, report = api.verify_files(
-                    source, converted, request, converted_format=from_format2, on_stage=progress
-                )
+                with certificate.collecting() as sink:
+                    first, second, report = api.verify_files(
+                        source,
+                        converted,
+                        request,
+                        converted_format=from_format2,
+                        on_stage=progress,
+                    )
         except EngineDisagreement as exc:
             print(
                 f"error: ENGINES DISAGREE: {exc}; one of the checkers is wrong, please report "
@@ -85,6 +92,16 @@ def register(app: typer.Typer) -> None:
             raise typer.Exit(EXIT_ENGINES_DISAGREE) from None
         for warning in [*first.warnings, *second.warnings]:
             print(f"warning: {warning}", file=sys.stderr)
+        if certificate_file is not None:
+            roles = (converted, source) if report.stats.get("swapped") else (source, converted)
+            write_certificate(
+                certificate_file,
+                sink,
+                report,
+                roles[0].read_bytes(),
+                roles[1].read_bytes(),
+                to_stderr=as_json,
+            )
         if as_json:
             data = report.to_dict()
             data["source_file"] = str(source)

@@ -32,6 +32,18 @@ def render(report: Report) -> RenderableType:
         f"  ({report.mode}, engine {report.engine})",
     )
     parts.append(header)
+    if report.method:
+        engines = ", ".join(f"{name} {version}" for name, version in report.engines.items())
+        parts.append(Text(f"proven by: {report.method} ({engines})", style="dim"))
+        for sentence in report.abstractions:
+            parts.append(Text(f"under the abstraction: {sentence}", style="dim"))
+    if report.stats.get("nusmv_limit"):
+        parts.append(
+            Text(
+                f"NuSMV gave up (native verdict only): {report.stats['nusmv_limit']}",
+                style="yellow",
+            )
+        )
     table = Table("property", "verdict", "detail", show_lines=False)
     for name in PROPERTIES:
         prop = report.properties.get(name)

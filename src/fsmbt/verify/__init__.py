@@ -3,21 +3,29 @@
 ``verify(source, result)`` gives a ``Report``: the verdict and the five properties, each with a
 shortest counterexample when it fails. Two engines: ``native`` (explicit-state product, the
 default) and ``nusmv``; ``both`` runs the two and raises ``EngineDisagreement`` if any property
-verdict differs, since then one of them is wrong.
+verdict differs, since then one of them is wrong; when NuSMV reaches its time or memory cap, ``both``
+returns the native verdict with ``stats["nusmv_limit"]`` saying so. Every report names its
+``method``, ``engines`` and ``abstractions`` (``fsmbt.verify.method``); inside
+``certificate.collecting()`` the native check's witness is kept for a certificate.
 """
 
 from __future__ import annotations
 
+from typing import Any
+
+from fsmbt import __version__
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import Hint, InputError, UnsupportedError
 from fsmbt.model.fsm import FSM
-from fsmbt.semantics.machine import FSMLeafMachine
+from fsmbt.semantics.machine import FSMLeafMachine, Machine
 from fsmbt.semantics.outcome_machine import OutcomeFSMMachine
 from fsmbt.semantics.outcome_rules import OutcomeRules
-from fsmbt.verify.native import DEFAULT_MAX_STATES, Replay, check, replay
+from fsmbt.verify import certificate
+from fsmbt.verify.method import describe_method, nusmv_engine
+from fsmbt.verify.native import DEFAULT_MAX_STATES, Replay, check, check_witnessed, replay
 from fsmbt.verify.outcome_pairing import is_outcome_pair, outcome_abstractions
 from fsmbt.verify.pairing import machines_for
-from fsmbt.verify.report import PROPERTIES, PropertyResult, Report, TraceStep
+from fsmbt.verify.report import PROPERTIES, SYMBOLIC, PropertyResult, Report, TraceStep
 
 ENGINES = ("native", "nusmv", "both")
 
@@ -71,6 +79,8 @@ def verify(
             reachable states.
         UnsupportedError: A construct the chosen engine does not model (located).
         EngineDisagreement: With ``both``, the engines differ on some property.
+        NuSMVLimitError: With ``nusmv``, NuSMV reached its cap (with ``both`` the native
+            verdict is returned instead, ``stats["nusmv_limit"]`` naming the cap).
     """
     if engine not in ENGINES:
         raise InputError(f"unknown verification engine '{engine}' (known: {', '.join(ENGINES)})")
@@ -86,18 +96,29 @@ def verify(
             hints=(Hint.NATIVE_VERIFIER,),
         )
     if engine == "nusmv":
-        return _nusmv(source, result, loop)
+        report = _nusmv(source, result, loop, fallback=False)
+        report.method = SYMBOLIC
+        report.engines = nusmv_engine()
+        return report
+    sink = certificate.active_sink()
     source_machine, result_machine, mode = machines_for(
         source, result, loop=loop, outcomes=outcomes, outcome_driven=outcome_driven
     )
-    native = check(source_machine, result_machine, max_states=max_states, mode=mode)
+    native = _native(source_machine, result_machine, max_states, mode, sink, loop, False)
     if isinstance(source_machine, OutcomeFSMMachine):
         native.stats["abstractions"] = outcome_abstractions(source_machine.view)
     native.source = _model_name(source, native.source)
     native.result = _model_name(result, native.result)
     if engine == "native":
         return native
-    other = _nusmv(source, result, loop)
+    try:
+        other = _nusmv(source, result, loop)
+    except NuSMVGaveUp as exc:
+        # NuSMV's time or memory cap: the native verdict stands, and the report says NuSMV
+        # could not confirm it (docs/verification.md, "What a verdict says").
+        native.engines.update(nusmv_engine())
+        native.stats["nusmv_limit"] = str(exc)
+        return native
     if _reachability_only(native, other):
         # Reachability compares states: a leaf machine on reduced states (docs/semantics.md
         # §4a) may merge a state reached only outside the agreeing pairs with one reached in
@@ -105,14 +126,36 @@ def verify(
         source_machine, result_machine, mode = machines_for(
             source, result, loop=loop, faithful=True
         )
-        faithful = check(source_machine, result_machine, max_states=max_states, mode=mode)
+        faithful = _native(source_machine, result_machine, max_states, mode, sink, loop, True)
         faithful.source, faithful.result = native.source, native.result
         native = faithful
     if native.verdicts() != other.verdicts():
         raise EngineDisagreement(native, other)
     native.engine = "native+nusmv"
+    native.method = f"{native.method}+{SYMBOLIC}"
+    native.engines.update(nusmv_engine())
     native.stats["nusmv"] = dict(other.stats)
     return native
+
+
+def _native(
+    source_machine: Machine[Any],
+    result_machine: Machine[Any],
+    max_states: int,
+    mode: str,
+    sink: certificate.WitnessSink | None,
+    loop: bool,
+    faithful: bool,
+) -> Report:
+    """The native check, its method and abstractions named; its witness left in ``sink``."""
+    report, witness = check_witnessed(
+        source_machine, result_machine, max_states=max_states, mode=mode
+    )
+    report.method, report.abstractions = describe_method(source_machine, result_machine)
+    report.engines = {"fsmbt native checker": __version__}
+    if sink is not None:
+        sink.witness, sink.loop, sink.faithful = witness, loop, faithful
+    return report
 
 
 def _reachability_only(native: Report, other: Report) -> bool:
@@ -122,7 +165,13 @@ def _reachability_only(native: Report, other: Report) -> bool:
     return differing == {"reachability"} and not native.equivalent
 
 
-def _nusmv(source: FSM | BTDocument, result: FSM | BTDocument, loop: bool) -> Report:
+class NuSMVGaveUp(RuntimeError):
+    """NuSMV reached its time or memory cap (``fsmbt.limits``) on a pair."""
+
+
+def _nusmv(
+    source: FSM | BTDocument, result: FSM | BTDocument, loop: bool, *, fallback: bool = True
+) -> Report:
     try:
         from fsmbt.verify import nusmv
     except ImportError as exc:
@@ -138,6 +187,10 @@ def _nusmv(source: FSM | BTDocument, result: FSM | BTDocument, loop: bool) -> Re
     try:
         report: Report = checker(source, result, loop=loop)
         return report
+    except nusmv.NuSMVLimitError as exc:
+        if fallback:
+            raise NuSMVGaveUp(str(exc)) from None
+        raise
     except FileNotFoundError as exc:
         raise InputError(
             f"the NuSMV binary is not installed ({exc}); scripts/setup.sh builds it",

@@ -597,6 +597,22 @@ def check(
     Raises:
         StateLimitError: past ``max_states`` (``CheckerTimeLimitError`` past ``max_seconds``).
     """
+    return check_witnessed(
+        source, result, max_states=max_states, max_seconds=max_seconds, mode=mode
+    )[0]
+
+
+def check_witnessed(
+    source: Machine[Any],
+    result: Machine[Any],
+    *,
+    max_states: int = DEFAULT_MAX_STATES,
+    max_seconds: float | None = None,
+    mode: str = "lockstep",
+) -> tuple[Report, Witness]:
+    """``check``, and the explored machines and product kept as a ``Witness`` (the stuff of a
+    certificate, ``fsmbt.verify.certificate``). Same arguments, same cost; the witness holds
+    the tables the check built anyway (O(|S| + |R| + |P|) memory while it is kept)."""
     seconds = limits.current().checker_max_seconds if max_seconds is None else max_seconds
     collecting = gc.isenabled()
     gc.disable()  # millions of small, acyclic objects: the cyclic GC would rescan them all
@@ -607,9 +623,55 @@ def check(
             gc.enable()
 
 
+@dataclass
+class Witness:
+    """What one native check explored: both machines' tables and the product's pairs.
+
+    For an equivalent pair, the product's pairs are a relation closed under both machines'
+    steps from their starts on which outputs, statuses and offered inputs agree: a proof of
+    equivalence that ``fsmbt.verify.certificate`` checks with one machine step per edge.
+    """
+
+    source: Machine[Any]
+    result: Machine[Any]
+    src: _Explored
+    res: _Explored
+    product: _Product
+    report: Report
+
+    def to_data(self) -> dict[str, Any]:
+        """The tables as plain data (JSON-ready): outputs, per machine its start outputs,
+        states (description, status, offered-input set), input sets and edges (in the order the
+        search met them, which fixes every state's id), and the relation as pairs of ids."""
+        product = self.product
+        return {
+            "outputs": [list(v) for v in self.src.outputs.values],
+            "machines": {
+                "source": _machine_data(self.src),
+                "result": _machine_data(self.res),
+            },
+            "relation": [[s, r] for s, r in zip(product.pair_s, product.pair_r, strict=True)],
+        }
+
+
+def _machine_data(explored: _Explored) -> dict[str, Any]:
+    describe = explored.machine.describe
+    return {
+        "start_outputs": explored.start_outputs,
+        "input_sets": [list(key) for key in explored.input_sets],
+        "states": [
+            [describe(state), explored.status[x], explored.offered[x]]
+            for x, state in enumerate(explored.states)
+        ],
+        "edges": [
+            [[symbol, nxt, out] for symbol, (nxt, out) in row.items()] for row in explored.edges
+        ],
+    }
+
+
 def _check(
     source: Machine[Any], result: Machine[Any], max_states: int, deadline: _Deadline, mode: str
-) -> Report:
+) -> tuple[Report, Witness]:
     started = time.perf_counter()
     outputs = _Interner()
     src = _Explored(source, outputs, max_states, "source", deadline)
@@ -652,7 +714,7 @@ def _check(
         "product_seconds": round(finished - explored, 6),
         "seconds": round(finished - started, 6),
     }
-    return report
+    return report, Witness(source, result, src, res, product, report)
 
 
 @dataclass(frozen=True)

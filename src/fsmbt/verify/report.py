@@ -20,6 +20,16 @@ PROPERTIES = (
     TERMINATION_CONSISTENCY,
 )
 
+#: The proof methods a verdict names (docs/verification.md, "What a verdict says"):
+#: the explicit product of the machines on faithful interpreter states; the same product with
+#: a BT side on its static leaf table (pure reactive trees) or on canonical states
+#: (docs/semantics.md §4a); NuSMV's symbolic (BDD) invariant check.
+WHOLE_PRODUCT = "whole product"
+TABLE = "table"
+CANONICAL = "canonical"
+SYMBOLIC = "symbolic"
+METHODS = (WHOLE_PRODUCT, TABLE, CANONICAL, SYMBOLIC)
+
 
 @dataclass
 class TraceStep:
@@ -65,6 +75,11 @@ class Report:
             leaf labels and root results out); see docs/verification.md.
         properties: The five properties by name, in :data:`PROPERTIES` order.
         stats: Figures of the run (states, edges, seconds, ...).
+        method: What was proven and how (docs/verification.md, "What a verdict says"): one of
+            :data:`METHODS`, joined with ``+`` when two engines decided the same pair.
+        engines: Each engine that decided the pair and its version (``fsmbt``, ``NuSMV``).
+        abstractions: Every abstraction the verdict holds under, one sentence each (the BT
+            side's representation, events not stepped, modelled leaves...).
     """
 
     engine: str
@@ -73,6 +88,9 @@ class Report:
     mode: str  # "macro-step" (FSM vs BT) or "leaf-execution" (BT vs FSM) ...
     properties: dict[str, PropertyResult] = field(default_factory=dict)
     stats: dict[str, Any] = field(default_factory=dict)
+    method: str = ""
+    engines: dict[str, str] = field(default_factory=dict)
+    abstractions: list[str] = field(default_factory=list)
 
     @property
     def equivalent(self) -> bool:

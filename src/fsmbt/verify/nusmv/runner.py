@@ -21,7 +21,7 @@ import signal
 import subprocess
 import sys
 import tempfile
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 from fsmbt import limits
@@ -159,6 +159,7 @@ def run_nusmv(
     timeout: float | None = None,
     memory_mb: int | None = None,
     keep: str | None = None,
+    options: Sequence[str] = (),
 ) -> tuple[list[SpecResult], float]:
     """Check every SPEC of ``model``; returns the results in file order and NuSMV's seconds.
 
@@ -170,6 +171,8 @@ def run_nusmv(
         memory_mb: address-space cap of the child, MiB; ``None``:
             ``limits.current().nusmv_max_memory_mb``.
         keep: also write the model to this path (debugging).
+        options: more NuSMV command-line options (``-coi``, ``-dynamic``: measured by
+            benchmarks/bench_nusmv_options.py, not used by default).
 
     Returns:
         The results in file order and NuSMV's wall seconds.
@@ -193,7 +196,7 @@ def run_nusmv(
                 handle.write(model)
         # -mono: one monolithic transition relation; the partitioned (IWLS95) default is ~10x
         # slower on these micro-step products.
-        command = [str(binary), "-mono"]
+        command = [str(binary), "-mono", *options]
         if order:
             order_path = os.path.join(tmp, "product.ord")
             with open(order_path, "w", encoding="utf-8") as handle:

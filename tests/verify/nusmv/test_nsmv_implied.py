@@ -1,0 +1,44 @@
+"""NuSMV's reachability implied by the other four properties (docs/nusmv.md, "Reachability
+implied"): one run without its spec on an equivalent pair; a failing pair is run whole again, and
+both ways give the verdicts of one run of every spec and of the native checker."""
+
+from __future__ import annotations
+
+import copy
+from pathlib import Path
+
+from fsmbt import api
+from fsmbt.verify import nusmv, verify
+from fsmbt.verify.report import REACHABILITY
+
+EXAMPLE = Path(__file__).resolve().parents[3] / "examples" / "guard_npc.csv"
+
+
+def test_equivalent_pair_skips_the_reachability_spec(nusmv_binary, monkeypatch) -> None:
+    monkeypatch.setenv("FSMBT_NUSMV", str(nusmv_binary))
+    fsm = api.load(EXAMPLE).model
+    report = nusmv.check(fsm, copy.deepcopy(fsm))
+    assert report.equivalent and report.stats["nusmv_runs"] == 1
+    assert report.properties[REACHABILITY].detail == nusmv.IMPLIED_DETAIL
+    whole = nusmv.check(fsm, copy.deepcopy(fsm), implied_reachability=False)
+    assert whole.verdicts() == report.verdicts()
+
+
+def test_failing_pairs_get_every_spec_verdict(nusmv_binary, monkeypatch) -> None:
+    monkeypatch.setenv("FSMBT_NUSMV", str(nusmv_binary))
+    fsm = api.load(EXAMPLE).model
+    compared = 0
+    for index in range(min(3, len(fsm.transitions))):
+        mutant = copy.deepcopy(fsm)
+        transition = mutant.transitions[index]
+        others = [name for name in mutant.states if name != transition.target]
+        transition.target = others[0]
+        native = verify(fsm, mutant)
+        if native.equivalent:
+            continue
+        report = nusmv.check(fsm, mutant)
+        assert report.stats["nusmv_runs"] == 2
+        assert report.verdicts() == native.verdicts()
+        assert report.verdicts() == nusmv.check(fsm, mutant, implied_reachability=False).verdicts()
+        compared += 1
+    assert compared >= 1
