@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-from fsmbt.formats import read_model, write_model
+from fsmbt import api
 from support.structured_machines import machine
 
 REPO = Path(__file__).resolve().parents[2]
@@ -36,7 +36,7 @@ def test_a_smach_file_becomes_its_structured_tree_by_default(tmp_path: Path) -> 
     assert done.returncode == 0, done.stderr
     assert "structured: " in done.stdout and " flag" in done.stdout and "LEBT blocks" in done.stdout
     assert "verdict: EQUIVALENT" in done.stdout
-    tree = read_model(out)
+    tree = api.load(out).model
     types = {node.type for _t, node in tree.nodes()}
     assert {"WaitForOrder", "Charge", "Drive", "Handover"} <= types
     assert not types & {"LebtGuard", "LebtState"}
@@ -50,14 +50,14 @@ def test_lebt_and_its_alias_paper_keep_the_papers_shape(tmp_path: Path, style: s
 
     out = tmp_path / "delivery.xml"
     assert main(["convert", str(DELIVERY), "--style", style, "-o", str(out)]) == 0
-    types = {node.type for _t, node in read_model(out).nodes()}
+    types = {node.type for _t, node in api.load(out).model.nodes()}
     assert {"LebtGuard", "LebtState"} <= types
 
 
 def _mixed(path: Path) -> None:
     fsm = machine({"Wait": {"ok": "succeeded", "bad": "aborted"}})
     fsm.add_transition("Wait", "timeout", "aborted")  # an external event beside the outcomes
-    write_model(fsm, path)
+    api.write(fsm, path)
 
 
 @pytest.mark.parametrize(

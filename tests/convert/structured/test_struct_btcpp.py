@@ -10,8 +10,8 @@ from pathlib import Path
 
 import pytest
 
+from fsmbt import api
 from fsmbt.convert.structured import fsm_to_structured
-from fsmbt.formats import read_model
 from fsmbt.generate.outcome_machines import random_outcome_fsm
 from fsmbt.model.bt import BTDocument
 from support.corpus import CORPUS
@@ -41,7 +41,7 @@ def _same_in_btcpp(fsm, doc: BTDocument, seeds: range) -> None:
 @pytest.mark.skipif(not FSM_DIR.exists(), reason="corpus not present (FSMBT_CORPUS)")
 @pytest.mark.parametrize("path", CORPUS_FILES, ids=lambda p: f"{p.parent.name}/{p.name}")
 def test_corpus_structured_trees_run_in_btcpp_like_their_machines(path: Path) -> None:
-    fsm = read_model(path)
+    fsm = api.load(path).model
     doc = fsm_to_structured(fsm).model
     _same_in_btcpp(fsm, doc, range(6))
 
@@ -86,8 +86,8 @@ def _nodes(doc: BTDocument) -> int:
     ],
 )
 def test_structured_trees_are_no_bigger_than_hand_written_ones(name: str) -> None:
-    fsm = read_model(FSM_DIR / name)
+    fsm = api.load(FSM_DIR / name).model
     doc = fsm_to_structured(fsm).model
-    hand = read_model(HAND / (name.replace("/", "__").removesuffix(".py") + ".xml"))
+    hand = api.load(HAND / (name.replace("/", "__").removesuffix(".py") + ".xml")).model
     assert isinstance(hand, BTDocument)
     assert _nodes(doc) <= 1.25 * _nodes(hand), (_nodes(doc), _nodes(hand))

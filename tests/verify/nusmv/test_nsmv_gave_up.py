@@ -31,7 +31,16 @@ def test_cli_both_prints_the_verdict_and_the_limit(nusmv_binary, monkeypatch, ca
     previous = limits.current()
     try:
         code = main(
-            ["verify", str(EXAMPLE), str(EXAMPLE), "--engine", "both", "-q", "--timeout", "0.001"]
+            [
+                "verify",
+                str(EXAMPLE),
+                str(EXAMPLE),
+                "--engine",
+                "both",
+                "--no-progress",
+                "--timeout",
+                "0.001",
+            ]
         )
     finally:
         limits.use(previous)
