@@ -231,7 +231,7 @@ def test_readme_marks_exactly_the_existing_commands_available(
     capsys: pytest.CaptureFixture,
 ) -> None:
     rows = re.findall(
-        r"^\| `fsmbt (\w+)[^|]*\|[^|]*\| (\w+) \|$",
+        r"^\| `fsmbt ([\w-]+)[^|]*\|[^|]*\| (\w+) \|$",
         (ROOT / "README.md").read_text(encoding="utf-8"),
         flags=re.M,
     )
@@ -244,7 +244,7 @@ def test_readme_marks_exactly_the_existing_commands_available(
 
 def test_cli_doc_has_a_section_per_command(capsys: pytest.CaptureFixture) -> None:
     text = (ROOT / "docs" / "cli.md").read_text(encoding="utf-8")
-    documented = set(re.findall(r"^## `fsmbt (\w+)`", text, flags=re.M))
+    documented = set(re.findall(r"^## `fsmbt ([\w-]+)`", text, flags=re.M))
     registered = _registered_commands()
     capsys.readouterr()
     assert registered <= documented, f"docs/cli.md lacks {sorted(registered - documented)}"
