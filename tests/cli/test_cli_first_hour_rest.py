@@ -125,7 +125,7 @@ def undeclared_bt(tmp_path: Path) -> Path:
 def test_validate_collapses_repeated_not_declared_warnings(
     undeclared_bt: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    assert main(["validate", "--json", str(undeclared_bt)]) == 0
+    assert main(["validate", "--json", "--no-profiles", str(undeclared_bt)]) == 0
     issues = json.loads(capsys.readouterr().out)["issues"]
     # one warning for every undeclared type, worded as convert words it, at the first one
     undeclared = [i for i in issues if i["code"] == "undeclared-leaf"]
@@ -135,7 +135,10 @@ def test_validate_collapses_repeated_not_declared_warnings(
     assert not [i for i in issues if "'Spin'" in i["message"] or "'Wait'" in i["message"]]
 
 
-@pytest.mark.parametrize("command", [["info"], ["convert", "--no-progress", "--no-verify"]])
+@pytest.mark.parametrize(
+    "command",
+    [["info", "--no-profiles"], ["convert", "--no-progress", "--no-verify", "--no-profiles"]],
+)
 def test_info_and_convert_name_each_undeclared_type_once(
     command: list[str], undeclared_bt: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
