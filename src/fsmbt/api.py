@@ -576,6 +576,17 @@ def write(
         hold the model, or the file system refuses the write.
     """
     path = check_destination(path, overwrite=overwrite)
+    if (
+        fmt is None
+        and path.suffix
+        and format_for_path(path, writing=True, kind=model_kind(model)) is None
+    ):
+        # a name whose extension no writer has: say so rather than write another format into it
+        raise InputError(
+            f"cannot tell the output format from '{path.name}'",
+            location=SourceLocation(str(path)),
+            hints=(Hint.OUTPUT_FORMAT,),
+        )
     chosen = output_format_for(model_kind(model), to=fmt, output=path)
     return write_text(dumps(model, chosen), path, overwrite=overwrite)
 
