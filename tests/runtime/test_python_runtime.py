@@ -44,7 +44,8 @@ DOOR = REPO / "examples" / "door_hfsm.scxml"
 
 
 def tree_of(fsm: FSM) -> str:
-    return dumps(converter_for("rules", fsm)(fsm).model, "btcpp")
+    # the LEBT runtimes run LEBTs (an outcome-driven example would be structured by default)
+    return dumps(converter_for("rules", fsm)(fsm, style="lebt").model, "btcpp")
 
 
 class Recorder:
