@@ -18,6 +18,7 @@ from __future__ import annotations
 
 from collections import Counter, deque
 
+from fsmbt.model import fsm_data
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.fsm import FSM
 from fsmbt.semantics.lebt.spec import DEFAULT_START, GUARD_TYPE, STATE_TYPE, GuardSpec, StateSpec
@@ -183,6 +184,10 @@ def check_hfsm(source: BTDocument, result: FSM) -> list[str]:
                     f"{level}: event {t.event!r} is not a leaf outcome (success, failure, running)"
                 )
             key = (t.source, t.event if t.event is not None else f"exit:{t.exit}")
+            if fsm_data.COND in t.attrs:
+                # a data guard (docs/semantics.md §6a): transitions on one event are tried in
+                # order, so guarded ones are not a second target; the checker decides them
+                continue
             if key in seen and seen[key] != t.target:
                 problems.append(
                     f"{level}: {t.source} has two transitions on {key[1]} "
