@@ -233,7 +233,7 @@ def reads_models(command: Callable[..., Any]) -> Callable[..., Any]:
     flags into the signature typer reads and builds the validated ``ReadOptions`` (an invalid
     value is the located ``InputError`` of ``fsmbt.api_types``: exit 2).
     """
-    from fsmbt.api_types import convert_request
+    from fsmbt.api_types import read_options
 
     signature = inspect.signature(command, eval_str=True)
     kept = [p for name, p in signature.parameters.items() if name != "read"]
@@ -253,8 +253,8 @@ def reads_models(command: Callable[..., Any]) -> Callable[..., Any]:
         }
         if isinstance(fields.get("include_root"), Path):
             fields["include_root"] = str(fields["include_root"])
-        request = convert_request(source_format=given["source_format"], options=fields)
-        return command(read=request.read, **kwargs)
+        read = read_options(format=given["source_format"], **fields)
+        return command(read=read, **kwargs)
 
     parameters = [
         p.replace(kind=inspect.Parameter.KEYWORD_ONLY)
