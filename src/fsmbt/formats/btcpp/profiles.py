@@ -201,6 +201,18 @@ def _bundled_custom_types() -> tuple[tuple[str, frozenset[str]], ...]:
     return tuple(out)
 
 
+def _given_library_types(given_nodes: tuple[str, ...]) -> set[str]:
+    """The control/decorator types the user's ``--nodes`` libraries alias or give semantics to
+    (none when they cannot be read: the reader reports that itself, located)."""
+    if not given_nodes:
+        return set()
+    try:
+        library = build_library(list(given_nodes))
+    except InputError:
+        return set()
+    return set(library.aliases) | set(library.semantics)
+
+
 def _bundled_libraries(used: dict[str, Usage], known: set[str]) -> list[tuple[str, list[str]]]:
     out: list[tuple[str, list[str]]] = []
     for path, custom in _bundled_custom_types():
@@ -266,7 +278,9 @@ def discover(
                 type_name, usage, model, "the Nav2 profile (Nav2's nav2_tree_nodes.xml)", found
             ):
                 found.models[type_name] = (model, "the Nav2 profile")
-    for library_path, hits in _bundled_libraries(used, set()):
+    # a bundled library is found only for types the user's own --nodes libraries leave open:
+    # what the user said about a type wins over what a bundled file guesses
+    for library_path, hits in _bundled_libraries(used, _given_library_types(tuple(given_nodes))):
         if library_path not in given_nodes:
             found.libraries.append(library_path)
             found.library_hits[library_path] = hits

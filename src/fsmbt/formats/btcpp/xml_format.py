@@ -551,7 +551,8 @@ def read_btcpp(text: str, ctx: ReadContext) -> BTDocument:
     doc = loader.document()
     loader.prune_extra_trees(doc)
     # --nodes / --abstract (fsmbt.model.nodes.library): project kinds, aliases, abstractions
-    nodes = given_nodes + (found.profiles + found.libraries if found is not None else [])
+    # the user's own libraries last: a later file's entry for a type wins (model/nodes/library.py)
+    nodes = (found.profiles + found.libraries if found is not None else []) + given_nodes
     library = build_library(nodes, ctx.options.get("abstract"))
 
     def warn(message: str, location: SourceLocation | None) -> None:
