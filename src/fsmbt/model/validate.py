@@ -380,7 +380,9 @@ class _BtValidator:
             return _path(trail, here)
 
         count = len(node.children)
-        spec = builtin_spec(node.type)
+        # a project node read with a library's semantics (--nodes, or a profile found by
+        # itself) follows that built-in's rules, as conversion does
+        spec = builtin_spec(node.semantics or node.type)
         if not node.kind_declared:
             if count:
                 self.add(
