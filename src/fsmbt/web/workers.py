@@ -28,7 +28,6 @@ from __future__ import annotations
 import asyncio
 import logging
 import multiprocessing
-import os
 import resource
 import signal
 from collections.abc import Callable
@@ -217,8 +216,8 @@ class Workers:
         processes = list(getattr(pool, "_processes", {}).values())
         pool.shutdown(wait=False, cancel_futures=True)
         for process in processes:
-            if process.is_alive() and process.pid is not None:
-                os.kill(process.pid, signal.SIGKILL)
+            if process.is_alive():
+                process.kill()  # SIGKILL; a process that ended meanwhile is no error
 
     def close(self, grace_s: float = 3.0) -> None:
         """Stop the workers: queued calls are cancelled, running ones get ``grace_s`` seconds
@@ -229,6 +228,6 @@ class Workers:
         pool.shutdown(wait=False, cancel_futures=True)
         for process in processes:
             process.join(timeout=grace_s)
-            if process.is_alive() and process.pid is not None:
-                os.kill(process.pid, signal.SIGKILL)
+            if process.is_alive():
+                process.kill()  # SIGKILL; a process that ended meanwhile is no error
                 process.join(timeout=1.0)
