@@ -4,6 +4,7 @@ existing outputs, a missing output folder, and the corpus's malformed files as r
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 
 import pytest
@@ -11,6 +12,8 @@ import pytest
 from fsmbt import api
 from fsmbt.cli import main
 from fsmbt.cli.cmd_batch import exit_code
+from fsmbt.formats.xml_safe import parse_xml
+from fsmbt.model.errors import InputError
 from support.corpus import CORPUS
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
@@ -88,6 +91,24 @@ def test_exit_codes() -> None:
 
 
 @pytest.mark.skipif(not CORPUS.is_dir(), reason=f"corpus not found at {CORPUS} (set FSMBT_CORPUS)")
+def _only_comment_dashes(path: Path) -> bool:
+    """The file is refused by a strict XML parser for '--' in a comment, and for nothing else:
+    read with those comments blanked, it parses."""
+    text = path.read_text(encoding="utf-8")
+    try:
+        parse_xml(text, str(path))
+    except InputError as exc:
+        if "omment" not in str(exc):
+            return False
+        blanked = re.sub(r"<!--.*?-->", "", text, flags=re.DOTALL)
+        try:
+            parse_xml(blanked, str(path))
+        except InputError:
+            return False
+        return True
+    return False
+
+
 def test_the_corpus_malformed_files_are_rows_not_a_crash(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -102,8 +123,14 @@ def test_the_corpus_malformed_files_are_rows_not_a_crash(
     captured = capsys.readouterr()
     rows = json.loads(captured.out)["results"]
     assert sorted(Path(r["input"]).name for r in rows) == expected
-    assert {r["status"] for r in rows} == {"bad_input"}
-    assert all(Path(r["input"]).name in r["error_message"] for r in rows)
+    refused = [r for r in rows if r["status"] == "bad_input"]
+    # malformed only by '--' inside comments, which BehaviorTree.CPP's tinyxml2 loads: read
+    # with a warning (docs/formats/btcpp.md) and converted like any tree
+    lenient = {r["input"] for r in rows if _only_comment_dashes(Path(r["input"]))}
+    assert {r["input"] for r in rows if r["status"] != "bad_input"} == lenient
+    assert all(r["status"] == "equivalent" for r in rows if r["input"] in lenient)
+    assert len(refused) >= 3  # the three malformed SCXML files at least
+    assert all(Path(r["input"]).name in r["error_message"] for r in refused)
     assert "Traceback" not in captured.err
 
 

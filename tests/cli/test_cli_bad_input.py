@@ -19,7 +19,10 @@ from pathlib import Path
 
 import pytest
 
-TIME_LIMIT_S = 2.0
+#: A guard against hangs and blow-ups (a 100 000-deep file parsed recursively, a billion-laughs
+#: expansion), not a speed target: those take minutes or never end. A normal refusal takes about
+#: 1 s, most of it the interpreter's start; speed figures belong in benchmarks/, which print them.
+TIME_LIMIT_S = 10.0
 DEEP = 100_000
 BT_HEAD = '<root BTCPP_format="4" main_tree_to_execute="T"><BehaviorTree ID="T">'
 BT_TAIL = "</BehaviorTree></root>"
@@ -243,9 +246,9 @@ def run_validate(target: Path) -> tuple[subprocess.CompletedProcess[str], float,
 
 
 def wall_limit() -> float:
-    """2 s, stretched only when the machine is oversubscribed (CI shares cores with other
-    jobs): a run that got a fraction of a core cannot finish in 2 s of wall time. The CPU time
-    the process used is held to the plain 2 s in every case."""
+    """The hang guard in wall time, stretched only when the machine is oversubscribed (CI shares
+    cores with other jobs): a run that got a fraction of a core takes longer in wall time. The
+    CPU time the process used is held to the plain limit in every case."""
     cores = os.cpu_count() or 1
     load = os.getloadavg()[0]
     return TIME_LIMIT_S * max(1.0, load / cores)

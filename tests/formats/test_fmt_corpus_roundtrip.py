@@ -16,8 +16,9 @@ import pytest
 
 from fsmbt import api
 from fsmbt.formats import dumps, loads
+from fsmbt.formats.translate import rename_events, scxml_event_renames
 from fsmbt.formats.xml_safe import parse_xml
-from fsmbt.model import BTDocument
+from fsmbt.model import FSM, BTDocument
 from fsmbt.model.errors import InputError, UnsupportedError
 from support.corpus import CORPUS
 
@@ -50,6 +51,10 @@ def _classify(path: Path) -> tuple[str, str]:
     except InputError as exc:
         return "rejected", str(exc)
     fmt = "btcpp" if isinstance(model, BTDocument) else "scxml"
+    if isinstance(model, FSM):
+        # event names an SCXML engine reads otherwise ('done' matches every done.state.X) are
+        # renamed by every SCXML write of the API (a named loss); the round trip is of that model
+        model = rename_events(model, scxml_event_renames(model))
     again = loads(dumps(model, fmt), fmt)
     if isinstance(model, BTDocument):
         model = dataclasses.replace(model, format_version="4", includes=[])
