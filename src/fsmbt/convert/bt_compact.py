@@ -160,6 +160,11 @@ class _Compactor:
             for symbol, (target, outs) in explored.transitions[s].items():
                 if len(outs) == 2 and top:
                     target, outs = self._looped(target, outs)
+                elif top and len(outs) != 1:  # never drop an output (as unrolled)
+                    raise UnsupportedError(
+                        f"cannot express the outputs {outs} of one step as one state's action",
+                        element=self.fsm.name,
+                    )
                 self.edges.append(
                     (n, symbol, target if isinstance(target, RootResult) else index[target], outs)
                 )

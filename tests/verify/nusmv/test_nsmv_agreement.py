@@ -235,9 +235,13 @@ def assert_agreement(
 
 # -- pair makers ---------------------------------------------------------------------------------
 def _convert(label: str, model: Model, *, loop: bool = False) -> Pair | Rejected | None:
-    """The rules engine's conversion of ``model`` as a pair; ``Rejected`` when it raises
+    """The rules engine's conversion of ``model`` (an FSM as its LEBT) as a pair; ``Rejected`` when it raises
     ``UnsupportedError``, ``None`` for any other refusal (the model does not convert)."""
-    options = {"loop": True} if loop else {}
+    options: dict[str, object] = {"loop": True} if loop else {}
+    if isinstance(model, FSM):
+        # the LEBT: a structured tree (an outcome-driven machine's default) is compared by the
+        # outcome pairing, which the NuSMV encoding does not hold (docs/nusmv.md)
+        options["style"] = "lebt"
     try:
         result = converter_for("rules", model)(model, **options).model
     except UnsupportedError as exc:
