@@ -96,6 +96,18 @@ def write_yasmin(model: Model) -> str:
     return text + "\n"
 
 
+def _outcome_list(outcomes: list[str], where: str) -> str:
+    """YASMIN's ``outcomes`` attribute: the names separated by blanks, so a name holding a
+    blank cannot be written (it would read back as several outcomes)."""
+    for outcome in outcomes:
+        if not outcome or any(c.isspace() for c in outcome):
+            raise UnsupportedError(
+                f"{where}: outcome {outcome!r} holds a blank; YASMIN's outcomes attribute "
+                "separates names by blanks"
+            )
+    return " ".join(outcomes)
+
+
 def _machine(
     machine: FSM, element: etree._Element, attrs: dict[str, str]
 ) -> list[tuple[FSM, etree._Element, dict[str, str]]]:
@@ -109,7 +121,7 @@ def _machine(
         raise UnsupportedError(
             f"machine '{machine.name}' starts in a final state; YASMIN starts in a state"
         )
-    element.set("outcomes", " ".join(finals))
+    element.set("outcomes", _outcome_list(finals, f"machine '{machine.name}'"))
     element.set("start_state", machine.initial)
     _annotate(element, attrs)
     pending: list[tuple[FSM, etree._Element, dict[str, str]]] = []
@@ -221,7 +233,7 @@ def _concurrence(state: State, parent: etree._Element, tag: str) -> etree._Eleme
     default = state.attrs.get(A_DEFAULT)
     outcome_map = json.loads(state.attrs[A_MAP])
     outcomes = list(dict.fromkeys([*([default] if default else []), *(o for o, _ in outcome_map)]))
-    element.set("outcomes", " ".join(sorted(outcomes)))
+    element.set("outcomes", _outcome_list(sorted(outcomes), f"Concurrence '{state.name}'"))
     if default:
         element.set("default_outcome", default)
     _annotate(element, state.attrs)
