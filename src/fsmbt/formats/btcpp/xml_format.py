@@ -28,6 +28,7 @@ from lxml import etree
 from fsmbt import limits
 from fsmbt.formats.btcpp import profiles as btcpp_profiles
 from fsmbt.formats.btcpp import trees as btcpp_trees
+from fsmbt.formats.btcpp import versions as btcpp_versions
 from fsmbt.formats.registry import Format, ReadContext, decode, register
 from fsmbt.formats.xml_safe import parse_xml, root_tag
 from fsmbt.model import Model
@@ -425,6 +426,8 @@ class _Loader:
             type_name = canonical_type(type_id)
         else:
             type_name = canonical_type(tag)
+        if f.version == "3":  # v3 ports and SubTree remaps in v4 terms (btcpp.versions)
+            attrs = btcpp_versions.v4_attrs(tag, type_name, attrs)
         if element.text and element.text.strip():
             self.ctx.warn("text inside a node is ignored", line=element.sourceline, element=tag)
         spec = builtin_spec(type_name)
@@ -653,6 +656,19 @@ def kept_as_written(text: str, doc: BTDocument) -> bool:
 # -- writing -------------------------------------------------------------------------------------
 def write_btcpp(model: Model) -> str:
     """Write a BehaviorTree.CPP v4 file: compact style, main tree named, custom types declared."""
+    return serialize(*document_root(model))
+
+
+def serialize(root: etree._Element, depth: int) -> str:
+    """The text of a written ``<root>``: indented unless a tree is deeper than
+    ``PRETTY_MAX_DEPTH``; ends with a newline."""
+    text = etree.tostring(root, encoding="unicode", pretty_print=depth <= PRETTY_MAX_DEPTH)
+    return text if text.endswith("\n") else text + "\n"
+
+
+def document_root(model: Model) -> tuple[etree._Element, int]:
+    """The v4 ``<root>`` element of a document and the depth of its deepest tree (the
+    ``btcpp3`` writer edits this element into v3; ``fsmbt.formats.btcpp.v3_write``)."""
     if not isinstance(model, BTDocument):
         raise InputError("BehaviorTree.CPP XML holds a behavior tree, not a state machine")
     doc = model
@@ -670,9 +686,7 @@ def write_btcpp(model: Model) -> str:
         if tree.root is not None:
             depth = max(depth, _write_nodes(element, tree.root))
     _write_models(root, doc)
-    pretty = depth <= PRETTY_MAX_DEPTH
-    text = etree.tostring(root, encoding="unicode", pretty_print=pretty)
-    return text if text.endswith("\n") else text + "\n"
+    return root, depth
 
 
 def _write_nodes(parent: etree._Element, top: BTNode) -> int:
