@@ -301,6 +301,8 @@ def loads(
     """
     _check_text_size(text, path)
     chosen = get_format(fmt) if fmt else detect_format(text, path)
+    if chosen.read is None and chosen.read_back_as is not None:
+        chosen = get_format(chosen.read_back_as)  # btcpp3 files are read as btcpp reads them
     if chosen.read is None:
         raise InputError(f"format '{chosen.name}' can be written but not read")
     ctx = ReadContext(path=path, options=dict(options or {}))

@@ -141,12 +141,11 @@ def translate(
     losses.extend(own_losses or [])
     losses.extend(_program_losses(target.name, written))
     result = Translation(text, source_format, target.name, losses, checked=checked)
-    reader = target.read_back_as or target.name
     if target.read is None and target.read_back_as is None:
         losses.append(f"{target.name} cannot be read back, so what it loses is not checked")
         return result
     try:
-        back = loads(text, reader)
+        back = loads(text, target.name)  # a write-only format: its read_back_as reader
     except InputError as exc:
         losses.append(
             f"fsmbt cannot read this {target.name} back ({exc.message}), so what it "
