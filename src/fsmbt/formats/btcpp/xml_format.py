@@ -628,31 +628,6 @@ def _find_profiles(
     return found
 
 
-def kept_as_written(text: str, doc: BTDocument) -> bool:
-    """Whether ``text``, the file ``doc`` was read from, is already what the writer must give:
-    a self-contained v4 file (``BTCPP_format="4"``, no ``<include>``), its main tree named,
-    every node BehaviorTree.CPP's factory does not hold declared in its own
-    ``<TreeNodesModel>`` and no kind assumed. A BT.CPP -> BT.CPP translation of such a file
-    writes it byte for byte (comments, attribute order, formatting kept: nothing changed);
-    docs/formats/btcpp.md "What is written"."""
-    if doc.format_version != "4" or doc.includes:
-        return False
-    root = parse_xml(text, "<source>", [])
-    if root.get("BTCPP_format") != "4" or (
-        root.get("main_tree_to_execute") is None and len(doc.trees) != 1
-    ):
-        return False
-    declared: set[str] = set()
-    for models in root.iter("TreeNodesModel"):
-        declared |= {m.type for m in _read_models(models, "<source>")}
-    for _tree, node in doc.nodes():
-        if node.kind is NodeKind.SUBTREE or _factory_builtin(node.type):
-            continue
-        if not node.kind_declared or node.type not in declared:
-            return False
-    return True
-
-
 # -- writing -------------------------------------------------------------------------------------
 def write_btcpp(model: Model) -> str:
     """Write a BehaviorTree.CPP v4 file: compact style, main tree named, custom types declared."""
