@@ -54,6 +54,7 @@ def main() -> int:
     lost_comments: list[str] = []
     v3_rows: Counter[str] = Counter()
     v3_causes: Counter[str] = Counter()
+    v3_files: dict[str, list[str]] = {}
     for path in files:
         original = read_text(path)
         v3 = 'BTCPP_format="4"' not in original
@@ -63,7 +64,8 @@ def main() -> int:
         try:
             loaded, result, report = api.translate(path, to="btcpp")
         except FsmbtError as exc:
-            refused_v4[str(exc).split(": ")[-1][:70]] += 1
+            message = str(exc).replace(str(path), "").replace(str(root), "corpus")
+            refused_v4[f"{path.name}: {message[:110]}"] += 1
             continue
         if report is None or not report.equivalent:
             continue
@@ -83,13 +85,16 @@ def main() -> int:
             if not same:
                 lost_comments.append(path.name)
         kept, lines = _lines_kept(original, text)
+        rows[f"{group} only insertions"] += text != original and kept == lines
         kept_lines += kept
         total_lines += lines
         try:
             _l3, result3, report3 = api.translate(path, to="btcpp3")
         except FsmbtError as exc:
             cause = _V3_CAUSE.search(str(exc))
-            v3_causes[(cause.group(1) or cause.group(2)) if cause else str(exc)[-60:]] += 1
+            name = (cause.group(1) or cause.group(2)) if cause else str(exc)[-60:]
+            v3_causes[name] += 1
+            v3_files.setdefault(name, []).append(path.name)
             v3_rows["refused"] += 1
             continue
         if report3 is None or not report3.equivalent:
@@ -103,7 +108,8 @@ def main() -> int:
         print(
             f"{group} -> v4: {done}/{n} translated and proven equivalent; "
             f"{rows[f'{group} byte-identical']} byte-identical, "
-            f"{rows[f'{group} edited']} the user's file edited, "
+            f"{rows[f'{group} edited']} the user's file edited ({rows[f'{group} only insertions']} "
+            "of them only by insertions: every source line kept), "
             f"{rows[f'{group} rewritten']} rewritten by the writer; comments kept in "
             f"{rows[f'{group} comments kept']}/{rows[f'{group} with comments']} files with comments"
         )
@@ -118,7 +124,7 @@ def main() -> int:
         f"named losses), {v3_rows['refused']} refused"
     )
     for cause, count in v3_causes.most_common():
-        print(f"  refused, {count} file(s): {cause}")
+        print(f"  refused, {count} file(s): {cause} ({', '.join(v3_files[cause])})")
     return 0
 
 

@@ -117,23 +117,42 @@ def test_a_v4_file_gains_only_its_missing_declarations(tmp_path: Path) -> None:
     ]
 
 
-def test_a_file_the_editor_cannot_keep_is_written_by_the_writer(tmp_path: Path) -> None:
+def test_includes_are_inlined_into_the_users_file(tmp_path: Path) -> None:
     (tmp_path / "other.xml").write_text(
-        '<root BTCPP_format="4"><BehaviorTree ID="O"><AlwaysSuccess/></BehaviorTree></root>',
+        '<root BTCPP_format="4"><BehaviorTree ID="O"><Fallback><Ok/><AlwaysSuccess/>'
+        "</Fallback></BehaviorTree></root>",
         encoding="utf-8",
     )
     with_include = """<root BTCPP_format="4" main_tree_to_execute="T">
   <include path="other.xml"/>
+  <!-- O comes from other.xml -->
   <BehaviorTree ID="T"><SubTree ID="O"/></BehaviorTree>
 </root>
 """
-    source = tmp_path / "main.xml"
-    source.write_text(with_include, encoding="utf-8")
-    loaded = api.load(source)
-    assert isinstance(loaded.model, BTDocument)
-    written = dumps(loaded.model, "btcpp")
-    assert edited_source(with_include, loaded.model, written) is None
-    assert _translate(tmp_path, with_include, "main.xml") == written
+    text = _translate(tmp_path, with_include, "main.xml")
+    removed, added = _changed_lines(with_include, text)
+    assert removed == ['  <include path="other.xml"/>']
+    assert added == [
+        '  <BehaviorTree ID="O">',
+        "    <Fallback>",
+        "      <Ok/>",
+        "      <AlwaysSuccess/>",
+        "    </Fallback>",
+        "  </BehaviorTree>",
+        "  <TreeNodesModel>",
+        '    <Action ID="Ok">',
+        f"      <description>{ASSUMED_DESCRIPTION}</description>",
+        "    </Action>",
+        "  </TreeNodesModel>",
+    ]
+
+
+def test_what_the_editor_cannot_keep_is_written_by_the_writer() -> None:
+    odd = """<root><BehaviorTree ID="T"><Go/></BehaviorTree><TreeNodesModel/></root>"""
+    doc = loads(odd, "btcpp")
+    assert isinstance(doc, BTDocument)
+    written = dumps(doc, "btcpp")
+    assert edited_source(odd, doc, written) is None  # a <TreeNodesModel/> to fill
 
 
 def test_a_corpus_v3_tree_keeps_its_comments() -> None:

@@ -18,11 +18,13 @@ when it cannot (then the writer's text is used):
   appended;
 - the ``<TreeNodesModel>`` entries the writer adds (every node BehaviorTree.CPP's factory does
   not hold) that the file does not declare are inserted before ``</TreeNodesModel>``, or in a
-  new ``<TreeNodesModel>`` before ``</root>``, indented like their neighbours.
+  new ``<TreeNodesModel>`` before ``</root>``, indented like their neighbours;
+- a written file is self-contained (as the writer's): each ``<include>`` is removed (with its
+  line) and the trees of included files, or of other files SubTrees name, are inserted before
+  ``</root>`` as the writer writes them.
 
-Refused (``None``): a file with ``<include>`` or trees taken from other files (the writer inlines
-them), a DOCTYPE with an internal subset, a self-closing ``<TreeNodesModel/>`` that needs
-entries, any element the scanner and lxml do not see alike. The result is kept only when it
+Refused (``None``): a DOCTYPE with an internal subset, a self-closing ``<TreeNodesModel/>``
+that needs entries, any element the scanner and lxml do not see alike. The result is kept only when it
 reads back to the same document as the writer's text (``model_to_dict`` equal), so an edit can
 never change what the file says.
 
@@ -72,6 +74,7 @@ class _Tag:
     start: int  # the "<"
     end_name: tuple[int, int] | None = None  # the end tag's name span
     end_start: int | None = None  # the "</" of the end tag
+    close_end: int = 0  # just after the tag's last ">" (its end tag's, if any)
     children: list[_Tag] = field(default_factory=list)
 
 
@@ -107,6 +110,7 @@ def _scan(text: str) -> list[_Tag] | None:
             top = stack.pop()
             top.end_name = (name.start(), name.end())
             top.end_start = i
+            top.close_end = text.find(">", name.end()) + 1
             i = text.find("<", name.end())
             continue
         name = _NAME.match(text, i + 1)
@@ -130,6 +134,7 @@ def _scan(text: str) -> list[_Tag] | None:
         if close is None:
             return None
         tag = _Tag(name.group(), name.start(), name.end(), attrs, pos, bool(close.group(1)), i)
+        tag.close_end = close.end()
         if stack:
             stack[-1].children.append(tag)
         tags.append(tag)
@@ -211,66 +216,93 @@ def _line_indent(text: str, position: int) -> str | None:
     return before if not before.strip() else None
 
 
-def _entries(written: str, declared: set[str]) -> list[str]:
+def _written_parts(
+    written: str, declared: set[str], own_trees: set[str]
+) -> tuple[list[str], list[str]]:
+    """The writer's ``<BehaviorTree>`` s the file does not define (from its includes or other
+    files) and its ``<TreeNodesModel>`` entries the file does not declare, as XML text."""
     root = parse_xml(written, "<written>")
-    out = []
-    for models in root.iter("TreeNodesModel"):
-        for entry in models:
-            if isinstance(entry.tag, str) and entry.get("ID") not in declared:
-                out.append(etree.tostring(entry, encoding="unicode", with_tail=False))
-    return out
+    trees: list[str] = []
+    entries: list[str] = []
+    for child in root:
+        if child.tag == "BehaviorTree" and child.get("ID") not in own_trees:
+            trees.append(etree.tostring(child, encoding="unicode", with_tail=False))
+        elif child.tag == "TreeNodesModel":
+            entries.extend(
+                etree.tostring(entry, encoding="unicode", with_tail=False)
+                for entry in child
+                if isinstance(entry.tag, str) and entry.get("ID") not in declared
+            )
+    return trees, entries
 
 
-def _indented(entry: str, indent: str) -> str:
-    lines = entry.split("\n")
-    rest = [indent + (line[4:] if line.startswith("    ") else line.lstrip()) for line in lines[1:]]
+def _indented(element: str, indent: str, base: int) -> str:
+    """An element the writer indented at ``base`` spaces, re-indented at ``indent``."""
+    lines = element.split("\n")
+    rest = [
+        indent + (line[base:] if line.startswith(" " * base) else line.lstrip())
+        for line in lines[1:]
+    ]
     return "\n".join([indent + lines[0], *rest])
 
 
-def _models(edits: _Edits, text: str, root: _Tag, written: str) -> bool:
-    """Insert the writer's declarations the file lacks; ``False`` when it cannot."""
+def _remove_line(edits: _Edits, text: str, tag: _Tag) -> None:
+    """Remove an element, with its line when nothing else is on it."""
+    indent = _line_indent(text, tag.start)
+    line_end = text.find("\n", tag.close_end)
+    line_end = len(text) if line_end == -1 else line_end + 1
+    if indent is not None and not text[tag.close_end : line_end].strip():
+        edits.replace(tag.start - len(indent), line_end, "")
+    else:
+        edits.replace(tag.start, tag.close_end, "")
+
+
+def _additions(edits: _Edits, text: str, root: _Tag, written: str, own_trees: set[str]) -> bool:
+    """Insert the trees and declarations of the writer's file that the file lacks; remove its
+    ``<include>`` s (their trees are inserted); ``False`` when it cannot."""
     model_tags = [t for t in root.children if t.name == "TreeNodesModel"]
     declared = {
-        a_value
+        value
         for t in model_tags
         for entry in t.children
-        for a_value in [_value(text, entry, "ID")]
-        if a_value is not None
+        for value in [_value(text, entry, "ID")]
+        if value is not None
     }
-    entries = _entries(written, declared)
-    if not entries:
-        return True
-    if model_tags:
-        models = model_tags[-1]
-        if models.end_start is None:
-            return False  # <TreeNodesModel/>
-        closing = _line_indent(text, models.end_start)
-        inner = (
-            _line_indent(text, models.children[-1].start)
-            if models.children
-            else (closing or "") + "  "
-        )
-        if closing is None or inner is None:
-            block = "".join(entries)
-            edits.replace(models.end_start, models.end_start, block)
-            return True
-        at = models.end_start - len(closing)
-        edits.replace(at, at, "".join(_indented(e, inner) + "\n" for e in entries))
-        return True
+    trees, entries = _written_parts(written, declared, own_trees)
+    for tag in root.children:
+        if tag.name == "include":
+            _remove_line(edits, text, tag)
     if root.end_start is None:
         return False
     closing = _line_indent(text, root.end_start)
     unit = _line_indent(text, root.children[0].start) if root.children else None
-    if closing is None or not unit:
-        edits.replace(
-            root.end_start,
-            root.end_start,
-            "<TreeNodesModel>" + "".join(entries) + "</TreeNodesModel>",
+    inline = closing is None or not unit
+    block = ""
+    for tree in trees:
+        block += tree if inline else _indented(tree, unit or "", 2) + "\n"
+    if entries and model_tags:
+        models = model_tags[-1]
+        if models.end_start is None:
+            return False  # <TreeNodesModel/>
+        last = _line_indent(text, models.end_start)
+        inner = (
+            _line_indent(text, models.children[-1].start)
+            if models.children
+            else (last or "") + "  "
         )
-        return True
-    body = "".join(_indented(e, unit * 2) + "\n" for e in entries)
-    at = root.end_start - len(closing)
-    edits.replace(at, at, f"{unit}<TreeNodesModel>\n{body}{unit}</TreeNodesModel>\n")
+        if last is None or inner is None:
+            edits.replace(models.end_start, models.end_start, "".join(entries))
+        else:
+            at = models.end_start - len(last)
+            edits.replace(at, at, "".join(_indented(e, inner, 4) + "\n" for e in entries))
+    elif entries and inline:
+        block += "<TreeNodesModel>" + "".join(entries) + "</TreeNodesModel>"
+    elif entries:
+        body = "".join(_indented(e, (unit or "") * 2, 4) + "\n" for e in entries)
+        block += f"{unit}<TreeNodesModel>\n{body}{unit}</TreeNodesModel>\n"
+    if block:
+        at = root.end_start - (0 if inline else len(closing or ""))
+        edits.replace(at, at, block)
     return True
 
 
@@ -304,8 +336,6 @@ def edited_source(original: str, doc: BTDocument, written: str) -> str | None:
         doc: the document read from it.
         written: the v4 writer's text of ``doc``.
     """
-    if doc.includes:
-        return None
     try:
         root_element = parse_xml(original, "<source>", [])
     except InputError:
@@ -323,7 +353,7 @@ def edited_source(original: str, doc: BTDocument, written: str) -> str | None:
     edits = _Edits()
     root = tags[0]
     trees = [e for e in root_element if e.tag == "BehaviorTree"]
-    _root(edits, original, root, doc, len(trees))
+    _root(edits, original, root, doc, len(doc.trees))
     for tree_element in trees:
         tree_id = tree_element.get("ID") or "MainTree"
         if tree_element.get("ID") is None:
@@ -338,7 +368,8 @@ def edited_source(original: str, doc: BTDocument, written: str) -> str | None:
             return None
         for element, node in zip(node_elements, nodes):
             _node(edits, by_element[element], element, node)
-    if not _models(edits, original, root, written):
+    own = {t.get("ID") or "MainTree" for t in trees}
+    if not _additions(edits, original, root, written, own):
         return None
     text = edits.apply(original)
     try:
