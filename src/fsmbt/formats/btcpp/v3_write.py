@@ -113,8 +113,13 @@ def prepare_v3(model: Model) -> tuple[BTDocument, list[str]]:
     if refused:
         tree_id, node, why = refused[0]
         more = f" ({len(refused) - 1} more such node(s))" if len(refused) > 1 else ""
+        hint = (
+            " (an FSM converted to a BT: --style lebt writes no Script)"
+            if node.type == "Script"
+            else ""
+        )
         raise UnsupportedError(
-            f"{_where(tree_id, node)}: {why}{more}; write v4 (--to btcpp) or replace it",
+            f"{_where(tree_id, node)}: {why}{more}; write v4 (--to btcpp) or replace it{hint}",
             location=node.location,
             element=node.label,
         )
