@@ -20,10 +20,12 @@ from __future__ import annotations
 import difflib
 import re
 import sys
+import tempfile
 from collections import Counter
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+import btcpp_loads  # noqa: E402
 from corpus_coverage import corpus_files, corpus_root  # noqa: E402
 
 from fsmbt import api  # noqa: E402
@@ -42,6 +44,15 @@ def _lines_kept(before: str, after: str) -> tuple[int, int]:
     return sum(block.size for block in matcher.get_matching_blocks()), len(a)
 
 
+def _loads(text: str, name: str) -> bool:
+    """Whether BehaviorTree.CPP 4.8.2 loads a written (self-contained) file
+    (``btcpp_loads.refusal``: unknown nodes registered as dummies of their declared kind)."""
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / name
+        path.write_text(text, encoding="utf-8")
+        return btcpp_loads.refusal(path, Path(tmp), {}) is None
+
+
 def main() -> int:
     root = corpus_root()
     files = [
@@ -51,6 +62,7 @@ def main() -> int:
     refused_v4: Counter[str] = Counter()
     kept_lines = total_lines = 0
     rewritten: list[str] = []
+    not_loaded: list[str] = []
     lost_comments: list[str] = []
     v3_rows: Counter[str] = Counter()
     v3_causes: Counter[str] = Counter()
@@ -84,6 +96,12 @@ def main() -> int:
             rows[f"{group} comments kept"] += same
             if not same:
                 lost_comments.append(path.name)
+        if btcpp_loads.available():
+            rows[f"{group} source loads"] += btcpp_loads.refusal(path, path.parent, {}) is None
+            loads = _loads(text, path.name)
+            rows[f"{group} output loads"] += loads
+            if not loads:
+                not_loaded.append(path.name)
         kept, lines = _lines_kept(original, text)
         rows[f"{group} only insertions"] += text != original and kept == lines
         kept_lines += kept
@@ -113,6 +131,14 @@ def main() -> int:
             f"{rows[f'{group} rewritten']} rewritten by the writer; comments kept in "
             f"{rows[f'{group} comments kept']}/{rows[f'{group} with comments']} files with comments"
         )
+    if btcpp_loads.available():
+        for group in ("v4", "v3"):
+            print(
+                f"{group} -> v4 files BehaviorTree.CPP 4.8.2 loads: "
+                f"{rows[f'{group} output loads']}/{rows[f'{group} translated']} written "
+                f"(their sources: {rows[f'{group} source loads']})"
+            )
+        print(f"  written files it refuses: {', '.join(not_loaded) or 'none'}")
     print(f"lines of the translated files unchanged: {kept_lines}/{total_lines}")
     print(f"  rewritten: {', '.join(rewritten) or 'none'}")
     print(f"  comments not kept: {', '.join(lost_comments) or 'none'}")
