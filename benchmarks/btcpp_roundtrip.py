@@ -35,7 +35,9 @@ from fsmbt.formats.registry import read_text  # noqa: E402
 from fsmbt.model.errors import FsmbtError  # noqa: E402
 
 _COMMENT = re.compile(r"<!--.*?-->", re.S)
-_V3_CAUSE = re.compile(r"(\w+) is a BehaviorTree\.CPP v4 node|pre-condition (_\w+)")
+_V3_CAUSE = re.compile(
+    r"(\w+) is a BehaviorTree\.CPP v4 node|pre-condition (_\w+)|v3's (\w+ .*?ancestor \w+)"
+)
 
 
 def _lines_kept(before: str, after: str) -> tuple[int, int]:
@@ -110,7 +112,8 @@ def main() -> int:
             _l3, result3, report3 = api.translate(path, to="btcpp3")
         except FsmbtError as exc:
             cause = _V3_CAUSE.search(str(exc))
-            name = (cause.group(1) or cause.group(2)) if cause else str(exc)[-60:]
+            name = next((g for g in cause.groups() if g), "") if cause else str(exc)[-60:]
+            name = re.sub(r" (goes|runs|retries) .*ancestor", " under", name)
             v3_causes[name] += 1
             v3_files.setdefault(name, []).append(path.name)
             v3_rows["refused"] += 1

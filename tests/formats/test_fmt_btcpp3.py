@@ -12,6 +12,7 @@ import pytest
 from fsmbt import api
 from fsmbt.formats import dumps, loads
 from fsmbt.formats.btcpp.v3_rules import v3_problems
+from fsmbt.formats.btcpp.v3_write import prepare_v3
 from fsmbt.formats.translate import Translation
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import UnsupportedError
@@ -171,3 +172,54 @@ def test_fsm_to_bt_for_humble(tmp_path: Path, name: str) -> None:
 def test_a_structured_conversion_names_the_way_out(tmp_path: Path) -> None:
     with pytest.raises(UnsupportedError, match="--style lebt writes no Script"):
         api.convert_file(EXAMPLES / "delivery_smach.py", tmp_path / "t.xml", to="btcpp3")
+
+
+@pytest.mark.parametrize(
+    ("ancestor", "node", "named"),
+    [
+        ("ReactiveSequence", "<SequenceWithMemory><Go/><Go/></SequenceWithMemory>", "SequenceStar"),
+        ("ReactiveFallback", '<Repeat num_cycles="3"><Go/></Repeat>', "cycles within one tick"),
+        (
+            "Parallel",
+            '<RetryUntilSuccessful num_attempts="2"><Go/></RetryUntilSuccessful>',
+            "retries",
+        ),
+    ],
+)
+def test_v3_ticks_otherwise_under_an_interrupting_ancestor(
+    ancestor: str, node: str, named: str
+) -> None:
+    # v4 returns RUNNING after a child that completed at once, 3.8 goes on in the same tick;
+    # a reactive parent or a Parallel ticks something else in between only in v4
+    doc = loads(
+        f"""<root BTCPP_format="4"><BehaviorTree ID="Main"><{ancestor}>
+<IsOk/>
+{node}
+</{ancestor}></BehaviorTree>
+<TreeNodesModel><Condition ID="IsOk"/><Action ID="Go"/></TreeNodesModel></root>""",
+        "btcpp",
+    )
+    with pytest.raises(UnsupportedError) as caught:
+        dumps(doc, "btcpp3")
+    message = str(caught.value)
+    assert named in message and f"ancestor {ancestor}" in message and "line 3" in message
+    # the same node under a plain Sequence is written
+    plain = dumps(loads(dumps(doc, "btcpp").replace(ancestor, "Sequence"), "btcpp"), "btcpp3")
+    assert v3_problems(plain) == []
+
+
+def test_under_a_control_fsmbt_cannot_tell_about_the_difference_is_named() -> None:
+    doc = loads(
+        """<root BTCPP_format="4"><BehaviorTree ID="Main"><MyControl>
+<IsOk/>
+<Repeat num_cycles="2"><Go/></Repeat>
+</MyControl></BehaviorTree>
+<TreeNodesModel><Control ID="MyControl"/><Condition ID="IsOk"/><Action ID="Go"/>
+</TreeNodesModel></root>""",
+        "btcpp",
+    )
+    assert isinstance(doc, BTDocument)
+    _written, losses = prepare_v3(doc)
+    assert len(losses) == 1
+    assert "node 'Repeat', line 3" in losses[0] and "MyControl" in losses[0]
+    assert v3_problems(dumps(doc, "btcpp3")) == []

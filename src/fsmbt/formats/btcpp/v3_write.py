@@ -12,7 +12,11 @@ What v3 cannot say (``prepare_v3``, the rule of docs/formats/btcpp.md):
 - refused (``UnsupportedError`` naming the node, its tree and line), because the tree would
   behave otherwise or not load: a v4-only built-in node (``Script``, ``RunOnce``,
   ``AsyncSequence``, ``LoopInt``...), a pre-condition (``_skipIf``, ``_failureIf``,
-  ``_successIf``, ``_while``: they decide whether a node runs);
+  ``_successIf``, ``_while``: they decide whether a node runs), a ``SequenceWithMemory``,
+  ``Repeat`` or ``RetryUntilSuccessful`` under an ancestor that ticks or halts between two
+  ticks (reactive controls, Parallel, PipelineSequence, WhileDoElse, Timeout: 3.8's nodes
+  go on within one tick, and SequenceStar restarts when halted; ``_GRANULAR``); under another
+  project's or a user's control or decorator, that difference is a named loss;
 - dropped and named as a loss, located: post-conditions (``_onSuccess``...: they only write
   the blackboard, which fsmbt's semantics do not read, docs/semantics.md section 2), other
   v4 ``_`` attributes (Groot2's ``_uid``...; 3.8 would refuse them as unknown ports), and a
@@ -36,6 +40,7 @@ from fsmbt.model import Model
 from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.bt_nodes import NodeKind, builtin_spec
 from fsmbt.model.errors import InputError, UnsupportedError
+from fsmbt.model.nodes import Family
 
 #: What the format cannot hold (``fsmbt formats``).
 CANNOT_HOLD = "v4-only nodes (Script, RunOnce, AsyncSequence, Loop*...), pre-conditions"
@@ -56,6 +61,87 @@ def _v4_only(node: BTNode) -> bool:
         and spec.library == "BehaviorTree.CPP"
         and versions.v3_name(spec.name) is None
     )
+
+
+#: v4 nodes whose v3 counterpart ticks otherwise between ticks: after a child that completed
+#: synchronously, v4 returns RUNNING (with a wake-up) where 3.8 goes on in the same tick, and
+#: v4's SequenceWithMemory keeps its place when halted where 3.8's SequenceStar restarts.
+_GRANULAR = {
+    "SequenceWithMemory": "v3's SequenceStar goes on in the same tick after a child that "
+    "succeeded at once (v4 returns RUNNING) and restarts from its first child when halted "
+    "(v4 keeps its place)",
+    "Repeat": "v3's Repeat runs its cycles within one tick (v4 returns RUNNING between them)",
+    "RetryUntilSuccessful": "v3's RetryUntilSuccessful retries within one tick (v4 returns "
+    "RUNNING between attempts)",
+}
+
+
+def _interrupts(node: BTNode) -> bool | None:
+    """Whether an ancestor ticks something else, or halts, between two ticks of a RUNNING
+    child: ``True`` for the reactive built-ins, Parallel, PipelineSequence, WhileDoElse and
+    Timeout; ``None`` (cannot tell) for another project's or user's control or decorator;
+    ``False`` for the rest (Sequence, Fallback, the status decorators...)."""
+    spec = builtin_spec(node.type)
+    if spec is not None and (
+        spec.reactive
+        or spec.family in (Family.PARALLEL, Family.PIPELINE)
+        or spec.name in ("WhileDoElse", "Timeout")
+    ):
+        return True
+    if node.kind not in (NodeKind.CONTROL, NodeKind.DECORATOR):
+        return False
+    if spec is not None and spec.library == "BehaviorTree.CPP":
+        return False
+    return None
+
+
+def _granularity(doc: BTDocument) -> tuple[list[tuple[str, BTNode, str]], list[str]]:
+    """The SequenceWithMemory / Repeat / RetryUntilSuccessful nodes whose v3 counterpart would
+    behave otherwise: under an ancestor that interrupts (refused), or under a control fsmbt
+    cannot tell about (a named loss). One pass with an explicit stack, O(n * depth)."""
+    refused: list[tuple[str, BTNode, str]] = []
+    losses: list[str] = []
+    for tree_id, tree in doc.trees.items():
+        if tree.root is None:
+            continue
+        stack: list[tuple[BTNode, tuple[BTNode, ...]]] = [(tree.root, ())]
+        while stack:
+            node, ancestors = stack.pop()
+            why = _GRANULAR.get(node.type)
+            if why is not None and not _one_step(node):
+                verdicts = [(a, _interrupts(a)) for a in reversed(ancestors)]  # nearest first
+                sure = next((a for a, v in verdicts if v), None)
+                unsure = next((a for a, v in verdicts if v is None), None)
+                if sure is not None:
+                    refused.append(
+                        (
+                            tree_id,
+                            node,
+                            f"{why}, and its ancestor {_label(sure)} ticks or halts "
+                            "in between: the tree would behave otherwise in v3",
+                        )
+                    )
+                elif unsure is not None:
+                    losses.append(
+                        f"{_where(tree_id, node)}: {why}; the same in v3 unless its ancestor "
+                        f"{_label(unsure)} ticks or halts in between (fsmbt cannot tell)"
+                    )
+            stack.extend((child, (*ancestors, node)) for child in node.children)
+    return refused, losses
+
+
+def _one_step(node: BTNode) -> bool:
+    """No v4 RUNNING in between and nothing to restart: a SequenceWithMemory of one child, a
+    Repeat / RetryUntilSuccessful of one cycle or attempt (a literal ``0`` or ``1``)."""
+    if node.type == "SequenceWithMemory":
+        return len(node.children) <= 1
+    count = node.attrs.get("num_cycles" if node.type == "Repeat" else "num_attempts", "")
+    return count.strip() in ("0", "1")
+
+
+def _label(node: BTNode) -> str:
+    line = f", line {node.location.line}" if node.location and node.location.line else ""
+    return f"{node.type} '{node.label}'{line}" if node.name else f"{node.type}{line}"
 
 
 def prepare_v3(model: Model) -> tuple[BTDocument, list[str]]:
@@ -110,6 +196,9 @@ def prepare_v3(model: Model) -> tuple[BTDocument, list[str]]:
                 )
         for port, default in versions.V3_REQUIRED_DEFAULTS.get(node.type, {}).items():
             node.attrs.setdefault(port, default)
+    granular, granular_losses = _granularity(doc)
+    refused.extend(granular)
+    losses.extend(granular_losses)
     if refused:
         tree_id, node, why = refused[0]
         more = f" ({len(refused) - 1} more such node(s))" if len(refused) > 1 else ""
