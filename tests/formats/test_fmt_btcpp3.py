@@ -223,3 +223,19 @@ def test_under_a_control_fsmbt_cannot_tell_about_the_difference_is_named() -> No
     assert len(losses) == 1
     assert "node 'Repeat', line 3" in losses[0] and "MyControl" in losses[0]
     assert v3_problems(dumps(doc, "btcpp3")) == []
+
+
+def test_a_while_do_else_without_else_gets_always_failure(tmp_path: Path) -> None:
+    result = _translate(
+        tmp_path,
+        """<root BTCPP_format="4"><BehaviorTree ID="Main">
+<WhileDoElse><IsOk/><Go/></WhileDoElse>
+</BehaviorTree><TreeNodesModel><Condition ID="IsOk"/><Action ID="Go"/></TreeNodesModel></root>""",
+    )
+    # 3.8 requires three children; v4 without an else branch returns FAILURE, as this does
+    assert "<AlwaysFailure/>\n    </WhileDoElse>" in result.text
+    assert v3_problems(result.text) == []
+    assert any("no else branch" in loss and "line 2" in loss for loss in result.losses)
+    assert any(
+        "three children" in p for p in v3_problems(result.text.replace("<AlwaysFailure/>", ""))
+    )

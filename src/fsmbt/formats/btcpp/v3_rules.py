@@ -10,7 +10,8 @@ break (docs/formats/btcpp.md, "Version 3").
   "Possible typo?" otherwise); no node carries another ``_`` attribute (v4's ``_skipIf``,
   ``_autoremap``...);
 - ``<SubTree>``: no child, an ``ID``; its remaps name a parent key without braces (a ``{key}``
-  value is v4's, or ``<SubTreePlus>``'s, syntax).
+  value is v4's, or ``<SubTreePlus>``'s, syntax);
+- ``<WhileDoElse>`` has three children (3.8 throws on two, v4 allows them).
 
 Cost: one parse, one pass over the elements (lxml iterates; no recursion).
 """
@@ -79,6 +80,8 @@ def _element_problems(element: etree._Element, declared: set[str]) -> list[str]:
         type_name = attrs.get("ID", "")
         if not type_name:
             return [*out, f"line {line}: <{tag}> without ID"]
+    if type_name == "WhileDoElse" and len([c for c in element if isinstance(c.tag, str)]) != 3:
+        out.append(f"line {line}: <WhileDoElse> needs three children in v3")
     if type_name in versions.V3_PORTS:
         allowed = versions.V3_PORTS[type_name] | versions.V3_RESERVED
         for key in attrs:

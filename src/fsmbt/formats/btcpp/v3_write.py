@@ -17,6 +17,8 @@ What v3 cannot say (``prepare_v3``, the rule of docs/formats/btcpp.md):
   ticks (reactive controls, Parallel, PipelineSequence, WhileDoElse, Timeout: 3.8's nodes
   go on within one tick, and SequenceStar restarts when halted; ``_GRANULAR``); under another
   project's or a user's control or decorator, that difference is a named loss;
+- written otherwise, named: a ``WhileDoElse`` without an else branch (3.8 requires three
+  children) gets ``<AlwaysFailure/>``, which v4's rule without one returns the same;
 - dropped and named as a loss, located: post-conditions (``_onSuccess``...: they only write
   the blackboard, which fsmbt's semantics do not read, docs/semantics.md section 2), other
   v4 ``_`` attributes (Groot2's ``_uid``...; 3.8 would refuse them as unknown ports), and a
@@ -196,6 +198,13 @@ def prepare_v3(model: Model) -> tuple[BTDocument, list[str]]:
                 )
         for port, default in versions.V3_REQUIRED_DEFAULTS.get(node.type, {}).items():
             node.attrs.setdefault(port, default)
+        if node.type == "WhileDoElse" and len(node.children) == 2:
+            # 3.8 needs the else branch; v4 returns FAILURE without one, as AlwaysFailure does
+            node.children.append(BTNode("AlwaysFailure", NodeKind.ACTION))
+            losses.append(
+                f"{_where(tree_id, node)}: no else branch, which v3's WhileDoElse requires: "
+                "written as <AlwaysFailure/> (v4 returns FAILURE without one, the same)"
+            )
     granular, granular_losses = _granularity(doc)
     refused.extend(granular)
     losses.extend(granular_losses)
