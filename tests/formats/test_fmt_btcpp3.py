@@ -239,3 +239,28 @@ def test_a_while_do_else_without_else_gets_always_failure(tmp_path: Path) -> Non
     assert any(
         "three children" in p for p in v3_problems(result.text.replace("<AlwaysFailure/>", ""))
     )
+
+
+def test_a_v3_file_that_3_8_ticks_otherwise_is_read_with_a_warning() -> None:
+    warnings: list[str] = []
+    loads(
+        """<root><BehaviorTree ID="Main"><ReactiveSequence>
+<IsOk/>
+<SequenceStar><Go/><Go/></SequenceStar>
+<Repeat num_cycles="2"><Go/></Repeat>
+</ReactiveSequence></BehaviorTree></root>""",
+        "btcpp",
+        warnings=warnings,
+    )
+    ticks = [w for w in warnings if "fsmbt reads this v3 file with v4's rule" in w]
+    assert len(ticks) == 1 and "line 3" in ticks[0] and "(1 more such node(s))" in ticks[0]
+    # the same tree in v4 is read without it: v4's rule is the file's own
+    warnings.clear()
+    loads(
+        """<root BTCPP_format="4"><BehaviorTree ID="Main"><ReactiveSequence>
+<IsOk/><SequenceWithMemory><Go/><Go/></SequenceWithMemory>
+</ReactiveSequence></BehaviorTree></root>""",
+        "btcpp",
+        warnings=warnings,
+    )
+    assert not any("v4's rule" in w for w in warnings)

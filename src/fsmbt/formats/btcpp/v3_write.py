@@ -35,22 +35,16 @@ import copy
 
 from lxml import etree
 
-from fsmbt.formats.btcpp import versions
+from fsmbt.formats.btcpp import v3_ticks, versions
 from fsmbt.formats.btcpp.xml_format import document_root, serialize
 from fsmbt.formats.registry import Format, register
 from fsmbt.model import Model
 from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.bt_nodes import NodeKind, builtin_spec
 from fsmbt.model.errors import InputError, UnsupportedError
-from fsmbt.model.nodes import Family
 
 #: What the format cannot hold (``fsmbt formats``).
 CANNOT_HOLD = "v4-only nodes (Script, RunOnce, AsyncSequence, Loop*...), pre-conditions"
-
-
-def _where(tree_id: str, node: BTNode) -> str:
-    line = f", line {node.location.line}" if node.location and node.location.line else ""
-    return f"tree '{tree_id}', node '{node.label}'{line}"
 
 
 def _v4_only(node: BTNode) -> bool:
@@ -63,87 +57,6 @@ def _v4_only(node: BTNode) -> bool:
         and spec.library == "BehaviorTree.CPP"
         and versions.v3_name(spec.name) is None
     )
-
-
-#: v4 nodes whose v3 counterpart ticks otherwise between ticks: after a child that completed
-#: synchronously, v4 returns RUNNING (with a wake-up) where 3.8 goes on in the same tick, and
-#: v4's SequenceWithMemory keeps its place when halted where 3.8's SequenceStar restarts.
-_GRANULAR = {
-    "SequenceWithMemory": "v3's SequenceStar goes on in the same tick after a child that "
-    "succeeded at once (v4 returns RUNNING) and restarts from its first child when halted "
-    "(v4 keeps its place)",
-    "Repeat": "v3's Repeat runs its cycles within one tick (v4 returns RUNNING between them)",
-    "RetryUntilSuccessful": "v3's RetryUntilSuccessful retries within one tick (v4 returns "
-    "RUNNING between attempts)",
-}
-
-
-def _interrupts(node: BTNode) -> bool | None:
-    """Whether an ancestor ticks something else, or halts, between two ticks of a RUNNING
-    child: ``True`` for the reactive built-ins, Parallel, PipelineSequence, WhileDoElse and
-    Timeout; ``None`` (cannot tell) for another project's or user's control or decorator;
-    ``False`` for the rest (Sequence, Fallback, the status decorators...)."""
-    spec = builtin_spec(node.type)
-    if spec is not None and (
-        spec.reactive
-        or spec.family in (Family.PARALLEL, Family.PIPELINE)
-        or spec.name in ("WhileDoElse", "Timeout")
-    ):
-        return True
-    if node.kind not in (NodeKind.CONTROL, NodeKind.DECORATOR):
-        return False
-    if spec is not None and spec.library == "BehaviorTree.CPP":
-        return False
-    return None
-
-
-def _granularity(doc: BTDocument) -> tuple[list[tuple[str, BTNode, str]], list[str]]:
-    """The SequenceWithMemory / Repeat / RetryUntilSuccessful nodes whose v3 counterpart would
-    behave otherwise: under an ancestor that interrupts (refused), or under a control fsmbt
-    cannot tell about (a named loss). One pass with an explicit stack, O(n * depth)."""
-    refused: list[tuple[str, BTNode, str]] = []
-    losses: list[str] = []
-    for tree_id, tree in doc.trees.items():
-        if tree.root is None:
-            continue
-        stack: list[tuple[BTNode, tuple[BTNode, ...]]] = [(tree.root, ())]
-        while stack:
-            node, ancestors = stack.pop()
-            why = _GRANULAR.get(node.type)
-            if why is not None and not _one_step(node):
-                verdicts = [(a, _interrupts(a)) for a in reversed(ancestors)]  # nearest first
-                sure = next((a for a, v in verdicts if v), None)
-                unsure = next((a for a, v in verdicts if v is None), None)
-                if sure is not None:
-                    refused.append(
-                        (
-                            tree_id,
-                            node,
-                            f"{why}, and its ancestor {_label(sure)} ticks or halts "
-                            "in between: the tree would behave otherwise in v3",
-                        )
-                    )
-                elif unsure is not None:
-                    losses.append(
-                        f"{_where(tree_id, node)}: {why}; the same in v3 unless its ancestor "
-                        f"{_label(unsure)} ticks or halts in between (fsmbt cannot tell)"
-                    )
-            stack.extend((child, (*ancestors, node)) for child in node.children)
-    return refused, losses
-
-
-def _one_step(node: BTNode) -> bool:
-    """No v4 RUNNING in between and nothing to restart: a SequenceWithMemory of one child, a
-    Repeat / RetryUntilSuccessful of one cycle or attempt (a literal ``0`` or ``1``)."""
-    if node.type == "SequenceWithMemory":
-        return len(node.children) <= 1
-    count = node.attrs.get("num_cycles" if node.type == "Repeat" else "num_attempts", "")
-    return count.strip() in ("0", "1")
-
-
-def _label(node: BTNode) -> str:
-    line = f", line {node.location.line}" if node.location and node.location.line else ""
-    return f"{node.type} '{node.label}'{line}" if node.name else f"{node.type}{line}"
 
 
 def prepare_v3(model: Model) -> tuple[BTDocument, list[str]]:
@@ -190,10 +103,10 @@ def prepare_v3(model: Model) -> tuple[BTDocument, list[str]]:
                     if key in versions.POST_CONDITIONS
                     else "v3 would refuse it as an unknown port"
                 )
-                losses.append(f'{_where(tree_id, node)}: {key}="{value}" dropped: {why}')
+                losses.append(f'{v3_ticks.where(tree_id, node)}: {key}="{value}" dropped: {why}')
             elif value.startswith("{@") or value == "{=}":
                 losses.append(
-                    f'{_where(tree_id, node)}: {key}="{value}" is v4 blackboard syntax; '
+                    f'{v3_ticks.where(tree_id, node)}: {key}="{value}" is v4 blackboard syntax; '
                     f"v3 reads it as the key '{value[1:-1]}'"
                 )
         for port, default in versions.V3_REQUIRED_DEFAULTS.get(node.type, {}).items():
@@ -202,10 +115,10 @@ def prepare_v3(model: Model) -> tuple[BTDocument, list[str]]:
             # 3.8 needs the else branch; v4 returns FAILURE without one, as AlwaysFailure does
             node.children.append(BTNode("AlwaysFailure", NodeKind.ACTION))
             losses.append(
-                f"{_where(tree_id, node)}: no else branch, which v3's WhileDoElse requires: "
+                f"{v3_ticks.where(tree_id, node)}: no else branch, which v3's WhileDoElse requires: "
                 "written as <AlwaysFailure/> (v4 returns FAILURE without one, the same)"
             )
-    granular, granular_losses = _granularity(doc)
+    granular, granular_losses = v3_ticks.granularity(doc)
     refused.extend(granular)
     losses.extend(granular_losses)
     if refused:
@@ -217,7 +130,7 @@ def prepare_v3(model: Model) -> tuple[BTDocument, list[str]]:
             else ""
         )
         raise UnsupportedError(
-            f"{_where(tree_id, node)}: {why}{more}; write v4 (--to btcpp) or replace it{hint}",
+            f"{v3_ticks.where(tree_id, node)}: {why}{more}; write v4 (--to btcpp) or replace it{hint}",
             location=node.location,
             element=node.label,
         )

@@ -28,6 +28,7 @@ from lxml import etree
 from fsmbt import limits
 from fsmbt.formats.btcpp import profiles as btcpp_profiles
 from fsmbt.formats.btcpp import trees as btcpp_trees
+from fsmbt.formats.btcpp import v3_ticks as btcpp_v3_ticks
 from fsmbt.formats.btcpp import versions as btcpp_versions
 from fsmbt.formats.registry import Format, ReadContext, decode, register
 from fsmbt.formats.xml_safe import parse_xml, root_tag
@@ -562,6 +563,14 @@ def read_btcpp(text: str, ctx: ReadContext) -> BTDocument:
 
     apply_library(doc, library, warn)
     _declare_library_kinds(doc)
+    ticks_otherwise = btcpp_v3_ticks.granularity(doc)[0] if doc.format_version == "3" else []
+    if ticks_otherwise:  # where 3.8 ticks otherwise than the v4 rule fsmbt reads: one line
+        tree_id, node, why = ticks_otherwise[0]
+        more = len(ticks_otherwise) - 1
+        ctx.warnings.append(
+            f"{btcpp_v3_ticks.where(tree_id, node)}: {why}; fsmbt reads this v3 file with v4's "
+            "rule (docs/semantics.md section 1)" + (f" ({more} more such node(s))" if more else "")
+        )
     if found is not None:
         abstractions: dict[str, list[str]] = {}
         for _tree, node in doc.nodes():
