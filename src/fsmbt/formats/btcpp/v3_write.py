@@ -65,8 +65,9 @@ def prepare_v3(model: Model) -> tuple[BTDocument, list[str]]:
 
     Raises:
         InputError: ``model`` is not a behavior tree.
-        UnsupportedError: a v4-only node or a pre-condition (the first one, located; the
-            message counts the others).
+        UnsupportedError: a v4-only node, a pre-condition, or a node 3.8 ticks otherwise
+            under its ancestor (``v3_ticks``): the first one, located; the message counts the
+            others.
     """
     if not isinstance(model, BTDocument):
         raise InputError("BehaviorTree.CPP XML holds a behavior tree, not a state machine")
