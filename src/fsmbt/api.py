@@ -926,13 +926,15 @@ def translate(
         raise InputError(f"cannot tell the target format; name it with --to{where}")
     result = translate_model(loaded.model, target, flatten=flatten, source_format=loaded.format)
     result.warnings = list(loaded.warnings)
-    if loaded.format == target == "btcpp" and not result.losses and loaded.path is not None:
-        # a v4 file that already declares every node is written unchanged, byte for byte
-        from fsmbt.formats.btcpp.xml_format import kept_as_written
+    if loaded.format == target == "btcpp" and loaded.path is not None:
+        # the user's own file, edited only where v4 needs it (comments, attribute order and
+        # every untouched byte kept; byte for byte when nothing changes): docs/formats/btcpp.md
+        from fsmbt.formats.btcpp.preserve import edited_source
 
-        original = loaded.path.read_text(encoding="utf-8")
-        if kept_as_written(original, loaded.model):  # type: ignore[arg-type]
-            result.text = original
+        original = read_text(loaded.path)
+        kept = edited_source(original, loaded.model, result.text)  # type: ignore[arg-type]
+        if kept is not None:
+            result.text = kept
     report: Report | None = None
     if result.read_back is not None and result.checked is not None:
         request = verify_request or VerifyRequest()

@@ -75,7 +75,8 @@ def test_v3_aliases_and_explicit_groot_style_equal_compact() -> None:
     ok, retry, sub = root.children
     assert ok.kind is NodeKind.CONDITION and retry.type == "RetryUntilSuccessful"
     assert retry.children[0].attrs == {"x": "1"} and "ID" not in retry.children[0].attrs
-    assert sub.type == "SubTree" and sub.attrs == {"ID": "S", "__autoremap": "1"}
+    # v3's SubTreePlus auto-remapping is v4's _autoremap (formats/btcpp/versions.py)
+    assert sub.type == "SubTree" and sub.attrs == {"ID": "S", "_autoremap": "1"}
     again = roundtrip(doc)
     assert again.format_version == "4"
     again.format_version = "3"

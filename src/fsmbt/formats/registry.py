@@ -83,6 +83,8 @@ class Format:
         write: Model to text, or ``None`` for a read-only format.
         sniff: Whether a text looks like this format (content detection).
         priority: Order of sniffing; lower is tried first.
+        cannot_hold: What its writer refuses, in a person's words.
+        read_back_as: The format whose reader reads this write-only format's files.
     """
 
     name: str
@@ -95,6 +97,9 @@ class Format:
     priority: int = 50  # lower is tried first when sniffing content
     #: what its writer refuses, in a person's words ("" when it holds every model of its kinds)
     cannot_hold: str = ""
+    #: a write-only format whose files another format's reader reads (``btcpp3``: ``btcpp``);
+    #: ``fsmbt translate`` reads what it wrote back with that reader to check it
+    read_back_as: str | None = None
 
 
 _FORMATS: dict[str, Format] = {}
@@ -149,6 +154,7 @@ BUILTIN_FORMAT_MODULES: tuple[str, ...] = (
     "fsmbt.formats.paper.text_format",
     "fsmbt.formats.scxml.structural",
     "fsmbt.formats.btcpp.xml_format",
+    "fsmbt.formats.btcpp.v3_write",
     "fsmbt.formats.pysm.smach",
     "fsmbt.formats.pysm.flexbe",
     "fsmbt.formats.schema.json_format",
@@ -295,6 +301,8 @@ def loads(
     """
     _check_text_size(text, path)
     chosen = get_format(fmt) if fmt else detect_format(text, path)
+    if chosen.read is None and chosen.read_back_as is not None:
+        chosen = get_format(chosen.read_back_as)  # btcpp3 files are read as btcpp reads them
     if chosen.read is None:
         raise InputError(f"format '{chosen.name}' can be written but not read")
     ctx = ReadContext(path=path, options=dict(options or {}))

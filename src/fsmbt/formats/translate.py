@@ -120,6 +120,11 @@ def translate(
                 f"{shown}{more}"
             )
     try:
+        if target.name == "btcpp3":  # what v3 cannot say: refused, or dropped and named
+            from fsmbt.formats.btcpp.v3_write import prepare_v3
+
+            written, v3_losses = prepare_v3(written)
+            losses.extend(v3_losses)
         refuse_data_loss(written, target.name)
         text = target.write(written)
     except UnsupportedError as exc:
@@ -136,11 +141,11 @@ def translate(
     losses.extend(own_losses or [])
     losses.extend(_program_losses(target.name, written))
     result = Translation(text, source_format, target.name, losses, checked=checked)
-    if target.read is None:
+    if target.read is None and target.read_back_as is None:
         losses.append(f"{target.name} cannot be read back, so what it loses is not checked")
         return result
     try:
-        back = loads(text, target.name)
+        back = loads(text, target.name)  # a write-only format: its read_back_as reader
     except InputError as exc:
         losses.append(
             f"fsmbt cannot read this {target.name} back ({exc.message}), so what it "

@@ -44,6 +44,7 @@ PICTURE_FORMATS = ("svg", "png")
 #: The file name ending of each download format.
 SUFFIXES = {
     "btcpp": ".xml",
+    "btcpp3": ".v3.xml",
     "scxml": ".scxml",
     "json": ".json",
     "yaml": ".yaml",

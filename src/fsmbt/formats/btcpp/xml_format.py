@@ -28,6 +28,8 @@ from lxml import etree
 from fsmbt import limits
 from fsmbt.formats.btcpp import profiles as btcpp_profiles
 from fsmbt.formats.btcpp import trees as btcpp_trees
+from fsmbt.formats.btcpp import v3_ticks as btcpp_v3_ticks
+from fsmbt.formats.btcpp import versions as btcpp_versions
 from fsmbt.formats.registry import Format, ReadContext, decode, register
 from fsmbt.formats.xml_safe import parse_xml, root_tag
 from fsmbt.model import Model
@@ -425,6 +427,8 @@ class _Loader:
             type_name = canonical_type(type_id)
         else:
             type_name = canonical_type(tag)
+        if f.version == "3":  # v3 ports and SubTree remaps in v4 terms (btcpp.versions)
+            attrs = btcpp_versions.v4_attrs(tag, type_name, attrs)
         if element.text and element.text.strip():
             self.ctx.warn("text inside a node is ignored", line=element.sourceline, element=tag)
         spec = builtin_spec(type_name)
@@ -560,6 +564,14 @@ def read_btcpp(text: str, ctx: ReadContext) -> BTDocument:
 
     apply_library(doc, library, warn)
     _declare_library_kinds(doc)
+    ticks_otherwise = btcpp_v3_ticks.granularity(doc)[0] if doc.format_version == "3" else []
+    if ticks_otherwise:  # where 3.8 ticks otherwise than the v4 rule fsmbt reads: one line
+        tree_id, node, why = ticks_otherwise[0]
+        more = len(ticks_otherwise) - 1
+        ctx.warnings.append(
+            f"{btcpp_v3_ticks.where(tree_id, node)}: {why}; fsmbt reads this v3 file with v4's "
+            "rule (docs/semantics.md section 1)" + (f" ({more} more such node(s))" if more else "")
+        )
     if found is not None:
         abstractions: dict[str, list[str]] = {}
         for _tree, node in doc.nodes():
@@ -626,34 +638,22 @@ def _find_profiles(
     return found
 
 
-def kept_as_written(text: str, doc: BTDocument) -> bool:
-    """Whether ``text``, the file ``doc`` was read from, is already what the writer must give:
-    a self-contained v4 file (``BTCPP_format="4"``, no ``<include>``), its main tree named,
-    every node BehaviorTree.CPP's factory does not hold declared in its own
-    ``<TreeNodesModel>`` and no kind assumed. A BT.CPP -> BT.CPP translation of such a file
-    writes it byte for byte (comments, attribute order, formatting kept: nothing changed);
-    docs/formats/btcpp.md "What is written"."""
-    if doc.format_version != "4" or doc.includes:
-        return False
-    root = parse_xml(text, "<source>", [])
-    if root.get("BTCPP_format") != "4" or (
-        root.get("main_tree_to_execute") is None and len(doc.trees) != 1
-    ):
-        return False
-    declared: set[str] = set()
-    for models in root.iter("TreeNodesModel"):
-        declared |= {m.type for m in _read_models(models, "<source>")}
-    for _tree, node in doc.nodes():
-        if node.kind is NodeKind.SUBTREE or _factory_builtin(node.type):
-            continue
-        if not node.kind_declared or node.type not in declared:
-            return False
-    return True
-
-
 # -- writing -------------------------------------------------------------------------------------
 def write_btcpp(model: Model) -> str:
     """Write a BehaviorTree.CPP v4 file: compact style, main tree named, custom types declared."""
+    return serialize(*document_root(model))
+
+
+def serialize(root: etree._Element, depth: int) -> str:
+    """The text of a written ``<root>``: indented unless a tree is deeper than
+    ``PRETTY_MAX_DEPTH``; ends with a newline."""
+    text = etree.tostring(root, encoding="unicode", pretty_print=depth <= PRETTY_MAX_DEPTH)
+    return text if text.endswith("\n") else text + "\n"
+
+
+def document_root(model: Model) -> tuple[etree._Element, int]:
+    """The v4 ``<root>`` element of a document and the depth of its deepest tree (the
+    ``btcpp3`` writer edits this element into v3; ``fsmbt.formats.btcpp.v3_write``)."""
     if not isinstance(model, BTDocument):
         raise InputError("BehaviorTree.CPP XML holds a behavior tree, not a state machine")
     doc = model
@@ -671,9 +671,7 @@ def write_btcpp(model: Model) -> str:
         if tree.root is not None:
             depth = max(depth, _write_nodes(element, tree.root))
     _write_models(root, doc)
-    pretty = depth <= PRETTY_MAX_DEPTH
-    text = etree.tostring(root, encoding="unicode", pretty_print=pretty)
-    return text if text.endswith("\n") else text + "\n"
+    return root, depth
 
 
 def _write_nodes(parent: etree._Element, top: BTNode) -> int:
