@@ -46,6 +46,9 @@ _DIRECTIONS = {"input_port": "input", "output_port": "output", "inout_port": "in
 # deep documents are what this check is for: lxml's own depth limit must not answer first
 _PARSER = etree.XMLParser(huge_tree=True, resolve_entities=False, no_network=True, load_dtd=False)
 _LINE = re.compile(r"(?:Line number|line)[= ]+(\d+)", re.IGNORECASE)
+#: tinyxml2's nesting limit in BehaviorTree.CPP 4.8.2 (``TINYXML2_MAX_ELEMENT_DEPTH``); its
+#: refusal names line 1, so the line of the first element that deep is found here instead.
+TINYXML2_MAX_DEPTH = 500
 
 
 class TreeLoadError(FsmbtError):
@@ -144,10 +147,27 @@ def declarations(root: etree._Element) -> str:
     return "\n".join(lines) + "\n"
 
 
-def _refused(engine: str, message: str) -> LoadCheck:
+def _refused(engine: str, message: str, root: etree._Element | None = None) -> LoadCheck:
     message = " ".join(message.split())[:600]
     found = _LINE.search(message)
-    return LoadCheck(engine, False, message, int(found.group(1)) if found else None)
+    line = int(found.group(1)) if found else None
+    if root is not None and "DEPTH_EXCEEDED" in message:
+        line = _too_deep_line(root) or line
+    return LoadCheck(engine, False, message, line)
+
+
+def _too_deep_line(root: etree._Element) -> int | None:
+    """The source line of the first element nested ``TINYXML2_MAX_DEPTH`` levels deep (the
+    root element = 1), found without recursion; ``None`` when there is none."""
+    stack = [(root, 1)]
+    while stack:
+        element, level = stack.pop()
+        if level >= TINYXML2_MAX_DEPTH:
+            return element.sourceline
+        stack.extend(
+            (child, level + 1) for child in reversed(element) if isinstance(child.tag, str)
+        )
+    return None
 
 
 def _cpp_check(program: Path, text: str, root: etree._Element, timeout: float) -> LoadCheck:
@@ -167,7 +187,7 @@ def _cpp_check(program: Path, text: str, root: etree._Element, timeout: float) -
         return LoadCheck(ENGINE_CPP, True, nodes=int(answer["nodes"]))
     if done.returncode < 0:  # killed by a signal: a crash of the loader is a refusal too
         return _refused(ENGINE_CPP, f"the loader stopped with signal {-done.returncode}")
-    return _refused(ENGINE_CPP, done.stderr.strip().removeprefix("error: "))
+    return _refused(ENGINE_CPP, done.stderr.strip().removeprefix("error: "), root)
 
 
 def _never_ticked(*_args: object) -> object:  # pragma: no cover - the check only loads
@@ -184,8 +204,7 @@ def _python_check(root: etree._Element) -> LoadCheck:
             if isinstance(entry.tag, str) and entry.tag in _KINDS and entry.get("ID"):
                 declared[str(entry.get("ID"))] = str(entry.tag)
     factory = btpy.BehaviorTreeFactory()
-    builtin = set(factory.builtin_nodes()) if hasattr(factory, "builtin_nodes") else set()
-    custom = {name: kind for name, kind in declared.items() if name not in builtin}
+    custom = declared
     for tree in root.iter("BehaviorTree"):
         for element in tree.iter():
             if not isinstance(element.tag, str):
@@ -201,13 +220,17 @@ def _python_check(root: etree._Element) -> LoadCheck:
             if kind == "Control":
                 element.tag = "Sequence"
                 element.attrib.pop("ID", None)
+    registrars = {
+        "Action": factory.register_simple_action,
+        "Condition": factory.register_simple_condition,
+        "Decorator": factory.register_simple_decorator,
+    }
     for name, kind in custom.items():
-        if kind == "Action":
-            factory.register_simple_action(name, _never_ticked)
-        elif kind == "Condition":
-            factory.register_simple_condition(name, _never_ticked)
-        elif kind == "Decorator":
-            factory.register_simple_decorator(name, _never_ticked)
+        if kind in registrars:
+            try:
+                registrars[kind](name, _never_ticked)
+            except Exception:  # a built-in's name: the built-in stays, as in BehaviorTree.CPP
+                continue
     for models in list(root.iter("TreeNodesModel")):
         parent = models.getparent()
         if parent is not None:
@@ -215,7 +238,7 @@ def _python_check(root: etree._Element) -> LoadCheck:
     try:
         factory.create_tree_from_text(etree.tostring(root, encoding="unicode"))
     except Exception as exc:  # behaviortreepy raises RuntimeError subclasses of its own
-        return _refused(ENGINE_PY, str(exc))
+        return _refused(ENGINE_PY, str(exc), root)
     return LoadCheck(ENGINE_PY, True)
 
 
