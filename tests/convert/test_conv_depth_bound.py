@@ -4,12 +4,18 @@ form is proven equivalent by the checker (flat and SubTree LEBTs)."""
 
 from __future__ import annotations
 
+import importlib
+
+import pytest
+
 from fsmbt.convert import convert
 from fsmbt.convert.lebt import build_lebt, fsm_to_lebt, lebt_node_models, tree_depth
 from fsmbt.convert.structure import MAX_SELECTOR_LEVELS, MAX_XML_LEVELS, analyse, bound_depth
 from fsmbt.formats import dumps
 from fsmbt.generate import random_fsm
+from fsmbt.generate.outcome_machines import random_outcome_fsm
 from fsmbt.model.bt import BTDocument
+from fsmbt.model.errors import UnsupportedError
 from fsmbt.model.fsm import FSM
 from support.conv_helpers import check, paper_aj_fsm
 
@@ -132,3 +138,23 @@ def test_a_hierarchy_deeper_than_the_subtree_bound_is_converted_flat() -> None:
     assert list(result.model.trees) == ["MainTree"]
     assert any("SubTree levels written: converted flat" in w for w in result.warnings)
     assert check(machine, result.model).equivalent
+
+
+def test_a_structured_tree_past_the_bound_becomes_the_bounded_lebt_under_auto(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """The rule of ``rules_fsm_to_bt`` with the bound lowered to 10 XML levels (a structured
+    tree that deep takes ~1 300 states, too slow for a test): ``auto`` writes the LEBT and says
+    why, ``structured`` refuses; both conversions proven or refused, never a deep tree."""
+    fsm = random_outcome_fsm(0, 50, containers=0.0)
+    natural = convert(fsm, style="structured", outcome_driven=True)
+    assert natural.stats["style"] == "structured" and natural.stats["depth"] + 2 > 10
+    # the module (``fsmbt.convert.engines`` the attribute is the function ``engines``)
+    engine_table = importlib.import_module("fsmbt.convert.engines")
+    monkeypatch.setattr(engine_table, "MAX_XML_LEVELS", 10)
+    result = convert(fsm, style="auto", outcome_driven=True)
+    assert result.stats["style"] == "lebt"
+    assert any("the depth-bounded LEBT was written instead" in w for w in result.warnings)
+    assert check(fsm, result.model).equivalent
+    with pytest.raises(UnsupportedError, match="--style lebt writes a depth-bounded tree"):
+        convert(fsm, style="structured", outcome_driven=True)
