@@ -141,3 +141,18 @@ def test_a_result_that_would_not_load_is_a_located_error_and_not_written(
     assert not output.exists()
     written = api.convert_file(source, output, verify=False, load_check=False)
     assert written.written and written.load is None
+
+
+def test_a_loader_that_cannot_run_falls_back_to_behaviortreepy(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A compiled check whose library is gone answers nothing about the tree (the dynamic
+    loader's exit 127): behaviortreepy loads it instead, and says so."""
+    broken = tmp_path / "fsmbt_btcpp_load-broken"
+    broken.write_text("#!/bin/sh\necho 'cannot open shared object file' >&2\nexit 127\n")
+    broken.chmod(0o755)
+    monkeypatch.setattr(btcpp_load, "find_program", lambda build=True: broken)
+    good = check_loads(nested_text(10))
+    assert good.loaded and good.engine == ENGINE_PY
+    deep = check_loads(nested_text(600))
+    assert not deep.loaded and deep.engine == ENGINE_PY

@@ -170,23 +170,32 @@ def _too_deep_line(root: etree._Element) -> int | None:
     return None
 
 
-def _cpp_check(program: Path, text: str, root: etree._Element, timeout: float) -> LoadCheck:
+def _cpp_check(program: Path, text: str, root: etree._Element, timeout: float) -> LoadCheck | None:
+    """The compiled check's answer; ``None`` when the program itself cannot run (its shared
+    library gone, not executable): that is no answer about the tree."""
     with tempfile.TemporaryDirectory(prefix="fsmbt-load-") as folder:
         tree_file = Path(folder) / "tree.xml"
         tree_file.write_text(text, encoding="utf-8")
-        done = subprocess.run(
-            [str(program), str(tree_file)],
-            input=declarations(root),
-            capture_output=True,
-            text=True,
-            timeout=timeout,
-            check=False,
-        )
+        try:
+            done = subprocess.run(
+                [str(program), str(tree_file)],
+                input=declarations(root),
+                capture_output=True,
+                text=True,
+                timeout=timeout,
+                check=False,
+            )
+        except subprocess.TimeoutExpired:
+            return _refused(ENGINE_CPP, f"the load did not finish within {timeout:g} s")
+        except OSError:
+            return None
     if done.returncode == 0:
         answer = json.loads(done.stdout.strip().splitlines()[-1])
         return LoadCheck(ENGINE_CPP, True, nodes=int(answer["nodes"]))
     if done.returncode < 0:  # killed by a signal: a crash of the loader is a refusal too
         return _refused(ENGINE_CPP, f"the loader stopped with signal {-done.returncode}")
+    if done.returncode != 1 or not done.stderr.startswith("error: "):
+        return None  # not the program's own answer (the dynamic loader's, a usage error)
     return _refused(ENGINE_CPP, done.stderr.strip().removeprefix("error: "), root)
 
 
@@ -251,7 +260,8 @@ def check_loads(text: str, *, timeout: float = 600.0, build: bool = True) -> Loa
         build: compile the C++ check when the library is built and the program is not.
 
     Returns:
-        The ``LoadCheck`` (C++ when the build is there, else behaviortreepy).
+        The ``LoadCheck`` (C++ when the build is there and runs, else behaviortreepy); a load
+        that takes longer than ``timeout`` is a refusal.
     """
     try:
         root = etree.fromstring(text.encode("utf-8"), _PARSER)
@@ -259,5 +269,7 @@ def check_loads(text: str, *, timeout: float = 600.0, build: bool = True) -> Loa
         return _refused(ENGINE_CPP, f"not XML: {exc}")
     program = find_program(build=build)
     if program is not None:
-        return _cpp_check(program, text, root, timeout)
+        answer = _cpp_check(program, text, root, timeout)
+        if answer is not None:
+            return answer
     return _python_check(root)
