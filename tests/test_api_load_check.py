@@ -16,7 +16,7 @@ from fsmbt.formats import dumps
 from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.bt_nodes import NodeKind
 from fsmbt.model.fsm import FSM
-from fsmbt.semantics.engines import btcpp_load
+from fsmbt.semantics.engines import btcpp_load, scxml_load
 from fsmbt.semantics.engines.btcpp_load import (
     ENGINE_CPP,
     ENGINE_PY,
@@ -156,3 +156,20 @@ def test_a_loader_that_cannot_run_falls_back_to_behaviortreepy(
     assert good.loaded and good.engine == ENGINE_PY
     deep = check_loads(nested_text(600))
     assert not deep.loaded and deep.engine == ENGINE_PY
+
+
+BROKEN_SCXML = (
+    '<scxml xmlns="http://www.w3.org/2005/07/scxml" version="1.0" initial="nowhere">'
+    '<state id="a"/></scxml>'
+)
+
+
+def test_an_scxml_result_is_loaded_in_python_statemachine(tmp_path: Path) -> None:
+    pytest.importorskip("statemachine")
+    robot = Path(__file__).resolve().parents[1] / "examples" / "robot_bt.xml"
+    outcome = api.convert_file(robot, tmp_path / "robot.scxml")
+    assert outcome.written and outcome.equivalent
+    assert outcome.load is not None and outcome.load.loaded
+    assert outcome.load.summary().startswith("loads in python-statemachine 3.")
+    refused = scxml_load.check_scxml_loads(BROKEN_SCXML)
+    assert refused is not None and not refused.loaded and "nowhere" in refused.error

@@ -17,8 +17,9 @@ The steps, each a thin public function over the package that owns it:
   and written atomically (a temporary file in the same folder, then a rename), so an output is
   never left half-written.
 - ``check_loads`` (``fsmbt.semantics.engines.btcpp_load``): a behavior tree written for
-  BehaviorTree.CPP is loaded in BehaviorTree.CPP 4.8.2 before it is reported or written; a tree
-  the engine refuses is a located ``TreeLoadError``, never a verdict (docs/semantics.md §5,
+  BehaviorTree.CPP is loaded in BehaviorTree.CPP 4.8.2 before it is reported or written, an
+  SCXML result in python-statemachine where it is installed (``scxml_load``); a result the
+  engine refuses is a located ``TreeLoadError``, never a verdict (docs/semantics.md §5,
   "Every written tree loads"). ``ConvertRequest.load_check=False`` skips it.
 - ``convert_file``: all of it for one input, returning one ``Outcome`` (both models, the
   conversion, the report, timings, warnings, where the result was written).
@@ -65,6 +66,7 @@ from fsmbt.model.validate import Issue
 from fsmbt.semantics.blockers import Blocker
 from fsmbt.semantics.blockers import conversion_blockers as blockers_of
 from fsmbt.semantics.engines.btcpp_load import LoadCheck, check_loads
+from fsmbt.semantics.engines.scxml_load import check_scxml_loads
 from fsmbt.semantics.outcome_rules import OutcomeRules
 from fsmbt.verify import Report, verify
 from fsmbt.verify.native import StateLimitError
@@ -129,8 +131,9 @@ class Outcome:
         output: where the result was written, or ``None`` (no path given, or not written).
         written: whether ``output`` holds the result.
         timings: seconds per step ("read", "convert", "verify", "load", "write").
-        load: the load check of a written BehaviorTree.CPP tree (``None``: not a BehaviorTree.CPP
-            tree, or the check was skipped); a refused tree never gets an ``Outcome``.
+        load: the load check of the written result (BehaviorTree.CPP for a BehaviorTree.CPP
+            tree, python-statemachine for SCXML; ``None``: another format, no engine, or the
+            check was skipped); a refused result never gets an ``Outcome``.
     """
 
     source: Loaded
@@ -837,6 +840,10 @@ def convert_loaded(
     if request.load_check and fmt == "btcpp" and isinstance(conversion.model, BTDocument):
         with _timed(timings, "load", on_stage):
             load = check_loads(text)
+    elif request.load_check and fmt == "scxml" and isinstance(conversion.model, FSM):
+        with _timed(timings, "load", on_stage):
+            load = check_scxml_loads(text)  # None without python-statemachine
+    if load is not None:
         load.raise_if_refused(str(destination) if destination is not None else "<stdout>")
     outcome = Outcome(loaded, conversion, report, fmt, text, output=destination, load=load)
     if destination is not None and (

@@ -83,7 +83,7 @@ class LoadCheck:
         if self.loaded:
             return
         raise TreeLoadError(
-            f"the written behavior tree does not load in {self.engine}: {self.error}",
+            f"the written result does not load in {self.engine}: {self.error}",
             location=SourceLocation(file or "<result>", self.line),
         )
 
