@@ -18,8 +18,8 @@ from typing import Any
 from fsmbt.convert.bt_to_hfsm import bt_to_hfsm
 from fsmbt.convert.hfsm_to_bt import fsm_to_bt
 from fsmbt.convert.result import ConversionResult, Converter, Model
-from fsmbt.convert.structured import structured_result
 from fsmbt.convert.structure import MAX_XML_LEVELS
+from fsmbt.convert.structured import structured_result
 from fsmbt.convert.structured.style import AUTO, STRUCTURED, check_style, resolve_style
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import InputError, UnsupportedError
