@@ -113,21 +113,24 @@ def find_program(*, build: bool = True) -> Path | None:
     if compiler is None:
         return None
     prefix = btcpp_prefix()
-    path.parent.mkdir(parents=True, exist_ok=True)
     partial = path.with_name(f"{path.name}.{os.getpid()}.tmp")
-    done = subprocess.run(
-        [compiler, "-std=c++17", "-O1", "-o", str(partial), str(SOURCE)]
-        + [f"-I{prefix / 'include'}", f"-L{prefix / 'lib'}", f"-Wl,-rpath,{prefix / 'lib'}"]
-        + ["-lbehaviortree_cpp", "-lpthread", "-ldl"],
-        capture_output=True,
-        text=True,
-        timeout=600,
-        check=False,
-    )
-    if done.returncode != 0:
-        partial.unlink(missing_ok=True)
+    try:  # a read-only cache or a compiler that hangs: no C++ check, never a traceback
+        path.parent.mkdir(parents=True, exist_ok=True)
+        done = subprocess.run(
+            [compiler, "-std=c++17", "-O1", "-o", str(partial), str(SOURCE)]
+            + [f"-I{prefix / 'include'}", f"-L{prefix / 'lib'}", f"-Wl,-rpath,{prefix / 'lib'}"]
+            + ["-lbehaviortree_cpp", "-lpthread", "-ldl"],
+            capture_output=True,
+            text=True,
+            timeout=600,
+            check=False,
+        )
+        if done.returncode != 0:
+            partial.unlink(missing_ok=True)
+            return None
+        partial.replace(path)  # atomic: a concurrent build writes the same bytes
+    except (OSError, subprocess.TimeoutExpired):
         return None
-    partial.replace(path)  # atomic: a concurrent build writes the same bytes
     return path
 
 
