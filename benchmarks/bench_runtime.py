@@ -16,12 +16,13 @@ ticks (BehaviorTree.CPP resumes each Sequence at its running child, but every ti
 from the root), which the chain rows and the extra depth series show.
 
 Limits met and printed, not hidden: BehaviorTree.CPP parses XML with tinyxml2, which refuses
-documents nested deeper than 500 elements, so a chain LEBT (two XML levels per state) beyond ~245
-states cannot be loaded in C++; py_trees ticks recursively, so very deep trees exceed Python's
-recursion limit, and every node it ticks is yielded up through all its ancestors' generators, so
-one tick costs O(depth^2) there. Trees deeper than ``--pytrees-max-depth`` (2 100: the 1 000-state
-chain runs, the 10 000-state one does not) are not run in py_trees; py_trees stops after
-``--pytrees-budget`` seconds per model (the steps measured are printed).
+documents nested deeper than 500 elements; the paper's chain LEBT (two XML levels per state)
+beyond ~245 states could not be loaded in C++, so fsmbt writes the depth-bounded LEBT
+(docs/semantics.md §5: a selector deeper than 98 levels becomes a root selector; depth <= 197)
+and every chain loads - the ``depth`` and ``roots`` columns show it. py_trees ticks
+recursively, and every node it ticks is yielded up through all its ancestors' generators, so one
+tick costs O(depth^2) there; trees deeper than ``--pytrees-max-depth`` are not run in py_trees,
+which stops after ``--pytrees-budget`` seconds per model (the steps measured are printed).
 """
 
 from __future__ import annotations

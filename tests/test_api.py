@@ -33,7 +33,8 @@ def test_convert_file_gives_one_outcome_with_models_verdict_and_timings(tmp_path
     assert outcome.equivalent is True and outcome.verdict == api.EQUIVALENT
     assert outcome.written and out.read_text(encoding="utf-8") == outcome.text
     assert outcome.output_format == "btcpp"
-    assert set(outcome.timings) == {"read", "convert", "verify", "write"}
+    assert set(outcome.timings) == {"read", "convert", "verify", "load", "write"}
+    assert outcome.load is not None and outcome.load.loaded
     summary = outcome.to_dict()
     assert summary["verdict"] == "EQUIVALENT" and summary["direction"] == "fsm->bt"
     assert all(summary["properties"].values()) and len(summary["properties"]) == 5
@@ -49,9 +50,12 @@ def test_convert_file_bt_to_fsm_without_output_keeps_the_text() -> None:
 def test_stages_are_announced_in_order(tmp_path: Path) -> None:
     seen: list[str] = []
     api.convert_file(PAPER_FSM, tmp_path / "x.xml", on_stage=seen.append)
-    assert seen == ["read", "convert", "verify", "write"]
+    assert seen == ["read", "convert", "verify", "load", "write"]
     seen.clear()
     api.convert_file(PAPER_FSM, verify=False, on_stage=seen.append)
+    assert seen == ["read", "convert", "load"]
+    seen.clear()
+    api.convert_file(PAPER_FSM, verify=False, load_check=False, on_stage=seen.append)
     assert seen == ["read", "convert"]
 
 

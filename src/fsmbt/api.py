@@ -16,6 +16,11 @@ The steps, each a thin public function over the package that owns it:
 - ``check_destination`` / ``write``: where the result goes, checked *before* any work is done,
   and written atomically (a temporary file in the same folder, then a rename), so an output is
   never left half-written.
+- ``check_loads`` (``fsmbt.semantics.engines.btcpp_load``): a behavior tree written for
+  BehaviorTree.CPP is loaded in BehaviorTree.CPP 4.8.2 before it is reported or written, an
+  SCXML result in python-statemachine where it is installed (``scxml_load``); a result the
+  engine refuses is a located ``TreeLoadError``, never a verdict (docs/semantics.md §5,
+  "Every written tree loads"). ``ConvertRequest.load_check=False`` skips it.
 - ``convert_file``: all of it for one input, returning one ``Outcome`` (both models, the
   conversion, the report, timings, warnings, where the result was written).
 
@@ -60,6 +65,8 @@ from fsmbt.model.fsm import FSM
 from fsmbt.model.validate import Issue
 from fsmbt.semantics.blockers import Blocker
 from fsmbt.semantics.blockers import conversion_blockers as blockers_of
+from fsmbt.semantics.engines.btcpp_load import LoadCheck, check_loads
+from fsmbt.semantics.engines.scxml_load import check_scxml_loads
 from fsmbt.semantics.outcome_rules import OutcomeRules
 from fsmbt.verify import Report, verify
 from fsmbt.verify.native import StateLimitError
@@ -123,7 +130,10 @@ class Outcome:
         text: the result serialised in ``output_format``.
         output: where the result was written, or ``None`` (no path given, or not written).
         written: whether ``output`` holds the result.
-        timings: seconds per step ("read", "convert", "verify", "write").
+        timings: seconds per step ("read", "convert", "verify", "load", "write").
+        load: the load check of the written result (BehaviorTree.CPP for a BehaviorTree.CPP
+            tree, python-statemachine for SCXML; ``None``: another format, no engine, or the
+            check was skipped); a refused result never gets an ``Outcome``.
     """
 
     source: Loaded
@@ -134,6 +144,7 @@ class Outcome:
     output: Path | None = None
     written: bool = False
     timings: dict[str, float] = field(default_factory=dict)
+    load: LoadCheck | None = None
 
     @property
     def result(self) -> Model:
@@ -176,6 +187,9 @@ class Outcome:
             "equivalent": self.equivalent,
             "properties": self.report.verdicts() if self.report is not None else None,
             "timings": {name: round(seconds, 6) for name, seconds in self.timings.items()},
+            "loads": None
+            if self.load is None
+            else {"engine": self.load.engine, "loaded": self.load.loaded},
         }
 
 
@@ -731,7 +745,9 @@ def convert_file(
 
     Raises:
         InputError, UnsupportedError: bad input or a refused destination (located);
-        EngineDisagreement: ``verify_engine="both"`` and the engines disagree.
+        EngineDisagreement: ``verify_engine="both"`` and the engines disagree;
+        TreeLoadError: the result is a BehaviorTree.CPP tree the engine does not load (not
+            written; located at the output and the engine's line).
     """
     request = convert_request(request, **fields)
     if output is not None:
@@ -820,7 +836,16 @@ def convert_loaded(
                 outcomes=request.outcomes if structured else None,
                 outcome_driven=structured,
             )
-    outcome = Outcome(loaded, conversion, report, fmt, text, output=destination)
+    load: LoadCheck | None = None
+    if request.load_check and fmt == "btcpp" and isinstance(conversion.model, BTDocument):
+        with _timed(timings, "load", on_stage):
+            load = check_loads(text)
+    elif request.load_check and fmt == "scxml" and isinstance(conversion.model, FSM):
+        with _timed(timings, "load", on_stage):
+            load = check_scxml_loads(text)  # None without python-statemachine
+    if load is not None:
+        load.raise_if_refused(str(destination) if destination is not None else "<stdout>")
+    outcome = Outcome(loaded, conversion, report, fmt, text, output=destination, load=load)
     if destination is not None and (
         report is None or report.equivalent or request.keep_not_equivalent
     ):

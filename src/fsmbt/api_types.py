@@ -170,6 +170,11 @@ class ConvertRequest(_Request):
     )
     verify: bool = Field(default=True, description="prove the result equivalent")
     verify_engine: VerifyEngine = Field(default="native", description="native, nusmv or both")
+    load_check: bool = Field(
+        default=True,
+        description="load a written BehaviorTree.CPP tree in BehaviorTree.CPP 4.8.2 (the C++ "
+        "build, else behaviortreepy) and refuse one that does not load",
+    )
     max_states: int | None = Field(
         default=None, ge=1, description="state limit of exploration and checker"
     )

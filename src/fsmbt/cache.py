@@ -19,3 +19,14 @@ def cache_root() -> Path:
         return Path(explicit)
     xdg = os.environ.get("XDG_CACHE_HOME")
     return (Path(xdg) if xdg else Path.home() / ".cache") / "fsmbt"
+
+
+#: The BehaviorTree.CPP version the build script installs (its cache folder's key).
+BTCPP_VERSION = "4.8.2"
+
+
+def btcpp_prefix() -> Path:
+    """Where the build script installs BehaviorTree.CPP (may not exist): ``btcpp-4.8.2`` under
+    ``cache_root()``. The C++ runtime (``fsmbt.runtime.cpp``) and the load check
+    (``fsmbt.semantics.engines.btcpp_load``) both find it here."""
+    return cache_root() / f"btcpp-{BTCPP_VERSION}"

@@ -21,15 +21,22 @@ EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 
 def test_an_equivalent_result_is_written_and_verifies_on_reading_back(tmp_path: Path) -> None:
     jobs = make_jobs([EXAMPLES], tmp_path / "out")
+    trees = 0
     for job in jobs:
         result = run_job(job)
         assert result.status == "equivalent", result.error_message
         assert result.output == job.output and result.verdict == api.EQUIVALENT
         assert set(result.properties) and all(result.properties.values())
         assert result.stats["product_states"] > 0 and result.timings["total"] > 0
+        if result.stats["output_format"] == "btcpp":  # every written tree is loaded
+            trees += 1
+            assert result.stats["loads"].startswith("loads in BehaviorTree.CPP 4.8.2") and (
+                result.stats["loads"].endswith(": yes")
+            )
         source = api.load(job.input).model
         written = api.load(result.output).model
         assert api.verify_either_order(source, written).equivalent
+    assert trees > 0
 
 
 @pytest.mark.parametrize(

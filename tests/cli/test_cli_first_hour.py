@@ -115,7 +115,8 @@ def test_convert_json_summary_has_verdict_and_timings(
     assert main(["convert", str(PAPER_FSM), "-o", str(tmp_path / "bt.xml"), "--json"]) == 0
     data = json.loads(capsys.readouterr().out)
     assert data["verdict"] == "EQUIVALENT" and data["written"] is True
-    assert set(data["timings"]) == {"read", "convert", "verify", "write"}
+    assert set(data["timings"]) == {"read", "convert", "verify", "load", "write"}
+    assert data["loads"]["loaded"] is True
 
 
 ROBOT_BT = EXAMPLES / "robot_bt.xml"

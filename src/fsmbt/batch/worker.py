@@ -244,6 +244,8 @@ def run_job(job: Job) -> JobResult:
                 "result_size": _size(outcome.result),
                 "warnings": len(outcome.warnings),
             }
+            if outcome.load is not None:  # docs/semantics.md §5, "Every written tree loads"
+                stats["loads"] = outcome.load.summary()
             if outcome.report is not None:
                 for name in ("product_states", "product_edges", "source_states", "result_states"):
                     if name in outcome.report.stats:

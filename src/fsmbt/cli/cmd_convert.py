@@ -78,6 +78,12 @@ def register(app: typer.Typer) -> None:
             "instead of SCXML data (a flat product, for tools without a data model)",
         ),
         no_verify: bool = typer.Option(False, "--no-verify", help="skip the equivalence check"),
+        no_load_check: bool = typer.Option(
+            False,
+            "--no-load-check",
+            help="FSM->BT: do not load the written tree in BehaviorTree.CPP 4.8.2 (by default a "
+            "tree the engine refuses is an error)",
+        ),
         verify_engine: str = typer.Option(
             "native",
             "--verify-engine",
@@ -133,6 +139,7 @@ def register(app: typer.Typer) -> None:
             hierarchy=hierarchy,
             verify=not no_verify,
             verify_engine=verify_engine,
+            load_check=not no_load_check,
             overwrite=force,
             max_states=max_states,
             keep_not_equivalent=keep_failed,
@@ -193,6 +200,8 @@ def _print_summary(outcome: api.Outcome, *, to_stderr: bool, brief: bool = False
         file=stream,
     )
     print(f"time: {format_timings(outcome.timings)}", file=stream)
+    if outcome.load is not None:
+        print(outcome.load.summary(), file=stream)
     report: Report | None = outcome.report
     if report is None:
         print("verification skipped (--no-verify)", file=stream)

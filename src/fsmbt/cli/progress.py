@@ -33,6 +33,7 @@ STAGE_WORDS = {
     "read": "reading the model",
     "convert": "converting",
     "verify": "proving equivalence",
+    "load": "loading the tree in BehaviorTree.CPP",
     "write": "writing the result",
 }
 

@@ -60,6 +60,11 @@ def _fsm_to_bt(s: Mapping[str, object], engine: str, used: set[str]) -> list[str
             shape.append(counted(take(key), noun, plural) + tail)
         used.add(key)
     parts = [head] + ([", ".join(shape)] if shape else [])
+    if s.get("depth_bound_roots"):
+        parts.append(
+            f"{counted(take('depth_bound_roots'), 'state')} promoted to the root to keep the "
+            "tree within 200 XML levels (docs/semantics.md §5, depth-bounded LEBT)"
+        )
     if s.get("unreachable_dropped"):
         parts.append(f"{counted(s['unreachable_dropped'], 'unreachable state')} dropped")
     used.add("unreachable_dropped")

@@ -18,6 +18,7 @@ from typing import Any
 from fsmbt.convert.bt_to_hfsm import bt_to_hfsm
 from fsmbt.convert.hfsm_to_bt import fsm_to_bt
 from fsmbt.convert.result import ConversionResult, Converter, Model
+from fsmbt.convert.structure import MAX_XML_LEVELS
 from fsmbt.convert.structured import structured_result
 from fsmbt.convert.structured.style import AUTO, STRUCTURED, check_style, resolve_style
 from fsmbt.model.bt import BTDocument
@@ -66,18 +67,35 @@ def rules_fsm_to_bt(
     """The rules engine's FSM -> BT: the structured tree for an outcome-driven machine, the
     LEBT otherwise (``fsmbt.convert.structured.style``: ``auto``, ``structured``, ``lebt``).
 
+    Depth bound (docs/semantics.md §5, "Depth-bounded LEBT"): a structured tree that would nest
+    deeper than ``MAX_XML_LEVELS`` XML levels is not written; under ``auto`` the depth-bounded
+    LEBT is written instead, with a warning saying why; under ``structured`` it is an error.
+
     Raises:
         InputError: an unknown style; OutcomeError: ``structured`` on an event-driven machine,
-        or a malformed outcome-driven one (state and cause named).
+        or a malformed outcome-driven one (state and cause named); UnsupportedError:
+        ``structured`` whose tree would nest deeper than the bound.
     """
     rules = OutcomeRules.from_option(outcomes)
     chosen, view = resolve_style(style, fsm, outcome_driven=outcome_driven, rules=rules)
+    too_deep = ""
     if view is not None:
         result = structured_result(view)
         result.engine = "rules"
-        return result
+        xml_levels = int(result.stats.get("depth", 0)) + 2  # <root>, <BehaviorTree>
+        if xml_levels <= MAX_XML_LEVELS:
+            return result
+        too_deep = (
+            f"the structured tree would nest {xml_levels} XML levels, more than the "
+            f"{MAX_XML_LEVELS} BehaviorTree.CPP loads everywhere (4.9+ refuses 256)"
+        )
+        if check_style(style) == STRUCTURED:
+            raise UnsupportedError(f"{too_deep}; --style lebt writes a depth-bounded tree")
+        chosen = "lebt"
     result = fsm_to_bt(fsm, style="paper", **options)
     result.stats.setdefault("style", chosen)
+    if too_deep:
+        result.warnings.append(f"{too_deep}: the depth-bounded LEBT was written instead")
     return result
 
 

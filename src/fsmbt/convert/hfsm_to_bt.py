@@ -31,6 +31,11 @@ transitions are resolved by flattening (transient configurations do not exist in
 machine). Names containing ``/``, ``[`` or ``|`` cannot be told apart from flat paths: such a
 machine is converted flat (``lebt``) with a warning that says so.
 
+Depth bound (docs/semantics.md §5, "Depth-bounded LEBT"): within each level's tree, a node
+whose selector would nest deeper than ``structure.MAX_SELECTOR_LEVELS`` becomes a root of its
+level (as a node entered from outside is), so no ``<BehaviorTree>`` nests more than 200 XML
+levels; a hierarchy deeper than ``MAX_SUBTREE_LEVELS`` is converted flat, with a warning.
+
 Complexity: O(F + T + L) after flattening (F flat states, T flat transitions, L total length of
 the flat names), explicit stacks only.
 """
@@ -42,7 +47,7 @@ from dataclasses import dataclass, field
 from fsmbt.convert.lebt import ROOT_NAME, LebtLeafWriter, fsm_to_lebt, lebt_node_models
 from fsmbt.convert.perf import without_gc_pauses
 from fsmbt.convert.result import ConversionResult
-from fsmbt.convert.structure import analyse
+from fsmbt.convert.structure import MAX_SELECTOR_LEVELS, analyse
 from fsmbt.model.bt import BehaviorTree, BTDocument, BTNode
 from fsmbt.model.bt_nodes import NodeKind
 from fsmbt.model.errors import UnsupportedError
@@ -50,6 +55,11 @@ from fsmbt.model.flatten import PATH_SEPARATOR, flatten, needs_flattening
 from fsmbt.model.fsm import FSM
 
 HIERARCHY_MODES = ("subtrees", "flatten")
+#: Most levels of ``SubTree`` nesting written (the main tree = 1): BehaviorTree.CPP's loader
+#: recurses through every SubTree's XML, so a deeper hierarchy is converted flat (with a
+#: warning) rather than written as a SubTree chain that grows with the machine
+#: (docs/semantics.md §5, "Depth-bounded LEBT").
+MAX_SUBTREE_LEVELS = 32
 _AMBIGUOUS = ("/", "[", "|")
 _OUTSIDE = "\x00outside"  # the predecessor standing for "from outside this level"
 
@@ -153,6 +163,14 @@ def fsm_to_subtree_bt(fsm: FSM, *, style: str = "paper", **options: object) -> C
     flat = flatten(fsm)
     structure = analyse(flat)
     clusters, owner = _classify(fsm, flat)
+    deepest = 1 + max((c.depth + 1 for p, c in clusters.items() if p), default=0)
+    if deepest > MAX_SUBTREE_LEVELS:
+        result = fsm_to_lebt(flat, style=style, **options)
+        result.warnings.append(
+            f"the hierarchy nests {deepest} levels of composite states, more than the "
+            f"{MAX_SUBTREE_LEVELS} SubTree levels written: converted flat, without SubTrees"
+        )
+        return result
     top = clusters.setdefault("", _Cluster("", None))
     levels = [path for path in clusters if path != ""]
     warnings = [
@@ -226,6 +244,7 @@ def fsm_to_subtree_bt(fsm: FSM, *, style: str = "paper", **options: object) -> C
             if key not in root_set:
                 (only,) = preds[key]
                 below.setdefault(only, []).append(key)
+        roots.extend(_bound_levels(roots, below))
 
         def selector(key: str) -> tuple[BTNode, BTNode | None]:
             label = key[2:]
@@ -290,6 +309,25 @@ def fsm_to_subtree_bt(fsm: FSM, *, style: str = "paper", **options: object) -> C
         "nodes": sum(1 for _tree, _node in doc.nodes()),
     }
     return ConversionResult(doc, "rules", "fsm->bt", stats, warnings)
+
+
+def _bound_levels(roots: list[str], below: dict[str, list[str]]) -> list[str]:
+    """The nodes to promote to roots of their level so that no selector nests deeper than
+    ``MAX_SELECTOR_LEVELS`` (``structure.bound_depth``'s rule; taken out of ``below`` here),
+    in the order a walk from the roots meets them. O(nodes of the level), no recursion."""
+    promoted: list[str] = []
+    queue = [(key, 1) for key in roots]
+    for key, level in queue:  # the list grows while it is read
+        children = below.get(key)
+        if not children:
+            continue
+        if level + 1 > MAX_SELECTOR_LEVELS:
+            promoted.extend(children)
+            queue.extend((child, 1) for child in children)
+            del below[key]
+        else:
+            queue.extend((child, level + 1) for child in children)
+    return promoted
 
 
 def fsm_to_bt(

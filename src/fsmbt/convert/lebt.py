@@ -10,8 +10,12 @@ Steps (``docs/conversion.md`` has the worked A-J example):
    ``LebtGuard`` holding every (source, event) pair entering ``s`` (the start pseudo-state's
    initialisation pair included for the entry state); ``body(s)`` is the ``LebtState`` leaf of
    ``s`` alone when no ordinary state hangs below ``s``, else ``Sequence(leaf(s), selector(c1),
-   ..., selector(ck))`` - a chain for k = 1, a branch for k >= 2 - nested without recursion
-   (a 100 000-state chain is a 200 000-level tree).
+   ..., selector(ck))`` - a chain for k = 1, a branch for k >= 2 - nested without recursion;
+6. depth bound (``structure.bound_depth``, docs/semantics.md §5 "Depth-bounded LEBT"): a state
+   whose selector would nest deeper than ``MAX_SELECTOR_LEVELS`` (98) is promoted to a root
+   selector instead, so every written ``<BehaviorTree>`` nests at most 200 XML levels and
+   BehaviorTree.CPP loads it (a 100 000-state chain: 1 021 root selectors, depth 197);
+   machines that shallow keep the paper's exact shape.
 
 Leaves are named for people: the guard of ``C`` is ``Enter_C``, the state leaf is ``C``; the
 selector is ``C_selector`` and the body ``C_chain`` / ``C_branch``. The document declares
@@ -40,7 +44,7 @@ from collections.abc import Callable, Iterable, Sequence
 
 from fsmbt.convert.perf import without_gc_pauses
 from fsmbt.convert.result import ConversionResult
-from fsmbt.convert.structure import LebtStructure, analyse
+from fsmbt.convert.structure import LebtStructure, analyse, bound_depth
 from fsmbt.model.bt import BTDocument, BTNode, NodeModel, PortModel
 from fsmbt.model.bt_nodes import NodeKind
 from fsmbt.model.errors import UnsupportedError
@@ -367,7 +371,12 @@ def fsm_to_lebt(fsm: FSM, *, style: str = "paper", **_options: object) -> Conver
         warnings.append(
             f"hierarchical FSM flattened to {len(flat.states)} states before conversion"
         )
-    structure = analyse(flat)
+    structure = bound_depth(analyse(flat))
+    promoted = (
+        len(structure.root_ids)
+        - 1
+        - len([i for i in structure.loop_ids if i != structure.entry_id])
+    )
     if structure.unreachable:
         shown = ", ".join(structure.unreachable[:10])
         more = "" if len(structure.unreachable) <= 10 else f" (+{len(structure.unreachable) - 10})"
@@ -389,4 +398,6 @@ def fsm_to_lebt(fsm: FSM, *, style: str = "paper", **_options: object) -> Conver
         "nodes": node_count,
         "depth": depth,
     }
+    if promoted:
+        stats["depth_bound_roots"] = promoted  # docs/semantics.md §5, "Depth-bounded LEBT"
     return ConversionResult(doc, "rules", "fsm->bt", stats, warnings)

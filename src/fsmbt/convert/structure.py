@@ -38,7 +38,7 @@ from __future__ import annotations
 
 from array import array
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import cached_property
 from itertools import compress
 from typing import NoReturn
@@ -46,6 +46,14 @@ from typing import NoReturn
 from fsmbt.model.errors import InputError, UnsupportedError
 from fsmbt.model.fsm import FSM, Transition
 from fsmbt.semantics.lebt.spec import DEFAULT_START, NO_EVENT
+
+#: Deepest XML element a written ``<BehaviorTree>`` may hold, ``<root>`` = level 1 (so its
+#: tree's root node is on level 3): BehaviorTree.CPP 4.8.2's tinyxml2 refuses 500, 4.9+ refuses
+#: 256 (docs/semantics.md §5, "Depth-bounded LEBT").
+MAX_XML_LEVELS = 200
+#: Selector levels an LEBT may nest (``bound_depth``): ``k`` levels give a tree of ``2k + 1``
+#: node levels, i.e. XML down to level ``2k + 3``.
+MAX_SELECTOR_LEVELS = (MAX_XML_LEVELS - 3) // 2
 
 # pred_mark values besides a state index: no predecessor yet, several distinct predecessors
 _NO_PRED = -1
@@ -62,7 +70,8 @@ class LebtStructure:
         entry_id: The entry state's index.
         reachable_ids: The reachable states' indices, ascending (declaration order); a
             ``range`` when every state is reachable (no integer object per state).
-        root_ids: The entry state, then the loop states, in declaration order.
+        root_ids: The entry state, then the loop states, in declaration order (after
+            ``bound_depth``: then the states promoted to roots to bound the depth).
         loop_ids: The loop states (in-degree >= 2), in declaration order.
         kept_sources: The source of every transition that can fire (out of a reachable,
             non-final state, the first per (source, event)), grouped by source in declaration
@@ -387,4 +396,69 @@ def analyse(fsm: FSM) -> LebtStructure:
         placed,
         fsm.initial_event if fsm.initial_event is not None else NO_EVENT,
         unreachable,
+    )
+
+
+def bound_depth(structure: LebtStructure, max_levels: int = MAX_SELECTOR_LEVELS) -> LebtStructure:
+    """The structure with no selector nested deeper than ``max_levels`` (root selectors = 1):
+    docs/semantics.md §5, "Depth-bounded LEBT".
+
+    Rule: walk the links from the roots; a state whose selector would sit on level
+    ``max_levels + 1`` is not linked below its predecessor but *promoted* to a root (appended
+    to the root Sequence in the order the walk meets them) and its own links are counted from
+    level 1 again. A promoted state is entered as a loop state is: its predecessor's leaf
+    returns SUCCESS with the event pending, every enclosing Sequence completes (the later
+    sibling guards do not hold the pair), and the root's Sequence reaches the promoted
+    selector in the same tick or, when it lies before, in the second tick of the macro step.
+    So a chain of ``n`` states becomes ``ceil(n / max_levels)`` root selectors each holding a
+    chain of at most ``max_levels`` states: depth ``2 * max_levels + 1`` for any ``n``.
+
+    Returns ``structure`` itself (no copy) when nothing is that deep, so small machines keep
+    the paper's exact shape. O(S) time, no recursion.
+    """
+    if max_levels < 1:
+        raise ValueError("max_levels must be >= 1")
+    counts = structure.child_counts
+    first = array("l", [0]) * (len(counts) + 1)  # where each state's links start
+    total = 0
+    for state, count in enumerate(counts):
+        first[state] = total
+        total += count
+    child_targets = structure.child_targets
+    level = array("l", [0]) * len(counts)
+    queue = list(structure.root_ids)
+    for root in queue:
+        level[root] = 1
+    promoted: list[int] = []
+    for state in queue:  # the list grows while it is read: a queue without pops
+        count = counts[state]
+        if not count:
+            continue
+        below = level[state] + 1
+        for child in child_targets[first[state] : first[state] + count]:
+            if below > max_levels:
+                promoted.append(child)
+                level[child] = 1
+            else:
+                level[child] = below
+            queue.append(child)
+    if not promoted:
+        return structure
+    cut = bytearray(len(counts))
+    for state in promoted:
+        cut[state] = 1
+    child_sources: array[int] = array("l")
+    kept_targets: array[int] = array("l")
+    child_counts = array("l", [0]) * len(counts)
+    for source, target in zip(structure.child_sources, child_targets):
+        if not cut[target]:
+            child_sources.append(source)
+            kept_targets.append(target)
+            child_counts[source] += 1
+    return replace(
+        structure,
+        root_ids=[*structure.root_ids, *promoted],
+        child_sources=child_sources,
+        child_targets=kept_targets,
+        child_counts=child_counts,
     )

@@ -286,6 +286,8 @@ def convert(request: dict[str, Any]) -> dict[str, Any]:
         "downloads": download_formats(kind),
         "runtimes": runtime_kinds() if kind == "bt" else [],
         "timings": {k: round(v, 6) for k, v in outcome.timings.items()},
+        # the load check (docs/semantics.md §5): "loads in BehaviorTree.CPP 4.8.2: yes"
+        "loads": outcome.load.summary() if outcome.load is not None else None,
     }
 
 

@@ -29,11 +29,10 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-from fsmbt.cache import cache_root
+from fsmbt.cache import BTCPP_VERSION, btcpp_prefix
 from fsmbt.install import build_script as install_script
 from fsmbt.model.errors import FsmbtError
 
-BTCPP_VERSION = "4.8.2"
 PACKAGE_DIR = Path(__file__).resolve().parent
 HEADER = PACKAGE_DIR / "include" / "fsmbt" / "lebt.hpp"
 DRIVER_SOURCE = PACKAGE_DIR / "driver" / "fsmbt_lebt_driver.cpp"
@@ -60,7 +59,7 @@ def build_script() -> Path:
 
 def library_prefix() -> Path:
     """Where BehaviorTree.CPP is installed by the build script (may not exist)."""
-    return cache_root() / f"btcpp-{BTCPP_VERSION}"
+    return btcpp_prefix()
 
 
 def library_built() -> bool:

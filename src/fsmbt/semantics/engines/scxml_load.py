@@ -1,0 +1,48 @@
+"""Does python-statemachine load an SCXML document fsmbt wrote? The load check of every written
+state machine (docs/semantics.md §5, "Every written tree loads").
+
+Rule: where python-statemachine (a W3C SCXML engine written by others; fsmbt's test oracle,
+issue 11) is installed, ``convert`` loads each SCXML result with
+``statemachine.io.loader.load(text, format="scxml")`` and makes one instance (which enters the
+initial configuration, as a user's first step would); an exception is a refusal - a located
+error, never a verdict. Without python-statemachine there is no check (``None``) and the summary
+says nothing about it. The text is fsmbt's own writer's: expressions are evaluated by the
+engine's safe evaluator, no user code is imported.
+
+Costs: the engine's parse and one start, O(document size).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+
+from fsmbt.semantics.engines.btcpp_load import LoadCheck
+
+ENGINE = "python-statemachine"
+
+
+def engine_name() -> str | None:
+    """``python-statemachine 3.2.2`` when it imports, else ``None``."""
+    try:
+        import statemachine
+    except ImportError:
+        return None
+    return f"{ENGINE} {getattr(statemachine, '__version__', '')}".strip()
+
+
+def check_scxml_loads(text: str) -> LoadCheck | None:
+    """Load ``text`` in python-statemachine and start one instance; ``None`` without it."""
+    engine = engine_name()
+    if engine is None:
+        return None
+    from statemachine.io.loader import load
+
+    try:
+        with contextlib.redirect_stdout(io.StringIO()):  # the engine prints <log> content
+            chart = load(text, format="scxml")
+            chart()
+    except Exception as exc:  # the engine's own error classes, whatever they are
+        message = " ".join(f"{type(exc).__name__}: {exc}".split())[:600]
+        return LoadCheck(engine, False, message)
+    return LoadCheck(engine, True)
