@@ -1,7 +1,7 @@
 """CI's fuzz budget: a short, seeded atheris run of every reader finds nothing.
 
 Runs fuzz/fuzz_readers.py as a user would (one subprocess per reader batch, memory cap, per-input
-alarm), 2 000 inputs per reader with a fixed seed, into a temporary working corpus and
+alarm), 800 inputs per reader (2 000 with ``FSMBT_FULL_SUITES=1``) with a fixed seed, into a temporary working corpus and
 regression folder, and checks the printed table: one row per reader of the format registry,
 every budgeted iteration run, no crash, timeout or memory finding. About 3 s per reader.
 """
@@ -18,8 +18,10 @@ import pytest
 
 from fsmbt.formats import formats
 from support.fuzz_harness_loader import ROOT, SCRIPT
+from support.sampling import full
 
-ITERATIONS = 2_000
+#: 800 inputs per reader in CI's budget (16 readers), 2 000 with FSMBT_FULL_SUITES=1
+ITERATIONS = 2_000 if full() else 800
 SEED = 18
 
 pytest.importorskip("atheris")

@@ -17,6 +17,10 @@ Six groups, one test each, so a failure names the group:
 - mutation suite: every mutant of every family of tests/verify/test_ver_mutations.py, mutated on
   the same side as there, plus the unmutated pairs.
 
+The examples' mutants and the mutation suite's are seeded samples (``MUTANTS_PER_FAMILY``,
+``EXAMPLE_MUTANTS``; ``FSMBT_FULL_SUITES=1`` checks all of them, ``FSMBT_TEST_SEED`` draws
+another sample: tests/support/sampling.py), so the suite fits CI's time budget.
+
 For each pair NuSMV's ``check`` and the native ``verify`` run in a worker thread (NuSMV is a
 subprocess, so threads suffice). ``UnsupportedError`` (from the NuSMV encoding or the converter)
 counts as *unsupported* and is reported by reason, never as agreement; in the examples and
@@ -51,12 +55,17 @@ from fsmbt.verify.nusmv import check
 from fsmbt.verify.nusmv.runner import NuSMVError
 from fsmbt.verify.pairing import machines_for
 from support.corpus import CORPUS
+from support.sampling import sample
 
 REPO = Path(__file__).resolve().parents[3]
 PAIRS = int(os.environ.get("FSMBT_NUSMV_PAIRS", "300"))
 TIMEOUT_S = 600  # a hang guard, not a speed target: workers share 2 cores with pytest-xdist
 WORKERS = os.cpu_count() or 2
 MUTATED = 4  # generated pairs whose mutants are checked too (the hand-built ones all are)
+#: The long groups check seeded samples of their mutants (support/sampling.py): the mutation
+#: suite's 465 mutants took 15 min of the 30-minute CI budget, the examples' 3 min
+MUTANTS_PER_FAMILY = 10
+EXAMPLE_MUTANTS = 12
 SHOWN = 5  # disagreements printed in full
 #: Examples and corpus: pairs whose native machines have more states are not given to NuSMV
 #: (its cost grows steeply with the states: game_npc_bt.xml, 264 states, takes ~100 CPU seconds
@@ -609,8 +618,21 @@ def _read(path: Path, notes: Counter[str]) -> Model | None:
 
 
 def example_pairs(notes: Counter[str]) -> Iterator[Pair | Rejected]:
-    """Every example converted (with mutants of both sides). The examples hold FSMs and BTs,
-    so both directions are covered."""
+    """Every example converted, and a seeded sample of the mutants of both sides (all of them
+    with ``FSMBT_FULL_SUITES=1``). The examples hold FSMs and BTs, so both directions are
+    covered."""
+    conversions: list[Pair | Rejected] = []
+    mutated: list[Pair] = []
+    for item in _example_pairs(notes):
+        if isinstance(item, Pair) and not item.conversion:
+            mutated.append(item)
+        else:
+            conversions.append(item)
+    yield from conversions
+    yield from sample(mutated, EXAMPLE_MUTANTS, "NuSMV example mutants")
+
+
+def _example_pairs(notes: Counter[str]) -> Iterator[Pair | Rejected]:
     for path in sorted((REPO / "examples").iterdir()):
         model = _read(path, notes)
         if model is None:
@@ -650,7 +672,8 @@ def corpus_pairs(notes: Counter[str]) -> Iterator[Pair | Rejected]:
 
 # -- the mutation suite --------------------------------------------------------------------------
 def mutation_suite_pairs() -> Iterator[Pair]:
-    """The unmutated pairs of each family once, and every mutant of every family."""
+    """The unmutated pairs of each family once, and a seeded sample of ``MUTANTS_PER_FAMILY``
+    mutants of every family (all of them with ``FSMBT_FULL_SUITES=1``; support/sampling.py)."""
     from support.mutation_families import FAMILIES, family_mutants  # tests/support
 
     seen: set[str] = set()
@@ -660,7 +683,8 @@ def mutation_suite_pairs() -> Iterator[Pair]:
             seen.add(make_pairs.__name__)
             for index, (source, result) in enumerate(pairs):
                 yield Pair(f"{make_pairs.__name__}[{index}]", source, result)
-        for index, k, mutant, source, result in family_mutants(pairs, side):
+        drawn = sample(family_mutants(pairs, side), MUTANTS_PER_FAMILY, f"NuSMV mutants {family}")
+        for index, k, mutant, source, result in drawn:
             yield Pair(f"{family}[{index}]/{k}-{mutant.operator}", source, result)
 
 
