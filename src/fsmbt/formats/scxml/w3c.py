@@ -113,6 +113,9 @@ def _flatten(actions: list[Action]) -> list[Action]:
     return out
 
 
+_UNKNOWN = object()  # a cache miss (a cached value may be None)
+
+
 @dataclass
 class _T:
     source: int
@@ -914,13 +917,22 @@ class _Interpreter:
         #: once: a guard is asked again in every configuration with the same data)
         self.pure: dict[int, tuple[str, ...] | None] = {}
         self.memo: dict[tuple[int, tuple[object, ...]], object] = {}
+        # the document's shape does not change while it runs: atomic/compound once per state
+        self.is_atomic: list[bool] = [
+            not any(self.s[c].kind != "history" for c in node.children) for node in self.s
+        ]
+        self.fixed_domain: dict[int, int | None] = {}
+        self.is_compound: list[bool] = [
+            node.kind in ("state", "scxml") and not self.is_atomic[i]
+            for i, node in enumerate(self.s)
+        ]
 
     # -- tree helpers ---------------------------------------------------------------------------
     def atomic(self, i: int) -> bool:
-        return not [c for c in self.s[i].children if self.s[c].kind != "history"]
+        return self.is_atomic[i]
 
     def compound(self, i: int) -> bool:
-        return self.s[i].kind in ("state", "scxml") and not self.atomic(i)
+        return self.is_compound[i]
 
     def descendant(self, i: int, of: int) -> bool:
         return of in self.ancestors[i]
@@ -978,10 +990,17 @@ class _Interpreter:
             )
             reads = self.pure[id(expr)] = tuple(sorted(expr.names)) if pure else None
         key = None
-        if reads is not None and all(name in run.data for name in reads):
-            key = (id(expr), tuple((type(v), v) for v in (run.data[n] for n in reads)))
-            if key in self.memo:
-                return self.memo[key]
+        if reads is not None:
+            data = run.data
+            try:
+                read = tuple([data[n] for n in reads])
+            except KeyError:
+                pass  # a variable not yet defined: evaluated (and raises) below
+            else:  # types too: 1, 1.0 and True are equal keys but print differently
+                key = (id(expr), read, tuple(map(type, read)))
+                hit = self.memo.get(key, _UNKNOWN)
+                if hit is not _UNKNOWN:
+                    return hit
         try:
             value = scxml_expr.evaluate(
                 expr,
@@ -1005,7 +1024,8 @@ class _Interpreter:
         self, run: _Run, event: str | None, valuation: dict[int, bool], read: set[int]
     ) -> list[_T]:
         enabled: list[_T] = []
-        atoms = sorted((i for i in run.config if self.atomic(i)), key=self.order.__getitem__)
+        is_atomic = self.is_atomic
+        atoms = sorted((i for i in run.config if is_atomic[i]), key=self.order.__getitem__)
         for atom in atoms:
             for state in [atom, *self.ancestors[atom]]:
                 chosen = None
@@ -1057,6 +1077,17 @@ class _Interpreter:
         return out
 
     def domain(self, t: _T, run: _Run) -> int | None:
+        """W3C getTransitionDomain. Without a history target it depends on ``t`` alone and is
+        computed once per transition (``fixed_domain``)."""
+        cached = self.fixed_domain.get(id(t), _UNKNOWN)
+        if cached is not _UNKNOWN:
+            return cached  # type: ignore[return-value]
+        found = self._domain(t, run)
+        if not any(self.s[x].kind == "history" for x in t.targets):
+            self.fixed_domain[id(t)] = found  # ``t`` lives as long as the document
+        return found
+
+    def _domain(self, t: _T, run: _Run) -> int | None:
         targets = self.effective_targets(t, run)
         if not targets:
             return None
