@@ -26,7 +26,7 @@ import corpus_coverage  # noqa: E402 - the sibling script: corpus files and prof
 
 from fsmbt import api  # noqa: E402
 from fsmbt.convert.bt_to_hfsm import bt_to_hfsm  # noqa: E402
-from fsmbt.formats.scxml import write_scxml  # noqa: E402
+from fsmbt.formats.scxml.structural import write_scxml  # noqa: E402
 from fsmbt.model.bt import BTDocument  # noqa: E402
 from fsmbt.model.errors import InputError  # noqa: E402
 from fsmbt.model.fsm import FSM  # noqa: E402

@@ -30,12 +30,19 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from fsmbt.formats.annotations import annotation_losses
-from fsmbt.formats.registry import ReadContext, get_format, loads, refuse_data_loss
+from fsmbt.formats.registry import (
+    DATA_FORMATS,
+    ReadContext,
+    get_format,
+    loads,
+    refuse_data_loss,
+)
 from fsmbt.model import Model
 from fsmbt.model.errors import InputError, UnsupportedError
 from fsmbt.model.flatten import flatten as flatten_fsm
 from fsmbt.model.flatten import needs_flattening
 from fsmbt.model.fsm import FSM
+from fsmbt.model.fsm_data import DATAMODEL, has_data, parse_lines
 from fsmbt.model.serialize import model_to_dict
 
 #: More generic differences than this are summarised in one line.
@@ -96,6 +103,20 @@ def translate(
             "parallel and transient states"
         )
         losses.extend(annotation_losses(model, written, "the flattened machine")[0])
+    if isinstance(written, FSM) and has_data(written) and target.name not in DATA_FORMATS:
+        # no place for the data model: the exact expansion, named (docs/semantics.md §6a)
+        variables = [name for name, _expr in parse_lines(written.attrs[DATAMODEL])]
+        expanded = flatten_fsm(written)
+        shown = ", ".join(variables[:4]) + (
+            f" and {len(variables) - 4} more" if len(variables) > 4 else ""
+        )
+        losses.append(
+            f"{target.name} has no data model: the {len(variables)} variable(s) ({shown}) and "
+            f"the guards and assignments reading them are written as the machine's exact "
+            f"expansion, {len(expanded.states)} flat states (configuration x values) instead "
+            f"of {sum(1 for _ in written.walk())}; SCXML, JSON, YAML and SMACH keep them as data"
+        )
+        written = expanded
     checked = model  # what the read-back must equal in behaviour (events renamed, if any)
     if target.name == "scxml" and isinstance(written, FSM):
         events = scxml_event_renames(written)
