@@ -922,6 +922,10 @@ class _Interpreter:
             not any(self.s[c].kind != "history" for c in node.children) for node in self.s
         ]
         self.fixed_domain: dict[int, int | None] = {}
+        self.names: dict[frozenset[int], str] = {}  # configuration -> its part of a name
+        self.actions: dict[frozenset[int], str | None] = {}  # configuration -> its action
+        self.fitting: dict[tuple[int, str | None], list[_T]] = {}  # (state, event) -> matching
+        self.shown: dict[tuple[str, type, object], str] = {}  # (var, type, value) -> "var=v"
         self.is_compound: list[bool] = [
             node.kind in ("state", "scxml") and not self.is_atomic[i]
             for i, node in enumerate(self.s)
@@ -1029,12 +1033,19 @@ class _Interpreter:
         for atom in atoms:
             for state in [atom, *self.ancestors[atom]]:
                 chosen = None
-                for t in self.s[state].transitions:
-                    if event is None:
-                        fits = not t.events
-                    else:
-                        fits = any(_matches(d, event) for d in t.events)
-                    if fits and self.cond_ok(t, run, valuation, read):
+                fitting = self.fitting.get((state, event))
+                if fitting is None:  # the transitions whose descriptors match, in order
+                    fitting = self.fitting[(state, event)] = [
+                        t
+                        for t in self.s[state].transitions
+                        if (
+                            not t.events
+                            if event is None
+                            else any(_matches(d, event) for d in t.events)
+                        )
+                    ]
+                for t in fitting:
+                    if self.cond_ok(t, run, valuation, read):
                         chosen = t
                         break
                 if chosen is not None:
@@ -1349,6 +1360,31 @@ class _Interpreter:
         history: tuple[tuple[int, frozenset[int]], ...],
         data: tuple[tuple[str, scxml_expr.Value], ...] = (),
     ) -> str:
+        """A flat state's name: the configuration, then the history values, then the data
+        (``on/cooking#door_closed=true;timer=3``). The configuration part and each shown
+        value are computed once (many flat states share them)."""
+        text = self.names.get(config)
+        if text is None:
+            text = self.names[config] = self._config_name(config)
+        if history:
+            parts = []
+            for h, value in history:
+                inner = ",".join(self.s[x].name for x in sorted(value, key=self.order.__getitem__))
+                parts.append(f"{self.s[h].name}={inner}")
+            text += "#" + ";".join(parts)
+        if data:
+            shown = self.shown
+            pieces = []
+            for k, v in data:
+                key = (k, type(v), v)
+                piece = shown.get(key)
+                if piece is None:
+                    piece = shown[key] = f"{k}={scxml_expr.shown(v)}"
+                pieces.append(piece)
+            text += ("#" if not history else ";") + ";".join(pieces)
+        return text
+
+    def _config_name(self, config: frozenset[int]) -> str:
         out: list[str] = []
         top = [c for c in self.s[0].children if c in config]
         stack: list[int | str] = list(reversed(top))
@@ -1373,19 +1409,15 @@ class _Interpreter:
                 stack.extend(reversed(pieces))
             else:
                 stack.extend([k for k in kids if k in config][:1] + ["/"])
-        text = "".join(out)
-        if history:
-            parts = []
-            for h, value in history:
-                inner = ",".join(self.s[x].name for x in sorted(value, key=self.order.__getitem__))
-                parts.append(f"{self.s[h].name}={inner}")
-            text += "#" + ";".join(parts)
-        if data:
-            values = ";".join(f"{k}={scxml_expr.shown(v)}" for k, v in data)
-            text += ("#" if not history else ";") + values
-        return text
+        return "".join(out)
 
     def action(self, config: frozenset[int]) -> str | None:
+        found = self.actions.get(config, _UNKNOWN)
+        if found is _UNKNOWN:
+            found = self.actions[config] = self._action(config)
+        return found  # type: ignore[return-value]
+
+    def _action(self, config: frozenset[int]) -> str | None:
         atoms = sorted(
             (i for i in config if self.atomic(i) and not self.s[i].wrapper),
             key=self.order.__getitem__,
