@@ -387,7 +387,7 @@ class _Writer:
             extension["data"] = self.data.extension()
         lines.append("__fsmbt__ = " + _py(extension))
         lines.append("")
-        keys = [name for name, _expr in self.data.variables]
+        data_keys = [name for name, _expr in self.data.variables]
         for name, outcomes, code in self.generated:
             lines += [
                 "",
@@ -397,7 +397,7 @@ class _Writer:
                 "",
                 "    def __init__(self):",
                 f"        smach.State.__init__(self, outcomes={_py(list(outcomes))}, "
-                f"input_keys={_py(keys)}, output_keys={_py(keys)})",
+                f"input_keys={_py(data_keys)}, output_keys={_py(data_keys)})",
                 "",
                 code,
                 "",

@@ -916,7 +916,7 @@ class _Interpreter:
         #: id(expr) -> the names read, and (id(expr), values) -> value (same result, computed
         #: once: a guard is asked again in every configuration with the same data)
         self.pure: dict[int, tuple[str, ...] | None] = {}
-        self.memo: dict[tuple[int, tuple[object, ...]], object] = {}
+        self.memo: dict[tuple[int, tuple[object, ...], tuple[type, ...]], object] = {}
         # the document's shape does not change while it runs: atomic/compound once per state
         self.is_atomic: list[bool] = [
             not any(self.s[c].kind != "history" for c in node.children) for node in self.s
