@@ -27,8 +27,9 @@ from fsmbt.formats.pysm.smach_write import smach_losses, write_smach, write_smac
 from fsmbt.formats.scxml import expr as scxml_expr
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import UnsupportedError
-from fsmbt.model.fsm import FSM
+from fsmbt.model.fsm import FSM, State
 from fsmbt.model.fsm_data import ASSIGN, COND, DATAMODEL, ONEXIT, parse_lines
+from fsmbt.verify import verify
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 
@@ -216,3 +217,44 @@ def test_formats_without_a_data_model_get_the_expansion_and_name_the_variables(
     assert report is not None and report.equivalent
     named = [loss for loss in result.losses if "has no data model" in loss]
     assert len(named) == 1 and "RetryUntilSuccessful_try_count" in named[0]
+
+
+def _guarded_exit_model() -> FSM:
+    """A composite that resets ``x`` on exit and is left by guarded completion transitions:
+    W3C selects on the old ``x``, then runs ``<onexit>``."""
+    region = FSM(name="C")
+    region.add_state(State("a", action="a"))
+    region.add_state(State("DONE", action=None, final=True))
+    region.initial = "a"
+    region.add_transition("a", "go", "DONE", attrs={ASSIGN: "x=x + 1"})
+    top = FSM(name="top")
+    top.add_state(State("C", action=None, regions=[region], attrs={ONEXIT: "x=0"}))
+    for name in ("T1", "T2"):
+        top.add_state(State(name, action=name.lower()))
+    top.add_state(State("END", action=None, final=True))
+    top.initial = "C"
+    top.add_transition("C", None, "T1", exit="DONE", attrs={COND: "x == 1"})
+    top.add_transition("C", None, "T2", exit="DONE")
+    top.add_transition("T1", "e", "C")
+    top.add_transition("T2", "e", "END")
+    top.attrs[DATAMODEL] = "x=0"
+    return top
+
+
+def test_a_guarded_exit_runs_the_reset_after_the_guard(monkeypatch: pytest.MonkeyPatch) -> None:
+    model = _guarded_exit_model()
+    text = write_smach(model)
+    back = loads(text, "smach")
+    assert isinstance(back, FSM)
+    assert back.states["C"].attrs.get(ONEXIT) == "x=0"
+    assert _guarded(back) == _guarded(model)
+    assert verify(model, back).equivalent
+    monkeypatch.setitem(sys.modules, "smach", _recording_smach())
+    namespace: dict[str, object] = {}
+    exec(compile(text, "<fsmbt smach>", "exec"), namespace)  # code fsmbt wrote
+    root = namespace["build_state_machine"]()  # type: ignore[operator]
+    decision, _transitions = root.children["C done [guards]"]
+    userdata = types.SimpleNamespace(x=1)
+    assert decision.execute(userdata) == "to_1" and userdata.x == 0  # guard on x == 1, reset
+    userdata = types.SimpleNamespace(x=0)
+    assert decision.execute(userdata) == "to_2" and userdata.x == 0

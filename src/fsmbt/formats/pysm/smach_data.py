@@ -15,7 +15,10 @@ on the writer's own copy of the model):
   valuation where no guard holds, which a SMACH state cannot do: the generated code raises
   there, and the writer names it as a loss;
 - a composite's ``<onexit>`` assignments become a **reset state** on each transition leaving
-  it (``execute`` runs the assignments and returns ``done``).
+  it (``execute`` runs the assignments and returns ``done``); where that transition is itself
+  guarded, its decision state runs them instead, after the guard and before the transition's
+  own assignments (the W3C order: select on the old values, exit, then the transition's
+  content).
 
 The guards and assignments are fsmbt's expression subset (``fsmbt.formats.scxml.expr``): they are
 parsed with ``ast`` (never run) and only names, literals, comparisons, ``and``/``or``/``not``,
@@ -74,7 +77,8 @@ class DataPlan:
     variables: list[tuple[str, str]] = field(default_factory=list)  # (name, initial expr)
     initial: list[tuple[str, str]] = field(default_factory=list)  # (name, Python code)
     decisions: list[list[object]] = field(default_factory=list)  # [path, name, [[cond, assign]]]
-    resets: list[list[object]] = field(default_factory=list)  # [path, name, composite, assign]
+    resets: list[list[object]] = field(default_factory=list)  # [path, name]
+    onexit: list[list[object]] = field(default_factory=list)  # [path, composite, assign]
     losses: list[str] = field(default_factory=list)
 
     def extension(self) -> dict[str, object]:
@@ -83,6 +87,7 @@ class DataPlan:
             "datamodel": "\n".join(f"{n}={e}" for n, e in self.variables),
             "decisions": self.decisions,
             "resets": self.resets,
+            "onexit": self.onexit,
         }
 
 
@@ -154,6 +159,15 @@ def split_data(top: FSM) -> DataPlan:
             raise UnsupportedError(f"SMACH: variable '{name}' is not a userdata key name")
         plan.initial.append((name, python_code(expr, set(), f"the initial value of '{name}'")))
     for path, machine in _machines(top):
+        exits: dict[str, list[str]] = {}  # composite -> its <onexit> assignments as code
+        for state in machine.states.values():
+            assign = state.attrs.pop(ONEXIT, None)
+            if assign is not None:
+                at = f"'{'/'.join([*path, state.name])}' (on exit)"
+                exits[state.name] = [
+                    f"userdata.{n} = {python_code(e, names, at)}" for n, e in parse_lines(assign)
+                ]
+                plan.onexit.append([path, state.name, assign])
         groups: dict[tuple[str, str | None], list[Transition]] = {}
         for t in machine.transitions:
             groups.setdefault((t.source, t.event), []).append(t)
@@ -175,10 +189,16 @@ def split_data(top: FSM) -> DataPlan:
             code = ["    def execute(self, userdata):"]
             for k, g in enumerate(group, start=1):
                 cond, assign = g.attrs.get(COND), g.attrs.get(ASSIGN)
+                # W3C order: the guard on the values before the step, then the source's
+                # <onexit>, then the transition's own assignments
                 body = [
-                    f"userdata.{n} = {python_code(e, names, at)}"
-                    for n, e in parse_lines(assign or "")
-                ] + [f"return {f'to_{k}'!r}"]
+                    *exits.get(t.source, []),
+                    *(
+                        f"userdata.{n} = {python_code(e, names, at)}"
+                        for n, e in parse_lines(assign or "")
+                    ),
+                    f"return {f'to_{k}'!r}",
+                ]
                 if cond is not None:
                     code.append(f"        if {python_code(cond, names, at)}:")
                     code.extend(f"            {line}" for line in body)
@@ -201,13 +221,11 @@ def split_data(top: FSM) -> DataPlan:
                 rebuilt.append(Transition(decision, f"to_{k}", g.target))
             plan.decisions.append([path, decision, branches])
         machine.transitions = rebuilt
-        for state in list(machine.states.values()):
-            assign = state.attrs.pop(ONEXIT, None)
-            if assign is None:
-                continue
-            at = f"'{'/'.join([*path, state.name])}' (on exit)"
-            lines = [f"userdata.{n} = {python_code(e, names, at)}" for n, e in parse_lines(assign)]
-            for t in [t for t in machine.transitions if t.source == state.name]:
+        deciding = {str(d[1]) for d in plan.decisions if d[0] == path}
+        for source, lines in exits.items():
+            for t in [t for t in machine.transitions if t.source == source]:
+                if t.target in deciding:
+                    continue  # the decision state runs the <onexit> after its guard
                 reset = _unique(f"{state.name} exit", machine.states)
                 made = State(reset, action=None)
                 made.attrs[A_CODE] = "\n".join(
@@ -218,7 +236,7 @@ def split_data(top: FSM) -> DataPlan:
                 machine.states[reset] = made
                 machine.transitions.append(Transition(reset, DONE, t.target))
                 t.target = reset
-                plan.resets.append([path, reset, state.name, assign])
+                plan.resets.append([path, reset])
     return plan
 
 
@@ -250,9 +268,9 @@ def fold_data(top: FSM, data: object) -> None:
                 rebuilt.append(Transition(t.source, t.event, outs[f"to_{k}"], t.exit, attrs))
         machine.transitions = rebuilt
         del machine.states[name]
-    for path, name, composite, assign in data.get("resets", []):
+    for path, name in data.get("resets", []):
         machine = machines.get(tuple(path))
-        if machine is None or name not in machine.states or composite not in machine.states:
+        if machine is None or name not in machine.states:
             continue
         after = next(t.target for t in machine.transitions if t.source == name)
         for t in machine.transitions:
@@ -260,5 +278,8 @@ def fold_data(top: FSM, data: object) -> None:
                 t.target = after
         machine.transitions = [t for t in machine.transitions if t.source != name]
         del machine.states[name]
-        machine.states[composite].attrs[ONEXIT] = assign
+    for path, composite, assign in data.get("onexit", []):
+        machine = machines.get(tuple(path))
+        if machine is not None and composite in machine.states:
+            machine.states[composite].attrs[ONEXIT] = assign
     top.attrs[DATAMODEL] = data["datamodel"]
