@@ -333,27 +333,51 @@ class _Compactor:
         return specs, undecided
 
     def _consistent(self, items: list, reads: list[int], chosen: list[int]):
-        """{valuation of ``reads``: spec}, or ``None`` when some valuation has no one spec."""
-        specs, undecided = self._specs(items, reads, chosen)
-        return None if undecided else specs
+        """{valuation of ``reads``: spec}, or ``None`` when some valuation has no one spec
+        (found at the first such valuation)."""
+        project = _projector(reads)
+        vec = self.vec
+        groups: dict[Hashable, list] = {}
+        for item in items:
+            key = project(vec[item[0]])
+            group = groups.get(key)
+            if group is None:
+                groups[key] = [item]
+            else:
+                group.append(item)
+        specs = {}
+        for key, group in groups.items():
+            spec = self._spec(group, chosen)
+            if spec is None:
+                return None
+            specs[key] = spec
+        return specs
 
     def decide(self, items, chosen: list[int]):
         """For one (leaf, input): the deciding variables and {outcome: valuations}. Greedy:
         add the variable that leaves the least uncertainty (conditional entropy) about what
         the transitions do, until every valuation has one outcome; then drop the variables
-        the others make redundant (last added first)."""
+        the others make redundant (last added first).
+
+        Only the transitions of still undecided valuations are looked at again when a variable
+        is added: a valuation with one outcome splits into valuations with that one outcome.
+        """
         signature = {id(item): self._signature(item, chosen) for item in items}
         reads: list[int] = []
+        pending = items  # the transitions of the valuations not decided yet
         while True:
-            specs, undecided = self._specs(items, reads, chosen)
+            _decided, undecided = self._specs(pending, reads, chosen)
             if not undecided:
                 break
             project = _projector(reads)
-            rows = [
-                (prefix, self.vec[it[0]], signature[id(it)])
-                for it in items
-                if (prefix := project(self.vec[it[0]])) in undecided
-            ]
+            rows = []
+            still = []
+            for it in pending:
+                prefix = project(self.vec[it[0]])
+                if prefix in undecided:
+                    rows.append((prefix, self.vec[it[0]], signature[id(it)]))
+                    still.append(it)
+            pending = still
             best, best_key = None, None
             prefixes = [prefix for prefix, _vs, _sig in rows]
             signatures = [sig for _p, _vs, sig in rows]
@@ -372,11 +396,15 @@ class _Compactor:
                     best, best_key = i, key
             assert best is not None  # all of ``chosen`` decides every outcome (rule 1)
             reads.append(best)
+        specs = None
         for i in reversed(list(reads)):
             fewer = [r for r in reads if r != i]
             smaller = self._consistent(items, fewer, chosen)
             if smaller is not None:
                 reads, specs = fewer, smaller
+        if specs is None:
+            specs = self._consistent(items, reads, chosen)
+            assert specs is not None  # every valuation of ``reads`` was decided above
         outcomes: dict[Hashable, list[tuple[Any, ...]]] = {}
         for valuation, spec in specs.items():
             outcomes.setdefault(spec, []).append(_as_tuple(valuation, len(reads)))
