@@ -26,6 +26,7 @@ as a 500 with one line, never a traceback.
 from __future__ import annotations
 
 import asyncio
+import contextlib
 import logging
 import multiprocessing
 import os
@@ -218,7 +219,7 @@ class Workers:
         pool.shutdown(wait=False, cancel_futures=True)
         for process in processes:
             if process.is_alive() and process.pid is not None:
-                os.kill(process.pid, signal.SIGKILL)
+                _kill(process.pid)
 
     def close(self, grace_s: float = 3.0) -> None:
         """Stop the workers: queued calls are cancelled, running ones get ``grace_s`` seconds
@@ -230,5 +231,11 @@ class Workers:
         for process in processes:
             process.join(timeout=grace_s)
             if process.is_alive() and process.pid is not None:
-                os.kill(process.pid, signal.SIGKILL)
+                _kill(process.pid)
                 process.join(timeout=1.0)
+
+
+def _kill(pid: int) -> None:
+    """SIGKILL a worker that was alive a moment ago; one that ended in between is fine."""
+    with contextlib.suppress(ProcessLookupError):
+        os.kill(pid, signal.SIGKILL)
