@@ -155,8 +155,8 @@ class _Compactor:
             keys.update(found)
         self.keys: list[Feature] = sorted(keys, key=lambda k: (k[0], k[1:]))
         defaults = [self._default(k) for k in self.keys]
-        self.vec: list[tuple[Any, ...]] = [
-            tuple(f.get(k, d) for k, d in zip(self.keys, defaults, strict=True)) for f in features
+        self.vec: list[tuple[Any, ...]] = [  # f.get(key, default) per key, in C
+            tuple(map(f.get, self.keys, defaults)) for f in features
         ]
         self.edges: list[tuple[int, str, int | RootResult, tuple[str, ...]]] = []
         for n, s in enumerate(live):
@@ -239,12 +239,14 @@ class _Compactor:
             for at, source, head, live_target in edges:
                 outcome = (head, -1 if live_target is None else cls[live_target])
                 seen = first.setdefault((at, cls[source]), (outcome, source))
-                if seen[0] != outcome and pairs < _MAX_PAIRS:
+                if seen[0] != outcome:
                     pairs += 1
                     vs, other = self.vec[source], self.vec[seen[1]]
                     for i in range(width):
                         if i not in taken and vs[i] != other[i]:
                             tally[i] += 1
+                    if pairs == _MAX_PAIRS:
+                        break  # the ranking is made: later pairs were not counted anyway
             if not tally:
                 return chosen
             best = max(tally, key=lambda i: (tally[i], -i))
