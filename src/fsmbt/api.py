@@ -57,7 +57,7 @@ from fsmbt.api_types import (
 from fsmbt.convert import ConversionResult, convert
 from fsmbt.formats import detect_format, dumps, get_format, loads
 from fsmbt.formats.registry import format_for_path, read_text
-from fsmbt.formats.translate import Translation
+from fsmbt.formats.translate import Translation, expand_data_for
 from fsmbt.formats.translate import translate as translate_model
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import Hint, InputError, SourceLocation, UnsupportedError
@@ -822,7 +822,11 @@ def convert_loaded(
             **engine_options,
         )
     fmt = output_format_for(model_kind(conversion.model), to=request.to, output=destination)
-    text = dumps(conversion.model, fmt)
+    # a format without a data model gets the proven machine's exact expansion, named
+    written_model, data_loss = expand_data_for(conversion.model, fmt)
+    if data_loss is not None:
+        conversion.warnings.append(data_loss)
+    text = dumps(written_model, fmt)
     report: Report | None = None
     if request.verify:
         with _timed(timings, "verify", on_stage):

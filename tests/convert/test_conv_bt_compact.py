@@ -193,7 +193,8 @@ def test_render_pages_one_level_per_picture_within_4096(tmp_path) -> None:  # no
 
 
 def test_cli_convert_compact_unroll_and_pages(tmp_path, capsys) -> None:  # noqa: ANN001
-    """``fsmbt convert`` writes the data model by default and says what the proof checked;
+    """``fsmbt convert`` writes the data model by default and says what the proof checked (a
+    format without a data model: the exact expansion, named as a loss);
     ``--unroll`` writes the product; ``fsmbt render --pages`` draws one picture per level."""
     from fsmbt.cli import main
 
@@ -210,6 +211,10 @@ def test_cli_convert_compact_unroll_and_pages(tmp_path, capsys) -> None:  # noqa
     assert main(["render", str(compact), "--pages", str(tmp_path / "pages")]) == 0
     assert (tmp_path / "pages" / "top.svg").exists()
     assert len(list((tmp_path / "pages").glob("*.svg"))) >= 2
-    assert main(["convert", str(example), "-o", str(tmp_path / "npc.txt")]) == 2
+    # a format without a data model gets the proven machine's exact expansion, named
+    assert main(["convert", str(example), "-o", str(tmp_path / "npc.txt")]) == 0
     shown = capsys.readouterr()
-    assert "no data model" in shown.out + shown.err
+    assert "paper-text has no data model: the 11 variable(s)" in shown.out + shown.err
+    flat = loads((tmp_path / "npc.txt").read_text(), "paper-text")
+    assert isinstance(flat, FSM) and not has_data(flat)
+    assert api.verify_models(api.load(example).model, flat).equivalent

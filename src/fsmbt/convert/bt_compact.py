@@ -38,6 +38,7 @@ transitions; the per-leaf choice O(|T|^2 · E) in the worst case, much less in p
 from __future__ import annotations
 
 import math
+import operator
 import re
 from collections import Counter
 from collections.abc import Callable, Hashable, Sequence
@@ -140,6 +141,8 @@ class _Compactor:
         self.namer = namer
         self.unique = unique
         self.fsm = FSM(name=name)
+        self.changed: dict[int, frozenset[int]] = {}  # id(explored transition) -> _changes
+        self.head_of: dict[int, Hashable] = {}  # id(explored transition) -> (next, outputs)
         self.default_memory = runtime_tables().default_memory
         live = [s for s in explored.states if not isinstance(s, RootResult)]
         # states as numbers from here on (a snapshot is a nested tuple: hashing it is costly)
@@ -152,8 +155,8 @@ class _Compactor:
             keys.update(found)
         self.keys: list[Feature] = sorted(keys, key=lambda k: (k[0], k[1:]))
         defaults = [self._default(k) for k in self.keys]
-        self.vec: list[tuple[Any, ...]] = [
-            tuple(f.get(k, d) for k, d in zip(self.keys, defaults, strict=True)) for f in features
+        self.vec: list[tuple[Any, ...]] = [  # f.get(key, default) per key, in C
+            tuple(map(f.get, self.keys, defaults)) for f in features
         ]
         self.edges: list[tuple[int, str, int | RootResult, tuple[str, ...]]] = []
         for n, s in enumerate(live):
@@ -241,12 +244,14 @@ class _Compactor:
             for at, source, head, live_target in edges:
                 outcome = (head, -1 if live_target is None else cls[live_target])
                 seen = first.setdefault((at, cls[source]), (outcome, source))
-                if seen[0] != outcome and pairs < _MAX_PAIRS:
+                if seen[0] != outcome:
                     pairs += 1
                     vs, other = self.vec[source], self.vec[seen[1]]
                     for i in range(width):
                         if i not in taken and vs[i] != other[i]:
                             tally[i] += 1
+                    if pairs == _MAX_PAIRS:
+                        break  # the ranking is made: later pairs were not counted anyway
             if not tally:
                 return chosen
             best = max(tally, key=lambda i: (tally[i], -i))
@@ -257,21 +262,39 @@ class _Compactor:
                 cls[s] = numbers.setdefault((cls[s], vs[best]), len(numbers))
 
     # -- rule 2: the transitions -------------------------------------------------------------
+    def _changes(self, item: tuple[Any, Any, Any], chosen: list[int]) -> frozenset[int]:
+        """The chosen variables one explored transition changes (cached per transition)."""
+        found = self.changed.get(id(item))
+        if found is None:
+            source, target, _outs = item
+            if isinstance(target, RootResult):
+                found = frozenset()
+            else:
+                vs, vt = self.vec[source], self.vec[target]
+                found = frozenset(i for i in chosen if vs[i] != vt[i])
+            self.changed[id(item)] = found
+        return found
+
     def _spec(self, group: list[Any], chosen: list[int]) -> Any:
         """The outcome of a group of explored transitions as one compact transition: (next,
-        outputs, updates), or ``None`` when the members disagree."""
-        heads = {(self._target(t), outs) for _s, t, outs in group}
+        outputs, updates), or ``None`` when the members disagree. Only the variables some
+        member changes are looked at (O(|group| · changed))."""
+        head_of = self.head_of
+        heads = {head_of[id(item)] for item in group}
         if len(heads) != 1:
             return None
         head = heads.pop()
         target = group[0][1]
         if isinstance(target, RootResult):
             return (head, ())
+        changed: set[int] = set()
+        for item in group:
+            changed |= self._changes(item, chosen)
         updates = []
         for i in chosen:
-            pairs = [(self.vec[s][i], self.vec[t][i]) for s, t, _o in group]
-            if all(a == b for a, b in pairs):
+            if i not in changed:
                 continue
+            pairs = [(self.vec[s][i], self.vec[t][i]) for s, t, _o in group]
             news = {b for _a, b in pairs}
             if len(news) == 1:
                 updates.append((i, "=", news.pop()))
@@ -295,12 +318,40 @@ class _Compactor:
         )
         return (self.leaf[target], outs, changes)
 
-    def _consistent(self, items: list, reads: list[int], chosen: list[int]):
-        """{valuation of ``reads``: spec}, or ``None`` when some valuation has no one spec."""
+    def _specs(self, items: list, reads: list[int], chosen: list[int]):
+        """({valuation of ``reads``: spec}, the valuations whose items have no one spec)."""
         project = _projector(reads)
+        vec = self.vec
         groups: dict[Hashable, list] = {}
         for item in items:
-            groups.setdefault(project(self.vec[item[0]]), []).append(item)
+            key = project(vec[item[0]])
+            group = groups.get(key)
+            if group is None:
+                groups[key] = [item]
+            else:
+                group.append(item)
+        specs, undecided = {}, set()
+        for key, group in groups.items():
+            spec = self._spec(group, chosen)
+            if spec is None:
+                undecided.add(key)
+            else:
+                specs[key] = spec
+        return specs, undecided
+
+    def _consistent(self, items: list, reads: list[int], chosen: list[int]):
+        """{valuation of ``reads``: spec}, or ``None`` when some valuation has no one spec
+        (found at the first such valuation)."""
+        project = _projector(reads)
+        vec = self.vec
+        groups: dict[Hashable, list] = {}
+        for item in items:
+            key = project(vec[item[0]])
+            group = groups.get(key)
+            if group is None:
+                groups[key] = [item]
+            else:
+                group.append(item)
         specs = {}
         for key, group in groups.items():
             spec = self._spec(group, chosen)
@@ -309,53 +360,58 @@ class _Compactor:
             specs[key] = spec
         return specs
 
-    def _undecided(self, items: list, reads: list[int], chosen: list[int]) -> set[Hashable]:
-        """The valuations of ``reads`` whose items have no one spec."""
-        project = _projector(reads)
-        groups: dict[Hashable, list] = {}
-        for item in items:
-            groups.setdefault(project(self.vec[item[0]]), []).append(item)
-        return {key for key, group in groups.items() if self._spec(group, chosen) is None}
-
     def decide(self, items, chosen: list[int]):
         """For one (leaf, input): the deciding variables and {outcome: valuations}. Greedy:
         add the variable that leaves the least uncertainty (conditional entropy) about what
         the transitions do, until every valuation has one outcome; then drop the variables
-        the others make redundant (last added first)."""
+        the others make redundant (last added first).
+
+        Only the transitions of still undecided valuations are looked at again when a variable
+        is added: a valuation with one outcome splits into valuations with that one outcome.
+        """
         signature = {id(item): self._signature(item, chosen) for item in items}
         reads: list[int] = []
+        pending = items  # the transitions of the valuations not decided yet
         while True:
-            specs = self._consistent(items, reads, chosen)
-            if specs is not None:
+            _decided, undecided = self._specs(pending, reads, chosen)
+            if not undecided:
                 break
             project = _projector(reads)
-            undecided = self._undecided(items, reads, chosen)
-            rows = [
-                (prefix, self.vec[it[0]], signature[id(it)])
-                for it in items
-                if (prefix := project(self.vec[it[0]])) in undecided
-            ]
+            rows = []
+            still = []
+            for it in pending:
+                prefix = project(self.vec[it[0]])
+                if prefix in undecided:
+                    rows.append((prefix, self.vec[it[0]], signature[id(it)]))
+                    still.append(it)
+            pending = still
             best, best_key = None, None
+            prefixes = [prefix for prefix, _vs, _sig in rows]
+            signatures = [sig for _p, _vs, sig in rows]
             for i in chosen:
-                if i in reads or len({vs[i] for _p, vs, _s in rows}) < 2:
+                if i in reads:
+                    continue
+                column = [vs[i] for _p, vs, _s in rows]
+                if len(set(column)) < 2:
                     continue  # a variable constant where it matters tells nothing apart
-                totals: dict[Hashable, int] = {}
-                counts: dict[tuple[Any, Any], int] = {}
-                for prefix, vs, sig in rows:
-                    cell = (prefix, vs[i])
-                    totals[cell] = totals.get(cell, 0) + 1
-                    counts[(cell, sig)] = counts.get((cell, sig), 0) + 1
+                cells = list(zip(prefixes, column))
+                totals = Counter(cells)
+                counts = Counter(zip(cells, signatures))
                 entropy = sum(c * math.log(totals[cs[0]] / c) for cs, c in counts.items())
                 key = (round(entropy, 9), len(totals))
                 if best_key is None or key < best_key:
                     best, best_key = i, key
             assert best is not None  # all of ``chosen`` decides every outcome (rule 1)
             reads.append(best)
+        specs = None
         for i in reversed(list(reads)):
             fewer = [r for r in reads if r != i]
             smaller = self._consistent(items, fewer, chosen)
             if smaller is not None:
                 reads, specs = fewer, smaller
+        if specs is None:
+            specs = self._consistent(items, reads, chosen)
+            assert specs is not None  # every valuation of ``reads`` was decided above
         outcomes: dict[Hashable, list[tuple[Any, ...]]] = {}
         for valuation, spec in specs.items():
             outcomes.setdefault(spec, []).append(_as_tuple(valuation, len(reads)))
@@ -367,6 +423,11 @@ class _Compactor:
         by_input: dict[tuple[int, str], list] = {}
         for source, symbol, target, outs in self.edges:
             by_input.setdefault((self.leaf[source], symbol), []).append((source, target, outs))
+        self.head_of = {
+            id(item): (self._target(item[1]), item[2])
+            for items in by_input.values()
+            for item in items
+        }
         decided = {k: self.decide(items, chosen) for k, items in by_input.items()}
         used = sorted({i for reads, _o in decided.values() for i in reads})
         names = {i: self._variable_name(self.keys[i]) for i in used}
@@ -471,8 +532,7 @@ def _projector(indices: Sequence[int]) -> Callable[[tuple[Any, ...]], Hashable]:
     if len(indices) == 1:
         only = indices[0]
         return lambda v: (v[only],)
-    picked = tuple(indices)
-    return lambda v: tuple(v[i] for i in picked)
+    return operator.itemgetter(*indices)  # a tuple for two or more indices
 
 
 def _as_tuple(valuation: Hashable, width: int) -> tuple[Any, ...]:

@@ -398,8 +398,10 @@ def dumps(model: Model, fmt: str) -> str:
 
 
 #: FSM formats that hold a data model (``fsmbt.model.fsm_data``): SCXML as ``<datamodel>``,
-#: JSON and YAML as the attributes they keep.
-DATA_FORMATS = frozenset({"scxml", "json", "yaml"})
+#: JSON and YAML as the attributes they keep, SMACH as userdata and generated decision states
+#: (``fsmbt.formats.pysm.smach_data``). ``fsmbt translate`` writes any other format as the
+#: machine's exact expansion, named as a loss.
+DATA_FORMATS = frozenset({"scxml", "json", "yaml", "smach"})
 
 
 def refuse_data_loss(model: Model, fmt: str) -> None:
@@ -412,8 +414,9 @@ def refuse_data_loss(model: Model, fmt: str) -> None:
     shown = ", ".join(names[:4]) + (f" and {len(names) - 4} more" if len(names) > 4 else "")
     raise UnsupportedError(
         f"{fmt} has no data model, and this state machine keeps {len(names)} variable(s) "
-        f"({shown}) in guards and assignments: write it as SCXML, JSON or YAML, translate "
-        "it with --flatten (its exact flat expansion), or convert with --unroll",
+        f"({shown}) in guards and assignments: write it as SCXML, JSON, YAML or SMACH, "
+        "translate it (written as its exact flat expansion, named as a loss), or convert "
+        "with --unroll",
         element=model.name,
     )
 

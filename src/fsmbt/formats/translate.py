@@ -30,12 +30,19 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from fsmbt.formats.annotations import annotation_losses
-from fsmbt.formats.registry import ReadContext, get_format, loads, refuse_data_loss
+from fsmbt.formats.registry import (
+    DATA_FORMATS,
+    ReadContext,
+    get_format,
+    loads,
+    refuse_data_loss,
+)
 from fsmbt.model import Model
 from fsmbt.model.errors import InputError, UnsupportedError
 from fsmbt.model.flatten import flatten as flatten_fsm
 from fsmbt.model.flatten import needs_flattening
 from fsmbt.model.fsm import FSM
+from fsmbt.model.fsm_data import DATAMODEL, has_data, parse_lines
 from fsmbt.model.serialize import model_to_dict
 
 #: More generic differences than this are summarised in one line.
@@ -96,6 +103,9 @@ def translate(
             "parallel and transient states"
         )
         losses.extend(annotation_losses(model, written, "the flattened machine")[0])
+    written, data_loss = expand_data_for(written, target.name)
+    if data_loss is not None:
+        losses.append(data_loss)
     checked = model  # what the read-back must equal in behaviour (events renamed, if any)
     if target.name == "scxml" and isinstance(written, FSM):
         events = scxml_event_renames(written)
@@ -160,6 +170,25 @@ def translate(
         losses.extend(named)
         losses.extend(differences_between(written_rest, back_rest))
     return result
+
+
+def expand_data_for(model: Model, fmt: str) -> tuple[Model, str | None]:
+    """A machine with data for a format without a data model: its exact expansion
+    (configuration x values, the W3C reading; docs/semantics.md §6a) and the loss that names
+    the variables; any other model as it is, with no loss. Cost: the expansion's."""
+    if not isinstance(model, FSM) or not has_data(model) or fmt in DATA_FORMATS:
+        return model, None
+    variables = [name for name, _expr in parse_lines(model.attrs[DATAMODEL])]
+    expanded = flatten_fsm(model)
+    shown = ", ".join(variables[:4]) + (
+        f" and {len(variables) - 4} more" if len(variables) > 4 else ""
+    )
+    return expanded, (
+        f"{fmt} has no data model: the {len(variables)} variable(s) ({shown}) and the guards "
+        "and assignments reading them are written as the machine's exact expansion, "
+        f"{len(expanded.states)} flat states (configuration x values) instead of "
+        f"{sum(1 for _ in model.walk())}; SCXML, JSON, YAML and SMACH keep them as data"
+    )
 
 
 def _writer_losses(target: str, model: Model) -> list[str] | None:

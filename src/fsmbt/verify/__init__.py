@@ -14,6 +14,7 @@ from __future__ import annotations
 from typing import Any
 
 from fsmbt import __version__
+from fsmbt.convert.perf import gc_paused
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import Hint, InputError, UnsupportedError
 from fsmbt.model.fsm import FSM
@@ -101,9 +102,10 @@ def verify(
         report.engines = nusmv_engine()
         return report
     sink = certificate.active_sink()
-    source_machine, result_machine, mode = machines_for(
-        source, result, loop=loop, outcomes=outcomes, outcome_driven=outcome_driven
-    )
+    with gc_paused():  # a data machine's expansion allocates its flat machine (acyclic)
+        source_machine, result_machine, mode = machines_for(
+            source, result, loop=loop, outcomes=outcomes, outcome_driven=outcome_driven
+        )
     native = _native(source_machine, result_machine, max_states, mode, sink, loop, False)
     if isinstance(source_machine, OutcomeFSMMachine):
         native.stats["abstractions"] = outcome_abstractions(source_machine.view)

@@ -14,10 +14,9 @@ from fastapi.responses import JSONResponse
 from starlette.exceptions import HTTPException as StarletteHTTPException
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
+from fsmbt.web.settings import DEFAULT_DRAIN_CAP_BYTES
+
 LOG = logging.getLogger("fsmbt.web")
-#: Bytes of an over-limit body read and thrown away so the client gets its 413 instead of a
-#: reset (``BodyLimit``); past this the connection is closed.
-DEFAULT_DRAIN_CAP_BYTES = 64 * 1024 * 1024
 
 
 class ApiError(Exception):

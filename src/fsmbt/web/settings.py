@@ -12,7 +12,11 @@ from pathlib import Path
 
 import fsmbt
 from fsmbt.web.answers import DEFAULT_CACHE_BYTES
-from fsmbt.web.errors import DEFAULT_DRAIN_CAP_BYTES
+
+#: Bytes of an over-limit body read and thrown away so the client gets its 413 instead of a
+#: reset (``fsmbt.web.errors.BodyLimit``); past this the connection is closed. Defined here,
+#: not beside ``BodyLimit``: the command line reads these defaults without importing FastAPI.
+DEFAULT_DRAIN_CAP_BYTES = 64 * 1024 * 1024
 
 #: Largest request body accepted (bytes).
 DEFAULT_MAX_BODY_BYTES = 2 * 1024 * 1024

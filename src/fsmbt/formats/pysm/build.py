@@ -945,6 +945,10 @@ def build_fsm(
         and isinstance(start.get("event"), str)
     ):
         fsm.start_name, fsm.initial_event = start["name"], start["event"]
+    if "data" in extension:  # written by fsmbt: userdata and decision states (smach_data)
+        from fsmbt.formats.pysm.smach_data import fold_data
+
+        fold_data(fsm, extension["data"])
     return fsm
 
 

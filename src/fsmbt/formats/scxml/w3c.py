@@ -113,6 +113,9 @@ def _flatten(actions: list[Action]) -> list[Action]:
     return out
 
 
+_UNKNOWN = object()  # a cache miss (a cached value may be None)
+
+
 @dataclass
 class _T:
     source: int
@@ -913,14 +916,27 @@ class _Interpreter:
         #: id(expr) -> the names read, and (id(expr), values) -> value (same result, computed
         #: once: a guard is asked again in every configuration with the same data)
         self.pure: dict[int, tuple[str, ...] | None] = {}
-        self.memo: dict[tuple[int, tuple[object, ...]], object] = {}
+        self.memo: dict[tuple[int, tuple[object, ...], tuple[type, ...]], object] = {}
+        # the document's shape does not change while it runs: atomic/compound once per state
+        self.is_atomic: list[bool] = [
+            not any(self.s[c].kind != "history" for c in node.children) for node in self.s
+        ]
+        self.fixed_domain: dict[int, int | None] = {}
+        self.names: dict[frozenset[int], str] = {}  # configuration -> its part of a name
+        self.actions: dict[frozenset[int], str | None] = {}  # configuration -> its action
+        self.fitting: dict[tuple[int, str | None], list[_T]] = {}  # (state, event) -> matching
+        self.shown: dict[tuple[str, type, object], str] = {}  # (var, type, value) -> "var=v"
+        self.is_compound: list[bool] = [
+            node.kind in ("state", "scxml") and not self.is_atomic[i]
+            for i, node in enumerate(self.s)
+        ]
 
     # -- tree helpers ---------------------------------------------------------------------------
     def atomic(self, i: int) -> bool:
-        return not [c for c in self.s[i].children if self.s[c].kind != "history"]
+        return self.is_atomic[i]
 
     def compound(self, i: int) -> bool:
-        return self.s[i].kind in ("state", "scxml") and not self.atomic(i)
+        return self.is_compound[i]
 
     def descendant(self, i: int, of: int) -> bool:
         return of in self.ancestors[i]
@@ -978,10 +994,17 @@ class _Interpreter:
             )
             reads = self.pure[id(expr)] = tuple(sorted(expr.names)) if pure else None
         key = None
-        if reads is not None and all(name in run.data for name in reads):
-            key = (id(expr), tuple((type(v), v) for v in (run.data[n] for n in reads)))
-            if key in self.memo:
-                return self.memo[key]
+        if reads is not None:
+            data = run.data
+            try:
+                read = tuple([data[n] for n in reads])
+            except KeyError:
+                pass  # a variable not yet defined: evaluated (and raises) below
+            else:  # types too: 1, 1.0 and True are equal keys but print differently
+                key = (id(expr), read, tuple(map(type, read)))
+                hit = self.memo.get(key, _UNKNOWN)
+                if hit is not _UNKNOWN:
+                    return hit
         try:
             value = scxml_expr.evaluate(
                 expr,
@@ -1005,16 +1028,24 @@ class _Interpreter:
         self, run: _Run, event: str | None, valuation: dict[int, bool], read: set[int]
     ) -> list[_T]:
         enabled: list[_T] = []
-        atoms = sorted((i for i in run.config if self.atomic(i)), key=self.order.__getitem__)
+        is_atomic = self.is_atomic
+        atoms = sorted((i for i in run.config if is_atomic[i]), key=self.order.__getitem__)
         for atom in atoms:
             for state in [atom, *self.ancestors[atom]]:
                 chosen = None
-                for t in self.s[state].transitions:
-                    if event is None:
-                        fits = not t.events
-                    else:
-                        fits = any(_matches(d, event) for d in t.events)
-                    if fits and self.cond_ok(t, run, valuation, read):
+                fitting = self.fitting.get((state, event))
+                if fitting is None:  # the transitions whose descriptors match, in order
+                    fitting = self.fitting[(state, event)] = [
+                        t
+                        for t in self.s[state].transitions
+                        if (
+                            not t.events
+                            if event is None
+                            else any(_matches(d, event) for d in t.events)
+                        )
+                    ]
+                for t in fitting:
+                    if self.cond_ok(t, run, valuation, read):
                         chosen = t
                         break
                 if chosen is not None:
@@ -1057,6 +1088,17 @@ class _Interpreter:
         return out
 
     def domain(self, t: _T, run: _Run) -> int | None:
+        """W3C getTransitionDomain. Without a history target it depends on ``t`` alone and is
+        computed once per transition (``fixed_domain``)."""
+        cached = self.fixed_domain.get(id(t), _UNKNOWN)
+        if cached is not _UNKNOWN:
+            return cached  # type: ignore[return-value]
+        found = self._domain(t, run)
+        if not any(self.s[x].kind == "history" for x in t.targets):
+            self.fixed_domain[id(t)] = found  # ``t`` lives as long as the document
+        return found
+
+    def _domain(self, t: _T, run: _Run) -> int | None:
         targets = self.effective_targets(t, run)
         if not targets:
             return None
@@ -1318,6 +1360,31 @@ class _Interpreter:
         history: tuple[tuple[int, frozenset[int]], ...],
         data: tuple[tuple[str, scxml_expr.Value], ...] = (),
     ) -> str:
+        """A flat state's name: the configuration, then the history values, then the data
+        (``on/cooking#door_closed=true;timer=3``). The configuration part and each shown
+        value are computed once (many flat states share them)."""
+        text = self.names.get(config)
+        if text is None:
+            text = self.names[config] = self._config_name(config)
+        if history:
+            parts = []
+            for h, value in history:
+                inner = ",".join(self.s[x].name for x in sorted(value, key=self.order.__getitem__))
+                parts.append(f"{self.s[h].name}={inner}")
+            text += "#" + ";".join(parts)
+        if data:
+            shown = self.shown
+            pieces = []
+            for k, v in data:
+                key = (k, type(v), v)
+                piece = shown.get(key)
+                if piece is None:
+                    piece = shown[key] = f"{k}={scxml_expr.shown(v)}"
+                pieces.append(piece)
+            text += ("#" if not history else ";") + ";".join(pieces)
+        return text
+
+    def _config_name(self, config: frozenset[int]) -> str:
         out: list[str] = []
         top = [c for c in self.s[0].children if c in config]
         stack: list[int | str] = list(reversed(top))
@@ -1342,19 +1409,15 @@ class _Interpreter:
                 stack.extend(reversed(pieces))
             else:
                 stack.extend([k for k in kids if k in config][:1] + ["/"])
-        text = "".join(out)
-        if history:
-            parts = []
-            for h, value in history:
-                inner = ",".join(self.s[x].name for x in sorted(value, key=self.order.__getitem__))
-                parts.append(f"{self.s[h].name}={inner}")
-            text += "#" + ";".join(parts)
-        if data:
-            values = ";".join(f"{k}={scxml_expr.shown(v)}" for k, v in data)
-            text += ("#" if not history else ";") + values
-        return text
+        return "".join(out)
 
     def action(self, config: frozenset[int]) -> str | None:
+        found = self.actions.get(config, _UNKNOWN)
+        if found is _UNKNOWN:
+            found = self.actions[config] = self._action(config)
+        return found  # type: ignore[return-value]
+
+    def _action(self, config: frozenset[int]) -> str | None:
         atoms = sorted(
             (i for i in config if self.atomic(i) and not self.s[i].wrapper),
             key=self.order.__getitem__,
