@@ -130,9 +130,12 @@ if [ "${FORCE:-0}" != "1" ] && [ -x "$DRIVER" ] && [ -f "$STAMP" ] && [ "$(cat "
 else
     T0="$(now)"
     mkdir -p "$PREFIX/bin"
+    # the driver's --db3 reads the SQLite log back (it waits until every transition is stored)
+    SQLITE_LIB=()
+    [ -f "$PREFIX/include/behaviortree_cpp/loggers/bt_sqlite_logger.h" ] && SQLITE_LIB=(-lsqlite3)
     run_logged "compile the driver ($(basename "$DRIVER_SRC") + fsmbt/lebt.hpp)" \
         nice -n 10 "$CXX" -std=c++17 -O2 -Wall -Wextra -o "$DRIVER.tmp" "$DRIVER_SRC" \
-        -I"$CPP_DIR/include" -I"$PREFIX/include" -L"$PREFIX/lib" -Wl,-rpath,"$PREFIX/lib" -lbehaviortree_cpp -lpthread -ldl
+        -I"$CPP_DIR/include" -I"$PREFIX/include" -L"$PREFIX/lib" -Wl,-rpath,"$PREFIX/lib" -lbehaviortree_cpp "${SQLITE_LIB[@]}" -lpthread -ldl
     mv "$DRIVER.tmp" "$DRIVER"
     echo "$WANT" >"$STAMP"
     T1="$(now)"
