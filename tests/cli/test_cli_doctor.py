@@ -10,8 +10,8 @@ from pathlib import Path
 import pytest
 
 import fsmbt.install
-from fsmbt.cli import main
 from fsmbt.cache import BTCPP_BUILD
+from fsmbt.cli import main
 
 
 def test_doctor_json_names_what_each_tool_adds_and_how_to_get_it(
