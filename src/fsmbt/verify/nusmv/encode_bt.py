@@ -230,23 +230,55 @@ class BTCore:
 
     def _ticks_a_leaf(self) -> list[bool]:
         """Per node: whether every tick of it ticks an environment leaf (a sufficient, static
-        test; docs/nusmv.md): a leaf; a reactive node whose first child does; a sequence, gate,
-        status map or SubTree all of whose children do. A root that does cannot livelock (no
-        tick ends without a leaf), so internal answers (RunOnce, SingleTrigger) are allowed
-        with ``loop`` under it. O(N)."""
+        test; docs/nusmv.md). A root that does cannot livelock (no tick ends without a leaf),
+        so internal answers (RunOnce, SingleTrigger, AlwaysSuccess...) are allowed with
+        ``loop`` under it. Two facts per node, children first: ``sure`` (any tick) and
+        ``busy`` (a tick while the node is RUNNING):
+
+        - a condition leaf: both; an action leaf: ``busy`` (RUNNING, it asks), ``sure`` only
+          under a parent that never ticks it again once completed without resetting it (the
+          sequences, status maps, SubTree, RunOnce; a stale action answers its old status
+          without asking); a reactive node: its first child is ``sure`` (it starts there);
+        - Sequence/Fallback (no wake-up, no memory): child 0 ``sure`` and every later child
+          ``busy`` (the index is above 0 at a tick's start only while that child is RUNNING:
+          any completion moves or resets it in the same tick, a halt resets it);
+        - a gated node, the other sequences: every child ``sure``;
+        - status maps, SubTree, RunOnce, SingleTrigger: ``busy`` when the child is (RUNNING,
+          they tick their RUNNING child), or ``sure`` if the child may skip (a SKIPPED child
+          leaves a status map RUNNING); status maps and SubTree are ``sure`` when the child is.
+
+        O(N)."""
         sure = [False] * len(self.nodes)
+        busy = [False] * len(self.nodes)
         for info in reversed(self.info):
             x = info.node
+            kids = list(x.children)
+            spec = node_semantics(x.type) if info.rule is not None else None
+            passes = info.rule in ("subtree", "run_once", "single_trigger") or (
+                info.rule == "simple_decorator" and spec is not None and spec.result_map is not None
+            )
             if info.env_leaf:
-                sure[x.id] = True
+                parent = self.info[x.parent].rule if x.parent is not None else None
+                busy[x.id] = True
+                sure[x.id] = x.kind is NodeKind.CONDITION or parent in (
+                    "sequence",
+                    "simple_decorator",
+                    "subtree",
+                    "run_once",
+                )
+            elif not kids:
+                continue
             elif info.rule == "reactive":
-                sure[x.id] = sure[x.children[0]]
-            elif info.rule in ("sequence", "gated", "subtree") or (
-                info.rule == "simple_decorator"
-                and (spec := node_semantics(x.type)) is not None
-                and spec.result_map is not None
-            ):
-                sure[x.id] = bool(x.children) and all(sure[c] for c in x.children)
+                sure[x.id] = busy[x.id] = sure[kids[0]]
+            elif info.rule == "sequence" and not SEQ_LIKE[x.type][1] and not SEQ_LIKE[x.type][2]:
+                plain = sure[kids[0]] and all(busy[c] for c in kids[1:])
+                sure[x.id] = busy[x.id] = plain
+            elif info.rule in ("sequence", "gated"):
+                sure[x.id] = busy[x.id] = all(sure[c] for c in kids)
+            elif passes:
+                (c,) = kids
+                sure[x.id] = info.rule in ("subtree", "simple_decorator") and sure[c]
+                busy[x.id] = sure[c] if self.may_skip[c] else busy[c]
         return sure
 
     # -- naming ----------------------------------------------------------------------------
