@@ -22,35 +22,11 @@ from pathlib import Path
 
 from fsmbt.convert import convert
 from fsmbt.formats import dumps
-from fsmbt.model.fsm import FSM
 from fsmbt.runtime.cpp import DriverSession, find_driver
 from fsmbt.semantics.engines.btcpp_load import check_loads
 
-
-def chain(n: int) -> FSM:
-    fsm = FSM(name="chain")
-    for i in range(n):
-        fsm.add_state(f"S{i}", action=f"a{i}", final=i == n - 1)
-    fsm.initial = "S0"
-    for i in range(n - 1):
-        fsm.add_transition(f"S{i}", "next", f"S{i + 1}")
-    return fsm
-
-
-def xml_depth(text: str) -> int:
-    """Deepest element (``<root>`` = 1), counting tags in order (no parser depth limit)."""
-    depth = deepest = 0
-    for piece in text.split("<")[1:]:
-        if piece.startswith(("?", "!")):
-            continue
-        if piece.startswith("/"):
-            depth -= 1
-            continue
-        depth += 1
-        deepest = max(deepest, depth)
-        if piece.split(">", 1)[0].endswith("/"):
-            depth -= 1
-    return deepest
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+from support.chains import chain, xml_depth  # noqa: E402
 
 
 def main() -> int:

@@ -15,7 +15,6 @@ from fsmbt.convert.result import ConversionResult
 from fsmbt.formats import dumps
 from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.bt_nodes import NodeKind
-from fsmbt.model.fsm import FSM
 from fsmbt.semantics.engines import btcpp_load, scxml_load
 from fsmbt.semantics.engines.btcpp_load import (
     ENGINE_CPP,
@@ -24,16 +23,7 @@ from fsmbt.semantics.engines.btcpp_load import (
     TreeLoadError,
     check_loads,
 )
-
-
-def chain(n: int) -> FSM:
-    fsm = FSM(name="chain")
-    for i in range(n):
-        fsm.add_state(f"S{i}", action=f"a{i}", final=i == n - 1)
-    fsm.initial = "S0"
-    for i in range(n - 1):
-        fsm.add_transition(f"S{i}", "next", f"S{i + 1}")
-    return fsm
+from support.chains import chain
 
 
 def nested_text(levels: int) -> str:

@@ -34,7 +34,12 @@ def test_a_non_loopback_address_prints_a_warning():
         first = process.stderr.readline()  # printed before the server starts listening
     finally:
         process.terminate()
-        process.communicate(timeout=30)
+        try:
+            process.communicate(timeout=30)
+        except subprocess.TimeoutExpired:
+            process.kill()  # never leave a server behind; the test still fails
+            process.communicate()
+            raise
     assert first.startswith("warning: listening on 0.0.0.0, not a loopback address")
 
 

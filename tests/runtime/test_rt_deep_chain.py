@@ -9,20 +9,10 @@ from pathlib import Path
 
 from fsmbt import api
 from fsmbt.formats import dumps
-from fsmbt.model.fsm import FSM
 from fsmbt.runtime.cpp import DriverSession
+from support.chains import chain
 
 STATES = 1000
-
-
-def chain(n: int) -> FSM:
-    fsm = FSM(name="chain")
-    for i in range(n):
-        fsm.add_state(f"S{i}", action=f"a{i}", final=i == n - 1)
-    fsm.initial = "S0"
-    for i in range(n - 1):
-        fsm.add_transition(f"S{i}", "next", f"S{i + 1}")
-    return fsm
 
 
 def test_a_1000_state_chain_loads_in_btcpp_and_ticks_to_its_last_state(

@@ -25,10 +25,9 @@ from pathlib import Path
 from lxml import etree
 
 from fsmbt.runtime.cpp import PACKAGE_DIR, CppRuntimeError, library_built, library_prefix
+from fsmbt.semantics.engines.btcpp_load import declarations
 
 XSD_SOURCE = PACKAGE_DIR / "xsd" / "fsmbt_btcpp_xsd.cpp"
-_KINDS = ("Action", "Condition", "Control", "Decorator")
-_DIRECTIONS = {"input_port": "input", "output_port": "output", "inout_port": "inout"}
 
 
 def program_path() -> Path:
@@ -65,22 +64,6 @@ def find_program(*, build: bool = True) -> Path | None:
         raise CppRuntimeError(f"cannot compile {XSD_SOURCE.name}: {done.stderr.strip()[:400]}")
     partial.replace(path)  # atomic: a concurrent build writes the same bytes
     return path
-
-
-def declarations(root: etree._Element) -> str:
-    """The program's input for a file's ``<TreeNodesModel>``: ``KIND ID dir:port...`` lines."""
-    lines: list[str] = []
-    for container in root.iter("TreeNodesModel"):
-        for entry in container:
-            if not isinstance(entry.tag, str) or entry.tag not in _KINDS or not entry.get("ID"):
-                continue
-            ports = [
-                f"{_DIRECTIONS[str(p.tag)]}:{p.get('name')}"
-                for p in entry
-                if isinstance(p.tag, str) and p.tag in _DIRECTIONS and p.get("name")
-            ]
-            lines.append(" ".join([str(entry.tag), str(entry.get("ID")), *ports]))
-    return "\n".join(lines) + "\n"
 
 
 @lru_cache(maxsize=256)

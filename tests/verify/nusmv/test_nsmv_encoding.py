@@ -63,9 +63,14 @@ def _internal(kind: str = "AlwaysSuccess") -> BTNode:
 @pytest.mark.parametrize(
     ("root", "loop", "reason"),
     [
-        # SKIPPED is not a status of the encoding: the node and the port are named
-        (_dec("RunOnce", _leaf("a")), False, r"RunOnce with then_skip=true"),
-        (_dec("RunOnce", _leaf("a"), then_skip="true"), False, r"RunOnce with then_skip=true"),
+        # SKIPPED is encoded under the sequences, reactive controls, status maps and SubTree
+        # only: under any other parent the parent is named
+        (
+            _dec("Repeat", _dec("RunOnce", _leaf("a")), num_cycles="2"),
+            False,
+            r"SKIPPED under Repeat",
+        ),
+        (_dec("RunOnce", _leaf("a")), True, "livelock"),
         # ticks that end without any leaf: the native leaf machine reports LIVELOCK
         (_dec("Repeat", _internal(), num_cycles="-1"), False, "livelock"),
         (

@@ -178,7 +178,7 @@ SINGLE_TRIGGER = register(
         memory=("triggered",),
         default_memory=(False,),
         handler="single_trigger",
-        nusmv_refusal="not encoded yet",
+        nusmv="single_trigger",
         library=_NAV2,
         source="nav2_behavior_tree/plugins/decorator/single_trigger_node.cpp",
     )

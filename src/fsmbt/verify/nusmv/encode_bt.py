@@ -82,6 +82,12 @@ NOT_ENCODED = {n.name: n.nusmv_refusal for n in all_nodes() if n.nusmv_refusal i
 ST = {s.name: s.name[0] for s in NodeStatus if s is not NodeStatus.SKIPPED}
 _S, _F = ST[NodeStatus.SUCCESS.name], ST[NodeStatus.FAILURE.name]
 STATUS_ENUM = "{I, R, S, F}"
+#: SKIPPED, a returned status only (``res``; never stored in ``st_n``, docs/semantics.md §2).
+_K = "K"
+#: Rules whose SMV rules handle a child that returns SKIPPED (docs/nusmv.md, "SKIPPED"): the
+#: sequences (skipped counter ``sk_n``), the reactive ones (frame flag ``rk_n``), the status
+#: maps and SubTree (passed on). Any other parent of a child that may skip is refused.
+SKIP_AWARE = frozenset({"sequence", "reactive", "simple_decorator", "subtree"})
 
 
 @dataclass
@@ -160,9 +166,16 @@ class BTCore:
             # its child (a count <= 0 other than -1), answers without any leaf
             limit = node.params[0] if rule in builtin_rules.LOOPS else None
             has_endless_loop |= limit == -1
-            has_internal |= rule == "run_once" or (limit is not None and -1 != limit <= 0)
+            has_internal |= rule in ("run_once", "single_trigger") or (
+                limit is not None and -1 != limit <= 0
+            )
             self.info.append(NodeInfo(node, False, None, spec.nusmv))
-        if has_internal and (loop or has_keep_running or has_endless_loop):
+        self.may_skip = self._may_skip()
+        if (
+            has_internal
+            and (loop or has_keep_running or has_endless_loop)
+            and not self._ticks_a_leaf()[0]
+        ):
             raise UnsupportedError(
                 "the NuSMV encoding does not model ticks that end without any leaf "
                 "(AlwaysSuccess/AlwaysFailure & co, a RunOnce or a zero-count Repeat/"
@@ -181,6 +194,92 @@ class BTCore:
         self.memory_vars: list[tuple[str, int]] = []
         #: memory variables a halt keeps (ManualSelector's repeated selection, RunOnce's result)
         self.kept_vars: list[str] = []
+
+    def _may_skip(self) -> list[bool]:
+        """Per node: whether it can return SKIPPED (RunOnce ``then_skip``, a gate closed on
+        SKIPPED; a sequence/reactive node all of whose children may skip; a status map or
+        SubTree over one that may). A parent of such a child whose rule is not in
+        ``SKIP_AWARE`` is refused. O(N), children before parents (reverse pre-order)."""
+        skip = [False] * len(self.nodes)
+        for info in reversed(self.info):
+            x = info.node
+            if info.rule is None:
+                continue
+            spec = node_semantics(x.type)
+            aware = info.rule in SKIP_AWARE and (
+                info.rule != "simple_decorator"
+                or (spec is not None and spec.result_map is not None)
+            )
+            if info.rule == "run_once":
+                skip[x.id] = bool(x.params[0])
+            elif info.rule == "gated":
+                gate = spec.gate if spec is not None else None
+                skip[x.id] = gate is not None and gate.closed == NodeStatus.SKIPPED.name
+            elif aware:
+                skip[x.id] = bool(x.children) and all(skip[c] for c in x.children)
+            if not aware and any(skip[c] for c in x.children):
+                raise UnsupportedError(
+                    f"the NuSMV encoding does not support a child that may return SKIPPED "
+                    f"under {x.type} (SKIPPED is encoded under Sequence/Fallback & co, the "
+                    "reactive controls, Inverter/Force* and SubTree only)",
+                    location=x.source.location,
+                    element=f"<{x.type}> '{x.label}'",
+                    hints=(Hint.NATIVE_VERIFIER,),
+                )
+        return skip
+
+    def _ticks_a_leaf(self) -> list[bool]:
+        """Per node: whether every tick of it ticks an environment leaf (a sufficient, static
+        test; docs/nusmv.md). A root that does cannot livelock (no tick ends without a leaf),
+        so internal answers (RunOnce, SingleTrigger, AlwaysSuccess...) are allowed with
+        ``loop`` under it. Two facts per node, children first: ``sure`` (any tick) and
+        ``busy`` (a tick while the node is RUNNING):
+
+        - a condition leaf: both; an action leaf: ``busy`` (RUNNING, it asks), ``sure`` only
+          under a parent that never ticks it again once completed without resetting it (the
+          sequences, status maps, SubTree, RunOnce; a stale action answers its old status
+          without asking); a reactive node: its first child is ``sure`` (it starts there);
+        - Sequence/Fallback (no wake-up, no memory): child 0 ``sure`` and every later child
+          ``busy`` (the index is above 0 at a tick's start only while that child is RUNNING:
+          any completion moves or resets it in the same tick, a halt resets it);
+        - a gated node, the other sequences: every child ``sure``;
+        - status maps, SubTree, RunOnce, SingleTrigger: ``busy`` when the child is (RUNNING,
+          they tick their RUNNING child), or ``sure`` if the child may skip (a SKIPPED child
+          leaves a status map RUNNING); status maps and SubTree are ``sure`` when the child is.
+
+        O(N)."""
+        sure = [False] * len(self.nodes)
+        busy = [False] * len(self.nodes)
+        for info in reversed(self.info):
+            x = info.node
+            kids = list(x.children)
+            spec = node_semantics(x.type) if info.rule is not None else None
+            passes = info.rule in ("subtree", "run_once", "single_trigger") or (
+                info.rule == "simple_decorator" and spec is not None and spec.result_map is not None
+            )
+            if info.env_leaf:
+                parent = self.info[x.parent].rule if x.parent is not None else None
+                busy[x.id] = True
+                sure[x.id] = x.kind is NodeKind.CONDITION or parent in (
+                    "sequence",
+                    "simple_decorator",
+                    "subtree",
+                    "run_once",
+                )
+            elif not kids:
+                continue
+            elif info.rule == "reactive":
+                sure[x.id] = busy[x.id] = sure[kids[0]]
+            elif info.rule == "sequence" and not SEQ_LIKE[x.type][1] and not SEQ_LIKE[x.type][2]:
+                plain = sure[kids[0]] and all(busy[c] for c in kids[1:])
+                sure[x.id] = busy[x.id] = plain
+            elif info.rule in ("sequence", "gated"):
+                sure[x.id] = busy[x.id] = all(sure[c] for c in kids)
+            elif passes:
+                (c,) = kids
+                sure[x.id] = info.rule in ("subtree", "simple_decorator") and sure[c]
+                busy[x.id] = sure[c] if self.may_skip[c] else busy[c]
+        return sure
 
     # -- naming ----------------------------------------------------------------------------
     def n(self, nid: int) -> str:
@@ -206,7 +305,7 @@ class BTCore:
     def declare(self, cur_extra: list[str], init_cur: str) -> None:
         cur_values = [self.n(x.id) for x in self.nodes] + cur_extra
         self.var_types["cur"] = "{" + ", ".join(cur_values) + "}"
-        self.var_types["res"] = "{NONE, R, S, F}"
+        self.var_types["res"] = "{NONE, R, S, F, K}"
         self.var_types["lidx"] = f"0..{max(self.max_children - 1, 1)}"
         self.var_types["wake"] = "boolean"
         self.init.update(cur=init_cur, res="NONE", lidx="0", wake="FALSE")
@@ -228,6 +327,8 @@ class BTCore:
                 out.append(f"idx_{x.id}")
             if self.has_prev(x.id):
                 out.append(f"prev_{x.id}")
+            if f"rk_{x.id}" in self.var_types:
+                out.append(f"rk_{x.id}")
         out += [var for var, _nid in self.memory_vars]
         out += self.kept_vars
         return out
@@ -254,12 +355,20 @@ class BTCore:
     def ret(self, cond: str, nid: int, status: str) -> None:
         """``nid`` returns ``status`` (an SMV expression over R/S/F) to its parent or to TOP."""
         node = self.nodes[nid]
-        self.rule(self.st(nid), cond, status)
+        st = self.st(nid)
+        if status == _K:  # never stored: the node keeps its status (docs/semantics.md §2)
+            self.rule(st, cond, st)
+        elif self.may_skip[nid] and status not in ST.values():
+            self.rule(st, cond, f"case ({status}) = K : {st}; TRUE : {status}; esac")
+        else:
+            self.rule(st, cond, status)
         self.rule("cur", cond, self.n(node.parent) if node.parent is not None else "TOP")
         self.rule("res", cond, status)
         self.rule("lidx", cond, str(node.index))
         if self.has_prev(nid):
             self.rule(f"prev_{nid}", cond, "I")
+        if f"rk_{nid}" in self.var_types:  # the reactive frame's flag: canonical off the stack
+            self.rule(f"rk_{nid}", cond, "1")
 
     def build(self) -> None:
         """Every node's tick rules, and the halt closure."""
@@ -318,6 +427,12 @@ class BTCore:
         is_fb, wakes, memory = SEQ_LIKE[t]
         stop, go_on = ("S", "F") if is_fb else ("F", "S")
         idx = f"idx_{x.id}"
+        skippable = any(self.may_skip[c] for c in kids)
+        if skippable:  # the skipped count (memory; SequenceWithMemory's halt keeps it)
+            skipped = self.memory(
+                "sk", x.id, sum(self.may_skip[c] for c in kids), reset_by_halt=not memory
+            )
+            self.rule(skipped, f"{called} & {self.st(x.id)} = I", "0")
         self.rule(self.st(x.id), called, "R")
         for i, c in enumerate(kids):
             cond = f"{called} & {idx} = {i}"
@@ -351,7 +466,29 @@ class BTCore:
                 for c in kids:
                     resets[c].append(cond)
                 self.rule(idx, cond, "0")
+                if skippable:
+                    self.rule(skipped, cond, "0")
                 self.ret(cond, x.id, go_on)
+        if not skippable:
+            return
+        # SKIPPED (``tick_sequence``): the next child, no wake-up; after the last one the node
+        # returns SKIPPED when every child was skipped, else go_on; the counter is zeroed when
+        # the node is ticked while IDLE and when it completes
+        top = sum(self.may_skip[c] for c in kids)
+        for i in range(k):
+            cond = f"{back} & res = K & {idx} = {i}"
+            self.rule(skipped, cond, _inc(skipped, top))
+            if i + 1 < k:
+                self.rule(idx, cond, str(i + 1))
+                self.call(cond, kids[i + 1])
+                self.rule(f"prev_{x.id}", cond, self.st(kids[i + 1]))
+            else:
+                for c in kids:
+                    resets[c].append(cond)
+                self.rule(idx, cond, "0")
+                self.rule(skipped, cond, "0")
+                all_skipped = f"case {skipped} >= {k - 1} : K; TRUE : {go_on}; esac"
+                self.ret(cond, x.id, all_skipped if self.may_skip[x.id] else go_on)
 
     def _reactive_rules(self, x: CompiledNode, here: str, called: str, resets: Resets) -> None:
         """ReactiveSequence, ReactiveFallback (``families.reactive``)."""
@@ -363,6 +500,23 @@ class BTCore:
         self.rule(self.st(x.id), called, "R")
         self.call(called, kids[0])
         back = f"{here} & res != NONE"
+        skippable = any(self.may_skip[c] for c in kids)
+        flag = f"rk_{x.id}"
+        if skippable:  # the frame's "every child so far skipped" (1; canonical off the stack)
+            self.var_types[flag] = "0..1"
+            self.init[flag] = "1"
+            self.rule(flag, called, "1")
+            for i in range(k):
+                cond = f"{back} & res = K & lidx = {i}"
+                resets[kids[i]].append(cond)
+                if i + 1 < k:
+                    self.call(cond, kids[i + 1])
+                else:
+                    for c in kids:
+                        resets[c].append(cond)
+                    all_skipped = f"case {flag} = 1 : K; TRUE : {go_on}; esac"
+                    self.ret(cond, x.id, all_skipped if self.may_skip[x.id] else go_on)
+            self.rule(flag, f"{back} & res = {go_on} & lidx < {k - 1}", "0")
         running = f"{back} & res = R"
         for i, c in enumerate(kids):
             resets[c].append(f"{running} & lidx != {i}")
@@ -402,6 +556,7 @@ class BTCore:
             self.ret(f"{back} & res != F", x.id, "R")
             return
         self.ret(f"{back} & res = R", x.id, "R")
+        self.ret(f"{back} & res = K", x.id, _K)  # SKIPPED passes through
         resets[c].append(done)
         # the child's S / F as the node returns them (a SubTree passes them on)
         on_s, on_f = (ST[result_map[0]], ST[result_map[1]]) if result_map is not None else (_S, _F)
@@ -493,7 +648,7 @@ class BTCore:
             return
         spec = node_semantics(x.type)
         assert spec is not None and spec.gate is not None
-        closed = self._returned_status(x, x.params[0], "")
+        closed = self._returned_status(x, x.params[0], "", skipped_ok=rule == "gated")
         if rule == "for_each":
             self.call(f"{called} & {self.st(c)} = R", c)
             self.call(called, gate)
@@ -522,10 +677,15 @@ class BTCore:
             resets[c].append(f"{from_child} & (res = S | res = F)")
         self.ret(from_child, x.id, passed)
 
-    def _returned_status(self, x: CompiledNode, value: int, when: str) -> str:
-        """The SMV constant of a status node ``x`` returns by parameter (``value``); IDLE and
-        SKIPPED are not statuses a node returns in the encoding, so they are refused."""
+    def _returned_status(
+        self, x: CompiledNode, value: int, when: str, *, skipped_ok: bool = False
+    ) -> str:
+        """The SMV constant of a status node ``x`` returns by parameter (``value``); IDLE is
+        refused, and SKIPPED unless ``skipped_ok`` (a gated node's closed gate, whose parents
+        ``_may_skip`` checked)."""
         status = NodeStatus(value).name
+        if skipped_ok and status == NodeStatus.SKIPPED.name:
+            return _K
         if status not in ST or status == NodeStatus.IDLE.name:
             raise UnsupportedError(
                 f"the NuSMV encoding does not support {x.type} returning {status}{when} "
@@ -785,7 +945,7 @@ def _inc(var: str, top: int) -> str:
     return f"case {var} < {top} : {var} + 1; TRUE : {top}; esac"
 
 
-_SAFE_STATUS = re.compile(r"(?<![\w$#-])(I|R|S|F|NONE)(?![\w$#-])")
+_SAFE_STATUS = re.compile(r"(?<![\w$#-])(I|R|S|F|K|NONE)(?![\w$#-])")
 
 
 def safe_text(text: str) -> str:
@@ -803,7 +963,11 @@ def describe_bt(core: BTCore, values: dict[str, str]) -> str:
     if cur.startswith("n") and cur[1:].isdigit():
         node = core.nodes[int(cur[1:])]
         return f"{node.label}@{node.path or 'root'}"
-    return {"DONE_S": RootResult.SUCCESS.value, "DONE_F": RootResult.FAILURE.value}.get(cur, cur)
+    return {
+        "DONE_S": RootResult.SUCCESS.value,
+        "DONE_F": RootResult.FAILURE.value,
+        "DONE_K": NodeStatus.SKIPPED.name,
+    }.get(cur, cur)
 
 
 class LeafBTEncoder:
@@ -827,6 +991,8 @@ class LeafBTEncoder:
         for leaf in self.core.env_leaves():
             outputs.id(leaf.label)
         outputs.add_all(tuple(r.value for r in RootResult))
+        if self.core.may_skip[0]:
+            outputs.add_all((NodeStatus.SKIPPED.name,))
 
     def _identity(self) -> list[str]:
         """The variables that make up a state, as the native leaf machine keys it: for a plain
@@ -841,7 +1007,8 @@ class LeafBTEncoder:
         from fsmbt.verify.nusmv.encode_fsm import NONE_OUT, Encoding
 
         core = self.core
-        core.declare(["TOP", "DONE_S", "DONE_F"], core.n(0))
+        done = ["DONE_S", "DONE_F"] + (["DONE_K"] if core.may_skip[0] else [])
+        core.declare(["TOP", *done], core.n(0))
         out_enum = self.outputs.enum([NONE_OUT])
         core.var_types["bres"] = out_enum
         core.init["bres"] = NONE_OUT
@@ -856,17 +1023,20 @@ class LeafBTEncoder:
                 if name == LeafOutcome.RUNNING and leaf.kind is NodeKind.CONDITION:
                     continue
                 core.ret(f"go & {req} & inp = {ids.id(name)}", leaf.id, status)
-        stable = any_of(requests + ["cur = DONE_S", "cur = DONE_F"])
+        stable = any_of(requests + [f"cur = {d}" for d in done])
         # the root returned: re-tick on a wake-up, else the tick is over
         top = "cur = TOP"
         core.rule("wake", f"{top} & res = R & wake", "FALSE")
         core.call(f"{top} & res = R", 0)
-        for status in ("S", "F"):
+        words = {_S: RootResult.SUCCESS.value, _F: RootResult.FAILURE.value}
+        if core.may_skip[0]:
+            words[_K] = NodeStatus.SKIPPED.name
+        for status, word in words.items():
             ended = f"{top} & res = {status}"
-            word = (RootResult.SUCCESS if status == _S else RootResult.FAILURE).value
             core.rules.setdefault("bres", []).append((ended, self.outputs.id(word)))
             if self.loop:
-                core.rules.setdefault(core.st(0), []).append((ended, "I"))
+                if status != _K:  # Tree::tickRoot resets a completed root, not a skipped one
+                    core.rules.setdefault(core.st(0), []).append((ended, "I"))
                 core.call(ended, 0)
             else:
                 core.rule("cur", ended, f"DONE_{status}")
@@ -881,7 +1051,7 @@ class LeafBTEncoder:
         ]
         defines = [
             ("stable", stable),
-            ("final", "(cur = DONE_S | cur = DONE_F)"),
+            ("final", any_of(f"cur = {d}" for d in done)),
             ("o1", "bres"),
             ("o2", case(label_rows, NONE_OUT)),
         ]

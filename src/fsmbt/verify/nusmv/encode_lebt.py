@@ -21,6 +21,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 from fsmbt.model.bt import BTDocument
+from fsmbt.model.errors import Hint, UnsupportedError
 from fsmbt.semantics.lebt.fast import strict_lebt_sels
 from fsmbt.semantics.lebt.leaves import LebtLeaves
 from fsmbt.semantics.lebt.spec import NO_EVENT
@@ -42,6 +43,12 @@ class LebtEncoder:
         alphabet: Sequence[str],
     ) -> None:
         self.core = BTCore(doc, loop=False)
+        if self.core.may_skip[0]:  # the LEBT protocol reads SUCCESS/FAILURE/RUNNING only
+            raise UnsupportedError(
+                "the NuSMV encoding of an LEBT does not support a root that may return SKIPPED",
+                element=self.core.nodes[0].label,
+                hints=(Hint.NATIVE_VERIFIER,),
+            )
         self.leaves = LebtLeaves.of(self.core.tree)
         self.module = module
         self.inputs = inputs

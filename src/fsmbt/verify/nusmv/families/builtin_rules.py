@@ -16,9 +16,10 @@ What each node keeps, and how it is encoded:
   frame local ``prev_n`` (the child's status when it was called) decides the wake-up: after a
   synchronous child (``prev_n = I``) the loop returns RUNNING and asks the tree to re-tick.
   ``L <= 0`` (other than -1) never ticks the child.
-- RunOnce (``then_skip=false``): ``ro_n`` (0 not run yet, 1 succeeded, 2 failed) that a halt
-  does **not** reset; once set the node returns it without ticking the child. ``then_skip=true``
-  returns SKIPPED, which is not a value of the encoding's statuses: refused, with the reason.
+- RunOnce: ``ro_n`` (0 not run yet, 1 succeeded, 2 failed) that a halt does **not** reset;
+  once set the node returns it (``then_skip=false``) or SKIPPED (``then_skip=true``, the
+  status ``K`` of ``res``, never stored) without ticking the child.
+- SingleTrigger (Nav2): ``tr_n`` (triggered), cleared when the node is ticked while IDLE.
 - Parallel / ParallelAll: the completed set and the counters are not variables. A child
   completed in this run of the parallel is exactly a child whose status is SUCCESS or FAILURE:
   a parallel never ticks a completed child again, and it resets every child whenever it
@@ -32,14 +33,13 @@ O(1) for the decorators; one variable of log2(L) bits per finite loop, 2 bits pe
 
 from __future__ import annotations
 
-from fsmbt.model.errors import Hint, UnsupportedError
 from fsmbt.semantics.compiled import CompiledNode
 from fsmbt.semantics.families.parallel import parallel_threshold
 from fsmbt.verify.nusmv.families.contract import BTCore, NusmvRule, Resets
 from fsmbt.verify.nusmv.smv import all_of
 
 #: The rule names (the node registry's ``nusmv`` field) this module encodes.
-RULES = ("repeat", "retry", "run_once", "parallel", "parallel_all")
+RULES = ("repeat", "retry", "run_once", "single_trigger", "parallel", "parallel_all")
 #: Loop rule -> (the result that repeats the child, the one that ends the loop)
 LOOPS = {"repeat": ("S", "F"), "retry": ("F", "S")}
 
@@ -53,6 +53,8 @@ def add_rules(
         _loop(core, x, rule, called, back, resets)
     elif rule == "run_once":
         _run_once(core, x, called, back, resets)
+    elif rule == "single_trigger":
+        _single_trigger(core, x, called, back)
     else:
         _parallel(core, x, rule, called, back, resets)
 
@@ -95,19 +97,13 @@ def _loop(core: BTCore, x: CompiledNode, rule: str, called: str, back: str, rese
 def _run_once(core: BTCore, x: CompiledNode, called: str, back: str, resets: Resets) -> None:
     """RunOnce (docs/semantics.md "Decorators"; ``once.tick_run_once``); its memory survives halts."""
     (then_skip,) = x.params
-    if then_skip:
-        raise UnsupportedError(
-            f"the NuSMV encoding does not support {x.type} with then_skip=true (after its first "
-            "run it returns SKIPPED, which the encoding's statuses do not represent); set "
-            'then_skip="false" or use --engine native',
-            location=x.source.location,
-            element=f"<{x.type}> '{x.label}'",
-            hints=(Hint.NATIVE_VERIFIER,),
-        )
     c = x.children[0]
     done = core.memory("ro", x.id, 2, reset_by_halt=False)
-    core.ret(f"{called} & {done} = 1", x.id, "S")
-    core.ret(f"{called} & {done} = 2", x.id, "F")
+    if then_skip:  # SKIPPED after the first run (never stored: the status stays, §2)
+        core.ret(f"{called} & {done} != 0", x.id, "K")
+    else:
+        core.ret(f"{called} & {done} = 1", x.id, "S")
+        core.ret(f"{called} & {done} = 2", x.id, "F")
     core.rule(core.st(x.id), called, "R")
     core.call(called, c)
     core.ret(f"{back} & res = R", x.id, "R")
@@ -115,6 +111,23 @@ def _run_once(core: BTCore, x: CompiledNode, called: str, back: str, resets: Res
     resets[c].append(finished)
     core.rule(done, finished, "case res = S : 1; TRUE : 2; esac")
     core.ret(finished, x.id, "case res = S : S; TRUE : F; esac")
+
+
+def _single_trigger(core: BTCore, x: CompiledNode, called: str, back: str) -> None:
+    """Nav2 SingleTrigger (docs/semantics.md "Project nodes"; ``once.tick_single_trigger``):
+    ``tr_n`` (triggered) is cleared when the node is ticked while IDLE, set when the child
+    completes; ticked while active and triggered, the node returns FAILURE without ticking the
+    child. The child is not reset on completion (as in Nav2); a halt keeps ``tr_n`` (the
+    next activation clears it)."""
+    c = x.children[0]
+    st = core.st(x.id)
+    triggered = core.memory("tr", x.id, 1, reset_by_halt=False)
+    core.ret(f"{called} & {st} != I & {triggered} = 1", x.id, "F")
+    core.rule(triggered, f"{called} & {st} = I", "0")
+    core.rule(st, called, "R")
+    core.call(called, c)
+    core.rule(triggered, f"{back} & (res = S | res = F)", "1")
+    core.ret(back, x.id, "case res = S : S; res = F : F; TRUE : R; esac")
 
 
 def _parallel(
