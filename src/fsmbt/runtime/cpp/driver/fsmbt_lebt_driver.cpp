@@ -51,6 +51,7 @@
 #include <fsmbt/lebt.hpp>
 
 #include <behaviortree_cpp/loggers/bt_file_logger_v2.h>
+#include <behaviortree_cpp/xml_parsing.h>
 #if __has_include(<behaviortree_cpp/loggers/bt_sqlite_logger.h>)
 #include <behaviortree_cpp/loggers/bt_sqlite_logger.h>
 #include <sqlite3.h>
@@ -58,6 +59,7 @@
 #endif
 
 #include <atomic>
+#include <filesystem>
 #include <chrono>
 #include <thread>
 #include <cstdio>
@@ -515,6 +517,53 @@ void bench(Runner& runner, fsmbt::lebt::LebtRunner* lebt, const std::vector<std:
               static_cast<unsigned long long>(ticks), sink);
 }
 
+/// BehaviorTree.CPP's FileLogger2 that counts the transitions it is given. 4.8.2's destructor
+/// stops the writer thread, which drops what it has not taken from its queue (everything when it
+/// has not run yet, on a loaded machine), so this waits until the file is as long as the header
+/// (magic, protocol, length, WriteTreeToXML(tree, true, true), first time stamp) plus 9 bytes per
+/// transition given (at most 60 s; then a warning on stderr).
+class CountingFileLogger2 : public BT::FileLogger2
+{
+public:
+  CountingFileLogger2(const BT::Tree& tree, const std::string& path)
+    : BT::FileLogger2(tree, path)
+    , path_(path)
+    , header_(18 + 1 + 4 + BT::WriteTreeToXML(tree, true, true).size() + 8)
+  {}
+
+  ~CountingFileLogger2() override { waitWritten(); }
+
+  void callback(BT::Duration timestamp, const BT::TreeNode& node, BT::NodeStatus prev_status,
+                BT::NodeStatus status) override
+  {
+    ++given_;
+    BT::FileLogger2::callback(timestamp, node, prev_status, status);
+  }
+
+private:
+  void waitWritten() const
+  {
+    const std::uintmax_t want = header_ + 9 * static_cast<std::uintmax_t>(given_.load());
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+    std::uintmax_t size = 0;
+    while(std::chrono::steady_clock::now() < deadline)
+    {
+      std::error_code error;
+      size = std::filesystem::file_size(path_, error);
+      if(!error && size >= want)
+      {
+        return;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+    std::fprintf(stderr, "warning: the .btlog holds %ju of %ju bytes\n", size, want);
+  }
+
+  std::string path_;
+  std::uintmax_t header_;
+  std::atomic<long> given_{ 0 };
+};
+
 #ifdef FSMBT_HAS_SQLITE_LOGGER
 /// BehaviorTree.CPP's SqliteLogger that counts the transitions it is given (all from the thread
 /// that ticks the tree).
@@ -590,7 +639,7 @@ public:
   {
     if(args.btlog)
     {
-      file_ = std::make_unique<BT::FileLogger2>(tree, *args.btlog);
+      file_ = std::make_unique<CountingFileLogger2>(tree, *args.btlog);
     }
     if(args.db3)
     {
@@ -604,7 +653,7 @@ public:
   }
 
 private:
-  std::unique_ptr<BT::FileLogger2> file_;
+  std::unique_ptr<CountingFileLogger2> file_;
 #ifdef FSMBT_HAS_SQLITE_LOGGER
   std::unique_ptr<CountingSqliteLogger> sqlite_;
 #endif
