@@ -19,14 +19,26 @@ pytestmark = pytest.mark.slow
 
 
 def _ray_workers() -> list[psutil.Process]:
-    """Ray's worker processes under this test's process (busy ones first)."""
+    """Ray's Python worker processes under this test's process (busy ones first).
+
+    A worker is a process titled ``ray::...`` or a Python running ``default_worker.py``. The
+    raylet is not one, although its command line names ``default_worker.py`` (in
+    ``--python_worker_command``): killing it, as this test once did under load, kills the node
+    and every task on it, which is not what the test is about."""
     found = []
     for process in psutil.Process().children(recursive=True):
         try:
-            command = " ".join(process.cmdline())
+            arguments = process.cmdline()
         except psutil.Error:
             continue
-        if "default_worker" in command or command.startswith("ray::"):
+        if not arguments:
+            continue
+        command = " ".join(arguments)
+        titled = command.startswith("ray::")
+        python_worker = Path(arguments[0]).name.startswith("python") and any(
+            argument.endswith("default_worker.py") for argument in arguments[1:3]
+        )
+        if titled or python_worker:
             found.append((0 if "run_chunk" in command else 1, process))
     return [process for _, process in sorted(found, key=lambda item: item[0])]
 

@@ -3,11 +3,12 @@
 from __future__ import annotations
 
 import os
+import signal
 import subprocess
 import sys
 
-from fsmbt.cli.cmd_serve import is_loopback
-from support.web_server import REPO, free_port
+from fsmbt.cli.cmd_serve import is_loopback, requested_stop_exits_zero
+from support.web_server import REPO, free_port, stop_leaving_nothing
 
 
 def test_loopback_addresses():
@@ -33,14 +34,37 @@ def test_a_non_loopback_address_prints_a_warning():
         assert process.stderr is not None
         first = process.stderr.readline()  # printed before the server starts listening
     finally:
-        process.terminate()
-        try:
-            process.communicate(timeout=30)
-        except subprocess.TimeoutExpired:
-            process.kill()  # never leave a server behind; the test still fails
-            process.communicate()
-            raise
+        # SIGTERM, then SIGKILL of the server and its workers if needed: a plain kill of the
+        # server alone leaves workers holding its pipes, and reading them would never end
+        stop_leaving_nothing(process, seconds=60.0)
     assert first.startswith("warning: listening on 0.0.0.0, not a loopback address")
+
+
+def test_a_stop_requested_while_the_server_starts_is_obeyed():
+    """SIGTERM right after the first line (uvicorn not yet listening) stops the server and its
+    workers by themselves, exit 0, nothing left to kill."""
+    process = _serve("--host", "127.0.0.1", "--port", str(free_port()), "--workers", "1")
+    assert process.stderr is not None
+    process.stderr.readline()
+    process.send_signal(signal.SIGTERM)
+    try:
+        returncode = process.wait(timeout=60)
+    finally:
+        killed = stop_leaving_nothing(process, seconds=1.0)
+    assert returncode == 0
+    assert killed == []
+
+
+def test_a_stop_noted_before_uvicorn_listens_still_stops_the_server():
+    """The window the subprocess test rarely hits: our handler is installed, uvicorn's are not
+    yet. The signal must still make the server exit (it used to be noted and ignored, and under
+    load a server kept running after SIGTERM)."""
+    import uvicorn
+
+    server = uvicorn.Server(uvicorn.Config(app=None))
+    with requested_stop_exits_zero(server):
+        signal.raise_signal(signal.SIGTERM)
+        assert server.should_exit
 
 
 def test_loopback_has_no_warning_and_a_missing_reports_folder_is_refused():

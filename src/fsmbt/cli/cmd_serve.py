@@ -14,6 +14,7 @@ import sys
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import typer
 
@@ -25,6 +26,9 @@ from fsmbt.web.settings import (
     DEFAULT_TIMEOUT_S,
     DEFAULT_WORKERS,
 )
+
+if TYPE_CHECKING:
+    import uvicorn
 
 
 def is_loopback(host: str) -> bool:
@@ -43,16 +47,23 @@ GRACE_S = 2
 
 
 @contextmanager
-def requested_stop_exits_zero() -> Iterator[None]:
+def requested_stop_exits_zero(server: uvicorn.Server) -> Iterator[None]:
     """While the server runs, SIGTERM and SIGINT are a requested stop: uvicorn stops accepting,
     lets in-flight requests finish (``GRACE_S``), the app's shutdown stops the workers, and
-    uvicorn re-raises the signal into the handlers found here, which only note it, so the
-    command returns normally and exits 0 (docs/web.md, 'Stopping')."""
+    uvicorn re-raises the signal into the handlers found here, which note it, so the
+    command returns normally and exits 0 (docs/web.md, 'Stopping').
+
+    A signal that arrives before uvicorn has installed its own handlers (while it still starts
+    up) lands here too; it also sets ``server.should_exit``, so uvicorn finishes starting, stops
+    at once and the workers are stopped. Only noting it would leave a server running that its
+    supervisor believes stopped (seen under load: a SIGTERM right after start was ignored)."""
     stopped: list[int] = []
-    previous = {
-        sig: signal.signal(sig, lambda number, _frame: stopped.append(number))
-        for sig in (signal.SIGTERM, signal.SIGINT)
-    }
+
+    def note_and_stop(number: int, _frame: object) -> None:
+        stopped.append(number)
+        server.should_exit = True
+
+    previous = {sig: signal.signal(sig, note_and_stop) for sig in (signal.SIGTERM, signal.SIGINT)}
     try:
         yield
     finally:
@@ -154,7 +165,7 @@ def register(app: typer.Typer) -> None:
             )
         )
         try:
-            with requested_stop_exits_zero():
+            with requested_stop_exits_zero(server):
                 server.run()
         except OSError as exc:
             raise fail(f"cannot listen on {host}:{port}: {exc.strerror or exc}") from None
