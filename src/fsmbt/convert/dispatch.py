@@ -186,6 +186,5 @@ def fsm_to_dispatch(fsm: FSM, **_options: object) -> ConversionResult:
         "depth": depth,
         "style": STYLE,
         "index_digits": levels,
-        "root_subtrees": 1,
     }
     return ConversionResult(doc, "rules", "fsm->bt", stats, warnings)
