@@ -66,9 +66,7 @@ def _switch(key: str, cases: list[tuple[str, BTNode]], default: BTNode, name: st
         cases = [*cases, (pad, _running() if key == EVENT_KEY else _leaf("AlwaysFailure"))]
     attrs = {"variable": "{" + key + "}"}
     attrs.update({f"case_{i}": value for i, (value, _n) in enumerate(cases, 1)})
-    return _control(
-        f"Switch{len(cases)}", name, [n for _v, n in cases] + [default], **attrs
-    )
+    return _control(f"Switch{len(cases)}", name, [n for _v, n in cases] + [default], **attrs)
 
 
 def _reachable(flat: FSM) -> list[str]:
