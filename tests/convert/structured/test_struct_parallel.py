@@ -12,6 +12,8 @@ import pytest
 
 from fsmbt import api
 from fsmbt.model.bt import BTDocument, BTNode
+from fsmbt.semantics.outcome_parallel import FLEXBE, SMACH, Concurrence, choose_form
+from fsmbt.semantics.outcome_rules import FAILURE, SUCCESS
 from fsmbt.verify import verify
 from support.corpus import CORPUS
 
@@ -119,12 +121,12 @@ def test_a_map_no_parallel_expresses_keeps_the_product_and_names_why(tmp_path: P
     assert outcome.report is not None and outcome.report.equivalent
 
 
-FLEXBE = CORPUS / "fsm" / "flexbe_turtlesim_demo" / "example_3_sm.py"
+FLEXBE_FILE = CORPUS / "fsm" / "flexbe_turtlesim_demo" / "example_3_sm.py"
 
 
-@pytest.mark.skipif(not FLEXBE.exists(), reason="corpus not present (FSMBT_CORPUS)")
+@pytest.mark.skipif(not FLEXBE_FILE.exists(), reason="corpus not present (FSMBT_CORPUS)")
 def test_flexbe_or_and_and_containers_are_halting_parallels() -> None:
-    outcome = _convert(FLEXBE)
+    outcome = _convert(FLEXBE_FILE)
     doc = outcome.conversion.model
     assert isinstance(doc, BTDocument)
     forms = sorted(
@@ -135,3 +137,46 @@ def test_flexbe_or_and_and_containers_are_halting_parallels() -> None:
     assert forms == [("1", "1"), ("2", "1")]
     assert outcome.report is not None and outcome.report.equivalent
     assert outcome.load is not None and outcome.load.loaded
+    # FlexBE stops the other child at the first failure: a ParallelAll, which lets it finish,
+    # is found NOT EQUIVALENT
+    waiting = copy.deepcopy(doc)
+    node = next(n for _t, n in waiting.nodes() if n.attrs.get("success_count") == "2")
+    node.type, node.attrs = "ParallelAll", {"max_failures": "1"}
+    assert verify(outcome.source.model, waiting, outcome_driven=True).equivalent is False
+
+
+def _two(cls: str, mapping: list[tuple[str, dict[str, str]]], default: str | None) -> Concurrence:
+    outs = [["done", "failed"], ["done", "failed"]]
+    return Concurrence(cls, ["A", "B"], ["X", "Y"], outs, mapping, default)
+
+
+STATUS = [{"done": SUCCESS, "failed": FAILURE}] * 2
+
+
+def test_flexbe_conditions_that_can_all_fail_to_hold_keep_the_product() -> None:
+    c = _two(FLEXBE, [("finished", {"A": "done", "B": "done"})], None)
+    choose_form(c, STATUS, lambda o: (SUCCESS, ""))
+    assert c.form is None
+    assert "no condition holds" in c.why and "A=" in c.why
+
+
+def test_an_outcome_without_a_status_keeps_the_product_and_is_named() -> None:
+    c = _two(SMACH, [("ok", {"A": "done", "B": "done"})], "bad")
+    choose_form(c, STATUS, lambda o: (None, "halts the tree") if o == "bad" else (SUCCESS, ""))
+    assert c.form is None
+    assert c.why == "its outcome 'bad' halts the tree"
+
+
+def test_smach_every_child_is_parallel_all_flexbe_first_failure_is_a_halting_parallel() -> None:
+    statuses = {"ok": SUCCESS, "bad": FAILURE}
+    smach = _two(SMACH, [("ok", {"A": "done", "B": "done"})], "bad")
+    choose_form(smach, STATUS, lambda o: (statuses[o], ""))
+    assert smach.form is not None and smach.form.describe() == "ParallelAll max_failures=1"
+    flexbe = _two(
+        FLEXBE,
+        [("ok", {"A": "done", "B": "done"}), ("bad", {"A": "failed"}), ("bad", {"B": "failed"})],
+        None,
+    )
+    choose_form(flexbe, STATUS, lambda o: (statuses[o], ""))
+    assert flexbe.form is not None
+    assert flexbe.form.describe() == "Parallel success_count=2 failure_count=1"
