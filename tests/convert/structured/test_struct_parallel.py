@@ -77,6 +77,8 @@ def test_every_child_succeeding_is_a_parallel_all_proven_and_loaded(tmp_path: Pa
     assert outcome.conversion.stats["parallels"] == 1
     assert "1 parallel," in str(outcome.conversion.stats["summary"])
     assert any("ParallelAll max_failures=1" in w for w in outcome.conversion.warnings)
+    abstractions = outcome.report.stats["abstractions"]
+    assert any("read in rounds" in a and a.endswith(": CC") for a in abstractions)
 
 
 def test_a_wrong_threshold_or_a_halting_parallel_is_not_equivalent(tmp_path: Path) -> None:
