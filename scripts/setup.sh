@@ -2,7 +2,8 @@
 # Set up fsmbt on a fresh Debian machine (run as root or with sudo); safe to run again.
 #
 #   1. Graphviz's `dot` (Debian package graphviz) when it is missing  - for `fsmbt render`; and
-#      GoogleTest (Debian libgtest-dev) when missing - for the C++ files `fsmbt testgen` writes
+#      GoogleTest (Debian libgtest-dev) when missing - for the C++ files `fsmbt testgen` writes;
+#      SQLite's headers (Debian libsqlite3-dev) when missing - BehaviorTree.CPP's SQLite logger
 #   2. .venv with Python 3.11 (python3.11, or python3 when that is 3.11)
 #   3. the project and its pinned dependencies: pip install -e '.[test]' (pins live in
 #      pyproject.toml); skipped when pyproject.toml has not changed since the last install
@@ -65,6 +66,14 @@ if [ -f /usr/include/gtest/gtest.h ]; then
     say "GoogleTest: /usr/include/gtest"
 else
     apt_install libgtest-dev
+fi
+
+# SQLite's headers: BehaviorTree.CPP is built with its SqliteLogger (the driver's --db3 log,
+# docs/conform.md); cmake's find_package(SQLite3) needs them
+if [ -f /usr/include/sqlite3.h ]; then
+    say "SQLite headers: /usr/include/sqlite3.h"
+else
+    apt_install libsqlite3-dev
 fi
 
 # -- 2. Python 3.11 and the virtual environment -------------------------------------------------

@@ -21,12 +21,17 @@ def cache_root() -> Path:
     return (Path(xdg) if xdg else Path.home() / ".cache") / "fsmbt"
 
 
-#: The BehaviorTree.CPP version the build script installs (its cache folder's key).
+#: The BehaviorTree.CPP version the build script installs.
 BTCPP_VERSION = "4.8.2"
+#: Its cache folder's key: the version and the build options that change what is installed
+#: (``-sqlite``: built with ``BTCPP_SQLITE_LOGGING=ON``, so the driver can write ``.db3`` logs).
+#: Must equal ``BTCPP_BUILD`` in src/fsmbt/install/build_btcpp.sh; a new key makes every machine
+#: build once into a new folder and leaves the old one untouched.
+BTCPP_BUILD = f"{BTCPP_VERSION}-sqlite"
 
 
 def btcpp_prefix() -> Path:
-    """Where the build script installs BehaviorTree.CPP (may not exist): ``btcpp-4.8.2`` under
-    ``cache_root()``. The C++ runtime (``fsmbt.runtime.cpp``) and the load check
+    """Where the build script installs BehaviorTree.CPP (may not exist): ``btcpp-4.8.2-sqlite``
+    under ``cache_root()``. The C++ runtime (``fsmbt.runtime.cpp``) and the load check
     (``fsmbt.semantics.engines.btcpp_load``) both find it here."""
-    return cache_root() / f"btcpp-{BTCPP_VERSION}"
+    return cache_root() / f"btcpp-{BTCPP_BUILD}"

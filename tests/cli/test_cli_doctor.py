@@ -10,6 +10,7 @@ from pathlib import Path
 import pytest
 
 import fsmbt.install
+from fsmbt.cache import BTCPP_BUILD
 from fsmbt.cli import main
 
 
@@ -28,7 +29,7 @@ def test_doctor_json_names_what_each_tool_adds_and_how_to_get_it(
     # the plain form prints the cache path whole, however long
     assert main(["doctor"]) == 1
     out = capsys.readouterr().out
-    assert str(tmp_path / "empty-cache" / "btcpp-4.8.2") in out
+    assert str(tmp_path / "empty-cache" / f"btcpp-{BTCPP_BUILD}") in out
 
 
 def test_the_build_scripts_ship_in_the_package() -> None:

@@ -340,7 +340,7 @@ def test_docs_show_the_shipped_example_files() -> None:
 # -- cache lookup, doctor, the build script without a compiler ----------------------------------
 def test_find_driver_ignores_a_stale_driver(tmp_path: Path, monkeypatch) -> None:
     monkeypatch.setenv("FSMBT_CACHE", str(tmp_path))
-    bin_dir = tmp_path / f"btcpp-{cpp_runtime.BTCPP_VERSION}" / "bin"
+    bin_dir = cpp_runtime.library_prefix() / "bin"
     bin_dir.mkdir(parents=True)
     fake = bin_dir / cpp_runtime.DRIVER_NAME
     fake.write_text("#!/bin/sh\n", encoding="utf-8")

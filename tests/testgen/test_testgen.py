@@ -111,9 +111,9 @@ def test_generated_gtest_file_builds_and_tells_trees_apart(
     """The GoogleTest file, built with the CMakeLists.txt written beside it against the
     BehaviorTree.CPP 4.8.2 scripts/setup.sh built: every case passes on the tree, some fail on
     the tree with two children of a Fallback swapped (given as the program's argument)."""
-    from fsmbt.cache import cache_root
+    from fsmbt.cache import btcpp_prefix
 
-    prefix = cache_root() / "btcpp-4.8.2"
+    prefix = btcpp_prefix()
     if shutil.which("cmake") is None or not Path("/usr/include/gtest/gtest.h").exists():
         pytest.fail("cmake and libgtest-dev are installed by scripts/setup.sh")
     assert (prefix / "lib").is_dir(), "scripts/setup.sh builds BehaviorTree.CPP into the cache"

@@ -23,7 +23,7 @@ def register(app: typer.Typer) -> None:
     def conform_command(
         model: Path = typer.Argument(..., help="The model (BT, or FSM through leaf <-> state)."),
         logs: list[Path] = typer.Argument(
-            ..., help="BehaviorTree.CPP .btlog files or fsmbt py_trees traces (.jsonl)."
+            ..., help="BehaviorTree.CPP .btlog or .db3 files, or fsmbt py_trees traces (.jsonl)."
         ),
         as_json: bool = typer.Option(False, "--json", help="Print the result as JSON."),
         *,

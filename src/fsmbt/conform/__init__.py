@@ -1,7 +1,8 @@
 """``fsmbt conform``: recorded executions checked against a model (docs/conform.md).
 
-``read_log(path)`` reads a BehaviorTree.CPP ``FileLogger2`` log (``btlog.py``) or the Python
-runtime's py_trees trace (``trace.py``), told apart by their first bytes; ``conform(model,
+``read_logs(path)`` reads a BehaviorTree.CPP ``FileLogger2`` log (``btlog.py``), a
+BehaviorTree.CPP ``SqliteLogger`` database (``db3.py``: one log per recording session) or the
+Python runtime's py_trees trace (``trace.py``), told apart by their first bytes; ``conform(model,
 logs)`` replays each through the model's leaf-execution semantics (``replay.py``) and returns
 one result per log and the coverage they reached together. This package sits above ``api``.
 """
@@ -13,20 +14,36 @@ from pathlib import Path
 
 from fsmbt import api
 from fsmbt.conform.btlog import MAGIC, read_btlog
+from fsmbt.conform.db3 import SQLITE_MAGIC, read_db3
 from fsmbt.conform.log import LoggedNode, RecordedLog
 from fsmbt.conform.replay import Coverage, Deviation, LogResult, Replayer
 from fsmbt.conform.trace import TraceWriter, read_trace
 from fsmbt.model.errors import InputError, SourceLocation
 
-#: The first bytes of a SQLite database (BehaviorTree.CPP's SqliteLogger writes .db3 files).
-SQLITE_MAGIC = b"SQLite format 3\x00"
-
 
 def read_log(path: str | Path) -> RecordedLog:
-    """A log file of any supported format, detected from its first bytes.
+    """A log file of any supported format, detected from its first bytes (a ``.db3`` of
+    several sessions: use ``read_logs``).
 
     Raises:
-        InputError: an unreadable file or an unknown or unsupported format (located).
+        InputError: an unreadable file, an unknown format, or a ``.db3`` of several sessions
+            (located).
+    """
+    logs = read_logs(path)
+    if len(logs) != 1:
+        raise InputError(
+            f"the SQLite log holds {len(logs)} sessions: read it with read_logs",
+            location=SourceLocation(str(path)),
+        )
+    return logs[0]
+
+
+def read_logs(path: str | Path) -> list[RecordedLog]:
+    """Every log a file holds (one, except a ``.db3`` of several sessions), its format detected
+    from its first bytes.
+
+    Raises:
+        InputError: an unreadable file or an unknown format (located).
     """
     location = SourceLocation(str(path))
     try:
@@ -35,18 +52,14 @@ def read_log(path: str | Path) -> RecordedLog:
     except OSError as exc:
         raise InputError(f"cannot read the log: {exc.strerror}", location=location) from None
     if head.startswith(MAGIC):
-        return read_btlog(path)
+        return [read_btlog(path)]
     if head.lstrip().startswith(b"{"):
-        return read_trace(path)
+        return [read_trace(path)]
     if head.startswith(SQLITE_MAGIC):
-        raise InputError(
-            "a SQLite database (BehaviorTree.CPP's SqliteLogger .db3): not read by this "
-            "version; record with FileLogger2 (.btlog) instead (docs/conform.md)",
-            location=location,
-        )
+        return read_db3(path)
     raise InputError(
-        "not a log fsmbt reads: neither a BehaviorTree.CPP FileLogger2 log (.btlog) nor a "
-        "fsmbt py_trees trace (JSON lines)",
+        "not a log fsmbt reads: neither a BehaviorTree.CPP FileLogger2 log (.btlog), a "
+        "SqliteLogger log (.db3) nor a fsmbt py_trees trace (JSON lines)",
         location=location,
     )
 
@@ -83,7 +96,7 @@ def conform_files(
         InputError: a model or log that does not load (located).
     """
     loaded = api.load(model, options=options)
-    return conform(loaded.model, [read_log(p) for p in logs], name=str(model))
+    return conform(loaded.model, [log for p in logs for log in read_logs(p)], name=str(model))
 
 
 __all__ = [
@@ -97,6 +110,8 @@ __all__ = [
     "conform",
     "conform_files",
     "read_btlog",
+    "read_db3",
     "read_log",
+    "read_logs",
     "read_trace",
 ]

@@ -29,6 +29,7 @@ lists (no object per record).
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 from fsmbt.conform.log import LoggedNode, RecordedLog
 from fsmbt.formats.xml_safe import local_name, parse_xml
@@ -123,6 +124,18 @@ def read_btlog(path: str | Path) -> RecordedLog:
     return log
 
 
+def _subtree(by_fullpath: dict[str, Any], fullpath: str, uid: int) -> Any:
+    """The ``<BehaviorTree>`` a ``<SubTree _fullpath=...>`` instantiates. 4.8.2 names a SubTree
+    with a ``name`` its instance ``NAME::UID`` while the tree it expands is ``NAME``
+    (``_fullpath="Operating::5"`` expands ``_fullpath="Operating"``): the exact path, else the
+    path without its ``::UID``."""
+    found = by_fullpath.get(fullpath)
+    suffix = f"::{uid}"
+    if found is None and fullpath.endswith(suffix):
+        found = by_fullpath.get(fullpath[: -len(suffix)])
+    return found
+
+
 def embedded_nodes(xml: str, name: str) -> tuple[dict[int, LoggedNode], int]:
     """The nodes of the tree a BehaviorTree.CPP log embeds, by ``_uid``, with their
     interpreter paths, and the root's uid (explicit stack).
@@ -152,7 +165,7 @@ def embedded_nodes(xml: str, name: str) -> tuple[dict[int, LoggedNode], int]:
         if root_uid < 0:
             root_uid = uid
         children = [child for child in el if isinstance(child.tag, str)]
-        sub = by_fullpath.get(el.get("_fullpath", "\0")) if tag == "SubTree" else None
+        sub = _subtree(by_fullpath, el.get("_fullpath", "\0"), uid) if tag == "SubTree" else None
         if sub is not None:
             children = [child for child in sub if isinstance(child.tag, str)][:1]
         is_leaf = not children and tag != "SubTree"

@@ -4,11 +4,13 @@
 # Where the sources come from: the behaviortreepy 0.1.4 sdist on PyPI ships the full
 # BehaviorTree.CPP 4.8.2 tree in its folder BehaviorTree.CPP/ (the same engine the Python tests
 # run through behaviortreepy). The library is configured without its tests, examples, command-line
-# tools, ZeroMQ/Groot2 publisher and SQLite logger (none is needed to load and tick a tree) and
-# installed, as a shared library, into a cache OUTSIDE the checkout, keyed by version (shared: the
-# static build does not install its vendored tinyxml2, so nothing could link against it):
+# tools and ZeroMQ/Groot2 publisher (none is needed to load and tick a tree), with its SQLite
+# logger (the driver's --db3 log, docs/conform.md; needs SQLite's headers: Debian libsqlite3-dev,
+# installed by scripts/setup.sh) and installed, as a shared library, into a cache OUTSIDE the
+# checkout, keyed by version and build options (shared: the static build does not install its
+# vendored tinyxml2, so nothing could link against it):
 #
-#     ${FSMBT_CACHE:-${XDG_CACHE_HOME:-$HOME/.cache}/fsmbt}/btcpp-4.8.2/
+#     ${FSMBT_CACHE:-${XDG_CACHE_HOME:-$HOME/.cache}/fsmbt}/btcpp-4.8.2-sqlite/
 #         include/ lib/ lib/cmake/behaviortree_cpp/   the installed library (CMake package)
 #         bin/fsmbt_lebt_driver                       the driver (src/fsmbt/runtime/cpp/driver)
 #         bin/fsmbt_lebt_driver.sources               sha256 of the sources it was built from
@@ -37,7 +39,10 @@ BTPY_VERSION="0.1.4"
 PKG_DIR="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 CHECKOUT="${FSMBT_CHECKOUT:-}"
 CACHE_ROOT="${FSMBT_CACHE:-${XDG_CACHE_HOME:-$HOME/.cache}/fsmbt}"
-PREFIX="$CACHE_ROOT/btcpp-$BTCPP_VERSION"
+# the cache folder's key: the version and the build options that change what is installed (the
+# SQLite logger); must equal fsmbt.cache.BTCPP_BUILD
+BTCPP_BUILD="$BTCPP_VERSION-sqlite"
+PREFIX="$CACHE_ROOT/btcpp-$BTCPP_BUILD"
 CPP_DIR="$PKG_DIR/runtime/cpp"
 DRIVER_SRC="$CPP_DIR/driver/fsmbt_lebt_driver.cpp"
 HEADER="$CPP_DIR/include/fsmbt/lebt.hpp"
@@ -101,12 +106,12 @@ else
     grep -q "VERSION $BTCPP_VERSION" "$SRC/CMakeLists.txt" \
         || die "the sdist's BehaviorTree.CPP is not version $BTCPP_VERSION"
     rm -rf "$PREFIX"
-    run_logged "configure BehaviorTree.CPP (shared; no tests, examples, tools, Groot2/ZeroMQ, SQLite)" \
+    run_logged "configure BehaviorTree.CPP (shared, SQLite logger; no tests, examples, tools, Groot2/ZeroMQ)" \
         cmake -S "$SRC" -B "$WORK/build" "${GENERATOR[@]}" \
         -DCMAKE_BUILD_TYPE=Release -DCMAKE_INSTALL_PREFIX="$PREFIX" \
         -DCMAKE_CXX_COMPILER="$CXX" -DCMAKE_POSITION_INDEPENDENT_CODE=ON \
         -DBTCPP_SHARED_LIBS=ON -DBTCPP_BUILD_TOOLS=OFF -DBTCPP_EXAMPLES=OFF -DBUILD_TESTING=OFF \
-        -DBTCPP_GROOT_INTERFACE=OFF -DBTCPP_SQLITE_LOGGING=OFF
+        -DBTCPP_GROOT_INTERFACE=OFF -DBTCPP_SQLITE_LOGGING=ON
     run_logged "build BehaviorTree.CPP (nice -n 10, $JOBS jobs)" \
         nice -n 10 cmake --build "$WORK/build" --parallel "$JOBS"
     run_logged "install into $PREFIX" cmake --install "$WORK/build"
@@ -125,9 +130,12 @@ if [ "${FORCE:-0}" != "1" ] && [ -x "$DRIVER" ] && [ -f "$STAMP" ] && [ "$(cat "
 else
     T0="$(now)"
     mkdir -p "$PREFIX/bin"
+    # the driver's --db3 reads the SQLite log back (it waits until every transition is stored)
+    SQLITE_LIB=()
+    [ -f "$PREFIX/include/behaviortree_cpp/loggers/bt_sqlite_logger.h" ] && SQLITE_LIB=(-lsqlite3)
     run_logged "compile the driver ($(basename "$DRIVER_SRC") + fsmbt/lebt.hpp)" \
         nice -n 10 "$CXX" -std=c++17 -O2 -Wall -Wextra -o "$DRIVER.tmp" "$DRIVER_SRC" \
-        -I"$CPP_DIR/include" -I"$PREFIX/include" -L"$PREFIX/lib" -Wl,-rpath,"$PREFIX/lib" -lbehaviortree_cpp -lpthread -ldl
+        -I"$CPP_DIR/include" -I"$PREFIX/include" -L"$PREFIX/lib" -Wl,-rpath,"$PREFIX/lib" -lbehaviortree_cpp "${SQLITE_LIB[@]}" -lpthread -ldl
     mv "$DRIVER.tmp" "$DRIVER"
     echo "$WANT" >"$STAMP"
     T1="$(now)"

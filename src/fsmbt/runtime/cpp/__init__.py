@@ -9,7 +9,7 @@ Shipped with the package (written out by ``fsmbt runtime cpp DIR``):
   written out; ``scripts/build_btcpp.sh`` compiles it).
 
 The build cache lives outside the checkout, keyed by the BehaviorTree.CPP version:
-``${FSMBT_CACHE:-${XDG_CACHE_HOME:-~/.cache}/fsmbt}/btcpp-4.8.2/`` holds the installed library
+``${FSMBT_CACHE:-${XDG_CACHE_HOME:-~/.cache}/fsmbt}/btcpp-4.8.2-sqlite/`` holds the installed library
 and ``bin/fsmbt_lebt_driver`` with, next to it, the sha256 of the header and driver sources it
 was built from. ``find_driver()`` is the one way Python finds the driver: it returns it only when
 that hash matches this package's sources (a stale driver would test old code).

@@ -3,6 +3,9 @@
 //
 //   fsmbt_lebt_driver TREE.xml [--start NAME] [--register A,B,...] [--table] [--bench R]
 //                              [--tick once|exactly-once|auto] [--entries]
+//                              [--btlog FILE.btlog] [--db3 FILE.db3]
+//   fsmbt_lebt_driver TREE.xml --scripted SEED [--ticks N] [--conditions A,B] [--actions C,D]
+//                              [--btlog FILE.btlog] [--db3 FILE.db3]
 //   fsmbt_lebt_driver --version
 //
 // Input (stdin): one event name per line (a trailing '\r' is dropped; empty lines are skipped).
@@ -31,12 +34,42 @@
 //   --bench R        read all of stdin first, replay it R times without printing steps, then print
 //                    one JSON object: {"mode","steps","seconds","ns_per_step","cpu_seconds",
 //                    "cpu_ns_per_step","leaf_ticks","actions"} (wall clock and process CPU time)
+//   --btlog FILE     log every status transition of the tree with BehaviorTree.CPP's FileLogger2
+//                    (the .btlog `fsmbt conform` reads; docs/conform.md), written by the end
+//   --db3 FILE       the same with BehaviorTree.CPP's SqliteLogger (FILE must end in .db3; needs
+//                    a BehaviorTree.CPP built with BTCPP_SQLITE_LOGGING, else exit 1). 4.8.2's
+//                    SqliteLogger drops the transitions its writer thread has not stored when it is
+//                    destroyed, so the driver waits (polling the file, at most 60 s) until the
+//                    table holds every transition the logger was given; it turns SQLite's
+//                    `synchronous` off for the file (one commit per transition otherwise syncs
+//                    the disk each time) and sets a busy timeout, which change no content.
+//
+// Scripted mode (any BehaviorTree.CPP v4 tree, not only an LEBT; no stdin):
+//   --scripted SEED  every leaf type named in --conditions (returns SUCCESS or FAILURE) and
+//                    --actions (a stateful action: SUCCESS, FAILURE or RUNNING, also when ticked
+//                    again while RUNNING) draws its outcome from one std::mt19937(SEED), uniformly;
+//                    the root is ticked --ticks times (default 30) with tickOnce, and each tick
+//                    prints {"tick":I,"status":"SUCCESS"|"FAILURE"|"RUNNING"}. The loggers above
+//                    record the run: the logs `fsmbt conform` checks in the tests.
 #include <fsmbt/lebt.hpp>
 
+#include <behaviortree_cpp/loggers/bt_file_logger_v2.h>
+#include <behaviortree_cpp/xml_parsing.h>
+#if __has_include(<behaviortree_cpp/loggers/bt_sqlite_logger.h>)
+#include <behaviortree_cpp/loggers/bt_sqlite_logger.h>
+#include <sqlite3.h>
+#define FSMBT_HAS_SQLITE_LOGGER 1
+#endif
+
+#include <atomic>
+#include <filesystem>
 #include <chrono>
+#include <thread>
 #include <cstdio>
 #include <ctime>
 #include <iostream>
+#include <memory>
+#include <random>
 #include <sstream>
 #include <string>
 #include <unordered_map>
@@ -290,13 +323,35 @@ struct Arguments
   bool entries = false;
   long bench = 0;
   fsmbt::lebt::TickMode tick = fsmbt::lebt::TickMode::Auto;
+  std::optional<std::string> btlog;
+  std::optional<std::string> db3;
+  std::optional<unsigned long> scripted;
+  long ticks = 30;
+  std::vector<std::string> conditions;
+  std::vector<std::string> actions;
 };
+
+std::vector<std::string> splitList(const std::string& text)
+{
+  std::vector<std::string> names;
+  std::stringstream list(text);
+  for(std::string name; std::getline(list, name, ',');)
+  {
+    if(!name.empty())
+    {
+      names.push_back(name);
+    }
+  }
+  return names;
+}
 
 [[noreturn]] void usage(const std::string& problem)
 {
   std::fprintf(stderr,
                "error: %s\nusage: fsmbt_lebt_driver TREE.xml [--start NAME] [--register A,B] "
-               "[--table] [--entries] [--bench R] [--tick once|exactly-once|auto] | --version\n",
+               "[--table] [--entries] [--bench R] [--tick once|exactly-once|auto] "
+               "[--btlog FILE] [--db3 FILE] [--scripted SEED [--ticks N] [--conditions A,B] "
+               "[--actions C,D]] | --version\n",
                problem.c_str());
   std::exit(2);
 }
@@ -358,6 +413,45 @@ Arguments parse(int argc, char** argv)
     else if(arg == "--table")
     {
       args.table = true;
+    }
+    else if(arg == "--btlog")
+    {
+      args.btlog = value();
+    }
+    else if(arg == "--db3")
+    {
+      args.db3 = value();
+    }
+    else if(arg == "--scripted" || arg == "--ticks")
+    {
+      long number = -1;
+      try
+      {
+        number = std::stol(value());
+      }
+      catch(const std::exception&)
+      {
+      }
+      if(number < 0)
+      {
+        usage(arg + " needs a number >= 0");
+      }
+      if(arg == "--ticks")
+      {
+        args.ticks = number;
+      }
+      else
+      {
+        args.scripted = static_cast<unsigned long>(number);
+      }
+    }
+    else if(arg == "--conditions")
+    {
+      args.conditions = splitList(value());
+    }
+    else if(arg == "--actions")
+    {
+      args.actions = splitList(value());
     }
     else if(arg == "--entries")
     {
@@ -513,6 +607,205 @@ void bench(Runner& runner, fsmbt::lebt::LebtRunner* lebt, const std::vector<std:
               static_cast<unsigned long long>(ticks), sink);
 }
 
+/// BehaviorTree.CPP's FileLogger2 that counts the transitions it is given. 4.8.2's destructor
+/// stops the writer thread, which drops what it has not taken from its queue (everything when it
+/// has not run yet, on a loaded machine), so this waits until the file is as long as the header
+/// (magic, protocol, length, WriteTreeToXML(tree, true, true), first time stamp) plus 9 bytes per
+/// transition given (at most 60 s; then a warning on stderr).
+class CountingFileLogger2 : public BT::FileLogger2
+{
+public:
+  CountingFileLogger2(const BT::Tree& tree, const std::string& path)
+    : BT::FileLogger2(tree, path)
+    , path_(path)
+    , header_(18 + 1 + 4 + BT::WriteTreeToXML(tree, true, true).size() + 8)
+  {}
+
+  ~CountingFileLogger2() override { waitWritten(); }
+
+  void callback(BT::Duration timestamp, const BT::TreeNode& node, BT::NodeStatus prev_status,
+                BT::NodeStatus status) override
+  {
+    ++given_;
+    BT::FileLogger2::callback(timestamp, node, prev_status, status);
+  }
+
+private:
+  void waitWritten() const
+  {
+    const std::uintmax_t want = header_ + 9 * static_cast<std::uintmax_t>(given_.load());
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+    std::uintmax_t size = 0;
+    while(std::chrono::steady_clock::now() < deadline)
+    {
+      std::error_code error;
+      size = std::filesystem::file_size(path_, error);
+      if(!error && size >= want)
+      {
+        return;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+    std::fprintf(stderr, "warning: the .btlog holds %ju of %ju bytes\n", size, want);
+  }
+
+  std::string path_;
+  std::uintmax_t header_;
+  std::atomic<long> given_{ 0 };
+};
+
+#ifdef FSMBT_HAS_SQLITE_LOGGER
+/// BehaviorTree.CPP's SqliteLogger that counts the transitions it is given (all from the thread
+/// that ticks the tree).
+class CountingSqliteLogger : public BT::SqliteLogger
+{
+public:
+  CountingSqliteLogger(const BT::Tree& tree, const std::string& path)
+    : BT::SqliteLogger(tree, path), path_(path)
+  {
+    execSqlStatement("PRAGMA synchronous = OFF;");
+    // the writer waits for waitStored()'s reads instead of failing with SQLITE_BUSY
+    execSqlStatement("PRAGMA busy_timeout = 10000;");
+  }
+
+  ~CountingSqliteLogger() override { waitStored(); }
+
+  void callback(BT::Duration timestamp, const BT::TreeNode& node, BT::NodeStatus prev_status,
+                BT::NodeStatus status) override
+  {
+    ++given_;
+    BT::SqliteLogger::callback(timestamp, node, prev_status, status);
+  }
+
+private:
+  /// Poll the file (a second, read-only connection) until its Transitions table holds every
+  /// transition given; the base destructor then stops the writer with nothing left to drop.
+  void waitStored() const
+  {
+    sqlite3* db = nullptr;
+    if(sqlite3_open_v2(path_.c_str(), &db, SQLITE_OPEN_READONLY, nullptr) != SQLITE_OK)
+    {
+      sqlite3_close(db);
+      return;
+    }
+    sqlite3_busy_timeout(db, 1000);
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+    long stored = -1;
+    while(std::chrono::steady_clock::now() < deadline)
+    {
+      sqlite3_stmt* stmt = nullptr;
+      if(sqlite3_prepare_v2(db, "SELECT COUNT(*) FROM Transitions", -1, &stmt, nullptr) ==
+             SQLITE_OK &&
+         sqlite3_step(stmt) == SQLITE_ROW)
+      {
+        stored = sqlite3_column_int64(stmt, 0);
+      }
+      sqlite3_finalize(stmt);
+      if(stored >= given_)
+      {
+        break;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+    sqlite3_close(db);
+    if(stored < given_)
+    {
+      std::fprintf(stderr, "warning: the SQLite log holds %ld of %ld transitions\n", stored,
+                   static_cast<long>(given_));
+    }
+  }
+
+  std::string path_;
+  std::atomic<long> given_{ 0 };
+};
+#endif
+
+/// The loggers --btlog and --db3 ask for, attached to `tree` while this object lives (destroy it
+/// before the tree: each destructor writes what is left).
+class Loggers
+{
+public:
+  Loggers(const BT::Tree& tree, const Arguments& args)
+  {
+    if(args.btlog)
+    {
+      file_ = std::make_unique<CountingFileLogger2>(tree, *args.btlog);
+    }
+    if(args.db3)
+    {
+#ifdef FSMBT_HAS_SQLITE_LOGGER
+      sqlite_ = std::make_unique<CountingSqliteLogger>(tree, *args.db3);
+#else
+      throw std::runtime_error("--db3: this BehaviorTree.CPP was built without its SQLite logger "
+                               "(BTCPP_SQLITE_LOGGING=OFF); rebuild with scripts/build_btcpp.sh");
+#endif
+    }
+  }
+
+private:
+  std::unique_ptr<CountingFileLogger2> file_;
+#ifdef FSMBT_HAS_SQLITE_LOGGER
+  std::unique_ptr<CountingSqliteLogger> sqlite_;
+#endif
+};
+
+/// A scripted action of --scripted: SUCCESS, FAILURE or RUNNING drawn from the shared generator
+/// at every tick (the first and each one while RUNNING).
+class ScriptedAction : public BT::StatefulActionNode
+{
+public:
+  ScriptedAction(const std::string& name, const BT::NodeConfig& config, std::mt19937& rng)
+    : BT::StatefulActionNode(name, config), rng_(rng)
+  {}
+
+  BT::NodeStatus onStart() override { return draw(); }
+  BT::NodeStatus onRunning() override { return draw(); }
+  void onHalted() override {}
+
+private:
+  BT::NodeStatus draw()
+  {
+    static constexpr BT::NodeStatus kOutcomes[] = { BT::NodeStatus::SUCCESS,
+                                                    BT::NodeStatus::FAILURE,
+                                                    BT::NodeStatus::RUNNING };
+    return kOutcomes[std::uniform_int_distribution<int>(0, 2)(rng_)];
+  }
+
+  std::mt19937& rng_;
+};
+
+/// --scripted: load any tree with the listed leaves scripted, tick it, print each root status.
+void scripted(const Arguments& args)
+{
+  std::mt19937 rng(static_cast<std::mt19937::result_type>(*args.scripted));
+  BT::BehaviorTreeFactory factory;
+  for(const std::string& name : args.conditions)
+  {
+    factory.registerSimpleCondition(name, [&rng](BT::TreeNode&) {
+      return std::uniform_int_distribution<int>(0, 1)(rng) == 0 ? BT::NodeStatus::SUCCESS :
+                                                                   BT::NodeStatus::FAILURE;
+    });
+  }
+  for(const std::string& name : args.actions)
+  {
+    factory.registerBuilder<ScriptedAction>(
+        name, [&rng](const std::string& instance, const BT::NodeConfig& config) {
+          return std::make_unique<ScriptedAction>(instance, config, rng);
+        });
+  }
+  BT::Tree tree = factory.createTreeFromFile(args.tree);
+  {
+    Loggers loggers(tree, args);
+    for(long i = 1; i <= args.ticks; ++i)
+    {
+      const BT::NodeStatus status = tree.tickOnce();
+      std::printf("{\"tick\":%ld,\"status\":%s}\n", i,
+                  jsonString(BT::toStr(status, false)).c_str());
+    }
+  }  // the loggers write the rest of the log here, before the tree goes
+  std::fflush(stdout);
+}
+
 }  // namespace
 
 int main(int argc, char** argv)
@@ -549,6 +842,11 @@ int main(int argc, char** argv)
   }
   try
   {
+    if(args.scripted)
+    {
+      scripted(args);
+      return 0;
+    }
     fsmbt::lebt::ActionRegistry actions;
     // --entries: each callback prints what it received, {"entered":STATE,"params":{...}}
     auto callback = [entries = args.entries](const std::string& state,
@@ -583,6 +881,7 @@ int main(int argc, char** argv)
     options.tick = args.tick;
     fsmbt::lebt::LebtRunner runner =
         fsmbt::lebt::LebtRunner::fromFile(args.tree, std::move(actions), options);
+    Loggers loggers(runner.tree(), args);  // after the runner: destroyed (and written) first
     if(args.table)
     {
       TableRunner table(runner);
