@@ -130,6 +130,15 @@ def measure(shape: str, n: int, args: argparse.Namespace, tmp: Path) -> dict[str
             row["cpp_once"], row["cpp_once_wall"] = once["cpu_ns_per_step"], once["ns_per_step"]
         except CppRuntimeError as exc:
             row["cpp"] = "cannot load: " + str(exc).split(": ", 2)[-1][:90]
+        dispatch_tree = tmp / f"{shape}-{n}-dispatch.xml"
+        dispatch = convert(fsm, style="dispatch")
+        row["dispatch_depth"] = dispatch.stats["depth"]
+        dispatch_tree.write_text(dumps(dispatch.model, "btcpp"), encoding="utf-8")
+        try:
+            session = DriverSession(dispatch_tree, driver=driver, dispatch=True, timeout=1200)
+            row["dispatch"] = session.bench(sequences, repeat)["cpu_ns_per_step"]
+        except CppRuntimeError as exc:
+            row["dispatch"] = "cannot load: " + str(exc).split(": ", 2)[-1][:60]
         table = DriverSession(tree, driver=driver, table=True, timeout=600)
         try:
             row["table"] = table.bench(sequences, repeat)["cpu_ns_per_step"]
@@ -240,6 +249,26 @@ def main() -> int:
                 f"{row.get('pytrees_steps', '-'):>7} {py_ratio:>7} {fmt(row.get('cpp_once')):>10} "
                 f"{'|':>7} {fmt(row.get('cpp_wall')):>10} {fmt(row.get('cpp_once_wall')):>10} "
                 f"{fmt(row.get('pytrees_wall')):>11}"
+            )
+        print(
+            "\nDispatch form (--style dispatch, docs/semantics.md section 12) in BehaviorTree.CPP "
+            "4.8.2 (driver --dispatch), ns of CPU time per macro step:\n"
+        )
+        dheader = (
+            f"{'shape':7} {'states':>6} {'depth':>5} {'dispatch':>10} {'table':>6} {'/table':>8}"
+        )
+        print(dheader)
+        print("-" * len(dheader))
+        for row in rows:
+            disp, table = row.get("dispatch"), row.get("table")
+            ratio = (
+                fmt(disp / table, unit="x")
+                if isinstance(disp, float) and isinstance(table, float) and table
+                else "-"
+            )
+            print(
+                f"{row['shape']:7} {row['states']:>6} {row.get('dispatch_depth', '-'):>5} "
+                f"{fmt(disp):>10} {fmt(table):>6} {ratio:>8}"
             )
         print(
             "\nroots = selectors of the root Sequence (the entry state and every state entered "

@@ -85,7 +85,7 @@ def run_source(fsm: FSM, seed: int, budget: int) -> tuple[list[str], str | None]
     while len(calls) < budget:
         if isinstance(state, tuple):
             return calls, state[0]
-        unit = machine.units[state]
+        unit = machine.unit_of(state)
         calls.append(unit.label)
         state, _outputs = machine.step(state, pick(seed, len(calls) - 1, unit))
     return calls, state[0] if isinstance(state, tuple) else None

@@ -38,7 +38,10 @@ def _fsm_to_bt(s: Mapping[str, object], engine: str, used: set[str]) -> list[str
     head = counted(take("states"), "FSM state")
     if "transitions" in s:
         head += f" and {counted(take('transitions'), 'transition')}"
-    head += " became " + ("a loop-execution BT" if engine == "rules" else "a BT")
+    if s.get("style") == "dispatch":  # docs/semantics.md section 12
+        head += " became a dispatch BT (a Switch dispatch over a state index)"
+    else:
+        head += " became " + ("a loop-execution BT" if engine == "rules" else "a BT")
     if "nodes" in s:
         head += f" of {counted(take('nodes'), 'node')}"
     if "depth" in s:

@@ -16,11 +16,18 @@ from dataclasses import dataclass
 from typing import Any
 
 from fsmbt.convert.bt_to_hfsm import bt_to_hfsm
+from fsmbt.convert.dispatch import fsm_to_dispatch
 from fsmbt.convert.hfsm_to_bt import fsm_to_bt
 from fsmbt.convert.result import ConversionResult, Converter, Model
 from fsmbt.convert.structure import MAX_XML_LEVELS
 from fsmbt.convert.structured import structured_result
-from fsmbt.convert.structured.style import AUTO, STRUCTURED, check_style, resolve_style
+from fsmbt.convert.structured.style import (
+    AUTO,
+    DISPATCH,
+    STRUCTURED,
+    check_style,
+    resolve_style,
+)
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import InputError, UnsupportedError
 from fsmbt.model.fsm import FSM
@@ -78,6 +85,8 @@ def rules_fsm_to_bt(
     """
     rules = OutcomeRules.from_option(outcomes)
     chosen, view = resolve_style(style, fsm, outcome_driven=outcome_driven, rules=rules)
+    if chosen == DISPATCH:
+        return fsm_to_dispatch(fsm, **options)
     too_deep = ""
     if view is not None:
         result = structured_result(view)

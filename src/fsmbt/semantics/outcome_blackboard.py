@@ -7,8 +7,8 @@ entries they touch:
 
 - a leaf with an output port ``outcome="{K}"`` writes its outcome's name to entry ``K`` (the
   leaf-execution machine is told which outcome: ``OutcomeLeafMachine``);
-- ``Script`` with code ``K:='value'`` (or ``K='value'``) writes the literal ``value`` to ``K``
-  and returns SUCCESS;
+- ``Script`` with code ``K:='value'`` (or ``K='value'``), or several such assignments joined by
+  ``;``, writes each literal ``value`` to its ``K`` in order and returns SUCCESS;
 - ``Switch2`` .. ``Switch6`` with ``variable="{K}"`` and literal ``case_i`` ticks the first
   child whose case equals ``K``'s value, else the last (default) child; it remembers the
   running child and halts it when the match changes, as ``switch_node.h`` does.
@@ -60,6 +60,7 @@ OUTCOME_PORT = "outcome"
 _SWITCH_TYPE = re.compile(r"Switch([2-6])")
 _ENTRY = re.compile(r"\{([A-Za-z_][A-Za-z0-9_]*)\}")
 _ASSIGN = re.compile(r"\s*([A-Za-z_][A-Za-z0-9_]*)\s*:?=\s*'([^']*)'\s*;?\s*")
+_ASSIGNS = re.compile(r"(?:\s*[A-Za-z_][A-Za-z0-9_]*\s*:?=\s*'[^']*'\s*;?\s*)+")
 _NUMBER = re.compile(r"\s*[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?\s*")
 
 
@@ -76,8 +77,10 @@ class OutcomeTree(CompiledTree):
         self.modelled: set[str] = set()
         self.outcome_keys: dict[int, str] = {}
         for node in self.nodes:
-            if node.type in (SWITCH, SCRIPT):
+            if node.type == SWITCH:
                 self.modelled.add(node.params[0])
+            elif node.type == SCRIPT:
+                self.modelled.update(key for key, _value in node.params)
         for node in self.nodes:
             key = _entry(node.source.attrs.get(OUTCOME_PORT, ""))
             if node.is_env_leaf and key is not None:
@@ -120,9 +123,10 @@ class OutcomeTree(CompiledTree):
                 cases.append(value)
             return SWITCH, NodeKind.CONTROL, (key, tuple(cases)), None, list(node.children)
         if node.type == "Script" and not node.children:
-            assign = _ASSIGN.fullmatch(node.attrs.get("code", ""))
-            if assign is not None:
-                return SCRIPT, NodeKind.CONTROL, (assign.group(1), assign.group(2)), None, []
+            code = node.attrs.get("code", "")
+            if _ASSIGNS.fullmatch(code) is not None:
+                pairs = tuple((m.group(1), m.group(2)) for m in _ASSIGN.finditer(code))
+                return SCRIPT, NodeKind.CONTROL, pairs, None, []
         return super()._check(node, chain)
 
     def _check_exclusive(self) -> None:
@@ -210,9 +214,9 @@ class OutcomeInterpreter(BTInterpreter):
     def _t_bb_script(
         self, w: Any, node: CompiledNode, frame: Frame, result: int | None, hook: HaltHook | None
     ) -> TickAction:
-        key, value = node.params
         entries = _blackboard(w)
-        entries[key] = value
+        for key, value in node.params:
+            entries[key] = value
         w.mem[BLACKBOARD_SLOT] = tuple(sorted(entries.items()))
         return ("ret", SUCCESS)
 

@@ -9,7 +9,9 @@ names; ``preempted`` ones that halt the machine removed, ``outcome_rules`` rule 
 targets and statuses, and whether a leaf needs a dispatch on its outcome.
 
 Rules (each violation is an ``OutcomeError`` naming the state and the cause, exit 2):
-- no parallel state (a Concurrence has no structured form in this version);
+- no parallel state (a reader builds a Concurrence as a composite whose region is the product
+  of its children; one of leaf children whose semantics a BehaviorTree.CPP parallel node has
+  is read in rounds instead, its units being its children: ``outcome_parallel``);
 - the machine needs no start event; an atomic state has no completion transition and at
   least one outcome; a composite state leaves only by completion transitions;
 - when a state declares its outcomes (``fsmbt.model.state_info``), every event of its
@@ -30,6 +32,7 @@ from dataclasses import dataclass, field
 
 from fsmbt.model import state_info
 from fsmbt.model.fsm import FSM, State
+from fsmbt.semantics.outcome_parallel import Concurrence, choose_form, read_concurrence
 from fsmbt.semantics.outcome_rules import (
     FAILURE,
     HALT_OUTCOME,
@@ -90,6 +93,14 @@ class Region:
     exits: list[str] = field(default_factory=list)
     exit_status: dict[str, str | None] = field(default_factory=dict)
     pc_key: str = ""
+    #: A Concurrence of leaf children (``outcome_parallel``); with a ``form`` the region's
+    #: units are its children, read in rounds, else its product machine's states.
+    concurrence: Concurrence | None = None
+
+    @property
+    def parallel(self) -> bool:
+        """Whether the region is a Concurrence read in rounds (a Parallel in the tree)."""
+        return self.concurrence is not None and self.concurrence.form is not None
 
     @property
     def initial(self) -> str:
@@ -154,8 +165,7 @@ def read_outcome_view(fsm: FSM, rules: OutcomeRules | None = None) -> OutcomeVie
             element=f"machine '{fsm.name}'",
         )
     regions: dict[str, Region] = {}
-    order_choices: list[str] = []
-    halts = 0
+    notes: dict[str, list[str]] = {}  # unit path -> its order choices, in words
     # work list: (region path, machine, owner unit, halting finals of this machine)
     work: list[tuple[str, FSM, Unit | None, frozenset[str]]] = []
     top_halting = frozenset(
@@ -184,7 +194,6 @@ def read_outcome_view(fsm: FSM, rules: OutcomeRules | None = None) -> OutcomeVie
                 work.append((where, state.regions[0], unit, inner_halting))
             else:
                 unit = _leaf_unit(where, name, state, outgoing, halting)
-            halts += len(unit.halted)
             region.units[name] = unit
         reached = {t for u in region.units.values() for t in u.targets.values()}
         reached.add(region.initial)
@@ -204,30 +213,89 @@ def read_outcome_view(fsm: FSM, rules: OutcomeRules | None = None) -> OutcomeVie
                     o: SUCCESS if unit.targets[o] == first else FAILURE for o in unit.outcomes
                 }
                 unit.order_choice = False
-                order_choices.append(
+                notes.setdefault(unit.path, []).append(
                     f"{unit.path}: the outcomes leading to '{first}' read as SUCCESS, the "
                     "others as FAILURE (two places to go)"
                 )
             if not unit.dispatch:  # one place to go whatever the status: say SUCCESS
                 unit.status = {o: s or SUCCESS for o, s in unit.status.items()}
             if unit.order_choice:
-                first, second = unit.outcomes
-                order_choices.append(
-                    f"{unit.path}: '{first}' read as SUCCESS, '{second}' as FAILURE "
-                    "(first declared outcome)"
-                )
+                notes.setdefault(unit.path, []).append(_order_note(unit))
     top = regions[""]
     top.exit_status, top_choice = rules.statuses(top.exits)
-    if top_choice:
-        order_choices.append(
-            f"{fsm.name}: outcome '{top.exits[0]}' read as SUCCESS, '{top.exits[1]}' as FAILURE"
-        )
     for path, region in regions.items():
         if region.owner is not None:
             region.exit_status = {e: region.owner.status.get(e) for e in region.exits}
         region.pc_key = "pc" if not path else f"pc_{_sanitize(path)}"
+    for region in regions.values():
+        _read_parallel(region, fsm, rules, notes)
+    order_choices = [
+        note for r in regions.values() for u in r.units.values() for note in notes.get(u.path, [])
+    ]
+    if top_choice:
+        order_choices.append(
+            f"{fsm.name}: outcome '{top.exits[0]}' read as SUCCESS, '{top.exits[1]}' as FAILURE"
+        )
+    halts = sum(len(u.halted) for r in regions.values() for u in r.units.values())
     by_label = _assign_labels(regions)
     return OutcomeView(fsm, rules, regions, by_label, order_choices, halts)
+
+
+def _order_note(unit: Unit) -> str:
+    first, second = unit.outcomes
+    return f"{unit.path}: '{first}' read as SUCCESS, '{second}' as FAILURE (first declared outcome)"
+
+
+def _read_parallel(
+    region: Region, fsm: FSM, rules: OutcomeRules, notes: dict[str, list[str]]
+) -> None:
+    """A Concurrence of leaf children: read in rounds when a parallel form is exactly
+    equivalent (its units become its children), else named with the cause
+    (``outcome_parallel``; docs/semantics.md §11, "Concurrences: Parallel or product")."""
+    owner = region.owner
+    concurrence = read_concurrence(owner.state if owner is not None else fsm)
+    if concurrence is None:
+        return
+    region.concurrence = concurrence
+    children: dict[str, Unit] = {}
+    statuses: list[dict[str, str]] = []
+    for state, outcomes in zip(concurrence.child_states(), concurrence.outcomes):
+        where = f"{region.path}/{state.name}" if region.path else state.name
+        status, choice = rules.statuses(outcomes)
+        if RUNNING_INPUT in outcomes:
+            concurrence.why = f"child '{state.name}' has an outcome named '{RUNNING_INPUT}'"
+            return
+        missing = [o for o in outcomes if status[o] is None]
+        if missing or not outcomes:
+            concurrence.why = (
+                f"child '{state.name}': outcome '{missing[0]}' has no status under the outcome "
+                "rules"
+                if missing
+                else f"child '{state.name}' declares no outcome"
+            )
+            return
+        full = {o: str(s) for o, s in status.items()}
+        statuses.append(full)
+        unit = Unit(where, state.name, state, False, tuple(outcomes),
+                    {o: "" for o in outcomes}, dict(full), (), choice)  # fmt: skip
+        children[state.name] = unit
+
+    def outcome_status(outcome: str) -> tuple[str | None, str]:
+        if owner is None:
+            return (FAILURE if region.exit_status.get(outcome) == FAILURE else SUCCESS), ""
+        if outcome in owner.halted:
+            return None, "halts the tree ('preempted' modelled as a halt)"
+        if owner.dispatch:
+            return None, "is dispatched on (the container's outcomes lead to more than two places)"
+        return owner.status.get(outcome), "leads nowhere"
+
+    choose_form(concurrence, statuses, outcome_status)
+    if concurrence.form is None:
+        return
+    region.units = children
+    for unit in children.values():
+        if unit.order_choice:
+            notes.setdefault(unit.path, []).append(_order_note(unit))
 
 
 def _leaf_unit(

@@ -83,5 +83,12 @@ def outcome_abstractions(view: OutcomeView) -> list[str]:
     ]
     if view.halts:
         sentences.append(f"'preempted' is the tree being halted ({view.halts} outcome(s))")
+    rounds = [path or view.fsm.name for path, r in view.regions.items() if r.parallel]
+    if rounds:
+        sentences.append(
+            "concurrence read in rounds (each child still running runs once per round, in the "
+            'order added; docs/semantics.md §11, "Concurrences: Parallel or product"): '
+            + ", ".join(rounds)
+        )
     sentences.extend(f"by declaration order: {choice}" for choice in view.order_choices)
     return sentences

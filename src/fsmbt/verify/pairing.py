@@ -131,10 +131,13 @@ def machines_for(
             MACRO_STEP,
         )
     if isinstance(source, FSM) and isinstance(result, BTDocument):
+        from fsmbt.semantics.dispatch_runtime import is_dispatch_bt, machines_for_dispatch
         from fsmbt.semantics.state_variable_runtime import machines_for_state_variable
 
         if flavour_of(result) is Flavour.STATE_VARIABLE:  # the baselines' leaves (BSD, CHDS)
             return (*machines_for_state_variable(source, result), MACRO_STEP)
+        if is_dispatch_bt(result):  # the dispatch form (docs/semantics.md section 12)
+            return (*machines_for_dispatch(source, result), MACRO_STEP)
         if is_outcome_pair(source, result, outcome_driven=outcome_driven):
             return outcome_machines(source, result, outcomes)
 

@@ -5,7 +5,9 @@ Steps: read the machine as outcome-driven (``semantics.outcome_view``: every vio
 located ``OutcomeError``, exit 2); structure each region (``regions``), or give it the flag form
 (``flags``) when no structured form exists; the top-level machine is the main
 ``<BehaviorTree>`` itself, each container one ``<BehaviorTree>`` used by one ``SubTree`` node;
-every leaf type is declared in ``<TreeNodesModel>``. The result's ``stats`` count what was found
+every leaf type is declared in ``<TreeNodesModel>``; a Concurrence the outcome view reads in
+rounds is a ``Parallel`` / ``ParallelAll`` over its children's leaves (``_parallel``; the rule:
+docs/semantics.md §11, "Concurrences: Parallel or product"). The result's ``stats`` count what was found
 and ``stats["summary"]`` says it in one line ("structured: 3 sequences, 1 fallback, ...").
 
 Cost: the regions' structuring (``regions``) plus O(nodes).
@@ -14,7 +16,7 @@ Cost: the regions' structuring (``regions``) plus O(nodes).
 from __future__ import annotations
 
 from collections import Counter
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 
 from fsmbt.convert.result import ConversionResult
 from fsmbt.convert.structured import builder
@@ -61,6 +63,9 @@ def structured_result(view: OutcomeView) -> ConversionResult:
     flagged: list[str] = []
     flags: list[str] = []
     for path, region in view.regions.items():
+        if region.parallel:
+            trees[tree_ids[path]] = BehaviorTree(tree_ids[path], _parallel(region, emit))
+            continue
         exits = _exit_terms(view, region)
         structurer = RegionStructurer(region, emit, exits)
         try:
@@ -101,21 +106,35 @@ def structured_result(view: OutcomeView) -> ConversionResult:
     return ConversionResult(doc, STYLE, "fsm->bt", stats=stats, warnings=warnings)
 
 
-#: Attributes the SMACH/FlexBE readers put on a Concurrence's composite state.
-_CONTAINER_ATTR = "smach.container"
-_CONCURRENT = ("Concurrence", "ConcurrencyContainer")
+def _parallel(region: Region, emit: Callable[[Unit], BTNode]) -> BTNode:
+    """A Concurrence read in rounds: its parallel form over its children's leaves, in the
+    order they were added (docs/semantics.md §11, "Concurrences: Parallel or product")."""
+    concurrence = region.concurrence
+    assert concurrence is not None and concurrence.form is not None
+    form = concurrence.form
+    node = builder.control(form.kind, *(emit(u) for u in region.units.values()), **dict(form.ports))
+    return builder.decorator(form.wrapper, node) if form.wrapper else node
 
 
 def _concurrences(view: OutcomeView) -> list[str]:
-    """Name every Concurrence: its region is the product the reader built (one leaf per
-    combination of its children's progress), the named fallback form; no Parallel yet."""
+    """Name every Concurrence of leaf children: the parallel form it became, or why it is kept
+    as its product machine (the named fallback form: one leaf per combination of its
+    children's progress)."""
     named = []
-    for region in view.regions.values():
-        owner = region.owner
-        if owner is not None and owner.state.attrs.get(_CONTAINER_ATTR) in _CONCURRENT:
+    for path, region in view.regions.items():
+        concurrence = region.concurrence
+        if concurrence is None:
+            continue
+        where = f"{concurrence.cls} '{path or view.fsm.name}'"
+        if concurrence.form is not None:
             named.append(
-                f"{owner.state.attrs[_CONTAINER_ATTR]} '{owner.path}': kept as its product "
-                "machine (one leaf per combination of its children's progress), not a Parallel"
+                f"{where}: a {concurrence.form.describe()} over its children, read in rounds "
+                '(docs/semantics.md §11, "Concurrences: Parallel or product")'
+            )
+        else:
+            named.append(
+                f"{where}: kept as its product machine (one leaf per combination of its "
+                f"children's progress), not a Parallel: {concurrence.why}"
             )
     return named
 
@@ -161,6 +180,8 @@ _COUNTED = {
     "Inverter": "inverters",
     "ForceSuccess": "forced",
     "ForceFailure": "forced",
+    "Parallel": "parallels",
+    "ParallelAll": "parallels",
 }
 
 
@@ -200,6 +221,7 @@ def summary(stats: Mapping[str, object]) -> str:
         _plural(stats["conditionals"], "if-then-else"),
         _plural(stats["switches"], "switch").replace("switchs", "switches"),
         _plural(loops, "retry loop"),
+        _plural(stats.get("parallels", 0), "parallel"),
         _plural(stats["subtrees"], "subtree"),
         _plural(stats["flags"], "flag"),
         f"{stats['lebt_blocks']} LEBT blocks",

@@ -4,6 +4,8 @@
   outcome-driven machines - on an event-driven one it is bad input naming the first state
   that does not fit (exit 2);
 - ``lebt`` (``paper`` is its old name, kept as an alias): the paper's LEBT shape, for any FSM;
+- ``dispatch``: a balanced ``Switch`` dispatch over a state index on the blackboard
+  (``fsmbt.convert.dispatch``; docs/semantics.md section 12), for event-driven machines;
 - ``auto`` (the default): ``structured`` when the machine is outcome-driven, else ``lebt``.
 
 A machine is outcome-driven when its format says its events are outcomes (SMACH, FlexBE,
@@ -25,8 +27,9 @@ from fsmbt.semantics.outcome_view import OutcomeView, declares_outcomes, read_ou
 AUTO = "auto"
 STRUCTURED = "structured"
 LEBT = "lebt"
+DISPATCH = "dispatch"
 #: Every style name ``--style`` takes; ``paper`` is ``lebt``.
-STYLES = (AUTO, STRUCTURED, LEBT, "paper")
+STYLES = (AUTO, STRUCTURED, LEBT, DISPATCH, "paper")
 ALIASES = {"paper": LEBT}
 
 
@@ -38,7 +41,7 @@ def check_style(style: str) -> str:
     """
     if style not in STYLES:
         raise UnsupportedError(
-            f"unknown style '{style}' (valid: auto, structured, lebt, paper = lebt)",
+            f"unknown style '{style}' (valid: auto, structured, lebt, dispatch, paper = lebt)",
             element="--style",
         )
     return ALIASES.get(style, style)
@@ -59,8 +62,8 @@ def resolve_style(
         outcomes but does not have their shape (the state and the cause named).
     """
     chosen = check_style(style)
-    if chosen == LEBT:
-        return LEBT, None
+    if chosen in (LEBT, DISPATCH):
+        return chosen, None
     claims = outcome_driven or declares_outcomes(fsm)
     if chosen == AUTO and not claims:
         return LEBT, None

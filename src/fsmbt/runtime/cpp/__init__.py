@@ -173,6 +173,7 @@ class DriverSession:
         *,
         driver: Path | None = None,
         table: bool = False,
+        dispatch: bool = False,
         start: str | None = None,
         tick: str | None = None,
         timeout: float = 120.0,
@@ -181,6 +182,7 @@ class DriverSession:
         self.tick = tick  # "once", "exactly-once", "auto" (the driver's default) or None
         self.driver = driver or require_driver()
         self.table = table
+        self.dispatch = dispatch  # the tree is the dispatch form (docs/semantics.md section 12)
         self.start = start
         self.timeout = timeout
 
@@ -188,6 +190,8 @@ class DriverSession:
         command = [str(self.driver), str(self.tree_file)]
         if self.table:
             command.append("--table")
+        if self.dispatch:
+            command.append("--dispatch")
         if self.start is not None:
             command += ["--start", self.start]
         if self.tick is not None:

@@ -28,6 +28,9 @@
 //                    JSON line {"entered":STATE,"params":{...}} before its step's line
 //   --table          run the same FSM as a plain transition table read off the tree's guards and
 //                    states (no behavior tree ticks): the baseline of benchmarks/bench_runtime.py
+//   --dispatch       the tree is the dispatch form of `fsmbt convert --style dispatch`
+//                    (docs/semantics.md section 12): a Switch dispatch over a state index on the
+//                    blackboard; each step writes {event} and ticks the root once
 //   --bench R        read all of stdin first, replay it R times without printing steps, then print
 //                    one JSON object: {"mode","steps","seconds","ns_per_step","cpu_seconds",
 //                    "cpu_ns_per_step","leaf_ticks","actions"} (wall clock and process CPU time)
@@ -228,8 +231,91 @@ private:
   std::vector<std::string> actions_run_;
 };
 
+/// The dispatch form's leaf: records the entered state and its action, returns SUCCESS.
+struct DispatchLog
+{
+  std::vector<std::string> actions;
+  const std::string* state = nullptr;
+};
+
+class DispatchEntryNode : public BT::SyncActionNode
+{
+public:
+  DispatchEntryNode(const std::string& name, const BT::NodeConfig& config, DispatchLog* log)
+    : BT::SyncActionNode(name, config), log_(log)
+  {
+    getInput("state", state_);
+    getInput("action", action_);
+  }
+
+  static BT::PortsList providedPorts()
+  {
+    return { BT::InputPort<std::string>("state"), BT::InputPort<std::string>("action") };
+  }
+
+  BT::NodeStatus tick() override
+  {
+    if(!action_.empty())
+    {
+      log_->actions.push_back(action_);
+    }
+    log_->state = &state_;
+    return BT::NodeStatus::SUCCESS;
+  }
+
+private:
+  DispatchLog* log_;
+  std::string state_;
+  std::string action_;
+};
+
+/// Runs a dispatch tree (docs/semantics.md section 12) in BehaviorTree.CPP: post(event) writes
+/// the blackboard entry `event` and ticks the root exactly once.
+class DispatchRunner
+{
+public:
+  explicit DispatchRunner(const std::string& path)
+  {
+    factory_.registerNodeType<DispatchEntryNode>("DispatchEntry", &log_);
+    tree_ = factory_.createTreeFromFile(path);
+    blackboard_ = tree_.rootBlackboard();
+  }
+
+  fsmbt::lebt::StepResult start()
+  {
+    tree_.haltTree();
+    for(const auto& key : blackboard_->getKeys())
+    {
+      blackboard_->unset(std::string(key));
+    }
+    log_ = DispatchLog{};
+    return tick();
+  }
+
+  fsmbt::lebt::StepResult post(const std::string& event)
+  {
+    log_.actions.clear();
+    blackboard_->set("event", event);
+    return tick();
+  }
+
+private:
+  fsmbt::lebt::StepResult tick()
+  {
+    const BT::NodeStatus status = tree_.tickExactlyOnce();
+    return { log_.actions, status == BT::NodeStatus::SUCCESS,
+             log_.state != nullptr ? *log_.state : std::string("start") };
+  }
+
+  BT::BehaviorTreeFactory factory_;
+  DispatchLog log_;
+  BT::Tree tree_;
+  BT::Blackboard::Ptr blackboard_;
+};
+
 struct Arguments
 {
+  bool dispatch = false;
   std::string tree;
   std::optional<std::string> start;
   std::optional<std::vector<std::string>> registered;
@@ -319,6 +405,10 @@ Arguments parse(int argc, char** argv)
       {
         usage("--tick takes once, exactly-once or auto");
       }
+    }
+    else if(arg == "--dispatch")
+    {
+      args.dispatch = true;
     }
     else if(arg == "--table")
     {
@@ -728,6 +818,28 @@ int main(int argc, char** argv)
     return 0;
   }
   const Arguments args = parse(argc, argv);
+  if(args.dispatch)
+  {
+    try
+    {
+      DispatchRunner runner(args.tree);
+      if(args.bench > 0)
+      {
+        bench(runner, nullptr, readLines(), args.bench, "dispatch");
+      }
+      else
+      {
+        interactive(runner, nullptr);
+      }
+    }
+    catch(const std::exception& exc)
+    {
+      std::fflush(stdout);
+      std::fprintf(stderr, "error: %s\n", exc.what());
+      return 1;
+    }
+    return 0;
+  }
   try
   {
     if(args.scripted)

@@ -1,0 +1,188 @@
+"""FSM -> BT, dispatch style: a balanced ``Switch`` dispatch over a state index on the
+blackboard (docs/semantics.md, "12. The dispatch form"; runs as
+``fsmbt.semantics.dispatch_runtime`` says).
+
+Shape, for reachable states numbered 0..n-1 in declaration order (index digits base 6, letters
+``a``..``f``, in the entries ``fsm_d0`` (least significant) .. ``fsm_d{L-1}``):
+
+- the root is a tree of ``Switch2``..``Switch6`` nodes: level ``j`` (counted from the leaves)
+  switches on ``{fsm_dj}``; a group of one case gets a padding case (``AlwaysFailure``); every
+  default child is ``AlwaysFailure`` (unreachable) except the root's, which is the start case
+  (the digits are unset before the first transition);
+- a final state's case is ``AlwaysSuccess``; a non-final state's case switches on ``{event}``
+  over its outgoing events (chains of ``Switch6`` when it has more than 6), each case the
+  transition ``ReactiveSequence(Script(digits of the target), DispatchEntry(target),
+  [KeepRunningUntilFailure(AlwaysSuccess) unless the target is final])``, the default
+  ``KeepRunningUntilFailure(AlwaysSuccess)`` (RUNNING: the event is ignored);
+- the start case is the transition to the initial state, or, when the FSM has an initial event,
+  an event switch with that one case.
+
+Bad input (UnsupportedError, state named): an event name BehaviorTree.CPP's ``Switch`` would
+not compare as a plain string (a number, a blackboard reference ``{..}``, empty).
+
+Cost: O(states + transitions) to build; depth O(log6 states + max out-degree / 6).
+"""
+
+from __future__ import annotations
+
+import re
+from collections import deque
+
+from fsmbt.convert.result import ConversionResult
+from fsmbt.model.bt import BTDocument, BTNode, NodeModel, PortModel
+from fsmbt.model.errors import InputError, UnsupportedError
+from fsmbt.model.flatten import flatten, needs_flattening
+from fsmbt.model.fsm import FSM
+from fsmbt.model.kinds import NodeKind
+from fsmbt.semantics.dispatch_runtime import BASE, DIGIT_PREFIX, DIGITS, ENTRY, EVENT_KEY
+
+STYLE = "dispatch"
+_NUMBER = re.compile(r"\s*[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?\s*")
+
+
+def _control(type_name: str, name: str, children: list[BTNode], **attrs: str) -> BTNode:
+    return BTNode(type=type_name, kind=NodeKind.CONTROL, name=name, children=children, attrs=attrs)
+
+
+def _leaf(type_name: str, name: str = "", **attrs: str) -> BTNode:
+    kind = NodeKind.ACTION
+    return BTNode(type=type_name, kind=kind, name=name, attrs=attrs)
+
+
+def _running() -> BTNode:
+    return BTNode(
+        type="KeepRunningUntilFailure",
+        kind=NodeKind.DECORATOR,
+        children=[_leaf("AlwaysSuccess")],
+    )
+
+
+def _switch(key: str, cases: list[tuple[str, BTNode]], default: BTNode, name: str) -> BTNode:
+    """``Switch{k}`` over ``cases`` (1..6 of them). One case gets a padding case: an unused
+    digit (``AlwaysFailure``, never written), or for ``{event}`` (only the last chunk of a
+    state's events has one case, its default is RUNNING) another name that also runs RUNNING."""
+    if len(cases) == 1:
+        pad = next(v for v in (*DIGITS, "z", "zz") if v != cases[0][0])
+        cases = [*cases, (pad, _running() if key == EVENT_KEY else _leaf("AlwaysFailure"))]
+    attrs = {"variable": "{" + key + "}"}
+    attrs.update({f"case_{i}": value for i, (value, _n) in enumerate(cases, 1)})
+    return _control(f"Switch{len(cases)}", name, [n for _v, n in cases] + [default], **attrs)
+
+
+def _reachable(flat: FSM) -> list[str]:
+    assert flat.initial is not None
+    table = flat.transition_map()
+    seen, queue = {flat.initial}, deque([flat.initial])
+    while queue:
+        name = queue.popleft()
+        if flat.states[name].final:
+            continue
+        for event, t in table.get(name, {}).items():
+            if event is None:
+                raise InputError("eventless transition in a flat FSM", element=name)
+            if t.target not in flat.states:
+                raise InputError(f"transition to unknown state '{t.target}'", element=name)
+            if t.target not in seen:
+                seen.add(t.target)
+                queue.append(t.target)
+    return [name for name in flat.states if name in seen]
+
+
+def _check_event(event: str, state: str) -> None:
+    if not event or "{" in event or "'" in event or _NUMBER.fullmatch(event):
+        raise UnsupportedError(
+            f"event {event!r} cannot be a Switch case (BehaviorTree.CPP compares numbers "
+            "numerically and reads {..} as a blackboard entry); use --style lebt",
+            element=f"state '{state}'",
+        )
+
+
+def fsm_to_dispatch(fsm: FSM, **_options: object) -> ConversionResult:
+    """The dispatch form of ``fsm`` (see the module docstring)."""
+    warnings: list[str] = []
+    flat = fsm
+    if needs_flattening(fsm):
+        flat = flatten(fsm)
+        warnings.append(f"hierarchical FSM flattened to {len(flat.states)} states")
+    if flat.initial is None or flat.initial not in flat.states:
+        raise InputError("the state machine has no initial state", element=fsm.name)
+    states = _reachable(flat)
+    index = {name: i for i, name in enumerate(states)}
+    levels = 1
+    while BASE**levels < len(states):
+        levels += 1
+
+    def transition(target: str, label: str) -> BTNode:
+        i = index[target]
+        code = []
+        for j in range(levels):
+            code.append(f"{DIGIT_PREFIX}{j}:='{DIGITS[i % BASE]}'")
+            i //= BASE
+        st = flat.states[target]
+        children = [
+            _leaf("Script", f"goto_{target}", code="; ".join(code)),
+            _leaf(ENTRY, target, state=target, action=st.action or ""),
+        ]
+        if not st.final:
+            children.append(_running())
+        return _control("ReactiveSequence", label, children)
+
+    def events_switch(source: str, exits: list[tuple[str, str]]) -> BTNode:
+        if not exits:
+            return _running()
+        node = _running()
+        chunks = [exits[k : k + 6] for k in range(0, len(exits), 6)]
+        for c, chunk in reversed(list(enumerate(chunks))):
+            cases = [(ev, transition(t, f"{source}/{ev}")) for ev, t in chunk]
+            node = _switch(EVENT_KEY, cases, node, f"{source}_events{c or ''}")
+        return node
+
+    table = flat.transition_map()
+    cases: list[BTNode] = []
+    for name in states:
+        st = flat.states[name]
+        if st.final:
+            cases.append(_leaf("AlwaysSuccess", f"{name}_final"))
+            continue
+        exits = [(str(e), t.target) for e, t in table.get(name, {}).items()]
+        for ev, _t in exits:
+            _check_event(ev, name)
+        cases.append(events_switch(name, exits))
+    if flat.initial_event is not None:
+        _check_event(flat.initial_event, flat.start_name or "start")
+        start = events_switch("start", [(flat.initial_event, flat.initial)])
+    else:
+        start = transition(flat.initial, "start")
+    nodes: list[BTNode] = cases
+    for j in range(levels):
+        groups = [nodes[k : k + BASE] for k in range(0, len(nodes), BASE)]
+        last = j == levels - 1
+        nodes = [
+            _switch(
+                f"{DIGIT_PREFIX}{j}",
+                [(DIGITS[i], n) for i, n in enumerate(group)],
+                start if last else _leaf("AlwaysFailure"),
+                "dispatch" if last else f"digit{j}_{g}",
+            )
+            for g, group in enumerate(groups)
+        ]
+    assert len(nodes) == 1
+    doc = BTDocument.single(nodes[0])
+    doc.node_models[ENTRY] = NodeModel(
+        ENTRY, NodeKind.ACTION, [PortModel("state", "input"), PortModel("action", "input")]
+    )
+    count = depth = 0
+    stack = [(nodes[0], 1)]
+    while stack:
+        node, d = stack.pop()
+        count += 1
+        depth = max(depth, d)
+        stack.extend((child, d + 1) for child in node.children)
+    stats: dict[str, object] = {
+        "states": len(states),
+        "nodes": count,
+        "depth": depth,
+        "style": STYLE,
+        "index_digits": levels,
+    }
+    return ConversionResult(doc, "rules", "fsm->bt", stats, warnings)

@@ -1,0 +1,77 @@
+"""The dispatch style (docs/semantics.md section 12): built, proven, logarithmic, bad input."""
+
+from __future__ import annotations
+
+import pytest
+
+from fsmbt.convert import convert
+from fsmbt.formats import dumps, loads
+from fsmbt.generate import random_fsm
+from fsmbt.model.errors import UnsupportedError
+from fsmbt.model.fsm import FSM
+from fsmbt.semantics.dispatch_runtime import DispatchMachine
+from fsmbt.verify import verify
+
+
+@pytest.mark.parametrize("shape", ["tree", "chain"])
+@pytest.mark.parametrize("n", [1, 2, 7, 40])
+@pytest.mark.parametrize("start_event", [False, True])
+def test_dispatch_is_proven_equivalent(shape: str, n: int, start_event: bool) -> None:
+    extra = {"extra_edges": 0} if shape == "chain" else {}
+    fsm = random_fsm(f"d{n}", n, start_event=start_event, shape=shape, **extra)  # type: ignore[arg-type]
+    result = convert(fsm, style="dispatch")
+    assert result.stats["style"] == "dispatch"
+    doc = loads(dumps(result.model, "btcpp"), "btcpp")  # what BehaviorTree.CPP reads
+    assert verify(fsm, doc).equivalent
+
+
+def test_a_wrong_target_is_caught() -> None:
+    fsm = random_fsm("wrong", 12, start_event=False, shape="tree")
+    text = dumps(convert(fsm, style="dispatch").model, "btcpp")
+    scripts = [line for line in text.splitlines() if "<Script" in line]
+    first = scripts[1]
+    assert "fsm_d0:='" in first
+    digit = first.split("fsm_d0:='")[1][0]
+    other = "b" if digit != "b" else "c"
+    mutated = text.replace(first, first.replace(f"fsm_d0:='{digit}'", f"fsm_d0:='{other}'"), 1)
+    assert not verify(fsm, loads(mutated, "btcpp")).equivalent
+
+
+def test_macro_steps_follow_the_fsm() -> None:
+    fsm = FSM("door")
+    fsm.add_state("Closed", action="lock")
+    fsm.add_state("Open", action="beep")
+    fsm.add_state("Gone", final=True)
+    fsm.initial = "Closed"
+    fsm.add_transition("Closed", "push", "Open")
+    fsm.add_transition("Open", "push", "Closed")
+    fsm.add_transition("Open", "leave", "Gone")
+    machine = DispatchMachine(convert(fsm, style="dispatch").model, ["push", "leave"])
+    state, out = machine.start()
+    assert out == ("lock",) and machine.status(state) == "running"
+    state, out = machine.step(state, "leave")  # ignored in Closed
+    assert out == ()
+    state, out = machine.step(state, "push")
+    assert out == ("beep",)
+    state, out = machine.step(state, "leave")
+    assert machine.status(state) == "final"
+
+
+def test_depth_is_logarithmic() -> None:
+    depths = {}
+    for n in (100, 5000):
+        fsm = random_fsm(f"c{n}", n, start_event=False, shape="chain", extra_edges=0)
+        depths[n] = int(convert(fsm, style="dispatch").stats["depth"])
+    # log6 levels of index Switches + an event Switch + the transition: 3 + 2 + 3, 5 + 2 + 3
+    assert depths[100] <= 8
+    assert depths[5000] <= 10
+
+
+def test_numeric_event_is_refused() -> None:
+    fsm = FSM("num")
+    fsm.add_state("A")
+    fsm.add_state("B")
+    fsm.initial = "A"
+    fsm.add_transition("A", "42", "B")
+    with pytest.raises(UnsupportedError, match="state 'A'"):
+        convert(fsm, style="dispatch")
