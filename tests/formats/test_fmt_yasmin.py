@@ -154,6 +154,9 @@ def test_package_found_in_its_source_folder(tmp_path: Path) -> None:
         ),
         ('file_path="../outside.xml"', "resolves outside the including file's folder"),
         ('file_path="main.xml"', "includes itself"),
+        ('file_path="/etc/hostname"', "outside the folder of the file read"),
+        ('package="../../etc" file_name="passwd"', "is not a ROS package name"),
+        ('package="my_pkg" file_name="../outside.xml"', "is not a file name"),
     ],
 )
 def test_include_errors_are_located(tmp_path: Path, include: str, message: str) -> None:
@@ -162,6 +165,32 @@ def test_include_errors_are_located(tmp_path: Path, include: str, message: str) 
         read_model(main)
     assert message in str(info.value)
     assert f"{main}:3" in str(info.value)
+
+
+def test_an_absolute_file_path_is_confined_to_the_folder_read_or_include_root(
+    tmp_path: Path,
+) -> None:
+    """docs/security.md, rule 4: an absolute ``file_path`` out of the folder of the file read
+    is refused, and read once ``include_root`` names a folder holding it."""
+    (tmp_path / "shared").mkdir()
+    inner = _write(tmp_path / "shared", "inner.xml", INCLUDED)
+    (tmp_path / "main").mkdir()
+    main = _write(tmp_path / "main", "main.xml", SIMPLE.format(include=f'file_path="{inner}"'))
+    with pytest.raises(InputError, match="outside the folder of the file read"):
+        read_model(main)
+    fsm = loads(read_text(main), path=main, options={"include_root": str(tmp_path)})
+    assert isinstance(fsm, FSM) and "X" in fsm.states["Sub"].regions[0].states
+
+
+@pytest.mark.parametrize(
+    "include", [f'file_path="{Path(__file__).resolve()}"', 'package="p" file_name="a.xml"']
+)
+def test_a_text_includes_no_file(include: str) -> None:
+    """A text (a paste, a web upload) has no folder: no include is resolved, so no file of the
+    host is read, whatever path it names."""
+    with pytest.raises(InputError, match="needs the including file's path") as info:
+        loads(SIMPLE.format(include=include), "yasmin")
+    assert str(info.value).startswith("<input>:3:")
 
 
 def test_unknown_element_is_one_located_line_exit_2(tmp_path: Path) -> None:

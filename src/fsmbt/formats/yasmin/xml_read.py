@@ -41,6 +41,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -69,6 +70,8 @@ ALLOWED: dict[str, frozenset[str]] = {
     "Item": frozenset(),
     "OutcomeMap": frozenset({"Item"}),
 }
+#: A ROS package name (REP 144, with upper case and dashes as older packages have them).
+_PACKAGE_NAME = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_-]*")
 #: The deepest chain of included files followed.
 MAX_INCLUDE_DEPTH = 32
 #: Files looked at while searching a package folder for an included file.
@@ -138,6 +141,15 @@ class XmlReader:
 
     def error(self, source: _File, element: etree._Element | None, message: str) -> InputError:
         return InputError(message, location=self.where(source, element))
+
+    def confinement_root(self) -> Path:
+        """The folder an absolute ``file_path`` must lie in: the reader option
+        ``include_root``, else the folder of the file read (docs/security.md, rule 4)."""
+        option = self.ctx.options.get("include_root")
+        if option:
+            return Path(str(option)).resolve()
+        assert self.ctx.path is not None  # ``included`` refuses includes of a text
+        return self.ctx.path.resolve().parent
 
     def warn(self, source: _File, element: etree._Element | None, message: str) -> None:
         self.ctx.warnings.append(f"{self.where(source, element)}: {message}")
@@ -623,6 +635,13 @@ class XmlReader:
                     child,
                     "an included machine (file_path / package) has no states of its own",
                 )
+        if source.path is None:  # a text (a paste, a web upload): no file of the host is read
+            raise self.error(
+                source,
+                element,
+                f"included machine '{element.get('name')}' needs the including file's path to "
+                "resolve (read the file, not text)",
+            )
         if file_path:
             target = self.resolve_path(source, element, file_path)
         else:
@@ -652,15 +671,19 @@ class XmlReader:
 
     def resolve_path(self, source: _File, element: etree._Element, file_path: str) -> Path:
         path = Path(file_path)
-        if path.is_absolute():
-            return path.resolve()
-        if source.path is None:
-            raise self.error(
-                source,
-                element,
-                f"file_path '{file_path}' is relative, and this text has no file to be "
-                "relative to; read it from its file",
-            )
+        if path.is_absolute():  # the factory takes it as is; fsmbt confines it (security.md, 4)
+            target = path.resolve()
+            top = self.confinement_root()
+            if not target.is_relative_to(top):
+                raise self.error(
+                    source,
+                    element,
+                    f"file_path '{file_path}' resolves to {target}, outside the folder of the "
+                    f"file read ({top}); refused (allow a wider folder with --include-root DIR, "
+                    "reader option include_root)",
+                )
+            return target
+        assert source.path is not None  # ``included`` refuses includes of a text
         folder = source.path.parent.resolve()
         target = (folder / path).resolve()
         if folder not in target.parents:
@@ -675,7 +698,16 @@ class XmlReader:
     def resolve_package(
         self, source: _File, element: etree._Element, package: str, file_name: str
     ) -> Path:
-        """As ``get_package_share_path`` + a walk, then a source folder, then beside the file."""
+        """As ``get_package_share_path`` + a walk, then a source folder, then beside the file.
+
+        ``package`` must be a package name and ``file_name`` a file name (no folder, no
+        ``..``): neither can lead the lookup out of the folders named above."""
+        if not _PACKAGE_NAME.fullmatch(package):
+            raise self.error(source, element, f"package '{package}' is not a ROS package name")
+        if not _plain_file_name(file_name):
+            raise self.error(
+                source, element, f"file_name '{file_name}' is not a file name (no folders)"
+            )
         roots: list[Path] = []
         for prefix in os.environ.get("AMENT_PREFIX_PATH", "").split(os.pathsep):
             if prefix:
@@ -709,6 +741,11 @@ class XmlReader:
             f"folder '{package}' with a package.xml) and there is no {file_name} beside "
             "this file; source the workspace's setup or give file_path",
         )
+
+
+def _plain_file_name(name: str) -> bool:
+    """A file name with no folder part: no separator, not ``.`` or ``..``."""
+    return bool(name) and "/" not in name and "\\" not in name and name not in (".", "..")
 
 
 def _find_file(root: Path, file_name: str) -> Path | None:
