@@ -15,7 +15,7 @@ from pathlib import Path
 
 import pytest
 
-from fsmbt import api
+from fsmbt import api, limits
 from fsmbt.model.errors import InputError
 from fsmbt.model.kinds import NodeKind
 from support.corpus import CORPUS
@@ -92,6 +92,33 @@ def test_a_model_file_beside_that_does_not_fit_is_a_warning_naming_both_files(
     refused = api.load(tree, options={"no_profiles": True})
     assert not any("my_tree_nodes" in w for w in refused.warnings)
     assert {n.type: n.kind for _, n in refused.model.nodes()}["IsReady"] is NodeKind.ACTION  # type: ignore[attr-defined]
+
+
+@pytest.mark.parametrize(
+    "hostile",
+    [
+        '<!DOCTYPE r [<!ENTITY a "x">]>\n<root><TreeNodesModel/></root>',
+        "<root><TreeNodesModel><!--" + "x" * 3000 + '--><Condition ID="IsReady"/>'
+        "</TreeNodesModel></root>",
+    ],
+    ids=["entity-declaration", "over-max-input-bytes"],
+)
+def test_a_found_model_file_the_input_rules_refuse_is_passed_over(
+    tmp_path: Path, hostile: str
+) -> None:
+    """docs/security.md: a node-model file found beside the tree is read as any input (size
+    limit, hardened XML parser); one those refuse is not applied and does not stop the read."""
+    (tmp_path / "x_tree_nodes.xml").write_text(hostile, encoding="utf-8")
+    tree = tmp_path / "tree.xml"
+    tree.write_text(
+        '<root BTCPP_format="4"><BehaviorTree ID="T"><Sequence>\n'
+        "<IsReady/><Go/></Sequence></BehaviorTree></root>",
+        encoding="utf-8",
+    )
+    with limits.changed(max_input_bytes=2000):
+        loaded = api.load(tree)
+    assert not any("x_tree_nodes" in w for w in loaded.warnings)
+    assert {n.type: n.kind for _, n in loaded.model.nodes()}["IsReady"] is NodeKind.ACTION  # type: ignore[attr-defined]
 
 
 def test_cli_no_profiles_flag_refuses_the_found_profile() -> None:

@@ -43,6 +43,7 @@ from lxml import etree
 from fsmbt.model.bt import NodeModel, PortModel
 from fsmbt.model.bt_nodes import builtin_spec, canonical_type
 from fsmbt.model.errors import InputError
+from fsmbt.model.files import read_bounded
 from fsmbt.model.kinds import NodeKind
 from fsmbt.model.nodes.library import build_library
 from fsmbt.model.nodes.nav2_leaves import nav2_leaf
@@ -142,12 +143,17 @@ def _model_files(path: Path) -> list[Path]:
 
 
 def _read_models(path: Path) -> dict[str, NodeModel]:
-    """The leaf/control/decorator declarations of a model file (``{}`` if it is not one)."""
+    """The leaf/control/decorator declarations of a model file (``{}`` if it is not one).
+
+    The file is read as any input is (``read_bounded``: a regular file within
+    ``max_input_bytes``; the hardened XML parser); one these refuse (too big, an entity
+    declaration, too deep, not UTF-8) is passed over, as an unreadable one is: a found file
+    never stops the read of the file the user gave."""
     from fsmbt.formats.xml_safe import parse_xml  # the hardened parser of every reader
 
     try:
-        root = parse_xml(path.read_text(encoding="utf-8"), str(path))
-    except (OSError, UnicodeDecodeError, ValueError):
+        root = parse_xml(read_bounded(path).decode("utf-8"), str(path))
+    except (OSError, UnicodeDecodeError, ValueError, InputError):
         return {}
     models: dict[str, NodeModel] = {}
     for container in root.iter("TreeNodesModel"):
