@@ -14,8 +14,9 @@ calls the API below, so everything it shows is available to any client:
 Rules: bodies over ``max_body_bytes`` are refused (413) before they are read whole; JSON or
 multipart only (415 otherwise); no request names a server path (uploads are texts, examples are
 picked by name from a listing, report files are resolved inside ``reports_dir`` and refused
-outside it); every error is ``{"error": "<one line>", "where": ...}`` with a 4xx (bad input),
-503 (time limit) or 500 (a bug, logged) - never a traceback.
+outside it); every error is ``{"error": "<one line>", "where": ...}`` with a 4xx (bad input;
+408/422 past the wall/CPU-time limit), 503 with ``Retry-After`` (busy) or 500 (a bug, logged) -
+never a traceback.
 """
 
 from __future__ import annotations

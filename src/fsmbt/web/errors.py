@@ -1,6 +1,7 @@
 """The web API's errors: every refusal is ``{"error": "<one line>", "where": ...}`` with a 4xx
-(bad input), 503 (time limit, busy) or 500 (a bug, logged) - never a traceback - and bodies over
-the server's limit are refused (413) before they are read whole (docs/web.md)."""
+(bad input; 408/422 past the wall/CPU-time limit), 503 (busy) or 500 (a bug, logged) - never a
+traceback - and bodies over the server's limit are refused (413) before they are read whole
+(docs/web.md)."""
 
 from __future__ import annotations
 

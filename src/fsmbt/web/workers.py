@@ -6,7 +6,8 @@ the ``fsmbt.web.service`` functions. Calls wait (in the server's event loop, cos
 a free process, at most ``max_waiting`` of them (beyond: 503 "busy" at once), and each call's
 wall-time limit starts when a process takes it, so a burst of requests queues instead of
 timing out. Past the limit the request gets a
-clear 503 answer with a hint to use the CLI, and the pool is replaced (its processes killed), so
+clear 408 answer naming the limit, with a hint to use the CLI, and the pool is replaced (its
+processes killed), so
 the worker is free for the next request instead of grinding on. Each worker also installs the
 checker's own time bound (``fsmbt.limits``, ``checker_max_seconds``) at the same value, so the
 native checker usually stops itself first, with its own message.
