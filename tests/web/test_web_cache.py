@@ -48,6 +48,31 @@ def test_disk_entries_survive_a_new_cache(tmp_path):
     assert not list(tmp_path.glob("*.part"))
 
 
+def test_disk_entries_are_data_and_a_planted_file_runs_nothing(tmp_path):
+    """Bytes (pictures, downloads) survive the disk as data; a pickle planted under an entry's
+    name, or any file that is not an answer, is a miss and runs nothing."""
+    answer = ("ok", (b"\x00\xffPNG", "tree.png", "image/png"))
+    AnswerCache(max_bytes=10_000, directory=tmp_path).put("k", answer)
+    status, (data, name, media) = AnswerCache(max_bytes=10_000, directory=tmp_path).get("k")
+    assert (status, data, name, media) == answer[:1] + answer[1]
+    assert b"PNG" not in (tmp_path / "k.json").read_bytes()  # base64, not raw bytes
+
+    import pickle
+
+    marker = tmp_path / "ran"
+
+    class Plant:
+        def __reduce__(self):
+            return (marker.write_text, ("code ran",))
+
+    for planted in (pickle.dumps(Plant()), b"[" * 100_000, b'["ok"]', b'{"$bytes": "@@"}'):
+        (tmp_path / "p.json").write_bytes(planted)
+        assert AnswerCache(max_bytes=10_000, directory=tmp_path).get("p") is None
+    (tmp_path / "p.pickle").write_bytes(pickle.dumps(Plant()))
+    assert AnswerCache(max_bytes=10_000, directory=tmp_path).get("p") is None
+    assert not marker.exists()
+
+
 def test_a_repeated_request_is_answered_from_the_cache():
     with TestClient(create_app(WebSettings.default(workers=1))) as client:
         cache = client.app.state.cache

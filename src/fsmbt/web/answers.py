@@ -15,16 +15,22 @@ Rules:
   least recently used entries leave first (``max_bytes``); an answer larger than a quarter of
   the bound is not kept.
 - Optional disk (``directory``, ``fsmbt serve --cache-dir``): entries are also written as
-  ``<hash>.pickle`` files (written to a temporary name, then renamed, so a reader never sees
-  half a file) and read back on a memory miss; the server wrote them itself, nothing else
-  is read from there. Disk is not bounded by this class (the operator owns the folder).
+  ``<hash>.json`` files (written to a temporary name, then renamed, so a reader never sees
+  half a file) and read back on a memory miss. On disk an answer is *data*, never pickle: JSON
+  whose byte strings are ``{"$bytes": base64}`` objects, so whoever can write into that folder
+  can at worst make the server answer wrongly, never run code in it. A file that does not
+  decode to an answer is ignored (a miss). Disk is not bounded by this class (the operator
+  owns the folder).
+- In memory (the server's own process, nothing else writes there) entries are pickled, which
+  keeps a hit to one ``pickle.loads``.
 
-Costs: one SHA-256 over the body and one pickle of the answer per miss; a hit is a dict
-lookup and one unpickle.
+Costs: one SHA-256 over the body and one pickle of the answer per miss (plus a JSON encoding
+with ``directory``); a hit is a dict lookup and one unpickle.
 """
 
 from __future__ import annotations
 
+import base64
 import hashlib
 import json
 import os
@@ -75,11 +81,9 @@ class AnswerCache:
         if data is not None:
             self._entries.move_to_end(key)
         elif self.directory is not None:
-            try:
-                data = (self.directory / f"{key}.pickle").read_bytes()
-            except OSError:
-                data = None
-            if data is not None:
+            stored = _read_stored(self.directory / f"{key}.json")
+            if stored is not None:
+                data = pickle.dumps(stored, protocol=pickle.HIGHEST_PROTOCOL)
                 self._remember(key, data)
         if data is None:
             self.misses += 1
@@ -95,10 +99,10 @@ class AnswerCache:
         data = pickle.dumps(answer, protocol=pickle.HIGHEST_PROTOCOL)
         self._remember(key, data)
         if self.directory is not None:
-            target = self.directory / f"{key}.pickle"
+            target = self.directory / f"{key}.json"
             handle, temporary = tempfile.mkstemp(dir=self.directory, suffix=".part")
             with os.fdopen(handle, "wb") as out:
-                out.write(data)
+                out.write(json.dumps(_as_data(answer), separators=(",", ":")).encode("utf-8"))
             os.replace(temporary, target)
 
     def _remember(self, key: str, data: bytes) -> None:
@@ -112,3 +116,57 @@ class AnswerCache:
         while self.bytes > self.max_bytes and self._entries:
             _, dropped = self._entries.popitem(last=False)
             self.bytes -= len(dropped)
+
+
+def _as_data(value: Any) -> Any:
+    """``value`` as JSON data: bytes become ``{"$bytes": base64}``, tuples lists. Iterative
+    (an answer is a few levels deep, but nothing here recurses on data)."""
+    root: list[Any] = [None]
+    stack: list[tuple[Any, Any, Any]] = [(value, root, 0)]
+    while stack:
+        item, parent, slot = stack.pop()
+        if isinstance(item, bytes):
+            parent[slot] = {"$bytes": base64.b64encode(item).decode("ascii")}
+        elif isinstance(item, dict):
+            copy: dict[str, Any] = {}
+            parent[slot] = copy
+            stack.extend((child, copy, str(name)) for name, child in item.items())
+        elif isinstance(item, list | tuple):
+            items: list[Any] = [None] * len(item)
+            parent[slot] = items
+            stack.extend((child, items, index) for index, child in enumerate(item))
+        else:
+            parent[slot] = item
+    return root[0]
+
+
+def _from_data(value: Any) -> Any:
+    """The inverse of ``_as_data`` (lists stay lists: callers unpack them like tuples)."""
+    root: list[Any] = [None]
+    stack: list[tuple[Any, Any, Any]] = [(value, root, 0)]
+    while stack:
+        item, parent, slot = stack.pop()
+        if isinstance(item, dict) and set(item) == {"$bytes"}:
+            parent[slot] = base64.b64decode(item["$bytes"], validate=True)
+        elif isinstance(item, dict):
+            copy: dict[str, Any] = {}
+            parent[slot] = copy
+            stack.extend((child, copy, name) for name, child in item.items())
+        elif isinstance(item, list):
+            items: list[Any] = [None] * len(item)
+            parent[slot] = items
+            stack.extend((child, items, index) for index, child in enumerate(item))
+        else:
+            parent[slot] = item
+    return root[0]
+
+
+def _read_stored(path: Path) -> tuple[str, Any] | None:
+    """The answer kept in ``path``, or ``None`` when it is missing or is not one."""
+    try:
+        value = _from_data(json.loads(path.read_bytes()))
+    except (OSError, ValueError, RecursionError):  # missing, unreadable, not JSON, bad base64
+        return None
+    if not (isinstance(value, list) and len(value) == 2 and value[0] in ("ok", "error")):
+        return None
+    return value[0], value[1]
