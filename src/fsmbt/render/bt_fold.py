@@ -84,6 +84,7 @@ class FoldPlan:
         gaps: path -> for each wrapped row after the first, how many ranks below the previous
             row it starts (one more than the previous row's deepest shown subtree).
         shown: nodes drawn (fold boxes not counted); total: nodes of the tree.
+        height: ranks the picture spans below its top (fold boxes and wrapped rows included).
     """
 
     folded: dict[str, int] = dataclasses.field(default_factory=dict)
@@ -91,6 +92,7 @@ class FoldPlan:
     gaps: dict[str, list[int]] = dataclasses.field(default_factory=dict)
     shown: int = 0
     total: int = 0
+    height: int = 0
 
 
 def drawn_children(
@@ -341,4 +343,5 @@ def _plan(items: list[Item], top: int, opened: set[int], wrapped: dict[int, list
             if len(counts) > 1:
                 plan.gaps[items[index].where] = gaps
             ranks[index] = 1 + sum(gaps) + deepest[-1]
+    plan.height = ranks[top]
     return plan

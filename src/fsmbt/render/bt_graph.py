@@ -96,6 +96,12 @@ CHAR_INCHES = 0.085
 LINE_INCHES = 0.19
 
 
+def _row_inches(depth: int) -> float:
+    """Estimated height (inches) of a row of trees at most ``depth`` levels deep, cluster
+    frame and title included (about 0.85 inch a level)."""
+    return 0.85 * depth + 0.7
+
+
 def _tree_size(root: BTNode | None) -> tuple[int, int, int]:
     """(nodes, leaves, depth) of one tree, explicit stack."""
     if root is None:
@@ -177,8 +183,6 @@ def bt_to_dot(
     builder = _Builder(doc, root, max_nodes, expand_subtrees, anchors)
     builder.marks = marks or {}
     builder.folding, builder.depth, builder.target = fold, depth, target
-    if fold:
-        root.attr(size=MAX_PICTURE_INCHES)
     if focus is not None:
         main = doc.main
         if main.root is None:
@@ -191,6 +195,8 @@ def bt_to_dot(
         builder.draw_tree(main.root, root, parent=None, path=(main.id,))
     else:
         _draw_all_trees(doc, root, builder, notes)
+    if any(plan.folded or plan.rows for plan in builder.plans) or builder.capped:
+        root.attr(size=MAX_PICTURE_INCHES)  # the last resort; a picture that fits is unchanged
     if notes is not None:
         notes.extend(_fold_notes(builder.plans, depth))
     builder.draw_ghosts(ghosts)
@@ -205,7 +211,7 @@ def _fold_notes(plans: list[FoldPlan], depth: int | None) -> list[str]:
     shown = sum(plan.shown for plan in plans)
     total = sum(plan.total for plan in plans)
     why = (
-        f"depth={depth}"
+        f"more than {depth} levels below the top"
         if depth is not None
         else f"to fit 4096 x 4096 pixels at 100 % (about {NODE_BUDGET} nodes)"
     )
@@ -245,6 +251,12 @@ def _draw_all_trees(
         builder.draw_tree(order[0].root, root, parent=None, path=(main_id,))
         return
     sizes = {t.id: _tree_size(t.root) for t in order}
+    if builder.folding:  # the depth each tree is drawn with (folds, wrapped rows)
+        for t in order:
+            if t.root is not None:
+                nodes, leaves, _ = sizes[t.id]
+                height = builder.plan_only(t.root, (t.id,), "").height
+                sizes[t.id] = (nodes, leaves, height + 1)
     total = sum(n for n, _, _ in sizes.values())
     left_out: list[str] = []
     rows: list[list[str]] = [[main_id]]  # the main tree alone on the top row
@@ -255,20 +267,30 @@ def _draw_all_trees(
         cap = max(20, int(FOLDED_MAX_NODES * share * share))
         row_max = max(4, int(FOLDED_ROW_LEAVES * share))
     row_leaves = row_max  # so the first other tree opens a new row
+    # folding: the rows' estimated height stays within the target too
+    tall = _row_inches(sizes[main_id][2])
+    row_tall = 0.0
     for t in order[1:]:
-        nodes, leaves, _ = sizes[t.id]
-        if drawn + nodes > cap:
+        nodes, leaves, depth = sizes[t.id]
+        opens = row_leaves + leaves > row_max
+        grows = _row_inches(depth) - (0.0 if opens else row_tall)
+        if drawn + nodes > cap or (builder.folding and tall + max(0.0, grows) > builder.target):
             left_out.append(t.id)
             continue
         drawn += nodes
-        if row_leaves + leaves > row_max:
+        if opens:
             rows.append([])
             row_leaves = 0
+            row_tall = 0.0
+        tall += max(0.0, grows)
+        row_tall = max(row_tall, _row_inches(depth))
         rows[-1].append(t.id)
         row_leaves += leaves
     previous_bottom: str | None = None
+    previous_root: tuple[str, int] | None = None  # folding: a row's first root, its ranks
     for row in rows:
         deepest: tuple[int, str] | None = None
+        row_root: tuple[str, int] | None = None
         for tree_id in row:
             t = doc.trees[tree_id]
             holder = graphviz.Digraph(name=builder.next_id("cluster_"))
@@ -282,22 +304,40 @@ def _draw_all_trees(
                 labeljust="l",
             )
             builder.clusters.append((holder, root))
-            first = builder.serial + 1
+            first = f"n{builder.serial + 1}"
+            planned = len(builder.plans)
             builder.draw_tree(t.root, holder, parent=None, path=(tree_id,))
-            if previous_bottom is not None:  # hang this row under the previous one
+            ranks = builder.plans[-1].height if len(builder.plans) > planned else 0
+            if previous_root is not None:  # folding: rows stacked under the first tree's root
+                tail, above = previous_root
                 builder.edges.append(
-                    (previous_bottom, f"n{first}", {"style": "invis", "weight": "0"})
+                    (
+                        tail,
+                        first,
+                        {
+                            "style": "invis",
+                            "minlen": str(above + 2),
+                            "weight": "10" if row_root is None else "0",
+                        },
+                    )
                 )
+            elif previous_bottom is not None:  # hang this row under the previous one
+                builder.edges.append((previous_bottom, first, {"style": "invis", "weight": "0"}))
+            row_root = (row_root or (first, 0))[0], max(ranks, (row_root or ("", 0))[1])
             depth = sizes[tree_id][2]
             if deepest is None or depth > deepest[0]:
                 deepest = (depth, builder.deepest)
         previous_bottom = deepest[1] if deepest is not None else previous_bottom
+        if builder.folding:
+            previous_root = row_root
+    builder.capped = bool(left_out) and builder.folding
     if left_out and notes is not None:
+        reason = "to fit 4096 x 4096 pixels" if builder.folding else f"at {cap} nodes"
         shown = ", ".join(left_out[:8]) + (
             f", ... (+{len(left_out) - 8})" if len(left_out) > 8 else ""
         )
         notes.append(
-            f"picture capped at {cap} nodes: drew {len(order) - len(left_out)}"
+            f"picture capped {reason}: drew {len(order) - len(left_out)}"
             f" of {len(order)} trees ({drawn} of {total} nodes); left out: {shown}; "
             "draw one tree alone with tree=ID"
         )
@@ -346,7 +386,9 @@ class _Builder:
         self.folding = False  # fold big trees (fsmbt.render.bt_fold)
         self.depth: int | None = None
         self.target = TARGET_INCHES  # the side (inches) a folded picture's estimate fits in
-        self.plans: list[FoldPlan] = []
+        self.plans: list[FoldPlan] = []  # of the trees drawn
+        self.capped = False  # trees left out of a folded multi-tree picture
+        self.planned: dict[tuple[tuple[str, ...], str], FoldPlan] = {}  # not drawn yet
 
     def next_id(self, prefix: str) -> str:
         self.serial += 1
@@ -486,11 +528,19 @@ class _Builder:
         """The fold plan of the tree under ``top`` (``None``: everything drawn)."""
         if not self.folding:
             return None
+        plan = self.planned.pop((trees, where), None)
+        if plan is None:
+            plan = self.plan_only(top, trees, where)
+        self.plans.append(plan)
+        return plan
+
+    def plan_only(self, top: BTNode, trees: tuple[str, ...], where: str) -> FoldPlan:
+        """The fold plan of the tree under ``top``, kept for when it is drawn."""
         items = walk(
             self.doc, top, trees, where, expanding=self.expanding, max_nodes=self.max_nodes
         )
         plan = plan_folds(items, 0, measure, depth=self.depth, target=self.target)
-        self.plans.append(plan)
+        self.planned[(trees, where)] = plan
         return plan
 
     def draw_fold(self, node_id: str, holder: graphviz.Digraph, where: str, hidden: int) -> None:
