@@ -189,6 +189,14 @@ def svg_text(
     return text[start:] if start >= 0 else text
 
 
+def picture_bytes(model: FSM | BTDocument, fmt: str, *, timeout: float = DOT_TIMEOUT_S) -> bytes:
+    """The default picture of ``model`` in ``fmt`` (``png``, ``svg``, ``pdf``) as
+    ``render_model`` draws it: measured (``picture_dot``), elongated pictures laid out again
+    (``fit_aspect``)."""
+    source = picture_dot(model, timeout=timeout)
+    return fit_aspect(source, fmt, run_dot(source, fmt, timeout=timeout), timeout=timeout)
+
+
 def render_model(
     model: FSM | BTDocument,
     path: str | Path,
@@ -262,6 +270,7 @@ __all__ = [
     "render_pages",
     "model_to_dot",
     "picture_dot",
+    "picture_bytes",
     "svg_text",
     "trace_anchors",
     "fsm_to_dot",
