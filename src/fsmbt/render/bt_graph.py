@@ -17,6 +17,15 @@ instead of as one strip tens of thousands of pixels wide. A picture holds at mos
 below it, in a dashed cluster (a recursive reference is not expanded again). Built with an
 explicit stack; complexity O(N) for N drawn nodes, refused beyond ``max_nodes``.
 
+With ``fold`` (the default of ``fsmbt render`` and the web page, not of the DOT format) a big
+tree is drawn to be read at 100 %: ``fsmbt.render.bt_fold`` chooses which nodes to show; a
+folded node gets a dashed ``[k nodes]`` box naming its path (``focus``), the children of a wide
+composite are drawn in rows, each row after the first hanging from a junction point (a small
+dot joined to the composite, or to the previous junction, by a dashed line) with invisible
+edges keeping the rows in columns; several trees are packed in rows while they fit the height
+budget (each row under the previous row's first root), and a ``size`` cap of 4 096 pixels is
+set only when something was folded, wrapped or left out. ``notes`` tells what was folded.
+
 This is also the DOT file format's BT writer (``fsmbt convert --to dot``, through
 ``fsmbt.formats.diagrams.dot``, with no size limit); BT DOT is write-only (docs/formats/dot.md).
 """
@@ -218,7 +227,7 @@ def _fold_notes(plans: list[FoldPlan], depth: int | None) -> list[str]:
     biggest = sorted(folded, key=lambda f: -f[1])[:3]
     listed = ", ".join(f"{where or 'root'} ({hidden})" for where, hidden in biggest)
     return [
-        f"folded {len(folded)} subtrees {why}: drew {shown} of {total} nodes, each fold a "
+        f"folded {len(folded)} subtree{'' if len(folded) == 1 else 's'} {why}: drew {shown} of {total} nodes, each fold a "
         f"'[k nodes]' box with its path; the largest: {listed}; draw one with focus=PATH, "
         "more levels with depth=N"
     ]
