@@ -3,6 +3,8 @@
     FSMBT_CORPUS=/work/shared/corpus nice -n 19 .venv/bin/python benchmarks/render_sizes.py
         [--sample 20] [--seed 29] [--all] [--no-generated] [FILE ...]
 
+(For a "before" figure, run it with ``PYTHONPATH=<older checkout>/src``.)
+
 Every model is drawn as ``fsmbt render MODEL -o x.png`` draws it (``fsmbt.render.render_model``
 with its defaults) into a temporary folder, and the PNG's size is read from its header. Rows:
 
@@ -40,7 +42,17 @@ from fsmbt.generate import random_bt, random_fsm
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import FsmbtError
 from fsmbt.model.fsm import FSM
-from fsmbt.render import picture_dot, render_model, run_dot
+from fsmbt.render import model_to_dot, render_model, run_dot
+
+
+def drawn_source(model: FSM | BTDocument) -> str:
+    """The DOT source the CLI draws: measured (``picture_dot``), or on an older checkout (a
+    "before" run) the plain ``model_to_dot``."""
+    import fsmbt.render as render
+
+    measured = getattr(render, "picture_dot", None)
+    return str(measured(model)) if measured is not None else model_to_dot(model)
+
 
 REPO = Path(__file__).resolve().parents[1]
 CORPUS = Path(os.environ.get("FSMBT_CORPUS", REPO / ".." / "shared" / "corpus"))
@@ -64,7 +76,7 @@ def png_size(path: Path) -> tuple[int, int]:
 def layout_scale(model: FSM | BTDocument) -> float:
     """The factor Graphviz scaled the default picture by to fit its ``size`` cap (1: drawn at
     100 %), from the first line of ``dot -Tplain`` (``graph SCALE WIDTH HEIGHT``)."""
-    first = run_dot(picture_dot(model), "plain").split(b"\n", 1)[0].split()
+    first = run_dot(drawn_source(model), "plain").split(b"\n", 1)[0].split()
     return float(first[1])
 
 

@@ -128,7 +128,7 @@ def picture_dot(
     next smaller side in ``FIT_TARGETS``; the first that fits is kept, else the one Graphviz has
     to scale down least. At most ``len(FIT_TARGETS)`` extra layouts (a fraction of a second each
     for a folded picture), one for a tree that fits at once. ``notes`` gets the notes of the
-    picture returned."""
+    picture returned. Without Graphviz, the first plan (from the estimate alone)."""
     attempt_notes: list[str] = []
     source = model_to_dot(model, notes=attempt_notes, **options)
     if isinstance(model, FSM) or not options.get("fold", True):
@@ -140,7 +140,11 @@ def picture_dot(
         if index:
             attempt_notes = []
             source = model_to_dot(model, notes=attempt_notes, target=target, **options)
-        _, width, height = layout_extent(source, timeout=timeout)
+        try:
+            _, width, height = layout_extent(source, timeout=timeout)
+        except GraphvizError:  # no dot (a .dot file needs none): the estimate's plan
+            best = (1.0, source, attempt_notes)
+            break
         long, short = max(width, height), max(0.01, min(width, height))
         if long <= FIT_INCHES and long <= MAX_ASPECT * short:
             best = (2.0, source, attempt_notes)
