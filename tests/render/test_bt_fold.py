@@ -19,7 +19,7 @@ from fsmbt.generate import random_bt
 from fsmbt.model import BTDocument, BTNode, NodeKind
 from fsmbt.model.errors import InputError
 from fsmbt.render import bt_to_dot, model_to_dot, picture_dot, render_model
-from fsmbt.render.bt_fold import walk
+from fsmbt.render.bt_fold import TOP_CHILDREN, walk
 from fsmbt.render.dot import layout_extent
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
@@ -161,3 +161,20 @@ def test_cli_says_what_was_folded_and_focus_draws_a_fold(
     assert width <= 4096 and height <= 4096
     assert main(["render", str(model), "-o", str(tmp_path / "x.png"), "--focus", "9/9/9/9"]) == 2
     assert "no node '9/9/9/9'" in capsys.readouterr().err
+
+
+def test_a_top_node_with_hundreds_of_children_shows_the_first_and_sums_up_the_rest() -> None:
+    leaves = [BTNode(f"Step{i:03d}", NodeKind.ACTION) for i in range(300)]
+    doc = BTDocument.single(BTNode("Sequence", NodeKind.CONTROL, children=leaves))
+    notes: list[str] = []
+    source = model_to_dot(doc, notes=notes)
+    assert len(drawn_nodes(source)) == 1 + TOP_CHILDREN
+    assert re.findall(r"label=<(Step\d+)>", source) == [f"Step{i:03d}" for i in range(TOP_CHILDREN)]
+    rest = 300 - TOP_CHILDREN
+    assert f"[{rest} more children, {rest} nodes]" in source
+    assert f"focus {TOP_CHILDREN} … 299" in source
+    assert notes == [
+        f"drew the first {TOP_CHILDREN} of 300 children of root (the others, {rest} nodes, in "
+        "one box; draw one with focus=PATH)"
+    ]
+    assert len(drawn_nodes(model_to_dot(doc, level=1))) == 301  # asked for: all of them

@@ -8,6 +8,8 @@ users read them:
   many nodes it hides (``[k nodes]``) and the path to draw it alone with (``focus``).
 - **Wrapped rows**: the children of a composite whose row would be too wide are laid out in rows,
   each row hanging below the previous one (``rows``).
+- **Cut**: the drawn top node (the root, or the ``focus``) cannot be folded; past
+  ``TOP_CHILDREN`` children, its first ones are shown and one box sums up the others (``cut``).
 
 ``plan_folds`` chooses both. Without a ``depth``, nodes are opened breadth first (every node of a
 level before the next level, so siblings are treated alike) while the estimated picture stays
@@ -49,6 +51,8 @@ KEEP_SHOWN = 0.85
 #: Layout spacing the estimate assumes (the picture's ``nodesep`` / ``ranksep``, inches).
 NODE_GAP = 0.25
 RANK_GAP = 0.45
+#: Most children of the drawn top node shown; the rest are summed up in one box ("cut").
+TOP_CHILDREN = 100
 #: Size of a fold box (inches).
 FOLD_BOX = (1.3, 0.55)
 
@@ -83,6 +87,9 @@ class FoldPlan:
         rows: path -> how many children each row holds, for composites drawn in wrapped rows.
         gaps: path -> for each wrapped row after the first, how many ranks below the previous
             row it starts (one more than the previous row's deepest shown subtree).
+        cut: path -> (children shown, children left out, nodes left out) for a top node with
+            more than ``TOP_CHILDREN`` children: the others are summed up in one box drawn
+            last in its rows (counted in ``rows``).
         shown: nodes drawn (fold boxes not counted); total: nodes of the tree.
         height: ranks the picture spans below its top (fold boxes and wrapped rows included).
     """
@@ -90,6 +97,7 @@ class FoldPlan:
     folded: dict[str, int] = dataclasses.field(default_factory=dict)
     rows: dict[str, list[int]] = dataclasses.field(default_factory=dict)
     gaps: dict[str, list[int]] = dataclasses.field(default_factory=dict)
+    cut: dict[str, tuple[int, int, int]] = dataclasses.field(default_factory=dict)
     shown: int = 0
     total: int = 0
     height: int = 0
@@ -195,6 +203,12 @@ class _Estimate:
         self.items = items
         self.sizes = sizes
         self.row = row
+        self.limit: dict[int, int] = {}  # node -> children shown (the rest cut)
+
+    def kids(self, index: int) -> list[int]:
+        """The children of ``items[index]`` that are drawn when it is open."""
+        kids = self.items[index].children
+        return kids[: self.limit[index]] if index in self.limit else kids
 
     def rows_of(self, profiles: list[Profile]) -> tuple[list[int], list[Profile]]:
         """How many children each row holds, and each row's profile: children join a row while
@@ -220,7 +234,7 @@ class _Estimate:
             index = stack.pop()
             order.append(index)
             if index in opened:
-                stack.extend(self.items[index].children)
+                stack.extend(self.kids(index))
         profiles: dict[int, Profile] = {}
         wrapped: dict[int, list[int]] = {}
         for index in reversed(order):
@@ -231,7 +245,10 @@ class _Estimate:
             elif index not in opened:
                 profiles[index] = ([width, FOLD_BOX[0]], [height, FOLD_BOX[1]])
             else:
-                counts, rows = self.rows_of([profiles.pop(c) for c in kids])
+                shown = [profiles.pop(c) for c in self.kids(index)]
+                if index in self.limit:  # the box summing up the cut children
+                    shown.append(([FOLD_BOX[0]], [FOLD_BOX[1]]))
+                counts, rows = self.rows_of(shown)
                 if len(counts) > 1:
                     wrapped[index] = counts
                 widths, heights = [width], [height]
@@ -260,7 +277,7 @@ def plan_folds(
         opened = _open(items, top, estimate, depth, target)
         width, height, wrapped = estimate.extent(top, opened)
         aspect = max(width, height) / max(0.1, min(width, height))
-        plan = _plan(items, top, opened, wrapped)
+        plan = _plan(items, top, opened, wrapped, estimate)
         tried.append((aspect <= TARGET_ASPECT, aspect, plan))
         if aspect <= TARGET_ASPECT and plan.shown == items[top].size:
             break  # everything drawn, in shape: no narrower rows needed
@@ -286,13 +303,15 @@ def _open(
                 opened.add(index)
                 stack.extend(items[index].children)
         return opened
+    if len(items[top].children) > TOP_CHILDREN:
+        estimate.limit[top] = TOP_CHILDREN
     shown = 1
     queue = [top]
     head = 0
     while head < len(queue):
         index = queue[head]
         head += 1
-        kids = items[index].children
+        kids = estimate.kids(index)
         if not kids:
             continue
         # children shown, fold boxes of the children that have children of their own, and
@@ -310,7 +329,13 @@ def _open(
     return opened
 
 
-def _plan(items: list[Item], top: int, opened: set[int], wrapped: dict[int, list[int]]) -> FoldPlan:
+def _plan(
+    items: list[Item],
+    top: int,
+    opened: set[int],
+    wrapped: dict[int, list[int]],
+    estimate: _Estimate,
+) -> FoldPlan:
     plan = FoldPlan(total=items[top].size)
     order: list[int] = []
     stack = [top]
@@ -320,14 +345,21 @@ def _plan(items: list[Item], top: int, opened: set[int], wrapped: dict[int, list
         item = items[index]
         plan.shown += 1
         if index in opened:
-            stack.extend(item.children)
+            stack.extend(estimate.kids(index))
             if index in wrapped:
                 plan.rows[item.where] = wrapped[index]
+            if index in estimate.limit:
+                rest = item.children[estimate.limit[index] :]
+                plan.cut[item.where] = (
+                    estimate.limit[index],
+                    len(rest),
+                    sum(items[c].size for c in rest),
+                )
         elif item.children:
             plan.folded[item.where] = item.size - 1
-    ranks: dict[int, int] = {}  # ranks a shown subtree spans below its top
+    ranks: dict[int, int] = {-1: 0}  # ranks a shown subtree spans below its top (-1: a cut box)
     for index in reversed(order):
-        kids = items[index].children
+        kids = estimate.kids(index) + ([-1] if index in estimate.limit else [])
         if not kids:
             ranks[index] = 0
         elif index not in opened:

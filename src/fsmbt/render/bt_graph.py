@@ -42,7 +42,7 @@ import graphviz
 from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.bt_nodes import NodeKind, canonical_type
 from fsmbt.model.errors import Hint, InputError
-from fsmbt.render.anchor_ids import node_anchor
+from fsmbt.render.anchor_ids import child_path, node_anchor
 from fsmbt.render.bt_fold import (
     NODE_BUDGET,
     TARGET_INCHES,
@@ -215,8 +215,14 @@ def bt_to_dot(
 def _fold_notes(plans: list[FoldPlan], depth: int | None) -> list[str]:
     """What folding left out and how to draw it, one note for the picture."""
     folded = [(where, hidden) for plan in plans for where, hidden in plan.folded.items()]
+    cuts = [
+        f"drew the first {shown} of {shown + rest} children of {where or 'root'} (the others, "
+        f"{hidden} nodes, in one box; draw one with focus=PATH)"
+        for plan in plans
+        for where, (shown, rest, hidden) in plan.cut.items()
+    ]
     if not folded:
-        return []
+        return cuts
     shown = sum(plan.shown for plan in plans)
     total = sum(plan.total for plan in plans)
     why = (
@@ -229,7 +235,8 @@ def _fold_notes(plans: list[FoldPlan], depth: int | None) -> list[str]:
     return [
         f"folded {len(folded)} subtree{'' if len(folded) == 1 else 's'} {why}: drew {shown} of {total} nodes, each fold a "
         f"'[k nodes]' box with its path; the largest: {listed}; draw one with focus=PATH, "
-        "more levels with depth=N"
+        "more levels with depth=N",
+        *cuts,
     ]
 
 
@@ -246,6 +253,8 @@ class Ghost:
     parent: str | None = None
 
 
+#: How a fold box (hidden nodes) looks.
+FOLD_STYLE = {"shape": "box", "style": "dashed,rounded", "color": "gray45", "fontcolor": "gray25"}
 #: How a ghost looks: dashed, grey, no fill.
 GHOST_STYLE = {"style": "dashed,rounded", "color": "gray55", "fontcolor": "gray45", "shape": "box"}
 
@@ -354,7 +363,8 @@ def _draw_all_trees(
 
 @dataclasses.dataclass
 class _Entry:
-    """A node waiting to be drawn (``node`` ``None``: a wrapped row's junction point).
+    """A node waiting to be drawn (``node`` ``None``: a wrapped row's junction point, or with
+    ``box`` the box summing up the children cut from a very wide top node).
 
     ``parent`` is the node id (or junction key) it hangs from, ``gap`` the ranks between them
     (``minlen``), ``column`` / ``above`` the keys of its place in wrapped rows and of the node
@@ -369,6 +379,7 @@ class _Entry:
     gap: int = 1
     column: str | None = None
     above: str | None = None
+    box: str | None = None  # with node None: the label of the box of cut children
 
 
 class _Builder:
@@ -424,6 +435,14 @@ class _Builder:
             entry = stack.pop()
             tail = drawn.get(entry.parent, entry.parent) if entry.parent is not None else None
             edge = {"minlen": str(entry.gap)} if entry.gap > 1 else {}
+            if entry.node is None and entry.box is not None:  # the cut children's box
+                cut_id = self.next_id("f")
+                entry.holder.node(cut_id, label=entry.box, **FOLD_STYLE)
+                edge.update(style="dashed", color="gray45")
+                self.edges.append((tail or "", cut_id, edge))
+                if entry.column is not None:
+                    drawn[entry.column] = cut_id
+                continue
             if entry.node is None:  # a wrapped row's junction point
                 junction = self.next_id("j")
                 entry.holder.node(junction, shape="point", width="0.09", color="gray40")
@@ -497,11 +516,21 @@ class _Builder:
             plan = None
         else:
             out = []
+        listed: list[tuple[BTNode | None, tuple[str, ...], str]] = list(children)
+        cut = plan.cut.get(entry.where) if plan is not None else None
+        box: str | None = None
+        if cut is not None:  # the children past the first ones: one box
+            shown, rest, hidden = cut
+            first, last = child_path(entry.where, shown), child_path(entry.where, shown + rest - 1)
+            box = html_label(
+                [f"[{rest} more children, {hidden} nodes]"], [f"focus {first} … {last}"]
+            )
+            listed = listed[:shown] + [(None, entry.trees, f"{node_id}#cut")]
         rows = plan.rows.get(entry.where) if plan is not None else None
-        if rows is None or not children:
+        if rows is None or not listed:
             out.extend(
-                _Entry(child, node_id, holder, inner, where, entry.level + 1)
-                for child, inner, where in children
+                _Entry(child, node_id, holder, inner, where, entry.level + 1, box=box)
+                for child, inner, where in listed
             )
             return out
         gaps = plan.gaps[entry.where] if plan is not None else []
@@ -516,18 +545,19 @@ class _Builder:
                     _Entry(None, row_parent, holder, entry.trees, key, entry.level, junction_gap)
                 )
                 row_parent = key
-            for column, (child, inner, where) in enumerate(children[start : start + count]):
+            for column, (kid, kid_trees, kid_where) in enumerate(listed[start : start + count]):
                 out.append(
                     _Entry(
-                        child,
+                        kid,
                         row_parent,
                         holder,
-                        inner,
-                        where,
+                        kid_trees,
+                        kid_where,
                         entry.level + 1,
                         gap,
                         column=f"{node_id}@{row}/{column}",
                         above=f"{node_id}@{row - 1}/{column}" if row > 0 else None,
+                        box=box,
                     )
                 )
             start += count
@@ -558,10 +588,7 @@ class _Builder:
         holder.node(
             box,
             label=html_label([f"[{hidden} {word}]"], [f"focus {where or 'root'}"]),
-            shape="box",
-            style="dashed,rounded",
-            color="gray45",
-            fontcolor="gray25",
+            **FOLD_STYLE,
         )
         self.edges.append((node_id, box, {"style": "dashed", "color": "gray45"}))
 
