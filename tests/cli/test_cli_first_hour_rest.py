@@ -334,7 +334,8 @@ def test_a_capped_picture_says_what_it_left_out(
     source.write_text(_many_trees(40, 20), encoding="utf-8")  # 40 x 21 = 840 nodes
     assert main(["render", str(source), "-o", str(tmp_path / "many.dot")]) == 0
     err = capsys.readouterr().err
-    assert "capped at 600 nodes" in err and "of 40 trees" in err and "--tree ID" in err
+    assert "picture capped to fit 4096 x 4096 pixels" in err and "of 40 trees" in err
+    assert "left out: " in err and "--tree ID" in err
     one = tmp_path / "one.dot"
     assert main(["render", str(source), "-o", str(one), "--tree", "T5"]) == 0
     text = one.read_text(encoding="utf-8")

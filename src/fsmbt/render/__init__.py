@@ -4,28 +4,46 @@
 output file's suffix names (``.svg``, ``.png``, ``.pdf``, or ``.dot`` for the source), never
 replacing an existing file unless ``overwrite``. Models with more than ``max_nodes`` states or
 nodes (default 5 000) are refused with a ``TooLargeError``.
+
+Pictures are made to be read at 100 %: a behavior tree too big for 4 096 x 4 096 pixels is
+folded (subtrees past a node budget drawn as a ``[k nodes]`` box, wide levels wrapped into rows,
+``fsmbt.render.bt_fold``; ``depth`` and ``focus`` choose what to show), an FSM is drawn level by
+level (``fsmbt.render.fsm_graph``); either is scaled down to fit only as a last resort. A PNG or
+SVG whose long side is more than 4 times its short side is laid out again with Graphviz's
+``ratio``, which spreads the nodes apart along the short side (node and label sizes unchanged).
 """
 
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import InputError
 from fsmbt.model.fsm import FSM
 from fsmbt.render.anchor_ids import trace_anchors
+from fsmbt.render.bt_fold import TARGET_INCHES
 from fsmbt.render.bt_graph import Ghost, bt_to_dot
 from fsmbt.render.dot import (
     DEFAULT_MAX_NODES,
     DOT_TIMEOUT_S,
+    MAX_ASPECT,
     OUTPUT_FORMATS,
     GraphvizError,
     TooLargeError,
     check_output,
+    fit_aspect,
+    layout_extent,
     run_dot,
     write_picture,
 )
 from fsmbt.render.fsm_graph import composite_paths, fsm_to_dot
+
+#: The sides (inches) a behavior tree's fold plan is tried with until its layout fits
+#: (``picture_dot``), largest first.
+FIT_TARGETS = (36.0, 30.0, 24.0, 18.0, 13.0)
+#: The side (inches) a layout must fit in to be drawn at 100 % (4 096 px at 96 dpi).
+FIT_INCHES = 42.6
 
 
 def model_to_dot(
@@ -38,6 +56,9 @@ def model_to_dot(
     tree: str | None = None,
     notes: list[str] | None = None,
     anchors: bool = False,
+    focus: str | None = None,
+    fold: bool = True,
+    target: float = TARGET_INCHES,
 ) -> str:
     """The DOT source of ``model``'s picture.
 
@@ -45,11 +66,15 @@ def model_to_dot(
         model: an FSM or a BT document.
         expand_subtrees: BT: the main (or ``tree``) tree with its SubTrees inlined.
         max_nodes: refuse models with more states/nodes than this.
-        level: FSM: composite states nested deeper than this are drawn closed.
+        level: FSM: composite states nested deeper than this are drawn closed. BT: nodes more
+            than this many levels below the drawn root are folded (``bt_to_dot``'s ``depth``).
         composite: FSM: draw only this composite state (path ``A/B``).
         tree: BT: draw only this tree.
         notes: told what a capped picture left out and how to draw it.
         anchors: give every state / node a predictable SVG id (``fsmbt.render.anchor_ids``).
+        focus: BT: draw only the subtree under this node (a path ``0/2/1`` or a node name).
+        fold: BT: fold a tree too big to read at 100 % (``bt_to_dot``'s ``fold``).
+        target: BT: the side (inches) the folded picture is estimated to fit (``bt_to_dot``).
 
     Returns:
         The DOT source.
@@ -59,8 +84,10 @@ def model_to_dot(
         an option of the other model kind.
     """
     if isinstance(model, FSM):
-        if tree is not None or expand_subtrees:
-            raise InputError("tree and expand_subtrees are for behavior trees; this is an FSM")
+        if tree is not None or expand_subtrees or focus is not None:
+            raise InputError(
+                "tree, focus and expand_subtrees are for behavior trees; this is an FSM"
+            )
         return fsm_to_dot(
             model,
             max_nodes=max_nodes,
@@ -69,10 +96,10 @@ def model_to_dot(
             notes=notes,
             anchors=anchors,
         )
-    if level is not None or composite is not None:
+    if composite is not None:
         raise InputError(
-            "level and composite are for hierarchical FSMs; this is a behavior "
-            "tree (draw one tree with tree=ID)"
+            "composite is for hierarchical FSMs; this is a behavior "
+            "tree (draw one tree with tree=ID, one subtree with focus=PATH)"
         )
     return bt_to_dot(
         model,
@@ -81,7 +108,56 @@ def model_to_dot(
         tree=tree,
         notes=notes,
         anchors=anchors,
+        fold=fold,
+        depth=level,
+        focus=focus,
+        target=target,
     )
+
+
+def picture_dot(
+    model: FSM | BTDocument,
+    *,
+    notes: list[str] | None = None,
+    timeout: float = DOT_TIMEOUT_S,
+    **options: Any,
+) -> str:
+    """``model_to_dot(model, **options)``, measured: the fold plan of a behavior tree only
+    estimates label sizes and dot's spacing, so its layout is measured (``dot -Tplain``) and, if
+    still larger than ``FIT_INCHES`` or more elongated than ``MAX_ASPECT``, planned again for the
+    next smaller side in ``FIT_TARGETS``; the first that fits is kept, else the one Graphviz has
+    to scale down least. At most ``len(FIT_TARGETS)`` extra layouts (a fraction of a second each
+    for a folded picture), one for a tree that fits at once. ``notes`` gets the notes of the
+    picture returned. Without Graphviz, the first plan (from the estimate alone)."""
+    attempt_notes: list[str] = []
+    source = model_to_dot(model, notes=attempt_notes, **options)
+    if isinstance(model, FSM) or not options.get("fold", True):
+        if notes is not None:
+            notes.extend(attempt_notes)
+        return source
+    best: tuple[float, str, list[str]] | None = None
+    for index, target in enumerate(FIT_TARGETS):
+        if index:
+            attempt_notes = []
+            source = model_to_dot(model, notes=attempt_notes, target=target, **options)
+        try:
+            _, width, height = layout_extent(source, timeout=timeout)
+        except GraphvizError:  # no dot (a .dot file needs none): the estimate's plan
+            best = (1.0, source, attempt_notes)
+            break
+        long, short = max(width, height), max(0.01, min(width, height))
+        if long <= FIT_INCHES and long <= MAX_ASPECT * short:
+            best = (2.0, source, attempt_notes)
+            break
+        fit = min(1.0, FIT_INCHES / long)
+        if best is None or fit > best[0]:
+            best = (fit, source, attempt_notes)
+        if not attempt_notes and long <= FIT_INCHES:
+            break  # nothing folded and within the cap: only the aspect is off (fit_aspect)
+    assert best is not None
+    if notes is not None:
+        notes.extend(best[2])
+    return best[1]
 
 
 def svg_text(
@@ -108,10 +184,21 @@ def svg_text(
         failed or took longer than ``timeout``.
     """
     expand = expand_subtrees and not isinstance(model, FSM)  # an FSM has no SubTrees
-    source = model_to_dot(model, expand_subtrees=expand, max_nodes=max_nodes, anchors=anchors)
-    text = run_dot(source, "svg", timeout=timeout).decode("utf-8")
+    source = picture_dot(
+        model, expand_subtrees=expand, max_nodes=max_nodes, anchors=anchors, timeout=timeout
+    )
+    data = fit_aspect(source, "svg", run_dot(source, "svg", timeout=timeout), timeout=timeout)
+    text = data.decode("utf-8")
     start = text.find("<svg")
     return text[start:] if start >= 0 else text
+
+
+def picture_bytes(model: FSM | BTDocument, fmt: str, *, timeout: float = DOT_TIMEOUT_S) -> bytes:
+    """The default picture of ``model`` in ``fmt`` (``png``, ``svg``, ``pdf``) as
+    ``render_model`` draws it: measured (``picture_dot``), elongated pictures laid out again
+    (``fit_aspect``)."""
+    source = picture_dot(model, timeout=timeout)
+    return fit_aspect(source, fmt, run_dot(source, fmt, timeout=timeout), timeout=timeout)
 
 
 def render_model(
@@ -125,11 +212,12 @@ def render_model(
     composite: str | None = None,
     tree: str | None = None,
     notes: list[str] | None = None,
+    focus: str | None = None,
 ) -> Path:
     """Draw ``model`` into ``path`` (format from the suffix) and return the path.
 
     Args:
-        model, expand_subtrees, max_nodes, level, composite, tree, notes: as for
+        model, expand_subtrees, max_nodes, level, composite, tree, notes, focus: as for
             ``model_to_dot``.
         path: the picture file.
         overwrite: replace an existing file.
@@ -138,7 +226,7 @@ def render_model(
         The path written.
     """
     check_output(Path(path), overwrite=overwrite)  # fail before laying out a picture
-    source = model_to_dot(
+    source = picture_dot(
         model,
         expand_subtrees=expand_subtrees,
         max_nodes=max_nodes,
@@ -146,8 +234,9 @@ def render_model(
         composite=composite,
         tree=tree,
         notes=notes,
+        focus=focus,
     )
-    return write_picture(source, path, overwrite=overwrite)
+    return write_picture(source, path, overwrite=overwrite, max_aspect=MAX_ASPECT)
 
 
 def render_pages(
@@ -177,13 +266,15 @@ def render_pages(
         path = folder / f"{safe}.{fmt}"
         check_output(path, overwrite=overwrite)
         source = fsm_to_dot(model, max_nodes=max_nodes, level=0, composite=composite, notes=notes)
-        written.append(write_picture(source, path, overwrite=overwrite))
+        written.append(write_picture(source, path, overwrite=overwrite, max_aspect=MAX_ASPECT))
     return written
 
 
 __all__ = [
     "render_pages",
     "model_to_dot",
+    "picture_dot",
+    "picture_bytes",
     "svg_text",
     "trace_anchors",
     "fsm_to_dot",

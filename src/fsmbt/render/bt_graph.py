@@ -17,6 +17,15 @@ instead of as one strip tens of thousands of pixels wide. A picture holds at mos
 below it, in a dashed cluster (a recursive reference is not expanded again). Built with an
 explicit stack; complexity O(N) for N drawn nodes, refused beyond ``max_nodes``.
 
+With ``fold`` (the default of ``fsmbt render`` and the web page, not of the DOT format) a big
+tree is drawn to be read at 100 %: ``fsmbt.render.bt_fold`` chooses which nodes to show; a
+folded node gets a dashed ``[k nodes]`` box naming its path (``focus``), the children of a wide
+composite are drawn in rows, each row after the first hanging from a junction point (a small
+dot joined to the composite, or to the previous junction, by a dashed line) with invisible
+edges keeping the rows in columns; several trees are packed in rows while they fit the height
+budget (each row under the previous row's first root), and a ``size`` cap of 4 096 pixels is
+set only when something was folded, wrapped or left out. ``notes`` tells what was folded.
+
 This is also the DOT file format's BT writer (``fsmbt convert --to dot``, through
 ``fsmbt.formats.diagrams.dot``, with no size limit); BT DOT is write-only (docs/formats/dot.md).
 """
@@ -24,6 +33,8 @@ This is also the DOT file format's BT writer (``fsmbt convert --to dot``, throug
 from __future__ import annotations
 
 import dataclasses
+import html
+import re
 from collections.abc import Mapping, Sequence
 
 import graphviz
@@ -32,6 +43,15 @@ from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.bt_nodes import NodeKind, canonical_type
 from fsmbt.model.errors import Hint, InputError
 from fsmbt.render.anchor_ids import child_path, node_anchor
+from fsmbt.render.bt_fold import (
+    NODE_BUDGET,
+    TARGET_INCHES,
+    FoldPlan,
+    drawn_children,
+    find_focus,
+    plan_folds,
+    walk,
+)
 from fsmbt.render.dot import (
     DEFAULT_MAX_NODES,
     FONT,
@@ -73,6 +93,22 @@ MAX_ATTRS_SHOWN = 4
 ROW_LEAVES = 24
 #: The most nodes drawn in one multi-tree picture before the remaining trees are left out.
 PICTURE_MAX_NODES = 600
+#: A folded (default) picture of several trees: at most this many nodes, rows of this many
+#: leaves (for a layout ``TARGET_INCHES`` wide; a smaller target shrinks both).
+FOLDED_MAX_NODES = 300
+FOLDED_ROW_LEAVES = 16
+#: Graphviz ``size`` of a folded picture: larger is scaled down to fit, so a PNG (96 dpi) stays
+#: within 4 096 x 4 096 pixels. Folding keeps most pictures well inside it (no scaling).
+MAX_PICTURE_INCHES = "42.6,42.6"
+#: Label size estimate (inches): per character, per line, and the shape's margins.
+CHAR_INCHES = 0.085
+LINE_INCHES = 0.19
+
+
+def _row_inches(depth: int) -> float:
+    """Estimated height (inches) of a row of trees at most ``depth`` levels deep, cluster
+    frame and title included (about 0.85 inch a level)."""
+    return 0.85 * depth + 0.7
 
 
 def _tree_size(root: BTNode | None) -> tuple[int, int, int]:
@@ -101,6 +137,10 @@ def bt_to_dot(
     anchors: bool = False,
     marks: Mapping[str, Mapping[str, str]] | None = None,
     ghosts: Sequence[Ghost] = (),
+    fold: bool = False,
+    depth: int | None = None,
+    focus: str | None = None,
+    target: float = TARGET_INCHES,
 ) -> str:
     """DOT source of the picture of ``doc``.
 
@@ -117,13 +157,26 @@ def bt_to_dot(
             whether or not ``anchors`` is set): how a diff highlights changed nodes.
         ghosts: nodes that are not in ``doc`` (a diff's removed nodes), drawn dashed and grey
             under the node whose anchor they name (or alone).
+        fold: a picture to read at 100 %: subtrees past the node budget are folded into a
+            ``[k nodes]`` box and wide levels wrapped (``fsmbt.render.bt_fold``), and the
+            picture is capped at 4 096 x 4 096 pixels (scaled down only as a last resort).
+        depth: fold every node more than this many levels below the drawn root (0: the root
+            alone); no node budget then. Implies ``fold``.
+        focus: draw only the subtree under this node: a child-index path (``0/2/1``, as the
+            fold boxes show it) or the name of exactly one node. Draws one tree (the main one,
+            or ``tree``); implies ``fold``.
+        target: with ``fold``, the side (inches) the estimated picture stays within; a caller
+            that measured Graphviz's layout too big draws again with a smaller one (the
+            multi-tree picture's rows and node cap shrink in proportion).
 
     Returns:
         The DOT source text.
 
     Raises:
-        InputError: no tree, or ``tree`` names none (the message lists the trees).
+        InputError: no tree, or ``tree`` names none (the message lists the trees), or
+        ``focus`` names no node (or several).
     """
+    fold = fold or depth is not None or focus is not None
     if not doc.trees:
         raise InputError("the document holds no behavior tree")
     if tree is not None:
@@ -138,13 +191,53 @@ def bt_to_dot(
     root.attr("edge", arrowsize="0.6", color="gray25")
     builder = _Builder(doc, root, max_nodes, expand_subtrees, anchors)
     builder.marks = marks or {}
-    if expand_subtrees or tree is not None:
+    builder.folding, builder.depth, builder.target = fold, depth, target
+    if focus is not None:
+        main = doc.main
+        if main.root is None:
+            raise InputError(f"tree '{main.id}' is empty: nothing to focus on", element=focus)
+        items = walk(doc, main.root, (main.id,), "", expanding=expand_subtrees, max_nodes=max_nodes)
+        item = items[find_focus(items, focus)]
+        builder.draw_tree(item.node, root, parent=None, path=item.trees, where=item.where)
+    elif expand_subtrees or tree is not None:
         main = doc.main
         builder.draw_tree(main.root, root, parent=None, path=(main.id,))
     else:
         _draw_all_trees(doc, root, builder, notes)
+    if any(plan.folded or plan.rows for plan in builder.plans) or builder.capped:
+        root.attr(size=MAX_PICTURE_INCHES)  # the last resort; a picture that fits is unchanged
+    if notes is not None:
+        notes.extend(_fold_notes(builder.plans, depth))
     builder.draw_ghosts(ghosts)
     return builder.finish()
+
+
+def _fold_notes(plans: list[FoldPlan], depth: int | None) -> list[str]:
+    """What folding left out and how to draw it, one note for the picture."""
+    folded = [(where, hidden) for plan in plans for where, hidden in plan.folded.items()]
+    cuts = [
+        f"drew the first {shown} of {shown + rest} children of {where or 'root'} (the others, "
+        f"{hidden} nodes, in one box; draw one with focus=PATH)"
+        for plan in plans
+        for where, (shown, rest, hidden) in plan.cut.items()
+    ]
+    if not folded:
+        return cuts
+    shown = sum(plan.shown for plan in plans)
+    total = sum(plan.total for plan in plans)
+    why = (
+        f"more than {depth} levels below the top"
+        if depth is not None
+        else f"to fit 4096 x 4096 pixels at 100 % (about {NODE_BUDGET} nodes)"
+    )
+    biggest = sorted(folded, key=lambda f: -f[1])[:3]
+    listed = ", ".join(f"{where or 'root'} ({hidden})" for where, hidden in biggest)
+    return [
+        f"folded {len(folded)} subtree{'' if len(folded) == 1 else 's'} {why}: drew {shown} of {total} nodes, each fold a "
+        f"'[k nodes]' box with its path; the largest: {listed}; draw one with focus=PATH, "
+        "more levels with depth=N",
+        *cuts,
+    ]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -160,6 +253,8 @@ class Ghost:
     parent: str | None = None
 
 
+#: How a fold box (hidden nodes) looks.
+FOLD_STYLE = {"shape": "box", "style": "dashed,rounded", "color": "gray45", "fontcolor": "gray25"}
 #: How a ghost looks: dashed, grey, no fill.
 GHOST_STYLE = {"style": "dashed,rounded", "color": "gray55", "fontcolor": "gray45", "shape": "box"}
 
@@ -174,25 +269,46 @@ def _draw_all_trees(
         builder.draw_tree(order[0].root, root, parent=None, path=(main_id,))
         return
     sizes = {t.id: _tree_size(t.root) for t in order}
+    if builder.folding:  # the depth each tree is drawn with (folds, wrapped rows)
+        for t in order:
+            if t.root is not None:
+                nodes, leaves, _ = sizes[t.id]
+                height = builder.plan_only(t.root, (t.id,), "").height
+                sizes[t.id] = (nodes, leaves, height + 1)
     total = sum(n for n, _, _ in sizes.values())
     left_out: list[str] = []
     rows: list[list[str]] = [[main_id]]  # the main tree alone on the top row
     drawn = sizes[main_id][0]
-    row_leaves = ROW_LEAVES  # so the first other tree opens a new row
+    cap, row_max = PICTURE_MAX_NODES, ROW_LEAVES
+    if builder.folding:  # a picture to read at 100 %: fewer nodes, narrower rows
+        share = builder.target / TARGET_INCHES
+        cap = max(20, int(FOLDED_MAX_NODES * share * share))
+        row_max = max(4, int(FOLDED_ROW_LEAVES * share))
+    row_leaves = row_max  # so the first other tree opens a new row
+    # folding: the rows' estimated height stays within the target too
+    tall = _row_inches(sizes[main_id][2])
+    row_tall = 0.0
     for t in order[1:]:
-        nodes, leaves, _ = sizes[t.id]
-        if drawn + nodes > PICTURE_MAX_NODES:
+        nodes, leaves, depth = sizes[t.id]
+        opens = row_leaves + leaves > row_max
+        grows = _row_inches(depth) - (0.0 if opens else row_tall)
+        if drawn + nodes > cap or (builder.folding and tall + max(0.0, grows) > builder.target):
             left_out.append(t.id)
             continue
         drawn += nodes
-        if row_leaves + leaves > ROW_LEAVES:
+        if opens:
             rows.append([])
             row_leaves = 0
+            row_tall = 0.0
+        tall += max(0.0, grows)
+        row_tall = max(row_tall, _row_inches(depth))
         rows[-1].append(t.id)
         row_leaves += leaves
     previous_bottom: str | None = None
+    previous_root: tuple[str, int] | None = None  # folding: a row's first root, its ranks
     for row in rows:
         deepest: tuple[int, str] | None = None
+        row_root: tuple[str, int] | None = None
         for tree_id in row:
             t = doc.trees[tree_id]
             holder = graphviz.Digraph(name=builder.next_id("cluster_"))
@@ -206,25 +322,64 @@ def _draw_all_trees(
                 labeljust="l",
             )
             builder.clusters.append((holder, root))
-            first = builder.serial + 1
+            first = f"n{builder.serial + 1}"
+            planned = len(builder.plans)
             builder.draw_tree(t.root, holder, parent=None, path=(tree_id,))
-            if previous_bottom is not None:  # hang this row under the previous one
+            ranks = builder.plans[-1].height if len(builder.plans) > planned else 0
+            if previous_root is not None:  # folding: rows stacked under the first tree's root
+                tail, above = previous_root
                 builder.edges.append(
-                    (previous_bottom, f"n{first}", {"style": "invis", "weight": "0"})
+                    (
+                        tail,
+                        first,
+                        {
+                            "style": "invis",
+                            "minlen": str(above + 2),
+                            "weight": "10" if row_root is None else "0",
+                        },
+                    )
                 )
+            elif previous_bottom is not None:  # hang this row under the previous one
+                builder.edges.append((previous_bottom, first, {"style": "invis", "weight": "0"}))
+            row_root = (row_root or (first, 0))[0], max(ranks, (row_root or ("", 0))[1])
             depth = sizes[tree_id][2]
             if deepest is None or depth > deepest[0]:
                 deepest = (depth, builder.deepest)
         previous_bottom = deepest[1] if deepest is not None else previous_bottom
+        if builder.folding:
+            previous_root = row_root
+    builder.capped = bool(left_out) and builder.folding
     if left_out and notes is not None:
+        reason = "to fit 4096 x 4096 pixels" if builder.folding else f"at {cap} nodes"
         shown = ", ".join(left_out[:8]) + (
             f", ... (+{len(left_out) - 8})" if len(left_out) > 8 else ""
         )
         notes.append(
-            f"picture capped at {PICTURE_MAX_NODES} nodes: drew {len(order) - len(left_out)}"
+            f"picture capped {reason}: drew {len(order) - len(left_out)}"
             f" of {len(order)} trees ({drawn} of {total} nodes); left out: {shown}; "
             "draw one tree alone with tree=ID"
         )
+
+
+@dataclasses.dataclass
+class _Entry:
+    """A node waiting to be drawn (``node`` ``None``: a wrapped row's junction point, or with
+    ``box`` the box summing up the children cut from a very wide top node).
+
+    ``parent`` is the node id (or junction key) it hangs from, ``gap`` the ranks between them
+    (``minlen``), ``column`` / ``above`` the keys of its place in wrapped rows and of the node
+    above it there."""
+
+    node: BTNode | None
+    parent: str | None
+    holder: graphviz.Digraph
+    trees: tuple[str, ...]
+    where: str
+    level: int
+    gap: int = 1
+    column: str | None = None
+    above: str | None = None
+    box: str | None = None  # with node None: the label of the box of cut children
 
 
 class _Builder:
@@ -248,6 +403,12 @@ class _Builder:
         self.clusters: list[tuple[graphviz.Digraph, graphviz.Digraph]] = []  # pre-order
         self.marks: Mapping[str, Mapping[str, str]] = {}
         self.by_anchor: dict[str, str] = {}  # anchor id -> DOT node id, for ghosts
+        self.folding = False  # fold big trees (fsmbt.render.bt_fold)
+        self.depth: int | None = None
+        self.target = TARGET_INCHES  # the side (inches) a folded picture's estimate fits in
+        self.plans: list[FoldPlan] = []  # of the trees drawn
+        self.capped = False  # trees left out of a folded multi-tree picture
+        self.planned: dict[tuple[tuple[str, ...], str], FoldPlan] = {}  # not drawn yet
 
     def next_id(self, prefix: str) -> str:
         self.serial += 1
@@ -260,17 +421,36 @@ class _Builder:
         *,
         parent: str | None,
         path: tuple[str, ...],
+        where: str = "",
     ) -> None:
         if top is None:
             self.deepest = self.next_id("n")
             graph.node(self.deepest, label="(empty tree)", shape="plaintext")
             return
-        stack: list[tuple[BTNode, str | None, graphviz.Digraph, tuple[str, ...], str, int]] = [
-            (top, parent, graph, path, "", 1)
-        ]
+        plan = self.plan_for(top, path, where)
+        stack = [_Entry(top, parent, graph, path, where, 1)]
         deepest_level = 0
+        drawn: dict[str, str] = {}  # junction / column key -> node id
         while stack:
-            node, parent_id, holder, trees, where, level = stack.pop()
+            entry = stack.pop()
+            tail = drawn.get(entry.parent, entry.parent) if entry.parent is not None else None
+            edge = {"minlen": str(entry.gap)} if entry.gap > 1 else {}
+            if entry.node is None and entry.box is not None:  # the cut children's box
+                cut_id = self.next_id("f")
+                entry.holder.node(cut_id, label=entry.box, **FOLD_STYLE)
+                edge.update(style="dashed", color="gray45")
+                self.edges.append((tail or "", cut_id, edge))
+                if entry.column is not None:
+                    drawn[entry.column] = cut_id
+                continue
+            if entry.node is None:  # a wrapped row's junction point
+                junction = self.next_id("j")
+                entry.holder.node(junction, shape="point", width="0.09", color="gray40")
+                drawn[entry.where] = junction
+                edge.update(style="dashed", arrowhead="none", color="gray40")
+                self.edges.append((tail or "", junction, edge))
+                continue
+            node = entry.node
             self.count += 1
             if self.max_nodes is not None and self.count > self.max_nodes:
                 raise TooLargeError(
@@ -278,38 +458,139 @@ class _Builder:
                     hints=(Hint.MAX_NODES, Hint.NO_EXPANSION),
                 )
             node_id = self.next_id("n")
-            if level > deepest_level:
-                deepest_level, self.deepest = level, node_id
-            attrs = node_attrs(node, recursive=node.subtree_id in trees)
-            anchor = node_anchor(where, None if self.expanding else trees[0])
+            if entry.level > deepest_level:
+                deepest_level, self.deepest = entry.level, node_id
+            attrs = node_attrs(node, recursive=node.subtree_id in entry.trees)
+            anchor = node_anchor(entry.where, None if self.expanding else entry.trees[0])
             self.by_anchor.setdefault(anchor, node_id)
             if self.anchors:
                 attrs["id"] = anchor
             attrs.update(self.marks.get(anchor, {}))
-            holder.node(node_id, **attrs)
-            if parent_id is not None:
-                self.edges.append((parent_id, node_id, {}))
-            ref = node.subtree_id
-            if self.expanding and ref is not None and ref in self.doc.trees and ref not in trees:
-                cluster = graphviz.Digraph(name=self.next_id("cluster_"))
-                cluster.attr(
-                    label=label_text(ref),
-                    style="dashed,rounded",
-                    color="gray50",
-                    fontname=FONT,
-                    fontsize="10",
-                    labeljust="l",
-                )
-                self.clusters.append((cluster, holder))
-                sub_root = self.doc.trees[ref].root
-                if sub_root is not None:
-                    stack.append(
-                        (sub_root, node_id, cluster, (*trees, ref), child_path(where, 0), level + 1)
+            entry.holder.node(node_id, **attrs)
+            if tail is not None:
+                self.edges.append((tail, node_id, edge))
+            if entry.column is not None:
+                drawn[entry.column] = node_id
+                above = drawn.get(entry.above or "")
+                if above is not None:  # keep wrapped rows in columns under each other
+                    self.edges.append(
+                        (
+                            above,
+                            node_id,
+                            {"style": "invis", "minlen": str(entry.gap), "weight": "3"},
+                        )
                     )
-            stack.extend(
-                (child, node_id, holder, trees, child_path(where, index), level + 1)
-                for index, child in reversed(list(enumerate(node.children)))
+            children = drawn_children(self.doc, node, entry.trees, entry.where, self.expanding)
+            if plan is not None and entry.where in plan.folded:
+                self.draw_fold(node_id, entry.holder, entry.where, plan.folded[entry.where])
+                children = []
+            if children:
+                stack.extend(reversed(self.child_entries(entry, node_id, children, plan)))
+
+    def child_entries(
+        self,
+        entry: _Entry,
+        node_id: str,
+        children: list[tuple[BTNode, tuple[str, ...], str]],
+        plan: FoldPlan | None,
+    ) -> list[_Entry]:
+        """What to draw under ``node_id``, in order: its children, in wrapped rows when the plan
+        says so (each row after the first hangs from a junction point drawn after the previous
+        row); an expanded SubTree's root in a dashed cluster named after its tree."""
+        holder = entry.holder
+        if len(children[0][1]) > len(entry.trees):  # an expanded SubTree: its own cluster
+            ref = children[0][1][-1]
+            cluster = graphviz.Digraph(name=self.next_id("cluster_"))
+            cluster.attr(
+                label=label_text(ref),
+                style="dashed,rounded",
+                color="gray50",
+                fontname=FONT,
+                fontsize="10",
+                labeljust="l",
             )
+            self.clusters.append((cluster, holder))
+            child, inner, where = children[0]
+            out = [_Entry(child, node_id, cluster, inner, where, entry.level + 1)]
+            children = children[1:]  # (a SubTree reference has no children of its own)
+            plan = None
+        else:
+            out = []
+        listed: list[tuple[BTNode | None, tuple[str, ...], str]] = list(children)
+        cut = plan.cut.get(entry.where) if plan is not None else None
+        box: str | None = None
+        if cut is not None:  # the children past the first ones: one box
+            shown, rest, hidden = cut
+            first, last = child_path(entry.where, shown), child_path(entry.where, shown + rest - 1)
+            box = html_label(
+                [f"[{rest} more children, {hidden} nodes]"], [f"focus {first} … {last}"]
+            )
+            listed = listed[:shown] + [(None, entry.trees, f"{node_id}#cut")]
+        rows = plan.rows.get(entry.where) if plan is not None else None
+        if rows is None or not listed:
+            out.extend(
+                _Entry(child, node_id, holder, inner, where, entry.level + 1, box=box)
+                for child, inner, where in listed
+            )
+            return out
+        gaps = plan.gaps[entry.where] if plan is not None else []
+        start = 0
+        row_parent = node_id
+        for row, count in enumerate(rows):
+            gap = gaps[row - 1] if row > 0 else 1
+            if row > 0:
+                key = f"{node_id}#{row}"
+                junction_gap = 1 if row == 1 else gaps[row - 2]
+                out.append(
+                    _Entry(None, row_parent, holder, entry.trees, key, entry.level, junction_gap)
+                )
+                row_parent = key
+            for column, (kid, kid_trees, kid_where) in enumerate(listed[start : start + count]):
+                out.append(
+                    _Entry(
+                        kid,
+                        row_parent,
+                        holder,
+                        kid_trees,
+                        kid_where,
+                        entry.level + 1,
+                        gap,
+                        column=f"{node_id}@{row}/{column}",
+                        above=f"{node_id}@{row - 1}/{column}" if row > 0 else None,
+                        box=box,
+                    )
+                )
+            start += count
+        return out
+
+    def plan_for(self, top: BTNode, trees: tuple[str, ...], where: str) -> FoldPlan | None:
+        """The fold plan of the tree under ``top`` (``None``: everything drawn)."""
+        if not self.folding:
+            return None
+        plan = self.planned.pop((trees, where), None)
+        if plan is None:
+            plan = self.plan_only(top, trees, where)
+        self.plans.append(plan)
+        return plan
+
+    def plan_only(self, top: BTNode, trees: tuple[str, ...], where: str) -> FoldPlan:
+        """The fold plan of the tree under ``top``, kept for when it is drawn."""
+        items = walk(
+            self.doc, top, trees, where, expanding=self.expanding, max_nodes=self.max_nodes
+        )
+        plan = plan_folds(items, 0, measure, depth=self.depth, target=self.target)
+        self.planned[(trees, where)] = plan
+        return plan
+
+    def draw_fold(self, node_id: str, holder: graphviz.Digraph, where: str, hidden: int) -> None:
+        box = self.next_id("f")
+        word = "node" if hidden == 1 else "nodes"
+        holder.node(
+            box,
+            label=html_label([f"[{hidden} {word}]"], [f"focus {where or 'root'}"]),
+            **FOLD_STYLE,
+        )
+        self.edges.append((node_id, box, {"style": "dashed", "color": "gray45"}))
 
     def draw_ghosts(self, ghosts: Sequence[Ghost]) -> None:
         for ghost in ghosts:
@@ -382,6 +663,18 @@ def node_attrs(node: BTNode, *, recursive: bool = False) -> dict[str, str]:
         "style": style,
         "fillcolor": "lightyellow",
     }
+
+
+def measure(node: BTNode) -> tuple[float, float]:
+    """Estimated (width, height) in inches of ``node``'s shape, from its label's lines."""
+    attrs = node_attrs(node)
+    lines = [
+        html.unescape(re.sub(r"<[^>]+>", "", line)) for line in attrs["label"][1:-1].split("<BR/>")
+    ]
+    width = max(len(line) for line in lines) * CHAR_INCHES + 0.35
+    if attrs["shape"] in ("ellipse", "hexagon"):
+        width *= 1.3
+    return max(0.75, width), max(0.4, LINE_INCHES * len(lines) + 0.2)
 
 
 def _shorten(value: str) -> str:

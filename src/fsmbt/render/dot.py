@@ -8,6 +8,7 @@ model goes through ``label_text`` so a name never changes the DOT's meaning.
 from __future__ import annotations
 
 import html
+import re
 import shutil
 import subprocess
 from pathlib import Path
@@ -25,6 +26,8 @@ DOT_TIMEOUT_S = 120.0
 #: Output formats by file suffix; ``.dot`` writes the source without running Graphviz.
 OUTPUT_FORMATS = {".svg": "svg", ".png": "png", ".pdf": "pdf", ".dot": "dot", ".gv": "dot"}
 FONT = "DejaVu Sans"
+#: A picture's long side is at most this many times its short side (issue 29).
+MAX_ASPECT = 4.0
 
 
 class GraphvizError(FsmbtError):
@@ -163,13 +166,71 @@ def run_dot(source: str, fmt: str, *, timeout: float = DOT_TIMEOUT_S) -> bytes:
     return done.stdout
 
 
+def layout_extent(source: str, *, timeout: float = DOT_TIMEOUT_S) -> tuple[float, float, float]:
+    """(scale, width, height) of Graphviz's layout of ``source``: the first line of
+    ``dot -Tplain`` (width and height in inches before a ``size`` cap scales them by scale)."""
+    first = run_dot(source, "plain", timeout=timeout).split(b"\n", 1)[0].split()
+    if len(first) < 4 or first[0] != b"graph":
+        raise GraphvizError("Graphviz gave no layout size")
+    return float(first[1]), float(first[2]), float(first[3])
+
+
+def picture_size(data: bytes, fmt: str) -> tuple[float, float] | None:
+    """(width, height) of a PNG (pixels, from its IHDR header) or an SVG (points, from the
+    root element's attributes); ``None`` for other formats or an unreadable header."""
+    if fmt == "png" and data[:8] == b"\x89PNG\r\n\x1a\n" and len(data) >= 24:
+        return float(int.from_bytes(data[16:20], "big")), float(int.from_bytes(data[20:24], "big"))
+    if fmt == "svg":
+        head = data[: data.find(b">", data.find(b"<svg")) + 1].decode("utf-8", "replace")
+        found = re.search(r'width="([\d.]+)(?:pt|px)?"\s+height="([\d.]+)(?:pt|px)?"', head)
+        if found:
+            return float(found.group(1)), float(found.group(2))
+    return None
+
+
+def fit_aspect(
+    source: str,
+    fmt: str,
+    data: bytes,
+    *,
+    max_aspect: float = MAX_ASPECT,
+    timeout: float = DOT_TIMEOUT_S,
+) -> bytes:
+    """``data`` (the picture of ``source`` in ``fmt``), or, when its long side is more than
+    ``max_aspect`` times its short side, the picture laid out again with Graphviz's ``ratio``
+    set to just within ``max_aspect``: dot then spreads the layout along the short side (more
+    space between ranks or nodes; node and label sizes unchanged), and a ``size`` cap in the
+    source still applies. Costs a second layout, only for such pictures."""
+    size = picture_size(data, fmt)
+    if size is None or min(size) <= 0:
+        return data
+    width, height = size
+    if max(width, height) <= max_aspect * min(width, height):
+        return data
+    ratio = 0.98 * max_aspect if height > width else 1.02 / max_aspect  # height / width
+    brace = source.find("{")
+    if brace < 0:
+        return data
+    patched = f"{source[: brace + 1]}\n\tratio={ratio:.3f}{source[brace + 1 :]}"
+    return run_dot(patched, fmt, timeout=timeout)
+
+
 def write_picture(
-    source: str, path: str | Path, *, overwrite: bool = False, timeout: float = DOT_TIMEOUT_S
+    source: str,
+    path: str | Path,
+    *,
+    overwrite: bool = False,
+    timeout: float = DOT_TIMEOUT_S,
+    max_aspect: float | None = None,
 ) -> Path:
-    """Write ``source`` as the picture ``path`` names (by suffix); refuse to replace a file."""
+    """Write ``source`` as the picture ``path`` names (by suffix); refuse to replace a file.
+    With ``max_aspect``, a PNG or SVG more elongated than that is laid out again
+    (``fit_aspect``)."""
     path = Path(path)
     fmt = check_output(path, overwrite=overwrite)
     data = source.encode("utf-8") if fmt == "dot" else run_dot(source, fmt, timeout=timeout)
+    if max_aspect is not None and fmt in ("png", "svg"):
+        data = fit_aspect(source, fmt, data, max_aspect=max_aspect, timeout=timeout)
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
         path.write_bytes(data)

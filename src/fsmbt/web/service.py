@@ -29,7 +29,7 @@ from fsmbt.formats import dumps, formats, get_format
 from fsmbt.metrics.elements import elements
 from fsmbt.model.errors import FsmbtError, Hint, InputError
 from fsmbt.model.validate import validate
-from fsmbt.render import run_dot, svg_text, trace_anchors
+from fsmbt.render import svg_text, trace_anchors
 from fsmbt.render.dot import TooLargeError
 from fsmbt.verify.report import Report
 
@@ -352,9 +352,9 @@ def export(request: dict[str, Any]) -> tuple[bytes, str, str]:
         svg = svg_text(loaded.model, expand_subtrees=False, anchors=False)
         if to == "svg":
             return svg.encode("utf-8"), f"{stem}.svg", "image/svg+xml"
-        from fsmbt.render import model_to_dot
+        from fsmbt.render import picture_bytes
 
-        data = run_dot(model_to_dot(loaded.model), "png")
+        data = picture_bytes(loaded.model, "png")
         return data, f"{stem}.png", "image/png"
     fmt = get_format(to)
     text = dumps(loaded.model, fmt.name)
