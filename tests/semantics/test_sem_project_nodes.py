@@ -232,6 +232,13 @@ def test_sem_node_file_alias_semantics_and_kind(tmp_path) -> None:
         ("nodes:\n  X: {alias: NoSuchKind}\n", "unknown node kind 'NoSuchKind'"),
         ("nodes:\n  X: {kind: control}\n", "kind must be action or condition"),
         ("nodes: [1, 2\n", "malformed node file"),
+        # an alias bomb: refused at the first alias, before anything is built
+        (
+            "a: &a [x, x, x, x, x, x, x, x, x]\nb: &b [*a, *a, *a, *a, *a, *a, *a, *a, *a]\n"
+            "nodes: [*b, *b, *b, *b, *b, *b, *b, *b, *b]\n",
+            "malformed node file: YAML aliases .* are not allowed",
+        ),
+        ("nodes:" + " [" * 5000 + "\n", "malformed node file: YAML nested deeper than"),
         ("other: 1\n", "unknown key"),
     ],
 )

@@ -38,6 +38,7 @@ from fsmbt.model.errors import InputError, SourceLocation
 from fsmbt.model.files import read_bounded
 from fsmbt.model.kinds import NodeKind
 from fsmbt.model.nodes.registry import ABSTRACTIONS, PROFILES, all_nodes, node_semantics
+from fsmbt.model.yaml_guarded import load_guarded_yaml
 
 if TYPE_CHECKING:  # only an annotation: model.bt reads the registry, not the reverse
     from fsmbt.model.bt import BTDocument
@@ -130,10 +131,12 @@ def _read_file(path: Path, library: NodeLibrary) -> list[str]:
     try:
         if path.suffix.lower() == ".json":
             data = json.loads(text)
-        else:
-            import yaml
-
-            data = yaml.safe_load(text)
+        else:  # aliases refused, depth bounded (model.yaml_guarded; docs/security.md)
+            data = load_guarded_yaml(
+                text, lambda line, column: SourceLocation(str(path), line, column)
+            )
+    except InputError as exc:
+        raise InputError(f"malformed node file: {exc.message}", location=exc.location) from None
     except Exception as exc:  # noqa: BLE001 - any parse error is the user's file: report it
         raise InputError(
             f"malformed node file: {str(exc).splitlines()[0]}", location=where
