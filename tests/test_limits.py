@@ -107,6 +107,26 @@ def test_state_and_node_counts(override: None) -> None:
         loads(BT_XML, "btcpp")
 
 
+def test_the_interpreter_bounds_expanded_subtrees_by_the_limit_in_force(override: None) -> None:
+    """A SubTree used twice per level doubles the tree at every level: 9 read nodes, at least
+    15 once expanded. The interpreter's bound is the ``max_nodes`` in force, not the default."""
+    from fsmbt.semantics.bt_interpreter import BTInterpreter
+
+    text = (
+        '<root BTCPP_format="4" main_tree_to_execute="T">'
+        '<BehaviorTree ID="T"><Sequence><SubTree ID="U"/><SubTree ID="U"/></Sequence></BehaviorTree>'
+        '<BehaviorTree ID="U"><Sequence><SubTree ID="V"/><SubTree ID="V"/></Sequence></BehaviorTree>'
+        '<BehaviorTree ID="V"><Sequence><AlwaysSuccess/><AlwaysFailure/></Sequence></BehaviorTree>'
+        "</root>"
+    )
+    use(max_nodes=10)
+    doc = loads(text, "btcpp")
+    with pytest.raises(InputError, match=r"expanded exceed\(s\) the limit of 10 .*FSMBT_MAX_NODES"):
+        BTInterpreter(doc)
+    use(max_nodes=100)
+    assert BTInterpreter(doc) is not None
+
+
 @pytest.mark.parametrize(
     ("fmt", "text", "variable"),
     [

@@ -40,6 +40,7 @@ from dataclasses import dataclass
 from types import MethodType
 from typing import Any, Final
 
+from fsmbt import limits
 from fsmbt.limits import Limits
 from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.errors import InputError, UnsupportedError
@@ -75,8 +76,8 @@ OUTCOME_RUNNING: Final[str] = LeafOutcome.RUNNING.value
 OUTCOME_TO_STATUS: dict[str, int] = {o.value: o.status.value for o in LeafOutcome}
 STATUS_TO_OUTCOME: dict[int, str] = {v: k for k, v in OUTCOME_TO_STATUS.items()}
 
-#: Upper bound on nodes after SubTree expansion (a SubTree used twice per level doubles); the
-#: default lives in ``fsmbt.limits`` (``max_nodes``).
+#: The default upper bound on nodes after SubTree expansion (a SubTree used twice per level
+#: doubles); the bound in force is ``fsmbt.limits.current().max_nodes`` (``FSMBT_MAX_NODES``).
 MAX_COMPILED_NODES = Limits.max_nodes
 
 # -- supported node types: the node registry (fsmbt.semantics.nodes) ----------------------------
@@ -133,12 +134,17 @@ class CompiledTree:
         stack: list[tuple[BTNode, int | None, int, tuple[str, ...]]] = [
             (tree.root, None, 0, (tree.id,))
         ]
+        max_nodes = limits.current().max_nodes
         while stack:
             node, parent, position, chain = stack.pop()
             nid = len(raw)
-            if nid >= MAX_COMPILED_NODES:
+            if nid >= max_nodes:
                 raise InputError(
-                    f"the tree has more than {MAX_COMPILED_NODES} nodes once SubTrees are expanded",
+                    limits.exceeded(
+                        "the tree's nodes once SubTrees are expanded",
+                        "max_nodes",
+                        max_nodes,
+                    ),
                     element=tree.id,
                 )
             if parent is not None:
