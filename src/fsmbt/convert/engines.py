@@ -17,6 +17,7 @@ from typing import Any
 
 from fsmbt.convert.bt_to_hfsm import bt_to_hfsm
 from fsmbt.convert.dispatch import fsm_to_dispatch
+from fsmbt.convert.dispatch_fsm import dispatch_to_fsm
 from fsmbt.convert.hfsm_to_bt import fsm_to_bt
 from fsmbt.convert.result import ConversionResult, Converter, Model
 from fsmbt.convert.structure import MAX_XML_LEVELS
@@ -31,6 +32,7 @@ from fsmbt.convert.structured.style import (
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import InputError, UnsupportedError
 from fsmbt.model.fsm import FSM
+from fsmbt.semantics.dispatch_runtime import is_dispatch_bt
 from fsmbt.semantics.outcome_rules import OutcomeRules
 
 
@@ -109,13 +111,29 @@ def rules_fsm_to_bt(
 
 
 def rules_bt_to_fsm(doc: BTDocument, *, style: str = AUTO, **options: Any) -> ConversionResult:
-    """The rules engine's BT -> FSM (one style; ``structured`` is an FSM -> BT style)."""
+    """The rules engine's BT -> FSM (one style; ``structured`` is an FSM -> BT style).
+
+    A dispatch tree (``DispatchEntry`` leaves, docs/semantics.md section 12) becomes the state
+    machine of its macro steps (``fsmbt.convert.dispatch_fsm``); any other tree the
+    hierarchical FSM of its leaf execution (``fsmbt.convert.bt_to_hfsm``).
+
+    Raises:
+        InputError: ``structured``, or ``loop`` on a dispatch tree (it runs by macro steps).
+    """
     if check_style(style) == STRUCTURED:
         raise InputError(
             "--style structured converts outcome-driven state machines into behavior trees; "
             "this input is a behavior tree",
             element="--style",
         )
+    if is_dispatch_bt(doc):
+        if options.get("loop"):
+            raise InputError(
+                "a dispatch tree runs by macro steps (its root is ticked once per event); "
+                "--loop is for trees read by leaf execution",
+                element="--loop",
+            )
+        return dispatch_to_fsm(doc, max_states=options.get("max_states"))
     return bt_to_hfsm(doc, style="paper", **options)
 
 
