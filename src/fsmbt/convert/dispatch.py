@@ -138,6 +138,7 @@ def fsm_to_dispatch(fsm: FSM, **_options: object) -> ConversionResult:
         return node
 
     table = flat.transition_map()
+    transitions = sum(len(table.get(name, {})) for name in states if not flat.states[name].final)
     cases: list[BTNode] = []
     for name in states:
         st = flat.states[name]
@@ -180,6 +181,7 @@ def fsm_to_dispatch(fsm: FSM, **_options: object) -> ConversionResult:
         stack.extend((child, d + 1) for child in node.children)
     stats: dict[str, object] = {
         "states": len(states),
+        "transitions": transitions,
         "nodes": count,
         "depth": depth,
         "style": STYLE,
