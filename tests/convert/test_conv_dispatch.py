@@ -36,7 +36,10 @@ def test_a_wrong_target_is_caught() -> None:
     digit = first.split("fsm_d0:='")[1][0]
     other = "b" if digit != "b" else "c"
     mutated = text.replace(first, first.replace(f"fsm_d0:='{digit}'", f"fsm_d0:='{other}'"), 1)
-    assert not verify(fsm, loads(mutated, "btcpp")).equivalent
+    report = verify(fsm, loads(mutated, "btcpp"))
+    assert not report.equivalent
+    trace = report.properties["completeness"].counterexample or []
+    assert trace and all(step.result_state in fsm.states for step in trace)  # named, not digits
 
 
 def test_macro_steps_follow_the_fsm() -> None:

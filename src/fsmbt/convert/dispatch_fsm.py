@@ -170,10 +170,10 @@ def _refine(explored: _Explored) -> list[int]:
     behave alike (the result is the source machine, not its minimum), and makes a tree fsmbt
     wrote stable after one or two rounds. Cost: O(moves) per round."""
     count = len(explored.states)
-    describe = explored.machine.describe
+    digits_of = explored.machine.digits
     labels: dict[Any, int] = {}
     block = [
-        labels.setdefault((explored.final[i], describe(explored.states[i])), len(labels))
+        labels.setdefault((explored.final[i], digits_of(explored.states[i])), len(labels))
         for i in range(count)
     ]
     blocks = len(labels)
@@ -246,7 +246,7 @@ class _States:
         self.index[key] = k
         base = self.explored.machine.entries[ran[-1]][0] if ran else ""
         if not base:
-            digits = self.explored.machine.describe(self.explored.states[self._first[block]])
+            digits = self.explored.machine.digits(self.explored.states[self._first[block]])
             fallback = START if start else self._block_names.get(block, f"index_{digits}")
             base = fallback
         self._taken[base] = self._taken.get(base, 0) + 1
@@ -267,7 +267,7 @@ def _port_warnings(explored: _Explored) -> list[str]:
         ran_any.update(ran)
         if ran:
             port = machine.entries[ran[-1]][0]
-            by_index.setdefault(machine.describe(state), {}).setdefault(port, ran[-1])
+            by_index.setdefault(machine.digits(state), {}).setdefault(port, ran[-1])
     warnings: list[str] = []
     for digits, named in by_index.items():
         if len(named) > 1:

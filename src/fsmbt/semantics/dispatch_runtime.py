@@ -117,6 +117,7 @@ class DispatchMachine:
         self.entries: dict[int, tuple[str, str | None]] = {}
         self.event_cases: set[str] = set()
         self._settled: dict[DispatchState, DispatchState] = {}
+        self._names: dict[str, str] = {}  # index digits -> state port (describe)
         self._alphabet_set = frozenset(self.alphabet)
         for node in self.tree.nodes:
             src = node.source
@@ -213,9 +214,16 @@ class DispatchMachine:
         return FINAL if state.last_result == NodeStatus.SUCCESS else RUNNING
 
     def describe(self, state: DispatchState) -> str:
+        """The state's name for traces: the ``state`` port of the ``DispatchEntry`` whose tick
+        wrote its index (the first seen), else the index digits (``start`` before any)."""
+        digits = self.digits(state)
+        return self._names.get(digits, digits)
+
+    def digits(self, state: DispatchState) -> str:
+        """The state index as its digits, most significant first (``start``: none written)."""
         entries = dict(dict(state.snapshot[1]).get(BLACKBOARD_SLOT, ()))
         digits = [v for k, v in sorted(entries.items()) if k.startswith(DIGIT_PREFIX)]
-        return "".join(digits) or "start"
+        return "".join(reversed(digits)) or "start"
 
     # -- one tick ------------------------------------------------------------------------------
     def _outputs(self, entered: tuple[int, ...]) -> Outputs:
@@ -240,6 +248,8 @@ class DispatchMachine:
             snap, request = self.interp.advance(snap, NodeStatus.SUCCESS.value)
         snap = without_entry(snap, EVENT_KEY)
         after = DispatchState(snap, NodeStatus(request.status))
+        if entered and self.entries[entered[-1]][0]:
+            self._names.setdefault(self.digits(after), self.entries[entered[-1]][0])
         return Tick(after, tuple(entered), frozenset(self.interp.read))
 
 
