@@ -40,7 +40,7 @@ PLAIN_ENGINES = ("rules", "bsd", "chds")
 #: The options a request may set (nothing else reaches an engine: no endpoint, no key).
 HIERARCHIES = ("subtrees", "flatten")
 #: FSM -> BT styles (docs/conversion.md, "Styles"; ``paper`` is ``lebt``).
-STYLES = ("auto", "structured", "lebt")
+STYLES = ("auto", "structured", "dispatch", "lebt")
 #: Download formats besides the registry's writers: pictures through Graphviz.
 PICTURE_FORMATS = ("svg", "png")
 #: The file name ending of each download format.
