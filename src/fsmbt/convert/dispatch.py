@@ -20,7 +20,8 @@ Shape, for reachable states numbered 0..n-1 in declaration order (index digits b
 Bad input (UnsupportedError, state named): an event name BehaviorTree.CPP's ``Switch`` would
 not compare as a plain string (a number, a blackboard reference ``{..}``, empty).
 
-Cost: O(states + transitions) to build; depth O(log6 states + max out-degree / 6).
+Cost: O(states + transitions) to build (the cyclic collector paused, ``convert/perf.py``: the
+tree is acyclic); depth O(log6 states + max out-degree / 6).
 """
 
 from __future__ import annotations
@@ -28,6 +29,7 @@ from __future__ import annotations
 import re
 from collections import deque
 
+from fsmbt.convert.perf import without_gc_pauses
 from fsmbt.convert.result import ConversionResult
 from fsmbt.model.bt import BTDocument, BTNode, NodeModel, PortModel
 from fsmbt.model.errors import InputError, UnsupportedError
@@ -97,6 +99,7 @@ def _check_event(event: str, state: str) -> None:
         )
 
 
+@without_gc_pauses
 def fsm_to_dispatch(fsm: FSM, **_options: object) -> ConversionResult:
     """The dispatch form of ``fsm`` (see the module docstring)."""
     warnings: list[str] = []

@@ -47,6 +47,7 @@ from collections import deque
 from typing import Any
 
 from fsmbt import limits
+from fsmbt.convert.perf import without_gc_pauses
 from fsmbt.convert.result import ConversionResult
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import SourceLocation, UnsupportedError
@@ -307,6 +308,7 @@ def _event_moves(explored: _Explored, block: list[int], i: int) -> list[tuple[st
     ]
 
 
+@without_gc_pauses
 def dispatch_to_fsm(
     doc: BTDocument, *, max_states: int | None = None, **_options: object
 ) -> ConversionResult:
