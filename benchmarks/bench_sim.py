@@ -46,7 +46,7 @@ def main() -> None:
     robot_bsd = api.convert_model(robot_hfsm, "bsd").model
     robot_chds = api.convert_model(robot_hfsm, "chds").model
     predator = load("predator_fsm.scxml")
-    predator_lebt = api.convert_model(predator).model
+    predator_lebt = api.convert_model(predator, style="lebt").model
     prey = load("prey_bt.xml")
     prey_hfsm = api.convert_model(prey).model
 

@@ -34,7 +34,8 @@ EVENTS = [
 
 def main() -> None:
     fsm = api.load(HERE / "paper_fsm.xml").model
-    tree_xml = dumps(converter_for("rules", fsm)(fsm).model, "btcpp")  # = fsmbt convert
+    lebt = converter_for("rules", fsm)(fsm, style="lebt").model  # = fsmbt convert --style lebt
+    tree_xml = dumps(lebt, "btcpp")
 
     machine = FSMMachine(fsm)
     state, _ = machine.start()

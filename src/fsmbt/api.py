@@ -55,6 +55,7 @@ from fsmbt.api_types import (
     verify_request,
 )
 from fsmbt.convert import ConversionResult, convert
+from fsmbt.convert.engines import NUSMV_CHECKED
 from fsmbt.formats import detect_format, dumps, get_format, loads
 from fsmbt.formats.registry import format_for_path, read_text
 from fsmbt.formats.translate import Translation, expand_data_for
@@ -344,7 +345,8 @@ def convert_model(
         model: the source model; its kind decides the direction.
         engine: the engine's name (``rules``, ``bsd``, ``chds``, ``llm``, ...).
         style: the output structure style: ``auto`` (default: ``structured`` for an
-            outcome-driven machine, else ``lebt``), ``structured``, ``lebt`` (``paper``).
+            outcome-driven machine, else ``dispatch``), ``structured``, ``dispatch``, ``lebt``
+            (``paper``).
         loop: BT -> FSM: the root is ticked again after it returns.
         hierarchy: FSM -> BT with ``rules``: ``subtrees`` (one SubTree per composite state) or
             ``flatten``; ``None`` leaves the engine's default.
@@ -813,6 +815,8 @@ def convert_loaded(
             engine_options["outcome_driven"] = True  # the format's events are outcomes
         if request.outcomes:
             engine_options["outcomes"] = request.outcomes
+        if request.engine == "rules" and request.verify and request.verify_engine != "native":
+            engine_options[NUSMV_CHECKED] = True  # auto writes a form NuSMV encodes
         conversion = convert_model(
             loaded.model,
             request.engine,

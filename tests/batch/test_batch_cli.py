@@ -42,6 +42,26 @@ def test_examples_convert_into_a_new_nested_folder_and_report_again(
         assert api.verify_either_order(source, api.load(row["output"]).model).equivalent
 
 
+@pytest.mark.parametrize(
+    ("style", "written", "leaf"),
+    [
+        (None, "dispatch", "DispatchEntry"),  # auto: the event-driven A-J machine
+        ("dispatch", "dispatch", "DispatchEntry"),
+        ("lebt", "lebt", "LebtState"),
+    ],
+)
+def test_the_style_reaches_every_job(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], style: str | None, written: str, leaf: str
+) -> None:
+    out = tmp_path / "out"
+    args = ["batch", str(EXAMPLES / "paper_fsm.xml"), "-o", str(out), "--quiet", "--json"]
+    assert main([*args, *(["--style", style] if style else [])]) == 0
+    (row,) = json.loads(capsys.readouterr().out)["results"]
+    assert row["status"] == "equivalent"
+    assert row["stats"]["conversion"]["style"] == written
+    assert f"<{leaf}" in Path(row["output"]).read_text(encoding="utf-8")
+
+
 def test_bad_input_is_a_row_and_exit_2(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     broken = tmp_path / "in" / "broken.xml"
     broken.parent.mkdir()

@@ -55,7 +55,7 @@ def _doors(folder: Path, n: int) -> list[Path]:
 
 def _answer() -> str:
     model = api.load_text(json.dumps(FSM_JSON), "json").model
-    return dumps(api.convert_model(model).model, "btcpp")
+    return dumps(api.convert_model(model, style="lebt").model, "btcpp")  # LLMs write LEBTs
 
 
 def test_a_failing_endpoint_is_a_row_with_its_cause_and_runs_again_on_resume(

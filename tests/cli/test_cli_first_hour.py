@@ -158,7 +158,7 @@ def test_not_equivalent_in_both_orders(tmp_path: Path) -> None:
 def test_a_pair_no_rule_compares_names_the_rules(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    lebt = api.convert_file(PAPER_FSM).text
+    lebt = api.convert_file(PAPER_FSM, style="lebt").text
     # an LEBT with one foreign action leaf: neither a loop-execution BT nor a plain BT's FSM
     broken = lebt.replace("<LebtState", "<SomeRobotAction", 1)
     path = tmp_path / "mixed.xml"

@@ -155,7 +155,20 @@ def test_info_and_convert_name_each_undeclared_type_once(
 @pytest.fixture
 def paper_lebt(tmp_path: Path) -> Path:
     out = tmp_path / "paper_bt.xml"
-    assert main(["convert", str(EXAMPLES / "paper_fsm.xml"), "--no-progress", "-o", str(out)]) == 0
+    assert (
+        main(
+            [
+                "convert",
+                str(EXAMPLES / "paper_fsm.xml"),
+                "--style",
+                "lebt",
+                "--no-progress",
+                "-o",
+                str(out),
+            ]
+        )
+        == 0
+    )
     return out
 
 

@@ -116,7 +116,7 @@ def test_lebt_run_on_events_logs_conform(tmp_path: Path) -> None:
     assert driver is not None
     tree = tmp_path / "door_bt.xml"
     door = api.load(ROOT / "examples" / "door_hfsm.scxml").model
-    tree.write_text(dumps(convert(door).model, "btcpp"), encoding="utf-8")
+    tree.write_text(dumps(convert(door, style="lebt").model, "btcpp"), encoding="utf-8")
     events = "open_cmd\nfully_open\nfire_alarm\nopen_cmd\nreset\nfire_alarm\nshutdown\n"
     btlog, db3 = tmp_path / "door.btlog", tmp_path / "door.db3"
 

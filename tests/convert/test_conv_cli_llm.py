@@ -69,7 +69,7 @@ def test_hybrid_reads_prose_through_the_llm_and_passes_url_and_model(
     assert "Extract the behavior model" in server.user_texts(0)
     text = capsys.readouterr().out
     assert "verdict: EQUIVALENT" in text and "extracted_by_llm=True" in text
-    assert "<LebtState" in out.read_text(encoding="utf-8")
+    assert "<DispatchEntry" in out.read_text(encoding="utf-8")  # the rules default: dispatch
 
 
 def test_hybrid_on_a_parsed_file_asks_no_llm(tmp_path: Path) -> None:
@@ -89,7 +89,7 @@ def test_llm_engine_gets_base_url_and_model(
 
     source = tmp_path / "door.json"
     source.write_text(json.dumps(FSM_JSON), encoding="utf-8")
-    answer = dumps(convert(api.load(source).model).model, "btcpp")
+    answer = dumps(convert(api.load(source).model, style="lebt").model, "btcpp")  # LLMs write LEBTs
     with ScriptedServer([{"content": answer}]) as server:
         code = main(
             [
@@ -114,6 +114,7 @@ def test_hierarchy_option_of_the_cli(tmp_path: Path) -> None:
     door = Path(__file__).resolve().parents[2] / "examples" / "door_hfsm.scxml"
     for mode, trees in (("subtrees", 2), ("flatten", 1)):
         out = tmp_path / f"door_{mode}.xml"
-        assert main(["convert", str(door), "-o", str(out), "--hierarchy", mode]) == 0
+        command = ["convert", str(door), "-o", str(out), "--style", "lebt", "--hierarchy", mode]
+        assert main(command) == 0  # --hierarchy shapes the LEBT
         assert out.read_text(encoding="utf-8").count("<BehaviorTree ") == trees
     assert main(["convert", str(door), "--hierarchy", "bogus"]) == 2

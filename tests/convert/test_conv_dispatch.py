@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 
 from fsmbt.convert import convert
@@ -34,7 +36,10 @@ def test_a_wrong_target_is_caught() -> None:
     digit = first.split("fsm_d0:='")[1][0]
     other = "b" if digit != "b" else "c"
     mutated = text.replace(first, first.replace(f"fsm_d0:='{digit}'", f"fsm_d0:='{other}'"), 1)
-    assert not verify(fsm, loads(mutated, "btcpp")).equivalent
+    report = verify(fsm, loads(mutated, "btcpp"))
+    assert not report.equivalent
+    trace = report.properties["completeness"].counterexample or []
+    assert trace and all(step.result_state in fsm.states for step in trace)  # named, not digits
 
 
 def test_macro_steps_follow_the_fsm() -> None:
@@ -75,3 +80,38 @@ def test_numeric_event_is_refused() -> None:
     fsm.add_transition("A", "42", "B")
     with pytest.raises(UnsupportedError, match="state 'A'"):
         convert(fsm, style="dispatch")
+
+
+def test_auto_gives_an_event_driven_machine_the_dispatch_form() -> None:
+    fsm = random_fsm("auto", 30, start_event=True, shape="tree")
+    result = convert(fsm)  # style auto
+    assert result.stats["style"] == "dispatch" and result.warnings == []
+    assert verify(fsm, result.model).equivalent
+    assert convert(fsm, style="lebt").stats["style"] == "lebt"  # the paper's shape, asked for
+
+
+def test_auto_writes_the_lebt_where_a_switch_cannot_compare_an_event() -> None:
+    fsm = FSM("num")
+    fsm.add_state("A")
+    fsm.add_state("B")
+    fsm.initial = "A"
+    fsm.add_transition("A", "42", "B")
+    result = convert(fsm)
+    assert result.stats["style"] == "lebt"
+    (warning,) = [w for w in result.warnings if "dispatch form cannot be written" in w]
+    assert "state 'A'" in warning and "'42'" in warning
+    assert verify(fsm, result.model).equivalent
+
+
+def test_auto_writes_the_lebt_when_nusmv_checks_the_result(tmp_path: Path) -> None:
+    from fsmbt import api
+
+    source = tmp_path / "fsm.json"
+    api.write(random_fsm("nusmv", 6, start_event=False, shape="tree"), source)
+    native = api.convert_file(source)
+    assert native.conversion.stats["style"] == "dispatch"
+    checked = api.convert_file(source, verify_engine="nusmv")
+    assert checked.conversion.stats["style"] == "lebt" and checked.equivalent
+    assert any("NuSMV" in w and "dispatch form" in w for w in checked.warnings)
+    with pytest.raises(UnsupportedError, match="NuSMV does not encode the dispatch form"):
+        api.convert_file(source, style="dispatch", verify_engine="nusmv")

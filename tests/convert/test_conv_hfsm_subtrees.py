@@ -30,7 +30,7 @@ def _subtree_refs(doc) -> list[str]:
 
 def test_door_example_has_one_tree_per_composite_and_is_equivalent() -> None:
     fsm = api.load(REPO / "examples" / "door_hfsm.scxml").model
-    result = convert(fsm)
+    result = convert(fsm, style="lebt")
     doc = result.model
     assert set(doc.trees) == {"MainTree", *_composites(fsm)}
     assert sorted(_subtree_refs(doc)) == sorted(_composites(fsm))
@@ -40,7 +40,7 @@ def test_door_example_has_one_tree_per_composite_and_is_equivalent() -> None:
 
 def test_flatten_mode_gives_one_tree() -> None:
     fsm = api.load(REPO / "examples" / "door_hfsm.scxml").model
-    result = convert(fsm, hierarchy="flatten")
+    result = convert(fsm, style="lebt", hierarchy="flatten")
     assert list(result.model.trees) == ["MainTree"]
     assert check(fsm, result.model).equivalent
 
@@ -77,7 +77,7 @@ def test_corpus_hierarchical_scxml_converts_to_subtrees_equivalently() -> None:
         if not isinstance(model, FSM) or not model.is_hierarchical:
             continue
         try:
-            result = convert(model)
+            result = convert(model, style="lebt")
             report = check(model, result.model, max_states=200_000)
         except InputError:
             continue

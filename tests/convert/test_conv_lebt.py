@@ -31,7 +31,7 @@ def _body_states(selector: BTNode) -> tuple[str, list[BTNode]]:
 
 def test_paper_aj_structure_and_equivalence() -> None:
     fsm = paper_aj_fsm()
-    result = convert(fsm)
+    result = convert(fsm, style="lebt")
     root = result.model.main.root
     assert root.type == "Sequence"
     assert [_subtree_state(c) for c in root.children] == ["A", "C", "D"]
@@ -86,7 +86,7 @@ def test_no_initial_event_self_loops_and_unreachable() -> None:
     fsm.add_transition("Run", "tick", "Run")  # self-loop: Run becomes a loop state
     fsm.add_transition("Run", "stop", "Done")
     fsm.add_transition("Orphan", "go", "Idle")  # unreachable source
-    result = convert(fsm)
+    result = convert(fsm, style="lebt")
     root = result.model.main.root
     assert [_subtree_state(c) for c in root.children] == ["Idle", "Run"]
     entry = GuardSpec.from_attrs(root.children[0].children[0].attrs)
@@ -105,7 +105,7 @@ def test_final_state_transitions_never_fire_and_hierarchy_flattens() -> None:
     fsm.add_state("After", final=True)
     fsm.add_transition("Top", None, "After")
     fsm.add_transition("Top", "abort", "After")
-    result = convert(fsm)
+    result = convert(fsm, style="lebt")
     assert result.stats["flattened"] is True
     assert check(fsm, result.model).equivalent
 

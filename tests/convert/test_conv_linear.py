@@ -119,7 +119,7 @@ def test_a_state_entered_only_by_a_transition_that_never_fires_is_left_out() -> 
     fsm.add_transition("A", "go", "B")
     fsm.add_transition("A", "go", "C")  # same event: the first transition wins, C never runs
     fsm.add_transition("B", "back", "A")
-    result = convert_model(fsm, hierarchy="flatten")
+    result = convert_model(fsm, style="lebt", hierarchy="flatten")
     root = result.model.main.root
     leaves = [node.name for node in root.walk() if node.is_leaf]
     assert "C" not in leaves and "Enter_C" not in leaves
@@ -130,7 +130,7 @@ def test_a_state_entered_only_by_a_transition_that_never_fires_is_left_out() -> 
 @pytest.mark.parametrize("shape", ["mixed", "chain"])
 def test_generated_2000_state_fsm_lebt_is_proven_equivalent(shape: str) -> None:
     fsm = random_fsm(19, 2000, "basic", shape=shape, extra_edges=1000 if shape == "mixed" else 0)
-    result = convert_model(fsm)
+    result = convert_model(fsm, style="lebt")
     root = result.model.main.root
     assert result.stats["states"] == 2000
     assert result.stats["nodes"] == sum(1 for _ in root.walk())
@@ -145,7 +145,7 @@ def test_escaping_is_kept_when_only_the_initial_event_needs_it() -> None:
     fsm.add_state("B")
     fsm.add_transition("A", "e", "B")
     fsm.add_transition("B", "f", "A")
-    root = convert_model(fsm).model.main.root
+    root = convert_model(fsm, style="lebt").model.main.root
     guard = next(n for n in root.walk() if n.type == GUARD_TYPE and n.name == "Enter_A")
     assert guard.attrs["pairs"] == "Start/go\\;now\\/x;B/f"
     assert GuardSpec.from_attrs(guard.attrs).pairs[0] == ("Start", "go;now/x")
@@ -210,8 +210,8 @@ def test_the_lebt_does_not_depend_on_how_the_sources_transitions_are_interleaved
     seed: int,
 ) -> None:
     fsm = _awkward(seed) if seed % 2 else random_fsm(seed, max_states=60)
-    grouped = convert_model(fsm, hierarchy="flatten")
-    backwards = convert_model(_sources_listed_backwards(fsm), hierarchy="flatten")
+    grouped = convert_model(fsm, style="lebt", hierarchy="flatten")
+    backwards = convert_model(_sources_listed_backwards(fsm), style="lebt", hierarchy="flatten")
     assert backwards.model.main.root == grouped.model.main.root
     assert backwards.stats == grouped.stats
     structure = analyse(_sources_listed_backwards(fsm))

@@ -36,7 +36,19 @@ def test_example_prints_what_the_page_shows(
 
 def test_bad_pair_message_is_the_page_s(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     lebt = tmp_path / "paper_bt.xml"
-    assert main(["convert", str(ROOT / "examples" / "paper_fsm.xml"), "-o", str(lebt)]) == 0
+    assert (
+        main(
+            [
+                "convert",
+                str(ROOT / "examples" / "paper_fsm.xml"),
+                "--style",
+                "lebt",
+                "-o",
+                str(lebt),
+            ]
+        )
+        == 0
+    )
     capsys.readouterr()
     assert main(["diff", str(lebt), str(ROOT / "examples" / "robot_bt.xml")]) == 2
     assert capsys.readouterr().err == _blocks()[1]

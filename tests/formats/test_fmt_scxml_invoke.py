@@ -118,7 +118,7 @@ def test_child_events_reach_the_parent_queue_before_the_environment_speaks() -> 
     # done.invoke.c: s3 --bye--> s4 --done.invoke.c--> t
     assert walk(model, ["poke", "poke"]) == ["s/s2{c=idle}", "s/s3{c=busy}", "t"]
     # FSM -> BT of the session system is proved equivalent (native checker and NuSMV)
-    result = api.convert_model(model)
+    result = api.convert_model(model, style="lebt")  # the LEBT: NuSMV checks it too
     assert api.verify_models(model, result.model, "native").equivalent
     if find_nusmv() is not None:
         assert api.verify_models(model, result.model, "nusmv").equivalent

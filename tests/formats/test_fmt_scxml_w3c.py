@@ -107,7 +107,7 @@ def test_fsm_to_bt_of_a_guarded_machine_verifies() -> None:
   <state id="u"><transition event="r" cond="ok" target="t"/>
     <transition event="back" target="s"/></state>"""
     model = loads(doc(body), "scxml")
-    result = api.convert_model(model)
+    result = api.convert_model(model, style="lebt")  # the LEBT: NuSMV checks it too
     assert api.verify_models(model, result.model, "native").equivalent
     if find_nusmv() is not None:
         assert api.verify_models(model, result.model, "nusmv").equivalent

@@ -153,7 +153,7 @@ def test_llm_convert_writes_only_a_verified_result(
     from fsmbt.formats import dumps
 
     model = api.load(model_file).model
-    answer = dumps(converter_for("rules", model)(model).model, "btcpp")
+    answer = dumps(converter_for("rules", model)(model, style="lebt").model, "btcpp")  # an LEBT
     monkeypatch.setenv("FSMBT_LLM_API_KEY", "k")
     out = tmp_path / "door_bt.xml"
     with ScriptedServer([{"content": answer}]) as server:
@@ -211,4 +211,4 @@ def test_hybrid_on_prose_asks_the_llm_only_to_extract(
     assert code == 0 and len(server.requests) == 1
     assert "Extract the behavior model" in server.user_texts(0)
     captured = capsys.readouterr()
-    assert "<LebtState" in captured.out and "extracted_by_llm=True" in captured.err
+    assert "<DispatchEntry" in captured.out and "extracted_by_llm=True" in captured.err

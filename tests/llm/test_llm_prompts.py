@@ -44,7 +44,7 @@ def door() -> FSM:
 def lebt_xml(fsm: FSM) -> str:
     from fsmbt.convert.engines import converter_for
 
-    return dumps(converter_for("rules", fsm)(fsm).model, "btcpp")
+    return dumps(converter_for("rules", fsm)(fsm, style="lebt").model, "btcpp")
 
 
 @pytest.mark.parametrize("direction", [FSM_TO_BT, BT_TO_FSM])
@@ -174,6 +174,6 @@ def test_the_structural_checks_accept_every_verified_rules_result(extended: bool
         assert verify(bt, hfsm).equivalent
         assert check_hfsm(bt, hfsm) == [], seed
         fsm = random_fsm(seed, 8 + seed)
-        lebt = converter_for("rules", fsm)(fsm).model
+        lebt = converter_for("rules", fsm)(fsm, style="lebt").model
         assert verify(fsm, lebt).equivalent
         assert check_lebt(flatten(fsm), lebt) == [], seed

@@ -55,7 +55,7 @@ def test_configuration_names_split_into_state_paths():
 @pytest.mark.parametrize("name", ["paper_fsm.xml", "robot_bt.xml", "door_hfsm.scxml"])
 def test_every_trace_state_of_a_mutant_maps_to_drawn_elements(name):
     source = api.load(EXAMPLES / name)
-    result = api.convert_loaded(source).result
+    result = api.convert_loaded(source, style="lebt").result  # LEBT anchors
     checked = 0
     for original in (source.model, result):
         other = result if original is source.model else source.model
@@ -91,7 +91,7 @@ def test_leaf_execution_state_names_the_leaf_at_its_path():
 
 def test_macro_step_state_names_the_lebt_leaves_acting_for_it():
     fsm = api.load(EXAMPLES / "paper_fsm.xml").model
-    bt = api.convert_loaded(api.load(EXAMPLES / "paper_fsm.xml")).result
+    bt = api.convert_loaded(api.load(EXAMPLES / "paper_fsm.xml"), style="lebt").result
     svg = svg_text(bt, expand_subtrees=True)
     for state in fsm.states:
         anchors = trace_anchors(bt, state)

@@ -226,6 +226,17 @@ def test_a_foreign_node_is_named_with_its_line(tag: str, attrs: dict[str, str], 
         assert info.value.location is not None and info.value.location.line == line
 
 
+def test_a_dispatch_tree_is_refused_naming_its_first_entry_and_the_style() -> None:
+    door = api.load(DOOR).model
+    text = dumps(converter_for("rules", door)(door).model, "btcpp")  # auto: the dispatch form
+    line = next(i for i, t in enumerate(text.splitlines(), 1) if "<DispatchEntry" in t)
+    for engine in ENGINES:
+        with pytest.raises(InputError) as info:
+            load_tree(text, {}, engine=engine, allow_unused=True)
+        assert "--style lebt" in str(info.value) and "DispatchEntry" in str(info.value)
+        assert info.value.location is not None and info.value.location.line == line
+
+
 def test_bad_sources_and_engines_are_clear_errors(tmp_path: Path) -> None:
     with pytest.raises(InputError, match="unknown engine 'ros'"):
         load_tree(door_tree(), DOOR_ACTIONS, engine="ros")

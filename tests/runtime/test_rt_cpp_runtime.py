@@ -57,7 +57,9 @@ def _tree(tmp_path: Path, leaf: str = GOOD_LEAF, name: str = "tree.xml") -> Path
 
 def _door_tree(tmp_path: Path) -> Path:
     path = tmp_path / "door_bt.xml"
-    path.write_text(dumps(convert(api.load(DOOR).model).model, "btcpp"), encoding="utf-8")
+    path.write_text(
+        dumps(convert(api.load(DOOR).model, style="lebt").model, "btcpp"), encoding="utf-8"
+    )
     return path
 
 

@@ -56,7 +56,7 @@ def test_robot_with_pictures(simulate, tmp_path: Path):
 
 def test_predator_against_its_lebt_file(simulate, tmp_path: Path):
     lebt = tmp_path / "predator_bt.xml"
-    api.write(api.convert_model(example("predator_fsm.scxml")).model, lebt, "btcpp")
+    api.write(api.convert_model(example("predator_fsm.scxml"), style="lebt").model, lebt, "btcpp")
     result = simulate(
         "predator-prey",
         EXAMPLES / "predator_fsm.scxml",

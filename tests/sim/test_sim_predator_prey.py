@@ -73,7 +73,7 @@ def test_game_is_exercised(predator, prey):
 
 
 def test_predator_fsm_vs_its_lebt_identical(predator, prey):
-    lebt = api.convert_model(predator).model
+    lebt = api.convert_model(predator, style="lebt").model
     c = compare(
         PredatorPreyWorld,
         side("fsm", game(predator, prey)),
@@ -96,7 +96,7 @@ def test_prey_bt_vs_its_hfsm_identical(predator, prey):
 
 @pytest.mark.parametrize("engine", ["btcpp", "py_trees"])
 def test_real_engines(predator, prey, engine):
-    lebt = api.convert_model(predator).model
+    lebt = api.convert_model(predator, style="lebt").model
     hfsm = api.convert_model(prey).model
     # the LEBT predator and the prey BT on the engine, against FSM predator and HFSM prey
     c = compare(
@@ -121,7 +121,7 @@ def test_python_statemachine(predator, prey):
 
 
 def test_predator_retargeted_transition_diverges(predator, prey):
-    lebt = api.convert_model(predator).model
+    lebt = api.convert_model(predator, style="lebt").model
     bad = mutant(predator, "retarget_transition", "Detect -prey_seen-> Chase now goes to Patrol")
     assert not api.verify_models(bad, lebt).equivalent
     c = compare(
@@ -135,7 +135,7 @@ def test_predator_retargeted_transition_diverges(predator, prey):
 
 
 def test_lebt_moved_guard_pair_diverges(predator, prey):
-    lebt = api.convert_model(predator).model
+    lebt = api.convert_model(predator, style="lebt").model
     bad = mutant(lebt, "retarget_transition", "pair Detect/prey_seen moved from Enter_Chase")
     assert not api.verify_models(predator, bad).equivalent
     c = compare(

@@ -80,7 +80,9 @@ def test_bt_on_real_engines_vs_hfsm(bt, hfsm, engine):
 
 @pytest.mark.parametrize("engine", ["btcpp", "py_trees"])
 def test_lebt_of_hfsm_on_real_engines(bt, hfsm, engine):
-    lebt = api.convert_model(hfsm).model  # HFSM -> BT (rules): an LEBT in leaf execution
+    lebt = api.convert_model(
+        hfsm, style="lebt"
+    ).model  # HFSM -> BT (rules): an LEBT in leaf execution
     c = compare(
         RobotWorld, side("bt", {"robot": bt}), side(engine, {"robot": lebt}, engine), episodes=20
     )

@@ -45,6 +45,25 @@ def test_formats_and_engines(client):
     assert engines["engines"][:3] == ["rules", "bsd", "chds"]
 
 
+def test_every_style_is_offered_and_applied(client):
+    styles = client.get("/api/engines").json()["styles"]
+    assert styles == ["auto", "structured", "dispatch", "lebt"]
+    leaves = {"auto": "DispatchEntry", "dispatch": "DispatchEntry", "lebt": "LebtState"}
+    for style, leaf in leaves.items():
+        data = client.post("/api/convert", json={"text": PAPER, "options": {"style": style}})
+        assert data.status_code == 200, data.text
+        answer = data.json()
+        assert answer["verdict"] == "EQUIVALENT" and answer["style"] == style.replace(
+            "auto", "dispatch"
+        )
+        assert f"<{leaf}" in answer["result"]["text"]
+        # v3 has no Script, and the LEBT runtimes do not run the dispatch form
+        assert ("btcpp3" in answer["downloads"]) == (leaf == "LebtState")
+        assert (answer["runtimes"] == []) == (leaf == "DispatchEntry")
+    refused = client.post("/api/convert", json={"text": PAPER, "options": {"style": "structured"}})
+    assert refused.status_code == 400 and "event-driven" in refused.text
+
+
 def test_examples_are_listed_by_name_and_read_by_name(client):
     listing = {e["name"]: e["format"] for e in client.get("/api/examples").json()}
     assert listing["paper_fsm.xml"] == "paper-xml"

@@ -243,8 +243,8 @@ def register(app: typer.Typer) -> None:
         style: str = typer.Option(
             "auto",
             "--style",
-            help="FSM->BT: auto (structured for outcome-driven machines, else lebt), "
-            "structured, lebt (paper is lebt)",
+            help="FSM->BT: auto (structured for outcome-driven machines, else dispatch), "
+            "structured, dispatch, lebt (paper is lebt)",
         ),
         loop: bool = typer.Option(
             False,

@@ -59,7 +59,7 @@ def register(app: typer.Typer) -> None:
             "auto",
             "--style",
             help="FSM->BT: auto (structured for SMACH/FlexBE/YASMIN and machines that declare "
-            "outcomes, else lebt), structured, lebt (paper is lebt)",
+            "outcomes, else dispatch), structured, dispatch, lebt (paper is lebt)",
         ),
         outcomes: str | None = typer.Option(
             None,

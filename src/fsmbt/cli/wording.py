@@ -39,7 +39,12 @@ def _fsm_to_bt(s: Mapping[str, object], engine: str, used: set[str]) -> list[str
     if "transitions" in s:
         head += f" and {counted(take('transitions'), 'transition')}"
     if s.get("style") == "dispatch":  # docs/semantics.md section 12
-        head += " became a dispatch BT (a Switch dispatch over a state index)"
+        digits = counted(take("index_digits"), "base-6 digit") if "index_digits" in s else ""
+        index = f" of {digits}" if digits else ""
+        head += (
+            f" became a dispatch BT (a Switch dispatch over a state index{index} on the "
+            "blackboard: a macro step ticks O(log states) nodes)"
+        )
     else:
         head += " became " + ("a loop-execution BT" if engine == "rules" else "a BT")
     if "nodes" in s:
@@ -148,6 +153,15 @@ def conversion_summary(direction: str, stats: Mapping[str, object], engine: str 
         return f"{stats['summary']}; {stats['nodes']} nodes, depth {stats['depth']}"
     if direction == "fsm->bt" and "states" in stats:
         parts = _fsm_to_bt(stats, engine, used)
+    elif direction == "bt->fsm" and stats.get("style") == "dispatch" and "states" in stats:
+        used.update(("style", "states", "transitions", "final_states", "configurations"))
+        parts = [
+            f"a dispatch BT became a state machine of {counted(stats['states'], 'state')} "
+            f"({stats.get('final_states', 0)} final) and "
+            f"{counted(stats.get('transitions', 0), 'transition')}, read from its "
+            f"{counted(stats.get('configurations', 0), 'macro-step configuration')} "
+            "(docs/semantics.md section 12)"
+        ]
     elif direction == "bt->fsm" and ("leaves" in stats or "k" in stats):
         parts = _bt_to_fsm(stats, used)
     rest = [f"{k}={v}" for k, v in stats.items() if k not in used]

@@ -1,8 +1,9 @@
 """Conversion between FSMs and BTs: ``convert(model)`` picks the direction from the model's kind.
 
-Engines are looked up by name (``fsmbt.convert.engines``): ``rules`` (default; LEBT for
-FSM -> BT, depth compression + conversion units for BT -> FSM), and whatever the baselines and the
-LLM path register (``bsd``, ``chds``, ``llm`` ...).
+Engines are looked up by name (``fsmbt.convert.engines``): ``rules`` (default; FSM -> BT: the
+structured tree for outcome-driven machines, the dispatch form for event-driven ones, the LEBT
+with ``style="lebt"``; BT -> FSM: depth compression + conversion units), and whatever the
+baselines and the LLM path register (``bsd``, ``chds``, ``llm`` ...).
 """
 
 from __future__ import annotations
@@ -21,7 +22,8 @@ def convert(
     Args:
         model: The source model; its kind picks the direction.
         engine: A registered engine name (``rules``, ``bsd``, ``chds``, ``llm``, ...).
-        style: The engine's output style (rules engine: ``auto``, ``structured``, ``lebt``/``paper``).
+        style: The engine's output style (rules engine: ``auto``, ``structured``, ``dispatch``,
+            ``lebt``/``paper``).
         **options: Passed to the engine (e.g. ``loop=True`` for BT -> FSM,
             ``hierarchy="flatten"`` for FSM -> BT).
 

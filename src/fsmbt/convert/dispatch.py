@@ -20,7 +20,8 @@ Shape, for reachable states numbered 0..n-1 in declaration order (index digits b
 Bad input (UnsupportedError, state named): an event name BehaviorTree.CPP's ``Switch`` would
 not compare as a plain string (a number, a blackboard reference ``{..}``, empty).
 
-Cost: O(states + transitions) to build; depth O(log6 states + max out-degree / 6).
+Cost: O(states + transitions) to build (the cyclic collector paused, ``convert/perf.py``: the
+tree is acyclic); depth O(log6 states + max out-degree / 6).
 """
 
 from __future__ import annotations
@@ -28,6 +29,7 @@ from __future__ import annotations
 import re
 from collections import deque
 
+from fsmbt.convert.perf import without_gc_pauses
 from fsmbt.convert.result import ConversionResult
 from fsmbt.model.bt import BTDocument, BTNode, NodeModel, PortModel
 from fsmbt.model.errors import InputError, UnsupportedError
@@ -97,6 +99,7 @@ def _check_event(event: str, state: str) -> None:
         )
 
 
+@without_gc_pauses
 def fsm_to_dispatch(fsm: FSM, **_options: object) -> ConversionResult:
     """The dispatch form of ``fsm`` (see the module docstring)."""
     warnings: list[str] = []
@@ -138,6 +141,7 @@ def fsm_to_dispatch(fsm: FSM, **_options: object) -> ConversionResult:
         return node
 
     table = flat.transition_map()
+    transitions = sum(len(table.get(name, {})) for name in states if not flat.states[name].final)
     cases: list[BTNode] = []
     for name in states:
         st = flat.states[name]
@@ -180,6 +184,7 @@ def fsm_to_dispatch(fsm: FSM, **_options: object) -> ConversionResult:
         stack.extend((child, d + 1) for child in node.children)
     stats: dict[str, object] = {
         "states": len(states),
+        "transitions": transitions,
         "nodes": count,
         "depth": depth,
         "style": STYLE,

@@ -17,6 +17,7 @@ from typing import Any
 
 from fsmbt.convert.bt_to_hfsm import bt_to_hfsm
 from fsmbt.convert.dispatch import fsm_to_dispatch
+from fsmbt.convert.dispatch_fsm import dispatch_to_fsm
 from fsmbt.convert.hfsm_to_bt import fsm_to_bt
 from fsmbt.convert.result import ConversionResult, Converter, Model
 from fsmbt.convert.structure import MAX_XML_LEVELS
@@ -31,6 +32,7 @@ from fsmbt.convert.structured.style import (
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import InputError, UnsupportedError
 from fsmbt.model.fsm import FSM
+from fsmbt.semantics.dispatch_runtime import is_dispatch_bt
 from fsmbt.semantics.outcome_rules import OutcomeRules
 
 
@@ -43,6 +45,10 @@ class Engine:
 
 
 _ENGINES: dict[str, Engine] = {}
+
+#: Option of the rules engine's FSM -> BT: NuSMV will check the result, so ``auto`` writes a
+#: form NuSMV encodes (the LEBT, not the dispatch form).
+NUSMV_CHECKED = "nusmv_checked"
 
 #: Modules that register further engines when imported (missing ones are skipped). They are
 #: plugins: each imports ``register_engine`` from here and registers itself, so this table does
@@ -72,7 +78,15 @@ def rules_fsm_to_bt(
     **options: Any,
 ) -> ConversionResult:
     """The rules engine's FSM -> BT: the structured tree for an outcome-driven machine, the
-    LEBT otherwise (``fsmbt.convert.structured.style``: ``auto``, ``structured``, ``lebt``).
+    dispatch form otherwise (``fsmbt.convert.structured.style``: ``auto``, ``structured``,
+    ``lebt``, ``dispatch``).
+
+    Under ``auto`` an event-driven machine gets the dispatch form (docs/semantics.md §12; a
+    hierarchical machine flattened, ``hierarchy`` shapes the LEBT only), or the LEBT with a
+    warning naming why when the dispatch form cannot be written (an event a ``Switch`` cannot
+    compare, an eventless transition: the dispatch builder's ``InputError``) or when NuSMV is
+    to check the result (option ``NUSMV_CHECKED``, set by ``fsmbt.api`` for
+    ``--verify-engine nusmv|both``: NuSMV does not encode the dispatch form).
 
     Depth bound (docs/semantics.md §5, "Depth-bounded LEBT"): a structured tree that would nest
     deeper than ``MAX_XML_LEVELS`` XML levels is not written; under ``auto`` the depth-bounded
@@ -85,7 +99,26 @@ def rules_fsm_to_bt(
     """
     rules = OutcomeRules.from_option(outcomes)
     chosen, view = resolve_style(style, fsm, outcome_driven=outcome_driven, rules=rules)
-    if chosen == DISPATCH:
+    not_dispatch = ""
+    checked_by_nusmv = bool(options.pop(NUSMV_CHECKED, False))
+    if chosen == DISPATCH and check_style(style) == AUTO and checked_by_nusmv:
+        not_dispatch = (
+            "NuSMV (--verify-engine nusmv|both) does not encode the dispatch form: the LEBT "
+            "was written, which both checkers prove (--verify-engine native gives the dispatch "
+            "form)"
+        )
+        chosen = "lebt"
+    elif chosen == DISPATCH and check_style(style) == AUTO:
+        try:
+            return fsm_to_dispatch(fsm, **options)
+        except InputError as exc:  # UnsupportedError too: an event a Switch cannot compare
+            where = f" ({exc.element})" if exc.element else ""
+            not_dispatch = (
+                f"the dispatch form cannot be written{where}: "
+                f"{exc.message.split('; use --style lebt')[0]}; the LEBT was written instead"
+            )
+        chosen = "lebt"
+    elif chosen == DISPATCH:
         return fsm_to_dispatch(fsm, **options)
     too_deep = ""
     if view is not None:
@@ -103,32 +136,52 @@ def rules_fsm_to_bt(
         chosen = "lebt"
     result = fsm_to_bt(fsm, style="paper", **options)
     result.stats.setdefault("style", chosen)
+    if not_dispatch:
+        result.warnings.append(not_dispatch)
     if too_deep:
         result.warnings.append(f"{too_deep}: the depth-bounded LEBT was written instead")
     return result
 
 
 def rules_bt_to_fsm(doc: BTDocument, *, style: str = AUTO, **options: Any) -> ConversionResult:
-    """The rules engine's BT -> FSM (one style; ``structured`` is an FSM -> BT style)."""
+    """The rules engine's BT -> FSM (one style; ``structured`` is an FSM -> BT style).
+
+    A dispatch tree (``DispatchEntry`` leaves, docs/semantics.md section 12) becomes the state
+    machine of its macro steps (``fsmbt.convert.dispatch_fsm``); any other tree the
+    hierarchical FSM of its leaf execution (``fsmbt.convert.bt_to_hfsm``).
+
+    Raises:
+        InputError: ``structured``, or ``loop`` on a dispatch tree (it runs by macro steps).
+    """
     if check_style(style) == STRUCTURED:
         raise InputError(
             "--style structured converts outcome-driven state machines into behavior trees; "
             "this input is a behavior tree",
             element="--style",
         )
+    if is_dispatch_bt(doc):
+        if options.get("loop"):
+            raise InputError(
+                "a dispatch tree runs by macro steps (its root is ticked once per event); "
+                "--loop is for trees read by leaf execution",
+                element="--loop",
+            )
+        return dispatch_to_fsm(doc, max_states=options.get("max_states"))
     return bt_to_hfsm(doc, style="paper", **options)
 
 
 def _register_rules() -> None:
-    """The default engine: the structured tree (outcome-driven machines) or the LEBT for
-    FSM -> BT (a SubTree per composite state of a hierarchical FSM, option ``hierarchy``),
-    hierarchical conversion units for BT -> FSM."""
+    """The default engine: the structured tree (outcome-driven machines), the dispatch form
+    (event-driven ones) or, asked for, the LEBT for FSM -> BT (a SubTree per composite state of
+    a hierarchical FSM, option ``hierarchy``); hierarchical conversion units for BT -> FSM (the
+    macro-step machine for a dispatch tree)."""
     register_engine(
         "rules",
         rules_fsm_to_bt,
         rules_bt_to_fsm,
-        "the paper's algorithms done exactly (LEBT; depth compression + units), and the "
-        "structured style for outcome-driven machines",
+        "the paper's algorithms done exactly (LEBT; depth compression + units), the "
+        "structured style for outcome-driven machines and the dispatch form for event-driven "
+        "ones",
     )
 
 

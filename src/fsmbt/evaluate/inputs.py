@@ -14,7 +14,7 @@ from pathlib import Path
 from typing import Any
 
 from fsmbt import api
-from fsmbt.evaluate.plan import NOT_RUN, RULE_ENGINES
+from fsmbt.evaluate.plan import NOT_RUN, RULE_ENGINES, method_style
 from fsmbt.formats import dumps
 from fsmbt.llm.extract import needs_llm
 from fsmbt.model.fsm import FSM
@@ -66,7 +66,7 @@ def table(examples: Path, outdir: Path, llm_methods: list[str]) -> list[dict[str
                 out.append(cell)
                 continue
             try:
-                outcome = api.convert_file(path, engine=method)
+                outcome = api.convert_file(path, engine=method, **method_style(method))
                 cell.update(
                     reader=f"{outcome.source.format} reader",
                     engine=method,

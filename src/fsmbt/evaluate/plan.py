@@ -85,7 +85,7 @@ def outcome_driven(entry: Entry) -> bool:
     return entry.kind == "fsm" and entry.path.endswith(".py")
 
 
-def _style(engine: str) -> dict[str, Any]:
+def method_style(engine: str) -> dict[str, Any]:
     """``rules`` is the paper's LEBT shape (``--style lebt``) whatever the model: the
     evaluation measures the paper's method (the structured style is not the paper's)."""
     return {"style": "lebt"} if engine == "rules" else {}
@@ -160,7 +160,7 @@ def plan(
     """
     readable = [e for e in entries if e.readable]
     planned = [
-        _job(e, outdir, engine, engine, "native", _style(engine))
+        _job(e, outdir, engine, engine, "native", method_style(engine))
         for engine in RULE_ENGINES
         for e in entries
     ]
@@ -171,7 +171,7 @@ def plan(
     ]
     sample = nusmv_models(readable, seed=seed, count=nusmv_sample)
     planned += [
-        _job(e, outdir, engine, engine, "both", _style(engine))
+        _job(e, outdir, engine, engine, "both", method_style(engine))
         for engine in RULE_ENGINES
         for e in sample
     ]

@@ -53,6 +53,7 @@ from fsmbt.formats import loads
 from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.bt_nodes import NodeKind
 from fsmbt.model.errors import InputError
+from fsmbt.semantics.dispatch_runtime import ENTRY as DISPATCH_ENTRY
 from fsmbt.semantics.execution import lebt_engine_run
 from fsmbt.semantics.lebt.ports import lebt_port_issues
 from fsmbt.semantics.lebt.spec import (
@@ -221,8 +222,20 @@ def check_lebt_nodes(doc: BTDocument) -> None:
     """Refuse any node an LEBT does not have, naming it and its line.
 
     Raises:
-        InputError: the first such node in document order.
+        InputError: the first such node in document order; for a dispatch tree (the form
+        ``fsmbt convert`` writes for an event-driven machine by default) its first
+        ``DispatchEntry``, saying to convert with ``--style lebt``.
     """
+    entry = next((n for _t, n in doc.nodes() if n.type == DISPATCH_ENTRY), None)
+    if entry is not None:
+        raise InputError(
+            "a dispatch tree (what `fsmbt convert` writes for an event-driven machine by "
+            "default, docs/semantics.md section 12) runs in BehaviorTree.CPP with DispatchEntry "
+            "registered (docs/runtime.md); this runtime runs loop-execution BTs: convert with "
+            "--style lebt",
+            location=entry.location,
+            element=f"<{entry.type}> '{entry.label}'",
+        )
     for tree in doc.trees.values():
         stack: list[BTNode] = [tree.root] if tree.root is not None else []
         while stack:
@@ -430,10 +443,11 @@ _EXAMPLE_FSM = """\
 
 
 def _example_tree() -> str:
-    """The example FSM converted as ``fsmbt convert`` does (the library pipeline, rules)."""
+    """The example FSM converted as ``fsmbt convert --style lebt`` does (the library pipeline,
+    rules; this runtime runs LEBTs, not the dispatch form ``auto`` writes for such a machine)."""
     from fsmbt import api
 
-    return api.convert_loaded(api.load_text(_EXAMPLE_FSM, "scxml"), to="btcpp").text
+    return api.convert_loaded(api.load_text(_EXAMPLE_FSM, "scxml"), to="btcpp", style="lebt").text
 
 
 _EXAMPLE_SCRIPT_TEXT = '''\

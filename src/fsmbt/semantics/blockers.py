@@ -18,6 +18,7 @@ from dataclasses import dataclass
 from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.errors import InputError, SourceLocation, UnsupportedError
 from fsmbt.semantics.bt_interpreter import CompiledTree
+from fsmbt.semantics.dispatch_runtime import DispatchMachine, is_dispatch_bt
 
 #: Stop after this many node checks (a tree whose SubTrees multiply beyond it is refused
 #: anyway, by the compiler's own node limit).
@@ -58,6 +59,8 @@ def conversion_blockers(doc: BTDocument) -> list[Blocker]:
         return [
             Blocker("the main behavior tree is empty", tree.location, f"tree '{tree.id}'", False)
         ]
+    if is_dispatch_bt(doc):  # the dispatch form's own model (docs/semantics.md section 12)
+        return _dispatch_blockers(doc)
     checker = CompiledTree.checker(doc)
     seen: set[tuple[str, tuple[str, ...]]] = set()
     stack: list[tuple[BTNode, tuple[str, ...]]] = [(tree.root, (tree.id,))]
@@ -84,3 +87,13 @@ def conversion_blockers(doc: BTDocument) -> list[Blocker]:
             continue
         stack.extend((child, chain) for child in reversed(kids))
     return found
+
+
+def _dispatch_blockers(doc: BTDocument) -> list[Blocker]:
+    """What the dispatch form's macro-step model refuses in ``doc`` (its first refusal: the
+    blackboard model compiles the whole tree at once)."""
+    try:
+        DispatchMachine(doc, ())
+    except InputError as exc:
+        return [Blocker(exc.message, exc.location, exc.element, isinstance(exc, UnsupportedError))]
+    return []

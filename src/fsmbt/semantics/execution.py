@@ -7,7 +7,8 @@ with an engine-name -> runner table in each. Every layer now asks here:
 - ``flavour_of(model)``: the one classification. An FSM runs as a macro-step machine (events in,
   actions out) or, against a plain BT, as a leaf-execution machine; a BT is an LEBT (fsmbt's
   FSM -> BT rules: ``LebtGuard``/``LebtState`` leaves, docs/semantics.md "The LEBT protocol"),
-  a state-variable tree (the BSD/CHDS baselines' leaves) or a plain tree (any other: its leaves
+  a state-variable tree (the BSD/CHDS baselines' leaves), a dispatch tree (``DispatchEntry``
+  leaves, docs/semantics.md section 12) or a plain tree (any other: its leaves
   are the environment's). The LEBT test comes first: its leaves decide the protocol.
 - ``ENGINES`` / ``engines_for(model)``: which engines can run it: ``fsmbt`` (the reference
   interpreters here), ``btcpp`` (BehaviorTree.CPP 4.8.2 through behaviortreepy), ``py_trees``,
@@ -29,6 +30,7 @@ from typing import Any
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import InputError, UnsupportedError
 from fsmbt.model.fsm import FSM
+from fsmbt.semantics.dispatch_runtime import is_dispatch_bt
 from fsmbt.semantics.lebt.spec import GUARD_TYPE, STATE_TYPE
 from fsmbt.semantics.machine import LEAF_OUTCOMES, FSMLeafMachine, FSMMachine, Machine
 from fsmbt.semantics.state_variable_runtime import is_state_variable_bt
@@ -40,6 +42,7 @@ class Flavour(StrEnum):
     FSM = "fsm"  # a state machine (flat or hierarchical)
     LEBT = "lebt"  # fsmbt's loop-execution BT of an FSM (macro steps under the LEBT protocol)
     STATE_VARIABLE = "state-variable"  # a baseline's BT with state-variable leaves (BSD, CHDS)
+    DISPATCH = "dispatch"  # fsmbt's dispatch form of an FSM (DispatchEntry leaves, macro steps)
     PLAIN = "plain"  # any other BT: its leaves are the environment's (leaf execution)
 
 
@@ -65,6 +68,8 @@ def flavour_of(model: FSM | BTDocument) -> Flavour:
         return Flavour.LEBT
     if is_state_variable_bt(model):
         return Flavour.STATE_VARIABLE
+    if is_dispatch_bt(model):
+        return Flavour.DISPATCH
     return Flavour.PLAIN
 
 
@@ -73,7 +78,7 @@ def engines_for(model: FSM | BTDocument) -> tuple[str, ...]:
     flavour = flavour_of(model)
     if flavour is Flavour.FSM:
         return ("fsmbt", "python-statemachine")
-    if flavour is Flavour.STATE_VARIABLE:
+    if flavour in (Flavour.STATE_VARIABLE, Flavour.DISPATCH):
         return ("fsmbt",)
     if flavour is Flavour.LEBT:
         return ("fsmbt", "btcpp", "py_trees")
@@ -132,7 +137,7 @@ def lebt_engine_run(doc: BTDocument, engine: str) -> Any:
 
 
 def event_machine(doc_or_fsm: FSM | BTDocument, alphabet: Sequence[str]) -> Machine[Any]:
-    """fsmbt's macro-step machine of an FSM, an LEBT or a state-variable tree over
+    """fsmbt's macro-step machine of an FSM, an LEBT, a state-variable or dispatch tree over
     ``alphabet`` (events in, actions out), as the checker explores it.
 
     Raises:
@@ -145,6 +150,10 @@ def event_machine(doc_or_fsm: FSM | BTDocument, alphabet: Sequence[str]) -> Mach
         from fsmbt.semantics.state_variable_runtime import StateVariableMachine
 
         return StateVariableMachine(doc_or_fsm, alphabet)
+    if flavour is Flavour.DISPATCH:
+        from fsmbt.semantics.dispatch_runtime import DispatchMachine
+
+        return DispatchMachine(doc_or_fsm, alphabet)
     if flavour is Flavour.LEBT:
         from fsmbt.semantics.bt_interpreter import CompiledTree
         from fsmbt.semantics.lebt.machine import LEBTMachine

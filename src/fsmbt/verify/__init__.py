@@ -18,6 +18,7 @@ from fsmbt.convert.perf import gc_paused
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import Hint, InputError, UnsupportedError
 from fsmbt.model.fsm import FSM
+from fsmbt.semantics.dispatch_runtime import is_dispatch_bt
 from fsmbt.semantics.machine import FSMLeafMachine, Machine
 from fsmbt.semantics.outcome_machine import OutcomeFSMMachine
 from fsmbt.semantics.outcome_rules import OutcomeRules
@@ -94,6 +95,14 @@ def verify(
         raise UnsupportedError(
             "NuSMV does not encode the outcome pairing of a structured tree (its Switch and "
             "Script blackboard model)",
+            hints=(Hint.NATIVE_VERIFIER,),
+        )
+    if engine != "native" and any(
+        isinstance(m, BTDocument) and is_dispatch_bt(m) for m in (source, result)
+    ):
+        raise UnsupportedError(
+            "NuSMV does not encode the dispatch form (its Switch and Script blackboard model, "
+            "docs/semantics.md section 12); --style lebt writes a tree NuSMV checks too",
             hints=(Hint.NATIVE_VERIFIER,),
         )
     if engine == "nusmv":

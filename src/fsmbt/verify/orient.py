@@ -12,6 +12,8 @@ rule                                        when
 FSM ~ loop-execution BT (macro steps)       one side is an FSM, the other a BT whose leaves are
                                             LebtGuard / LebtState
 FSM ~ state-variable BT (macro steps)       the BT's leaves are the baselines' Sv* leaves
+FSM ~ dispatch BT (macro steps)             the BT's leaves are DispatchEntry (docs/semantics.md
+                                            section 12)
 FSM ~ structured BT (outcome execution)     an outcome-driven FSM (its format's events are
                                             outcomes, or a state declares them) and any other
                                             BT (docs/semantics.md §11)
@@ -38,6 +40,7 @@ Model = FSM | BTDocument
 
 LEBT_RULE = "FSM ~ loop-execution BT (macro steps)"
 STATE_VARIABLE_RULE = "FSM ~ state-variable BT (macro steps)"
+DISPATCH_RULE = "FSM ~ dispatch BT (macro steps)"
 OUTCOME_RULE = "FSM ~ structured BT (outcome execution)"
 LEAF_EXECUTION_RULE = "BT ~ FSM (leaf execution)"
 FSM_FSM_RULE = "FSM ~ FSM (macro steps)"
@@ -46,6 +49,7 @@ BT_BT_RULE = "BT ~ BT (leaf execution)"
 PAIRING_RULES = (
     LEBT_RULE,
     STATE_VARIABLE_RULE,
+    DISPATCH_RULE,
     OUTCOME_RULE,
     LEAF_EXECUTION_RULE,
     FSM_FSM_RULE,
@@ -72,7 +76,11 @@ class Orientation:
 
 #: The macro-step rule by which an FSM is compared with a BT of each flavour (the rest: leaf
 #: execution). ``fsmbt.semantics.execution.flavour_of`` says what a BT is.
-_MACRO_STEP_RULES = {Flavour.LEBT: LEBT_RULE, Flavour.STATE_VARIABLE: STATE_VARIABLE_RULE}
+_MACRO_STEP_RULES = {
+    Flavour.LEBT: LEBT_RULE,
+    Flavour.STATE_VARIABLE: STATE_VARIABLE_RULE,
+    Flavour.DISPATCH: DISPATCH_RULE,
+}
 
 
 def fsm_side_rule(doc: BTDocument) -> str | None:

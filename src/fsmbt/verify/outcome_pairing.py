@@ -22,6 +22,7 @@ from __future__ import annotations
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import InputError
 from fsmbt.model.fsm import FSM
+from fsmbt.semantics.dispatch_runtime import is_dispatch_bt
 from fsmbt.semantics.lebt.spec import GUARD_TYPE, STATE_TYPE
 from fsmbt.semantics.outcome_blackboard import OutcomeLeafMachine
 from fsmbt.semantics.outcome_machine import OutcomeFSMMachine
@@ -39,7 +40,7 @@ def is_outcome_pair(source: FSM, result: BTDocument, *, outcome_driven: bool = F
     """Whether ``(source, result)`` is compared by the outcome pairing (module docstring)."""
     if any(node.type in (GUARD_TYPE, STATE_TYPE) for _tree, node in result.nodes()):
         return False
-    if is_state_variable_bt(result):
+    if is_state_variable_bt(result) or is_dispatch_bt(result):
         return False
     return outcome_driven or declares_outcomes(source) or _structured_signature(source, result)
 

@@ -2,6 +2,8 @@
 
 - FSM source, BT result (macro steps): the FSM's macro-step machine against the LEBT run under
   the LEBT protocol (docs/semantics.md); inputs are events (the FSM's, then any the LEBT's guards name).
+- dispatch BT source, FSM result (macro steps, docs/semantics.md section 12): the tree's
+  macro-step machine against the FSM's, over the union of their events.
 - BT source, FSM result (leaf execution): the BT's leaf-execution machine against the FSM read as
   one (``FSMLeafMachine``): a state is the leaf about to be ticked, inputs are leaf outcomes.
 - FSM source, structured BT result (outcome execution): both leaf-execution machines over the
@@ -18,6 +20,7 @@ from typing import Any
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import InputError
 from fsmbt.model.fsm import FSM
+from fsmbt.semantics.dispatch_runtime import is_dispatch_bt, machines_for_dispatch
 from fsmbt.semantics.execution import Flavour, flavour_of, leaf_machine
 from fsmbt.semantics.lebt.machine import LEBTMachine
 from fsmbt.semantics.lebt.spec import GUARD_TYPE, GuardSpec
@@ -131,7 +134,6 @@ def machines_for(
             MACRO_STEP,
         )
     if isinstance(source, FSM) and isinstance(result, BTDocument):
-        from fsmbt.semantics.dispatch_runtime import is_dispatch_bt, machines_for_dispatch
         from fsmbt.semantics.state_variable_runtime import machines_for_state_variable
 
         if flavour_of(result) is Flavour.STATE_VARIABLE:  # the baselines' leaves (BSD, CHDS)
@@ -145,6 +147,10 @@ def machines_for(
         alphabet = _union(source_machine.alphabet, lebt_guard_events(result))
         source_machine = FSMMachine(source, alphabet=alphabet)
         return source_machine, LEBTWithActiveInputs(LEBTMachine(result, alphabet)), MACRO_STEP
+    if isinstance(source, BTDocument) and isinstance(result, FSM) and is_dispatch_bt(source):
+        # BT -> FSM of a dispatch tree (fsmbt.convert.dispatch_fsm): macro steps, both ways
+        fsm_machine, dispatch_machine = machines_for_dispatch(result, source)
+        return dispatch_machine, fsm_machine, MACRO_STEP
     if isinstance(source, BTDocument):  # leaf execution against an FSM or another BT
         return (
             leaf_machine(source, loop=loop, generic=faithful),

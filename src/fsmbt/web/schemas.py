@@ -33,8 +33,8 @@ class Options(BaseModel):
     hierarchy: str = Field(default="subtrees", description="FSM -> BT: `subtrees` or `flatten`")
     style: str = Field(
         default="auto",
-        description="FSM -> BT: `auto` (structured for outcome-driven machines, else lebt), "
-        "`structured` or `lebt`",
+        description="FSM -> BT: `auto` (structured for outcome-driven machines, else dispatch), "
+        "`structured`, `dispatch` or `lebt`",
     )
 
 

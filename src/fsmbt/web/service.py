@@ -26,7 +26,9 @@ from typing import Any
 
 from fsmbt import api
 from fsmbt.formats import dumps, formats, get_format
+from fsmbt.formats.btcpp.v3_write import prepare_v3
 from fsmbt.metrics.elements import elements
+from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import FsmbtError, Hint, InputError
 from fsmbt.model.validate import validate
 from fsmbt.render import svg_text, trace_anchors
@@ -38,7 +40,7 @@ PLAIN_ENGINES = ("rules", "bsd", "chds")
 #: The options a request may set (nothing else reaches an engine: no endpoint, no key).
 HIERARCHIES = ("subtrees", "flatten")
 #: FSM -> BT styles (docs/conversion.md, "Styles"; ``paper`` is ``lebt``).
-STYLES = ("auto", "structured", "lebt")
+STYLES = ("auto", "structured", "dispatch", "lebt")
 #: Download formats besides the registry's writers: pictures through Graphviz.
 PICTURE_FORMATS = ("svg", "png")
 #: The file name ending of each download format.
@@ -127,11 +129,17 @@ def format_list() -> list[dict[str, Any]]:
     return listed
 
 
-def download_formats(kind: str) -> list[str]:
-    """The formats a model of ``kind`` can be downloaded in (writers, then pictures)."""
-    return [f.name for f in formats() if f.write is not None and kind in f.kinds] + list(
-        PICTURE_FORMATS
-    )
+def download_formats(kind: str, model: api.Model | None = None) -> list[str]:
+    """The formats a model of ``kind`` can be downloaded in (writers, then pictures); with
+    ``model``, without BehaviorTree.CPP v3 when v3 cannot hold it (a ``Script`` or another
+    v4-only node: the dispatch form, a structured tree with a dispatch; ``prepare_v3``)."""
+    names = [f.name for f in formats() if f.write is not None and kind in f.kinds]
+    if isinstance(model, BTDocument) and "btcpp3" in names:
+        try:
+            prepare_v3(model)
+        except FsmbtError:
+            names.remove("btcpp3")
+    return names + list(PICTURE_FORMATS)
 
 
 #: The runtimes offered for download and the modules that write their files.
@@ -263,6 +271,7 @@ def convert(request: dict[str, Any]) -> dict[str, Any]:
     report = outcome.report
     pictures = {"source": _picture(loaded.model), "result": _picture(outcome.result)}
     kind = api.model_kind(outcome.result)
+    style = outcome.conversion.stats.get("style")
     return {
         "verdict": outcome.verdict,
         "equivalent": outcome.equivalent,
@@ -274,7 +283,7 @@ def convert(request: dict[str, Any]) -> dict[str, Any]:
         "mode": report.mode if report is not None else None,
         "counterexample": _steps(report, loaded.model, outcome.result) if report else None,
         "warnings": outcome.warnings,
-        "style": outcome.conversion.stats.get("style"),
+        "style": style,
         "summary": outcome.conversion.stats.get("summary"),
         "issues": _issues(loaded),
         "metrics": {"source": _metrics(loaded.model), "result": _metrics(outcome.result)},
@@ -283,8 +292,9 @@ def convert(request: dict[str, Any]) -> dict[str, Any]:
             "source": pictures["source"]["error"],
             "result": pictures["result"]["error"],
         },
-        "downloads": download_formats(kind),
-        "runtimes": runtime_kinds() if kind == "bt" else [],
+        "downloads": download_formats(kind, outcome.result),
+        # the runtimes run LEBTs (docs/runtime.md); a dispatch tree needs only DispatchEntry
+        "runtimes": runtime_kinds() if kind == "bt" and style != "dispatch" else [],
         "timings": {k: round(v, 6) for k, v in outcome.timings.items()},
         # the load check (docs/semantics.md §5): "loads in BehaviorTree.CPP 4.8.2: yes"
         "loads": outcome.load.summary() if outcome.load is not None else None,

@@ -216,8 +216,9 @@ def test_an_irreducible_region_gets_the_flag_form_named_in_the_summary() -> None
 
 def test_states_without_declared_outcomes_use_their_transitions() -> None:
     fsm = machine({"A": {"ok": "B", "bad": "aborted"}, "B": {"done": "succeeded"}}, declared=False)
-    lebt = convert(fsm)  # nothing says its events are outcomes: auto gives the LEBT
-    assert "LebtState" in _types(lebt.model)
+    event_driven = convert(fsm)  # nothing says its events are outcomes: auto gives dispatch
+    assert event_driven.stats["style"] == "dispatch"
+    assert "DispatchEntry" in _types(event_driven.model)
     structured = convert(fsm, outcome_driven=True)
     assert structured.stats["style"] == "structured"
     assert _proven(fsm, structured.model)

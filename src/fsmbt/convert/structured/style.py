@@ -6,7 +6,10 @@
 - ``lebt`` (``paper`` is its old name, kept as an alias): the paper's LEBT shape, for any FSM;
 - ``dispatch``: a balanced ``Switch`` dispatch over a state index on the blackboard
   (``fsmbt.convert.dispatch``; docs/semantics.md section 12), for event-driven machines;
-- ``auto`` (the default): ``structured`` when the machine is outcome-driven, else ``lebt``.
+- ``auto`` (the default): ``structured`` when the machine is outcome-driven, else ``dispatch``
+  (a macro step in O(log states) node ticks, issue 23 item 6); ``fsmbt.convert.engines`` falls
+  back to ``lebt``, with a warning naming why, where the dispatch form cannot be written (an
+  event name a ``Switch`` cannot compare, an eventless transition).
 
 A machine is outcome-driven when its format says its events are outcomes (SMACH, FlexBE,
 YASMIN: ``outcome_driven``) or some state declares its outcomes (``state_info``), and it has
@@ -54,7 +57,8 @@ def resolve_style(
     outcome_driven: bool = False,
     rules: OutcomeRules | None = None,
 ) -> tuple[str, OutcomeView | None]:
-    """``(structured or lebt, the outcome view when structured)`` for an FSM source.
+    """``(the style chosen, the outcome view when structured)`` for an FSM source:
+    ``structured``, ``lebt`` or ``dispatch``.
 
     Raises:
         UnsupportedError: an unknown style.
@@ -66,7 +70,7 @@ def resolve_style(
         return chosen, None
     claims = outcome_driven or declares_outcomes(fsm)
     if chosen == AUTO and not claims:
-        return LEBT, None
+        return DISPATCH, None
     if not claims:
         first = fsm.initial or next(iter(fsm.states), fsm.name)
         raise OutcomeError(
