@@ -17,9 +17,10 @@ The tick rules of BehaviorTree.CPP v4 are transition relations over per-node var
 
 Which kinds are encoded and by which rule is the node registry's ``nusmv`` field, and why a
 kind is refused its ``nusmv_refusal`` (``fsmbt.semantics.nodes``, docs/semantics.md "Node
-registry"); the built-in loops and parallels (Repeat, RetryUntilSuccessful, RunOnce,
-Parallel, ParallelAll) have their rules in ``builtin_rules``. Leaf requests are where the
-environment answers: in a leaf-execution machine they are the stable states that take an input (success/failure/running); the LEBT encoding
+registry"); each rule lives in its family's module of ``fsmbt.verify.nusmv.families`` (named
+as the interpreter's family modules, merged by ``families.registry``), which this encoder
+dispatches on. Leaf requests are where the environment answers: in a leaf-execution machine
+they are the stable states that take an input (success/failure/running); the LEBT encoding
 (``encode_lebt``) answers them from its blackboard instead. Supported node types are listed in
 ``SUPPORTED`` (derived from the registry); anything else raises ``UnsupportedError`` (docs/nusmv.md says why).
 Size: O(N · d) SMV text for N nodes of depth d.
@@ -38,8 +39,9 @@ from fsmbt.model.errors import Hint, UnsupportedError
 from fsmbt.semantics.bt_interpreter import CompiledNode, CompiledTree
 from fsmbt.semantics.nodes import NUSMV_ENCODED, all_nodes, node_semantics
 from fsmbt.semantics.status import LeafOutcome, NodeStatus, RootResult
-from fsmbt.verify.nusmv.families import builtin_rules
 from fsmbt.verify.nusmv.families.contract import NusmvRule, Resets
+from fsmbt.verify.nusmv.families.loops import LOOP_KINDS
+from fsmbt.verify.nusmv.families.once import ONCE_KINDS
 from fsmbt.verify.nusmv.families.registry import nusmv_rules
 from fsmbt.verify.nusmv.smv import Symbols, any_of, case
 
@@ -61,8 +63,6 @@ MEMORY_RULES = {
     if n.nusmv
     in ("pipeline", "recovery", "round_robin", "repeat_each_tick", "if_then_else", "while_do_else")
 }
-#: Built-in loops and parallels (``builtin_rules``): rule name.
-BUILTIN_RULES = {n.name: n.nusmv for n in all_nodes() if n.nusmv in builtin_rules.RULES}
 #: Abstractions and wrappers whose only state is statuses (docs/semantics.md §10): rule name.
 GATE_RULES = {
     n.name: n.nusmv
@@ -161,14 +161,11 @@ class BTCore:
             has_keep_running |= (
                 node.type in SIMPLE_DECORATORS and spec is not None and spec.result_map is None
             )
-            rule = BUILTIN_RULES.get(node.type)
             # so can Repeat/Retry with -1; a RunOnce that has run, or a loop that never ticks
             # its child (a count <= 0 other than -1), answers without any leaf
-            limit = node.params[0] if rule in builtin_rules.LOOPS else None
+            limit = node.params[0] if node.type in LOOP_KINDS else None
             has_endless_loop |= limit == -1
-            has_internal |= rule in ("run_once", "single_trigger") or (
-                limit is not None and -1 != limit <= 0
-            )
+            has_internal |= node.type in ONCE_KINDS or (limit is not None and -1 != limit <= 0)
             self.info.append(NodeInfo(node, False, None, spec.nusmv))
         self.may_skip = self._may_skip()
         if (
@@ -297,9 +294,7 @@ class BTCore:
     def has_prev(self, nid: int) -> bool:
         """Whether ``nid``'s frame keeps ``prev_n``, its child's status when called (the
         wake-up test of the sequences and of Repeat/RetryUntilSuccessful)."""
-        return (
-            self.is_seq_like(nid) or BUILTIN_RULES.get(self.nodes[nid].type) in builtin_rules.LOOPS
-        )
+        return self.is_seq_like(nid) or self.nodes[nid].type in LOOP_KINDS
 
     # -- declarations ----------------------------------------------------------------------
     def declare(self, cur_extra: list[str], init_cur: str) -> None:
