@@ -43,16 +43,13 @@ from fsmbt.verify.nusmv.families.contract import NusmvRule, Resets
 from fsmbt.verify.nusmv.families.loops import LOOP_KINDS
 from fsmbt.verify.nusmv.families.once import ONCE_KINDS
 from fsmbt.verify.nusmv.families.registry import nusmv_rules
+from fsmbt.verify.nusmv.families.sequence import SEQ_LIKE
 from fsmbt.verify.nusmv.smv import Symbols, any_of, case
 
 if TYPE_CHECKING:
     from fsmbt.verify.nusmv.encode_fsm import Encoding
 
 # The encoding rules by node kind, from the registry's ``nusmv`` field.
-#: type -> (is_fallback, emits wake-up after a fresh child succeeds/fails, with memory)
-SEQ_LIKE = {
-    n.name: (n.is_fallback, n.wakes_up, n.with_memory) for n in all_nodes() if n.nusmv == "sequence"
-}
 #: type -> is_fallback
 REACTIVE = {n.name: n.is_fallback for n in all_nodes() if n.nusmv == "reactive"}
 SIMPLE_DECORATORS = frozenset(n.name for n in all_nodes() if n.nusmv == "simple_decorator")
@@ -115,7 +112,6 @@ class BTCore:
             name: self._registered(rule) for name, rule in nusmv_rules().items()
         }
         self.dispatch.update(
-            sequence=self._sequence_rules,
             reactive=self._reactive_rules,
             simple_decorator=self._one_child_rules,
             subtree=self._one_child_rules,
@@ -413,77 +409,6 @@ class BTCore:
             method(x, name, here, called, resets)
 
         return encode
-
-    def _sequence_rules(self, x: CompiledNode, here: str, called: str, resets: Resets) -> None:
-        """Sequence, Fallback, Async*, SequenceWithMemory (``families.sequence``)."""
-        kids = list(x.children)
-        k = len(kids)
-        t = x.type
-        is_fb, wakes, memory = SEQ_LIKE[t]
-        stop, go_on = ("S", "F") if is_fb else ("F", "S")
-        idx = f"idx_{x.id}"
-        skippable = any(self.may_skip[c] for c in kids)
-        if skippable:  # the skipped count (memory; SequenceWithMemory's halt keeps it)
-            skipped = self.memory(
-                "sk", x.id, sum(self.may_skip[c] for c in kids), reset_by_halt=not memory
-            )
-            self.rule(skipped, f"{called} & {self.st(x.id)} = I", "0")
-        self.rule(self.st(x.id), called, "R")
-        for i, c in enumerate(kids):
-            cond = f"{called} & {idx} = {i}"
-            self.call(cond, c)
-            self.rule(f"prev_{x.id}", cond, self.st(c))
-        back = f"{here} & res != NONE"
-        self.ret(f"{back} & res = R", x.id, "R")
-        stopped = f"{back} & res = {stop}"
-        if memory:
-            for i, c in enumerate(kids):
-                resets[c].append(f"{stopped} & {idx} <= {i}")
-        else:
-            for c in kids:
-                resets[c].append(stopped)
-            self.rule(idx, stopped, "0")
-        self.ret(stopped, x.id, stop)
-        went = f"{back} & res = {go_on}"
-        for i in range(k):
-            cond = f"{went} & {idx} = {i}"
-            if i + 1 < k:
-                if wakes:
-                    woke = f"{cond} & prev_{x.id} = I"
-                    self.rule("wake", woke, "TRUE")
-                    self.rule(idx, woke, str(i + 1))
-                    self.ret(woke, x.id, "R")
-                    cond = f"{cond} & prev_{x.id} != I"
-                self.rule(idx, cond, str(i + 1))
-                self.call(cond, kids[i + 1])
-                self.rule(f"prev_{x.id}", cond, self.st(kids[i + 1]))
-            else:
-                for c in kids:
-                    resets[c].append(cond)
-                self.rule(idx, cond, "0")
-                if skippable:
-                    self.rule(skipped, cond, "0")
-                self.ret(cond, x.id, go_on)
-        if not skippable:
-            return
-        # SKIPPED (``tick_sequence``): the next child, no wake-up; after the last one the node
-        # returns SKIPPED when every child was skipped, else go_on; the counter is zeroed when
-        # the node is ticked while IDLE and when it completes
-        top = sum(self.may_skip[c] for c in kids)
-        for i in range(k):
-            cond = f"{back} & res = K & {idx} = {i}"
-            self.rule(skipped, cond, _inc(skipped, top))
-            if i + 1 < k:
-                self.rule(idx, cond, str(i + 1))
-                self.call(cond, kids[i + 1])
-                self.rule(f"prev_{x.id}", cond, self.st(kids[i + 1]))
-            else:
-                for c in kids:
-                    resets[c].append(cond)
-                self.rule(idx, cond, "0")
-                self.rule(skipped, cond, "0")
-                all_skipped = f"case {skipped} >= {k - 1} : K; TRUE : {go_on}; esac"
-                self.ret(cond, x.id, all_skipped if self.may_skip[x.id] else go_on)
 
     def _reactive_rules(self, x: CompiledNode, here: str, called: str, resets: Resets) -> None:
         """ReactiveSequence, ReactiveFallback (``families.reactive``)."""
