@@ -44,15 +44,13 @@ from fsmbt.verify.nusmv.families.loops import LOOP_KINDS
 from fsmbt.verify.nusmv.families.once import ONCE_KINDS
 from fsmbt.verify.nusmv.families.registry import nusmv_rules
 from fsmbt.verify.nusmv.families.sequence import SEQ_LIKE
+from fsmbt.verify.nusmv.families.status_map import SIMPLE_DECORATORS
 from fsmbt.verify.nusmv.smv import Symbols, any_of, case
 
 if TYPE_CHECKING:
     from fsmbt.verify.nusmv.encode_fsm import Encoding
 
 # The encoding rules by node kind, from the registry's ``nusmv`` field.
-#: type -> is_fallback
-REACTIVE = {n.name: n.is_fallback for n in all_nodes() if n.nusmv == "reactive"}
-SIMPLE_DECORATORS = frozenset(n.name for n in all_nodes() if n.nusmv == "simple_decorator")
 #: Project kinds with an index or counter (docs/semantics.md §10): rule name.
 MEMORY_RULES = {
     n.name: n.nusmv
@@ -112,16 +110,13 @@ class BTCore:
             name: self._registered(rule) for name, rule in nusmv_rules().items()
         }
         self.dispatch.update(
-            reactive=self._reactive_rules,
-            simple_decorator=self._one_child_rules,
-            subtree=self._one_child_rules,
             loop_queue=self._loop_rules,
             real_parallel=lambda x, here, called, resets: self._real_parallel_rules(
                 x, here, called
             ),
             manual_selector=self._manual_rules,
         )
-        for name in ("gated", "timeout", "sleep", "for_each", "pass_through", "pass_through_keep"):
+        for name in ("gated", "timeout", "sleep", "for_each"):
             self.dispatch[name] = self._with_name(self._gate_rules, name)
         for name in (
             "pipeline",
@@ -410,79 +405,6 @@ class BTCore:
 
         return encode
 
-    def _reactive_rules(self, x: CompiledNode, here: str, called: str, resets: Resets) -> None:
-        """ReactiveSequence, ReactiveFallback (``families.reactive``)."""
-        kids = list(x.children)
-        k = len(kids)
-        t = x.type
-        is_fb = REACTIVE[t]
-        stop, go_on = ("S", "F") if is_fb else ("F", "S")
-        self.rule(self.st(x.id), called, "R")
-        self.call(called, kids[0])
-        back = f"{here} & res != NONE"
-        skippable = any(self.may_skip[c] for c in kids)
-        flag = f"rk_{x.id}"
-        if skippable:  # the frame's "every child so far skipped" (1; canonical off the stack)
-            self.var_types[flag] = "0..1"
-            self.init[flag] = "1"
-            self.rule(flag, called, "1")
-            for i in range(k):
-                cond = f"{back} & res = K & lidx = {i}"
-                resets[kids[i]].append(cond)
-                if i + 1 < k:
-                    self.call(cond, kids[i + 1])
-                else:
-                    for c in kids:
-                        resets[c].append(cond)
-                    all_skipped = f"case {flag} = 1 : K; TRUE : {go_on}; esac"
-                    self.ret(cond, x.id, all_skipped if self.may_skip[x.id] else go_on)
-            self.rule(flag, f"{back} & res = {go_on} & lidx < {k - 1}", "0")
-        running = f"{back} & res = R"
-        for i, c in enumerate(kids):
-            resets[c].append(f"{running} & lidx != {i}")
-        self.ret(running, x.id, "R")
-        stopped = f"{back} & res = {stop}"
-        for c in kids:
-            resets[c].append(stopped)
-        self.ret(stopped, x.id, stop)
-        for i in range(k):
-            cond = f"{back} & res = {go_on} & lidx = {i}"
-            if i + 1 < k:
-                self.call(cond, kids[i + 1])
-            else:
-                for c in kids:
-                    resets[c].append(cond)
-                self.ret(cond, x.id, go_on)
-
-    def _one_child_rules(self, x: CompiledNode, here: str, called: str, resets: Resets) -> None:
-        """Status-map decorators and SubTree (``families.status_map``, ``.wrappers``)."""
-        kids = list(x.children)
-        t = x.type
-        c = kids[0]
-        spec = node_semantics(t)
-        assert spec is not None
-        result_map = spec.result_map
-        if spec.kind is NodeKind.SUBTREE:
-            self.rule(self.st(x.id), f"{called} & {self.st(x.id)} = I", "R")
-        else:
-            self.rule(self.st(x.id), called, "R")
-        self.call(called, c)
-        back = f"{here} & res != NONE"
-        done = f"{back} & (res = S | res = F)"
-        if result_map is None and spec.kind is not NodeKind.SUBTREE:
-            # KeepRunningUntilFailure
-            resets[c].append(done)
-            self.ret(f"{back} & res = F", x.id, "F")
-            self.ret(f"{back} & res != F", x.id, "R")
-            return
-        self.ret(f"{back} & res = R", x.id, "R")
-        self.ret(f"{back} & res = K", x.id, _K)  # SKIPPED passes through
-        resets[c].append(done)
-        # the child's S / F as the node returns them (a SubTree passes them on)
-        on_s, on_f = (ST[result_map[0]], ST[result_map[1]]) if result_map is not None else (_S, _F)
-        mapped = on_s if on_s == on_f else f"case res = S : {on_s}; TRUE : {on_f}; esac"
-        self.ret(done, x.id, mapped)
-
     def _manual_rules(
         self, x: CompiledNode, here: str, called: str, resets: dict[int, list[str]]
     ) -> None:
@@ -540,13 +462,6 @@ class BTCore:
         back = f"{here} & res != NONE"
         passed = "case res = S : S; res = F : F; TRUE : R; esac"
         self.rule(self.st(x.id), called, "R")
-        if rule in ("pass_through", "pass_through_keep"):
-            c = kids[0]
-            self.call(called, c)
-            if rule == "pass_through":
-                resets[c].append(f"{back} & (res = S | res = F)")
-            self.ret(back, x.id, passed)
-            return
         gate = kids[-1]
         from_gate = f"{back} & lidx = {len(kids) - 1}"
         resets[gate].append(from_gate)

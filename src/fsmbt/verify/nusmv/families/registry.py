@@ -11,11 +11,27 @@ from __future__ import annotations
 
 from types import ModuleType
 
-from fsmbt.verify.nusmv.families import loops, once, parallel, sequence
+from fsmbt.verify.nusmv.families import (
+    loops,
+    once,
+    parallel,
+    reactive,
+    sequence,
+    status_map,
+    wrappers,
+)
 from fsmbt.verify.nusmv.families.contract import NusmvRule
 
 #: The built-in family modules, each exporting ``RULES`` (rule name -> ``NusmvRule``).
-BUILTIN_FAMILIES: tuple[ModuleType, ...] = (sequence, parallel, loops, once)
+BUILTIN_FAMILIES: tuple[ModuleType, ...] = (
+    sequence,
+    reactive,
+    parallel,
+    status_map,
+    loops,
+    once,
+    wrappers,
+)
 
 
 def _builtin() -> dict[str, NusmvRule]:
