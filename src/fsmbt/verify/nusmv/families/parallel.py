@@ -1,16 +1,21 @@
-"""NuSMV rules of the parallel family: Parallel, ParallelAll (docs/semantics.md "Control
-nodes"; docs/nusmv.md), mirroring ``fsmbt.semantics.families.parallel`` (``tick_parallel``,
-``tick_parallel_all``; BehaviorTree.CPP 4.8 parallel_node.cpp, parallel_all_node.cpp).
+"""NuSMV rules of the parallel family: Parallel, ParallelAll and julienbayle/stardust
+RealParallel (docs/semantics.md "Control nodes", "Project nodes"; docs/nusmv.md), mirroring
+``fsmbt.semantics.families.parallel`` (``tick_parallel``, ``tick_parallel_all``,
+``tick_real_parallel``; BehaviorTree.CPP 4.8 parallel_node.cpp, parallel_all_node.cpp).
 
-Rules ``parallel`` / ``parallel_all``: the completed set and the counters are not variables. A
+- ``parallel`` / ``parallel_all``: the completed set and the counters are not variables. A
 child completed in this run of the parallel is exactly a child whose status is SUCCESS or
 FAILURE: a parallel never ticks a completed child again, and it resets every child whenever it
 completes (its halt clears them too), so the statuses already hold the memory; the success and
 failure counts are DEFINEs summing them (``psc_n``, ``pfc_n``). The threshold checks run after
 every child's return, in the interpreter's order (success first).
+- ``real_parallel``: every child is called in order on every tick and none is reset; ``pr_n`` /
+  ``pf_n`` remember within the tick whether a child was RUNNING / failed (both zeroed when the
+  node is called and when it returns: RUNNING if any child ran, else FAILURE if any failed,
+  else SUCCESS).
 
-Cost: O(k²) rules for a parallel of k children (the next child not completed after each one);
-no variable.
+Cost: O(k²) rules for a parallel of k children (the next child not completed after each one),
+no variable; O(k) rules and 2 bits for a RealParallel.
 """
 
 from __future__ import annotations
@@ -83,8 +88,32 @@ def parallel(
     first_open(called, 0)
 
 
+def real_parallel(core: BTCore, x: CompiledNode, here: str, called: str, resets: Resets) -> None:
+    """stardust RealParallel (the module docstring)."""
+    kids = list(x.children)
+    back = f"{here} & res != NONE"
+    ran = core.memory("pr", x.id, 1)
+    failed = core.memory("pf", x.id, 1)
+    core.rule(core.st(x.id), called, "R")
+    core.rule(ran, called, "0")
+    core.rule(failed, called, "0")
+    core.call(called, kids[0])
+    for i in range(len(kids)):
+        at = f"{back} & lidx = {i}"
+        if i + 1 < len(kids):
+            core.rule(ran, f"{at} & res = R", "1")
+            core.rule(failed, f"{at} & res = F", "1")
+            core.call(at, kids[i + 1])
+            continue
+        core.rule(ran, at, "0")
+        core.rule(failed, at, "0")
+        status = f"case {ran} = 1 | res = R : R; {failed} = 1 | res = F : F; TRUE : S; esac"
+        core.ret(at, x.id, status)
+
+
 #: This family's rules by name (``registry`` merges the families' tables).
 RULES: dict[str, NusmvRule] = {
     "parallel": named(parallel, "parallel"),
     "parallel_all": named(parallel, "parallel_all"),
+    "real_parallel": real_parallel,
 }

@@ -12,7 +12,11 @@ from __future__ import annotations
 from types import ModuleType
 
 from fsmbt.verify.nusmv.families import (
+    conditional,
+    gates,
     loops,
+    manual,
+    nav2,
     once,
     parallel,
     reactive,
@@ -27,10 +31,14 @@ BUILTIN_FAMILIES: tuple[ModuleType, ...] = (
     sequence,
     reactive,
     parallel,
+    conditional,
     status_map,
     loops,
     once,
     wrappers,
+    manual,
+    nav2,
+    gates,
 )
 
 
