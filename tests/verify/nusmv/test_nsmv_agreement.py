@@ -481,8 +481,9 @@ def abstraction_pairs() -> Iterator[Pair | Rejected]:
 
 # -- built-ins: loops, RunOnce, parallels ------------------------------------------------------
 def _builtin_trees() -> list[BTDocument]:
-    """Every built-in the encoding covers through ``builtin_rules`` (docs/nusmv.md), in the
-    places that exercise its memory: a halt by a reactive parent, a wake-up, a re-tick."""
+    """Every built-in the encoding covers through its loops, once and parallel family modules
+    (docs/nusmv.md), in the places that exercise its memory: a halt by a reactive parent, a
+    wake-up, a re-tick."""
     seq = _node
     trees = [
         _built_in("Repeat", seq("Sequence", _leaf("c", True), _leaf("a")), num_cycles="2"),

@@ -17,9 +17,10 @@ The tick rules of BehaviorTree.CPP v4 are transition relations over per-node var
 
 Which kinds are encoded and by which rule is the node registry's ``nusmv`` field, and why a
 kind is refused its ``nusmv_refusal`` (``fsmbt.semantics.nodes``, docs/semantics.md "Node
-registry"); the built-in loops and parallels (Repeat, RetryUntilSuccessful, RunOnce,
-Parallel, ParallelAll) have their rules in ``builtin_rules``. Leaf requests are where the
-environment answers: in a leaf-execution machine they are the stable states that take an input (success/failure/running); the LEBT encoding
+registry"); each rule lives in its family's module of ``fsmbt.verify.nusmv.families`` (named
+as the interpreter's family modules, merged by ``families.registry``), which this encoder
+dispatches on. Leaf requests are where the environment answers: in a leaf-execution machine
+they are the stable states that take an input (success/failure/running); the LEBT encoding
 (``encode_lebt``) answers them from its blackboard instead. Supported node types are listed in
 ``SUPPORTED`` (derived from the registry); anything else raises ``UnsupportedError`` (docs/nusmv.md says why).
 Size: O(N · d) SMV text for N nodes of depth d.
@@ -28,7 +29,6 @@ Size: O(N · d) SMV text for N nodes of depth d.
 from __future__ import annotations
 
 import re
-from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -38,52 +38,24 @@ from fsmbt.model.errors import Hint, UnsupportedError
 from fsmbt.semantics.bt_interpreter import CompiledNode, CompiledTree
 from fsmbt.semantics.nodes import NUSMV_ENCODED, all_nodes, node_semantics
 from fsmbt.semantics.status import LeafOutcome, NodeStatus, RootResult
-from fsmbt.verify.nusmv.families import builtin_rules
+from fsmbt.verify.nusmv.families.common import FAILURE, SKIPPED, ST, SUCCESS
 from fsmbt.verify.nusmv.families.contract import NusmvRule, Resets
+from fsmbt.verify.nusmv.families.loops import LOOP_KINDS
+from fsmbt.verify.nusmv.families.once import ONCE_KINDS
 from fsmbt.verify.nusmv.families.registry import nusmv_rules
+from fsmbt.verify.nusmv.families.sequence import SEQ_LIKE
+from fsmbt.verify.nusmv.families.status_map import SIMPLE_DECORATORS
 from fsmbt.verify.nusmv.smv import Symbols, any_of, case
 
 if TYPE_CHECKING:
     from fsmbt.verify.nusmv.encode_fsm import Encoding
 
 # The encoding rules by node kind, from the registry's ``nusmv`` field.
-#: type -> (is_fallback, emits wake-up after a fresh child succeeds/fails, with memory)
-SEQ_LIKE = {
-    n.name: (n.is_fallback, n.wakes_up, n.with_memory) for n in all_nodes() if n.nusmv == "sequence"
-}
-#: type -> is_fallback
-REACTIVE = {n.name: n.is_fallback for n in all_nodes() if n.nusmv == "reactive"}
-SIMPLE_DECORATORS = frozenset(n.name for n in all_nodes() if n.nusmv == "simple_decorator")
-#: Project kinds with an index or counter (docs/semantics.md §10): rule name.
-MEMORY_RULES = {
-    n.name: n.nusmv
-    for n in all_nodes()
-    if n.nusmv
-    in ("pipeline", "recovery", "round_robin", "repeat_each_tick", "if_then_else", "while_do_else")
-}
-#: Built-in loops and parallels (``builtin_rules``): rule name.
-BUILTIN_RULES = {n.name: n.nusmv for n in all_nodes() if n.nusmv in builtin_rules.RULES}
-#: Abstractions and wrappers whose only state is statuses (docs/semantics.md §10): rule name.
-GATE_RULES = {
-    n.name: n.nusmv
-    for n in all_nodes()
-    if n.nusmv in ("gated", "timeout", "sleep", "for_each", "pass_through", "pass_through_keep")
-}
-#: The Loop family (docs/semantics.md, "LoopInt, LoopBool, LoopDouble, LoopString").
-LOOP_RULES = frozenset(n.name for n in all_nodes() if n.nusmv == "loop_queue")
-#: julienbayle/stardust RealParallel (docs/semantics.md, "Project nodes").
-REAL_PARALLEL_RULES = frozenset(n.name for n in all_nodes() if n.nusmv == "real_parallel")
-#: Kinds whose pick is an environment input asked through choice conditions (ManualSelector).
-MANUAL_RULES = frozenset(n.name for n in all_nodes() if n.nusmv == "manual_selector")
 SUPPORTED = NUSMV_ENCODED
 #: type -> why the encoding refuses it
 NOT_ENCODED = {n.name: n.nusmv_refusal for n in all_nodes() if n.nusmv_refusal is not None}
-#: The SMV constants of the four stored statuses (``NodeStatus`` names' initials).
-ST = {s.name: s.name[0] for s in NodeStatus if s is not NodeStatus.SKIPPED}
-_S, _F = ST[NodeStatus.SUCCESS.name], ST[NodeStatus.FAILURE.name]
+#: The SMV type of a stored status (``families.common.ST``).
 STATUS_ENUM = "{I, R, S, F}"
-#: SKIPPED, a returned status only (``res``; never stored in ``st_n``, docs/semantics.md §2).
-_K = "K"
 #: Rules whose SMV rules handle a child that returns SKIPPED (docs/nusmv.md, "SKIPPED"): the
 #: sequences (skipped counter ``sk_n``), the reactive ones (frame flag ``rk_n``), the status
 #: maps and SubTree (passed on). Any other parent of a child that may skip is refused.
@@ -110,32 +82,9 @@ class BTCore:
         self.nodes = self.tree.nodes
         self.loop = loop
         # One table from NuSMV rule name to the rule (docs/semantics.md "Node families"): the
-        # families' rules registered by name, then the ones this encoder writes itself.
-        self.dispatch: dict[str, Callable[[CompiledNode, str, str, Resets], None]] = {
-            name: self._registered(rule) for name, rule in nusmv_rules().items()
-        }
-        self.dispatch.update(
-            sequence=self._sequence_rules,
-            reactive=self._reactive_rules,
-            simple_decorator=self._one_child_rules,
-            subtree=self._one_child_rules,
-            loop_queue=self._loop_rules,
-            real_parallel=lambda x, here, called, resets: self._real_parallel_rules(
-                x, here, called
-            ),
-            manual_selector=self._manual_rules,
-        )
-        for name in ("gated", "timeout", "sleep", "for_each", "pass_through", "pass_through_keep"):
-            self.dispatch[name] = self._with_name(self._gate_rules, name)
-        for name in (
-            "pipeline",
-            "recovery",
-            "round_robin",
-            "repeat_each_tick",
-            "if_then_else",
-            "while_do_else",
-        ):
-            self.dispatch[name] = self._with_name(self._memory_rules, name)
+        # families' rules (``families.registry``: the built-in family modules and any rule
+        # registered at run time), read once per encoder.
+        self.dispatch: dict[str, NusmvRule] = dict(nusmv_rules())
         self.info: list[NodeInfo] = []
         has_internal = False
         has_keep_running = False
@@ -144,7 +93,7 @@ class BTCore:
             if node.kind in (NodeKind.ACTION, NodeKind.CONDITION):
                 internal = None
                 if node.internal_status is not None:
-                    internal = _S if node.internal_status == NodeStatus.SUCCESS else _F
+                    internal = SUCCESS if node.internal_status == NodeStatus.SUCCESS else FAILURE
                     has_internal = True
                 self.info.append(NodeInfo(node, internal is None, internal))
                 continue
@@ -161,14 +110,11 @@ class BTCore:
             has_keep_running |= (
                 node.type in SIMPLE_DECORATORS and spec is not None and spec.result_map is None
             )
-            rule = BUILTIN_RULES.get(node.type)
             # so can Repeat/Retry with -1; a RunOnce that has run, or a loop that never ticks
             # its child (a count <= 0 other than -1), answers without any leaf
-            limit = node.params[0] if rule in builtin_rules.LOOPS else None
+            limit = node.params[0] if node.type in LOOP_KINDS else None
             has_endless_loop |= limit == -1
-            has_internal |= rule in ("run_once", "single_trigger") or (
-                limit is not None and -1 != limit <= 0
-            )
+            has_internal |= node.type in ONCE_KINDS or (limit is not None and -1 != limit <= 0)
             self.info.append(NodeInfo(node, False, None, spec.nusmv))
         self.may_skip = self._may_skip()
         if (
@@ -297,9 +243,7 @@ class BTCore:
     def has_prev(self, nid: int) -> bool:
         """Whether ``nid``'s frame keeps ``prev_n``, its child's status when called (the
         wake-up test of the sequences and of Repeat/RetryUntilSuccessful)."""
-        return (
-            self.is_seq_like(nid) or BUILTIN_RULES.get(self.nodes[nid].type) in builtin_rules.LOOPS
-        )
+        return self.is_seq_like(nid) or self.nodes[nid].type in LOOP_KINDS
 
     # -- declarations ----------------------------------------------------------------------
     def declare(self, cur_extra: list[str], init_cur: str) -> None:
@@ -356,7 +300,7 @@ class BTCore:
         """``nid`` returns ``status`` (an SMV expression over R/S/F) to its parent or to TOP."""
         node = self.nodes[nid]
         st = self.st(nid)
-        if status == _K:  # never stored: the node keeps its status (docs/semantics.md §2)
+        if status == SKIPPED:  # never stored: the node keeps its status (docs/semantics.md §2)
             self.rule(st, cond, st)
         elif self.may_skip[nid] and status not in ST.values():
             self.rule(st, cond, f"case ({status}) = K : {st}; TRUE : {status}; esac")
@@ -372,7 +316,7 @@ class BTCore:
 
     def build(self) -> None:
         """Every node's tick rules, and the halt closure."""
-        resets: dict[int, list[str]] = {x.id: [] for x in self.nodes}  # child -> conditions
+        resets: Resets = {x.id: [] for x in self.nodes}  # child -> conditions
         for info in self.info:
             x = info.node
             here = f"cur = {self.n(x.id)}"
@@ -386,7 +330,7 @@ class BTCore:
                     self.ret(stale, x.id, f"case {self.st(x.id)} = S : S; TRUE : F; esac")
                 continue  # leaf requests: answered by the machine encoding
             assert info.rule is not None
-            self.dispatch[info.rule](x, here, called, resets)
+            self.dispatch[info.rule](self, x, here, called, resets)
         # halt closure (pre-order ids: a parent's defines come before its children's)
         for x in self.nodes:
             parent_halt = f"hlt_{x.parent}" if x.parent is not None else "FALSE"
@@ -399,518 +343,6 @@ class BTCore:
             self.rules.setdefault(var, []).insert(0, (f"hlt_{nid}", "0"))
         for x in self.nodes:
             self.rules.setdefault(self.st(x.id), []).insert(0, (f"clr_{x.id}", "I"))
-
-    def _registered(self, rule: NusmvRule) -> Callable[[CompiledNode, str, str, Resets], None]:
-        """A registered family rule bound to this encoder."""
-
-        def encode(x: CompiledNode, here: str, called: str, resets: Resets) -> None:
-            rule(self, x, here, called, resets)
-
-        return encode
-
-    @staticmethod
-    def _with_name(
-        method: Callable[[CompiledNode, str, str, str, Resets], None], name: str
-    ) -> Callable[[CompiledNode, str, str, Resets], None]:
-        """One of this encoder's rules that serves several names, for ``name``."""
-
-        def encode(x: CompiledNode, here: str, called: str, resets: Resets) -> None:
-            method(x, name, here, called, resets)
-
-        return encode
-
-    def _sequence_rules(self, x: CompiledNode, here: str, called: str, resets: Resets) -> None:
-        """Sequence, Fallback, Async*, SequenceWithMemory (``families.sequence``)."""
-        kids = list(x.children)
-        k = len(kids)
-        t = x.type
-        is_fb, wakes, memory = SEQ_LIKE[t]
-        stop, go_on = ("S", "F") if is_fb else ("F", "S")
-        idx = f"idx_{x.id}"
-        skippable = any(self.may_skip[c] for c in kids)
-        if skippable:  # the skipped count (memory; SequenceWithMemory's halt keeps it)
-            skipped = self.memory(
-                "sk", x.id, sum(self.may_skip[c] for c in kids), reset_by_halt=not memory
-            )
-            self.rule(skipped, f"{called} & {self.st(x.id)} = I", "0")
-        self.rule(self.st(x.id), called, "R")
-        for i, c in enumerate(kids):
-            cond = f"{called} & {idx} = {i}"
-            self.call(cond, c)
-            self.rule(f"prev_{x.id}", cond, self.st(c))
-        back = f"{here} & res != NONE"
-        self.ret(f"{back} & res = R", x.id, "R")
-        stopped = f"{back} & res = {stop}"
-        if memory:
-            for i, c in enumerate(kids):
-                resets[c].append(f"{stopped} & {idx} <= {i}")
-        else:
-            for c in kids:
-                resets[c].append(stopped)
-            self.rule(idx, stopped, "0")
-        self.ret(stopped, x.id, stop)
-        went = f"{back} & res = {go_on}"
-        for i in range(k):
-            cond = f"{went} & {idx} = {i}"
-            if i + 1 < k:
-                if wakes:
-                    woke = f"{cond} & prev_{x.id} = I"
-                    self.rule("wake", woke, "TRUE")
-                    self.rule(idx, woke, str(i + 1))
-                    self.ret(woke, x.id, "R")
-                    cond = f"{cond} & prev_{x.id} != I"
-                self.rule(idx, cond, str(i + 1))
-                self.call(cond, kids[i + 1])
-                self.rule(f"prev_{x.id}", cond, self.st(kids[i + 1]))
-            else:
-                for c in kids:
-                    resets[c].append(cond)
-                self.rule(idx, cond, "0")
-                if skippable:
-                    self.rule(skipped, cond, "0")
-                self.ret(cond, x.id, go_on)
-        if not skippable:
-            return
-        # SKIPPED (``tick_sequence``): the next child, no wake-up; after the last one the node
-        # returns SKIPPED when every child was skipped, else go_on; the counter is zeroed when
-        # the node is ticked while IDLE and when it completes
-        top = sum(self.may_skip[c] for c in kids)
-        for i in range(k):
-            cond = f"{back} & res = K & {idx} = {i}"
-            self.rule(skipped, cond, _inc(skipped, top))
-            if i + 1 < k:
-                self.rule(idx, cond, str(i + 1))
-                self.call(cond, kids[i + 1])
-                self.rule(f"prev_{x.id}", cond, self.st(kids[i + 1]))
-            else:
-                for c in kids:
-                    resets[c].append(cond)
-                self.rule(idx, cond, "0")
-                self.rule(skipped, cond, "0")
-                all_skipped = f"case {skipped} >= {k - 1} : K; TRUE : {go_on}; esac"
-                self.ret(cond, x.id, all_skipped if self.may_skip[x.id] else go_on)
-
-    def _reactive_rules(self, x: CompiledNode, here: str, called: str, resets: Resets) -> None:
-        """ReactiveSequence, ReactiveFallback (``families.reactive``)."""
-        kids = list(x.children)
-        k = len(kids)
-        t = x.type
-        is_fb = REACTIVE[t]
-        stop, go_on = ("S", "F") if is_fb else ("F", "S")
-        self.rule(self.st(x.id), called, "R")
-        self.call(called, kids[0])
-        back = f"{here} & res != NONE"
-        skippable = any(self.may_skip[c] for c in kids)
-        flag = f"rk_{x.id}"
-        if skippable:  # the frame's "every child so far skipped" (1; canonical off the stack)
-            self.var_types[flag] = "0..1"
-            self.init[flag] = "1"
-            self.rule(flag, called, "1")
-            for i in range(k):
-                cond = f"{back} & res = K & lidx = {i}"
-                resets[kids[i]].append(cond)
-                if i + 1 < k:
-                    self.call(cond, kids[i + 1])
-                else:
-                    for c in kids:
-                        resets[c].append(cond)
-                    all_skipped = f"case {flag} = 1 : K; TRUE : {go_on}; esac"
-                    self.ret(cond, x.id, all_skipped if self.may_skip[x.id] else go_on)
-            self.rule(flag, f"{back} & res = {go_on} & lidx < {k - 1}", "0")
-        running = f"{back} & res = R"
-        for i, c in enumerate(kids):
-            resets[c].append(f"{running} & lidx != {i}")
-        self.ret(running, x.id, "R")
-        stopped = f"{back} & res = {stop}"
-        for c in kids:
-            resets[c].append(stopped)
-        self.ret(stopped, x.id, stop)
-        for i in range(k):
-            cond = f"{back} & res = {go_on} & lidx = {i}"
-            if i + 1 < k:
-                self.call(cond, kids[i + 1])
-            else:
-                for c in kids:
-                    resets[c].append(cond)
-                self.ret(cond, x.id, go_on)
-
-    def _one_child_rules(self, x: CompiledNode, here: str, called: str, resets: Resets) -> None:
-        """Status-map decorators and SubTree (``families.status_map``, ``.wrappers``)."""
-        kids = list(x.children)
-        t = x.type
-        c = kids[0]
-        spec = node_semantics(t)
-        assert spec is not None
-        result_map = spec.result_map
-        if spec.kind is NodeKind.SUBTREE:
-            self.rule(self.st(x.id), f"{called} & {self.st(x.id)} = I", "R")
-        else:
-            self.rule(self.st(x.id), called, "R")
-        self.call(called, c)
-        back = f"{here} & res != NONE"
-        done = f"{back} & (res = S | res = F)"
-        if result_map is None and spec.kind is not NodeKind.SUBTREE:
-            # KeepRunningUntilFailure
-            resets[c].append(done)
-            self.ret(f"{back} & res = F", x.id, "F")
-            self.ret(f"{back} & res != F", x.id, "R")
-            return
-        self.ret(f"{back} & res = R", x.id, "R")
-        self.ret(f"{back} & res = K", x.id, _K)  # SKIPPED passes through
-        resets[c].append(done)
-        # the child's S / F as the node returns them (a SubTree passes them on)
-        on_s, on_f = (ST[result_map[0]], ST[result_map[1]]) if result_map is not None else (_S, _F)
-        mapped = on_s if on_s == on_f else f"case res = S : {on_s}; TRUE : {on_f}; esac"
-        self.ret(done, x.id, mapped)
-
-    def _manual_rules(
-        self, x: CompiledNode, here: str, called: str, resets: dict[int, list[str]]
-    ) -> None:
-        """ManualSelector (docs/semantics.md, "ManualSelector"): the choice conditions after
-        the ``n`` children are asked in order, the first SUCCESS is the pick, none means the last
-        pick; a picked child's status is returned; with ``repeat_last_selection`` the first pick
-        is kept in ``sel_<id>`` (0: none yet, i + 1: child i), which a halt does not reset."""
-        n, repeat_last = x.params
-        kids, choices = list(x.children[:n]), list(x.children[n:])
-        back = f"{here} & res != NONE"
-        sel = f"sel_{x.id}"
-        choosing = called
-        if n and repeat_last:
-            self.var_types[sel] = f"0..{max(n, 1)}"
-            self.init[sel] = "0"
-            self.kept_vars.append(sel)
-            for i, c in enumerate(kids):
-                self.call(f"{called} & {sel} = {i + 1}", c)
-            choosing = f"{called} & {sel} = 0"
-        if n:
-            self.rule(self.st(x.id), choosing, "R")
-
-        def pick(cond: str, index: int) -> None:
-            if index < n:
-                if repeat_last:
-                    self.rule(sel, cond, str(index + 1))
-                self.call(cond, kids[index])
-            else:
-                self.ret(cond, x.id, ("S", "F", "R")[index - n])
-
-        if choices:
-            self.call(choosing, choices[0])
-        else:  # one child under repeat_last_selection: the only pick
-            pick(choosing, 0)
-        for j, choice in enumerate(choices):
-            answered = f"{back} & lidx = {n + j}"
-            resets[choice].append(answered)  # a choice keeps no status
-            pick(f"{answered} & res = S", j)
-            if j + 1 < len(choices):
-                self.call(f"{answered} & res != S", choices[j + 1])
-            else:
-                pick(f"{answered} & res != S", len(choices))
-        self.ret(
-            f"{back} & lidx < {max(n, 1)}" if n else "FALSE",
-            x.id,
-            "case res = S : S; res = F : F; TRUE : R; esac",
-        )
-
-    def _gate_rules(
-        self, x: CompiledNode, rule: str, here: str, called: str, resets: dict[int, list[str]]
-    ) -> None:
-        """Project wrappers and gated abstractions (docs/semantics.md §10): the gate is the
-        last child, a condition leaf the environment answers; only statuses are kept."""
-        kids = list(x.children)
-        back = f"{here} & res != NONE"
-        passed = "case res = S : S; res = F : F; TRUE : R; esac"
-        self.rule(self.st(x.id), called, "R")
-        if rule in ("pass_through", "pass_through_keep"):
-            c = kids[0]
-            self.call(called, c)
-            if rule == "pass_through":
-                resets[c].append(f"{back} & (res = S | res = F)")
-            self.ret(back, x.id, passed)
-            return
-        gate = kids[-1]
-        from_gate = f"{back} & lidx = {len(kids) - 1}"
-        resets[gate].append(from_gate)
-        if rule == "sleep":
-            self.call(called, gate)
-            self.ret(f"{from_gate} & res = S", x.id, "S")
-            self.ret(from_gate, x.id, "R")
-            return
-        c = kids[0]
-        from_child = f"{back} & lidx = 0"
-        if rule == "timeout":  # the gate says the timer fired; not asked on the first tick
-            self.call(f"{called} & {self.st(x.id)} != R", c)
-            self.call(called, gate)
-            resets[c].append(f"{from_gate} & res = S")
-            self.ret(f"{from_gate} & res = S", x.id, "F")
-            self.call(from_gate, c)
-            resets[c].append(f"{from_child} & (res = S | res = F)")
-            self.ret(from_child, x.id, passed)
-            return
-        spec = node_semantics(x.type)
-        assert spec is not None and spec.gate is not None
-        closed = self._returned_status(x, x.params[0], "", skipped_ok=rule == "gated")
-        if rule == "for_each":
-            self.call(f"{called} & {self.st(c)} = R", c)
-            self.call(called, gate)
-            self.call(f"{from_gate} & res = S", c)
-            self.ret(from_gate, x.id, closed)
-            stop = "F" if closed == _S else "S"
-            self.ret(f"{from_child} & res = R", x.id, "R")
-            resets[c].append(f"{from_child} & res != R")
-            self.ret(f"{from_child} & res = {stop}", x.id, stop)
-            self.ret(from_child, x.id, "R")
-            return
-        gate_rule = spec.gate
-        free = []
-        if gate_rule.free_when_idle:
-            free.append(f"{self.st(x.id)} = I")
-        if gate_rule.free_when_running:
-            free.append(f"{self.st(c)} = R")
-        if free:
-            self.call(f"{called} & {any_of(free)}", c)
-        self.call(called, gate)
-        self.call(f"{from_gate} & res = S", c)
-        if gate_rule.halt_on_closed:
-            resets[c].append(f"{from_gate} & res = F & {self.st(c)} = R")
-        self.ret(from_gate, x.id, closed)
-        if gate_rule.reset_on_done:
-            resets[c].append(f"{from_child} & (res = S | res = F)")
-        self.ret(from_child, x.id, passed)
-
-    def _returned_status(
-        self, x: CompiledNode, value: int, when: str, *, skipped_ok: bool = False
-    ) -> str:
-        """The SMV constant of a status node ``x`` returns by parameter (``value``); IDLE is
-        refused, and SKIPPED unless ``skipped_ok`` (a gated node's closed gate, whose parents
-        ``_may_skip`` checked)."""
-        status = NodeStatus(value).name
-        if skipped_ok and status == NodeStatus.SKIPPED.name:
-            return _K
-        if status not in ST or status == NodeStatus.IDLE.name:
-            raise UnsupportedError(
-                f"the NuSMV encoding does not support {x.type} returning {status}{when} "
-                "(SKIPPED is not encoded); use --engine native",
-                location=x.source.location,
-                element=f"<{x.type}> '{x.label}'",
-            )
-        return ST[status]
-
-    def _loop_rules(
-        self, x: CompiledNode, here: str, called: str, resets: dict[int, list[str]]
-    ) -> None:
-        """LoopInt & co (loop_node.h). ``params = (if_empty, length)``: a literal queue keeps
-        ``lq`` (elements left, reloaded when the node is ticked while IDLE); a {blackboard}
-        queue (``length = -1``) asks its gate, the last child, whether an element is left.
-        Either way an element is taken only while the child is not RUNNING."""
-        if_empty, length = x.params
-        empty = self._returned_status(x, if_empty, " on an empty queue")
-        kids = list(x.children)
-        c = kids[0]
-        back = f"{here} & res != NONE"
-        from_child = f"{back} & lidx = 0"
-        resumed = f"{called} & {self.st(c)} = R"
-        if length < 0:
-            gate = kids[-1]
-            from_gate = f"{back} & lidx = {len(kids) - 1}"
-            resets[gate].append(from_gate)
-            self.rule(self.st(x.id), resumed, "R")
-            self.call(resumed, c)
-            self.call(called, gate)
-            opened = f"{from_gate} & res = S"
-            self.rule(self.st(x.id), opened, "R")
-            self.call(opened, c)
-            self.ret(from_gate, x.id, empty)
-        else:
-            left = self.memory("lq", x.id, length)
-            fresh = f"{called} & {self.st(x.id)} = I"
-            if length == 0:
-                self.ret(fresh, x.id, empty)
-            else:
-                self.rule(left, fresh, str(length - 1))
-                self.rule(self.st(x.id), fresh, "R")
-                self.call(fresh, c)
-            self.rule(left, resumed, left)  # a RUNNING child: nothing is popped
-            self.rule(self.st(x.id), resumed, "R")
-            self.call(resumed, c)
-            more = f"{called} & {left} > 0"
-            self.rule(left, more, f"case {left} > 0 : {left} - 1; TRUE : 0; esac")
-            self.rule(self.st(x.id), more, "R")
-            self.call(more, c)
-            self.ret(called, x.id, empty)
-        self.ret(f"{from_child} & res = R", x.id, "R")
-        resets[c].append(f"{from_child} & res != R")
-        self.ret(f"{from_child} & res = F", x.id, "F")
-        self.ret(from_child, x.id, "R")
-
-    def _real_parallel_rules(self, x: CompiledNode, here: str, called: str) -> None:
-        """stardust RealParallel: every child ticked in order on every tick, none reset;
-        ``pr``/``pf`` remember within the tick whether a child was RUNNING / failed."""
-        kids = list(x.children)
-        back = f"{here} & res != NONE"
-        ran = self.memory("pr", x.id, 1)
-        failed = self.memory("pf", x.id, 1)
-        self.rule(self.st(x.id), called, "R")
-        self.rule(ran, called, "0")
-        self.rule(failed, called, "0")
-        self.call(called, kids[0])
-        for i in range(len(kids)):
-            at = f"{back} & lidx = {i}"
-            if i + 1 < len(kids):
-                self.rule(ran, f"{at} & res = R", "1")
-                self.rule(failed, f"{at} & res = F", "1")
-                self.call(at, kids[i + 1])
-                continue
-            self.rule(ran, at, "0")
-            self.rule(failed, at, "0")
-            status = f"case {ran} = 1 | res = R : R; {failed} = 1 | res = F : F; TRUE : S; esac"
-            self.ret(at, x.id, status)
-
-    def _memory_rules(
-        self, x: CompiledNode, rule: str, here: str, called: str, resets: dict[int, list[str]]
-    ) -> None:
-        """PipelineSequence, RecoveryNode, RoundRobin, RepeatUnlessFailureEachTick
-        (docs/semantics.md §10; SKIPPED children are not encoded)."""
-        kids = list(x.children)
-        n = len(kids)
-        back = f"{here} & res != NONE"
-        self.rule(self.st(x.id), called, "R")
-
-        def reset_all(cond: str) -> None:
-            for c in kids:
-                resets[c].append(cond)
-
-        passed = "case res = S : S; res = F : F; TRUE : R; esac"
-        if rule in ("if_then_else", "while_do_else"):
-            # docs/semantics.md §2: IfThenElse keeps the chosen branch (ci), WhileDoElse
-            # re-ticks its condition every tick
-            memo = self.memory("ci", x.id, n - 1) if rule == "if_then_else" else None
-            if memo is not None:
-                for i in range(n - 1, 0, -1):
-                    self.call(f"{called} & {memo} = {i}", kids[i])
-            self.call(called, kids[0])
-            from_cond = f"{back} & lidx = 0"
-            self.ret(f"{from_cond} & res = R", x.id, "R")
-            if memo is not None:
-                self.rule(memo, f"{from_cond} & res = S", "1")
-            elif n == 3:
-                resets[kids[2]].append(f"{from_cond} & res = S")
-            self.call(f"{from_cond} & res = S", kids[1])
-            if n == 3:
-                if memo is not None:
-                    self.rule(memo, f"{from_cond} & res = F", "2")
-                else:
-                    resets[kids[1]].append(f"{from_cond} & res = F")
-                self.call(f"{from_cond} & res = F", kids[2])
-            else:
-                if memo is None:
-                    reset_all(f"{from_cond} & res = F")
-                self.ret(f"{from_cond} & res = F", x.id, "F")
-            from_branch = f"{back} & lidx != 0"
-            self.ret(f"{from_branch} & res = R", x.id, "R")
-            reset_all(f"{from_branch} & res != R")
-            if memo is not None:
-                self.rule(memo, f"{from_branch} & res != R", "0")
-            self.ret(from_branch, x.id, passed)
-            return
-        if rule == "pipeline":
-            last = self.memory("pl", x.id, n - 1)
-            self.call(called, kids[0])
-            failed = f"{back} & res = F"
-            reset_all(failed)
-            self.rule(last, failed, "0")
-            self.ret(failed, x.id, "F")
-            for i in range(n):
-                at = f"{back} & lidx = {i}"
-                self.ret(f"{at} & res = R & {last} <= {i}", x.id, "R")
-                self.rule(last, f"{at} & res = R & {last} <= {i}", str(i))
-                if i + 1 < n:
-                    self.call(at, kids[i + 1])  # SUCCESS, or RUNNING before the furthest
-                else:
-                    reset_all(f"{at} & res = S")  # (res = R returned above)
-                    self.rule(last, at, "0")
-                    self.ret(at, x.id, "S")
-            return
-        if rule == "repeat_each_tick":
-            (limit,) = x.params
-            c = kids[0]
-            self.call(called, c)
-            self.ret(f"{back} & res = R", x.id, "R")
-            done = f"{back} & (res = S | res = F)"
-            resets[c].append(done)
-            if limit == -1:
-                self.ret(f"{back} & res = S", x.id, "R")
-                self.ret(back, x.id, "F")
-                return
-            count = self.memory("rc", x.id, limit - 1)
-            self.rule(count, f"{back} & res = F", "0")
-            self.ret(f"{back} & res = F", x.id, "F")
-            finished = f"{back} & res = S & {count} >= {limit - 1}"
-            self.rule(count, finished, "0")
-            self.ret(finished, x.id, "S")
-            self.rule(count, f"{back} & res = S", _inc(count, limit - 1))
-            self.ret(f"{back} & res = S", x.id, "R")
-            return
-        if rule == "recovery":
-            (retries,) = x.params
-            main, recovery = kids
-            cur = self.memory("ri", x.id, 1)
-            tries = self.memory("rt", x.id, max(retries, 0))
-            self.call(f"{called} & {cur} = 0", main)
-            self.call(called, recovery)
-            from_main, from_rec = f"{back} & lidx = 0", f"{back} & lidx = 1"
-            for side in (from_main, from_rec):
-                self.ret(f"{side} & res = R", x.id, "R")
-            won = f"{from_main} & res = S"
-            retry = f"{from_main} & res = F & {tries} < {retries}"
-            lost = f"({from_main} & res = F & {tries} >= {retries}) | ({from_rec} & res = F)"
-            for cond, status in ((won, "S"),):
-                reset_all(cond)
-                self.rule(cur, cond, "0")
-                self.rule(tries, cond, "0")
-                self.ret(cond, x.id, status)
-            resets[main].append(retry)
-            self.rule(cur, retry, "1")
-            self.call(retry, recovery)
-            reset_all(f"({lost})")
-            self.rule(cur, f"({lost})", "0")
-            self.rule(tries, f"({lost})", "0")
-            self.ret(f"({lost})", x.id, "F")
-            recovered = f"{from_rec} & res = S"
-            resets[recovery].append(recovered)
-            self.rule(cur, recovered, "0")
-            self.rule(tries, recovered, _inc(tries, max(retries, 0)))
-            self.call(recovered, main)
-            return
-        # round_robin
-        (wrap,) = x.params
-        pos = self.memory("rr", x.id, n - 1)
-        fails = self.memory("rf", x.id, n)
-        for i, c in enumerate(kids):
-            self.call(f"{called} & {pos} = {i}", c)
-        self.ret(f"{back} & res = R", x.id, "R")
-        for i in range(n):
-            at = f"{back} & lidx = {i}"
-            end = i + 1 == n and not wrap
-            nxt = (i + 1) % n
-            won, lost = f"{at} & res = S", f"{at} & res = F"
-            if end:  # the last child completed without wrap-around: FAILURE (as Nav2 reads)
-                reset_all(f"{at} & res != R")
-                self.rule(pos, f"{at} & res != R", "0")
-                self.rule(fails, f"{at} & res != R", "0")
-                self.ret(f"{at} & res != R", x.id, "F")
-                continue
-            reset_all(won)
-            self.rule(pos, won, str(nxt))
-            self.rule(fails, won, "0")
-            self.ret(won, x.id, "S")
-            more = f"{lost} & {fails} < {n - 1}"
-            self.rule(pos, more, str(nxt))
-            self.rule(fails, more, _inc(fails, n))
-            self.call(more, kids[nxt])
-            reset_all(lost)
-            self.rule(pos, lost, "0")
-            self.rule(fails, lost, "0")
-            self.ret(lost, x.id, "F")
 
     def leaf_request(self, nid: int) -> str:
         """The condition: ``cur`` is env leaf ``nid`` asking the environment."""
@@ -937,12 +369,6 @@ class BTCore:
         # NuSMV reserves S, F (and X, G, U, ...) as temporal operators: status constants are
         # written I/R/S/F/NONE above for readability and renamed to safe words here.
         return _SAFE_STATUS.sub(lambda m: "z" + m.group(1), "\n".join(lines) + "\n")
-
-
-def _inc(var: str, top: int) -> str:
-    """``var + 1`` kept inside ``0..top`` (NuSMV checks every assignment's range, even on
-    states the rules never reach)."""
-    return f"case {var} < {top} : {var} + 1; TRUE : {top}; esac"
 
 
 _SAFE_STATUS = re.compile(r"(?<![\w$#-])(I|R|S|F|K|NONE)(?![\w$#-])")
@@ -1028,14 +454,14 @@ class LeafBTEncoder:
         top = "cur = TOP"
         core.rule("wake", f"{top} & res = R & wake", "FALSE")
         core.call(f"{top} & res = R", 0)
-        words = {_S: RootResult.SUCCESS.value, _F: RootResult.FAILURE.value}
+        words = {SUCCESS: RootResult.SUCCESS.value, FAILURE: RootResult.FAILURE.value}
         if core.may_skip[0]:
-            words[_K] = NodeStatus.SKIPPED.name
+            words[SKIPPED] = NodeStatus.SKIPPED.name
         for status, word in words.items():
             ended = f"{top} & res = {status}"
             core.rules.setdefault("bres", []).append((ended, self.outputs.id(word)))
             if self.loop:
-                if status != _K:  # Tree::tickRoot resets a completed root, not a skipped one
+                if status != SKIPPED:  # Tree::tickRoot resets a completed root, not a skipped one
                     core.rules.setdefault(core.st(0), []).append((ended, "I"))
                 core.call(ended, 0)
             else:

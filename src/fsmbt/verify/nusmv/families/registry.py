@@ -1,18 +1,58 @@
-"""The NuSMV rules registered by name, beside the ones ``encode_bt`` writes itself
-(docs/semantics.md, "Node families"): the built-in loops and parallels of ``builtin_rules``,
-and any rule added at run time with ``register_nusmv_rule`` for a kind whose declaration names
-it in its ``nusmv`` field. ``encode_bt`` merges this table with its own into one dispatch table
-per encoder.
+"""The NuSMV rules by name, the one table ``encode_bt`` dispatches on (docs/semantics.md,
+"Node families"; docs/nusmv.md): the built-in families' tables (``BUILTIN_FAMILIES``, one module
+per family, named as in ``fsmbt.semantics.families``, each exporting ``RULES``), and any rule
+added at run time with ``register_nusmv_rule`` for a kind whose declaration names it in its
+``nusmv`` field.
 
 Costs: dict reads; registering is O(1).
 """
 
 from __future__ import annotations
 
-from fsmbt.verify.nusmv.families import builtin_rules
+from types import ModuleType
+
+from fsmbt.verify.nusmv.families import (
+    conditional,
+    gates,
+    loops,
+    manual,
+    nav2,
+    once,
+    parallel,
+    reactive,
+    sequence,
+    status_map,
+    wrappers,
+)
 from fsmbt.verify.nusmv.families.contract import NusmvRule
 
-_BUILTIN: dict[str, NusmvRule] = dict(builtin_rules.RULE_TABLE)
+#: The built-in family modules, each exporting ``RULES`` (rule name -> ``NusmvRule``).
+BUILTIN_FAMILIES: tuple[ModuleType, ...] = (
+    sequence,
+    reactive,
+    parallel,
+    conditional,
+    status_map,
+    loops,
+    once,
+    wrappers,
+    manual,
+    nav2,
+    gates,
+)
+
+
+def _builtin() -> dict[str, NusmvRule]:
+    table: dict[str, NusmvRule] = {}
+    for module in BUILTIN_FAMILIES:
+        for name, rule in module.RULES.items():
+            if name in table:
+                raise ValueError(f"NuSMV rule {name!r} is defined twice ({module.__name__})")
+            table[name] = rule
+    return table
+
+
+_BUILTIN: dict[str, NusmvRule] = _builtin()
 _RULES: dict[str, NusmvRule] = dict(_BUILTIN)
 
 
