@@ -93,10 +93,29 @@ def test_format_has_no_size_limit_the_picture_has() -> None:
 def test_cli_convert_to_dot_and_render_dot_give_the_same_bt_dot(tmp_path: Path) -> None:
     source = EXAMPLES / "paper_fsm.json"
     as_dot, as_xml, drawn = tmp_path / "bt.dot", tmp_path / "bt.xml", tmp_path / "drawn.dot"
+    lebt = ["--style", "lebt"]  # 37 nodes: a picture with nothing folded or wrapped
+    assert (
+        main(["convert", str(source), *lebt, "--to", "dot", "-o", str(as_dot), "--no-verify"]) == 0
+    )
+    assert main(["convert", str(source), *lebt, "-o", str(as_xml), "--no-verify"]) == 0
+    assert main(["render", str(as_xml), "-o", str(drawn)]) == 0
+    assert as_dot.read_text(encoding="utf-8") == drawn.read_text(encoding="utf-8")
+
+
+def test_the_dot_format_is_the_whole_tree_while_render_folds_a_big_one(tmp_path: Path) -> None:
+    """The paper FSM's dispatch tree (the default style, 117 nodes): ``--to dot`` is an exchange
+    format and holds every node; ``render`` draws the picture a person reads, with folds."""
+    source = EXAMPLES / "paper_fsm.json"
+    as_dot, as_xml, drawn = tmp_path / "bt.dot", tmp_path / "bt.xml", tmp_path / "drawn.dot"
     assert main(["convert", str(source), "--to", "dot", "-o", str(as_dot), "--no-verify"]) == 0
     assert main(["convert", str(source), "-o", str(as_xml), "--no-verify"]) == 0
     assert main(["render", str(as_xml), "-o", str(drawn)]) == 0
-    assert as_dot.read_text(encoding="utf-8") == drawn.read_text(encoding="utf-8")
+    whole = as_dot.read_text(encoding="utf-8")
+    picture = drawn.read_text(encoding="utf-8")
+    assert len(re.findall(r"^\tn\d+ \[label=", whole, flags=re.MULTILINE)) == 117
+    assert "nodes]" not in whole
+    assert "nodes]" in picture  # at least one fold box
+    assert len(re.findall(r"^\tn\d+ \[label=", picture, flags=re.MULTILINE)) < 117
 
 
 def test_format_dot_of_odd_names_is_accepted_by_graphviz() -> None:

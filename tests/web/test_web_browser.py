@@ -67,11 +67,11 @@ def test_download_the_result_and_read_it_back(page, tmp_path, screenshots):
     page.screenshot(path=str(screenshots / "03-downloads.png"), full_page=True)
 
 
-def _mutated_pair(tmp_path: Path) -> tuple[Path, Path, list]:
-    """The paper FSM's BT (first) and the FSM with one transition dropped (second), and the
-    counterexample fsmbt gives for them."""
+def _mutated_pair(tmp_path: Path, style: str = "lebt") -> tuple[Path, Path, list]:
+    """The paper FSM's BT in ``style`` (first) and the FSM with one transition dropped (second),
+    and the counterexample fsmbt gives for them."""
     source = api.load(PAPER)
-    outcome = api.convert_loaded(source)
+    outcome = api.convert_loaded(source, style=style)
     bt_file = api.write_text(outcome.text, tmp_path / "paper_bt.xml")
     for mutant in mutants(source.model, per_operator=1):
         if mutant.operator != "drop_transition":
@@ -127,6 +127,25 @@ def test_verify_a_mutated_pair_and_step_the_counterexample(page, tmp_path, scree
     left_out = page.inner_text('#verify-results [data-role="left-out"]')
     assert ", ".join(last.result_outputs) in left_out
     page.screenshot(path=str(screenshots / "05-counterexample-end.png"), full_page=True)
+
+
+def test_a_step_inside_a_fold_marks_the_folded_node(page, tmp_path):
+    """The paper FSM's dispatch tree (117 nodes, the default style) is drawn with folds; a step
+    whose DispatchEntry is folded away marks the folded node above it, never nothing."""
+    bt_file, fsm_file, trace = _mutated_pair(tmp_path, style="dispatch")
+    page.click("#tab-verify")
+    page.set_input_files("#first-file", str(bt_file))
+    page.set_input_files("#second-file", str(fsm_file))
+    page.wait_for_function("document.getElementById('second-text').value.length > 0")
+    page.click("#verify")
+    page.wait_for_selector("#verify-results-verdict")
+    assert page.inner_text("#verify-results-verdict").startswith("NOT EQUIVALENT")
+    folds = page.locator("#svg-first text", has_text="nodes]").count()
+    assert folds >= 1  # the premise: the tree is folded on the page
+    for index in range(len(trace)):
+        if index:
+            page.click('#verify-results [data-role="next"]')
+        assert page.locator("#svg-first .hl").count() >= 1, f"step {index}: nothing marked"
 
 
 def test_a_malformed_file_shows_its_line_number(page, tmp_path, screenshots):

@@ -202,10 +202,25 @@ function setupStepper(root, ce, left, right, leftSvg, rightSvg) {
     return row;
   });
   let current = 0;
+  // The element of a step's anchor, or, for a BT node hidden in a fold of a big tree (docs/web.md
+  // 'Big models'), its nearest drawn ancestor - the folded node - found by dropping the last
+  // step of its path (n@0/4/2 -> n@0/4 -> n@0 -> n@root; n@T@1/0 -> ... -> n@T@root).
+  function drawnElement(svgBox, id) {
+    let candidate = id;
+    for (;;) {
+      const node = svgBox.querySelector(`[id="${CSS.escape(candidate)}"]`);
+      if (node) return node;
+      const parent = /^(n@(?:[^@/]*@)?)(.+)\/[^/]+$/.exec(candidate);
+      if (parent) { candidate = parent[1] + parent[2]; continue; }
+      const top = /^(n@(?:[^@/]*@)?)([^/@]+)$/.exec(candidate);
+      if (top && top[2] !== "root") { candidate = top[1] + "root"; continue; }
+      return null;
+    }
+  }
   function mark(svgBox, anchors, cls) {
     for (const node of svgBox.querySelectorAll(`.${cls}`)) node.classList.remove(cls);
     for (const id of anchors) {
-      const node = svgBox.querySelector(`[id="${CSS.escape(id)}"]`);
+      const node = drawnElement(svgBox, id);
       if (node) node.classList.add(cls);
     }
   }
