@@ -2,6 +2,15 @@
 
     nice -n 10 .venv/bin/python benchmarks/bench_batch.py [--n 10000] [--big 100000]
         [--workers 1,2] [--executors local,ray] [--big-workers 2] [--folder DIR]
+    .venv/bin/python benchmarks/bench_batch.py --n 600 --repeat 3 [--executors local]
+
+``--repeat R`` (issue 29, item 4) is the scaling measure: each configuration runs ``R`` times,
+interleaved (1 worker, 2 workers, 1 worker, ...: a change in the machine's load hits both), and
+each run is the whole ``fsmbt batch IN -o OUT -j W --quiet`` command, timed from its start to
+its exit: the interpreter's start, the imports, the job list, the pool's start and the store's
+close are all inside the figure. Every run is printed, then per configuration the median
+models/s and the scaling (median of ``W`` workers over the median of the first worker count).
+``--via library`` times ``make_jobs`` + ``run_jobs`` in a fresh interpreter instead.
 
 The models: ``n`` generated models, half FSMs (2-30 states) and half BTs (depth 2-10, the
 generator's default draw), from ``fsmbt.generate`` with seed 14, written as JSON (FSMs) and
@@ -30,6 +39,7 @@ import json
 import os
 import resource
 import shutil
+import statistics
 import subprocess
 import sys
 import tempfile
@@ -171,6 +181,74 @@ def run_isolated(folder: Path, workers: int, executor: str, scratch: Path) -> di
     return json.loads(done.stdout.strip().splitlines()[-1])  # type: ignore[no-any-return]
 
 
+def run_cli(folder: Path, workers: int, executor: str, scratch: Path) -> dict[str, object]:
+    """The whole ``fsmbt batch`` command over ``folder`` (a fresh output folder), timed from
+    the process's start to its exit; its figures (store read after the exit)."""
+    out = scratch / f"out-cli-{executor}-{workers}"
+    if out.exists():
+        shutil.rmtree(out)
+    command = [sys.executable, "-m", "fsmbt.cli", "batch", str(folder), "-o", str(out)]
+    command += ["-j", str(workers), "--executor", executor, "--quiet"]
+    started = time.perf_counter()
+    done = subprocess.run(command, capture_output=True, text=True)
+    seconds = time.perf_counter() - started
+    if done.returncode not in (0, 1, 2) or not (out / "fsmbt-batch.sqlite").exists():
+        raise SystemExit(f"fsmbt batch failed ({done.returncode}): {done.stderr[-2000:]}")
+    with ResultStore(out) as store:
+        summary = store.summary()
+    shutil.rmtree(out, ignore_errors=True)
+    if summary["pending"]:
+        raise SystemExit(f"fsmbt batch left {summary['pending']} rows pending")
+    models = sum(summary["statuses"].values())
+    return {
+        "executor": executor,
+        "workers": workers,
+        "models": models,
+        "seconds": seconds,
+        "rate": models / seconds,
+        "statuses": {k: v for k, v in summary["statuses"].items() if v},
+        "pending": summary["pending"],
+    }
+
+
+def load_average() -> str:
+    return ", ".join(f"{x:.2f}" for x in os.getloadavg())
+
+
+def repeated(args: argparse.Namespace, folder: Path, scratch: Path) -> None:
+    """``--repeat``: every run printed, then the medians and the scaling (see the module text)."""
+    counts = [int(w) for w in args.workers.split(",")]
+    print(f"# load average before: {load_average()}", flush=True)
+    print("| run | executor | workers | models | seconds | models/s | load (1 min) | statuses |")
+    print("|---|---|---|---|---|---|---|---|", flush=True)
+    rates: dict[tuple[str, int], list[float]] = {}
+    for executor in args.executors.split(","):
+        for run in range(1, args.repeat + 1):
+            for workers in counts:
+                if args.via == "cli":
+                    row = run_cli(folder, workers, executor, scratch)
+                else:
+                    row = run_isolated(folder, workers, executor, scratch)
+                rate = float(row["rate"])  # type: ignore[arg-type]
+                rates.setdefault((executor, workers), []).append(rate)
+                statuses = ", ".join(f"{k} {v}" for k, v in row["statuses"].items())  # type: ignore[attr-defined]
+                print(
+                    f"| {run} | {executor} | {workers} | {row['models']} | "
+                    f"{row['seconds']:.2f} | {rate:.1f} | {os.getloadavg()[0]:.2f} | "
+                    f"{statuses} |",
+                    flush=True,
+                )
+    print(f"# load average after: {load_average()}", flush=True)
+    print()
+    print(f"| executor | workers | median models/s (of {args.repeat}) | scaling |")
+    print("|---|---|---|---|")
+    for executor in args.executors.split(","):
+        base = statistics.median(rates[(executor, counts[0])])
+        for workers in counts:
+            median = statistics.median(rates[(executor, workers)])
+            print(f"| {executor} | {workers} | {median:.1f} | {median / base:.2f} |", flush=True)
+
+
 def print_row(row: dict[str, object], base: dict[str, float]) -> None:
     rate = float(row["rate"])  # type: ignore[arg-type]
     key = str(row["executor"])
@@ -189,7 +267,7 @@ def main() -> int:
     parser.add_argument("--n", type=int, default=10_000)
     parser.add_argument("--big", type=int, default=100_000, help="0 skips the big run")
     parser.add_argument("--workers", default="1,2")
-    parser.add_argument("--executors", default="local,ray")
+    parser.add_argument("--executors", default=None, help="default: local,ray (--repeat: local)")
     parser.add_argument("--big-workers", type=int, default=2)
     parser.add_argument(
         "--folder",
@@ -197,10 +275,24 @@ def main() -> int:
         default=None,
         help="where the generated models are kept (default: a temp folder)",
     )
+    parser.add_argument(
+        "--repeat",
+        type=int,
+        default=0,
+        help="the scaling measure: each configuration this many times, medians printed",
+    )
+    parser.add_argument(
+        "--via",
+        choices=("cli", "library"),
+        default="cli",
+        help="--repeat: time the whole fsmbt batch command (cli) or make_jobs + run_jobs",
+    )
     parser.add_argument("--one", default=None, help=argparse.SUPPRESS)  # EXECUTOR:WORKERS
     parser.add_argument("--models", type=Path, default=None, help=argparse.SUPPRESS)
     args = parser.parse_args()
     scratch = args.folder or Path(tempfile.mkdtemp(prefix="fsmbt-bench-batch-"))
+    if args.executors is None:
+        args.executors = "local" if args.repeat else "local,ray"
     if args.one:
         executor, workers = args.one.split(":")
         print(json.dumps(run_one(args.models, int(workers), executor, scratch)))
@@ -211,9 +303,17 @@ def main() -> int:
         f"{sys.version.split()[0]}",
         flush=True,
     )
+    print(
+        "# the cores are shared with other work: absolute figures are lower bounds, compare "
+        "ratios of interleaved runs",
+        flush=True,
+    )
     started = time.perf_counter()
     build_folder(scratch / f"models-{args.n}", args.n)
     print(f"# generated {args.n} models in {time.perf_counter() - started:.1f} s", flush=True)
+    if args.repeat:
+        repeated(args, scratch / f"models-{args.n}", scratch)
+        return 0
     print(
         "| executor | workers | models | seconds | models/s | scaling | driver MB | "
         "worker MB | all MB | store MB | statuses |"

@@ -15,7 +15,8 @@ Rules (docs/batch.md, "Resume"):
   (an earlier attempt, a worker that died, a driver that was killed after the write).
 - A claimed job whose earlier attempt was interrupted mid-write has its stale temporary file
   removed before it runs again.
-- Each result is stored the moment it reaches the driver, then handed to ``on_result``.
+- Each result is stored the moment it reaches the driver, then handed to ``on_result``; the
+  results that arrive together (one chunk) are stored in one transaction.
 - LLM engines run on at most ``llm_concurrency`` workers (requests at once) and under the
   per-minute limit of ``fsmbt.batch.ratelimit``.
 
@@ -171,7 +172,7 @@ def run_jobs(
         collect: return the results (``False`` for very large batches: read the store).
         llm_concurrency: at most this many LLM jobs at once (default 4).
         max_attempts: worker deaths a job may see before its row says so.
-        chunk_size: jobs per Ray task.
+        chunk_size: jobs per Ray task (the local executor sizes its chunks itself).
 
     Returns:
         The results of this run, in the order they arrived (empty when ``collect`` is off).
@@ -183,13 +184,14 @@ def run_jobs(
         raise InputError(f"unknown executor {executor!r} (known: local, ray)")
     collected: list[JobResult] = []
 
-    def deliver(result: JobResult) -> None:
+    def deliver(results: list[JobResult]) -> None:
         if store is not None:
-            store.put(result)
-        if collect:
-            collected.append(result)
-        if on_result is not None:
-            on_result(result)
+            store.put_many(results)  # the results that arrived together: one transaction
+        for result in results:
+            if collect:
+                collected.append(result)
+            if on_result is not None:
+                on_result(result)
 
     todo: list[Job] = []
     for job in jobs:
@@ -197,7 +199,7 @@ def run_jobs(
             continue
         prepared = _prepare(store, job)
         if isinstance(prepared, JobResult):
-            deliver(prepared)
+            deliver([prepared])
         else:
             todo.append(prepared)
     if not todo:

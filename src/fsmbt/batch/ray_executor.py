@@ -27,18 +27,11 @@ from typing import Any
 
 from fsmbt.batch.jobs import Job
 from fsmbt.batch.local import Claim, Deliver, worker_died
-from fsmbt.batch.result import JobResult
-from fsmbt.batch.worker import run_job, warm_up
+from fsmbt.batch.worker import run_chunk
 from fsmbt.model.errors import InputError
 
 #: Jobs per Ray task.
 DEFAULT_CHUNK = 8
-
-
-def run_chunk(jobs: list[Job]) -> list[JobResult]:
-    """Run jobs one after another in this worker (the body of the Ray task)."""
-    warm_up()
-    return [run_job(job) for job in jobs]
 
 
 def _import_ray() -> Any:
@@ -123,11 +116,9 @@ class RayExecutor:
                     try:
                         results = ray.get(ref)
                     except ray.exceptions.RayError:
-                        for job in chunk:
-                            deliver(worker_died(job, self.max_retries + 1))
+                        deliver([worker_died(job, self.max_retries + 1) for job in chunk])
                         continue
-                    for result in results:
-                        deliver(result)
+                    deliver(results)
         finally:
             for ref in out:
                 ray.cancel(ref, force=True)

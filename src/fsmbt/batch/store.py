@@ -3,7 +3,8 @@
 Schema (docs/batch.md, "The store"): table ``results`` with the key as primary key and a
 column per ``JobResult`` attribute (dicts as JSON text), plus ``state`` (``pending`` while a
 job is out, ``done`` once its result is in). Rows are written by the driver only, one
-transaction per result (``put``) or per batch of claims (``claim``), in WAL mode, so a
+transaction per result (``put``), per group of results that reached the driver together (a
+chunk: ``put_many``) or per batch of claims (``claim``), in WAL mode, so a
 process killed at any point (SIGKILL included) leaves every committed row intact and no row
 twice: ``INSERT OR REPLACE`` on the key.
 
@@ -12,7 +13,8 @@ in between, the output exists and its row does not. A ``pending`` row, committed
 job was handed out and only when its output did not exist (or ``--force``), says the file there
 is this batch's own work, so the resumed run may replace it (``pending_output``).
 
-Costs: ``put`` and ``done`` are one indexed statement each; ``results`` and ``summary`` read
+Costs: ``put`` and ``done`` are one indexed statement each (``put_many``: one per row, one
+commit for all); ``results`` and ``summary`` read
 the whole table.
 """
 
@@ -108,14 +110,27 @@ class ResultStore:
 
     def put(self, result: JobResult) -> None:
         """Store one finished result, replacing any row with its key (one transaction)."""
-        if not result.finished_at:
-            result.finished_at = time.time()
-        values = _encode(result)
+        self.put_many([result])
+
+    def put_many(self, results: Iterable[JobResult]) -> None:
+        """Store finished results, each replacing any row with its key, in one transaction
+        (all of them are committed, or none: a kill mid-way leaves the earlier commits)."""
+        rows = []
+        for result in results:
+            if not result.finished_at:
+                result.finished_at = time.time()
+            rows.append(("done", *_encode(result)))
+        if not rows:
+            return
         marks = ", ".join("?" for _ in range(len(_COLUMNS) + 1))
-        self._db.execute(
-            f"INSERT OR REPLACE INTO results (state, {', '.join(_COLUMNS)}) VALUES ({marks})",
-            ("done", *values),
+        statement = (
+            f"INSERT OR REPLACE INTO results (state, {', '.join(_COLUMNS)}) VALUES ({marks})"
         )
+        if len(rows) == 1:
+            self._db.execute(statement, rows[0])  # autocommit: one transaction
+            return
+        with self._transaction():
+            self._db.executemany(statement, rows)
 
     def claim(self, jobs: Iterable[Job]) -> None:
         """Mark jobs as handed out (``pending``), in one transaction; done rows are kept."""

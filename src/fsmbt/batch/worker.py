@@ -21,7 +21,8 @@ Ray workers run tasks; the driver's watchdog kills a worker that overruns it by 
 stuck in C code), see ``fsmbt.batch.local``.
 
 Pool and Ray workers call ``warm_up`` once before their first job, so no input's time includes
-the library's imports.
+the library's imports. Executors hand jobs out in chunks (``run_chunk``: several jobs per task,
+one pickled round trip).
 
 Costs: those of the pipeline, plus one ``model_stats`` pass over each model.
 """
@@ -272,3 +273,10 @@ def run_job(job: Job) -> JobResult:
         # what the batch wrote: a re-run may replace this file only while it is still this
         result.stats["output_hash"] = content_hash(result.output)
     return result
+
+
+def run_chunk(jobs: list[Job]) -> list[JobResult]:
+    """Run jobs one after another in this worker, each under its own time limit (the body of
+    a pool task or a Ray task: one round trip for several jobs). Warms the worker up first."""
+    warm_up()
+    return [run_job(job) for job in jobs]
