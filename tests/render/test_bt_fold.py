@@ -178,3 +178,33 @@ def test_a_top_node_with_hundreds_of_children_shows_the_first_and_sums_up_the_re
         "one box; draw one with focus=PATH)"
     ]
     assert len(drawn_nodes(model_to_dot(doc, level=1))) == 301  # asked for: all of them
+
+
+PAGES_BT = """<root BTCPP_format="4" main_tree_to_execute="Main">
+  <BehaviorTree ID="Helper"><Sequence><Action ID="Fetch"/><Action ID="Carry"/></Sequence></BehaviorTree>
+  <BehaviorTree ID="Main"><Fallback><SubTree ID="Helper"/><Action ID="Recover"/></Fallback></BehaviorTree>
+  <BehaviorTree ID="main"><Action ID="Other"/></BehaviorTree>
+</root>
+"""
+
+
+@needs_dot
+def test_pages_draw_one_picture_per_tree_main_first(tmp_path: Path, capsys) -> None:
+    """``render --pages DIR`` on a BT: one SVG per <BehaviorTree>, the main tree first, names
+    made unique (``Main`` and ``main`` on a case-insensitive disk); an existing page without
+    --force is refused before any file is written."""
+    source = tmp_path / "three.xml"
+    source.write_text(PAGES_BT, encoding="utf-8")
+    pages = tmp_path / "pages"
+    assert main(["render", str(source), "--pages", str(pages)]) == 0
+    listed = capsys.readouterr().out
+    assert "wrote 3 pictures" in listed and listed.index("Main.svg") < listed.index("Helper.svg")
+    assert sorted(p.name for p in pages.iterdir()) == ["Helper.svg", "Main.svg", "main-2.svg"]
+    helper = (pages / "Helper.svg").read_text(encoding="utf-8")
+    assert "Fetch" in helper and "Recover" not in helper
+    assert "Recover" in (pages / "Main.svg").read_text(encoding="utf-8")
+    (pages / "Main.svg").unlink()
+    before = {p.name: p.stat().st_mtime_ns for p in pages.iterdir()}
+    assert main(["render", str(source), "--pages", str(pages)]) != 0  # Helper.svg exists
+    assert not (pages / "Main.svg").exists()
+    assert {p.name: p.stat().st_mtime_ns for p in pages.iterdir()} == before

@@ -13,7 +13,6 @@ from fsmbt.cli import EXIT_INTERNAL, fail
 from fsmbt.cli.options import (
     reads_models,
 )
-from fsmbt.model.fsm import FSM
 from fsmbt.render import DEFAULT_MAX_NODES, GraphvizError, render_model, render_pages
 
 
@@ -71,7 +70,8 @@ def register(app: typer.Typer) -> None:
             None,
             "--pages",
             help="FSM: write one picture per level into this folder: top.svg (composites "
-            "closed) and one per composite state, data guards on the arrows.",
+            "closed) and one per composite state, data guards on the arrows. BT: one picture "
+            "per BehaviorTree, the main tree first.",
         ),
         composite: str | None = typer.Option(
             None, "--composite", help="FSM: draw only this composite state (path A/B)."
@@ -92,8 +92,6 @@ def register(app: typer.Typer) -> None:
         ).model
         notes: list[str] = []
         if pages is not None:
-            if not isinstance(loaded, FSM):
-                raise fail("--pages draws a state machine's levels; this is a behavior tree")
             fmt = output.suffix.lstrip(".") if output is not None else "svg"
             try:
                 drawn = render_pages(
@@ -107,6 +105,8 @@ def register(app: typer.Typer) -> None:
             except GraphvizError as exc:
                 raise fail(str(exc), EXIT_INTERNAL) from None
             print(f"wrote {len(drawn)} pictures into {pages}: " + ", ".join(p.name for p in drawn))
+            for note in notes:
+                print(f"note: {_cli_words(note)}", file=sys.stderr)
             return
         if output is None:
             raise fail("missing option -o/--output (or --pages DIR)")

@@ -240,7 +240,7 @@ def render_model(
 
 
 def render_pages(
-    model: FSM,
+    model: FSM | BTDocument,
     directory: str | Path,
     *,
     fmt: str = "svg",
@@ -251,13 +251,17 @@ def render_pages(
     """One picture per level of a hierarchical FSM: ``top.<fmt>`` (the top machine, every
     composite closed into a box) and one per composite state, its own machine with the
     composites inside it closed (``A.<fmt>``, ``A__B.<fmt>`` for ``A/B``); data guards and
-    updates label the arrows. Each picture is capped at 4096 x 4096 pixels.
+    updates label the arrows. A behavior tree gets one picture per ``<BehaviorTree>``, the main
+    one first, each drawn alone (its SubTrees as references, big ones folded; file names from
+    the tree IDs, made unique). Each picture is capped at 4096 x 4096 pixels.
 
     Returns:
-        The pictures written, top first.
+        The pictures written, top (main tree) first.
     """
     folder = Path(directory)
     folder.mkdir(parents=True, exist_ok=True)
+    if isinstance(model, BTDocument):
+        return _tree_pages(model, folder, fmt, overwrite, max_nodes, notes)
     pages: list[tuple[str, str | None]] = [("top", None)]
     pages += [(path.replace("/", "__"), path) for path in composite_paths(model)]
     written: list[Path] = []
@@ -266,6 +270,36 @@ def render_pages(
         path = folder / f"{safe}.{fmt}"
         check_output(path, overwrite=overwrite)
         source = fsm_to_dot(model, max_nodes=max_nodes, level=0, composite=composite, notes=notes)
+        written.append(write_picture(source, path, overwrite=overwrite, max_aspect=MAX_ASPECT))
+    return written
+
+
+def _tree_pages(
+    doc: BTDocument,
+    folder: Path,
+    fmt: str,
+    overwrite: bool,
+    max_nodes: int,
+    notes: list[str] | None,
+) -> list[Path]:
+    """``render_pages`` for a behavior tree: one picture per tree, the main one first."""
+    main = doc.main.id
+    order = [main, *(tree_id for tree_id in doc.trees if tree_id != main)]
+    taken: set[str] = set()
+    paths: list[Path] = []
+    for tree_id in order:
+        stem = "".join(c if c.isalnum() or c in "-_." else "_" for c in tree_id) or "tree"
+        unique, count = stem, 1
+        while unique.lower() in taken:  # two IDs that differ only in unsafe characters or case
+            count += 1
+            unique = f"{stem}-{count}"
+        taken.add(unique.lower())
+        paths.append(folder / f"{unique}.{fmt}")
+    for path in paths:  # refuse before writing any, so a refusal leaves the folder as it was
+        check_output(path, overwrite=overwrite)
+    written: list[Path] = []
+    for tree_id, path in zip(order, paths, strict=True):
+        source = picture_dot(doc, max_nodes=max_nodes, tree=tree_id, notes=notes)
         written.append(write_picture(source, path, overwrite=overwrite, max_aspect=MAX_ASPECT))
     return written
 
