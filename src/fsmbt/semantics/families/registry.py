@@ -27,6 +27,7 @@ from fsmbt.semantics.families import (
     wrappers,
 )
 from fsmbt.semantics.families.contract import FamilyRule
+from fsmbt.semantics.families.rule_table import RuleTable
 
 #: The built-in family modules, each exporting ``RULES``.
 BUILTIN_FAMILIES: tuple[ModuleType, ...] = (
@@ -44,27 +45,17 @@ BUILTIN_FAMILIES: tuple[ModuleType, ...] = (
 )
 
 
-def _builtin() -> dict[str, FamilyRule]:
-    table: dict[str, FamilyRule] = {}
-    for module in BUILTIN_FAMILIES:
-        for handler, rule in module.RULES.items():
-            if handler in table:
-                raise ValueError(f"tick rule {handler!r} is defined twice ({module.__name__})")
-            table[handler] = rule
-    return table
-
-
-_RULES: dict[str, FamilyRule] = _builtin()
+_TABLE: RuleTable[FamilyRule] = RuleTable("tick rule", BUILTIN_FAMILIES)
 
 
 def rules() -> dict[str, FamilyRule]:
     """Every registered rule, by handler name (read-only: use ``register_rule``)."""
-    return _RULES
+    return _TABLE.rules
 
 
 def rule(handler: str) -> FamilyRule | None:
     """The rule of ``handler``, ``None`` when none is registered."""
-    return _RULES.get(handler)
+    return _TABLE.rules.get(handler)
 
 
 def register_rule(handler: str, family_rule: FamilyRule) -> None:
@@ -73,9 +64,7 @@ def register_rule(handler: str, family_rule: FamilyRule) -> None:
     Raises:
         ValueError: ``handler`` already has a rule.
     """
-    if handler in _RULES:
-        raise ValueError(f"tick rule {handler!r} is already registered")
-    _RULES[handler] = family_rule
+    _TABLE.register(handler, family_rule)
 
 
 def unregister_rule(handler: str) -> None:
@@ -84,6 +73,4 @@ def unregister_rule(handler: str) -> None:
     Raises:
         ValueError: ``handler`` is a built-in rule or not registered.
     """
-    if handler not in _RULES or any(handler in m.RULES for m in BUILTIN_FAMILIES):
-        raise ValueError(f"tick rule {handler!r} is not a registered extra rule")
-    del _RULES[handler]
+    _TABLE.unregister(handler)

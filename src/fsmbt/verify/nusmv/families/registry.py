@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from types import ModuleType
 
+from fsmbt.semantics.families.rule_table import RuleTable
 from fsmbt.verify.nusmv.families import (
     conditional,
     gates,
@@ -42,23 +43,12 @@ BUILTIN_FAMILIES: tuple[ModuleType, ...] = (
 )
 
 
-def _builtin() -> dict[str, NusmvRule]:
-    table: dict[str, NusmvRule] = {}
-    for module in BUILTIN_FAMILIES:
-        for name, rule in module.RULES.items():
-            if name in table:
-                raise ValueError(f"NuSMV rule {name!r} is defined twice ({module.__name__})")
-            table[name] = rule
-    return table
-
-
-_BUILTIN: dict[str, NusmvRule] = _builtin()
-_RULES: dict[str, NusmvRule] = dict(_BUILTIN)
+_TABLE: RuleTable[NusmvRule] = RuleTable("NuSMV rule", BUILTIN_FAMILIES)
 
 
 def nusmv_rules() -> dict[str, NusmvRule]:
     """Every registered rule, by name (read-only: use ``register_nusmv_rule``)."""
-    return _RULES
+    return _TABLE.rules
 
 
 def register_nusmv_rule(name: str, rule: NusmvRule) -> None:
@@ -67,9 +57,7 @@ def register_nusmv_rule(name: str, rule: NusmvRule) -> None:
     Raises:
         ValueError: ``name`` already has a rule.
     """
-    if name in _RULES:
-        raise ValueError(f"NuSMV rule {name!r} is already registered")
-    _RULES[name] = rule
+    _TABLE.register(name, rule)
 
 
 def unregister_nusmv_rule(name: str) -> None:
@@ -78,6 +66,4 @@ def unregister_nusmv_rule(name: str) -> None:
     Raises:
         ValueError: ``name`` is built in or not registered.
     """
-    if name not in _RULES or name in _BUILTIN:
-        raise ValueError(f"NuSMV rule {name!r} is not a registered extra rule")
-    del _RULES[name]
+    _TABLE.unregister(name)
