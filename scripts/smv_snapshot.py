@@ -93,26 +93,19 @@ for gname, items in groups:
         else:
             save(f"{gname}-rejected-{item.label}", f"REJECTED {item.reason}")
 
-# the example BTs themselves, both loop modes
-for path in sorted(Path("examples").iterdir()):
-    try:
-        model = api.load(path).model
-    except FsmbtError:
-        continue
-    if isinstance(model, BTDocument):
-        for loop in (False, True):
-            tree(f"example-{path.name}-loop{int(loop)}", model, loop)
-
-# the corpus BTs themselves (FSMBT_CORPUS), both loop modes
-if agr.CORPUS.is_dir():
-    for path in agr.corpus_files():
+# the example and corpus (FSMBT_CORPUS) BTs themselves, both loop modes
+for group, paths in (
+    ("example", sorted(Path("examples").iterdir())),
+    ("corpus", agr.corpus_files() if agr.CORPUS.is_dir() else []),
+):
+    for path in paths:
         try:
             model = api.load(path).model
         except FsmbtError:
             continue
         if isinstance(model, BTDocument):
             for loop in (False, True):
-                tree(f"corpus-{path.name}-loop{int(loop)}", model, loop)
+                tree(f"{group}-{path.name}-loop{int(loop)}", model, loop)
 
 # -- random trees over every encoded kind ---------------------------------------------------
 KINDS = [n for n in all_nodes() if n.nusmv and n.nusmv != "internal_leaf"]

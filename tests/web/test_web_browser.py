@@ -86,9 +86,8 @@ def _mutated_pair(tmp_path: Path, style: str = "lebt") -> tuple[Path, Path, list
     raise AssertionError("no mutant with a counterexample")
 
 
-def test_verify_a_mutated_pair_and_step_the_counterexample(page, tmp_path, screenshots):
-    bt_file, fsm_file, trace = _mutated_pair(tmp_path)
-    assert len(trace) >= 3
+def _verify_on_the_page(page, bt_file: Path, fsm_file: Path) -> None:
+    """Upload the pair on the Verify tab, check it, and expect NOT EQUIVALENT."""
     page.click("#tab-verify")
     page.set_input_files("#first-file", str(bt_file))
     page.set_input_files("#second-file", str(fsm_file))
@@ -96,6 +95,12 @@ def test_verify_a_mutated_pair_and_step_the_counterexample(page, tmp_path, scree
     page.click("#verify")
     page.wait_for_selector("#verify-results-verdict")
     assert page.inner_text("#verify-results-verdict").startswith("NOT EQUIVALENT")
+
+
+def test_verify_a_mutated_pair_and_step_the_counterexample(page, tmp_path, screenshots):
+    bt_file, fsm_file, trace = _mutated_pair(tmp_path)
+    assert len(trace) >= 3
+    _verify_on_the_page(page, bt_file, fsm_file)
     assert page.locator("#verify-results table.props tr.fails").count() >= 1
     assert page.locator("#verify-results table.steps tbody tr").count() == len(trace)
     page.screenshot(path=str(screenshots / "04-counterexample-start.png"), full_page=True)
@@ -133,13 +138,7 @@ def test_a_step_inside_a_fold_marks_the_folded_node(page, tmp_path):
     """The paper FSM's dispatch tree (117 nodes, the default style) is drawn with folds; a step
     whose DispatchEntry is folded away marks the folded node above it, never nothing."""
     bt_file, fsm_file, trace = _mutated_pair(tmp_path, style="dispatch")
-    page.click("#tab-verify")
-    page.set_input_files("#first-file", str(bt_file))
-    page.set_input_files("#second-file", str(fsm_file))
-    page.wait_for_function("document.getElementById('second-text').value.length > 0")
-    page.click("#verify")
-    page.wait_for_selector("#verify-results-verdict")
-    assert page.inner_text("#verify-results-verdict").startswith("NOT EQUIVALENT")
+    _verify_on_the_page(page, bt_file, fsm_file)
     folds = page.locator("#svg-first text", has_text="nodes]").count()
     assert folds >= 1  # the premise: the tree is folded on the page
     for index in range(len(trace)):
