@@ -99,10 +99,11 @@ class AnswerCache:
         data = pickle.dumps(answer, protocol=pickle.HIGHEST_PROTOCOL)
         self._remember(key, data)
         if self.directory is not None:
+            stored = json.dumps(answer, default=_bytes_as_data, separators=(",", ":"))
             target = self.directory / f"{key}.json"
             handle, temporary = tempfile.mkstemp(dir=self.directory, suffix=".part")
             with os.fdopen(handle, "wb") as out:
-                out.write(json.dumps(_as_data(answer), separators=(",", ":")).encode("utf-8"))
+                out.write(stored.encode("utf-8"))
             os.replace(temporary, target)
 
     def _remember(self, key: str, data: bytes) -> None:
@@ -118,53 +119,24 @@ class AnswerCache:
             self.bytes -= len(dropped)
 
 
-def _as_data(value: Any) -> Any:
-    """``value`` as JSON data: bytes become ``{"$bytes": base64}``, tuples lists. Iterative
-    (an answer is a few levels deep, but nothing here recurses on data)."""
-    root: list[Any] = [None]
-    stack: list[tuple[Any, Any, Any]] = [(value, root, 0)]
-    while stack:
-        item, parent, slot = stack.pop()
-        if isinstance(item, bytes):
-            parent[slot] = {"$bytes": base64.b64encode(item).decode("ascii")}
-        elif isinstance(item, dict):
-            copy: dict[str, Any] = {}
-            parent[slot] = copy
-            stack.extend((child, copy, str(name)) for name, child in item.items())
-        elif isinstance(item, list | tuple):
-            items: list[Any] = [None] * len(item)
-            parent[slot] = items
-            stack.extend((child, items, index) for index, child in enumerate(item))
-        else:
-            parent[slot] = item
-    return root[0]
+def _bytes_as_data(value: object) -> dict[str, str]:
+    """``json.dumps``'s hook: bytes become ``{"$bytes": base64}`` (tuples are lists already)."""
+    if isinstance(value, bytes):
+        return {"$bytes": base64.b64encode(value).decode("ascii")}
+    raise TypeError(f"{type(value).__name__} is not kept in the answer cache")
 
 
-def _from_data(value: Any) -> Any:
-    """The inverse of ``_as_data`` (lists stay lists: callers unpack them like tuples)."""
-    root: list[Any] = [None]
-    stack: list[tuple[Any, Any, Any]] = [(value, root, 0)]
-    while stack:
-        item, parent, slot = stack.pop()
-        if isinstance(item, dict) and set(item) == {"$bytes"}:
-            parent[slot] = base64.b64decode(item["$bytes"], validate=True)
-        elif isinstance(item, dict):
-            copy: dict[str, Any] = {}
-            parent[slot] = copy
-            stack.extend((child, copy, name) for name, child in item.items())
-        elif isinstance(item, list):
-            items: list[Any] = [None] * len(item)
-            parent[slot] = items
-            stack.extend((child, items, index) for index, child in enumerate(item))
-        else:
-            parent[slot] = item
-    return root[0]
+def _data_as_bytes(item: dict[str, Any]) -> Any:
+    """``json.loads``'s hook, the inverse of ``_bytes_as_data`` (bad base64: ``ValueError``)."""
+    if set(item) == {"$bytes"}:
+        return base64.b64decode(item["$bytes"], validate=True)
+    return item
 
 
 def _read_stored(path: Path) -> tuple[str, Any] | None:
     """The answer kept in ``path``, or ``None`` when it is missing or is not one."""
     try:
-        value = _from_data(json.loads(path.read_bytes()))
+        value = json.loads(path.read_bytes(), object_hook=_data_as_bytes)
     except (OSError, ValueError, RecursionError):  # missing, unreadable, not JSON, bad base64
         return None
     if not (isinstance(value, list) and len(value) == 2 and value[0] in ("ok", "error")):
