@@ -41,7 +41,6 @@ from types import MethodType
 from typing import Any, Final
 
 from fsmbt import limits
-from fsmbt.limits import Limits
 from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.errors import InputError, UnsupportedError
 from fsmbt.model.kinds import NodeKind
@@ -76,9 +75,6 @@ OUTCOME_RUNNING: Final[str] = LeafOutcome.RUNNING.value
 OUTCOME_TO_STATUS: dict[str, int] = {o.value: o.status.value for o in LeafOutcome}
 STATUS_TO_OUTCOME: dict[int, str] = {v: k for k, v in OUTCOME_TO_STATUS.items()}
 
-#: The default upper bound on nodes after SubTree expansion (a SubTree used twice per level
-#: doubles); the bound in force is ``fsmbt.limits.current().max_nodes`` (``FSMBT_MAX_NODES``).
-MAX_COMPILED_NODES = Limits.max_nodes
 
 # -- supported node types: the node registry (fsmbt.semantics.nodes) ----------------------------
 # Which kinds are ticked and by which rule, their default memory, which are refused and why:
@@ -134,6 +130,7 @@ class CompiledTree:
         stack: list[tuple[BTNode, int | None, int, tuple[str, ...]]] = [
             (tree.root, None, 0, (tree.id,))
         ]
+        # nodes once SubTrees are expanded (a SubTree used twice per level doubles the tree)
         max_nodes = limits.current().max_nodes
         while stack:
             node, parent, position, chain = stack.pop()
