@@ -266,12 +266,17 @@ def render_pages(
     pages += [(path.replace("/", "__"), path) for path in composite_paths(model)]
     written: list[Path] = []
     for stem, composite in pages:
-        safe = "".join(c if c.isalnum() or c in "-_." else "_" for c in stem)
+        safe = _page_stem(stem)
         path = folder / f"{safe}.{fmt}"
         check_output(path, overwrite=overwrite)
         source = fsm_to_dot(model, max_nodes=max_nodes, level=0, composite=composite, notes=notes)
         written.append(write_picture(source, path, overwrite=overwrite, max_aspect=MAX_ASPECT))
     return written
+
+
+def _page_stem(name: str) -> str:
+    """A page's file name from a composite path or tree ID: plain characters only."""
+    return "".join(c if c.isalnum() or c in "-_." else "_" for c in name)
 
 
 def _tree_pages(
@@ -288,7 +293,7 @@ def _tree_pages(
     taken: set[str] = set()
     paths: list[Path] = []
     for tree_id in order:
-        stem = "".join(c if c.isalnum() or c in "-_." else "_" for c in tree_id) or "tree"
+        stem = _page_stem(tree_id) or "tree"
         unique, count = stem, 1
         while unique.lower() in taken:  # two IDs that differ only in unsafe characters or case
             count += 1
