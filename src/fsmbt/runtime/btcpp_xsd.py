@@ -15,55 +15,32 @@ per distinct ``<TreeNodesModel>`` (memoised) and validates with lxml in O(file s
 
 from __future__ import annotations
 
-import hashlib
-import os
-import shutil
 import subprocess
 from functools import lru_cache
 from pathlib import Path
 
 from lxml import etree
 
-from fsmbt.runtime.cpp import PACKAGE_DIR, CppRuntimeError, library_built, library_prefix
+from fsmbt.runtime.cpp import PACKAGE_DIR, CppRuntimeError
 from fsmbt.semantics.engines.btcpp_load import declarations
+from fsmbt.semantics.engines.btcpp_tool import ToolBuildError, build_tool, tool_path
 
 XSD_SOURCE = PACKAGE_DIR / "xsd" / "fsmbt_btcpp_xsd.cpp"
 
 
 def program_path() -> Path:
     """Where the program built from this package's source is (may not exist)."""
-    digest = hashlib.sha256(XSD_SOURCE.read_bytes()).hexdigest()[:16]
-    return library_prefix() / "bin" / f"fsmbt_btcpp_xsd-{digest}"
+    return tool_path(XSD_SOURCE, "fsmbt_btcpp_xsd")
 
 
 def find_program(*, build: bool = True) -> Path | None:
     """The program, compiled first when ``build`` and the library is there; ``None`` when the
-    library is not built or no C++ compiler is found."""
-    path = program_path()
-    if path.is_file() and os.access(path, os.X_OK):
-        return path
-    if not build or not library_built():
-        return None
-    compiler = os.environ.get("CXX") or shutil.which("g++") or shutil.which("clang++")
-    if compiler is None:
-        return None
-    prefix = library_prefix()
-    path.parent.mkdir(parents=True, exist_ok=True)
-    partial = path.with_name(f"{path.name}.{os.getpid()}.tmp")
-    done = subprocess.run(
-        [compiler, "-std=c++17", "-O1", "-o", str(partial), str(XSD_SOURCE)]
-        + [f"-I{prefix / 'include'}", f"-L{prefix / 'lib'}", f"-Wl,-rpath,{prefix / 'lib'}"]
-        + ["-lbehaviortree_cpp", "-lpthread", "-ldl"],
-        capture_output=True,
-        text=True,
-        timeout=600,
-        check=False,
-    )
-    if done.returncode != 0:
-        partial.unlink(missing_ok=True)
-        raise CppRuntimeError(f"cannot compile {XSD_SOURCE.name}: {done.stderr.strip()[:400]}")
-    partial.replace(path)  # atomic: a concurrent build writes the same bytes
-    return path
+    library is not built or no C++ compiler is found (``CppRuntimeError`` when it does not
+    compile)."""
+    try:
+        return build_tool(XSD_SOURCE, "fsmbt_btcpp_xsd", build=build)
+    except ToolBuildError as exc:
+        raise CppRuntimeError(str(exc)) from exc
 
 
 @lru_cache(maxsize=256)

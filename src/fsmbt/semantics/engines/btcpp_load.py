@@ -23,11 +23,8 @@ process start plus BehaviorTree.CPP's load, O(file size) (a 100 000-state LEBT: 
 
 from __future__ import annotations
 
-import hashlib
 import json
-import os
 import re
-import shutil
 import subprocess
 import tempfile
 from dataclasses import dataclass
@@ -35,8 +32,9 @@ from pathlib import Path
 
 from lxml import etree
 
-from fsmbt.cache import BTCPP_VERSION, btcpp_prefix
+from fsmbt.cache import BTCPP_VERSION
 from fsmbt.model.errors import FsmbtError, SourceLocation
+from fsmbt.semantics.engines.btcpp_tool import ToolBuildError, build_tool, tool_path
 
 SOURCE = Path(__file__).resolve().with_name("btcpp_load.cpp")
 ENGINE_CPP = f"BehaviorTree.CPP {BTCPP_VERSION}"
@@ -90,48 +88,16 @@ class LoadCheck:
 
 def program_path() -> Path:
     """Where the program built from this module's C++ source is (may not exist)."""
-    digest = hashlib.sha256(SOURCE.read_bytes()).hexdigest()[:16]
-    return btcpp_prefix() / "bin" / f"fsmbt_btcpp_load-{digest}"
-
-
-def _library_built() -> bool:
-    prefix = btcpp_prefix()
-    return (prefix / "lib" / "libbehaviortree_cpp.so").is_file() and (
-        prefix / "include" / "behaviortree_cpp" / "bt_factory.h"
-    ).is_file()
+    return tool_path(SOURCE, "fsmbt_btcpp_load")
 
 
 def find_program(*, build: bool = True) -> Path | None:
     """The compiled check, compiled first when ``build`` and the library is there; ``None``
     when the library is not built, no C++ compiler is found or compiling fails."""
-    path = program_path()
-    if path.is_file() and os.access(path, os.X_OK):
-        return path
-    if not build or not _library_built():
+    try:  # a read-only cache, a refused source or a compiler that hangs: no C++ check
+        return build_tool(SOURCE, "fsmbt_btcpp_load", build=build)
+    except (ToolBuildError, OSError, subprocess.TimeoutExpired):
         return None
-    compiler = os.environ.get("CXX") or shutil.which("g++") or shutil.which("clang++")
-    if compiler is None:
-        return None
-    prefix = btcpp_prefix()
-    partial = path.with_name(f"{path.name}.{os.getpid()}.tmp")
-    try:  # a read-only cache or a compiler that hangs: no C++ check, never a traceback
-        path.parent.mkdir(parents=True, exist_ok=True)
-        done = subprocess.run(
-            [compiler, "-std=c++17", "-O1", "-o", str(partial), str(SOURCE)]
-            + [f"-I{prefix / 'include'}", f"-L{prefix / 'lib'}", f"-Wl,-rpath,{prefix / 'lib'}"]
-            + ["-lbehaviortree_cpp", "-lpthread", "-ldl"],
-            capture_output=True,
-            text=True,
-            timeout=600,
-            check=False,
-        )
-        if done.returncode != 0:
-            partial.unlink(missing_ok=True)
-            return None
-        partial.replace(path)  # atomic: a concurrent build writes the same bytes
-    except (OSError, subprocess.TimeoutExpired):
-        return None
-    return path
 
 
 def declarations(root: etree._Element) -> str:
