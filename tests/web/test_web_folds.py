@@ -16,7 +16,7 @@ from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.render.anchor_ids import child_path
 from fsmbt.web import WebSettings, create_app
 from fsmbt.web.answers import request_key
-from support.web_models import hierarchical_scxml
+from support.web_models import hierarchical_scxml, nested_scxml
 
 FOLD_IDS = re.compile(r'<g id="(fold@[^"]*)" class="node fold"')
 NODE_IDS = re.compile(r'<g id="n@([^"]*)" class="node')
@@ -89,6 +89,21 @@ def test_a_closed_composite_state_opens_to_its_states(client):
     assert data["composite"] == "G3" and data["kind"] == "fsm"
     states = {anchor for anchor, _ in STATE_IDS.findall(data["svg"])}
     assert states == {f"G3/G3_{i}" for i in range(10)}
+
+
+def test_a_composite_opened_inside_an_opened_composite_keeps_full_paths(client):
+    text = nested_scxml(outer=3, groups=8, inner=10)
+
+    def closed(composite: str | None) -> list[str]:
+        body = {"text": text, "filename": "n.scxml", "composite": composite}
+        return CLOSED_IDS.findall(client.post("/api/picture", json=body).json()["svg"])
+
+    assert closed("O1") == [f"O1/O1G{g}" for g in range(8)]
+    data = client.post(
+        "/api/picture", json={"text": text, "filename": "n.scxml", "composite": "O1/O1G2"}
+    ).json()
+    states = {anchor for anchor, _ in STATE_IDS.findall(data["svg"])}
+    assert states == {f"O1/O1G2/O1G2_{i}" for i in range(10)}
 
 
 def test_wrong_openings_are_located_json_errors(client, big_bt):
