@@ -65,6 +65,19 @@ def test_folded_subtrees_account_for_every_node_and_name_their_path() -> None:
     assert "focus=PATH" in notes[0] and "depth=N" in notes[0]
 
 
+def test_with_anchors_each_fold_box_names_its_folded_node_for_a_page_to_open() -> None:
+    doc = big_tree()
+    source = model_to_dot(doc, expand_subtrees=True, anchors=True)
+    boxes = FOLD_BOX.findall(source)
+    ids = re.findall(r'id="fold@([^"]+)"', source)
+    assert boxes and sorted(ids) == sorted(path for _, path in boxes)
+    assert source.count("class=fold") == len(ids)
+    # the box's id opens exactly that subtree: focus on it draws the folded node on top
+    opened = model_to_dot(doc, expand_subtrees=True, anchors=True, focus=ids[0])
+    assert f'id="n@{ids[0]}"' in opened
+    assert "fold@" not in model_to_dot(doc, expand_subtrees=True)  # no anchors: no ids
+
+
 def test_small_trees_and_the_dot_file_format_are_not_folded() -> None:
     doc = api.load(EXAMPLES / "robot_bt.xml").model
     notes: list[str] = []

@@ -18,11 +18,14 @@ from typing import TYPE_CHECKING
 
 import typer
 
+from fsmbt.web.admission import parse_networks
 from fsmbt.web.answers import DEFAULT_CACHE_BYTES
 from fsmbt.web.settings import (
     DEFAULT_CPU_LIMIT_S,
     DEFAULT_MAX_BODY_BYTES,
     DEFAULT_MAX_WAITING,
+    DEFAULT_RATE_BURST,
+    DEFAULT_RATE_LIMIT,
     DEFAULT_TIMEOUT_S,
     DEFAULT_WORKERS,
 )
@@ -122,6 +125,34 @@ def register(app: typer.Typer) -> None:
         workers: int = typer.Option(
             DEFAULT_WORKERS, "--workers", min=1, max=64, help="worker processes for conversions"
         ),
+        rate_limit: float = typer.Option(
+            DEFAULT_RATE_LIMIT,
+            "--rate-limit",
+            min=0.0,
+            envvar="FSMBT_RATE_LIMIT",
+            help="requests a second each client may sustain (429 with Retry-After past it; "
+            "0: no per-client limit; loopback clients exempt unless --rate-limit-loopback)",
+        ),
+        rate_burst: int = typer.Option(
+            DEFAULT_RATE_BURST,
+            "--rate-burst",
+            min=1,
+            envvar="FSMBT_RATE_BURST",
+            help="requests a client may send at once before --rate-limit applies",
+        ),
+        rate_limit_loopback: bool = typer.Option(
+            False,
+            "--rate-limit-loopback",
+            envvar="FSMBT_RATE_LIMIT_LOOPBACK",
+            help="limit loopback clients too (exempt by default)",
+        ),
+        trusted_proxy: list[str] = typer.Option(
+            [],
+            "--trusted-proxy",
+            envvar="FSMBT_TRUSTED_PROXIES",
+            help="address or network of a reverse proxy whose X-Forwarded-For names the "
+            "client (repeatable; without it the header is ignored)",
+        ),
     ) -> None:
         """Serve the web page: convert, compare both pictures, step through a counterexample."""
         import uvicorn
@@ -132,6 +163,10 @@ def register(app: typer.Typer) -> None:
         for name, folder in (("--reports", reports), ("--examples", examples)):
             if folder is not None and not folder.is_dir():
                 raise fail(f"{name} {folder}: not a folder")
+        try:
+            parse_networks(trusted_proxy)
+        except ValueError as exc:
+            raise fail(f"--trusted-proxy: {exc}") from None
         changes: dict[str, object] = {
             "max_body_bytes": max_body,
             "timeout_s": timeout,
@@ -141,6 +176,10 @@ def register(app: typer.Typer) -> None:
             "cache_dir": cache_dir,
             "workers": workers,
             "reports_dir": reports,
+            "rate_limit": rate_limit,
+            "rate_burst": rate_burst,
+            "rate_limit_loopback": rate_limit_loopback,
+            "trusted_proxies": tuple(trusted_proxy),
         }
         if examples is not None:
             changes["examples_dir"] = examples
@@ -162,6 +201,10 @@ def register(app: typer.Typer) -> None:
                 port=port,
                 log_level="warning",
                 timeout_graceful_shutdown=GRACE_S,
+                # X-Forwarded-For is read by fsmbt.web.admission, and only from the proxies
+                # named with --trusted-proxy; uvicorn's own handling would believe it from
+                # any loopback peer
+                proxy_headers=False,
             )
         )
         try:

@@ -167,6 +167,8 @@ def svg_text(
     max_nodes: int = DEFAULT_MAX_NODES,
     anchors: bool = True,
     timeout: float = DOT_TIMEOUT_S,
+    focus: str | None = None,
+    composite: str | None = None,
 ) -> str:
     """The picture of ``model`` as an SVG document to embed in a page (no XML prolog).
 
@@ -175,6 +177,9 @@ def svg_text(
         expand_subtrees, max_nodes, anchors: as for ``model_to_dot`` (``expand_subtrees`` is
             ignored for an FSM, so one call serves either kind).
         timeout: seconds Graphviz may take.
+        focus, composite: as for ``model_to_dot``: a BT's subtree under ``focus`` alone (what
+            a fold box opens), an FSM's composite state ``composite`` alone (what a closed
+            composite's box opens); each is refused (``InputError``) for the other kind.
 
     Returns:
         The ``<svg>`` element's text.
@@ -185,7 +190,13 @@ def svg_text(
     """
     expand = expand_subtrees and not isinstance(model, FSM)  # an FSM has no SubTrees
     source = picture_dot(
-        model, expand_subtrees=expand, max_nodes=max_nodes, anchors=anchors, timeout=timeout
+        model,
+        expand_subtrees=expand,
+        max_nodes=max_nodes,
+        anchors=anchors,
+        timeout=timeout,
+        focus=focus,
+        composite=composite,
     )
     data = fit_aspect(source, "svg", run_dot(source, "svg", timeout=timeout), timeout=timeout)
     text = data.decode("utf-8")

@@ -253,6 +253,11 @@ class Ghost:
     parent: str | None = None
 
 
+#: With anchors, a fold box's SVG id is this prefix and its folded node's anchor path
+#: (``fold@0/2``, ``fold@root``; without SubTrees expanded ``fold@<tree>@<path>``) and its class
+#: ``FOLD_CLASS``: what a page clicks to draw the folded subtree (``focus``).
+FOLD_PREFIX = "fold@"
+FOLD_CLASS = "fold"
 #: How a fold box (hidden nodes) looks.
 FOLD_STYLE = {"shape": "box", "style": "dashed,rounded", "color": "gray45", "fontcolor": "gray25"}
 #: How a ghost looks: dashed, grey, no fill.
@@ -482,7 +487,10 @@ class _Builder:
                     )
             children = drawn_children(self.doc, node, entry.trees, entry.where, self.expanding)
             if plan is not None and entry.where in plan.folded:
-                self.draw_fold(node_id, entry.holder, entry.where, plan.folded[entry.where])
+                fold_anchor = FOLD_PREFIX + anchor.removeprefix("n@")
+                self.draw_fold(
+                    node_id, entry.holder, entry.where, plan.folded[entry.where], fold_anchor
+                )
                 children = []
             if children:
                 stack.extend(reversed(self.child_entries(entry, node_id, children, plan)))
@@ -582,13 +590,20 @@ class _Builder:
         self.planned[(trees, where)] = plan
         return plan
 
-    def draw_fold(self, node_id: str, holder: graphviz.Digraph, where: str, hidden: int) -> None:
+    def draw_fold(
+        self, node_id: str, holder: graphviz.Digraph, where: str, hidden: int, anchor: str
+    ) -> None:
+        """The ``[k nodes]`` box under the folded node ``node_id``; with anchors its SVG id is
+        ``anchor`` (``fold@`` + the folded node's anchor path) and its class ``fold``, so a page
+        can open it (draw with ``focus`` = the path after ``fold@``)."""
         box = self.next_id("f")
         word = "node" if hidden == 1 else "nodes"
+        extra = {"id": anchor, "class": FOLD_CLASS} if self.anchors else {}
         holder.node(
             box,
             label=html_label([f"[{hidden} {word}]"], [f"focus {where or 'root'}"]),
             **FOLD_STYLE,
+            **extra,
         )
         self.edges.append((node_id, box, {"style": "dashed", "color": "gray45"}))
 

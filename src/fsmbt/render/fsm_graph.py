@@ -58,6 +58,9 @@ from fsmbt.render.dot import (
 #: reader (``fsmbt.formats.diagrams.dot``) takes a node of this name as the start marker.
 START_NODE = "__start__"
 
+#: The SVG class of a closed composite state's box (with anchors; its id is the state's
+#: ``s@`` anchor): what a page clicks to draw that composite alone.
+CLOSED_CLASS = "fold"
 #: Nested clusters beyond this depth make dot slow and the picture unreadable.
 MAX_NESTING = 60
 #: Beyond these sizes the layered ``dot`` layout is too slow; ``sfdp`` is used, without clusters.
@@ -254,7 +257,12 @@ def fsm_to_dot(
     marks = marks or {}
     drawn: dict[str, str] = {}  # anchor id -> DOT node id of atomic states, for ghost edges
     level_cap = level  # the drawing loop below names each machine being drawn ``lv``
-    top = _Level(fsm, root)
+    # a composite drawn alone keeps its states' full paths in their anchors (s@A/B/x)
+    top_anchor = ""
+    if composite is not None and not exchange:
+        parent = composite.rpartition("/")[0]  # a parallel one is drawn as its parent's state
+        top_anchor = f"{composite}/" if first_level == 0 else (f"{parent}/" if parent else "")
+    top = _Level(fsm, root, anchor=top_anchor)
     depth_of: dict[int, int] = {id(top): 0}
     pending: list[_Level] = [top]
     levels: list[_Level] = []
@@ -273,12 +281,20 @@ def fsm_to_dot(
                 node_id = counter.state_id(lv, state.name)
                 lv.ids[state.name] = node_id
                 inside = _inner_states(state)
+                # anchors: the closed box carries the composite's id and the class a page
+                # clicks to draw it (composite=PATH)
+                closed_extra = (
+                    {"id": state_anchor(lv.anchor + state.name), "class": CLOSED_CLASS}
+                    if anchors
+                    else {}
+                )
                 lv.graph.node(
                     node_id,
                     label=label_text(_state_title(state, title), f"[{inside} states inside]"),
                     shape="box",
                     style="rounded,bold,filled",
                     fillcolor="gray95",
+                    **closed_extra,
                 )
                 continue
             if state.is_atomic:

@@ -14,9 +14,10 @@ calls the API below, so everything it shows is available to any client:
 Rules: bodies over ``max_body_bytes`` are refused (413) before they are read whole; JSON or
 multipart only (415 otherwise); no request names a server path (uploads are texts, examples are
 picked by name from a listing, report files are resolved inside ``reports_dir`` and refused
-outside it); every error is ``{"error": "<one line>", "where": ...}`` with a 4xx (bad input;
-408/422 past the wall/CPU-time limit), 503 with ``Retry-After`` (busy) or 500 (a bug, logged) -
-never a traceback.
+outside it); a client over its rate gets 429 with ``Retry-After`` (``admission``); every error
+is ``{"error": "<one line>", "where": ...}`` with a 4xx (bad input; 408/422 past the
+wall/CPU-time limit; 429 over the client's rate), 503 with ``Retry-After`` (busy) or 500 (a bug,
+logged) - never a traceback.
 """
 
 from __future__ import annotations
@@ -29,6 +30,7 @@ from fastapi import FastAPI
 from fastapi.staticfiles import StaticFiles
 
 from fsmbt.web import routes_pipeline, routes_reference, routes_reports
+from fsmbt.web.admission import ClientRateLimit
 from fsmbt.web.answers import AnswerCache
 from fsmbt.web.errors import BodyLimit, install_handlers
 from fsmbt.web.headers import SecurityHeaders
@@ -71,6 +73,13 @@ def create_app(settings: WebSettings | None = None) -> FastAPI:
     app.state.settings = settings
     app.state.cache = (
         AnswerCache(settings.cache_bytes, settings.cache_dir) if settings.cache_bytes > 0 else None
+    )
+    app.add_middleware(  # inside BodyLimit: a refused client's body is bounded when drained
+        ClientRateLimit,
+        rate=settings.rate_limit,
+        burst=settings.rate_burst,
+        trusted=settings.trusted_proxies,
+        limit_loopback=settings.rate_limit_loopback,
     )
     app.add_middleware(BodyLimit, limit=settings.max_body_bytes, drain_cap=settings.drain_cap_bytes)
     app.add_middleware(SecurityHeaders)  # outermost: the 413s carry them too

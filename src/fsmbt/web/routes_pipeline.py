@@ -16,7 +16,7 @@ from fsmbt.web.answers import request_key
 from fsmbt.web.bodies import body_doc, model_body, pair_body
 from fsmbt.web.errors import ApiError
 from fsmbt.web.routes_reference import llm_engines
-from fsmbt.web.schemas import ConvertBody, ExportBody, ModelText, VerifyBody
+from fsmbt.web.schemas import ConvertBody, ExportBody, ModelText, PictureBody, VerifyBody
 from fsmbt.web.workers import Busy, CpuTimeout, WorkerCrashed, WorkTimeout
 
 router = APIRouter()
@@ -114,6 +114,16 @@ async def convert(request: Request) -> Any:
 async def verify(request: Request) -> Any:
     body = await pair_body(request, VerifyBody)
     return await json_work(request, service.verify, body)
+
+
+@router.post(
+    "/api/picture",
+    summary="One model's picture with a fold opened (a BT subtree, an FSM composite state)",
+    openapi_extra=body_doc(PictureBody),
+)
+async def picture(request: Request) -> Any:
+    body = await model_body(request, PictureBody)
+    return await json_work(request, service.picture, body)
 
 
 @router.post(

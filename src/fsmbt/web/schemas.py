@@ -58,6 +58,21 @@ class VerifyBody(BaseModel):
     options: Options = Options()
 
 
+class PictureBody(ModelText):
+    """One model's picture with a fold opened (the page's click on a fold box)."""
+
+    focus: str | None = Field(
+        default=None,
+        description="BT: draw the subtree under this node, a child-index path from the main "
+        "root with SubTrees expanded (`0/2/1`, `root`): what a `fold@PATH` box opens",
+    )
+    composite: str | None = Field(
+        default=None,
+        description="FSM: draw this composite state alone (`A/B`): what a closed "
+        "composite's box (class `fold`, id `s@A/B`) opens",
+    )
+
+
 class ExportBody(ModelText):
     """A model to download in another format."""
 

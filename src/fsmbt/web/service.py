@@ -343,6 +343,57 @@ def verify(request: dict[str, Any]) -> dict[str, Any]:
     }
 
 
+def picture(request: dict[str, Any]) -> dict[str, Any]:
+    """One model's picture with a fold opened: the page's click on a ``[k nodes]`` box of a
+    behavior tree (``focus``: that node's path from the main root, SubTrees expanded, as the
+    box's ``fold@`` id names it) or on a closed composite state's box (``composite``: its
+    path ``A/B``); without either, the picture the convert and verify answers show. The
+    subtree is drawn by ``fsmbt render``'s rules (docs/cli.md 'Pictures at any size'): a big
+    one is folded again, each fold openable in turn, and anchors keep their full paths, so a
+    counterexample step still finds its element.
+
+    Args:
+        request: ``{"text", "filename"?, "format"?, "focus"?, "composite"?}``.
+
+    Returns:
+        ``{"kind", "focus", "composite", "svg", "error"}`` (``error``: the picture is over
+        the drawing limit; then ``svg`` is ``None``).
+
+    Raises:
+        FsmbtError: unreadable model, ``focus`` on an FSM or ``composite`` on a BT, or a path
+        naming no node / composite state.
+    """
+    loaded = _load(request)
+    focus = request.get("focus") or None
+    composite = request.get("composite") or None
+    if focus is not None and composite is not None:
+        raise InputError("open one fold at a time: focus (a BT node) or composite (an FSM state)")
+    is_bt = isinstance(loaded.model, BTDocument)
+    if focus is not None and not is_bt:
+        raise InputError("focus opens a fold of a behavior tree; this is an FSM (use composite)")
+    if composite is not None and is_bt:
+        raise InputError(
+            "composite opens a composite state of an FSM; this is a behavior tree (use focus)"
+        )
+    try:
+        svg = svg_text(
+            loaded.model,
+            expand_subtrees=True,
+            focus=None if focus is None else str(focus),
+            composite=None if composite is None else str(composite),
+        )
+        error = None
+    except TooLargeError as exc:
+        svg, error = None, exc.text(WEB_WORDING)
+    return {
+        "kind": loaded.kind,
+        "focus": focus,
+        "composite": composite,
+        "svg": svg,
+        "error": error,
+    }
+
+
 def export(request: dict[str, Any]) -> tuple[bytes, str, str]:
     """A model (typically a conversion's result) in another format, for download.
 

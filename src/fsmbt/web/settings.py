@@ -28,6 +28,12 @@ DEFAULT_CPU_LIMIT_S = 20.0
 DEFAULT_MAX_WAITING = 1000
 #: Worker processes.
 DEFAULT_WORKERS = 2
+#: Requests a second each client may sustain (token bucket per client address,
+#: ``fsmbt.web.admission``); past it 429 with ``Retry-After``. Loopback clients are exempt
+#: unless ``rate_limit_loopback``.
+DEFAULT_RATE_LIMIT = 20.0
+#: Requests a client may send at once (the bucket's size): a burst of 200 fits.
+DEFAULT_RATE_BURST = 400
 
 
 def default_examples_dir() -> Path | None:
@@ -51,6 +57,12 @@ class WebSettings:
         drain_cap_bytes: an over-limit body is read and dropped up to this size so the client
             gets its 413 (``errors.BodyLimit``); past it the connection is closed.
         workers: worker processes.
+        rate_limit: requests a second each client may sustain (0: no per-client limit); past
+            it 429 with ``Retry-After`` (``fsmbt.web.admission``).
+        rate_burst: requests a client may send at once.
+        rate_limit_loopback: limit loopback clients too (exempt by default).
+        trusted_proxies: addresses or networks of reverse proxies whose ``X-Forwarded-For``
+            names the client (empty: the header is ignored).
         examples_dir: the folder whose model files the page offers as examples (``None``: none).
         reports_dir: the folder of evaluation reports and batch stores browsed read-only
             (``None``: browsing is off).
@@ -64,6 +76,10 @@ class WebSettings:
     cache_bytes: int = DEFAULT_CACHE_BYTES
     cache_dir: Path | None = None
     workers: int = DEFAULT_WORKERS
+    rate_limit: float = DEFAULT_RATE_LIMIT
+    rate_burst: int = DEFAULT_RATE_BURST
+    rate_limit_loopback: bool = False
+    trusted_proxies: tuple[str, ...] = ()
     examples_dir: Path | None = None
     reports_dir: Path | None = None
 

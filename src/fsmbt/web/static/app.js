@@ -141,18 +141,65 @@ async function loadChoices() {
 
 // -- results: pictures, verdict, properties, metrics, warnings, downloads, stepper -------
 function mountSvg(box, svgText, error) {
+  if (box.panZoom) { try { box.panZoom.destroy(); } catch (_) { /* already gone */ } box.panZoom = null; }
   box.textContent = "";
   if (!svgText) { box.append(el("div", { class: "error" }, error || "no picture")); return null; }
   box.innerHTML = svgText;
+  for (const fold of box.querySelectorAll(".fold")) {  // a fold box: say what a click does
+    const title = fold.querySelector("title");
+    if (title) title.textContent = fold.id.startsWith("fold@") ? "click: draw this subtree" : "click: draw this composite state";
+  }
   const svg = box.querySelector("svg");
   svg.removeAttribute("width");
   svg.removeAttribute("height");
   svg.setAttribute("width", "100%");
   svg.setAttribute("height", "100%");
   if (window.svgPanZoom) {
-    return window.svgPanZoom(svg, { controlIconsEnabled: true, zoomScaleSensitivity: 0.3, minZoom: 0.2, maxZoom: 20 });
+    box.panZoom = window.svgPanZoom(svg, { controlIconsEnabled: true, zoomScaleSensitivity: 0.3, minZoom: 0.2, maxZoom: 20 });
+    return box.panZoom;
   }
   return null;
+}
+
+// -- folds: a click on a folded subtree ([k nodes], id fold@PATH) or a closed composite state
+// (class fold, id s@PATH) draws it alone (POST /api/picture, docs/web.md 'Big models'); the
+// breadcrumb above the picture goes back. Each level's picture is kept, so going back draws
+// nothing again; the server caches each opened picture by its request (model and path).
+function setupFolds(box, crumbs, model, svgText, error) {
+  const levels = [{ label: "whole model", svg: svgText, error }];
+  function draw() {
+    const level = levels[levels.length - 1];
+    mountSvg(box, level.svg, level.error);
+    crumbs.textContent = "";
+    crumbs.hidden = levels.length === 1 && !box.querySelector(".fold");
+    levels.forEach((entry, i) => {
+      if (i) crumbs.append(document.createTextNode(" › "));
+      const last = i === levels.length - 1;
+      const crumb = el(last ? "span" : "a", last ? { class: "crumb current" } : { href: "#", class: "crumb", "data-level": i }, entry.label);
+      if (!last) crumb.addEventListener("click", (e) => { e.preventDefault(); levels.length = i + 1; draw(); });
+      crumbs.append(crumb);
+    });
+    if (levels.length === 1 && box.querySelector(".fold")) crumbs.append(el("span", { class: "muted" }, "  (click a dashed box to open it)"));
+    box.dataset.level = String(levels.length - 1);
+    box.dispatchEvent(new Event("fsmbt:redrawn"));
+  }
+  box.addEventListener("click", async (e) => {
+    const fold = e.target.closest && e.target.closest(".fold");
+    if (!fold || !box.contains(fold)) return;
+    const isTree = fold.id.startsWith("fold@");
+    const path = isTree ? fold.id.slice("fold@".length) : fold.id.slice("s@".length);
+    const body = Object.assign({}, model, isTree ? { focus: path } : { composite: path });
+    box.classList.add("loading");
+    try {
+      const data = await api("/api/picture", body);
+      levels.push({ label: isTree ? (path === "root" ? "root" : path) : path, svg: data.svg, error: data.error });
+      draw();
+    } catch (err) {
+      crumbs.hidden = false;
+      crumbs.append(el("span", { class: "error" }, ` ${err.message}`));
+    } finally { box.classList.remove("loading"); }
+  });
+  draw();
 }
 
 function role(root, name) { return root.querySelector(`[data-role="${name}"]`); }
@@ -247,6 +294,7 @@ function setupStepper(root, ce, left, right, leftSvg, rightSvg) {
   role(root, "prev").addEventListener("click", () => show(current - 1));
   role(root, "next").addEventListener("click", () => show(current + 1));
   role(root, "last").addEventListener("click", () => show(ce.steps.length - 1));
+  for (const svgBox of [leftSvg, rightSvg]) svgBox.addEventListener("fsmbt:redrawn", () => show(current));
   show(0);
 }
 
@@ -299,6 +347,7 @@ async function convert() {
   $("convert").disabled = true;
   $("convert").textContent = "Converting…";
   try {
+    const sourceModel = sourceRequest();  // what a fold of the source picture is drawn from
     const body = sourceRequest();
     body.engine = $("engine").value || "rules";
     body.options = { loop: $("loop").checked, hierarchy: $("hierarchy").value || "subtrees", style: $("style").value || "auto" };
@@ -309,8 +358,9 @@ async function convert() {
     role(box, "right-title").textContent = `result (${data.result.format})`;
     const leftBox = role(box, "left"), rightBox = role(box, "right");
     leftBox.id = "svg-source"; rightBox.id = "svg-result";
-    mountSvg(leftBox, data.svg.source, data.svg_errors.source);
-    mountSvg(rightBox, data.svg.result, data.svg_errors.result);
+    setupFolds(leftBox, role(box, "left-crumbs"), sourceModel, data.svg.source, data.svg_errors.source);
+    setupFolds(rightBox, role(box, "right-crumbs"), { text: data.result.text, format: data.result.format },
+      data.svg.result, data.svg_errors.result);
     fillTables(box, data, data.metrics.source, data.metrics.result);
     fillDownloads(box, data);
     setupStepper(box, data.counterexample, "source", "result", leftBox, rightBox);
@@ -348,8 +398,8 @@ async function verify() {
     role(box, "right-title").textContent = `second (${data.formats.second})${data.source_side === "second" ? " — source of the check" : ""}`;
     const leftBox = role(box, "left"), rightBox = role(box, "right");
     leftBox.id = "svg-first"; rightBox.id = "svg-second";
-    mountSvg(leftBox, data.svg.first, data.svg_errors.first);
-    mountSvg(rightBox, data.svg.second, data.svg_errors.second);
+    setupFolds(leftBox, role(box, "left-crumbs"), model("first"), data.svg.first, data.svg_errors.first);
+    setupFolds(rightBox, role(box, "right-crumbs"), model("second"), data.svg.second, data.svg_errors.second);
     role(box, "m-left").textContent = "first"; role(box, "m-right").textContent = "second";
     fillTables(box, data, data.metrics.first, data.metrics.second);
     const [left, right] = data.source_side === "first" ? ["source", "result"] : ["result", "source"];
