@@ -76,7 +76,7 @@ from fsmbt.semantics.bt_interpreter import (
     CompiledTree,
     Snapshot,
 )
-from fsmbt.semantics.nodes import node_semantics, runtime_tables
+from fsmbt.semantics.nodes import SUBTREE_TYPE, node_semantics, runtime_tables
 
 #: The interpreter's control rules whose nodes may be in the canonical class (the registry
 #: names each kind's rule, ``NodeSemantics.handler``).
@@ -120,7 +120,7 @@ def is_canonical_class(tree: CompiledTree) -> bool:
             if handler == "gated" and _gate_closed_skipped(node):
                 return False
         elif node.kind is NodeKind.SUBTREE:
-            if node.type != "SubTree" or len(node.children) != 1:
+            if node.type != SUBTREE_TYPE or len(node.children) != 1:
                 return False
         elif node.kind not in (NodeKind.ACTION, NodeKind.CONDITION):
             return False

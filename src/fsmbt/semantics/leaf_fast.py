@@ -37,7 +37,13 @@ from typing import Final
 
 from fsmbt.model.kinds import NodeKind
 from fsmbt.semantics.bt_interpreter import CompiledTree
-from fsmbt.semantics.nodes import FALLBACK_TYPES, PLAIN_CONTROLS, node_semantics, rewired
+from fsmbt.semantics.nodes import (
+    FALLBACK_TYPES,
+    PLAIN_CONTROLS,
+    SUBTREE_TYPE,
+    node_semantics,
+    rewired,
+)
 from fsmbt.semantics.status import LeafOutcome, RootResult
 
 ROOT = 0  # the compiled root's id (ids are pre-order indices)
@@ -59,7 +65,7 @@ def is_plain_tree(tree: CompiledTree) -> bool:
             if node.type not in PLAIN_CONTROLS or not node.children:
                 return False
         elif node.kind is NodeKind.SUBTREE:
-            if node.type != "SubTree" or len(node.children) != 1:
+            if node.type != SUBTREE_TYPE or len(node.children) != 1:
                 return False
         elif not node.is_env_leaf:  # decorators, internal built-in leaves
             return False
@@ -96,7 +102,7 @@ def is_static_tree(tree: CompiledTree) -> bool:
             if spec is None or spec.result_map is None:
                 return False
         elif node.kind is NodeKind.SUBTREE:
-            if node.type != "SubTree" or len(node.children) != 1:
+            if node.type != SUBTREE_TYPE or len(node.children) != 1:
                 return False
         elif not node.is_env_leaf:
             return False
