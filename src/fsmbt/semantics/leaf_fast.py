@@ -37,6 +37,7 @@ from typing import Final
 
 from fsmbt.model.kinds import NodeKind
 from fsmbt.semantics.bt_interpreter import CompiledTree
+from fsmbt.semantics.families.registry import rule as family_rule
 from fsmbt.semantics.nodes import (
     FALLBACK_TYPES,
     PLAIN_CONTROLS,
@@ -72,10 +73,17 @@ def is_plain_tree(tree: CompiledTree) -> bool:
     return True
 
 
+def _restarts(handler: str | None) -> bool:
+    """Whether the rule ``handler`` restarts at child 0 on every tick and keeps no memory
+    (``FamilyRule.restarts``: the ``reactive`` rule)."""
+    found = family_rule(handler) if handler is not None else None
+    return found is not None and found.restarts
+
+
 def is_static_tree(tree: CompiledTree) -> bool:
     """Whether ``tree`` has a static leaf table: the plain class, widened (docs/semantics.md §4a)
-    with reactive Sequence/Fallback nodes (registry: ``reactive``) whose subtrees hold no plain
-    control, and status-mapping decorators (registry: ``result_map``). O(N).
+    with reactive Sequence/Fallback nodes (registry: ``reactive``; their family rule says it
+    ``restarts``, ``FamilyRule``) whose subtrees hold no plain control, and status-mapping decorators (registry: ``result_map``). O(N).
 
     Why that shape: a reactive node restarts at child 0 every tick and keeps no memory, and the
     only other memory in the class is a plain node's running index, which is read only when no
@@ -91,7 +99,7 @@ def is_static_tree(tree: CompiledTree) -> bool:
                 spec is None
                 or not node.children
                 or node.type not in PLAIN_CONTROLS
-                and not (spec.reactive and spec.handler == "reactive")
+                and not (spec.reactive and _restarts(spec.handler))
             ):
                 return False
             if node.type in PLAIN_CONTROLS and below:

@@ -17,6 +17,8 @@ kinds declare in ``fsmbt.model.nodes``. Each ``FamilyRule`` has:
   is False when the kind is used as an abstraction (docs/semantics.md §10).
 - ``extra_children(node, params) -> list[BTNode]``: synthetic condition leaves added after the
   node's children at compile time (ManualSelector's picks); ``None``: none.
+- ``restarts``: a node of the rule ticks its children from the first on every tick and keeps
+  no memory (the ``reactive`` rule): ``leaf_fast``'s static tables read it.
 - ``canonical``: a ``CanonicalReads`` when the rule's nodes may be in the canonical class of
   ``semantics/leaf_canonical.py`` (docs/semantics.md §4a): who reads what a node of the rule
   stores; ``None``: a tree with such a node keeps faithful snapshots.
@@ -114,4 +116,5 @@ class FamilyRule:
     tick: TickFn
     params: ParamsFn | None = None
     extra_children: ExtraChildrenFn | None = None
+    restarts: bool = False
     canonical: CanonicalReads | None = None

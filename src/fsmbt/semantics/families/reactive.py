@@ -57,5 +57,5 @@ def tick_reactive(
 
 #: This family's rules, by the ``handler`` name its kinds declare.
 RULES: dict[str, FamilyRule] = {
-    "reactive": FamilyRule(tick_reactive, canonical=PLAIN_READS),
+    "reactive": FamilyRule(tick_reactive, restarts=True, canonical=PLAIN_READS),
 }
