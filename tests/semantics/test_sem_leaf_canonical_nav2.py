@@ -19,11 +19,7 @@ import pytest
 
 from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.bt_nodes import NodeKind
-from fsmbt.semantics.leaf_canonical import (
-    CANONICAL_DECORATOR_RULES,
-    CANONICAL_RULES,
-    is_canonical_class,
-)
+from fsmbt.semantics.leaf_canonical import canonical_rules, is_canonical_class
 from fsmbt.semantics.leaf_machine import LeafMachine
 from fsmbt.semantics.nodes import all_nodes
 from fsmbt.verify import native
@@ -34,7 +30,7 @@ from support.random_trees import LEAVES, TreeGenerator
 #: Controls of the class, from the registry (the rule decides, not a list here).
 CONTROLS = tuple(
     sorted(
-        n.name for n in all_nodes() if n.kind is NodeKind.CONTROL and n.handler in CANONICAL_RULES
+        n.name for n in all_nodes() if n.kind is NodeKind.CONTROL and n.handler in canonical_rules()
     )
 )
 #: Decorators of the class whose gate (if any) does not return SKIPPED.
@@ -43,7 +39,7 @@ DECORATORS = tuple(
         n.name
         for n in all_nodes()
         if n.kind is NodeKind.DECORATOR
-        and n.handler in CANONICAL_DECORATOR_RULES
+        and n.handler in canonical_rules()
         and (n.gate is None or n.gate.closed != "SKIPPED")
     )
 )

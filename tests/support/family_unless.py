@@ -25,7 +25,13 @@ from fsmbt.semantics.compiled import (
 )
 from fsmbt.semantics.families.contract import FamilyRule, Interp
 from fsmbt.semantics.families.registry import register_rule, unregister_rule
-from fsmbt.verify.nusmv.families.contract import BTCore, Resets
+from fsmbt.verify.nusmv.families.common import (
+    SKIPPED,
+    always,
+    every_child_skips,
+    one_child_facts,
+)
+from fsmbt.verify.nusmv.families.contract import BTCore, Resets, RuleTraits
 from fsmbt.verify.nusmv.families.registry import register_nusmv_rule, unregister_nusmv_rule
 
 # 1. The declaration: what the readers, validate and the tables know of the kind.
@@ -61,17 +67,29 @@ def nusmv_unless(core: BTCore, x: CompiledNode, here: str, called: str, resets: 
     core.call(called, child)
     back = f"{here} & res != NONE"
     core.ret(f"{back} & res = R", x.id, "R")
+    core.ret(f"{back} & res = K", x.id, SKIPPED)  # SKIPPED passed on, as tick_unless does
     done = f"{back} & (res = S | res = F)"
     resets[child].append(done)
     core.ret(done, x.id, "case res = S : F; TRUE : S; esac")
 
 
-# 4. Registration (a built-in kind is listed in its family modules instead).
+# 4. What the encoder's whole-tree checks read of the rule (the contract's RuleTraits): it
+# passes SKIPPED on (so a child that may skip is allowed, and it skips when its child does),
+# resets a completed child, and ticks its child on every tick (the livelock test).
+UNLESS_TRAITS = RuleTraits(
+    skip_aware=always,
+    returns_skipped=every_child_skips,
+    keeps_completed=True,
+    leaf_facts=one_child_facts(sure_with_child=True),
+)
+
+
+# 5. Registration (a built-in kind is listed in its family modules instead).
 @contextmanager
 def unless_installed() -> Iterator[None]:
     """``Unless`` known to the registry, the interpreter and the NuSMV encoder in the block."""
     register_rule("unless", FamilyRule(tick_unless))
-    register_nusmv_rule("unless", nusmv_unless)
+    register_nusmv_rule("unless", nusmv_unless, UNLESS_TRAITS)
     try:
         with registered(UNLESS):
             yield

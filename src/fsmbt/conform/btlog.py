@@ -35,6 +35,7 @@ from fsmbt.conform.log import LoggedNode, RecordedLog
 from fsmbt.formats.xml_safe import local_name, parse_xml
 from fsmbt.model.errors import InputError, SourceLocation
 from fsmbt.model.files import read_located
+from fsmbt.model.nodes import SUBTREE_TYPE
 
 MAGIC = b"BTCPP4-FileLogger2"
 PROTOCOL = 1
@@ -165,10 +166,10 @@ def embedded_nodes(xml: str, name: str) -> tuple[dict[int, LoggedNode], int]:
         if root_uid < 0:
             root_uid = uid
         children = [child for child in el if isinstance(child.tag, str)]
-        sub = _subtree(by_fullpath, el.get("_fullpath", "\0"), uid) if tag == "SubTree" else None
+        sub = _subtree(by_fullpath, el.get("_fullpath", "\0"), uid) if tag == SUBTREE_TYPE else None
         if sub is not None:
             children = [child for child in sub if isinstance(child.tag, str)][:1]
-        is_leaf = not children and tag != "SubTree"
+        is_leaf = not children and tag != SUBTREE_TYPE
         nodes[uid] = LoggedNode(uid, el.get("name") or tag, tag, path, is_leaf)
         for index in range(len(children) - 1, -1, -1):
             stack.append((children[index], f"{path}/{index}" if path else str(index)))

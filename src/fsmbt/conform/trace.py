@@ -29,6 +29,7 @@ from typing import IO, Any
 from fsmbt.conform.log import STATUS_NAMES, LoggedNode, RecordedLog
 from fsmbt.model.errors import InputError, SourceLocation
 from fsmbt.model.files import read_located
+from fsmbt.model.nodes import SUBTREE_TYPE
 
 VERSION = 1
 _BY_NAME = {name: value for value, name in STATUS_NAMES.items()}
@@ -156,7 +157,7 @@ class TracedPyTreesRunner:
 
         compiled = doc if isinstance(doc, CompiledTree) else CompiledTree(doc)
         nodes = [
-            LoggedNode(n.id, n.label, n.type, n.path, not n.children and n.type != "SubTree")
+            LoggedNode(n.id, n.label, n.type, n.path, not n.children and n.type != SUBTREE_TYPE)
             for n in compiled.nodes
         ]
         self.writer = TraceWriter(stream, nodes)

@@ -19,6 +19,7 @@ from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.errors import InputError, SourceLocation, UnsupportedError
 from fsmbt.semantics.bt_interpreter import CompiledTree
 from fsmbt.semantics.dispatch_runtime import DispatchMachine, is_dispatch_bt
+from fsmbt.semantics.nodes import SUBTREE_TYPE
 
 #: Stop after this many node checks (a tree whose SubTrees multiply beyond it is refused
 #: anyway, by the compiler's own node limit).
@@ -76,7 +77,7 @@ def conversion_blockers(doc: BTDocument) -> list[Blocker]:
             )
             kids = [] if node.is_leaf else list(node.children)
             ctype = None
-        if ctype == "SubTree":
+        if ctype == SUBTREE_TYPE:
             target = node.attrs["ID"]
             key = (target, chain)
             if key not in seen:

@@ -63,7 +63,13 @@ from fsmbt.semantics.families.parallel import parallel_threshold as parallel_thr
 from fsmbt.semantics.families.ports import status_param, where
 from fsmbt.semantics.families.registry import rule as family_rule
 from fsmbt.semantics.families.registry import rules as family_rules
-from fsmbt.semantics.nodes import canonical_type, enabling_option, node_semantics, runtime_tables
+from fsmbt.semantics.nodes import (
+    SUBTREE_TYPE,
+    canonical_type,
+    enabling_option,
+    node_semantics,
+    runtime_tables,
+)
 from fsmbt.semantics.status import LeafOutcome, NodeStatus
 
 # -- statuses: plain-int aliases of NodeStatus for the hot loops (``fsmbt.semantics.compiled``)
@@ -155,7 +161,7 @@ class CompiledTree:
             extra = extra_children.get(ctype)
             if extra is not None:  # e.g. ManualSelector's picks: conditions after the children
                 kids = [*kids, *extra(node, params)]
-            if ctype == "SubTree":
+            if ctype == SUBTREE_TYPE:
                 target = node.attrs["ID"]
                 kids = [self.doc.trees[target].root]  # type: ignore[list-item]
                 chain = chain + (target,)
@@ -264,9 +270,9 @@ class CompiledTree:
                 if kids:
                     raise InputError("a leaf node has children", **where(node))
                 return ctype, NodeKind.DECORATOR, params, internal, kids  # Sleep: gate only
-        if kind is NodeKind.SUBTREE or ctype == "SubTree":
+        if kind is NodeKind.SUBTREE or ctype == SUBTREE_TYPE:
             kind = NodeKind.SUBTREE
-            ctype = "SubTree"
+            ctype = SUBTREE_TYPE
             target = node.attrs.get("ID")
             if not target or target not in self.doc.trees:
                 raise InputError(

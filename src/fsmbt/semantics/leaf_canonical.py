@@ -10,12 +10,13 @@ reactive trees that multiplies the leaf-execution machine (``benchmarks/bench_re
 and on Nav2's trees (PipelineSequence, RecoveryNode, RoundRobin, RateController) it made the
 explored machines two to six times larger than needed (``benchmarks/bench_nav2.py``).
 
-The canonical class (``is_canonical_class``; read from the node registry, no node list here):
-every control is ticked by a rule of ``CANONICAL_RULES`` (the ``sequence`` rule: Sequence and
-Fallback, plain, WithMemory or Async; ``reactive``; Nav2's ``pipeline``, ``recovery`` and
-``round_robin``), every decorator by a rule of ``CANONICAL_DECORATOR_RULES`` (status maps and
-KeepRunningUntilFailure, Repeat, RetryUntilSuccessful, the gated abstractions whose closed gate
-does not return SKIPPED, GoalUpdater, Groot's Root), plus transparent SubTrees, internal leaves
+The canonical class (``is_canonical_class``; read from the node registry and the family rules,
+no node or rule list here): every control and decorator is ticked by a rule whose family gives
+it ``CanonicalReads`` (``FamilyRule.canonical``, ``semantics/families/contract.py``): the
+``sequence`` rule (Sequence and Fallback, plain, WithMemory or Async), ``reactive``, Nav2's
+``pipeline``, ``recovery`` and ``round_robin``; status maps and KeepRunningUntilFailure, Repeat,
+RetryUntilSuccessful, the gated abstractions whose closed gate does not return SKIPPED (the
+rule's ``member`` test), GoalUpdater, Groot's Root; plus transparent SubTrees, internal leaves
 and environment leaves. No node of the class ever returns SKIPPED (only RunOnce and the
 SKIPPED-gates do, and composites only when every child did), so a sequence's skipped counter is
 always 0.
@@ -24,8 +25,8 @@ Who reads a stored status (every read in ``bt_interpreter``): a leaf action's ow
 or FAILURE is returned without asking; IDLE and RUNNING both ask the environment), a gated
 node's own tick when ``free_when_idle`` (IDLE or not), the parent's frame ``prev`` (the wake-up
 test of asynchronous / WithMemory sequences, Repeat and Retry: IDLE or not), a gated parent's
-child-RUNNING tests, and every ``haltChild`` (RUNNING or not). The rule tables below say, per
-node, which of these apply (``_Tables``).
+child-RUNNING tests, and every ``haltChild`` (RUNNING or not). Each rule's ``CanonicalReads``
+says which of these apply to its nodes; ``_Tables`` reads them per node.
 
 ``canonical(snapshot)`` applies five rewrites (the proof that each keeps the future is
 docs/semantics.md §4a):
@@ -70,57 +71,47 @@ from fsmbt.model.nodes.registry import Gate
 from fsmbt.semantics.bt_interpreter import (
     IDLE,
     RUNNING,
-    SKIPPED,
     SUCCESS,
     CompiledNode,
     CompiledTree,
     Snapshot,
 )
-from fsmbt.semantics.nodes import node_semantics, runtime_tables
-
-#: The interpreter's control rules whose nodes may be in the canonical class (the registry
-#: names each kind's rule, ``NodeSemantics.handler``).
-CANONICAL_RULES: frozenset[str] = frozenset(
-    {"sequence", "reactive", "pipeline", "recovery", "round_robin"}
-)
-#: The decorator rules of the class (``gated`` only when the closed gate is not SKIPPED).
-CANONICAL_DECORATOR_RULES: frozenset[str] = frozenset(
-    {"simple_decorator", "repeat", "retry", "gated", "pass_through", "pass_through_keep"}
-)
-#: Rules that never reset a finished child before ticking it again: PipelineSequence re-ticks
-#: every child from the first on each tick, GoalUpdater passes its child's status on. The
-#: ``gated`` rule is decided by the gate's ``reset_on_done``.
-KEEPING_RULES: frozenset[str] = frozenset({"pipeline", "pass_through_keep"})
-#: Decorator rules whose frame holds the child's status before the call and read it (wake-up).
-PREV_READING_DECORATORS: frozenset[str] = frozenset({"repeat", "retry"})
+from fsmbt.semantics.families.contract import CanonicalReads
+from fsmbt.semantics.families.registry import rule as family_rule
+from fsmbt.semantics.families.registry import rules as family_rules
+from fsmbt.semantics.nodes import SUBTREE_TYPE, node_semantics, runtime_tables
 
 
-def _gate_of(node: CompiledNode) -> Gate | None:
+def canonical_rules() -> frozenset[str]:
+    """The handler names whose rules may put a node in the class (their family gives them
+    ``CanonicalReads``; a ``member`` test may still exclude a node). O(rules)."""
+    return frozenset(name for name, found in family_rules().items() if found.canonical)
+
+
+def _reads_of(node: CompiledNode) -> CanonicalReads | None:
+    """The ``CanonicalReads`` of ``node``'s rule (``None``: the rule is outside the class)."""
+    handler = runtime_tables().handlers.get(node.type)
+    found = family_rule(handler) if handler is not None else None
+    return found.canonical if found is not None else None
+
+
+def _gate_of(node: CompiledNode, reads: CanonicalReads | None) -> Gate | None:
+    """The declared gate of a node whose rule reads it (``CanonicalReads.reads_gate``)."""
+    if reads is None or not reads.reads_gate:
+        return None
     spec = node_semantics(node.type)
     return spec.gate if spec is not None else None
 
 
-def _gate_closed_skipped(node: CompiledNode) -> bool:
-    """A gated node whose closed gate returns SKIPPED (its ``closed`` port or the registry's
-    default): outside the class."""
-    return bool(node.params) and node.params[0] == SKIPPED
-
-
 def is_canonical_class(tree: CompiledTree) -> bool:
     """Whether every node of ``tree`` is in the canonical class (module docstring). O(N)."""
-    tables = runtime_tables()
     for node in tree.nodes:
-        handler = tables.handlers.get(node.type)
-        if node.kind is NodeKind.CONTROL:
-            if handler not in CANONICAL_RULES:
-                return False
-        elif node.kind is NodeKind.DECORATOR:
-            if handler not in CANONICAL_DECORATOR_RULES:
-                return False
-            if handler == "gated" and _gate_closed_skipped(node):
+        if node.kind in (NodeKind.CONTROL, NodeKind.DECORATOR):
+            reads = _reads_of(node)
+            if reads is None or (reads.member is not None and not reads.member(node)):
                 return False
         elif node.kind is NodeKind.SUBTREE:
-            if node.type != "SubTree" or len(node.children) != 1:
+            if node.type != SUBTREE_TYPE or len(node.children) != 1:
                 return False
         elif node.kind not in (NodeKind.ACTION, NodeKind.CONDITION):
             return False
@@ -132,30 +123,24 @@ class _Tables:
 
     def __init__(self, tree: CompiledTree) -> None:
         tables = runtime_tables()
-        flags = tables.sequence_flags
         nodes = tree.nodes
-        handler = [tables.handlers.get(node.type) for node in nodes]
-        gates = [_gate_of(node) if handler[i] == "gated" else None for i, node in enumerate(nodes)]
+        reads = [_reads_of(node) or _NO_READS for node in nodes]
+        gates = [_gate_of(node, reads[i]) for i, node in enumerate(nodes)]
         #: reads_prev[n]: n's frame holds its child's status before the call and reads it:
         #: asynchronous / WithMemory sequences, and Repeat/Retry when a child's completion can
         #: loop again in the same activation (num_cycles / num_attempts -1 or at least 2).
         self.reads_prev = [
-            (node.type in flags and (flags[node.type][1] or flags[node.type][2]))
-            or (handler[i] in PREV_READING_DECORATORS and _loops_again(node))
-            for i, node in enumerate(nodes)
+            r.prev_frame and r.reads_prev is not None and r.reads_prev(node)
+            for r, node in zip(reads, nodes)
         ]
-        #: sequence_frame[n]: n's frames are (id, pc, prev) of the ``sequence`` rule;
         #: prev_frame[n]: n's frames hold ``prev`` at index 2 (the sequence and loop rules).
-        self.sequence_frame = [node.type in flags for node in nodes]
-        self.prev_frame = [
-            self.sequence_frame[i] or handler[i] in PREV_READING_DECORATORS
-            for i in range(len(nodes))
-        ]
-        #: last_child[n]: n is the last child of a ``sequence``-rule parent, whose wake-up test
-        #: (``idx < n`` after the child) is never true for it: its ``prev`` is not read.
+        self.prev_frame = [r.prev_frame for r in reads]
+        #: last_child[n]: n is the last child of a parent whose wake-up test (``idx < n``
+        #: after the child: the ``sequence`` rule) is never true for it: its ``prev`` is not
+        #: read.
         last_child = [
             node.parent is not None
-            and self.sequence_frame[node.parent]
+            and reads[node.parent].last_child_prev_unread
             and node.index == len(nodes[node.parent].children) - 1
             for node in nodes
         ]
@@ -164,7 +149,7 @@ class _Tables:
         self.halt_resets = [node.type in tables.halt_resets_memory for node in nodes]
         #: keeps_finished[n]: n may tick a finished child again without resetting it.
         keeps_finished = [
-            handler[i] in KEEPING_RULES or (gate is not None and not gate.reset_on_done)
+            reads[i].keeps_finished or (gate is not None and not gate.reset_on_done)
             for i, gate in enumerate(gates)
         ]
         #: reads_child_running[n]: n's rule tests its child's RUNNING status (gates).
@@ -222,11 +207,9 @@ class _Tables:
             )
 
 
-def _loops_again(node: CompiledNode) -> bool:
-    """Repeat/Retry: a child's completion may be followed by another cycle in the same
-    activation, so the wake-up test reads the child's status before the call."""
-    (limit,) = node.params
-    return bool(limit == -1 or limit >= 2)
+#: What a node whose rule is outside the class reads beyond every rule (nothing is erased
+#: for it: ``Canonicalizer`` runs on trees of the class only).
+_NO_READS = CanonicalReads()
 
 
 class Canonicalizer:
@@ -244,7 +227,6 @@ class Canonicalizer:
         self.sf_as_running = t.sf_as_running
         self.weak_running = t.weak_running
         self.pairs_idle = t.pairs_idle
-        tables = runtime_tables()
         #: pipeline id -> for each child, whether it is an environment Action (whose stored
         #: SUCCESS is returned again without asking: it can never return RUNNING, rule 5).
         self.pipelines: dict[int, tuple[bool, ...]] = {
@@ -253,7 +235,7 @@ class Canonicalizer:
                 for c in node.children
             )
             for node in tree.nodes
-            if tables.handlers.get(node.type) == "pipeline"
+            if (reads := _reads_of(node)) is not None and reads.furthest_index
         }
         self.children = [node.children for node in tree.nodes]
 

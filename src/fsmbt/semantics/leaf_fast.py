@@ -37,7 +37,14 @@ from typing import Final
 
 from fsmbt.model.kinds import NodeKind
 from fsmbt.semantics.bt_interpreter import CompiledTree
-from fsmbt.semantics.nodes import FALLBACK_TYPES, PLAIN_CONTROLS, node_semantics, rewired
+from fsmbt.semantics.families.registry import rule as family_rule
+from fsmbt.semantics.nodes import (
+    FALLBACK_TYPES,
+    PLAIN_CONTROLS,
+    SUBTREE_TYPE,
+    node_semantics,
+    rewired,
+)
 from fsmbt.semantics.status import LeafOutcome, RootResult
 
 ROOT = 0  # the compiled root's id (ids are pre-order indices)
@@ -59,17 +66,24 @@ def is_plain_tree(tree: CompiledTree) -> bool:
             if node.type not in PLAIN_CONTROLS or not node.children:
                 return False
         elif node.kind is NodeKind.SUBTREE:
-            if node.type != "SubTree" or len(node.children) != 1:
+            if node.type != SUBTREE_TYPE or len(node.children) != 1:
                 return False
         elif not node.is_env_leaf:  # decorators, internal built-in leaves
             return False
     return True
 
 
+def _restarts(handler: str | None) -> bool:
+    """Whether the rule ``handler`` restarts at child 0 on every tick and keeps no memory
+    (``FamilyRule.restarts``: the ``reactive`` rule)."""
+    found = family_rule(handler) if handler is not None else None
+    return found is not None and found.restarts
+
+
 def is_static_tree(tree: CompiledTree) -> bool:
     """Whether ``tree`` has a static leaf table: the plain class, widened (docs/semantics.md §4a)
-    with reactive Sequence/Fallback nodes (registry: ``reactive``) whose subtrees hold no plain
-    control, and status-mapping decorators (registry: ``result_map``). O(N).
+    with reactive Sequence/Fallback nodes (registry: ``reactive``; their family rule says it
+    ``restarts``, ``FamilyRule``) whose subtrees hold no plain control, and status-mapping decorators (registry: ``result_map``). O(N).
 
     Why that shape: a reactive node restarts at child 0 every tick and keeps no memory, and the
     only other memory in the class is a plain node's running index, which is read only when no
@@ -85,7 +99,7 @@ def is_static_tree(tree: CompiledTree) -> bool:
                 spec is None
                 or not node.children
                 or node.type not in PLAIN_CONTROLS
-                and not (spec.reactive and spec.handler == "reactive")
+                and not (spec.reactive and _restarts(spec.handler))
             ):
                 return False
             if node.type in PLAIN_CONTROLS and below:
@@ -96,7 +110,7 @@ def is_static_tree(tree: CompiledTree) -> bool:
             if spec is None or spec.result_map is None:
                 return False
         elif node.kind is NodeKind.SUBTREE:
-            if node.type != "SubTree" or len(node.children) != 1:
+            if node.type != SUBTREE_TYPE or len(node.children) != 1:
                 return False
         elif not node.is_env_leaf:
             return False

@@ -21,6 +21,7 @@ from fsmbt.model import state_info
 from fsmbt.model.bt import BTNode, NodeModel, PortModel
 from fsmbt.model.bt_nodes import builtin_spec
 from fsmbt.model.kinds import NodeKind
+from fsmbt.model.nodes import SUBTREE_TYPE
 from fsmbt.semantics.outcome_blackboard import OUTCOME_PORT
 from fsmbt.semantics.outcome_view import Unit
 
@@ -34,7 +35,7 @@ def type_id(text: str) -> str:
     out = _NOT_ID.sub("_", text).strip("_") or "State"
     if out[0].isdigit():
         out = f"S_{out}"
-    if builtin_spec(out) is not None or out == "SubTree":
+    if builtin_spec(out) is not None or out == SUBTREE_TYPE:
         out = f"{out}State"
     return out
 

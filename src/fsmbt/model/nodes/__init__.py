@@ -53,6 +53,9 @@ TIME_BASED = kinds_where(lambda n: n.time_based)
 BLACKBOARD_BASED = kinds_where(lambda n: n.blackboard_based)
 #: Kinds the NuSMV encoder encodes.
 NUSMV_ENCODED = kinds_where(lambda n: n.nusmv is not None)
+#: The SubTree reference's canonical type name (its declaration, ``leaves.SUBTREE``): a compiled
+#: tree gives every expanded reference this type and the referenced root as its one child.
+SUBTREE_TYPE: str = leaves.SUBTREE.name
 
 __all__ = [
     "ABSTRACTIONS",
@@ -67,6 +70,7 @@ __all__ = [
     "MERGEABLE_CONTROLS",
     "NUSMV_ENCODED",
     "PLAIN_CONTROLS",
+    "SUBTREE_TYPE",
     "REACTIVE_CONTROLS",
     "RESULT_MAP_DECORATORS",
     "SEQUENCE_TYPES",

@@ -27,6 +27,7 @@ from __future__ import annotations
 
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import InputError
+from fsmbt.model.nodes import SUBTREE_TYPE
 from fsmbt.runtime.skeleton.files import SkeletonFile
 from fsmbt.runtime.skeleton.leaves import LeafKind
 from fsmbt.runtime.skeleton.render import render
@@ -73,7 +74,7 @@ def tree_statements(doc: BTDocument, leaves: list[LeafKind]) -> tuple[list[str],
                 location=source.location,
                 element=f"<{source.type}> '{source.label}'",
             )
-        runnable = node.type == "SubTree" or (
+        runnable = node.type == SUBTREE_TYPE or (
             node.type in _COMPOSITES and (node.type in SUPPORTED_TYPES or node.type in LOOPS)
         )
         if leaf is None and not runnable:
@@ -96,7 +97,7 @@ def tree_statements(doc: BTDocument, leaves: list[LeafKind]) -> tuple[list[str],
             params = {k: v for k, v in source.attrs.items() if not k.startswith("_")}
             lines.append(f"{var} = {leaf.class_name}({name}, **{params!r})")
             continue
-        if node.type == "SubTree":
+        if node.type == SUBTREE_TYPE:
             lines.append(f"{var} = n{node.children[0]}  # SubTree {source.attrs.get('ID')}")
             continue
         template = _COMPOSITES[node.type]

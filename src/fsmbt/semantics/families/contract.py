@@ -17,6 +17,11 @@ kinds declare in ``fsmbt.model.nodes``. Each ``FamilyRule`` has:
   is False when the kind is used as an abstraction (docs/semantics.md §10).
 - ``extra_children(node, params) -> list[BTNode]``: synthetic condition leaves added after the
   node's children at compile time (ManualSelector's picks); ``None``: none.
+- ``restarts``: a node of the rule ticks its children from the first on every tick and keeps
+  no memory (the ``reactive`` rule): ``leaf_fast``'s static tables read it.
+- ``canonical``: a ``CanonicalReads`` when the rule's nodes may be in the canonical class of
+  ``semantics/leaf_canonical.py`` (docs/semantics.md §4a): who reads what a node of the rule
+  stores; ``None``: a tree with such a node keeps faithful snapshots.
 
 ``halt()`` is not a function: every node's halt halts its RUNNING children and resets their
 statuses (``bt_interpreter._halt``), and whether it also forgets its memory is the declared
@@ -67,6 +72,43 @@ ParamsFn = Callable[[BTNode, str, bool], tuple[Any, ...]]
 ExtraChildrenFn = Callable[[BTNode, tuple[Any, ...]], list[BTNode]]
 
 
+#: ``(node) -> bool``: a fact of one compiled node of the rule (its ports are ``node.params``).
+NodeFact = Callable[[CompiledNode], bool]
+
+
+@dataclass(frozen=True)
+class CanonicalReads:
+    """What ``leaf_canonical`` reads of a rule in the canonical class (docs/semantics.md §4a):
+    which stored statuses and frame locals a node of the rule reads, so the others can be erased.
+
+    Attributes:
+        member: a node of the rule is in the class only when this holds (``None``: always; the
+            ``gated`` rule: its closed gate does not return SKIPPED).
+        prev_frame: the rule's frames hold the child's status before the call at index 2.
+        reads_prev: the node reads that status (the wake-up test; ``None``: never).
+        last_child_prev_unread: the wake-up test is never true after the last child (the
+            ``sequence`` rule: ``idx < n`` fails there), so the last child's ``prev`` is unread.
+        keeps_finished: the node may tick a finished child again without resetting it
+            (PipelineSequence, GoalUpdater; a gate decides by its ``reset_on_done``).
+        reads_gate: the declared ``Gate`` says what the node reads (its child's RUNNING, its
+            own IDLE, whether it keeps a finished child).
+        furthest_index: the memory is a furthest-child index over children that may be
+            environment Actions holding SUCCESS (rule 5: PipelineSequence).
+    """
+
+    member: NodeFact | None = None
+    prev_frame: bool = False
+    reads_prev: NodeFact | None = None
+    last_child_prev_unread: bool = False
+    keeps_finished: bool = False
+    reads_gate: bool = False
+    furthest_index: bool = False
+
+
+#: The reads of a rule in the canonical class that reads nothing more than every rule does.
+PLAIN_READS = CanonicalReads()
+
+
 @dataclass(frozen=True)
 class FamilyRule:
     """One handler's behaviour (the module docstring says what each part does)."""
@@ -74,3 +116,5 @@ class FamilyRule:
     tick: TickFn
     params: ParamsFn | None = None
     extra_children: ExtraChildrenFn | None = None
+    restarts: bool = False
+    canonical: CanonicalReads | None = None

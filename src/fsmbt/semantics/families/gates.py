@@ -17,6 +17,7 @@ from fsmbt.semantics.compiled import (
     FAILURE,
     IDLE,
     RUNNING,
+    SKIPPED,
     SUCCESS,
     CompiledNode,
     Frame,
@@ -24,7 +25,7 @@ from fsmbt.semantics.compiled import (
     TickAction,
     Work,
 )
-from fsmbt.semantics.families.contract import FamilyRule, Interp
+from fsmbt.semantics.families.contract import CanonicalReads, FamilyRule, Interp
 
 
 def gate_of(node: CompiledNode) -> Gate:
@@ -126,9 +127,19 @@ def tick_for_each(
     return ("ret", stop if result == stop else RUNNING)
 
 
+def _closed_not_skipped(node: CompiledNode) -> bool:
+    """A gated node whose closed gate returns SKIPPED (its ``closed`` port or the declared
+    default) is outside the canonical class."""
+    return not (bool(node.params) and node.params[0] == SKIPPED)
+
+
+#: A gated node in the canonical class: its declared ``Gate`` says what it reads.
+_GATED_READS = CanonicalReads(member=_closed_not_skipped, reads_gate=True)
+
+
 #: This family's rules, by the ``handler`` name its kinds declare.
 RULES: dict[str, FamilyRule] = {
-    "gated": FamilyRule(tick_gated),
+    "gated": FamilyRule(tick_gated, canonical=_GATED_READS),
     "timeout": FamilyRule(tick_timeout),
     "sleep": FamilyRule(tick_sleep),
     "for_each": FamilyRule(tick_for_each),

@@ -32,7 +32,7 @@ from fsmbt.semantics.compiled import (
     TickAction,
     Work,
 )
-from fsmbt.semantics.families.contract import FamilyRule, Interp
+from fsmbt.semantics.families.contract import CanonicalReads, FamilyRule, Interp
 from fsmbt.semantics.families.ports import int_param, status_param, where
 
 
@@ -248,10 +248,22 @@ def tick_loop_queue(
     return ("ret", FAILURE if result == FAILURE else RUNNING)
 
 
+def _loops_again(node: CompiledNode) -> bool:
+    """Repeat/Retry: a child's completion may be followed by another cycle in the same
+    activation, so the wake-up test reads the child's status before the call."""
+    (limit,) = node.params
+    return bool(limit == -1 or limit >= 2)
+
+
+#: Repeat and Retry in the canonical class: their frames hold ``prev``, read when the loop may
+#: go round again (``CanonicalReads``).
+_COUNTED_READS = CanonicalReads(prev_frame=True, reads_prev=_loops_again)
+
+
 #: This family's rules, by the ``handler`` name its kinds declare.
 RULES: dict[str, FamilyRule] = {
-    "repeat": FamilyRule(tick_repeat, params=repeat_params),
-    "retry": FamilyRule(tick_retry, params=retry_params),
+    "repeat": FamilyRule(tick_repeat, params=repeat_params, canonical=_COUNTED_READS),
+    "retry": FamilyRule(tick_retry, params=retry_params, canonical=_COUNTED_READS),
     "repeat_each_tick": FamilyRule(tick_repeat_each_tick, params=repeat_each_tick_params),
     "loop_queue": FamilyRule(tick_loop_queue, params=loop_params),
 }

@@ -25,7 +25,12 @@ from fsmbt.semantics.compiled import (
     TickAction,
     Work,
 )
-from fsmbt.semantics.families.contract import FamilyRule, Interp
+from fsmbt.semantics.families.contract import (
+    PLAIN_READS,
+    CanonicalReads,
+    FamilyRule,
+    Interp,
+)
 from fsmbt.semantics.families.ports import bool_param, int_param
 
 
@@ -163,7 +168,9 @@ def tick_round_robin(
 
 #: This family's rules, by the ``handler`` name its kinds declare.
 RULES: dict[str, FamilyRule] = {
-    "pipeline": FamilyRule(tick_pipeline),
-    "recovery": FamilyRule(tick_recovery, params=recovery_params),
-    "round_robin": FamilyRule(tick_round_robin, params=round_robin_params),
+    "pipeline": FamilyRule(
+        tick_pipeline, canonical=CanonicalReads(keeps_finished=True, furthest_index=True)
+    ),
+    "recovery": FamilyRule(tick_recovery, params=recovery_params, canonical=PLAIN_READS),
+    "round_robin": FamilyRule(tick_round_robin, params=round_robin_params, canonical=PLAIN_READS),
 }

@@ -21,7 +21,7 @@ from fsmbt.semantics.compiled import (
     TickAction,
     Work,
 )
-from fsmbt.semantics.families.contract import FamilyRule, Interp
+from fsmbt.semantics.families.contract import PLAIN_READS, FamilyRule, Interp
 
 
 def tick_reactive(
@@ -57,5 +57,5 @@ def tick_reactive(
 
 #: This family's rules, by the ``handler`` name its kinds declare.
 RULES: dict[str, FamilyRule] = {
-    "reactive": FamilyRule(tick_reactive),
+    "reactive": FamilyRule(tick_reactive, restarts=True, canonical=PLAIN_READS),
 }

@@ -13,6 +13,7 @@ from there). All children SKIPPED: SKIPPED. Halt: forgets the memory except Sequ
 
 from __future__ import annotations
 
+from fsmbt.model.nodes import node_semantics
 from fsmbt.semantics.compiled import (
     FAILURE,
     IDLE,
@@ -26,7 +27,7 @@ from fsmbt.semantics.compiled import (
     TickAction,
     Work,
 )
-from fsmbt.semantics.families.contract import FamilyRule, Interp
+from fsmbt.semantics.families.contract import CanonicalReads, FamilyRule, Interp
 
 
 def tick_sequence(
@@ -75,7 +76,19 @@ def tick_sequence(
     return ("ret", SKIPPED if all_skipped else go_on)
 
 
+def _wakes_up(node: CompiledNode) -> bool:
+    """An asynchronous or WithMemory sequence reads its child's status before the call (the
+    wake-up test; ``CanonicalReads.reads_prev``)."""
+    spec = node_semantics(node.type)
+    return spec is not None and (spec.asynchronous or spec.with_memory)
+
+
 #: This family's rules, by the ``handler`` name its kinds declare.
 RULES: dict[str, FamilyRule] = {
-    "sequence": FamilyRule(tick_sequence),
+    "sequence": FamilyRule(
+        tick_sequence,
+        canonical=CanonicalReads(
+            prev_frame=True, reads_prev=_wakes_up, last_child_prev_unread=True
+        ),
+    ),
 }

@@ -20,7 +20,7 @@ from fsmbt.semantics.compiled import (
     TickAction,
     Work,
 )
-from fsmbt.semantics.families.contract import FamilyRule, Interp
+from fsmbt.semantics.families.contract import PLAIN_READS, FamilyRule, Interp
 
 
 def tick_simple_decorator(
@@ -48,5 +48,5 @@ def tick_simple_decorator(
 
 #: This family's rules, by the ``handler`` name its kinds declare.
 RULES: dict[str, FamilyRule] = {
-    "simple_decorator": FamilyRule(tick_simple_decorator),
+    "simple_decorator": FamilyRule(tick_simple_decorator, canonical=PLAIN_READS),
 }

@@ -20,7 +20,12 @@ from fsmbt.semantics.compiled import (
     TickAction,
     Work,
 )
-from fsmbt.semantics.families.contract import FamilyRule, Interp
+from fsmbt.semantics.families.contract import (
+    PLAIN_READS,
+    CanonicalReads,
+    FamilyRule,
+    Interp,
+)
 
 
 def tick_subtree(
@@ -61,6 +66,8 @@ def tick_pass_through_keep(
 #: This family's rules, by the ``handler`` name its kinds declare.
 RULES: dict[str, FamilyRule] = {
     "subtree": FamilyRule(tick_subtree),
-    "pass_through": FamilyRule(tick_pass_through),
-    "pass_through_keep": FamilyRule(tick_pass_through_keep),
+    "pass_through": FamilyRule(tick_pass_through, canonical=PLAIN_READS),
+    "pass_through_keep": FamilyRule(
+        tick_pass_through_keep, canonical=CanonicalReads(keeps_finished=True)
+    ),
 }

@@ -24,7 +24,7 @@ from dataclasses import dataclass
 
 from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.bt_nodes import canonical_type
-from fsmbt.model.nodes import SEQUENCE_TYPES
+from fsmbt.model.nodes import SEQUENCE_TYPES, SUBTREE_TYPE
 from fsmbt.model.validate import Issue
 from fsmbt.semantics.lebt.spec import GUARD_TYPE, STATE_TYPE, GuardSpec, StateSpec
 
@@ -45,7 +45,7 @@ def _guarded_name(node: BTNode) -> str | None:
     """The state name a guarded element stands for (``None``: not a state)."""
     if node.type == STATE_TYPE:
         return StateSpec.from_attrs(node.attrs).state
-    if node.type == "SubTree":
+    if node.type == SUBTREE_TYPE:
         return node.name or node.attrs.get("ID")
     return None
 

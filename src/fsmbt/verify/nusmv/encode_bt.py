@@ -19,7 +19,10 @@ Which kinds are encoded and by which rule is the node registry's ``nusmv`` field
 kind is refused its ``nusmv_refusal`` (``fsmbt.semantics.nodes``, docs/semantics.md "Node
 registry"); each rule lives in its family's module of ``fsmbt.verify.nusmv.families`` (named
 as the interpreter's family modules, merged by ``families.registry``), which this encoder
-dispatches on. Leaf requests are where the environment answers: in a leaf-execution machine
+dispatches on, and the traits its whole-tree checks read (``families.contract.RuleTraits``:
+which rules encode a child that returns SKIPPED and which may return it, the frame variables
+``idx_n``/``prev_n``, the livelock test's facts), so this module names no node kind and no
+rule. Leaf requests are where the environment answers: in a leaf-execution machine
 they are the stable states that take an input (success/failure/running); the LEBT encoding
 (``encode_lebt``) answers them from its blackboard instead. Supported node types are listed in
 ``SUPPORTED`` (derived from the registry); anything else raises ``UnsupportedError`` (docs/nusmv.md says why).
@@ -36,15 +39,11 @@ from fsmbt.model.bt import BTDocument
 from fsmbt.model.bt_nodes import NodeKind
 from fsmbt.model.errors import Hint, UnsupportedError
 from fsmbt.semantics.bt_interpreter import CompiledNode, CompiledTree
-from fsmbt.semantics.nodes import NUSMV_ENCODED, all_nodes, node_semantics
+from fsmbt.semantics.nodes import NUSMV_ENCODED, NodeSemantics, all_nodes, node_semantics
 from fsmbt.semantics.status import LeafOutcome, NodeStatus, RootResult
 from fsmbt.verify.nusmv.families.common import FAILURE, SKIPPED, ST, SUCCESS
-from fsmbt.verify.nusmv.families.contract import NusmvRule, Resets
-from fsmbt.verify.nusmv.families.loops import LOOP_KINDS
-from fsmbt.verify.nusmv.families.once import ONCE_KINDS
-from fsmbt.verify.nusmv.families.registry import nusmv_rules
-from fsmbt.verify.nusmv.families.sequence import SEQ_LIKE
-from fsmbt.verify.nusmv.families.status_map import SIMPLE_DECORATORS
+from fsmbt.verify.nusmv.families.contract import NO_TRAITS, NusmvRule, Resets, RuleTraits
+from fsmbt.verify.nusmv.families.registry import nusmv_rules, rule_traits
 from fsmbt.verify.nusmv.smv import Symbols, any_of, case
 
 if TYPE_CHECKING:
@@ -56,10 +55,6 @@ SUPPORTED = NUSMV_ENCODED
 NOT_ENCODED = {n.name: n.nusmv_refusal for n in all_nodes() if n.nusmv_refusal is not None}
 #: The SMV type of a stored status (``families.common.ST``).
 STATUS_ENUM = "{I, R, S, F}"
-#: Rules whose SMV rules handle a child that returns SKIPPED (docs/nusmv.md, "SKIPPED"): the
-#: sequences (skipped counter ``sk_n``), the reactive ones (frame flag ``rk_n``), the status
-#: maps and SubTree (passed on). Any other parent of a child that may skip is refused.
-SKIP_AWARE = frozenset({"sequence", "reactive", "simple_decorator", "subtree"})
 
 
 @dataclass
@@ -68,6 +63,8 @@ class NodeInfo:
     env_leaf: bool
     internal: str | None  # "S"/"F" for AlwaysSuccess & co
     rule: str | None = None  # the kind's NuSMV rule name (the registry's ``nusmv`` field)
+    spec: NodeSemantics | None = None  # the kind's declaration (``None`` for a leaf)
+    traits: RuleTraits = NO_TRAITS  # what the whole-tree checks read of the rule
 
 
 class BTCore:
@@ -87,8 +84,7 @@ class BTCore:
         self.dispatch: dict[str, NusmvRule] = dict(nusmv_rules())
         self.info: list[NodeInfo] = []
         has_internal = False
-        has_keep_running = False
-        has_endless_loop = False
+        forever = False
         for node in self.nodes:
             if node.kind in (NodeKind.ACTION, NodeKind.CONDITION):
                 internal = None
@@ -106,22 +102,16 @@ class BTCore:
                     element=f"<{node.type}> '{node.label}'",
                     hints=(Hint.NATIVE_VERIFIER,),
                 )
-            # a simple decorator without a result map (KeepRunningUntilFailure) can tick forever
-            has_keep_running |= (
-                node.type in SIMPLE_DECORATORS and spec is not None and spec.result_map is None
-            )
-            # so can Repeat/Retry with -1; a RunOnce that has run, or a loop that never ticks
-            # its child (a count <= 0 other than -1), answers without any leaf
-            limit = node.params[0] if node.type in LOOP_KINDS else None
-            has_endless_loop |= limit == -1
-            has_internal |= node.type in ONCE_KINDS or (limit is not None and -1 != limit <= 0)
-            self.info.append(NodeInfo(node, False, None, spec.nusmv))
+            traits = rule_traits(spec.nusmv)
+            # a node that can tick forever (KeepRunningUntilFailure, an endless Repeat/Retry),
+            # one that can answer without any leaf (a RunOnce that has run, a zero-count loop):
+            # the families say which (``RuleTraits``)
+            forever |= traits.ticks_forever is not None and traits.ticks_forever(node, spec)
+            alone = traits.answers_alone
+            has_internal |= alone is not None and alone(node, spec)
+            self.info.append(NodeInfo(node, False, None, spec.nusmv, spec, traits))
         self.may_skip = self._may_skip()
-        if (
-            has_internal
-            and (loop or has_keep_running or has_endless_loop)
-            and not self._ticks_a_leaf()[0]
-        ):
+        if has_internal and (loop or forever) and not self._ticks_a_leaf()[0]:
             raise UnsupportedError(
                 "the NuSMV encoding does not model ticks that end without any leaf "
                 "(AlwaysSuccess/AlwaysFailure & co, a RunOnce or a zero-count Repeat/"
@@ -142,27 +132,19 @@ class BTCore:
         self.kept_vars: list[str] = []
 
     def _may_skip(self) -> list[bool]:
-        """Per node: whether it can return SKIPPED (RunOnce ``then_skip``, a gate closed on
-        SKIPPED; a sequence/reactive node all of whose children may skip; a status map or
-        SubTree over one that may). A parent of such a child whose rule is not in
-        ``SKIP_AWARE`` is refused. O(N), children before parents (reverse pre-order)."""
+        """Per node: whether it can return SKIPPED (its rule's ``returns_skipped``: RunOnce
+        ``then_skip``, a gate closed on SKIPPED; a sequence/reactive node all of whose children
+        may skip; a status map or SubTree over one that may). A parent of such a child whose
+        rule is not ``skip_aware`` is refused. O(N), children before parents (reverse
+        pre-order)."""
         skip = [False] * len(self.nodes)
         for info in reversed(self.info):
-            x = info.node
-            if info.rule is None:
+            x, spec, traits = info.node, info.spec, info.traits
+            if info.rule is None or spec is None:
                 continue
-            spec = node_semantics(x.type)
-            aware = info.rule in SKIP_AWARE and (
-                info.rule != "simple_decorator"
-                or (spec is not None and spec.result_map is not None)
-            )
-            if info.rule == "run_once":
-                skip[x.id] = bool(x.params[0])
-            elif info.rule == "gated":
-                gate = spec.gate if spec is not None else None
-                skip[x.id] = gate is not None and gate.closed == NodeStatus.SKIPPED.name
-            elif aware:
-                skip[x.id] = bool(x.children) and all(skip[c] for c in x.children)
+            if traits.returns_skipped is not None:
+                skip[x.id] = traits.returns_skipped(x, spec, skip)
+            aware = traits.skip_aware is not None and traits.skip_aware(x, spec)
             if not aware and any(skip[c] for c in x.children):
                 raise UnsupportedError(
                     f"the NuSMV encoding does not support a child that may return SKIPPED "
@@ -193,38 +175,19 @@ class BTCore:
           they tick their RUNNING child), or ``sure`` if the child may skip (a SKIPPED child
           leaves a status map RUNNING); status maps and SubTree are ``sure`` when the child is.
 
-        O(N)."""
+        The facts of a node with children are its rule's ``leaf_facts`` (``RuleTraits``;
+        neither without). O(N)."""
         sure = [False] * len(self.nodes)
         busy = [False] * len(self.nodes)
         for info in reversed(self.info):
             x = info.node
-            kids = list(x.children)
-            spec = node_semantics(x.type) if info.rule is not None else None
-            passes = info.rule in ("subtree", "run_once", "single_trigger") or (
-                info.rule == "simple_decorator" and spec is not None and spec.result_map is not None
-            )
             if info.env_leaf:
-                parent = self.info[x.parent].rule if x.parent is not None else None
+                parent = self.info[x.parent].traits if x.parent is not None else NO_TRAITS
                 busy[x.id] = True
-                sure[x.id] = x.kind is NodeKind.CONDITION or parent in (
-                    "sequence",
-                    "simple_decorator",
-                    "subtree",
-                    "run_once",
-                )
-            elif not kids:
-                continue
-            elif info.rule == "reactive":
-                sure[x.id] = busy[x.id] = sure[kids[0]]
-            elif info.rule == "sequence" and not SEQ_LIKE[x.type][1] and not SEQ_LIKE[x.type][2]:
-                plain = sure[kids[0]] and all(busy[c] for c in kids[1:])
-                sure[x.id] = busy[x.id] = plain
-            elif info.rule in ("sequence", "gated"):
-                sure[x.id] = busy[x.id] = all(sure[c] for c in kids)
-            elif passes:
-                (c,) = kids
-                sure[x.id] = info.rule in ("subtree", "simple_decorator") and sure[c]
-                busy[x.id] = sure[c] if self.may_skip[c] else busy[c]
+                sure[x.id] = x.kind is NodeKind.CONDITION or parent.keeps_completed
+            elif x.children and info.spec is not None and info.traits.leaf_facts is not None:
+                facts = info.traits.leaf_facts(x, info.spec, sure, busy, self.may_skip)
+                sure[x.id], busy[x.id] = facts
         return sure
 
     # -- naming ----------------------------------------------------------------------------
@@ -238,12 +201,14 @@ class BTCore:
         self.rules.setdefault(var, []).append((cond, value))
 
     def is_seq_like(self, nid: int) -> bool:
-        return self.nodes[nid].type in SEQ_LIKE
+        """Whether ``nid``'s frame keeps ``idx_n``, its running child's index (its rule's
+        ``RuleTraits.index``: the sequences)."""
+        return self.info[nid].traits.index
 
     def has_prev(self, nid: int) -> bool:
-        """Whether ``nid``'s frame keeps ``prev_n``, its child's status when called (the
-        wake-up test of the sequences and of Repeat/RetryUntilSuccessful)."""
-        return self.is_seq_like(nid) or self.nodes[nid].type in LOOP_KINDS
+        """Whether ``nid``'s frame keeps ``prev_n``, its child's status when called (its rule's
+        ``RuleTraits.prev``: the wake-up test of the sequences and of Repeat/Retry)."""
+        return self.info[nid].traits.prev
 
     # -- declarations ----------------------------------------------------------------------
     def declare(self, cur_extra: list[str], init_cur: str) -> None:
@@ -336,8 +301,9 @@ class BTCore:
             parent_halt = f"hlt_{x.parent}" if x.parent is not None else "FALSE"
             self.defines.append((f"clr_{x.id}", any_of(resets[x.id] + [parent_halt])))
             self.defines.append((f"hlt_{x.id}", f"(clr_{x.id} & {self.st(x.id)} = R)"))
-            # a halted node's memory is reset (Sequence/Fallback/Async*; not WithMemory)
-            if self.is_seq_like(x.id) and not SEQ_LIKE[x.type][2]:
+            # a halted node's index is reset (Sequence/Fallback/Async*; not WithMemory)
+            spec = self.info[x.id].spec
+            if self.is_seq_like(x.id) and spec is not None and not spec.with_memory:
                 self.rules.setdefault(f"idx_{x.id}", []).insert(0, (f"hlt_{x.id}", "0"))
         for var, nid in self.memory_vars:
             self.rules.setdefault(var, []).insert(0, (f"hlt_{nid}", "0"))

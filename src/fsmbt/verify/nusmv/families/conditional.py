@@ -23,7 +23,7 @@ from __future__ import annotations
 
 from fsmbt.semantics.compiled import CompiledNode
 from fsmbt.verify.nusmv.families.common import PASSED
-from fsmbt.verify.nusmv.families.contract import BTCore, NusmvRule, Resets, named
+from fsmbt.verify.nusmv.families.contract import BTCore, NusmvRule, Resets, RuleTraits, named
 
 
 def conditional(
@@ -75,3 +75,6 @@ RULES: dict[str, NusmvRule] = {
     "if_then_else": named(conditional, "if_then_else"),
     "while_do_else": named(conditional, "while_do_else"),
 }
+#: What the encoder's whole-tree checks read of them (``contract.RuleTraits``): the defaults
+#: for each (a child that may return SKIPPED is refused; no leaf tick is guaranteed).
+TRAITS: dict[str, RuleTraits] = {}

@@ -25,10 +25,18 @@ Cost: O(1) rules per node.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 from fsmbt.semantics.compiled import CompiledNode
-from fsmbt.semantics.nodes import node_semantics
-from fsmbt.verify.nusmv.families.common import PASSED, SUCCESS, returned_status
-from fsmbt.verify.nusmv.families.contract import BTCore, NusmvRule, Resets, named
+from fsmbt.semantics.nodes import NodeSemantics, node_semantics
+from fsmbt.semantics.status import NodeStatus
+from fsmbt.verify.nusmv.families.common import (
+    PASSED,
+    SUCCESS,
+    every_child_sure,
+    returned_status,
+)
+from fsmbt.verify.nusmv.families.contract import BTCore, NusmvRule, Resets, RuleTraits, named
 from fsmbt.verify.nusmv.smv import any_of
 
 
@@ -108,4 +116,17 @@ RULES: dict[str, NusmvRule] = {
     "for_each": named(gated, "for_each"),
     "timeout": timeout,
     "sleep": sleep,
+}
+
+
+def _closed_skips(x: CompiledNode, spec: NodeSemantics, may_skip: Sequence[bool]) -> bool:
+    """A gated node whose declared gate answers SKIPPED when closed may return SKIPPED."""
+    return spec.gate is not None and spec.gate.closed == NodeStatus.SKIPPED.name
+
+
+#: What the encoder's whole-tree checks read of them (``contract.RuleTraits``): a ``gated``
+#: node may return SKIPPED (its closed gate) and may tick any child on any tick; the others
+#: have the defaults.
+TRAITS: dict[str, RuleTraits] = {
+    "gated": RuleTraits(returns_skipped=_closed_skips, leaf_facts=every_child_sure),
 }

@@ -9,8 +9,8 @@ retry_node.cpp, loop_node.h).
 variable ``lc_n`` in ``0..L-1`` reset by the node's halt (at rest the count is below L: the L-th
 repeated result ends the loop and resets it). With ``-1`` the interpreter keeps the count at 0
 (it is never read), so no variable is declared: the node's state is its status alone. The frame
-local ``prev_n`` (the child's status when it was called; declared by the encoder for the kinds
-in ``LOOP_KINDS``) decides the wake-up: after a synchronous child (``prev_n = I``) the loop
+local ``prev_n`` (the child's status when it was called; declared by the encoder, as
+``TRAITS`` below asks) decides the wake-up: after a synchronous child (``prev_n = I``) the loop
 returns RUNNING and asks the tree to re-tick. ``L <= 0`` (other than -1) never ticks the child.
 - ``repeat_each_tick`` (``num_cycles`` = L): one cycle per tick, no wake-up: a SUCCESS returns
   RUNNING until the L-th (count ``rc_n`` in ``0..L-1``, reset by a halt; none for -1), FAILURE
@@ -28,14 +28,12 @@ Cost: O(1) rules per node; one variable of log2(L) bits per finite loop or liter
 from __future__ import annotations
 
 from fsmbt.semantics.compiled import CompiledNode
-from fsmbt.semantics.nodes import all_nodes
+from fsmbt.semantics.nodes import NodeSemantics
 from fsmbt.verify.nusmv.families.common import increment, returned_status
-from fsmbt.verify.nusmv.families.contract import BTCore, NusmvRule, Resets, named
+from fsmbt.verify.nusmv.families.contract import BTCore, NusmvRule, Resets, RuleTraits, named
 
 #: Loop rule -> (the result that repeats the child, the one that ends the loop)
 LOOPS = {"repeat": ("S", "F"), "retry": ("F", "S")}
-#: Kind -> its loop rule (the kinds whose frame keeps ``prev_n``).
-LOOP_KINDS = {n.name: n.nusmv for n in all_nodes() if n.nusmv in LOOPS}
 
 
 def loop(core: BTCore, x: CompiledNode, rule: str, here: str, called: str, resets: Resets) -> None:
@@ -148,3 +146,21 @@ RULES: dict[str, NusmvRule] = {
     "repeat_each_tick": repeat_each_tick,
     "loop_queue": loop_queue,
 }
+
+
+def _never_ticks(x: CompiledNode, spec: NodeSemantics) -> bool:
+    """A count <= 0 other than -1 answers without ticking the child."""
+    limit: int = x.params[0]
+    return -1 != limit <= 0
+
+
+def _endless(x: CompiledNode, spec: NodeSemantics) -> bool:
+    """A count of -1 loops without end."""
+    return bool(x.params[0] == -1)
+
+
+_LOOP_TRAITS = RuleTraits(prev=True, answers_alone=_never_ticks, ticks_forever=_endless)
+#: What the encoder's whole-tree checks read of them (``contract.RuleTraits``): Repeat and
+#: RetryUntilSuccessful keep ``prev_n`` (the wake-up test), may answer without ticking the
+#: child or loop forever by their count; the others have the defaults.
+TRAITS: dict[str, RuleTraits] = {"repeat": _LOOP_TRAITS, "retry": _LOOP_TRAITS}

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 from fsmbt.semantics.compiled import CompiledNode
 from fsmbt.verify.nusmv.families.common import PASSED
-from fsmbt.verify.nusmv.families.contract import BTCore, NusmvRule, Resets
+from fsmbt.verify.nusmv.families.contract import BTCore, NusmvRule, Resets, RuleTraits
 
 
 def manual_selector(core: BTCore, x: CompiledNode, here: str, called: str, resets: Resets) -> None:
@@ -60,3 +60,6 @@ def manual_selector(core: BTCore, x: CompiledNode, here: str, called: str, reset
 
 #: This family's rules by name (``registry`` merges the families' tables).
 RULES: dict[str, NusmvRule] = {"manual_selector": manual_selector}
+#: What the encoder's whole-tree checks read of them (``contract.RuleTraits``): the defaults
+#: for each (a child that may return SKIPPED is refused; no leaf tick is guaranteed).
+TRAITS: dict[str, RuleTraits] = {}

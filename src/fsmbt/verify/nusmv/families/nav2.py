@@ -26,7 +26,7 @@ from __future__ import annotations
 
 from fsmbt.semantics.compiled import CompiledNode
 from fsmbt.verify.nusmv.families.common import increment
-from fsmbt.verify.nusmv.families.contract import BTCore, NusmvRule, Resets
+from fsmbt.verify.nusmv.families.contract import BTCore, NusmvRule, Resets, RuleTraits
 
 
 def _reset_all(x: CompiledNode, resets: Resets, cond: str) -> None:
@@ -136,3 +136,6 @@ RULES: dict[str, NusmvRule] = {
     "recovery": recovery,
     "round_robin": round_robin,
 }
+#: What the encoder's whole-tree checks read of them (``contract.RuleTraits``): the defaults
+#: for each (a child that may return SKIPPED is refused; no leaf tick is guaranteed).
+TRAITS: dict[str, RuleTraits] = {}

@@ -15,14 +15,12 @@ Cost: O(1) rules per node; 2 bits per RunOnce, 1 per SingleTrigger.
 
 from __future__ import annotations
 
-from fsmbt.semantics.compiled import CompiledNode
-from fsmbt.semantics.nodes import all_nodes
-from fsmbt.verify.nusmv.families.common import SKIPPED
-from fsmbt.verify.nusmv.families.contract import BTCore, NusmvRule, Resets
+from collections.abc import Sequence
 
-#: Kinds that can answer without ticking any leaf (a RunOnce that has run, a triggered
-#: SingleTrigger): the encoder's livelock check reads it.
-ONCE_KINDS = frozenset(n.name for n in all_nodes() if n.nusmv in ("run_once", "single_trigger"))
+from fsmbt.semantics.compiled import CompiledNode
+from fsmbt.semantics.nodes import NodeSemantics
+from fsmbt.verify.nusmv.families.common import SKIPPED, always, one_child_facts
+from fsmbt.verify.nusmv.families.contract import BTCore, NusmvRule, Resets, RuleTraits
 
 
 def run_once(core: BTCore, x: CompiledNode, here: str, called: str, resets: Resets) -> None:
@@ -61,3 +59,25 @@ def single_trigger(core: BTCore, x: CompiledNode, here: str, called: str, resets
 
 #: This family's rules by name (``registry`` merges the families' tables).
 RULES: dict[str, NusmvRule] = {"run_once": run_once, "single_trigger": single_trigger}
+
+
+def _then_skip(x: CompiledNode, spec: NodeSemantics, may_skip: Sequence[bool]) -> bool:
+    """RunOnce with ``then_skip`` returns SKIPPED after its first run."""
+    return bool(x.params[0])
+
+
+#: What the encoder's whole-tree checks read of them (``contract.RuleTraits``): both can answer
+#: without ticking any leaf (a RunOnce that has run, a triggered SingleTrigger) and tick their
+#: RUNNING child while RUNNING; RunOnce may return SKIPPED and never ticks a completed child
+#: again. Neither encodes a child that returns SKIPPED.
+TRAITS: dict[str, RuleTraits] = {
+    "run_once": RuleTraits(
+        returns_skipped=_then_skip,
+        keeps_completed=True,
+        leaf_facts=one_child_facts(sure_with_child=False),
+        answers_alone=always,
+    ),
+    "single_trigger": RuleTraits(
+        leaf_facts=one_child_facts(sure_with_child=False), answers_alone=always
+    ),
+}

@@ -22,7 +22,7 @@ from __future__ import annotations
 
 from fsmbt.semantics.compiled import CompiledNode
 from fsmbt.semantics.families.parallel import parallel_threshold
-from fsmbt.verify.nusmv.families.contract import BTCore, NusmvRule, Resets, named
+from fsmbt.verify.nusmv.families.contract import BTCore, NusmvRule, Resets, RuleTraits, named
 from fsmbt.verify.nusmv.smv import all_of
 
 
@@ -117,3 +117,6 @@ RULES: dict[str, NusmvRule] = {
     "parallel_all": named(parallel, "parallel_all"),
     "real_parallel": real_parallel,
 }
+#: What the encoder's whole-tree checks read of them (``contract.RuleTraits``): the defaults
+#: for each (a child that may return SKIPPED is refused; no leaf tick is guaranteed).
+TRAITS: dict[str, RuleTraits] = {}

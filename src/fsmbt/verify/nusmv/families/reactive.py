@@ -15,9 +15,12 @@ Cost: O(k) rules for k children; one bit when a child may skip.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 from fsmbt.semantics.compiled import CompiledNode
-from fsmbt.semantics.nodes import all_nodes
-from fsmbt.verify.nusmv.families.contract import BTCore, NusmvRule, Resets
+from fsmbt.semantics.nodes import NodeSemantics, all_nodes
+from fsmbt.verify.nusmv.families.common import always, every_child_skips
+from fsmbt.verify.nusmv.families.contract import BTCore, NusmvRule, Resets, RuleTraits
 
 #: kind -> is_fallback
 REACTIVE = {n.name: n.is_fallback for n in all_nodes() if n.nusmv == "reactive"}
@@ -67,5 +70,24 @@ def reactive(core: BTCore, x: CompiledNode, here: str, called: str, resets: Rese
             core.ret(cond, x.id, go_on)
 
 
+def _leaf_facts(
+    x: CompiledNode,
+    spec: NodeSemantics,
+    sure: Sequence[bool],
+    busy: Sequence[bool],
+    may_skip: Sequence[bool],
+) -> tuple[bool, bool]:
+    """The livelock test's facts (``RuleTraits.leaf_facts``): every tick starts at child 0."""
+    first = sure[x.children[0]]
+    return first, first
+
+
 #: This family's rules by name (``registry`` merges the families' tables).
 RULES: dict[str, NusmvRule] = {"reactive": reactive}
+#: What the encoder's whole-tree checks read of them (``contract.RuleTraits``): SKIPPED is
+#: tracked by ``rk_n`` and returned when every child was skipped.
+TRAITS: dict[str, RuleTraits] = {
+    "reactive": RuleTraits(
+        skip_aware=always, returns_skipped=every_child_skips, leaf_facts=_leaf_facts
+    )
+}

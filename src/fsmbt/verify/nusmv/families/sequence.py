@@ -3,7 +3,7 @@ SequenceWithMemory (docs/semantics.md "Control nodes", "SKIPPED"; docs/nusmv.md)
 ``fsmbt.semantics.families.sequence`` (``tick_sequence``; BehaviorTree.CPP 4.8
 sequence_node.cpp, fallback_node.cpp, sequence_with_memory_node.cpp).
 
-Rule ``sequence``. Variables (declared by the encoder for the kinds in ``SEQ_LIKE``): ``idx_n``,
+Rule ``sequence``. Variables (declared by the encoder, as ``TRAITS`` asks): ``idx_n``,
 the running child's index (reset by a halt except with memory), and the frame local ``prev_n``,
 the child's status when it was called. Children are called in order from ``idx_n``; the stop
 status (FAILURE for a sequence, SUCCESS for a fallback) resets the children (with memory: only
@@ -19,10 +19,12 @@ Cost: O(k) rules for k children; one variable of log2(k) bits for the skipped co
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 from fsmbt.semantics.compiled import CompiledNode
-from fsmbt.semantics.nodes import all_nodes
-from fsmbt.verify.nusmv.families.common import increment
-from fsmbt.verify.nusmv.families.contract import BTCore, NusmvRule, Resets
+from fsmbt.semantics.nodes import NodeSemantics, all_nodes
+from fsmbt.verify.nusmv.families.common import always, every_child_skips, increment
+from fsmbt.verify.nusmv.families.contract import BTCore, NusmvRule, Resets, RuleTraits
 
 #: kind -> (is_fallback, emits wake-up after a fresh child succeeds/fails, with memory)
 SEQ_LIKE = {
@@ -101,5 +103,37 @@ def sequence(core: BTCore, x: CompiledNode, here: str, called: str, resets: Rese
             core.ret(cond, x.id, all_skipped if core.may_skip[x.id] else go_on)
 
 
+def _leaf_facts(
+    x: CompiledNode,
+    spec: NodeSemantics,
+    sure: Sequence[bool],
+    busy: Sequence[bool],
+    may_skip: Sequence[bool],
+) -> tuple[bool, bool]:
+    """The livelock test's facts (``RuleTraits.leaf_facts``). Sequence/Fallback (no wake-up,
+    no memory): child 0 ``sure`` and every later child ``busy`` (the index is above 0 at a
+    tick's start only while that child is RUNNING: any completion moves or resets it in the
+    same tick, a halt resets it). The other kinds: every child ``sure``."""
+    kids = x.children
+    if not spec.wakes_up and not spec.with_memory:
+        plain = sure[kids[0]] and all(busy[c] for c in kids[1:])
+        return plain, plain
+    every = all(sure[c] for c in kids)
+    return every, every
+
+
 #: This family's rules by name (``registry`` merges the families' tables).
 RULES: dict[str, NusmvRule] = {"sequence": sequence}
+#: What the encoder's whole-tree checks read of them (``contract.RuleTraits``): SKIPPED is
+#: counted (``sk_n``) and returned when every child was skipped; ``idx_n`` and ``prev_n`` are
+#: the frame; a completed child is reset before it is ticked again.
+TRAITS: dict[str, RuleTraits] = {
+    "sequence": RuleTraits(
+        skip_aware=always,
+        returns_skipped=every_child_skips,
+        index=True,
+        prev=True,
+        keeps_completed=True,
+        leaf_facts=_leaf_facts,
+    )
+}

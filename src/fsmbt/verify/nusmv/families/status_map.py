@@ -15,13 +15,12 @@ Cost: O(1) rules per node.
 
 from __future__ import annotations
 
-from fsmbt.semantics.compiled import CompiledNode
-from fsmbt.semantics.nodes import all_nodes, node_semantics
-from fsmbt.verify.nusmv.families.common import SKIPPED, ST
-from fsmbt.verify.nusmv.families.contract import BTCore, NusmvRule, Resets
+from collections.abc import Sequence
 
-#: The kinds of this rule (the encoder reads which can tick forever: no result map).
-SIMPLE_DECORATORS = frozenset(n.name for n in all_nodes() if n.nusmv == "simple_decorator")
+from fsmbt.semantics.compiled import CompiledNode
+from fsmbt.semantics.nodes import NodeSemantics, node_semantics
+from fsmbt.verify.nusmv.families.common import SKIPPED, ST, every_child_skips, one_child_facts
+from fsmbt.verify.nusmv.families.contract import BTCore, NusmvRule, Resets, RuleTraits
 
 
 def simple_decorator(core: BTCore, x: CompiledNode, here: str, called: str, resets: Resets) -> None:
@@ -47,5 +46,47 @@ def simple_decorator(core: BTCore, x: CompiledNode, here: str, called: str, rese
     core.ret(done, x.id, mapped)
 
 
+def _maps(x: CompiledNode, spec: NodeSemantics) -> bool:
+    """A status map (a declared ``result_map``): it passes SKIPPED on."""
+    return spec.result_map is not None
+
+
+def _skips(x: CompiledNode, spec: NodeSemantics, may_skip: Sequence[bool]) -> bool:
+    """A status map returns SKIPPED when its child may."""
+    return _maps(x, spec) and every_child_skips(x, spec, may_skip)
+
+
+def _keeps_running(x: CompiledNode, spec: NodeSemantics) -> bool:
+    """KeepRunningUntilFailure (no result map) can tick its child forever."""
+    return spec.result_map is None
+
+
+_PASSES = one_child_facts(sure_with_child=True)
+
+
+def _leaf_facts(
+    x: CompiledNode,
+    spec: NodeSemantics,
+    sure: Sequence[bool],
+    busy: Sequence[bool],
+    may_skip: Sequence[bool],
+) -> tuple[bool, bool]:
+    """The livelock test's facts (``RuleTraits.leaf_facts``): a status map's are its child's;
+    KeepRunningUntilFailure guarantees none."""
+    return _PASSES(x, spec, sure, busy, may_skip) if _maps(x, spec) else (False, False)
+
+
 #: This family's rules by name (``registry`` merges the families' tables).
 RULES: dict[str, NusmvRule] = {"simple_decorator": simple_decorator}
+#: What the encoder's whole-tree checks read of them (``contract.RuleTraits``): a status map
+#: passes SKIPPED on; every kind resets a completed child; KeepRunningUntilFailure may tick
+#: forever.
+TRAITS: dict[str, RuleTraits] = {
+    "simple_decorator": RuleTraits(
+        skip_aware=_maps,
+        returns_skipped=_skips,
+        keeps_completed=True,
+        leaf_facts=_leaf_facts,
+        ticks_forever=_keeps_running,
+    )
+}

@@ -14,8 +14,16 @@ No variable. Cost: O(1) rules per node.
 from __future__ import annotations
 
 from fsmbt.semantics.compiled import CompiledNode
-from fsmbt.verify.nusmv.families.common import FAILURE, PASSED, SKIPPED, SUCCESS
-from fsmbt.verify.nusmv.families.contract import BTCore, NusmvRule, Resets, named
+from fsmbt.verify.nusmv.families.common import (
+    FAILURE,
+    PASSED,
+    SKIPPED,
+    SUCCESS,
+    always,
+    every_child_skips,
+    one_child_facts,
+)
+from fsmbt.verify.nusmv.families.contract import BTCore, NusmvRule, Resets, RuleTraits, named
 
 
 def subtree(core: BTCore, x: CompiledNode, here: str, called: str, resets: Resets) -> None:
@@ -49,4 +57,15 @@ RULES: dict[str, NusmvRule] = {
     "subtree": subtree,
     "pass_through": named(pass_through, "pass_through"),
     "pass_through_keep": named(pass_through, "pass_through_keep"),
+}
+#: What the encoder's whole-tree checks read of them (``contract.RuleTraits``): SubTree passes
+#: SKIPPED on, resets its completed root and ticks it on every tick; Root and GoalUpdater have
+#: the defaults.
+TRAITS: dict[str, RuleTraits] = {
+    "subtree": RuleTraits(
+        skip_aware=always,
+        returns_skipped=every_child_skips,
+        keeps_completed=True,
+        leaf_facts=one_child_facts(sure_with_child=True),
+    )
 }
