@@ -239,10 +239,12 @@ class Lockstep:
     mismatch: str | None = None
 
     def active_leaf(self) -> str:
+        """The actions of the active atomic states, joined; empty ones dropped, as fsmbt's W3C
+        reading does (a ``<parallel>`` region waiting for its turn has no action)."""
         doc = self.engine.doc
         active = {s.id for s in self.engine.machine.configuration}
         atoms = [s for s in active if not doc.children.get(s)]
-        return "+".join(sorted(self.actions.get(s, doc.name[s]) for s in atoms))
+        return "+".join(sorted(a for s in atoms if (a := self.actions.get(s, doc.name[s]))))
 
     def __call__(self, node, _path: str) -> str:  # noqa: ANN001 - the tree's BTNode
         label = node.name or node.type

@@ -47,6 +47,7 @@ from typing import Any
 
 from fsmbt import limits
 from fsmbt.convert.bt_compact import Namer, compact_region
+from fsmbt.convert.bt_parallel import ParallelRegion, is_parallel_kind, parallel_region
 from fsmbt.convert.compress import inline_and_compress
 from fsmbt.convert.perf import without_gc_pauses
 from fsmbt.convert.result import ConversionResult
@@ -137,6 +138,7 @@ class _Builder:
     namer: Namer = field(default_factory=Namer)
     variables: list[tuple[str, str]] = field(default_factory=list)
     guarded: int = 0
+    parallels: int = 0
 
     # -- naming ----------------------------------------------------------------------------
     @staticmethod
@@ -222,7 +224,13 @@ class _Builder:
     # -- explored regions --------------------------------------------------------------------
     def _explored_state(self, node: BTNode, cont: _Cont, machine: FSM) -> str:
         reset: list[tuple[str, str]] = []
-        if self.compact:
+        parallel = self.parallel_region(node) if self.compact else None
+        if parallel is not None:
+            sub, ends = parallel.fsm, parallel.ends
+            reset = parallel.variables
+            self.variables.extend(reset)
+            self.parallels += 1
+        elif self.compact:
             region = self.compact_region(node, loop=False, top=False)
             sub, ends = region.fsm, region.ends
             reset = region.variables
@@ -248,9 +256,41 @@ class _Builder:
             machine.add_transition(name, None, cont.failure, exit=FAILURE)
         return name
 
+    def parallel_region(self, node: BTNode) -> ParallelRegion | None:
+        """A Parallel/ParallelAll heading its region as a ``<parallel>`` (``bt_parallel``), or
+        ``None`` (not such a node, or not exactly expressible: the reason is warned)."""
+        if not is_parallel_kind(node):
+            return None
+        found = parallel_region(
+            node, name=f"parallel_{node.label}", plain=_is_structural, new_variable=self.namer.name
+        )
+        if isinstance(found, str):
+            self.warnings.append(f"{self._place(node)}: kept as a product, not <parallel>: {found}")
+            return None
+        return found
+
+    def _place(self, node: BTNode) -> str:
+        return f"{node.type} at {self.where.path(node) if self.where else node.label}"
+
+    def warn_inner_parallels(self, node: BTNode) -> None:
+        """Warn for each Parallel inside ``node``'s explored region (below its head): it stays
+        part of the region's product (docs/semantics.md §6a); ``node`` too when it is the
+        whole tree (``loop``: the root's memory outlives its restart)."""
+        stack = [node] if self.loop else list(node.children)
+        while stack:
+            inner = stack.pop()
+            if is_parallel_kind(inner):
+                self.warnings.append(
+                    f"{self._place(inner)}: kept as a product, not <parallel>: it runs inside "
+                    f"the region of {node.type} '{node.label}', whose memory, restarts or "
+                    "re-checks halt and restart it"
+                )
+            stack.extend(inner.children)
+
     def compact_region(self, node: BTNode, *, loop: bool, top: bool):  # noqa: ANN201
         """``node``'s region as one state per leaf with data (``bt_compact``); its variables
         join the conversion's data model."""
+        self.warn_inner_parallels(node)
         machine, explored = _explore(node, loop=loop, max_states=self.max_states, where=self.where)
         region = compact_region(
             machine,
@@ -481,5 +521,6 @@ def bt_to_hfsm(
         "unroll": unroll,
         "data_variables": len(builder.variables),
         "guarded_transitions": builder.guarded,
+        "parallel_states": builder.parallels,
     }
     return ConversionResult(hfsm, "rules", "bt->fsm", stats, builder.warnings)
