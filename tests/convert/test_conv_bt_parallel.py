@@ -141,6 +141,10 @@ def test_a_wrong_turn_order_is_caught() -> None:
             "</Parallel>",
             "a threshold of 0",
         ),
+        (
+            '<Parallel success_count="1" failure_count="1"><Action ID="A"/></Parallel>',
+            "a single child",
+        ),
     ],
 )
 def test_inexpressible_parallels_keep_the_product_and_say_why(tree: str, reason: str) -> None:

@@ -47,7 +47,8 @@ leaf-execution machine (§4); the checker proves it for every conversion.
 Not expressed (``parallel_region`` returns the reason; the caller keeps the product form and
 warns): a child that is not plain (its memory, restarts or reactive re-checks would have to
 mark where its ticks end), a threshold of 0 (the node returns after its first child whatever
-it does) and a node with a meaning other than the built-in one.
+it does), a single child (nothing runs side by side) and a node with a meaning other than the
+built-in one.
 
 Costs: O(nodes of the Parallel's subtree); no exploration.
 """
@@ -130,6 +131,8 @@ def parallel_region(
     """
     kind = canonical_type(node.type)
     n = len(node.children)
+    if n < 2:
+        return "a single child: no regions run side by side"
     if kind == "Parallel":
         succ_param, fail_param = parallel_params(node, kind, True)
         need_s, need_f = parallel_threshold(succ_param, n), parallel_threshold(fail_param, n)
