@@ -368,10 +368,9 @@ def test_compact_parallels_run_like_btcpp() -> None:
     (tests/support/parallel_trees.py) and the corpus trees of that shape, each written with one
     ``<parallel>`` whose regions take turns, run in python-statemachine leaf for leaf and
     result for result as in BehaviorTree.CPP (``COMPACT_SEQUENCES`` random runs each)."""
+    from fsmbt.formats import loads
     from support.corpus import profile_options
     from support.parallel_trees import parallel_tree_xml
-
-    from fsmbt.formats import loads
 
     trees: list[tuple[str, BTDocument]] = []
     for relative in ("kitchen_sim__write_text.xml", "dual_arm_sim__draw.xml"):
