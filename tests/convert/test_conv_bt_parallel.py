@@ -19,10 +19,12 @@ from support.corpus import CORPUS, profile_options
 from support.parallel_trees import parallel_tree_xml
 
 SCXML = "{http://www.w3.org/2005/07/scxml}"
-#: Corpus trees whose Parallel heads its region with plain children.
+#: Corpus trees whose Parallel heads its region (plain children; a RepeatUnlessFailureEachTick
+#: in the last one's second child).
 CORPUS_PARALLEL = (
     "bt/moveit_pro/kitchen_sim__write_text.xml",
     "bt/moveit_pro/dual_arm_sim__draw.xml",
+    "bt/moveit_pro/hangar_sim__cartesian_draw_geometry_from_file.xml",
 )
 
 
@@ -71,12 +73,15 @@ def test_corpus_parallel_becomes_parallel_regions(relative: str) -> None:
     proven_parallel(doc, relative)
 
 
-def test_generated_parallels_are_proven() -> None:
-    """60 seeded trees: Parallel (every success/failure threshold but 0) and ParallelAll,
-    plain children up to three levels, at the root or inside a plain Sequence/Fallback."""
+@pytest.mark.parametrize("memory", [False, True], ids=["plain", "memory"])
+def test_generated_parallels_are_proven(memory: bool) -> None:
+    """40 seeded trees each: Parallel (every success/failure threshold but 0) and ParallelAll,
+    children up to three levels - plain, or with Retry/Repeat, SequenceWithMemory and reactive
+    controls (their compact regions, tick ends marked) -, at the root or inside a plain
+    Sequence/Fallback."""
     kinds = set()
-    for seed in range(60):
-        text = parallel_tree_xml(seed)
+    for seed in range(40):
+        text = parallel_tree_xml(seed, memory=memory)
         doc = loads(text, "btcpp")
         proven_parallel(doc, text)
         kinds.add("ParallelAll" if "ParallelAll" in text else "Parallel")
@@ -130,11 +135,16 @@ def test_a_wrong_turn_order_is_caught() -> None:
             'failure_count="1"><Action ID="A"/><Action ID="B"/></Parallel></ReactiveSequence>',
             "inside the region of ReactiveSequence",
         ),
-        (  # a child with memory: where its ticks end is not where a leaf runs
+        (  # the retry ends a tick with no leaf ticked, then fails in the next one
+            '<Parallel success_count="1" failure_count="1"><Action ID="A"/><Sequence>'
+            '<Action ID="B"/><RetryUntilSuccessful num_attempts="2"><AlwaysFailure/>'
+            "</RetryUntilSuccessful></Sequence></Parallel>",
+            "child 2 can return its result in a tick that ticks none of its leaves",
+        ),
+        (
             '<Parallel success_count="1" failure_count="1"><Action ID="A"/>'
-            '<RetryUntilSuccessful num_attempts="2"><Action ID="B"/></RetryUntilSuccessful>'
-            "</Parallel>",
-            "child 2 holds RetryUntilSuccessful",
+            "<KeepRunningUntilFailure><AlwaysSuccess/></KeepRunningUntilFailure></Parallel>",
+            "child 2 can end in LIVELOCK",
         ),
         (
             '<Parallel success_count="0" failure_count="1"><Action ID="A"/><Action ID="B"/>'

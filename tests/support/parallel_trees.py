@@ -8,10 +8,15 @@ from __future__ import annotations
 import random
 
 DECORATORS = ("Inverter", "ForceSuccess", "ForceFailure")
+#: Nodes with memory, restarts or re-checks a child may hold with ``memory=True``.
+MEMORY_DECORATORS = ('RetryUntilSuccessful num_attempts="2"', 'Repeat num_cycles="2"')
+MEMORY_CONTROLS = ("SequenceWithMemory", "ReactiveSequence", "ReactiveFallback")
 
 
-def parallel_tree_xml(seed: int) -> str:
-    """One tree as BehaviorTree.CPP v4 XML (leaves ``<Action ID>``/``<Condition ID>``)."""
+def parallel_tree_xml(seed: int, memory: bool = False) -> str:
+    """One tree as BehaviorTree.CPP v4 XML (leaves ``<Action ID>``/``<Condition ID>``);
+    ``memory``: the children may also hold Retry/Repeat, SequenceWithMemory and reactive
+    controls (each child's tick end is then read from its leaf-execution machine)."""
     rng = random.Random(seed)
     names = iter(range(1, 1000))
 
@@ -25,12 +30,16 @@ def parallel_tree_xml(seed: int) -> str:
         if depth == 0 or roll < 0.35:
             inner = leaf()
         else:
-            kind = rng.choice(("Sequence", "Fallback"))
+            kinds = ("Sequence", "Fallback") + (MEMORY_CONTROLS if memory else ())
+            kind = rng.choice(kinds)
             kids = "".join(child(depth - 1) for _ in range(rng.randint(2, 3)))
             inner = f"<{kind}>{kids}</{kind}>"
         if rng.random() < 0.2:
             decorator = rng.choice(DECORATORS)
             inner = f"<{decorator}>{inner}</{decorator}>"
+        if memory and rng.random() < 0.3:
+            decorator = rng.choice(MEMORY_DECORATORS)
+            inner = f"<{decorator}>{inner}</{decorator.split()[0]}>"
         return inner
 
     count = rng.randint(2, 3)

@@ -58,8 +58,10 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass
 
+from fsmbt.convert.bt_compact import TICK_MARK, CompactRegion
 from fsmbt.model.bt import BTNode
 from fsmbt.model.bt_nodes import NodeKind
+from fsmbt.model.errors import InputError, UnsupportedError
 from fsmbt.model.fsm import FSM, State
 from fsmbt.model.fsm_data import ASSIGN, COND, join_lines
 from fsmbt.model.nodes import canonical_type
@@ -115,6 +117,7 @@ def parallel_region(
     name: str,
     plain: Callable[[BTNode], bool],
     new_variable: Callable[[str], str],
+    compact_child: Callable[[BTNode], CompactRegion] | None = None,
 ) -> ParallelRegion | str:
     """``node`` (a Parallel/ParallelAll heading its region) as a ``<parallel>`` composite, or
     the reason it cannot be one exactly (see the module docstring).
@@ -125,6 +128,9 @@ def parallel_region(
         plain: whether a node is one the paper's rules wire (leaves, plain Sequence/Fallback,
             stateless decorators); every node of every child must be.
         new_variable: a unique variable name for a base name (shared by the conversion).
+        compact_child: a child that is not plain as a compact region of its tick-marked
+            leaf-execution machine (``bt_compact``, ``tick_marks``); ``None``: such a child
+            is a reason to keep the product form.
 
     Raises:
         InputError: a threshold above the number of children (as the interpreter).
@@ -141,17 +147,30 @@ def parallel_region(
     else:
         (need_f,) = parallel_all_params(node, kind, True)
         need_s = 0
+    opaque: dict[int, BTNode] = {}
     for index, child in enumerate(node.children):
         stack = [child]
         while stack:
             inner = stack.pop()
             if not plain(inner):
-                return (
-                    f"child {index + 1} holds {inner.type} '{inner.label}', whose memory or "
-                    "restarts are not the paper's rules (its ticks' ends are not its leaves' "
-                    "running)"
-                )
+                if compact_child is None:
+                    return (
+                        f"child {index + 1} holds {inner.type} '{inner.label}', whose memory "
+                        "or restarts are not the paper's rules"
+                    )
+                opaque[index] = inner
+                break
             stack.extend(inner.children)
+    compacted: dict[int, CompactRegion] = {}
+    for index in opaque:
+        assert compact_child is not None
+        try:
+            compacted[index] = compact_child(node.children[index])
+        except (InputError, UnsupportedError) as exc:
+            return f"child {index + 1}: {getattr(exc, 'message', exc)}"
+        odd = _odd_ends(compacted[index])
+        if odd:
+            return f"child {index + 1} {odd}"
     base = node.label
     turn = new_variable(f"{base}_turn")
     successes = new_variable(f"{base}_successes")
@@ -165,10 +184,16 @@ def parallel_region(
         first_end, first_cond = FAILURE, f"{failures} >= {need_f}"
         other_end = SUCCESS
     sub = FSM(name=name)
-    regions = [
-        _region(child, i, n, f"{name}_r{i}", turn, successes, failures, stop)
-        for i, child in enumerate(node.children)
-    ]
+    regions = []
+    variables = [(turn, "0"), (successes, "0"), (failures, "0")]
+    for i, child in enumerate(node.children):
+        region_name = f"{name}_r{i}"
+        counters = (turn, successes, failures, stop)
+        if i in compacted:
+            regions.append(_compact_region(compacted[i], i, n, region_name, *counters))
+            variables.extend(compacted[i].variables)
+        else:
+            regions.append(_region(child, i, n, region_name, *counters))
     parallel_name = f"{base}_regions"
     sub.add_state(State(parallel_name, action=None, regions=regions))
     for result in (SUCCESS, FAILURE):
@@ -176,7 +201,6 @@ def parallel_region(
     sub.initial = parallel_name
     sub.add_transition(parallel_name, None, first_end, attrs={COND: first_cond})
     sub.add_transition(parallel_name, None, other_end)
-    variables = [(turn, "0"), (successes, "0"), (failures, "0")]
     return ParallelRegion(sub, {SUCCESS, FAILURE}, variables, len(regions))
 
 
@@ -251,6 +275,71 @@ def _region(
     for leaf_id, wait in waits.items():
         fsm.add_transition(wait, None, end, attrs={COND: stop})
         fsm.add_transition(wait, None, state_of[leaf_id], attrs={COND: f"{turn} == {index}"})
+    fsm.add_transition(done, None, end, attrs={COND: stop})
+    fsm.add_transition(done, None, done, attrs={COND: f"{turn} == {index}", ASSIGN: pass_on})
+    return fsm
+
+
+def _odd_ends(region: CompactRegion) -> str:
+    """Why a child's compact region cannot be a turn-taking region (``""``: it can): it ends
+    otherwise than SUCCESS/FAILURE, or in a tick after one that ran no leaf."""
+    if region.ends - {SUCCESS, FAILURE}:
+        return f"can end in {', '.join(sorted(region.ends - {SUCCESS, FAILURE}))}"
+    for t in region.fsm.transitions:
+        if t.attrs.get(TICK_MARK) and t.target in region.ends:
+            return "can return its result in a tick that ticks none of its leaves"
+    return ""
+
+
+def _compact_region(
+    compact: CompactRegion,
+    index: int,
+    count: int,
+    name: str,
+    turn: str,
+    successes: str,
+    failures: str,
+    stop: str,
+) -> FSM:
+    """Region ``index`` from a child's tick-marked compact region: its leaf states and
+    guarded transitions as they are; a step that ended the child's tick goes to the wait
+    state of its target and passes the turn on; the child's end goes to DONE."""
+    source = compact.fsm
+    fsm = FSM(name=name)
+    pass_on = f"{turn}={(index + 1) % count}"
+    for state in source.states.values():
+        if not state.final:
+            fsm.add_state(State(state.name, action=state.action))
+    waits: dict[str, str] = {}
+
+    def wait_for(leaf: str) -> str:
+        if leaf not in waits:
+            waits[leaf] = _unique(fsm, f"wait_{leaf}")
+            fsm.add_state(State(waits[leaf], action=""))
+        return waits[leaf]
+
+    assert source.initial is not None
+    fsm.initial = wait_for(source.initial)
+    done = _unique(fsm, DONE)
+    fsm.add_state(State(done, action=""))
+    end = _unique(fsm, END)
+    fsm.add_state(State(end, action="", final=True))
+    counter = {SUCCESS: successes, FAILURE: failures}
+    for t in source.transitions:
+        attrs = {k: v for k, v in t.attrs.items() if k != TICK_MARK}
+        assigns = [attrs[ASSIGN]] if ASSIGN in attrs else []
+        if t.target in counter:
+            name_ = counter[t.target]
+            attrs[ASSIGN] = "\n".join([*assigns, f"{name_}={name_} + 1", pass_on])
+            fsm.add_transition(t.source, t.event, done, attrs=attrs)
+        elif t.attrs.get(TICK_MARK):
+            attrs[ASSIGN] = "\n".join([*assigns, pass_on])
+            fsm.add_transition(t.source, t.event, wait_for(t.target), attrs=attrs)
+        else:
+            fsm.add_transition(t.source, t.event, t.target, attrs=attrs)
+    for leaf, wait in waits.items():
+        fsm.add_transition(wait, None, end, attrs={COND: stop})
+        fsm.add_transition(wait, None, leaf, attrs={COND: f"{turn} == {index}"})
     fsm.add_transition(done, None, end, attrs={COND: stop})
     fsm.add_transition(done, None, done, attrs={COND: f"{turn} == {index}", ASSIGN: pass_on})
     return fsm

@@ -46,7 +46,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from fsmbt import limits
-from fsmbt.convert.bt_compact import Namer, compact_region
+from fsmbt.convert.bt_compact import CompactRegion, Namer, compact_region
 from fsmbt.convert.bt_parallel import ParallelRegion, is_parallel_kind, parallel_region
 from fsmbt.convert.compress import inline_and_compress
 from fsmbt.convert.perf import without_gc_pauses
@@ -262,12 +262,48 @@ class _Builder:
         if not is_parallel_kind(node):
             return None
         found = parallel_region(
-            node, name=f"parallel_{node.label}", plain=_is_structural, new_variable=self.namer.name
+            node,
+            name=f"parallel_{node.label}",
+            plain=_is_structural,
+            new_variable=self.namer.name,
+            compact_child=self._tick_marked_region,
         )
         if isinstance(found, str):
             self.warnings.append(f"{self._place(node)}: kept as a product, not <parallel>: {found}")
             return None
         return found
+
+    def _tick_marked_region(self, node: BTNode) -> CompactRegion:
+        """``node``'s subtree as a compact region whose steps say where its ticks end (a
+        Parallel's child that is not plain; ``bt_parallel``)."""
+        limit = (
+            self.max_states
+            if self.max_states is not None
+            else limits.current().conversion_max_states
+        )
+        machine = LeafMachine(BTDocument.single(node), loop=False, mark_ticks=True)
+        try:
+            explored = explore(machine, max_states=limit)
+        except StateLimitError:
+            raise StateLimitError(
+                f"exploring this subtree (a child of a Parallel with memory or reactive "
+                f"children) reaches more than {limit} states",
+                element=self.where.path(node) if self.where else node.label,
+                location=node.location,
+                hints=(Hint.MAX_STATES,),
+            ) from None
+        region = compact_region(
+            machine,
+            explored,
+            name=f"compact_{node.label}",
+            top=False,
+            namer=self.namer,
+            unique=self._unique,
+            tick_marks=True,
+        )
+        self.explored_states += region.explored_states
+        self.guarded += region.guarded
+        return region
 
     def _place(self, node: BTNode) -> str:
         return f"{node.type} at {self.where.path(node) if self.where else node.label}"
