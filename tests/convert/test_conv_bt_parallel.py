@@ -168,3 +168,16 @@ def test_inexpressible_parallels_keep_the_product_and_say_why(tree: str, reason:
     said = [w for w in result.warnings if "not <parallel>" in w]
     assert len(said) == 1 and reason in said[0] and "tree 'M'" in said[0], result.warnings
     assert api.verify_models(doc, result.model).equivalent
+
+
+def test_loop_and_unroll_keep_the_product() -> None:
+    """With ``loop`` the whole tree is one explored region (the warning says so); ``--unroll``
+    keeps every memory as states, Parallels included, as before."""
+    doc = loads(TWO_OF_THREE, "btcpp")
+    looped = bt_to_hfsm(doc, loop=True)
+    assert counts(looped.model)[1] == 0
+    assert any("with loop the whole tree is one explored region" in w for w in looped.warnings)
+    assert api.verify_models(doc, looped.model, loop=True).equivalent
+    unrolled = bt_to_hfsm(doc, unroll=True)
+    assert counts(unrolled.model)[1] == 0 and not has_data(unrolled.model)
+    assert api.verify_models(doc, unrolled.model).equivalent

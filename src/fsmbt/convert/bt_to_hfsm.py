@@ -315,7 +315,12 @@ class _Builder:
         stack = [node] if self.loop else list(node.children)
         while stack:
             inner = stack.pop()
-            if is_parallel_kind(inner):
+            if is_parallel_kind(inner) and self.loop:
+                self.warnings.append(
+                    f"{self._place(inner)}: kept as a product, not <parallel>: with loop the "
+                    "whole tree is one explored region (its memory outlives the root's restart)"
+                )
+            elif is_parallel_kind(inner):
                 self.warnings.append(
                     f"{self._place(inner)}: kept as a product, not <parallel>: it runs inside "
                     f"the region of {node.type} '{node.label}', whose memory, restarts or "
