@@ -23,10 +23,13 @@ paper's per-leaf rules. The topmost such node on a path (its ancestors are all p
 Sequence/Fallback/stateless decorators, which always resume straight into it, so it behaves the
 same in isolation) becomes one composite state whose sub-FSM is the leaf-execution machine of its
 subtree, explored with the reference interpreter (``fsmbt.semantics.leaf_machine``; the
-interpreter is cross-checked against BehaviorTree.CPP). Parallel nodes are therefore converted as
-a product (one state per combination of running children), not as orthogonal regions: the
-interleaving of their children's ticks is observable leaf by leaf, which orthogonal regions do not
-express. The whole tree is explored instead when such a region can end in ``SKIPPED`` or
+interpreter is cross-checked against BehaviorTree.CPP). With ``unroll=True``, or inside a region
+headed by another node, a Parallel is part of that product (one state per combination of
+running children); by default a Parallel/ParallelAll heading its region is an SCXML
+``<parallel>`` whose regions take turns on data, so that the interleaving of its children's
+ticks, observable leaf by leaf, is BehaviorTree.CPP's (``fsmbt.convert.bt_parallel``;
+docs/semantics.md §6a; a Parallel it cannot express is warned about, naming the reason). The
+whole tree is explored instead when such a region can end in ``SKIPPED`` or
 ``LIVELOCK`` (no sequence/fallback rule covers them) and, with ``loop=True``, when any such node
 exists (its memory outlives the root's restart). The verdict for those parts then checks the
 assembly and the flattening; the node semantics come from the interpreter.
