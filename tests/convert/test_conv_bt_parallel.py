@@ -181,3 +181,18 @@ def test_loop_and_unroll_keep_the_product() -> None:
     unrolled = bt_to_hfsm(doc, unroll=True)
     assert counts(unrolled.model)[1] == 0 and not has_data(unrolled.model)
     assert api.verify_models(doc, unrolled.model).equivalent
+
+
+def test_render_pages_open_the_regions(tmp_path) -> None:  # noqa: ANN001
+    """``fsmbt render --pages``: the ``<parallel>``'s page draws its regions with their leaf
+    states (a parallel's level counts from its regions; they were one closed box)."""
+    from fsmbt.render import render_pages
+
+    doc, hfsm = _one_parallel(TWO_OF_THREE)
+    pages = render_pages(hfsm, tmp_path)
+    regions = [p for p in pages if p.name.endswith("P_regions.svg")]
+    assert len(regions) == 1, [p.name for p in pages]
+    text = regions[0].read_text()
+    for leaf in ("wait_A", ">A<", ">B<", ">C<", ">D<", "DONE"):
+        assert leaf in text, leaf
+    assert "states inside" not in text
