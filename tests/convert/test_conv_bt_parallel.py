@@ -196,3 +196,16 @@ def test_render_pages_open_the_regions(tmp_path) -> None:  # noqa: ANN001
     for leaf in ("wait_A", ">A<", ">B<", ">C<", ">D<", "DONE"):
         assert leaf in text, leaf
     assert "states inside" not in text
+
+
+@pytest.mark.nusmv
+def test_nusmv_agrees_on_the_parallel_regions(nusmv_binary) -> None:  # noqa: ANN001
+    """NuSMV checks the same flat meaning (the W3C expansion of the data model) and agrees:
+    the conversion is equivalent, the wrong threshold is not."""
+    doc, hfsm = _one_parallel(TWO_OF_THREE)
+    assert api.verify_models(doc, hfsm, "both").equivalent
+    for machine in hfsm.machines():
+        for t in machine.transitions:
+            if t.attrs.get(COND) == "P_successes >= 2":
+                t.attrs[COND] = "P_successes >= 1"
+    assert not api.verify_models(doc, hfsm, "nusmv").equivalent
