@@ -209,3 +209,21 @@ def test_nusmv_agrees_on_the_parallel_regions(nusmv_binary) -> None:  # noqa: AN
             if t.attrs.get(COND) == "P_successes >= 2":
                 t.attrs[COND] = "P_successes >= 1"
     assert not api.verify_models(doc, hfsm, "nusmv").equivalent
+
+
+def test_a_parallel_inside_a_child_is_named() -> None:
+    """The outer Parallel becomes ``<parallel>``; the inner one, inside a child with memory,
+    is part of that child's compact region, and the warning names it."""
+    doc = loads(
+        '<root BTCPP_format="4" main_tree_to_execute="M"><BehaviorTree ID="M">'
+        '<Parallel name="Outer" success_count="1" failure_count="1"><Action ID="A"/>'
+        '<RetryUntilSuccessful num_attempts="2"><Parallel name="Inner" success_count="1" '
+        'failure_count="1"><Action ID="B"/><Action ID="C"/></Parallel></RetryUntilSuccessful>'
+        "</Parallel></BehaviorTree></root>",
+        "btcpp",
+    )
+    result = bt_to_hfsm(doc)
+    assert counts(result.model)[1] == 1
+    said = [w for w in result.warnings if "not <parallel>" in w]
+    assert len(said) == 1 and "'Inner'" in said[0] and "region of Parallel 'Outer'" in said[0]
+    assert api.verify_models(doc, result.model).equivalent

@@ -274,6 +274,7 @@ class _Builder:
         if isinstance(found, str):
             self.warnings.append(f"{self._place(node)}: kept as a product, not <parallel>: {found}")
             return None
+        self.warn_inner_parallels(node)  # a Parallel inside a child: part of its compact region
         return found
 
     def _tick_marked_region(self, node: BTNode) -> CompactRegion:
