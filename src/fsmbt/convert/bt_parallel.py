@@ -28,6 +28,14 @@ ForceSuccess, ForceFailure; wired by the paper's sequence and fallback rules, fl
 - eventless transitions of ``wait_*`` and ``DONE``, in this order: ``cond stop -> END``
   (``<final>``), ``cond P_turn == i -> <leaf>`` (``DONE``: ``-> DONE``, the turn passed on).
 
+A child that is not plain (memory, restarts, reactive re-checks) is explored alone with its
+tick ends marked (``LeafMachine(mark_ticks=True)``: ``TICK_END`` where its root returns
+RUNNING, a wake-up's re-tick included) and compacted (``bt_compact``, ``tick_marks``): its
+leaf states and guarded transitions are the region's, a marked step goes to ``wait_<target>``
+and passes the turn on, its ends go to ``DONE``; its variables join the composite's reset.
+Alone or under the Parallel the child is ticked the same way, once per tick until it
+completes, and halted with the Parallel.
+
 Turn ``0`` after child ``n-1`` is the next tick: the Parallel heads its region, so its
 ancestors (plain Sequence/Fallback/stateless decorators) resume straight into it.
 ``stop`` is ``P_successes >= S or P_failures >= F'`` with ``S`` the success threshold and
@@ -45,12 +53,13 @@ Parallel ticks next. Proof obligation: the W3C meaning of the composite equals t
 leaf-execution machine (§4); the checker proves it for every conversion.
 
 Not expressed (``parallel_region`` returns the reason; the caller keeps the product form and
-warns): a child that is not plain (its memory, restarts or reactive re-checks would have to
-mark where its ticks end), a threshold of 0 (the node returns after its first child whatever
-it does), a single child (nothing runs side by side) and a node with a meaning other than the
-built-in one.
+warns): a child that can livelock or return its result in a tick that ticks none of its
+leaves (the turn would have to pass without a leaf), a threshold of 0 (the node returns after
+its first child whatever it does), a single child (nothing runs side by side) and a node with
+a meaning other than the built-in one.
 
-Costs: O(nodes of the Parallel's subtree); no exploration.
+Costs: O(nodes of the Parallel's subtree) for plain children; a child that is not plain costs
+its exploration and compaction (``bt_compact``'s costs), never the product of the children.
 """
 
 from __future__ import annotations
