@@ -10,8 +10,12 @@ and the CPU time of the compact conversion, of its proof (native checker, throug
 expansion of the data model; docs/conversion.md "Compact conversion") and of both together
 (``--repeat N``: the least of N runs each, which a shared machine's load disturbs least).
 The last line counts the trees whose conversion and proof together take under one second.
+``--parallel``: only the trees with a ``Parallel`` or ``ParallelAll`` node (SubTrees inlined);
+the column "par" counts the ``<parallel>`` elements of the compact SCXML (docs/semantics.md
+§6a, "Parallel as `<parallel>`").
 
-Run: PYTHONPATH=src python benchmarks/bench_compact.py [--only nav2] [--markdown] [--repeat 3]
+Run: PYTHONPATH=src python benchmarks/bench_compact.py [--only nav2] [--parallel] [--markdown]
+[--repeat 3]
 """
 
 from __future__ import annotations
@@ -41,7 +45,29 @@ SCXML_NS = "http://www.w3.org/2005/07/scxml"
 def elements(fsm: FSM) -> tuple[int, int]:
     """(``<state>`` + ``<parallel>`` + ``<final>`` elements, ``<transition>`` elements) of the
     SCXML the machine is written as."""
+    return _elements(etree.fromstring(write_scxml(fsm).encode()))
+
+
+def parallels(fsm: FSM) -> int:
+    """``<parallel>`` elements of the SCXML the machine is written as."""
     root = etree.fromstring(write_scxml(fsm).encode())
+    return sum(1 for _ in root.iter(f"{{{SCXML_NS}}}parallel"))
+
+
+def has_parallel(doc: BTDocument) -> bool:
+    """Whether the main tree, SubTrees inlined, holds a Parallel or ParallelAll node."""
+    from fsmbt.convert.compress import inline_and_compress
+
+    stack = [inline_and_compress(doc).compression.root]
+    while stack:
+        node = stack.pop()
+        if node.type in ("Parallel", "ParallelAll"):
+            return True
+        stack.extend(node.children)
+    return False
+
+
+def _elements(root: etree._Element) -> tuple[int, int]:
     states = sum(
         1
         for e in root.iter()
@@ -81,11 +107,13 @@ def inputs(only: str | None) -> list[tuple[str, Path, dict[str, object]]]:
 
 
 def measure(
-    label: str, path: Path, options: dict[str, object], repeat: int = 1
+    label: str, path: Path, options: dict[str, object], repeat: int = 1, only_parallel: bool = False
 ) -> list[object] | None:
     try:
         doc = api.load(path, options=options).model
         assert isinstance(doc, BTDocument)
+        if only_parallel and not has_parallel(doc):
+            return None
         unrolled = bt_to_hfsm(doc, unroll=True)
     except InputError:
         return None  # does not convert today: not part of the table
@@ -111,6 +139,7 @@ def measure(
         c_states,
         c_trans,
         compact.stats["data_variables"],
+        parallels(compact.model),
         formula,
         4 * nodes + 10,
         "yes" if c_states <= 4 * nodes + 10 else "NO",
@@ -129,6 +158,7 @@ HEADER = [
     "compact st",
     "compact tr",
     "vars",
+    "par",
     "4M+2k+1",
     "4n+10",
     "within",
@@ -144,10 +174,13 @@ def main() -> int:
     parser.add_argument("--only", help="only sources whose folder contains this text (nav2)")
     parser.add_argument("--markdown", action="store_true")
     parser.add_argument("--repeat", type=int, default=1, help="times: the least is shown")
+    parser.add_argument(
+        "--parallel", action="store_true", help="only trees with a Parallel or ParallelAll node"
+    )
     args = parser.parse_args()
     rows = []
     for label, path, options in inputs(args.only):
-        row = measure(label, path, options, args.repeat)
+        row = measure(label, path, options, args.repeat, args.parallel)
         if row is not None:
             rows.append(row)
             if not args.markdown:
@@ -157,10 +190,10 @@ def main() -> int:
         print("|" + "---|" * len(HEADER))
         for row in rows:
             print("| " + " | ".join(str(c) for c in row) + " |")
-    within = sum(1 for r in rows if r[9] == "yes")
-    proved = sum(1 for r in rows if r[13] == "EQUIVALENT")
-    fast = [r for r in rows if float(str(r[12])) < 1.0]
-    slowest = max(rows, key=lambda r: float(str(r[12])), default=None)
+    within = sum(1 for r in rows if r[10] == "yes")
+    proved = sum(1 for r in rows if r[14] == "EQUIVALENT")
+    fast = [r for r in rows if float(str(r[13])) < 1.0]
+    slowest = max(rows, key=lambda r: float(str(r[13])), default=None)
     print(
         f"\n{len(rows)} trees: {within} within 4*nodes+10 states, {proved} proven equivalent; "
         f"elements before/after: {sum(int(r[2]) for r in rows)} / {sum(int(r[4]) for r in rows)}"
@@ -168,7 +201,7 @@ def main() -> int:
     if slowest is not None:
         print(
             f"conversion + proof under 1 s CPU: {len(fast)} of {len(rows)} trees; slowest "
-            f"{slowest[0]} {slowest[12]} s (least of {max(1, args.repeat)} run(s))"
+            f"{slowest[0]} {slowest[13]} s (least of {max(1, args.repeat)} run(s))"
         )
     return 0 if within == proved == len(rows) else 1
 

@@ -277,8 +277,9 @@ def test_random_trees_with_memory_round_trip_through_smach_proven() -> None:
             continue
         try:
             text = write_smach(model)
-        except FsmbtError as exc:  # SMACH's own limits (a region starting in a final state)
-            assert "starts in a final state" in exc.message
+        except FsmbtError as exc:  # SMACH's own limits (a region starting in a final state;
+            # a <parallel> whose regions take turns on data: docs/semantics.md §6a)
+            assert "starts in a final state" in exc.message or "take turns" in exc.message
             continue
         back = loads(text, "smach")
         assert isinstance(back, FSM) and has_data(back)

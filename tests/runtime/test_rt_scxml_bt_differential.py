@@ -239,10 +239,12 @@ class Lockstep:
     mismatch: str | None = None
 
     def active_leaf(self) -> str:
+        """The actions of the active atomic states, joined; empty ones dropped, as fsmbt's W3C
+        reading does (a ``<parallel>`` region waiting for its turn has no action)."""
         doc = self.engine.doc
         active = {s.id for s in self.engine.machine.configuration}
         atoms = [s for s in active if not doc.children.get(s)]
-        return "+".join(sorted(self.actions.get(s, doc.name[s]) for s in atoms))
+        return "+".join(sorted(a for s in atoms if (a := self.actions.get(s, doc.name[s]))))
 
     def __call__(self, node, _path: str) -> str:  # noqa: ANN001 - the tree's BTNode
         label = node.name or node.type
@@ -361,6 +363,44 @@ def test_compact_runs_like_btcpp() -> None:
     assert tally.models >= 0.8 * len(trees)
 
 
+def test_compact_parallels_run_like_btcpp() -> None:
+    """Issue 24, ``<parallel>``: 40 seeded trees whose Parallel/ParallelAll heads its region
+    (tests/support/parallel_trees.py; every other one with Retry/Repeat, SequenceWithMemory
+    and reactive controls in its children) and the corpus trees of that shape, each written with one
+    ``<parallel>`` whose regions take turns, run in python-statemachine leaf for leaf and
+    result for result as in BehaviorTree.CPP (``COMPACT_SEQUENCES`` random runs each)."""
+    from fsmbt.formats import loads
+    from support.corpus import profile_options
+    from support.parallel_trees import parallel_tree_xml
+
+    trees: list[tuple[str, BTDocument]] = []
+    for relative in (
+        "kitchen_sim__write_text.xml",
+        "dual_arm_sim__draw.xml",
+        "hangar_sim__cartesian_draw_geometry_from_file.xml",
+    ):
+        path = CORPUS / "bt" / "moveit_pro" / relative
+        if path.exists():
+            trees.append((relative, api.load(path, options=profile_options(path)).model))
+    for seed in range(40):
+        text = parallel_tree_xml(SEED * 100 + seed, memory=seed % 2 == 1)
+        trees.append((f"parallel{seed}", loads(text, "btcpp")))
+    tally = Tally("compact parallel")
+    rng = random.Random(SEED)
+    engines: Counter[str] = Counter()
+    with_parallel = 0
+    for label, doc in trees:
+        with_parallel += "<parallel" in dumps(bt_to_hfsm(doc).model, "scxml")
+        ran = run_compact(doc, rng, tally, label)
+        assert ran is not None, label
+        engines[ran[0]] += 1
+        # generated trees have only BehaviorTree.CPP's nodes (MoveIt Pro's run interpreted)
+        assert ran[0] == "btcpp" or not label.startswith("parallel"), label
+    print(tally.report() + f"; run against {dict(engines)}; {with_parallel} with <parallel>")
+    assert not tally.mismatches, tally.mismatches[:5]
+    assert with_parallel == len(trees) and engines["btcpp"] >= 40
+
+
 def test_compact_lockstep_catches_a_wrong_guard() -> None:
     """The lockstep can fail: the Nav2 default tree's compact SCXML with one retry guard
     negated (a failing selector ends the run instead of recovering) disagrees with the tree."""
@@ -388,6 +428,38 @@ def test_compact_lockstep_catches_a_wrong_guard() -> None:
     for _ in range(20):
         env = Lockstep(Engine(spelled), _actions(text), rng)
         runner = BTRunner(doc, env)
+        while env.steps < COMPACT_LEAF_STEPS and env.mismatch is None:
+            before = env.steps
+            if runner.tick_once().result != "RUNNING" or env.steps == before:
+                break
+        caught += env.mismatch is not None
+    assert caught
+
+
+def test_parallel_lockstep_catches_a_wrong_turn() -> None:
+    """The lockstep can fail on ``<parallel>``: when the first region passes the turn back to
+    itself instead of on (its ``running`` keeps the turn), python-statemachine ticks the first
+    child again where BehaviorTree.CPP ticks the second."""
+    from fsmbt.formats import loads
+
+    doc = loads(
+        '<root BTCPP_format="4" main_tree_to_execute="M"><BehaviorTree ID="M">'
+        '<Parallel name="P" success_count="2" failure_count="2"><Action ID="A"/>'
+        '<Action ID="B"/><Action ID="C"/></Parallel></BehaviorTree></root>',
+        "btcpp",
+    )
+    text = dumps(bt_to_hfsm(doc).model, "scxml")
+    wrong = '<transition event="running" target="wait_A">\n            <assign location="P_turn" expr="0"/>'
+    right = wrong.replace('expr="0"', 'expr="1"')
+    assert right in text
+    text = text.replace(right, wrong)
+    from fsmbt.semantics.engines.btcpp_engine import BTCppRunner
+
+    rng = random.Random(SEED)
+    caught = 0
+    for _ in range(20):
+        env = Lockstep(Engine(python_spelled(text) or text), _actions(text), rng)
+        runner = BTCppRunner(doc, env)
         while env.steps < COMPACT_LEAF_STEPS and env.mismatch is None:
             before = env.steps
             if runner.tick_once().result != "RUNNING" or env.steps == before:

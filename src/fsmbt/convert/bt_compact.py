@@ -50,7 +50,7 @@ from fsmbt.model.fsm import FSM, State
 from fsmbt.model.fsm_data import ASSIGN, COND
 from fsmbt.model.nodes import canonical_type, node_semantics
 from fsmbt.semantics.bt_interpreter import STATUS_NAMES
-from fsmbt.semantics.leaf_machine import ExploredMachine, LeafMachine, RootResult
+from fsmbt.semantics.leaf_machine import TICK_END, ExploredMachine, LeafMachine, RootResult
 from fsmbt.semantics.nodes import runtime_tables
 
 _NOT_NAME = re.compile(r"[^A-Za-z0-9_]+")
@@ -60,6 +60,9 @@ _STATUS, _MEMORY, _FRAME, _WAKE = "status", "memory", "frame", "wake"
 Feature = tuple[Any, ...]
 #: Conflicting pairs looked at per refinement round (enough to rank the features).
 _MAX_PAIRS = 400
+#: Transition attribute of a ``tick_marks`` region: the step ended a tick of the region's root
+#: (RUNNING) before reaching its target (``fsmbt.convert.bt_parallel`` reads and removes it).
+TICK_MARK = "fsmbt:tick-end"
 
 
 @dataclass
@@ -107,6 +110,7 @@ def compact_region(
     top: bool,
     namer: Namer,
     unique: Callable[[FSM, str], str],
+    tick_marks: bool = False,
 ) -> CompactRegion:
     """The compact machine of an explored region (see the module docstring).
 
@@ -117,11 +121,15 @@ def compact_region(
         top: the region is the whole tree (final states carry the result as action).
         namer: names the variables (shared by the regions of one conversion).
         unique: makes a state name unique in a machine (the converter's rule).
+        tick_marks: the machine marks its ticks' ends (``LeafMachine(mark_ticks=True)``): a
+            step with outputs ``(TICK_END, leaf)`` is a transition with ``TICK_MARK``.
 
     Raises:
         InputError: a step outputs more than one label inside a composite (as unrolled).
     """
-    return _Compactor(machine, explored, name, top, namer, unique).build()
+    compactor = _Compactor(machine, explored, name, top, namer, unique)
+    compactor.tick_marks = tick_marks
+    return compactor.build()
 
 
 class _Compactor:
@@ -138,6 +146,7 @@ class _Compactor:
         self.explored = explored
         self.nodes = machine.tree.nodes
         self.top = top
+        self.tick_marks = False
         self.namer = namer
         self.unique = unique
         self.fsm = FSM(name=name)
@@ -465,12 +474,15 @@ class _Compactor:
             ordered = ordered[1:] + ordered[:1]
             for n, (spec, valuations) in enumerate(ordered):
                 (target, outs), updates = spec
+                marked = self.tick_marks and len(outs) == 2 and outs[0] == TICK_END
+                if marked:
+                    outs = outs[1:]
                 if len(outs) != 1 and not self.top:
                     raise InputError(
                         f"cannot express the outputs {outs} of one step as one state's action",
                         element=fsm.name,
                     )
-                attrs: dict[str, str] = {}
+                attrs: dict[str, str] = {TICK_MARK: "true"} if marked else {}
                 if spec != default:
                     later = [v for _spec, vs in ordered[n + 1 :] for v in vs]
                     attrs[COND] = _guard(

@@ -23,10 +23,13 @@ paper's per-leaf rules. The topmost such node on a path (its ancestors are all p
 Sequence/Fallback/stateless decorators, which always resume straight into it, so it behaves the
 same in isolation) becomes one composite state whose sub-FSM is the leaf-execution machine of its
 subtree, explored with the reference interpreter (``fsmbt.semantics.leaf_machine``; the
-interpreter is cross-checked against BehaviorTree.CPP). Parallel nodes are therefore converted as
-a product (one state per combination of running children), not as orthogonal regions: the
-interleaving of their children's ticks is observable leaf by leaf, which orthogonal regions do not
-express. The whole tree is explored instead when such a region can end in ``SKIPPED`` or
+interpreter is cross-checked against BehaviorTree.CPP). With ``unroll=True``, or inside a region
+headed by another node, a Parallel is part of that product (one state per combination of
+running children); by default a Parallel/ParallelAll heading its region is an SCXML
+``<parallel>`` whose regions take turns on data, so that the interleaving of its children's
+ticks, observable leaf by leaf, is BehaviorTree.CPP's (``fsmbt.convert.bt_parallel``;
+docs/semantics.md §6a; a Parallel it cannot express is warned about, naming the reason). The
+whole tree is explored instead when such a region can end in ``SKIPPED`` or
 ``LIVELOCK`` (no sequence/fallback rule covers them) and, with ``loop=True``, when any such node
 exists (its memory outlives the root's restart). The verdict for those parts then checks the
 assembly and the flattening; the node semantics come from the interpreter.
@@ -46,7 +49,8 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from fsmbt import limits
-from fsmbt.convert.bt_compact import Namer, compact_region
+from fsmbt.convert.bt_compact import CompactRegion, Namer, compact_region
+from fsmbt.convert.bt_parallel import ParallelRegion, is_parallel_kind, parallel_region
 from fsmbt.convert.compress import inline_and_compress
 from fsmbt.convert.perf import without_gc_pauses
 from fsmbt.convert.result import ConversionResult
@@ -137,6 +141,7 @@ class _Builder:
     namer: Namer = field(default_factory=Namer)
     variables: list[tuple[str, str]] = field(default_factory=list)
     guarded: int = 0
+    parallels: int = 0
 
     # -- naming ----------------------------------------------------------------------------
     @staticmethod
@@ -222,7 +227,13 @@ class _Builder:
     # -- explored regions --------------------------------------------------------------------
     def _explored_state(self, node: BTNode, cont: _Cont, machine: FSM) -> str:
         reset: list[tuple[str, str]] = []
-        if self.compact:
+        parallel = self.parallel_region(node) if self.compact else None
+        if parallel is not None:
+            sub, ends = parallel.fsm, parallel.ends
+            reset = parallel.variables
+            self.variables.extend(reset)
+            self.parallels += 1
+        elif self.compact:
             region = self.compact_region(node, loop=False, top=False)
             sub, ends = region.fsm, region.ends
             reset = region.variables
@@ -248,9 +259,83 @@ class _Builder:
             machine.add_transition(name, None, cont.failure, exit=FAILURE)
         return name
 
+    def parallel_region(self, node: BTNode) -> ParallelRegion | None:
+        """A Parallel/ParallelAll heading its region as a ``<parallel>`` (``bt_parallel``), or
+        ``None`` (not such a node, or not exactly expressible: the reason is warned)."""
+        if not is_parallel_kind(node):
+            return None
+        found = parallel_region(
+            node,
+            name=f"parallel_{node.label}",
+            plain=_is_structural,
+            new_variable=self.namer.name,
+            compact_child=self._tick_marked_region,
+        )
+        if isinstance(found, str):
+            self.warnings.append(f"{self._place(node)}: kept as a product, not <parallel>: {found}")
+            return None
+        self.warn_inner_parallels(node)  # a Parallel inside a child: part of its compact region
+        return found
+
+    def _tick_marked_region(self, node: BTNode) -> CompactRegion:
+        """``node``'s subtree as a compact region whose steps say where its ticks end (a
+        Parallel's child that is not plain; ``bt_parallel``)."""
+        limit = (
+            self.max_states
+            if self.max_states is not None
+            else limits.current().conversion_max_states
+        )
+        machine = LeafMachine(BTDocument.single(node), loop=False, mark_ticks=True)
+        try:
+            explored = explore(machine, max_states=limit)
+        except StateLimitError:
+            raise StateLimitError(
+                f"exploring this subtree (a child of a Parallel with memory or reactive "
+                f"children) reaches more than {limit} states",
+                element=self.where.path(node) if self.where else node.label,
+                location=node.location,
+                hints=(Hint.MAX_STATES,),
+            ) from None
+        region = compact_region(
+            machine,
+            explored,
+            name=f"compact_{node.label}",
+            top=False,
+            namer=self.namer,
+            unique=self._unique,
+            tick_marks=True,
+        )
+        self.explored_states += region.explored_states
+        self.guarded += region.guarded
+        return region
+
+    def _place(self, node: BTNode) -> str:
+        return f"{node.type} at {self.where.path(node) if self.where else node.label}"
+
+    def warn_inner_parallels(self, node: BTNode) -> None:
+        """Warn for each Parallel inside ``node``'s explored region (below its head): it stays
+        part of the region's product (docs/semantics.md §6a); ``node`` too when it is the
+        whole tree (``loop``: the root's memory outlives its restart)."""
+        stack = [node] if self.loop else list(node.children)
+        while stack:
+            inner = stack.pop()
+            if is_parallel_kind(inner) and self.loop:
+                self.warnings.append(
+                    f"{self._place(inner)}: kept as a product, not <parallel>: with loop the "
+                    "whole tree is one explored region (its memory outlives the root's restart)"
+                )
+            elif is_parallel_kind(inner):
+                self.warnings.append(
+                    f"{self._place(inner)}: kept as a product, not <parallel>: it runs inside "
+                    f"the region of {node.type} '{node.label}', whose memory, restarts or "
+                    "re-checks halt and restart it"
+                )
+            stack.extend(inner.children)
+
     def compact_region(self, node: BTNode, *, loop: bool, top: bool):  # noqa: ANN201
         """``node``'s region as one state per leaf with data (``bt_compact``); its variables
         join the conversion's data model."""
+        self.warn_inner_parallels(node)
         machine, explored = _explore(node, loop=loop, max_states=self.max_states, where=self.where)
         region = compact_region(
             machine,
@@ -481,5 +566,6 @@ def bt_to_hfsm(
         "unroll": unroll,
         "data_variables": len(builder.variables),
         "guarded_transitions": builder.guarded,
+        "parallel_states": builder.parallels,
     }
     return ConversionResult(hfsm, "rules", "bt->fsm", stats, builder.warnings)

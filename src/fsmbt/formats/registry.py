@@ -18,7 +18,7 @@ from fsmbt import limits
 from fsmbt.model.errors import Hint, InputError, SourceLocation, UnsupportedError
 from fsmbt.model.files import read_located
 from fsmbt.model.fsm import FSM
-from fsmbt.model.fsm_data import DATAMODEL, has_data, parse_lines
+from fsmbt.model.fsm_data import DATAMODEL, data_places, has_data, parallel_states, parse_lines
 
 if TYPE_CHECKING:
     from fsmbt.model import Model
@@ -404,19 +404,42 @@ def dumps(model: Model, fmt: str) -> str:
 DATA_FORMATS = frozenset({"scxml", "json", "yaml", "smach"})
 
 
+def keeps_data(model: Model, fmt: str) -> bool:
+    """Whether ``fmt`` writes ``model``'s data as data: a machine without data always; else a
+    format of ``DATA_FORMATS``, except SMACH for a machine with a parallel state (its regions
+    take turns on the data, docs/semantics.md §6a; a SMACH ``Concurrence`` runs its children at
+    once, so no userdata can keep the turns)."""
+    if not isinstance(model, FSM) or not has_data(model):
+        return True
+    if fmt == "smach":
+        return not parallel_states(model)
+    return fmt in DATA_FORMATS
+
+
+def data_loss_reason(model: FSM, fmt: str) -> str:
+    """Why ``fmt`` cannot keep ``model``'s data, in a person's words (``keeps_data`` false)."""
+    if fmt == "smach":
+        shown = ", ".join(parallel_states(model)[:3])
+        return (
+            f"smach keeps data as userdata, but not in the parallel state(s) {shown}, whose "
+            "regions take turns on it (a SMACH Concurrence runs its children at once)"
+        )
+    return f"{fmt} has no data model"
+
+
 def refuse_data_loss(model: Model, fmt: str) -> None:
-    """A machine that keeps data written in a format without a data model would lose its
-    guards and updates, and with them its meaning: refused, naming what would be lost and the
-    ways out (docs/semantics.md, "Data in state machines")."""
-    if fmt in DATA_FORMATS or not isinstance(model, FSM) or not has_data(model):
+    """A machine that keeps data written in a format that cannot keep it would lose its
+    guards and updates, and with them its meaning: refused, naming what would be lost, where,
+    and the ways out (docs/semantics.md, "Data in state machines")."""
+    if keeps_data(model, fmt):
         return
+    assert isinstance(model, FSM)
     names = [name for name, _expr in parse_lines(model.attrs[DATAMODEL])]
-    shown = ", ".join(names[:4]) + (f" and {len(names) - 4} more" if len(names) > 4 else "")
     raise UnsupportedError(
-        f"{fmt} has no data model, and this state machine keeps {len(names)} variable(s) "
-        f"({shown}) in guards and assignments: write it as SCXML, JSON, YAML or SMACH, "
-        "translate it (written as its exact flat expansion, named as a loss), or convert "
-        "with --unroll",
+        f"{data_loss_reason(model, fmt)}, and this state machine keeps {len(names)} "
+        f"variable(s) in guards and assignments ({data_places(model)}): write it as SCXML, "
+        "JSON, YAML or SMACH, translate it (written as its exact flat expansion, named as a "
+        "loss), or convert with --unroll",
         element=model.name,
     )
 

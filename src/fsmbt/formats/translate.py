@@ -31,9 +31,10 @@ from typing import Any
 
 from fsmbt.formats.annotations import annotation_losses
 from fsmbt.formats.registry import (
-    DATA_FORMATS,
     ReadContext,
+    data_loss_reason,
     get_format,
+    keeps_data,
     loads,
     refuse_data_loss,
 )
@@ -42,7 +43,7 @@ from fsmbt.model.errors import InputError, UnsupportedError
 from fsmbt.model.flatten import flatten as flatten_fsm
 from fsmbt.model.flatten import needs_flattening
 from fsmbt.model.fsm import FSM
-from fsmbt.model.fsm_data import DATAMODEL, has_data, parse_lines
+from fsmbt.model.fsm_data import DATAMODEL, data_places, parallel_states, parse_lines
 from fsmbt.model.serialize import model_to_dict
 
 #: More generic differences than this are summarised in one line.
@@ -173,21 +174,20 @@ def translate(
 
 
 def expand_data_for(model: Model, fmt: str) -> tuple[Model, str | None]:
-    """A machine with data for a format without a data model: its exact expansion
-    (configuration x values, the W3C reading; docs/semantics.md §6a) and the loss that names
-    the variables; any other model as it is, with no loss. Cost: the expansion's."""
-    if not isinstance(model, FSM) or not has_data(model) or fmt in DATA_FORMATS:
+    """A machine with data for a format that cannot keep it (``registry.keeps_data``): its
+    exact expansion (configuration x values, the W3C reading; docs/semantics.md §6a) and the
+    loss, which names the variables and where each is read and assigned; any other model as it
+    is, with no loss. Cost: the expansion's."""
+    if not isinstance(model, FSM) or keeps_data(model, fmt):
         return model, None
     variables = [name for name, _expr in parse_lines(model.attrs[DATAMODEL])]
     expanded = flatten_fsm(model)
-    shown = ", ".join(variables[:4]) + (
-        f" and {len(variables) - 4} more" if len(variables) > 4 else ""
-    )
     return expanded, (
-        f"{fmt} has no data model: the {len(variables)} variable(s) ({shown}) and the guards "
-        "and assignments reading them are written as the machine's exact expansion, "
+        f"{data_loss_reason(model, fmt)}: the {len(variables)} variable(s) and the guards and "
+        "assignments reading them are written as the machine's exact expansion, "
         f"{len(expanded.states)} flat states (configuration x values) instead of "
-        f"{sum(1 for _ in model.walk())}; SCXML, JSON, YAML and SMACH keep them as data"
+        f"{sum(1 for _ in model.walk())}; lost: {data_places(model)}; SCXML, JSON, YAML"
+        f"{'' if parallel_states(model) else ' and SMACH'} keep them as data"
     )
 
 

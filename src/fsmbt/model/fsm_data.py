@@ -27,6 +27,7 @@ layer needs no import from above. Cost of ``has_data``: O(1).
 from __future__ import annotations
 
 import importlib
+import re
 from collections.abc import Callable
 
 from fsmbt.model.errors import UnsupportedError
@@ -61,6 +62,53 @@ def parse_lines(text: str) -> list[tuple[str, str]]:
 def join_lines(pairs: list[tuple[str, str]]) -> str:
     """The inverse of ``parse_lines``."""
     return "\n".join(f"{name}={expr}" for name, expr in pairs)
+
+
+def data_places(fsm: FSM, limit: int = 4) -> str:
+    """Where a machine's data lives, for a loss a person can find in the machine: per variable
+    (the first ``limit``) its initial value, how many guards read it and how many transitions
+    or ``<onexit>`` blocks assign it, each with the first place (``path`` of the state as
+    ``FSM.walk`` names it, and the event). O(states + transitions) per variable shown."""
+    pairs = parse_lines(fsm.attrs.get(DATAMODEL, ""))
+    reads: dict[str, list[str]] = {name: [] for name, _e in pairs}
+    writes: dict[str, list[str]] = {name: [] for name, _e in pairs}
+    words = {name: re.compile(rf"\b{re.escape(name)}\b") for name, _e in pairs}
+    paths: dict[tuple[int, str], str] = {}
+    for path, machine, state in fsm.walk():
+        paths[(id(machine), state.name)] = path
+        for name, _expr in parse_lines(state.attrs.get(ONEXIT, "")):
+            if name in writes:
+                writes[name].append(f"{path} (on exit)")
+    for machine in fsm.machines():
+        for t in machine.transitions:
+            source = machine.states.get(t.source)
+            plain = "eventless" if source is not None and source.is_atomic else "completion"
+            at = f"{paths.get((id(machine), t.source), t.source)} on {t.event or plain}"
+            cond = t.attrs.get(COND, "")
+            for name, word in words.items():
+                if word.search(cond):
+                    reads[name].append(at)
+            for name, _expr in parse_lines(t.attrs.get(ASSIGN, "")):
+                if name in writes:
+                    writes[name].append(at)
+    parts = []
+    for name, initial in pairs[:limit]:
+        read, written = reads[name], writes[name]
+        parts.append(
+            f"{name} (initial {initial}; read by {len(read)} guard(s)"
+            + (f", first at {read[0]}" if read else "")
+            + f"; assigned {len(written)} time(s)"
+            + (f", first at {written[0]}" if written else "")
+            + ")"
+        )
+    if len(pairs) > limit:
+        parts.append(f"and {len(pairs) - limit} more")
+    return "; ".join(parts)
+
+
+def parallel_states(fsm: FSM) -> list[str]:
+    """The paths of the parallel states of ``fsm`` (any level), in ``walk`` order."""
+    return [path for path, _machine, state in fsm.walk() if state.is_parallel]
 
 
 def register_expander(expander: Callable[[FSM], FSM]) -> None:

@@ -197,6 +197,8 @@ def fsm_to_dot(
         else:  # parallel: the state's cluster with one sub-cluster per region
             fsm = FSM(name=composite, states={state.name: state}, initial=state.name)
             first_level = 1
+            if level is not None:  # a level counts from the regions: open them at least
+                level += first_level
     stats = fsm_stats(fsm)
     if max_nodes is not None:
         check_size(stats.all_states, max_nodes, "states")

@@ -11,6 +11,9 @@ way: the root's result when a tick ends with one (``"SUCCESS"``/``"FAILURE"``, o
 - A tick whose root returns RUNNING (a running leaf, KeepRunningUntilFailure...) is not
   observable: the next tick starts at once (that is also why ``tickOnce``'s immediate re-tick on
   a wake-up and ``tickExactlyOnce`` give the same leaf machine).
+- ``mark_ticks=True`` makes that tick end observable: the output ``TICK_END`` where the root
+  returned RUNNING, a wake-up's immediate re-tick included (``fsmbt.convert.bt_parallel``:
+  where a Parallel's child yields the turn to its next sibling).
 - ``loop=False``: a root result ends the run: the state becomes ``RootResult(result)``, status
   ``"final"``, outputs ``(result,)``. ``loop=True``: the root is ticked again; the outputs are
   ``(result, next leaf label)`` and the status stays ``"running"``.
@@ -66,6 +69,8 @@ from fsmbt.semantics.machine import RUNNING as STATUS_RUNNING
 from fsmbt.semantics.status import LeafOutcome, NodeStatus
 
 LIVELOCK = "LIVELOCK"
+#: Output of a ``mark_ticks`` machine when its root returned RUNNING (a tick ended) on the way.
+TICK_END = "TICK_END"
 #: The leaf outcomes a condition / an action may be given (``LeafOutcome`` values, plain str).
 CONDITION_INPUTS: tuple[str, ...] = (LeafOutcome.SUCCESS.value, LeafOutcome.FAILURE.value)
 ACTION_INPUTS: tuple[str, ...] = CONDITION_INPUTS + (LeafOutcome.RUNNING.value,)
@@ -104,13 +109,17 @@ class LeafMachine:
         *,
         name: str | None = None,
         generic: bool = False,
+        mark_ticks: bool = False,
     ) -> None:
-        self.interp = BTInterpreter(doc)
+        # marking ticks: a wake-up's immediate re-tick (``tickOnce``) is a tick end too
+        self.interp = BTInterpreter(doc, exactly_once=mark_ticks)
         self.tree = self.interp.tree
         self.loop = loop
+        #: output ``TICK_END`` where the root returns RUNNING (the fast path is not taken)
+        self.mark_ticks = mark_ticks
         main = self.tree.doc.main
         self.name = name or main.id
-        self.fast = not generic and is_static_tree(self.tree)
+        self.fast = not generic and not mark_ticks and is_static_tree(self.tree)
         self.table = PlainLeafTable(self.tree) if self.fast else None
         self.canonicalizer = (
             Canonicalizer(self.tree)
@@ -209,6 +218,8 @@ class LeafMachine:
                 outputs.append(result)
                 if not self.loop:
                     return RootResult(result)
+            elif self.mark_ticks:
+                outputs.append(TICK_END)
             if snap in boundaries:  # ticks repeat without any leaf: the engine would hang
                 outputs.append(LIVELOCK)
                 return RootResult(LIVELOCK)

@@ -39,6 +39,7 @@ import re
 from dataclasses import dataclass, field
 
 from fsmbt.formats.pysm.smach_data import A_CODE, DataPlan, split_data
+from fsmbt.formats.registry import refuse_data_loss
 from fsmbt.model import Model, state_info
 from fsmbt.model.errors import InputError, UnsupportedError
 from fsmbt.model.flatten import flatten
@@ -96,6 +97,7 @@ def write_smach_with_losses(model: Model) -> Written:
     """
     if not isinstance(model, FSM):
         raise InputError("SMACH holds state machines, not behavior trees")
+    refuse_data_loss(model, "smach")  # regions taking turns on data (registry.keeps_data)
     return _Writer(copy.deepcopy(model)).run()
 
 
