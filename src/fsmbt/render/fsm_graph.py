@@ -275,7 +275,9 @@ def fsm_to_dot(
                 inside = _inner_states(state)
                 lv.graph.node(
                     node_id,
-                    label=label_text(_state_title(state, title), f"[{inside} states inside]"),
+                    label=label_text(
+                        *_name_lines(_state_title(state, title)), f"[{inside} states inside]"
+                    ),
                     shape="box",
                     style="rounded,bold,filled",
                     fillcolor="gray95",
@@ -284,7 +286,7 @@ def fsm_to_dot(
             if state.is_atomic:
                 node_id = counter.state_id(lv, state.name)
                 lv.ids[state.name] = node_id
-                attrs = _state_attrs(state, title, compact=not layered)
+                attrs = _state_attrs(state, title, compact=not layered, wrap=not exchange)
                 anchor = state_anchor(lv.anchor + state.name)
                 drawn[anchor] = node_id
                 if anchors:
@@ -297,7 +299,7 @@ def fsm_to_dot(
                 extra = {"id": state_anchor(lv.anchor + state.name)} if anchors else {}
                 lv.graph.node(
                     node_id,
-                    label=label_text(_state_title(state, title)),
+                    label=label_text(*_name_lines(_state_title(state, title))),
                     shape="box",
                     style="rounded,bold",
                     **extra,
@@ -318,7 +320,13 @@ def fsm_to_dot(
                 continue
             cluster = graphviz.Digraph(name=counter.next("cluster_"))
             cluster.attr(
-                label=label_text(_state_title(state, state.name)),
+                label=label_text(
+                    *(
+                        [_state_title(state, state.name)]
+                        if exchange
+                        else _name_lines(_state_title(state, state.name), 2 * NAME_LINE)
+                    )
+                ),
                 style="rounded",
                 color="gray30",
                 fontname=FONT,
@@ -402,20 +410,60 @@ def _state_title(state: State, title: str) -> str:
     return title
 
 
+#: Pictures: a state name longer than this many characters is broken into lines (a circle is
+#: as wide as its longest line, so one long name makes the whole rank wide).
+NAME_LINE = 18
+_STRONG_BREAK = re.compile(r"(?<=[/#;, ])")
+_WEAK_BREAK = re.compile(r"(?<=[_.\-])|(?<=[a-z0-9])(?=[A-Z])")
+
+
+def _name_lines(text: str, width: int = NAME_LINE) -> list[str]:
+    """``text`` as lines of at most ``width`` characters where it can be: broken after ``/ # ;
+    ,`` and spaces first, then (inside a longer piece) after ``_ . -`` and between a lower-case
+    letter and a capital; a piece without such a place stays whole. Nothing is shortened: the
+    lines joined give ``text`` back but for the spaces at the breaks. O(len(text))."""
+    if len(text) <= width:
+        return [text]
+    pieces: list[str] = []
+    for piece in _STRONG_BREAK.split(text):
+        pieces.extend(_WEAK_BREAK.split(piece) if len(piece) > width else [piece])
+    lines: list[str] = []
+    current = ""
+    for piece in pieces:
+        if current and len(current) + len(piece.rstrip()) > width:
+            lines.append(current.rstrip())
+            current = ""
+        current += piece
+    if current:
+        lines.append(current)
+    return lines
+
+
+def _says_action(title: str, action: str) -> bool:
+    """Whether a state's drawn name already shows its action: ``q3:Move``, a flattened path
+    ``on/ready/begin`` running ``begin``, or a data-expanded name ``off#timer=1`` running
+    ``off`` - then the ``/ action`` line is left out."""
+    base = title.split("#", 1)[0]
+    return base == action or base.endswith((f"/{action}", f":{action}"))
+
+
 def _region_title(region: FSM, index: int) -> str:
     return region.name if region.name and region.name != "fsm" else f"region {index + 1}"
 
 
-def _state_attrs(state: State, title: str, *, compact: bool = False) -> dict[str, str]:
+def _state_attrs(
+    state: State, title: str, *, compact: bool = False, wrap: bool = False
+) -> dict[str, str]:
     """Circles (double for final states); ellipses in large pictures, where long path names
-    would make circles huge."""
-    lines = [title]
-    if (
-        state.action is not None
-        and state.action != state.name
-        and not title.endswith(f":{state.action}")
-    ):  # ``q3:Move`` already says it
-        lines.append(f"/ {state.action}")
+    would make circles huge. ``wrap`` (pictures): long names broken into lines
+    (``_name_lines``), the action line left out when the name shows it (``_says_action``)."""
+    lines = _name_lines(title) if wrap else [title]
+    if state.action is not None and state.action != state.name:
+        if not wrap and not title.endswith(f":{state.action}"):  # ``q3:Move`` already says it
+            lines.append(f"/ {state.action}")
+        elif wrap and not _says_action(title, state.action):
+            action_lines = _name_lines(state.action, NAME_LINE - 2)
+            lines += [f"/ {action_lines[0]}", *action_lines[1:]]
     attrs = {"label": label_text(*lines), "shape": "doublecircle" if state.final else "circle"}
     if state.action != state.name:  # read back by fsmbt.formats.diagrams.dot; Graphviz ignores it
         attrs["action"] = dot_id(state.action or "")
