@@ -37,6 +37,7 @@ from fsmbt.render.dot import (
     run_dot,
     write_picture,
 )
+from fsmbt.render.fsm_fit import fit_fsm_dot
 from fsmbt.render.fsm_graph import composite_paths, fsm_to_dot
 
 #: The sides (inches) a behavior tree's fold plan is tried with until its layout fits
@@ -73,6 +74,7 @@ def model_to_dot(
         notes: told what a capped picture left out and how to draw it.
         anchors: give every state / node a predictable SVG id (``fsmbt.render.anchor_ids``).
         focus: BT: draw only the subtree under this node (a path ``0/2/1`` or a node name).
+            FSM: ``composite``'s other name (the composite state whose inside is drawn).
         fold: BT: fold a tree too big to read at 100 % (``bt_to_dot``'s ``fold``).
         target: BT: the side (inches) the folded picture is estimated to fit (``bt_to_dot``).
 
@@ -84,15 +86,11 @@ def model_to_dot(
         an option of the other model kind.
     """
     if isinstance(model, FSM):
-        if tree is not None or expand_subtrees or focus is not None:
-            raise InputError(
-                "tree, focus and expand_subtrees are for behavior trees; this is an FSM"
-            )
         return fsm_to_dot(
             model,
             max_nodes=max_nodes,
             level=level,
-            composite=composite,
+            composite=_fsm_composite(tree, expand_subtrees, composite, focus),
             notes=notes,
             anchors=anchors,
         )
@@ -115,6 +113,20 @@ def model_to_dot(
     )
 
 
+def _fsm_composite(
+    tree: str | None, expand_subtrees: bool, composite: str | None, focus: str | None
+) -> str | None:
+    """The composite state an FSM picture draws (``composite``, or ``focus``: the same for an
+    FSM); refuses the behavior-tree options and two different composites."""
+    if tree is not None or expand_subtrees:
+        raise InputError("tree and expand_subtrees are for behavior trees; this is an FSM")
+    if focus is not None and composite is not None and focus != composite:
+        raise InputError(
+            f"focus '{focus}' and composite '{composite}' name two parts of one FSM; give one"
+        )
+    return composite if composite is not None else focus
+
+
 def picture_dot(
     model: FSM | BTDocument,
     *,
@@ -129,9 +141,24 @@ def picture_dot(
     to scale down least. At most ``len(FIT_TARGETS)`` extra layouts (a fraction of a second each
     for a folded picture), one for a tree that fits at once. ``notes`` gets the notes of the
     picture returned. Without Graphviz, the first plan (from the estimate alone)."""
+    if isinstance(model, FSM):  # measured and laid out again by fsm_fit
+        return fit_fsm_dot(
+            model,
+            notes=notes,
+            timeout=timeout,
+            max_nodes=options.get("max_nodes", DEFAULT_MAX_NODES),
+            level=options.get("level"),
+            composite=_fsm_composite(
+                options.get("tree"),
+                bool(options.get("expand_subtrees")),
+                options.get("composite"),
+                options.get("focus"),
+            ),
+            anchors=bool(options.get("anchors")),
+        )
     attempt_notes: list[str] = []
     source = model_to_dot(model, notes=attempt_notes, **options)
-    if isinstance(model, FSM) or not options.get("fold", True):
+    if not options.get("fold", True):
         if notes is not None:
             notes.extend(attempt_notes)
         return source
@@ -269,7 +296,7 @@ def render_pages(
         safe = _page_stem(stem)
         path = folder / f"{safe}.{fmt}"
         check_output(path, overwrite=overwrite)
-        source = fsm_to_dot(model, max_nodes=max_nodes, level=0, composite=composite, notes=notes)
+        source = fit_fsm_dot(model, max_nodes=max_nodes, level=0, composite=composite, notes=notes)
         written.append(write_picture(source, path, overwrite=overwrite, max_aspect=MAX_ASPECT))
     return written
 

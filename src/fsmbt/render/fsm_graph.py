@@ -90,6 +90,7 @@ class _Level:
     path: str = ""  # exchange DOT: the node-id prefix of this level's states
     anchor: str = ""  # anchors: the composite-state path of this level ("Parent/"), no regions
     aliases: dict[str, str] = field(default_factory=dict)  # data variable -> its short name
+    owner: str = ""  # the top-level state this level is inside ("": the top machine)
 
 
 def _find_composite(fsm: FSM, path: str) -> State:
@@ -132,8 +133,8 @@ def _inner_states(state: State) -> int:
     return count
 
 
-def _visible(fsm: FSM, level: int) -> tuple[int, int]:
-    """(states, transitions) drawn when composites deeper than ``level`` are closed."""
+def visible_size(fsm: FSM, level: int) -> tuple[int, int]:
+    """(states, transitions) drawn when composites deeper than ``level`` are closed. O(S + T)."""
     states = transitions = 0
     stack: list[tuple[FSM, int]] = [(fsm, 0)]
     while stack:
@@ -145,6 +146,32 @@ def _visible(fsm: FSM, level: int) -> tuple[int, int]:
                 (region, depth + 1) for state in machine.states.values() for region in state.regions
             )
     return states, transitions
+
+
+def _layered(states: int, transitions: int) -> bool:
+    return states <= LAYERED_MAX_STATES and transitions <= LAYERED_MAX_ARROWS
+
+
+def layered_size_fits(fsm: FSM, level: int) -> bool:
+    """Whether ``fsm`` with its composites nested deeper than ``level`` closed is small enough
+    for the layered layout (else it is drawn force-directed). O(S + T)."""
+    return _layered(*visible_size(fsm, level))
+
+
+def drawn_machine(fsm: FSM, composite: str | None) -> tuple[FSM, int]:
+    """The machine a picture of ``composite`` (``None``: the whole of ``fsm``) draws, and the
+    level its own states are at: a composite state's sub-machine (level 0), or for a parallel
+    state a machine holding that state alone (level 1: its regions are one level down).
+
+    Raises:
+        InputError: ``composite`` names no composite state (the message lists them).
+    """
+    if composite is None:
+        return fsm, 0
+    state = _find_composite(fsm, composite)
+    if len(state.regions) == 1:  # its sub-machine is the picture
+        return state.regions[0], 0
+    return FSM(name=composite, states={state.name: state}, initial=state.name), 1
 
 
 def fsm_to_dot(
@@ -159,6 +186,9 @@ def fsm_to_dot(
     marks: Mapping[str, Mapping[str, str]] | None = None,
     ghosts: Sequence[str] = (),
     ghost_edges: Sequence[tuple[str, str, str]] = (),
+    rankdir: str = "LR",
+    rows: Mapping[str, int] | None = None,
+    owners: dict[str, str] | None = None,
 ) -> str:
     """DOT source of ``fsm``.
 
@@ -179,6 +209,15 @@ def fsm_to_dot(
         ghosts: states that are not in ``fsm`` (a diff's removed states), drawn dashed and grey.
         ghost_edges: transitions that are not in ``fsm`` as ``(tail anchor, head anchor,
             label)`` between drawn atomic states or ghosts (``s@`` + the ghost's name), dashed.
+        rankdir: pictures: ``LR`` (transitions left to right) or ``TB`` (top down).
+        rows: pictures, layered layout: wrap the top machine into rows (``TB``: columns), the
+            row of each top-level state by name (missing: 0). A transition between two rows
+            does not rank its ends (``constraint=false``), so every row starts again at the
+            left: a long chain becomes a block of shorter rows. (Rows are not clusters: dot
+            fails with "lost edge" on such edges between clusters.)
+        owners: filled with each drawn node's DOT id -> the top-level state it belongs to (the
+            state itself, or the composite state holding it): what ``fsm_fit`` needs to
+            choose rows from a measured layout.
 
     Returns:
         The DOT source text.
@@ -188,12 +227,7 @@ def fsm_to_dot(
     """
     first_level = 0
     if composite is not None and not exchange:
-        state = _find_composite(fsm, composite)
-        if len(state.regions) == 1:  # its sub-machine is the picture
-            fsm = state.regions[0]
-        else:  # parallel: the state's cluster with one sub-cluster per region
-            fsm = FSM(name=composite, states={state.name: state}, initial=state.name)
-            first_level = 1
+        fsm, first_level = drawn_machine(fsm, composite)
     stats = fsm_stats(fsm)
     if max_nodes is not None:
         check_size(stats.all_states, max_nodes, "states")
@@ -203,20 +237,17 @@ def fsm_to_dot(
                 f"too deeply nested to draw: {stats.nesting_depth} levels (limit {MAX_NESTING})"
             )
 
-    def fits(states: int, transitions: int) -> bool:
-        return states <= LAYERED_MAX_STATES and transitions <= LAYERED_MAX_ARROWS
-
     if (
         not exchange
         and level is None
         and stats.hierarchical
-        and not fits(stats.all_states, stats.all_transitions)
+        and not _layered(stats.all_states, stats.all_transitions)
     ):
         level = first_level
-        while level + 1 < stats.nesting_depth and fits(*_visible(fsm, level + 1)):
+        while level + 1 < stats.nesting_depth and _layered(*visible_size(fsm, level + 1)):
             level += 1
         if notes is not None:
-            shown, _ = _visible(fsm, level)
+            shown, _ = visible_size(fsm, level)
             closed = [p for p in composite_paths(fsm) if p.count("/") == level]
             names = ", ".join(closed[:6]) + (
                 f", ... (+{len(closed) - 6})" if len(closed) > 6 else ""
@@ -228,9 +259,9 @@ def fsm_to_dot(
                 "composite=NAME or more levels with level=N"
             )
     visible = (
-        _visible(fsm, level) if level is not None else (stats.all_states, stats.all_transitions)
+        visible_size(fsm, level) if level is not None else (stats.all_states, stats.all_transitions)
     )
-    layered = exchange or fits(*visible)
+    layered = exchange or _layered(*visible)
     if not layered and notes is not None and level is None:
         notes.append(
             f"{visible[0]} states without hierarchy to split into levels: drawn with "
@@ -240,7 +271,13 @@ def fsm_to_dot(
     if not exchange:  # at most 4096 x 4096 pixels at 96 dpi (scaled down, never up)
         root.attr(size=MAX_PICTURE_INCHES)
     if layered:
-        root.attr(rankdir="LR", compound="true", fontname=FONT, nodesep="0.35", ranksep="0.5")
+        root.attr(
+            rankdir="LR" if exchange else rankdir,
+            compound="true",
+            fontname=FONT,
+            nodesep="0.35",
+            ranksep="0.5",
+        )
     else:
         root.attr(
             layout="sfdp", overlap="prism", splines="false", outputorder="edgesfirst", fontname=FONT
@@ -250,6 +287,9 @@ def fsm_to_dot(
     counter = _Counter(exchange)
     edges: list[tuple[str, str, dict[str, str]]] = []
     clusters: list[tuple[graphviz.Digraph, graphviz.Digraph]] = []  # (cluster, parent), pre-order
+
+    owner_of: dict[str, str] = {} if owners is None else owners
+    owner_of.clear()
 
     marks = marks or {}
     drawn: dict[str, str] = {}  # anchor id -> DOT node id of atomic states, for ghost edges
@@ -263,6 +303,7 @@ def fsm_to_dot(
         levels.append(lv)
         for state in lv.machine.states.values():
             title = lv.prefix + state.name
+            owner = lv.owner or state.name
             is_closed = (
                 not exchange
                 and level_cap is not None
@@ -272,6 +313,7 @@ def fsm_to_dot(
             if is_closed:
                 node_id = counter.state_id(lv, state.name)
                 lv.ids[state.name] = node_id
+                owner_of[node_id] = owner
                 inside = _inner_states(state)
                 lv.graph.node(
                     node_id,
@@ -286,6 +328,7 @@ def fsm_to_dot(
             if state.is_atomic:
                 node_id = counter.state_id(lv, state.name)
                 lv.ids[state.name] = node_id
+                owner_of[node_id] = owner
                 attrs = _state_attrs(state, title, compact=not layered, wrap=not exchange)
                 anchor = state_anchor(lv.anchor + state.name)
                 drawn[anchor] = node_id
@@ -296,6 +339,7 @@ def fsm_to_dot(
                 continue
             if not layered:  # a box standing for the composite state, no cluster
                 node_id = counter.next("c")
+                owner_of[node_id] = owner
                 extra = {"id": state_anchor(lv.anchor + state.name)} if anchors else {}
                 lv.graph.node(
                     node_id,
@@ -311,6 +355,7 @@ def fsm_to_dot(
                         prefix=f"{title}/",
                         entry=node_id,
                         anchor=f"{lv.anchor}{state.name}/",
+                        owner=owner,
                     )
                     for region in state.regions
                 ]
@@ -338,22 +383,32 @@ def fsm_to_dot(
             clusters.append((cluster, lv.graph))
             inner = []
             for index, region in enumerate(state.regions):
-                holder = cluster
+                region_graph = cluster
                 path = f"{lv.path}{state.name}/"
                 if state.is_parallel:
-                    holder = graphviz.Digraph(name=counter.next("cluster_"))
-                    holder.attr(
+                    region_graph = graphviz.Digraph(name=counter.next("cluster_"))
+                    region_graph.attr(
                         label=label_text(_region_title(region, index)),
                         style="dashed",
                         color="gray50",
                         fontname=FONT,
                         fontsize="10",
                     )
-                    clusters.append((holder, cluster))
+                    clusters.append((region_graph, cluster))
                     path = f"{path}{index}:"
-                inner.append(_Level(region, holder, path=path, anchor=f"{lv.anchor}{state.name}/"))
+                inner.append(
+                    _Level(
+                        region,
+                        region_graph,
+                        path=path,
+                        anchor=f"{lv.anchor}{state.name}/",
+                        owner=owner,
+                    )
+                )
             # Arrows to/from the composite state end at its cluster, through its first initial point.
-            lv.anchors[state.name] = (_initial_point_id(inner[0], counter), cluster.name)
+            point = _initial_point_id(inner[0], counter)
+            owner_of[point] = owner
+            lv.anchors[state.name] = (point, cluster.name)
             depth_of.update((id(x), depth_of[id(lv)] + 1) for x in inner)
             pending.extend(reversed(inner))
 
@@ -365,6 +420,8 @@ def fsm_to_dot(
         lv.aliases = aliases
         _draw_initial(lv, edges, counter, is_top=lv is top, anchors=anchors)
         _draw_transitions(lv, edges, exact=exchange)
+    if fsm.initial is not None and "__initial_point__" in top.ids:
+        owner_of[top.ids["__initial_point__"]] = fsm.initial
     for name in ghosts:
         ghost_id = counter.next("g")
         drawn.setdefault(state_anchor(name), ghost_id)
@@ -375,6 +432,11 @@ def fsm_to_dot(
                 (drawn[tail], drawn[head], {"label": label_text(text), **GHOST_EDGE_STYLE})
             )
 
+    if rows and layered and not exchange:  # an arrow between rows does not rank its ends
+        row_of = rows
+        for tail, head, attrs in edges:
+            if row_of.get(owner_of.get(tail, ""), 0) != row_of.get(owner_of.get(head, ""), 0):
+                attrs["constraint"] = "false"
     return assemble(root, clusters, [edge_line(tail, head, attrs) for tail, head, attrs in edges])
 
 
