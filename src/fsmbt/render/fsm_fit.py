@@ -203,7 +203,7 @@ def fit_fsm_dot(
                     best = (fit, source, [*attempt, *([fold_note] if fold_note else [])])
                 if fit >= 1.0:
                     return _finish(best, notes)
-            if spread:
+            if spread and best is not None:
                 return _finish(best, notes)
     assert best is not None
     return _finish(best, notes)
