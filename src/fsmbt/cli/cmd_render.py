@@ -64,7 +64,8 @@ def register(app: typer.Typer) -> None:
             None,
             "--focus",
             help="BT: draw only the subtree under this node: its path as a fold box shows it "
-            "(0/2/1) or its name.",
+            "(0/2/1) or its name. FSM: draw only this composite state (path A/B, as "
+            "--composite).",
         ),
         pages: Path | None = typer.Option(
             None,

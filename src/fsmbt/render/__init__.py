@@ -278,8 +278,10 @@ def render_pages(
     """One picture per level of a hierarchical FSM: ``top.<fmt>`` (the top machine, every
     composite closed into a box) and one per composite state, its own machine with the
     composites inside it closed (``A.<fmt>``, ``A__B.<fmt>`` for ``A/B``); data guards and
-    updates label the arrows. A behavior tree gets one picture per ``<BehaviorTree>``, the main
-    one first, each drawn alone (its SubTrees as references, big ones folded; file names from
+    updates label the arrows; each state is drawn on the page of the machine it belongs to
+    (every page laid out to fit at 100 % as ``fit_fsm_dot`` does, never folded further), file
+    names made unique. A behavior tree gets one picture per ``<BehaviorTree>``, the main one
+    first, each drawn alone (its SubTrees as references, big ones folded; file names from
     the tree IDs, made unique). Each picture is capped at 4096 x 4096 pixels.
 
     Returns:
@@ -291,11 +293,11 @@ def render_pages(
         return _tree_pages(model, folder, fmt, overwrite, max_nodes, notes)
     pages: list[tuple[str, str | None]] = [("top", None)]
     pages += [(path.replace("/", "__"), path) for path in composite_paths(model)]
-    written: list[Path] = []
-    for stem, composite in pages:
-        safe = _page_stem(stem)
-        path = folder / f"{safe}.{fmt}"
+    paths = _page_paths(folder, [stem for stem, _ in pages], fmt, "page")
+    for path in paths:  # refuse before writing any, so a refusal leaves the folder as it was
         check_output(path, overwrite=overwrite)
+    written: list[Path] = []
+    for (_, composite), path in zip(pages, paths, strict=True):
         source = fit_fsm_dot(model, max_nodes=max_nodes, level=0, composite=composite, notes=notes)
         written.append(write_picture(source, path, overwrite=overwrite, max_aspect=MAX_ASPECT))
     return written
@@ -304,6 +306,23 @@ def render_pages(
 def _page_stem(name: str) -> str:
     """A page's file name from a composite path or tree ID: plain characters only."""
     return "".join(c if c.isalnum() or c in "-_." else "_" for c in name)
+
+
+def _page_paths(folder: Path, names: list[str], fmt: str, fallback: str) -> list[Path]:
+    """One file per name in ``folder``, from ``_page_stem`` made unique (``-2``, ``-3``, ...):
+    two names that differ only in unsafe characters or case (``A B`` and ``A_B``, ``Main``
+    and ``main`` on a case-insensitive disk) never share a page."""
+    taken: set[str] = set()
+    paths: list[Path] = []
+    for name in names:
+        stem = _page_stem(name) or fallback
+        unique, count = stem, 1
+        while unique.lower() in taken:
+            count += 1
+            unique = f"{stem}-{count}"
+        taken.add(unique.lower())
+        paths.append(folder / f"{unique}.{fmt}")
+    return paths
 
 
 def _tree_pages(
@@ -317,16 +336,7 @@ def _tree_pages(
     """``render_pages`` for a behavior tree: one picture per tree, the main one first."""
     main = doc.main.id
     order = [main, *(tree_id for tree_id in doc.trees if tree_id != main)]
-    taken: set[str] = set()
-    paths: list[Path] = []
-    for tree_id in order:
-        stem = _page_stem(tree_id) or "tree"
-        unique, count = stem, 1
-        while unique.lower() in taken:  # two IDs that differ only in unsafe characters or case
-            count += 1
-            unique = f"{stem}-{count}"
-        taken.add(unique.lower())
-        paths.append(folder / f"{unique}.{fmt}")
+    paths = _page_paths(folder, order, fmt, "tree")
     for path in paths:  # refuse before writing any, so a refusal leaves the folder as it was
         check_output(path, overwrite=overwrite)
     written: list[Path] = []

@@ -80,11 +80,13 @@ def _rows(
     extent: float,
     rankdir: str,
     count: int,
-) -> dict[str, int]:
+) -> dict[str, int] | None:
     """The row of each top-level state when its ranks (in the measured layout, along ``LR``: x,
     ``TB``: y from the top) are cut into ``count`` runs of about equal length: every state
     whose first node starts at the same place is in one rank, a rank as long as its longest
-    state, and a rank goes to the row its middle falls in. O(N log N) for N drawn nodes."""
+    state, and a rank goes to the row its middle falls in; ``None`` when one rank alone is longer
+    than ``FIT_INCHES`` (a composite state that big: no wrapping makes it fit). O(N log N) for
+    N drawn nodes."""
     span: dict[str, tuple[float, float]] = {}  # owner -> (start, end) along the rank axis
     for node, owner in owners.items():
         if node not in boxes:
@@ -102,6 +104,8 @@ def _rows(
             ranks[-1] = (start, max(length, last - first), [*members, owner])
         else:
             ranks.append((first, last - first, [owner]))
+    if any(length > FIT_INCHES for _, length, _ in ranks):
+        return None
     total = sum(length for _, length, _ in ranks) or 1.0
     rows: dict[str, int] = {}
     done = 0.0
@@ -177,8 +181,8 @@ def fit_fsm_dot(
                 and layouts < MAX_LAYOUTS
             ):
                 rows = _rows(owners, centres, extent, rankdir, count)
-                if len(set(rows.values())) < 2:
-                    break  # one state or composite spans the whole picture
+                if rows is None or len(set(rows.values())) < 2:
+                    break  # one state or composite alone is too long
                 attempt = []
                 source = fsm_to_dot(
                     fsm,
