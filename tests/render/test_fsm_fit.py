@@ -75,6 +75,9 @@ def test_a_composite_too_big_at_100_percent_is_folded_into_a_box_with_its_count(
     scale, width, height = layout_extent(source)
     assert scale == 1.0 and max(width, height) <= FIT_INCHES
     assert any("folded" in note and "Run" in note and "--pages" in note for note in notes)
+    # on the web page a trace step inside Run highlights the box (its anchor is Run's)
+    boxes = [line for line in picture_dot(fsm, anchors=True).splitlines() if "inside]" in line]
+    assert len(boxes) == 1 and 'id="s@Run"' in boxes[0]
 
 
 def test_a_long_flat_chain_is_wrapped_into_rows_not_scaled_down() -> None:

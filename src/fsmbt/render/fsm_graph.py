@@ -315,8 +315,10 @@ def fsm_to_dot(
                 lv.ids[state.name] = node_id
                 owner_of[node_id] = owner
                 inside = _inner_states(state)
+                closed_id = {"id": state_anchor(lv.anchor + state.name)} if anchors else {}
                 lv.graph.node(
                     node_id,
+                    **closed_id,
                     label=label_text(
                         *_name_lines(_state_title(state, title)), f"[{inside} states inside]"
                     ),
