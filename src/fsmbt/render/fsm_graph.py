@@ -526,7 +526,7 @@ def _state_attrs(
         if not wrap and not title.endswith(f":{state.action}"):  # ``q3:Move`` already says it
             lines.append(f"/ {state.action}")
         elif wrap and not _says_action(title, state.action):
-            action_lines = _name_lines(state.action, NAME_LINE - 2)
+            action_lines = _name_lines(state.action)
             lines += [f"/ {action_lines[0]}", *action_lines[1:]]
     attrs = {"label": label_text(*lines), "shape": "doublecircle" if state.final else "circle"}
     if state.action != state.name:  # read back by fsmbt.formats.diagrams.dot; Graphviz ignores it
