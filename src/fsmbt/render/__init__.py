@@ -7,8 +7,10 @@ nodes (default 5 000) are refused with a ``TooLargeError``.
 
 Pictures are made to be read at 100 %: a behavior tree too big for 4 096 x 4 096 pixels is
 folded (subtrees past a node budget drawn as a ``[k nodes]`` box, wide levels wrapped into rows,
-``fsmbt.render.bt_fold``; ``depth`` and ``focus`` choose what to show), an FSM is drawn level by
-level (``fsmbt.render.fsm_graph``); either is scaled down to fit only as a last resort. A PNG or
+``fsmbt.render.bt_fold``; ``depth`` and ``focus`` choose what to show), an FSM is measured and
+laid out again - top down, its top machine wrapped into rows, its composites folded into
+``[k states inside]`` boxes (``fsmbt.render.fsm_fit``; ``level`` and ``composite``/``focus``
+choose what to show); either is scaled down to fit only as a last resort. A PNG or
 SVG whose long side is more than 4 times its short side is laid out again with Graphviz's
 ``ratio``, which spreads the nodes apart along the short side (node and label sizes unchanged).
 """

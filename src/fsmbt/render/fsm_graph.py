@@ -14,6 +14,9 @@ ones closed (a bold rounded box saying how many states it holds); ``composite="A
 composite state alone (its cluster, its sub-machines). A hierarchical machine too large for the
 layered layout (more than ``LAYERED_MAX_STATES`` states or ``LAYERED_MAX_ARROWS`` arrows) is drawn
 to the deepest level that fits, and ``notes`` says so and names the composites to draw next.
+``fsmbt.render.fsm_fit`` measures a picture and draws it again (``rankdir``, ``rows``, a
+``level``) until it fits 4 096 pixels at 100 %. In pictures, names longer than ``NAME_LINE``
+are broken into lines.
 A flat machine that large uses the force-directed ``sfdp`` layout (seconds for thousands of
 states; dot's layered layout with edge labels needs minutes from about a hundred states).
 
