@@ -74,7 +74,7 @@ def test_a_composite_too_big_at_100_percent_is_folded_into_a_box_with_its_count(
     assert {"Start", "Stop"} <= names_drawn(source)
     scale, width, height = layout_extent(source)
     assert scale == 1.0 and max(width, height) <= FIT_INCHES
-    assert any("folded" in note and "Run" in note and "--pages" in note for note in notes)
+    assert any("folded" in note and "Run" in note and "pages=DIR" in note for note in notes)
     # on the web page a trace step inside Run highlights the box (its anchor is Run's)
     boxes = [line for line in picture_dot(fsm, anchors=True).splitlines() if "inside]" in line]
     assert len(boxes) == 1 and 'id="s@Run"' in boxes[0]
@@ -132,7 +132,8 @@ def write_plant(folder: Path) -> Path:
 def test_focus_draws_the_inner_states_of_a_folded_composite(tmp_path: Path, capsys) -> None:
     model = write_plant(tmp_path)
     assert main(["render", str(model), "-o", str(tmp_path / "all.dot")]) == 0
-    assert "folded" in capsys.readouterr().err  # the default picture folds Run ...
+    said = capsys.readouterr().err  # the default picture folds Run, and says how to see it ...
+    assert "folded" in said and "--focus PATH" in said and "--pages DIR" in said
     out = tmp_path / "run.dot"
     assert main(["render", str(model), "-o", str(out), "--focus", "Run"]) == 0
     source = out.read_text(encoding="utf-8")

@@ -24,6 +24,7 @@ def _cli_words(note: str) -> str:
         .replace("tree=ID", "--tree ID")
         .replace("focus=PATH", "--focus PATH")
         .replace("depth=N", "--depth N")
+        .replace("pages=DIR", "--pages DIR")
     )
 
 

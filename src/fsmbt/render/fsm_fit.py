@@ -222,7 +222,7 @@ def _finish(best: tuple[float, str, list[str]], notes: list[str] | None) -> str:
         if fit < 1.0:
             notes.append(
                 f"picture scaled to {fit:.0%} to fit 4096 x 4096 pixels; draw parts with "
-                "composite=NAME or level=N, every level with --pages DIR"
+                "composite=NAME or level=N, every level with pages=DIR"
             )
     return source
 
@@ -238,7 +238,7 @@ def _fold_note(drawn: FSM, fold: int | None, asked: int | None, prefix: str) -> 
     return (
         f"picture folded to fit 4096 x 4096 pixels at 100 %: drew {shown} states, composite "
         f"states nested deeper than level {fold} closed ({names}); draw one with composite=NAME "
-        "(or focus=NAME), every level with --pages DIR"
+        "(or focus=PATH), every level with pages=DIR"
     )
 
 
