@@ -24,6 +24,7 @@ def _cli_words(note: str) -> str:
         .replace("tree=ID", "--tree ID")
         .replace("focus=PATH", "--focus PATH")
         .replace("depth=N", "--depth N")
+        .replace("pages=DIR", "--pages DIR")
     )
 
 
@@ -64,7 +65,8 @@ def register(app: typer.Typer) -> None:
             None,
             "--focus",
             help="BT: draw only the subtree under this node: its path as a fold box shows it "
-            "(0/2/1) or its name.",
+            "(0/2/1) or its name. FSM: draw only this composite state (path A/B, as "
+            "--composite).",
         ),
         pages: Path | None = typer.Option(
             None,

@@ -7,8 +7,10 @@ nodes (default 5 000) are refused with a ``TooLargeError``.
 
 Pictures are made to be read at 100 %: a behavior tree too big for 4 096 x 4 096 pixels is
 folded (subtrees past a node budget drawn as a ``[k nodes]`` box, wide levels wrapped into rows,
-``fsmbt.render.bt_fold``; ``depth`` and ``focus`` choose what to show), an FSM is drawn level by
-level (``fsmbt.render.fsm_graph``); either is scaled down to fit only as a last resort. A PNG or
+``fsmbt.render.bt_fold``; ``depth`` and ``focus`` choose what to show), an FSM is measured and
+laid out again - top down, its top machine wrapped into rows, its composites folded into
+``[k states inside]`` boxes (``fsmbt.render.fsm_fit``; ``level`` and ``composite``/``focus``
+choose what to show); either is scaled down to fit only as a last resort. A PNG or
 SVG whose long side is more than 4 times its short side is laid out again with Graphviz's
 ``ratio``, which spreads the nodes apart along the short side (node and label sizes unchanged).
 """
@@ -37,6 +39,7 @@ from fsmbt.render.dot import (
     run_dot,
     write_picture,
 )
+from fsmbt.render.fsm_fit import fit_fsm_dot
 from fsmbt.render.fsm_graph import composite_paths, fsm_to_dot
 
 #: The sides (inches) a behavior tree's fold plan is tried with until its layout fits
@@ -73,6 +76,7 @@ def model_to_dot(
         notes: told what a capped picture left out and how to draw it.
         anchors: give every state / node a predictable SVG id (``fsmbt.render.anchor_ids``).
         focus: BT: draw only the subtree under this node (a path ``0/2/1`` or a node name).
+            FSM: ``composite``'s other name (the composite state whose inside is drawn).
         fold: BT: fold a tree too big to read at 100 % (``bt_to_dot``'s ``fold``).
         target: BT: the side (inches) the folded picture is estimated to fit (``bt_to_dot``).
 
@@ -84,15 +88,11 @@ def model_to_dot(
         an option of the other model kind.
     """
     if isinstance(model, FSM):
-        if tree is not None or expand_subtrees or focus is not None:
-            raise InputError(
-                "tree, focus and expand_subtrees are for behavior trees; this is an FSM"
-            )
         return fsm_to_dot(
             model,
             max_nodes=max_nodes,
             level=level,
-            composite=composite,
+            composite=_fsm_composite(tree, expand_subtrees, composite, focus),
             notes=notes,
             anchors=anchors,
         )
@@ -115,6 +115,20 @@ def model_to_dot(
     )
 
 
+def _fsm_composite(
+    tree: str | None, expand_subtrees: bool, composite: str | None, focus: str | None
+) -> str | None:
+    """The composite state an FSM picture draws (``composite``, or ``focus``: the same for an
+    FSM); refuses the behavior-tree options and two different composites."""
+    if tree is not None or expand_subtrees:
+        raise InputError("tree and expand_subtrees are for behavior trees; this is an FSM")
+    if focus is not None and composite is not None and focus != composite:
+        raise InputError(
+            f"focus '{focus}' and composite '{composite}' name two parts of one FSM; give one"
+        )
+    return composite if composite is not None else focus
+
+
 def picture_dot(
     model: FSM | BTDocument,
     *,
@@ -129,9 +143,24 @@ def picture_dot(
     to scale down least. At most ``len(FIT_TARGETS)`` extra layouts (a fraction of a second each
     for a folded picture), one for a tree that fits at once. ``notes`` gets the notes of the
     picture returned. Without Graphviz, the first plan (from the estimate alone)."""
+    if isinstance(model, FSM):  # measured and laid out again by fsm_fit
+        return fit_fsm_dot(
+            model,
+            notes=notes,
+            timeout=timeout,
+            max_nodes=options.get("max_nodes", DEFAULT_MAX_NODES),
+            level=options.get("level"),
+            composite=_fsm_composite(
+                options.get("tree"),
+                bool(options.get("expand_subtrees")),
+                options.get("composite"),
+                options.get("focus"),
+            ),
+            anchors=bool(options.get("anchors")),
+        )
     attempt_notes: list[str] = []
     source = model_to_dot(model, notes=attempt_notes, **options)
-    if isinstance(model, FSM) or not options.get("fold", True):
+    if not options.get("fold", True):
         if notes is not None:
             notes.extend(attempt_notes)
         return source
@@ -262,8 +291,10 @@ def render_pages(
     """One picture per level of a hierarchical FSM: ``top.<fmt>`` (the top machine, every
     composite closed into a box) and one per composite state, its own machine with the
     composites inside it closed (``A.<fmt>``, ``A__B.<fmt>`` for ``A/B``); data guards and
-    updates label the arrows. A behavior tree gets one picture per ``<BehaviorTree>``, the main
-    one first, each drawn alone (its SubTrees as references, big ones folded; file names from
+    updates label the arrows; each state is drawn on the page of the machine it belongs to
+    (every page laid out to fit at 100 % as ``fit_fsm_dot`` does, never folded further), file
+    names made unique. A behavior tree gets one picture per ``<BehaviorTree>``, the main one
+    first, each drawn alone (its SubTrees as references, big ones folded; file names from
     the tree IDs, made unique). Each picture is capped at 4096 x 4096 pixels.
 
     Returns:
@@ -275,12 +306,12 @@ def render_pages(
         return _tree_pages(model, folder, fmt, overwrite, max_nodes, notes)
     pages: list[tuple[str, str | None]] = [("top", None)]
     pages += [(path.replace("/", "__"), path) for path in composite_paths(model)]
-    written: list[Path] = []
-    for stem, composite in pages:
-        safe = _page_stem(stem)
-        path = folder / f"{safe}.{fmt}"
+    paths = _page_paths(folder, [stem for stem, _ in pages], fmt, "page")
+    for path in paths:  # refuse before writing any, so a refusal leaves the folder as it was
         check_output(path, overwrite=overwrite)
-        source = fsm_to_dot(model, max_nodes=max_nodes, level=0, composite=composite, notes=notes)
+    written: list[Path] = []
+    for (_, composite), path in zip(pages, paths, strict=True):
+        source = fit_fsm_dot(model, max_nodes=max_nodes, level=0, composite=composite, notes=notes)
         written.append(write_picture(source, path, overwrite=overwrite, max_aspect=MAX_ASPECT))
     return written
 
@@ -288,6 +319,23 @@ def render_pages(
 def _page_stem(name: str) -> str:
     """A page's file name from a composite path or tree ID: plain characters only."""
     return "".join(c if c.isalnum() or c in "-_." else "_" for c in name)
+
+
+def _page_paths(folder: Path, names: list[str], fmt: str, fallback: str) -> list[Path]:
+    """One file per name in ``folder``, from ``_page_stem`` made unique (``-2``, ``-3``, ...):
+    two names that differ only in unsafe characters or case (``A B`` and ``A_B``, ``Main``
+    and ``main`` on a case-insensitive disk) never share a page."""
+    taken: set[str] = set()
+    paths: list[Path] = []
+    for name in names:
+        stem = _page_stem(name) or fallback
+        unique, count = stem, 1
+        while unique.lower() in taken:
+            count += 1
+            unique = f"{stem}-{count}"
+        taken.add(unique.lower())
+        paths.append(folder / f"{unique}.{fmt}")
+    return paths
 
 
 def _tree_pages(
@@ -301,16 +349,7 @@ def _tree_pages(
     """``render_pages`` for a behavior tree: one picture per tree, the main one first."""
     main = doc.main.id
     order = [main, *(tree_id for tree_id in doc.trees if tree_id != main)]
-    taken: set[str] = set()
-    paths: list[Path] = []
-    for tree_id in order:
-        stem = _page_stem(tree_id) or "tree"
-        unique, count = stem, 1
-        while unique.lower() in taken:  # two IDs that differ only in unsafe characters or case
-            count += 1
-            unique = f"{stem}-{count}"
-        taken.add(unique.lower())
-        paths.append(folder / f"{unique}.{fmt}")
+    paths = _page_paths(folder, order, fmt, "tree")
     for path in paths:  # refuse before writing any, so a refusal leaves the folder as it was
         check_output(path, overwrite=overwrite)
     written: list[Path] = []

@@ -201,18 +201,24 @@ def fit_aspect(
     set to just within ``max_aspect``: dot then spreads the layout along the short side (more
     space between ranks or nodes; node and label sizes unchanged), and a ``size`` cap in the
     source still applies. Costs a second layout, only for such pictures."""
+    patched = aspect_source(source, fmt, data, max_aspect=max_aspect)
+    return data if patched == source else run_dot(patched, fmt, timeout=timeout)
+
+
+def aspect_source(source: str, fmt: str, data: bytes, *, max_aspect: float = MAX_ASPECT) -> str:
+    """The source ``fit_aspect`` draws for ``data`` (the picture of ``source`` in ``fmt``):
+    ``source`` itself, or with Graphviz's ``ratio`` set when the picture is too elongated."""
     size = picture_size(data, fmt)
     if size is None or min(size) <= 0:
-        return data
+        return source
     width, height = size
     if max(width, height) <= max_aspect * min(width, height):
-        return data
+        return source
     ratio = 0.98 * max_aspect if height > width else 1.02 / max_aspect  # height / width
     brace = source.find("{")
     if brace < 0:
-        return data
-    patched = f"{source[: brace + 1]}\n\tratio={ratio:.3f}{source[brace + 1 :]}"
-    return run_dot(patched, fmt, timeout=timeout)
+        return source
+    return f"{source[: brace + 1]}\n\tratio={ratio:.3f}{source[brace + 1 :]}"
 
 
 def write_picture(

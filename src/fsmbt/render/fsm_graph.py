@@ -14,6 +14,9 @@ ones closed (a bold rounded box saying how many states it holds); ``composite="A
 composite state alone (its cluster, its sub-machines). A hierarchical machine too large for the
 layered layout (more than ``LAYERED_MAX_STATES`` states or ``LAYERED_MAX_ARROWS`` arrows) is drawn
 to the deepest level that fits, and ``notes`` says so and names the composites to draw next.
+``fsmbt.render.fsm_fit`` measures a picture and draws it again (``rankdir``, ``rows``, a
+``level``) until it fits 4 096 pixels at 100 %. In pictures, names longer than ``NAME_LINE``
+are broken into lines.
 A flat machine that large uses the force-directed ``sfdp`` layout (seconds for thousands of
 states; dot's layered layout with edge labels needs minutes from about a hundred states).
 
@@ -93,6 +96,7 @@ class _Level:
     path: str = ""  # exchange DOT: the node-id prefix of this level's states
     anchor: str = ""  # anchors: the composite-state path of this level ("Parent/"), no regions
     aliases: dict[str, str] = field(default_factory=dict)  # data variable -> its short name
+    owner: str = ""  # the top-level state this level is inside ("": the top machine)
 
 
 def _find_composite(fsm: FSM, path: str) -> State:
@@ -135,8 +139,8 @@ def _inner_states(state: State) -> int:
     return count
 
 
-def _visible(fsm: FSM, level: int) -> tuple[int, int]:
-    """(states, transitions) drawn when composites deeper than ``level`` are closed."""
+def visible_size(fsm: FSM, level: int) -> tuple[int, int]:
+    """(states, transitions) drawn when composites deeper than ``level`` are closed. O(S + T)."""
     states = transitions = 0
     stack: list[tuple[FSM, int]] = [(fsm, 0)]
     while stack:
@@ -148,6 +152,32 @@ def _visible(fsm: FSM, level: int) -> tuple[int, int]:
                 (region, depth + 1) for state in machine.states.values() for region in state.regions
             )
     return states, transitions
+
+
+def _layered(states: int, transitions: int) -> bool:
+    return states <= LAYERED_MAX_STATES and transitions <= LAYERED_MAX_ARROWS
+
+
+def layered_size_fits(fsm: FSM, level: int) -> bool:
+    """Whether ``fsm`` with its composites nested deeper than ``level`` closed is small enough
+    for the layered layout (else it is drawn force-directed). O(S + T)."""
+    return _layered(*visible_size(fsm, level))
+
+
+def drawn_machine(fsm: FSM, composite: str | None) -> tuple[FSM, int]:
+    """The machine a picture of ``composite`` (``None``: the whole of ``fsm``) draws, and the
+    level its own states are at: a composite state's sub-machine (level 0), or for a parallel
+    state a machine holding that state alone (level 1: its regions are one level down).
+
+    Raises:
+        InputError: ``composite`` names no composite state (the message lists them).
+    """
+    if composite is None:
+        return fsm, 0
+    state = _find_composite(fsm, composite)
+    if len(state.regions) == 1:  # its sub-machine is the picture
+        return state.regions[0], 0
+    return FSM(name=composite, states={state.name: state}, initial=state.name), 1
 
 
 def fsm_to_dot(
@@ -162,6 +192,9 @@ def fsm_to_dot(
     marks: Mapping[str, Mapping[str, str]] | None = None,
     ghosts: Sequence[str] = (),
     ghost_edges: Sequence[tuple[str, str, str]] = (),
+    rankdir: str = "LR",
+    rows: Mapping[str, int] | None = None,
+    owners: dict[str, str] | None = None,
 ) -> str:
     """DOT source of ``fsm``.
 
@@ -182,6 +215,15 @@ def fsm_to_dot(
         ghosts: states that are not in ``fsm`` (a diff's removed states), drawn dashed and grey.
         ghost_edges: transitions that are not in ``fsm`` as ``(tail anchor, head anchor,
             label)`` between drawn atomic states or ghosts (``s@`` + the ghost's name), dashed.
+        rankdir: pictures: ``LR`` (transitions left to right) or ``TB`` (top down).
+        rows: pictures, layered layout: wrap the top machine into rows (``TB``: columns), the
+            row of each top-level state by name (missing: 0). A transition between two rows
+            does not rank its ends (``constraint=false``), so every row starts again at the
+            left: a long chain becomes a block of shorter rows. (Rows are not clusters: dot
+            fails with "lost edge" on such edges between clusters.)
+        owners: filled with each drawn node's DOT id -> the top-level state it belongs to (the
+            state itself, or the composite state holding it): what ``fsm_fit`` needs to
+            choose rows from a measured layout.
 
     Returns:
         The DOT source text.
@@ -191,14 +233,9 @@ def fsm_to_dot(
     """
     first_level = 0
     if composite is not None and not exchange:
-        state = _find_composite(fsm, composite)
-        if len(state.regions) == 1:  # its sub-machine is the picture
-            fsm = state.regions[0]
-        else:  # parallel: the state's cluster with one sub-cluster per region
-            fsm = FSM(name=composite, states={state.name: state}, initial=state.name)
-            first_level = 1
-            if level is not None:  # a level counts from the regions: open them at least
-                level += first_level
+        fsm, first_level = drawn_machine(fsm, composite)
+        if level is not None:  # a parallel state's level counts from its regions: open them
+            level += first_level
     stats = fsm_stats(fsm)
     if max_nodes is not None:
         check_size(stats.all_states, max_nodes, "states")
@@ -208,20 +245,17 @@ def fsm_to_dot(
                 f"too deeply nested to draw: {stats.nesting_depth} levels (limit {MAX_NESTING})"
             )
 
-    def fits(states: int, transitions: int) -> bool:
-        return states <= LAYERED_MAX_STATES and transitions <= LAYERED_MAX_ARROWS
-
     if (
         not exchange
         and level is None
         and stats.hierarchical
-        and not fits(stats.all_states, stats.all_transitions)
+        and not _layered(stats.all_states, stats.all_transitions)
     ):
         level = first_level
-        while level + 1 < stats.nesting_depth and fits(*_visible(fsm, level + 1)):
+        while level + 1 < stats.nesting_depth and _layered(*visible_size(fsm, level + 1)):
             level += 1
         if notes is not None:
-            shown, _ = _visible(fsm, level)
+            shown, _ = visible_size(fsm, level)
             closed = [p for p in composite_paths(fsm) if p.count("/") == level]
             names = ", ".join(closed[:6]) + (
                 f", ... (+{len(closed) - 6})" if len(closed) > 6 else ""
@@ -233,9 +267,9 @@ def fsm_to_dot(
                 "composite=NAME or more levels with level=N"
             )
     visible = (
-        _visible(fsm, level) if level is not None else (stats.all_states, stats.all_transitions)
+        visible_size(fsm, level) if level is not None else (stats.all_states, stats.all_transitions)
     )
-    layered = exchange or fits(*visible)
+    layered = exchange or _layered(*visible)
     if not layered and notes is not None and level is None:
         notes.append(
             f"{visible[0]} states without hierarchy to split into levels: drawn with "
@@ -245,7 +279,13 @@ def fsm_to_dot(
     if not exchange:  # at most 4096 x 4096 pixels at 96 dpi (scaled down, never up)
         root.attr(size=MAX_PICTURE_INCHES)
     if layered:
-        root.attr(rankdir="LR", compound="true", fontname=FONT, nodesep="0.35", ranksep="0.5")
+        root.attr(
+            rankdir="LR" if exchange else rankdir,
+            compound="true",
+            fontname=FONT,
+            nodesep="0.35",
+            ranksep="0.5",
+        )
     else:
         root.attr(
             layout="sfdp", overlap="prism", splines="false", outputorder="edgesfirst", fontname=FONT
@@ -255,6 +295,9 @@ def fsm_to_dot(
     counter = _Counter(exchange)
     edges: list[tuple[str, str, dict[str, str]]] = []
     clusters: list[tuple[graphviz.Digraph, graphviz.Digraph]] = []  # (cluster, parent), pre-order
+
+    owner_of: dict[str, str] = {} if owners is None else owners
+    owner_of.clear()
 
     marks = marks or {}
     drawn: dict[str, str] = {}  # anchor id -> DOT node id of atomic states, for ghost edges
@@ -273,6 +316,7 @@ def fsm_to_dot(
         levels.append(lv)
         for state in lv.machine.states.values():
             title = lv.prefix + state.name
+            owner = lv.owner or state.name
             is_closed = (
                 not exchange
                 and level_cap is not None
@@ -282,27 +326,31 @@ def fsm_to_dot(
             if is_closed:
                 node_id = counter.state_id(lv, state.name)
                 lv.ids[state.name] = node_id
+                owner_of[node_id] = owner
                 inside = _inner_states(state)
                 # anchors: the closed box carries the composite's id and the class a page
                 # clicks to draw it (composite=PATH)
-                closed_extra = (
+                closed_id = (
                     {"id": state_anchor(lv.anchor + state.name), "class": CLOSED_CLASS}
                     if anchors
                     else {}
                 )
                 lv.graph.node(
                     node_id,
-                    label=label_text(_state_title(state, title), f"[{inside} states inside]"),
+                    **closed_id,
+                    label=label_text(
+                        *_name_lines(_state_title(state, title)), f"[{inside} states inside]"
+                    ),
                     shape="box",
                     style="rounded,bold,filled",
                     fillcolor="gray95",
-                    **closed_extra,
                 )
                 continue
             if state.is_atomic:
                 node_id = counter.state_id(lv, state.name)
                 lv.ids[state.name] = node_id
-                attrs = _state_attrs(state, title, compact=not layered)
+                owner_of[node_id] = owner
+                attrs = _state_attrs(state, title, compact=not layered, wrap=not exchange)
                 anchor = state_anchor(lv.anchor + state.name)
                 drawn[anchor] = node_id
                 if anchors:
@@ -312,10 +360,11 @@ def fsm_to_dot(
                 continue
             if not layered:  # a box standing for the composite state, no cluster
                 node_id = counter.next("c")
+                owner_of[node_id] = owner
                 extra = {"id": state_anchor(lv.anchor + state.name)} if anchors else {}
                 lv.graph.node(
                     node_id,
-                    label=label_text(_state_title(state, title)),
+                    label=label_text(*_name_lines(_state_title(state, title))),
                     shape="box",
                     style="rounded,bold",
                     **extra,
@@ -327,6 +376,7 @@ def fsm_to_dot(
                         prefix=f"{title}/",
                         entry=node_id,
                         anchor=f"{lv.anchor}{state.name}/",
+                        owner=owner,
                     )
                     for region in state.regions
                 ]
@@ -336,7 +386,13 @@ def fsm_to_dot(
                 continue
             cluster = graphviz.Digraph(name=counter.next("cluster_"))
             cluster.attr(
-                label=label_text(_state_title(state, state.name)),
+                label=label_text(
+                    *(
+                        [_state_title(state, state.name)]
+                        if exchange
+                        else _name_lines(_state_title(state, state.name), 2 * NAME_LINE)
+                    )
+                ),
                 style="rounded",
                 color="gray30",
                 fontname=FONT,
@@ -348,22 +404,32 @@ def fsm_to_dot(
             clusters.append((cluster, lv.graph))
             inner = []
             for index, region in enumerate(state.regions):
-                holder = cluster
+                region_graph = cluster
                 path = f"{lv.path}{state.name}/"
                 if state.is_parallel:
-                    holder = graphviz.Digraph(name=counter.next("cluster_"))
-                    holder.attr(
+                    region_graph = graphviz.Digraph(name=counter.next("cluster_"))
+                    region_graph.attr(
                         label=label_text(_region_title(region, index)),
                         style="dashed",
                         color="gray50",
                         fontname=FONT,
                         fontsize="10",
                     )
-                    clusters.append((holder, cluster))
+                    clusters.append((region_graph, cluster))
                     path = f"{path}{index}:"
-                inner.append(_Level(region, holder, path=path, anchor=f"{lv.anchor}{state.name}/"))
+                inner.append(
+                    _Level(
+                        region,
+                        region_graph,
+                        path=path,
+                        anchor=f"{lv.anchor}{state.name}/",
+                        owner=owner,
+                    )
+                )
             # Arrows to/from the composite state end at its cluster, through its first initial point.
-            lv.anchors[state.name] = (_initial_point_id(inner[0], counter), cluster.name)
+            point = _initial_point_id(inner[0], counter)
+            owner_of[point] = owner
+            lv.anchors[state.name] = (point, cluster.name)
             depth_of.update((id(x), depth_of[id(lv)] + 1) for x in inner)
             pending.extend(reversed(inner))
 
@@ -375,6 +441,8 @@ def fsm_to_dot(
         lv.aliases = aliases
         _draw_initial(lv, edges, counter, is_top=lv is top, anchors=anchors)
         _draw_transitions(lv, edges, exact=exchange)
+    if fsm.initial is not None and "__initial_point__" in top.ids:
+        owner_of[top.ids["__initial_point__"]] = fsm.initial
     for name in ghosts:
         ghost_id = counter.next("g")
         drawn.setdefault(state_anchor(name), ghost_id)
@@ -385,6 +453,11 @@ def fsm_to_dot(
                 (drawn[tail], drawn[head], {"label": label_text(text), **GHOST_EDGE_STYLE})
             )
 
+    if rows and layered and not exchange:  # an arrow between rows does not rank its ends
+        row_of = rows
+        for tail, head, attrs in edges:
+            if row_of.get(owner_of.get(tail, ""), 0) != row_of.get(owner_of.get(head, ""), 0):
+                attrs["constraint"] = "false"
     return assemble(root, clusters, [edge_line(tail, head, attrs) for tail, head, attrs in edges])
 
 
@@ -420,20 +493,60 @@ def _state_title(state: State, title: str) -> str:
     return title
 
 
+#: Pictures: a state name longer than this many characters is broken into lines (a circle is
+#: as wide as its longest line, so one long name makes the whole rank wide).
+NAME_LINE = 18
+_STRONG_BREAK = re.compile(r"(?<=[/#;, ])")
+_WEAK_BREAK = re.compile(r"(?<=[_.\-])|(?<=[a-z0-9])(?=[A-Z])")
+
+
+def _name_lines(text: str, width: int = NAME_LINE) -> list[str]:
+    """``text`` as lines of at most ``width`` characters where it can be: broken after ``/ # ;
+    ,`` and spaces first, then (inside a longer piece) after ``_ . -`` and between a lower-case
+    letter and a capital; a piece without such a place stays whole. Nothing is shortened: the
+    lines joined give ``text`` back but for the spaces at the breaks. O(len(text))."""
+    if len(text) <= width:
+        return [text]
+    pieces: list[str] = []
+    for piece in _STRONG_BREAK.split(text):
+        pieces.extend(_WEAK_BREAK.split(piece) if len(piece) > width else [piece])
+    lines: list[str] = []
+    current = ""
+    for piece in pieces:
+        if current and len(current) + len(piece.rstrip()) > width:
+            lines.append(current.rstrip())
+            current = ""
+        current += piece
+    if current:
+        lines.append(current)
+    return lines
+
+
+def _says_action(title: str, action: str) -> bool:
+    """Whether a state's drawn name already shows its action: ``q3:Move``, a flattened path
+    ``on/ready/begin`` running ``begin``, or a data-expanded name ``off#timer=1`` running
+    ``off`` - then the ``/ action`` line is left out."""
+    base = title.split("#", 1)[0]
+    return base == action or base.endswith((f"/{action}", f":{action}"))
+
+
 def _region_title(region: FSM, index: int) -> str:
     return region.name if region.name and region.name != "fsm" else f"region {index + 1}"
 
 
-def _state_attrs(state: State, title: str, *, compact: bool = False) -> dict[str, str]:
+def _state_attrs(
+    state: State, title: str, *, compact: bool = False, wrap: bool = False
+) -> dict[str, str]:
     """Circles (double for final states); ellipses in large pictures, where long path names
-    would make circles huge."""
-    lines = [title]
-    if (
-        state.action is not None
-        and state.action != state.name
-        and not title.endswith(f":{state.action}")
-    ):  # ``q3:Move`` already says it
-        lines.append(f"/ {state.action}")
+    would make circles huge. ``wrap`` (pictures): long names broken into lines
+    (``_name_lines``), the action line left out when the name shows it (``_says_action``)."""
+    lines = _name_lines(title) if wrap else [title]
+    if state.action is not None and state.action != state.name:
+        if not wrap and not title.endswith(f":{state.action}"):  # ``q3:Move`` already says it
+            lines.append(f"/ {state.action}")
+        elif wrap and not _says_action(title, state.action):
+            action_lines = _name_lines(state.action)
+            lines += [f"/ {action_lines[0]}", *action_lines[1:]]
     attrs = {"label": label_text(*lines), "shape": "doublecircle" if state.final else "circle"}
     if state.action != state.name:  # read back by fsmbt.formats.diagrams.dot; Graphviz ignores it
         attrs["action"] = dot_id(state.action or "")
