@@ -65,7 +65,8 @@ def _mutated(fsm: FSM) -> str:
     """The dispatch tree of ``fsm`` with the second transition's Script writing another
     state's lowest digit."""
     text = _dispatch_text(fsm)
-    first = [line for line in text.splitlines() if "<Script" in line][1]
+    lines = text.splitlines()
+    first = [line for line in lines if "<Script" in line and "fsm_d0:='" in line][1]
     digit = first.split("fsm_d0:='")[1][0]
     other = "b" if digit != "b" else "c"
     return text.replace(first, first.replace(f"fsm_d0:='{digit}'", f"fsm_d0:='{other}'"), 1)

@@ -24,7 +24,7 @@ pairing rule explores):
   interpreter models exactly (``OutcomeTree``).
 
 Cost: building is O(nodes); a macro step is one tick of the blackboard interpreter,
-O(log6 states + events of the current state / 6) node ticks (each with an O(entries) blackboard
+O(log7 states + events of the current state / 6) node ticks (each with an O(entries) blackboard
 copy: the snapshot is immutable).
 """
 

@@ -47,7 +47,7 @@ Rules:
 Costs: loading is O(n) in the tree's nodes plus the engine's own build; an LEBT's macro step
 costs one or two root ticks, each O(root-level selectors + depth of the active state's leaf) in
 both engines (the root Sequence asks every root-level guard before the running branch); a
-dispatch tree's one tick O(log6 states + events of the current state / 6). User code is never
+dispatch tree's one tick O(log7 states + events of the current state / 6). User code is never
 imported or executed by fsmbt itself: only the callables you pass are called.
 """
 

@@ -1,10 +1,11 @@
 """Macro steps of the dispatch form of an FSM (docs/semantics.md, "12. The dispatch form").
 
 The dispatch form (``fsmbt.convert.dispatch``) keeps the FSM's current state as an index on the
-blackboard, written in base 6 as the digit entries ``fsm_d0`` (least significant) ..
-``fsm_d{L-1}`` with the letters ``a``..``f`` (BehaviorTree.CPP's ``Switch`` compares numbers
-numerically, so digits are letters). Its control nodes are BehaviorTree.CPP built-ins
-(``Switch2``..``Switch6``, ``Script``, ``ReactiveSequence``, ``KeepRunningUntilFailure``,
+blackboard, written in base 7 as the digit entries ``fsm_d0`` (least significant) ..
+``fsm_d{L-1}`` with the letters ``a``..``g`` (BehaviorTree.CPP's ``Switch`` compares numbers
+numerically, so digits are letters; a ``Switch6``'s default child is the seventh digit). Its
+control nodes are BehaviorTree.CPP built-ins
+(``Switch2``..``Switch6``, ``Script``, ``Sequence``, ``KeepRunningUntilFailure``,
 ``AlwaysSuccess``, ``AlwaysFailure``), modelled exactly by ``fsmbt.semantics.outcome_blackboard``;
 its only leaf is ``DispatchEntry`` (Action; ports ``state``, ``action``): it runs ``action``
 (empty: none) and returns SUCCESS.
@@ -13,7 +14,7 @@ One macro step: the environment writes the event to the entry ``event`` and tick
 ``event`` is then unset again (the tree never writes it). The start is one tick with ``event``
 unset. The tree has terminated when the last tick returned SUCCESS (the current state is final).
 
-Cost: a tick is O(log6(states) + events of the current state / 6) node ticks.
+Cost: a tick is O(log7(states) + events of the current state / 6) node ticks.
 """
 
 from __future__ import annotations
@@ -47,8 +48,10 @@ from fsmbt.semantics.status import NodeStatus
 ENTRY = "DispatchEntry"
 EVENT_KEY = "event"
 DIGIT_PREFIX = "fsm_d"
-DIGITS = "abcdef"
+DIGITS = "abcdefg"
 BASE = len(DIGITS)
+#: The most cases a BehaviorTree.CPP ``Switch`` has (``Switch6``); its default is one more.
+MAX_CASES = 6
 #: An event value no ``Switch`` case can equal (XML cannot hold NUL): the "any other event" of
 #: ``DispatchMachine.active_inputs``.
 OTHER_EVENT = "\x00"
