@@ -14,10 +14,11 @@ Shape, for reachable states numbered 0..n-1 in declaration order (index digits b
   is the start case;
 - a final state's case is ``AlwaysSuccess``; a non-final state's case switches on ``{event}``
   over its outgoing events (chains of ``Switch6`` when it has more than 6), each case the
-  transition ``KeepRunningUntilFailure(Sequence(Script(the target's digits that differ from the
-  source's), DispatchEntry(target)))`` (``Sequence`` and ``Script`` left out when no digit
-  differs: a self-loop; ``KeepRunningUntilFailure`` left out when the target is final), the
-  default ``KeepRunningUntilFailure(AlwaysSuccess)`` (RUNNING: the event is ignored);
+  transition ``KeepRunningUntilFailure(DispatchEntry(target, _onSuccess="the target's digits
+  that differ from the source's"))`` (BehaviorTree.CPP's post-condition writes them after the
+  leaf's SUCCESS; no ``_onSuccess`` when no digit differs: a self-loop;
+  ``KeepRunningUntilFailure`` left out when the target is final), the default
+  ``KeepRunningUntilFailure(AlwaysSuccess)`` (RUNNING: the event is ignored);
 - the start case is the transition to the initial state (every digit written), or, when the FSM
   has an initial event, an event switch with that one case.
 
@@ -25,8 +26,9 @@ Why this shape (issue 23 item 6, measured in benchmarks/bench_dispatch_floor.py 
 bench_runtime.py): in BehaviorTree.CPP 4.8.2 every ticked node costs about 100 ns (two clock
 reads and mutexes in ``executeTick``) and a ``Switch`` more per case read, so the tree ticks
 as few nodes as it can: base 7 (one index level fewer than base 6 from 2 402 to 7 776 states,
-and so at 10 000), the transition as two to three nodes instead of four to five, and a
-``Script`` writing one digit on most chain steps instead of all of them.
+and so at 10 000), the transition as one or two nodes instead of four to five (the digits
+written by the leaf's post-condition, not by a ``Script`` node under a ``Sequence``), writing
+one digit on most chain steps instead of all of them.
 
 Bad input (UnsupportedError, state named): an event name BehaviorTree.CPP's ``Switch`` would
 not compare as a plain string (a number, a blackboard reference ``{..}``, empty).
@@ -54,6 +56,7 @@ from fsmbt.semantics.dispatch_runtime import (
     ENTRY,
     EVENT_KEY,
     MAX_CASES,
+    ON_SUCCESS,
 )
 
 STYLE = "dispatch"
@@ -147,10 +150,10 @@ def fsm_to_dispatch(fsm: FSM, **_options: object) -> ConversionResult:
         have = digits(index[source]) if source is not None else [""] * levels
         code = [f"{DIGIT_PREFIX}{j}:='{want[j]}'" for j in range(levels) if want[j] != have[j]]
         st = flat.states[target]
-        node = _leaf(ENTRY, target, state=target, action=st.action or "")
+        attrs = {"state": target, "action": st.action or ""}
         if code:
-            script = _leaf("Script", f"goto_{target}", code="; ".join(code))
-            node = _control("Sequence", label, [script, node])
+            attrs[ON_SUCCESS] = "; ".join(code)
+        node = _leaf(ENTRY, target, **attrs)
         if st.final:
             return node
         return BTNode(
