@@ -30,7 +30,8 @@ def test_dispatch_is_proven_equivalent(shape: str, n: int, start_event: bool) ->
 def test_a_wrong_target_is_caught() -> None:
     fsm = random_fsm("wrong", 12, start_event=False, shape="tree")
     text = dumps(convert(fsm, style="dispatch").model, "btcpp")
-    scripts = [line for line in text.splitlines() if "<Script" in line]
+    # a transition writes only the digits it changes: take the second one writing d0
+    scripts = [line for line in text.splitlines() if "fsm_d0:='" in line]
     first = scripts[1]
     assert "fsm_d0:='" in first
     digit = first.split("fsm_d0:='")[1][0]
@@ -67,7 +68,8 @@ def test_depth_is_logarithmic() -> None:
     for n in (100, 5000):
         fsm = random_fsm(f"c{n}", n, start_event=False, shape="chain", extra_edges=0)
         depths[n] = int(convert(fsm, style="dispatch").stats["depth"])
-    # log6 levels of index Switches + an event Switch + the transition: 3 + 2 + 3, 5 + 2 + 3
+    # log7 levels of index Switches (+ the root's seventh digit) + an event Switch + the
+    # transition (KeepRunningUntilFailure, Sequence, Script): 3 + 1 + 3, 5 + 1 + 1 + 3
     assert depths[100] <= 8
     assert depths[5000] <= 10
 
@@ -115,3 +117,18 @@ def test_auto_writes_the_lebt_when_nusmv_checks_the_result(tmp_path: Path) -> No
     assert any("NuSMV" in w and "dispatch form" in w for w in checked.warnings)
     with pytest.raises(UnsupportedError, match="NuSMV does not encode the dispatch form"):
         api.convert_file(source, style="dispatch", verify_engine="nusmv")
+
+
+def test_post_conditions_other_than_literal_on_success_on_an_entry_are_refused() -> None:
+    fsm = random_fsm("post", 5, start_event=False, shape="chain", extra_edges=0)
+    text = dumps(convert(fsm, style="dispatch").model, "btcpp")
+    assert "_onSuccess=" in text  # the transitions write their digits after the leaf
+    line = next(x for x in text.splitlines() if "_onSuccess=" in x)
+    bad_code = line.replace('_onSuccess="', '_onSuccess="fsm_d0:=fsm_d1; ', 1)
+    on_switch = text.replace("<Switch2 ", "<Switch2 _onSuccess=\"fsm_d0:='a'\" ", 1)
+    on_failure = text.replace(line, line.replace("_onSuccess=", "_onFailure="), 1)
+    for bad in (text.replace(line, bad_code, 1), on_switch, on_failure):
+        assert bad != text
+        with pytest.raises(UnsupportedError, match="_on") as caught:
+            DispatchMachine(loads(bad, "btcpp"), ["x"])
+        assert caught.value.location is not None

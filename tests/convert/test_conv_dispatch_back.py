@@ -65,7 +65,8 @@ def _mutated(fsm: FSM) -> str:
     """The dispatch tree of ``fsm`` with the second transition's Script writing another
     state's lowest digit."""
     text = _dispatch_text(fsm)
-    first = [line for line in text.splitlines() if "<Script" in line][1]
+    lines = text.splitlines()
+    first = [line for line in lines if "fsm_d0:='" in line][1]
     digit = first.split("fsm_d0:='")[1][0]
     other = "b" if digit != "b" else "c"
     return text.replace(first, first.replace(f"fsm_d0:='{digit}'", f"fsm_d0:='{other}'"), 1)
@@ -116,9 +117,11 @@ def test_a_tick_entering_two_states_is_refused() -> None:
     fsm.initial = "A"
     fsm.add_transition("A", "go", "B")
     text = _dispatch_text(fsm)
-    entry = '<DispatchEntry name="B" state="B" action="B"/>'
-    assert entry in text
-    doubled = text.replace(entry, entry + '<DispatchEntry name="C" state="C" action="C"/>', 1)
+    entry = next(line.strip() for line in text.splitlines() if 'state="B"' in line)
+    assert entry.startswith("<DispatchEntry")
+    doubled = text.replace(
+        entry, f'<Sequence>{entry}<DispatchEntry name="C" state="C" action="C"/></Sequence>', 1
+    )
     with pytest.raises(UnsupportedError, match="enters one state per step") as caught:
         convert(loads(doubled, "btcpp"))
     assert caught.value.location is not None

@@ -10,10 +10,12 @@ from pathlib import Path
 import pytest
 
 from fsmbt import api
+from fsmbt.convert import convert
 from fsmbt.formats import dumps, loads
 from fsmbt.formats.btcpp.v3_rules import v3_problems
 from fsmbt.formats.btcpp.v3_write import prepare_v3
 from fsmbt.formats.translate import Translation
+from fsmbt.generate import random_fsm
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import UnsupportedError
 from support.corpus import CORPUS
@@ -264,3 +266,14 @@ def test_a_v3_file_that_3_8_ticks_otherwise_is_read_with_a_warning() -> None:
         warnings=warnings,
     )
     assert not any("v4's rule" in w for w in warnings)
+
+
+def test_a_post_condition_a_switch_reads_is_refused_not_dropped() -> None:
+    """The dispatch form's transitions write the state index in ``_onSuccess``; dropping it
+    would leave a v3 tree that never leaves its initial state."""
+    fsm = random_fsm("v3post", 5, start_event=False, shape="chain", extra_edges=0)
+    doc = convert(fsm, style="dispatch").model
+    with pytest.raises(
+        UnsupportedError, match="post-condition _onSuccess writes a blackboard entry"
+    ):
+        prepare_v3(doc)

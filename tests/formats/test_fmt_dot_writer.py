@@ -14,6 +14,7 @@ import pytest
 from fsmbt import api
 from fsmbt.cli import main
 from fsmbt.formats import dumps, loads
+from fsmbt.generate import random_fsm
 from fsmbt.model import FSM, State
 from fsmbt.render import bt_to_dot, fsm_to_dot
 
@@ -103,19 +104,22 @@ def test_cli_convert_to_dot_and_render_dot_give_the_same_bt_dot(tmp_path: Path) 
 
 
 def test_the_dot_format_is_the_whole_tree_while_render_folds_a_big_one(tmp_path: Path) -> None:
-    """The paper FSM's dispatch tree (the default style, 117 nodes): ``--to dot`` is an exchange
+    """A 40-state machine's dispatch tree (the default style): ``--to dot`` is an exchange
     format and holds every node; ``render`` draws the picture a person reads, with folds."""
-    source = EXAMPLES / "paper_fsm.json"
+    source = tmp_path / "big_fsm.json"
+    source.write_text(dumps(random_fsm("fold", 40, start_event=False), "json"), encoding="utf-8")
     as_dot, as_xml, drawn = tmp_path / "bt.dot", tmp_path / "bt.xml", tmp_path / "drawn.dot"
     assert main(["convert", str(source), "--to", "dot", "-o", str(as_dot), "--no-verify"]) == 0
     assert main(["convert", str(source), "-o", str(as_xml), "--no-verify"]) == 0
     assert main(["render", str(as_xml), "-o", str(drawn)]) == 0
     whole = as_dot.read_text(encoding="utf-8")
     picture = drawn.read_text(encoding="utf-8")
-    assert len(re.findall(r"^\tn\d+ \[label=", whole, flags=re.MULTILINE)) == 117
+    nodes = sum(1 for _ in loads(as_xml.read_text(encoding="utf-8"), "btcpp").nodes())
+    assert nodes > 60
+    assert len(re.findall(r"^\tn\d+ \[label=", whole, flags=re.MULTILINE)) == nodes
     assert "nodes]" not in whole
     assert "nodes]" in picture  # at least one fold box
-    assert len(re.findall(r"^\tn\d+ \[label=", picture, flags=re.MULTILINE)) < 117
+    assert len(re.findall(r"^\tn\d+ \[label=", picture, flags=re.MULTILINE)) < nodes
 
 
 def test_format_dot_of_odd_names_is_accepted_by_graphviz() -> None:

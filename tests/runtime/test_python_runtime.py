@@ -226,15 +226,21 @@ def test_a_foreign_node_is_named_with_its_line(tag: str, attrs: dict[str, str], 
         assert info.value.location is not None and info.value.location.line == line
 
 
-def test_a_dispatch_tree_is_refused_naming_its_first_entry_and_the_style() -> None:
+def test_a_dispatch_tree_runs_on_fsmbt_and_the_lebt_engines_refuse_it() -> None:
     door = api.load(DOOR).model
     text = dumps(converter_for("rules", door)(door).model, "btcpp")  # auto: the dispatch form
-    line = next(i for i, t in enumerate(text.splitlines(), 1) if "<DispatchEntry" in t)
+    assert "<DispatchEntry" in text
     for engine in ENGINES:
-        with pytest.raises(InputError) as info:
-            load_tree(text, {}, engine=engine, allow_unused=True)
-        assert "--style lebt" in str(info.value) and "DispatchEntry" in str(info.value)
-        assert info.value.location is not None and info.value.location.line == line
+        with pytest.raises(InputError, match=f"dispatch tree.*runs on fsmbt, not on '{engine}'"):
+            load_tree(text, DOOR_ACTIONS, engine=engine)
+    recorder = Recorder(set(DOOR_ACTIONS))
+    runner = load_tree(text, recorder.actions)
+    assert runner.engine == "fsmbt"
+    runner.start()
+    for event in ["open_cmd", "fully_open", "fire_alarm", "open_cmd", "shutdown"]:
+        runner.post(event)
+    assert recorder.calls == ["Closed", "Opening", "Open", "Emergency", "Off"]
+    assert runner.state == "Off" and runner.terminated
 
 
 def test_bad_sources_and_engines_are_clear_errors(tmp_path: Path) -> None:

@@ -7,6 +7,8 @@ from __future__ import annotations
 from pathlib import Path
 
 from fsmbt import api
+from fsmbt.formats import dumps
+from fsmbt.generate import random_fsm
 from fsmbt.model.errors import InputError
 from fsmbt.verify.mutations import mutants
 from support.web_server import REPO
@@ -67,10 +69,12 @@ def test_download_the_result_and_read_it_back(page, tmp_path, screenshots):
     page.screenshot(path=str(screenshots / "03-downloads.png"), full_page=True)
 
 
-def _mutated_pair(tmp_path: Path, style: str = "lebt") -> tuple[Path, Path, list]:
-    """The paper FSM's BT in ``style`` (first) and the FSM with one transition dropped (second),
-    and the counterexample fsmbt gives for them."""
-    source = api.load(PAPER)
+def _mutated_pair(
+    tmp_path: Path, style: str = "lebt", machine: Path | None = None
+) -> tuple[Path, Path, list]:
+    """The paper FSM's (or ``machine``'s) BT in ``style`` (first) and the FSM with one
+    transition dropped (second), and the counterexample fsmbt gives for them."""
+    source = api.load(machine or PAPER)
     outcome = api.convert_loaded(source, style=style)
     bt_file = api.write_text(outcome.text, tmp_path / "paper_bt.xml")
     for mutant in mutants(source.model, per_operator=1):
@@ -135,9 +139,11 @@ def test_verify_a_mutated_pair_and_step_the_counterexample(page, tmp_path, scree
 
 
 def test_a_step_inside_a_fold_marks_the_folded_node(page, tmp_path):
-    """The paper FSM's dispatch tree (117 nodes, the default style) is drawn with folds; a step
+    """A 40-state machine's dispatch tree (the default style) is drawn with folds; a step
     whose DispatchEntry is folded away marks the folded node above it, never nothing."""
-    bt_file, fsm_file, trace = _mutated_pair(tmp_path, style="dispatch")
+    machine = tmp_path / "big_fsm.json"
+    machine.write_text(dumps(random_fsm("fold", 40, start_event=False), "json"), encoding="utf-8")
+    bt_file, fsm_file, trace = _mutated_pair(tmp_path, style="dispatch", machine=machine)
     _verify_on_the_page(page, bt_file, fsm_file)
     folds = page.locator("#svg-first text", has_text="nodes]").count()
     assert folds >= 1  # the premise: the tree is folded on the page

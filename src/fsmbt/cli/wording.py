@@ -11,6 +11,8 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 
+from fsmbt.semantics.dispatch_runtime import BASE as DISPATCH_BASE
+
 
 def counted(n: object, noun: str, plural: str | None = None) -> str:
     """``1 state``, ``2 states``, ``1 branch``/``3 branches`` (``plural`` when irregular).
@@ -39,7 +41,11 @@ def _fsm_to_bt(s: Mapping[str, object], engine: str, used: set[str]) -> list[str
     if "transitions" in s:
         head += f" and {counted(take('transitions'), 'transition')}"
     if s.get("style") == "dispatch":  # docs/semantics.md section 12
-        digits = counted(take("index_digits"), "base-6 digit") if "index_digits" in s else ""
+        digits = (
+            counted(take("index_digits"), f"base-{DISPATCH_BASE} digit")
+            if "index_digits" in s
+            else ""
+        )
         index = f" of {digits}" if digits else ""
         head += (
             f" became a dispatch BT (a Switch dispatch over a state index{index} on the "

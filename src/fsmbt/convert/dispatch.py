@@ -2,26 +2,39 @@
 blackboard (docs/semantics.md, "12. The dispatch form"; runs as
 ``fsmbt.semantics.dispatch_runtime`` says).
 
-Shape, for reachable states numbered 0..n-1 in declaration order (index digits base 6, letters
-``a``..``f``, in the entries ``fsm_d0`` (least significant) .. ``fsm_d{L-1}``):
+Shape, for reachable states numbered 0..n-1 in declaration order (index digits base 7, letters
+``a``..``g``, in the entries ``fsm_d0`` (least significant) .. ``fsm_d{L-1}``):
 
 - the root is a tree of ``Switch2``..``Switch6`` nodes: level ``j`` (counted from the leaves)
-  switches on ``{fsm_dj}``; a group of one case gets a padding case (``AlwaysFailure``); every
-  default child is ``AlwaysFailure`` (unreachable) except the root's, which is the start case
-  (the digits are unset before the first transition);
+  switches on ``{fsm_dj}``; below the root a full group of seven takes ``a``..``f`` as cases
+  and ``g`` as the default child (no comparison for it); a smaller group's default is
+  ``AlwaysFailure`` (unreachable), and a group of one gets a padding case (``AlwaysFailure``).
+  The root's default is the start case (the digits are unset before the first transition), so
+  a full root group puts its seventh member under a ``Switch2`` on the same digit whose default
+  is the start case;
 - a final state's case is ``AlwaysSuccess``; a non-final state's case switches on ``{event}``
   over its outgoing events (chains of ``Switch6`` when it has more than 6), each case the
-  transition ``ReactiveSequence(Script(digits of the target), DispatchEntry(target),
-  [KeepRunningUntilFailure(AlwaysSuccess) unless the target is final])``, the default
+  transition ``KeepRunningUntilFailure(DispatchEntry(target, _onSuccess="the target's digits
+  that differ from the source's"))`` (BehaviorTree.CPP's post-condition writes them after the
+  leaf's SUCCESS; no ``_onSuccess`` when no digit differs: a self-loop;
+  ``KeepRunningUntilFailure`` left out when the target is final), the default
   ``KeepRunningUntilFailure(AlwaysSuccess)`` (RUNNING: the event is ignored);
-- the start case is the transition to the initial state, or, when the FSM has an initial event,
-  an event switch with that one case.
+- the start case is the transition to the initial state (every digit written), or, when the FSM
+  has an initial event, an event switch with that one case.
+
+Why this shape (issue 23 item 6, measured in benchmarks/bench_dispatch_floor.py and
+bench_runtime.py): in BehaviorTree.CPP 4.8.2 every ticked node costs about 100 ns (two clock
+reads and mutexes in ``executeTick``) and a ``Switch`` more per case read, so the tree ticks
+as few nodes as it can: base 7 (one index level fewer than base 6 from 2 402 to 7 776 states,
+and so at 10 000), the transition as one or two nodes instead of four to five (the digits
+written by the leaf's post-condition, not by a ``Script`` node under a ``Sequence``), writing
+one digit on most chain steps instead of all of them.
 
 Bad input (UnsupportedError, state named): an event name BehaviorTree.CPP's ``Switch`` would
 not compare as a plain string (a number, a blackboard reference ``{..}``, empty).
 
 Cost: O(states + transitions) to build (the cyclic collector paused, ``convert/perf.py``: the
-tree is acyclic); depth O(log6 states + max out-degree / 6).
+tree is acyclic); depth O(log7 states + max out-degree / 6).
 """
 
 from __future__ import annotations
@@ -36,7 +49,15 @@ from fsmbt.model.errors import InputError, UnsupportedError
 from fsmbt.model.flatten import flatten, needs_flattening
 from fsmbt.model.fsm import FSM
 from fsmbt.model.kinds import NodeKind
-from fsmbt.semantics.dispatch_runtime import BASE, DIGIT_PREFIX, DIGITS, ENTRY, EVENT_KEY
+from fsmbt.semantics.dispatch_runtime import (
+    BASE,
+    DIGIT_PREFIX,
+    DIGITS,
+    ENTRY,
+    EVENT_KEY,
+    MAX_CASES,
+    ON_SUCCESS,
+)
 
 STYLE = "dispatch"
 _NUMBER = re.compile(r"\s*[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?\s*")
@@ -115,29 +136,38 @@ def fsm_to_dispatch(fsm: FSM, **_options: object) -> ConversionResult:
     while BASE**levels < len(states):
         levels += 1
 
-    def transition(target: str, label: str) -> BTNode:
-        i = index[target]
-        code = []
-        for j in range(levels):
-            code.append(f"{DIGIT_PREFIX}{j}:='{DIGITS[i % BASE]}'")
+    def digits(i: int) -> list[str]:
+        out = []
+        for _j in range(levels):
+            out.append(DIGITS[i % BASE])
             i //= BASE
-        st = flat.states[target]
-        children = [
-            _leaf("Script", f"goto_{target}", code="; ".join(code)),
-            _leaf(ENTRY, target, state=target, action=st.action or ""),
-        ]
-        if not st.final:
-            children.append(_running())
-        return _control("ReactiveSequence", label, children)
+        return out
 
-    def events_switch(source: str, exits: list[tuple[str, str]]) -> BTNode:
+    def transition(source: str | None, target: str, label: str) -> BTNode:
+        """The transition to ``target``; its Script writes only the digits that differ from
+        ``source``'s (all of them from the start, ``source`` None)."""
+        want = digits(index[target])
+        have = digits(index[source]) if source is not None else [""] * levels
+        code = [f"{DIGIT_PREFIX}{j}:='{want[j]}'" for j in range(levels) if want[j] != have[j]]
+        st = flat.states[target]
+        attrs = {"state": target, "action": st.action or ""}
+        if code:
+            attrs[ON_SUCCESS] = "; ".join(code)
+        node = _leaf(ENTRY, target, **attrs)
+        if st.final:
+            return node
+        return BTNode(
+            type="KeepRunningUntilFailure", kind=NodeKind.DECORATOR, name=label, children=[node]
+        )
+
+    def events_switch(source: str | None, name: str, exits: list[tuple[str, str]]) -> BTNode:
         if not exits:
             return _running()
         node = _running()
         chunks = [exits[k : k + 6] for k in range(0, len(exits), 6)]
         for c, chunk in reversed(list(enumerate(chunks))):
-            cases = [(ev, transition(t, f"{source}/{ev}")) for ev, t in chunk]
-            node = _switch(EVENT_KEY, cases, node, f"{source}_events{c or ''}")
+            cases = [(ev, transition(source, t, f"{name}/{ev}")) for ev, t in chunk]
+            node = _switch(EVENT_KEY, cases, node, f"{name}_events{c or ''}")
         return node
 
     table = flat.transition_map()
@@ -151,25 +181,28 @@ def fsm_to_dispatch(fsm: FSM, **_options: object) -> ConversionResult:
         exits = [(str(e), t.target) for e, t in table.get(name, {}).items()]
         for ev, _t in exits:
             _check_event(ev, name)
-        cases.append(events_switch(name, exits))
+        cases.append(events_switch(name, name, exits))
     if flat.initial_event is not None:
         _check_event(flat.initial_event, flat.start_name or "start")
-        start = events_switch("start", [(flat.initial_event, flat.initial)])
+        start = events_switch(None, "start", [(flat.initial_event, flat.initial)])
     else:
-        start = transition(flat.initial, "start")
+        start = transition(None, flat.initial, "start")
     nodes: list[BTNode] = cases
     for j in range(levels):
+        key = f"{DIGIT_PREFIX}{j}"
         groups = [nodes[k : k + BASE] for k in range(0, len(nodes), BASE)]
         last = j == levels - 1
-        nodes = [
-            _switch(
-                f"{DIGIT_PREFIX}{j}",
-                [(DIGITS[i], n) for i, n in enumerate(group)],
-                start if last else _leaf("AlwaysFailure"),
-                "dispatch" if last else f"digit{j}_{g}",
-            )
-            for g, group in enumerate(groups)
-        ]
+        nodes = []
+        for g, group in enumerate(groups):
+            name = "dispatch" if last else f"digit{j}_{g}"
+            cases_j = [(DIGITS[i], n) for i, n in enumerate(group)]
+            if len(cases_j) <= MAX_CASES:
+                default = start if last else _leaf("AlwaysFailure")
+            elif last:  # the root's default is the start case: the seventh digit is a case
+                default = _switch(key, cases_j[MAX_CASES:], start, f"{name}_{DIGITS[-1]}")
+            else:  # the seventh digit is the default child: one comparison fewer
+                default = cases_j[MAX_CASES][1]
+            nodes.append(_switch(key, cases_j[:MAX_CASES], default, name))
     assert len(nodes) == 1
     doc = BTDocument.single(nodes[0])
     doc.node_models[ENTRY] = NodeModel(

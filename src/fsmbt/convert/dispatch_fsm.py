@@ -36,7 +36,7 @@ leaves whose ``state`` ports disagree about the state one index holds, and leave
 
 Cost: O(C · (1 + e)) ticks for C reachable configurations (one per state of the machine for a
 tree fsmbt wrote, at most one per transition plus one per state) and e events tested where a configuration's tick passes (the
-others share one tick, ``DispatchMachine.active_inputs``), each O(log6 states + out-degree / 6)
+others share one tick, ``DispatchMachine.active_inputs``), each O(log7 states + out-degree / 6)
 node ticks, plus O(C · E) to record the moves of E events where that shared tick is not silent;
 the refinement is O(moves) per round, one or two rounds for a tree fsmbt wrote.
 """

@@ -1,8 +1,10 @@
-"""Run a converted behavior tree (an LEBT) with your own actions, on py_trees or BehaviorTree.CPP.
+"""Run a converted behavior tree with your own actions: an LEBT on py_trees or BehaviorTree.CPP,
+a dispatch tree on fsmbt's interpreter.
 
 fsmbt's FSM -> BT conversion writes a BehaviorTree.CPP v4 tree whose leaves are ``LebtGuard``
-and ``LebtState`` (docs/semantics.md, "loop-execution BT"). This module runs such a tree in a
-real engine and calls *your* code when a state is entered:
+and ``LebtState`` (``--style lebt``; docs/semantics.md, "loop-execution BT"), or, by default for
+an event-driven machine, the dispatch form whose one leaf is ``DispatchEntry`` (docs/semantics.md
+section 12). This module runs either and calls *your* code when a state is entered:
 
     runner = load_tree(Path("door_bt.xml"), {"Open": open_door, "Closed": stop_motor})
     runner.start()            # the initial state's action runs (FSMs without initial event)
@@ -11,10 +13,17 @@ real engine and calls *your* code when a state is entered:
 
 Rules:
 
-- Engines: ``"py_trees"`` (py_trees 2.6) and ``"btcpp"`` (BehaviorTree.CPP 4.8.2 through
-  ``behaviortreepy``); both run the same leaf behaviours (``fsmbt.semantics.lebt.leaves``) and
-  the macro step of docs/semantics.md: post the event, tick, tick once more when the root
-  succeeded with the event still pending, drop an event no state takes.
+- Engines of an LEBT: ``"py_trees"`` (py_trees 2.6, the default) and ``"btcpp"``
+  (BehaviorTree.CPP 4.8.2 through ``behaviortreepy``); both run the same leaf behaviours
+  (``fsmbt.semantics.lebt.leaves``) and the macro step of docs/semantics.md: post the event,
+  tick, tick once more when the root succeeded with the event still pending, drop an event no
+  state takes.
+- A dispatch tree runs on ``"fsmbt"`` (its only engine, the default for it): the checker's own
+  macro steps (``fsmbt.runtime.dispatch_run``, over ``semantics.dispatch_runtime``): write
+  ``event``, tick the root once, unset ``event``. Its entries are its ``DispatchEntry`` leaves
+  (ports ``state``, ``action``, optional ``params``), called as below. py_trees has no
+  ``Switch``/``Script``, and behaviortreepy cannot declare ``DispatchEntry``'s ports, so
+  neither engine runs it (asking for one is a load error).
 - An action is a callable looked up by the action name the ``LebtState`` leaf carries (its
   ``action`` port; by default the FSM state's name, for SMACH/FlexBE states their class, so
   several states share one). It is called ``action(state, params)``: the label of the state
@@ -25,7 +34,7 @@ Rules:
   order, after the engine's ticks of that macro step (the tree's control flow never depends on
   an action). An exception raised by an action propagates to the caller of ``start``/``post``.
 - Checked when loading, never at tick time (``InputError`` naming the place): the file is a
-  v4 tree fsmbt can read; every node is ``LebtGuard``, ``LebtState``, ``SubTree`` or the
+  v4 tree fsmbt can read; a dispatch tree: ``DispatchRun``'s checks; an LEBT: every node is ``LebtGuard``, ``LebtState``, ``SubTree`` or the
   control nodes the LEBT uses (``Sequence``, ``Fallback``) - any other node is named with its
   line; the LEBT annotations agree with each other (``check_lebt_annotations``: a guard pair
   naming an event its source state does not list as an exit, an exit no guard takes, a guard
@@ -35,9 +44,10 @@ Rules:
   ``allow_unused=True``) every callable names an action of the tree (a typo is caught).
 - ``write_files`` writes a runnable example (a converted tree and a script) into a folder.
 
-Costs: loading is O(n) in the tree's nodes plus the engine's own build; a macro step costs one
-or two root ticks, each O(root-level selectors + depth of the active state's leaf) in both
-engines (the root Sequence asks every root-level guard before the running branch). User code is never
+Costs: loading is O(n) in the tree's nodes plus the engine's own build; an LEBT's macro step
+costs one or two root ticks, each O(root-level selectors + depth of the active state's leaf) in
+both engines (the root Sequence asks every root-level guard before the running branch); a
+dispatch tree's one tick O(log7 states + events of the current state / 6). User code is never
 imported or executed by fsmbt itself: only the callables you pass are called.
 """
 
@@ -45,7 +55,6 @@ from __future__ import annotations
 
 import inspect
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
 from pathlib import Path
 
 from fsmbt import api
@@ -53,8 +62,8 @@ from fsmbt.formats import loads
 from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.bt_nodes import NodeKind
 from fsmbt.model.errors import InputError
-from fsmbt.semantics.dispatch_runtime import ENTRY as DISPATCH_ENTRY
-from fsmbt.semantics.execution import lebt_engine_run
+from fsmbt.runtime.dispatch_run import DispatchRun, Entry
+from fsmbt.semantics.execution import Flavour, flavour_of, lebt_engine_run
 from fsmbt.semantics.lebt.ports import lebt_port_issues
 from fsmbt.semantics.lebt.spec import (
     GUARD_TYPE,
@@ -66,8 +75,10 @@ from fsmbt.semantics.lebt.spec import (
 )
 from fsmbt.semantics.nodes import PLAIN_CONTROLS
 
-#: The engines a tree can run on.
+#: The engines an LEBT can run on (the first is the default).
 ENGINES = ("py_trees", "btcpp")
+#: The engines a dispatch tree can run on: fsmbt's interpreter (docs/semantics.md section 12).
+DISPATCH_ENGINES = ("fsmbt",)
 #: The non-leaf nodes an LEBT is built from (fsmbt.convert.lebt, hfsm_to_bt): the plain,
 #: memoryless Sequence and Fallback of the node registry.
 LEBT_CONTROLS = PLAIN_CONTROLS
@@ -78,27 +89,49 @@ Action = Callable[..., object]
 #: The action key the engines run instead of each state's action name (one per state leaf).
 _ENTRY_KEY = "fsmbt-entry-{}"
 
-__all__ = ["ENGINES", "Entry", "TreeRunner", "check_lebt_annotations", "load_tree", "write_files"]
+__all__ = [
+    "DISPATCH_ENGINES",
+    "ENGINES",
+    "Entry",
+    "TreeRunner",
+    "check_lebt_annotations",
+    "load_tree",
+    "write_files",
+]
 
 
-@dataclass(frozen=True)
-class Entry:
-    """One state leaf's entry: the action it runs, the state's label, its parameters."""
+class _LebtRun:
+    """An LEBT engine run seen through ``DispatchRun``'s interface."""
 
-    action: str
-    state: str
-    params: dict[str, str]
+    def __init__(self, doc: BTDocument, engine: str) -> None:
+        self._run = lebt_engine_run(doc, engine)
+        self.start: str = self._run.leaves.start
+
+    @property
+    def state(self) -> str:
+        return str(self._run.bb.state)
+
+    @property
+    def terminated(self) -> bool:
+        return bool(self._run.terminated)
+
+    def initial(self) -> tuple[str, ...]:
+        return tuple(self._run.initial())
+
+    def macro_step(self, event: str) -> tuple[str, ...]:
+        return tuple(self._run.macro_step(event))
 
 
 class TreeRunner:
-    """A loaded LEBT on one engine, with the user's actions (build it with ``load_tree``)."""
+    """A loaded converted tree on one engine, with the user's actions (build it with
+    ``load_tree``)."""
 
     def __init__(
         self,
         doc: BTDocument,
         actions: Mapping[str, Action],
         *,
-        engine: str = "py_trees",
+        engine: str | None = None,
         allow_unused: bool = False,
     ) -> None:
         """Check ``doc`` and ``actions`` and build the engine's tree (not started).
@@ -106,23 +139,44 @@ class TreeRunner:
         Args:
             doc: the converted tree, as fsmbt read it.
             actions: action name -> ``callable(state, params)`` (or without arguments).
-            engine: ``"py_trees"`` or ``"btcpp"``.
+            engine: ``"py_trees"`` or ``"btcpp"`` for an LEBT, ``"fsmbt"`` for a dispatch
+                tree; ``None``: the first of the tree's engines (``ENGINES``,
+                ``DISPATCH_ENGINES``).
             allow_unused: accept callables whose name no state of the tree uses.
         Raises:
-            InputError: a node the LEBT does not use (with its line), contradicting LEBT
-                annotations (``check_lebt_annotations``), an action without callable, a
-                callable without action, an unknown engine.
+            InputError: a node the tree's form does not use (with its line), contradicting
+                LEBT annotations (``check_lebt_annotations``), a malformed ``DispatchEntry``
+                (``DispatchRun``), an action without callable, a callable without action, an
+                unknown engine or one that cannot run the tree.
         """
-        if engine not in ENGINES:
-            raise InputError(f"unknown engine '{engine}' (known: {', '.join(ENGINES)})")
-        check_lebt_nodes(doc)
-        check_lebt_annotations(doc)
+        dispatch = flavour_of(doc) is Flavour.DISPATCH
+        runs_on = DISPATCH_ENGINES if dispatch else ENGINES
+        if engine is None:
+            engine = runs_on[0]
+        if engine not in (*ENGINES, *DISPATCH_ENGINES):
+            raise InputError(
+                f"unknown engine '{engine}' (known: {', '.join((*ENGINES, *DISPATCH_ENGINES))})"
+            )
+        if engine not in runs_on:
+            form = (
+                "a dispatch tree (DispatchEntry leaves, docs/semantics.md section 12)"
+                if dispatch
+                else "a loop-execution BT"
+            )
+            raise InputError(f"{form} runs on {', '.join(runs_on)}, not on '{engine}'")
         self.engine = engine
-        self._entries = _keyed_entries(doc)
-        try:  # the engines run one key per state leaf, so each call knows its state
-            self._run = lebt_engine_run(doc, engine)
-        finally:
-            _restore_actions(doc, self._entries)
+        self._run: DispatchRun | _LebtRun
+        if dispatch:
+            self._run = DispatchRun(doc)
+            self._entries = dict(self._run.entries)
+        else:
+            check_lebt_nodes(doc)
+            check_lebt_annotations(doc)
+            self._entries = _keyed_entries(doc)
+            try:  # the engines run one key per state leaf, so each call knows its state
+                self._run = _LebtRun(doc, engine)
+            finally:
+                _restore_actions(doc, self._entries)
         self.used_actions = _check_actions(self._entries, actions, allow_unused=allow_unused)
         self._actions = dict(actions)
         self._with_entry = {name: _takes_entry(name, action) for name, action in actions.items()}
@@ -130,13 +184,14 @@ class TreeRunner:
 
     @property
     def state(self) -> str:
-        """The FSM state the tree is in (the start pseudo-state before the initial event)."""
-        return self._run.bb.state
+        """The FSM state the tree is in (the start pseudo-state before the initial event; in
+        a dispatch tree ``start``)."""
+        return self._run.state
 
     @property
     def start_state(self) -> str:
         """The start pseudo-state's name."""
-        return self._run.leaves.start
+        return self._run.start
 
     @property
     def terminated(self) -> bool:
@@ -190,7 +245,7 @@ def load_tree(
     source: Path | str,
     actions: Mapping[str, Action],
     *,
-    engine: str = "py_trees",
+    engine: str | None = None,
     allow_unused: bool = False,
 ) -> TreeRunner:
     """Load a converted tree and bind the user's actions.
@@ -199,7 +254,8 @@ def load_tree(
         source: the BehaviorTree.CPP XML text (a string starting with ``<``), or the path of
             the file (a ``Path``, or any other string).
         actions: action name -> ``callable(state, params)`` (or without arguments).
-        engine: ``"py_trees"`` or ``"btcpp"``.
+        engine: ``"py_trees"`` or ``"btcpp"`` (an LEBT), ``"fsmbt"`` (a dispatch tree);
+            ``None``: the tree's default (``py_trees``, ``fsmbt``).
         allow_unused: accept callables whose name no state of the tree uses.
     Returns:
         A ``TreeRunner``, not started.
@@ -222,20 +278,9 @@ def check_lebt_nodes(doc: BTDocument) -> None:
     """Refuse any node an LEBT does not have, naming it and its line.
 
     Raises:
-        InputError: the first such node in document order; for a dispatch tree (the form
-        ``fsmbt convert`` writes for an event-driven machine by default) its first
-        ``DispatchEntry``, saying to convert with ``--style lebt``.
+        InputError: the first such node in document order (a ``DispatchEntry`` among LEBT
+        leaves too: a tree is one form or the other).
     """
-    entry = next((n for _t, n in doc.nodes() if n.type == DISPATCH_ENTRY), None)
-    if entry is not None:
-        raise InputError(
-            "a dispatch tree (what `fsmbt convert` writes for an event-driven machine by "
-            "default, docs/semantics.md section 12) runs in BehaviorTree.CPP with DispatchEntry "
-            "registered (docs/runtime.md); this runtime runs loop-execution BTs: convert with "
-            "--style lebt",
-            location=entry.location,
-            element=f"<{entry.type}> '{entry.label}'",
-        )
     for tree in doc.trees.values():
         stack: list[BTNode] = [tree.root] if tree.root is not None else []
         while stack:

@@ -1,19 +1,23 @@
 """Macro steps of the dispatch form of an FSM (docs/semantics.md, "12. The dispatch form").
 
 The dispatch form (``fsmbt.convert.dispatch``) keeps the FSM's current state as an index on the
-blackboard, written in base 6 as the digit entries ``fsm_d0`` (least significant) ..
-``fsm_d{L-1}`` with the letters ``a``..``f`` (BehaviorTree.CPP's ``Switch`` compares numbers
-numerically, so digits are letters). Its control nodes are BehaviorTree.CPP built-ins
-(``Switch2``..``Switch6``, ``Script``, ``ReactiveSequence``, ``KeepRunningUntilFailure``,
+blackboard, written in base 7 as the digit entries ``fsm_d0`` (least significant) ..
+``fsm_d{L-1}`` with the letters ``a``..``g`` (BehaviorTree.CPP's ``Switch`` compares numbers
+numerically, so digits are letters; a ``Switch6``'s default child is the seventh digit). Its
+control nodes are BehaviorTree.CPP built-ins
+(``Switch2``..``Switch6``, ``Script``, ``Sequence``, ``KeepRunningUntilFailure``,
 ``AlwaysSuccess``, ``AlwaysFailure``), modelled exactly by ``fsmbt.semantics.outcome_blackboard``;
 its only leaf is ``DispatchEntry`` (Action; ports ``state``, ``action``): it runs ``action``
-(empty: none) and returns SUCCESS.
+(empty: none) and returns SUCCESS, after which BehaviorTree.CPP runs its ``_onSuccess``
+post-condition: ``KEY:='literal'`` assignments (the target's index digits), applied here to the
+blackboard before the parent sees the SUCCESS. No other node may carry a post-condition, and no
+other script form is accepted there (``InputError``/``UnsupportedError`` naming the node).
 
 One macro step: the environment writes the event to the entry ``event`` and ticks the root once;
 ``event`` is then unset again (the tree never writes it). The start is one tick with ``event``
 unset. The tree has terminated when the last tick returned SUCCESS (the current state is final).
 
-Cost: a tick is O(log6(states) + events of the current state / 6) node ticks.
+Cost: a tick is O(log7(states) + events of the current state / 6) node ticks.
 """
 
 from __future__ import annotations
@@ -23,7 +27,7 @@ from dataclasses import dataclass
 from typing import Any, NamedTuple
 
 from fsmbt.model.bt import BTDocument
-from fsmbt.model.errors import InputError
+from fsmbt.model.errors import InputError, UnsupportedError
 from fsmbt.model.fsm import FSM
 from fsmbt.model.kinds import NodeKind
 from fsmbt.semantics.bt_interpreter import (
@@ -40,6 +44,7 @@ from fsmbt.semantics.outcome_blackboard import (
     SWITCH,
     OutcomeInterpreter,
     OutcomeTree,
+    script_assignments,
     with_entry,
 )
 from fsmbt.semantics.status import NodeStatus
@@ -47,11 +52,17 @@ from fsmbt.semantics.status import NodeStatus
 ENTRY = "DispatchEntry"
 EVENT_KEY = "event"
 DIGIT_PREFIX = "fsm_d"
-DIGITS = "abcdef"
+DIGITS = "abcdefg"
 BASE = len(DIGITS)
+#: The most cases a BehaviorTree.CPP ``Switch`` has (``Switch6``); its default is one more.
+MAX_CASES = 6
 #: An event value no ``Switch`` case can equal (XML cannot hold NUL): the "any other event" of
 #: ``DispatchMachine.active_inputs``.
 OTHER_EVENT = "\x00"
+#: The post-condition a ``DispatchEntry`` may carry (BehaviorTree.CPP runs it after SUCCESS).
+ON_SUCCESS = "_onSuccess"
+#: BehaviorTree.CPP 4's post-condition attributes (refused anywhere else in a dispatch tree).
+POST_CONDITIONS = ("_onSuccess", "_onFailure", "_onHalted", "_post")
 
 
 def is_dispatch_bt(doc: BTDocument) -> bool:
@@ -121,8 +132,28 @@ class DispatchMachine:
         self._ticks: dict[tuple[DispatchState, str], Tick] = {}  # settle's, used once
         self._alphabet_set = frozenset(self.alphabet)
         self._order = {event: k for k, event in enumerate(self.alphabet)}
+        #: node id -> the blackboard writes of its ``_onSuccess`` (DispatchEntry leaves)
+        self.on_success: dict[int, tuple[tuple[str, str], ...]] = {}
         for node in self.tree.nodes:
             src = node.source
+            posts = [a for a in POST_CONDITIONS if a in src.attrs]
+            if posts and (posts != [ON_SUCCESS] or not node.is_env_leaf):
+                raise UnsupportedError(
+                    f"post-condition '{posts[0]}': in a dispatch tree only a {ENTRY} leaf may "
+                    f"carry one, {ON_SUCCESS} with KEY:='literal' assignments",
+                    location=src.location,
+                    element=f"<{node.type}> '{node.label}'",
+                )
+            if posts:
+                pairs = script_assignments(src.attrs[ON_SUCCESS])
+                if pairs is None:
+                    raise UnsupportedError(
+                        f"{ON_SUCCESS} {src.attrs[ON_SUCCESS]!r}: only KEY:='literal' "
+                        "assignments joined by ';' are modelled",
+                        location=src.location,
+                        element=f"<{node.type}> '{node.label}'",
+                    )
+                self.on_success[node.id] = pairs
             if node.is_env_leaf:
                 if node.type != ENTRY or node.kind is not NodeKind.ACTION:
                     raise InputError(
@@ -158,7 +189,8 @@ class DispatchMachine:
         self-loop (the checker skips those).
 
         Why it is sound: an event's value is read only by the ``Switch`` nodes on ``{event}``
-        (``Script`` writes literals, ``DispatchEntry`` reads no entry, and ``event`` is unset
+        (``Script`` and ``_onSuccess`` write literals, ``DispatchEntry`` reads no entry, and
+        ``event`` is unset
         after the tick). One tick with ``OTHER_EVENT`` takes the default at every such switch
         it reaches; any event that is no case of those switches takes the same defaults, so
         the same path, the same state and the same outputs. When that tick is silent (state
@@ -263,6 +295,8 @@ class DispatchMachine:
         snap, request = self.interp.advance(snap)
         while isinstance(request, LeafRequest):
             entered.append(request.node.id)
+            for key, value in self.on_success.get(request.node.id, ()):
+                snap = with_entry(snap, key, value)
             snap, request = self.interp.advance(snap, NodeStatus.SUCCESS.value)
         snap = without_entry(snap, EVENT_KEY)
         after = DispatchState(snap, NodeStatus(request.status))

@@ -124,8 +124,8 @@ class OutcomeTree(CompiledTree):
             return SWITCH, NodeKind.CONTROL, (key, tuple(cases)), None, list(node.children)
         if node.type == "Script" and not node.children:
             code = node.attrs.get("code", "")
-            if _ASSIGNS.fullmatch(code) is not None:
-                pairs = tuple((m.group(1), m.group(2)) for m in _ASSIGN.finditer(code))
+            pairs = script_assignments(code)
+            if pairs is not None:
                 return SCRIPT, NodeKind.CONTROL, pairs, None, []
         return super()._check(node, chain)
 
@@ -160,6 +160,14 @@ class OutcomeTree(CompiledTree):
                         "(only an outcome port, a Script and a Switch may)",
                         **_where(src),
                     )
+
+
+def script_assignments(code: str) -> tuple[tuple[str, str], ...] | None:
+    """The ``(key, literal)`` pairs of ``KEY:='literal'`` assignments joined by ``;`` (the one
+    script form modelled), in order; ``None`` for any other code. O(len(code))."""
+    if _ASSIGNS.fullmatch(code) is None:
+        return None
+    return tuple((m.group(1), m.group(2)) for m in _ASSIGN.finditer(code))
 
 
 def _entry(value: str) -> str | None:
@@ -275,5 +283,6 @@ __all__ = [
     "OutcomeInterpreter",
     "OutcomeLeafMachine",
     "OutcomeTree",
+    "script_assignments",
     "with_entry",
 ]

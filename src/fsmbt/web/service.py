@@ -132,7 +132,8 @@ def format_list() -> list[dict[str, Any]]:
 def download_formats(kind: str, model: api.Model | None = None) -> list[str]:
     """The formats a model of ``kind`` can be downloaded in (writers, then pictures); with
     ``model``, without BehaviorTree.CPP v3 when v3 cannot hold it (a ``Script`` or another
-    v4-only node: the dispatch form, a structured tree with a dispatch; ``prepare_v3``)."""
+    v4-only node, a post-condition a ``Switch`` reads: the dispatch form, a structured tree with
+    a dispatch; ``prepare_v3``)."""
     names = [f.name for f in formats() if f.write is not None and kind in f.kinds]
     if isinstance(model, BTDocument) and "btcpp3" in names:
         try:

@@ -12,15 +12,17 @@ What v3 cannot say (``prepare_v3``, the rule of docs/formats/btcpp.md):
 - refused (``UnsupportedError`` naming the node, its tree and line), because the tree would
   behave otherwise or not load: a v4-only built-in node (``Script``, ``RunOnce``,
   ``AsyncSequence``, ``LoopInt``...), a pre-condition (``_skipIf``, ``_failureIf``,
-  ``_successIf``, ``_while``: they decide whether a node runs), a ``SequenceWithMemory``,
+  ``_successIf``, ``_while``: they decide whether a node runs), a post-condition writing an
+  entry a ``Switch`` reads (the dispatch form's ``_onSuccess``: it steers the tree), a
+  ``SequenceWithMemory``,
   ``Repeat`` or ``RetryUntilSuccessful`` under an ancestor that ticks or halts between two
   ticks (reactive controls, Parallel, PipelineSequence, WhileDoElse, Timeout: 3.8's nodes
   go on within one tick, and SequenceStar restarts when halted; ``_GRANULAR``); under another
   project's or a user's control or decorator, that difference is a named loss;
 - written otherwise, named: a ``WhileDoElse`` without an else branch (3.8 requires three
   children) gets ``<AlwaysFailure/>``, which v4's rule without one returns the same;
-- dropped and named as a loss, located: post-conditions (``_onSuccess``...: they only write
-  the blackboard, which fsmbt's semantics do not read, docs/semantics.md section 2), other
+- dropped and named as a loss, located: other post-conditions (``_onSuccess``...: they only
+  write the blackboard, which no control node then reads, docs/semantics.md section 2), other
   v4 ``_`` attributes (Groot2's ``_uid``...; 3.8 would refuse them as unknown ports), and a
   ``{@key}`` / ``{=}`` port value is kept but named (v3 reads it as a key of that name).
 
@@ -32,6 +34,7 @@ Costs: one copy of the document and one pass over its nodes and elements, O(n).
 from __future__ import annotations
 
 import copy
+import re
 
 from lxml import etree
 
@@ -75,7 +78,30 @@ def prepare_v3(model: Model) -> tuple[BTDocument, list[str]]:
     doc.format_version = "3"
     losses: list[str] = []
     refused: list[tuple[str, BTNode, str]] = []
+    # entries a Switch reads: a post-condition writing one steers the tree (the dispatch form)
+    switched = {
+        m.group(1)
+        for _t, n in doc.nodes()
+        if n.type.startswith("Switch")
+        and (m := re.fullmatch(r"\{([A-Za-z_][A-Za-z0-9_]*)\}", n.attrs.get("variable", "")))
+    }
     for tree_id, node in doc.nodes():
+        steering = [
+            k
+            for k in versions.POST_CONDITIONS
+            if k in node.attrs
+            and any(re.search(rf"\b{re.escape(key)}\s*:?=", node.attrs[k]) for key in switched)
+        ]
+        if steering:
+            refused.append(
+                (
+                    tree_id,
+                    node,
+                    f"the post-condition {steering[0]} writes a blackboard entry a Switch reads; "
+                    "version 3 has no post-conditions",
+                )
+            )
+            continue
         if _v4_only(node):
             refused.append(
                 (tree_id, node, f"{node.type} is a BehaviorTree.CPP v4 node; version 3 has none")
@@ -126,8 +152,8 @@ def prepare_v3(model: Model) -> tuple[BTDocument, list[str]]:
         tree_id, node, why = refused[0]
         more = f" ({len(refused) - 1} more such node(s))" if len(refused) > 1 else ""
         hint = (
-            " (an FSM converted to a BT: --style lebt writes no Script)"
-            if node.type == "Script"
+            " (an FSM converted to a BT: --style lebt writes no Script and no post-condition)"
+            if node.type == "Script" or any(k in node.attrs for k in versions.POST_CONDITIONS)
             else ""
         )
         raise UnsupportedError(
