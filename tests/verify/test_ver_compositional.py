@@ -1,4 +1,4 @@
-"""The compositional check (``fsmbt.verify.compositional``, docs/semantics.md §4b) agrees with
+"""The compositional check (``fsmbt.verify.compositional``, docs/semantics.md §4c) agrees with
 the whole product on every pair the latter decides.
 
 Generated pairs: seeded random trees mixing plain, reactive and WithMemory controls with

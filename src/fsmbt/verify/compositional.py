@@ -1,5 +1,5 @@
 """The compositional check of a BT against an HFSM: the sum of local proofs
-(docs/verification.md §5 "Compositional check"; the argument in docs/semantics.md §4b).
+(docs/verification.md §5 "Compositional check"; the argument in docs/semantics.md §4c).
 
 Scope: a behavior tree (no ``SubTree``, ``loop=False``) whose *plain skeleton* - the nodes
 from the root down to the topmost non-plain nodes, where plain means a ``Sequence`` or
@@ -26,7 +26,7 @@ built by fsmbt's own semantics):
    the FSM by walking the two skeleton machines in lockstep (a step where the two put different
    abstract labels pairs them; a second, different partner refuses the decomposition).
 
-If every part holds, the pair is equivalent (docs/semantics.md §4b: a plain parent ticks each
+If every part holds, the pair is equivalent (docs/semantics.md §4c: a plain parent ticks each
 child at most once per run, resumes a running child straight into it, never halts it, and
 never reads its memory after it returned; a region state is entered at most once per run, from
 its initial state with its variables at their declared values, and nothing but its own
@@ -80,7 +80,7 @@ COMPOSITIONAL_SENTENCE = (
     "compositional: every region with memory (a topmost node that is not a plain Sequence/"
     "Fallback/result map) is checked alone against its composite state, and the plain "
     "skeleton with each region abstracted to the results it can return (docs/semantics.md "
-    "§4b: equivalence is a congruence for plain parents)"
+    "§4c: equivalence is a congruence for plain parents)"
 )
 
 

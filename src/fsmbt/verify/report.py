@@ -29,7 +29,7 @@ TABLE = "table"
 CANONICAL = "canonical"
 SYMBOLIC = "symbolic"
 #: per region of the tree and its composite state, plus the plain skeleton
-#: (``fsmbt.verify.compositional``; docs/semantics.md §4b)
+#: (``fsmbt.verify.compositional``; docs/semantics.md §4c)
 COMPOSITIONAL = "compositional"
 METHODS = (WHOLE_PRODUCT, TABLE, CANONICAL, SYMBOLIC, COMPOSITIONAL)
 
