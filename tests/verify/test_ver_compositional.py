@@ -18,6 +18,8 @@ import re
 
 import pytest
 
+from fsmbt import api
+from fsmbt.cli import main
 from fsmbt.convert.bt_to_hfsm import bt_to_hfsm
 from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.bt_nodes import NodeKind
@@ -219,3 +221,18 @@ def test_a_subtree_or_a_flat_machine_is_out_of_scope() -> None:
     flat.add_state("x")
     with pytest.raises(NotDecomposable, match="flat"):
         decompose(doc, flat)
+
+
+def test_the_cli_proves_compositionally_unless_a_certificate_is_asked_for(tmp_path, capsys) -> None:
+    """Through files (the HFSM written as SCXML and read back, its sub-machines renamed): the
+    command names the compositional method; with ``--certificate`` it proves by the product,
+    whose witness the certificate needs."""
+    doc = _memory_tree()
+    tree = api.write(doc, tmp_path / "tree.xml")
+    machine = api.write(bt_to_hfsm(doc).model, tmp_path / "tree.scxml")
+    assert main(["verify", str(tree), str(machine)]) == 0
+    assert f"proven by: {COMPOSITIONAL}" in capsys.readouterr().out
+    certificate = tmp_path / "proof.json"
+    assert main(["verify", str(tree), str(machine), "--certificate", str(certificate)]) == 0
+    assert f"proven by: {COMPOSITIONAL}" not in capsys.readouterr().out
+    assert certificate.exists()

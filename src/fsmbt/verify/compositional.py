@@ -157,6 +157,22 @@ def _no_subtree_below(node: BTNode) -> None:
         stack.extend(x.children)
 
 
+def region_labels(doc: BTDocument, regions: list[BTNode]) -> frozenset[str]:
+    """The regions' labels that no plain control of the skeleton carries (O(N))."""
+    inside = {id(node) for node in regions}
+    plain: set[str] = set()
+    root = doc.main.root
+    stack = [root] if root is not None else []
+    while stack:
+        node = stack.pop()
+        if id(node) in inside:
+            continue
+        if not node.is_leaf:
+            plain.add(node.label)
+        stack.extend(node.children)
+    return frozenset(node.label for node in regions) - plain
+
+
 def _abstract_child(label: str, results: frozenset[str]) -> BTNode:
     """An action leaf standing for a region that may return ``results``."""
     leaf = BTNode(label, NodeKind.ACTION, name=label)
@@ -219,13 +235,17 @@ def _mentions(fsm: FSM, names: set[str]) -> set[str]:
     return found
 
 
-def _is_region_state(state: State) -> bool:
-    """A composite state fsmbt made of a region (a flat sub-machine named ``compact_...`` or
-    ``explored_...``): recognition only, the checks below decide."""
+def _is_region_state(name: str, state: State, labels: frozenset[str]) -> bool:
+    """A composite state made of a region: a flat sub-machine named ``compact_...`` or
+    ``explored_...`` (``bt_to_hfsm``), or, once the names are lost (an SCXML file read back), a
+    state named after a region of the tree and after no plain control of it. Recognition only:
+    the checks decide."""
     if len(state.regions) != 1:
         return False
     sub = state.regions[0]
-    return sub.name.startswith(("compact_", "explored_")) and not sub.is_hierarchical
+    if sub.is_hierarchical:
+        return False
+    return sub.name.startswith(("compact_", "explored_")) or name.split("#")[0] in labels
 
 
 @dataclass
@@ -242,8 +262,9 @@ def _check_machine_shape(machine: FSM, where: str) -> None:
             raise NotDecomposable(f"{where}: a transition leaves its machine")
 
 
-def fsm_regions(fsm: FSM) -> list[_FsmRegion]:
-    """The region states of ``fsm`` (depth first) with their completion targets.
+def fsm_regions(fsm: FSM, labels: frozenset[str] = frozenset()) -> list[_FsmRegion]:
+    """The region states of ``fsm`` (depth first) with their completion targets; ``labels``:
+    the labels of the tree's regions that no plain control of the tree carries.
 
     Raises:
         NotDecomposable: a region state is left by anything but one completion transition per
@@ -257,7 +278,7 @@ def fsm_regions(fsm: FSM) -> list[_FsmRegion]:
         _check_machine_shape(machine, prefix or machine.name)
         for name, state in machine.states.items():
             path = f"{prefix}{name}"
-            if _is_region_state(state):
+            if _is_region_state(name, state, labels):
                 exits: dict[str, str] = {}
                 for t in machine.outgoing(name):
                     if t.event is not None or t.exit not in (SUCCESS, FAILURE) or t.attrs:
@@ -419,9 +440,9 @@ def decompose(
     regions = tree_regions(source)
     if not regions:
         raise NotDecomposable("no region with memory (the static table decides the tree)")
-    machine_regions = fsm_regions(result)
-    if len(machine_regions) != len(regions):
-        raise NotDecomposable("the tree's regions and the machine's region states differ")
+    machine_regions = fsm_regions(result, region_labels(source, regions))
+    if not machine_regions:
+        raise NotDecomposable("the machine has no region state")
     declared = _declared(result)
     names = set(declared)
     owner: dict[str, int] = {}
