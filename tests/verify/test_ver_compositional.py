@@ -3,7 +3,7 @@ the whole product on every pair the latter decides.
 
 Generated pairs (8 batches of 250 seeded trees: about 1 900 converted trees and one mutant each,
 about 3 800 pairs): seeded random trees mixing plain, reactive and WithMemory controls with
-Repeat/Retry/RunOnce decorators and built-in leaves (``support.random_trees``), each converted
+Inverter/ForceSuccess/ForceFailure/Repeat/RetryUntilSuccessful decorators and built-in leaves (``support.random_trees``), each converted
 by ``bt_to_hfsm`` and checked against its HFSM and against single mutants of that HFSM
 (``fsmbt.verify.mutations``). For every pair: when the compositional check proves it
 equivalent, the whole product (fsmbt's interpreter, canonical states) says equivalent too; the
