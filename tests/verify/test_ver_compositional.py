@@ -29,6 +29,7 @@ from fsmbt.model.fsm import FSM
 from fsmbt.model.fsm_data import ASSIGN, DATAMODEL, parse_lines
 from fsmbt.verify import replay, verify
 from fsmbt.verify.compositional import (
+    FAILED_PART,
     NotDecomposable,
     compositional_report,
     decompose,
@@ -141,7 +142,7 @@ def test_verify_names_the_compositional_method() -> None:
 def test_every_mutant_is_refuted_with_a_counterexample_that_replays() -> None:
     doc = _memory_tree()
     hfsm = bt_to_hfsm(doc).model
-    found = 0
+    found = said = 0
     for mutant in mutants(hfsm, seed=seed(), per_operator=None):
         assert isinstance(mutant.model, FSM)
         report = verify(doc, mutant.model)
@@ -151,6 +152,8 @@ def test_every_mutant_is_refuted_with_a_counterexample_that_replays() -> None:
             continue
         found += 1
         assert report.method != COMPOSITIONAL
+        if str(report.stats.get("compositional", "")).startswith(FAILED_PART):
+            said += 1  # the verdict says which local check failed before the whole product
         failing = [p for p in report.properties.values() if not p.holds]
         trace = failing[0].counterexample
         assert trace is not None
@@ -158,6 +161,7 @@ def test_every_mutant_is_refuted_with_a_counterexample_that_replays() -> None:
         inputs = [step.input for step in trace[1:] if step.input is not None]
         assert replay(source, result, inputs).differs
     assert found >= 5
+    assert said >= 1
 
 
 def _data_regions_tree() -> BTDocument:

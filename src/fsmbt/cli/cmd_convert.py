@@ -212,6 +212,11 @@ def _print_summary(outcome: api.Outcome, *, to_stderr: bool, brief: bool = False
         print(f"  proven by: {report.method} ({engines})", file=stream)
         for sentence in report.abstractions:
             print(f"  under the abstraction: {sentence}", file=stream)
+    if report.stats.get("compositional"):
+        print(
+            f"  compositional check: {report.stats['compositional']}; the whole product decided",
+            file=stream,
+        )
     counts = checked_counts(report.stats)
     if counts:
         print(f"  checked {counts}", file=stream)

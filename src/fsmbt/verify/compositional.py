@@ -84,6 +84,10 @@ COMPOSITIONAL_SENTENCE = (
 )
 
 
+#: How ``compositional_report`` starts the reason when a part's check failed.
+FAILED_PART = "the local check of"
+
+
 class NotDecomposable(Exception):
     """The pair is outside the compositional check's scope (the reason is the message)."""
 
@@ -526,7 +530,7 @@ def compositional_report(
     except NotDecomposable as exc:
         return None, str(exc)
     if not found.equivalent:
-        return None, f"the local check of {found.failed_region} fails"
+        return None, f"{FAILED_PART} {found.failed_region} fails"
     seconds = time.perf_counter() - started
     report = Report(engine="native", source="source", result="result", mode="leaf-execution")
     detail = (
