@@ -1,8 +1,9 @@
 """The compositional check (``fsmbt.verify.compositional``, docs/semantics.md §4c) agrees with
 the whole product on every pair the latter decides.
 
-Generated pairs (8 batches of 250 seeded trees: about 1 900 converted trees and one mutant each,
-about 3 800 pairs): seeded random trees mixing plain, reactive and WithMemory controls with
+Generated pairs (8 batches of 250 seeded trees: about 2 000 converted trees and one mutant of
+each, about 3 980 pairs; a mutant changes one transition of the top machine or of any
+sub-machine, regions included): seeded random trees mixing plain, reactive and WithMemory controls with
 Inverter/ForceSuccess/ForceFailure/Repeat/RetryUntilSuccessful decorators and built-in leaves (``support.random_trees``), each converted
 by ``bt_to_hfsm`` and checked against its HFSM and against single mutants of that HFSM
 (``fsmbt.verify.mutations``). For every pair: when the compositional check proves it
@@ -14,6 +15,7 @@ method not ``compositional``.
 
 from __future__ import annotations
 
+import copy
 import random
 import re
 
@@ -68,9 +70,28 @@ def _pairs(batch: int) -> list[tuple[BTDocument, FSM, bool]]:
         except (InputError, UnsupportedError):
             continue  # a tree the converter refuses has no pair
         out.append((doc, hfsm, True))
-        for mutant in mutants(hfsm, seed=rng.randrange(1 << 30), per_operator=1)[:1]:
+        for mutant in deep_mutants(hfsm, rng.randrange(1 << 30), per_operator=1)[:1]:
+            out.append((doc, mutant, False))
+    return out
+
+
+def deep_mutants(hfsm: FSM, seed_value: int, per_operator: int | None) -> list[FSM]:
+    """Single mutants of one machine of ``hfsm`` - the top machine or any sub-machine, so the
+    regions' own transitions are mutated too (``mutants`` mutates the machine it is given)."""
+    rng = random.Random(seed_value)
+    count = len(list(hfsm.machines()))
+    picks = range(count) if per_operator is None else [rng.randrange(count)]
+    out: list[FSM] = []
+    for index in picks:
+        inner = list(hfsm.machines())[index]
+        for mutant in mutants(inner, seed=seed_value, per_operator=per_operator):
             assert isinstance(mutant.model, FSM)
-            out.append((doc, mutant.model, False))
+            whole = copy.deepcopy(hfsm)
+            target = list(whole.machines())[index]
+            target.states, target.transitions = mutant.model.states, mutant.model.transitions
+            target.initial = mutant.model.initial
+            out.append(whole)
+    rng.shuffle(out)
     return out
 
 
@@ -143,10 +164,9 @@ def test_every_mutant_is_refuted_with_a_counterexample_that_replays() -> None:
     doc = _memory_tree()
     hfsm = bt_to_hfsm(doc).model
     found = said = 0
-    for mutant in mutants(hfsm, seed=seed(), per_operator=None):
-        assert isinstance(mutant.model, FSM)
-        report = verify(doc, mutant.model)
-        whole = _whole(doc, mutant.model)
+    for mutated in deep_mutants(hfsm, seed(), per_operator=None):
+        report = verify(doc, mutated)
+        whole = _whole(doc, mutated)
         assert report.equivalent == whole.equivalent
         if report.equivalent:
             continue
@@ -157,7 +177,7 @@ def test_every_mutant_is_refuted_with_a_counterexample_that_replays() -> None:
         failing = [p for p in report.properties.values() if not p.holds]
         trace = failing[0].counterexample
         assert trace is not None
-        source, result, _mode = machines_for(doc, mutant.model)
+        source, result, _mode = machines_for(doc, mutated)
         inputs = [step.input for step in trace[1:] if step.input is not None]
         assert replay(source, result, inputs).differs
     assert found >= 5

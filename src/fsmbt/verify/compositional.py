@@ -505,8 +505,9 @@ def decompose(
     _add(outcome.stats, report.stats)
     outcome.skeleton_states = report.stats["product_states"]
     if not report.equivalent:
-        outcome.equivalent = False
-        outcome.failed_region = "the skeleton"
+        # the skeletons differ: a real difference outside the regions, or a tree whose
+        # non-plain leaves the machine keeps as plain states; the whole product tells which
+        raise NotDecomposable("the skeletons differ")
     return outcome
 
 
