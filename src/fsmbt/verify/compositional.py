@@ -4,7 +4,7 @@
 Scope: a behavior tree (no ``SubTree``, ``loop=False``) whose *plain skeleton* - the nodes
 from the root down to the topmost non-plain nodes, where plain means a ``Sequence`` or
 ``Fallback`` without ports, an ``Inverter``/``ForceSuccess``/``ForceFailure`` without ports, or
-an environment leaf - holds every node with memory inside a *region* (the subtree of a topmost
+an environment leaf (ports allowed, no pre-condition, no library kind) - holds every node with memory inside a *region* (the subtree of a topmost
 non-plain node), checked against a hierarchical FSM in which each region is one composite state
 (a sub-machine that only its completion transitions leave). That is the shape ``bt_to_hfsm``
 gives a tree whose memory nodes sit under plain controls, but nothing of the converter is read:
@@ -108,9 +108,14 @@ class Decomposition:
 
 # -- the tree side ---------------------------------------------------------------------------
 def _is_plain(node: BTNode) -> bool:
-    """A node of the skeleton: no memory, no port, no blackboard, no pre-condition."""
+    """A node of the skeleton: no memory, no blackboard, no pre-condition; a control or
+    decorator without ports, an environment leaf with any ports but a pre-condition (the
+    model never reads an environment leaf's ports: its outcome is the input)."""
     if node.semantics is not None and node.semantics != node.type:
         return False
+    if node.is_leaf and not any(key.startswith("_") for key in node.attrs):
+        # a library kind (``semantics`` set) may carry a gate the environment answers: not plain
+        return node.semantics is None and not node.is_builtin and not node.children
     if node.attrs:
         return False
     kind_type = canonical_type(node.type)
@@ -118,8 +123,6 @@ def _is_plain(node: BTNode) -> bool:
         return kind_type in PLAIN_SKELETON_CONTROLS and bool(node.children)
     if node.kind is NodeKind.DECORATOR:
         return kind_type in PLAIN_SKELETON_DECORATORS and len(node.children) == 1
-    if node.is_leaf:
-        return not node.is_builtin and not node.children
     return False
 
 
