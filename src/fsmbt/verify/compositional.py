@@ -56,6 +56,7 @@ from typing import Any
 
 from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.bt_nodes import NodeKind
+from fsmbt.model.errors import FsmbtError
 from fsmbt.model.fsm import FSM, State, Transition
 from fsmbt.model.fsm_data import DATAMODEL, ONEXIT, join_lines, parse_lines
 from fsmbt.semantics.leaf_machine import LeafMachine
@@ -533,6 +534,10 @@ def compositional_report(
         found = decompose(source, result, max_states=max_states)
     except NotDecomposable as exc:
         return None, str(exc)
+    except FsmbtError as exc:
+        # a part the machines refuse (a limit, a construct): the whole product decides and
+        # gives the error or verdict it gave before
+        return None, f"a part cannot be checked ({type(exc).__name__})"
     if not found.equivalent:
         return None, f"{FAILED_PART} {found.failed_region} fails"
     seconds = time.perf_counter() - started
