@@ -21,7 +21,7 @@ import re
 
 import pytest
 
-from fsmbt import api
+from fsmbt import api, limits
 from fsmbt.cli import main
 from fsmbt.convert.bt_to_hfsm import bt_to_hfsm
 from fsmbt.model.bt import BTDocument, BTNode
@@ -261,3 +261,14 @@ def test_the_cli_proves_compositionally_unless_a_certificate_is_asked_for(tmp_pa
     assert main(["verify", str(tree), str(machine), "--certificate", str(certificate)]) == 0
     assert f"proven by: {COMPOSITIONAL}" not in capsys.readouterr().out
     assert certificate.exists()
+
+
+def test_a_part_past_a_limit_is_a_fallback_not_an_error() -> None:
+    """A region whose data expansion passes the conversion limit makes the compositional check
+    give way (the whole product then gives whatever it gave before), never raise itself."""
+    doc = _data_regions_tree()
+    hfsm = bt_to_hfsm(doc).model
+    with limits.changed(conversion_max_states=2):
+        proved, why = compositional_report(doc, hfsm)
+    assert proved is None
+    assert why.startswith("a part cannot be checked")
