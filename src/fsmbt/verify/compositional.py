@@ -4,8 +4,8 @@
 Scope: a behavior tree (no ``SubTree``, ``loop=False``) whose *plain skeleton* - the nodes
 from the root down to the topmost non-plain nodes, where plain means a ``Sequence`` or
 ``Fallback`` without ports, an ``Inverter``/``ForceSuccess``/``ForceFailure`` without ports, or
-an environment leaf (ports allowed, no pre-condition, no library kind) - holds every node with memory inside a *region* (the subtree of a topmost
-non-plain node), checked against a hierarchical FSM in which each region is one composite state
+an environment leaf (ports allowed, no pre-condition, no library kind) - holds every node with
+memory inside a *region* (the subtree of a topmost non-plain node), checked against a hierarchical FSM in which each region is one composite state
 (a sub-machine that only its completion transitions leave). That is the shape ``bt_to_hfsm``
 gives a tree whose memory nodes sit under plain controls, but nothing of the converter is read:
 the regions of the tree come from the node registry's meaning of each kind, the regions of the
@@ -35,10 +35,11 @@ caller runs the whole-product check, which gives the verdict and its shortest co
 the user's terms: the compositional check never says "not equivalent" on its own.
 
 Data: variables of the FSM's data model must each be read or written by one region only (and
-nowhere in the skeleton); a region's check declares exactly its own. A tree node that reads or
-writes the blackboard (``Script``, ``Switch``, ``SetBlackboard``...) is never plain, so it lies
-inside a region and is checked whole there: couplings between regions are not modelled, and a
-tree with a blackboard-reading node the interpreter refuses is refused as before.
+nowhere in the skeleton); a region's check declares exactly its own. A tree holding a kind whose
+control flow reads the blackboard (``BLACKBOARD_BASED``: ``Switch``, ``Precondition``...) or a
+pre-condition is out of scope (the whole product decides it). ``Script``/``SetBlackboard`` are
+never plain, so they lie inside a region; their writes are never read in the model (the readers
+are refused or out of scope), so they couple no regions.
 
 Cost: the sum of the regions' checks (each the explicit product of that region only) plus one
 check of the skeleton (plain: the static leaf table, O(leaves)); a tree of k regions of at most
