@@ -20,6 +20,8 @@ Columns:
   temporary SCXML file, as ``fsmbt convert FILE -o out.xml`` does (``Outcome.timings``;
   ``write`` is the file write); ``total s``: the whole call (read, convert, the SCXML text,
   verify, write);
+- ``method``: what the verdict's proof was (docs/verification.md §6: ``table``,
+  ``canonical``, ``compositional``, ``whole product``);
 - ``proof`` (``--prove``): the native checker run on the faithful machine against the canonical
   one (every input sequence): ``equal`` or the failing property.
 Nothing is written into the repository; a row over ``--limit`` seconds prints ``stopped``.
@@ -114,8 +116,9 @@ def run_row(path: Path, options: dict[str, object], args: argparse.Namespace) ->
             cells.extend(f"{timings.get(step, 0.0):.1f}" for step in ("convert", "verify", "write"))
             cells.append(f"{total:.1f}")
             cells.append(api.verdict_word(outcome.report))
+            cells.append(outcome.report.method if outcome.report is not None else "-")
         except _Timeout:
-            cells.extend(["-", "-", "-", f">{args.limit}", "stopped"])
+            cells.extend(["-", "-", "-", f">{args.limit}", "stopped", "-"])
         signal.alarm(0)
     if args.prove and machine.canonical:
         signal.alarm(args.limit)
@@ -163,9 +166,10 @@ def main(argv: list[str] | None = None) -> int:
         "write s",
         "total s",
         "verdict",
+        "method",
         "proof",
     ]
-    widths = [58, 9, 9, 9, 8, 9, 8, 7, 8, 14, 6]
+    widths = [58, 9, 9, 9, 8, 9, 8, 7, 8, 14, 13, 6]
     print(
         " ".join(
             h.ljust(w) if i < 2 else h.rjust(w) for i, (h, w) in enumerate(zip(header, widths))

@@ -21,6 +21,11 @@ product of k index ranges as states; the first stop ends the family). ``faithful
 interpreter's leaf machine (``LeafMachine(generic=True)``), explored for trees up to
 ``--faithful-up-to`` nodes (it is the cost this work removes; past the limit it is not run).
 Targets (issue 19): a 1 000-node reactive tree under 1 s, a 10 000-node one under 10 s.
+
+``--convert`` times the whole ``fsmbt convert`` of each tree (read, convert, verify, write) and
+prints the verdict's method. ``--compositional`` (issue 27) prints another table: per tree the conversion's seconds, the
+compositional check's regions, largest region product, summed products and seconds (or why the
+pair falls back to the whole product), and the whole product's states and seconds beside it.
 """
 
 from __future__ import annotations
@@ -29,6 +34,7 @@ import argparse
 import random
 import signal
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -39,7 +45,10 @@ from fsmbt.convert.bt_to_hfsm import bt_to_hfsm  # noqa: E402
 from fsmbt.model import BTDocument  # noqa: E402
 from fsmbt.model.bt import BTNode  # noqa: E402
 from fsmbt.model.bt_nodes import NodeKind  # noqa: E402
+from fsmbt.model.errors import InputError  # noqa: E402
+from fsmbt.model.fsm import FSM  # noqa: E402
 from fsmbt.semantics.leaf_machine import LeafMachine, StateLimitError, explore  # noqa: E402
+from fsmbt.verify.compositional import compositional_report  # noqa: E402
 from fsmbt.verify.native import check  # noqa: E402
 from fsmbt.verify.pairing import machines_for  # noqa: E402
 
@@ -129,6 +138,24 @@ def leaves_for(nodes: int) -> int:
     return max(2, round(nodes / 1.45))
 
 
+def _whole_check(doc: BTDocument, hfsm: FSM, limit: int) -> tuple[str, str]:
+    """The whole product (``check`` on both machines): its product states and seconds, or
+    why it stopped."""
+    signal.alarm(limit)
+    try:
+        source, result, _mode = machines_for(doc, hfsm)
+        started = time.perf_counter()
+        report = check(source, result)
+        seconds = time.perf_counter() - started
+    except (_Timeout, StateLimitError, InputError) as exc:
+        signal.alarm(0)
+        return "-", f"over {limit} s" if isinstance(exc, _Timeout) else "state limit"
+    signal.alarm(0)
+    if not report.equivalent:
+        raise SystemExit(f"tree and HFSM differ: {report.verdicts()}")
+    return str(report.stats["product_states"]), f"{seconds:.3f}"
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--sizes", default="100,300,1000,3000,10000", help="nodes per tree")
@@ -140,14 +167,32 @@ def main(argv: list[str] | None = None) -> int:
         help="explore the faithful machine for trees up to this many nodes",
     )
     parser.add_argument("--families", default=",".join(FAMILIES))
+    parser.add_argument(
+        "--compositional",
+        action="store_true",
+        help="time the compositional check (fsmbt.verify.compositional) and the conversion, "
+        "and the whole product beside it (columns: conv s, regions, largest, comp st, comp s, "
+        "whole st, whole s)",
+    )
+    parser.add_argument(
+        "--convert",
+        action="store_true",
+        help="time the whole `fsmbt convert` of each tree (fsmbt.api.convert_file: read, "
+        "convert, verify, write SCXML; the tree written to a temporary XML file first) and "
+        "print the verdict and its method",
+    )
     args = parser.parse_args(argv)
+    signal.signal(signal.SIGALRM, _alarm)
+    if args.compositional:
+        return _compositional_table(args)
+    if args.convert:
+        return _convert_table(args)
     header = (
         f"{'family':<9} {'nodes':>6} {'path':<9} {'leaf st':>8} {'faithful':>9} "
         f"{'product':>8} {'time s':>8} {'us/node':>8} {'x time':>7} {'x nodes':>7}"
     )
     print(header)
     print("-" * len(header))
-    signal.signal(signal.SIGALRM, _alarm)
     for family in args.families.split(","):
         previous: tuple[float, int] | None = None
         for size in (int(s) for s in args.sizes.split(",")):
@@ -194,6 +239,99 @@ def main(argv: list[str] | None = None) -> int:
     print(
         "path: table = leaf_fast static table; canonical = interpreter on canonical states "
         "(leaf_canonical); faithful = full interpreter snapshots"
+    )
+    return 0
+
+
+def _convert_table(args: argparse.Namespace) -> int:
+    """One row per tree: the whole ``convert`` (``fsmbt.api.convert_file``) in seconds, the
+    verdict and the method that proved it, or why it stopped (the time limit or the error)."""
+    from fsmbt import api
+
+    header = f"{'family':<14} {'nodes':>6} {'convert s':>10} {'verdict':>15} {'method':>14}"
+    print(header)
+    print("-" * len(header))
+    with tempfile.TemporaryDirectory() as folder:
+        for family in args.families.split(","):
+            for size in (int(s) for s in args.sizes.split(",")):
+                doc = family_tree(family, leaves_for(size), size)
+                nodes = node_count(doc)
+                tree = api.write(doc, Path(folder) / f"{family}{size}.xml")
+                signal.alarm(args.limit)
+                try:
+                    started = time.perf_counter()
+                    outcome = api.convert_file(
+                        tree, Path(folder) / f"{family}{size}.scxml", overwrite=True
+                    )
+                    seconds = time.perf_counter() - started
+                    signal.alarm(0)
+                except Exception as exc:  # the time limit, or what fsmbt refused and why
+                    signal.alarm(0)
+                    why = f"over {args.limit} s" if isinstance(exc, _Timeout) else str(exc)
+                    if "_Timeout" in why:  # the limit met inside a step that wraps errors
+                        why = f"over {args.limit} s"
+                    print(f"{family:<14} {nodes:>6}  stopped: {why[:90]}", flush=True)
+                    continue
+                report = outcome.report
+                method = report.method if report is not None else "-"
+                print(
+                    f"{family:<14} {nodes:>6} {seconds:>10.3f} "
+                    f"{api.verdict_word(report):>15} {method:>14}",
+                    flush=True,
+                )
+    return 0
+
+
+def _compositional_table(args: argparse.Namespace) -> int:
+    """One row per tree: the conversion's time, then the compositional check's (its regions,
+    the largest region's product, the sum of the products, its seconds) or why it falls back,
+    then the whole product's (states and seconds, or why it stopped)."""
+    header = (
+        f"{'family':<14} {'nodes':>6} {'conv s':>7} {'regions':>7} {'largest':>8} "
+        f"{'comp st':>8} {'comp s':>7} {'whole st':>9} {'whole s':>9}"
+    )
+    print(header)
+    print("-" * len(header))
+    for family in args.families.split(","):
+        for size in (int(s) for s in args.sizes.split(",")):
+            doc = family_tree(family, leaves_for(size), size)
+            nodes = node_count(doc)
+            signal.alarm(args.limit)
+            try:
+                started = time.perf_counter()
+                hfsm = bt_to_hfsm(doc).model
+                converted = time.perf_counter() - started
+                signal.alarm(0)
+            except (_Timeout, InputError) as exc:
+                signal.alarm(0)
+                why = f"over {args.limit} s" if isinstance(exc, _Timeout) else "state limit"
+                print(f"{family:<14} {nodes:>6}  conversion stopped: {why}", flush=True)
+                break
+            signal.alarm(args.limit)
+            try:
+                started = time.perf_counter()
+                proved, why = compositional_report(doc, hfsm)
+                comp_seconds = time.perf_counter() - started
+                signal.alarm(0)
+            except _Timeout:
+                proved, why, comp_seconds = None, f"over {args.limit} s", 0.0
+            whole_states, whole_seconds = _whole_check(doc, hfsm, args.limit)
+            if proved is None:
+                comp = f"{'falls back: ' + why[:40]:>41}"
+            else:
+                st = proved.stats
+                comp = (
+                    f"{st['regions']:>7} {st['largest_region']:>8} {st['product_states']:>8} "
+                    f"{comp_seconds:>7.3f}"
+                )
+            print(
+                f"{family:<14} {nodes:>6} {converted:>7.3f} {comp} {whole_states:>9} "
+                f"{whole_seconds:>9}",
+                flush=True,
+            )
+    print(
+        "conv s = bt_to_hfsm (explores each region); comp = fsmbt.verify.compositional "
+        "(regions alone + the skeleton); whole = the explicit product of the two machines"
     )
     return 0
 

@@ -150,7 +150,7 @@ def register(app: typer.Typer) -> None:
         if certificate_file is not None and no_verify:
             raise InputError("--certificate needs the equivalence check (drop --no-verify)")
         with StageProgress(quiet=quiet or no_progress, label=source.name) as progress:
-            with certificate.collecting() as sink:
+            with certificate.collecting_if(certificate_file is not None) as sink:
                 outcome = api.convert_file(source, output, request, on_stage=progress)
         if certificate_file is not None and outcome.report is not None:
             write_certificate(
@@ -212,6 +212,11 @@ def _print_summary(outcome: api.Outcome, *, to_stderr: bool, brief: bool = False
         print(f"  proven by: {report.method} ({engines})", file=stream)
         for sentence in report.abstractions:
             print(f"  under the abstraction: {sentence}", file=stream)
+    if report.stats.get("compositional"):
+        print(
+            f"  compositional check: {report.stats['compositional']}; the whole product decided",
+            file=stream,
+        )
     counts = checked_counts(report.stats)
     if counts:
         print(f"  checked {counts}", file=stream)

@@ -75,7 +75,7 @@ def register(app: typer.Typer) -> None:
                 request = api.verify_request(
                     engine=engine, loop=loop, max_states=max_states, read=read
                 )
-                with certificate.collecting() as sink:
+                with certificate.collecting_if(certificate_file is not None) as sink:
                     first, second, report = api.verify_files(
                         source,
                         converted,

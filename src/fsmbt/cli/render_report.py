@@ -37,6 +37,14 @@ def render(report: Report) -> RenderableType:
         parts.append(Text(f"proven by: {report.method} ({engines})", style="dim"))
         for sentence in report.abstractions:
             parts.append(Text(f"under the abstraction: {sentence}", style="dim"))
+    if report.stats.get("compositional"):
+        parts.append(
+            Text(
+                f"compositional check: {report.stats['compositional']}; the whole product "
+                "decided (docs/verification.md §5)",
+                style="dim",
+            )
+        )
     if report.stats.get("nusmv_limit"):
         parts.append(
             Text(

@@ -19,10 +19,12 @@ from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import Hint, InputError, UnsupportedError
 from fsmbt.model.fsm import FSM
 from fsmbt.semantics.dispatch_runtime import is_dispatch_bt
+from fsmbt.semantics.execution import Flavour, flavour_of
 from fsmbt.semantics.machine import FSMLeafMachine, Machine
 from fsmbt.semantics.outcome_machine import OutcomeFSMMachine
 from fsmbt.semantics.outcome_rules import OutcomeRules
 from fsmbt.verify import certificate
+from fsmbt.verify.compositional import FAILED_PART, compositional_report
 from fsmbt.verify.method import describe_method, nusmv_engine
 from fsmbt.verify.native import DEFAULT_MAX_STATES, Replay, check, check_witnessed, replay
 from fsmbt.verify.outcome_pairing import is_outcome_pair, outcome_abstractions
@@ -111,6 +113,11 @@ def verify(
         report.engines = nusmv_engine()
         return report
     sink = certificate.active_sink()
+    fell_back = ""
+    if engine == "native" and sink is None and not loop:
+        proved, fell_back = _compositional(source, result, max_states)
+        if proved is not None:
+            return proved
     with gc_paused():  # a data machine's expansion allocates its flat machine (acyclic)
         source_machine, result_machine, mode = machines_for(
             source, result, loop=loop, outcomes=outcomes, outcome_driven=outcome_driven
@@ -120,6 +127,8 @@ def verify(
         native.stats["abstractions"] = outcome_abstractions(source_machine.view)
     native.source = _model_name(source, native.source)
     native.result = _model_name(result, native.result)
+    if fell_back:  # the verdict says the compositional check did not decide it, and why
+        native.stats["compositional"] = fell_back
     if engine == "native":
         return native
     try:
@@ -167,6 +176,32 @@ def _native(
     if sink is not None:
         sink.witness, sink.loop, sink.faithful = witness, loop, faithful
     return report
+
+
+def _compositional(
+    source: FSM | BTDocument, result: FSM | BTDocument, max_states: int
+) -> tuple[Report | None, str]:
+    """The compositional proof of a BT against a hierarchical FSM (``fsmbt.verify.
+    compositional``) when the pair decomposes into regions and every local check holds;
+    ``None`` otherwise, and the whole product decides (and explains a difference). A pair
+    with a single region is left to the whole product too (the same product, done once). The
+    string says why a local check failed (the whole product then gives the verdict), else
+    ``""``."""
+    if not (isinstance(source, BTDocument) and isinstance(result, FSM)):
+        return None, ""
+    if is_dispatch_bt(source) or flavour_of(source) is not Flavour.PLAIN:
+        return None, ""
+    with gc_paused():
+        report, why = compositional_report(source, result, max_states=max_states)
+    if report is None:
+        # a part failed: the whole product decides and explains; the verdict says so
+        return None, why if why.startswith(FAILED_PART) else ""
+    if report.stats["regions"] < 2:
+        return None, ""  # one region: its check is the whole product again; let that decide
+    report.engines = {"fsmbt native checker": __version__}
+    report.source = _model_name(source, report.source)
+    report.result = _model_name(result, report.result)
+    return report, ""
 
 
 def _reachability_only(native: Report, other: Report) -> bool:

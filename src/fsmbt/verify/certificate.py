@@ -86,6 +86,17 @@ def collecting() -> Iterator[WitnessSink]:
         _SINK.reset(token)
 
 
+@contextlib.contextmanager
+def collecting_if(wanted: bool) -> Iterator[WitnessSink]:
+    """``collecting()`` when a certificate is ``wanted``; else a sink that stays empty and no
+    witness is kept (so ``verify`` may choose a method without one, e.g. ``compositional``)."""
+    if not wanted:
+        yield WitnessSink()
+        return
+    with collecting() as sink:
+        yield sink
+
+
 def active_sink() -> WitnessSink | None:
     """The sink of the innermost ``collecting`` block, or ``None``."""
     return _SINK.get()

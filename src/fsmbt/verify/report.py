@@ -28,7 +28,10 @@ WHOLE_PRODUCT = "whole product"
 TABLE = "table"
 CANONICAL = "canonical"
 SYMBOLIC = "symbolic"
-METHODS = (WHOLE_PRODUCT, TABLE, CANONICAL, SYMBOLIC)
+#: per region of the tree and its composite state, plus the plain skeleton
+#: (``fsmbt.verify.compositional``; docs/semantics.md §4c)
+COMPOSITIONAL = "compositional"
+METHODS = (WHOLE_PRODUCT, TABLE, CANONICAL, SYMBOLIC, COMPOSITIONAL)
 
 
 @dataclass

@@ -1,0 +1,563 @@
+"""The compositional check of a BT against an HFSM: the sum of local proofs
+(docs/verification.md §5 "Compositional check"; the argument in docs/semantics.md §4c).
+
+Scope: a behavior tree (no ``SubTree``, ``loop=False``) whose *plain skeleton* - the nodes
+from the root down to the topmost non-plain nodes, where plain means a ``Sequence`` or
+``Fallback`` without ports, an ``Inverter``/``ForceSuccess``/``ForceFailure`` without ports, or
+an environment leaf (ports allowed, no pre-condition, no library kind) - holds every node with
+memory inside a *region* (the subtree of a topmost non-plain node), checked against a hierarchical FSM in which each region is one composite state
+(a sub-machine that only its completion transitions leave). That is the shape ``bt_to_hfsm``
+gives a tree whose memory nodes sit under plain controls, but nothing of the converter is read:
+the regions of the tree come from the node registry's meaning of each kind, the regions of the
+FSM from its structure, and the two are paired by the skeleton check itself.
+
+The proof, in three parts (each one the native checker, ``fsmbt.verify.native``, on machines
+built by fsmbt's own semantics):
+
+1. each region alone: the region's subtree as a tree of its own (its leaf-execution machine,
+   ``LeafMachine``, from the interpreter: tick *and* halt rules) against the composite state's
+   sub-machine as a machine of its own (final states showing their result, the data it reads
+   declared as the whole machine declares it). This also gives the results ``P`` the region can
+   return (bottom-up: the final states its exploration reaches);
+2. the skeleton: the tree with each region replaced by an abstract action whose outcomes are
+   ``P`` (``ForceSuccess``/``ForceFailure`` when ``P`` has one result), against the FSM with each
+   region state replaced by a leaf state that goes where its completion transitions go;
+3. the pairing: every abstract action of the tree is matched with exactly one region state of
+   the FSM by walking the two skeleton machines in lockstep (a step where the two put different
+   abstract labels pairs them; a second, different partner refuses the decomposition).
+
+If every part holds, the pair is equivalent (docs/semantics.md §4c: a plain parent ticks each
+child at most once per run, resumes a running child straight into it, never halts it, and
+never reads its memory after it returned; a region state is entered at most once per run, from
+its initial state with its variables at their declared values, and nothing but its own
+completion transitions leaves it). If any part fails, or the pair does not decompose, the
+caller runs the whole-product check, which gives the verdict and its shortest counterexample in
+the user's terms: the compositional check never says "not equivalent" on its own.
+
+Data: variables of the FSM's data model must each be read or written by one region only (and
+nowhere in the skeleton); a region's check declares exactly its own. A tree holding a kind whose
+control flow reads the blackboard (``BLACKBOARD_BASED``: ``Switch``, ``Precondition``...) or a
+pre-condition is out of scope (the whole product decides it). ``Script``/``SetBlackboard`` are
+never plain, so they lie inside a region; their writes are never read in the model (the readers
+are refused or out of scope), so they couple no regions.
+
+Cost: the sum of the regions' checks (each the explicit product of that region only) plus one
+check of the skeleton (plain: the static leaf table, O(leaves)); a tree of k regions of at most
+m states costs O(k · m) instead of the product of the regions' memories.
+"""
+
+from __future__ import annotations
+
+import copy
+import re
+from collections import deque
+from collections.abc import Hashable
+from dataclasses import dataclass, field
+from typing import Any
+
+from fsmbt.model.bt import BTDocument, BTNode
+from fsmbt.model.bt_nodes import NodeKind
+from fsmbt.model.errors import FsmbtError
+from fsmbt.model.fsm import FSM, State, Transition
+from fsmbt.model.fsm_data import DATAMODEL, ONEXIT, join_lines, parse_lines
+from fsmbt.semantics.leaf_machine import LeafMachine
+from fsmbt.semantics.machine import FSMLeafMachine
+from fsmbt.semantics.nodes import BLACKBOARD_BASED, canonical_type
+from fsmbt.semantics.status import LeafOutcome, RootResult
+from fsmbt.verify.native import DEFAULT_MAX_STATES, StateLimitError, check_witnessed
+from fsmbt.verify.report import COMPOSITIONAL, PROPERTIES, PropertyResult, Report
+
+SUCCESS, FAILURE = RootResult.SUCCESS.value, RootResult.FAILURE.value
+EV_SUCCESS, EV_FAILURE = LeafOutcome.SUCCESS.value, LeafOutcome.FAILURE.value
+#: Plain controls and stateless result maps: no memory a later tick reads (docs/semantics.md).
+PLAIN_SKELETON_CONTROLS = frozenset({"Sequence", "Fallback"})
+PLAIN_SKELETON_DECORATORS = frozenset({"Inverter", "ForceSuccess", "ForceFailure"})
+#: Labels of the abstract children (never a name a file gives: ``⟪`` is not an XML name char).
+_BT_TOKEN = "⟪unit {}⟫"
+_FSM_TOKEN = "⟪state {}⟫"
+_NO_EXIT = "⟪no completion⟫"
+_IDENT = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+
+COMPOSITIONAL_SENTENCE = (
+    "compositional: every region with memory (a topmost node that is not a plain Sequence/"
+    "Fallback/result map) is checked alone against its composite state, and the plain "
+    "skeleton with each region abstracted to the results it can return (docs/semantics.md "
+    "§4c: equivalence is a congruence for plain parents)"
+)
+
+
+#: How ``compositional_report`` starts the reason when a part's check failed.
+FAILED_PART = "the local check of"
+
+
+class NotDecomposable(Exception):
+    """The pair is outside the compositional check's scope (the reason is the message)."""
+
+
+@dataclass
+class Decomposition:
+    """What the compositional check found: its verdict and the figures of each part."""
+
+    equivalent: bool
+    reason: str = ""
+    regions: int = 0
+    region_states: int = 0
+    largest_region: int = 0
+    skeleton_states: int = 0
+    failed_region: str | None = None
+    stats: dict[str, Any] = field(default_factory=dict)
+
+
+# -- the tree side ---------------------------------------------------------------------------
+def _is_plain(node: BTNode) -> bool:
+    """A node of the skeleton: no memory, no blackboard, no pre-condition; a control or
+    decorator without ports, an environment leaf with any ports but a pre-condition (the
+    model never reads an environment leaf's ports: its outcome is the input)."""
+    if node.semantics is not None and node.semantics != node.type:
+        return False
+    if node.is_leaf and not any(key.startswith("_") for key in node.attrs):
+        # a library kind (``semantics`` set) may carry a gate the environment answers: not plain
+        return node.semantics is None and not node.is_builtin and not node.children
+    if node.attrs:
+        return False
+    kind_type = canonical_type(node.type)
+    if node.kind is NodeKind.CONTROL:
+        return kind_type in PLAIN_SKELETON_CONTROLS and bool(node.children)
+    if node.kind is NodeKind.DECORATOR:
+        return kind_type in PLAIN_SKELETON_DECORATORS and len(node.children) == 1
+    return False
+
+
+def tree_regions(doc: BTDocument) -> list[BTNode]:
+    """The topmost non-plain nodes of ``doc``'s main tree, in pre-order (iterative, O(N)).
+
+    Raises:
+        NotDecomposable: the tree holds a SubTree (its expansion is not decomposed here).
+    """
+    root = doc.main.root
+    if root is None:
+        raise NotDecomposable("the main tree is empty")
+    found: list[BTNode] = []
+    stack = [root]
+    while stack:
+        node = stack.pop()
+        if node.kind is NodeKind.SUBTREE or node.type == "SubTree":
+            raise NotDecomposable("the tree uses SubTrees")
+        if not _is_plain(node):
+            found.append(node)
+            _no_subtree_below(node)
+            continue
+        stack.extend(reversed(node.children))
+    return found
+
+
+def _no_subtree_below(node: BTNode) -> None:
+    """Refuse a region holding a SubTree or a kind whose control flow reads the blackboard
+    (``BLACKBOARD_BASED``: even abstracted, it is kept out of the scope) or a pre-condition."""
+    stack = [node]
+    while stack:
+        x = stack.pop()
+        if x.kind is NodeKind.SUBTREE or x.type == "SubTree":
+            raise NotDecomposable("the tree uses SubTrees")
+        if canonical_type(x.semantics or x.type) in BLACKBOARD_BASED or any(
+            key.startswith("_") for key in x.attrs
+        ):
+            raise NotDecomposable(f"{x.label} reads the blackboard")
+        stack.extend(x.children)
+
+
+def region_labels(doc: BTDocument, regions: list[BTNode]) -> frozenset[str]:
+    """The regions' labels that no plain control of the skeleton carries (O(N))."""
+    inside = {id(node) for node in regions}
+    plain: set[str] = set()
+    root = doc.main.root
+    stack = [root] if root is not None else []
+    while stack:
+        node = stack.pop()
+        if id(node) in inside:
+            continue
+        if not node.is_leaf:
+            plain.add(node.label)
+        stack.extend(node.children)
+    return frozenset(node.label for node in regions) - plain
+
+
+def _abstract_child(label: str, results: frozenset[str]) -> BTNode:
+    """An action leaf standing for a region that may return ``results``."""
+    leaf = BTNode(label, NodeKind.ACTION, name=label)
+    if results == {SUCCESS}:
+        return BTNode("ForceSuccess", NodeKind.DECORATOR, children=[leaf])
+    if results == {FAILURE}:
+        return BTNode("ForceFailure", NodeKind.DECORATOR, children=[leaf])
+    return leaf
+
+
+def skeleton_tree(
+    doc: BTDocument, regions: list[BTNode], results: list[frozenset[str]]
+) -> BTDocument:
+    """``doc``'s main tree with region ``k`` replaced by an abstract child labelled
+    ``⟪unit k⟫`` (a copy; O(N))."""
+    index = {id(node): k for k, node in enumerate(regions)}
+    root = doc.main.root
+    assert root is not None
+
+    def copy_shallow(node: BTNode) -> BTNode:
+        k = index.get(id(node))
+        if k is not None:
+            return _abstract_child(_BT_TOKEN.format(k), results[k])
+        return BTNode(node.type, node.kind, name=node.name, attrs={}, children=[])
+
+    new_root = copy_shallow(root)
+    stack = [(root, new_root)]
+    while stack:
+        old, new = stack.pop()
+        if id(old) in index:
+            continue
+        for child in old.children:
+            made = copy_shallow(child)
+            new.children.append(made)
+            stack.append((child, made))
+    return BTDocument.single(new_root)
+
+
+# -- the state machine side ------------------------------------------------------------------
+def _declared(fsm: FSM) -> dict[str, str]:
+    return dict(parse_lines(fsm.attrs.get(DATAMODEL, "")))
+
+
+def _data_text(attrs: dict[str, str]) -> str:
+    return " ".join(value for key, value in attrs.items() if key != "name")
+
+
+def _mentions(fsm: FSM, names: set[str]) -> set[str]:
+    """The declared variables that a machine (and the machines nested in it) names anywhere."""
+    found: set[str] = set()
+    stack = [fsm]
+    while stack:
+        machine = stack.pop()
+        texts = [_data_text(t.attrs) for t in machine.transitions]
+        for state in machine.states.values():
+            texts.append(_data_text(state.attrs))
+            stack.extend(state.regions)
+        for text in texts:
+            found.update(word for word in _IDENT.findall(text) if word in names)
+    return found
+
+
+def _is_region_state(name: str, state: State, labels: frozenset[str]) -> bool:
+    """A composite state made of a region: a flat sub-machine named ``compact_...`` or
+    ``explored_...`` (``bt_to_hfsm``), or, once the names are lost (an SCXML file read back), a
+    state named after a region of the tree and after no plain control of it. Recognition only:
+    the checks decide."""
+    if len(state.regions) != 1:
+        return False
+    sub = state.regions[0]
+    if sub.is_hierarchical:
+        return False
+    return sub.name.startswith(("compact_", "explored_")) or name.split("#")[0] in labels
+
+
+@dataclass
+class _FsmRegion:
+    path: str
+    machine: FSM
+    state: State
+    exits: dict[str, str]  # SUCCESS/FAILURE -> target in the parent machine
+
+
+def _check_machine_shape(machine: FSM, where: str) -> None:
+    for t in machine.transitions:
+        if t.source not in machine.states or t.target not in machine.states:
+            raise NotDecomposable(f"{where}: a transition leaves its machine")
+
+
+def fsm_regions(fsm: FSM, labels: frozenset[str] = frozenset()) -> list[_FsmRegion]:
+    """The region states of ``fsm`` (depth first) with their completion targets; ``labels``:
+    the labels of the tree's regions that no plain control of the tree carries.
+
+    Raises:
+        NotDecomposable: a region state is left by anything but one completion transition per
+            result (an event transition on it could restart the region), or the skeleton
+            carries data.
+    """
+    found: list[_FsmRegion] = []
+    stack: list[tuple[str, FSM]] = [("", fsm)]
+    while stack:
+        prefix, machine = stack.pop()
+        _check_machine_shape(machine, prefix or machine.name)
+        for name, state in machine.states.items():
+            path = f"{prefix}{name}"
+            if _is_region_state(name, state, labels):
+                exits: dict[str, str] = {}
+                for t in machine.outgoing(name):
+                    if t.event is not None or t.exit not in (SUCCESS, FAILURE) or t.attrs:
+                        raise NotDecomposable(f"state {path}: left by more than completions")
+                    if t.exit in exits:
+                        raise NotDecomposable(f"state {path}: two completions on {t.exit}")
+                    exits[t.exit] = t.target
+                if state.action is not None or set(state.attrs) - {ONEXIT}:
+                    raise NotDecomposable(f"state {path}: an action or data on the region")
+                found.append(_FsmRegion(path, state.regions[0], state, exits))
+                continue
+            if state.attrs:
+                raise NotDecomposable(f"state {path}: data outside a region")
+            for sub in state.regions:
+                stack.append((f"{path}/", sub))
+        if any(t.attrs for t in machine.transitions):
+            raise NotDecomposable(f"{prefix or machine.name}: data outside a region")
+    return found
+
+
+def skeleton_fsm(fsm: FSM, regions: list[_FsmRegion], results: list[frozenset[str]] | None) -> FSM:
+    """A copy of ``fsm`` with region state ``j`` a leaf state labelled ``⟪state j⟫`` whose
+    outcomes go where its completions go (an outcome the region never returns goes where its
+    one result goes, as the abstract child of the tree maps it; ``results=None``, for the
+    pairing walk: an outcome without a completion leads to a state that matches nothing);
+    data dropped."""
+    by_state = {id(r.state): j for j, r in enumerate(regions)}
+    top = copy.copy(fsm)
+    top.attrs = {k: v for k, v in fsm.attrs.items() if k != DATAMODEL}
+    stack = [top]
+    while stack:
+        machine = stack.pop()
+        states: dict[str, State] = {}
+        transitions: list[Transition] = []
+        replaced: set[str] = set()
+        for name, state in machine.states.items():
+            j = by_state.get(id(state))
+            if j is None:
+                new = copy.copy(state)
+                new.regions = [copy.copy(sub) for sub in state.regions]
+                stack.extend(new.regions)
+                states[name] = new
+                continue
+            replaced.add(name)
+            token = _FSM_TOKEN.format(j)
+            states[name] = State(name, action=token)
+            exits = regions[j].exits
+            possible = frozenset(exits) if results is None else results[j] & set(exits)
+            for outcome, result in ((EV_SUCCESS, SUCCESS), (EV_FAILURE, FAILURE)):
+                if result in possible:
+                    transitions.append(Transition(name, outcome, exits[result]))
+                elif possible and results is not None:
+                    transitions.append(Transition(name, outcome, exits[min(possible)]))
+                elif results is None:  # pairing: an outcome without completion matches nothing
+                    states.setdefault(_NO_EXIT, State(_NO_EXIT, action=_NO_EXIT))
+                    transitions.append(Transition(name, outcome, _NO_EXIT))
+        transitions.extend(t for t in machine.transitions if t.source not in replaced)
+        machine.states = states
+        machine.transitions = transitions
+    return top
+
+
+def region_fsm(region: _FsmRegion, declared: dict[str, str], names: set[str]) -> FSM:
+    """The region's sub-machine as a machine of its own: final states show their result, the
+    variables it names declared as the whole machine declares them."""
+    sub = copy.copy(region.machine)
+    sub.states = {
+        name: (State(name, action=name, final=True) if state.final else state)
+        for name, state in region.machine.states.items()
+    }
+    sub.attrs = dict(region.machine.attrs)
+    if names:
+        sub.attrs[DATAMODEL] = join_lines([(n, declared[n]) for n in sorted(names)])
+    return sub
+
+
+# -- pairing the abstract children -----------------------------------------------------------
+def pair_regions(bt_machine: Any, fsm_machine: Any, max_states: int) -> dict[str, str]:
+    """Walk the two skeleton machines in lockstep on the tree's offered inputs; where one
+    outputs ``⟪unit k⟫`` and the other ``⟪state j⟫`` at the same position, pair them.
+
+    Returns:
+        FSM token -> tree token, one-to-one.
+
+    Raises:
+        NotDecomposable: a token meets two partners (a step whose outputs differ otherwise
+            is not followed: the skeleton check decides it).
+    """
+    pairs: dict[str, str] = {}
+    back: dict[str, str] = {}
+
+    def match(a: tuple[str, ...], b: tuple[str, ...]) -> bool:
+        """Pair the tokens of two output tuples; False when they differ otherwise (that
+        branch is not followed: the skeleton check decides it)."""
+        if len(a) != len(b):
+            return False
+        for x, y in zip(a, b, strict=True):
+            if x == y:
+                continue
+            if not (x.startswith("⟪unit ") and y.startswith("⟪state ")):
+                return False
+            if pairs.setdefault(y, x) != x or back.setdefault(x, y) != y:
+                raise NotDecomposable("a region state meets two regions of the tree")
+        return True
+
+    s0, out_s = bt_machine.start()
+    r0, out_r = fsm_machine.start()
+    if not match(out_s, out_r):
+        raise NotDecomposable("the skeletons differ at the start")
+    seen: set[tuple[Hashable, Hashable]] = {(s0, r0)}
+    queue = deque([(s0, r0)])
+    while queue:
+        s, r = queue.popleft()
+        for symbol in bt_machine.inputs(s):
+            s2, o1 = bt_machine.step(s, symbol)
+            r2, o2 = fsm_machine.step(r, symbol)
+            if match(o1, o2) and (s2, r2) not in seen:
+                if len(seen) >= max_states:
+                    raise NotDecomposable("the skeleton is too large")
+                seen.add((s2, r2))
+                queue.append((s2, r2))
+    return pairs
+
+
+def _rename(fsm: FSM, names: dict[str, str]) -> None:
+    stack = [fsm]
+    while stack:
+        machine = stack.pop()
+        for state in machine.states.values():
+            if state.action in names:
+                state.action = names[state.action]
+            stack.extend(state.regions)
+
+
+# -- the check -------------------------------------------------------------------------------
+def _results(witness: Any) -> frozenset[str]:
+    """The root results a region's explored leaf machine reaches (its final states' outputs)."""
+    src = witness.src
+    found: set[str] = set()
+    if src.status and src.status[0] == "final":
+        found.update(src.outputs.values[src.start_outputs][-1:])
+    for row in src.edges:
+        for nxt, out in row.values():
+            if src.status[nxt] == "final":
+                found.update(src.outputs.values[out][-1:])
+    return frozenset(found)
+
+
+def decompose(
+    source: BTDocument, result: FSM, *, max_states: int = DEFAULT_MAX_STATES
+) -> Decomposition:
+    """Run the three parts of the compositional check (module docstring).
+
+    Raises:
+        NotDecomposable: the pair is outside the scope; the caller falls back.
+    """
+    if not result.is_hierarchical:
+        raise NotDecomposable("the state machine is flat")
+    regions = tree_regions(source)
+    if not regions:
+        raise NotDecomposable("no region with memory (the static table decides the tree)")
+    machine_regions = fsm_regions(result, region_labels(source, regions))
+    if not machine_regions:
+        raise NotDecomposable("the machine has no region state")
+    declared = _declared(result)
+    names = set(declared)
+    owner: dict[str, int] = {}
+    mentioned: list[set[str]] = []
+    for j, region in enumerate(machine_regions):
+        used = _mentions(region.machine, names) | {
+            w for w in _IDENT.findall(region.state.attrs.get(ONEXIT, "")) if w in names
+        }
+        for name in used:
+            if owner.setdefault(name, j) != j:
+                raise NotDecomposable(f"variable {name} is shared by two regions")
+        mentioned.append(used)
+    # 1. the skeleton pairing needs the results, the results need the pairing: pair first on
+    # the widest abstraction (every region may succeed or fail), then check each pair
+    both = frozenset({SUCCESS, FAILURE})
+    wide_tree = skeleton_tree(source, regions, [both] * len(regions))
+    wide_fsm = skeleton_fsm(result, machine_regions, None)
+    pairs = pair_regions(LeafMachine(wide_tree), FSMLeafMachine(wide_fsm), max_states)
+    tree_of_state = {
+        int(fsm_token[len("⟪state ") : -1]): int(tree_token[len("⟪unit ") : -1])
+        for fsm_token, tree_token in pairs.items()
+    }
+    # a region the walk never reaches keeps its own label: if the skeleton check reaches it
+    # after all, its label differs from anything on the other side and the check fails
+    outcome = Decomposition(equivalent=True, regions=len(tree_of_state))
+    results: list[frozenset[str]] = [both] * len(regions)
+    fsm_results = [frozenset(r.exits) for r in machine_regions]
+    for j, region in enumerate(machine_regions):
+        k = tree_of_state.get(j)
+        if k is None:
+            continue
+        bt_region = LeafMachine(BTDocument.single(regions[k]))
+        fsm_region = FSMLeafMachine(region_fsm(region, declared, mentioned[j]))
+        try:
+            report, witness = check_witnessed(bt_region, fsm_region, max_states=max_states)
+        except StateLimitError as exc:
+            raise NotDecomposable(f"region {regions[k].label}: {exc}") from None
+        _add(outcome.stats, report.stats)
+        outcome.region_states += report.stats["product_states"]
+        outcome.largest_region = max(outcome.largest_region, report.stats["product_states"])
+        if not report.equivalent:
+            outcome.equivalent = False
+            outcome.failed_region = f"{regions[k].label} (state {region.path})"
+            return outcome
+        possible = _results(witness)
+        if not possible or not possible <= both or not possible <= set(region.exits):
+            raise NotDecomposable(f"region {regions[k].label} ends in {sorted(possible)}")
+        results[k] = fsm_results[j] = possible
+    # 2. the skeleton with each region abstracted to its results
+    bt_skeleton = skeleton_tree(source, regions, results)
+    fsm_skeleton = skeleton_fsm(result, machine_regions, fsm_results)
+    _rename(fsm_skeleton, pairs)
+    report, _witness = check_witnessed(
+        LeafMachine(bt_skeleton), FSMLeafMachine(fsm_skeleton), max_states=max_states
+    )
+    _add(outcome.stats, report.stats)
+    outcome.skeleton_states = report.stats["product_states"]
+    if not report.equivalent:
+        # the skeletons differ: a real difference outside the regions, or a tree whose
+        # non-plain leaves the machine keeps as plain states; the whole product tells which
+        raise NotDecomposable("the skeletons differ")
+    return outcome
+
+
+def _add(total: dict[str, Any], part: dict[str, Any]) -> None:
+    """Sum each part's state and edge counts (the figures a verdict prints)."""
+    for key in ("source_states", "result_states", "product_states", "product_edges"):
+        total[key] = total.get(key, 0) + part.get(key, 0)
+
+
+def compositional_report(
+    source: BTDocument, result: FSM, *, max_states: int = DEFAULT_MAX_STATES
+) -> tuple[Report | None, str]:
+    """The compositional verdict when it proves the pair equivalent, else ``None`` and why
+    (out of scope, or a part failed: the caller runs the whole product for the verdict and
+    its counterexample). Cost: see the module docstring."""
+    import time
+
+    started = time.perf_counter()
+    try:
+        found = decompose(source, result, max_states=max_states)
+    except NotDecomposable as exc:
+        return None, str(exc)
+    except FsmbtError as exc:
+        # a part the machines refuse (a limit, a construct): the whole product decides and
+        # gives the error or verdict it gave before
+        return None, f"a part cannot be checked ({type(exc).__name__})"
+    if not found.equivalent:
+        return None, f"{FAILED_PART} {found.failed_region} fails"
+    seconds = time.perf_counter() - started
+    report = Report(engine="native", source="source", result="result", mode="leaf-execution")
+    detail = (
+        f"proved compositionally: {found.regions} regions checked alone "
+        f"({found.region_states} product states, largest {found.largest_region}) and the "
+        f"skeleton ({found.skeleton_states} product states)"
+    )
+    for name in PROPERTIES:
+        report.properties[name] = PropertyResult(name, True, detail)
+    report.method = COMPOSITIONAL
+    report.abstractions = [COMPOSITIONAL_SENTENCE]
+    report.stats = {
+        **found.stats,
+        "regions": found.regions,
+        "region_product_states": found.region_states,
+        "largest_region": found.largest_region,
+        "skeleton_product_states": found.skeleton_states,
+        "seconds": round(seconds, 6),
+    }
+    return report, ""

@@ -1,0 +1,274 @@
+"""The compositional check (``fsmbt.verify.compositional``, docs/semantics.md §4c) agrees with
+the whole product on every pair the latter decides.
+
+Generated pairs (8 batches of 250 seeded trees: about 2 000 converted trees and one mutant of
+each, about 3 980 pairs; a mutant changes one transition of the top machine or of any
+sub-machine, regions included): seeded random trees mixing plain, reactive and WithMemory controls with
+Inverter/ForceSuccess/ForceFailure/Repeat/RetryUntilSuccessful decorators and built-in leaves (``support.random_trees``), each converted
+by ``bt_to_hfsm`` and checked against its HFSM and against single mutants of that HFSM
+(``fsmbt.verify.mutations``). For every pair: when the compositional check proves it
+equivalent, the whole product (fsmbt's interpreter, canonical states) says equivalent too; the
+compositional check decides a good share of the pairs (so the agreement is not vacuous); and a
+mutant the whole product refutes is refuted by ``verify`` with a counterexample that replays, its
+method not ``compositional``.
+"""
+
+from __future__ import annotations
+
+import copy
+import random
+import re
+
+import pytest
+
+from fsmbt import api, limits
+from fsmbt.cli import main
+from fsmbt.convert.bt_to_hfsm import bt_to_hfsm
+from fsmbt.model.bt import BTDocument, BTNode
+from fsmbt.model.bt_nodes import NodeKind
+from fsmbt.model.errors import InputError, UnsupportedError
+from fsmbt.model.fsm import FSM
+from fsmbt.model.fsm_data import ASSIGN, DATAMODEL, parse_lines
+from fsmbt.verify import replay, verify
+from fsmbt.verify.compositional import (
+    FAILED_PART,
+    NotDecomposable,
+    compositional_report,
+    decompose,
+    fsm_regions,
+    tree_regions,
+)
+from fsmbt.verify.mutations import mutants
+from fsmbt.verify.native import check
+from fsmbt.verify.pairing import machines_for
+from fsmbt.verify.report import COMPOSITIONAL
+from support.random_trees import random_tree
+from support.sampling import seed
+
+CONTROLS = (
+    "Sequence",
+    "Fallback",
+    "Sequence",
+    "Fallback",
+    "SequenceWithMemory",
+    "ReactiveSequence",
+    "ReactiveFallback",
+)
+DECORATORS = ("Inverter", "ForceSuccess", "ForceFailure", "Repeat", "RetryUntilSuccessful")
+#: Batches and trees per batch: 8 x 250 = 2 000 trees, each with its HFSM and one mutant.
+BATCHES, TREES = 8, 250
+
+
+def _pairs(batch: int) -> list[tuple[BTDocument, FSM, bool]]:
+    """(tree, HFSM or a mutant of it, is the converter's own HFSM) for one seeded batch."""
+    rng = random.Random(f"{seed()}:compositional:{batch}")
+    out: list[tuple[BTDocument, FSM, bool]] = []
+    for _ in range(TREES):
+        doc = random_tree(rng, controls=CONTROLS, decorators=DECORATORS, max_nodes=12)
+        try:
+            hfsm = bt_to_hfsm(doc).model
+        except (InputError, UnsupportedError):
+            continue  # a tree the converter refuses has no pair
+        out.append((doc, hfsm, True))
+        for mutant in deep_mutants(hfsm, rng.randrange(1 << 30), per_operator=1)[:1]:
+            out.append((doc, mutant, False))
+    return out
+
+
+def deep_mutants(hfsm: FSM, seed_value: int, per_operator: int | None) -> list[FSM]:
+    """Single mutants of one machine of ``hfsm`` - the top machine or any sub-machine, so the
+    regions' own transitions are mutated too (``mutants`` mutates the machine it is given)."""
+    rng = random.Random(seed_value)
+    count = len(list(hfsm.machines()))
+    picks = range(count) if per_operator is None else [rng.randrange(count)]
+    out: list[FSM] = []
+    for index in picks:
+        inner = list(hfsm.machines())[index]
+        for mutant in mutants(inner, seed=seed_value, per_operator=per_operator):
+            assert isinstance(mutant.model, FSM)
+            whole = copy.deepcopy(hfsm)
+            target = list(whole.machines())[index]
+            target.states, target.transitions = mutant.model.states, mutant.model.transitions
+            target.initial = mutant.model.initial
+            out.append(whole)
+    rng.shuffle(out)
+    return out
+
+
+def _whole(doc: BTDocument, fsm: FSM):  # type: ignore[no-untyped-def]
+    source, result, _mode = machines_for(doc, fsm)
+    return check(source, result)
+
+
+@pytest.mark.parametrize("batch", range(BATCHES))
+def test_compositional_agrees_with_the_whole_product(batch: int) -> None:
+    decided = pairs = refuted = 0
+    for doc, fsm, _own in _pairs(batch):
+        try:
+            whole = _whole(doc, fsm)
+        except InputError:
+            continue  # e.g. a state limit: the whole product does not decide this pair
+        pairs += 1
+        proved, _why = compositional_report(doc, fsm)
+        if proved is not None:
+            decided += 1
+            assert whole.equivalent, (
+                f"compositional proved a pair the whole product refutes: {_why}"
+            )
+        if not whole.equivalent:
+            refuted += 1
+    print(f"batch {batch}: {pairs} pairs, {decided} decided compositionally, {refuted} refuted")
+    assert pairs >= 400
+    assert decided >= pairs // 10  # the agreement covers real compositional proofs
+    assert refuted >= pairs // 10  # and mutants that differ
+
+
+def _memory_tree() -> BTDocument:
+    """Fallback(SequenceWithMemory(a1, a2), Sequence(c1, ReactiveSequence(c2, a3)), a4)."""
+
+    def act(name: str) -> BTNode:
+        return BTNode("Act", NodeKind.ACTION, name=name)
+
+    def cond(name: str) -> BTNode:
+        return BTNode("Cond", NodeKind.CONDITION, name=name)
+
+    def ctrl(kind: str, *children: BTNode) -> BTNode:
+        return BTNode(kind, NodeKind.CONTROL, children=list(children))
+
+    return BTDocument.single(
+        ctrl(
+            "Fallback",
+            ctrl("SequenceWithMemory", act("a1"), act("a2")),
+            ctrl("Sequence", cond("c1"), ctrl("ReactiveSequence", cond("c2"), act("a3"))),
+            act("a4"),
+        )
+    )
+
+
+def test_regions_are_the_topmost_nodes_with_memory() -> None:
+    doc = _memory_tree()
+    assert [n.type for n in tree_regions(doc)] == ["SequenceWithMemory", "ReactiveSequence"]
+
+
+def test_verify_names_the_compositional_method() -> None:
+    doc = _memory_tree()
+    hfsm = bt_to_hfsm(doc).model
+    report = verify(doc, hfsm)
+    assert report.equivalent
+    assert report.method == COMPOSITIONAL
+    assert report.stats["regions"] == 2
+    assert _whole(doc, hfsm).equivalent
+
+
+def test_every_mutant_is_refuted_with_a_counterexample_that_replays() -> None:
+    doc = _memory_tree()
+    hfsm = bt_to_hfsm(doc).model
+    found = said = 0
+    for mutated in deep_mutants(hfsm, seed(), per_operator=None):
+        report = verify(doc, mutated)
+        whole = _whole(doc, mutated)
+        assert report.equivalent == whole.equivalent
+        if report.equivalent:
+            continue
+        found += 1
+        assert report.method != COMPOSITIONAL
+        if str(report.stats.get("compositional", "")).startswith(FAILED_PART):
+            said += 1  # the verdict says which local check failed before the whole product
+        failing = [p for p in report.properties.values() if not p.holds]
+        trace = failing[0].counterexample
+        assert trace is not None
+        source, result, _mode = machines_for(doc, mutated)
+        inputs = [step.input for step in trace[1:] if step.input is not None]
+        assert replay(source, result, inputs).differs
+    assert found >= 5
+    assert said >= 1
+
+
+def _data_regions_tree() -> BTDocument:
+    """Sequence(ReactiveSequence(c1, Sequence(a1, a2)), ReactiveSequence(c2, Sequence(a3, a4))):
+    two regions whose plain Sequence under a reactive one keeps a running index (data)."""
+
+    def region(c: str, x: str, y: str) -> BTNode:
+        inner = BTNode(
+            "Sequence",
+            NodeKind.CONTROL,
+            children=[
+                BTNode("Act", NodeKind.ACTION, name=x),
+                BTNode("Act", NodeKind.ACTION, name=y),
+            ],
+        )
+        return BTNode(
+            "ReactiveSequence",
+            NodeKind.CONTROL,
+            children=[BTNode("Cond", NodeKind.CONDITION, name=c), inner],
+        )
+
+    return BTDocument.single(
+        BTNode(
+            "Sequence",
+            NodeKind.CONTROL,
+            children=[region("c1", "a1", "a2"), region("c2", "a3", "a4")],
+        )
+    )
+
+
+def test_regions_with_data_are_proved_and_a_shared_variable_is_refused() -> None:
+    doc = _data_regions_tree()
+    hfsm = bt_to_hfsm(doc).model
+    assert DATAMODEL in hfsm.attrs  # the compact regions keep their indices as data
+    assert decompose(doc, hfsm).equivalent
+    assert verify(doc, hfsm).method == COMPOSITIONAL
+    first, second = fsm_regions(hfsm)[:2]
+    names = [name for name, _init in parse_lines(hfsm.attrs[DATAMODEL])]
+    words = {
+        w
+        for t in second.machine.transitions
+        for w in re.findall(r"[A-Za-z_][A-Za-z0-9_]*", " ".join(t.attrs.values()))
+    }
+    theirs = [n for n in names if n in words]
+    mine = [n for n in names if n not in theirs]
+    assert mine and theirs
+    # the second region now also writes a variable of the first: they are coupled
+    second.machine.transitions[0].attrs[ASSIGN] = f"{mine[0]}=0"
+    with pytest.raises(NotDecomposable, match="shared"):
+        decompose(doc, hfsm)
+
+
+def test_a_subtree_or_a_flat_machine_is_out_of_scope() -> None:
+    doc = _memory_tree()
+    sub = BTNode("SubTree", NodeKind.SUBTREE, attrs={"ID": "S"})
+    with_subtree = BTDocument.single(
+        BTNode("Sequence", NodeKind.CONTROL, children=[sub, BTNode("Act", NodeKind.ACTION)])
+    )
+    with pytest.raises(NotDecomposable, match="SubTree"):
+        tree_regions(with_subtree)
+    flat = FSM(name="flat")
+    flat.add_state("x")
+    with pytest.raises(NotDecomposable, match="flat"):
+        decompose(doc, flat)
+
+
+def test_the_cli_proves_compositionally_unless_a_certificate_is_asked_for(tmp_path, capsys) -> None:
+    """Through files (the HFSM written as SCXML and read back, its sub-machines renamed): the
+    command names the compositional method; with ``--certificate`` it proves by the product,
+    whose witness the certificate needs."""
+    doc = _memory_tree()
+    tree = api.write(doc, tmp_path / "tree.xml")
+    machine = api.write(bt_to_hfsm(doc).model, tmp_path / "tree.scxml")
+    assert main(["verify", str(tree), str(machine)]) == 0
+    assert f"proven by: {COMPOSITIONAL}" in capsys.readouterr().out
+    certificate = tmp_path / "proof.json"
+    assert main(["verify", str(tree), str(machine), "--certificate", str(certificate)]) == 0
+    assert f"proven by: {COMPOSITIONAL}" not in capsys.readouterr().out
+    assert certificate.exists()
+
+
+def test_a_part_past_a_limit_is_a_fallback_not_an_error() -> None:
+    """A region whose data expansion passes the conversion limit makes the compositional check
+    give way (the whole product then gives whatever it gave before), never raise itself."""
+    doc = _data_regions_tree()
+    hfsm = bt_to_hfsm(doc).model
+    with limits.changed(conversion_max_states=2):
+        proved, why = compositional_report(doc, hfsm)
+    assert proved is None
+    assert why.startswith("a part cannot be checked")
