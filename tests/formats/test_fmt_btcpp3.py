@@ -277,3 +277,30 @@ def test_a_post_condition_a_switch_reads_is_refused_not_dropped() -> None:
         UnsupportedError, match="post-condition _onSuccess writes a blackboard entry"
     ):
         prepare_v3(doc)
+
+
+def test_v3_holds_answers_as_prepare_v3_does() -> None:
+    """``v3_holds`` (the web page's v3 download offer) agrees with ``prepare_v3`` on trees it
+    decides without a copy (the dispatch form's Script, a pre-condition) and on trees it hands
+    to ``prepare_v3`` (the LEBT and structured forms, a v4-only feature, the examples)."""
+    from fsmbt.formats.btcpp.v3_write import v3_holds
+    from fsmbt.model.errors import FsmbtError
+
+    examples = Path(__file__).resolve().parents[2] / "examples"
+    paper = api.load(examples / "paper_fsm.xml")
+    trees = [loads(V4, "btcpp")]
+    trees += [api.convert_loaded(paper, style=s).result for s in ("dispatch", "lebt", "auto")]
+    trees += [api.load(examples / n).model for n in ("robot_bt.xml", "game_npc_bt.xml")]
+    pre = V4.replace("<IsReady/>", '<IsReady _skipIf="x"/>')
+    trees.append(loads(pre, "btcpp"))
+    answers = []
+    for tree in trees:
+        assert isinstance(tree, BTDocument)
+        try:
+            prepare_v3(tree)
+            expected = True
+        except FsmbtError:
+            expected = False
+        assert v3_holds(tree) is expected
+        answers.append(expected)
+    assert True in answers and False in answers  # both answers were exercised

@@ -44,7 +44,7 @@ from fsmbt.formats.registry import Format, register
 from fsmbt.model import Model
 from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.bt_nodes import NodeKind, builtin_spec
-from fsmbt.model.errors import InputError, UnsupportedError
+from fsmbt.model.errors import FsmbtError, InputError, UnsupportedError
 
 #: What the format cannot hold (``fsmbt formats``).
 CANNOT_HOLD = "v4-only nodes (Script, RunOnce, AsyncSequence, Loop*...), pre-conditions"
@@ -162,6 +162,24 @@ def prepare_v3(model: Model) -> tuple[BTDocument, list[str]]:
             element=node.label,
         )
     return doc, losses
+
+
+def v3_holds(model: BTDocument) -> bool:
+    """Whether ``prepare_v3(model)`` succeeds (the web page offers the v3 download only then).
+
+    A v4-only node or a pre-condition is refused whatever else the document holds, so one
+    read-only pass over the nodes answers for the trees that have one (the dispatch form's
+    ``Script`` nodes) without ``prepare_v3``'s copy of the document; any other is answered by
+    ``prepare_v3`` itself. Costs: O(n), plus ``prepare_v3``'s copy when no node decides it.
+    """
+    for _tree_id, node in model.nodes():
+        if _v4_only(node) or any(key in versions.PRE_CONDITIONS for key in node.attrs):
+            return False
+    try:
+        prepare_v3(model)
+    except FsmbtError:
+        return False
+    return True
 
 
 def _v3_element(element: etree._Element) -> None:
