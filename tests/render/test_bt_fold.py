@@ -221,3 +221,64 @@ def test_pages_draw_one_picture_per_tree_main_first(tmp_path: Path, capsys) -> N
     assert main(["render", str(source), "--pages", str(pages)]) != 0  # Helper.svg exists
     assert not (pages / "Main.svg").exists()
     assert {p.name: p.stat().st_mtime_ns for p in pages.iterdir()} == before
+
+
+def _open_by_full_extent(items, top, estimate, target):  # type: ignore[no-untyped-def]
+    """``bt_fold._open`` as it was before the incremental profiles: the whole estimate
+    (``_Estimate.extent``) recomputed for every node tried."""
+    from fsmbt.render.bt_fold import NODE_BUDGET
+
+    opened: set[int] = set()
+    if len(items[top].children) > TOP_CHILDREN:
+        estimate.limit[top] = TOP_CHILDREN
+    shown, queue, head = 1, [top], 0
+    while head < len(queue):
+        index = queue[head]
+        head += 1
+        kids = estimate.kids(index)
+        if not kids:
+            continue
+        cost = len(kids) + sum(1 for c in kids if items[c].children) - (1 if index != top else 0)
+        if index != top and shown + cost > NODE_BUDGET:
+            continue
+        opened.add(index)
+        width, height, _ = estimate.extent(top, opened)
+        if index != top and (width > target or height > target):
+            opened.discard(index)
+            continue
+        shown += cost
+        queue.extend(kids)
+    return opened
+
+
+def test_the_incremental_estimate_opens_what_the_full_estimate_opens() -> None:
+    """``_open`` updates only the profiles of the node it tries and its ancestors
+    (``bt_fold._Profiles``); it must open exactly the nodes the whole-tree estimate opens, for
+    every row width and size tried: FSM dispatch and LEBT trees, random BTs, a wide root."""
+    from fsmbt.generate.generator import random_fsm
+    from fsmbt.render.bt_fold import ROW_WIDTHS, _Estimate, _open
+    from fsmbt.render.bt_graph import measure
+
+    docs: list[BTDocument] = []
+    for seed in range(4):
+        fsm = random_fsm(seed=f"fold-{seed}", n_states=12 + 8 * seed, max_states=12 + 8 * seed)
+        docs += [api.convert_model(fsm, "rules", style=s).model for s in ("dispatch", "lebt")]
+    docs += [random_bt(seed=seed, depth=8, max_nodes=400) for seed in range(6)]
+    wide = BTNode(
+        "Sequence",
+        NodeKind.CONTROL,
+        children=[BTNode(f"A{i}", NodeKind.ACTION) for i in range(130)],
+    )
+    docs.append(BTDocument.single(wide))
+    tried = 0
+    for doc in docs:
+        tree = doc.main
+        assert tree.root is not None
+        items = walk(doc, tree.root, (tree.id,), "", expanding=True, max_nodes=None)
+        sizes = [measure(item.node) for item in items]
+        for row in ROW_WIDTHS:
+            for target in (36.0, 18.0, 6.0):
+                expected = _open_by_full_extent(items, 0, _Estimate(items, sizes, row), target)
+                assert _open(items, 0, _Estimate(items, sizes, row), None, target) == expected
+                tried += 1
+    assert tried == len(docs) * len(ROW_WIDTHS) * 3
