@@ -141,6 +141,10 @@ def test_a_wrong_turn_order_is_caught() -> None:
             "</RetryUntilSuccessful></Sequence></Parallel>",
             "child 2 can return its result in a tick that ticks none of its leaves",
         ),
+        (  # a child that is a constant: it returns in its first tick with no leaf ticked
+            '<ParallelAll><Action ID="A"/><AlwaysSuccess/></ParallelAll>',
+            "child 2 returns its result in its first tick without ticking a leaf",
+        ),
         (
             '<Parallel success_count="1" failure_count="1"><Action ID="A"/>'
             "<KeepRunningUntilFailure><AlwaysSuccess/></KeepRunningUntilFailure></Parallel>",

@@ -74,17 +74,13 @@ from fsmbt.model.errors import InputError, UnsupportedError
 from fsmbt.model.fsm import FSM, State
 from fsmbt.model.fsm_data import ASSIGN, COND, join_lines
 from fsmbt.model.nodes import canonical_type
-from fsmbt.semantics.families.parallel import (
-    parallel_all_params,
-    parallel_params,
-    parallel_threshold,
-)
+from fsmbt.semantics.families.parallel import COUNTING_PARALLELS, parallel_counts
 from fsmbt.semantics.leaf_machine import leaf_label
 from fsmbt.semantics.nodes import SEQUENCE_TYPES, rewired
 from fsmbt.semantics.status import LeafOutcome, RootResult
 
 #: The BT kinds written as ``<parallel>``.
-PARALLEL_KINDS = ("Parallel", "ParallelAll")
+PARALLEL_KINDS = COUNTING_PARALLELS
 SUCCESS, FAILURE = RootResult.SUCCESS.value, RootResult.FAILURE.value
 EV_SUCCESS, EV_FAILURE, EV_RUNNING = (
     LeafOutcome.SUCCESS.value,
@@ -144,18 +140,14 @@ def parallel_region(
     Raises:
         InputError: a threshold above the number of children (as the interpreter).
     """
-    kind = canonical_type(node.type)
     n = len(node.children)
     if n < 2:
         return "a single child: no regions run side by side"
-    if kind == "Parallel":
-        succ_param, fail_param = parallel_params(node, kind, True)
-        need_s, need_f = parallel_threshold(succ_param, n), parallel_threshold(fail_param, n)
-        if need_s == 0 or need_f == 0:
-            return "a threshold of 0 ends the node after its first child, whatever it returns"
-    else:
-        (need_f,) = parallel_all_params(node, kind, True)
-        need_s = 0
+    counts = parallel_counts(node)
+    assert counts is not None, "is_parallel_kind holds"
+    need_s, need_f = counts.successes, counts.failures
+    if not counts.waits_for_all and (need_s == 0 or need_f == 0):
+        return "a threshold of 0 ends the node after its first child, whatever it returns"
     opaque: dict[int, BTNode] = {}
     for index, child in enumerate(node.children):
         stack = [child]
@@ -184,7 +176,7 @@ def parallel_region(
     turn = new_variable(f"{base}_turn")
     successes = new_variable(f"{base}_successes")
     failures = new_variable(f"{base}_failures")
-    if kind == "Parallel":
+    if not counts.waits_for_all:
         stop = f"{successes} >= {need_s} or {failures} >= {min(need_f, n - need_s + 1)}"
         first_end, first_cond = SUCCESS, f"{successes} >= {need_s}"
         other_end = FAILURE
@@ -291,9 +283,11 @@ def _region(
 
 def _odd_ends(region: CompactRegion) -> str:
     """Why a child's compact region cannot be a turn-taking region (``""``: it can): it ends
-    otherwise than SUCCESS/FAILURE, or in a tick after one that ran no leaf."""
+    otherwise than SUCCESS/FAILURE, or in a tick that ran no leaf (its first tick included)."""
     if region.ends - {SUCCESS, FAILURE}:
         return f"can end in {', '.join(sorted(region.ends - {SUCCESS, FAILURE}))}"
+    if region.fsm.initial in region.ends:
+        return "returns its result in its first tick without ticking a leaf"
     for t in region.fsm.transitions:
         if t.attrs.get(TICK_MARK) and t.target in region.ends:
             return "can return its result in a tick that ticks none of its leaves"

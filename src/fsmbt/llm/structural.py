@@ -197,9 +197,8 @@ def check_hfsm(source: BTDocument, result: FSM) -> list[str]:
         for state in machine.states.values():
             if state.regions:
                 stack.extend((f"{prefix}{state.name}/", region) for region in state.regions)
-            elif (
-                not state.final and state.action is not None and state.action not in TERMINAL_STATES
-            ):
+            elif not state.final and state.action and state.action not in TERMINAL_STATES:
+                # an empty action is a state that runs nothing (a <parallel> region's wait)
                 actions[state.action] += 1
     leaves: Counter[str] = Counter()
     for _, node in source.nodes():

@@ -62,16 +62,19 @@ from fsmbt.model.fsm import FSM, State, Transition
 from fsmbt.model.fsm_data import DATAMODEL, ONEXIT, join_lines, parse_lines
 from fsmbt.semantics.leaf_machine import LeafMachine
 from fsmbt.semantics.machine import FSMLeafMachine
-from fsmbt.semantics.nodes import BLACKBOARD_BASED, canonical_type
+from fsmbt.semantics.nodes import (
+    BLACKBOARD_BASED,
+    PLAIN_CONTROLS,
+    RESULT_MAP_DECORATORS,
+    SUBTREE_TYPE,
+    canonical_type,
+)
 from fsmbt.semantics.status import LeafOutcome, RootResult
 from fsmbt.verify.native import DEFAULT_MAX_STATES, StateLimitError, check_witnessed
 from fsmbt.verify.report import COMPOSITIONAL, PROPERTIES, PropertyResult, Report
 
 SUCCESS, FAILURE = RootResult.SUCCESS.value, RootResult.FAILURE.value
 EV_SUCCESS, EV_FAILURE = LeafOutcome.SUCCESS.value, LeafOutcome.FAILURE.value
-#: Plain controls and stateless result maps: no memory a later tick reads (docs/semantics.md).
-PLAIN_SKELETON_CONTROLS = frozenset({"Sequence", "Fallback"})
-PLAIN_SKELETON_DECORATORS = frozenset({"Inverter", "ForceSuccess", "ForceFailure"})
 #: Labels of the abstract children (never a name a file gives: ``⟪`` is not an XML name char).
 _BT_TOKEN = "⟪unit {}⟫"
 _FSM_TOKEN = "⟪state {}⟫"
@@ -122,9 +125,9 @@ def _is_plain(node: BTNode) -> bool:
         return False
     kind_type = canonical_type(node.type)
     if node.kind is NodeKind.CONTROL:
-        return kind_type in PLAIN_SKELETON_CONTROLS and bool(node.children)
+        return kind_type in PLAIN_CONTROLS and bool(node.children)
     if node.kind is NodeKind.DECORATOR:
-        return kind_type in PLAIN_SKELETON_DECORATORS and len(node.children) == 1
+        return kind_type in RESULT_MAP_DECORATORS and len(node.children) == 1
     return False
 
 
@@ -141,7 +144,7 @@ def tree_regions(doc: BTDocument) -> list[BTNode]:
     stack = [root]
     while stack:
         node = stack.pop()
-        if node.kind is NodeKind.SUBTREE or node.type == "SubTree":
+        if node.kind is NodeKind.SUBTREE or node.type == SUBTREE_TYPE:
             raise NotDecomposable("the tree uses SubTrees")
         if not _is_plain(node):
             found.append(node)
@@ -157,7 +160,7 @@ def _no_subtree_below(node: BTNode) -> None:
     stack = [node]
     while stack:
         x = stack.pop()
-        if x.kind is NodeKind.SUBTREE or x.type == "SubTree":
+        if x.kind is NodeKind.SUBTREE or x.type == SUBTREE_TYPE:
             raise NotDecomposable("the tree uses SubTrees")
         if canonical_type(x.semantics or x.type) in BLACKBOARD_BASED or any(
             key.startswith("_") for key in x.attrs

@@ -11,10 +11,12 @@ resets them. Checks at build time: a threshold above the number of children is a
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Any
 
 from fsmbt.model.bt import BTNode
 from fsmbt.model.errors import InputError
+from fsmbt.model.nodes import canonical_type
 from fsmbt.semantics.compiled import (
     FAILURE,
     RUNNING,
@@ -53,6 +55,45 @@ def parallel_all_params(node: BTNode, ctype: str, exact: bool) -> tuple[Any, ...
     if n < parallel_threshold(fail, n):
         raise InputError("ParallelAll max_failures exceeds the number of children", **where(node))
     return (parallel_threshold(fail, n),)
+
+
+#: The kinds that end by counting their children's results (RealParallel never ends itself).
+COUNTING_PARALLELS = ("Parallel", "ParallelAll")
+
+
+@dataclass(frozen=True)
+class ParallelCounts:
+    """When a counting parallel ends, as counts of completed children (thresholds resolved).
+
+    Attributes:
+        waits_for_all: ParallelAll: it ends once every child completed, FAILURE when at least
+            ``failures`` failed, else SUCCESS. Parallel: it ends as soon as ``successes``
+            children succeeded (SUCCESS, checked first) or ``failures`` failed (FAILURE).
+        successes: the success threshold (ParallelAll: 0, unused).
+        failures: the failure threshold (ParallelAll: ``max_failures``).
+    """
+
+    waits_for_all: bool
+    successes: int
+    failures: int
+
+
+def parallel_counts(node: BTNode) -> ParallelCounts | None:
+    """The end rule of a counting parallel (``None``: ``node`` is not one), read with the
+    interpreter's own checks.
+
+    Raises:
+        InputError: a threshold above the number of children.
+    """
+    kind = canonical_type(node.type)
+    n = len(node.children)
+    if kind == "Parallel":
+        succ, fail = parallel_params(node, kind, True)
+        return ParallelCounts(False, parallel_threshold(succ, n), parallel_threshold(fail, n))
+    if kind == "ParallelAll":
+        (fail,) = parallel_all_params(node, kind, True)
+        return ParallelCounts(True, 0, fail)
+    return None
 
 
 def tick_parallel(
