@@ -79,8 +79,6 @@ from fsmbt.semantics.leaf_machine import leaf_label
 from fsmbt.semantics.nodes import SEQUENCE_TYPES, rewired
 from fsmbt.semantics.status import LeafOutcome, RootResult
 
-#: The BT kinds written as ``<parallel>``.
-PARALLEL_KINDS = COUNTING_PARALLELS
 SUCCESS, FAILURE = RootResult.SUCCESS.value, RootResult.FAILURE.value
 EV_SUCCESS, EV_FAILURE, EV_RUNNING = (
     LeafOutcome.SUCCESS.value,
@@ -113,7 +111,7 @@ def is_parallel_kind(node: BTNode) -> bool:
     """Whether ``node`` is a built-in Parallel or ParallelAll (a project type given that
     meaning by a node library is not: its ports may differ)."""
     kind = canonical_type(node.type)
-    return kind in PARALLEL_KINDS and node.semantics in (None, node.type)
+    return kind in COUNTING_PARALLELS and node.semantics in (None, node.type)
 
 
 def parallel_region(
