@@ -204,7 +204,9 @@ def test_partial_start_index_and_foreign_post_condition_are_refused(
 ) -> None:
     fsm = random_fsm("g60", 60, shape="tree", start_event=False)
     text = _write_dispatch(fsm, tmp_path).read_text(encoding="utf-8")
-    start = re.search(r'(<KeepRunningUntilFailure name="start">\s*<DispatchEntry [^>]*_onSuccess=")([^"]*)"', text)
+    start = re.search(
+        r'(<KeepRunningUntilFailure name="start">\s*<DispatchEntry [^>]*_onSuccess=")([^"]*)"', text
+    )
     assert start is not None and ";" in start.group(2)  # 60 states: two digits
     kept = start.group(2).split(";")[0]
     broken = text[: start.start(2)] + kept + text[start.end(2) :]
@@ -243,7 +245,13 @@ def test_callbacks_get_the_state_label_and_its_parameters(driver: Path, tmp_path
     path = tmp_path / "params.xml"
     path.write_text(text, encoding="utf-8")
     proc = subprocess.run(
-        [str(driver), str(path), "--entries", "--register", "Closed,Closing,Emergency,Off,Open,Opening"],
+        [
+            str(driver),
+            str(path),
+            "--entries",
+            "--register",
+            "Closed,Closing,Emergency,Off,Open,Opening",
+        ],
         input="fire_alarm\nreset\nopen_cmd\n",
         capture_output=True,
         text=True,
