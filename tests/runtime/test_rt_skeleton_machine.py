@@ -200,3 +200,19 @@ def test_built_skeleton_refuses_foreign_and_broken_trees(binary: tuple[Path, Pat
     assert proc.returncode == 1 and proc.stdout == ""
     [line] = proc.stderr.strip().splitlines()
     assert "<DispatchEntry name=" in line and "malformed index digit 'q'" in line, line
+
+
+def test_docs_show_what_the_built_skeleton_prints(binary: tuple[Path, Path]) -> None:
+    """docs/runtime.md, "An event-driven machine": the command and its output (the test's
+    binary overrides on_D; the documented one prints every action by default)."""
+    program, _root = binary
+    docs = (REPO / "docs" / "runtime.md").read_text(encoding="utf-8")
+    section = docs[docs.index("## An event-driven machine") :]
+    command = next(
+        line for line in section.splitlines() if line.startswith("out/paper_cpp/build/paper_bt")
+    )
+    shown = section[section.index("```text\n") + 8 :]
+    shown = shown[: shown.index("```")]
+    run = subprocess.run([str(program), *command.split()[1:]], capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+    assert run.stdout == shown.replace("  action D (entered D)", "  user D in D")
