@@ -1,8 +1,13 @@
-// fsmbt LEBT runtime for BehaviorTree.CPP v4 (header-only; C++17).
+// fsmbt runtime for BehaviorTree.CPP v4 (header-only; C++17).
 //
-// Runs the loop-execution behavior trees (LEBT) that `fsmbt convert` writes from a state
-// machine: their leaves are `LebtGuard` and `LebtState`, their meaning is fsmbt's
-// docs/semantics.md section 5 ("The LEBT protocol"), and this file follows it literally:
+// Runs the two forms of tree `fsmbt convert` writes from an event-driven state machine, through
+// one API (LebtRunner, ActionRegistry, StepResult), the form told from the tree's leaves:
+//  - the dispatch form (the default style; docs/semantics.md section 12): a Switch dispatch over
+//    a state index on the blackboard, one leaf type, `DispatchEntry` - see "the dispatch form"
+//    below, and LebtRunner::checkDispatch for the annotations checked at load time;
+//  - the loop-execution behavior tree (LEBT, `--style lebt`): leaves `LebtGuard` and
+//    `LebtState`, meaning docs/semantics.md section 5 ("The LEBT protocol"), which this file
+//    follows literally:
 //
 //  - blackboard: `state` (starts at the start pseudo-state) and `event` ("" = none). Both live in
 //    a `fsmbt::lebt::Context` owned by the runner and shared by every leaf of the tree, SubTrees
@@ -34,13 +39,20 @@
 //  - terminated: the last root result is SUCCESS and `state` is no longer the start
 //    pseudo-state.
 //
+// The dispatch form (section 12): `DispatchEntry` runs its action's callback (state label and
+// params, as LebtState) and returns SUCCESS, after which BehaviorTree.CPP runs its `_onSuccess`
+// post-condition writing the entered state's index digits; start() ticks once with `event`
+// unset, post(e) writes the blackboard entry `event` and ticks once; terminated = last root
+// result SUCCESS. A step ticks O(log7 states + out-degree / 6) nodes.
+//
 // Load-time errors (fsmbt::lebt::LebtError, derived from std::runtime_error): a leaf the runtime
 // does not define (BehaviorTree.CPP's "Error at line N: -> Node not recognized: X"), a port that
 // is a blackboard reference or malformed, an action name with no registered callback, and LEBT
 // annotations that contradict each other (a guard pair whose event is not an exit of its source
 // state, an exit no guard pair takes, a pair source that is neither a state nor the start
-// pseudo-state: hand edits that would otherwise stop the machine silently) - all raised by the
-// LebtRunner constructor, never at tick time, naming the node and its line.
+// pseudo-state: hand edits that would otherwise stop the machine silently), dispatch annotations
+// that disagree (a malformed index digit, an index no state has, ...: checkDispatch) - all
+// raised by the LebtRunner constructor, never at tick time, naming the node and its line.
 //
 // Cost: a guard tick is two hash look-ups, a state tick one. A macro step ticks from the root
 // down to the running leaf (BehaviorTree.CPP resumes each Sequence at its running child, but every
@@ -87,7 +99,8 @@ inline constexpr const char* kStateType = "LebtState";
 inline constexpr const char* kDefaultStart = "__start__";
 inline constexpr const char* kRuntimeVersion = "fsmbt-lebt 1.0";
 
-/// Every load-time problem of an LEBT: unknown leaves, bad ports, missing action callbacks.
+/// Every load-time problem of a tree (LEBT or dispatch form): unknown leaves, bad ports, missing
+/// action callbacks, annotations that disagree.
 class LebtError : public std::runtime_error
 {
 public:
@@ -698,12 +711,13 @@ struct Options
   std::optional<std::string> start;
 };
 
-/// Loads an LEBT and runs it macro step by macro step (docs/semantics.md section 5).
+/// Loads an LEBT or a dispatch tree and runs it macro step by macro step (docs/semantics.md
+/// sections 5 and 12).
 class LebtRunner
 {
 public:
   /// Load the tree from XML text. Throws LebtError on an unknown leaf (naming it and its line),
-  /// a malformed LEBT port, or an action without a callback in `actions`.
+  /// a malformed port, an action without a callback in `actions`, or annotations that disagree.
   LebtRunner(const std::string& xml_text, ActionRegistry actions, Options options = {})
     : registry_(std::make_unique<ActionRegistry>(std::move(actions)))
     , context_(std::make_unique<Context>())
@@ -775,7 +789,8 @@ public:
   LebtRunner& operator=(LebtRunner&&) = default;
 
   /// Before any event: ticks once with no event when the FSM has no initial event (its initial
-  /// state's action runs), else nothing. Call once after loading and after reset().
+  /// state's action runs), else nothing (a dispatch tree: always the start tick, which runs
+  /// nothing when the machine has an initial event). Call once after loading and after reset().
   StepResult start()
   {
     if(started_)
@@ -791,7 +806,7 @@ public:
     return result();
   }
 
-  /// One macro step for `event` (docs/semantics.md section 5).
+  /// One macro step for `event` (docs/semantics.md section 5; a dispatch tree: section 12).
   StepResult post(const std::string& event)
   {
     if(!started_)
