@@ -207,7 +207,7 @@ def test_partial_start_index_and_foreign_post_condition_are_refused(
     start = re.search(
         r'(<KeepRunningUntilFailure name="start">\s*<DispatchEntry [^>]*_onSuccess=")([^"]*)"', text
     )
-    assert start is not None and ";" in start.group(2)  # 60 states: two digits
+    assert start is not None and ";" in start.group(2)  # 60 states: three digits
     kept = start.group(2).split(";")[0]
     broken = text[: start.start(2)] + kept + text[start.end(2) :]
     line = _load_error(driver, tmp_path, broken)
@@ -215,6 +215,9 @@ def test_partial_start_index_and_foreign_post_condition_are_refused(
     foreign = re.sub(r"<(Switch\d) ", "<\\1 _onFailure=\"fsm_d0:='a'\" ", text, count=1)
     line = _load_error(driver, tmp_path, foreign)
     assert "only a DispatchEntry carries a post-condition" in line and "line 3" in line, line
+    guarded = re.sub(r"<(Switch\d) ", "<\\1 _skipIf=\"fsm_d0=='a'\" ", text, count=1)
+    line = _load_error(driver, tmp_path, guarded)
+    assert "a pre-condition" in line and "line 3" in line, line
 
 
 def test_lebt_and_dispatch_leaves_in_one_tree_are_refused(driver: Path, tmp_path: Path) -> None:
