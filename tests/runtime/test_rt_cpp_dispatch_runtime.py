@@ -277,3 +277,13 @@ def test_callbacks_get_the_state_label_and_its_parameters(driver: Path, tmp_path
         "error: no callback registered for action(s): 'Closing' (state Operating/Closing), "
         "'Emergency' (state Emergency), "
     ), proc.stderr
+
+
+def test_dispatch_leaves_without_an_index_are_refused(driver: Path, tmp_path: Path) -> None:
+    tree = (
+        '<root BTCPP_format="4"><BehaviorTree ID="M">\n<KeepRunningUntilFailure>\n'
+        '<DispatchEntry name="A" state="A" action="a"/>\n</KeepRunningUntilFailure>\n'
+        "</BehaviorTree></root>"
+    )
+    line = _load_error(driver, tmp_path, tree)
+    assert "no Switch reads a state index digit" in line and "line 3" in line, line

@@ -226,3 +226,14 @@ def test_broken_index_annotations_are_located_load_errors() -> None:
     assert info.value.location is not None and info.value.location.line == located(
         broken, 'name="dispatch"'
     )
+
+
+def test_dispatch_leaves_without_an_index_are_refused() -> None:
+    tree = (
+        '<root BTCPP_format="4"><BehaviorTree ID="M">\n<KeepRunningUntilFailure>\n'
+        '<DispatchEntry name="A" state="A" action="a"/>\n</KeepRunningUntilFailure>\n'
+        "</BehaviorTree></root>"
+    )
+    with pytest.raises(InputError, match="no Switch reads a state index digit") as info:
+        load_tree(tree, {"a": print})
+    assert info.value.location is not None and info.value.location.line == 3

@@ -6,8 +6,8 @@ machine that silently stops.
 
 Rules, over the compiled tree of a ``DispatchMachine`` (SubTrees expanded):
 
-- the index switches are the ``Switch`` nodes whose variable is ``fsm_dJ``; each case is one
-  digit ``a``..``g``;
+- the index switches are the ``Switch`` nodes whose variable is ``fsm_dJ`` (there is at least
+  one); each case is one digit ``a``..``g``;
 - a ``DispatchEntry``'s ``_onSuccess`` (already refused elsewhere when not ``KEY:='literal'``
   assignments) writes only index digits: keys ``fsm_dJ`` with ``J`` below the number of digits
   the switches read, values one digit each;
@@ -82,6 +82,13 @@ def check_dispatch_annotations(machine: DispatchMachine) -> None:
                 )
         switches[node.id] = (digit, cases)
         levels = max(levels, digit + 1)
+    if not switches and machine.entries:
+        first = nodes[min(machine.entries)]
+        raise _error(
+            first,
+            f"no Switch reads a state index digit ({{{DIGIT_PREFIX}0}}, ...): a tree of "
+            f"{first.source.type} leaves is the dispatch form, a Switch dispatch over the index",
+        )
     writes: dict[int, list[tuple[int, str]]] = {}
     for nid, pairs in machine.on_success.items():
         items: list[tuple[int, str]] = []

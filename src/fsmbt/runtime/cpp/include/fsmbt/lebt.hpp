@@ -1110,7 +1110,8 @@ private:
   ///  - only a DispatchEntry carries a post-condition, `_onSuccess` alone, made of
   ///    `fsm_dJ:='x'` assignments of index digits x in a..g, J below the digits the Switches
   ///    read; no node carries a pre-condition (either could change the index unseen);
-  ///  - every case of a Switch on `{fsm_dJ}` is one index digit (a..g);
+  ///  - at least one Switch reads an index digit `{fsm_dJ}`, and each of its cases is one
+  ///    index digit (a..g);
   ///  - every index a transition writes is a state's: starting from the start (no digit set),
   ///    each state's case - the node the index Switches reach for its digits - is searched
   ///    for its DispatchEntry leaves, and the index each one writes (the source's digits with
@@ -1184,6 +1185,13 @@ private:
         levels = std::max(levels, digit + 1);
         switches.emplace(node.get(), std::move(info));
       }
+    }
+    if(switches.empty())
+    {
+      throw LebtError(where(entries_.front(), xml_text) + ": dispatch annotations disagree: no " +
+                      "Switch reads a state index digit ({" + kDigitPrefix + "0}, ...): a tree " +
+                      "of DispatchEntry leaves is the dispatch form, a Switch dispatch over the " +
+                      "index");
     }
     for(const auto& [entry, items] : writes)
     {
