@@ -83,11 +83,11 @@ def check_dispatch_annotations(machine: DispatchMachine) -> None:
         switches[node.id] = (digit, cases)
         levels = max(levels, digit + 1)
     if not switches and machine.entries:
-        first = nodes[min(machine.entries)]
+        leaf = nodes[min(machine.entries)]
         raise _error(
-            first,
+            leaf,
             f"no Switch reads a state index digit ({{{DIGIT_PREFIX}0}}, ...): a tree of "
-            f"{first.source.type} leaves is the dispatch form, a Switch dispatch over the index",
+            f"{leaf.source.type} leaves is the dispatch form, a Switch dispatch over the index",
         )
     writes: dict[int, list[tuple[int, str]]] = {}
     for nid, pairs in machine.on_success.items():
