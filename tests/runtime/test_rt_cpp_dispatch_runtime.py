@@ -7,8 +7,9 @@ leaves. Differential: the C++ run of the written tree, fsmbt's own FSM interpret
 the same seeded event sequences (mostly events the state handles, some it ignores, one no
 machine knows); after the start and every event the C++ run must name the state the other two
 are in, run the entry actions ``FSMMachine`` runs, and terminate when they do. Machines: the
-paper's A-J machine (``examples/paper_fsm.json``, an initial event) and generated ones (four
-shapes, with and without an initial event, 8 to 400 states: one to four index digits).
+paper's A-J machine (``examples/paper_fsm.json``, an initial event), generated ones (four
+shapes, with and without an initial event, 8 to 400 states: one to four index digits) and a
+seeded batch of 30 FSMs and 10 HFSMs (flattened by the converter).
 """
 
 from __future__ import annotations
@@ -287,3 +288,23 @@ def test_dispatch_leaves_without_an_index_are_refused(driver: Path, tmp_path: Pa
     )
     line = _load_error(driver, tmp_path, tree)
     assert "no Switch reads a state index digit" in line and "line 3" in line, line
+
+
+def test_a_seeded_batch_of_machines_and_hierarchical_machines_runs_alike(
+    driver: Path, tmp_path: Path
+) -> None:
+    """30 generated FSMs of every shape (2-80 states, an initial event or not) and 10 generated
+    HFSMs (flattened by the converter; states named by their flat paths), 3 sequences each."""
+    from support.conv_hfsm_gen import random_hfsm
+
+    rng = random.Random(2026)
+    machines: list[FSM] = []
+    for k in range(30):
+        shape = ("mixed", "chain", "tree", "loop")[k % 4]
+        n = rng.randint(2, 80)
+        machines.append(random_fsm(f"b{k}", n, shape=shape, start_event=k % 3 == 0))
+    machines += [random_hfsm(seed, parallel=False) for seed in range(10)]
+    steps = sum(
+        _differential(fsm, tmp_path, driver, seed=k, count=3) for k, fsm in enumerate(machines)
+    )
+    assert steps == len(machines) * 3 * 41
