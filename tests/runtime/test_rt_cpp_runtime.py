@@ -277,6 +277,19 @@ def test_cmake_example_builds_and_runs_the_door(driver: Path, tmp_path: Path) ->
     )
     assert run.returncode == 0, run.stderr
     assert run.stdout == printed  # docs/runtime.md shows what it prints
+    # the same program on the door's dispatch form (the default style): the same run
+    door = api.load(REPO / "examples" / "door_hfsm.scxml").model
+    dispatch = tmp_path / "door_dispatch.xml"
+    dispatch.write_text(dumps(convert(door).model, "btcpp"), encoding="utf-8")
+    assert "<DispatchEntry" in dispatch.read_text(encoding="utf-8")
+    run = subprocess.run(
+        [str(build / "lebt_example"), str(dispatch), *documented_args],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert run.returncode == 0, run.stderr
+    assert run.stdout == printed
     run = subprocess.run(
         [
             str(build / "lebt_example"),

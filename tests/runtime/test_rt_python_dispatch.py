@@ -15,6 +15,7 @@
 from __future__ import annotations
 
 import random
+import re
 
 import pytest
 from lxml import etree
@@ -172,3 +173,67 @@ def test_load_errors_are_located() -> None:
         load_tree(bad, {a: print for a in actions}, allow_unused=True)
     assert info.value.location is not None
     assert info.value.location.line == located(bad, "<MoveBase")
+
+
+#: Hand edits of a dispatch tree the load check refuses (docs/semantics.md section 12, "Checked
+#: at load time"): (what, a function of the text giving the broken text and the line of the
+#: edited element, the message).
+def _retarget(text: str, old: str, new: str) -> tuple[str, str]:
+    """Replace the first ``_onSuccess="old"`` whose leaf is not the start transition."""
+    at = text.index(f'_onSuccess="{old}"', text.index("_events"))
+    line_start = text.rindex("\n", 0, at) + 1
+    fragment = text[line_start : text.index("\n", at)].strip()
+    broken = text[:at] + f'_onSuccess="{new}"' + text[at + len(f'_onSuccess="{old}"') :]
+    return broken, fragment.replace(old, new)
+
+
+def test_broken_index_annotations_are_located_load_errors() -> None:
+    fsm = random_fsm(seed=3, n_states=60, shape="tree", start_event=False)
+    text = dispatch_text(fsm)
+    doc = loads(text, "btcpp")
+    actions = {n.attrs["action"]: print for _t, n in doc.nodes() if n.type == "DispatchEntry"}
+    load_tree(text, actions)  # as written: accepted
+    first = re.search(r"_onSuccess=\"(fsm_d0:='([a-g])')\"", text[text.index("_events") :])
+    assert first is not None
+    old, digit = first.group(1), first.group(2)
+    unused = next(d for d in "abcdefg" if d != digit)
+    cases = [
+        ("fsm_d2:='g'", "which no state has"),  # 60 states: d2 is 'a' or 'b'
+        (f"fsm_d0:='{unused}'; fsm_d1:='g'", "but writes the state index .* of "),
+        ("fsm_d0:='h'", "malformed index digit 'h'"),
+        ("fsm_d7:='a'", "no Switch reads that digit"),
+        ("fsm_dx:='a'", "no state index digit"),
+    ]
+    for new, message in cases:
+        broken, fragment = _retarget(text, old, new)
+        with pytest.raises(InputError, match=message) as info:
+            load_tree(broken, actions)
+        assert info.value.location is not None
+        line = located(broken, fragment)
+        # the edited leaf is the one named (or, for one index two states, one of the two)
+        assert info.value.location.line == line or f"line {line})" in str(info.value), new
+    # the start transition writes one digit of two
+    start = re.search(r"name=\"start\">\s*<DispatchEntry [^>]*_onSuccess=\"([^\"]*)\"", text)
+    assert start is not None and ";" in start.group(1)
+    broken = text.replace(start.group(1), start.group(1).split(";")[0], 1)
+    with pytest.raises(InputError, match="from the start, _onSuccess leaves fsm_d1 unset"):
+        load_tree(broken, actions)
+    # an index switch case that is no digit
+    broken = re.sub(r'(<Switch\d name="dispatch"[^>]*case_1=)"a"', r'\1"q"', text, count=1)
+    assert broken != text
+    with pytest.raises(InputError, match="case_1 is the malformed index digit 'q'") as info:
+        load_tree(broken, actions)
+    assert info.value.location is not None and info.value.location.line == located(
+        broken, 'name="dispatch"'
+    )
+
+
+def test_dispatch_leaves_without_an_index_are_refused() -> None:
+    tree = (
+        '<root BTCPP_format="4"><BehaviorTree ID="M">\n<KeepRunningUntilFailure>\n'
+        '<DispatchEntry name="A" state="A" action="a"/>\n</KeepRunningUntilFailure>\n'
+        "</BehaviorTree></root>"
+    )
+    with pytest.raises(InputError, match="no Switch reads a state index digit") as info:
+        load_tree(tree, {"a": print})
+    assert info.value.location is not None and info.value.location.line == 3

@@ -196,9 +196,15 @@ def read_model_text(text: str):
             '<Detect name="DETECT" timeout="2.0" colour="red"/>',
             "attribute 'colour' is not a port of <Detect> in <TreeNodesModel>",
         ),
-        (
+        (  # LEBT leaves mixed with the user's (a tree of LEBT leaves only gets the C++
+            # skeleton of an event-driven machine: tests/runtime/test_rt_skeleton_machine.py)
+            '<Detect name="D" timeout="1"/>'
             '<LebtState name="A" state="A" action="" final="true" exits=""/>',
             "is a leaf of an LEBT",
+        ),
+        (
+            '<Detect name="D" timeout="1"/><DispatchEntry name="A" state="A" action="a"/>',
+            "is the leaf of the dispatch form",
         ),
         ("<AlwaysSuccess/>", "no leaf of its own to implement"),
     ],

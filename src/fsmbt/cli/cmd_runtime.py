@@ -12,7 +12,9 @@ and list the files they wrote.
 
 With MODEL (a BehaviorTree.CPP v4 tree): the migration path's skeleton
 (``fsmbt.runtime.skeleton``) - the tree's leaf classes for the user to fill in, their
-registration or tree builder, and a main. Generated files are rewritten on every run; the
+registration or tree builder, and a main; for the tree of an event-driven machine (the
+dispatch form or an LEBT, ``cpp`` only) the runtime header, one method per state action and a
+main that posts events (``fsmbt.runtime.skeleton.machine``). Generated files are rewritten on every run; the
 user's files (``nodes/``, ``main``, ``CMakeLists.txt``) are written once and never replaced
 (``--force`` only replaces files at generated paths that fsmbt did not write); a changed port
 list is printed. Exit 2 on bad input or a refusal, with one line naming the cause.
@@ -75,11 +77,13 @@ def register(app: typer.Typer) -> None:
     def cpp_command(
         directory: Path = typer.Argument(..., help="where to write (created when missing)"),
         model: Path | None = typer.Argument(
-            None, help="a BehaviorTree.CPP v4 tree: write its leaf classes (the skeleton)"
+            None,
+            help="a BehaviorTree.CPP v4 tree: write its leaf classes (the skeleton); for a "
+            "dispatch or LEBT tree, one method per state action and a main",
         ),
         force: bool = typer.Option(False, "--force", help="replace existing files"),
     ) -> None:
-        """Write the LEBT runtime and a CMake example, or with MODEL the tree's C++ skeleton."""
+        """Write the C++ runtime and a CMake example, or with MODEL the tree's C++ skeleton."""
         if model is not None:
             _skeleton(directory, model, force, "cpp")
             print("build: cmake -S DIR -B DIR/build -DCMAKE_PREFIX_PATH=<behaviortree_cpp prefix>")

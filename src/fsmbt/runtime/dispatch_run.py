@@ -21,9 +21,11 @@ pairing rule explores):
 - Checked when built (``InputError`` naming the leaf and its line): every leaf is a
   ``DispatchEntry`` action (``DispatchMachine``), every ``DispatchEntry`` has a non-empty
   ``state`` port and a well-formed ``params`` port; every node is one the blackboard
-  interpreter models exactly (``OutcomeTree``).
+  interpreter models exactly (``OutcomeTree``); the index annotations agree
+  (``fsmbt.semantics.dispatch_check``: every digit well formed, every index a transition writes
+  a state's, one state per index - docs/semantics.md section 12, "Checked at load time").
 
-Cost: building is O(nodes); a macro step is one tick of the blackboard interpreter,
+Cost: building is O(nodes + reachable states x digits + transitions x digits); a macro step is one tick of the blackboard interpreter,
 O(log7 states + events of the current state / 6) node ticks (each with an O(entries) blackboard
 copy: the snapshot is immutable).
 """
@@ -34,6 +36,7 @@ from dataclasses import dataclass
 
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import InputError
+from fsmbt.semantics.dispatch_check import check_dispatch_annotations
 from fsmbt.semantics.dispatch_runtime import ENTRY, DispatchMachine
 from fsmbt.semantics.lebt.spec import PARAMS_PORT, decode_params
 from fsmbt.semantics.status import NodeStatus
@@ -60,7 +63,7 @@ class DispatchRun:
         Raises:
             InputError: a leaf other than ``DispatchEntry``, a node the interpreter does not
                 model, a ``DispatchEntry`` with an empty ``state`` port or a malformed
-                ``params`` port (each named with its line).
+                ``params`` port, index annotations that disagree (each named with its line).
         """
         self.machine = DispatchMachine(doc, ())
         #: entry key (the leaf's node id, as text) -> the entry, for leaves with an action
@@ -82,6 +85,7 @@ class DispatchRun:
                 ) from None
             if action is not None:
                 self.entries[str(nid)] = Entry(action, state, params)
+        check_dispatch_annotations(self.machine)
         self._at = self.machine.before_start()
         self._state = START
         self.start = START

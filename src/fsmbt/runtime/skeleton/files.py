@@ -120,7 +120,8 @@ def _atomic_write(path: Path, text: str) -> None:
         raise
 
 
-def _read_manifest(directory: Path) -> dict[str, object]:
+def read_manifest(directory: Path) -> dict[str, object]:
+    """The manifest a previous run wrote into ``directory`` (``{}`` when none or unreadable)."""
     path = directory / MANIFEST
     if not path.is_file():
         return {}
@@ -157,7 +158,7 @@ def write_files(
     """
     if directory.exists() and not directory.is_dir():
         raise InputError(f"{directory} exists and is not a folder")
-    old = _read_manifest(directory)
+    old = read_manifest(directory)
     if old and old.get("language") != record["language"]:
         raise InputError(
             f"{directory} holds a {old.get('language')} skeleton; write the "

@@ -13,8 +13,9 @@ Rules (docs/runtime.md, "The migration path"):
   every tree of the document.
 - A leaf that uses an attribute its declared model does not list is an error naming the leaf
   and its line: BehaviorTree.CPP 4.8.2 refuses such a tree at load time.
-- An LEBT (``LebtGuard``/``LebtState`` leaves) is not a skeleton input: it runs on the LEBT
-  runtime (``fsmbt runtime cpp DIR`` without a model), and is refused with that advice.
+- An LEBT (``LebtGuard``/``LebtState`` leaves) or a dispatch tree (``DispatchEntry``) is not a
+  leaf-skeleton input: its leaves are fsmbt's runtime's, and it is refused with that advice
+  (a C++ skeleton of such a tree, every leaf fsmbt's, is ``machine.py``'s).
 - A ROS action or service leaf is declared by an attribute of its ``<TreeNodesModel>`` entry:
   ``ros_action="nav2_msgs/action/NavigateToPose"`` or ``ros_service="std_srvs/srv/Trigger"``
   (ROS 1 spellings ``move_base_msgs/MoveBaseAction`` and ``std_srvs/Trigger`` are accepted).
@@ -31,6 +32,7 @@ from dataclasses import dataclass, field
 from fsmbt.model.bt import BTDocument, BTNode, NodeModel, PortModel
 from fsmbt.model.errors import InputError
 from fsmbt.model.kinds import NodeKind
+from fsmbt.semantics.dispatch_runtime import ENTRY
 from fsmbt.semantics.lebt.spec import GUARD_TYPE, STATE_TYPE
 
 #: ``<TreeNodesModel>`` attributes that declare a ROS interface, and the kind each declares.
@@ -174,6 +176,16 @@ def leaf_kinds(doc: BTDocument) -> list[LeafKind]:
         while stack:
             node = stack.pop()
             stack.extend(reversed(node.children))
+            if node.type == ENTRY:
+                raise InputError(
+                    f"<{ENTRY}> is the leaf of the dispatch form (a tree written by fsmbt "
+                    "convert for an event-driven machine): run it with fsmbt's runtime (fsmbt "
+                    "runtime python DIR, no model; fsmbt runtime cpp DIR MODEL writes its C++ "
+                    "skeleton when every leaf is one), or convert the machine with the "
+                    "structured style for a skeleton of your own leaves",
+                    location=node.location,
+                    element=f"<{node.type}> '{node.label}'",
+                )
             if node.type in (GUARD_TYPE, STATE_TYPE):
                 raise InputError(
                     f"<{node.type}> is a leaf of an LEBT (a tree written by fsmbt convert "

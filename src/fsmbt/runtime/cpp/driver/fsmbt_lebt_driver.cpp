@@ -28,9 +28,10 @@
 //                    JSON line {"entered":STATE,"params":{...}} before its step's line
 //   --table          run the same FSM as a plain transition table read off the tree's guards and
 //                    states (no behavior tree ticks): the baseline of benchmarks/bench_runtime.py
-//   --dispatch       the tree is the dispatch form of `fsmbt convert --style dispatch`
-//                    (docs/semantics.md section 12): a Switch dispatch over a state index on the
-//                    blackboard; each step writes {event} and ticks the root once
+//   --dispatch       require the dispatch form of `fsmbt convert --style dispatch`
+//                    (docs/semantics.md section 12; LebtRunner detects the form by itself: a tree
+//                    of DispatchEntry leaves runs as one, each step writes {event} and ticks the
+//                    root once); an LEBT is then refused
 //   --bench R        read all of stdin first, replay it R times without printing steps, then print
 //                    one JSON object: {"mode","steps","seconds","ns_per_step","cpu_seconds",
 //                    "cpu_ns_per_step","leaf_ticks","actions"} (wall clock and process CPU time)
@@ -229,88 +230,6 @@ private:
   int init_target_ = -1;
   int current_ = -1;
   std::vector<std::string> actions_run_;
-};
-
-/// The dispatch form's leaf: records the entered state and its action, returns SUCCESS.
-struct DispatchLog
-{
-  std::vector<std::string> actions;
-  const std::string* state = nullptr;
-};
-
-class DispatchEntryNode : public BT::SyncActionNode
-{
-public:
-  DispatchEntryNode(const std::string& name, const BT::NodeConfig& config, DispatchLog* log)
-    : BT::SyncActionNode(name, config), log_(log)
-  {
-    getInput("state", state_);
-    getInput("action", action_);
-  }
-
-  static BT::PortsList providedPorts()
-  {
-    return { BT::InputPort<std::string>("state"), BT::InputPort<std::string>("action") };
-  }
-
-  BT::NodeStatus tick() override
-  {
-    if(!action_.empty())
-    {
-      log_->actions.push_back(action_);
-    }
-    log_->state = &state_;
-    return BT::NodeStatus::SUCCESS;
-  }
-
-private:
-  DispatchLog* log_;
-  std::string state_;
-  std::string action_;
-};
-
-/// Runs a dispatch tree (docs/semantics.md section 12) in BehaviorTree.CPP: post(event) writes
-/// the blackboard entry `event` and ticks the root exactly once.
-class DispatchRunner
-{
-public:
-  explicit DispatchRunner(const std::string& path)
-  {
-    factory_.registerNodeType<DispatchEntryNode>("DispatchEntry", &log_);
-    tree_ = factory_.createTreeFromFile(path);
-    blackboard_ = tree_.rootBlackboard();
-  }
-
-  fsmbt::lebt::StepResult start()
-  {
-    tree_.haltTree();
-    for(const auto& key : blackboard_->getKeys())
-    {
-      blackboard_->unset(std::string(key));
-    }
-    log_ = DispatchLog{};
-    return tick();
-  }
-
-  fsmbt::lebt::StepResult post(const std::string& event)
-  {
-    log_.actions.clear();
-    blackboard_->set("event", event);
-    return tick();
-  }
-
-private:
-  fsmbt::lebt::StepResult tick()
-  {
-    const BT::NodeStatus status = tree_.tickExactlyOnce();
-    return { log_.actions, status == BT::NodeStatus::SUCCESS,
-             log_.state != nullptr ? *log_.state : std::string("start") };
-  }
-
-  BT::BehaviorTreeFactory factory_;
-  DispatchLog log_;
-  BT::Tree tree_;
-  BT::Blackboard::Ptr blackboard_;
 };
 
 struct Arguments
@@ -554,7 +473,7 @@ void bench(Runner& runner, fsmbt::lebt::LebtRunner* lebt, const std::vector<std:
     return static_cast<double>(ts.tv_sec) + static_cast<double>(ts.tv_nsec) * 1e-9;
   };
   std::size_t sink = 0;  // keeps the results observable
-  const std::uint64_t ticks_before = lebt != nullptr && mode[0] == 'b' ? lebt->leafTicks() : 0;
+  const std::uint64_t ticks_before = lebt != nullptr && mode[0] != 't' ? lebt->leafTicks() : 0;
   for(long r = 0; r < repeat; ++r)
   {
     if(lebt != nullptr)
@@ -598,7 +517,7 @@ void bench(Runner& runner, fsmbt::lebt::LebtRunner* lebt, const std::vector<std:
   steps *= repeat;
   const double seconds = std::chrono::duration<double>(spent).count();
   const std::uint64_t ticks =
-      (lebt != nullptr && mode[0] == 'b' ? lebt->leafTicks() : 0) - ticks_before;
+      (lebt != nullptr && mode[0] != 't' ? lebt->leafTicks() : 0) - ticks_before;
   const double per = steps ? 1e9 / static_cast<double>(steps) : 0.0;
   std::printf("{\"mode\":\"%s\",\"steps\":%ld,\"seconds\":%.9f,\"ns_per_step\":%.1f,"
               "\"cpu_seconds\":%.9f,\"cpu_ns_per_step\":%.1f,\"leaf_ticks\":%llu,"
@@ -818,28 +737,6 @@ int main(int argc, char** argv)
     return 0;
   }
   const Arguments args = parse(argc, argv);
-  if(args.dispatch)
-  {
-    try
-    {
-      DispatchRunner runner(args.tree);
-      if(args.bench > 0)
-      {
-        bench(runner, nullptr, readLines(), args.bench, "dispatch");
-      }
-      else
-      {
-        interactive(runner, nullptr);
-      }
-    }
-    catch(const std::exception& exc)
-    {
-      std::fflush(stdout);
-      std::fprintf(stderr, "error: %s\n", exc.what());
-      return 1;
-    }
-    return 0;
-  }
   try
   {
     if(args.scripted)
@@ -881,6 +778,11 @@ int main(int argc, char** argv)
     options.tick = args.tick;
     fsmbt::lebt::LebtRunner runner =
         fsmbt::lebt::LebtRunner::fromFile(args.tree, std::move(actions), options);
+    if(args.dispatch && runner.form() != fsmbt::lebt::Form::Dispatch)
+    {
+      throw fsmbt::lebt::LebtError("--dispatch: " + args.tree +
+                                   " is an LEBT, not the dispatch form (DispatchEntry leaves)");
+    }
     Loggers loggers(runner.tree(), args);  // after the runner: destroyed (and written) first
     if(args.table)
     {
@@ -896,7 +798,8 @@ int main(int argc, char** argv)
     }
     else if(args.bench > 0)
     {
-      bench(runner, &runner, readLines(), args.bench, "bt");
+      const bool dispatch = runner.form() == fsmbt::lebt::Form::Dispatch;
+      bench(runner, &runner, readLines(), args.bench, dispatch ? "dispatch" : "bt");
     }
     else
     {

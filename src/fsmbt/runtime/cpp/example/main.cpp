@@ -1,11 +1,13 @@
-// Minimal program running an LEBT written by `fsmbt convert` (here: the door of
-// examples/door_hfsm.scxml) in BehaviorTree.CPP v4 with the user's own actions.
+// Minimal program running a tree written by `fsmbt convert` from a state machine (here: the door
+// of examples/door_hfsm.scxml) in BehaviorTree.CPP v4 with the user's own actions: the dispatch
+// form (the default) or an LEBT (--style lebt); LebtRunner tells them apart.
 //
 //   lebt_example TREE.xml EVENT...
 //
 // Each state's action calls the function registered under the action's name, once per entry of
-// the state. Loading fails (exit 1, one line) when the tree uses a leaf other than LebtGuard /
-// LebtState or names an action that has no registered function.
+// the state. Loading fails (exit 1, one line) when the tree uses a leaf other than fsmbt's
+// (LebtGuard / LebtState, or DispatchEntry), names an action that has no registered function,
+// or carries annotations a hand edit broke.
 #include <fsmbt/lebt.hpp>
 
 #include <iostream>

@@ -1,8 +1,13 @@
-// fsmbt LEBT runtime for BehaviorTree.CPP v4 (header-only; C++17).
+// fsmbt runtime for BehaviorTree.CPP v4 (header-only; C++17).
 //
-// Runs the loop-execution behavior trees (LEBT) that `fsmbt convert` writes from a state
-// machine: their leaves are `LebtGuard` and `LebtState`, their meaning is fsmbt's
-// docs/semantics.md section 5 ("The LEBT protocol"), and this file follows it literally:
+// Runs the two forms of tree `fsmbt convert` writes from an event-driven state machine, through
+// one API (LebtRunner, ActionRegistry, StepResult), the form told from the tree's leaves:
+//  - the dispatch form (the default style; docs/semantics.md section 12): a Switch dispatch over
+//    a state index on the blackboard, one leaf type, `DispatchEntry` - see "the dispatch form"
+//    below, and LebtRunner::checkDispatch for the annotations checked at load time;
+//  - the loop-execution behavior tree (LEBT, `--style lebt`): leaves `LebtGuard` and
+//    `LebtState`, meaning docs/semantics.md section 5 ("The LEBT protocol"), which this file
+//    follows literally:
 //
 //  - blackboard: `state` (starts at the start pseudo-state) and `event` ("" = none). Both live in
 //    a `fsmbt::lebt::Context` owned by the runner and shared by every leaf of the tree, SubTrees
@@ -34,13 +39,20 @@
 //  - terminated: the last root result is SUCCESS and `state` is no longer the start
 //    pseudo-state.
 //
+// The dispatch form (section 12): `DispatchEntry` runs its action's callback (state label and
+// params, as LebtState) and returns SUCCESS, after which BehaviorTree.CPP runs its `_onSuccess`
+// post-condition writing the entered state's index digits; start() ticks once with `event`
+// unset, post(e) writes the blackboard entry `event` and ticks once; terminated = last root
+// result SUCCESS. A step ticks O(log7 states + out-degree / 6) nodes.
+//
 // Load-time errors (fsmbt::lebt::LebtError, derived from std::runtime_error): a leaf the runtime
 // does not define (BehaviorTree.CPP's "Error at line N: -> Node not recognized: X"), a port that
 // is a blackboard reference or malformed, an action name with no registered callback, and LEBT
 // annotations that contradict each other (a guard pair whose event is not an exit of its source
 // state, an exit no guard pair takes, a pair source that is neither a state nor the start
-// pseudo-state: hand edits that would otherwise stop the machine silently) - all raised by the
-// LebtRunner constructor, never at tick time, naming the node and its line.
+// pseudo-state: hand edits that would otherwise stop the machine silently), dispatch annotations
+// that disagree (a malformed index digit, an index no state has, ...: checkDispatch) - all
+// raised by the LebtRunner constructor, never at tick time, naming the node and its line.
 //
 // Cost: a guard tick is two hash look-ups, a state tick one. A macro step ticks from the root
 // down to the running leaf (BehaviorTree.CPP resumes each Sequence at its running child, but every
@@ -87,7 +99,8 @@ inline constexpr const char* kStateType = "LebtState";
 inline constexpr const char* kDefaultStart = "__start__";
 inline constexpr const char* kRuntimeVersion = "fsmbt-lebt 1.0";
 
-/// Every load-time problem of an LEBT: unknown leaves, bad ports, missing action callbacks.
+/// Every load-time problem of a tree (LEBT or dispatch form): unknown leaves, bad ports, missing
+/// action callbacks, annotations that disagree.
 class LebtError : public std::runtime_error
 {
 public:
@@ -466,13 +479,185 @@ private:
   const ActionCallback* callback_ = nullptr;
 };
 
-/// Register `LebtGuard` and `LebtState` in `factory`; their leaves share `context`, which must
-/// outlive every tree the factory creates. LebtRunner calls this; call it yourself to mix LEBT
-/// leaves with your own nodes in one factory.
+// -- the dispatch form (docs/semantics.md section 12) ------------------------------------------
+
+inline constexpr const char* kDispatchType = "DispatchEntry";
+/// The blackboard entry holding the pending event of a dispatch tree.
+inline constexpr const char* kEventKey = "event";
+/// The dispatch form's state index digits: entries `fsm_d0` (least significant) .. and the
+/// letters a dispatch `Switch` compares them with.
+inline constexpr const char* kDigitPrefix = "fsm_d";
+inline constexpr const char* kDigitLetters = "abcdefg";
+
+namespace detail {
+
+/// The digit number J of a blackboard key `fsm_dJ` (or of a port value `{fsm_dJ}` when
+/// `braced`), or -1 when it is not one.
+inline int digitNumber(std::string_view text, bool braced)
+{
+  if(braced)
+  {
+    if(text.size() < 2 || text.front() != '{' || text.back() != '}')
+    {
+      return -1;
+    }
+    text = text.substr(1, text.size() - 2);
+  }
+  const std::string_view prefix(kDigitPrefix);
+  if(text.size() <= prefix.size() || text.substr(0, prefix.size()) != prefix ||
+     text.size() - prefix.size() > 4)
+  {
+    return -1;
+  }
+  int number = 0;
+  for(char ch : text.substr(prefix.size()))
+  {
+    if(ch < '0' || ch > '9')
+    {
+      return -1;
+    }
+    number = number * 10 + (ch - '0');
+  }
+  return number;
+}
+
+/// True when `value` is one index digit (one of kDigitLetters).
+inline bool isDigitLetter(std::string_view value)
+{
+  return value.size() == 1 && std::string_view(kDigitLetters).find(value[0]) != std::string::npos;
+}
+
+/// The `KEY:='literal'` assignments of a DispatchEntry's `_onSuccess` (joined by `;`, the one
+/// script form docs/semantics.md section 12 models), as (digit number, letter) pairs, in order.
+/// Throws std::invalid_argument naming the first item that is no such assignment, writes a key
+/// that is no index digit, or a value that is no index digit (one of a..g).
+inline std::vector<std::pair<int, char>> decodeDigitWrites(std::string_view code)
+{
+  std::vector<std::pair<int, char>> writes;
+  auto trim = [](std::string_view text) {
+    const std::size_t first = text.find_first_not_of(" \t\r\n");
+    if(first == std::string_view::npos)
+    {
+      return std::string_view();
+    }
+    return text.substr(first, text.find_last_not_of(" \t\r\n") - first + 1);
+  };
+  std::size_t at = 0;
+  while(at <= code.size())
+  {
+    const std::size_t end = std::min(code.find(';', at), code.size());
+    const std::string_view item = trim(code.substr(at, end - at));
+    at = end + 1;
+    if(item.empty())
+    {
+      continue;
+    }
+    const std::size_t eq = item.find('=');
+    if(eq == std::string_view::npos)
+    {
+      throw std::invalid_argument("'" + std::string(item) + "' is no KEY:='digit' assignment");
+    }
+    std::string_view key = trim(item.substr(0, eq));
+    if(!key.empty() && key.back() == ':')
+    {
+      key = trim(key.substr(0, key.size() - 1));
+    }
+    std::string_view value = trim(item.substr(eq + 1));
+    if(value.size() < 2 || value.front() != '\'' || value.back() != '\'')
+    {
+      throw std::invalid_argument("'" + std::string(item) +
+                                  "' assigns no quoted literal (KEY:='digit')");
+    }
+    value = value.substr(1, value.size() - 2);
+    const int digit = digitNumber(key, false);
+    if(digit < 0)
+    {
+      throw std::invalid_argument("'" + std::string(item) + "' writes '" + std::string(key) +
+                                  "', which is no state index digit (" + kDigitPrefix + "0, " +
+                                  kDigitPrefix + "1, ...)");
+    }
+    if(!isDigitLetter(value))
+    {
+      throw std::invalid_argument("'" + std::string(item) + "' writes the malformed index digit '" +
+                                  std::string(value) + "' (a digit is one of the letters " +
+                                  kDigitLetters + ")");
+    }
+    writes.emplace_back(digit, value[0]);
+  }
+  return writes;
+}
+
+}  // namespace detail
+
+/// `DispatchEntry`, the dispatch form's one leaf: runs the entered state's action (the user's
+/// callback registered under its `action` port, called with the state's label and parameters)
+/// and returns SUCCESS; BehaviorTree.CPP then runs its `_onSuccess` post-condition, which writes
+/// the entered state's index digits (docs/semantics.md section 12).
+class DispatchEntry : public BT::SyncActionNode
+{
+public:
+  DispatchEntry(const std::string& name, const BT::NodeConfig& config, Context* context)
+    : BT::SyncActionNode(name, config), context_(context)
+  {
+    state_ = detail::literalPort(config, name, kDispatchType, "state");
+    action_ = detail::literalPort(config, name, kDispatchType, "action");
+    try
+    {
+      params_ = decodeParams(detail::literalPort(config, name, kDispatchType, "params"));
+    }
+    catch(const std::invalid_argument& exc)
+    {
+      throw LebtError(std::string("<DispatchEntry name=\"") + name + "\"> (" + config.path +
+                      "): port 'params': " + exc.what());
+    }
+  }
+
+  static BT::PortsList providedPorts()
+  {
+    return { BT::InputPort<std::string>("state", "the FSM state entered"),
+             BT::InputPort<std::string>("action", "the state's action (empty = none)"),
+             BT::InputPort<std::string>("params", "the state's parameters, name=value;...") };
+  }
+
+  const std::string& stateName() const { return state_; }
+  const std::string& actionName() const { return action_; }
+  const Parameters& parameters() const { return params_; }
+
+  /// Bind the user's callback (done by LebtRunner at load time; nullptr = no action).
+  void bind(const ActionCallback* callback) { callback_ = callback; }
+
+protected:
+  BT::NodeStatus tick() override
+  {
+    ++context_->leaf_ticks;
+    if(!action_.empty())
+    {
+      context_->actions_run.push_back(action_);
+      if(callback_ != nullptr)
+      {
+        (*callback_)(state_, params_);
+      }
+    }
+    context_->state = state_;
+    return BT::NodeStatus::SUCCESS;
+  }
+
+private:
+  Context* context_;
+  std::string state_;
+  std::string action_;
+  Parameters params_;
+  const ActionCallback* callback_ = nullptr;
+};
+
+/// Register `LebtGuard`, `LebtState` and `DispatchEntry` in `factory`; their leaves share
+/// `context`, which must outlive every tree the factory creates. LebtRunner calls this; call it
+/// yourself to mix fsmbt's leaves with your own nodes in one factory.
 inline void registerLebtNodes(BT::BehaviorTreeFactory& factory, Context& context)
 {
   factory.registerNodeType<LebtGuard>(kGuardType, &context);
   factory.registerNodeType<LebtState>(kStateType, &context);
+  factory.registerNodeType<DispatchEntry>(kDispatchType, &context);
 }
 
 /// What one macro step (or the start) did.
@@ -491,7 +676,8 @@ inline const std::unordered_set<std::string>& neverWakeUp()
   static const std::unordered_set<std::string> types = {
     kGuardType,  kStateType,      "Sequence",      "Fallback",     "ReactiveSequence",
     "ReactiveFallback", "SubTree", "Inverter",     "ForceSuccess", "ForceFailure",
-    "AlwaysSuccess", "AlwaysFailure"
+    "AlwaysSuccess", "AlwaysFailure", kDispatchType, "Switch2", "Switch3", "Switch4",
+    "Switch5", "Switch6", "KeepRunningUntilFailure", "Script"
   };
   return types;
 }
@@ -504,22 +690,34 @@ enum class TickMode
   ExactlyOnce,  ///< always tickExactlyOnce()
 };
 
+/// The two forms of tree `fsmbt convert` writes for an event-driven machine; LebtRunner tells
+/// them apart by their leaves.
+enum class Form
+{
+  Lebt,      ///< LebtGuard / LebtState leaves (docs/semantics.md section 5; `--style lebt`)
+  Dispatch,  ///< DispatchEntry leaves under a Switch dispatch (section 12; the default style)
+};
+
+/// The name `state()` reports before a dispatch tree entered its first state.
+inline constexpr const char* kDispatchStart = "start";
+
 /// Options of LebtRunner.
 struct Options
 {
   TickMode tick = TickMode::Auto;
 
   /// The start pseudo-state; default: the one guard source that is not a state, else
-  /// "__start__" (docs/semantics.md section 5).
+  /// "__start__" (docs/semantics.md section 5); for a dispatch tree "start".
   std::optional<std::string> start;
 };
 
-/// Loads an LEBT and runs it macro step by macro step (docs/semantics.md section 5).
+/// Loads an LEBT or a dispatch tree and runs it macro step by macro step (docs/semantics.md
+/// sections 5 and 12).
 class LebtRunner
 {
 public:
   /// Load the tree from XML text. Throws LebtError on an unknown leaf (naming it and its line),
-  /// a malformed LEBT port, or an action without a callback in `actions`.
+  /// a malformed port, an action without a callback in `actions`, or annotations that disagree.
   LebtRunner(const std::string& xml_text, ActionRegistry actions, Options options = {})
     : registry_(std::make_unique<ActionRegistry>(std::move(actions)))
     , context_(std::make_unique<Context>())
@@ -546,6 +744,16 @@ public:
       throw LebtError(text);
     }
     collectLeaves(xml_text);
+    if(form_ == Form::Dispatch)
+    {
+      start_ = options.start ? *options.start : std::string(kDispatchStart);
+      checkDispatch(xml_text);
+      blackboard_ = tree_.rootBlackboard();
+      context_->state = start_;
+      exactly_once_ = options.tick == TickMode::ExactlyOnce ||
+                      (options.tick == TickMode::Auto && never_wakes_up_);
+      return;
+    }
     start_ = options.start ? *options.start : inferStart();
     for(const LebtGuard* guard : guards_)
     {
@@ -581,7 +789,8 @@ public:
   LebtRunner& operator=(LebtRunner&&) = default;
 
   /// Before any event: ticks once with no event when the FSM has no initial event (its initial
-  /// state's action runs), else nothing. Call once after loading and after reset().
+  /// state's action runs), else nothing (a dispatch tree: always the start tick, which runs
+  /// nothing when the machine has an initial event). Call once after loading and after reset().
   StepResult start()
   {
     if(started_)
@@ -590,14 +799,14 @@ public:
     }
     started_ = true;
     context_->actions_run.clear();
-    if(init_on_start_)
+    if(init_on_start_ || form_ == Form::Dispatch)
     {
-      tick();
+      tick();  // a dispatch tree's start tick: `event` unset, the start case runs
     }
     return result();
   }
 
-  /// One macro step for `event` (docs/semantics.md section 5).
+  /// One macro step for `event` (docs/semantics.md section 5; a dispatch tree: section 12).
   StepResult post(const std::string& event)
   {
     if(!started_)
@@ -609,6 +818,15 @@ public:
       throw LebtError("LebtRunner::post(): an event name cannot be empty");
     }
     context_->actions_run.clear();
+    if(form_ == Form::Dispatch)
+    {
+      // docs/semantics.md section 12: write `event`, tick once. The entry then keeps the event
+      // until the next post() overwrites it; nothing ticks in between, so that is the same as
+      // unsetting it (reset() does unset it), without re-creating the entry every step.
+      blackboard_->set(kEventKey, event);
+      tick();
+      return result();
+    }
     context_->event = event;
     BT::NodeStatus status = tick();
     if(status == BT::NodeStatus::SUCCESS && !context_->event.empty())
@@ -623,6 +841,13 @@ public:
   void reset()
   {
     tree_.haltTree();
+    if(form_ == Form::Dispatch)
+    {
+      for(const std::string& key : blackboardKeys())
+      {
+        blackboard_->unset(key);
+      }
+    }
     context_->state = start_;
     context_->event.clear();
     context_->actions_run.clear();
@@ -630,11 +855,16 @@ public:
     started_ = false;
   }
 
-  /// Root SUCCESS and the start pseudo-state left: the FSM is in a final state.
+  /// Root SUCCESS and the start pseudo-state left: the FSM is in a final state (a dispatch
+  /// tree: root SUCCESS, docs/semantics.md section 12).
   bool terminated() const
   {
-    return last_ == BT::NodeStatus::SUCCESS && context_->state != start_;
+    return last_ == BT::NodeStatus::SUCCESS &&
+           (form_ == Form::Dispatch || context_->state != start_);
   }
+
+  /// Which form the loaded tree is.
+  Form form() const { return form_; }
 
   const std::string& state() const { return context_->state; }
   const std::string& startState() const { return start_; }
@@ -649,12 +879,21 @@ public:
   /// Every LebtGuard / LebtState of the tree (SubTree instances included).
   const std::vector<const LebtGuard*>& guards() const { return guards_; }
   const std::vector<const LebtState*>& states() const { return state_leaves_; }
+  /// Every DispatchEntry of a dispatch tree.
+  const std::vector<const DispatchEntry*>& entries() const { return entries_; }
 
   /// The distinct non-empty action names the tree's states run.
   std::vector<std::string> actionNames() const
   {
     std::set<std::string> names;
     for(const LebtState* leaf : state_leaves_)
+    {
+      if(!leaf->actionName().empty())
+      {
+        names.insert(leaf->actionName());
+      }
+    }
+    for(const DispatchEntry* leaf : entries_)
     {
       if(!leaf->actionName().empty())
       {
@@ -710,25 +949,77 @@ private:
                                            text.begin() + static_cast<std::ptrdiff_t>(first), '\n'));
   }
 
+  /// 1-based line of the `occurrence`-th (from 0) element `<tag ...>` of `text` whose attributes
+  /// hold name="`name`" (a dispatch tree names every transition into a state by the state, so
+  /// several leaves share a name); lineOf's answer when there are fewer.
+  static int lineOfNth(const std::string& text, const std::string& tag, const std::string& name,
+                       int occurrence)
+  {
+    const std::string open = "<" + tag;
+    const std::string named = "name=\"" + name + "\"";
+    int seen = 0;
+    for(std::size_t at = text.find(open); at != std::string::npos; at = text.find(open, at + 1))
+    {
+      const std::size_t after = at + open.size();
+      if(after < text.size() && std::string(" \t\r\n/>").find(text[after]) == std::string::npos)
+      {
+        continue;
+      }
+      const std::size_t end = text.find('>', after);
+      if(text.substr(after, end == std::string::npos ? std::string::npos : end - after)
+             .find(named) == std::string::npos)
+      {
+        continue;
+      }
+      if(seen++ == occurrence)
+      {
+        return 1 + static_cast<int>(std::count(
+                       text.begin(), text.begin() + static_cast<std::ptrdiff_t>(at), '\n'));
+      }
+    }
+    return lineOf(text, tag, name);
+  }
+
+  /// `<Type name="..."> (path, line N)`: a node as load errors name it.
+  std::string where(const BT::TreeNode* node, const std::string& xml_text) const
+  {
+    auto it = occurrence_.find(node);
+    const std::string& type = node->registrationName();
+    const int line = lineOfNth(xml_text, type, node->name(), it == occurrence_.end() ? 0 : it->second);
+    return "<" + type + " name=\"" + node->name() + "\"> (" + node->fullPath() +
+           (line > 0 ? ", line " + std::to_string(line) : "") + ")";
+  }
+
   void collectLeaves(const std::string& xml_text)
   {
     std::map<std::string, std::vector<std::string>> missing;  // action -> states
+    std::map<std::pair<std::string, std::string>, int> occurrences;  // (type, name) -> count
+    auto need = [&](const std::string& action, const std::string& state) {
+      const ActionCallback* callback = registry_->find(action);
+      std::vector<std::string>& states = missing[action];
+      if(callback == nullptr && std::find(states.begin(), states.end(), state) == states.end())
+      {
+        states.push_back(state);  // once per state: a dispatch tree enters one from many places
+      }
+      return callback;
+    };
     for(const auto& subtree : tree_.subtrees)
     {
       for(const BT::TreeNode::Ptr& node : subtree->nodes)
       {
         const BT::NodeType type = node->type();
         const std::string& id = node->registrationName();
+        occurrence_[node.get()] = occurrences[{ id, node->name() }]++;
         never_wakes_up_ = never_wakes_up_ && neverWakeUp().count(id) != 0;
         if((type == BT::NodeType::ACTION || type == BT::NodeType::CONDITION) &&
-           id != kGuardType && id != kStateType && id != "AlwaysSuccess" &&
-           id != "AlwaysFailure")
+           id != kGuardType && id != kStateType && id != kDispatchType &&
+           id != "AlwaysSuccess" && id != "AlwaysFailure")
         {
           const int line = lineOf(xml_text, id, node->name());
           throw LebtError("leaf <" + id + " name=\"" + node->name() + "\"> (" +
                           node->fullPath() + (line > 0 ? ", line " + std::to_string(line) : "") +
-                          ") is not an LEBT leaf: this runtime runs only LebtGuard and "
-                          "LebtState leaves");
+                          ") is not an LEBT leaf: this runtime runs LebtGuard and LebtState "
+                          "leaves (an LEBT) or DispatchEntry leaves (the dispatch form)");
         }
         if(auto* guard = dynamic_cast<LebtGuard*>(node.get()))
         {
@@ -737,18 +1028,37 @@ private:
         else if(auto* leaf = dynamic_cast<LebtState*>(node.get()))
         {
           state_leaves_.push_back(leaf);
-          if(leaf->actionName().empty())
+          if(!leaf->actionName().empty())
           {
-            continue;
+            leaf->bind(need(leaf->actionName(), leaf->stateName()));
           }
-          const ActionCallback* callback = registry_->find(leaf->actionName());
-          if(callback == nullptr)
+        }
+        else if(auto* entry = dynamic_cast<DispatchEntry*>(node.get()))
+        {
+          entries_.push_back(entry);
+          if(!entry->actionName().empty())
           {
-            missing[leaf->actionName()].push_back(leaf->stateName());
+            entry->bind(need(entry->actionName(), entry->stateName()));
           }
-          leaf->bind(callback);
         }
       }
+    }
+    if(!entries_.empty())
+    {
+      if(!guards_.empty() || !state_leaves_.empty())
+      {
+        const BT::TreeNode* lebt = guards_.empty() ?
+                                       static_cast<const BT::TreeNode*>(state_leaves_.front()) :
+                                       static_cast<const BT::TreeNode*>(guards_.front());
+        throw LebtError(where(lebt, xml_text) + " and " + where(entries_.front(), xml_text) +
+                        ": a tree is an LEBT (LebtGuard/LebtState) or the dispatch form "
+                        "(DispatchEntry), not both");
+      }
+      form_ = Form::Dispatch;
+    }
+    for(auto it = missing.begin(); it != missing.end();)
+    {
+      it = it->second.empty() ? missing.erase(it) : std::next(it);
     }
     if(!missing.empty())
     {
@@ -763,10 +1073,247 @@ private:
       }
       throw LebtError(text + "; register each with ActionRegistry::add (or addFallback)");
     }
-    if(state_leaves_.empty())
+    if(state_leaves_.empty() && entries_.empty())
     {
-      throw LebtError("the tree has no LebtState leaf: it is not an LEBT written by fsmbt");
+      throw LebtError("the tree has no LebtState or DispatchEntry leaf: it is not a tree "
+                      "`fsmbt convert` wrote from a state machine");
     }
+  }
+
+  /// The children of `node` (a control's, a decorator's or SubTree's one; none for a leaf).
+  static std::vector<const BT::TreeNode*> childrenOf(const BT::TreeNode* node)
+  {
+    if(const auto* control = dynamic_cast<const BT::ControlNode*>(node))
+    {
+      return { control->children().begin(), control->children().end() };
+    }
+    if(const auto* decorator = dynamic_cast<const BT::DecoratorNode*>(node))
+    {
+      if(decorator->child() != nullptr)
+      {
+        return { decorator->child() };
+      }
+    }
+    return {};
+  }
+
+  /// A `Switch` on an index digit `{fsm_dJ}`: its digit and its case letters, in order.
+  struct IndexSwitch
+  {
+    int digit = 0;
+    std::string cases;
+  };
+
+  /// The dispatch tree's annotations agree (docs/semantics.md section 12), checked on the
+  /// loaded tree, never at tick time; a LebtError names the first node that disagrees, with its
+  /// line:
+  ///  - only a DispatchEntry carries a post-condition, `_onSuccess` alone, made of
+  ///    `fsm_dJ:='x'` assignments of index digits x in a..g, J below the digits the Switches
+  ///    read; no node carries a pre-condition (either could change the index unseen);
+  ///  - at least one Switch reads an index digit `{fsm_dJ}`, and each of its cases is one
+  ///    index digit (a..g);
+  ///  - every index a transition writes is a state's: starting from the start (no digit set),
+  ///    each state's case - the node the index Switches reach for its digits - is searched
+  ///    for its DispatchEntry leaves, and the index each one writes (the source's digits with
+  ///    its `_onSuccess` applied) must set every digit and lead through the index Switches to a
+  ///    state's case, not to an `AlwaysFailure` (a padding case or an unused default) or back to
+  ///    the start case; and every leaf writing one index names the same `state` (one index,
+  ///    one state).
+  /// Cost: O(nodes + reachable states x digits + transitions x digits).
+  void checkDispatch(const std::string& xml_text)
+  {
+    std::unordered_map<const BT::TreeNode*, IndexSwitch> switches;
+    std::unordered_map<const DispatchEntry*, std::vector<std::pair<int, char>>> writes;
+    int levels = 0;
+    for(const auto& subtree : tree_.subtrees)
+    {
+      for(const BT::TreeNode::Ptr& node : subtree->nodes)
+      {
+        const BT::NodeConfig& config = std::as_const(*node).config();
+        const auto* entry = dynamic_cast<const DispatchEntry*>(node.get());
+        if(!config.pre_conditions.empty())
+        {
+          throw LebtError(where(node.get(), xml_text) + ": a pre-condition (_skipIf, " +
+                          "_successIf, ...) in a dispatch tree is not modelled: it could " +
+                          "change the state index unseen");
+        }
+        for(const auto& [kind, code] : config.post_conditions)
+        {
+          if(entry == nullptr || kind != BT::PostCond::ON_SUCCESS)
+          {
+            throw LebtError(where(node.get(), xml_text) + ": in a dispatch tree only a " +
+                            "DispatchEntry carries a post-condition, _onSuccess");
+          }
+          try
+          {
+            writes[entry] = detail::decodeDigitWrites(code);
+          }
+          catch(const std::invalid_argument& exc)
+          {
+            throw LebtError(where(node.get(), xml_text) +
+                            ": dispatch annotations disagree: _onSuccess " + exc.what());
+          }
+        }
+        const std::string& id = node->registrationName();
+        if(id.rfind("Switch", 0) != 0)
+        {
+          continue;
+        }
+        auto variable = config.input_ports.find("variable");
+        const int digit = variable == config.input_ports.end() ?
+                              -1 :
+                              detail::digitNumber(variable->second, true);
+        if(digit < 0)
+        {
+          continue;  // a Switch on {event}
+        }
+        IndexSwitch info{ digit, {} };
+        const std::size_t cases = childrenOf(node.get()).size() - 1;
+        for(std::size_t k = 1; k <= cases; ++k)
+        {
+          auto value = config.input_ports.find("case_" + std::to_string(k));
+          const std::string text = value == config.input_ports.end() ? "" : value->second;
+          if(!detail::isDigitLetter(text))
+          {
+            throw LebtError(where(node.get(), xml_text) +
+                            ": dispatch annotations disagree: case_" + std::to_string(k) +
+                            " is the malformed index digit '" + text +
+                            "' (a digit is one of the letters " + kDigitLetters + ")");
+          }
+          info.cases.push_back(text[0]);
+        }
+        levels = std::max(levels, digit + 1);
+        switches.emplace(node.get(), std::move(info));
+      }
+    }
+    if(switches.empty())
+    {
+      throw LebtError(where(entries_.front(), xml_text) + ": dispatch annotations disagree: no " +
+                      "Switch reads a state index digit ({" + kDigitPrefix + "0}, ...): a tree " +
+                      "of DispatchEntry leaves is the dispatch form, a Switch dispatch over the " +
+                      "index");
+    }
+    for(const auto& [entry, items] : writes)
+    {
+      for(const auto& [digit, letter] : items)
+      {
+        if(digit >= levels)
+        {
+          throw LebtError(where(entry, xml_text) + ": dispatch annotations disagree: " +
+                          "_onSuccess writes " + kDigitPrefix + std::to_string(digit) +
+                          ", but no Switch reads that digit (the index has " +
+                          std::to_string(levels) + ")");
+        }
+      }
+    }
+    // the node the index Switches lead `index` to (index[J] = digit J's letter, 0 = unset)
+    auto resolve = [&](const std::string& index) {
+      const BT::TreeNode* node = tree_.rootNode();
+      for(;;)
+      {
+        auto it = switches.find(node);
+        const std::vector<const BT::TreeNode*> children = childrenOf(node);
+        if(it != switches.end())
+        {
+          const std::size_t at = it->second.cases.find(index[it->second.digit]);
+          node = children[at == std::string::npos || index[it->second.digit] == 0 ?
+                              children.size() - 1 :
+                              at];
+        }
+        else if(node->registrationName() == "SubTree" && !children.empty())
+        {
+          node = children.front();
+        }
+        else
+        {
+          return node;
+        }
+      }
+    };
+    auto shown = [](const std::string& index) {  // most significant digit first
+      std::string text(index.rbegin(), index.rend());
+      std::replace(text.begin(), text.end(), '\0', '-');
+      return "'" + text + "'";
+    };
+    const std::string start(static_cast<std::size_t>(levels), '\0');
+    const BT::TreeNode* start_case = resolve(start);
+    std::unordered_map<std::string, const DispatchEntry*> named;  // index -> first entry
+    std::vector<std::pair<std::string, const BT::TreeNode*>> queue{ { start, start_case } };
+    for(std::size_t next = 0; next < queue.size(); ++next)
+    {
+      const std::string source = queue[next].first;
+      std::vector<const BT::TreeNode*> stack{ queue[next].second };
+      while(!stack.empty())
+      {
+        const BT::TreeNode* node = stack.back();
+        stack.pop_back();
+        for(const BT::TreeNode* child : childrenOf(node))
+        {
+          stack.push_back(child);
+        }
+        const auto* entry = dynamic_cast<const DispatchEntry*>(node);
+        if(entry == nullptr)
+        {
+          continue;
+        }
+        std::string target = source;
+        auto written = writes.find(entry);
+        if(written != writes.end())
+        {
+          for(const auto& [digit, letter] : written->second)
+          {
+            target[static_cast<std::size_t>(digit)] = letter;
+          }
+        }
+        const std::size_t unset = target.find('\0');
+        if(unset != std::string::npos)
+        {
+          throw LebtError(where(entry, xml_text) + ": dispatch annotations disagree: entering '" +
+                          entry->stateName() + "' from the start, _onSuccess leaves " +
+                          kDigitPrefix + std::to_string(unset) +
+                          " unset (from the start every index digit is written)");
+        }
+        auto first = named.find(target);
+        if(first != named.end())
+        {
+          if(first->second->stateName() != entry->stateName())
+          {
+            throw LebtError(where(entry, xml_text) + ": dispatch annotations disagree: it " +
+                            "enters '" + entry->stateName() + "' but writes the state index " +
+                            shown(target) + " of '" + first->second->stateName() + "' (" +
+                            where(first->second, xml_text) + ")");
+          }
+          continue;
+        }
+        const BT::TreeNode* found = resolve(target);
+        if(found == start_case || found->registrationName() == "AlwaysFailure")
+        {
+          throw LebtError(where(entry, xml_text) + ": dispatch annotations disagree: entering '" +
+                          entry->stateName() + "', _onSuccess writes the state index " +
+                          shown(target) + ", which no state has (the index Switches lead it to " +
+                          (found == start_case ? std::string("the start case") :
+                                                 where(found, xml_text)) +
+                          ")");
+        }
+        named.emplace(target, entry);
+        queue.emplace_back(target, found);
+      }
+    }
+  }
+
+  /// The blackboard entries a dispatch tree's run writes (the index digits and `event`).
+  std::vector<std::string> blackboardKeys() const
+  {
+    std::vector<std::string> keys;
+    for(const auto& key : blackboard_->getKeys())
+    {
+      const std::string text(key);
+      if(text == kEventKey || detail::digitNumber(text, false) >= 0)
+      {
+        keys.push_back(text);
+      }
+    }
+    return keys;
   }
 
   /// The LEBT annotations agree (docs/semantics.md section 5): every guard pair leaving a
@@ -870,6 +1417,10 @@ private:
   BT::Tree tree_;
   std::vector<const LebtGuard*> guards_;
   std::vector<const LebtState*> state_leaves_;
+  std::vector<const DispatchEntry*> entries_;
+  std::unordered_map<const BT::TreeNode*, int> occurrence_;  // n-th node of its (type, name)
+  BT::Blackboard::Ptr blackboard_;                            // a dispatch tree's
+  Form form_ = Form::Lebt;
   std::string start_;
   bool init_on_start_ = false;
   bool never_wakes_up_ = true;
