@@ -166,12 +166,35 @@ def read_outcome_view(fsm: FSM, rules: OutcomeRules | None = None) -> OutcomeVie
         )
     regions: dict[str, Region] = {}
     notes: dict[str, list[str]] = {}  # unit path -> its order choices, in words
-    # work list: (region path, machine, owner unit, halting finals of this machine)
-    work: list[tuple[str, FSM, Unit | None, frozenset[str]]] = []
     top_halting = frozenset(
         {HALT_OUTCOME} if HALT_OUTCOME in fsm.states and fsm.states[HALT_OUTCOME].final else ()
     )
-    work.append(("", fsm, None, top_halting))
+    _read_regions(fsm, [("", fsm, None, top_halting)], regions)
+    _read_statuses(regions, rules, notes)
+    top = regions[""]
+    top.exit_status, top_choice = rules.statuses(top.exits)
+    _read_exit_statuses(regions)
+    for region in list(regions.values()):
+        _read_parallel(region, fsm, rules, notes, regions)
+    order_choices = [
+        note for r in regions.values() for u in r.units.values() for note in notes.get(u.path, [])
+    ]
+    if top_choice:
+        order_choices.append(
+            f"{fsm.name}: outcome '{top.exits[0]}' read as SUCCESS, '{top.exits[1]}' as FAILURE"
+        )
+    halts = sum(len(u.halted) for r in regions.values() for u in r.units.values())
+    by_label = _assign_labels(regions)
+    return OutcomeView(fsm, rules, regions, by_label, order_choices, halts)
+
+
+#: A region to read: its path, machine, owner unit and the halting finals of its machine.
+_Job = tuple[str, FSM, "Unit | None", frozenset[str]]
+
+
+def _read_regions(fsm: FSM, work: list[_Job], regions: dict[str, Region]) -> None:
+    """Read every region the work list reaches into ``regions`` (the shape rules of the
+    module docstring; each violation an ``OutcomeError``)."""
     while work:
         path, machine, owner, halting = work.pop()
         region = Region(path, machine, owner)
@@ -198,7 +221,12 @@ def read_outcome_view(fsm: FSM, rules: OutcomeRules | None = None) -> OutcomeVie
         reached = {t for u in region.units.values() for t in u.targets.values()}
         reached.add(region.initial)
         region.exits = [n for n, s in machine.states.items() if s.final and n in reached]
-    # statuses: a container's exits have the statuses of the container's outcomes
+
+
+def _read_statuses(
+    regions: dict[str, Region], rules: OutcomeRules, notes: dict[str, list[str]]
+) -> None:
+    """Each unit's outcome statuses (a container's exits have its outcomes' statuses)."""
     for region in regions.values():
         for unit in region.units.values():
             if unit.container:
@@ -221,24 +249,14 @@ def read_outcome_view(fsm: FSM, rules: OutcomeRules | None = None) -> OutcomeVie
                 unit.status = {o: s or SUCCESS for o, s in unit.status.items()}
             if unit.order_choice:
                 notes.setdefault(unit.path, []).append(_order_note(unit))
-    top = regions[""]
-    top.exit_status, top_choice = rules.statuses(top.exits)
+
+
+def _read_exit_statuses(regions: dict[str, Region]) -> None:
+    """A container's region: its exits' statuses (its owner's); every region's flag key."""
     for path, region in regions.items():
         if region.owner is not None:
             region.exit_status = {e: region.owner.status.get(e) for e in region.exits}
         region.pc_key = "pc" if not path else f"pc_{_sanitize(path)}"
-    for region in regions.values():
-        _read_parallel(region, fsm, rules, notes)
-    order_choices = [
-        note for r in regions.values() for u in r.units.values() for note in notes.get(u.path, [])
-    ]
-    if top_choice:
-        order_choices.append(
-            f"{fsm.name}: outcome '{top.exits[0]}' read as SUCCESS, '{top.exits[1]}' as FAILURE"
-        )
-    halts = sum(len(u.halted) for r in regions.values() for u in r.units.values())
-    by_label = _assign_labels(regions)
-    return OutcomeView(fsm, rules, regions, by_label, order_choices, halts)
 
 
 def _order_note(unit: Unit) -> str:
@@ -247,11 +265,15 @@ def _order_note(unit: Unit) -> str:
 
 
 def _read_parallel(
-    region: Region, fsm: FSM, rules: OutcomeRules, notes: dict[str, list[str]]
+    region: Region,
+    fsm: FSM,
+    rules: OutcomeRules,
+    notes: dict[str, list[str]],
+    regions: dict[str, Region],
 ) -> None:
-    """A Concurrence of leaf children: read in rounds when a parallel form is exactly
-    equivalent (its units become its children), else named with the cause
-    (``outcome_parallel``; docs/semantics.md §11, "Concurrences: Parallel or product")."""
+    """A Concurrence: read in rounds when a parallel form is exactly equivalent (its units
+    become its children, a container child's regions join ``regions``), else named with the
+    cause (``outcome_parallel``; docs/semantics.md §11, "Concurrences: Parallel or product")."""
     owner = region.owner
     concurrence = read_concurrence(owner.state if owner is not None else fsm)
     if concurrence is None:
@@ -259,8 +281,18 @@ def _read_parallel(
     region.concurrence = concurrence
     children: dict[str, Unit] = {}
     statuses: list[dict[str, str]] = []
-    for state, outcomes in zip(concurrence.child_states(), concurrence.outcomes):
+    inner: dict[str, Region] = {}
+    for index, state in enumerate(concurrence.child_states()):
         where = f"{region.path}/{state.name}" if region.path else state.name
+        outcomes = concurrence.outcomes[index]
+        machine = concurrence.machines.get(state.name)
+        if machine is not None:
+            found = _container_child(where, machine, fsm, rules, notes, inner)
+            if isinstance(found, str):
+                concurrence.why = f"child '{state.name}' {found}"
+                return
+            outcomes = list(found)
+            concurrence.outcomes[index] = outcomes
         status, choice = rules.statuses(outcomes)
         if RUNNING_INPUT in outcomes:
             concurrence.why = f"child '{state.name}' has an outcome named '{RUNNING_INPUT}'"
@@ -276,7 +308,7 @@ def _read_parallel(
             return
         full = {o: str(s) for o, s in status.items()}
         statuses.append(full)
-        unit = Unit(where, state.name, state, False, tuple(outcomes),
+        unit = Unit(where, state.name, state, machine is not None, tuple(outcomes),
                     {o: "" for o in outcomes}, dict(full), (), choice)  # fmt: skip
         children[state.name] = unit
 
@@ -294,8 +326,74 @@ def _read_parallel(
         return
     region.units = children
     for unit in children.values():
+        if unit.container:
+            inner[unit.path].owner = unit
         if unit.order_choice:
             notes.setdefault(unit.path, []).append(_order_note(unit))
+    regions.update(inner)
+    _read_exit_statuses(inner)
+
+
+def _container_child(
+    where: str,
+    machine: FSM,
+    fsm: FSM,
+    rules: OutcomeRules,
+    notes: dict[str, list[str]],
+    regions: dict[str, Region],
+) -> tuple[str, ...] | str:
+    """A container child of a concurrence (a StateMachine, a YASMIN Region): its regions read
+    into ``regions`` and its outcomes (the exits its machine reaches), or why it keeps the
+    product. Under a Parallel its tree must return RUNNING only when a leaf does, so the round
+    reading can follow it: no loop (a loop node returns RUNNING between iterations:
+    docs/semantics.md §11) and no concurrence inside; and it must run a state before it ends."""
+    found: dict[str, Region] = {}
+    try:
+        _read_regions(fsm, [(where, machine, None, frozenset())], found)
+    except OutcomeError as error:
+        return f"is not outcome-driven ({error})"
+    for sub in found.values():
+        looping = _loop_state(sub)
+        if looping is not None:
+            return (
+                f"loops back to '{looping}' (a loop node returns RUNNING between iterations, "
+                "which the round reading does not follow)"
+            )
+        if any(read_concurrence(u.state) is not None for u in sub.units.values()):
+            return "holds a concurrence"
+    top = found[where]
+    if machine.states[top.initial].final:
+        return "ends before running a state"
+    if not top.exits:
+        return "never ends"
+    _read_statuses(found, rules, notes)
+    regions.update(found)
+    return tuple(top.exits)
+
+
+def _loop_state(region: Region) -> str | None:
+    """A unit of the region on a cycle of its transitions, else None (iterative DFS)."""
+    graph = {name: [t for t in u.targets.values() if t in region.units]
+             for name, u in region.units.items()}  # fmt: skip
+    colour: dict[str, int] = {}
+    for root in graph:
+        if root in colour:
+            continue
+        colour[root] = 1
+        stack: list[tuple[str, int]] = [(root, 0)]
+        while stack:
+            node, i = stack.pop()
+            if i < len(graph[node]):
+                stack.append((node, i + 1))
+                nxt = graph[node][i]
+                if colour.get(nxt) == 1:
+                    return nxt
+                if nxt not in colour:
+                    colour[nxt] = 1
+                    stack.append((nxt, 0))
+            else:
+                colour[node] = 2
+    return None
 
 
 def _leaf_unit(

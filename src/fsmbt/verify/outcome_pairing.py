@@ -91,5 +91,21 @@ def outcome_abstractions(view: OutcomeView) -> list[str]:
             'order added; docs/semantics.md §11, "Concurrences: Parallel or product"): '
             + ", ".join(rounds)
         )
+    for path, region in view.regions.items():
+        concurrence = region.concurrence
+        if concurrence is None:
+            continue
+        where = path or view.fsm.name
+        if "outcome_cb" in concurrence.callbacks:
+            sentences.append(
+                f"outcome_cb {concurrence.callbacks['outcome_cb']} of {where} not modelled: its "
+                "outcome is chosen by the environment"
+            )
+        if "child_termination_cb" in concurrence.callbacks:
+            sentences.append(
+                f"child_termination_cb {concurrence.callbacks['child_termination_cb']} of "
+                f"{where} not modelled: a child stopped early ends with an outcome the "
+                "environment chooses"
+            )
     sentences.extend(f"by declaration order: {choice}" for choice in view.order_choices)
     return sentences
