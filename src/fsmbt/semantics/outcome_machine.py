@@ -65,6 +65,10 @@ class OutcomeFSMMachine:
         self.region_of = {
             u.path: path for path, r in view.regions.items() for u in r.units.values()
         }
+        self.round_trips = frozenset(t for r in view.regions.values() for t in r.round_trips)
+        #: Whether the last ``_enter`` took a round trip (a loop of a container child going
+        #: round: its SubTree returns RUNNING, the turn passes on).
+        self._went_round = False
 
     def start(self) -> tuple[OutcomeState, Outputs]:
         top = self.view.top
@@ -146,10 +150,15 @@ class OutcomeFSMMachine:
             ended: str | None = symbol
             if inner and inner[index]:
                 here = inner[index]
+                self._went_round = (here, symbol) in self.round_trips
                 entered = self._enter(self.region_of[here], self.units[here].targets[symbol])
                 if not isinstance(entered, _Ended):
                     assert isinstance(entered, str), "a container child holds no concurrence"
-                    after = Round(state.region, done, index, _put(inner, index, entered))
+                    inner = _put(inner, index, entered)
+                    if self._went_round:  # its tree returned RUNNING: the next child's turn
+                        after = Round(state.region, done, next_child(done, index), inner)
+                        return after, (self.units[self._child(after)].label,)
+                    after = Round(state.region, done, index, inner)
                     return after, (self.units[entered].label,)
                 ended = entered.outcome
                 inner = _put(inner, index, "")
@@ -182,6 +191,8 @@ class OutcomeFSMMachine:
                 region_path = self.region_of[owner.path]
                 if self.view.regions[region_path].parallel:
                     return _Ended(target)
+                if (owner.path, target) in self.round_trips:
+                    self._went_round = True
                 target = owner.targets[target]
                 continue
             unit = region.units[target]

@@ -28,6 +28,7 @@ Everything is computed with explicit work lists, O(states + transitions).
 from __future__ import annotations
 
 import re
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from fsmbt.model import state_info
@@ -96,6 +97,10 @@ class Region:
     #: A Concurrence of leaf children (``outcome_parallel``); with a ``form`` the region's
     #: units are its children, read in rounds, else its product machine's states.
     concurrence: Concurrence | None = None
+    #: In a Concurrence read in rounds: the (unit path, outcome) transitions of its container
+    #: children that go round a loop - their SubTree returns RUNNING there, so the turn passes
+    #: to the next child (``ChildSchedule``).
+    round_trips: frozenset[tuple[str, str]] = frozenset()
 
     @property
     def parallel(self) -> bool:
@@ -134,6 +139,14 @@ class OutcomeView:
                 if not u.container]  # fmt: skip
 
 
+#: How a container child's tree runs under a Parallel, given its top region (owner set) and
+#: every region of its hierarchy: why it cannot (or None), and the transitions where its tree
+#: returns RUNNING without a leaf doing so (a loop going round). The structured conversion
+#: gives it (``convert.structured.schedule``): the reading follows the tree the conversion
+#: writes, which is a function of the source alone.
+ChildSchedule = Callable[[Region, dict[str, Region]], tuple[str | None, frozenset[tuple[str, str]]]]
+
+
 def declares_outcomes(fsm: FSM) -> bool:
     """Whether some state declares its outcomes (a reader of an outcome-driven format)."""
     return any(
@@ -151,8 +164,13 @@ def _sanitize(text: str) -> str:
     return out if not out[0].isdigit() else f"s_{out}"
 
 
-def read_outcome_view(fsm: FSM, rules: OutcomeRules | None = None) -> OutcomeView:
+def read_outcome_view(
+    fsm: FSM, rules: OutcomeRules | None = None, schedule: ChildSchedule | None = None
+) -> OutcomeView:
     """Check ``fsm`` is outcome-driven and read its units (see the module docstring).
+
+    ``schedule`` says how a Concurrence's container child runs under a Parallel; without it
+    only a child without loops is read in rounds.
 
     Raises:
         OutcomeError: the first violation, naming the state's path and the cause.
@@ -175,7 +193,7 @@ def read_outcome_view(fsm: FSM, rules: OutcomeRules | None = None) -> OutcomeVie
     top.exit_status, top_choice = rules.statuses(top.exits)
     _read_exit_statuses(regions)
     for region in list(regions.values()):
-        _read_parallel(region, fsm, rules, notes, regions)
+        _read_parallel(region, fsm, rules, notes, regions, schedule)
     order_choices = [
         note for r in regions.values() for u in r.units.values() for note in notes.get(u.path, [])
     ]
@@ -270,6 +288,7 @@ def _read_parallel(
     rules: OutcomeRules,
     notes: dict[str, list[str]],
     regions: dict[str, Region],
+    schedule: ChildSchedule | None,
 ) -> None:
     """A Concurrence: read in rounds when a parallel form is exactly equivalent (its units
     become its children, a container child's regions join ``regions``), else named with the
@@ -282,12 +301,19 @@ def _read_parallel(
     children: dict[str, Unit] = {}
     statuses: list[dict[str, str]] = []
     inner: dict[str, Region] = {}
+    trips: set[tuple[str, str]] = set()
+    if concurrence.machines and not concurrence.smach:
+        concurrence.why = (
+            "FlexBE steps a container child one state per tick, where its SubTree would go on "
+            "in the same tick"
+        )
+        return
     for index, state in enumerate(concurrence.child_states()):
         where = f"{region.path}/{state.name}" if region.path else state.name
         outcomes = concurrence.outcomes[index]
         machine = concurrence.machines.get(state.name)
         if machine is not None:
-            found = _container_child(where, machine, fsm, rules, notes, inner)
+            found = _container_child(where, machine, fsm, rules, notes, inner, schedule is None)
             if isinstance(found, str):
                 concurrence.why = f"child '{state.name}' {found}"
                 return
@@ -311,6 +337,15 @@ def _read_parallel(
         unit = Unit(where, state.name, state, machine is not None, tuple(outcomes),
                     {o: "" for o in outcomes}, dict(full), (), choice)  # fmt: skip
         children[state.name] = unit
+        if machine is not None and schedule is not None:
+            inner[where].owner = unit
+            mine = {p: r for p, r in inner.items() if p == where or p.startswith(where + "/")}
+            _read_exit_statuses(mine)
+            why, yields = schedule(inner[where], mine)
+            if why is not None:
+                concurrence.why = f"child '{state.name}' {why}"
+                return
+            trips |= yields
 
     def outcome_status(outcome: str) -> tuple[str | None, str]:
         if owner is None:
@@ -325,6 +360,7 @@ def _read_parallel(
     if concurrence.form is None:
         return
     region.units = children
+    region.round_trips = frozenset(trips)
     for unit in children.values():
         if unit.container:
             inner[unit.path].owner = unit
@@ -341,19 +377,21 @@ def _container_child(
     rules: OutcomeRules,
     notes: dict[str, list[str]],
     regions: dict[str, Region],
+    no_loops: bool,
 ) -> tuple[str, ...] | str:
     """A container child of a concurrence (a StateMachine, a YASMIN Region): its regions read
     into ``regions`` and its outcomes (the exits its machine reaches), or why it keeps the
-    product. Under a Parallel its tree must return RUNNING only when a leaf does, so the round
-    reading can follow it: no loop (a loop node returns RUNNING between iterations:
-    docs/semantics.md §11) and no concurrence inside; and it must run a state before it ends."""
+    product. The round reading must know where its tree returns RUNNING: without a
+    ``ChildSchedule`` (``no_loops``) only where a leaf does, so it may have no loop (a loop
+    node returns RUNNING between iterations: docs/semantics.md §11); no concurrence inside;
+    and it must run a state before it ends."""
     found: dict[str, Region] = {}
     try:
         _read_regions(fsm, [(where, machine, None, frozenset())], found)
     except OutcomeError as error:
         return f"is not outcome-driven ({error})"
     for sub in found.values():
-        looping = _loop_state(sub)
+        looping = _loop_state(sub) if no_loops else None
         if looping is not None:
             return (
                 f"loops back to '{looping}' (a loop node returns RUNNING between iterations, "
