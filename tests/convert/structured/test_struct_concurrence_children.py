@@ -216,3 +216,19 @@ def test_generated_container_children_are_proven_and_run_alike(seed: int) -> Non
     assert any(n.type == "ParallelAll" for _t, n in doc.nodes())
     assert verify(fsm, doc, outcome_driven=True).equivalent
     _runs_alike(fsm, doc, range(seed * 4, seed * 4 + 4))
+
+
+def test_the_yasmin_writer_writes_an_orthogonal_state_back_while_its_product_is_unchanged() -> None:
+    from fsmbt.formats import dumps, loads
+
+    source = api.load(DATA / "yasmin_orthogonal.xml").model
+    assert isinstance(source, FSM)
+    text = dumps(source, "yasmin")
+    assert "<OrthogonalState" in text and text.count("<Region") == 2
+    again = loads(text, "yasmin")
+    assert isinstance(again, FSM)
+    assert again.states["par"].regions[0].transitions == source.states["par"].regions[0].transitions
+    edited = copy.deepcopy(source)
+    product = edited.states["par"].regions[0]
+    product.transitions.pop()
+    assert "<OrthogonalState" not in dumps(edited, "yasmin")

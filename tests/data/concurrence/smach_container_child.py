@@ -17,8 +17,12 @@ def build():
         with cc:
             nav = smach.StateMachine(outcomes=["arrived", "lost"])
             with nav:
-                smach.StateMachine.add("PLAN", Two(), transitions={"done": "DRIVE", "failed": "lost"})
-                smach.StateMachine.add("DRIVE", Two(), transitions={"done": "arrived", "failed": "lost"})
+                smach.StateMachine.add(
+                    "PLAN", Two(), transitions={"done": "DRIVE", "failed": "lost"}
+                )
+                smach.StateMachine.add(
+                    "DRIVE", Two(), transitions={"done": "arrived", "failed": "lost"}
+                )
             smach.Concurrence.add("NAV", nav)
             smach.Concurrence.add("WATCH", Two())
         smach.StateMachine.add("CC", cc, transitions={"ok": "finished", "bad": "gave_up"})

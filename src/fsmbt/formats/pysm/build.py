@@ -46,6 +46,7 @@ costs the product of (1 + outcomes) over its children, capped at ``MAX_PRODUCT_S
 from __future__ import annotations
 
 import ast
+import hashlib
 import json
 from collections import deque
 from collections.abc import Callable
@@ -687,6 +688,7 @@ class Builder:
                     "outcome_map": container.outcome_map,
                     "default": container.default_outcome,
                     "barriers": len(container.sync_groups),
+                    "product": product_fingerprint(fsm),
                     "machines": {
                         c.label: fsm_to_dict(work.child_machines[c.label])
                         for c in container.children
@@ -909,6 +911,18 @@ class Builder:
             f"'{work.label}.exhausted'; an empty item list is not modelled)",
         )
         return pending
+
+
+def product_fingerprint(fsm: FSM) -> str:
+    """A digest of a concurrence's product machine (its states, initial state and
+    transitions): a writer gives the concurrence back only while the product is the one read.
+    O(S + T log T)."""
+    data = [
+        fsm.initial,
+        sorted(fsm.states),
+        sorted((t.source, t.event or "", t.target, t.exit or "") for t in fsm.transitions),
+    ]
+    return hashlib.sha256(json.dumps(data).encode()).hexdigest()[:16]
 
 
 def _child_class(child: Child) -> str:
