@@ -10,11 +10,14 @@ container's completion transition for that outcome, up as many levels as it take
 top-level final state ends the run with ``SUCCESS``/``FAILURE`` (``OutcomeView.root_result``).
 
 A Concurrence read in rounds (``Region.parallel``; docs/semantics.md §11, "Concurrences:
-Parallel or product") is a ``Round`` state: each child's outcome so far and the child about to
-run. Entering it runs its first child; after each answer the source decision
-(``Concurrence.decide``) is taken, and a decided outcome leaves the container like the
-product's final state of that name; else the next child still running runs
-(``outcome_parallel.next_child``).
+Parallel or product") is a ``Round`` state: each child's outcome so far, the child about to
+run and where each container child is. Entering it runs its first child; a container child's
+outcome that leads to another of its states keeps its turn (its SubTree goes on in the same
+tick), unless it goes round a loop (``Region.round_trips``: its tree returns RUNNING there);
+when a child ends the source decision (``Concurrence.decide``) is taken, and a decided outcome
+leaves the container like the product's final state of that name; else, and after ``running``,
+the next child still running runs (``outcome_parallel.next_child``; docs/semantics.md §11,
+"Container children").
 
 Cost: O(nesting depth) per step; states are strings and result tuples.
 """

@@ -1,17 +1,20 @@
 """A concurrence read as a BehaviorTree.CPP Parallel where the semantics allow (docs/semantics.md
 §11, "Concurrences: Parallel or product").
 
-The SMACH/FlexBE readers build a ``Concurrence`` / ``ConcurrencyContainer`` whose children are
-all leaves as a composite state whose region is the *product* of the children's progress, and
-record the children, the outcome map and the default outcome in the composite's ``attrs``
-(``smach.container``, ``smach.children``, ``smach.outcome_map``, ``smach.default_outcome``).
+The SMACH/FlexBE/YASMIN readers build a ``Concurrence`` / ``ConcurrencyContainer`` /
+``OrthogonalState`` as a composite state whose region is the *product* of the children's
+progress, and record the children, the outcome map and the default outcome in the composite's
+``attrs`` (leaf children: ``smach.container``, ``smach.children``, ``smach.outcome_map``,
+``smach.default_outcome``; with a container child: ``smach.concurrence``, which also holds each
+container child's machine; SMACH callbacks, never run: ``smach.callbacks``).
 This module decides from those alone whether the concurrence has the semantics of a built-in
 parallel node under the outcome rules, and gives its *round reading* (what the outcome pairing
 compares the Parallel with):
 
 - the *source decision* ``decide(done)``, ``done`` giving each child's outcome or ``None``
-  while it runs: SMACH ends the container only when every child has ended, with the last
-  ``outcome_map`` entry that holds, else ``default_outcome`` (``smach/concurrence.py``);
+  while it runs: SMACH and YASMIN end the container only when every child has ended, with the
+  last ``outcome_map`` entry that holds, else ``default_outcome`` (``smach/concurrence.py``,
+  YASMIN's ``concurrence.cpp`` / ``orthogonal_state.cpp``);
   FlexBE ends it as soon as the first condition holds (``concurrency_container.py``), the
   children still running stopped;
 - the *round reading*: entering the container, and after each round in which a child is still
@@ -33,7 +36,9 @@ compares the Parallel with):
 Otherwise the concurrence keeps its product reading and ``Concurrence.why`` names the cause:
 the outcome-map entry (or default) and the child outcomes where every form differs, a
 container outcome with no status (a dispatch), an outcome that halts the tree, a combination
-where FlexBE would wait for ever, or the size cap.
+where FlexBE would wait for ever, an ``outcome_cb`` (its outcome is the environment's choice:
+a state of the product), a YASMIN JoinState barrier, or the size cap. How a container child runs
+in a round: ``outcome_view`` and docs/semantics.md §11, "Container children".
 
 Cost: O(forms x combinations) with at most ``MAX_CHILDREN`` children and ``MAX_COMBINATIONS``
 reachable combinations, else the product is kept.

@@ -10,8 +10,10 @@ targets and statuses, and whether a leaf needs a dispatch on its outcome.
 
 Rules (each violation is an ``OutcomeError`` naming the state and the cause, exit 2):
 - no parallel state (a reader builds a Concurrence as a composite whose region is the product
-  of its children; one of leaf children whose semantics a BehaviorTree.CPP parallel node has
-  is read in rounds instead, its units being its children: ``outcome_parallel``);
+  of its children; one whose semantics a BehaviorTree.CPP parallel node has is read in rounds
+  instead, its units being its children: ``outcome_parallel``; a container child is one unit
+  whose own regions join the view, read as a container's, when the ``ChildSchedule`` says its
+  tree can run under a Parallel: docs/semantics.md §11, "Container children");
 - the machine needs no start event; an atomic state has no completion transition and at
   least one outcome; a composite state leaves only by completion transitions;
 - when a state declares its outcomes (``fsmbt.model.state_info``), every event of its

@@ -88,9 +88,10 @@ def outcome_abstractions(view: OutcomeView) -> list[str]:
     rounds = [path or view.fsm.name for path, r in view.regions.items() if r.parallel]
     if rounds:
         sentences.append(
-            "concurrence read in rounds (each child still running runs once per round, in the "
-            'order added; docs/semantics.md §11, "Concurrences: Parallel or product"): '
-            + ", ".join(rounds)
+            "concurrence read in rounds (each child still running takes one turn per round, in "
+            "the order added - a container child runs on until a leaf runs on or a loop goes "
+            'round; docs/semantics.md §11, "Concurrences: Parallel or product", "Container '
+            'children"): ' + ", ".join(rounds)
         )
     for path, region in view.regions.items():
         concurrence = region.concurrence

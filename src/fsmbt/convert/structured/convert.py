@@ -6,8 +6,10 @@ located ``OutcomeError``, exit 2); structure each region (``regions``), or give 
 (``flags``) when no structured form exists; the top-level machine is the main
 ``<BehaviorTree>`` itself, each container one ``<BehaviorTree>`` used by one ``SubTree`` node;
 every leaf type is declared in ``<TreeNodesModel>``; a Concurrence the outcome view reads in
-rounds is a ``Parallel`` / ``ParallelAll`` over its children's leaves (``_parallel``; the rule:
-docs/semantics.md §11, "Concurrences: Parallel or product"). The result's ``stats`` count what was found
+rounds is a ``Parallel`` / ``ParallelAll`` over its children's leaves and SubTrees (``_parallel``;
+a container child's loops return RUNNING when they go round, ``RegionStructurer(
+yielding_loops=True)``; the rule: docs/semantics.md §11, "Concurrences: Parallel or product",
+"Container children"). The result's ``stats`` count what was found
 and ``stats["summary"]`` says it in one line ("structured: 3 sequences, 1 fallback, ...").
 
 Cost: the regions' structuring (``regions``) plus O(nodes).
@@ -108,8 +110,8 @@ def structured_result(view: OutcomeView) -> ConversionResult:
 
 
 def _parallel(region: Region, emit: Callable[[Unit], BTNode]) -> BTNode:
-    """A Concurrence read in rounds: its parallel form over its children's leaves, in the
-    order they were added (docs/semantics.md §11, "Concurrences: Parallel or product")."""
+    """A Concurrence read in rounds: its parallel form over its children's leaves and
+    SubTrees, in the order they were added (docs/semantics.md §11, "Concurrences: Parallel or product")."""
     concurrence = region.concurrence
     assert concurrence is not None and concurrence.form is not None
     form = concurrence.form
@@ -126,7 +128,7 @@ def _under_parallel(view: OutcomeView) -> set[str]:
 
 
 def _concurrences(view: OutcomeView) -> list[str]:
-    """Name every Concurrence of leaf children: the parallel form it became, or why it is kept
+    """Name every Concurrence: the parallel form it became, or why it is kept
     as its product machine (the named fallback form: one leaf per combination of its
     children's progress)."""
     named = []
