@@ -31,7 +31,7 @@ CORPUS = Path(os.environ.get("FSMBT_CORPUS", REPO / ".." / "shared" / "corpus"))
 TESTS = REPO / "tests" / "data" / "concurrence"
 _MENTION = re.compile(r"Concurrence|ConcurrencyContainer|OrthogonalState")
 _KIND = r"(Concurrence|ConcurrencyContainer|OrthogonalState)"
-_FORM = re.compile(rf"^{_KIND} '([^']*)': a (.*) over its children")
+_FORM = re.compile(rf"^{_KIND} '([^']*)': a (.*) over its children(, then [^,]*)?")
 _KEPT = re.compile(rf"^{_KIND} '([^']*)': kept as .*not a Parallel: (.*)")
 
 
@@ -85,7 +85,8 @@ def main() -> None:
             if form:
                 parallels += 1
                 where = form.group(2)
-                print(f"| {name} | {where} | {children.get(where, '?')} | {form.group(3)} | "
+                result = form.group(3) + (form.group(4) or "")
+                print(f"| {name} | {where} | {children.get(where, '?')} | {result} | "
                       f"{verdict} | {loads} |")  # fmt: skip
             elif rest:
                 kept += 1

@@ -169,6 +169,8 @@ class OutcomeFSMMachine:
             concurrence = self.view.regions[state.region].concurrence
             assert concurrence is not None
             outcome = concurrence.decide(done)
+            if outcome is not None and concurrence.callback_state is not None:
+                outcome = concurrence.callback_state  # its outcome_cb runs, as a leaf
             if outcome is not None:
                 return self._settled(self._enter(state.region, outcome))
         after = Round(state.region, done, next_child(done, index), inner)

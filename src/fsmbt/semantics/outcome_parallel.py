@@ -36,8 +36,9 @@ compares the Parallel with):
 Otherwise the concurrence keeps its product reading and ``Concurrence.why`` names the cause:
 the outcome-map entry (or default) and the child outcomes where every form differs, a
 container outcome with no status (a dispatch), an outcome that halts the tree, a combination
-where FlexBE would wait for ever, an ``outcome_cb`` (its outcome is the environment's choice:
-a state of the product), a YASMIN JoinState barrier, or the size cap. How a container child runs
+where FlexBE would wait for ever, a YASMIN JoinState barrier, or the size cap. A SMACH
+``outcome_cb`` (its outcome the environment's choice) is a state of its own run once every
+child has ended: ``ForceSuccess(ParallelAll)`` then its leaf (``outcome_view``). How a container child runs
 in a round: ``outcome_view`` and docs/semantics.md §11, "Container children".
 
 Cost: O(forms x combinations) with at most ``MAX_CHILDREN`` children and ``MAX_COMBINATIONS``
@@ -110,6 +111,12 @@ class Concurrence:
     callbacks: dict[str, str] = field(default_factory=dict)
     form: ParallelForm | None = None
     why: str = ""
+
+    @property
+    def callback_state(self) -> str | None:
+        """The product state standing for a SMACH ``outcome_cb`` (run once every child has
+        ended; its outcome is the environment's choice), or None."""
+        return self.callbacks.get("outcome_cb_state")
 
     @property
     def smach(self) -> bool:

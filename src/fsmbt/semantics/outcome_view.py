@@ -35,7 +35,12 @@ from dataclasses import dataclass, field
 
 from fsmbt.model import state_info
 from fsmbt.model.fsm import FSM, State
-from fsmbt.semantics.outcome_parallel import Concurrence, choose_form, read_concurrence
+from fsmbt.semantics.outcome_parallel import (
+    Concurrence,
+    ParallelForm,
+    choose_form,
+    read_concurrence,
+)
 from fsmbt.semantics.outcome_rules import (
     FAILURE,
     HALT_OUTCOME,
@@ -63,11 +68,14 @@ class Unit:
     order_choice: bool
     label: str = ""
     key: str = ""
+    #: Its status is its container's result (a SMACH ``outcome_cb``'s leaf, last in its
+    #: container's tree): never dispatched on.
+    gives_result: bool = False
 
     @property
     def dispatch(self) -> bool:
         """Whether the outcome must be written to the blackboard and dispatched on."""
-        if len(set(self.targets.values())) <= 1:
+        if self.gives_result or len(set(self.targets.values())) <= 1:
             return False
         if any(self.status[o] is None for o in self.outcomes):
             return True
@@ -358,7 +366,16 @@ def _read_parallel(
             return None, "is dispatched on (the container's outcomes lead to more than two places)"
         return owner.status.get(outcome), "leads nowhere"
 
-    choose_form(concurrence, statuses, outcome_status)
+    callback = _callback_unit(region, concurrence, outcome_status)
+    if isinstance(callback, Unit):
+        concurrence.form = ParallelForm("ParallelAll", (("max_failures", "1"),), "ForceSuccess")
+        children[callback.name] = callback
+        notes.pop(callback.path, None)  # its statuses are its container's
+    elif callback:
+        concurrence.why = callback
+        return
+    else:
+        choose_form(concurrence, statuses, outcome_status)
     if concurrence.form is None:
         return
     region.units = children
@@ -370,6 +387,32 @@ def _read_parallel(
             notes.setdefault(unit.path, []).append(_order_note(unit))
     regions.update(inner)
     _read_exit_statuses(inner)
+
+
+def _callback_unit(
+    region: Region,
+    concurrence: Concurrence,
+    outcome_status: Callable[[str], tuple[str | None, str]],
+) -> Unit | str:
+    """A SMACH ``outcome_cb``: its product state as the leaf run once every child has ended,
+    returning its container's result (``ForceSuccess(ParallelAll)`` then that leaf:
+    docs/semantics.md §11, "Concurrence callbacks"); why not; "" without one."""
+    name = concurrence.callback_state
+    if "outcome_cb" not in concurrence.callbacks:
+        return ""
+    unit = region.units.get(name or "")
+    if unit is None or unit.container:
+        return "its outcome_cb has no state of its own"
+    status: dict[str, str | None] = {}
+    for outcome in unit.outcomes:
+        status[outcome], why = outcome_status(outcome)
+        if status[outcome] is None:
+            text = concurrence.callbacks["outcome_cb"]
+            return f"its outcome_cb {text} may give '{outcome}', which {why}"
+    unit.status = status
+    unit.gives_result = True
+    unit.order_choice = False
+    return unit
 
 
 def _container_child(

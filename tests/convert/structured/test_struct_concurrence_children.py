@@ -156,10 +156,25 @@ def test_smach_callbacks_are_an_environment_choice_named_in_the_verdict() -> Non
     abstractions = outcome.report.stats["abstractions"]
     assert any(a.startswith("outcome_cb out_cb of CC not modelled") for a in abstractions)
     assert any(a.startswith("child_termination_cb child_term_cb of CC") for a in abstractions)
-    callback = next(n for _t, n in doc.nodes() if n.name == "out_cb")
-    assert callback.type == "out_cb"
-    assert "outcome_cb out_cb decides its outcome" in _kept(outcome)[0]
+    root = doc.trees["CC"].root
+    assert [c.type for c in root.children] == ["ForceSuccess", "out_cb"]
+    assert [c.name for c in root.children[0].children[0].children] == ["A", "B"]
     _runs_alike(outcome.source.model, doc, range(20))
+
+
+def test_an_outcome_cb_whose_outcome_is_dispatched_on_keeps_the_product(tmp_path: Path) -> None:
+    text = (DATA / "smach_callbacks.py").read_text()
+    three = text.replace('outcomes=["ok", "bad"]', 'outcomes=["ok", "bad", "again"]').replace(
+        '"bad": "gave_up"}', '"bad": "gave_up", "again": "CC"}'
+    )
+    assert three != text
+    path = tmp_path / "callbacks3.py"
+    path.write_text(three)
+    outcome = api.convert_file(path, style="structured")
+    kept = _kept(outcome)
+    assert len(kept) == 1 and "its outcome_cb out_cb may give" in kept[0]
+    assert any(n.name == "out_cb" for _t, n in _doc(outcome).nodes())  # a leaf of the product
+    _proven_loaded(outcome)
 
 
 def _child(seed: int) -> FSM:

@@ -115,8 +115,13 @@ def _parallel(region: Region, emit: Callable[[Unit], BTNode]) -> BTNode:
     concurrence = region.concurrence
     assert concurrence is not None and concurrence.form is not None
     form = concurrence.form
-    node = builder.control(form.kind, *(emit(u) for u in region.units.values()), **dict(form.ports))
-    return builder.decorator(form.wrapper, node) if form.wrapper else node
+    children = [region.units[label] for label in concurrence.labels]
+    node = builder.control(form.kind, *(emit(u) for u in children), **dict(form.ports))
+    node = builder.decorator(form.wrapper, node) if form.wrapper else node
+    callback = concurrence.callback_state
+    if callback is None:
+        return node
+    return builder.control("Sequence", node, emit(region.units[callback]))
 
 
 def _under_parallel(view: OutcomeView) -> set[str]:
@@ -138,9 +143,11 @@ def _concurrences(view: OutcomeView) -> list[str]:
             continue
         where = f"{concurrence.cls} '{path or view.fsm.name}'"
         if concurrence.form is not None:
+            callback = concurrence.callback_state
+            then = f", then its outcome_cb's leaf '{callback}'" if callback else ""
             named.append(
-                f"{where}: a {concurrence.form.describe()} over its children, read in rounds "
-                '(docs/semantics.md §11, "Concurrences: Parallel or product")'
+                f"{where}: a {concurrence.form.describe()} over its children{then}, read in "
+                'rounds (docs/semantics.md §11, "Concurrences: Parallel or product")'
             )
         else:
             named.append(

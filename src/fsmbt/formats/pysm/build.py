@@ -758,6 +758,7 @@ class Builder:
         )
         for outcome in container.outcomes:
             fsm.add_transition(name, outcome, outcome, location=where)
+        container.callbacks["outcome_cb_state"] = name
         self.warn(
             work.source,
             container.line,
