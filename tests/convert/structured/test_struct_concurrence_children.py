@@ -247,3 +247,18 @@ def test_the_yasmin_writer_writes_an_orthogonal_state_back_while_its_product_is_
     product = edited.states["par"].regions[0]
     product.transitions.pop()
     assert "<OrthogonalState" not in dumps(edited, "yasmin")
+
+
+def test_the_child_schedule_names_the_round_trips_and_without_it_a_loop_keeps_the_product() -> None:
+    from fsmbt.convert.structured.schedule import read_structured_view
+    from fsmbt.semantics.outcome_view import read_outcome_view
+
+    fsm = api.load(DATA / "smach_looping_child.py").model
+    assert isinstance(fsm, FSM)
+    plain = read_outcome_view(fsm).regions["CC"]
+    assert plain.concurrence is not None and plain.concurrence.form is None
+    assert "child 'NAV' loops back to 'PLAN'" in plain.concurrence.why
+    region = read_structured_view(fsm).regions["CC"]
+    assert region.parallel
+    assert region.round_trips == {("CC/NAV/PLAN", "failed")}
+    assert [u.name for u in region.units.values()] == ["NAV", "WATCH"]
