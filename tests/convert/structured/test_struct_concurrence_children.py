@@ -262,3 +262,29 @@ def test_the_child_schedule_names_the_round_trips_and_without_it_a_loop_keeps_th
     assert region.parallel
     assert region.round_trips == {("CC/NAV/PLAN", "failed")}
     assert [u.name for u in region.units.values()] == ["NAV", "WATCH"]
+
+
+@pytest.mark.parametrize(
+    "name",
+    [
+        "smach_container_child.py",
+        "smach_looping_child.py",
+        "smach_callbacks.py",
+        "yasmin_orthogonal.xml",
+        "yasmin_concurrence.xml",
+    ],
+)
+def test_bt_to_fsm_of_a_tree_with_a_parallel_is_proven_equivalent_to_the_source(name: str) -> None:
+    from fsmbt.convert.bt_to_hfsm import bt_to_hfsm
+    from fsmbt.verify.native import check
+    from fsmbt.verify.outcome_roundtrip import leaf_fsm_machines
+
+    fsm = api.load(DATA / name).model
+    assert isinstance(fsm, FSM)
+    doc = fsm_to_structured(fsm).model
+    assert isinstance(doc, BTDocument)
+    assert any(n.type.startswith("Parallel") for _t, n in doc.nodes())
+    back = bt_to_hfsm(doc).model
+    assert isinstance(back, FSM)
+    source, result, mode = leaf_fsm_machines(fsm, back)
+    assert check(source, result, mode=mode).equivalent
