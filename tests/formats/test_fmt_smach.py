@@ -425,15 +425,6 @@ UNSUPPORTED = {
     """,
         "under a condition",
     ),
-    "concurrence callback": (
-        """
-        cc = smach.Concurrence(outcomes=['a'], default_outcome='a',
-                               child_termination_cb=lambda so: True)
-        with cc:
-            smach.Concurrence.add('B', Bar())
-    """,
-        "child_termination_cb",
-    ),
     "concurrence child of unknown outcomes": (
         """
         cc = smach.Concurrence(outcomes=['a'], default_outcome='a')
@@ -443,6 +434,28 @@ UNSUPPORTED = {
         "outcomes of Concurrence child 'EXT'",
     ),
 }
+
+
+def test_a_concurrence_callback_is_read_not_run_and_named() -> None:
+    # docs/semantics.md §11, "Concurrence callbacks": never executed; child_termination_cb
+    # only stops children early (an outcome the environment already chooses); outcome_cb
+    # becomes a state returning any declared outcome of the container
+    text = smach(
+        """
+        cc = smach.Concurrence(outcomes=['a', 'b'], default_outcome='a',
+                               child_termination_cb=lambda so: True, outcome_cb=pick)
+        with cc:
+            smach.Concurrence.add('B', Bar())
+    """
+    )
+    model, warnings = read(text)
+    assert any("child_termination_cb lambda so: True not modelled" in w for w in warnings)
+    assert any("outcome_cb pick not modelled" in w for w in warnings)
+    inner = model.states[str(model.initial)].regions[0] if model.name != "cc" else model
+    chooser = inner.states["pick"]
+    assert sorted(t.event for t in inner.outgoing("pick")) == ["a", "b"]
+    assert all(inner.states[t.target].final for t in inner.outgoing("pick"))
+    assert chooser.action == "pick"
 
 
 @pytest.mark.parametrize("case", sorted(UNSUPPORTED))

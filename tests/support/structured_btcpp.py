@@ -17,11 +17,12 @@ import random
 import behaviortreepy as btpy
 from lxml import etree
 
+from fsmbt.convert.structured.schedule import read_structured_view
 from fsmbt.formats import dumps
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.fsm import FSM
 from fsmbt.semantics.outcome_machine import OutcomeFSMMachine
-from fsmbt.semantics.outcome_view import RUNNING_INPUT, Unit, read_outcome_view
+from fsmbt.semantics.outcome_view import RUNNING_INPUT, Unit
 
 LEAF_ID = "ScriptedLeaf"
 
@@ -48,7 +49,7 @@ def engine_xml(doc: BTDocument) -> str:
 
 
 def run_btcpp(doc: BTDocument, fsm: FSM, seed: int, budget: int) -> tuple[list[str], str | None]:
-    view = read_outcome_view(fsm)
+    view = read_structured_view(fsm)
     calls: list[str] = []
     factory = btpy.BehaviorTreeFactory()
     holder: dict[str, object] = {}
@@ -79,7 +80,7 @@ def run_btcpp(doc: BTDocument, fsm: FSM, seed: int, budget: int) -> tuple[list[s
 
 
 def run_source(fsm: FSM, seed: int, budget: int) -> tuple[list[str], str | None]:
-    machine = OutcomeFSMMachine(read_outcome_view(fsm))
+    machine = OutcomeFSMMachine(read_structured_view(fsm))
     state, _outputs = machine.start()
     calls: list[str] = []
     while len(calls) < budget:

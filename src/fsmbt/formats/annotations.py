@@ -82,6 +82,8 @@ _OTHER = {
     "smach.children": "concurrence children",
     "smach.outcome_map": "concurrence outcome maps",
     "smach.default_outcome": "concurrence default outcomes",
+    "smach.concurrence": "concurrences with container children",
+    "smach.callbacks": "Concurrence callbacks (outcome_cb, child_termination_cb)",
 }
 
 

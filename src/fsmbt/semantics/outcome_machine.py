@@ -10,11 +10,14 @@ container's completion transition for that outcome, up as many levels as it take
 top-level final state ends the run with ``SUCCESS``/``FAILURE`` (``OutcomeView.root_result``).
 
 A Concurrence read in rounds (``Region.parallel``; docs/semantics.md §11, "Concurrences:
-Parallel or product") is a ``Round`` state: each child's outcome so far and the child about to
-run. Entering it runs its first child; after each answer the source decision
-(``Concurrence.decide``) is taken, and a decided outcome leaves the container like the
-product's final state of that name; else the next child still running runs
-(``outcome_parallel.next_child``).
+Parallel or product") is a ``Round`` state: each child's outcome so far, the child about to
+run and where each container child is. Entering it runs its first child; a container child's
+outcome that leads to another of its states keeps its turn (its SubTree goes on in the same
+tick), unless it goes round a loop (``Region.round_trips``: its tree returns RUNNING there);
+when a child ends the source decision (``Concurrence.decide``) is taken, and a decided outcome
+leaves the container like the product's final state of that name; else, and after ``running``,
+the next child still running runs (``outcome_parallel.next_child``; docs/semantics.md §11,
+"Container children").
 
 Cost: O(nesting depth) per step; states are strings and result tuples.
 """
@@ -33,11 +36,20 @@ from fsmbt.semantics.outcome_view import RUNNING_INPUT, OutcomeView, Unit
 @dataclass(frozen=True, order=True)
 class Round:
     """Inside a Concurrence read in rounds: its region, each child's outcome so far (None
-    while it runs), and the index of the child about to run."""
+    while it runs), the index of the child about to run, and where each container child is
+    (the path of its atomic state about to run; "" for a leaf child or one that has ended)."""
 
     region: str
     done: Done
     index: int
+    inner: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True)
+class _Ended:
+    """A container child of a concurrence reached its final state ``outcome``."""
+
+    outcome: str
 
 
 #: A state: an atomic state's path, a ``Round``, or ``(result,)`` once the machine has ended.
@@ -56,20 +68,52 @@ class OutcomeFSMMachine:
         self.region_of = {
             u.path: path for path, r in view.regions.items() for u in r.units.values()
         }
+        self.round_trips = frozenset(t for r in view.regions.values() for t in r.round_trips)
+        #: Whether the last ``_enter`` took a round trip (a loop of a container child going
+        #: round: its SubTree returns RUNNING, the turn passes on).
+        self._went_round = False
 
     def start(self) -> tuple[OutcomeState, Outputs]:
         top = self.view.top
-        if top.parallel and top.concurrence is not None:
-            first = Round("", tuple(None for _ in top.concurrence.labels), 0)
+        if top.parallel:
+            first = self._round_start("")
             return first, (self.units[self._child(first)].label,)
-        return self._enter("", top.initial)
+        return self._settled(self._enter("", top.initial))
+
+    def _child_path(self, region: str, index: int) -> str:
+        concurrence = self.view.regions[region].concurrence
+        assert concurrence is not None
+        label = concurrence.labels[index]
+        return f"{region}/{label}" if region else label
 
     def _child(self, state: Round) -> str:
-        region = self.view.regions[state.region]
-        concurrence = region.concurrence
+        """The path of the atomic state about to run in a Round."""
+        if state.inner and state.inner[state.index]:
+            return state.inner[state.index]
+        return self._child_path(state.region, state.index)
+
+    def _round_start(self, region: str) -> Round:
+        """Entering a Concurrence: no child has ended, each container child at its first
+        state (it runs one before it ends: ``outcome_view``), the first child about to run."""
+        concurrence = self.view.regions[region].concurrence
         assert concurrence is not None
-        return f"{state.region}/{concurrence.labels[state.index]}" if state.region else (
-            concurrence.labels[state.index])  # fmt: skip
+        inner: list[str] = []
+        for index in range(len(concurrence.labels)):
+            unit = self.units[self._child_path(region, index)]
+            if not unit.container:
+                inner.append("")
+                continue
+            entered = self._enter(unit.path, self.view.regions[unit.path].initial)
+            assert isinstance(entered, str), "a container child runs a state before it ends"
+            inner.append(entered)
+        return Round(region, tuple(None for _ in inner), 0, tuple(inner))
+
+    def _settled(self, entered: OutcomeState | _Ended) -> tuple[OutcomeState, Outputs]:
+        """A state reached outside any concurrence child, with its output."""
+        assert not isinstance(entered, _Ended)
+        if isinstance(entered, tuple):
+            return entered, entered
+        return entered, (self.describe(entered),)
 
     def unit_of(self, state: str | Round) -> Unit:
         """The unit about to run in a state that has not ended."""
@@ -88,7 +132,7 @@ class OutcomeFSMMachine:
         unit = self.units[state]
         if symbol == RUNNING_INPUT:
             return state, (unit.label,)
-        return self._enter(self.region_of[state], unit.targets[symbol])
+        return self._settled(self._enter(self.region_of[state], unit.targets[symbol]))
 
     def status(self, state: OutcomeState) -> str:
         return FINAL if isinstance(state, tuple) else RUNNING
@@ -99,18 +143,42 @@ class OutcomeFSMMachine:
         return state[0] if isinstance(state, tuple) else self.units[state].label
 
     def _round_step(self, state: Round, symbol: str) -> tuple[OutcomeState, Outputs]:
-        done = state.done
+        """One answer inside a Round: a container child's outcome that leads to another of its
+        states keeps it running (its SubTree goes on in the same tick); a child that ends
+        records its outcome and the source decision is taken; a leaf that runs on, or a child
+        that ended without a decision, passes the turn to the next child still running."""
+        done, inner = state.done, state.inner
+        index = state.index
         if symbol != RUNNING_INPUT:
-            done = done[: state.index] + (symbol,) + done[state.index + 1 :]
+            ended: str | None = symbol
+            if inner and inner[index]:
+                here = inner[index]
+                self._went_round = (here, symbol) in self.round_trips
+                entered = self._enter(self.region_of[here], self.units[here].targets[symbol])
+                if not isinstance(entered, _Ended):
+                    assert isinstance(entered, str), "a container child holds no concurrence"
+                    inner = _put(inner, index, entered)
+                    if self._went_round:  # its tree returned RUNNING: the next child's turn
+                        after = Round(state.region, done, next_child(done, index), inner)
+                        return after, (self.units[self._child(after)].label,)
+                    after = Round(state.region, done, index, inner)
+                    return after, (self.units[entered].label,)
+                ended = entered.outcome
+                inner = _put(inner, index, "")
+            done = done[:index] + (ended,) + done[index + 1 :]
             concurrence = self.view.regions[state.region].concurrence
             assert concurrence is not None
             outcome = concurrence.decide(done)
+            if outcome is not None and concurrence.callback_state is not None:
+                outcome = concurrence.callback_state  # its outcome_cb runs, as a leaf
             if outcome is not None:
-                return self._enter(state.region, outcome)
-        after = Round(state.region, done, next_child(done, state.index))
+                return self._settled(self._enter(state.region, outcome))
+        after = Round(state.region, done, next_child(done, index), inner)
         return after, (self.units[self._child(after)].label,)
 
-    def _enter(self, region_path: str, target: str) -> tuple[OutcomeState, Outputs]:
+    def _enter(self, region_path: str, target: str) -> OutcomeState | _Ended:
+        """The state reached by going to ``target`` in a region: up through the containers
+        it ends (``_Ended`` at a concurrence child's end), down into the ones it enters."""
         seen: set[tuple[str, str]] = set()
         while True:
             if (region_path, target) in seen:
@@ -124,19 +192,23 @@ class OutcomeFSMMachine:
             if state.final:
                 owner = region.owner
                 if owner is None:
-                    result = self.view.root_result(target)
-                    return (result,), (result,)
+                    return (self.view.root_result(target),)
                 region_path = self.region_of[owner.path]
+                if self.view.regions[region_path].parallel:
+                    return _Ended(target)
+                if (owner.path, target) in self.round_trips:
+                    self._went_round = True
                 target = owner.targets[target]
                 continue
             unit = region.units[target]
             if unit.container and self.view.regions[unit.path].parallel:
-                inner = self.view.regions[unit.path].concurrence
-                assert inner is not None
-                first = Round(unit.path, tuple(None for _ in inner.labels), 0)
-                return first, (self.units[self._child(first)].label,)
+                return self._round_start(unit.path)
             if unit.container:
                 region_path = unit.path
                 target = self.view.regions[unit.path].initial
                 continue
-            return unit.path, (unit.label,)
+            return unit.path
+
+
+def _put(inner: tuple[str, ...], index: int, value: str) -> tuple[str, ...]:
+    return inner[:index] + (value,) + inner[index + 1 :]

@@ -1,17 +1,20 @@
 """A concurrence read as a BehaviorTree.CPP Parallel where the semantics allow (docs/semantics.md
 §11, "Concurrences: Parallel or product").
 
-The SMACH/FlexBE readers build a ``Concurrence`` / ``ConcurrencyContainer`` whose children are
-all leaves as a composite state whose region is the *product* of the children's progress, and
-record the children, the outcome map and the default outcome in the composite's ``attrs``
-(``smach.container``, ``smach.children``, ``smach.outcome_map``, ``smach.default_outcome``).
+The SMACH/FlexBE/YASMIN readers build a ``Concurrence`` / ``ConcurrencyContainer`` /
+``OrthogonalState`` as a composite state whose region is the *product* of the children's
+progress, and record the children, the outcome map and the default outcome in the composite's
+``attrs`` (leaf children: ``smach.container``, ``smach.children``, ``smach.outcome_map``,
+``smach.default_outcome``; with a container child: ``smach.concurrence``, which also holds each
+container child's machine; SMACH callbacks, never run: ``smach.callbacks``).
 This module decides from those alone whether the concurrence has the semantics of a built-in
 parallel node under the outcome rules, and gives its *round reading* (what the outcome pairing
 compares the Parallel with):
 
 - the *source decision* ``decide(done)``, ``done`` giving each child's outcome or ``None``
-  while it runs: SMACH ends the container only when every child has ended, with the last
-  ``outcome_map`` entry that holds, else ``default_outcome`` (``smach/concurrence.py``);
+  while it runs: SMACH and YASMIN end the container only when every child has ended, with the
+  last ``outcome_map`` entry that holds, else ``default_outcome`` (``smach/concurrence.py``,
+  YASMIN's ``concurrence.cpp`` / ``orthogonal_state.cpp``);
   FlexBE ends it as soon as the first condition holds (``concurrency_container.py``), the
   children still running stopped;
 - the *round reading*: entering the container, and after each round in which a child is still
@@ -33,7 +36,10 @@ compares the Parallel with):
 Otherwise the concurrence keeps its product reading and ``Concurrence.why`` names the cause:
 the outcome-map entry (or default) and the child outcomes where every form differs, a
 container outcome with no status (a dispatch), an outcome that halts the tree, a combination
-where FlexBE would wait for ever, or the size cap.
+where FlexBE would wait for ever, a YASMIN JoinState barrier, or the size cap. A SMACH
+``outcome_cb`` (its outcome the environment's choice) is a state of its own run once every
+child has ended: ``ForceSuccess(ParallelAll)`` then its leaf (``outcome_view``). How a container child runs
+in a round: ``outcome_view`` and docs/semantics.md §11, "Container children".
 
 Cost: O(forms x combinations) with at most ``MAX_CHILDREN`` children and ``MAX_COMBINATIONS``
 reachable combinations, else the product is kept.
@@ -46,7 +52,9 @@ from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
+from fsmbt.model.errors import InputError
 from fsmbt.model.fsm import FSM, State
+from fsmbt.model.serialize import fsm_from_dict
 from fsmbt.semantics.outcome_rules import FAILURE, SUCCESS
 
 A_CONTAINER = "smach.container"
@@ -54,9 +62,14 @@ A_CHILDREN = "smach.children"
 A_MAP = "smach.outcome_map"
 A_DEFAULT = "smach.default_outcome"
 A_CHILD_STATES = "children.states"
+A_NESTED = "smach.concurrence"
+A_CALLBACKS = "smach.callbacks"
+#: SMACH's and YASMIN's ``Concurrence`` (same class name, same rule: wait for every child),
+#: YASMIN's ``OrthogonalState`` (its regions are machines; same rule) and FlexBE's container.
 SMACH = "Concurrence"
+ORTHOGONAL = "OrthogonalState"
 FLEXBE = "ConcurrencyContainer"
-CONCURRENT = (SMACH, FLEXBE)
+CONCURRENT = (SMACH, ORTHOGONAL, FLEXBE)
 MAX_CHILDREN = 8
 MAX_COMBINATIONS = 4096
 
@@ -90,12 +103,25 @@ class Concurrence:
     outcome_map: list[tuple[str, dict[str, str]]]
     default: str | None
     child_attrs: dict[str, dict[str, str]] = field(default_factory=dict)
+    #: A container child's machine (its label -> the machine; leaf children have none).
+    machines: dict[str, FSM] = field(default_factory=dict)
+    #: YASMIN JoinState barriers between its regions (no parallel node waits on them).
+    barriers: int = 0
+    #: SMACH callbacks (never run): name -> source text.
+    callbacks: dict[str, str] = field(default_factory=dict)
     form: ParallelForm | None = None
     why: str = ""
 
     @property
+    def callback_state(self) -> str | None:
+        """The product state standing for a SMACH ``outcome_cb`` (run once every child has
+        ended; its outcome is the environment's choice), or None."""
+        return self.callbacks.get("outcome_cb_state")
+
+    @property
     def smach(self) -> bool:
-        return self.cls == SMACH
+        """Whether it waits for every child (SMACH, YASMIN), not ends at a condition (FlexBE)."""
+        return self.cls != FLEXBE
 
     def decide(self, done: Done) -> str | None:
         """The source decision (module docstring): the container outcome, or None."""
@@ -138,15 +164,21 @@ class Concurrence:
 
 
 def read_concurrence(owner: State | FSM) -> Concurrence | None:
-    """The concurrence recorded on a composite state (or a machine), else None."""
-    cls = owner.attrs.get(A_CONTAINER)
-    if cls not in CONCURRENT or A_CHILDREN not in owner.attrs:
-        return None
+    """The concurrence recorded on a composite state (or a machine), else None: of leaf
+    children under the ``smach.*`` keys, with a container child under ``smach.concurrence``
+    (its machines in fsmbt's JSON form, ``model.serialize``)."""
     try:
+        raw = json.loads(owner.attrs.get(A_CALLBACKS, "{}"))
+        callbacks = {str(k): str(v) for k, v in raw.items()}
+        if A_NESTED in owner.attrs:
+            return _nested(owner.attrs[A_NESTED], callbacks)
+        cls = owner.attrs.get(A_CONTAINER)
+        if cls not in CONCURRENT or A_CHILDREN not in owner.attrs:
+            return None
         children = json.loads(owner.attrs[A_CHILDREN])
         mapping = json.loads(owner.attrs.get(A_MAP, "[]"))
         child_attrs = json.loads(owner.attrs.get(A_CHILD_STATES, "{}"))
-    except ValueError:
+    except (ValueError, InputError, KeyError, TypeError):
         return None
     return Concurrence(
         str(cls),
@@ -156,6 +188,28 @@ def read_concurrence(owner: State | FSM) -> Concurrence | None:
         [(str(o), {str(k): str(v) for k, v in req.items()}) for o, req in mapping],
         owner.attrs.get(A_DEFAULT),
         {str(k): {str(a): str(b) for a, b in v.items()} for k, v in child_attrs.items()},
+        callbacks=callbacks,
+    )
+
+
+def _nested(text: str, callbacks: dict[str, str]) -> Concurrence | None:
+    spec = json.loads(text)
+    cls = str(spec["class"])
+    if cls not in CONCURRENT:
+        return None
+    children = spec["children"]
+    machines = {str(k): fsm_from_dict(v, where=f"child '{k}'") for k, v in spec["machines"].items()}
+    default = spec.get("default")
+    return Concurrence(
+        cls,
+        [str(c[0]) for c in children],
+        [str(c[1]) for c in children],
+        [[str(o) for o in c[2]] for c in children],
+        [(str(o), {str(k): str(v) for k, v in req.items()}) for o, req in spec["outcome_map"]],
+        None if default is None else str(default),
+        machines=machines,
+        barriers=int(spec.get("barriers", 0)),
+        callbacks=callbacks,
     )
 
 
@@ -239,6 +293,15 @@ def choose_form(
             (a dispatch, an outcome that halts the tree).
     """
     n = len(c.labels)
+    if "outcome_cb" in c.callbacks:
+        c.why = (
+            f"its outcome_cb {c.callbacks['outcome_cb']} decides its outcome (not modelled: "
+            "the environment chooses; a leaf for the callback in the product)"
+        )
+        return
+    if c.barriers:
+        c.why = f"{c.barriers} JoinState barrier(s) make its regions wait for each other"
+        return
     if n > MAX_CHILDREN:
         c.why = f"more than {MAX_CHILDREN} children"
         return

@@ -10,8 +10,10 @@ targets and statuses, and whether a leaf needs a dispatch on its outcome.
 
 Rules (each violation is an ``OutcomeError`` naming the state and the cause, exit 2):
 - no parallel state (a reader builds a Concurrence as a composite whose region is the product
-  of its children; one of leaf children whose semantics a BehaviorTree.CPP parallel node has
-  is read in rounds instead, its units being its children: ``outcome_parallel``);
+  of its children; one whose semantics a BehaviorTree.CPP parallel node has is read in rounds
+  instead, its units being its children: ``outcome_parallel``; a container child is one unit
+  whose own regions join the view, read as a container's, when the ``ChildSchedule`` says its
+  tree can run under a Parallel: docs/semantics.md §11, "Container children");
 - the machine needs no start event; an atomic state has no completion transition and at
   least one outcome; a composite state leaves only by completion transitions;
 - when a state declares its outcomes (``fsmbt.model.state_info``), every event of its
@@ -28,11 +30,17 @@ Everything is computed with explicit work lists, O(states + transitions).
 from __future__ import annotations
 
 import re
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from fsmbt.model import state_info
 from fsmbt.model.fsm import FSM, State
-from fsmbt.semantics.outcome_parallel import Concurrence, choose_form, read_concurrence
+from fsmbt.semantics.outcome_parallel import (
+    Concurrence,
+    ParallelForm,
+    choose_form,
+    read_concurrence,
+)
 from fsmbt.semantics.outcome_rules import (
     FAILURE,
     HALT_OUTCOME,
@@ -60,11 +68,14 @@ class Unit:
     order_choice: bool
     label: str = ""
     key: str = ""
+    #: Its status is its container's result (a SMACH ``outcome_cb``'s leaf, last in its
+    #: container's tree): never dispatched on.
+    gives_result: bool = False
 
     @property
     def dispatch(self) -> bool:
         """Whether the outcome must be written to the blackboard and dispatched on."""
-        if len(set(self.targets.values())) <= 1:
+        if self.gives_result or len(set(self.targets.values())) <= 1:
             return False
         if any(self.status[o] is None for o in self.outcomes):
             return True
@@ -96,6 +107,10 @@ class Region:
     #: A Concurrence of leaf children (``outcome_parallel``); with a ``form`` the region's
     #: units are its children, read in rounds, else its product machine's states.
     concurrence: Concurrence | None = None
+    #: In a Concurrence read in rounds: the (unit path, outcome) transitions of its container
+    #: children that go round a loop - their SubTree returns RUNNING there, so the turn passes
+    #: to the next child (``ChildSchedule``).
+    round_trips: frozenset[tuple[str, str]] = frozenset()
 
     @property
     def parallel(self) -> bool:
@@ -134,6 +149,14 @@ class OutcomeView:
                 if not u.container]  # fmt: skip
 
 
+#: How a container child's tree runs under a Parallel, given its top region (owner set) and
+#: every region of its hierarchy: why it cannot (or None), and the transitions where its tree
+#: returns RUNNING without a leaf doing so (a loop going round). The structured conversion
+#: gives it (``convert.structured.schedule``): the reading follows the tree the conversion
+#: writes, which is a function of the source alone.
+ChildSchedule = Callable[[Region, dict[str, Region]], tuple[str | None, frozenset[tuple[str, str]]]]
+
+
 def declares_outcomes(fsm: FSM) -> bool:
     """Whether some state declares its outcomes (a reader of an outcome-driven format)."""
     return any(
@@ -151,8 +174,13 @@ def _sanitize(text: str) -> str:
     return out if not out[0].isdigit() else f"s_{out}"
 
 
-def read_outcome_view(fsm: FSM, rules: OutcomeRules | None = None) -> OutcomeView:
+def read_outcome_view(
+    fsm: FSM, rules: OutcomeRules | None = None, schedule: ChildSchedule | None = None
+) -> OutcomeView:
     """Check ``fsm`` is outcome-driven and read its units (see the module docstring).
+
+    ``schedule`` says how a Concurrence's container child runs under a Parallel; without it
+    only a child without loops is read in rounds.
 
     Raises:
         OutcomeError: the first violation, naming the state's path and the cause.
@@ -166,12 +194,35 @@ def read_outcome_view(fsm: FSM, rules: OutcomeRules | None = None) -> OutcomeVie
         )
     regions: dict[str, Region] = {}
     notes: dict[str, list[str]] = {}  # unit path -> its order choices, in words
-    # work list: (region path, machine, owner unit, halting finals of this machine)
-    work: list[tuple[str, FSM, Unit | None, frozenset[str]]] = []
     top_halting = frozenset(
         {HALT_OUTCOME} if HALT_OUTCOME in fsm.states and fsm.states[HALT_OUTCOME].final else ()
     )
-    work.append(("", fsm, None, top_halting))
+    _read_regions(fsm, [("", fsm, None, top_halting)], regions)
+    _read_statuses(regions, rules, notes)
+    top = regions[""]
+    top.exit_status, top_choice = rules.statuses(top.exits)
+    _read_exit_statuses(regions)
+    for region in list(regions.values()):
+        _read_parallel(region, fsm, rules, notes, regions, schedule)
+    order_choices = [
+        note for r in regions.values() for u in r.units.values() for note in notes.get(u.path, [])
+    ]
+    if top_choice:
+        order_choices.append(
+            f"{fsm.name}: outcome '{top.exits[0]}' read as SUCCESS, '{top.exits[1]}' as FAILURE"
+        )
+    halts = sum(len(u.halted) for r in regions.values() for u in r.units.values())
+    by_label = _assign_labels(regions)
+    return OutcomeView(fsm, rules, regions, by_label, order_choices, halts)
+
+
+#: A region to read: its path, machine, owner unit and the halting finals of its machine.
+_Job = tuple[str, FSM, "Unit | None", frozenset[str]]
+
+
+def _read_regions(fsm: FSM, work: list[_Job], regions: dict[str, Region]) -> None:
+    """Read every region the work list reaches into ``regions`` (the shape rules of the
+    module docstring; each violation an ``OutcomeError``)."""
     while work:
         path, machine, owner, halting = work.pop()
         region = Region(path, machine, owner)
@@ -198,7 +249,12 @@ def read_outcome_view(fsm: FSM, rules: OutcomeRules | None = None) -> OutcomeVie
         reached = {t for u in region.units.values() for t in u.targets.values()}
         reached.add(region.initial)
         region.exits = [n for n, s in machine.states.items() if s.final and n in reached]
-    # statuses: a container's exits have the statuses of the container's outcomes
+
+
+def _read_statuses(
+    regions: dict[str, Region], rules: OutcomeRules, notes: dict[str, list[str]]
+) -> None:
+    """Each unit's outcome statuses (a container's exits have its outcomes' statuses)."""
     for region in regions.values():
         for unit in region.units.values():
             if unit.container:
@@ -221,24 +277,14 @@ def read_outcome_view(fsm: FSM, rules: OutcomeRules | None = None) -> OutcomeVie
                 unit.status = {o: s or SUCCESS for o, s in unit.status.items()}
             if unit.order_choice:
                 notes.setdefault(unit.path, []).append(_order_note(unit))
-    top = regions[""]
-    top.exit_status, top_choice = rules.statuses(top.exits)
+
+
+def _read_exit_statuses(regions: dict[str, Region]) -> None:
+    """A container's region: its exits' statuses (its owner's); every region's flag key."""
     for path, region in regions.items():
         if region.owner is not None:
             region.exit_status = {e: region.owner.status.get(e) for e in region.exits}
         region.pc_key = "pc" if not path else f"pc_{_sanitize(path)}"
-    for region in regions.values():
-        _read_parallel(region, fsm, rules, notes)
-    order_choices = [
-        note for r in regions.values() for u in r.units.values() for note in notes.get(u.path, [])
-    ]
-    if top_choice:
-        order_choices.append(
-            f"{fsm.name}: outcome '{top.exits[0]}' read as SUCCESS, '{top.exits[1]}' as FAILURE"
-        )
-    halts = sum(len(u.halted) for r in regions.values() for u in r.units.values())
-    by_label = _assign_labels(regions)
-    return OutcomeView(fsm, rules, regions, by_label, order_choices, halts)
 
 
 def _order_note(unit: Unit) -> str:
@@ -247,11 +293,16 @@ def _order_note(unit: Unit) -> str:
 
 
 def _read_parallel(
-    region: Region, fsm: FSM, rules: OutcomeRules, notes: dict[str, list[str]]
+    region: Region,
+    fsm: FSM,
+    rules: OutcomeRules,
+    notes: dict[str, list[str]],
+    regions: dict[str, Region],
+    schedule: ChildSchedule | None,
 ) -> None:
-    """A Concurrence of leaf children: read in rounds when a parallel form is exactly
-    equivalent (its units become its children), else named with the cause
-    (``outcome_parallel``; docs/semantics.md §11, "Concurrences: Parallel or product")."""
+    """A Concurrence: read in rounds when a parallel form is exactly equivalent (its units
+    become its children, a container child's regions join ``regions``), else named with the
+    cause (``outcome_parallel``; docs/semantics.md §11, "Concurrences: Parallel or product")."""
     owner = region.owner
     concurrence = read_concurrence(owner.state if owner is not None else fsm)
     if concurrence is None:
@@ -259,8 +310,25 @@ def _read_parallel(
     region.concurrence = concurrence
     children: dict[str, Unit] = {}
     statuses: list[dict[str, str]] = []
-    for state, outcomes in zip(concurrence.child_states(), concurrence.outcomes):
+    inner: dict[str, Region] = {}
+    trips: set[tuple[str, str]] = set()
+    if concurrence.machines and not concurrence.smach:
+        concurrence.why = (
+            "FlexBE steps a container child one state per tick, where its SubTree would go on "
+            "in the same tick"
+        )
+        return
+    for index, state in enumerate(concurrence.child_states()):
         where = f"{region.path}/{state.name}" if region.path else state.name
+        outcomes = concurrence.outcomes[index]
+        machine = concurrence.machines.get(state.name)
+        if machine is not None:
+            found = _container_child(where, machine, fsm, rules, notes, inner, schedule is None)
+            if isinstance(found, str):
+                concurrence.why = f"child '{state.name}' {found}"
+                return
+            outcomes = list(found)
+            concurrence.outcomes[index] = outcomes
         status, choice = rules.statuses(outcomes)
         if RUNNING_INPUT in outcomes:
             concurrence.why = f"child '{state.name}' has an outcome named '{RUNNING_INPUT}'"
@@ -276,9 +344,18 @@ def _read_parallel(
             return
         full = {o: str(s) for o, s in status.items()}
         statuses.append(full)
-        unit = Unit(where, state.name, state, False, tuple(outcomes),
+        unit = Unit(where, state.name, state, machine is not None, tuple(outcomes),
                     {o: "" for o in outcomes}, dict(full), (), choice)  # fmt: skip
         children[state.name] = unit
+        if machine is not None and schedule is not None:
+            inner[where].owner = unit
+            mine = {p: r for p, r in inner.items() if p == where or p.startswith(where + "/")}
+            _read_exit_statuses(mine)
+            why, yields = schedule(inner[where], mine)
+            if why is not None:
+                concurrence.why = f"child '{state.name}' {why}"
+                return
+            trips |= yields
 
     def outcome_status(outcome: str) -> tuple[str | None, str]:
         if owner is None:
@@ -289,13 +366,117 @@ def _read_parallel(
             return None, "is dispatched on (the container's outcomes lead to more than two places)"
         return owner.status.get(outcome), "leads nowhere"
 
-    choose_form(concurrence, statuses, outcome_status)
+    callback = _callback_unit(region, concurrence, outcome_status)
+    if isinstance(callback, Unit):
+        concurrence.form = ParallelForm("ParallelAll", (("max_failures", "1"),), "ForceSuccess")
+        children[callback.name] = callback
+        notes.pop(callback.path, None)  # its statuses are its container's
+    elif callback:
+        concurrence.why = callback
+        return
+    else:
+        choose_form(concurrence, statuses, outcome_status)
     if concurrence.form is None:
         return
     region.units = children
+    region.round_trips = frozenset(trips)
     for unit in children.values():
+        if unit.container:
+            inner[unit.path].owner = unit
         if unit.order_choice:
             notes.setdefault(unit.path, []).append(_order_note(unit))
+    regions.update(inner)
+    _read_exit_statuses(inner)
+
+
+def _callback_unit(
+    region: Region,
+    concurrence: Concurrence,
+    outcome_status: Callable[[str], tuple[str | None, str]],
+) -> Unit | str:
+    """A SMACH ``outcome_cb``: its product state as the leaf run once every child has ended,
+    returning its container's result (``ForceSuccess(ParallelAll)`` then that leaf:
+    docs/semantics.md §11, "Concurrence callbacks"); why not; "" without one."""
+    name = concurrence.callback_state
+    if "outcome_cb" not in concurrence.callbacks:
+        return ""
+    unit = region.units.get(name or "")
+    if unit is None or unit.container:
+        return "its outcome_cb has no state of its own"
+    status: dict[str, str | None] = {}
+    for outcome in unit.outcomes:
+        status[outcome], why = outcome_status(outcome)
+        if status[outcome] is None:
+            text = concurrence.callbacks["outcome_cb"]
+            return f"its outcome_cb {text} may give '{outcome}', which {why}"
+    unit.status = status
+    unit.gives_result = True
+    unit.order_choice = False
+    return unit
+
+
+def _container_child(
+    where: str,
+    machine: FSM,
+    fsm: FSM,
+    rules: OutcomeRules,
+    notes: dict[str, list[str]],
+    regions: dict[str, Region],
+    no_loops: bool,
+) -> tuple[str, ...] | str:
+    """A container child of a concurrence (a StateMachine, a YASMIN Region): its regions read
+    into ``regions`` and its outcomes (the exits its machine reaches), or why it keeps the
+    product. The round reading must know where its tree returns RUNNING: without a
+    ``ChildSchedule`` (``no_loops``) only where a leaf does, so it may have no loop (a loop
+    node returns RUNNING between iterations: docs/semantics.md §11); no concurrence inside;
+    and it must run a state before it ends."""
+    found: dict[str, Region] = {}
+    try:
+        _read_regions(fsm, [(where, machine, None, frozenset())], found)
+    except OutcomeError as error:
+        return f"is not outcome-driven ({error})"
+    for sub in found.values():
+        looping = _loop_state(sub) if no_loops else None
+        if looping is not None:
+            return (
+                f"loops back to '{looping}' (a loop node returns RUNNING between iterations, "
+                "which the round reading does not follow)"
+            )
+        if any(read_concurrence(u.state) is not None for u in sub.units.values()):
+            return "holds a concurrence"
+    top = found[where]
+    if machine.states[top.initial].final:
+        return "ends before running a state"
+    if not top.exits:
+        return "never ends"
+    _read_statuses(found, rules, notes)
+    regions.update(found)
+    return tuple(top.exits)
+
+
+def _loop_state(region: Region) -> str | None:
+    """A unit of the region on a cycle of its transitions, else None (iterative DFS)."""
+    graph = {name: [t for t in u.targets.values() if t in region.units]
+             for name, u in region.units.items()}  # fmt: skip
+    colour: dict[str, int] = {}
+    for root in graph:
+        if root in colour:
+            continue
+        colour[root] = 1
+        stack: list[tuple[str, int]] = [(root, 0)]
+        while stack:
+            node, i = stack.pop()
+            if i < len(graph[node]):
+                stack.append((node, i + 1))
+                nxt = graph[node][i]
+                if colour.get(nxt) == 1:
+                    return nxt
+                if nxt not in colour:
+                    colour[nxt] = 1
+                    stack.append((nxt, 0))
+            else:
+                colour[node] = 2
+    return None
 
 
 def _leaf_unit(

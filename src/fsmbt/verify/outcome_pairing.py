@@ -19,6 +19,7 @@ are), and every custom leaf of the tree is named after one of its states.
 
 from __future__ import annotations
 
+from fsmbt.convert.structured.schedule import read_structured_view
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import InputError
 from fsmbt.model.fsm import FSM
@@ -27,7 +28,7 @@ from fsmbt.semantics.lebt.spec import GUARD_TYPE, STATE_TYPE
 from fsmbt.semantics.outcome_blackboard import OutcomeLeafMachine
 from fsmbt.semantics.outcome_machine import OutcomeFSMMachine
 from fsmbt.semantics.outcome_rules import OutcomeRules
-from fsmbt.semantics.outcome_view import OutcomeView, declares_outcomes, read_outcome_view
+from fsmbt.semantics.outcome_view import OutcomeView, declares_outcomes
 from fsmbt.semantics.state_variable_runtime import is_state_variable_bt
 from fsmbt.semantics.status import LeafOutcome
 
@@ -57,7 +58,7 @@ def _structured_signature(source: FSM, result: BTDocument) -> bool:
     if not leaves:
         return False
     try:
-        view = read_outcome_view(source)
+        view = read_structured_view(source)
     except InputError:
         return False
     return leaves <= set(view.by_label)
@@ -71,7 +72,7 @@ def outcome_machines(
     Raises:
         OutcomeError: the FSM is not outcome-driven (the state and the cause named).
     """
-    view = read_outcome_view(source, rules)
+    view = read_structured_view(source, rules)
     return OutcomeFSMMachine(view), OutcomeLeafMachine(result, view), OUTCOME_EXECUTION
 
 
@@ -87,9 +88,26 @@ def outcome_abstractions(view: OutcomeView) -> list[str]:
     rounds = [path or view.fsm.name for path, r in view.regions.items() if r.parallel]
     if rounds:
         sentences.append(
-            "concurrence read in rounds (each child still running runs once per round, in the "
-            'order added; docs/semantics.md §11, "Concurrences: Parallel or product"): '
-            + ", ".join(rounds)
+            "concurrence read in rounds (each child still running takes one turn per round, in "
+            "the order added - a container child runs on until a leaf runs on or a loop goes "
+            'round; docs/semantics.md §11, "Concurrences: Parallel or product", "Container '
+            'children"): ' + ", ".join(rounds)
         )
+    for path, region in view.regions.items():
+        concurrence = region.concurrence
+        if concurrence is None:
+            continue
+        where = path or view.fsm.name
+        if "outcome_cb" in concurrence.callbacks:
+            sentences.append(
+                f"outcome_cb {concurrence.callbacks['outcome_cb']} of {where} not modelled: its "
+                "outcome is chosen by the environment"
+            )
+        if "child_termination_cb" in concurrence.callbacks:
+            sentences.append(
+                f"child_termination_cb {concurrence.callbacks['child_termination_cb']} of "
+                f"{where} not modelled: a child stopped early ends with an outcome the "
+                "environment chooses"
+            )
     sentences.extend(f"by declaration order: {choice}" for choice in view.order_choices)
     return sentences

@@ -9,11 +9,12 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
+from fsmbt.convert.structured.schedule import read_structured_view
 from fsmbt.model.fsm import FSM
 from fsmbt.semantics.machine import FINAL, FSMLeafMachine, Outputs
 from fsmbt.semantics.outcome_machine import OutcomeFSMMachine
 from fsmbt.semantics.outcome_rules import OutcomeRules
-from fsmbt.semantics.outcome_view import RUNNING_INPUT, OutcomeView, Unit, read_outcome_view
+from fsmbt.semantics.outcome_view import RUNNING_INPUT, OutcomeView, Unit
 from fsmbt.verify.outcome_pairing import OUTCOME_EXECUTION
 
 
@@ -62,5 +63,5 @@ def leaf_fsm_machines(
 ) -> tuple[OutcomeFSMMachine, OutcomeFSMLeafMachine, str]:
     """The outcome pairing of a source machine and the BT -> FSM conversion of its structured
     tree (``OutcomeFSMLeafMachine``)."""
-    view = read_outcome_view(source, rules)
+    view = read_structured_view(source, rules)
     return OutcomeFSMMachine(view), OutcomeFSMLeafMachine(leaf_fsm, view), OUTCOME_EXECUTION

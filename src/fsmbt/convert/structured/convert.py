@@ -6,8 +6,10 @@ located ``OutcomeError``, exit 2); structure each region (``regions``), or give 
 (``flags``) when no structured form exists; the top-level machine is the main
 ``<BehaviorTree>`` itself, each container one ``<BehaviorTree>`` used by one ``SubTree`` node;
 every leaf type is declared in ``<TreeNodesModel>``; a Concurrence the outcome view reads in
-rounds is a ``Parallel`` / ``ParallelAll`` over its children's leaves (``_parallel``; the rule:
-docs/semantics.md §11, "Concurrences: Parallel or product"). The result's ``stats`` count what was found
+rounds is a ``Parallel`` / ``ParallelAll`` over its children's leaves and SubTrees (``_parallel``;
+a container child's loops return RUNNING when they go round, ``RegionStructurer(
+yielding_loops=True)``; the rule: docs/semantics.md §11, "Concurrences: Parallel or product",
+"Container children"). The result's ``stats`` count what was found
 and ``stats["summary"]`` says it in one line ("structured: 3 sequences, 1 fallback, ...").
 
 Cost: the regions' structuring (``regions``) plus O(nodes).
@@ -22,11 +24,11 @@ from fsmbt.convert.result import ConversionResult
 from fsmbt.convert.structured import builder
 from fsmbt.convert.structured.flags import flag_form
 from fsmbt.convert.structured.regions import RegionStructurer, Unstructured
-from fsmbt.convert.structured.shapes import Term
+from fsmbt.convert.structured.schedule import exit_terms, read_structured_view
 from fsmbt.model.bt import BehaviorTree, BTDocument, BTNode, NodeModel
 from fsmbt.model.fsm import FSM
-from fsmbt.semantics.outcome_rules import FAILURE, SUCCESS, OutcomeRules
-from fsmbt.semantics.outcome_view import OutcomeView, Region, Unit, read_outcome_view
+from fsmbt.semantics.outcome_rules import OutcomeRules
+from fsmbt.semantics.outcome_view import OutcomeView, Region, Unit
 
 STYLE = "structured"
 
@@ -45,7 +47,7 @@ def fsm_to_structured(
         both results (the message names the state or the option).
     """
     rules = OutcomeRules.from_option(outcomes)
-    view = read_outcome_view(fsm, rules)
+    view = read_structured_view(fsm, rules)
     return structured_result(view)
 
 
@@ -60,14 +62,15 @@ def structured_result(view: OutcomeView) -> ConversionResult:
         return builder.leaf(unit, models)
 
     trees: dict[str, BehaviorTree] = {}
+    under = _under_parallel(view)
     flagged: list[str] = []
     flags: list[str] = []
     for path, region in view.regions.items():
         if region.parallel:
             trees[tree_ids[path]] = BehaviorTree(tree_ids[path], _parallel(region, emit))
             continue
-        exits = _exit_terms(view, region)
-        structurer = RegionStructurer(region, emit, exits)
+        exits = exit_terms(region, view.root_result)
+        structurer = RegionStructurer(region, emit, exits, yielding_loops=path in under)
         try:
             root = structurer.structure()
             flags.extend(structurer.flags)
@@ -107,17 +110,30 @@ def structured_result(view: OutcomeView) -> ConversionResult:
 
 
 def _parallel(region: Region, emit: Callable[[Unit], BTNode]) -> BTNode:
-    """A Concurrence read in rounds: its parallel form over its children's leaves, in the
-    order they were added (docs/semantics.md §11, "Concurrences: Parallel or product")."""
+    """A Concurrence read in rounds: its parallel form over its children's leaves and
+    SubTrees, in the order they were added (docs/semantics.md §11, "Concurrences: Parallel or product")."""
     concurrence = region.concurrence
     assert concurrence is not None and concurrence.form is not None
     form = concurrence.form
-    node = builder.control(form.kind, *(emit(u) for u in region.units.values()), **dict(form.ports))
-    return builder.decorator(form.wrapper, node) if form.wrapper else node
+    children = [region.units[label] for label in concurrence.labels]
+    node = builder.control(form.kind, *(emit(u) for u in children), **dict(form.ports))
+    node = builder.decorator(form.wrapper, node) if form.wrapper else node
+    callback = concurrence.callback_state
+    if callback is None:
+        return node
+    return builder.control("Sequence", node, emit(region.units[callback]))
+
+
+def _under_parallel(view: OutcomeView) -> set[str]:
+    """The regions of a Parallel's container children (their loops return RUNNING when they
+    go round: ``schedule``)."""
+    tops = [u.path for r in view.regions.values() if r.parallel
+            for u in r.units.values() if u.container]  # fmt: skip
+    return {p for p in view.regions for top in tops if p == top or p.startswith(top + "/")}
 
 
 def _concurrences(view: OutcomeView) -> list[str]:
-    """Name every Concurrence of leaf children: the parallel form it became, or why it is kept
+    """Name every Concurrence: the parallel form it became, or why it is kept
     as its product machine (the named fallback form: one leaf per combination of its
     children's progress)."""
     named = []
@@ -127,9 +143,11 @@ def _concurrences(view: OutcomeView) -> list[str]:
             continue
         where = f"{concurrence.cls} '{path or view.fsm.name}'"
         if concurrence.form is not None:
+            callback = concurrence.callback_state
+            then = f", then its outcome_cb's leaf '{callback}'" if callback else ""
             named.append(
-                f"{where}: a {concurrence.form.describe()} over its children, read in rounds "
-                '(docs/semantics.md §11, "Concurrences: Parallel or product")'
+                f"{where}: a {concurrence.form.describe()} over its children{then}, read in "
+                'rounds (docs/semantics.md §11, "Concurrences: Parallel or product")'
             )
         else:
             named.append(
@@ -151,24 +169,6 @@ def _tree_ids(view: OutcomeView) -> dict[str, str]:
         used.add(tree_id)
         ids[path] = tree_id
     return ids
-
-
-def _exit_terms(view: OutcomeView, region: Region) -> dict[str, Term]:
-    """The region's exits as terminals: the root's result at the top; the container's
-    outcome status below; for a dispatch container SUCCESS after writing the outcome."""
-    owner = region.owner
-    terms: dict[str, Term] = {}
-    for name, state in region.machine.states.items():
-        if not state.final:
-            continue
-        if owner is None:
-            status = FAILURE if view.root_result(name) == "FAILURE" else SUCCESS
-            terms[name] = Term(status)
-        elif owner.dispatch:
-            terms[name] = Term(SUCCESS, (owner.key, name))
-        else:
-            terms[name] = Term(owner.status.get(name) or SUCCESS)
-    return terms
 
 
 _COUNTED = {

@@ -68,9 +68,22 @@ class RegionStructurer:
     """Structures one region; ``emit`` makes a unit's node (leaf or SubTree)."""
 
     def __init__(
-        self, region: Region, emit: Callable[[Unit], BTNode], exits: dict[str, Term]
+        self,
+        region: Region,
+        emit: Callable[[Unit], BTNode],
+        exits: dict[str, Term],
+        *,
+        yielding_loops: bool = False,
     ) -> None:
         self.region = region
+        #: Under a Parallel (a Concurrence's container child) every loop returns RUNNING when
+        #: it goes round (``Inverter(KeepRunningUntilFailure(Inverter(body)))`` for the retry
+        #: loop, whose ``RetryUntilSuccessful`` would go round in the same tick after a body
+        #: that had run on): the round reading then knows where the turn passes
+        #: (docs/semantics.md §11, "Container children").
+        self.yielding_loops = yielding_loops
+        #: The (unit path, outcome) transitions that go round a loop (back to its head).
+        self.round_trips: set[tuple[str, str]] = set()
         self.units = region.units
         self.emit = emit
         self.exits = exits
@@ -138,6 +151,10 @@ class RegionStructurer:
                     body.add(p)
                     todo.append(p)
         outs = {t for x in body for t in self.units[x].targets.values() if t not in body}
+        for x in body:
+            for outcome, target in self.units[x].targets.items():
+                if target == head:
+                    self.round_trips.add((self.units[x].path, outcome))
         terminals = [t for t in outs if t in ctx]
         units = [t for t in outs if t not in ctx]
         statuses = {ctx[t].status for t in terminals}
@@ -146,16 +163,23 @@ class RegionStructurer:
             return decorator("KeepRunningUntilFailure", as_node(inner))
         if not units and statuses == {SUCCESS}:
             inner = yield (head, {**ctx, head: Term(FAILURE)}, True)
-            return decorator("RetryUntilSuccessful", as_node(inner), num_attempts="-1")
+            return self._retry(as_node(inner))
         if len(units) == 1 and not terminals:
             (m,) = units
             inner = yield (head, {**ctx, head: Term(FAILURE), m: Term(SUCCESS)}, True)
             rest = yield (m, ctx, False)
-            retry = decorator("RetryUntilSuccessful", as_node(inner), num_attempts="-1")
-            return sequence(retry, as_node(rest))
+            return sequence(self._retry(as_node(inner)), as_node(rest))
         ordered = [t for x in sorted(body, key=self.order.__getitem__)
                    for t in self.units[x].targets.values() if t in outs]  # fmt: skip
         return (yield from self._flag_loop(head, ctx, list(dict.fromkeys(ordered))))
+
+    def _retry(self, body: BTNode) -> BTNode:
+        """Run ``body`` again while it fails: ``RetryUntilSuccessful num_attempts=-1``, or its
+        form that returns RUNNING each time it goes round (``yielding_loops``)."""
+        if not self.yielding_loops:
+            return decorator("RetryUntilSuccessful", body, num_attempts="-1")
+        again = decorator("KeepRunningUntilFailure", decorator("Inverter", body))
+        return decorator("Inverter", again)
 
     def _flag_loop(self, head: str, ctx: Context, outs: list[str]) -> Task:
         """A loop with several ways out: ``Sequence(Script flag:='', Fallback(

@@ -22,10 +22,11 @@ Cost: ``read_outcome_view``, O(states + transitions).
 
 from __future__ import annotations
 
+from fsmbt.convert.structured.schedule import read_structured_view
 from fsmbt.model.errors import UnsupportedError
 from fsmbt.model.fsm import FSM
 from fsmbt.semantics.outcome_rules import OutcomeError, OutcomeRules
-from fsmbt.semantics.outcome_view import OutcomeView, declares_outcomes, read_outcome_view
+from fsmbt.semantics.outcome_view import OutcomeView, declares_outcomes
 
 AUTO = "auto"
 STRUCTURED = "structured"
@@ -79,4 +80,4 @@ def resolve_style(
             "(use --style lebt)",
             element=f"state '{first}'",
         )
-    return STRUCTURED, read_outcome_view(fsm, rules)
+    return STRUCTURED, read_structured_view(fsm, rules)

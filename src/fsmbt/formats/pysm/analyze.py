@@ -130,6 +130,9 @@ class Container:
     # Concurrence / ConcurrencyContainer
     default_outcome: str | None = None
     outcome_map: list[tuple[str, dict[str, str]]] = field(default_factory=list)
+    #: SMACH ``outcome_cb`` / ``child_termination_cb`` -> the callback's source text (user code
+    #: fsmbt never runs; docs/semantics.md §11, "Concurrence callbacks")
+    callbacks: dict[str, str] = field(default_factory=dict)
     # Iterator
     items: int | None = None  # static number of items, None = computed at run time
     items_text: str = ""
@@ -685,11 +688,8 @@ class Analyzer:
         for callback in ("outcome_cb", "child_termination_cb"):
             node = args.get(callback)
             if node is not None and not (isinstance(node, ast.Constant) and node.value is None):
-                container.blocker = self.unsupported(
-                    node,
-                    f"Concurrence {callback}: a callback decides the container's "
-                    "behaviour at run time",
-                )
+                # never run: read as an environment choice (docs/semantics.md §11)
+                container.callbacks[callback] = ast.unparse(node)[:80]
         container.default_outcome = self.string(
             args.get("default_outcome"), ctx, call, "the Concurrence default_outcome"
         )

@@ -46,6 +46,7 @@ costs the product of (1 + outcomes) over its children, capped at ``MAX_PRODUCT_S
 from __future__ import annotations
 
 import ast
+import hashlib
 import json
 from collections import deque
 from collections.abc import Callable
@@ -72,6 +73,7 @@ from fsmbt.model.errors import InputError, SourceLocation, UnsupportedError
 from fsmbt.model.files import note_read, read_bounded, read_located
 from fsmbt.model.flatten import flatten
 from fsmbt.model.fsm import FSM, State, Transition
+from fsmbt.model.serialize import fsm_to_dict
 
 MAX_PRODUCT_STATES = 20_000
 #: Where a concurrence child is: ``(False, flat state)`` while it runs, ``(True, outcome)`` done.
@@ -84,6 +86,13 @@ A_CONTAINER = "smach.container"
 A_CHILDREN = "smach.children"
 A_MAP = "smach.outcome_map"
 A_DEFAULT = "smach.default_outcome"
+#: A concurrence with a container child (a StateMachine, an OrthogonalState's Region): its class,
+#: children, outcome map, default and each container child's machine, as one JSON object
+#: (``semantics.outcome_parallel``; the smach.* keys above stay for leaf children only, which
+#: the SMACH and YASMIN writers write back as a Concurrence).
+A_NESTED = "smach.concurrence"
+#: SMACH Concurrence callbacks (never run): name -> source text (docs/semantics.md §11).
+A_CALLBACKS = "smach.callbacks"
 A_BEHAVIOUR = "flexbe.behaviour"
 #: An embedded behaviour whose file was not found, read as one state (docs/formats/flexbe.md).
 A_OPAQUE = "flexbe.opaque"
@@ -553,6 +562,7 @@ class Builder:
         )
         names: dict[Key, str] = {}
         queue: deque[Key] = deque()
+        reached: set[str] = set()
 
         def part(label: str, position: Position, machine: FSM) -> str:
             done, name = position
@@ -580,6 +590,18 @@ class Builder:
                 queue.append(key)
             return names[key]
 
+        callback = self.outcome_callback(work, fsm) if smach else None
+        if "child_termination_cb" in container.callbacks:
+            self.warn(
+                work.source,
+                container.line,
+                f"Concurrence '{container.name}': child_termination_cb "
+                f"{container.callbacks['child_termination_cb']} not modelled: it only asks the "
+                "running children to stop, and when a child ends with which outcome is already "
+                "the environment's choice",
+            )
+        if callback is not None:
+            reached.update(container.outcomes)
         barriers: dict[tuple[int, str], list[tuple[int, str]]] = {}
         for members in container.sync_groups:
             parties = [(labels.index(label), state) for label, state in members]
@@ -587,7 +609,6 @@ class Builder:
                 barriers[party] = parties
         fsm.initial = visit((start_positions, start_action))
         stuck: list[str] = []
-        reached: set[str] = set()
         while queue:
             key = queue.popleft()
             positions = key[0]
@@ -612,6 +633,9 @@ class Builder:
                     combo = tuple(name if is_done else None for is_done, name in after)
                     qualified = f"{labels[index]}.{event}" if shared else event
                     decided = self.decide(container, smach, labels, combo)
+                    if decided is not None and callback is not None:
+                        fsm.add_transition(source, qualified, callback)
+                        continue
                     if decided is not None:
                         reached.add(decided)
                         fsm.add_transition(source, qualified, decided)
@@ -651,7 +675,27 @@ class Builder:
                 children_info[c.label] = info
         if children_info:
             attrs[state_info.CHILD_STATES] = json.dumps(children_info)
+        if container.callbacks:
+            attrs[A_CALLBACKS] = json.dumps(container.callbacks)
         if not leaves:
+            attrs[A_NESTED] = json.dumps(
+                {
+                    "class": container.cls,
+                    "children": [
+                        [lab, _child_class(c), outs]
+                        for lab, c, outs in zip(labels, container.children, outcomes)
+                    ],
+                    "outcome_map": container.outcome_map,
+                    "default": container.default_outcome,
+                    "barriers": len(container.sync_groups),
+                    "product": product_fingerprint(fsm),
+                    "machines": {
+                        c.label: fsm_to_dict(work.child_machines[c.label])
+                        for c in container.children
+                        if not isinstance(c.state, StateRef)
+                    },
+                }
+            )
             return
         attrs.update(
             {
@@ -696,6 +740,33 @@ class Builder:
             if not target.final and target.action is not None:
                 actions.append(target.action)
         return tuple(moved), "+".join(actions) or None
+
+    def outcome_callback(self, work: _Work, fsm: FSM) -> str | None:
+        """A SMACH ``outcome_cb``, never run: once every child has ended, a state named after
+        it returns any declared outcome of the container - the environment's choice, which
+        includes what the callback returns and the map's outcome when it returns None
+        (docs/semantics.md §11, "Concurrence callbacks"). Its name, or None without one."""
+        container = work.container
+        text = container.callbacks.get("outcome_cb")
+        if text is None:
+            return None
+        name = _product_name(text, text, False, fsm)
+        where = self.loc(work.source, container.line)
+        declared = json.dumps(list(container.outcomes))
+        fsm.states[name] = State(
+            name, action=text, attrs={state_info.OUTCOMES: declared}, location=where
+        )
+        for outcome in container.outcomes:
+            fsm.add_transition(name, outcome, outcome, location=where)
+        container.callbacks["outcome_cb_state"] = name
+        self.warn(
+            work.source,
+            container.line,
+            f"Concurrence '{container.name}': outcome_cb {text} not modelled: its outcome is "
+            f"chosen by the environment (state '{name}' returns any of "
+            f"{', '.join(container.outcomes)})",
+        )
+        return name
 
     def owner_state(self, work: _Work) -> State | None:
         return self.owners.get(id(work.machine))
@@ -841,6 +912,23 @@ class Builder:
             f"'{work.label}.exhausted'; an empty item list is not modelled)",
         )
         return pending
+
+
+def product_fingerprint(fsm: FSM) -> str:
+    """A digest of a concurrence's product machine (its states, initial state and
+    transitions): a writer gives the concurrence back only while the product is the one read.
+    O(S + T log T)."""
+    data = [
+        fsm.initial,
+        sorted(fsm.states),
+        sorted((t.source, t.event or "", t.target, t.exit or "") for t in fsm.transitions),
+    ]
+    return hashlib.sha256(json.dumps(data).encode()).hexdigest()[:16]
+
+
+def _child_class(child: Child) -> str:
+    """A concurrence child's class (a container's: ``StateMachine``, ``Region``, ...)."""
+    return child.state.cls
 
 
 def _product_name(name: str, action: str | None, at_start: bool, fsm: FSM) -> str:

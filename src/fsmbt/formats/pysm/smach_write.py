@@ -50,8 +50,20 @@ A_CONTAINER = "smach.container"
 A_CHILDREN = "smach.children"
 A_MAP = "smach.outcome_map"
 A_DEFAULT = "smach.default_outcome"
+#: (``smach.concurrence`` / ``smach.callbacks``: a concurrence with container children or
+#: callbacks, written as the StateMachine of its product; ``translate`` names the loss.)
 _READER_ATTRS = frozenset(
-    {"class", A_CONTAINER, A_CHILDREN, A_MAP, A_DEFAULT, "flexbe.behaviour", A_CODE}
+    {
+        "class",
+        A_CONTAINER,
+        A_CHILDREN,
+        A_MAP,
+        A_DEFAULT,
+        "flexbe.behaviour",
+        A_CODE,
+        "smach.concurrence",
+        "smach.callbacks",
+    }
 )
 #: ``state_info`` entries the SMACH program holds itself (constructor keyword arguments, the stub
 #: class's outcomes and userdata keys, ``remapping=``, a container's keys and ``userdata``).
@@ -609,6 +621,13 @@ class _Writer:
             "default": state.attrs.get(A_DEFAULT),
             "outcomes": [s.name for s in region.states.values() if s.final],
         }
+        if "smach.callbacks" in state.attrs:
+            self.losses.append(
+                f"Concurrence '{state.name}' had callbacks ({state.attrs['smach.callbacks']}), "
+                "read as environment choices: written as the StateMachine of its combinations, "
+                "with a state for its outcome_cb (its children's configuration dropped)"
+            )
+            return None
         if not _product_matches(spec, region):
             self.losses.append(
                 f"Concurrence '{state.name}' was changed after reading; written "

@@ -15,10 +15,11 @@ from __future__ import annotations
 import json
 
 from fsmbt.formats.pysm.analyze import Analysis, Container
-from fsmbt.formats.pysm.build import build_records
+from fsmbt.formats.pysm.build import A_NESTED, build_records
 from fsmbt.formats.registry import ReadContext
 from fsmbt.formats.yasmin.xml_read import A_CHILD_INFO, NO_ACTION_CLASS, START_CLASS, Records
-from fsmbt.model.fsm import FSM
+from fsmbt.model.fsm import FSM, State
+from fsmbt.model.serialize import fsm_from_dict, fsm_to_dict
 
 
 def build(records: Records, ctx: ReadContext) -> FSM:
@@ -26,12 +27,12 @@ def build(records: Records, ctx: ReadContext) -> FSM:
     analysis = Analysis([records.root], {}, {}, records.warnings)
     fsm = build_records(records.root, records.name, ctx, analysis)
     fsm.attrs.update(records.root_info)
-    _attach(fsm, records)
+    _attach(fsm, records.root, records)
     return fsm
 
 
-def _attach(fsm: FSM, records: Records) -> None:
-    work: list[tuple[FSM, Container]] = [(fsm, records.root)]
+def _attach(fsm: FSM, root: Container, records: Records) -> None:
+    work: list[tuple[FSM, Container]] = [(fsm, root)]
     while work:
         machine, container = work.pop()
         _start_state(machine)
@@ -52,6 +53,7 @@ def _attach(fsm: FSM, records: Records) -> None:
                 # its states are combinations of its children: their declarations go here
                 infos = {c.label: records.info.get(id(c), {}) for c in inner.children}
                 state.attrs[A_CHILD_INFO] = json.dumps(infos, sort_keys=True)
+                _attach_nested(state, inner, records)
             else:
                 work.append((state.regions[0], inner))
 
@@ -69,3 +71,19 @@ def _start_state(machine: FSM) -> None:
     machine.initial = leaving[0].target
     machine.transitions.remove(leaving[0])
     del machine.states[start.name]
+
+
+def _attach_nested(state: State, concurrence: Container, records: Records) -> None:
+    """The declarations of a concurrence's container children (an OrthogonalState's regions)
+    go on the states of the machines the reader recorded for them (``A_NESTED``), so they
+    travel into the structured tree's leaves. Each child machine once: O(its states)."""
+    if A_NESTED not in state.attrs:
+        return
+    spec = json.loads(state.attrs[A_NESTED])
+    for child in concurrence.children:
+        if not isinstance(child.state, Container) or child.label not in spec["machines"]:
+            continue
+        machine = fsm_from_dict(spec["machines"][child.label])
+        _attach(machine, child.state, records)
+        spec["machines"][child.label] = fsm_to_dict(machine)
+    state.attrs[A_NESTED] = json.dumps(spec)

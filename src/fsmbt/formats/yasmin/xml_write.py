@@ -11,8 +11,11 @@ Mapping (the inverse of the reader, so that what is written reads back as the sa
   returns one of its outcomes, and the outcome picks the next state;
 - a composite state whose transitions are all completion transitions naming their exit is a
   nested ``<StateMachine>`` whose outcomes are its final states, each exit a ``<Transition>``;
-- a composite read from a YASMIN ``Concurrence`` / ``OrthogonalState`` whose children are
-  leaves is written back as that container with its outcome map;
+- a composite read from a YASMIN ``Concurrence`` / ``OrthogonalState`` is written back as that
+  container with its outcome map: leaf children as ``<State>``, container children (recorded
+  with their machines, ``pysm.build.A_NESTED``) as ``<StateMachine>`` / ``<Region>``, while
+  its product machine is the one read (``product_fingerprint``); else as the StateMachine of
+  the product, the container named as a loss;
 - a start pseudo-state left on an initial event is a state of class ``fsmbt_states/Start``
   whose one transition is that event (read back as the start pseudo-state);
 - parameters, keys, remappings, positions and descriptions kept in ``State.attrs`` (by the
@@ -32,10 +35,17 @@ that differs when the text is read back (an action that is not a class,
 from __future__ import annotations
 
 import json
+from typing import Any
 
 from lxml import etree
 
-from fsmbt.formats.pysm.build import A_CHILDREN, A_DEFAULT, A_MAP
+from fsmbt.formats.pysm.build import (
+    A_CHILDREN,
+    A_DEFAULT,
+    A_MAP,
+    A_NESTED,
+    product_fingerprint,
+)
 from fsmbt.formats.yasmin.xml_read import (
     A_CHILD_INFO,
     A_DESCRIPTION,
@@ -54,6 +64,7 @@ from fsmbt.formats.yasmin.xml_read import (
 from fsmbt.model import Model, state_info
 from fsmbt.model.errors import UnsupportedError
 from fsmbt.model.fsm import FSM, State
+from fsmbt.model.serialize import fsm_from_dict
 
 #: The module written for Python states whose module is not known.
 DEFAULT_MODULE = "fsmbt_states"
@@ -145,9 +156,7 @@ def _machine(
             continue
         if state.name in finals:
             raise UnsupportedError(f"state '{state.name}' is named like an outcome")
-        child = _state(machine, state, element)
-        if child is not None:
-            pending.append(child)
+        pending.extend(_state(machine, state, element))
     for name in finals:
         final = etree.SubElement(element, "FinalOutcome")
         final.set("name", name)
@@ -166,7 +175,7 @@ def _machine(
 
 def _state(
     machine: FSM, state: State, parent: etree._Element
-) -> tuple[FSM, etree._Element, dict[str, str]] | None:
+) -> list[tuple[FSM, etree._Element, dict[str, str]]]:
     if state.is_parallel:
         raise UnsupportedError(
             f"parallel state '{state.name}': YASMIN's Concurrence runs children that end "
@@ -178,11 +187,16 @@ def _state(
         if tag in ("Concurrence", "OrthogonalState") and state.attrs.get(A_MAP) is not None:
             element = _concurrence(state, parent, tag)
             _transitions(machine, state, element, completion=True)
-            return None
+            return []
+        nested = _nested_spec(state) if tag in ("Concurrence", "OrthogonalState") else None
+        if tag is not None and nested is not None:
+            element, children = _nested_concurrence(state, nested, parent, tag)
+            _transitions(machine, state, element, completion=True)
+            return children
         element = etree.SubElement(parent, "StateMachine")
         element.set("name", state.name)
         _transitions(machine, state, element, completion=True)
-        return region, element, state.attrs
+        return [(region, element, state.attrs)]
     element = etree.SubElement(
         parent, "JoinState" if state.attrs.get(A_TAG) == "JoinState" else "State"
     )
@@ -202,7 +216,7 @@ def _state(
         element.set("class", state.action)
     _annotate(element, state.attrs)
     _transitions(machine, state, element, completion=False)
-    return None
+    return []
 
 
 def _transitions(machine: FSM, state: State, element: etree._Element, *, completion: bool) -> None:
@@ -262,6 +276,63 @@ def _concurrence(state: State, parent: etree._Element, tag: str) -> etree._Eleme
             item.set("state", label)
             item.set("outcome", child_outcome)
     return element
+
+
+def _nested_spec(state: State) -> dict[str, Any] | None:
+    """The concurrence with container children the reader recorded on ``state``, while its
+    product machine is the one read; else None."""
+    if A_NESTED not in state.attrs or not state.regions:
+        return None
+    spec: dict[str, Any] = json.loads(state.attrs[A_NESTED])
+    if spec.get("product") != product_fingerprint(state.regions[0]):
+        return None
+    return spec
+
+
+def _nested_concurrence(
+    state: State, spec: dict[str, Any], parent: etree._Element, tag: str
+) -> tuple[etree._Element, list[tuple[FSM, etree._Element, dict[str, str]]]]:
+    """A Concurrence / OrthogonalState with container children, and its children's machines
+    to write (``<Region>`` in an OrthogonalState, ``<StateMachine>`` in a Concurrence)."""
+    element = etree.SubElement(parent, tag)
+    element.set("name", state.name)
+    default = spec.get("default")
+    outcome_map = spec["outcome_map"]
+    outcomes = list(dict.fromkeys([*([default] if default else []), *(o for o, _ in outcome_map)]))
+    element.set("outcomes", _outcome_list(sorted(outcomes), f"{tag} '{state.name}'"))
+    if default:
+        element.set("default_outcome", default)
+    _annotate(element, state.attrs)
+    infos = json.loads(state.attrs.get(A_CHILD_INFO, "{}"))
+    pending: list[tuple[FSM, etree._Element, dict[str, str]]] = []
+    for label, cls, _outcomes in spec["children"]:
+        info = infos.get(label, {})
+        if label in spec["machines"]:
+            child_tag = "Region" if tag == "OrthogonalState" else "StateMachine"
+            child = etree.SubElement(element, child_tag)
+            child.set("name", label)
+            machine = fsm_from_dict(spec["machines"][label], where=f"child '{label}'")
+            pending.append((machine, child, {**info, **machine.attrs}))
+            continue
+        child = etree.SubElement(element, "State")
+        child.set("name", label)
+        kind = info.get(A_TYPE, "py")
+        child.set("type", kind)
+        if kind == "py":
+            child.set("module", info.get(A_MODULE, DEFAULT_MODULE))
+        child.set("class", info.get(state_info.CLASS, cls))
+        _annotate(child, info)
+    for outcome in outcomes:
+        final = etree.SubElement(element, "FinalOutcome")
+        final.set("name", outcome)
+    for outcome, required in outcome_map:
+        entry = etree.SubElement(element, "OutcomeMap")
+        entry.set("outcome", outcome)
+        for label, child_outcome in required.items():
+            item = etree.SubElement(entry, "Item")
+            item.set("state", label)
+            item.set("outcome", child_outcome)
+    return element, pending
 
 
 def _annotate(element: etree._Element, attrs: dict[str, str]) -> None:
