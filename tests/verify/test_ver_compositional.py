@@ -273,3 +273,21 @@ def test_a_part_past_a_limit_is_a_fallback_not_an_error() -> None:
         proved, why = compositional_report(doc, hfsm)
     assert proved is None
     assert why.startswith("a part cannot be checked")
+
+
+def test_one_region_gives_way_before_any_part_is_checked() -> None:
+    """A tree whose root is reactive is one region: the whole tree. ``verify``'s attempt gives
+    way at once (``min_regions=2``: no region is explored, the reason says so) and the whole
+    product decides; the same pair checked with ``min_regions=1`` explores the region."""
+    doc = _memory_tree()
+    assert doc.main.root is not None
+    doc.main.root.type = "ReactiveFallback"
+    hfsm = bt_to_hfsm(doc).model
+    assert len(tree_regions(doc)) == 1
+    proved, why = compositional_report(doc, hfsm, min_regions=2)
+    assert proved is None and "1 region(s) paired" in why
+    alone, _why = compositional_report(doc, hfsm)
+    assert alone is not None and alone.stats["region_product_states"] > 0
+    report = verify(doc, hfsm)
+    assert report.equivalent and report.method != COMPOSITIONAL
+    assert report.equivalent == _whole(doc, hfsm).equivalent

@@ -25,7 +25,12 @@ from fsmbt.semantics.machine import FSMLeafMachine, Machine
 from fsmbt.semantics.outcome_machine import OutcomeFSMMachine
 from fsmbt.semantics.outcome_rules import OutcomeRules
 from fsmbt.verify import certificate
-from fsmbt.verify.compositional import FAILED_PART, Parts, compositional_report
+from fsmbt.verify.compositional import (
+    FAILED_PART,
+    Parts,
+    attempt_seconds,
+    compositional_report,
+)
 from fsmbt.verify.method import describe_method, nusmv_engine
 from fsmbt.verify.native import DEFAULT_MAX_STATES, Replay, check, check_witnessed, replay
 from fsmbt.verify.outcome_pairing import is_outcome_pair, outcome_abstractions
@@ -186,9 +191,10 @@ def _compositional(
     sink: certificate.WitnessSink | None,
 ) -> tuple[Report | None, str]:
     """The compositional proof of a BT against a hierarchical FSM (``fsmbt.verify.
-    compositional``) when the pair decomposes into regions and every local check holds;
-    ``None`` otherwise, and the whole product decides (and explains a difference). A pair
-    with a single region is left to the whole product too (the same product, done once). The
+    compositional``) when the pair decomposes into regions and every local check holds within
+    its budget (``attempt_seconds``); ``None`` otherwise, and the whole product decides (and
+    explains a difference). A pair with a single region is left to the whole product before
+    any part is checked (the same product, done once). The
     string says why a local check failed (the whole product then gives the verdict), else
     ``""``. Inside ``certificate.collecting()`` the parts' witnesses are left in ``sink``."""
     if not (isinstance(source, BTDocument) and isinstance(result, FSM)):
@@ -196,13 +202,18 @@ def _compositional(
     if is_dispatch_bt(source) or flavour_of(source) is not Flavour.PLAIN:
         return None, ""
     parts = Parts() if sink is not None else None
-    with gc_paused():
-        report, why = compositional_report(source, result, max_states=max_states, keep=parts)
+    with gc_paused():  # one region is the whole product again: give way before any part
+        report, why = compositional_report(
+            source,
+            result,
+            max_states=max_states,
+            keep=parts,
+            min_regions=2,
+            max_seconds=attempt_seconds(),
+        )
     if report is None:
         # a part failed: the whole product decides and explains; the verdict says so
         return None, why if why.startswith(FAILED_PART) else ""
-    if report.stats["regions"] < 2:
-        return None, ""  # one region: its check is the whole product again; let that decide
     report.engines = {"fsmbt native checker": __version__}
     if sink is not None:
         sink.witness, sink.parts, sink.loop, sink.faithful = None, parts, False, False

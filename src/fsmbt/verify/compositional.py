@@ -50,11 +50,13 @@ from __future__ import annotations
 
 import copy
 import re
+import time
 from collections import deque
 from collections.abc import Hashable, Iterable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
+from fsmbt import limits
 from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.bt_nodes import NodeKind
 from fsmbt.model.errors import FsmbtError
@@ -91,6 +93,17 @@ COMPOSITIONAL_SENTENCE = (
 
 #: The mode of a compositional verdict (a BT's leaf-execution machine against an FSM's).
 LEAF_EXECUTION = "leaf-execution"
+
+#: The share of the checker's time limit (``fsmbt.limits``: ``checker_max_seconds``) that
+#: ``verify``'s compositional attempt may spend before it gives way to the whole product.
+ATTEMPT_SHARE = 0.25
+
+
+def attempt_seconds() -> float:
+    """The wall-clock budget of ``verify``'s compositional attempt (:data:`ATTEMPT_SHARE` of the
+    checker's time limit in force)."""
+    return limits.current().checker_max_seconds * ATTEMPT_SHARE
+
 
 #: How ``compositional_report`` starts the reason when a part's check failed.
 FAILED_PART = "the local check of"
@@ -581,13 +594,21 @@ def decompose(
     *,
     max_states: int = DEFAULT_MAX_STATES,
     keep: Parts | None = None,
+    min_regions: int = 1,
+    max_seconds: float | None = None,
 ) -> Decomposition:
     """Run the three parts of the compositional check (module docstring); with ``keep``, each
     part's witness is appended to it (for a certificate: the parts' tables stay alive).
 
+    The give-way (the attempt costs little when it cannot win): with fewer than
+    ``min_regions`` paired regions no part is checked (one region *is* the whole product,
+    checked again, e.g. a tree whose root is reactive: the region is the whole tree), and the
+    parts' checks share one wall-clock budget of ``max_seconds`` (default: the checker's limit).
+
     Raises:
-        NotDecomposable: the pair is outside the scope; the caller falls back.
+        NotDecomposable: the pair is outside the scope or past the budget; the caller falls back.
     """
+    budget = _Budget(max_seconds)
     shape = structure(source, result)
     regions, machine_regions = shape.regions, shape.machine_regions
     if keep is not None:
@@ -602,6 +623,10 @@ def decompose(
         int(fsm_token[len("⟪state ") : -1]): int(tree_token[len("⟪unit ") : -1])
         for fsm_token, tree_token in pairs.items()
     }
+    if len(tree_of_state) < min_regions:
+        raise NotDecomposable(
+            f"{len(tree_of_state)} region(s) paired: the whole product is the same check"
+        )
     # a region the walk never reaches keeps its own label: if the skeleton check reaches it
     # after all, its label differs from anything on the other side and the check fails
     outcome = Decomposition(equivalent=True, regions=len(tree_of_state))
@@ -612,7 +637,9 @@ def decompose(
             continue
         bt_region, fsm_region = region_machines(shape, k, j)
         try:
-            report, witness = check_witnessed(bt_region, fsm_region, max_states=max_states)
+            report, witness = check_witnessed(
+                bt_region, fsm_region, max_states=max_states, max_seconds=budget.left()
+            )
         except StateLimitError as exc:
             raise NotDecomposable(f"region {regions[k].label}: {exc}") from None
         _add(outcome.stats, report.stats)
@@ -630,7 +657,12 @@ def decompose(
             keep.units.append(Part("region", witness, k, j))
     # 2. the skeleton with each region abstracted to its results
     bt_skeleton, fsm_skeleton = skeleton_machines(source, result, shape, tree_of_state, results)
-    report, witness = check_witnessed(bt_skeleton, fsm_skeleton, max_states=max_states)
+    try:
+        report, witness = check_witnessed(
+            bt_skeleton, fsm_skeleton, max_states=max_states, max_seconds=budget.left()
+        )
+    except StateLimitError as exc:
+        raise NotDecomposable(f"the skeleton: {exc}") from None
     _add(outcome.stats, report.stats)
     outcome.skeleton_states = report.stats["product_states"]
     if not report.equivalent:
@@ -640,6 +672,21 @@ def decompose(
     if keep is not None:
         keep.units.append(Part("skeleton", witness))
     return outcome
+
+
+class _Budget:
+    """The wall-clock seconds the parts' checks share (``None``: each part gets the checker's
+    own limit)."""
+
+    def __init__(self, seconds: float | None) -> None:
+        self.ends = None if seconds is None else time.perf_counter() + seconds
+
+    def left(self) -> float | None:
+        """Seconds left for the next part (at least a millisecond: a part past the budget
+        stops at its first clock reading, ``native._Deadline``)."""
+        if self.ends is None:
+            return None
+        return max(self.ends - time.perf_counter(), 0.001)
 
 
 def _add(total: dict[str, Any], part: dict[str, Any]) -> None:
@@ -654,16 +701,24 @@ def compositional_report(
     *,
     max_states: int = DEFAULT_MAX_STATES,
     keep: Parts | None = None,
+    min_regions: int = 1,
+    max_seconds: float | None = None,
 ) -> tuple[Report | None, str]:
     """The compositional verdict when it proves the pair equivalent, else ``None`` and why
-    (out of scope, or a part failed: the caller runs the whole product for the verdict and
-    its counterexample). With ``keep``, each part's witness is appended (for a certificate).
+    (out of scope, past its budget, or a part failed: the caller runs the whole product for
+    the verdict and its counterexample). With ``keep``, each part's witness is appended (for a
+    certificate); ``min_regions`` and ``max_seconds``: the give-way of ``decompose``.
     Cost: see the module docstring."""
-    import time
-
     started = time.perf_counter()
     try:
-        found = decompose(source, result, max_states=max_states, keep=keep)
+        found = decompose(
+            source,
+            result,
+            max_states=max_states,
+            keep=keep,
+            min_regions=min_regions,
+            max_seconds=max_seconds,
+        )
     except NotDecomposable as exc:
         return None, str(exc)
     except FsmbtError as exc:
