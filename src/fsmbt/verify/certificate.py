@@ -314,7 +314,7 @@ def _check_whole(
     units = data["units"]
     if len(units) != 1 or units[0].get("kind") != PRODUCT:
         raise CertificateError(f"a {method} proof is one unit of kind {PRODUCT!r}")
-    src, res, pairs = _check_unit(units[0], source_machine, result_machine, "")
+    src, res, pairs = check_unit(units[0], source_machine, result_machine, "")
     checked.states = {"source": len(src.status), "result": len(res.status)}
     checked.pairs = pairs
     checked.steps = src.steps + res.steps
@@ -452,7 +452,7 @@ class _Table:
         return x, self.silent
 
 
-def _check_unit(
+def check_unit(
     unit: dict[str, Any], source: Machine[Any], result: Machine[Any], name: str
 ) -> tuple[_Table, _Table, int]:
     """Replay one unit's two tables on its rebuilt machines and check its relation (module
@@ -543,14 +543,14 @@ def _check_compositional(
         if j in tree_of_state or k in results:
             raise CertificateError(f"a region is paired twice ({k}, {j})")
         name = f"region {shape.regions[k].label} ~ state {shape.machine_regions[j].path}"
-        src, res, pairs = _check_unit(unit, *region_machines(shape, k, j), name)
+        src, res, pairs = check_unit(unit, *region_machines(shape, k, j), name)
         possible = src.results()
         if not results_allowed(possible, shape, j):
             raise CertificateError(f"{name}: the region ends in {sorted(possible)}")
         tree_of_state[j], results[k] = k, possible
         _count(checked, states, src, res, pairs)
     machines = skeleton_machines(source, result, shape, tree_of_state, results)
-    src, res, pairs = _check_unit(units[-1], *machines, SKELETON)
+    src, res, pairs = check_unit(units[-1], *machines, SKELETON)
     _count(checked, states, src, res, pairs)
     checked.states = states
     checked.units = {REGION: len(units) - 1, SKELETON: 1}
