@@ -22,6 +22,7 @@ from fsmbt.model.fsm import FSM
 from fsmbt.verify import certificate, verify
 from fsmbt.verify.mutations import mutants
 from fsmbt.verify.report import COMPOSITIONAL
+from support.random_trees import random_tree
 from support.sampling import seed
 from support.ver_models import paper_fsm
 
@@ -223,3 +224,51 @@ def test_a_certificate_of_the_first_format_still_checks(tmp_path):
     loaded["units"][0]["relation"].pop()
     with pytest.raises(certificate.CertificateError):
         certificate.check(loaded, source, lebt, source_digest="s", result_digest="r")
+
+
+#: Controls of the compositional family: plain ones (the skeleton) and ones with memory.
+CONTROLS = (
+    "Sequence",
+    "Fallback",
+    "Sequence",
+    "Fallback",
+    "SequenceWithMemory",
+    "ReactiveSequence",
+)
+DECORATORS = ("Inverter", "ForceSuccess", "ForceFailure", "Repeat", "RetryUntilSuccessful")
+
+
+def test_random_compositional_certificates_check_and_tree_mutants_are_refused():
+    """A seeded sample of random trees with memory under plain controls: every compositional
+    proof's certificate checks (through JSON), and offered for a mutant of the *tree* that
+    the whole product tells apart (the mutants are valid trees: ``mutations`` keeps each kind's
+    arity), it is refused."""
+    rng = random.Random(f"{seed()}:certificate-units")
+    proved = refused = 0
+    for _ in range(250):
+        doc = random_tree(rng, controls=CONTROLS, decorators=DECORATORS, max_nodes=16)
+        try:
+            hfsm = bt_to_hfsm(doc).model
+        except InputError:
+            continue
+        with certificate.collecting() as sink:
+            report = verify(doc, hfsm)
+        if report.method != COMPOSITIONAL:
+            continue
+        data = certificate.build(sink, report, source_digest="s", result_digest="r")
+        data = json.loads(json.dumps(data))
+        checked = certificate.check(data, doc, hfsm, source_digest="s", result_digest="r")
+        assert checked.equivalent and checked.units["region"] >= 2
+        proved += 1
+        for mutant in mutants(doc, seed=rng.randrange(1 << 30), per_operator=1)[:3]:
+            assert isinstance(mutant.model, BTDocument)
+            try:
+                if verify(mutant.model, hfsm).equivalent:
+                    continue
+            except InputError:
+                continue
+            with pytest.raises(certificate.CertificateError):
+                certificate.check(data, mutant.model, hfsm, source_digest="s", result_digest="r")
+            refused += 1
+    print(f"{proved} compositional certificates checked, {refused} mutants refused")
+    assert proved >= 15 and refused >= 15
