@@ -1,11 +1,13 @@
 """Certificates: the proof, the certificate's size, the check without search, and the memory of
 each proof (issue 27, item 3 "verdicts that say what was proven"). Prints a table.
 
-    .venv/bin/python benchmarks/bench_certificate.py [--sizes 100,1000,10000] [--limit 120]
+    .venv/bin/python benchmarks/bench_certificate.py [--sizes 100,1000,10000] [--small 30,100]
+        [--memory 30,100,300] [--limit 120]
 
 Rows: BT ~ HFSM for the ``bench_reactive`` families ``plain``, ``reactive`` (static table),
-``reactive-plain`` and ``memory`` (canonical states; small sizes: their products explode, see
-docs/verification.md), and FSM ~ LEBT for ``bench_checker.chain_fsm``. Each row runs in a
+``reactive-plain`` (canonical states; small sizes: their products explode, see
+docs/verification.md) and ``memory`` (from 100 nodes proved compositionally: one certificate
+unit per region plus the skeleton, ``units``), and FSM ~ LEBT for ``bench_checker.chain_fsm``. Each row runs in a
 forked child (so ``peak MiB`` is that proof's own peak resident memory, from ``wait4``):
 ``prove s`` is ``verify`` (both machines explored and the product), ``cert KiB`` the JSON
 certificate, ``check s`` ``fsmbt.verify.certificate.check`` on it (one machine step per
@@ -56,6 +58,7 @@ def _row(kind: str, size: int) -> dict[str, object]:
         "method": report.method,
         "equivalent": report.equivalent and checked.equivalent,
         "pairs": checked.pairs,
+        "units": sum(checked.units.values()),
         "prove": proved,
         "cert_kib": len(text) / 1024,
         "check": time.perf_counter() - started,
@@ -92,17 +95,19 @@ def _in_child(kind: str, size: int, limit: int) -> tuple[dict[str, object] | Non
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--sizes", default="100,1000,10000")
-    parser.add_argument("--small", default="30,100", help="sizes for reactive-plain and memory")
+    parser.add_argument("--small", default="30,100", help="sizes for reactive-plain")
+    parser.add_argument("--memory", default="30,100,300", help="sizes for memory")
     parser.add_argument("--limit", type=int, default=120, help="seconds per row")
     args = parser.parse_args(argv)
     header = (
-        f"{'pair':<15} {'size':>6} {'method':<14} {'pairs':>7} {'prove s':>8} "
+        f"{'pair':<15} {'size':>6} {'method':<14} {'units':>5} {'pairs':>7} {'prove s':>8} "
         f"{'cert KiB':>9} {'check s':>8} {'peak MiB':>9}"
     )
     print(header)
     print("-" * len(header))
     plan = [(k, s) for k in ("plain", "reactive", "fsm~lebt") for s in args.sizes.split(",")]
-    plan += [(k, s) for k in ("reactive-plain", "memory") for s in args.small.split(",")]
+    plan += [("reactive-plain", s) for s in args.small.split(",")]
+    plan += [("memory", s) for s in args.memory.split(",")]
     for kind, size in plan:
         row, peak = _in_child(kind, int(size), args.limit)
         pair = kind if kind == "fsm~lebt" else f"bt~hfsm {kind}"
@@ -110,7 +115,7 @@ def main(argv: list[str] | None = None) -> int:
             print(f"{pair:<15} {size:>6} {(row or {}).get('error', '')}", flush=True)
             continue
         print(
-            f"{pair:<15} {row['size']:>6} {row['method']:<14} {row['pairs']:>7} "
+            f"{pair:<15} {row['size']:>6} {row['method']:<14} {row['units']:>5} {row['pairs']:>7} "
             f"{row['prove']:>8.3f} {row['cert_kib']:>9.0f} {row['check']:>8.3f} {peak:>9.0f}",
             flush=True,
         )

@@ -16,6 +16,7 @@ import pytest
 from fsmbt import api, diff
 from fsmbt.cli import main
 from fsmbt.model.errors import InputError
+from fsmbt.semantics.nodes import node_semantics
 from fsmbt.verify import verify
 from fsmbt.verify.mutations import mutants
 from fsmbt.verify.native import replay
@@ -166,17 +167,45 @@ def test_fsm_against_its_converted_tree(tmp_path: Path) -> None:
     assert diff.diff_models(fsm, bt).same
     differing = 0
     for mutant in mutants(bt, seed=1, per_operator=3):
-        try:
-            verdict = verify(fsm, mutant.model).equivalent
-        except InputError as exc:  # e.g. a Switch that lost a case: not a valid tree
-            with pytest.raises(InputError) as raised:
-                diff.diff_models(fsm, mutant.model)
-            assert raised.value.message == exc.message, mutant.description
-            continue
+        # every mutant is a valid tree (the generator respects each kind's declared arity)
+        verdict = verify(fsm, mutant.model).equivalent
         report = diff.diff_models(fsm, mutant.model)
         assert report.same == verdict, mutant.description
         assert report.script is None  # two kinds: no edit script
         assert diff.diff_models(mutant.model, fsm).same == report.same
         _confirm(fsm, mutant.model, report)
         differing += not report.same
-    assert differing >= 2  # and the invalid ones were refused alike
+    assert differing >= 2
+
+
+def test_an_invalid_tree_is_refused_alike(tmp_path: Path) -> None:
+    """A hand-made invalid tree (a Switch that lost a case): the verifier and the diff refuse
+    it with the same one-line message, which names the arity the kind declares."""
+    fsm = api.load(EXAMPLES / "paper_fsm.xml").model
+    bt_path = tmp_path / "paper_bt.xml"
+    assert main(["convert", str(EXAMPLES / "paper_fsm.xml"), "-o", str(bt_path)]) == 0
+    bt = api.load(bt_path).model
+    switch = next(node for _tree, node in bt.nodes() if node.type.startswith("Switch"))
+    spec = node_semantics(switch.type)
+    assert spec is not None and spec.children == len(switch.children)
+    switch.children.pop(0)
+    with pytest.raises(InputError) as by_verify:
+        verify(fsm, bt)
+    with pytest.raises(InputError) as by_diff:
+        diff.diff_models(fsm, bt)
+    assert by_verify.value.message == by_diff.value.message
+    assert f"needs {spec.children} children" in by_verify.value.message
+
+
+def test_mutants_respect_the_declared_arity() -> None:
+    """No BT mutant breaks its kind's declared child count (``NodeSemantics.allows_children``,
+    what ``fsmbt.model.validate`` reads): a Switch never loses a case."""
+    bt = api.convert_model(api.load(EXAMPLES / "paper_fsm.xml").model).model
+    checked = 0
+    for mutant in mutants(bt, seed=1, per_operator=None):
+        for _tree, node in mutant.model.nodes():
+            spec = node_semantics(node.type)
+            if spec is not None and node.children:
+                assert spec.allows_children(len(node.children)), mutant.description
+                checked += 1
+    assert checked

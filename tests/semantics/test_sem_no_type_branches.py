@@ -33,7 +33,6 @@ ALLOWED = {
     "generate/generator.py": "random trees: the ports drawn per kind (num_cycles or "
     "num_attempts, a Parallel's thresholds)",
     "runtime/skeleton/python.py": "generated py_trees code: the loop decorators it writes",
-    "verify/mutations.py": "the Sequence <-> Fallback mutation operator is defined by the names",
 }
 
 

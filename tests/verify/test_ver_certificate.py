@@ -40,13 +40,18 @@ def _edit(path, change) -> None:
         json.dump(data, stream)
 
 
+def _unit(data, index=0):
+    return data["units"][index]
+
+
 def test_verify_writes_a_certificate_that_checks(files, tmp_path, capsys):
     cert = tmp_path / "c.json"
     assert main(["verify", files["source"], files["lebt"], "--certificate", str(cert)]) == 0
     out = capsys.readouterr().out
     assert "proven by: whole product" in out
     data = json.loads(cert.read_text())
-    assert data["equivalent"] is True and data["relation"]
+    assert data["equivalent"] is True and [u["kind"] for u in data["units"]] == ["product"]
+    assert _unit(data)["relation"]
     assert main(["check-certificate", files["source"], files["lebt"], str(cert)]) == 0
     out = capsys.readouterr().out
     assert "certificate valid: EQUIVALENT" in out and "no search" in out
@@ -61,14 +66,25 @@ def test_arguments_in_either_order(files, tmp_path):
 @pytest.mark.parametrize(
     "tamper",
     [
-        lambda d: d["machines"]["result"]["edges"][1][0].__setitem__(1, 0),  # edge target
-        lambda d: d["machines"]["source"]["edges"][1][0].__setitem__(2, 0),  # edge outputs
-        lambda d: d["relation"].pop(),  # relation no longer closed
-        lambda d: d["machines"]["source"]["states"][2].__setitem__(1, "final"),  # status
-        lambda d: d["machines"]["result"]["edges"][2].pop(),  # an explored input left out
+        lambda d: _unit(d)["machines"]["result"]["edges"][1][0].__setitem__(1, 0),  # edge target
+        lambda d: _unit(d)["machines"]["source"]["edges"][1][0].__setitem__(2, 0),  # outputs
+        lambda d: _unit(d)["relation"].pop(),  # relation no longer closed
+        lambda d: _unit(d)["machines"]["source"]["states"][2].__setitem__(1, "final"),  # status
+        lambda d: _unit(d)["machines"]["result"]["edges"][2].pop(),  # an input left out
         lambda d: d.__setitem__("method", "symbolic"),  # a method the pair was not proven by
+        lambda d: d.__setitem__("method", "compositional"),  # parts it does not have
+        lambda d: _unit(d).__setitem__("kind", "skeleton"),  # a unit kind of another method
     ],
-    ids=["edge-target", "edge-outputs", "relation", "status", "missing-edge", "method"],
+    ids=[
+        "edge-target",
+        "edge-outputs",
+        "relation",
+        "status",
+        "missing-edge",
+        "method",
+        "method-compositional",
+        "unit-kind",
+    ],
 )
 def test_a_tampered_certificate_is_refused(files, tmp_path, capsys, tamper):
     cert = tmp_path / "c.json"

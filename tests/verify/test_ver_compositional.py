@@ -248,10 +248,10 @@ def test_a_subtree_or_a_flat_machine_is_out_of_scope() -> None:
         decompose(doc, flat)
 
 
-def test_the_cli_proves_compositionally_unless_a_certificate_is_asked_for(tmp_path, capsys) -> None:
+def test_the_cli_proves_compositionally_with_or_without_a_certificate(tmp_path, capsys) -> None:
     """Through files (the HFSM written as SCXML and read back, its sub-machines renamed): the
-    command names the compositional method; with ``--certificate`` it proves by the product,
-    whose witness the certificate needs."""
+    command names the compositional method; with ``--certificate`` too, whose units (one per
+    region, one for the skeleton) ``check-certificate`` validates."""
     doc = _memory_tree()
     tree = api.write(doc, tmp_path / "tree.xml")
     machine = api.write(bt_to_hfsm(doc).model, tmp_path / "tree.scxml")
@@ -259,8 +259,9 @@ def test_the_cli_proves_compositionally_unless_a_certificate_is_asked_for(tmp_pa
     assert f"proven by: {COMPOSITIONAL}" in capsys.readouterr().out
     certificate = tmp_path / "proof.json"
     assert main(["verify", str(tree), str(machine), "--certificate", str(certificate)]) == 0
-    assert f"proven by: {COMPOSITIONAL}" not in capsys.readouterr().out
-    assert certificate.exists()
+    assert f"proven by: {COMPOSITIONAL}" in capsys.readouterr().out
+    assert main(["check-certificate", str(tree), str(machine), str(certificate)]) == 0
+    assert "2 region, 1 skeleton" in capsys.readouterr().out
 
 
 def test_a_part_past_a_limit_is_a_fallback_not_an_error() -> None:
@@ -272,3 +273,21 @@ def test_a_part_past_a_limit_is_a_fallback_not_an_error() -> None:
         proved, why = compositional_report(doc, hfsm)
     assert proved is None
     assert why.startswith("a part cannot be checked")
+
+
+def test_one_region_gives_way_before_any_part_is_checked() -> None:
+    """A tree whose root is reactive is one region: the whole tree. ``verify``'s attempt gives
+    way at once (``min_regions=2``: no region is explored, the reason says so) and the whole
+    product decides; the same pair checked with ``min_regions=1`` explores the region."""
+    doc = _memory_tree()
+    assert doc.main.root is not None
+    doc.main.root.type = "ReactiveFallback"
+    hfsm = bt_to_hfsm(doc).model
+    assert len(tree_regions(doc)) == 1
+    proved, why = compositional_report(doc, hfsm, min_regions=2)
+    assert proved is None and "1 region(s) paired" in why
+    alone, _why = compositional_report(doc, hfsm)
+    assert alone is not None and alone.stats["region_product_states"] > 0
+    report = verify(doc, hfsm)
+    assert report.equivalent and report.method != COMPOSITIONAL
+    assert report.equivalent == _whole(doc, hfsm).equivalent

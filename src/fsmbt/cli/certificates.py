@@ -44,8 +44,12 @@ def write_certificate(
         result_digest=certificate.digest(result_bytes),
     )
     certificate.write(data, path)
+    units = data.get("units")
     what = (
-        f"{len(data['relation'])} related state pairs" if "relation" in data else "counterexamples"
+        f"{certificate.relation_pairs(data)} related state pairs in {len(units)} "
+        f"unit{'s' if len(units) != 1 else ''}"
+        if units
+        else "counterexamples"
     )
     print(
         f"certificate: {path} ({what}; method {report.method})",

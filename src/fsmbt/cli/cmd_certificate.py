@@ -55,10 +55,11 @@ def register(app: typer.Typer) -> None:
         verdict = "EQUIVALENT" if checked.equivalent else "NOT EQUIVALENT"
         print(f"certificate valid: {verdict} ({checked.mode}, method {checked.method})")
         if checked.equivalent:
+            parts = ", ".join(f"{n} {kind}" for kind, n in checked.units.items())
             print(
-                f"  checked a relation of {checked.pairs} state pairs over "
+                f"  checked relations of {checked.pairs} state pairs over "
                 f"{checked.states['source']} source and {checked.states['result']} result "
-                f"states ({checked.steps} machine steps, no search)"
+                f"states in {parts} unit(s) ({checked.steps} machine steps, no search)"
             )
         else:
             print(f"  a counterexample replays to a difference ({checked.steps} steps)")

@@ -49,6 +49,7 @@ from fsmbt.semantics.bt_interpreter import (
     TickAction,
 )
 from fsmbt.semantics.leaf_machine import LeafMachine, LeafState
+from fsmbt.semantics.nodes import Family, node_semantics
 from fsmbt.semantics.outcome_view import RUNNING_INPUT, OutcomeView
 
 #: The memory slot holding the blackboard (no node has this id).
@@ -57,7 +58,6 @@ SWITCH = "bb.Switch"
 SCRIPT = "bb.Script"
 #: The output port an outcome leaf writes its outcome to.
 OUTCOME_PORT = "outcome"
-_SWITCH_TYPE = re.compile(r"Switch([2-6])")
 _ENTRY = re.compile(r"\{([A-Za-z_][A-Za-z0-9_]*)\}")
 _ASSIGN = re.compile(r"\s*([A-Za-z_][A-Za-z0-9_]*)\s*:?=\s*'([^']*)'\s*;?\s*")
 _ASSIGNS = re.compile(r"(?:\s*[A-Za-z_][A-Za-z0-9_]*\s*:?=\s*'[^']*'\s*;?\s*)+")
@@ -96,15 +96,16 @@ class OutcomeTree(CompiledTree):
     def _check(
         self, node: BTNode, chain: tuple[str, ...]
     ) -> tuple[str, NodeKind, tuple[Any, ...], int | None, list[BTNode]]:
-        match = _SWITCH_TYPE.fullmatch(node.type)
-        if match is not None and node.kind is NodeKind.CONTROL:
-            n = int(match.group(1))
-            if len(node.children) != n + 1:
+        spec = node_semantics(node.type)
+        if spec is not None and spec.family is Family.SWITCH and node.kind is NodeKind.CONTROL:
+            # the arity the kind declares (fsmbt.model.nodes), as the validator reads it
+            if not spec.allows_children(len(node.children)) or spec.children is None:
                 raise InputError(
-                    f"{node.type} needs {n + 1} children (the cases and a default), has "
-                    f"{len(node.children)}",
+                    f"{node.type} needs {spec.children} children (the cases and a default), "
+                    f"has {len(node.children)}",
                     **_where(node),
                 )
+            n = spec.children - 1
             key = _entry(node.attrs.get("variable", ""))
             if key is None:
                 raise UnsupportedError(

@@ -6,7 +6,8 @@ default) and ``nusmv``; ``both`` runs the two and raises ``EngineDisagreement`` 
 verdict differs, since then one of them is wrong; when NuSMV reaches its time or memory cap, ``both``
 returns the native verdict with ``stats["nusmv_limit"]`` saying so. Every report names its
 ``method``, ``engines`` and ``abstractions`` (``fsmbt.verify.method``); inside
-``certificate.collecting()`` the native check's witness is kept for a certificate.
+``certificate.collecting()`` the native check's witness (or, for a compositional proof, each
+part's) is kept for a certificate.
 """
 
 from __future__ import annotations
@@ -24,7 +25,12 @@ from fsmbt.semantics.machine import FSMLeafMachine, Machine
 from fsmbt.semantics.outcome_machine import OutcomeFSMMachine
 from fsmbt.semantics.outcome_rules import OutcomeRules
 from fsmbt.verify import certificate
-from fsmbt.verify.compositional import FAILED_PART, compositional_report
+from fsmbt.verify.compositional import (
+    FAILED_PART,
+    Parts,
+    attempt_seconds,
+    compositional_report,
+)
 from fsmbt.verify.method import describe_method, nusmv_engine
 from fsmbt.verify.native import DEFAULT_MAX_STATES, Replay, check, check_witnessed, replay
 from fsmbt.verify.outcome_pairing import is_outcome_pair, outcome_abstractions
@@ -114,8 +120,8 @@ def verify(
         return report
     sink = certificate.active_sink()
     fell_back = ""
-    if engine == "native" and sink is None and not loop:
-        proved, fell_back = _compositional(source, result, max_states)
+    if engine == "native" and not loop:
+        proved, fell_back = _compositional(source, result, max_states, sink)
         if proved is not None:
             return proved
     with gc_paused():  # a data machine's expansion allocates its flat machine (acyclic)
@@ -179,26 +185,38 @@ def _native(
 
 
 def _compositional(
-    source: FSM | BTDocument, result: FSM | BTDocument, max_states: int
+    source: FSM | BTDocument,
+    result: FSM | BTDocument,
+    max_states: int,
+    sink: certificate.WitnessSink | None,
 ) -> tuple[Report | None, str]:
     """The compositional proof of a BT against a hierarchical FSM (``fsmbt.verify.
-    compositional``) when the pair decomposes into regions and every local check holds;
-    ``None`` otherwise, and the whole product decides (and explains a difference). A pair
-    with a single region is left to the whole product too (the same product, done once). The
+    compositional``) when the pair decomposes into regions and every local check holds within
+    its budget (``attempt_seconds``); ``None`` otherwise, and the whole product decides (and
+    explains a difference). A pair with a single region is left to the whole product before
+    any part is checked (the same product, done once). The
     string says why a local check failed (the whole product then gives the verdict), else
-    ``""``."""
+    ``""``. Inside ``certificate.collecting()`` the parts' witnesses are left in ``sink``."""
     if not (isinstance(source, BTDocument) and isinstance(result, FSM)):
         return None, ""
     if is_dispatch_bt(source) or flavour_of(source) is not Flavour.PLAIN:
         return None, ""
-    with gc_paused():
-        report, why = compositional_report(source, result, max_states=max_states)
+    parts = Parts() if sink is not None else None
+    with gc_paused():  # one region is the whole product again: give way before any part
+        report, why = compositional_report(
+            source,
+            result,
+            max_states=max_states,
+            keep=parts,
+            min_regions=2,
+            max_seconds=attempt_seconds(),
+        )
     if report is None:
         # a part failed: the whole product decides and explains; the verdict says so
         return None, why if why.startswith(FAILED_PART) else ""
-    if report.stats["regions"] < 2:
-        return None, ""  # one region: its check is the whole product again; let that decide
     report.engines = {"fsmbt native checker": __version__}
+    if sink is not None:
+        sink.witness, sink.parts, sink.loop, sink.faithful = None, parts, False, False
     report.source = _model_name(source, report.source)
     report.result = _model_name(result, report.result)
     return report, ""

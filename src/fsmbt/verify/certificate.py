@@ -1,35 +1,48 @@
 """Certificates: a verdict that can be re-checked without re-running the search.
 
 Why: a CI or a reviewer should be able to trust a conversion without trusting the checker's
-breadth-first search, its state limits or its shortcuts (docs/verification.md, "Certificates").
+breadth-first search, its state limits or its shortcuts (docs/verification.md §6,
+"Certificates", which also documents the format).
 
 What a certificate holds (JSON, ``format`` = :data:`FORMAT`):
 
 - the two files' SHA-256 digests by role (source, result), the pairing mode, ``loop`` and
   ``faithful`` (which machines were built: ``fsmbt.verify.pairing.machines_for``), the method,
   engine versions and abstractions of the verdict;
-- *equivalent*: both machines' explored tables (per state its description, status and offered
-  inputs; per state its edges ``[input, next state, outputs]`` in the order the search met
-  them) and the product's relation as pairs of state ids;
+- *equivalent*: a list of ``units``, each a ``kind`` and one local proof: the two machines'
+  explored tables (per state its description, status and offered inputs; per state its edges
+  ``[input, next state, outputs]`` in the order the search met them) and the relation as pairs
+  of state ids. A whole-product proof (methods ``whole product``, ``table``, ``canonical``) is
+  one unit of kind ``product``; a compositional proof (docs/semantics.md §4c) is one unit of
+  kind ``region`` per paired region (naming the tree region and the region state it pairs)
+  and one of kind ``skeleton``, plus the ``decomposition`` it claims (the tree regions' labels
+  and the region states' paths). A method that proves by other parts adds its own unit kinds
+  and its checker in :data:`METHOD_CHECKS`;
 - *not equivalent*: each failing property's counterexample (an input sequence).
 
 How it is checked (``check``), in time linear in the certificate (one machine step per edge):
 
 1. the files are the ones certified (digests), read in the same order (``orient``);
-2. each machine is rebuilt from its model (fsmbt's interpreter, never the converter) and its
-   table is replayed: from the start, every listed edge is one ``step``; a state met for the
-   first time gets the next id, which must be the one the certificate names; every state's
-   description, status and offered inputs must be the listed ones, and its listed edges must be
-   exactly the inputs the machine explores there (its ``active_inputs``, the others being silent
-   self-loops by the machine's own contract);
-3. the relation must contain the start pair and, for each pair: equal statuses, equal offered
-   inputs (unless the result follows the environment), and for every input the source offers,
-   equal outputs and a successor pair in the relation.
+2. each unit's two machines are rebuilt from the models (fsmbt's interpreter, never the
+   converter): for a ``product`` unit the pairing's machines; for a compositional proof the
+   decomposition is derived again from the models (``compositional.structure``: its side
+   conditions checked, its regions compared with the claimed ones), each region's machines and
+   the skeleton's are built by the same functions the check used, the skeleton's from the
+   pairing the region units name and the results their replayed tables reach;
+3. each unit's tables are replayed: from the start, every listed edge is one ``step``; a state
+   met for the first time gets the next id, which must be the one the certificate names; every
+   state's description, status and offered inputs must be the listed ones, and its listed edges
+   must be exactly the inputs the machine explores there (its ``active_inputs``, the others
+   being silent self-loops by the machine's own contract);
+4. each unit's relation must contain the start pair and, for each pair: equal statuses, equal
+   offered inputs (unless the result follows the environment), and for every input the source
+   offers, equal outputs and a successor pair in the relation.
 
-Step 3 makes the relation a bisimulation between two deterministic machines that contains the
+Step 4 makes each relation a bisimulation between two deterministic machines that contains the
 starts, so every input sequence gets the same outputs, statuses and offered inputs from both:
-all five properties hold (reachability: the relation is closed under every offered input, so it
-covers every reachable state). A not-equivalent certificate is checked by replaying each
+all five properties hold for that unit's pair (reachability: the relation is closed under every
+offered input, so it covers every reachable state); for a compositional proof the units add up
+by docs/semantics.md §4c. A not-equivalent certificate is checked by replaying each
 counterexample on both machines (``fsmbt.verify.native.replay``): at least one must differ.
 """
 
@@ -38,7 +51,7 @@ from __future__ import annotations
 import contextlib
 import hashlib
 import json
-from collections.abc import Hashable, Iterator
+from collections.abc import Callable, Hashable, Iterator
 from contextvars import ContextVar
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -48,13 +61,29 @@ from fsmbt import __version__
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import InputError
 from fsmbt.model.fsm import FSM
+from fsmbt.semantics.dispatch_runtime import is_dispatch_bt
+from fsmbt.semantics.execution import Flavour, flavour_of
 from fsmbt.semantics.machine import Machine
+from fsmbt.verify.compositional import (
+    LEAF_EXECUTION,
+    NotDecomposable,
+    Parts,
+    final_results,
+    region_machines,
+    results_allowed,
+    skeleton_machines,
+    structure,
+)
 from fsmbt.verify.method import describe_method
 from fsmbt.verify.native import Witness, replay
 from fsmbt.verify.pairing import machines_for
-from fsmbt.verify.report import Report
+from fsmbt.verify.report import COMPOSITIONAL, Report
 
-FORMAT = "fsmbt-certificate/1"
+FORMAT = "fsmbt-certificate/2"
+#: The first format: one whole-product proof at the top level (read as one ``product`` unit).
+FORMAT_1 = "fsmbt-certificate/1"
+#: The unit kinds of the methods this module checks.
+PRODUCT, REGION, SKELETON = "product", "region", "skeleton"
 
 
 class CertificateError(InputError):
@@ -69,6 +98,8 @@ class WitnessSink:
     witness: Witness | None = None
     loop: bool = False
     faithful: bool = False
+    #: a compositional proof's parts (``None`` when the verdict came from one product)
+    parts: Parts | None = None
 
 
 _SINK: ContextVar[WitnessSink | None] = ContextVar("fsmbt_witness_sink", default=None)
@@ -89,7 +120,7 @@ def collecting() -> Iterator[WitnessSink]:
 @contextlib.contextmanager
 def collecting_if(wanted: bool) -> Iterator[WitnessSink]:
     """``collecting()`` when a certificate is ``wanted``; else a sink that stays empty and no
-    witness is kept (so ``verify`` may choose a method without one, e.g. ``compositional``)."""
+    witness is kept."""
     if not wanted:
         yield WitnessSink()
         return
@@ -126,8 +157,7 @@ def build(
     Raises:
         InputError: no native witness (the NuSMV engine alone leaves none).
     """
-    witness = sink.witness
-    if witness is None:
+    if sink.witness is None and sink.parts is None:
         raise InputError(
             "--certificate needs the native checker's witness: use --verify-engine native or both"
         )
@@ -143,15 +173,35 @@ def build(
         "abstractions": list(report.abstractions) + list(report.stats.get("abstractions", [])),
         "equivalent": report.equivalent,
     }
-    if report.equivalent:
-        data.update(witness.to_data())
-    else:
+    if not report.equivalent:
         data["counterexamples"] = {
             name: [step.input for step in prop.counterexample[1:]]
             for name, prop in report.properties.items()
             if not prop.holds and prop.counterexample
         }
+    elif sink.parts is not None:
+        parts = sink.parts
+        data["decomposition"] = {
+            "tree_regions": parts.tree_regions,
+            "fsm_regions": parts.fsm_regions,
+        }
+        units: list[dict[str, Any]] = []
+        for part in parts.units:
+            unit: dict[str, Any] = {"kind": part.kind}
+            if part.kind == REGION:
+                unit["tree_region"], unit["fsm_region"] = part.tree_region, part.fsm_region
+            unit.update(part.witness.to_data())
+            units.append(unit)
+        data["units"] = units
+    else:
+        assert sink.witness is not None
+        data["units"] = [{"kind": PRODUCT, **sink.witness.to_data()}]
     return data
+
+
+def relation_pairs(data: dict[str, Any]) -> int:
+    """How many related state pairs a certificate lists, over all its units."""
+    return sum(len(unit.get("relation", ())) for unit in data.get("units", ()))
 
 
 def write(data: dict[str, Any], path: Path) -> None:
@@ -170,6 +220,7 @@ class Checked:
     mode: str
     states: dict[str, int] = field(default_factory=dict)
     pairs: int = 0
+    units: dict[str, int] = field(default_factory=dict)
     steps: int = 0
     abstractions: list[str] = field(default_factory=list)
     engines: dict[str, str] = field(default_factory=dict)
@@ -181,9 +232,23 @@ def load(path: Path) -> dict[str, Any]:
         data = json.loads(path.read_text(encoding="utf-8"))
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
         raise CertificateError(f"cannot read the certificate {path}: {exc}") from None
+    if isinstance(data, dict) and data.get("format") == FORMAT_1:
+        return upgrade(data)
     if not isinstance(data, dict) or data.get("format") != FORMAT:
         raise CertificateError(f"{path} is not an fsmbt certificate (format {FORMAT} expected)")
     return data
+
+
+def upgrade(data: dict[str, Any]) -> dict[str, Any]:
+    """A ``fsmbt-certificate/1`` certificate in the current format: its one proof becomes one
+    ``product`` unit (nothing else changed, so it is checked as before)."""
+    out = {k: v for k, v in data.items() if k not in ("outputs", "machines", "relation")}
+    out["format"] = FORMAT
+    if "relation" in data:
+        out["units"] = [
+            {"kind": PRODUCT, **{k: data[k] for k in ("outputs", "machines", "relation")}}
+        ]
+    return out
 
 
 def check(
@@ -204,6 +269,31 @@ def check(
         raise CertificateError(
             "the certificate was made for other files (their SHA-256 digests differ)"
         )
+    claimed = str(data.get("method", ""))
+    checked = Checked(
+        equivalent=bool(data.get("equivalent")),
+        method=claimed,
+        mode=str(data.get("mode", "")),
+        abstractions=[str(a) for a in data.get("abstractions", [])],
+        engines={str(k): str(v) for k, v in (data.get("engines") or {}).items()},
+    )
+    by_parts = METHOD_CHECKS.get(claimed)
+    try:
+        if by_parts is not None and checked.equivalent:
+            by_parts(data, source, result, checked)
+        else:
+            _check_whole(data, source, result, checked)
+    except (KeyError, IndexError, TypeError, ValueError, AttributeError) as exc:
+        raise CertificateError(
+            f"the certificate is malformed ({type(exc).__name__}: {exc})"
+        ) from None
+    return checked
+
+
+def _check_whole(
+    data: dict[str, Any], source: FSM | BTDocument, result: FSM | BTDocument, checked: Checked
+) -> None:
+    """A proof on the pairing's two machines: one ``product`` unit, or counterexamples."""
     loop, faithful = bool(data.get("loop")), bool(data.get("faithful"))
     source_machine, result_machine, mode = machines_for(
         source, result, loop=loop, faithful=faithful
@@ -213,28 +303,22 @@ def check(
             f"the certificate is for mode {data.get('mode')}, the pair is {mode}"
         )
     method = describe_method(source_machine, result_machine)[0]
-    claimed = str(data.get("method", ""))
-    if claimed.split("+")[0] != method:
+    if checked.method.split("+")[0] != method:
         raise CertificateError(
-            f"the certificate claims method {claimed!r}, the machines are checked by {method!r}"
+            f"the certificate claims method {checked.method!r}, the machines are checked by "
+            f"{method!r}"
         )
-    checked = Checked(
-        equivalent=bool(data.get("equivalent")),
-        method=str(data.get("method", "")),
-        mode=mode,
-        abstractions=[str(a) for a in data.get("abstractions", [])],
-        engines={str(k): str(v) for k, v in (data.get("engines") or {}).items()},
-    )
-    try:
-        if checked.equivalent:
-            _check_equivalent(data, source_machine, result_machine, checked)
-        else:
-            _check_counterexamples(data, source_machine, result_machine, checked)
-    except (KeyError, IndexError, TypeError, ValueError) as exc:
-        raise CertificateError(
-            f"the certificate is malformed ({type(exc).__name__}: {exc})"
-        ) from None
-    return checked
+    if not checked.equivalent:
+        _check_counterexamples(data, source_machine, result_machine, checked)
+        return
+    units = data["units"]
+    if len(units) != 1 or units[0].get("kind") != PRODUCT:
+        raise CertificateError(f"a {method} proof is one unit of kind {PRODUCT!r}")
+    src, res, pairs = check_unit(units[0], source_machine, result_machine, "")
+    checked.states = {"source": len(src.status), "result": len(res.status)}
+    checked.pairs = pairs
+    checked.steps = src.steps + res.steps
+    checked.units = {PRODUCT: 1}
 
 
 def _check_counterexamples(
@@ -266,7 +350,7 @@ class _Table:
         self.edges: list[list[list[Any]]] = part["edges"]
         if len(self.rows) != len(self.edges) or not self.rows:
             raise CertificateError(
-                f"the {role} table has {len(self.rows)} states and {len(self.edges)} edge lists"
+                f"{role} table has {len(self.rows)} states and {len(self.edges)} edge lists"
             )
         self.follows = bool(getattr(machine, "follows_environment", False))
         self.offered: list[frozenset[str]] = []
@@ -275,8 +359,9 @@ class _Table:
         self.status: list[str] = []
         self.steps = 0
         start, start_out = machine.start()
-        if self._output_id(tuple(start_out)) != part["start_outputs"]:
-            raise CertificateError(f"the {role} machine's start outputs are not the certified ones")
+        self.start_outputs = self._output_id(tuple(start_out))
+        if self.start_outputs != part["start_outputs"]:
+            raise CertificateError(f"{role} machine's start outputs are not the certified ones")
         self._replay(start)
 
     def _output_id(self, out: tuple[str, ...]) -> int:
@@ -295,7 +380,7 @@ class _Table:
         x = 0
         while x < len(states):
             if x >= len(self.rows):
-                raise CertificateError(f"the {role} machine reaches more states than certified")
+                raise CertificateError(f"{role} machine reaches more states than certified")
             state = states[x]
             described, status, set_id = self.rows[x]
             given = machine.inputs(state)
@@ -348,8 +433,17 @@ class _Table:
             self.status.append(status)
             x += 1
         if len(states) != len(self.rows):
-            raise CertificateError(f"the {role} table lists states the machine never reaches")
+            raise CertificateError(f"{role} table lists states the machine never reaches")
         self.silent = output_ids.get((), -1)
+
+    def results(self) -> frozenset[str]:
+        """The root results this (tree) table reaches: ``compositional.final_results`` on the
+        replayed edges, never on anything the certificate claims about them."""
+        return final_results(
+            self.status,
+            self.outputs[self.start_outputs],
+            ((nxt, self.outputs[out]) for row in self.moves for nxt, out in row.values()),
+        )
 
     def move(self, x: int, symbol: str) -> tuple[int, int]:
         hit = self.moves[x].get(symbol)
@@ -358,28 +452,33 @@ class _Table:
         return x, self.silent
 
 
-def _check_equivalent(
-    data: dict[str, Any], source: Machine[Any], result: Machine[Any], checked: Checked
-) -> None:
-    outputs = [tuple(str(o) for o in value) for value in data["outputs"]]
-    src = _Table("source", source, data["machines"]["source"], outputs)
-    res = _Table("result", result, data["machines"]["result"], outputs)
-    relation = {(int(s), int(r)) for s, r in data["relation"]}
+def check_unit(
+    unit: dict[str, Any], source: Machine[Any], result: Machine[Any], name: str
+) -> tuple[_Table, _Table, int]:
+    """Replay one unit's two tables on its rebuilt machines and check its relation (module
+    docstring, steps 3 and 4); the replayed tables and the relation's size."""
+    where = f"{name}: " if name else ""
+    outputs = [tuple(str(o) for o in value) for value in unit["outputs"]]
+    src = _Table(f"{where}source", source, unit["machines"]["source"], outputs)
+    res = _Table(f"{where}result", result, unit["machines"]["result"], outputs)
+    relation = {(int(s), int(r)) for s, r in unit["relation"]}
     if (0, 0) not in relation:
-        raise CertificateError("the relation does not contain the two start states")
-    if data["machines"]["source"]["start_outputs"] != data["machines"]["result"]["start_outputs"]:
-        raise CertificateError("the two machines' start outputs differ")
+        raise CertificateError(f"{where}the relation does not contain the two start states")
+    if unit["machines"]["source"]["start_outputs"] != unit["machines"]["result"]["start_outputs"]:
+        raise CertificateError(f"{where}the two machines' start outputs differ")
     compatible: set[tuple[int, int]] = set()
     for s, r in relation:
         if not (0 <= s < len(src.status) and 0 <= r < len(res.status)):
-            raise CertificateError(f"the relation names a state that is not in a table ({s}, {r})")
+            raise CertificateError(
+                f"{where}the relation names a state that is not in a table ({s}, {r})"
+            )
         if src.status[s] != res.status[r]:
-            raise CertificateError(f"related states ({s}, {r}) have different statuses")
+            raise CertificateError(f"{where}related states ({s}, {r}) have different statuses")
         offered_s, offered_r = src.offered[s], res.offered[r]
         key = (src.set_ids[s], res.set_ids[r])
         if key not in compatible:  # O(inputs) once per pair of input sets
             if offered_s != offered_r if not res.follows else not offered_s <= offered_r:
-                raise CertificateError(f"related states ({s}, {r}) offer different inputs")
+                raise CertificateError(f"{where}related states ({s}, {r}) offer different inputs")
             compatible.add(key)
         # An offered input explored on neither side is a silent self-loop on both: the pair
         # itself is its successor. So only the explored ones need a step.
@@ -391,12 +490,81 @@ def _check_equivalent(
             r2, o2 = res.move(r, symbol)
             if o1 != o2:
                 raise CertificateError(
-                    f"related states ({s}, {r}) give different outputs on {symbol!r}"
+                    f"{where}related states ({s}, {r}) give different outputs on {symbol!r}"
                 )
             if (s2, r2) not in relation:
                 raise CertificateError(
-                    f"the relation is not closed: ({s}, {r}) on {symbol!r} leads to ({s2}, {r2})"
+                    f"{where}the relation is not closed: ({s}, {r}) on {symbol!r} leads to "
+                    f"({s2}, {r2})"
                 )
-    checked.states = {"source": len(src.status), "result": len(res.status)}
-    checked.pairs = len(relation)
-    checked.steps = src.steps + res.steps
+    return src, res, len(relation)
+
+
+# -- a compositional proof (docs/semantics.md §4c) --------------------------------------------
+def _check_compositional(
+    data: dict[str, Any], source: FSM | BTDocument, result: FSM | BTDocument, checked: Checked
+) -> None:
+    """Re-derive the decomposition from the models, check each region unit on the machines
+    ``compositional.region_machines`` builds for the pair it names, then the skeleton unit on
+    the machines ``compositional.skeleton_machines`` builds from those pairs and the results
+    the replayed region tables reach. Every side condition of §4c is checked here again:
+    structural ones by ``structure``, (2) by ``results_allowed``, (1) and (3) by the units."""
+    if not isinstance(source, BTDocument) or not isinstance(result, FSM):
+        raise CertificateError(
+            "a compositional proof is of a behavior tree against a state machine"
+        )
+    if data.get("loop") or data.get("faithful") or data.get("mode") != LEAF_EXECUTION:
+        raise CertificateError(
+            f"a compositional proof is in mode {LEAF_EXECUTION}, without loop or faithful machines"
+        )
+    if is_dispatch_bt(source) or flavour_of(source) is not Flavour.PLAIN:
+        raise CertificateError("a compositional proof needs a plain tree (not LEBT or dispatch)")
+    try:
+        shape = structure(source, result)
+    except NotDecomposable as exc:
+        raise CertificateError(f"the pair does not decompose: {exc}") from None
+    claimed = data["decomposition"]
+    if [str(x) for x in claimed["tree_regions"]] != shape.tree_labels():
+        raise CertificateError("the tree's regions are not the ones the certificate names")
+    if [str(x) for x in claimed["fsm_regions"]] != shape.fsm_paths():
+        raise CertificateError("the machine's region states are not the ones the certificate names")
+    units = data["units"]
+    if not units or units[-1].get("kind") != SKELETON:
+        raise CertificateError(f"a compositional proof ends with one {SKELETON!r} unit")
+    tree_of_state: dict[int, int] = {}
+    results: dict[int, frozenset[str]] = {}
+    states = {"source": 0, "result": 0}
+    for unit in units[:-1]:
+        if unit.get("kind") != REGION:
+            raise CertificateError(f"a compositional proof has {REGION!r} units, then the skeleton")
+        k, j = int(unit["tree_region"]), int(unit["fsm_region"])
+        if not (0 <= k < len(shape.regions) and 0 <= j < len(shape.machine_regions)):
+            raise CertificateError(f"a region unit names no region ({k}, {j})")
+        if j in tree_of_state or k in results:
+            raise CertificateError(f"a region is paired twice ({k}, {j})")
+        name = f"region {shape.regions[k].label} ~ state {shape.machine_regions[j].path}"
+        src, res, pairs = check_unit(unit, *region_machines(shape, k, j), name)
+        possible = src.results()
+        if not results_allowed(possible, shape, j):
+            raise CertificateError(f"{name}: the region ends in {sorted(possible)}")
+        tree_of_state[j], results[k] = k, possible
+        _count(checked, states, src, res, pairs)
+    machines = skeleton_machines(source, result, shape, tree_of_state, results)
+    src, res, pairs = check_unit(units[-1], *machines, SKELETON)
+    _count(checked, states, src, res, pairs)
+    checked.states = states
+    checked.units = {REGION: len(units) - 1, SKELETON: 1}
+
+
+def _count(checked: Checked, states: dict[str, int], src: _Table, res: _Table, pairs: int) -> None:
+    states["source"] += len(src.status)
+    states["result"] += len(res.status)
+    checked.pairs += pairs
+    checked.steps += src.steps + res.steps
+
+
+#: The methods whose proofs come in parts, each with the function that checks its units (a
+#: method proved on one product is checked by ``_check_whole``).
+METHOD_CHECKS: dict[
+    str, Callable[[dict[str, Any], FSM | BTDocument, FSM | BTDocument, Checked], None]
+] = {COMPOSITIONAL: _check_compositional}

@@ -50,11 +50,13 @@ from __future__ import annotations
 
 import copy
 import re
+import time
 from collections import deque
-from collections.abc import Hashable
+from collections.abc import Hashable, Iterable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
+from fsmbt import limits
 from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.bt_nodes import NodeKind
 from fsmbt.model.errors import FsmbtError
@@ -87,6 +89,20 @@ COMPOSITIONAL_SENTENCE = (
     "skeleton with each region abstracted to the results it can return (docs/semantics.md "
     "§4c: equivalence is a congruence for plain parents)"
 )
+
+
+#: The mode of a compositional verdict (a BT's leaf-execution machine against an FSM's).
+LEAF_EXECUTION = "leaf-execution"
+
+#: The share of the checker's time limit (``fsmbt.limits``: ``checker_max_seconds``) that
+#: ``verify``'s compositional attempt may spend before it gives way to the whole product.
+ATTEMPT_SHARE = 0.25
+
+
+def attempt_seconds() -> float:
+    """The wall-clock budget of ``verify``'s compositional attempt (:data:`ATTEMPT_SHARE` of the
+    checker's time limit in force)."""
+    return limits.current().checker_max_seconds * ATTEMPT_SHARE
 
 
 #: How ``compositional_report`` starts the reason when a part's check failed.
@@ -429,23 +445,58 @@ def _rename(fsm: FSM, names: dict[str, str]) -> None:
 def _results(witness: Any) -> frozenset[str]:
     """The root results a region's explored leaf machine reaches (its final states' outputs)."""
     src = witness.src
+    values = src.outputs.values
+    return final_results(
+        src.status,
+        values[src.start_outputs],
+        ((nxt, values[out]) for row in src.edges for nxt, out in row.values()),
+    )
+
+
+def final_results(
+    status: Sequence[str],
+    start_outputs: Sequence[str],
+    edges: Iterable[tuple[int, Sequence[str]]],
+) -> frozenset[str]:
+    """The root results an explored tree machine reaches: the last output of every step into
+    a final state (and of the start, when the start is final). ``status`` by state number,
+    ``edges`` each explored edge as (next state, outputs). O(edges)."""
     found: set[str] = set()
-    if src.status and src.status[0] == "final":
-        found.update(src.outputs.values[src.start_outputs][-1:])
-    for row in src.edges:
-        for nxt, out in row.values():
-            if src.status[nxt] == "final":
-                found.update(src.outputs.values[out][-1:])
+    if status and status[0] == "final":
+        found.update(start_outputs[-1:])
+    for nxt, out in edges:
+        if status[nxt] == "final":
+            found.update(out[-1:])
     return frozenset(found)
 
 
-def decompose(
-    source: BTDocument, result: FSM, *, max_states: int = DEFAULT_MAX_STATES
-) -> Decomposition:
-    """Run the three parts of the compositional check (module docstring).
+@dataclass
+class Structure:
+    """The decomposition read off the two models alone (no check run yet): the tree's regions
+    in pre-order, the FSM's region states depth first, the data model and, per region state,
+    the variables it names. Building it checks the side conditions of docs/semantics.md §4c
+    that are structural (scope, region-state shape, data ownership); ``fsmbt.verify.
+    certificate`` builds it again to re-derive what a certificate claims."""
+
+    regions: list[BTNode]
+    machine_regions: list[_FsmRegion]
+    declared: dict[str, str]
+    mentioned: list[set[str]]
+
+    def tree_labels(self) -> list[str]:
+        """The tree regions' labels, in pre-order (how a certificate names them)."""
+        return [node.label for node in self.regions]
+
+    def fsm_paths(self) -> list[str]:
+        """The region states' paths, depth first (how a certificate names them)."""
+        return [region.path for region in self.machine_regions]
+
+
+def structure(source: BTDocument, result: FSM) -> Structure:
+    """The decomposition of the pair and its structural side conditions (O(N + |FSM|)).
 
     Raises:
-        NotDecomposable: the pair is outside the scope; the caller falls back.
+        NotDecomposable: the pair is outside the scope (the message says why).
     """
     if not result.is_hierarchical:
         raise NotDecomposable("the state machine is flat")
@@ -467,6 +518,101 @@ def decompose(
             if owner.setdefault(name, j) != j:
                 raise NotDecomposable(f"variable {name} is shared by two regions")
         mentioned.append(used)
+    return Structure(regions, machine_regions, declared, mentioned)
+
+
+def region_machines(shape: Structure, k: int, j: int) -> tuple[LeafMachine, FSMLeafMachine]:
+    """Part 1's two machines for tree region ``k`` paired with region state ``j``: the
+    region's subtree as a tree of its own (the interpreter's leaf machine) and the state's
+    sub-machine as a machine of its own (its own variables declared)."""
+    region = shape.machine_regions[j]
+    return (
+        LeafMachine(BTDocument.single(shape.regions[k])),
+        FSMLeafMachine(region_fsm(region, shape.declared, shape.mentioned[j])),
+    )
+
+
+def results_allowed(possible: frozenset[str], shape: Structure, j: int) -> bool:
+    """Side condition (2) of docs/semantics.md §4c: the results a region reaches are non-empty,
+    within {SUCCESS, FAILURE} and within the completions its region state has."""
+    exits = set(shape.machine_regions[j].exits)
+    return bool(possible) and possible <= {SUCCESS, FAILURE} and possible <= exits
+
+
+def skeleton_machines(
+    source: BTDocument,
+    result: FSM,
+    shape: Structure,
+    tree_of_state: dict[int, int],
+    results: dict[int, frozenset[str]],
+) -> tuple[LeafMachine, FSMLeafMachine]:
+    """Part 2's two machines: the skeletons with each paired region abstracted to the results
+    it reaches (``results``: tree region -> results; an unpaired region may return either and
+    keeps its own label, so the skeleton check fails if it is ever reached), the FSM's
+    region-state labels renamed to their partners'."""
+    both = frozenset({SUCCESS, FAILURE})
+    tree_results = [results.get(k, both) for k in range(len(shape.regions))]
+    fsm_results = [
+        results[tree_of_state[j]] if tree_of_state.get(j) in results else frozenset(r.exits)
+        for j, r in enumerate(shape.machine_regions)
+    ]
+    bt_skeleton = skeleton_tree(source, shape.regions, tree_results)
+    fsm_skeleton = skeleton_fsm(result, shape.machine_regions, fsm_results)
+    _rename(
+        fsm_skeleton,
+        {_FSM_TOKEN.format(j): _BT_TOKEN.format(k) for j, k in tree_of_state.items()},
+    )
+    return LeafMachine(bt_skeleton), FSMLeafMachine(fsm_skeleton)
+
+
+@dataclass
+class Part:
+    """One local check of a compositional proof, kept for a certificate: its kind
+    (``region`` or ``skeleton``), the native checker's witness and, for a region, the tree
+    region ``k`` and region state ``j`` it pairs."""
+
+    kind: str
+    witness: Any
+    tree_region: int = -1
+    fsm_region: int = -1
+
+
+@dataclass
+class Parts:
+    """A compositional proof's parts as a certificate lists them: the decomposition (the tree
+    regions' labels, the region states' paths) and each part's witness, regions first, the
+    skeleton last."""
+
+    tree_regions: list[str] = field(default_factory=list)
+    fsm_regions: list[str] = field(default_factory=list)
+    units: list[Part] = field(default_factory=list)
+
+
+def decompose(
+    source: BTDocument,
+    result: FSM,
+    *,
+    max_states: int = DEFAULT_MAX_STATES,
+    keep: Parts | None = None,
+    min_regions: int = 1,
+    max_seconds: float | None = None,
+) -> Decomposition:
+    """Run the three parts of the compositional check (module docstring); with ``keep``, each
+    part's witness is appended to it (for a certificate: the parts' tables stay alive).
+
+    The give-way (the attempt costs little when it cannot win): with fewer than
+    ``min_regions`` paired regions no part is checked (one region *is* the whole product,
+    checked again, e.g. a tree whose root is reactive: the region is the whole tree), and the
+    parts' checks share one wall-clock budget of ``max_seconds`` (default: the checker's limit).
+
+    Raises:
+        NotDecomposable: the pair is outside the scope or past the budget; the caller falls back.
+    """
+    budget = _Budget(max_seconds)
+    shape = structure(source, result)
+    regions, machine_regions = shape.regions, shape.machine_regions
+    if keep is not None:
+        keep.tree_regions, keep.fsm_regions = shape.tree_labels(), shape.fsm_paths()
     # 1. the skeleton pairing needs the results, the results need the pairing: pair first on
     # the widest abstraction (every region may succeed or fail), then check each pair
     both = frozenset({SUCCESS, FAILURE})
@@ -477,19 +623,23 @@ def decompose(
         int(fsm_token[len("⟪state ") : -1]): int(tree_token[len("⟪unit ") : -1])
         for fsm_token, tree_token in pairs.items()
     }
+    if len(tree_of_state) < min_regions:
+        raise NotDecomposable(
+            f"{len(tree_of_state)} region(s) paired: the whole product is the same check"
+        )
     # a region the walk never reaches keeps its own label: if the skeleton check reaches it
     # after all, its label differs from anything on the other side and the check fails
     outcome = Decomposition(equivalent=True, regions=len(tree_of_state))
-    results: list[frozenset[str]] = [both] * len(regions)
-    fsm_results = [frozenset(r.exits) for r in machine_regions]
+    results: dict[int, frozenset[str]] = {}
     for j, region in enumerate(machine_regions):
         k = tree_of_state.get(j)
         if k is None:
             continue
-        bt_region = LeafMachine(BTDocument.single(regions[k]))
-        fsm_region = FSMLeafMachine(region_fsm(region, declared, mentioned[j]))
+        bt_region, fsm_region = region_machines(shape, k, j)
         try:
-            report, witness = check_witnessed(bt_region, fsm_region, max_states=max_states)
+            report, witness = check_witnessed(
+                bt_region, fsm_region, max_states=max_states, max_seconds=budget.left()
+            )
         except StateLimitError as exc:
             raise NotDecomposable(f"region {regions[k].label}: {exc}") from None
         _add(outcome.stats, report.stats)
@@ -500,23 +650,43 @@ def decompose(
             outcome.failed_region = f"{regions[k].label} (state {region.path})"
             return outcome
         possible = _results(witness)
-        if not possible or not possible <= both or not possible <= set(region.exits):
+        if not results_allowed(possible, shape, j):
             raise NotDecomposable(f"region {regions[k].label} ends in {sorted(possible)}")
-        results[k] = fsm_results[j] = possible
+        results[k] = possible
+        if keep is not None:
+            keep.units.append(Part("region", witness, k, j))
     # 2. the skeleton with each region abstracted to its results
-    bt_skeleton = skeleton_tree(source, regions, results)
-    fsm_skeleton = skeleton_fsm(result, machine_regions, fsm_results)
-    _rename(fsm_skeleton, pairs)
-    report, _witness = check_witnessed(
-        LeafMachine(bt_skeleton), FSMLeafMachine(fsm_skeleton), max_states=max_states
-    )
+    bt_skeleton, fsm_skeleton = skeleton_machines(source, result, shape, tree_of_state, results)
+    try:
+        report, witness = check_witnessed(
+            bt_skeleton, fsm_skeleton, max_states=max_states, max_seconds=budget.left()
+        )
+    except StateLimitError as exc:
+        raise NotDecomposable(f"the skeleton: {exc}") from None
     _add(outcome.stats, report.stats)
     outcome.skeleton_states = report.stats["product_states"]
     if not report.equivalent:
         # the skeletons differ: a real difference outside the regions, or a tree whose
         # non-plain leaves the machine keeps as plain states; the whole product tells which
         raise NotDecomposable("the skeletons differ")
+    if keep is not None:
+        keep.units.append(Part("skeleton", witness))
     return outcome
+
+
+class _Budget:
+    """The wall-clock seconds the parts' checks share (``None``: each part gets the checker's
+    own limit)."""
+
+    def __init__(self, seconds: float | None) -> None:
+        self.ends = None if seconds is None else time.perf_counter() + seconds
+
+    def left(self) -> float | None:
+        """Seconds left for the next part (at least a millisecond: a part past the budget
+        stops at its first clock reading, ``native._Deadline``)."""
+        if self.ends is None:
+            return None
+        return max(self.ends - time.perf_counter(), 0.001)
 
 
 def _add(total: dict[str, Any], part: dict[str, Any]) -> None:
@@ -526,16 +696,29 @@ def _add(total: dict[str, Any], part: dict[str, Any]) -> None:
 
 
 def compositional_report(
-    source: BTDocument, result: FSM, *, max_states: int = DEFAULT_MAX_STATES
+    source: BTDocument,
+    result: FSM,
+    *,
+    max_states: int = DEFAULT_MAX_STATES,
+    keep: Parts | None = None,
+    min_regions: int = 1,
+    max_seconds: float | None = None,
 ) -> tuple[Report | None, str]:
     """The compositional verdict when it proves the pair equivalent, else ``None`` and why
-    (out of scope, or a part failed: the caller runs the whole product for the verdict and
-    its counterexample). Cost: see the module docstring."""
-    import time
-
+    (out of scope, past its budget, or a part failed: the caller runs the whole product for
+    the verdict and its counterexample). With ``keep``, each part's witness is appended (for a
+    certificate); ``min_regions`` and ``max_seconds``: the give-way of ``decompose``.
+    Cost: see the module docstring."""
     started = time.perf_counter()
     try:
-        found = decompose(source, result, max_states=max_states)
+        found = decompose(
+            source,
+            result,
+            max_states=max_states,
+            keep=keep,
+            min_regions=min_regions,
+            max_seconds=max_seconds,
+        )
     except NotDecomposable as exc:
         return None, str(exc)
     except FsmbtError as exc:
@@ -545,7 +728,7 @@ def compositional_report(
     if not found.equivalent:
         return None, f"{FAILED_PART} {found.failed_region} fails"
     seconds = time.perf_counter() - started
-    report = Report(engine="native", source="source", result="result", mode="leaf-execution")
+    report = Report(engine="native", source="source", result="result", mode=LEAF_EXECUTION)
     detail = (
         f"proved compositionally: {found.regions} regions checked alone "
         f"({found.region_states} product states, largest {found.largest_region}) and the "

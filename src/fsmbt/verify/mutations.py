@@ -11,6 +11,12 @@ BT operators: ``swap_children``, ``sequence_to_fallback`` (and ``fallback_to_seq
 (a leaf's label, or an LEBT state leaf's action), and for LEBTs ``drop_guard_pair``,
 ``retarget_transition`` (move a guard pair to another state's guard) and ``flip_final``.
 
+Every BT mutant is a valid tree: a kind is read from its declaration (``fsmbt.model.nodes``,
+``NodeSemantics``: family, result map, arity), never from a type-name literal, and a child is
+dropped only where the parent's declared arity (``allows_children``) admits one child fewer -
+the arity ``fsmbt.model.validate`` and the verifier's own Switch check read (a ``Switch``'s
+count is fixed: its cases and a default).
+
 Complexity: O(M · N) for M mutants of a model of size N (each mutant is a deep copy).
 """
 
@@ -26,7 +32,13 @@ from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.bt_nodes import NodeKind
 from fsmbt.model.fsm import FSM
 from fsmbt.semantics.lebt.spec import GUARD_TYPE, STATE_TYPE, GuardSpec, StateSpec
-from fsmbt.semantics.nodes import PLAIN_CONTROLS
+from fsmbt.semantics.nodes import (
+    FALLBACK_TYPES,
+    PLAIN_CONTROLS,
+    RESULT_MAP_DECORATORS,
+    node_semantics,
+)
+from fsmbt.semantics.status import RootResult
 
 Model = FSM | BTDocument
 
@@ -91,26 +103,29 @@ def _bt_candidates(doc: BTDocument) -> Iterator[tuple[str, str, Callable[[list[B
                     kids[a], kids[a + 1] = kids[a + 1], kids[a]
 
                 yield "swap_children", f"children {a} and {a + 1} of {label} swapped", swap
-        if node.type in PLAIN_CONTROLS:  # the paper's two controls swap into each other
-            other = "Fallback" if node.type == "Sequence" else "Sequence"
+        other = _counterpart(node)
+        if other is not None:  # the paper's two controls swap into each other
 
             def turn(ns: list[BTNode], i: int = i, other: str = other) -> None:
                 ns[i].type = other
 
-            operator = "sequence_to_fallback" if node.type == "Sequence" else "fallback_to_sequence"
+            operator = (
+                "fallback_to_sequence" if node.type in FALLBACK_TYPES else "sequence_to_fallback"
+            )
             yield operator, f"{label} ({node.type}) turned into a {other}", turn
-        if node.kind is NodeKind.CONDITION:
+        inverter = _inverter()
+        if node.kind is NodeKind.CONDITION and inverter is not None:
 
-            def invert(ns: list[BTNode], i: int = i) -> None:
+            def invert(ns: list[BTNode], i: int = i, inverter: str = inverter) -> None:
                 parent = ns[parent_at[i]]
-                wrapper = BTNode(type="Inverter", kind=NodeKind.DECORATOR, children=[ns[i]])
+                wrapper = BTNode(type=inverter, kind=NodeKind.DECORATOR, children=[ns[i]])
                 parent.children[_index_of(parent, ns[i])] = wrapper
 
             if i in parent_at:
-                yield "invert_condition", f"condition {label} wrapped in an Inverter", invert
+                yield "invert_condition", f"condition {label} wrapped in an {inverter}", invert
         if node.is_leaf and i in parent_at:
             parent = nodes[parent_at[i]]
-            if parent.kind is NodeKind.CONTROL and len(parent.children) >= 2:
+            if parent.kind is NodeKind.CONTROL and _may_lose_a_child(parent):
 
                 def drop(ns: list[BTNode], i: int = i) -> None:
                     parent = ns[parent_at[i]]
@@ -167,6 +182,45 @@ def _bt_candidates(doc: BTDocument) -> Iterator[tuple[str, str, Callable[[list[B
                         f"pair {pair[0]}/{pair[1]} moved from {label} to {nodes[j].label}",
                         move_pair,
                     )
+
+
+def _may_lose_a_child(parent: BTNode) -> bool:
+    """Whether ``parent`` stays a valid node with one child fewer: the arity its kind declares
+    (``NodeSemantics.allows_children``: an exact count such as a ``Switch``'s cases and default,
+    a set of counts, or a least count; the rule ``fsmbt.model.validate`` applies) and never
+    none (BehaviorTree.CPP's loader refuses a control without children). A kind without a
+    declaration (a custom control) keeps at least one child."""
+    count = len(parent.children)
+    spec = node_semantics(parent.type)
+    return count >= 2 and (spec is None or spec.allows_children(count - 1))
+
+
+def _counterpart(node: BTNode) -> str | None:
+    """The plain control of the other family (sequence <-> fallback) that ``node``, a plain
+    control, turns into, read from the declarations (``None``: not a plain control, or no
+    counterpart whose arity admits the node's children)."""
+    spec = node_semantics(node.type)
+    if spec is None or node.type not in PLAIN_CONTROLS:
+        return None
+    for kind in sorted(PLAIN_CONTROLS):
+        other = node_semantics(kind)
+        if (
+            other is not None
+            and (kind in FALLBACK_TYPES) != (node.type in FALLBACK_TYPES)
+            and other.allows_children(len(node.children))
+        ):
+            return kind
+    return None
+
+
+def _inverter() -> str | None:
+    """The declared decorator that swaps SUCCESS and FAILURE (its ``result_map``)."""
+    swapped = (RootResult.FAILURE.value, RootResult.SUCCESS.value)
+    for kind in sorted(RESULT_MAP_DECORATORS):
+        spec = node_semantics(kind)
+        if spec is not None and spec.result_map == swapped:
+            return kind
+    return None
 
 
 def _index_of(parent: BTNode, child: BTNode) -> int:
