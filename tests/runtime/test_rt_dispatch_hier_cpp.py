@@ -17,7 +17,7 @@ from fsmbt.generate.hierarchical import random_hfsm
 from fsmbt.model.fsm import FSM
 from fsmbt.runtime.cpp import DriverSession
 from fsmbt.semantics.machine import FINAL, FSMMachine
-from tests.support.corpus import CORPUS
+from support.corpus import CORPUS
 
 KEPT = (
     "fsm/commons_scxml/state-01.scxml",

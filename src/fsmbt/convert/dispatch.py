@@ -41,6 +41,7 @@ from __future__ import annotations
 
 from collections import deque
 
+from fsmbt.convert.dispatch_hier import fsm_to_hier_dispatch, hierarchy_blocker
 from fsmbt.convert.dispatch_parts import (
     check_event,
     digits_of,
@@ -52,7 +53,6 @@ from fsmbt.convert.dispatch_parts import (
     running,
     size,
 )
-from fsmbt.convert.dispatch_hier import fsm_to_hier_dispatch, hierarchy_blocker
 from fsmbt.convert.perf import without_gc_pauses
 from fsmbt.convert.result import ConversionResult
 from fsmbt.model.bt import BTDocument, BTNode
@@ -154,4 +154,6 @@ def fsm_to_dispatch(fsm: FSM, **_options: object) -> ConversionResult:
         "style": STYLE,
         "index_digits": levels,
     }
+    if flat is not fsm:
+        stats["flattened"] = True
     return ConversionResult(doc, "rules", "fsm->bt", stats, warnings)

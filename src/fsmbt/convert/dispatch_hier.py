@@ -182,7 +182,7 @@ class _Builder:
             for state in reversed(list(machine.states.values())):
                 if state.is_composite:
                     stack.append((state.regions[0], level.flat(state.name), n, state.name))
-        for n, level in enumerate(self.levels):  # each level is inside its ancestors' owners
+        for n in range(len(self.levels)):  # each level is inside its ancestors' owners
             up = n
             while self.levels[up].parent is not None:
                 parent_level = self.levels[up].parent
@@ -199,9 +199,7 @@ class _Builder:
         assert initial is not None
         return initial
 
-    def dead_events(
-        self, observed: set[tuple[int, str]] | None
-    ) -> dict[tuple[int, str], set[str]]:
+    def dead_events(self, observed: set[tuple[int, str]] | None) -> dict[tuple[int, str], set[str]]:
         """Per composite state, the events of its own transitions that never fire: every
         child of its sub-machine that is ever active (in ``observed``; ``None``: every child)
         handles them first (an atomic non-final child by a transition, a composite one by
@@ -290,9 +288,7 @@ class _Builder:
             else:
                 before = move.known.get(n, self.initial(n))
                 have = digits_of(lv.index[before], lv.digits)
-            code.extend(
-                f"{lv.key}{j}:='{want[j]}'" for j in range(lv.digits) if want[j] != have[j]
-            )
+            code.extend(f"{lv.key}{j}:='{want[j]}'" for j in range(lv.digits) if want[j] != have[j])
         return "; ".join(code)
 
     def explore(
@@ -445,8 +441,7 @@ class _Builder:
             "style": STYLE,
             "form": FORM,
             "subtrees": subtrees,
-            "levels": 1 + max((_nesting(self.levels, n) for n in range(len(self.levels)))),
-            "hierarchy": "subtrees",
+            "levels": 1 + max(_nesting(self.levels, n) for n in range(len(self.levels))),
         }
         return ConversionResult(doc, "rules", "fsm->bt", stats, [])
 
