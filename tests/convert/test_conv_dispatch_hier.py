@@ -200,3 +200,13 @@ def test_unkept_constructs_are_named() -> None:
     result = convert(fsm, style="dispatch")
     assert result.stats.get("flattened") is True
     assert any("state 'B' has an eventless transition" in w for w in result.warnings)
+
+
+def test_auto_keeps_the_hierarchy_and_hierarchy_flatten_asks_for_the_flat_form() -> None:
+    fsm = _conflict_machine()
+    kept = convert(fsm)  # style auto: an event-driven machine gets the dispatch form
+    assert kept.stats["style"] == "dispatch" and kept.stats["form"] == "hierarchical"
+    flat = convert(fsm, hierarchy="flatten")
+    assert "form" not in flat.stats and flat.stats["flattened"] is True
+    assert any("--hierarchy flatten" in w for w in flat.warnings)
+    assert verify(fsm, kept.model).equivalent and verify(fsm, flat.model).equivalent

@@ -30,6 +30,12 @@ and so at 10 000), the transition as one or two nodes instead of four to five (t
 written by the leaf's post-condition, not by a ``Script`` node under a ``Sequence``), writing
 one digit on most chain steps instead of all of them.
 
+A hierarchical machine gets the hierarchical form (``fsmbt.convert.dispatch_hier``,
+docs/semantics.md §12a: one dispatch level per composite state) unless it has a construct that
+form cannot keep (``hierarchy_blocker``) or ``hierarchy="flatten"`` is asked for: then it is
+flattened first and this shape written for the flat machine, with a warning naming the state
+and the cause.
+
 Bad input (UnsupportedError, state named): an event name BehaviorTree.CPP's ``Switch`` would
 not compare as a plain string (a number, a blackboard reference ``{..}``, empty).
 
@@ -85,15 +91,17 @@ def _reachable(flat: FSM) -> list[str]:
 
 
 @without_gc_pauses
-def fsm_to_dispatch(fsm: FSM, **_options: object) -> ConversionResult:
+def fsm_to_dispatch(
+    fsm: FSM, *, hierarchy: str = "subtrees", **_options: object
+) -> ConversionResult:
     """The dispatch form of ``fsm`` (see the module docstring): the hierarchical form
-    (``fsmbt.convert.dispatch_hier``) for a hierarchical machine whose hierarchy it keeps,
-    else the flat form of the machine, flattened first when it is hierarchical (a warning
-    names the state and the cause)."""
+    (``fsmbt.convert.dispatch_hier``, docs/semantics.md §12a) for a hierarchical machine
+    whose hierarchy it keeps, else the flat form of the machine, flattened first when it is
+    hierarchical (a warning names the state and the cause, or ``--hierarchy flatten``)."""
     warnings: list[str] = []
     flat = fsm
     if needs_flattening(fsm):
-        reason = hierarchy_blocker(fsm)
+        reason = hierarchy_blocker(fsm) if hierarchy != "flatten" else "--hierarchy flatten"
         if reason is None:
             return fsm_to_hier_dispatch(fsm)
         flat = flatten(fsm)

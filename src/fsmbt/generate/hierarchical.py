@@ -3,7 +3,8 @@ completions): the inputs of the hierarchical dispatch form (docs/semantics.md §
 
 ``random_hfsm(seed, states=20, depth=3)``: a top machine whose children are atomic or (with
 probability ``composites``, down to ``depth`` levels) composite states holding a sub-machine
-of 2-5 children, until about ``states`` states exist. In each machine:
+of 2-5 children (up to 10 while many states are still to make), until about ``states``
+states exist (``depth`` and the draws may stop it earlier). In each machine:
 
 - a chain from the initial child makes every child reachable; extra edges (back, self, cross)
   are added; a source has at most one transition per event;
@@ -44,7 +45,10 @@ def random_hfsm(
     counter = [0]
     while work:
         machine, levels, prefix = work.pop()
-        count = rng.randint(2, 5) if machine is not top else max(2, min(6, budget[0] // 3))
+        if machine is top:
+            count = max(2, min(10, budget[0] // 4))
+        else:
+            count = rng.randint(2, min(10, 5 + budget[0] // 40))
         names = []
         for _ in range(count):
             name = f"{prefix}s{counter[0]}"
