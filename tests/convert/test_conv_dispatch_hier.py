@@ -54,7 +54,9 @@ def _proven_and_read_back(fsm: FSM) -> str:
     assert isinstance(back.model, FSM) and back.warnings == []
     assert verify(doc, back.model).equivalent and verify(fsm, back.model).equivalent
     flat = flatten(fsm)
-    states = {s.name: (s.action, s.final) for s in back.model.states.values()}
+    # flat, or hierarchical when the composites could be rebuilt: its flattening either way
+    read = flatten(back.model)
+    states = {s.name: (s.action, s.final) for s in read.states.values()}
     # the flattening's observable states: the same names, actions and finality
     assert states == {n: (flat.states[n].action, flat.states[n].final) for n in states}
     assert len(states) == len(flat.states)
@@ -75,7 +77,22 @@ def test_corpus_hierarchical_scxml_keeps_its_hierarchy(name: str) -> None:
     fsm = _corpus(name)
     text = _proven_and_read_back(fsm)
     assert 'SubTree name="' in text and 'ID="MainTree"' in text
+    back = convert(loads(text, "btcpp"))
+    assert back.model.is_hierarchical and back.stats["composites"] == 1  # rebuilt
     _refuted(fsm, text)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_bt_to_fsm_rebuilds_the_composite_states_of_machines_without_completions(
+    seed: int,
+) -> None:
+    fsm = random_hfsm(seed, 30, completions=0.0)
+    text = _proven_and_read_back(fsm)
+    back = convert(loads(text, "btcpp"))
+    assert isinstance(back.model, FSM) and back.model.is_hierarchical
+    composites = sum(1 for _p, _m, s in fsm.walk() if s.is_composite)
+    assert back.stats["composites"] == composites
+    assert verify(back.model, fsm).equivalent  # FSM against FSM: both flattened
 
 
 @pytest.mark.parametrize("name", PARALLEL)

@@ -175,6 +175,12 @@ def conversion_summary(direction: str, stats: Mapping[str, object], engine: str 
             f"{counted(stats.get('configurations', 0), 'macro-step configuration')} "
             "(docs/semantics.md section 12)"
         ]
+        if "composites" in stats:
+            used.add("composites")
+            parts.append(
+                f"{counted(stats['composites'], 'composite state')} rebuilt from the "
+                "configurations' names (docs/semantics.md §12a)"
+            )
     elif direction == "bt->fsm" and ("leaves" in stats or "k" in stats):
         parts = _bt_to_fsm(stats, used)
     rest = [f"{k}={v}" for k, v in stats.items() if k not in used]

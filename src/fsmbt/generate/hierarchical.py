@@ -11,7 +11,8 @@ states exist (``depth`` and the draws may stop it earlier). In each machine:
 - events come from one small pool shared by every level (``e0``..``e{k-1}``), so a child and
   its ancestor often react to the same event (the child's transition must win);
 - a sub-machine has a final child with probability 0.6; its owner then gets a completion
-  transition (``done.state``, ``exit`` that final state or ``None``) with probability 0.7;
+  transition (``done.state``, ``exit`` that final state or ``None``) with probability
+  ``completions`` (0.7);
 - the top machine's second child is always composite (when ``depth`` > 0);
 - the top machine has a final child with probability 0.5; half the machines start from a
   start pseudo-state with an initial event.
@@ -35,6 +36,7 @@ def random_hfsm(
     composites: float = 0.35,
     events: int = 5,
     start_event: bool | None = None,
+    completions: float = 0.7,
 ) -> FSM:
     """A seeded hierarchical event-driven machine (see the module docstring)."""
     rng = random.Random(f"hfsm:{seed}")
@@ -69,7 +71,7 @@ def random_hfsm(
             machine.add_state(State(final, action=final, final=True))
         machine.initial = names[0]
         _edges(rng, machine, names, final, pool)
-    _completions(rng, top)
+    _completions(rng, top, completions)
     if start_event if start_event is not None else rng.random() < 0.5:
         top.start_name, top.initial_event = "Start", "go"
     return top
@@ -103,13 +105,14 @@ def _edges(
             add(source, rng.choice(targets))  # cross
 
 
-def _completions(rng: random.Random, top: FSM) -> None:
-    """``done.state`` transitions: a composite with a final child completes on it."""
+def _completions(rng: random.Random, top: FSM, chance: float) -> None:
+    """``done.state`` transitions: a composite with a final child completes on it (with
+    probability ``chance``)."""
     for _path, machine, state in list(top.walk()):
         if not state.is_composite:
             continue
         finals = [s.name for s in state.regions[0].states.values() if s.final]
-        if not finals or rng.random() >= 0.7:
+        if not finals or rng.random() >= chance:
             continue
         siblings = [s for s in machine.states if s != state.name] or [state.name]
         exit_name = rng.choice([None, finals[0]])
