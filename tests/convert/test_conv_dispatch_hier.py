@@ -227,3 +227,22 @@ def test_auto_keeps_the_hierarchy_and_hierarchy_flatten_asks_for_the_flat_form()
     assert "form" not in flat.stats and flat.stats["flattened"] is True
     assert any("--hierarchy flatten" in w for w in flat.warnings)
     assert verify(fsm, kept.model).equivalent and verify(fsm, flat.model).equivalent
+
+
+@pytest.mark.parametrize("parallel", [False, True])
+def test_the_subtree_tests_generator_machines_are_proven(parallel: bool) -> None:
+    """A second, independent generator (tests/support/conv_hfsm_gen.py: inner final states
+    with completions, shared events, self-loops, parallel states)."""
+    from support.conv_hfsm_gen import random_hfsm as other_hfsm
+
+    forms = set()
+    for seed in range(10):
+        fsm = other_hfsm(seed, parallel=parallel)
+        result = convert(fsm, style="dispatch")
+        forms.add(result.stats.get("form", "flat"))
+        if result.stats.get("flattened"):
+            assert any("is parallel" in w for w in result.warnings)
+        doc = loads(dumps(result.model, "btcpp"), "btcpp")
+        assert verify(fsm, doc).equivalent
+        assert verify(fsm, convert(doc).model).equivalent
+    assert "hierarchical" in forms
