@@ -1,7 +1,7 @@
 """The Python runtime runs dispatch trees (issue 23: docs/semantics.md section 12, the form
 ``--style auto`` writes for an event-driven machine), through the checker's own macro steps.
 
-- differential: random event-driven FSMs (and HFSMs, flattened by the converter) converted with
+- differential: random event-driven FSMs (and HFSMs: the hierarchical form, §12a) converted with
   ``--style auto`` (asserted to be the dispatch form), written as XML and loaded from the text,
   run by ``load_tree`` with one recording callable per action: after the start and every event
   of seeded random walks the callables really called (action, state label, params), the

@@ -111,7 +111,7 @@ def register(app: typer.Typer) -> None:
             "--hierarchy",
             help="FSM->BT of a "
             "hierarchical FSM: subtrees (one SubTree per composite "
-            "state) or flatten (one flat LEBT)",
+            "state, LEBT or dispatch form) or flatten (the machine flattened first)",
         ),
         llm_base_url: str | None = typer.Option(
             None, "--llm-base-url", help=f"LLM engines: endpoint URL or provider ({PROVIDER_NAMES})"

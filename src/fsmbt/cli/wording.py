@@ -40,7 +40,14 @@ def _fsm_to_bt(s: Mapping[str, object], engine: str, used: set[str]) -> list[str
     head = counted(take("states"), "FSM state")
     if "transitions" in s:
         head += f" and {counted(take('transitions'), 'transition')}"
-    if s.get("style") == "dispatch":  # docs/semantics.md section 12
+    if s.get("style") == "dispatch" and s.get("form") == "hierarchical":  # §12a
+        used.add("form")
+        head += (
+            " became a hierarchical dispatch BT (a Switch dispatch over each level's child "
+            "index on the blackboard, a SubTree per composite state trying the active "
+            "child's transitions before the composite's own)"
+        )
+    elif s.get("style") == "dispatch":  # docs/semantics.md section 12
         digits = (
             counted(take("index_digits"), f"base-{DISPATCH_BASE} digit")
             if "index_digits" in s
@@ -168,6 +175,12 @@ def conversion_summary(direction: str, stats: Mapping[str, object], engine: str 
             f"{counted(stats.get('configurations', 0), 'macro-step configuration')} "
             "(docs/semantics.md section 12)"
         ]
+        if "composites" in stats:
+            used.add("composites")
+            parts.append(
+                f"{counted(stats['composites'], 'composite state')} rebuilt from the "
+                "configurations' names (docs/semantics.md §12a)"
+            )
     elif direction == "bt->fsm" and ("leaves" in stats or "k" in stats):
         parts = _bt_to_fsm(stats, used)
     rest = [f"{k}={v}" for k, v in stats.items() if k not in used]

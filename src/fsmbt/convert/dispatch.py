@@ -30,6 +30,12 @@ and so at 10 000), the transition as one or two nodes instead of four to five (t
 written by the leaf's post-condition, not by a ``Script`` node under a ``Sequence``), writing
 one digit on most chain steps instead of all of them.
 
+A hierarchical machine gets the hierarchical form (``fsmbt.convert.dispatch_hier``,
+docs/semantics.md §12a: one dispatch level per composite state) unless it has a construct that
+form cannot keep (``hierarchy_blocker``) or ``hierarchy="flatten"`` is asked for: then it is
+flattened first and this shape written for the flat machine, with a warning naming the state
+and the cause.
+
 Bad input (UnsupportedError, state named): an event name BehaviorTree.CPP's ``Switch`` would
 not compare as a plain string (a number, a blackboard reference ``{..}``, empty).
 
@@ -39,57 +45,30 @@ tree is acyclic); depth O(log7 states + max out-degree / 6).
 
 from __future__ import annotations
 
-import re
 from collections import deque
 
+from fsmbt.convert.dispatch_hier import fsm_to_hier_dispatch, hierarchy_blocker
+from fsmbt.convert.dispatch_parts import (
+    check_event,
+    digits_of,
+    entry_model,
+    event_switch,
+    index_levels,
+    index_tree,
+    leaf,
+    running,
+    size,
+)
 from fsmbt.convert.perf import without_gc_pauses
 from fsmbt.convert.result import ConversionResult
-from fsmbt.model.bt import BTDocument, BTNode, NodeModel, PortModel
-from fsmbt.model.errors import InputError, UnsupportedError
+from fsmbt.model.bt import BTDocument, BTNode
+from fsmbt.model.errors import InputError
 from fsmbt.model.flatten import flatten, needs_flattening
 from fsmbt.model.fsm import FSM
 from fsmbt.model.kinds import NodeKind
-from fsmbt.semantics.dispatch_runtime import (
-    BASE,
-    DIGIT_PREFIX,
-    DIGITS,
-    ENTRY,
-    EVENT_KEY,
-    MAX_CASES,
-    ON_SUCCESS,
-)
+from fsmbt.semantics.dispatch_runtime import DIGIT_PREFIX, ENTRY, ON_SUCCESS
 
 STYLE = "dispatch"
-_NUMBER = re.compile(r"\s*[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?\s*")
-
-
-def _control(type_name: str, name: str, children: list[BTNode], **attrs: str) -> BTNode:
-    return BTNode(type=type_name, kind=NodeKind.CONTROL, name=name, children=children, attrs=attrs)
-
-
-def _leaf(type_name: str, name: str = "", **attrs: str) -> BTNode:
-    kind = NodeKind.ACTION
-    return BTNode(type=type_name, kind=kind, name=name, attrs=attrs)
-
-
-def _running() -> BTNode:
-    return BTNode(
-        type="KeepRunningUntilFailure",
-        kind=NodeKind.DECORATOR,
-        children=[_leaf("AlwaysSuccess")],
-    )
-
-
-def _switch(key: str, cases: list[tuple[str, BTNode]], default: BTNode, name: str) -> BTNode:
-    """``Switch{k}`` over ``cases`` (1..6 of them). One case gets a padding case: an unused
-    digit (``AlwaysFailure``, never written), or for ``{event}`` (only the last chunk of a
-    state's events has one case, its default is RUNNING) another name that also runs RUNNING."""
-    if len(cases) == 1:
-        pad = next(v for v in (*DIGITS, "z", "zz") if v != cases[0][0])
-        cases = [*cases, (pad, _running() if key == EVENT_KEY else _leaf("AlwaysFailure"))]
-    attrs = {"variable": "{" + key + "}"}
-    attrs.update({f"case_{i}": value for i, (value, _n) in enumerate(cases, 1)})
-    return _control(f"Switch{len(cases)}", name, [n for _v, n in cases] + [default], **attrs)
 
 
 def _reachable(flat: FSM) -> list[str]:
@@ -111,49 +90,39 @@ def _reachable(flat: FSM) -> list[str]:
     return [name for name in flat.states if name in seen]
 
 
-def _check_event(event: str, state: str) -> None:
-    if not event or "{" in event or "'" in event or _NUMBER.fullmatch(event):
-        raise UnsupportedError(
-            f"event {event!r} cannot be a Switch case (BehaviorTree.CPP compares numbers "
-            "numerically and reads {..} as a blackboard entry); use --style lebt",
-            element=f"state '{state}'",
-        )
-
-
 @without_gc_pauses
-def fsm_to_dispatch(fsm: FSM, **_options: object) -> ConversionResult:
-    """The dispatch form of ``fsm`` (see the module docstring)."""
+def fsm_to_dispatch(
+    fsm: FSM, *, hierarchy: str = "subtrees", **_options: object
+) -> ConversionResult:
+    """The dispatch form of ``fsm`` (see the module docstring): the hierarchical form
+    (``fsmbt.convert.dispatch_hier``, docs/semantics.md §12a) for a hierarchical machine
+    whose hierarchy it keeps, else the flat form of the machine, flattened first when it is
+    hierarchical (a warning names the state and the cause, or ``--hierarchy flatten``)."""
     warnings: list[str] = []
     flat = fsm
     if needs_flattening(fsm):
+        reason = hierarchy_blocker(fsm) if hierarchy != "flatten" else "--hierarchy flatten"
+        if reason is None:
+            return fsm_to_hier_dispatch(fsm)
         flat = flatten(fsm)
-        warnings.append(f"hierarchical FSM flattened to {len(flat.states)} states")
+        warnings.append(f"hierarchical FSM flattened to {len(flat.states)} states: {reason}")
     if flat.initial is None or flat.initial not in flat.states:
         raise InputError("the state machine has no initial state", element=fsm.name)
     states = _reachable(flat)
     index = {name: i for i, name in enumerate(states)}
-    levels = 1
-    while BASE**levels < len(states):
-        levels += 1
-
-    def digits(i: int) -> list[str]:
-        out = []
-        for _j in range(levels):
-            out.append(DIGITS[i % BASE])
-            i //= BASE
-        return out
+    levels = index_levels(len(states))
 
     def transition(source: str | None, target: str, label: str) -> BTNode:
-        """The transition to ``target``; its Script writes only the digits that differ from
-        ``source``'s (all of them from the start, ``source`` None)."""
-        want = digits(index[target])
-        have = digits(index[source]) if source is not None else [""] * levels
+        """The transition to ``target``; its post-condition writes only the digits that
+        differ from ``source``'s (all of them from the start, ``source`` None)."""
+        want = digits_of(index[target], levels)
+        have = digits_of(index[source], levels) if source is not None else [""] * levels
         code = [f"{DIGIT_PREFIX}{j}:='{want[j]}'" for j in range(levels) if want[j] != have[j]]
         st = flat.states[target]
         attrs = {"state": target, "action": st.action or ""}
         if code:
             attrs[ON_SUCCESS] = "; ".join(code)
-        node = _leaf(ENTRY, target, **attrs)
+        node = leaf(ENTRY, target, **attrs)
         if st.final:
             return node
         return BTNode(
@@ -161,14 +130,8 @@ def fsm_to_dispatch(fsm: FSM, **_options: object) -> ConversionResult:
         )
 
     def events_switch(source: str | None, name: str, exits: list[tuple[str, str]]) -> BTNode:
-        if not exits:
-            return _running()
-        node = _running()
-        chunks = [exits[k : k + 6] for k in range(0, len(exits), 6)]
-        for c, chunk in reversed(list(enumerate(chunks))):
-            cases = [(ev, transition(source, t, f"{name}/{ev}")) for ev, t in chunk]
-            node = _switch(EVENT_KEY, cases, node, f"{name}_events{c or ''}")
-        return node
+        cases = [(ev, transition(source, t, f"{name}/{ev}")) for ev, t in exits]
+        return event_switch(name, cases, running)
 
     table = flat.transition_map()
     transitions = sum(len(table.get(name, {})) for name in states if not flat.states[name].final)
@@ -176,45 +139,21 @@ def fsm_to_dispatch(fsm: FSM, **_options: object) -> ConversionResult:
     for name in states:
         st = flat.states[name]
         if st.final:
-            cases.append(_leaf("AlwaysSuccess", f"{name}_final"))
+            cases.append(leaf("AlwaysSuccess", f"{name}_final"))
             continue
         exits = [(str(e), t.target) for e, t in table.get(name, {}).items()]
         for ev, _t in exits:
-            _check_event(ev, name)
+            check_event(ev, name)
         cases.append(events_switch(name, name, exits))
     if flat.initial_event is not None:
-        _check_event(flat.initial_event, flat.start_name or "start")
+        check_event(flat.initial_event, flat.start_name or "start")
         start = events_switch(None, "start", [(flat.initial_event, flat.initial)])
     else:
         start = transition(None, flat.initial, "start")
-    nodes: list[BTNode] = cases
-    for j in range(levels):
-        key = f"{DIGIT_PREFIX}{j}"
-        groups = [nodes[k : k + BASE] for k in range(0, len(nodes), BASE)]
-        last = j == levels - 1
-        nodes = []
-        for g, group in enumerate(groups):
-            name = "dispatch" if last else f"digit{j}_{g}"
-            cases_j = [(DIGITS[i], n) for i, n in enumerate(group)]
-            if len(cases_j) <= MAX_CASES:
-                default = start if last else _leaf("AlwaysFailure")
-            elif last:  # the root's default is the start case: the seventh digit is a case
-                default = _switch(key, cases_j[MAX_CASES:], start, f"{name}_{DIGITS[-1]}")
-            else:  # the seventh digit is the default child: one comparison fewer
-                default = cases_j[MAX_CASES][1]
-            nodes.append(_switch(key, cases_j[:MAX_CASES], default, name))
-    assert len(nodes) == 1
-    doc = BTDocument.single(nodes[0])
-    doc.node_models[ENTRY] = NodeModel(
-        ENTRY, NodeKind.ACTION, [PortModel("state", "input"), PortModel("action", "input")]
-    )
-    count = depth = 0
-    stack = [(nodes[0], 1)]
-    while stack:
-        node, d = stack.pop()
-        count += 1
-        depth = max(depth, d)
-        stack.extend((child, d + 1) for child in node.children)
+    root = index_tree(cases, DIGIT_PREFIX, levels, start, ("dispatch", "digit"))
+    doc = BTDocument.single(root)
+    doc.node_models[ENTRY] = entry_model()
+    count, depth = size(root)
     stats: dict[str, object] = {
         "states": len(states),
         "transitions": transitions,
@@ -223,4 +162,6 @@ def fsm_to_dispatch(fsm: FSM, **_options: object) -> ConversionResult:
         "style": STYLE,
         "index_digits": levels,
     }
+    if flat is not fsm:
+        stats["flattened"] = True
     return ConversionResult(doc, "rules", "fsm->bt", stats, warnings)

@@ -24,6 +24,11 @@ macro steps, exactly:
    event only leaves it, never to come back, it is the FSM's start pseudo-state with that
    initial event (the form ``fsm_to_dispatch`` writes for such machines).
 
+For a tree of the hierarchical form (docs/semantics.md §12a: a ``SubTree`` per composite
+state), whose states are named by their configurations (``A/a1``),
+``fsmbt.convert.dispatch_lift`` rebuilds the composite states when the hierarchical machine it
+recovers flattens to exactly this machine; otherwise the flat machine is the result.
+
 The result is the tree's behaviour itself, so the checker's macro-step pairing
 (``fsmbt.verify.pairing``) proves it equivalent to the tree, and, for a tree fsmbt wrote, to the
 source machine it was written from.
@@ -47,6 +52,7 @@ from collections import deque
 from typing import Any
 
 from fsmbt import limits
+from fsmbt.convert.dispatch_lift import lift_hierarchy
 from fsmbt.convert.perf import without_gc_pauses
 from fsmbt.convert.result import ConversionResult
 from fsmbt.model.bt import BTDocument
@@ -371,4 +377,9 @@ def dispatch_to_fsm(
         "configurations": len(explored.states),
         "final_states": sum(1 for s in fsm.states.values() if s.final),
     }
-    return ConversionResult(fsm, "rules", "bt->fsm", stats, _port_warnings(explored))
+    warnings = _port_warnings(explored)
+    lifted = lift_hierarchy(fsm) if len(doc.trees) > 1 and not warnings else None
+    if lifted is not None:  # a hierarchical dispatch tree (docs/semantics.md §12a)
+        stats["composites"] = sum(1 for _p, _m, s in lifted.walk() if s.is_composite)
+        return ConversionResult(lifted, "rules", "bt->fsm", stats, warnings)
+    return ConversionResult(fsm, "rules", "bt->fsm", stats, warnings)

@@ -82,7 +82,8 @@ def rules_fsm_to_bt(
     ``lebt``, ``dispatch``).
 
     Under ``auto`` an event-driven machine gets the dispatch form (docs/semantics.md §12; a
-    hierarchical machine flattened, ``hierarchy`` shapes the LEBT only), or the LEBT with a
+    hierarchical machine keeps its composite states, §12a, unless the form cannot keep them or
+    ``hierarchy="flatten"``: then it is flattened first), or the LEBT with a
     warning naming why when the dispatch form cannot be written (an event a ``Switch`` cannot
     compare, an eventless transition: the dispatch builder's ``InputError``) or when NuSMV is
     to check the result (option ``NUSMV_CHECKED``, set by ``fsmbt.api`` for
