@@ -2,7 +2,9 @@
 written as one small sub-machine per node, its memory as data, never explored.
 
 Proof obligation (docs/semantics.md §4d): the flat meaning of the result is the tree's
-leaf-execution machine. The whole-product check discharges it on every tree here: seeded
+leaf-execution machine. The whole-product check discharges it on every tree here (and the
+per-node check, ``verify/pernode.py``, proves most of them on its own; it never proves one
+the whole product refutes: tests/verify/test_ver_pernode.py): seeded
 trees of the bench families (``benchmarks/bench_reactive.py``: memory, mixed, reactive-plain,
 decorated) at small sizes and trees over every kind the module writes
 (``tests/support/pernode_trees.py``), each converted with ``pernode=True``. Counts are printed
@@ -26,8 +28,10 @@ from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import FsmbtError
 from fsmbt.model.fsm import FSM
 from fsmbt.model.fsm_data import ASSIGN, COND
+from fsmbt.verify.compositional import compositional_report
 from fsmbt.verify.native import check
 from fsmbt.verify.pairing import machines_for
+from fsmbt.verify.report import PER_NODE
 from support.pernode_trees import pernode_tree
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))
@@ -76,8 +80,11 @@ def test_pernode_regions_are_proven_on_2000_generated_trees() -> None:
         tally["trees with one"] += bool(written)
         assert whole_product(doc, result.model), label
         tally["proven"] += 1
+        report, _why = compositional_report(doc, result.model)  # agrees: tests/verify too
+        tally["also proven per node"] += report is not None and report.method == PER_NODE
     print(f"\n[per-node conversion] {dict(tally)}")
     assert tally["proven"] >= 1900 and tally["trees with one"] >= 1500
+    assert tally["also proven per node"] >= 1200
 
 
 def test_a_converter_without_halt_resets_is_caught(monkeypatch) -> None:

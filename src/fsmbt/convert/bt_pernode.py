@@ -22,6 +22,8 @@ namespace, Clark notation in ``attrs``) = the node's path as
   plus the assignments to run on the way (``Cont``). A return that depends on data (a wake-up
   test, a retry count) is a transient state of the node with guarded eventless transitions;
 - a RUNNING that reaches the region's root ends the tick: the next tick enters the root again
+  at its own entry state (the root always has one, so that the next tick is told apart from
+  a child's entry: ``fsmbt.verify.pernode`` reads it as the root's RUNNING exit)
   (the region heads its part of the tree: its plain ancestors resume straight into it;
   docs/semantics.md §4c). A tick ending RUNNING and a wake-up's re-tick are not observable
   (§4), so they are the same eventless step back to the root's entry;
@@ -308,7 +310,7 @@ class _Writer:
         for node in reversed(self.nodes):
             if node.is_env_leaf:
                 self.entry[node.id] = self._state(node, node.label, node.label, "")
-            elif node.id in self.idx:
+            elif node.id in self.idx or node.id == 0:  # the root: the next tick's target
                 self.entry[node.id] = self._state(node, f"{node.label}.tick", "", "tick")
             else:
                 self.entry[node.id] = self.entry[node.children[0]]
@@ -319,6 +321,8 @@ class _Writer:
         self._entries()
         finals = {SUCCESS: Cont(END_SUCCESS), FAILURE: Cont(END_FAILURE)}
         self.fsm.initial = self.entry[0]
+        if 0 not in self.idx:  # the root's own entry starts at its first child
+            self._go(self.entry[0], None, Cont(self.entry[self.nodes[0].children[0]]))
         work: list[tuple[int, dict[int, Cont]]] = [(0, {**finals, RUNNING: Cont(self.entry[0])})]
         while work:
             nid, returns = work.pop()

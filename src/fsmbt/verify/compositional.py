@@ -70,8 +70,10 @@ from fsmbt.semantics.nodes import (
     canonical_type,
 )
 from fsmbt.semantics.status import LeafOutcome, RootResult
+from fsmbt.verify.method import PER_NODE_SENTENCE
 from fsmbt.verify.native import DEFAULT_MAX_STATES, StateLimitError, check_witnessed
-from fsmbt.verify.report import COMPOSITIONAL, PROPERTIES, PropertyResult, Report
+from fsmbt.verify.pernode import NODE_ATTR, NotPerNode, PerNodeOutcome, check_region
+from fsmbt.verify.report import COMPOSITIONAL, PER_NODE, PROPERTIES, PropertyResult, Report
 
 SUCCESS, FAILURE = RootResult.SUCCESS.value, RootResult.FAILURE.value
 EV_SUCCESS, EV_FAILURE = LeafOutcome.SUCCESS.value, LeafOutcome.FAILURE.value
@@ -486,6 +488,19 @@ def decompose(
         k = tree_of_state.get(j)
         if k is None:
             continue
+        per_node = _per_node(regions[k], region.machine, declared, outcome)
+        if per_node is not None:  # proven (or refuted) node by node (verify/pernode.py)
+            if not per_node.equivalent:
+                outcome.equivalent = False
+                outcome.failed_region = (
+                    f"{regions[k].label} (state {region.path}), node {per_node.failed}"
+                )
+                return outcome
+            possible = per_node.results
+            if not possible or not possible <= set(region.exits):
+                raise NotDecomposable(f"region {regions[k].label} ends in {sorted(possible)}")
+            results[k] = fsm_results[j] = possible
+            continue
         bt_region = LeafMachine(BTDocument.single(regions[k]))
         fsm_region = FSMLeafMachine(region_fsm(region, declared, mentioned[j]))
         try:
@@ -517,6 +532,27 @@ def decompose(
         # non-plain leaves the machine keeps as plain states; the whole product tells which
         raise NotDecomposable("the skeletons differ")
     return outcome
+
+
+def _per_node(
+    region_root: BTNode, machine: FSM, declared: dict[str, str], outcome: Decomposition
+) -> PerNodeOutcome | None:
+    """The per-node check of one region (``verify/pernode.py``) when its machine is tagged
+    per node and decomposes; ``None``: check the region whole."""
+    if not any(NODE_ATTR in state.attrs for state in machine.states.values()):
+        return None
+    try:
+        found = check_region(region_root, machine, declared)
+    except NotPerNode as exc:
+        outcome.stats.setdefault("per_node_refused", []).append(str(exc))
+        return None
+    outcome.stats["per_node_regions"] = outcome.stats.get("per_node_regions", 0) + 1
+    outcome.stats["per_node_nodes"] = outcome.stats.get("per_node_nodes", 0) + found.nodes
+    outcome.stats["per_node_distinct"] = outcome.stats.get("per_node_distinct", 0) + found.distinct
+    outcome.stats["per_node_local_states"] = (
+        outcome.stats.get("per_node_local_states", 0) + found.local_states
+    )
+    return found
 
 
 def _add(total: dict[str, Any], part: dict[str, Any]) -> None:
@@ -555,6 +591,16 @@ def compositional_report(
         report.properties[name] = PropertyResult(name, True, detail)
     report.method = COMPOSITIONAL
     report.abstractions = [COMPOSITIONAL_SENTENCE]
+    if found.stats.get("per_node_regions"):
+        report.method = PER_NODE
+        report.abstractions.append(PER_NODE_SENTENCE)
+        detail += (
+            f"; {found.stats['per_node_regions']} of them node by node "
+            f"({found.stats['per_node_nodes']} nodes, {found.stats['per_node_distinct']} "
+            "distinct local checks)"
+        )
+        for name in PROPERTIES:
+            report.properties[name] = PropertyResult(name, True, detail)
     report.stats = {
         **found.stats,
         "regions": found.regions,
