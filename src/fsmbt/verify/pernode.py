@@ -136,9 +136,22 @@ _ALLOWED = (
 )
 
 
+_COMPILED: dict[tuple[str, tuple[tuple[str, str], ...]], Any] = {}
+
+
 def _compile(text: str, names: dict[str, str]) -> tuple[str, Callable[[dict[str, Any]], Any]]:
     """An expression with its variables renamed (``names``; the canonical text) and a function
-    evaluating it over an environment. Refuses anything outside the subset."""
+    evaluating it over an environment (cached by text and renaming). Refuses anything outside
+    the subset."""
+    used = tuple(sorted((w, names[w]) for w in set(_IDENT.findall(text)) if w in names))
+    key = (text, used)
+    found = _COMPILED.get(key)
+    if found is None:
+        found = _COMPILED[key] = _compile_new(text, names)
+    return found  # type: ignore[no-any-return]
+
+
+def _compile_new(text: str, names: dict[str, str]) -> tuple[str, Callable[[dict[str, Any]], Any]]:
     try:
         tree = ast.parse(text.strip(), mode="eval")
     except SyntaxError:
@@ -177,7 +190,7 @@ class _Hop:
     updates: tuple[tuple[str, str], ...]
     update_fns: tuple[tuple[str, Callable[[dict[str, Any]], Any]], ...]
     halts: frozenset[int]
-    outside: tuple[int, ...]  # canonical ids of the assignments outside the node's subtree
+    outside: tuple[int, ...]  # canonical id of the hop's assignments outside the subtree
     target: tuple[str, Any]
 
 
@@ -248,6 +261,11 @@ class _Region:
                         continue
                     if self.owner.setdefault(word, self.tag[name]) != self.tag[name]:
                         raise NotPerNode(f"variable {word} is read by two nodes")
+        self.own: dict[int, set[str]] = {}
+        for var, x in self.owner.items():
+            self.own.setdefault(x, set()).add(var)
+        self._halts: list[dict[str, Any]] = []
+        self._below: list[list[str]] = []
         self.initial: dict[str, Any] = {}
         for var in self.owner:
             value = _literal(declared.get(var, ""))
@@ -292,8 +310,29 @@ class _Region:
         # through): nothing of it is checked, and its parent's check fails if the tree ticks it
 
     def halt_vars(self, nid: int) -> dict[str, Any]:
-        """The halt values of the variables owned in ``nid``'s subtree."""
-        return {v: h for v, h in self.halt_value.items() if nid <= self.owner[v] < self.end[nid]}
+        """The halt values of the variables owned in ``nid``'s subtree (bottom-up once)."""
+        if not self._halts:
+            own: dict[int, dict[str, Any]] = {}
+            for v, h in self.halt_value.items():
+                own.setdefault(self.owner[v], {})[v] = h
+            self._halts = [{} for _ in self.nodes]
+            for node in reversed(self.nodes):
+                found = dict(own.get(node.id, {}))
+                for c in node.children:
+                    found.update(self._halts[c])
+                self._halts[node.id] = found
+        return self._halts[nid]
+
+    def owned_below(self, nid: int) -> list[str]:
+        """The variables owned in ``nid``'s subtree (bottom-up once)."""
+        if not self._below:
+            self._below = [[] for _ in self.nodes]
+            for node in reversed(self.nodes):
+                found = sorted(self.own.get(node.id, ()))
+                for c in node.children:
+                    found.extend(self._below[c])
+                self._below[node.id] = found
+        return self._below[nid]
 
 
 # -- one node's local problem ------------------------------------------------------------------
@@ -319,7 +358,7 @@ def _local(region: _Region, node: CompiledNode, interfaces: dict[int, Interface]
     """``node``'s fragment (see the module docstring), canonically named: its states in
     discovery order, its variables ``v0, v1 ...`` in order of first use, the targets and
     assignments outside its subtree numbered in order of first use."""
-    own = {v for v, x in region.owner.items() if x == node.id}
+    own = region.own.get(node.id, set())
     names: dict[str, str] = {}
     outside_ids: dict[Any, int] = {}
     state_ids: dict[str, int] = {}
@@ -329,9 +368,8 @@ def _local(region: _Region, node: CompiledNode, interfaces: dict[int, Interface]
     halts_of = [region.halt_vars(c) for c in kids]
     owner_child: dict[str, int] = {}
     for i, c in enumerate(kids):
-        for var, x in region.owner.items():
-            if c <= x < region.end[c]:
-                owner_child[var] = i
+        for var in region.owned_below(c):
+            owner_child[var] = i
     root_entry = region.entry[0] if node.id == 0 else None
 
     def outside_id(value: Any) -> int:
@@ -365,7 +403,7 @@ def _local(region: _Region, node: CompiledNode, interfaces: dict[int, Interface]
             canonical, cond_fn = _compile(cond_text, names)
         updates: list[tuple[str, str]] = []
         fns: list[tuple[str, Callable[[dict[str, Any]], Any]]] = []
-        outside: list[int] = []
+        outside: list[tuple[str, str]] = []
         halted: dict[int, dict[str, Any]] = {}
         for var, expr in pairs:
             if var in own:
@@ -377,7 +415,7 @@ def _local(region: _Region, node: CompiledNode, interfaces: dict[int, Interface]
             elif node.id <= region.owner[var] < region.end[node.id]:
                 raise NotPerNode(f"{node.label} assigns {var} of a descendant")
             else:
-                outside.append(outside_id(("a", (var, expr))))
+                outside.append((var, expr))
         for i, values in halted.items():
             if values != halts_of[i]:
                 raise NotPerNode(f"{node.label} halts child {i} partly")
@@ -387,7 +425,7 @@ def _local(region: _Region, node: CompiledNode, interfaces: dict[int, Interface]
             tuple(updates),
             tuple(fns),
             frozenset(halted),
-            tuple(outside),
+            (outside_id(("a", tuple(outside))),) if outside else (),
             target_of(target, entering),
         )
 
@@ -673,6 +711,6 @@ def _real_exits(local: _Local, pairing: dict[int, Any]) -> Interface:
     found: Interface = {}
     for status, (target_id, assign_ids) in pairing.items():
         target = local.exits[target_id][1]
-        assigns = tuple(local.exits[a][1] for a in assign_ids)
+        assigns = tuple(pair for a in assign_ids for pair in local.exits[a][1])
         found[status] = (target, assigns)
     return found
