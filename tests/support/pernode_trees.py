@@ -2,7 +2,8 @@
 for its property tests: the controls of the sequence and reactive families (with memory,
 asynchronous), the status maps and the loop decorators with small counts and -1.
 
-``pernode_tree(leaves, seed)``: groups of 2-3 nodes under a random control, bottom-up (no
+``pernode_tree(leaves, seed)``: groups of 2-3 nodes under a random control (Parallel and
+ParallelAll with random thresholds among them), bottom-up (no
 recursion), 40 % conditions, and each node wrapped in a random decorator with probability 0.25.
 ``family_tree`` of ``benchmarks/bench_reactive.py`` gives the bench families; this one covers
 the kinds those families lack (Async*, KeepRunningUntilFailure, counts 1, 3 and -1).
@@ -23,6 +24,8 @@ CONTROLS = (
     "SequenceWithMemory",
     "AsyncSequence",
     "AsyncFallback",
+    "Parallel",
+    "ParallelAll",
 )
 DECORATORS: tuple[tuple[str, dict[str, str]], ...] = (
     ("Inverter", {}),
@@ -46,6 +49,18 @@ def _decorated(node: BTNode, rng: random.Random) -> BTNode:
     return BTNode(kind, NodeKind.DECORATOR, attrs=dict(ports), children=[node])
 
 
+def _ports(control: BTNode, rng: random.Random) -> None:
+    """A Parallel's thresholds (1, all, "all but one" as -2) and ParallelAll's max_failures,
+    within its children (they may still grow by one: counts stay valid)."""
+    if control.type == "Parallel":
+        control.attrs = {
+            "success_count": rng.choice(("1", "-1", "2")),
+            "failure_count": rng.choice(("1", "-1", "2")),
+        }
+    elif control.type == "ParallelAll":
+        control.attrs = {"max_failures": rng.choice(("1", "2", "-1"))}
+
+
 def pernode_tree(leaves: int, seed: int) -> BTDocument:
     """A random tree of ``leaves`` leaves over ``CONTROLS`` and ``DECORATORS`` (see above)."""
     rng = random.Random(seed)
@@ -66,6 +81,7 @@ def pernode_tree(leaves: int, seed: int) -> BTDocument:
             controls.append(
                 BTNode(rng.choice(CONTROLS), NodeKind.CONTROL, children=level[i : i + k])
             )
+            _ports(controls[-1], rng)
             i += k
         level = [_decorated(control, rng) for control in controls]
     root = level[0]

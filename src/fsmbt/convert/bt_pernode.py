@@ -73,6 +73,7 @@ from fsmbt.model.kinds import NodeKind
 from fsmbt.model.nodes import canonical_type
 from fsmbt.semantics.bt_interpreter import CompiledTree
 from fsmbt.semantics.compiled import FAILURE, RUNNING, SUCCESS, CompiledNode
+from fsmbt.semantics.families.parallel import parallel_threshold
 from fsmbt.semantics.nodes import runtime_tables
 
 #: State attribute naming the node a state belongs to (its ``CompiledNode.path`` in the region).
@@ -80,11 +81,16 @@ NODE_ATTR = "{https://fsmbt.dev/ns/scxml}node"
 #: State attribute naming the part of the node's rule a transient state is (entry, a return).
 ROLE_ATTR = "{https://fsmbt.dev/ns/scxml}role"
 EV_SUCCESS, EV_FAILURE, EV_RUNNING = "success", "failure", "running"
+EVENTS_BY_STATUS = {SUCCESS: "S", FAILURE: "F"}
 END_SUCCESS, END_FAILURE = "SUCCESS", "FAILURE"
 #: Handlers of the loop family and the result they repeat on (``loops.loop_decorator``).
 LOOP_AGAIN_ON = {"repeat": SUCCESS, "retry": FAILURE}
 #: The tick rules this module writes (``FamilyRule`` handler names).
-SUPPORTED_HANDLERS = frozenset({"sequence", "reactive", "simple_decorator", *LOOP_AGAIN_ON})
+#: Handlers of the counting parallels (``families.parallel``): Parallel, ParallelAll.
+PARALLEL_HANDLERS = frozenset({"parallel", "parallel_all"})
+SUPPORTED_HANDLERS = frozenset(
+    {"sequence", "reactive", "simple_decorator", *LOOP_AGAIN_ON, *PARALLEL_HANDLERS}
+)
 
 Assign = tuple[str, str]
 
@@ -139,9 +145,21 @@ def refusal(tree: CompiledTree) -> str | None:
             return f"{node.type} '{node.label}' has no per-node rule"
         if rule in LOOP_AGAIN_ON and node.params[0] is not None and node.params[0] == 0:
             return f"{node.type} '{node.label}' returns at once (a count of 0)"
+        if rule in PARALLEL_HANDLERS and 0 in _thresholds(node):
+            return f"{node.type} '{node.label}' has a threshold of 0"
         if not node.children:
             return f"{node.type} '{node.label}' has no children"
     return None
+
+
+def _thresholds(node: CompiledNode) -> tuple[int, int]:
+    """(successes, failures) needed, resolved (``families.parallel``); ParallelAll:
+    (children, max_failures)."""
+    n = len(node.children)
+    if _rule(node) == "parallel":
+        succ, fail = node.params
+        return parallel_threshold(succ, n), parallel_threshold(fail, n)
+    return n, node.params[0]
 
 
 def memory_log2(tree: CompiledTree) -> float:
@@ -204,6 +222,9 @@ class _Writer:
         self.idx: dict[int, str] = {}
         self.cr: dict[int, str] = {}
         self.count: dict[int, str] = {}
+        self.done: dict[int, dict[int, str]] = {}  # parallel -> child index -> completed flag
+        self.successes: dict[int, str] = {}
+        self.failures: dict[int, str] = {}
         self.entry: dict[int, str] = {}
         self.node_of: dict[str, str] = {}
         self.guarded = 0
@@ -227,13 +248,17 @@ class _Writer:
             elif rule in LOOP_AGAIN_ON:
                 limit = node.params[0]
                 found[node.id] = kids[0] or limit != 1
+            elif rule in PARALLEL_HANDLERS:
+                found[node.id] = len(kids) > 1 or kids[0]  # waits for the others
             else:
                 found[node.id] = any(kids)
         return found
 
-    def _variable(self, node: CompiledNode, field_name: str, table: dict[int, str]) -> str:
+    def _variable(
+        self, node: CompiledNode, field_name: str, table: dict[int, str], key: int | None = None
+    ) -> str:
         var = self.new_variable(f"{node.label}_{field_name}")
-        table[node.id] = var
+        table[node.id if key is None else key] = var
         self.variables.append((var, "0"))
         return var
 
@@ -259,6 +284,16 @@ class _Writer:
                     own.append((self._variable(node, "count", self.count), "0"))
                 if limit != 1 and self.can_run[node.children[0]]:
                     own.append((self._variable(node, "cr", self.cr), "0"))
+            elif rule in PARALLEL_HANDLERS:  # (both kinds forget their memory on halt)
+                for i in range(len(node.children)):
+                    own.append(
+                        (
+                            self._variable(node, f"done{i}", self.done.setdefault(node.id, {}), i),
+                            "0",
+                        )
+                    )
+                own.append((self._variable(node, "successes", self.successes), "0"))
+                own.append((self._variable(node, "failures", self.failures), "0"))
             self.halt_vars[node.id] = own
 
     def _halt(self, nid: int) -> list[Assign]:
@@ -310,7 +345,8 @@ class _Writer:
         for node in reversed(self.nodes):
             if node.is_env_leaf:
                 self.entry[node.id] = self._state(node, node.label, node.label, "")
-            elif node.id in self.idx or node.id == 0:  # the root: the next tick's target
+            elif node.id in self.idx or node.id == 0 or node.id in self.done:
+                # the root: the next tick's target; a parallel: its first visit
                 self.entry[node.id] = self._state(node, f"{node.label}.tick", "", "tick")
             else:
                 self.entry[node.id] = self.entry[node.children[0]]
@@ -321,7 +357,7 @@ class _Writer:
         self._entries()
         finals = {SUCCESS: Cont(END_SUCCESS), FAILURE: Cont(END_FAILURE)}
         self.fsm.initial = self.entry[0]
-        if 0 not in self.idx:  # the root's own entry starts at its first child
+        if 0 not in self.idx and 0 not in self.done:  # the root's entry: its first child
             self._go(self.entry[0], None, Cont(self.entry[self.nodes[0].children[0]]))
         work: list[tuple[int, dict[int, Cont]]] = [(0, {**finals, RUNNING: Cont(self.entry[0])})]
         while work:
@@ -337,6 +373,8 @@ class _Writer:
                 kids = self._reactive(node, returns)
             elif rule == "simple_decorator":
                 kids = [self._status_map(node, returns)]
+            elif rule in PARALLEL_HANDLERS:
+                kids = self._parallel(node, returns)
             else:
                 kids = [self._loop(node, returns)]
             work.extend(zip(node.children, kids, strict=True))
@@ -394,12 +432,12 @@ class _Writer:
             out.append(conts)
         return out
 
-    def _chain(self, node: CompiledNode, tag: str, end: Cont) -> list[Cont]:
+    def _chain(self, node: CompiledNode, tag: str, end: Cont, first: int = 1) -> list[Cont]:
         """``chain[k]``: halt children k.. of ``node`` (each child with memory one transient
-        state), then ``end``; ``chain[n] = end``."""
+        state), then ``end``; ``chain[n] = end`` (built from ``first`` on)."""
         kids = node.children
         chain: list[Cont] = [end] * (len(kids) + 1)
-        for k in range(len(kids) - 1, 0, -1):
+        for k in range(len(kids) - 1, first - 1, -1):
             halt = self._halt(kids[k])
             if halt:  # a state per child, so each subtree's resets are written once per chain
                 chain[k] = self._halt_state(node, f"halt{k}{tag}", chain[k + 1].after(halt))
@@ -427,6 +465,67 @@ class _Writer:
                 stop: stops[i + 1],
                 RUNNING: runs[i + 1],
             }
+            out.append(conts)
+        return out
+
+    def _parallel(self, node: CompiledNode, returns: dict[int, Cont]) -> list[dict[int, Cont]]:
+        """``families.parallel.tick_parallel`` / ``tick_parallel_all`` per child: every child
+        not completed is ticked in order (``visit i``: ``[done_i == 1]`` skips it); Parallel
+        checks its thresholds after each child's result (success first), ParallelAll once
+        every child completed; ending halts every child and forgets the memory."""
+        kids = node.children
+        n = len(kids)
+        done = self.done[node.id]
+        sc, fc = self.successes[node.id], self.failures[node.id]
+        need_s, need_f = _thresholds(node)
+        waits_for_all = _rule(node) == "parallel_all"
+        forget = [(done[i], "0") for i in range(n)] + [(sc, "0"), (fc, "0")]
+        halt_s = self._chain(node, "S", returns[SUCCESS].after(forget), first=0)
+        halt_f = self._chain(node, "F", returns[FAILURE].after(forget), first=0)
+        # visit i, from the last: skip a completed child, else tick it
+        visits: list[Cont] = [Cont("")] * (n + 1)
+        if waits_for_all:
+            all_done = " and ".join(f"{done[i]} == 1" for i in range(n))
+            visits[n] = self._transient(
+                node,
+                "end",
+                [
+                    (f"({all_done}) and {fc} >= {need_f}", halt_f[0]),
+                    (f"{all_done}", halt_s[0]),
+                    (None, returns[RUNNING]),
+                ],
+            )
+        else:
+            visits[n] = returns[RUNNING]
+        for i in range(n - 1, -1, -1):
+            if i == 0:
+                visits[i] = Cont(self.entry[node.id])
+                self._go(self.entry[node.id], None, visits[i + 1], f"{done[i]} == 1")
+                self._go(self.entry[node.id], None, Cont(self.entry[kids[i]]))
+            else:
+                visits[i] = self._transient(
+                    node,
+                    f"visit{i}",
+                    [(f"{done[i]} == 1", visits[i + 1]), (None, Cont(self.entry[kids[i]]))],
+                )
+        out: list[dict[int, Cont]] = []
+        for i in range(n):
+            conts: dict[int, Cont] = {RUNNING: visits[i + 1]}
+            for status, count in ((SUCCESS, sc), (FAILURE, fc)):
+                mark = [(done[i], "1"), (count, f"{count} + 1")]
+                if waits_for_all:
+                    conts[status] = visits[i + 1].after(mark)
+                    continue
+                check = self._transient(
+                    node,
+                    f"check{i}{EVENTS_BY_STATUS[status]}",
+                    [
+                        (f"{sc} >= {need_s}", halt_s[0]),
+                        (f"{fc} > {n - need_s} or {fc} == {need_f}", halt_f[0]),
+                        (None, visits[i + 1]),
+                    ],
+                )
+                conts[status] = check.after(mark)
             out.append(conts)
         return out
 
@@ -486,6 +585,8 @@ def pernode_estimate(node: BTNode) -> float:
             total += math.log2(len(x.children)) + 1
         elif rule in LOOP_AGAIN_ON:
             total += 2.0
+        elif rule in PARALLEL_HANDLERS:
+            total += len(x.children) + 2 * math.log2(len(x.children) + 1)
         elif rule is not None and rule not in SUPPORTED_HANDLERS:
             total += math.log2(len(x.children) + 1) + 1
     return total + math.log2(max(1, leaves))

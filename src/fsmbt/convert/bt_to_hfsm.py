@@ -236,8 +236,8 @@ class _Builder:
     # -- explored regions --------------------------------------------------------------------
     def _explored_state(self, node: BTNode, cont: _Cont, machine: FSM) -> str:
         reset: list[tuple[str, str]] = []
-        parallel = self.parallel_region(node) if self.compact else None
-        per_node = self.pernode_region(node) if self.compact and parallel is None else None
+        per_node = self.pernode_region(node) if self.compact else None
+        parallel = self.parallel_region(node) if self.compact and per_node is None else None
         if parallel is not None:
             sub, ends = parallel.fsm, parallel.ends
             reset = parallel.variables
@@ -278,9 +278,9 @@ class _Builder:
     def pernode_region(self, node: BTNode) -> PerNodeRegion | None:
         """``node``'s region written per node (``bt_pernode``) when ``pernode`` says so (by
         default: when the estimate of its explored size passes ``PERNODE_MIN_LOG2``), else
-        ``None`` (the compact form; a large region that cannot be written per node is warned
-        about, naming why)."""
-        if self.pernode is False or is_parallel_kind(node):
+        ``None`` (the compact form, or ``<parallel>`` for a Parallel heading a small region; a
+        large region that cannot be written per node is warned about, naming why)."""
+        if self.pernode is False:
             return None
         if self.pernode is None and pernode_estimate(node) < PERNODE_MIN_LOG2:
             return None

@@ -148,7 +148,7 @@ def _compile(text: str, names: dict[str, str]) -> tuple[str, Callable[[dict[str,
     found = _COMPILED.get(key)
     if found is None:
         found = _COMPILED[key] = _compile_new(text, names)
-    return found  # type: ignore[no-any-return]
+    return found
 
 
 def _compile_new(text: str, names: dict[str, str]) -> tuple[str, Callable[[dict[str, Any]], Any]]:
