@@ -562,10 +562,24 @@ class _Writer:
         }
 
 
-#: Regions whose estimated explored size (``memory_log2``) is at least this many bits are
-#: written per node by default; below it the compact form is kept (byte for byte as before).
-#: 2**12 configurations: where exploring and compacting starts to cost more than ~0.1 s.
+#: The default form of a region (``bt_to_hfsm``): below this estimate (bits, ``pernode_estimate``,
+#: a loose upper bound of the explored configurations) the compact form, as before; at or above
+#: it, per node when the region has ``PERNODE_SURE_NODES`` nodes or more, or when exploring it
+#: passes ``PERNODE_TRY_STATES`` states (a region that fits keeps the compact form, byte for
+#: byte: every tree of the tests and examples that converted before converts the same).
 PERNODE_MIN_LOG2 = 12.0
+PERNODE_SURE_NODES = 150
+PERNODE_TRY_STATES = 4_000
+
+
+def region_size(node: BTNode) -> int:
+    """Nodes of ``node``'s subtree (iterative)."""
+    count, stack = 0, [node]
+    while stack:
+        x = stack.pop()
+        count += 1
+        stack.extend(x.children)
+    return count
 
 
 def pernode_estimate(node: BTNode) -> float:

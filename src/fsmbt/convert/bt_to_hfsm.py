@@ -53,9 +53,12 @@ from fsmbt.convert.bt_compact import CompactRegion, Namer, compact_region
 from fsmbt.convert.bt_parallel import ParallelRegion, is_parallel_kind, parallel_region
 from fsmbt.convert.bt_pernode import (
     PERNODE_MIN_LOG2,
+    PERNODE_SURE_NODES,
+    PERNODE_TRY_STATES,
     PerNodeRegion,
     pernode_estimate,
     pernode_region,
+    region_size,
 )
 from fsmbt.convert.compress import inline_and_compress
 from fsmbt.convert.perf import without_gc_pauses
@@ -151,6 +154,10 @@ class _Builder:
     #: write regions per node (``bt_pernode``): True always, False never, None past the estimate
     pernode: bool | None = None
     pernode_regions: int = 0
+    #: explorations made while choosing the form, reused by the compact form
+    explored_cache: dict[int, tuple[LeafMachine, ExploredMachine[Any]]] = field(
+        default_factory=dict
+    )
 
     # -- naming ----------------------------------------------------------------------------
     @staticmethod
@@ -282,7 +289,7 @@ class _Builder:
         large region that cannot be written per node is warned about, naming why)."""
         if self.pernode is False:
             return None
-        if self.pernode is None and pernode_estimate(node) < PERNODE_MIN_LOG2:
+        if self.pernode is None and not self._large(node):
             return None
         found = pernode_region(
             node, name=f"pernode_{node.label}", new_variable=self.namer.name, unique=self._unique
@@ -294,6 +301,25 @@ class _Builder:
                 )
             return None
         return found
+
+    def _large(self, node: BTNode) -> bool:
+        """Whether the default writes ``node``'s region per node: its estimate passes
+        ``PERNODE_MIN_LOG2`` and either it holds ``PERNODE_SURE_NODES`` nodes or more, or its
+        exploration passes ``PERNODE_TRY_STATES`` (a region that fits keeps the compact form,
+        byte for byte; the exploration is kept for it)."""
+        if pernode_estimate(node) < PERNODE_MIN_LOG2:
+            return False
+        if region_size(node) >= PERNODE_SURE_NODES:
+            return True
+        limit = PERNODE_TRY_STATES
+        if self.max_states is not None:
+            limit = min(limit, self.max_states)
+        machine = LeafMachine(BTDocument.single(node), loop=False)
+        try:
+            self.explored_cache[id(node)] = (machine, explore(machine, max_states=limit))
+        except StateLimitError:
+            return True
+        return False
 
     def parallel_region(self, node: BTNode) -> ParallelRegion | None:
         """A Parallel/ParallelAll heading its region as a ``<parallel>`` (``bt_parallel``), or
@@ -372,7 +398,13 @@ class _Builder:
         """``node``'s region as one state per leaf with data (``bt_compact``); its variables
         join the conversion's data model."""
         self.warn_inner_parallels(node)
-        machine, explored = _explore(node, loop=loop, max_states=self.max_states, where=self.where)
+        cached = self.explored_cache.pop(id(node), None) if not loop else None
+        if cached is not None:
+            machine, explored = cached
+        else:
+            machine, explored = _explore(
+                node, loop=loop, max_states=self.max_states, where=self.where
+            )
         region = compact_region(
             machine,
             explored,
@@ -559,8 +591,9 @@ def bt_to_hfsm(
         unroll: keep every memory as states (a region = its explored leaf-execution
             machine) instead of data (the default, ``bt_compact``; docs/conversion.md).
         pernode: write regions one sub-machine per node (``bt_pernode``): ``True`` every
-            region it can, ``False`` none, ``None`` (default) a region whose estimated
-            explored size passes ``bt_pernode.PERNODE_MIN_LOG2`` (small trees unchanged).
+            region it can, ``False`` none, ``None`` (default) a large region (``_large``:
+            past the estimate, and past ``PERNODE_SURE_NODES`` nodes or
+            ``PERNODE_TRY_STATES`` explored states; smaller trees unchanged).
 
     Returns:
         The HFSM with the conversion's figures and warnings.
