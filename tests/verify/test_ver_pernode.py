@@ -155,3 +155,33 @@ def test_a_region_without_its_halt_resets_is_not_proven_per_node() -> None:
         assert report is None or report.method != PER_NODE or whole(doc, mutant)
         refused += report is None or report.method != PER_NODE
     assert refused >= 5
+
+
+def test_lying_tags_never_give_a_wrong_proof() -> None:
+    """The tags are hints: a state moved to another node's fragment (its tag rewritten to a
+    random node of the region) and one transition retargeted must never be proven per node
+    unless the whole product agrees."""
+    from fsmbt.convert.bt_pernode import NODE_ATTR
+
+    rng = random.Random(11)
+    tally: Counter[str] = Counter()
+    for doc in trees(160, seed=13):
+        model = bt_to_hfsm(doc, pernode=True).model
+        if pernode_machine(model) is None:
+            continue
+        mutant = copy.deepcopy(model)
+        sub = pernode_machine(mutant)
+        assert sub is not None
+        tags = sorted({s.attrs[NODE_ATTR] for s in sub.states.values() if NODE_ATTR in s.attrs})
+        tagged = [s for s in sub.states.values() if NODE_ATTR in s.attrs]
+        rng.choice(tagged).attrs[NODE_ATTR] = rng.choice(tags)
+        t = rng.choice(sub.transitions)
+        t.target = rng.choice([s for s in sub.states if s != t.target])
+        with limits.changed(conversion_max_states=BOUND):
+            report, _why = compositional_report(doc, mutant, max_states=BOUND)
+        proved = report is not None and report.method == PER_NODE
+        tally["proved" if proved else "not proved"] += 1
+        if proved:
+            assert whole(doc, mutant) is True
+    print(f"\n[lying tags] {dict(tally)}")
+    assert sum(tally.values()) >= 100

@@ -23,7 +23,9 @@ the check refuses (``NotPerNode``), so the caller checks the region whole as bef
    an assignment to an owned variable is a literal or ``v + 1``; from outside the owner's
    subtree a variable is only ever set to one literal, its *halt value*; a transition of a
    node's fragment that sets variables of a child's subtree sets exactly that subtree's halt
-   values (a halt of that child). Variables no guard reads cannot change a decision: ignored.
+   values (a halt of that child); variables owned outside a node's subtree are assigned by its
+   fragment only on the way out of it (an exit), never on a path that ticks one of its children.
+   Variables no guard reads cannot change a decision: ignored.
 
 The local problem of a node ``N`` with children ``c1..cn`` (docs/semantics.md §4d):
 
@@ -513,6 +515,8 @@ class _FsmSide:
             outside.extend(hop.outside)
             kind, where = hop.target
             if kind == "child":
+                if outside:  # an ancestor's variable written where the tick does not return
+                    raise NotPerNode("a variable outside the node is assigned inside its tick")
                 return where, (frozenset(halted), ("tick", where), frozenset(touched))
             if kind == "exit":
                 exit_ = ("exit", (where, tuple(outside)))
