@@ -181,8 +181,18 @@ def main(argv: list[str] | None = None) -> int:
         "convert, verify, write SCXML; the tree written to a temporary XML file first) and "
         "print the verdict and its method",
     )
+    parser.add_argument(
+        "--pernode",
+        action="store_true",
+        help="issue 27's per-node table: per tree the conversion (bt_to_hfsm, regions written "
+        "per node past the estimate), the result's states, the per-node proof "
+        "(compositional_report: distinct local checks, their product states, seconds); then a "
+        "one-transition mutant of the biggest tree's result (see _pernode_table)",
+    )
     args = parser.parse_args(argv)
     signal.signal(signal.SIGALRM, _alarm)
+    if args.pernode:
+        return _pernode_table(args)
     if args.compositional:
         return _compositional_table(args)
     if args.convert:
@@ -284,6 +294,92 @@ def _convert_table(args: argparse.Namespace) -> int:
                     f"{api.verdict_word(report):>15} {method:>14}",
                     flush=True,
                 )
+    return 0
+
+
+def _pernode_table(args: argparse.Namespace) -> int:
+    """One row per tree: nodes, conversion seconds, result states (every state at any level),
+    per-node regions, nodes checked, distinct local checks and their product states, proof
+    seconds and method. Then the mutant row for the last tree: the first guarded transition
+    of its first per-node region loses its guard; the per-node check must not prove it (it
+    names the node whose local check fails, or the side condition that refuses), then the
+    whole product is given ``--limit`` seconds to find the counterexample."""
+    import copy
+
+    from fsmbt.model.fsm_data import COND
+    from fsmbt.verify import verify
+
+    header = (
+        f"{'family':<14} {'nodes':>6} {'conv s':>7} {'states':>7} {'regions':>7} "
+        f"{'checked':>7} {'distinct':>8} {'local st':>8} {'proof s':>8} {'method':>24}"
+    )
+    print(header)
+    print("-" * len(header))
+    last: tuple[BTDocument, FSM] | None = None
+    for family in args.families.split(","):
+        for size in (int(s) for s in args.sizes.split(",")):
+            doc = family_tree(family, leaves_for(size), size)
+            nodes = node_count(doc)
+            started = time.perf_counter()
+            hfsm = bt_to_hfsm(doc).model
+            converted = time.perf_counter() - started
+            states = sum(1 for _ in hfsm.walk())
+            signal.alarm(args.limit)
+            try:
+                started = time.perf_counter()
+                proved, why = compositional_report(doc, hfsm)
+                proof = time.perf_counter() - started
+                signal.alarm(0)
+            except _Timeout:
+                proved, why, proof = None, f"over {args.limit} s", 0.0
+            if proved is None:
+                print(f"{family:<14} {nodes:>6} {converted:>7.2f} {states:>7}  falls back: {why}")
+                continue
+            st = proved.stats
+            print(
+                f"{family:<14} {nodes:>6} {converted:>7.2f} {states:>7} "
+                f"{st.get('per_node_regions', 0):>7} {st.get('per_node_nodes', 0):>7} "
+                f"{st.get('per_node_distinct', 0):>8} {st.get('per_node_local_states', 0):>8} "
+                f"{proof:>8.2f} {proved.method:>24}",
+                flush=True,
+            )
+            last = (doc, hfsm)
+    if last is None:
+        return 0
+    doc, hfsm = last
+    mutant = copy.deepcopy(hfsm)
+    region = next(
+        s.regions[0]
+        for _p, _m, s in mutant.walk()
+        if s.regions and s.regions[0].name.startswith("pernode_")
+    )
+    changed = next(t for t in region.transitions if COND in t.attrs)
+    del changed.attrs[COND]
+    started = time.perf_counter()
+    proved, why = compositional_report(doc, mutant)
+    seconds = time.perf_counter() - started
+    print(
+        f"mutant (guard of {changed.source} -> {changed.target} dropped): per node "
+        f"{'PROVED (wrong)' if proved is not None else 'not proven: ' + why[:110]} "
+        f"in {seconds:.2f} s"
+    )
+    signal.alarm(args.limit)
+    try:
+        started = time.perf_counter()
+        report = verify(doc, mutant)
+        signal.alarm(0)
+        traces = [p.counterexample for p in report.properties.values() if p.counterexample]
+        found = (
+            f"found, counterexample of {min(len(t) for t in traces)} steps"
+            if not report.equivalent and traces
+            else ("not equivalent" if not report.equivalent else "EQUIVALENT")
+        )
+        print(f"whole product: {found} in {time.perf_counter() - started:.2f} s")
+    except _Timeout:
+        print(f"whole product: not found within {args.limit} s")
+    except InputError as exc:
+        signal.alarm(0)
+        print(f"whole product: stopped ({str(exc)[:100]})")
     return 0
 
 

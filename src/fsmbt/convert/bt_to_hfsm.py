@@ -51,6 +51,15 @@ from typing import Any
 from fsmbt import limits
 from fsmbt.convert.bt_compact import CompactRegion, Namer, compact_region
 from fsmbt.convert.bt_parallel import ParallelRegion, is_parallel_kind, parallel_region
+from fsmbt.convert.bt_pernode import (
+    PERNODE_MIN_LOG2,
+    PERNODE_SURE_NODES,
+    PERNODE_TRY_STATES,
+    PerNodeRegion,
+    pernode_estimate,
+    pernode_region,
+    region_size,
+)
 from fsmbt.convert.compress import inline_and_compress
 from fsmbt.convert.perf import without_gc_pauses
 from fsmbt.convert.result import ConversionResult
@@ -142,6 +151,13 @@ class _Builder:
     variables: list[tuple[str, str]] = field(default_factory=list)
     guarded: int = 0
     parallels: int = 0
+    #: write regions per node (``bt_pernode``): True always, False never, None past the estimate
+    pernode: bool | None = None
+    pernode_regions: int = 0
+    #: explorations made while choosing the form, reused by the compact form
+    explored_cache: dict[int, tuple[LeafMachine, ExploredMachine[Any]]] = field(
+        default_factory=dict
+    )
 
     # -- naming ----------------------------------------------------------------------------
     @staticmethod
@@ -227,12 +243,19 @@ class _Builder:
     # -- explored regions --------------------------------------------------------------------
     def _explored_state(self, node: BTNode, cont: _Cont, machine: FSM) -> str:
         reset: list[tuple[str, str]] = []
-        parallel = self.parallel_region(node) if self.compact else None
+        per_node = self.pernode_region(node) if self.compact else None
+        parallel = self.parallel_region(node) if self.compact and per_node is None else None
         if parallel is not None:
             sub, ends = parallel.fsm, parallel.ends
             reset = parallel.variables
             self.variables.extend(reset)
             self.parallels += 1
+        elif per_node is not None:
+            sub, ends = per_node.fsm, per_node.ends
+            reset = per_node.variables
+            self.variables.extend(reset)
+            self.guarded += per_node.guarded
+            self.pernode_regions += 1
         elif self.compact:
             region = self.compact_region(node, loop=False, top=False)
             sub, ends = region.fsm, region.ends
@@ -258,6 +281,45 @@ class _Builder:
         if FAILURE in ends:
             machine.add_transition(name, None, cont.failure, exit=FAILURE)
         return name
+
+    def pernode_region(self, node: BTNode) -> PerNodeRegion | None:
+        """``node``'s region written per node (``bt_pernode``) when ``pernode`` says so (by
+        default: when the estimate of its explored size passes ``PERNODE_MIN_LOG2``), else
+        ``None`` (the compact form, or ``<parallel>`` for a Parallel heading a small region; a
+        large region that cannot be written per node is warned about, naming why)."""
+        if self.pernode is False:
+            return None
+        if self.pernode is None and not self._large(node):
+            return None
+        found = pernode_region(
+            node, name=f"pernode_{node.label}", new_variable=self.namer.name, unique=self._unique
+        )
+        if isinstance(found, str):
+            if self.pernode is None:
+                self.warnings.append(
+                    f"{self._place(node)}: explored as a whole, not per node: {found}"
+                )
+            return None
+        return found
+
+    def _large(self, node: BTNode) -> bool:
+        """Whether the default writes ``node``'s region per node: its estimate passes
+        ``PERNODE_MIN_LOG2`` and either it holds ``PERNODE_SURE_NODES`` nodes or more, or its
+        exploration passes ``PERNODE_TRY_STATES`` (a region that fits keeps the compact form,
+        byte for byte; the exploration is kept for it)."""
+        if pernode_estimate(node) < PERNODE_MIN_LOG2:
+            return False
+        if region_size(node) >= PERNODE_SURE_NODES:
+            return True
+        limit = PERNODE_TRY_STATES
+        if self.max_states is not None:
+            limit = min(limit, self.max_states)
+        machine = LeafMachine(BTDocument.single(node), loop=False)
+        try:
+            self.explored_cache[id(node)] = (machine, explore(machine, max_states=limit))
+        except StateLimitError:
+            return True
+        return False
 
     def parallel_region(self, node: BTNode) -> ParallelRegion | None:
         """A Parallel/ParallelAll heading its region as a ``<parallel>`` (``bt_parallel``), or
@@ -336,7 +398,13 @@ class _Builder:
         """``node``'s region as one state per leaf with data (``bt_compact``); its variables
         join the conversion's data model."""
         self.warn_inner_parallels(node)
-        machine, explored = _explore(node, loop=loop, max_states=self.max_states, where=self.where)
+        cached = self.explored_cache.pop(id(node), None) if not loop else None
+        if cached is not None:
+            machine, explored = cached
+        else:
+            machine, explored = _explore(
+                node, loop=loop, max_states=self.max_states, where=self.where
+            )
         region = compact_region(
             machine,
             explored,
@@ -509,6 +577,7 @@ def bt_to_hfsm(
     style: str = "paper",
     max_states: int | None = None,
     unroll: bool = False,
+    pernode: bool | None = None,
     **_options: object,
 ) -> ConversionResult:
     """Convert a BT document into a hierarchical FSM whose flattening is the BT's
@@ -521,6 +590,10 @@ def bt_to_hfsm(
         max_states: most states explored per region (``None``: the limits in force).
         unroll: keep every memory as states (a region = its explored leaf-execution
             machine) instead of data (the default, ``bt_compact``; docs/conversion.md).
+        pernode: write regions one sub-machine per node (``bt_pernode``): ``True`` every
+            region it can, ``False`` none, ``None`` (default) a large region (``_large``:
+            past the estimate, and past ``PERNODE_SURE_NODES`` nodes or
+            ``PERNODE_TRY_STATES`` explored states; smaller trees unchanged).
 
     Returns:
         The HFSM with the conversion's figures and warnings.
@@ -529,7 +602,9 @@ def bt_to_hfsm(
     compression = prepared.compression
     root = compression.root
     places = _Places(doc.main.id, root)
-    builder = _Builder(loop=loop, max_states=max_states, where=places, compact=not unroll)
+    builder = _Builder(
+        loop=loop, max_states=max_states, where=places, compact=not unroll, pernode=pernode
+    )
     opaque_nodes = _opaque_roots(root)
     whole_tree = loop and bool(opaque_nodes)
     hfsm: FSM | None = None
@@ -567,5 +642,6 @@ def bt_to_hfsm(
         "data_variables": len(builder.variables),
         "guarded_transitions": builder.guarded,
         "parallel_states": builder.parallels,
+        "pernode_regions": builder.pernode_regions,
     }
     return ConversionResult(hfsm, "rules", "bt->fsm", stats, builder.warnings)

@@ -214,6 +214,8 @@ def _compositional(
     if report is None:
         # a part failed: the whole product decides and explains; the verdict says so
         return None, why if why.startswith(FAILED_PART) else ""
+    if report.stats["regions"] < 2 and not report.stats.get("per_node_regions"):
+        return None, ""  # one region: its check is the whole product again; let that decide
     report.engines = {"fsmbt native checker": __version__}
     if sink is not None:
         sink.witness, sink.parts, sink.loop, sink.faithful = None, parts, False, False

@@ -72,8 +72,10 @@ from fsmbt.semantics.nodes import (
     canonical_type,
 )
 from fsmbt.semantics.status import LeafOutcome, RootResult
+from fsmbt.verify.method import PER_NODE_SENTENCE
 from fsmbt.verify.native import DEFAULT_MAX_STATES, StateLimitError, check_witnessed
-from fsmbt.verify.report import COMPOSITIONAL, PROPERTIES, PropertyResult, Report
+from fsmbt.verify.pernode import NODE_ATTR, NotPerNode, PerNodeOutcome, check_region
+from fsmbt.verify.report import COMPOSITIONAL, PER_NODE, PROPERTIES, PropertyResult, Report
 
 SUCCESS, FAILURE = RootResult.SUCCESS.value, RootResult.FAILURE.value
 EV_SUCCESS, EV_FAILURE = LeafOutcome.SUCCESS.value, LeafOutcome.FAILURE.value
@@ -623,7 +625,10 @@ def decompose(
         int(fsm_token[len("⟪state ") : -1]): int(tree_token[len("⟪unit ") : -1])
         for fsm_token, tree_token in pairs.items()
     }
-    if len(tree_of_state) < min_regions:
+    per_node_possible = keep is None and any(
+        _tagged_per_node(machine_regions[j].machine) for j in tree_of_state
+    )
+    if len(tree_of_state) < min_regions and not per_node_possible:
         raise NotDecomposable(
             f"{len(tree_of_state)} region(s) paired: the whole product is the same check"
         )
@@ -635,6 +640,20 @@ def decompose(
         k = tree_of_state.get(j)
         if k is None:
             continue
+        if keep is None:  # a per-node proof has no certificate unit: with one asked, whole
+            per_node = _per_node(regions[k], region.machine, shape.declared, outcome)
+            if per_node is not None:  # proven (or refuted) node by node (verify/pernode.py)
+                if not per_node.equivalent:
+                    outcome.equivalent = False
+                    outcome.failed_region = (
+                        f"{regions[k].label} (state {region.path}), node {per_node.failed}"
+                    )
+                    return outcome
+                possible = per_node.results
+                if not results_allowed(possible, shape, j):
+                    raise NotDecomposable(f"region {regions[k].label} ends in {sorted(possible)}")
+                results[k] = possible
+                continue
         bt_region, fsm_region = region_machines(shape, k, j)
         try:
             report, witness = check_witnessed(
@@ -689,6 +708,32 @@ class _Budget:
         return max(self.ends - time.perf_counter(), 0.001)
 
 
+def _tagged_per_node(machine: FSM) -> bool:
+    """Whether the converter wrote this region per node (its states carry ``fsmbt:node``)."""
+    return any(NODE_ATTR in state.attrs for state in machine.states.values())
+
+
+def _per_node(
+    region_root: BTNode, machine: FSM, declared: dict[str, str], outcome: Decomposition
+) -> PerNodeOutcome | None:
+    """The per-node check of one region (``verify/pernode.py``) when its machine is tagged
+    per node and decomposes; ``None``: check the region whole."""
+    if not _tagged_per_node(machine):
+        return None
+    try:
+        found = check_region(region_root, machine, declared)
+    except NotPerNode as exc:
+        outcome.stats.setdefault("per_node_refused", []).append(str(exc))
+        return None
+    outcome.stats["per_node_regions"] = outcome.stats.get("per_node_regions", 0) + 1
+    outcome.stats["per_node_nodes"] = outcome.stats.get("per_node_nodes", 0) + found.nodes
+    outcome.stats["per_node_distinct"] = outcome.stats.get("per_node_distinct", 0) + found.distinct
+    outcome.stats["per_node_local_states"] = (
+        outcome.stats.get("per_node_local_states", 0) + found.local_states
+    )
+    return found
+
+
 def _add(total: dict[str, Any], part: dict[str, Any]) -> None:
     """Sum each part's state and edge counts (the figures a verdict prints)."""
     for key in ("source_states", "result_states", "product_states", "product_edges"):
@@ -738,6 +783,16 @@ def compositional_report(
         report.properties[name] = PropertyResult(name, True, detail)
     report.method = COMPOSITIONAL
     report.abstractions = [COMPOSITIONAL_SENTENCE]
+    if found.stats.get("per_node_regions"):
+        report.method = PER_NODE
+        report.abstractions.append(PER_NODE_SENTENCE)
+        detail += (
+            f"; {found.stats['per_node_regions']} of them node by node "
+            f"({found.stats['per_node_nodes']} nodes, {found.stats['per_node_distinct']} "
+            "distinct local checks)"
+        )
+        for name in PROPERTIES:
+            report.properties[name] = PropertyResult(name, True, detail)
     report.stats = {
         **found.stats,
         "regions": found.regions,

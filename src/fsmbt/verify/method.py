@@ -24,6 +24,12 @@ LEBT_FAST_SENTENCE = (
     "an LEBT side of the strict grammar runs on its fast macro-step runtime "
     "(semantics/lebt/fast.py, the same MacroStepDriver rules as the LEBT interpreter)"
 )
+PER_NODE_SENTENCE = (
+    "compositional (per node): each node of a region written per node is checked alone "
+    "against fsmbt's interpreter (tick and halt) running it over abstract children, equal "
+    "local problems once; the results compose (docs/semantics.md §4d: equivalence is a "
+    "congruence for the per-node wiring under the side conditions checked)"
+)
 ACTIVE_SENTENCE = (
     "inputs a machine declares silent in a state (active_inputs) are not stepped there: "
     "they are self-loops without output by the machine's own rules"

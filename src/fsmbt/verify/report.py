@@ -31,7 +31,10 @@ SYMBOLIC = "symbolic"
 #: per region of the tree and its composite state, plus the plain skeleton
 #: (``fsmbt.verify.compositional``; docs/semantics.md §4c)
 COMPOSITIONAL = "compositional"
-METHODS = (WHOLE_PRODUCT, TABLE, CANONICAL, SYMBOLIC, COMPOSITIONAL)
+#: the same, with regions written per node checked node by node against the interpreter over
+#: abstract children (``fsmbt.verify.pernode``; docs/semantics.md §4d)
+PER_NODE = "compositional (per node)"
+METHODS = (WHOLE_PRODUCT, TABLE, CANONICAL, SYMBOLIC, COMPOSITIONAL, PER_NODE)
 
 
 @dataclass

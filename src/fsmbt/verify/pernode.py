@@ -1,0 +1,720 @@
+"""The per-node check of a region: each node of a BT region against its fragment of the
+region's state machine, children abstracted by their interfaces (docs/semantics.md §4d;
+docs/verification.md §5, "Compositional check (per node)"; issue 27 item 2).
+
+Why: a region written one sub-machine per node (``convert/bt_pernode``) has a flat meaning
+that is the product of its nodes' memories, so checking the region whole costs that product.
+Here each node is checked alone, on a few dozen states, and equal local problems are checked
+once (memoized by a canonical form), so the proof grows with the number of *distinct* node
+shapes, not with the product.
+
+What is checked is the *result*: the machine's states are grouped by their ``fsmbt:node`` tag
+(the node's path in the region, ``CompiledNode.path``), but a tag is only a hint - every side
+condition that makes the grouping a valid decomposition is checked here, and when one fails
+the check refuses (``NotPerNode``), so the caller checks the region whole as before:
+
+1. *states*: every state but the finals ``SUCCESS``/``FAILURE`` is atomic and tagged with a
+   node of the region; a leaf's one state has the leaf's label as action and exactly one
+   transition on each outcome the leaf may return (``running`` for an action only), without
+   guard; every other state has no action and only eventless transitions, the last unguarded;
+2. *entries*: every transition entering ``sub(x)`` (the states tagged with ``x`` or a
+   descendant) from outside enters one state, ``E(x)``;
+3. *data*: each variable a guard reads is read by the guards of one node only, its *owner*;
+   an assignment to an owned variable is a literal or ``v + 1``; from outside the owner's
+   subtree a variable is only ever set to one literal, its *halt value*; a transition of a
+   node's fragment that sets variables of a child's subtree sets exactly that subtree's halt
+   values (a halt of that child); variables owned outside a node's subtree are assigned by its
+   fragment only on the way out of it (an exit), never on a path that ticks one of its children.
+   Variables no guard reads cannot change a decision: ignored.
+
+The local problem of a node ``N`` with children ``c1..cn`` (docs/semantics.md §4d):
+
+- *tree side*: ``N`` itself (type and ports) over abstract leaves ``⟪i⟫`` (an action when child
+  i may return RUNNING, else a condition), run by fsmbt's interpreter one tick at a time
+  (``exactly_once``: a RUNNING with a wake-up is returned to the parent, as N's parent sees it),
+  with two inputs between ticks: ``tick`` and ``halt`` (the interpreter's ``haltChild``:
+  ``halt()`` when RUNNING, the status reset otherwise), and the abstract children's outcomes
+  restricted to what each child may return; outputs: the child ticked, the halts of RUNNING
+  abstract children, N's result;
+- *machine side*: N's fragment (its transient states and the halt values of its variables),
+  each child's exits replaced by its interface ``σ_i``: status -> (target, assignments outside
+  the child's subtree), found by the child's own local check; outputs: the child whose entry
+  is reached, the halts of children whose subtree has halt values and that returned RUNNING
+  last, and N's exit (target, assignments outside N's subtree);
+- the two are explored in lockstep (a product of at most ``LOCAL_LIMIT`` pairs); N's statuses
+  and its exits are paired as they first meet (``σ_N``); a second, different partner fails.
+
+The region's root must pair SUCCESS with the final ``SUCCESS``, FAILURE with ``FAILURE`` and
+RUNNING with its own entry (the next tick), each without assignment. Then (the congruence of
+§4d) the region's machine is equivalent to the region's leaf-execution machine.
+
+Cost: O(states + transitions · depth) to group and canonicalize, plus one local product per
+distinct canonical problem (a few hundred pairs each).
+"""
+
+from __future__ import annotations
+
+import ast
+import re
+from collections import deque
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+from fsmbt.convert.compress import inline_and_compress
+from fsmbt.model.bt import BTDocument, BTNode
+from fsmbt.model.bt_nodes import NodeKind
+from fsmbt.model.errors import FsmbtError
+from fsmbt.model.fsm import FSM
+from fsmbt.model.fsm_data import ASSIGN, COND, parse_lines
+from fsmbt.semantics.bt_interpreter import (
+    BTInterpreter,
+    CompiledNode,
+    CompiledTree,
+    LeafRequest,
+)
+from fsmbt.semantics.compiled import FAILURE, RUNNING, SUCCESS, Work
+
+#: The tag the per-node conversion writes (``convert.bt_pernode.NODE_ATTR``; the SCXML
+#: writer's fsmbt namespace in Clark notation).
+NODE_ATTR = "{https://fsmbt.dev/ns/scxml}node"
+END_SUCCESS, END_FAILURE = "SUCCESS", "FAILURE"
+EVENTS = {SUCCESS: "success", FAILURE: "failure", RUNNING: "running"}
+#: Most pairs one local product may hold before the check refuses.
+LOCAL_LIMIT = 20_000
+#: Most eventless steps one resolution may take before the check refuses (a cycle).
+STEP_LIMIT = 10_000
+_IDENT = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+_NUMBER = re.compile(r"-?\d+")
+
+
+class NotPerNode(Exception):
+    """The region's machine is not a valid per-node decomposition (the reason is the message):
+    the caller checks the region whole."""
+
+
+@dataclass
+class PerNodeOutcome:
+    """A region proven per node (or one local check that failed).
+
+    Attributes:
+        equivalent: every local check held and the root's interface is the finals'.
+        results: the results the region may return (``SUCCESS``/``FAILURE``).
+        nodes: nodes checked; ``distinct``: local problems actually explored (the rest
+            memoized); ``local_states``: their product states summed.
+        failed: the node whose local check failed (its path and type), else ``None``.
+    """
+
+    equivalent: bool
+    results: frozenset[str] = frozenset()
+    nodes: int = 0
+    distinct: int = 0
+    local_states: int = 0
+    failed: str | None = None
+    stats: dict[str, Any] = field(default_factory=dict)
+
+
+# -- expressions (fsmbt's subset: literals, names, ==, !=, <, <=, >, >=, and, or, x + 1) -------
+_ALLOWED = (
+    ast.Expression,
+    ast.BoolOp,
+    ast.And,
+    ast.Or,
+    ast.Compare,
+    ast.Eq,
+    ast.NotEq,
+    ast.Lt,
+    ast.LtE,
+    ast.Gt,
+    ast.GtE,
+    ast.Name,
+    ast.Load,
+    ast.Constant,
+    ast.BinOp,
+    ast.Add,
+    ast.UnaryOp,
+    ast.USub,
+    ast.Not,
+)
+
+
+_COMPILED: dict[tuple[str, tuple[tuple[str, str], ...]], Any] = {}
+
+
+def _compile(text: str, names: dict[str, str]) -> tuple[str, Callable[[dict[str, Any]], Any]]:
+    """An expression with its variables renamed (``names``; the canonical text) and a function
+    evaluating it over an environment (cached by text and renaming). Refuses anything outside
+    the subset."""
+    used = tuple(sorted((w, names[w]) for w in set(_IDENT.findall(text)) if w in names))
+    key = (text, used)
+    found = _COMPILED.get(key)
+    if found is None:
+        found = _COMPILED[key] = _compile_new(text, names)
+    return found
+
+
+def _compile_new(text: str, names: dict[str, str]) -> tuple[str, Callable[[dict[str, Any]], Any]]:
+    try:
+        tree = ast.parse(text.strip(), mode="eval")
+    except SyntaxError:
+        raise NotPerNode(f"expression {text!r} is not in fsmbt's subset") from None
+    for node in ast.walk(tree):
+        if not isinstance(node, _ALLOWED):
+            raise NotPerNode(f"expression {text!r} is not in fsmbt's subset")
+        if isinstance(node, ast.Name) and node.id not in ("True", "False"):
+            if node.id not in names:
+                raise NotPerNode(f"expression {text!r} reads {node.id}, not the node's own")
+            node.id = names[node.id]
+    canonical = ast.unparse(tree)
+    code = compile(tree, "<pernode>", "eval")
+    return canonical, lambda env: eval(code, {"__builtins__": {}}, env)  # noqa: S307
+
+
+def _literal(text: str) -> Any:
+    """A literal's value (an int or a quoted string), else ``None``."""
+    text = text.strip()
+    if _NUMBER.fullmatch(text):
+        return int(text)
+    if len(text) >= 2 and text[0] == text[-1] and text[0] in "'\"":
+        return text[1:-1]
+    return None
+
+
+# -- the grouping ------------------------------------------------------------------------------
+@dataclass
+class _Hop:
+    """One transition as a node's fragment reads it: its guard, the updates of the node's own
+    variables, the halts of its children (by index), the assignments outside its subtree (in
+    order) and its target."""
+
+    cond: Callable[[dict[str, Any]], Any] | None
+    cond_text: str
+    updates: tuple[tuple[str, str], ...]
+    update_fns: tuple[tuple[str, Callable[[dict[str, Any]], Any]], ...]
+    halts: frozenset[int]
+    outside: tuple[int, ...]  # canonical id of the hop's assignments outside the subtree
+    target: tuple[str, Any]
+
+
+class _Region:
+    """The region's machine grouped by node (side conditions 1-3 of the module docstring)."""
+
+    def __init__(self, tree: CompiledTree, machine: FSM, declared: dict[str, str]) -> None:
+        self.tree = tree
+        self.nodes = tree.nodes
+        self.machine = machine
+        by_path = {node.path: node.id for node in self.nodes}
+        self.tag: dict[str, int] = {}
+        for name, state in machine.states.items():
+            if state.final and name in (END_SUCCESS, END_FAILURE) and not state.regions:
+                continue
+            path = state.attrs.get(NODE_ATTR)
+            if path is None or path not in by_path or state.regions or state.final:
+                raise NotPerNode(f"state {name} is not an atomic state tagged with a node")
+            self.tag[name] = by_path[path]
+        # ancestors: pre-order ids, so x in sub(y) iff y <= x < end[y]
+        self.end = [0] * len(self.nodes)
+        for node in reversed(self.nodes):
+            self.end[node.id] = max([node.id + 1, *(self.end[c] for c in node.children)])
+        self.out: dict[str, list[Any]] = {name: [] for name in machine.states}
+        for t in machine.transitions:
+            if t.source not in self.out or t.target not in machine.states:
+                raise NotPerNode(f"transition {t.source} -> {t.target} leaves the region")
+            self.out[t.source].append(t)
+        self._leaf_states()
+        self._variables(declared)
+        self._entries()
+
+    def inside(self, state: str, nid: int) -> bool:
+        x = self.tag.get(state)
+        return x is not None and nid <= x < self.end[nid]
+
+    def _leaf_states(self) -> None:
+        self.leaf_state: dict[int, str] = {}
+        for name, nid in self.tag.items():
+            node = self.nodes[nid]
+            state = self.machine.states[name]
+            if node.is_env_leaf and not node.children:
+                if nid in self.leaf_state or state.action != node.label:
+                    raise NotPerNode(f"leaf {node.label} has no one state with its label")
+                self.leaf_state[nid] = name
+                events = [t.event for t in self.out[name]]
+                wanted = ["success", "failure"] + (
+                    ["running"] if node.kind is NodeKind.ACTION else []
+                )
+                if sorted(events) != sorted(wanted) or any(COND in t.attrs for t in self.out[name]):
+                    raise NotPerNode(f"leaf {node.label}'s state has other transitions")
+            else:
+                if state.action not in (None, ""):
+                    raise NotPerNode(f"state {name} of a control node has an action")
+                arms = self.out[name]
+                if not arms or any(t.event is not None for t in arms) or COND in arms[-1].attrs:
+                    raise NotPerNode(f"state {name} is not a transient state")
+        for node in self.nodes:
+            if node.is_env_leaf and node.id not in self.leaf_state:
+                raise NotPerNode(f"leaf {node.label} has no state")
+
+    def _variables(self, declared: dict[str, str]) -> None:
+        self.owner: dict[str, int] = {}
+        for name, transitions in self.out.items():
+            for t in transitions:
+                for word in _IDENT.findall(t.attrs.get(COND, "")):
+                    if word in ("and", "or", "not", "True", "False"):
+                        continue
+                    if self.owner.setdefault(word, self.tag[name]) != self.tag[name]:
+                        raise NotPerNode(f"variable {word} is read by two nodes")
+        self.own: dict[int, set[str]] = {}
+        for var, x in self.owner.items():
+            self.own.setdefault(x, set()).add(var)
+        self._halts: list[dict[str, Any]] = []
+        self._below: list[list[str]] = []
+        self.initial: dict[str, Any] = {}
+        for var in self.owner:
+            value = _literal(declared.get(var, ""))
+            if value is None:
+                raise NotPerNode(f"variable {var} has no literal initial value")
+            self.initial[var] = value
+        self.halt_value: dict[str, Any] = {}
+        self.assigns: dict[int, list[tuple[str, str]]] = {}
+        for transitions in self.out.values():
+            for t in transitions:
+                pairs = parse_lines(t.attrs.get(ASSIGN, ""))
+                live = [(v, e) for v, e in pairs if v in self.owner]
+                if len({v for v, _e in live}) != len(live):
+                    raise NotPerNode(f"a transition of {t.source} assigns a variable twice")
+                self.assigns[id(t)] = live
+                for var, expr in live:
+                    value = _literal(expr)
+                    if value is None and expr.replace(" ", "") != f"{var}+1":
+                        raise NotPerNode(f"assignment {var}={expr} is not a literal or +1")
+                    if not self.inside(t.source, self.owner[var]):
+                        if value is None or self.halt_value.setdefault(var, value) != value:
+                            raise NotPerNode(f"variable {var} is reset to two values")
+
+    def _entries(self) -> None:
+        self.entry: dict[int, str] = {}
+        initial = self.machine.initial
+        if initial is None or initial not in self.tag:
+            raise NotPerNode("the region's initial state is not a node's")
+        self.entry[0] = initial
+        for transitions in self.out.values():
+            for t in transitions:
+                if t.target not in self.tag:
+                    continue
+                x: int | None = self.tag[t.target]
+                while x is not None:  # every node whose subtree the transition enters
+                    if self.inside(t.source, x):
+                        break
+                    if self.entry.setdefault(x, t.target) != t.target:
+                        raise NotPerNode(f"node {self.nodes[x].label} is entered twice")
+                    x = self.nodes[x].parent
+        # a node no transition enters is dead (its siblings before it never let the tick
+        # through): nothing of it is checked, and its parent's check fails if the tree ticks it
+
+    def halt_vars(self, nid: int) -> dict[str, Any]:
+        """The halt values of the variables owned in ``nid``'s subtree (bottom-up once)."""
+        if not self._halts:
+            own: dict[int, dict[str, Any]] = {}
+            for v, h in self.halt_value.items():
+                own.setdefault(self.owner[v], {})[v] = h
+            self._halts = [{} for _ in self.nodes]
+            for node in reversed(self.nodes):
+                found = dict(own.get(node.id, {}))
+                for c in node.children:
+                    found.update(self._halts[c])
+                self._halts[node.id] = found
+        return self._halts[nid]
+
+    def owned_below(self, nid: int) -> list[str]:
+        """The variables owned in ``nid``'s subtree (bottom-up once)."""
+        if not self._below:
+            self._below = [[] for _ in self.nodes]
+            for node in reversed(self.nodes):
+                found = sorted(self.own.get(node.id, ()))
+                for c in node.children:
+                    found.extend(self._below[c])
+                self._below[node.id] = found
+        return self._below[nid]
+
+
+# -- one node's local problem ------------------------------------------------------------------
+Interface = dict[int, tuple[str, tuple[tuple[str, str], ...]]]
+
+
+@dataclass
+class _Local:
+    """A node's fragment over abstract children, canonically named (``key`` is the memo key;
+    exits are canonical ids, ``exits`` maps them back to the machine's names)."""
+
+    key: tuple[Any, ...]
+    entry: _Hop
+    states: list[list[_Hop]]
+    children: list[dict[int, _Hop]]
+    halt: tuple[tuple[str, Any], ...]
+    initial: tuple[tuple[str, Any], ...]
+    halting: frozenset[int]  # children whose subtree has halt values
+    exits: dict[int, Any]  # canonical id -> ("t", target) or ("a", (var, expr))
+
+
+def _local(region: _Region, node: CompiledNode, interfaces: dict[int, Interface]) -> _Local:
+    """``node``'s fragment (see the module docstring), canonically named: its states in
+    discovery order, its variables ``v0, v1 ...`` in order of first use, the targets and
+    assignments outside its subtree numbered in order of first use."""
+    own = region.own.get(node.id, set())
+    names: dict[str, str] = {}
+    outside_ids: dict[Any, int] = {}
+    state_ids: dict[str, int] = {}
+    order: list[str] = []
+    kids = node.children
+    child_of_entry = {region.entry[c]: i for i, c in enumerate(kids) if c in region.entry}
+    halts_of = [region.halt_vars(c) for c in kids]
+    owner_child: dict[str, int] = {}
+    for i, c in enumerate(kids):
+        for var in region.owned_below(c):
+            owner_child[var] = i
+    root_entry = region.entry[0] if node.id == 0 else None
+
+    def outside_id(value: Any) -> int:
+        return outside_ids.setdefault(value, len(outside_ids))
+
+    def target_of(name: str, entering: bool = False) -> tuple[str, int]:
+        if name == root_entry and not entering:
+            return ("exit", outside_id(("t", name)))  # the root's RUNNING: the next tick
+        if name in child_of_entry:
+            return ("child", child_of_entry[name])
+        if region.tag.get(name) == node.id:
+            if name not in state_ids:
+                state_ids[name] = len(order)
+                order.append(name)
+            return ("state", state_ids[name])
+        if region.inside(name, node.id):
+            raise NotPerNode(f"a transition of {node.label} enters a child not at its entry")
+        return ("exit", outside_id(("t", name)))
+
+    def hop(
+        cond_text: str, pairs: list[tuple[str, str]], target: str, entering: bool = False
+    ) -> _Hop:
+        for word in _IDENT.findall(cond_text):
+            if word in own:
+                names.setdefault(word, f"v{len(names)}")
+        for var, _expr in pairs:
+            if var in own:
+                names.setdefault(var, f"v{len(names)}")
+        cond_fn, canonical = None, ""
+        if cond_text:
+            canonical, cond_fn = _compile(cond_text, names)
+        updates: list[tuple[str, str]] = []
+        fns: list[tuple[str, Callable[[dict[str, Any]], Any]]] = []
+        outside: list[tuple[str, str]] = []
+        halted: dict[int, dict[str, Any]] = {}
+        for var, expr in pairs:
+            if var in own:
+                text, fn = _compile(expr, {var: names[var]})
+                updates.append((names[var], text))
+                fns.append((names[var], fn))
+            elif var in owner_child:
+                halted.setdefault(owner_child[var], {})[var] = _literal(expr)
+            elif node.id <= region.owner[var] < region.end[node.id]:
+                raise NotPerNode(f"{node.label} assigns {var} of a descendant")
+            else:
+                outside.append((var, expr))
+        for i, values in halted.items():
+            if values != halts_of[i]:
+                raise NotPerNode(f"{node.label} halts child {i} partly")
+        return _Hop(
+            cond_fn,
+            canonical,
+            tuple(updates),
+            tuple(fns),
+            frozenset(halted),
+            (outside_id(("a", tuple(outside))),) if outside else (),
+            target_of(target, entering),
+        )
+
+    def shape(h: _Hop) -> tuple[Any, ...]:
+        return (h.cond_text, h.updates, tuple(sorted(h.halts)), h.outside, h.target)
+
+    entry = hop("", [], region.entry[node.id], entering=True)
+    children: list[dict[int, _Hop]] = []
+    for c in kids:
+        children.append(
+            {
+                status: hop("", list(interfaces[c][status][1]), interfaces[c][status][0])
+                for status in sorted(interfaces[c])
+            }
+        )
+    states: list[list[_Hop]] = []
+    while len(states) < len(order):
+        name = order[len(states)]
+        states.append(
+            [hop(t.attrs.get(COND, ""), region.assigns[id(t)], t.target) for t in region.out[name]]
+        )
+    for var in sorted(own):  # read by a guard, so named above; kept total for safety
+        names.setdefault(var, f"v{len(names)}")
+    halt = tuple(sorted((names[v], region.halt_value[v]) for v in own if v in region.halt_value))
+    initial = tuple(sorted((names[v], region.initial[v]) for v in own))
+    halting = frozenset(i for i, values in enumerate(halts_of) if values)
+    key = (
+        node.type,
+        node.params,
+        len(kids),
+        shape(entry),
+        tuple(tuple((s, shape(h)) for s, h in arms.items()) for arms in children),
+        tuple(tuple(shape(h) for h in arms) for arms in states),
+        halt,
+        initial,
+        tuple(sorted(halting)),
+    )
+    exits = {cid: value for value, cid in outside_ids.items()}
+    return _Local(key, entry, states, children, halt, initial, halting, exits)
+
+
+# -- the local product ---------------------------------------------------------------------------
+def _abstract_tree(node: CompiledNode, kids_running: list[bool]) -> BTDocument:
+    source = node.source
+    leaves = [
+        BTNode(
+            f"⟪{i}⟫",
+            NodeKind.ACTION if running else NodeKind.CONDITION,
+            name=f"⟪{i}⟫",
+        )
+        for i, running in enumerate(kids_running)
+    ]
+    copy = BTNode(
+        source.type,
+        source.kind,
+        attrs=dict(source.attrs),
+        children=leaves,
+        semantics=source.semantics,
+    )
+    return BTDocument.single(copy)
+
+
+class _FsmSide:
+    """The fragment as a machine: configuration = (position, own values, children that
+    returned RUNNING last); position ``None`` between ticks, ``i`` at child i."""
+
+    def __init__(self, local: _Local) -> None:
+        self.local = local
+
+    def resolve(self, hop: _Hop, values: dict[str, Any], running: set[int]) -> tuple[Any, Any]:
+        """Follow ``hop`` and the eventless hops after it (updating ``values`` and
+        ``running``): (new position, outputs = (halts, ("tick", i) or ("exit", exit)))."""
+        outside: list[int] = []
+        halted: set[int] = set()
+        touched: set[int] = set()  # every child halted, running or not
+        for _step in range(STEP_LIMIT):
+            env = dict(values)
+            for var, fn in hop.update_fns:
+                values[var] = fn(env)
+            touched |= hop.halts
+            for i in hop.halts:
+                if i in running and i in self.local.halting:
+                    halted.add(i)
+                running.discard(i)
+            outside.extend(hop.outside)
+            kind, where = hop.target
+            if kind == "child":
+                if outside:  # an ancestor's variable written where the tick does not return
+                    raise NotPerNode("a variable outside the node is assigned inside its tick")
+                return where, (frozenset(halted), ("tick", where), frozenset(touched))
+            if kind == "exit":
+                exit_ = ("exit", (where, tuple(outside)))
+                return None, (frozenset(halted), exit_, frozenset(touched))
+            env = dict(values)
+            for arm in self.local.states[where]:
+                if arm.cond is None or arm.cond(env):
+                    hop = arm
+                    break
+            else:  # the last arm is unguarded (checked when grouping)
+                raise NotPerNode("a transient state has no enabled transition")
+        raise NotPerNode("an eventless cycle without a leaf")
+
+
+class _BtSide:
+    """The interpreter on the node over abstract leaves, one tick at a time, halts visible."""
+
+    def __init__(self, doc: BTDocument) -> None:
+        self.interp = BTInterpreter(doc, exactly_once=True)
+        self.leaf_index = {
+            n.id: int(n.label[1:-1]) for n in self.interp.tree.nodes if n.is_env_leaf
+        }
+
+    def run(self, snap: Any, outcome: int | None) -> tuple[Any, Any]:
+        halted: set[int] = set()
+
+        def hook(leaf: CompiledNode) -> None:
+            halted.add(self.leaf_index[leaf.id])
+
+        snap, event = self.interp.advance(snap, outcome, hook)
+        if isinstance(event, LeafRequest):
+            index = self.leaf_index[event.node.id]
+            return (snap, index), (frozenset(halted), ("tick", index))
+        snap = (snap[0], snap[1], snap[2], False)  # the wake-up is the parent's business
+        return (snap, None), (frozenset(halted), ("exit", event.status))
+
+    def halt(self, snap: Any) -> tuple[Any, frozenset[int]]:
+        halted: set[int] = set()
+
+        def hook(leaf: CompiledNode) -> None:
+            halted.add(self.leaf_index[leaf.id])
+
+        w = Work(snap)
+        self.interp.reset_child(w, 0, hook)
+        return w.snapshot(), frozenset(halted)
+
+
+def _check_local(
+    local: _Local,
+    node: CompiledNode,
+    allowed: list[list[int]],
+    haltable: frozenset[int],
+    with_halt: bool,
+) -> tuple[bool, dict[int, Any], int]:
+    """The lockstep product of the two sides (module docstring). ``haltable``: the children
+    whose own check held with ``halt`` offered (any halt of another child fails this one);
+    ``with_halt``: offer ``halt`` between ticks. Returns (equivalent, σ: status -> canonical
+    exit, product states)."""
+    bt = _BtSide(_abstract_tree(node, [RUNNING in a for a in allowed]))
+    fsm = _FsmSide(local)
+    never = frozenset(range(len(allowed))) - haltable
+    pairing: dict[int, Any] = {}
+    start: tuple[Any, Any] = ((bt.interp.initial(), None), (None, local.initial, frozenset()))
+    seen = {start}
+    queue = deque([start])
+
+    def same(bt_out: Any, fsm_out: Any) -> bool:
+        if bt_out[0] & never or fsm_out[2] & never:
+            return False  # a child whose halt was not proven is halted
+        if frozenset(i for i in bt_out[0] if i in local.halting) != fsm_out[0]:
+            return False
+        (b_kind, b_what), (f_kind, f_what) = bt_out[1], fsm_out[1]
+        if b_kind != f_kind:
+            return False
+        if b_kind == "tick":
+            return bool(b_what == f_what)
+        # two statuses may share an exit (a parent that treats them alike): σ is a function
+        return bool(pairing.setdefault(b_what, f_what) == f_what)
+
+    while queue:
+        (snap, position), (fpos, fvalues, frunning) = queue.popleft()
+        if position != fpos:
+            return False, pairing, len(seen)
+        if position is None:
+            inputs: list[Any] = ["tick", "halt"] if with_halt else ["tick"]
+        else:
+            inputs = allowed[position]
+        for symbol in inputs:
+            values = dict(fvalues)
+            running = set(frunning)
+            if symbol == "halt":
+                new_snap, halted = bt.halt(snap)
+                bt_next: Any = (new_snap, None)
+                values.update(local.halt)
+                fsm_halts = frozenset(i for i in running if i in local.halting)
+                if halted & never or any(i in never for i in running):
+                    return False, pairing, len(seen)
+                running.clear()
+                if frozenset(i for i in halted if i in local.halting) != fsm_halts:
+                    return False, pairing, len(seen)
+                fpos_next = None
+            else:
+                if symbol == "tick":
+                    bt_next, bt_out = bt.run(bt.interp.begin_tick(snap), None)
+                    hop = local.entry
+                else:
+                    bt_next, bt_out = bt.run(snap, symbol)
+                    assert position is not None
+                    hop = local.children[position][symbol]
+                    running.discard(position)
+                    if symbol == RUNNING:
+                        running.add(position)
+                fpos_next, fsm_out = fsm.resolve(hop, values, running)
+                if not same(bt_out, fsm_out):
+                    return False, pairing, len(seen)
+            pair = (bt_next, (fpos_next, tuple(sorted(values.items())), frozenset(running)))
+            if pair not in seen:
+                if len(seen) >= LOCAL_LIMIT:
+                    raise NotPerNode(f"the local problem of {node.label} passes {LOCAL_LIMIT}")
+                seen.add(pair)
+                queue.append(pair)
+    return True, pairing, len(seen)
+
+
+# -- the whole region ----------------------------------------------------------------------------
+def check_region(region_root: BTNode, machine: FSM, declared: dict[str, str]) -> PerNodeOutcome:
+    """Check ``machine`` (a region state's sub-machine, tagged per node) against the region
+    headed by ``region_root``, node by node (the module docstring).
+
+    Raises:
+        NotPerNode: the machine is not a valid per-node decomposition of this region.
+    """
+    try:
+        # the same-type merge of plain Sequence/Fallback children (docs/semantics.md §4d,
+        # lemma M: it keeps the leaf-execution machine), so that the nodes are the machine's
+        merged = inline_and_compress(BTDocument.single(region_root)).compression.root
+        tree = CompiledTree(BTDocument.single(merged))
+    except FsmbtError as exc:
+        raise NotPerNode(str(exc)) from None
+    region = _Region(tree, machine, declared)
+    interfaces: dict[int, Interface] = {}
+    memo: dict[tuple[Any, ...], tuple[bool, dict[int, Any], int, bool]] = {}
+    haltable: set[int] = set()
+    outcome = PerNodeOutcome(equivalent=True, nodes=len(tree.nodes))
+    for node in reversed(tree.nodes):
+        if node.id not in region.entry:  # dead: never ticked by the machine
+            interfaces[node.id] = {}
+            haltable.add(node.id)
+            continue
+        if node.is_env_leaf and not node.children:
+            state = region.leaf_state[node.id]
+            interface: Interface = {}
+            for t in region.out[state]:
+                status = {v: k for k, v in EVENTS.items()}[t.event]
+                interface[status] = (t.target, tuple(region.assigns[id(t)]))
+            interfaces[node.id] = interface
+            haltable.add(node.id)  # a leaf's halt is its halt hook: nothing of it is kept
+            continue
+        local = _local(region, node, interfaces)
+        allowed = [sorted(interfaces[c]) for c in node.children]
+        halts = frozenset(i for i, c in enumerate(node.children) if c in haltable)
+        key = (local.key, tuple(tuple(a) for a in allowed), tuple(sorted(halts)))
+        found = memo.get(key)
+        if found is None:
+            found = (*_check_local(local, node, allowed, halts, with_halt=True), True)
+            if not found[0]:  # proven for a node nobody halts, or not at all
+                found = (*_check_local(local, node, allowed, halts, with_halt=False), False)
+            memo[key] = found
+            outcome.distinct += 1
+            outcome.local_states += found[2]
+        equivalent, pairing, _states, can_halt = found
+        if can_halt:
+            haltable.add(node.id)
+        if not equivalent:
+            outcome.equivalent = False
+            outcome.failed = f"{node.type} '{node.label}' at {node.path or 'the root'}"
+            return outcome
+        interfaces[node.id] = _real_exits(local, pairing)
+    root = interfaces[0]
+    wanted = {
+        SUCCESS: (END_SUCCESS, ()),
+        FAILURE: (END_FAILURE, ()),
+        RUNNING: (region.entry[0], ()),
+    }
+    for status, exit_ in root.items():
+        if wanted[status] != exit_:
+            raise NotPerNode(f"the region's root returns {EVENTS[status]} elsewhere")
+    outcome.results = frozenset(
+        {SUCCESS: END_SUCCESS, FAILURE: END_FAILURE}[s] for s in root if s != RUNNING
+    )
+    return outcome
+
+
+def _real_exits(local: _Local, pairing: dict[int, Any]) -> Interface:
+    """σ_N in the machine's names: each status's exit target and outside assignments."""
+    found: Interface = {}
+    for status, (target_id, assign_ids) in pairing.items():
+        target = local.exits[target_id][1]
+        assigns = tuple(pair for a in assign_ids for pair in local.exits[a][1])
+        found[status] = (target, assigns)
+    return found
