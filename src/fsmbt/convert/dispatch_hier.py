@@ -19,7 +19,10 @@ form, ``fsm_d_<composite>_0..`` for a composite):
   ``AlwaysFailure`` inside a composite (a final sub-state ignores events: its ancestors'
   transitions apply); an atomic child a ``Switch`` on ``{event}`` over its transitions whose
   default is "not handled here": RUNNING (``KeepRunningUntilFailure(AlwaysSuccess)``) at the
-  top, ``AlwaysFailure`` inside a composite; a composite child the ``SubTree`` of its tree;
+  top, ``AlwaysFailure`` inside a composite (a child without transitions: that
+  ``AlwaysFailure`` alone, named, as a final child's, by its flat path - the load-time check,
+  ``fsmbt.semantics.dispatch_check``, tells a state's case from an unnamed padding case so); a
+  composite child the ``SubTree`` of its tree;
 - a composite's tree: ``ReactiveFallback(index tree over its children, Switch on {event} over
   its own transitions)`` (the second child's default again "not handled here"); only the index
   tree when the composite is nested and has no transition of its own;
@@ -34,7 +37,8 @@ configuration of the machine is one valuation of the digits: the start writes ev
 digits; a transition resets every level inside the states it exits (inside the source when
 the source is composite: its active children are not known statically, so every digit of
 those levels is written) and writes the levels whose active child changes (the levels on the
-source's path are known statically: only the digits that differ). Completion transitions
+source's path are known statically: only the digits that differ); no digit of a composite
+never entered is written (it has no tree, so no ``Switch`` reads it). Completion transitions
 (``done.state``: eventless transitions out of a composite, ``exit`` naming which final
 sub-state) are resolved when the tree is built: a transition whose target configuration has a
 final atomic state whose parent composite completes on it goes on to that completion's target
@@ -79,7 +83,7 @@ from fsmbt.model.errors import InputError
 from fsmbt.model.flatten import MAX_COMPLETION_CHAIN, PATH_SEPARATOR
 from fsmbt.model.fsm import FSM, State, Transition
 from fsmbt.model.kinds import NodeKind
-from fsmbt.semantics.dispatch_runtime import DIGIT_PREFIX, ENTRY, ON_SUCCESS
+from fsmbt.semantics.dispatch_runtime import DIGIT_PREFIX, ENTRY, ON_SUCCESS, level_prefix
 
 STYLE = "dispatch"
 #: ``stats["form"]`` of this form (the flat form has none).
@@ -160,6 +164,8 @@ class _Builder:
         self.fsm = fsm
         self.levels: list[_Level] = []
         self.inside: dict[tuple[int, str], list[int]] = {}
+        #: the (level, child) pairs ever active (``explore``; every one until it has run)
+        self.observed: set[tuple[int, str]] | None = None
         used_keys: set[str] = set()
         used_ids = {MAIN}
         stack: list[tuple[FSM, str, int | None, str | None]] = [(fsm, "", None, None)]
@@ -169,7 +175,7 @@ class _Builder:
             if parent is None:
                 key, tree_id = DIGIT_PREFIX, MAIN
             else:
-                key = _unique(f"{DIGIT_PREFIX}_{_UNSAFE.sub('_', path)}", used_keys, "_") + "_"
+                key = level_prefix(_unique(_UNSAFE.sub("_", path), used_keys, "_"))
                 tree_id = _unique(path, used_ids, "#")
                 self.levels[parent].sub[owner or ""] = n
             level = _Level(machine, path, parent, owner, key, tree_id)
@@ -272,16 +278,23 @@ class _Builder:
                 return t
         return None
 
+    def entered(self, level: int, name: str) -> bool:
+        """Whether child ``name`` of ``level`` is ever active."""
+        return self.observed is None or (level, name) in self.observed
+
     def _exit(self, level: int, name: str, value: dict[int, str]) -> None:
         """Leaving ``name`` of ``level``: every level inside it back to its initial child."""
         for n in self.inside.get((level, name), ()):
             value[n] = self.initial(n)
 
     def writes(self, move: _Move) -> str:
-        """The ``_onSuccess`` assignments of ``move`` (only digits that change)."""
+        """The ``_onSuccess`` assignments of ``move`` (only digits that change; none of a
+        level never entered: it has no tree, so no ``Switch`` reads its digits)."""
         code: list[str] = []
         for n in sorted(move.value):
             lv = self.levels[n]
+            if lv.parent is not None and not self.entered(lv.parent, lv.owner or ""):
+                continue
             want = digits_of(lv.index[move.value[n]], lv.digits)
             if n in move.unknown:
                 have = [""] * lv.digits
@@ -341,6 +354,7 @@ class _Builder:
             if again == dead:
                 break
             dead = again
+        self.observed = observed
         for n, lv in enumerate(self.levels):
             initial = self.initial(n)
             lv.children = [c for c in lv.machine.states if (n, c) in observed or c == initial]
@@ -371,6 +385,9 @@ class _Builder:
                 (event, transition(move, f"{flat}/{event}"))
                 for event, move in moves.get((at, name), [])
             ]
+            if not cases and at != 0:
+                # named by the state: the load-time check tells it from a padding case
+                return leaf("AlwaysFailure", flat)
             return event_switch(flat, cases, running if at == 0 else never)
 
         trees: dict[str, BTNode] = {}

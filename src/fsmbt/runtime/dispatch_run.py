@@ -25,7 +25,8 @@ pairing rule explores):
   (``fsmbt.semantics.dispatch_check``: every digit well formed, every index a transition writes
   a state's, one state per index - docs/semantics.md section 12, "Checked at load time").
 
-Cost: building is O(nodes + reachable states x digits + transitions x digits); a macro step is one tick of the blackboard interpreter,
+Cost: building is O(nodes + reachable configurations x (digits + nesting) + transitions x
+digits); a macro step is one tick of the blackboard interpreter,
 O(log7 states + events of the current state / 6) node ticks (each with an O(entries) blackboard
 copy: the snapshot is immutable).
 """

@@ -22,6 +22,7 @@ Cost: a tick is O(log7(states) + events of the current state / 6) node ticks.
 
 from __future__ import annotations
 
+import re
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any, NamedTuple
@@ -54,6 +55,29 @@ EVENT_KEY = "event"
 DIGIT_PREFIX = "fsm_d"
 DIGITS = "abcdefg"
 BASE = len(DIGITS)
+#: The digit-entry key grammar of both dispatch forms (docs/semantics.md §12, §12a): a level's
+#: prefix - ``fsm_d`` for the top machine, ``fsm_d_<level>_`` for a composite state's
+#: sub-machine (``<level>`` its path, letters, digits and ``_``) - then the digit number ``J``
+#: (0 = least significant, at most 4 decimal digits). ``J`` is what follows the last ``_``, so
+#: a key names one (prefix, J) pair.
+_DIGIT_KEY = re.compile(re.escape(DIGIT_PREFIX) + r"((?:_[A-Za-z0-9_]+_)?)([0-9]{1,4})")
+
+
+def level_prefix(level: str) -> str:
+    """The digit-entry prefix of the composite level ``level`` (``[A-Za-z0-9_]+``):
+    ``fsm_d_<level>_``; its digits are ``fsm_d_<level>_0``, ``fsm_d_<level>_1``, ..."""
+    return f"{DIGIT_PREFIX}_{level}_"
+
+
+def digit_key(key: str) -> tuple[str, int] | None:
+    """``(level prefix, J)`` of a digit entry ``fsm_dJ`` (prefix ``fsm_d``) or
+    ``fsm_d_<level>_J`` (prefix ``fsm_d_<level>_``), else ``None``."""
+    match = _DIGIT_KEY.fullmatch(key)
+    if match is None:
+        return None
+    return DIGIT_PREFIX + match.group(1), int(match.group(2))
+
+
 #: The most cases a BehaviorTree.CPP ``Switch`` has (``Switch6``); its default is one more.
 MAX_CASES = 6
 #: An event value no ``Switch`` case can equal (XML cannot hold NUL): the "any other event" of

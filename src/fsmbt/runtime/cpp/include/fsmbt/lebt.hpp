@@ -484,41 +484,83 @@ private:
 inline constexpr const char* kDispatchType = "DispatchEntry";
 /// The blackboard entry holding the pending event of a dispatch tree.
 inline constexpr const char* kEventKey = "event";
-/// The dispatch form's state index digits: entries `fsm_d0` (least significant) .. and the
-/// letters a dispatch `Switch` compares them with.
+/// The dispatch form's state index digits and the letters a dispatch `Switch` compares them
+/// with. A digit entry is a level's prefix and its digit number J (0 = least significant, at
+/// most 4 decimal digits): `fsm_dJ` for the top machine, `fsm_d_<level>_J` for a composite
+/// state's sub-machine in the hierarchical form (section 12a; `<level>` letters, digits and
+/// `_`, J what follows the last `_`) - the grammar of fsmbt.semantics.dispatch_runtime.digit_key.
 inline constexpr const char* kDigitPrefix = "fsm_d";
 inline constexpr const char* kDigitLetters = "abcdefg";
 
 namespace detail {
 
-/// The digit number J of a blackboard key `fsm_dJ` (or of a port value `{fsm_dJ}` when
-/// `braced`), or -1 when it is not one.
-inline int digitNumber(std::string_view text, bool braced)
+/// A digit entry: its level's prefix (`fsm_d` or `fsm_d_<level>_`) and its digit number
+/// (-1: the key is no digit entry).
+struct DigitKey
+{
+  std::string prefix;
+  int number = -1;
+
+  bool operator<(const DigitKey& other) const
+  {
+    return prefix != other.prefix ? prefix < other.prefix : number < other.number;
+  }
+  /// The blackboard key, `<prefix><number>`.
+  std::string key() const { return prefix + std::to_string(number); }
+};
+
+/// The digit entry a blackboard key `fsm_dJ` / `fsm_d_<level>_J` names (or a port value
+/// `{...}` when `braced`); number -1 when it is none.
+inline DigitKey digitKey(std::string_view text, bool braced)
 {
   if(braced)
   {
     if(text.size() < 2 || text.front() != '{' || text.back() != '}')
     {
-      return -1;
+      return {};
     }
     text = text.substr(1, text.size() - 2);
   }
   const std::string_view prefix(kDigitPrefix);
-  if(text.size() <= prefix.size() || text.substr(0, prefix.size()) != prefix ||
-     text.size() - prefix.size() > 4)
+  if(text.size() <= prefix.size() || text.substr(0, prefix.size()) != prefix)
   {
-    return -1;
+    return {};
+  }
+  std::string_view rest = text.substr(prefix.size());
+  std::size_t digits_at = 0;  // where J starts in `rest`
+  if(rest.front() == '_')
+  {
+    const std::size_t last = rest.rfind('_');
+    if(last < 2)  // `_<level>_` with a non-empty level
+    {
+      return {};
+    }
+    for(char ch : rest.substr(1, last - 1))
+    {
+      const bool word = (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') ||
+                        (ch >= '0' && ch <= '9') || ch == '_';
+      if(!word)
+      {
+        return {};
+      }
+    }
+    digits_at = last + 1;
+  }
+  const std::string_view number_text = rest.substr(digits_at);
+  if(number_text.empty() || number_text.size() > 4)
+  {
+    return {};
   }
   int number = 0;
-  for(char ch : text.substr(prefix.size()))
+  for(char ch : number_text)
   {
     if(ch < '0' || ch > '9')
     {
-      return -1;
+      return {};
     }
     number = number * 10 + (ch - '0');
   }
-  return number;
+  return { std::string(text.substr(0, prefix.size() + digits_at)), number };
 }
 
 /// True when `value` is one index digit (one of kDigitLetters).
@@ -528,12 +570,12 @@ inline bool isDigitLetter(std::string_view value)
 }
 
 /// The `KEY:='literal'` assignments of a DispatchEntry's `_onSuccess` (joined by `;`, the one
-/// script form docs/semantics.md section 12 models), as (digit number, letter) pairs, in order.
+/// script form docs/semantics.md section 12 models), as (digit entry, letter) pairs, in order.
 /// Throws std::invalid_argument naming the first item that is no such assignment, writes a key
 /// that is no index digit, or a value that is no index digit (one of a..g).
-inline std::vector<std::pair<int, char>> decodeDigitWrites(std::string_view code)
+inline std::vector<std::pair<DigitKey, char>> decodeDigitWrites(std::string_view code)
 {
-  std::vector<std::pair<int, char>> writes;
+  std::vector<std::pair<DigitKey, char>> writes;
   auto trim = [](std::string_view text) {
     const std::size_t first = text.find_first_not_of(" \t\r\n");
     if(first == std::string_view::npos)
@@ -569,8 +611,8 @@ inline std::vector<std::pair<int, char>> decodeDigitWrites(std::string_view code
                                   "' assigns no quoted literal (KEY:='digit')");
     }
     value = value.substr(1, value.size() - 2);
-    const int digit = digitNumber(key, false);
-    if(digit < 0)
+    DigitKey digit = digitKey(key, false);
+    if(digit.number < 0)
     {
       throw std::invalid_argument("'" + std::string(item) + "' writes '" + std::string(key) +
                                   "', which is no state index digit (" + kDigitPrefix + "0, " +
@@ -582,7 +624,7 @@ inline std::vector<std::pair<int, char>> decodeDigitWrites(std::string_view code
                                   std::string(value) + "' (a digit is one of the letters " +
                                   kDigitLetters + ")");
     }
-    writes.emplace_back(digit, value[0]);
+    writes.emplace_back(std::move(digit), value[0]);
   }
   return writes;
 }
@@ -1097,34 +1139,44 @@ private:
     return {};
   }
 
-  /// A `Switch` on an index digit `{fsm_dJ}`: its digit and its case letters, in order.
+  /// A `Switch` on an index digit `{fsm_dJ}` / `{fsm_d_<level>_J}`: its digit entry and its
+  /// case letters, in order.
   struct IndexSwitch
   {
-    int digit = 0;
+    detail::DigitKey digit;
     std::string cases;
   };
 
-  /// The dispatch tree's annotations agree (docs/semantics.md section 12), checked on the
-  /// loaded tree, never at tick time; a LebtError names the first node that disagrees, with its
-  /// line:
+  /// The dispatch tree's annotations agree (docs/semantics.md section 12, "Checked at load
+  /// time"; the flat form and the hierarchical form of section 12a), checked on the loaded tree,
+  /// never at tick time; a LebtError names the first node that disagrees, with its line. The
+  /// rule of fsmbt.semantics.dispatch_check, the Python runtime's:
   ///  - only a DispatchEntry carries a post-condition, `_onSuccess` alone, made of
-  ///    `fsm_dJ:='x'` assignments of index digits x in a..g, J below the digits the Switches
-  ///    read; no node carries a pre-condition (either could change the index unseen);
-  ///  - at least one Switch reads an index digit `{fsm_dJ}`, and each of its cases is one
-  ///    index digit (a..g);
-  ///  - every index a transition writes is a state's: starting from the start (no digit set),
-  ///    each state's case - the node the index Switches reach for its digits - is searched
-  ///    for its DispatchEntry leaves, and the index each one writes (the source's digits with
-  ///    its `_onSuccess` applied) must set every digit and lead through the index Switches to a
-  ///    state's case, not to an `AlwaysFailure` (a padding case or an unused default) or back to
-  ///    the start case; and every leaf writing one index names the same `state` (one index,
-  ///    one state).
-  /// Cost: O(nodes + reachable states x digits + transitions x digits).
+  ///    `KEY:='x'` assignments of index digits x in a..g to digit entries (`fsm_dJ`, or
+  ///    `fsm_d_<level>_J` for a composite's level) that the Switches read (J below the digits
+  ///    they read of that level); no node carries a pre-condition (either could change the
+  ///    index unseen);
+  ///  - at least one Switch reads a digit entry, and each of its cases is one index digit;
+  ///  - the index is the joint valuation of every level's digits; it resolves from the root:
+  ///    an index Switch takes its digit's case (the default when none equals it), a SubTree
+  ///    its tree, a control node that is no Switch and whose first child is (through SubTrees)
+  ///    an index Switch - a composite's ReactiveFallback - its first child, its other children
+  ///    holding that composite's own transitions. The node reached is the state's case, and the
+  ///    state's transitions are the DispatchEntry leaves in it and in the own transitions
+  ///    passed;
+  ///  - every index a transition writes is a state's: from the start (no digit set), each
+  ///    DispatchEntry of a reached state writes an index (the state's with its `_onSuccess`
+  ///    applied) that must set every digit and lead to a state's case, neither back to the
+  ///    start case nor to an `AlwaysFailure` (a padding case or an unused default) - except,
+  ///    inside a composite (below a Switch on a `fsm_d_<level>_` digit), an `AlwaysFailure`
+  ///    named as the state the leaf enters (a final sub-state, or one whose events only its
+  ///    ancestors handle); and every leaf writing one index names the same `state`.
+  /// Cost: O(nodes + reachable configurations x (digits + nesting) + transitions x digits).
   void checkDispatch(const std::string& xml_text)
   {
     std::unordered_map<const BT::TreeNode*, IndexSwitch> switches;
-    std::unordered_map<const DispatchEntry*, std::vector<std::pair<int, char>>> writes;
-    int levels = 0;
+    std::unordered_map<const DispatchEntry*, std::vector<std::pair<detail::DigitKey, char>>> writes;
+    std::map<std::string, int> widths;  // level prefix -> digits its Switches read
     for(const auto& subtree : tree_.subtrees)
     {
       for(const BT::TreeNode::Ptr& node : subtree->nodes)
@@ -1154,16 +1206,15 @@ private:
                             ": dispatch annotations disagree: _onSuccess " + exc.what());
           }
         }
-        const std::string& id = node->registrationName();
-        if(id.rfind("Switch", 0) != 0)
+        if(!isSwitch(node.get()))
         {
           continue;
         }
         auto variable = config.input_ports.find("variable");
-        const int digit = variable == config.input_ports.end() ?
-                              -1 :
-                              detail::digitNumber(variable->second, true);
-        if(digit < 0)
+        detail::DigitKey digit = variable == config.input_ports.end() ?
+                                     detail::DigitKey{} :
+                                     detail::digitKey(variable->second, true);
+        if(digit.number < 0)
         {
           continue;  // a Switch on {event}
         }
@@ -1182,7 +1233,8 @@ private:
           }
           info.cases.push_back(text[0]);
         }
-        levels = std::max(levels, digit + 1);
+        int& width = widths[digit.prefix];
+        width = std::max(width, digit.number + 1);
         switches.emplace(node.get(), std::move(info));
       }
     }
@@ -1193,21 +1245,59 @@ private:
                       "of DispatchEntry leaves is the dispatch form, a Switch dispatch over the " +
                       "index");
     }
+    // the joint index: one slot per digit, the top level's (`fsm_d`, the smallest prefix) first,
+    // then each composite level's by prefix, each least significant digit first
+    std::vector<detail::DigitKey> keys;
+    std::map<detail::DigitKey, std::size_t> slot;
+    for(const auto& [prefix, width] : widths)
+    {
+      for(int j = 0; j < width; ++j)
+      {
+        slot.emplace(detail::DigitKey{ prefix, j }, keys.size());
+        keys.push_back(detail::DigitKey{ prefix, j });
+      }
+    }
+    std::unordered_map<const DispatchEntry*, std::vector<std::pair<std::size_t, char>>> slots;
     for(const auto& [entry, items] : writes)
     {
       for(const auto& [digit, letter] : items)
       {
-        if(digit >= levels)
+        auto width = widths.find(digit.prefix);
+        const int has = width == widths.end() ? 0 : width->second;
+        if(digit.number >= has)
         {
+          const std::string why =
+              digit.prefix == kDigitPrefix ? "the index has " + std::to_string(has) :
+              has > 0 ? "the level " + digit.prefix + ".. has " + std::to_string(has) :
+                        "no Switch reads a digit of the level " + digit.prefix + "..";
           throw LebtError(where(entry, xml_text) + ": dispatch annotations disagree: " +
-                          "_onSuccess writes " + kDigitPrefix + std::to_string(digit) +
-                          ", but no Switch reads that digit (the index has " +
-                          std::to_string(levels) + ")");
+                          "_onSuccess writes " + digit.key() + ", but no Switch reads that " +
+                          "digit (" + why + ")");
         }
+        slots[entry].emplace_back(slot.at(digit), letter);
       }
     }
-    // the node the index Switches lead `index` to (index[J] = digit J's letter, 0 = unset)
+    auto isIndex = [&](const BT::TreeNode* node) {
+      while(switches.count(node) == 0 && node->registrationName() == "SubTree")
+      {
+        const std::vector<const BT::TreeNode*> children = childrenOf(node);
+        if(children.empty())
+        {
+          return false;
+        }
+        node = children.front();
+      }
+      return switches.count(node) > 0;
+    };
+    struct Resolved
+    {
+      const BT::TreeNode* node = nullptr;     // the state's case
+      std::vector<const BT::TreeNode*> own;  // own transitions passed
+      bool inside = false;                     // below a composite level's Switch
+    };
+    // where the index Switches lead `index` (index[slot] = that digit's letter, 0 = unset)
     auto resolve = [&](const std::string& index) {
+      Resolved out;
       const BT::TreeNode* node = tree_.rootNode();
       for(;;)
       {
@@ -1215,54 +1305,78 @@ private:
         const std::vector<const BT::TreeNode*> children = childrenOf(node);
         if(it != switches.end())
         {
-          const std::size_t at = it->second.cases.find(index[it->second.digit]);
-          node = children[at == std::string::npos || index[it->second.digit] == 0 ?
-                              children.size() - 1 :
-                              at];
+          const char value = index[slot.at(it->second.digit)];
+          const std::size_t at = it->second.cases.find(value);
+          out.inside = out.inside || it->second.digit.prefix != kDigitPrefix;
+          node = children[at == std::string::npos || value == 0 ? children.size() - 1 : at];
         }
         else if(node->registrationName() == "SubTree" && !children.empty())
         {
           node = children.front();
         }
+        else if(dynamic_cast<const BT::ControlNode*>(node) != nullptr && !isSwitch(node) &&
+                children.size() > 1 && isIndex(children.front()))
+        {
+          out.own.insert(out.own.end(), children.begin() + 1, children.end());
+          node = children.front();
+        }
         else
         {
-          return node;
+          out.node = node;
+          return out;
         }
       }
     };
-    auto shown = [](const std::string& index) {  // most significant digit first
-      std::string text(index.rbegin(), index.rend());
-      std::replace(text.begin(), text.end(), '\0', '-');
-      return "'" + text + "'";
+    auto shown = [&](const std::string& index) {  // most significant digit first
+      std::vector<std::pair<std::string, std::string>> parts;  // (prefix, digits)
+      for(std::size_t k = 0; k < keys.size(); ++k)
+      {
+        if(parts.empty() || parts.back().first != keys[k].prefix)
+        {
+          parts.emplace_back(keys[k].prefix, "");
+        }
+        parts.back().second.insert(parts.back().second.begin(), index[k] == 0 ? '-' : index[k]);
+      }
+      if(parts.size() == 1 && parts.front().first == kDigitPrefix)
+      {
+        return "'" + parts.front().second + "'";
+      }
+      std::string text;
+      for(const auto& [prefix, digits] : parts)
+      {
+        text += (text.empty() ? "" : ", ") + prefix + "='" + digits + "'";
+      }
+      return text;
     };
-    const std::string start(static_cast<std::size_t>(levels), '\0');
-    const BT::TreeNode* start_case = resolve(start);
+    const std::string start(keys.size(), '\0');
+    const BT::TreeNode* start_case = resolve(start).node;
     std::unordered_map<std::string, const DispatchEntry*> named;  // index -> first entry
-    std::vector<std::pair<std::string, const BT::TreeNode*>> queue{ { start, start_case } };
+    std::vector<std::pair<std::string, std::vector<const BT::TreeNode*>>> queue{
+      { start, { start_case } }
+    };
     for(std::size_t next = 0; next < queue.size(); ++next)
     {
       const std::string source = queue[next].first;
-      std::vector<const BT::TreeNode*> stack{ queue[next].second };
+      std::vector<const BT::TreeNode*> stack(queue[next].second.rbegin(),
+                                             queue[next].second.rend());
       while(!stack.empty())
       {
         const BT::TreeNode* node = stack.back();
         stack.pop_back();
-        for(const BT::TreeNode* child : childrenOf(node))
-        {
-          stack.push_back(child);
-        }
+        const std::vector<const BT::TreeNode*> children = childrenOf(node);
+        stack.insert(stack.end(), children.rbegin(), children.rend());
         const auto* entry = dynamic_cast<const DispatchEntry*>(node);
         if(entry == nullptr)
         {
           continue;
         }
         std::string target = source;
-        auto written = writes.find(entry);
-        if(written != writes.end())
+        auto written = slots.find(entry);
+        if(written != slots.end())
         {
-          for(const auto& [digit, letter] : written->second)
+          for(const auto& [at, letter] : written->second)
           {
-            target[static_cast<std::size_t>(digit)] = letter;
+            target[at] = letter;
           }
         }
         const std::size_t unset = target.find('\0');
@@ -1270,7 +1384,7 @@ private:
         {
           throw LebtError(where(entry, xml_text) + ": dispatch annotations disagree: entering '" +
                           entry->stateName() + "' from the start, _onSuccess leaves " +
-                          kDigitPrefix + std::to_string(unset) +
+                          keys[unset].key() +
                           " unset (from the start every index digit is written)");
         }
         auto first = named.find(target);
@@ -1285,20 +1399,30 @@ private:
           }
           continue;
         }
-        const BT::TreeNode* found = resolve(target);
-        if(found == start_case || found->registrationName() == "AlwaysFailure")
+        Resolved found = resolve(target);
+        const bool failure = found.node->registrationName() == "AlwaysFailure";
+        const bool final_inside =
+            failure && found.inside && found.node->name() == entry->stateName();
+        if(found.node == start_case || (failure && !final_inside))
         {
           throw LebtError(where(entry, xml_text) + ": dispatch annotations disagree: entering '" +
                           entry->stateName() + "', _onSuccess writes the state index " +
                           shown(target) + ", which no state has (the index Switches lead it to " +
-                          (found == start_case ? std::string("the start case") :
-                                                 where(found, xml_text)) +
+                          (found.node == start_case ? std::string("the start case") :
+                                                      where(found.node, xml_text)) +
                           ")");
         }
         named.emplace(target, entry);
-        queue.emplace_back(target, found);
+        found.own.insert(found.own.begin(), found.node);
+        queue.emplace_back(target, std::move(found.own));
       }
     }
+  }
+
+  /// True when `node` is one of BehaviorTree.CPP's `Switch2`..`Switch6`.
+  static bool isSwitch(const BT::TreeNode* node)
+  {
+    return node->registrationName().rfind("Switch", 0) == 0;
   }
 
   /// The blackboard entries a dispatch tree's run writes (the index digits and `event`).
@@ -1308,7 +1432,7 @@ private:
     for(const auto& key : blackboard_->getKeys())
     {
       const std::string text(key);
-      if(text == kEventKey || detail::digitNumber(text, false) >= 0)
+      if(text == kEventKey || detail::digitKey(text, false).number >= 0)
       {
         keys.push_back(text);
       }
