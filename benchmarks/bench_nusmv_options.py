@@ -1,80 +1,115 @@
-"""NuSMV options and the implied-reachability run, measured (issue 27, item 2). Prints a table.
+"""NuSMV options and runs, measured (issue 27, item 2). Prints a table of NuSMV CPU seconds.
 
-    .venv/bin/python benchmarks/bench_nusmv_options.py [--sizes 10,20,30,50] [--timeout 60]
+    .venv/bin/python benchmarks/bench_nusmv_options.py [--sizes 10,30,100,300,1000]
+        [--timeout 60] [--columns whole,coi,dynamic,split-mono,after]
 
-Pairs: ``bench_checker.chain_fsm(n, n)`` against its renamed copy (equivalent), and the same
-with one transition retargeted (``mutant``: not equivalent), FSM ~ FSM by macro steps. Columns
-(NuSMV wall seconds, ``-`` past ``--timeout``):
+Pairs: ``bench_checker.chain_fsm(n, n)`` against its renamed copy (``copy``: equivalent), and
+the same with one transition retargeted (``mutant``: not equivalent), FSM ~ FSM by macro
+steps. Each cell is NuSMV's CPU seconds (user + system of the NuSMV children, from
+``RUSAGE_CHILDREN``: independent of the load of this shared machine; wall seconds vary 2-10x
+with it), ``-`` past ``--timeout`` wall seconds in one run:
 
-- ``before``: every spec in one run, ``-mono`` and fsmbt's variable order (``check(...,
-  implied_reachability=False)``);
-- ``-coi``, ``-dynamic``: the same model with NuSMV's cone of influence / dynamic reordering;
-- ``after``: ``check``'s default: the four specs without reachability first, reachability
-  reported as implied when they hold (docs/nusmv.md), the whole model again when one fails.
+- ``whole``: every spec in one model and one run, ``-mono`` and fsmbt's variable order, the
+  reachability spec left out when the other four hold (``check(..., split=False)``: the runs
+  of the previous version, on today's product);
+- ``-coi``, ``-dynamic``: the whole model, every spec, with NuSMV's cone of influence /
+  dynamic reordering;
+- ``split-mono``: ``check``'s two runs (invariants on the product without detaching; CTL
+  specs with ``-df``) but each with ``-mono``;
+- ``after``: ``check``'s default: the two runs with NuSMV's partitioned relation.
 
-``agree`` compares ``after``'s five verdicts with the native checker's.
+``agree`` compares ``after``'s five verdicts with the native checker's; ``native`` is the
+native checker's CPU seconds.
 """
 
 from __future__ import annotations
 
 import argparse
 import copy
+import resource
 import sys
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).parent))
 from bench_checker import chain_fsm, renamed  # noqa: E402
 
 from fsmbt import limits  # noqa: E402
+from fsmbt.model.fsm import FSM  # noqa: E402
 from fsmbt.verify import nusmv, verify  # noqa: E402
 from fsmbt.verify.nusmv.runner import NuSMVLimitError, run_nusmv  # noqa: E402
 
 
-def _timed(run, *args, **kwargs) -> str:  # type: ignore[no-untyped-def]
-    started = time.perf_counter()
+def child_cpu() -> float:
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return usage.ru_utime + usage.ru_stime
+
+
+def cpu_of(run: Callable[[], object]) -> tuple[str, object]:
+    """NuSMV CPU seconds of ``run()`` (``-`` past the cap) and its value."""
+    before = child_cpu()
     try:
-        run(*args, **kwargs)
+        value = run()
     except NuSMVLimitError:
-        return "-"
-    return f"{time.perf_counter() - started:.2f}"
+        return "-", None
+    return f"{child_cpu() - before:.2f}", value
+
+
+def _runs(
+    source: FSM, result: FSM, text: str, names: list[str], order: str
+) -> dict[str, Callable[[], object]]:
+    """The measured ways to run NuSMV on one pair, by column name."""
+    return {
+        "whole": lambda: nusmv.check(source, result, split=False),
+        "coi": lambda: run_nusmv(text, len(names), order=order, options=["-coi"]),
+        "dynamic": lambda: run_nusmv(text, len(names), order=order, options=["-dynamic"]),
+        "split-mono": lambda: nusmv.check(source, result, split=True, mono=True),
+        "after": lambda: nusmv.check(source, result),
+    }
 
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--sizes", default="10,20,30,50")
+    parser.add_argument("--sizes", default="10,30,100,300,1000")
     parser.add_argument("--timeout", type=float, default=60.0)
+    parser.add_argument("--columns", default="whole,coi,dynamic,split-mono,after")
     args = parser.parse_args(argv)
     limits.use(limits.current().with_changes(nusmv_max_seconds=args.timeout))
-    header = (
-        f"{'pair':<10} {'states':>6} {'before':>8} {'-coi':>8} {'-dynamic':>8} {'after':>8}  agree"
-    )
-    print(header)
-    print("-" * len(header))
+    columns = args.columns.split(",")
+    header = f"{'pair':<7} {'states':>6} {'native':>7} " + " ".join(f"{c:>10}" for c in columns)
+    print(header + "  agree")
+    print("-" * (len(header) + 7))
+    gave_up: set[str] = set()  # a column past the cap is not run on larger sizes
     for n in [int(x) for x in args.sizes.split(",")]:
         source = chain_fsm(n, n)
         same = renamed(chain_fsm(n, n))
         mutant = copy.deepcopy(source)
         mutant.transitions[0].target = mutant.transitions[-1].target
         for label, result in (("copy", same), ("mutant", mutant)):
+            started = time.process_time()
+            native = verify(source, result)
+            native_s = time.process_time() - started
             text, names, context = nusmv.build_model(source, result)
             order = context[-1]
-            cells = [
-                _timed(nusmv.check, source, result, implied_reachability=False),
-                _timed(run_nusmv, text, len(names), order=order, options=["-coi"]),
-                _timed(run_nusmv, text, len(names), order=order, options=["-dynamic"]),
-            ]
-            agree = "-"
-            started = time.perf_counter()
-            try:
-                after = nusmv.check(source, result)
-                cells.append(f"{time.perf_counter() - started:.2f}")
-                native = verify(source, result)
-                agree = "yes" if after.verdicts() == native.verdicts() else "NO"
-            except NuSMVLimitError:
-                cells.append("-")
+            runs = _runs(source, result, text, names, order)
+            cells, agree = [], "-"
+            for column in columns:
+                key = f"{column}/{label}"
+                if key in gave_up:
+                    cells.append("-")
+                    continue
+                cell, value = cpu_of(runs[column])
+                if cell == "-":
+                    gave_up.add(key)
+                cells.append(cell)
+                if column == "after" and value is not None:
+                    same_verdicts = value.verdicts() == native.verdicts()  # type: ignore[attr-defined]
+                    agree = "yes" if same_verdicts else "NO"
             print(
-                f"{label:<10} {n:>6} " + " ".join(f"{c:>8}" for c in cells) + f"  {agree}",
+                f"{label:<7} {n:>6} {native_s:>7.3f} "
+                + " ".join(f"{c:>10}" for c in cells)
+                + f"  {agree}",
                 flush=True,
             )
     return 0

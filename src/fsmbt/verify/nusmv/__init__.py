@@ -2,7 +2,8 @@
 
 ``check(source, result, loop=False)`` encodes both models as SMV modules from their structure
 (the BT's tick rules as transition relations, never the native interpreter's explored graph),
-builds the product and the five properties as CTL specs, runs NuSMV once and returns the same
+builds the product and the five properties as CTL specs, runs NuSMV (twice: the invariants,
+then the CTL specs; docs/nusmv.md, "Two runs") and returns the same
 ``Report`` the native checker gives, counterexamples decoded to ``TraceStep`` s.
 """
 
@@ -18,11 +19,16 @@ from fsmbt.model.fsm import FSM
 from fsmbt.verify.nusmv.binary import NuSMVNotFound, find_nusmv, require_nusmv
 from fsmbt.verify.nusmv.encode_bt import LeafBTEncoder
 from fsmbt.verify.nusmv.encode_fsm import FSMEncoder
-from fsmbt.verify.nusmv.runner import NuSMVError, NuSMVLimitError, run_nusmv
+from fsmbt.verify.nusmv.runner import NuSMVError, NuSMVLimitError, SpecResult, run_nusmv
 from fsmbt.verify.nusmv.smv import Symbols
-from fsmbt.verify.nusmv.specs import product
+from fsmbt.verify.nusmv.specs import CTL, INVARIANTS, WHOLE, product
 from fsmbt.verify.nusmv.traces import Context, Encoder, build_report
-from fsmbt.verify.report import PROPERTIES, REACHABILITY, PropertyResult, Report
+from fsmbt.verify.report import (
+    PROPERTIES,
+    REACHABILITY,
+    PropertyResult,
+    Report,
+)
 
 if TYPE_CHECKING:
     from fsmbt.verify.nusmv.encode_lebt import LebtEncoder  # noqa: F401 - in Encoder
@@ -88,15 +94,38 @@ def encode(source: FSM | BTDocument, result: FSM | BTDocument, *, loop: bool = F
 
 
 def build_model(
-    source: FSM | BTDocument, result: FSM | BTDocument, *, loop: bool = False
+    source: FSM | BTDocument,
+    result: FSM | BTDocument,
+    *,
+    loop: bool = False,
+    part: str = WHOLE,
 ) -> tuple[str, list[str], Context]:
-    """The SMV text of the product, the spec names and what is needed to decode traces."""
+    """The SMV text of the product, the spec names and what is needed to decode traces.
+
+    ``part`` (``specs.WHOLE``, ``INVARIANTS``, ``CTL``): which model - every spec on one
+    product (the single model of earlier versions, kept for the benchmarks and
+    ``scripts/smv_snapshot.py``) or one of the two that ``check`` runs."""
+    return build_models(source, result, loop=loop, parts=(part,))[0]
+
+
+def build_models(
+    source: FSM | BTDocument,
+    result: FSM | BTDocument,
+    *,
+    loop: bool = False,
+    parts: tuple[str, ...] = (INVARIANTS, CTL),
+) -> list[tuple[str, list[str], Context]]:
+    """``build_model`` for several parts, encoding the two machines once."""
     src_enc, res_enc, inputs, outputs, mode = encode(source, result, loop=loop)
     src, res = src_enc.encode(), res_enc.encode()
     extra: list[tuple[str, str]] = getattr(res_enc, "extra_specs", lambda: [])()
-    prod = product(src, res, inputs, extra)
-    text = src.text + "\n" + res.text + "\n" + prod.text
-    return text, prod.spec_names, (src, res, src_enc, res_enc, inputs, outputs, mode, prod.order)
+    models = []
+    for part in parts:
+        prod = product(src, res, inputs, extra, part=part)
+        text = src.text + "\n" + res.text + "\n" + prod.text
+        context = (src, res, src_enc, res_enc, inputs, outputs, mode, prod.order)
+        models.append((text, prod.spec_names, context))
+    return models
 
 
 def check(
@@ -106,46 +135,85 @@ def check(
     loop: bool = False,
     timeout: float | None = None,
     implied_reachability: bool = True,
+    split: bool | None = None,
+    mono: bool | None = None,
 ) -> Report:
     """Verify ``result_model`` against ``source_model`` with NuSMV; see the module docstring.
 
-    ``implied_reachability``: first run the model without the reachability spec (its frozen
-    copies make it a transitive closure, the costliest spec: 7.7 of 8.1 s on a 30-state pair);
-    when the other four properties hold, reachability follows from them (docs/nusmv.md,
-    "Reachability implied") and is reported as such; otherwise the whole model is run again, so
-    a failing pair gets reachability's own verdict and counterexample. ``False``: one run of
-    every spec (the benchmarks' "before").
+    ``split`` (docs/nusmv.md, "Two runs"): the invariants run on the product without
+    detaching (NuSMV's forward search then visits the faithful product only), the CTL specs on
+    the product with detaching under ``-df`` (no forward search: the backward fixpoints of the
+    specs alone). ``False``: one run of one model holding every spec. ``None`` (default): split
+    for an FSM ~ FSM pair only - there it wins by orders of magnitude, while on a BT's
+    micro-step product the unrestricted backward fixpoints of ``-df`` cost far more than the
+    forward search saves (measured: benchmarks/bench_nusmv_options.py, docs/nusmv.md). ``mono``: NuSMV's ``-mono`` (one monolithic transition relation); ``None``: only
+    for the single model (the two runs are 4-7x cheaper on the partitioned relation;
+    benchmarks/bench_nusmv_options.py).
 
-    ``timeout`` defaults to ``fsmbt.limits.current().nusmv_max_seconds``; the memory cap is
-    ``nusmv_max_memory_mb``. Raises ``UnsupportedError`` for BT node types the encoding does not
-    model (docs/nusmv.md), ``NuSMVLimitError`` past a cap and ``NuSMVNotFound`` when no binary is
-    available.
+    ``implied_reachability``: the reachability spec (its frozen copies make it a transitive
+    closure, the costliest spec) is left out at first; when the other four properties hold,
+    reachability follows from them (docs/nusmv.md, "Reachability implied") and is reported as
+    such; otherwise it is run too, so a failing pair gets reachability's own verdict and
+    counterexample.
+
+    ``timeout`` defaults to ``fsmbt.limits.current().nusmv_max_seconds`` (per NuSMV run); the
+    memory cap is ``nusmv_max_memory_mb``. Raises ``UnsupportedError`` for BT node types the
+    encoding does not model (docs/nusmv.md), ``NuSMVLimitError`` past a cap and
+    ``NuSMVNotFound`` when no binary is available.
     """
     started = time.perf_counter()
-    text, names, context = build_model(source_model, result_model, loop=loop)
+    if split is None:
+        split = isinstance(source_model, FSM) and isinstance(result_model, FSM)
+    parts = (INVARIANTS, CTL) if split else (WHOLE,)
+    mono = not split if mono is None else mono
+    models = build_models(source_model, result_model, loop=loop, parts=parts)
     encoded = time.perf_counter()
-    report: Report | None = None
-    runs = 1
-    lean = without_spec(text, names, REACHABILITY) if implied_reachability else None
-    if lean is not None:
-        lean_text, lean_names = lean
-        results, nusmv_seconds = run_nusmv(
-            lean_text, len(lean_names), order=context[-1], timeout=timeout
+    context = models[0][2]
+    names: list[str] = []
+    results: list[SpecResult] = []
+    runs, nusmv_seconds = 0, 0.0
+    deferred: tuple[str, list[str], list[str]] | None = None  # the reachability run, if needed
+    for part, (text, part_names, _context) in zip(parts, models):
+        options = ["-df"] if part == CTL else []
+        lean = without_spec(text, part_names, REACHABILITY) if implied_reachability else None
+        if lean is not None:
+            deferred = (text, part_names, options)
+            text, part_names = lean
+        if not part_names:
+            continue
+        found, seconds = run_nusmv(
+            text,
+            len(part_names),
+            order=context[-1],
+            timeout=timeout,
+            options=options,
+            mono=mono,
         )
-        report = build_report(lean_names, results, context, source_model, result_model)
+        names += part_names
+        results += found
+        runs += 1
+        nusmv_seconds += seconds
+    report = build_report(names, results, context, source_model, result_model)
+    if deferred is not None:
         if all(p.holds for p in report.properties.values()):
             report.properties[REACHABILITY] = PropertyResult(REACHABILITY, True, IMPLIED_DETAIL)
-            report.properties = {n: report.properties[n] for n in PROPERTIES}
         else:  # a failing pair: reachability is decided by its own spec (its counterexample)
-            report = None
-    if report is None:
-        results, seconds = run_nusmv(text, len(names), order=context[-1], timeout=timeout)
-        nusmv_seconds = seconds if lean is None else nusmv_seconds + seconds
-        runs = 1 if lean is None else 2
-        report = build_report(names, results, context, source_model, result_model)
+            text, part_names, options = deferred
+            only = _only_spec(text, part_names, REACHABILITY)
+            if split:  # the closure over the frozen copies: forward-restricted, reordered
+                options = ["-dynamic"]  # (CPU s on a 100-state mutant: 17.6 -df, 6.2 here)
+            found, seconds = run_nusmv(
+                only, 1, order=context[-1], timeout=timeout, options=options, mono=mono
+            )
+            runs += 1
+            nusmv_seconds += seconds
+            report = build_report(
+                names + [REACHABILITY], results + found, context, source_model, result_model
+            )
+        report.properties = {n: report.properties[n] for n in PROPERTIES}
     report.stats.update(
         {
-            "smv_lines": text.count("\n"),
+            "smv_lines": sum(text.count("\n") for text, _n, _c in models),
             "encode_seconds": round(encoded - started, 6),
             "nusmv_seconds": round(nusmv_seconds, 6),
             "nusmv_runs": runs,
@@ -153,6 +221,16 @@ def check(
         }
     )
     return report
+
+
+def _only_spec(text: str, names: list[str], kept: str) -> str:
+    """The model with only the spec named ``kept`` (see ``without_spec``)."""
+    for name in names:
+        if name != kept:
+            dropped = without_spec(text, names, name)
+            assert dropped is not None
+            text, names = dropped
+    return text
 
 
 #: The reachability verdict when the other four hold (docs/nusmv.md, "Reachability implied").

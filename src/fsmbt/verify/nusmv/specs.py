@@ -45,10 +45,28 @@ class Product:
     order: str
 
 
+#: The parts ``check`` runs (docs/nusmv.md, "Two runs"): the invariants on the attached product
+#: alone (forward reachability), the CTL specs on the product with detaching (``-df``).
+WHOLE, INVARIANTS, CTL = "whole", "invariants", "ctl"
+
+
 def product(
-    src: Encoding, res: Encoding, inputs: Symbols, extra_specs: list[tuple[str, str]] | None = None
+    src: Encoding,
+    res: Encoding,
+    inputs: Symbols,
+    extra_specs: list[tuple[str, str]] | None = None,
+    *,
+    part: str = WHOLE,
 ) -> Product:
-    """The ``main`` module and the specs, in the order ``spec_names`` lists them."""
+    """The ``main`` module and the specs, in the order ``spec_names`` lists them.
+
+    ``part``: ``WHOLE`` every spec on the product with detaching; ``INVARIANTS`` only the
+    invariants (completeness, no additional behaviour, termination consistency) on the product
+    without detaching - they read attached pairs only, and the detached states (each faithful
+    pair times everything one machine reaches alone) are most of a forward search's cost;
+    ``CTL`` the CTL specs (deadlock absence, reachability) and the extra invariants written
+    as ``AG``, for a run without the forward search (``-df``)."""
+    detach = part != INVARIANTS
     in_ids = list(inputs.to_id.values())
     in_enum = enum_type(in_ids, "in_pad")  # never offered: no machine defines offers_in_pad
     follows = res.follows
@@ -62,16 +80,15 @@ def product(
         for i in in_ids
     )
     alone_s = any_of(f"(inp_s = {i} & s.offers_{i})" for i in in_ids)
-    alone_r = any_of(f"(inp_r = {i} & r.offers_{i})" for i in in_ids)
+    alone_r = any_of(f"(inp_s = {i} & r.offers_{i})" for i in in_ids)
     lines = [
         "MODULE main",
         "IVAR",
         f"  inp_s : {in_enum};",
-        f"  inp_r : {in_enum};",
         "  ctl : {step, alone_s, alone_r, idle};",
         "VAR",
         "  s : " + src.module + "(go_s, inp_s);",
-        "  r : " + res.module + "(go_r, inp_eff_r);",
+        "  r : " + res.module + "(go_r, inp_s);",
         "  mode : {att, sa, ra};",
         "  s_obs : boolean;",
         "  r_obs : boolean;",
@@ -79,6 +96,7 @@ def product(
         "  r_run : boolean;",
         "  s_st0 : boolean;",
         "  r_st0 : boolean;",
+        "  ok : boolean;",
         "FROZENVAR",
     ]
     for prefix, enc in (("ts", src), ("tr", res)):
@@ -89,17 +107,20 @@ def product(
         "  det := mode != att;",
         "  both := s.stable & r.stable;",
         f"  agree := both & {equal_outs} & (s.final <-> r.final);",
-        "  faithful := !det & agree;",
-        f"  attached_go := !det & faithful & ctl = step & {joint};",
+        "  faithful := !det & ok & agree;",
+        f"  attached_go := !det & ok & both & ctl = step & {joint};",
         f"  go_s := attached_go | (mode = sa & s.stable & {alone_s});",
         f"  go_r := attached_go | (mode = ra & r.stable & {alone_r});",
-        "  inp_eff_r := case det : inp_r; TRUE : inp_s; esac;",
         "  s_out := " + any_of(f"{x} != {NONE_OUT}" for x in s_slots) + ";",
         "  r_out := " + any_of(f"{x} != {NONE_OUT}" for x in r_slots) + ";",
         "ASSIGN",
         "  init(mode) := att;",
-        "  next(mode) := case !det & both & ctl = alone_s : sa; "
-        "!det & both & ctl = alone_r : ra; TRUE : mode; esac;",
+        "  next(mode) := case !det & ok & both & ctl = alone_s : sa; "
+        "!det & ok & both & ctl = alone_r : ra; TRUE : mode; esac;"
+        if detach
+        else "  next(mode) := mode;",
+        "  init(ok) := TRUE;",
+        "  next(ok) := case !det & both : ok & agree; TRUE : ok; esac;",
     ]
     for side in ("s", "r"):
         lines += [
@@ -127,15 +148,22 @@ def product(
         reach += f" & ((EF (mode = ra & r.stable & {same_r})) -> (EF (faithful & {same_r})))"
     specs.append((REACHABILITY, "SPEC", reach))
     # invariants are checked by forward reachability: much cheaper than AG in CTL
-    compl = f"((!det & both) -> {subsequence(s_slots, r_slots, NONE_OUT)})"
-    noadd = f"((!det & both) -> {subsequence(r_slots, s_slots, NONE_OUT)})"
+    compl = f"((!det & ok & both) -> {subsequence(s_slots, r_slots, NONE_OUT)})"
+    noadd = f"((!det & ok & both) -> {subsequence(r_slots, s_slots, NONE_OUT)})"
     if not follows:
         compl = f"{compl} & (faithful -> {offers_s_in_r})"
         noadd = f"{noadd} & (faithful -> {offers_r_in_s})"
     specs.append((COMPLETENESS, "INVARSPEC", compl))
     specs.append((NO_ADDITIONAL_BEHAVIOR, "INVARSPEC", noadd))
-    specs.append((TERMINATION_CONSISTENCY, "INVARSPEC", "((!det & both) -> (s.final <-> r.final))"))
-    specs += [(name, "INVARSPEC", formula) for name, formula in (extra_specs or [])]
+    specs.append(
+        (TERMINATION_CONSISTENCY, "INVARSPEC", "((!det & ok & both) -> (s.final <-> r.final))")
+    )
+    extra_kind = "INVARSPEC" if part == WHOLE else "SPEC AG"
+    specs += [(name, extra_kind, f"(ok -> {formula})") for name, formula in (extra_specs or [])]
+    if part == INVARIANTS:
+        specs = [spec for spec in specs if spec[1] == "INVARSPEC"]
+    elif part == CTL:
+        specs = [spec for spec in specs if spec[1] != "INVARSPEC"]
     for _name, kind, formula in specs:
         lines.append(f"{kind} {formula};")
     order = _order(src, res)
@@ -145,7 +173,7 @@ def product(
 def _order(src: Encoding, res: Encoding) -> str:
     """A BDD variable order: each identity variable next to its frozen copy (the reachability
     spec compares them), inputs first. Without it NuSMV is 20x slower on small models."""
-    order = ["inp_s", "inp_r", "ctl", "mode", "s_obs", "r_obs", "s_run", "r_run", "s_st0", "r_st0"]
+    order = ["ok", "ctl", "mode", "inp_s", "s_obs", "r_obs", "s_run", "r_run", "s_st0", "r_st0"]
     for side, copy, enc in (("s", "ts", src), ("r", "tr", res)):
         ids = {v for v, _ in enc.id_vars}
         for var in enc.var_order:
