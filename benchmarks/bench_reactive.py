@@ -358,10 +358,15 @@ def _pernode_table(args: argparse.Namespace) -> int:
     started = time.perf_counter()
     proved, why = compositional_report(doc, mutant)
     seconds = time.perf_counter() - started
+    if proved is None:
+        said = "not proven: " + why[:110]
+    elif proved.equivalent:
+        said = "PROVED (wrong)"
+    else:
+        said = f"NOT EQUIVALENT ({proved.method}: {proved.stats.get('per_node_failed')})"
     print(
         f"mutant (guard of {changed.source} -> {changed.target} dropped): per node "
-        f"{'PROVED (wrong)' if proved is not None else 'not proven: ' + why[:110]} "
-        f"in {seconds:.2f} s"
+        f"{said} in {seconds:.2f} s"
     )
     signal.alarm(args.limit)
     try:
@@ -370,16 +375,16 @@ def _pernode_table(args: argparse.Namespace) -> int:
         signal.alarm(0)
         traces = [p.counterexample for p in report.properties.values() if p.counterexample]
         found = (
-            f"found, counterexample of {min(len(t) for t in traces)} steps"
+            f"found ({report.method}), counterexample of {min(len(t) for t in traces)} steps"
             if not report.equivalent and traces
             else ("not equivalent" if not report.equivalent else "EQUIVALENT")
         )
-        print(f"whole product: {found} in {time.perf_counter() - started:.2f} s")
+        print(f"verify: {found} in {time.perf_counter() - started:.2f} s")
     except _Timeout:
-        print(f"whole product: not found within {args.limit} s")
+        print(f"verify: not found within {args.limit} s")
     except InputError as exc:
         signal.alarm(0)
-        print(f"whole product: stopped ({str(exc)[:100]})")
+        print(f"verify: stopped ({str(exc)[:100]})")
     return 0
 
 

@@ -7,7 +7,7 @@ from rich.console import Console, Group, RenderableType
 from rich.table import Table
 from rich.text import Text
 
-from fsmbt.verify.report import PROPERTIES, PropertyResult, Report, TraceStep
+from fsmbt.verify.report import PER_NODE_LIFTED, PROPERTIES, PropertyResult, Report, TraceStep
 
 _TITLES = {
     "reachability": "reachability",
@@ -70,7 +70,10 @@ def render(report: Report) -> RenderableType:
     for props in groups.values():  # properties failing on the same trace share one table
         parts.append(
             counterexample_table(
-                props[0], [p.name for p in props], leaf_execution=report.mode == "leaf-execution"
+                props[0],
+                [p.name for p in props],
+                leaf_execution=report.mode == "leaf-execution",
+                shortest=report.method != PER_NODE_LIFTED,
             )
         )
     stats = report.stats
@@ -80,9 +83,13 @@ def render(report: Report) -> RenderableType:
 
 
 def counterexample_table(
-    prop: PropertyResult, names: list[str] | None = None, leaf_execution: bool | None = None
+    prop: PropertyResult,
+    names: list[str] | None = None,
+    leaf_execution: bool | None = None,
+    shortest: bool = True,
 ) -> Table:
-    """The shortest counterexample of one failed property (or several sharing it).
+    """The shortest counterexample of one failed property (or several sharing it); with
+    ``shortest`` false, a lifted one (docs/verification.md §3: real, not always shortest).
 
     Args:
         prop: the failed property.
@@ -104,7 +111,10 @@ def counterexample_table(
         "result did",
         "states",
         "note",
-        title=f"{titles}: shortest counterexample ({steps} {unit}{'' if steps == 1 else 's'})",
+        title=(
+            f"{titles}: {'shortest' if shortest else 'lifted (not always shortest)'} "
+            f"counterexample ({steps} {unit}{'' if steps == 1 else 's'})"
+        ),
         title_justify="left",
     )
     for step in prop.counterexample or []:

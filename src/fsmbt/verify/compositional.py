@@ -72,6 +72,7 @@ from fsmbt.semantics.nodes import (
     canonical_type,
 )
 from fsmbt.semantics.status import LeafOutcome, RootResult
+from fsmbt.verify.lift import lifted_report
 from fsmbt.verify.method import PER_NODE_SENTENCE
 from fsmbt.verify.native import DEFAULT_MAX_STATES, StateLimitError, check_witnessed
 from fsmbt.verify.pernode import NODE_ATTR, NotPerNode, PerNodeOutcome, check_region
@@ -127,6 +128,8 @@ class Decomposition:
     skeleton_states: int = 0
     failed_region: str | None = None
     stats: dict[str, Any] = field(default_factory=dict)
+    #: the region whose per-node check failed and that check (for ``verify/lift.py``)
+    per_node_failure: tuple[BTNode, PerNodeOutcome] | None = None
 
 
 # -- the tree side ---------------------------------------------------------------------------
@@ -648,6 +651,7 @@ def decompose(
                     outcome.failed_region = (
                         f"{regions[k].label} (state {region.path}), node {per_node.failed}"
                     )
+                    outcome.per_node_failure = (regions[k], per_node)
                     return outcome
                 possible = per_node.results
                 if not results_allowed(possible, shape, j):
@@ -734,6 +738,27 @@ def _per_node(
     return found
 
 
+def _lifted(source: BTDocument, result: FSM, found: Decomposition) -> Report | None:
+    """NOT EQUIVALENT with the failing node's local counterexample lifted to the whole tree
+    and confirmed by replay (``verify/lift.py``), or ``None``: the whole product decides."""
+    assert found.per_node_failure is not None
+    region, failed = found.per_node_failure
+    started = time.perf_counter()
+    try:
+        report = lifted_report(source, result, region, failed)
+    except FsmbtError:
+        return None
+    if report is None:
+        return None
+    report.abstractions.insert(0, PER_NODE_SENTENCE)
+    report.stats.update(found.stats)
+    report.stats["per_node_failed"] = found.failed_region
+    report.stats.setdefault("per_node_regions", 1)
+    report.stats["regions"] = found.regions
+    report.stats["lift_seconds"] = round(time.perf_counter() - started, 6)
+    return report
+
+
 def _add(total: dict[str, Any], part: dict[str, Any]) -> None:
     """Sum each part's state and edge counts (the figures a verdict prints)."""
     for key in ("source_states", "result_states", "product_states", "product_edges"):
@@ -771,6 +796,10 @@ def compositional_report(
         # gives the error or verdict it gave before
         return None, f"a part cannot be checked ({type(exc).__name__})"
     if not found.equivalent:
+        if found.per_node_failure is not None:
+            lifted = _lifted(source, result, found)
+            if lifted is not None:
+                return lifted, ""
         return None, f"{FAILED_PART} {found.failed_region} fails"
     seconds = time.perf_counter() - started
     report = Report(engine="native", source="source", result="result", mode=LEAF_EXECUTION)

@@ -112,6 +112,13 @@ class PerNodeOutcome:
     local_states: int = 0
     failed: str | None = None
     stats: dict[str, Any] = field(default_factory=dict)
+    #: the failing node's id in ``tree`` (the region after the same-type merge), and the local
+    #: counterexample: the inputs from the fresh node, each ``(position, symbol)`` with
+    #: position ``None`` between ticks (symbol ``"tick"``/``"halt"``) or the child ticked
+    #: (symbol its status); ``verify/lift.py`` lifts it to the whole tree
+    failed_id: int | None = None
+    trace: list[tuple[int | None, Any]] = field(default_factory=list)
+    tree: CompiledTree | None = None
 
 
 # -- expressions (fsmbt's subset: literals, names, ==, !=, <, <=, >, >=, and, or, x + 1) -------
@@ -570,7 +577,7 @@ def _check_local(
     allowed: list[list[int]],
     haltable: frozenset[int],
     with_halt: bool,
-) -> tuple[bool, dict[int, Any], int]:
+) -> tuple[bool, dict[int, Any], int, list[tuple[int | None, Any]]]:
     """The lockstep product of the two sides (module docstring). ``haltable``: the children
     whose own check held with ``halt`` offered (any halt of another child fails this one);
     ``with_halt``: offer ``halt`` between ticks. Returns (equivalent, σ: status -> canonical
@@ -580,8 +587,17 @@ def _check_local(
     never = frozenset(range(len(allowed))) - haltable
     pairing: dict[int, Any] = {}
     start: tuple[Any, Any] = ((bt.interp.initial(), None), (None, local.initial, frozenset()))
-    seen = {start}
+    seen: dict[Any, tuple[Any, tuple[int | None, Any]] | None] = {start: None}
     queue = deque([start])
+
+    def trace(pair: Any, last: tuple[int | None, Any] | None = None) -> list[Any]:
+        found: list[tuple[int | None, Any]] = [] if last is None else [last]
+        link = seen[pair]
+        while link is not None:  # parent links: iterative
+            pair, step = link
+            found.append(step)
+            link = seen[pair]
+        return found[::-1]
 
     def same(bt_out: Any, fsm_out: Any) -> bool:
         if bt_out[0] & never or fsm_out[2] & never:
@@ -597,9 +613,10 @@ def _check_local(
         return bool(pairing.setdefault(b_what, f_what) == f_what)
 
     while queue:
-        (snap, position), (fpos, fvalues, frunning) = queue.popleft()
+        current = queue.popleft()
+        (snap, position), (fpos, fvalues, frunning) = current
         if position != fpos:
-            return False, pairing, len(seen)
+            return False, pairing, len(seen), trace(current)
         if position is None:
             inputs: list[Any] = ["tick", "halt"] if with_halt else ["tick"]
         else:
@@ -613,10 +630,10 @@ def _check_local(
                 values.update(local.halt)
                 fsm_halts = frozenset(i for i in running if i in local.halting)
                 if halted & never or any(i in never for i in running):
-                    return False, pairing, len(seen)
+                    return False, pairing, len(seen), trace(current, (position, symbol))
                 running.clear()
                 if frozenset(i for i in halted if i in local.halting) != fsm_halts:
-                    return False, pairing, len(seen)
+                    return False, pairing, len(seen), trace(current, (position, symbol))
                 fpos_next = None
             else:
                 if symbol == "tick":
@@ -631,14 +648,14 @@ def _check_local(
                         running.add(position)
                 fpos_next, fsm_out = fsm.resolve(hop, values, running)
                 if not same(bt_out, fsm_out):
-                    return False, pairing, len(seen)
+                    return False, pairing, len(seen), trace(current, (position, symbol))
             pair = (bt_next, (fpos_next, tuple(sorted(values.items())), frozenset(running)))
             if pair not in seen:
                 if len(seen) >= LOCAL_LIMIT:
                     raise NotPerNode(f"the local problem of {node.label} passes {LOCAL_LIMIT}")
-                seen.add(pair)
+                seen[pair] = (current, (position, symbol))
                 queue.append(pair)
-    return True, pairing, len(seen)
+    return True, pairing, len(seen), []
 
 
 # -- the whole region ----------------------------------------------------------------------------
@@ -658,7 +675,7 @@ def check_region(region_root: BTNode, machine: FSM, declared: dict[str, str]) ->
         raise NotPerNode(str(exc)) from None
     region = _Region(tree, machine, declared)
     interfaces: dict[int, Interface] = {}
-    memo: dict[tuple[Any, ...], tuple[bool, dict[int, Any], int, bool]] = {}
+    memo: dict[tuple[Any, ...], tuple[bool, dict[int, Any], int, list[Any], bool]] = {}
     haltable: set[int] = set()
     outcome = PerNodeOutcome(equivalent=True, nodes=len(tree.nodes))
     for node in reversed(tree.nodes):
@@ -687,12 +704,13 @@ def check_region(region_root: BTNode, machine: FSM, declared: dict[str, str]) ->
             memo[key] = found
             outcome.distinct += 1
             outcome.local_states += found[2]
-        equivalent, pairing, _states, can_halt = found
+        equivalent, pairing, _states, local_trace, can_halt = found
         if can_halt:
             haltable.add(node.id)
         if not equivalent:
             outcome.equivalent = False
             outcome.failed = f"{node.type} '{node.label}' at {node.path or 'the root'}"
+            outcome.failed_id, outcome.trace, outcome.tree = node.id, local_trace, tree
             return outcome
         interfaces[node.id] = _real_exits(local, pairing)
     root = interfaces[0]

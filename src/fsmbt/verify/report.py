@@ -34,7 +34,10 @@ COMPOSITIONAL = "compositional"
 #: the same, with regions written per node checked node by node against the interpreter over
 #: abstract children (``fsmbt.verify.pernode``; docs/semantics.md §4d)
 PER_NODE = "compositional (per node)"
-METHODS = (WHOLE_PRODUCT, TABLE, CANONICAL, SYMBOLIC, COMPOSITIONAL, PER_NODE)
+#: a NOT EQUIVALENT verdict whose counterexample the per-node check found locally and
+#: ``fsmbt.verify.lift`` lifted to the whole tree and confirmed by replay (not always shortest)
+PER_NODE_LIFTED = "per node, lifted"
+METHODS = (WHOLE_PRODUCT, TABLE, CANONICAL, SYMBOLIC, COMPOSITIONAL, PER_NODE, PER_NODE_LIFTED)
 
 
 @dataclass
