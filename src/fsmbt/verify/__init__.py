@@ -194,7 +194,8 @@ def _compositional(
     compositional``) when the pair decomposes into regions and every local check holds within
     its budget (``attempt_seconds``); ``None`` otherwise, and the whole product decides (and
     explains a difference). A pair with a single region is left to the whole product before
-    any part is checked (the same product, done once). The
+    any part is checked (the same product, done once), unless that region was written per node
+    (its per-node check, ``verify/pernode.py``, is not the whole product). The
     string says why a local check failed (the whole product then gives the verdict), else
     ``""``. Inside ``certificate.collecting()`` the parts' witnesses are left in ``sink``."""
     if not (isinstance(source, BTDocument) and isinstance(result, FSM)):
