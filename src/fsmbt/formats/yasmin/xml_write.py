@@ -242,29 +242,59 @@ def _transitions(machine: FSM, state: State, element: etree._Element, *, complet
 
 
 def _concurrence(state: State, parent: etree._Element, tag: str) -> etree._Element:
-    element = etree.SubElement(parent, tag)
-    element.set("name", state.name)
     default = state.attrs.get(A_DEFAULT)
     outcome_map = json.loads(state.attrs[A_MAP])
-    outcomes = list(dict.fromkeys([*([default] if default else []), *(o for o, _ in outcome_map)]))
-    element.set("outcomes", _outcome_list(sorted(outcomes), f"Concurrence '{state.name}'"))
-    if default:
-        element.set("default_outcome", default)
-    _annotate(element, state.attrs)
+    element, outcomes = _concurrence_element(
+        state, parent, tag, default, outcome_map, f"Concurrence '{state.name}'"
+    )
     children = json.loads(state.attrs.get(A_CHILDREN, "[]"))
     infos = json.loads(state.attrs.get(A_CHILD_INFO, "{}"))
     for label, cls, _outcomes in children:
         info = infos.get(label, {})
-        child_tag = "JoinState" if info.get(A_TAG) == "JoinState" else "State"
-        child = etree.SubElement(element, child_tag)
-        child.set("name", label)
-        if child_tag == "State":
-            kind = info.get(A_TYPE, "py")
-            child.set("type", kind)
-            if kind == "py":
-                child.set("module", info.get(A_MODULE, DEFAULT_MODULE))
-            child.set("class", info.get(state_info.CLASS, cls))
-        _annotate(child, info)
+        if info.get(A_TAG) == "JoinState":
+            child = etree.SubElement(element, "JoinState")
+            child.set("name", label)
+            _annotate(child, info)
+        else:
+            _leaf_child(element, label, cls, info)
+    _finals_and_map(element, outcomes, outcome_map)
+    return element
+
+
+def _concurrence_element(
+    state: State,
+    parent: etree._Element,
+    tag: str,
+    default: str | None,
+    outcome_map: list[Any],
+    where: str,
+) -> tuple[etree._Element, list[str]]:
+    """The concurrence's element with its name, outcomes (the default first, then the map's),
+    default outcome and annotations; and those outcomes."""
+    element = etree.SubElement(parent, tag)
+    element.set("name", state.name)
+    outcomes = list(dict.fromkeys([*([default] if default else []), *(o for o, _ in outcome_map)]))
+    element.set("outcomes", _outcome_list(sorted(outcomes), where))
+    if default:
+        element.set("default_outcome", default)
+    _annotate(element, state.attrs)
+    return element, outcomes
+
+
+def _leaf_child(element: etree._Element, label: str, cls: str, info: dict[str, str]) -> None:
+    """A leaf child ``<State>`` of a concurrence: its type, module and class, annotated."""
+    child = etree.SubElement(element, "State")
+    child.set("name", label)
+    kind = info.get(A_TYPE, "py")
+    child.set("type", kind)
+    if kind == "py":
+        child.set("module", info.get(A_MODULE, DEFAULT_MODULE))
+    child.set("class", info.get(state_info.CLASS, cls))
+    _annotate(child, info)
+
+
+def _finals_and_map(element: etree._Element, outcomes: list[str], outcome_map: list[Any]) -> None:
+    """A concurrence's ``<FinalOutcome>`` per outcome, then its ``<OutcomeMap>`` entries."""
     for outcome in outcomes:
         final = etree.SubElement(element, "FinalOutcome")
         final.set("name", outcome)
@@ -275,7 +305,6 @@ def _concurrence(state: State, parent: etree._Element, tag: str) -> etree._Eleme
             item = etree.SubElement(entry, "Item")
             item.set("state", label)
             item.set("outcome", child_outcome)
-    return element
 
 
 def _nested_spec(state: State) -> dict[str, Any] | None:
@@ -294,15 +323,11 @@ def _nested_concurrence(
 ) -> tuple[etree._Element, list[tuple[FSM, etree._Element, dict[str, str]]]]:
     """A Concurrence / OrthogonalState with container children, and its children's machines
     to write (``<Region>`` in an OrthogonalState, ``<StateMachine>`` in a Concurrence)."""
-    element = etree.SubElement(parent, tag)
-    element.set("name", state.name)
     default = spec.get("default")
     outcome_map = spec["outcome_map"]
-    outcomes = list(dict.fromkeys([*([default] if default else []), *(o for o, _ in outcome_map)]))
-    element.set("outcomes", _outcome_list(sorted(outcomes), f"{tag} '{state.name}'"))
-    if default:
-        element.set("default_outcome", default)
-    _annotate(element, state.attrs)
+    element, outcomes = _concurrence_element(
+        state, parent, tag, default, outcome_map, f"{tag} '{state.name}'"
+    )
     infos = json.loads(state.attrs.get(A_CHILD_INFO, "{}"))
     pending: list[tuple[FSM, etree._Element, dict[str, str]]] = []
     for label, cls, _outcomes in spec["children"]:
@@ -314,24 +339,8 @@ def _nested_concurrence(
             machine = fsm_from_dict(spec["machines"][label], where=f"child '{label}'")
             pending.append((machine, child, {**info, **machine.attrs}))
             continue
-        child = etree.SubElement(element, "State")
-        child.set("name", label)
-        kind = info.get(A_TYPE, "py")
-        child.set("type", kind)
-        if kind == "py":
-            child.set("module", info.get(A_MODULE, DEFAULT_MODULE))
-        child.set("class", info.get(state_info.CLASS, cls))
-        _annotate(child, info)
-    for outcome in outcomes:
-        final = etree.SubElement(element, "FinalOutcome")
-        final.set("name", outcome)
-    for outcome, required in outcome_map:
-        entry = etree.SubElement(element, "OutcomeMap")
-        entry.set("outcome", outcome)
-        for label, child_outcome in required.items():
-            item = etree.SubElement(entry, "Item")
-            item.set("state", label)
-            item.set("outcome", child_outcome)
+        _leaf_child(element, label, cls, info)
+    _finals_and_map(element, outcomes, outcome_map)
     return element, pending
 
 
