@@ -54,7 +54,6 @@ distinct canonical problem (a few hundred pairs each).
 
 from __future__ import annotations
 
-import ast
 import re
 from collections import deque
 from collections.abc import Callable
@@ -74,6 +73,7 @@ from fsmbt.semantics.bt_interpreter import (
     LeafRequest,
 )
 from fsmbt.semantics.compiled import FAILURE, RUNNING, SUCCESS, Work
+from fsmbt.verify.subset_expr import ForeignName, OutsideSubset, compile_subset
 
 #: The tag the per-node conversion writes (``convert.bt_pernode.NODE_ATTR``; the SCXML
 #: writer's fsmbt namespace in Clark notation).
@@ -122,27 +122,6 @@ class PerNodeOutcome:
 
 
 # -- expressions (fsmbt's subset: literals, names, ==, !=, <, <=, >, >=, and, or, x + 1) -------
-_ALLOWED = (
-    ast.Expression,
-    ast.BoolOp,
-    ast.And,
-    ast.Or,
-    ast.Compare,
-    ast.Eq,
-    ast.NotEq,
-    ast.Lt,
-    ast.LtE,
-    ast.Gt,
-    ast.GtE,
-    ast.Name,
-    ast.Load,
-    ast.Constant,
-    ast.BinOp,
-    ast.Add,
-    ast.UnaryOp,
-    ast.USub,
-    ast.Not,
-)
 
 
 _COMPILED: dict[tuple[str, tuple[tuple[str, str], ...]], Any] = {}
@@ -162,19 +141,11 @@ def _compile(text: str, names: dict[str, str]) -> tuple[str, Callable[[dict[str,
 
 def _compile_new(text: str, names: dict[str, str]) -> tuple[str, Callable[[dict[str, Any]], Any]]:
     try:
-        tree = ast.parse(text.strip(), mode="eval")
-    except SyntaxError:
+        return compile_subset(text, rename=names)
+    except OutsideSubset:
         raise NotPerNode(f"expression {text!r} is not in fsmbt's subset") from None
-    for node in ast.walk(tree):
-        if not isinstance(node, _ALLOWED):
-            raise NotPerNode(f"expression {text!r} is not in fsmbt's subset")
-        if isinstance(node, ast.Name) and node.id not in ("True", "False"):
-            if node.id not in names:
-                raise NotPerNode(f"expression {text!r} reads {node.id}, not the node's own")
-            node.id = names[node.id]
-    canonical = ast.unparse(tree)
-    code = compile(tree, "<pernode>", "eval")
-    return canonical, lambda env: eval(code, {"__builtins__": {}}, env)  # noqa: S307
+    except ForeignName as exc:
+        raise NotPerNode(f"expression {text!r} reads {exc.name}, not the node's own") from None
 
 
 def _literal(text: str) -> Any:
