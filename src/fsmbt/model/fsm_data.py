@@ -26,6 +26,7 @@ layer needs no import from above. Cost of ``has_data``: O(1).
 
 from __future__ import annotations
 
+import ast
 import importlib
 import re
 from collections.abc import Callable
@@ -40,6 +41,33 @@ ASSIGN = "fsmbt:assign"
 ONEXIT = "fsmbt:onexit"
 #: The data model dialect the expressions are written in.
 DIALECT = "python"
+
+#: The Python syntax-tree node kinds of the expressions fsmbt writes (literals, names,
+#: comparisons, ``and``/``or``/``not``, unary minus, ``+`` and ``-``): what the readers that
+#: compile such an expression to Python (the SMACH writer's userdata code, the checkers'
+#: evaluators in ``verify/subset_expr.py``) accept, node by node, and nothing else.
+SUBSET_NODES: tuple[type[ast.AST], ...] = (
+    ast.Expression,
+    ast.Name,
+    ast.Load,
+    ast.Constant,
+    ast.Compare,
+    ast.Eq,
+    ast.NotEq,
+    ast.Lt,
+    ast.LtE,
+    ast.Gt,
+    ast.GtE,
+    ast.BoolOp,
+    ast.And,
+    ast.Or,
+    ast.UnaryOp,
+    ast.Not,
+    ast.USub,
+    ast.BinOp,
+    ast.Add,
+    ast.Sub,
+)
 
 _expander: Callable[[FSM], FSM] | None = None
 

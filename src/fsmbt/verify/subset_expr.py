@@ -17,28 +17,10 @@ import ast
 from collections.abc import Callable, Mapping
 from typing import Any
 
-#: The node kinds of the subset (``ast.Sub`` only where asked: ``subtract=True``).
-SUBSET_NODES: tuple[type[ast.AST], ...] = (
-    ast.Expression,
-    ast.BoolOp,
-    ast.And,
-    ast.Or,
-    ast.Compare,
-    ast.Eq,
-    ast.NotEq,
-    ast.Lt,
-    ast.LtE,
-    ast.Gt,
-    ast.GtE,
-    ast.Name,
-    ast.Load,
-    ast.Constant,
-    ast.BinOp,
-    ast.Add,
-    ast.UnaryOp,
-    ast.USub,
-    ast.Not,
-)
+from fsmbt.model.fsm_data import SUBSET_NODES
+
+#: The subset without ``-`` (``subtract=False``): fsmbt's converters write only ``x + 1``.
+_NO_SUBTRACT = tuple(kind for kind in SUBSET_NODES if kind is not ast.Sub)
 
 Evaluator = Callable[[dict[str, Any]], Any]
 
@@ -71,7 +53,7 @@ def compile_subset(
         OutsideSubset: a syntax error or a node kind outside the subset.
         ForeignName: a name ``rename`` does not cover.
     """
-    allowed = (*SUBSET_NODES, ast.Sub) if subtract else SUBSET_NODES
+    allowed = SUBSET_NODES if subtract else _NO_SUBTRACT
     try:
         tree = ast.parse(text.strip(), mode="eval")
     except SyntaxError:

@@ -39,35 +39,20 @@ from dataclasses import dataclass, field
 
 from fsmbt.model.errors import UnsupportedError
 from fsmbt.model.fsm import FSM, State, Transition
-from fsmbt.model.fsm_data import ASSIGN, COND, DATAMODEL, ONEXIT, has_data, parse_lines
+from fsmbt.model.fsm_data import (
+    ASSIGN,
+    COND,
+    DATAMODEL,
+    ONEXIT,
+    SUBSET_NODES,
+    has_data,
+    parse_lines,
+)
 
 #: The outcome of a reset state.
 DONE = "done"
 #: ``State.attrs`` key marking a generated state (its class source, for the writer).
 A_CODE = "fsmbt:smach.code"
-
-_ALLOWED = (
-    ast.Expression,
-    ast.Name,
-    ast.Load,
-    ast.Constant,
-    ast.Compare,
-    ast.Eq,
-    ast.NotEq,
-    ast.Lt,
-    ast.LtE,
-    ast.Gt,
-    ast.GtE,
-    ast.BoolOp,
-    ast.And,
-    ast.Or,
-    ast.UnaryOp,
-    ast.Not,
-    ast.USub,
-    ast.BinOp,
-    ast.Add,
-    ast.Sub,
-)
 
 
 @dataclass
@@ -105,7 +90,7 @@ def python_code(expr: str, names: set[str], where: str) -> str:
             f"SMACH: {where}: '{expr}' is not an expression fsmbt writes as code"
         ) from None
     for node in ast.walk(tree):
-        if not isinstance(node, _ALLOWED):
+        if not isinstance(node, SUBSET_NODES):
             raise UnsupportedError(
                 f"SMACH: {where}: '{expr}' uses {type(node).__name__}, which fsmbt does not "
                 "write as code (names, literals, comparisons, and/or/not, + and -)"
