@@ -328,6 +328,44 @@ struct Context
   std::uint64_t leaf_ticks = 0;          ///< LEBT leaf ticks so far (a cost counter)
 };
 
+namespace detail {
+
+/// The `params` port of a state leaf (`LebtState`, `DispatchEntry`) decoded; a malformed one
+/// is a load error naming the leaf.
+inline Parameters paramsPort(const BT::NodeConfig& config, const std::string& name,
+                             const char* type)
+{
+  try
+  {
+    return decodeParams(literalPort(config, name, type, "params"));
+  }
+  catch(const std::invalid_argument& exc)
+  {
+    throw LebtError(std::string("<") + type + " name=\"" + name + "\"> (" + config.path +
+                    "): port 'params': " + exc.what());
+  }
+}
+
+/// A state leaf's entry, the same in both forms: count the leaf tick, run the state's action
+/// (recorded, and the user's callback with the state's label and parameters when one is
+/// bound), make the state current.
+inline void enterState(Context& context, const std::string& state, const std::string& action,
+                       const Parameters& params, const ActionCallback* callback)
+{
+  ++context.leaf_ticks;
+  if(!action.empty())
+  {
+    context.actions_run.push_back(action);
+    if(callback != nullptr)
+    {
+      (*callback)(state, params);
+    }
+  }
+  context.state = state;
+}
+
+}  // namespace detail
+
 /// `LebtGuard`: FAILURE when (state, event) is one of its pairs, else SUCCESS.
 class LebtGuard : public BT::ConditionNode
 {
@@ -407,15 +445,7 @@ public:
     {
       exits_.insert(std::move(exit));
     }
-    try
-    {
-      params_ = decodeParams(detail::literalPort(config, name, kStateType, "params"));
-    }
-    catch(const std::invalid_argument& exc)
-    {
-      throw LebtError(std::string("<LebtState name=\"") + name + "\"> (" + config.path +
-                      "): port 'params': " + exc.what());
-    }
+    params_ = detail::paramsPort(config, name, kStateType);
   }
 
   static BT::PortsList providedPorts()
@@ -439,16 +469,7 @@ public:
 protected:
   BT::NodeStatus onStart() override
   {
-    ++context_->leaf_ticks;
-    if(!action_.empty())
-    {
-      context_->actions_run.push_back(action_);
-      if(callback_ != nullptr)
-      {
-        (*callback_)(state_, params_);
-      }
-    }
-    context_->state = state_;
+    detail::enterState(*context_, state_, action_, params_, callback_);
     context_->event.clear();
     return final_ ? BT::NodeStatus::SUCCESS : BT::NodeStatus::RUNNING;
   }
@@ -643,15 +664,7 @@ public:
   {
     state_ = detail::literalPort(config, name, kDispatchType, "state");
     action_ = detail::literalPort(config, name, kDispatchType, "action");
-    try
-    {
-      params_ = decodeParams(detail::literalPort(config, name, kDispatchType, "params"));
-    }
-    catch(const std::invalid_argument& exc)
-    {
-      throw LebtError(std::string("<DispatchEntry name=\"") + name + "\"> (" + config.path +
-                      "): port 'params': " + exc.what());
-    }
+    params_ = detail::paramsPort(config, name, kDispatchType);
   }
 
   static BT::PortsList providedPorts()
@@ -671,16 +684,7 @@ public:
 protected:
   BT::NodeStatus tick() override
   {
-    ++context_->leaf_ticks;
-    if(!action_.empty())
-    {
-      context_->actions_run.push_back(action_);
-      if(callback_ != nullptr)
-      {
-        (*callback_)(state_, params_);
-      }
-    }
-    context_->state = state_;
+    detail::enterState(*context_, state_, action_, params_, callback_);
     return BT::NodeStatus::SUCCESS;
   }
 
