@@ -29,9 +29,9 @@ from fsmbt.generate import random_fsm
 from fsmbt.model.fsm import FSM
 from fsmbt.runtime.cpp import DriverSession
 from fsmbt.semantics.machine import FINAL, FSMMachine
+from support.event_walks import event_walks
 
 REPO = Path(__file__).resolve().parents[2]
-UNKNOWN = "no_such_event"
 
 
 def _write_dispatch(fsm: FSM, tmp_path: Path) -> Path:
@@ -42,26 +42,12 @@ def _write_dispatch(fsm: FSM, tmp_path: Path) -> Path:
     return path
 
 
-def _sequences(machine: FSMMachine, rng: random.Random, count: int, length: int) -> list[list[str]]:
-    alphabet = [*machine.alphabet, UNKNOWN]
-    sequences = []
-    for _ in range(count):
-        events, state = [], machine.start()[0]
-        for _ in range(length):
-            active = list(machine.active_inputs(state))
-            event = rng.choice(active) if active and rng.random() < 0.8 else rng.choice(alphabet)
-            events.append(event)
-            state = machine.step(state, event)[0]
-        sequences.append(events)
-    return sequences
-
-
 def _differential(fsm: FSM, tmp_path: Path, driver: Path, seed: int, count: int = 6) -> int:
     """Run the three sides; return the number of macro steps compared."""
     tree = _write_dispatch(fsm, tmp_path)
     machine = FSMMachine(fsm)
     start_name = machine.start()[0] if fsm.initial_event is not None else None
-    sequences = _sequences(machine, random.Random(seed), count, 40)
+    sequences = event_walks(machine, random.Random(seed), count, 40)
     session = DriverSession(tree, driver=driver, start=start_name)
     runs = session.run(sequences)
     scxml = dumps(fsm, "scxml")

@@ -13,6 +13,7 @@ from fsmbt.formats import dumps
 from fsmbt.generate import random_fsm
 from fsmbt.runtime.cpp import DriverSession
 from fsmbt.semantics.machine import FINAL, FSMMachine
+from support.event_walks import event_walks
 
 
 @pytest.mark.parametrize(("shape", "n"), [("tree", 30), ("chain", 40), ("tree", 8)])
@@ -22,17 +23,7 @@ def test_dispatch_runs_like_the_fsm(driver: Path, tmp_path: Path, shape: str, n:
     tree = tmp_path / "dispatch.xml"
     tree.write_text(dumps(convert(fsm, style="dispatch").model, "btcpp"), encoding="utf-8")
     machine = FSMMachine(fsm)
-    rng = random.Random(n)
-    alphabet = [*machine.alphabet, "no_such_event"]
-    sequences = []
-    for _ in range(5):
-        events, state = [], machine.start()[0]
-        for _ in range(60):
-            active = list(machine.active_inputs(state))
-            event = rng.choice(active) if active and rng.random() < 0.8 else rng.choice(alphabet)
-            events.append(event)
-            state = machine.step(state, event)[0]
-        sequences.append(events)
+    sequences = event_walks(machine, random.Random(n), runs=5, length=60)
     runs = DriverSession(tree, driver=driver, dispatch=True).run(sequences)
     assert len(runs) == len(sequences)
     for events, run in zip(sequences, runs, strict=True):

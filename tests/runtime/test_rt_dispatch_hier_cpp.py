@@ -18,6 +18,7 @@ from fsmbt.model.fsm import FSM
 from fsmbt.runtime.cpp import DriverSession
 from fsmbt.semantics.machine import FINAL, FSMMachine
 from support.corpus import CORPUS
+from support.event_walks import event_walks
 
 KEPT = (
     "fsm/commons_scxml/state-01.scxml",
@@ -27,29 +28,13 @@ KEPT = (
 )
 
 
-def _sequences(machine: FSMMachine, seed: int, runs: int, length: int) -> list[list[str]]:
-    """Seeded walks: mostly events the state reacts to, sometimes any event or an unknown one."""
-    rng = random.Random(seed)
-    alphabet = [*machine.alphabet, "no_such_event"]
-    sequences = []
-    for _ in range(runs):
-        events, state = [], machine.start()[0]
-        for _ in range(length):
-            active = list(machine.active_inputs(state))
-            event = rng.choice(active) if active and rng.random() < 0.8 else rng.choice(alphabet)
-            events.append(event)
-            state = machine.step(state, event)[0]
-        sequences.append(events)
-    return sequences
-
-
 def _runs_like_the_source(fsm: FSM, driver: Path, tmp_path: Path, seed: int) -> None:
     result = convert(fsm, style="dispatch")
     assert result.stats.get("form") == "hierarchical", result.warnings
     tree = tmp_path / "hier_dispatch.xml"
     tree.write_text(dumps(result.model, "btcpp"), encoding="utf-8")
     machine = FSMMachine(fsm)
-    sequences = _sequences(machine, seed, runs=6, length=50)
+    sequences = event_walks(machine, random.Random(seed), runs=6, length=50)
     runs = DriverSession(tree, driver=driver, dispatch=True).run(sequences)
     assert len(runs) == len(sequences)
     for events, run in zip(sequences, runs, strict=True):

@@ -27,6 +27,7 @@ from fsmbt.formats import dumps
 from fsmbt.model.fsm import FSM
 from fsmbt.runtime.cpp import library_built, library_prefix
 from fsmbt.semantics.machine import FINAL, FSMMachine
+from support.event_walks import event_walks
 
 REPO = Path(__file__).resolve().parents[2]
 PAPER = REPO / "examples" / "paper_fsm.json"
@@ -166,15 +167,7 @@ def _expected(machine: FSMMachine, events: list[str]) -> list[str]:
 def test_built_skeleton_runs_the_paper_machine_like_the_fsm(binary: tuple[Path, Path]) -> None:
     program, _root = binary
     machine = FSMMachine(_paper())
-    rng = random.Random(23)
-    alphabet = [*machine.alphabet, "no_such_event"]
-    for _ in range(15):
-        events, state = [], machine.start()[0]
-        for _ in range(25):
-            active = list(machine.active_inputs(state))
-            event = rng.choice(active) if active and rng.random() < 0.8 else rng.choice(alphabet)
-            events.append(event)
-            state = machine.step(state, event)[0]
+    for events in event_walks(machine, random.Random(23), runs=15, length=25):
         proc = subprocess.run(
             [str(program)], input="\n".join(events) + "\n", capture_output=True, text=True
         )
