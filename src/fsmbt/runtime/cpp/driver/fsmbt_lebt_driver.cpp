@@ -44,6 +44,10 @@
 //                    table holds every transition the logger was given; it turns SQLite's
 //                    `synchronous` off for the file (one commit per transition otherwise syncs
 //                    the disk each time) and sets a busy timeout, which change no content.
+//                    Its destructor can also hang for ever (a lost wakeup, see
+//                    CountingSqliteLogger::finish), so once every row is stored the driver
+//                    disables the logger and never destroys it: the rows are committed, the
+//                    process exit closes the file.
 //
 // Scripted mode (any BehaviorTree.CPP v4 tree, not only an LEBT; no stdin):
 //   --scripted SEED  every leaf type named in --conditions (returns SUCCESS or FAILURE) and
@@ -587,7 +591,18 @@ public:
     execSqlStatement("PRAGMA busy_timeout = 10000;");
   }
 
-  ~CountingSqliteLogger() override { waitStored(); }
+  /// End the log: wait until every transition given is stored, then stop logging. Call it, then
+  /// leave the object alive until the process exits (Loggers does): BehaviorTree.CPP 4.8.2's
+  /// ~SqliteLogger stores `loop_ = false` and notifies its writer without holding the queue
+  /// mutex, so a writer between its wait predicate and its wait misses the wakeup and the
+  /// destructor's join() never returns (a CI run of test_mutants_db3_logs_against_the_source
+  /// timed out so under load). Every row is committed by then (one autocommit per INSERT), so
+  /// skipping the destructor loses nothing but its `PRAGMA optimize`.
+  void finish()
+  {
+    waitStored();
+    setEnabled(false);  // halts at the tree's destruction are not logged, as before
+  }
 
   void callback(BT::Duration timestamp, const BT::TreeNode& node, BT::NodeStatus prev_status,
                 BT::NodeStatus status) override
@@ -640,7 +655,8 @@ private:
 #endif
 
 /// The loggers --btlog and --db3 ask for, attached to `tree` while this object lives (destroy it
-/// before the tree: each destructor writes what is left).
+/// before the tree: each destructor writes what is left; the SQLite logger is finished and then
+/// deliberately left alive until the process exits, see CountingSqliteLogger::finish).
 class Loggers
 {
 public:
@@ -659,6 +675,20 @@ public:
                                "(BTCPP_SQLITE_LOGGING=OFF); rebuild with scripts/build_btcpp.sh");
 #endif
     }
+  }
+
+  Loggers(const Loggers&) = delete;
+  Loggers& operator=(const Loggers&) = delete;
+
+  ~Loggers()
+  {
+#ifdef FSMBT_HAS_SQLITE_LOGGER
+    if(sqlite_)
+    {
+      sqlite_->finish();
+      static_cast<void>(sqlite_.release());  // left alive on purpose: see finish()
+    }
+#endif
   }
 
 private:
