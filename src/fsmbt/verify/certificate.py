@@ -28,7 +28,9 @@ How it is checked (``check``), in time linear in the certificate (one machine st
    decomposition is derived again from the models (``compositional.structure``: its side
    conditions checked, its regions compared with the claimed ones), each region's machines and
    the skeleton's are built by the same functions the check used, the skeleton's from the
-   pairing the region units name and the results their replayed tables reach;
+   pairing the region units name and the results their replayed tables reach; for a region
+   proven per node, ``pernode.NodeWalk`` derives which local checks exist and each unit's
+   machines are ``pernode.local_machines`` of the nodes it covers (every one covered once);
 3. each unit's tables are replayed: from the start, every listed edge is one ``step``; a state
    met for the first time gets the next id, which must be the one the certificate names; every
    state's description, status and offered inputs must be the listed ones, and its listed edges
@@ -43,7 +45,8 @@ starts, so every input sequence gets the same outputs, statuses and offered inpu
 all five properties hold for that unit's pair (reachability: the relation is closed under every
 offered input, so it covers every reachable state); for a compositional proof the units add up
 by docs/semantics.md §4c. A not-equivalent certificate is checked by replaying each
-counterexample on both machines (``fsmbt.verify.native.replay``): at least one must differ.
+counterexample on both machines (``fsmbt.verify.native.replay``): at least one must differ
+(for a lifted per-node counterexample, on the machines the lift confirmed it on).
 """
 
 from __future__ import annotations
