@@ -50,6 +50,13 @@ RUNNING with its own entry (the next tick), each without assignment. Then (the c
 
 Cost: O(states + transitions · depth) to group and canonicalize, plus one local product per
 distinct canonical problem (a few hundred pairs each).
+
+For a certificate (``fsmbt.verify.certificate``, docs/verification.md §6) the proof and the
+checker share two public pieces: ``NodeWalk`` (which local checks exist, children first, and
+the interfaces they settle) and ``local_machines`` (one local problem as two
+``semantics.machine.Machine`` objects for the native checker, σ fixed). With ``keep``,
+``check_region`` checks each distinct local problem that held once more on those machines and
+keeps the witness (about doubling the per-node proof's time).
 """
 
 from __future__ import annotations
@@ -638,7 +645,8 @@ BT_UNPROVEN_HALT = "⟪tree halts an unproven child⟫"
 FSM_UNPROVEN_HALT = "⟪fragment halts an unproven child⟫"
 UNPAIRED = "⟪status without an exit⟫ {}"
 STATUS_OF = {name: status for status, name in EVENTS.items()}
-#: σ as plain data: status name -> (canonical exit target id, canonical assignment ids).
+#: σ as plain data: status (``compiled.SUCCESS``...) -> (canonical exit target id, canonical
+#: assignment ids), the ids of ``_Local.exits``.
 Sigma = dict[int, tuple[int, tuple[int, ...]]]
 
 
