@@ -9,16 +9,20 @@ from __future__ import annotations
 
 import copy
 import random
+from collections import Counter
 
 import pytest
 
 from fsmbt import api
 from fsmbt.cli import main
+from fsmbt.convert.bt_to_hfsm import bt_to_hfsm
 from fsmbt.model.errors import InputError
 from fsmbt.verify import certificate
+from fsmbt.verify.compositional import compositional_report
 from fsmbt.verify.report import PER_NODE, PER_NODE_LIFTED
 from support.pernode_certs import FAMILIES, SOURCE, certify, family_pair, recheck
 from support.pernode_mutants import mutate, whole
+from support.pernode_trees import pernode_tree
 
 PERNODE = certificate.PERNODE
 STATUSES = ("success", "failure", "running")
@@ -43,6 +47,30 @@ def test_a_per_node_proof_gets_a_certificate_that_checks(family: str) -> None:
         assert checked.equivalent and checked.method == PER_NODE
         assert checked.units[PERNODE] == len(units)
         assert checked.pairs == certificate.relation_pairs(data)
+
+
+def test_a_certificate_changes_no_verdict_on_seeded_small_trees() -> None:
+    """The bench families and every kind ``convert/bt_pernode`` writes (Async*, Parallel,
+    ParallelAll, loops with -1): with a certificate the method is the one without, the local
+    machines never disagree with the proof's lockstep product (the guard that would refuse the
+    region), and every certificate checks."""
+    rng = random.Random(5)
+    tally: Counter[str] = Counter()
+    for index in range(160):
+        if index % 2:
+            doc = pernode_tree(rng.randint(2, 7), 1000 + index)
+            model = bt_to_hfsm(doc, pernode=True).model
+        else:
+            doc, model = family_pair(FAMILIES[index // 2 % 4], rng.randint(2, 12), 1000 + index)
+        plain, _why = compositional_report(doc, model)
+        report, data = certify(doc, model)
+        assert not [r for r in report.stats.get("per_node_refused", []) if "local machines" in r]
+        if plain is not None:
+            assert report.method == plain.method
+        tally[report.method] += 1
+        assert report.equivalent and recheck(data, doc, model).equivalent
+    print(f"\n[certificates on small trees] {dict(tally)}")
+    assert tally[PER_NODE] >= 120
 
 
 def test_a_certificate_does_not_make_a_large_proof_fall_back() -> None:
