@@ -56,7 +56,7 @@ def test_a_certificate_changes_no_verdict_on_seeded_small_trees() -> None:
     region), and every certificate checks."""
     rng = random.Random(5)
     tally: Counter[str] = Counter()
-    for index in range(160):
+    for index in range(120):
         if index % 2:
             doc = pernode_tree(rng.randint(2, 7), 1000 + index)
             model = bt_to_hfsm(doc, pernode=True).model
@@ -70,7 +70,7 @@ def test_a_certificate_changes_no_verdict_on_seeded_small_trees() -> None:
         tally[report.method] += 1
         assert report.equivalent and recheck(data, doc, model).equivalent
     print(f"\n[certificates on small trees] {dict(tally)}")
-    assert tally[PER_NODE] >= 120
+    assert tally[PER_NODE] >= 90
 
 
 def test_a_certificate_does_not_make_a_large_proof_fall_back() -> None:
@@ -249,6 +249,8 @@ def test_a_lifted_not_equivalent_certificate_replays() -> None:
         with pytest.raises(certificate.CertificateError):
             recheck(forged, doc, mutant)
         found += 1
+        if found == 2:
+            break
     assert found >= 2
 
 
