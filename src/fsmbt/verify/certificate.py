@@ -555,6 +555,26 @@ def check_unit(
 def _check_compositional(
     data: dict[str, Any], source: FSM | BTDocument, result: FSM | BTDocument, checked: Checked
 ) -> None:
+    """A ``compositional`` proof: ``region`` units and the skeleton (``_check_parts``)."""
+    _check_parts(data, source, result, checked, per_node=False)
+
+
+def _check_pernode(
+    data: dict[str, Any], source: FSM | BTDocument, result: FSM | BTDocument, checked: Checked
+) -> None:
+    """A ``compositional (per node)`` proof: as ``compositional``, with at least one region
+    certified by ``pernode`` units (``_check_pernode_region``)."""
+    _check_parts(data, source, result, checked, per_node=True)
+
+
+def _check_parts(
+    data: dict[str, Any],
+    source: FSM | BTDocument,
+    result: FSM | BTDocument,
+    checked: Checked,
+    *,
+    per_node: bool,
+) -> None:
     """Re-derive the decomposition from the models, check each region unit on the machines
     ``compositional.region_machines`` builds for the pair it names (or, for a region proven
     per node, its ``pernode`` units: ``_check_pernode_region``), then the skeleton unit on
@@ -588,34 +608,34 @@ def _check_compositional(
     tree_of_state: dict[int, int] = {}
     results: dict[int, frozenset[str]] = {}
     states = {"source": 0, "result": 0}
-    per_node: dict[tuple[int, int], list[dict[str, Any]]] = {}
+    by_region: dict[tuple[int, int], list[dict[str, Any]]] = {}
     order: list[tuple[int, int, dict[str, Any] | None]] = []
     for unit in units[:-1]:
         kind = unit.get("kind")
-        if kind not in (REGION, PERNODE) or (kind == PERNODE and checked.method != PER_NODE):
+        if kind not in (REGION, PERNODE) or (kind == PERNODE and not per_node):
             raise CertificateError(
                 f"a {checked.method} proof has {REGION!r}"
-                + (f" or {PERNODE!r}" if checked.method == PER_NODE else "")
+                + (f" or {PERNODE!r}" if per_node else "")
                 + " units, then the skeleton"
             )
         k, j = int(unit["tree_region"]), int(unit["fsm_region"])
         if not (0 <= k < len(shape.regions) and 0 <= j < len(shape.machine_regions)):
             raise CertificateError(f"a region unit names no region ({k}, {j})")
         if kind == PERNODE:
-            if (k, j) not in per_node:
-                per_node[(k, j)] = []
+            if (k, j) not in by_region:
+                by_region[(k, j)] = []
                 order.append((k, j, None))
-            per_node[(k, j)].append(unit)
+            by_region[(k, j)].append(unit)
         else:
             order.append((k, j, unit))
-    if checked.method == PER_NODE and not per_node:
+    if per_node and not by_region:
         raise CertificateError(f"a {PER_NODE} proof has at least one {PERNODE!r} unit")
     for k, j, unit in order:
         if j in tree_of_state or k in results:
             raise CertificateError(f"a region is paired twice ({k}, {j})")
         name = f"region {shape.regions[k].label} ~ state {shape.machine_regions[j].path}"
         if unit is None:
-            possible = _check_pernode_region(per_node[(k, j)], shape, k, j, name, checked, states)
+            possible = _check_pernode_region(by_region[(k, j)], shape, k, j, name, checked, states)
         else:
             src, res, pairs = check_unit(unit, *region_machines(shape, k, j), name)
             possible = src.results()
@@ -628,9 +648,9 @@ def _check_compositional(
     _count(checked, states, src, res, pairs)
     checked.states = states
     regions_whole = sum(1 for _k, _j, unit in order if unit is not None)
-    checked.units = {REGION: regions_whole} if regions_whole or not per_node else {}
-    if per_node:
-        checked.units[PERNODE] = sum(len(found) for found in per_node.values())
+    checked.units = {REGION: regions_whole} if regions_whole or not by_region else {}
+    if by_region:
+        checked.units[PERNODE] = sum(len(found) for found in by_region.values())
     checked.units[SKELETON] = 1
 
 
@@ -729,4 +749,4 @@ def _count(checked: Checked, states: dict[str, int], src: _Table, res: _Table, p
 #: method proved on one product is checked by ``_check_whole``).
 METHOD_CHECKS: dict[
     str, Callable[[dict[str, Any], FSM | BTDocument, FSM | BTDocument, Checked], None]
-] = {COMPOSITIONAL: _check_compositional, PER_NODE: _check_compositional}
+] = {COMPOSITIONAL: _check_compositional, PER_NODE: _check_pernode}
