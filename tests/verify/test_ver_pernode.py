@@ -19,14 +19,11 @@ from pathlib import Path
 from fsmbt import limits
 from fsmbt.convert.bt_to_hfsm import bt_to_hfsm
 from fsmbt.model.bt import BTDocument
-from fsmbt.model.errors import FsmbtError
-from fsmbt.model.fsm import FSM
-from fsmbt.model.fsm_data import ASSIGN, COND, parse_lines
+from fsmbt.model.fsm_data import ASSIGN, parse_lines
 from fsmbt.verify import verify
 from fsmbt.verify.compositional import compositional_report
-from fsmbt.verify.native import check
-from fsmbt.verify.pairing import machines_for
 from fsmbt.verify.report import PER_NODE
+from support.pernode_mutants import BOUND, mutate, pernode_machine, whole
 from support.pernode_trees import pernode_tree
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))
@@ -46,51 +43,6 @@ def trees(count: int, seed: int) -> list[BTDocument]:
             family = FAMILIES[(index // 2) % len(FAMILIES)]
             found.append(family_tree(family, leaves, seed * 10_000 + index))
     return found
-
-
-def pernode_machine(model: FSM) -> FSM | None:
-    for _path, _machine, state in model.walk():
-        if state.regions and state.regions[0].name.startswith("pernode_"):
-            return state.regions[0]
-    return None
-
-
-def mutate(model: FSM, rng: random.Random) -> FSM | None:
-    """One transition of the first per-node sub-machine changed (``None``: nothing to do)."""
-    mutant = copy.deepcopy(model)
-    sub = pernode_machine(mutant)
-    if sub is None:
-        return None
-    t = rng.choice(sub.transitions)
-    operator = rng.choice(("retarget", "guard", "assignment", "value"))
-    pairs = parse_lines(t.attrs.get(ASSIGN, ""))
-    if operator == "guard" and COND in t.attrs:
-        del t.attrs[COND]
-    elif operator in ("assignment", "value") and pairs:
-        i = rng.randrange(len(pairs))
-        if operator == "assignment":
-            del pairs[i]
-        else:
-            pairs[i] = (pairs[i][0], "1" if pairs[i][1] != "1" else "0")
-        t.attrs[ASSIGN] = "\n".join(f"{n}={e}" for n, e in pairs)
-        if not pairs:
-            del t.attrs[ASSIGN]
-    else:
-        t.target = rng.choice([s for s in sub.states if s != t.target])
-    return mutant
-
-
-#: Most states per machine or product here: a mutant may blow a machine up (seconds each).
-BOUND = 4_000
-
-
-def whole(doc: BTDocument, model: FSM) -> bool | None:
-    try:
-        with limits.changed(conversion_max_states=BOUND):  # the data expansion too
-            source, result, _mode = machines_for(doc, model)
-            return check(source, result, max_states=BOUND).equivalent
-    except FsmbtError:
-        return None  # an eventless cycle without a leaf (not a machine), or past BOUND
 
 
 def test_per_node_agrees_with_the_whole_product_on_mutants() -> None:

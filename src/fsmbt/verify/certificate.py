@@ -28,7 +28,9 @@ How it is checked (``check``), in time linear in the certificate (one machine st
    decomposition is derived again from the models (``compositional.structure``: its side
    conditions checked, its regions compared with the claimed ones), each region's machines and
    the skeleton's are built by the same functions the check used, the skeleton's from the
-   pairing the region units name and the results their replayed tables reach;
+   pairing the region units name and the results their replayed tables reach; for a region
+   proven per node, ``pernode.NodeWalk`` derives which local checks exist and each unit's
+   machines are ``pernode.local_machines`` of the nodes it covers (every one covered once);
 3. each unit's tables are replayed: from the start, every listed edge is one ``step``; a state
    met for the first time gets the next id, which must be the one the certificate names; every
    state's description, status and offered inputs must be the listed ones, and its listed edges
@@ -43,7 +45,8 @@ starts, so every input sequence gets the same outputs, statuses and offered inpu
 all five properties hold for that unit's pair (reachability: the relation is closed under every
 offered input, so it covers every reachable state); for a compositional proof the units add up
 by docs/semantics.md §4c. A not-equivalent certificate is checked by replaying each
-counterexample on both machines (``fsmbt.verify.native.replay``): at least one must differ.
+counterexample on both machines (``fsmbt.verify.native.replay``): at least one must differ
+(for a lifted per-node counterexample, on the machines the lift confirmed it on).
 """
 
 from __future__ import annotations
@@ -66,24 +69,37 @@ from fsmbt.semantics.execution import Flavour, flavour_of
 from fsmbt.semantics.machine import Machine
 from fsmbt.verify.compositional import (
     LEAF_EXECUTION,
+    PERNODE_UNIT,
     NotDecomposable,
     Parts,
+    Structure,
     final_results,
     region_machines,
     results_allowed,
     skeleton_machines,
     structure,
 )
+from fsmbt.verify.lazy_fsm import Unsupported
+from fsmbt.verify.lift import lift_machines, separates
 from fsmbt.verify.method import describe_method
 from fsmbt.verify.native import Witness, replay
 from fsmbt.verify.pairing import machines_for
-from fsmbt.verify.report import COMPOSITIONAL, Report
+from fsmbt.verify.pernode import (
+    EVENTS,
+    STATUS_OF,
+    LocalProblem,
+    NodeWalk,
+    NotPerNode,
+    Sigma,
+    local_machines,
+)
+from fsmbt.verify.report import COMPOSITIONAL, PER_NODE, PER_NODE_LIFTED, Report
 
 FORMAT = "fsmbt-certificate/2"
 #: The first format: one whole-product proof at the top level (read as one ``product`` unit).
 FORMAT_1 = "fsmbt-certificate/1"
 #: The unit kinds of the methods this module checks.
-PRODUCT, REGION, SKELETON = "product", "region", "skeleton"
+PRODUCT, REGION, SKELETON, PERNODE = "product", "region", "skeleton", PERNODE_UNIT
 
 
 class CertificateError(InputError):
@@ -188,8 +204,15 @@ def build(
         units: list[dict[str, Any]] = []
         for part in parts.units:
             unit: dict[str, Any] = {"kind": part.kind}
-            if part.kind == REGION:
+            if part.kind in (REGION, PERNODE):
                 unit["tree_region"], unit["fsm_region"] = part.tree_region, part.fsm_region
+            if part.kind == PERNODE:
+                unit["nodes"] = list(part.nodes)
+                unit["interface"] = {
+                    EVENTS[status]: [target, list(assigns)]
+                    for status, (target, assigns) in sorted(part.sigma.items())
+                }
+                unit["halt"] = part.can_halt
             unit.update(part.witness.to_data())
             units.append(unit)
         data["units"] = units
@@ -281,6 +304,8 @@ def check(
     try:
         if by_parts is not None and checked.equivalent:
             by_parts(data, source, result, checked)
+        elif claimed == PER_NODE_LIFTED and not checked.equivalent:
+            _check_lifted(data, source, result, checked)
         else:
             _check_whole(data, source, result, checked)
     except (KeyError, IndexError, TypeError, ValueError, AttributeError) as exc:
@@ -319,6 +344,32 @@ def _check_whole(
     checked.pairs = pairs
     checked.steps = src.steps + res.steps
     checked.units = {PRODUCT: 1}
+
+
+def _check_lifted(
+    data: dict[str, Any], source: FSM | BTDocument, result: FSM | BTDocument, checked: Checked
+) -> None:
+    """A not-equivalent verdict whose counterexample the per-node check found and
+    ``verify/lift.py`` lifted: it must replay, and tell the two models apart, on the machines
+    the lift confirmed it on (``lift.lift_machines``: the interpreter's leaf machine and the
+    result's data machine expanded lazily, so a large result is not flattened)."""
+    if not isinstance(source, BTDocument) or not isinstance(result, FSM):
+        raise CertificateError("a lifted counterexample is of a behavior tree against a machine")
+    if data.get("mode") != LEAF_EXECUTION or data.get("loop"):
+        raise CertificateError(f"a lifted counterexample is in mode {LEAF_EXECUTION}, no loop")
+    try:
+        source_machine, result_machine = lift_machines(source, result)
+    except Unsupported as exc:
+        raise CertificateError(f"the result cannot be replayed lazily: {exc}") from None
+    traces = data["counterexamples"]
+    if not traces:
+        raise CertificateError("a not-equivalent certificate without a counterexample")
+    for inputs in traces.values():
+        run = replay(source_machine, result_machine, [str(symbol) for symbol in inputs])
+        checked.steps += len(inputs)
+        if separates(run):  # a difference that is not the source refusing its input
+            return
+    raise CertificateError("no counterexample of the certificate tells the two models apart")
 
 
 def _check_counterexamples(
@@ -500,15 +551,38 @@ def check_unit(
     return src, res, len(relation)
 
 
-# -- a compositional proof (docs/semantics.md §4c) --------------------------------------------
+# -- a compositional proof (docs/semantics.md §4c), its regions whole or per node (§4d) -------
 def _check_compositional(
     data: dict[str, Any], source: FSM | BTDocument, result: FSM | BTDocument, checked: Checked
 ) -> None:
+    """A ``compositional`` proof: ``region`` units and the skeleton (``_check_parts``)."""
+    _check_parts(data, source, result, checked, per_node=False)
+
+
+def _check_pernode(
+    data: dict[str, Any], source: FSM | BTDocument, result: FSM | BTDocument, checked: Checked
+) -> None:
+    """A ``compositional (per node)`` proof: as ``compositional``, with at least one region
+    certified by ``pernode`` units (``_check_pernode_region``)."""
+    _check_parts(data, source, result, checked, per_node=True)
+
+
+def _check_parts(
+    data: dict[str, Any],
+    source: FSM | BTDocument,
+    result: FSM | BTDocument,
+    checked: Checked,
+    *,
+    per_node: bool,
+) -> None:
     """Re-derive the decomposition from the models, check each region unit on the machines
-    ``compositional.region_machines`` builds for the pair it names, then the skeleton unit on
+    ``compositional.region_machines`` builds for the pair it names (or, for a region proven
+    per node, its ``pernode`` units: ``_check_pernode_region``), then the skeleton unit on
     the machines ``compositional.skeleton_machines`` builds from those pairs and the results
     the replayed region tables reach. Every side condition of §4c is checked here again:
-    structural ones by ``structure``, (2) by ``results_allowed``, (1) and (3) by the units."""
+    structural ones by ``structure``, (2) by ``results_allowed``, (1) and (3) by the units.
+    A ``compositional`` proof has no ``pernode`` unit; a ``compositional (per node)`` one has
+    at least one."""
     if not isinstance(source, BTDocument) or not isinstance(result, FSM):
         raise CertificateError(
             "a compositional proof is of a behavior tree against a state machine"
@@ -534,26 +608,134 @@ def _check_compositional(
     tree_of_state: dict[int, int] = {}
     results: dict[int, frozenset[str]] = {}
     states = {"source": 0, "result": 0}
+    by_region: dict[tuple[int, int], list[dict[str, Any]]] = {}
+    order: list[tuple[int, int, dict[str, Any] | None]] = []
     for unit in units[:-1]:
-        if unit.get("kind") != REGION:
-            raise CertificateError(f"a compositional proof has {REGION!r} units, then the skeleton")
+        kind = unit.get("kind")
+        if kind not in (REGION, PERNODE) or (kind == PERNODE and not per_node):
+            raise CertificateError(
+                f"a {checked.method} proof has {REGION!r}"
+                + (f" or {PERNODE!r}" if per_node else "")
+                + " units, then the skeleton"
+            )
         k, j = int(unit["tree_region"]), int(unit["fsm_region"])
         if not (0 <= k < len(shape.regions) and 0 <= j < len(shape.machine_regions)):
             raise CertificateError(f"a region unit names no region ({k}, {j})")
+        if kind == PERNODE:
+            if (k, j) not in by_region:
+                by_region[(k, j)] = []
+                order.append((k, j, None))
+            by_region[(k, j)].append(unit)
+        else:
+            order.append((k, j, unit))
+    if per_node and not by_region:
+        raise CertificateError(f"a {PER_NODE} proof has at least one {PERNODE!r} unit")
+    for k, j, unit in order:
         if j in tree_of_state or k in results:
             raise CertificateError(f"a region is paired twice ({k}, {j})")
         name = f"region {shape.regions[k].label} ~ state {shape.machine_regions[j].path}"
-        src, res, pairs = check_unit(unit, *region_machines(shape, k, j), name)
-        possible = src.results()
+        if unit is None:
+            possible = _check_pernode_region(by_region[(k, j)], shape, k, j, name, checked, states)
+        else:
+            src, res, pairs = check_unit(unit, *region_machines(shape, k, j), name)
+            possible = src.results()
+            _count(checked, states, src, res, pairs)
         if not results_allowed(possible, shape, j):
             raise CertificateError(f"{name}: the region ends in {sorted(possible)}")
         tree_of_state[j], results[k] = k, possible
-        _count(checked, states, src, res, pairs)
     machines = skeleton_machines(source, result, shape, tree_of_state, results)
     src, res, pairs = check_unit(units[-1], *machines, SKELETON)
     _count(checked, states, src, res, pairs)
     checked.states = states
-    checked.units = {REGION: len(units) - 1, SKELETON: 1}
+    regions_whole = sum(1 for _k, _j, unit in order if unit is not None)
+    checked.units = {REGION: regions_whole} if regions_whole or not by_region else {}
+    if by_region:
+        checked.units[PERNODE] = sum(len(found) for found in by_region.values())
+    checked.units[SKELETON] = 1
+
+
+def _check_pernode_region(
+    units: list[dict[str, Any]],
+    shape: Structure,
+    k: int,
+    j: int,
+    name: str,
+    checked: Checked,
+    states: dict[str, int],
+) -> frozenset[str]:
+    """A region proven per node (docs/semantics.md §4d): the local checks are re-derived from
+    the two models by ``pernode.NodeWalk`` (the same walk the proof made), each must be
+    covered by exactly one unit, and each unit is replayed once (``check_unit``) on the
+    ``pernode.local_machines`` of the first node it covers, with the σ and ``halt`` it
+    claims; the other nodes it covers must have the same canonical problem (memo key). The
+    statuses σ pairs must be exactly those the replayed tree side returns. The region's
+    results are its root's interface. Cost: one grouping of the region, one fragment
+    canonicalization per node, one table replay per unit."""
+    try:
+        walk = NodeWalk(shape.regions[k], shape.machine_regions[j].machine, shape.declared)
+    except NotPerNode as exc:
+        raise CertificateError(f"{name}: not a per-node decomposition ({exc})") from None
+    owner: dict[str, int] = {}
+    for index, unit in enumerate(units):
+        listed = [str(path) for path in unit["nodes"]]
+        if not listed:
+            raise CertificateError(f"{name}: a {PERNODE!r} unit covers no node")
+        for path in listed:
+            if path in owner:
+                raise CertificateError(f"{name}: node {path!r} is covered twice")
+            owner[path] = index
+    keys: dict[int, tuple[Any, ...]] = {}
+    covered: set[str] = set()
+    try:
+        for problem in walk.problems():
+            path = problem.node.path
+            where = f"{name}, node {problem.node.label} at {path or 'the root'}"
+            if path not in owner:
+                raise CertificateError(f"{where}: no unit covers its local check")
+            index = owner[path]
+            covered.add(path)
+            unit = units[index]
+            sigma = _sigma(unit["interface"])
+            can_halt = bool(unit["halt"])
+            if index not in keys:
+                _check_local_unit(unit, problem, sigma, can_halt, where, checked, states)
+                keys[index] = problem.key
+            elif keys[index] != problem.key:
+                raise CertificateError(f"{where}: not the local problem its unit was checked on")
+            walk.settle(problem, sigma, can_halt)
+        possible = walk.root_results()
+    except NotPerNode as exc:
+        raise CertificateError(f"{name}: {exc}") from None
+    extra = sorted(set(owner) - covered)
+    if extra:
+        raise CertificateError(f"{name}: units cover nodes with no local check ({extra[:3]})")
+    return possible
+
+
+def _sigma(data: dict[str, Any]) -> Sigma:
+    return {
+        STATUS_OF[str(status)]: (int(exit_[0]), tuple(int(a) for a in exit_[1]))
+        for status, exit_ in data.items()
+    }
+
+
+def _check_local_unit(
+    unit: dict[str, Any],
+    problem: LocalProblem,
+    sigma: Sigma,
+    can_halt: bool,
+    where: str,
+    checked: Checked,
+    states: dict[str, int],
+) -> None:
+    tree_side, fragment = local_machines(problem, sigma, can_halt)
+    src, res, pairs = check_unit(unit, tree_side, fragment, where)
+    if set(sigma) != tree_side.exited:
+        raise CertificateError(
+            f"{where}: the interface pairs {sorted(EVENTS[s] for s in sigma)}, the node returns "
+            f"{sorted(EVENTS[s] for s in tree_side.exited)}"
+        )
+    _count(checked, states, src, res, pairs)
 
 
 def _count(checked: Checked, states: dict[str, int], src: _Table, res: _Table, pairs: int) -> None:
@@ -567,4 +749,4 @@ def _count(checked: Checked, states: dict[str, int], src: _Table, res: _Table, p
 #: method proved on one product is checked by ``_check_whole``).
 METHOD_CHECKS: dict[
     str, Callable[[dict[str, Any], FSM | BTDocument, FSM | BTDocument, Checked], None]
-] = {COMPOSITIONAL: _check_compositional}
+] = {COMPOSITIONAL: _check_compositional, PER_NODE: _check_pernode}

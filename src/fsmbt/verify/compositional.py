@@ -75,7 +75,13 @@ from fsmbt.semantics.status import LeafOutcome, RootResult
 from fsmbt.verify.lift import lifted_report
 from fsmbt.verify.method import PER_NODE_SENTENCE
 from fsmbt.verify.native import DEFAULT_MAX_STATES, StateLimitError, check_witnessed
-from fsmbt.verify.pernode import NODE_ATTR, NotPerNode, PerNodeOutcome, check_region
+from fsmbt.verify.pernode import (
+    NODE_ATTR,
+    LocalWitness,
+    NotPerNode,
+    PerNodeOutcome,
+    check_region,
+)
 from fsmbt.verify.report import COMPOSITIONAL, PER_NODE, PROPERTIES, PropertyResult, Report
 
 SUCCESS, FAILURE = RootResult.SUCCESS.value, RootResult.FAILURE.value
@@ -570,16 +576,25 @@ def skeleton_machines(
     return LeafMachine(bt_skeleton), FSMLeafMachine(fsm_skeleton)
 
 
+#: The kind of a certificate unit that is one distinct local check of a region proven per node.
+PERNODE_UNIT = "pernode"
+
+
 @dataclass
 class Part:
     """One local check of a compositional proof, kept for a certificate: its kind
-    (``region`` or ``skeleton``), the native checker's witness and, for a region, the tree
-    region ``k`` and region state ``j`` it pairs."""
+    (``region``, ``pernode`` or ``skeleton``), the native checker's witness and, for a region
+    or a per-node check, the tree region ``k`` and region state ``j`` it pairs; for a per-node
+    check, the paths of the nodes it stands for, σ (status -> canonical exit) and whether it
+    held with ``halt`` offered (``verify/pernode.py``)."""
 
     kind: str
     witness: Any
     tree_region: int = -1
     fsm_region: int = -1
+    nodes: list[str] = field(default_factory=list)
+    sigma: dict[int, tuple[int, tuple[int, ...]]] = field(default_factory=dict)
+    can_halt: bool = False
 
 
 @dataclass
@@ -628,9 +643,7 @@ def decompose(
         int(fsm_token[len("⟪state ") : -1]): int(tree_token[len("⟪unit ") : -1])
         for fsm_token, tree_token in pairs.items()
     }
-    per_node_possible = keep is None and any(
-        _tagged_per_node(machine_regions[j].machine) for j in tree_of_state
-    )
+    per_node_possible = any(_tagged_per_node(machine_regions[j].machine) for j in tree_of_state)
     if len(tree_of_state) < min_regions and not per_node_possible:
         raise NotDecomposable(
             f"{len(tree_of_state)} region(s) paired: the whole product is the same check"
@@ -643,21 +656,25 @@ def decompose(
         k = tree_of_state.get(j)
         if k is None:
             continue
-        if keep is None:  # a per-node proof has no certificate unit: with one asked, whole
-            per_node = _per_node(regions[k], region.machine, shape.declared, outcome)
-            if per_node is not None:  # proven (or refuted) node by node (verify/pernode.py)
-                if not per_node.equivalent:
-                    outcome.equivalent = False
-                    outcome.failed_region = (
-                        f"{regions[k].label} (state {region.path}), node {per_node.failed}"
-                    )
-                    outcome.per_node_failure = (regions[k], per_node)
-                    return outcome
-                possible = per_node.results
-                if not results_allowed(possible, shape, j):
-                    raise NotDecomposable(f"region {regions[k].label} ends in {sorted(possible)}")
-                results[k] = possible
-                continue
+        local: list[LocalWitness] | None = [] if keep is not None else None
+        per_node = _per_node(regions[k], region.machine, shape.declared, outcome, local)
+        if per_node is not None:  # proven (or refuted) node by node (verify/pernode.py)
+            if not per_node.equivalent:
+                outcome.equivalent = False
+                outcome.failed_region = (
+                    f"{regions[k].label} (state {region.path}), node {per_node.failed}"
+                )
+                outcome.per_node_failure = (regions[k], per_node)
+                return outcome
+            possible = per_node.results
+            if not results_allowed(possible, shape, j):
+                raise NotDecomposable(f"region {regions[k].label} ends in {sorted(possible)}")
+            results[k] = possible
+            if keep is not None and local is not None:  # one unit per distinct local check
+                keep.units.extend(
+                    Part(PERNODE_UNIT, w.witness, k, j, w.nodes, w.sigma, w.can_halt) for w in local
+                )
+            continue
         bt_region, fsm_region = region_machines(shape, k, j)
         try:
             report, witness = check_witnessed(
@@ -718,14 +735,19 @@ def _tagged_per_node(machine: FSM) -> bool:
 
 
 def _per_node(
-    region_root: BTNode, machine: FSM, declared: dict[str, str], outcome: Decomposition
+    region_root: BTNode,
+    machine: FSM,
+    declared: dict[str, str],
+    outcome: Decomposition,
+    keep: list[LocalWitness] | None = None,
 ) -> PerNodeOutcome | None:
     """The per-node check of one region (``verify/pernode.py``) when its machine is tagged
-    per node and decomposes; ``None``: check the region whole."""
+    per node and decomposes; ``None``: check the region whole. With ``keep``, the distinct
+    local checks' witnesses are appended (for a certificate)."""
     if not _tagged_per_node(machine):
         return None
     try:
-        found = check_region(region_root, machine, declared)
+        found = check_region(region_root, machine, declared, keep)
     except NotPerNode as exc:
         outcome.stats.setdefault("per_node_refused", []).append(str(exc))
         return None

@@ -416,6 +416,17 @@ LIFTED_SENTENCE = (
 )
 
 
+def lift_machines(source: BTDocument, result: FSM) -> tuple[Machine[Any], LazyDataMachine]:
+    """The two whole machines a lifted counterexample is confirmed on (and a certificate of it
+    replayed on): the interpreter's leaf machine of ``source`` and ``result``'s data machine
+    expanded lazily (a large result is never flattened).
+
+    Raises:
+        Unsupported: the result's data is outside what the lazy machine expands.
+    """
+    return leaf_machine(source), LazyDataMachine(result)
+
+
 def lifted_report(
     source: BTDocument, result: FSM, region: BTNode, failed: PerNodeOutcome
 ) -> Report | None:
@@ -439,8 +450,7 @@ def lifted_report(
     if inputs is None:
         return None
     try:
-        result_machine = LazyDataMachine(result)
-        found = confirm(leaf_machine(source), result_machine, inputs)
+        found = confirm(*lift_machines(source, result), inputs)
     except Unsupported:
         return None
     if found is None:

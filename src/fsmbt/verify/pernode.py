@@ -50,13 +50,20 @@ RUNNING with its own entry (the next tick), each without assignment. Then (the c
 
 Cost: O(states + transitions · depth) to group and canonicalize, plus one local product per
 distinct canonical problem (a few hundred pairs each).
+
+For a certificate (``fsmbt.verify.certificate``, docs/verification.md §6) the proof and the
+checker share two public pieces: ``NodeWalk`` (which local checks exist, children first, and
+the interfaces they settle) and ``local_machines`` (one local problem as two
+``semantics.machine.Machine`` objects for the native checker, σ fixed). With ``keep``,
+``check_region`` checks each distinct local problem that held once more on those machines and
+keeps the witness (about doubling the per-node proof's time).
 """
 
 from __future__ import annotations
 
 import re
 from collections import deque
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -73,6 +80,7 @@ from fsmbt.semantics.bt_interpreter import (
     LeafRequest,
 )
 from fsmbt.semantics.compiled import FAILURE, RUNNING, SUCCESS, Work
+from fsmbt.verify.native import check_witnessed
 from fsmbt.verify.subset_expr import ForeignName, OutsideSubset, compile_subset
 
 #: The tag the per-node conversion writes (``convert.bt_pernode.NODE_ATTR``; the SCXML
@@ -629,77 +637,329 @@ def _check_local(
     return True, pairing, len(seen), []
 
 
+# -- the local machines (for a certificate: the same problem as ``_check_local``) ------------
+#: Tokens only one side can output: a halt of a child whose halt was not proven (on the tree
+#: side, on the fragment's side) and a tree status without a partner in σ. Each makes the
+#: outputs differ, as ``_check_local`` fails there.
+BT_UNPROVEN_HALT = "⟪tree halts an unproven child⟫"
+FSM_UNPROVEN_HALT = "⟪fragment halts an unproven child⟫"
+UNPAIRED = "⟪status without an exit⟫ {}"
+STATUS_OF = {name: status for status, name in EVENTS.items()}
+#: σ as plain data: status (``compiled.SUCCESS``...) -> (canonical exit target id, canonical
+#: assignment ids), the ids of ``_Local.exits``.
+Sigma = dict[int, tuple[int, tuple[int, ...]]]
+
+
+def _exit_token(exit_: Any) -> str:
+    target, assigns = exit_
+    return "exit " + " ".join(str(x) for x in (target, *assigns))
+
+
+def _local_outputs(
+    halts: frozenset[int], bad: str | None, event: tuple[str, Any]
+) -> tuple[str, ...]:
+    found = [f"halt {i}" for i in sorted(halts)]
+    if bad is not None:
+        found.append(bad)
+    kind, what = event
+    if kind == "tick":
+        found.append(f"tick {what}")
+    elif kind == "exit":
+        found.append(what)
+    return tuple(found)
+
+
+class _LocalInputs:
+    """The inputs both local machines offer: ``tick`` (and ``halt``) between ticks, child
+    i's statuses (as leaf outcomes) while child i runs; one tuple per position (shared)."""
+
+    def __init__(self, allowed: list[list[int]], with_halt: bool) -> None:
+        self.between: tuple[str, ...] = ("tick", "halt") if with_halt else ("tick",)
+        self.at = [tuple(EVENTS[s] for s in a) for a in allowed]
+
+    def of(self, position: int | None) -> tuple[str, ...]:
+        return self.between if position is None else self.at[position]
+
+
+class LocalTreeMachine:
+    """The tree side of one local problem as a ``semantics.machine.Machine``: fsmbt's
+    interpreter on the node over abstract children (``_BtSide``), statuses mapped to exits by
+    a given σ. ``exited``: the statuses its steps have returned (what σ must cover)."""
+
+    def __init__(self, problem: LocalProblem, sigma: Sigma, with_halt: bool) -> None:
+        self.name = f"node {problem.node.label}"
+        self.bt = _BtSide(_abstract_tree(problem.node, [RUNNING in a for a in problem.allowed]))
+        self.halting = problem.local.halting
+        self.never = problem.never
+        self.sigma = {s: _exit_token(e) for s, e in sigma.items()}
+        self.offered = _LocalInputs(problem.allowed, with_halt)
+        self.exited: set[int] = set()
+
+    def start(self) -> tuple[Any, tuple[str, ...]]:
+        return (self.bt.interp.initial(), None), ()
+
+    def inputs(self, state: Any) -> tuple[str, ...]:
+        return self.offered.of(state[1])
+
+    def step(self, state: Any, symbol: str) -> tuple[Any, tuple[str, ...]]:
+        snap, _position = state
+        if symbol == "halt":
+            new_snap, halted = self.bt.halt(snap)
+            bad = BT_UNPROVEN_HALT if halted & self.never else None
+            return (new_snap, None), _local_outputs(halted & self.halting, bad, ("none", None))
+        if symbol == "tick":
+            nxt, out = self.bt.run(self.bt.interp.begin_tick(snap), None)
+        else:
+            nxt, out = self.bt.run(snap, STATUS_OF[symbol])
+        halted, (kind, what) = out
+        bad = BT_UNPROVEN_HALT if halted & self.never else None
+        if kind == "exit":
+            self.exited.add(what)
+            event: tuple[str, Any] = ("exit", self.sigma.get(what, UNPAIRED.format(what)))
+        else:
+            event = ("tick", what)
+        return nxt, _local_outputs(halted & self.halting, bad, event)
+
+    def status(self, state: Any) -> str:
+        return "running"
+
+    def describe(self, state: Any) -> str:
+        return "between ticks" if state[1] is None else f"at child {state[1]}"
+
+
+class LocalFragmentMachine:
+    """The machine side of one local problem as a ``semantics.machine.Machine``: the node's
+    fragment with each child replaced by its interface (``_FsmSide``); a configuration is
+    (position, own values, children that returned RUNNING last)."""
+
+    def __init__(self, problem: LocalProblem, with_halt: bool) -> None:
+        self.name = f"fragment of {problem.node.label}"
+        self.local = problem.local
+        self.fsm = _FsmSide(problem.local)
+        self.never = problem.never
+        self.offered = _LocalInputs(problem.allowed, with_halt)
+
+    def start(self) -> tuple[Any, tuple[str, ...]]:
+        return (None, self.local.initial, frozenset()), ()
+
+    def inputs(self, state: Any) -> tuple[str, ...]:
+        return self.offered.of(state[0])
+
+    def step(self, state: Any, symbol: str) -> tuple[Any, tuple[str, ...]]:
+        position, fvalues, frunning = state
+        values = dict(fvalues)
+        running = set(frunning)
+        local = self.local
+        if symbol == "halt":
+            values.update(local.halt)
+            bad = FSM_UNPROVEN_HALT if running & self.never else None
+            halts = frozenset(i for i in running if i in local.halting)
+            cleared: tuple[Any, ...] = (None, tuple(sorted(values.items())), frozenset())
+            return cleared, _local_outputs(halts, bad, ("none", None))
+        if symbol == "tick":
+            hop = local.entry
+        else:
+            status = STATUS_OF[symbol]
+            hop = local.children[position][status]
+            running.discard(position)
+            if status == RUNNING:
+                running.add(position)
+        fpos, (halted, (kind, what), touched) = self.fsm.resolve(hop, values, running)
+        bad = FSM_UNPROVEN_HALT if touched & self.never else None
+        event = ("exit", _exit_token(what)) if kind == "exit" else ("tick", what)
+        nxt = (fpos, tuple(sorted(values.items())), frozenset(running))
+        return nxt, _local_outputs(halted, bad, event)
+
+    def status(self, state: Any) -> str:
+        return "running"
+
+    def describe(self, state: Any) -> str:
+        return "between ticks" if state[0] is None else f"at child {state[0]}"
+
+
+def local_machines(
+    problem: LocalProblem, sigma: Sigma, with_halt: bool
+) -> tuple[LocalTreeMachine, LocalFragmentMachine]:
+    """The two machines of ``problem`` (tree side first) for the native checker: equivalent
+    exactly when ``_check_local`` holds with this ``with_halt`` and pairs statuses as ``sigma``
+    does (outputs: the halts of halting children, the child ticked or the exit; a halt of an
+    unproven child or an unpaired status is a token only one side outputs). Cost: one
+    interpreter step or one fragment resolution per machine step."""
+    return LocalTreeMachine(problem, sigma, with_halt), LocalFragmentMachine(problem, with_halt)
+
+
+def sigma_exits(local: _Local, pairing: dict[int, Any]) -> Sigma:
+    """σ as ``local_machines`` takes it (canonical exits) from ``_check_local``'s pairing."""
+    return {status: (int(t), tuple(int(a) for a in ids)) for status, (t, ids) in pairing.items()}
+
+
+# -- which local checks exist: the bottom-up walk -----------------------------------------------
+@dataclass
+class LocalProblem:
+    """One node's local check: the node, its fragment over abstract children (canonically
+    named), the statuses each child may return, the children whose halt was proven and the
+    memo key (equal keys, equal problems: checked once)."""
+
+    node: CompiledNode
+    local: _Local
+    allowed: list[list[int]]
+    halts: frozenset[int]
+    key: tuple[Any, ...]
+
+    @property
+    def never(self) -> frozenset[int]:
+        """The children whose halt was not proven (a halt of one fails the check)."""
+        return frozenset(range(len(self.allowed))) - self.halts
+
+
+class NodeWalk:
+    """The local checks of a region written per node, in the order they must be decided
+    (children first): ``problems()`` yields each live control node's ``LocalProblem``; the
+    caller settles it (``settle``: its σ and whether it held with ``halt`` offered) before
+    the next. Leaves and dead nodes (never entered) are settled from the machine alone.
+    ``verify`` (``check_region``) and ``fsmbt.verify.certificate`` both walk it, so both
+    decide the same local checks. Cost: O(states + transitions · depth) to group, plus the
+    canonicalization of each node's fragment.
+
+    Raises:
+        NotPerNode: the machine is not a valid per-node decomposition of the region.
+    """
+
+    def __init__(self, region_root: BTNode, machine: FSM, declared: dict[str, str]) -> None:
+        try:
+            # the same-type merge of plain Sequence/Fallback children (docs/semantics.md §4d,
+            # lemma M: it keeps the leaf-execution machine), so that the nodes are the machine's
+            merged = inline_and_compress(BTDocument.single(region_root)).compression.root
+            self.tree = CompiledTree(BTDocument.single(merged))
+        except FsmbtError as exc:
+            raise NotPerNode(str(exc)) from None
+        self.region = _Region(self.tree, machine, declared)
+        self.interfaces: dict[int, Interface] = {}
+        self.haltable: set[int] = set()
+
+    def problems(self) -> Iterator[LocalProblem]:
+        region, interfaces = self.region, self.interfaces
+        for node in reversed(self.tree.nodes):
+            if node.id not in region.entry:  # dead: never ticked by the machine
+                interfaces[node.id] = {}
+                self.haltable.add(node.id)
+                continue
+            if node.is_env_leaf and not node.children:
+                state = region.leaf_state[node.id]
+                interface: Interface = {}
+                for t in region.out[state]:
+                    status = STATUS_OF[t.event]
+                    interface[status] = (t.target, tuple(region.assigns[id(t)]))
+                interfaces[node.id] = interface
+                self.haltable.add(node.id)  # a leaf's halt is its halt hook: nothing is kept
+                continue
+            local = _local(region, node, interfaces)
+            allowed = [sorted(interfaces[c]) for c in node.children]
+            halts = frozenset(i for i, c in enumerate(node.children) if c in self.haltable)
+            key = (local.key, tuple(tuple(a) for a in allowed), tuple(sorted(halts)))
+            yield LocalProblem(node, local, allowed, halts, key)
+            if node.id not in interfaces:
+                raise NotPerNode(f"the local check of {node.label} was not settled")
+
+    def settle(self, problem: LocalProblem, sigma: Sigma, can_halt: bool) -> None:
+        """Record ``problem``'s node as proven with interface σ (canonical exits)."""
+        if can_halt:
+            self.haltable.add(problem.node.id)
+        self.interfaces[problem.node.id] = _real_exits(problem.local, sigma)
+
+    def root_results(self) -> frozenset[str]:
+        """The region's results, once every node is settled; the root's interface must be the
+        finals' (SUCCESS, FAILURE) and its own entry (RUNNING), without assignment.
+
+        Raises:
+            NotPerNode: the root returns a status elsewhere.
+        """
+        root = self.interfaces[0]
+        wanted = {
+            SUCCESS: (END_SUCCESS, ()),
+            FAILURE: (END_FAILURE, ()),
+            RUNNING: (self.region.entry[0], ()),
+        }
+        for status, exit_ in root.items():
+            if wanted[status] != exit_:
+                raise NotPerNode(f"the region's root returns {EVENTS[status]} elsewhere")
+        return frozenset(
+            {SUCCESS: END_SUCCESS, FAILURE: END_FAILURE}[s] for s in root if s != RUNNING
+        )
+
+
+@dataclass
+class LocalWitness:
+    """One distinct local check kept for a certificate: the nodes it stands for (their paths
+    in the merged region), σ (canonical), whether it held with ``halt`` offered, and the
+    native checker's witness on ``local_machines``."""
+
+    nodes: list[str]
+    sigma: Sigma
+    can_halt: bool
+    witness: Any
+
+
 # -- the whole region ----------------------------------------------------------------------------
-def check_region(region_root: BTNode, machine: FSM, declared: dict[str, str]) -> PerNodeOutcome:
+def check_region(
+    region_root: BTNode,
+    machine: FSM,
+    declared: dict[str, str],
+    keep: list[LocalWitness] | None = None,
+) -> PerNodeOutcome:
     """Check ``machine`` (a region state's sub-machine, tagged per node) against the region
-    headed by ``region_root``, node by node (the module docstring).
+    headed by ``region_root``, node by node (the module docstring). With ``keep``, each
+    distinct local check that held is checked again by the native checker on
+    ``local_machines`` and its witness appended (for a certificate: one small product more
+    per distinct check).
 
     Raises:
         NotPerNode: the machine is not a valid per-node decomposition of this region.
     """
-    try:
-        # the same-type merge of plain Sequence/Fallback children (docs/semantics.md §4d,
-        # lemma M: it keeps the leaf-execution machine), so that the nodes are the machine's
-        merged = inline_and_compress(BTDocument.single(region_root)).compression.root
-        tree = CompiledTree(BTDocument.single(merged))
-    except FsmbtError as exc:
-        raise NotPerNode(str(exc)) from None
-    region = _Region(tree, machine, declared)
-    interfaces: dict[int, Interface] = {}
+    walk = NodeWalk(region_root, machine, declared)
     memo: dict[tuple[Any, ...], tuple[bool, dict[int, Any], int, list[Any], bool]] = {}
-    haltable: set[int] = set()
-    outcome = PerNodeOutcome(equivalent=True, nodes=len(tree.nodes))
-    for node in reversed(tree.nodes):
-        if node.id not in region.entry:  # dead: never ticked by the machine
-            interfaces[node.id] = {}
-            haltable.add(node.id)
-            continue
-        if node.is_env_leaf and not node.children:
-            state = region.leaf_state[node.id]
-            interface: Interface = {}
-            for t in region.out[state]:
-                status = {v: k for k, v in EVENTS.items()}[t.event]
-                interface[status] = (t.target, tuple(region.assigns[id(t)]))
-            interfaces[node.id] = interface
-            haltable.add(node.id)  # a leaf's halt is its halt hook: nothing of it is kept
-            continue
-        local = _local(region, node, interfaces)
-        allowed = [sorted(interfaces[c]) for c in node.children]
-        halts = frozenset(i for i, c in enumerate(node.children) if c in haltable)
-        key = (local.key, tuple(tuple(a) for a in allowed), tuple(sorted(halts)))
-        found = memo.get(key)
+    kept: dict[tuple[Any, ...], LocalWitness] = {}
+    outcome = PerNodeOutcome(equivalent=True, nodes=len(walk.tree.nodes))
+    for problem in walk.problems():
+        node = problem.node
+        found = memo.get(problem.key)
         if found is None:
-            found = (*_check_local(local, node, allowed, halts, with_halt=True), True)
+            found = (*_check_local(problem.local, node, problem.allowed, problem.halts, True), True)
             if not found[0]:  # proven for a node nobody halts, or not at all
-                found = (*_check_local(local, node, allowed, halts, with_halt=False), False)
-            memo[key] = found
+                found = (
+                    *_check_local(problem.local, node, problem.allowed, problem.halts, False),
+                    False,
+                )
+            memo[problem.key] = found
             outcome.distinct += 1
             outcome.local_states += found[2]
+            if keep is not None and found[0]:
+                kept[problem.key] = _witnessed(problem, found[1], found[4])
+                keep.append(kept[problem.key])
         equivalent, pairing, _states, local_trace, can_halt = found
-        if can_halt:
-            haltable.add(node.id)
         if not equivalent:
             outcome.equivalent = False
             outcome.failed = f"{node.type} '{node.label}' at {node.path or 'the root'}"
-            outcome.failed_id, outcome.trace, outcome.tree = node.id, local_trace, tree
+            outcome.failed_id, outcome.trace, outcome.tree = node.id, local_trace, walk.tree
             return outcome
-        interfaces[node.id] = _real_exits(local, pairing)
-    root = interfaces[0]
-    wanted = {
-        SUCCESS: (END_SUCCESS, ()),
-        FAILURE: (END_FAILURE, ()),
-        RUNNING: (region.entry[0], ()),
-    }
-    for status, exit_ in root.items():
-        if wanted[status] != exit_:
-            raise NotPerNode(f"the region's root returns {EVENTS[status]} elsewhere")
-    outcome.results = frozenset(
-        {SUCCESS: END_SUCCESS, FAILURE: END_FAILURE}[s] for s in root if s != RUNNING
-    )
+        if keep is not None:
+            kept[problem.key].nodes.append(node.path)
+        walk.settle(problem, sigma_exits(problem.local, pairing), can_halt)
+    outcome.results = walk.root_results()
     return outcome
 
 
-def _real_exits(local: _Local, pairing: dict[int, Any]) -> Interface:
+def _witnessed(problem: LocalProblem, pairing: dict[int, Any], can_halt: bool) -> LocalWitness:
+    """The native checker's witness of a local check that held (the certificate's unit)."""
+    sigma = sigma_exits(problem.local, pairing)
+    tree_side, fragment = local_machines(problem, sigma, can_halt)
+    report, witness = check_witnessed(tree_side, fragment, max_states=LOCAL_LIMIT)
+    if not report.equivalent:  # the two formulations of one local check disagree: a bug
+        raise NotPerNode(f"the local machines of {problem.node.label} are not equivalent")
+    return LocalWitness([], sigma, can_halt, witness)
+
+
+def _real_exits(local: _Local, pairing: Sigma) -> Interface:
     """σ_N in the machine's names: each status's exit target and outside assignments."""
     found: Interface = {}
     for status, (target_id, assign_ids) in pairing.items():

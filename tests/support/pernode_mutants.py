@@ -1,0 +1,66 @@
+"""One-transition mutants of the per-node sub-machines ``bt_to_hfsm`` writes, and the whole
+product's verdict on small pairs: shared by the per-node, lift and certificate tests.
+
+``mutate(model, rng)``: a copy of ``model`` with one transition of its first per-node
+sub-machine retargeted, its guard dropped, one assignment dropped or its value changed.
+``whole(doc, model)``: the whole-product verdict, ``None`` past ``BOUND`` states.
+"""
+
+from __future__ import annotations
+
+import copy
+import random
+
+from fsmbt import limits
+from fsmbt.model.bt import BTDocument
+from fsmbt.model.errors import FsmbtError
+from fsmbt.model.fsm import FSM
+from fsmbt.model.fsm_data import ASSIGN, COND, parse_lines
+from fsmbt.verify.native import check
+from fsmbt.verify.pairing import machines_for
+
+#: Most states per machine or product here: a mutant may blow a machine up (seconds each).
+BOUND = 4_000
+
+
+def pernode_machine(model: FSM) -> FSM | None:
+    """The first sub-machine the converter wrote per node (``None``: there is none)."""
+    for _path, _machine, state in model.walk():
+        if state.regions and state.regions[0].name.startswith("pernode_"):
+            return state.regions[0]
+    return None
+
+
+def mutate(model: FSM, rng: random.Random) -> FSM | None:
+    """One transition of the first per-node sub-machine changed (``None``: nothing to do)."""
+    mutant = copy.deepcopy(model)
+    sub = pernode_machine(mutant)
+    if sub is None:
+        return None
+    t = rng.choice(sub.transitions)
+    operator = rng.choice(("retarget", "guard", "assignment", "value"))
+    pairs = parse_lines(t.attrs.get(ASSIGN, ""))
+    if operator == "guard" and COND in t.attrs:
+        del t.attrs[COND]
+    elif operator in ("assignment", "value") and pairs:
+        i = rng.randrange(len(pairs))
+        if operator == "assignment":
+            del pairs[i]
+        else:
+            pairs[i] = (pairs[i][0], "1" if pairs[i][1] != "1" else "0")
+        t.attrs[ASSIGN] = "\n".join(f"{n}={e}" for n, e in pairs)
+        if not pairs:
+            del t.attrs[ASSIGN]
+    else:
+        t.target = rng.choice([s for s in sub.states if s != t.target])
+    return mutant
+
+
+def whole(doc: BTDocument, model: FSM) -> bool | None:
+    """The whole product's verdict on a small pair (``None``: not a machine, or past BOUND)."""
+    try:
+        with limits.changed(conversion_max_states=BOUND):  # the data expansion too
+            source, result, _mode = machines_for(doc, model)
+            return check(source, result, max_states=BOUND).equivalent
+    except FsmbtError:
+        return None  # an eventless cycle without a leaf (not a machine), or past BOUND
