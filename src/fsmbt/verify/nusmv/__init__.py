@@ -18,6 +18,7 @@ from fsmbt.model.errors import InputError
 from fsmbt.model.fsm import FSM
 from fsmbt.verify.nusmv.binary import NuSMVNotFound, find_nusmv, require_nusmv
 from fsmbt.verify.nusmv.encode_bt import LeafBTEncoder
+from fsmbt.verify.nusmv.encode_dispatch import encode_dispatch_pair
 from fsmbt.verify.nusmv.encode_fsm import FSMEncoder
 from fsmbt.verify.nusmv.runner import NuSMVError, NuSMVLimitError, SpecResult, run_nusmv
 from fsmbt.verify.nusmv.smv import Symbols
@@ -62,6 +63,9 @@ def encode(source: FSM | BTDocument, result: FSM | BTDocument, *, loop: bool = F
             outputs,
             MACRO_STEP,
         )
+    dispatch = encode_dispatch_pair(source, result, inputs, outputs)
+    if dispatch is not None:  # the dispatch form, by macro steps (docs/nusmv.md)
+        return (*dispatch, inputs, outputs, MACRO_STEP)
     if isinstance(source, FSM) and isinstance(result, BTDocument):
         from fsmbt.model.flatten import flatten
         from fsmbt.verify.nusmv.encode_lebt import LebtEncoder
