@@ -62,11 +62,11 @@ _PLUGIN_MODULES = (
 )
 
 
-def nusmv_refusal(result: ConversionResult) -> str:
-    """Why NuSMV's encoding of the dispatch form would refuse the tree written (the node and
+def nusmv_refusal(doc: Model) -> str:
+    """Why NuSMV's encoding of the dispatch form would refuse the tree ``doc`` (the node and
     the reason, ``fsmbt.semantics.dispatch_memoryless``), or ``""``. O(nodes)."""
-    assert isinstance(result.model, BTDocument)
-    refused = memory_refusal(OutcomeTree(result.model))
+    assert isinstance(doc, BTDocument)
+    refused = memory_refusal(OutcomeTree(doc))
     if refused is None:
         return ""
     node, why = refused
@@ -120,7 +120,7 @@ def rules_fsm_to_bt(
     if chosen == DISPATCH and check_style(style) == AUTO:
         try:
             written = fsm_to_dispatch(fsm, **options)
-            refused = nusmv_refusal(written) if checked_by_nusmv else ""
+            refused = nusmv_refusal(written.model) if checked_by_nusmv else ""
             if not refused:
                 return written
             not_dispatch = (
