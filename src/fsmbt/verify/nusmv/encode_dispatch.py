@@ -327,3 +327,15 @@ def encode_dispatch_pair(
     fsm_enc = FSMEncoder(fsm, fsm_side, inputs, outputs, alphabet=alphabet)
     tree_enc = DispatchEncoder(doc, tree_side, inputs, outputs, alphabet=alphabet)
     return (fsm_enc, tree_enc) if fsm_side == "source" else (tree_enc, fsm_enc)
+
+
+def one_step_per_input(source: FSM | BTDocument, result: FSM | BTDocument) -> bool:
+    """Both models are encoded as modules that take one step per input with no micro-steps
+    (an FSM, a dispatch tree beside an FSM): ``check`` then splits the invariants from the
+    CTL specs (docs/nusmv.md, "Two runs")."""
+    if isinstance(source, FSM) and isinstance(result, FSM):
+        return True
+    return any(
+        isinstance(a, FSM) and isinstance(b, BTDocument) and is_dispatch_bt(b)
+        for a, b in ((source, result), (result, source))
+    )
