@@ -93,6 +93,7 @@ class DispatchEncoder:
         self.inputs = inputs
         self.outputs = outputs
         self.alphabet = list(alphabet)
+        self._offered = frozenset(self.alphabet)
         inputs.add_all(self.alphabet)
         self.entries = parsed.entries  # node id -> (state port, action or None)
         self.writes: dict[int, dict[str, str]] = {}
@@ -113,11 +114,11 @@ class DispatchEncoder:
                 outputs.id(action)
         self._paths = self._entry_paths()
 
-    # -- one tick, over two algebras: SMV expressions and concrete values ---------------------
+    # -- one tick: as SMV expressions (the module) and on concrete values (the start tick) ------
     def _eq_smv(self, key: str, value: str) -> str:
         if key == EVENT_KEY:
             sid = self.inputs.to_id.get(value)
-            return "FALSE" if sid is None or value not in self.alphabet else f"inp = {sid}"
+            return "FALSE" if sid is None or value not in self._offered else f"inp = {sid}"
         found = self.keys.get(key)
         if found is None or value not in found[1].to_id:
             return "FALSE"
@@ -224,9 +225,8 @@ class DispatchEncoder:
         lines += [f"  o1 : {out_enum};", "  fin : boolean;", "DEFINE"]
         lines += [f"  {name} := {expr};" for name, expr in self._smv_tick()]
         lines += ["  stable := TRUE;", "  final := fin;"]
-        offered = set(self.alphabet)
         for symbol, sid in sorted(self.inputs.to_id.items()):
-            lines.append(f"  offers_{sid} := {'TRUE' if symbol in offered else 'FALSE'};")
+            lines.append(f"  offers_{sid} := {'TRUE' if symbol in self._offered else 'FALSE'};")
         lines.append("ASSIGN")
         for key, (var, table) in self.keys.items():
             rows = [
