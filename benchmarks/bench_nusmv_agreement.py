@@ -1,12 +1,16 @@
 """NuSMV against the native checker on many generated FSM ~ FSM pairs (issue 27, item 2).
 
     .venv/bin/python benchmarks/bench_nusmv_agreement.py [--pairs 1000]
-        [--sizes 5,10,20,50,100,300,1000] [--timeout 60] [--seed 27]
+        [--sizes 5,10,20,50,100,300,1000] [--timeout 60] [--seed 27] [--style fsm|dispatch]
 
 Pairs: ``--pairs`` random FSMs (``fsmbt.generate.generator.random_fsm``, sizes cycling through
 ``--sizes``), each against its renamed copy (``bench_checker.renamed``: equivalent) or, every
 other pair, a mutant of it (one transition retargeted: usually not equivalent). For each pair
 both engines decide the five properties; the pair *agrees* when every verdict is the same.
+``--style dispatch`` (docs/nusmv.md, "The dispatch form"): the result is the dispatch tree
+(``convert(..., style="dispatch")``) of the random FSM, against the FSM itself (equivalent) or,
+every other pair, against a mutant of the FSM (one transition retargeted); every fourth pair
+puts the tree first (dispatch source, FSM result), so both orders are compared.
 A NuSMV run past ``--timeout`` wall seconds is counted as *gave up* (the native verdict stands,
 as with ``--engine both``), never as agreement. Prints one line per size (pairs, agree,
 disagree, gave up, NuSMV CPU seconds total and largest) and the totals; exit 1 on any
@@ -28,7 +32,9 @@ sys.path.insert(0, str(Path(__file__).parent))
 from bench_checker import renamed  # noqa: E402
 
 from fsmbt import limits  # noqa: E402
+from fsmbt.convert import convert  # noqa: E402
 from fsmbt.generate.generator import random_fsm  # noqa: E402
+from fsmbt.model.bt import BTDocument  # noqa: E402
 from fsmbt.model.fsm import FSM  # noqa: E402
 from fsmbt.verify import nusmv, verify  # noqa: E402
 from fsmbt.verify.nusmv.runner import NuSMVLimitError  # noqa: E402
@@ -51,12 +57,28 @@ def pair(index: int, size: int, rng: random.Random) -> tuple[FSM, FSM, str]:
     return source, mutant, "mutant"
 
 
+def dispatch_pair(
+    index: int, size: int, rng: random.Random
+) -> tuple[FSM | BTDocument, FSM | BTDocument, str]:
+    """The ``index``-th ``--style dispatch`` pair: the FSM's dispatch tree against the FSM
+    (even indices) or a one-transition mutant of it (odd); the tree first every fourth."""
+    source, other, kind = pair(index, size, rng)
+    tree = convert(source, style="dispatch").model
+    assert isinstance(tree, BTDocument)
+    fsm = source if kind == "copy" else other
+    assert isinstance(fsm, FSM)
+    if index % 4 in (2, 3):
+        return tree, fsm, kind
+    return fsm, tree, kind
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--pairs", type=int, default=1000)
     parser.add_argument("--sizes", default="5,10,20,50,100,300,1000")
     parser.add_argument("--timeout", type=float, default=60.0)
     parser.add_argument("--seed", type=int, default=27)
+    parser.add_argument("--style", choices=("fsm", "dispatch"), default="fsm")
     args = parser.parse_args(argv)
     limits.use(limits.current().with_changes(nusmv_max_seconds=args.timeout))
     sizes = [int(s) for s in args.sizes.split(",")]
@@ -66,7 +88,8 @@ def main(argv: list[str] | None = None) -> int:
     started = time.perf_counter()
     for index in range(args.pairs):
         size = sizes[index % len(sizes)]
-        source, result, kind = pair(index, size, rng)
+        make = dispatch_pair if args.style == "dispatch" else pair
+        source, result, kind = make(index, size, rng)
         native = verify(source, result)
         before = child_cpu()
         try:

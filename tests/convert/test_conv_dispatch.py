@@ -105,18 +105,19 @@ def test_auto_writes_the_lebt_where_a_switch_cannot_compare_an_event() -> None:
     assert verify(fsm, result.model).equivalent
 
 
-def test_auto_writes_the_lebt_when_nusmv_checks_the_result(tmp_path: Path) -> None:
+def test_auto_keeps_the_dispatch_form_when_nusmv_checks_the_result(tmp_path: Path) -> None:
     from fsmbt import api
 
     source = tmp_path / "fsm.json"
     api.write(random_fsm("nusmv", 6, start_event=False, shape="tree"), source)
     native = api.convert_file(source)
     assert native.conversion.stats["style"] == "dispatch"
-    checked = api.convert_file(source, verify_engine="nusmv")
-    assert checked.conversion.stats["style"] == "lebt" and checked.equivalent
-    assert any("NuSMV" in w and "dispatch form" in w for w in checked.warnings)
-    with pytest.raises(UnsupportedError, match="NuSMV does not encode the dispatch form"):
-        api.convert_file(source, style="dispatch", verify_engine="nusmv")
+    checked = api.convert_file(source, verify_engine="nusmv")  # NuSMV encodes the form
+    assert checked.conversion.stats["style"] == "dispatch" and checked.equivalent
+    assert not any("NuSMV" in w for w in checked.warnings)
+    both = api.convert_file(source, style="dispatch", verify_engine="both")
+    assert both.equivalent and both.report is not None
+    assert both.report.engine == "native+nusmv"
 
 
 def test_post_conditions_other_than_literal_on_success_on_an_entry_are_refused() -> None:

@@ -32,7 +32,9 @@ from fsmbt.convert.structured.style import (
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import InputError, UnsupportedError
 from fsmbt.model.fsm import FSM
+from fsmbt.semantics.dispatch_memoryless import memory_refusal
 from fsmbt.semantics.dispatch_runtime import is_dispatch_bt
+from fsmbt.semantics.outcome_blackboard import OutcomeTree
 from fsmbt.semantics.outcome_rules import OutcomeRules
 
 
@@ -47,7 +49,7 @@ class Engine:
 _ENGINES: dict[str, Engine] = {}
 
 #: Option of the rules engine's FSM -> BT: NuSMV will check the result, so ``auto`` writes a
-#: form NuSMV encodes (the LEBT, not the dispatch form).
+#: form NuSMV encodes (the dispatch form when ``nusmv_refusal`` finds nothing, else the LEBT).
 NUSMV_CHECKED = "nusmv_checked"
 
 #: Modules that register further engines when imported (missing ones are skipped). They are
@@ -58,6 +60,17 @@ _PLUGIN_MODULES = (
     "fsmbt.convert.baselines",
     "fsmbt.llm.engine",
 )
+
+
+def nusmv_refusal(doc: Model) -> str:
+    """Why NuSMV's encoding of the dispatch form would refuse the tree ``doc`` (the node and
+    the reason, ``fsmbt.semantics.dispatch_memoryless``), or ``""``. O(nodes)."""
+    assert isinstance(doc, BTDocument)
+    refused = memory_refusal(OutcomeTree(doc))
+    if refused is None:
+        return ""
+    node, why = refused
+    return f"<{node.source.type}> '{node.label}': {why}"
 
 
 def register_engine(
@@ -85,9 +98,11 @@ def rules_fsm_to_bt(
     hierarchical machine keeps its composite states, §12a, unless the form cannot keep them or
     ``hierarchy="flatten"``: then it is flattened first), or the LEBT with a
     warning naming why when the dispatch form cannot be written (an event a ``Switch`` cannot
-    compare, an eventless transition: the dispatch builder's ``InputError``) or when NuSMV is
+    compare, an eventless transition: the dispatch builder's ``InputError``), or when NuSMV is
     to check the result (option ``NUSMV_CHECKED``, set by ``fsmbt.api`` for
-    ``--verify-engine nusmv|both``: NuSMV does not encode the dispatch form).
+    ``--verify-engine nusmv|both``) and the tree holds a node its encoding of the dispatch
+    form does not model (``nusmv_refusal``; never for a tree this builder writes, both
+    forms are encoded: docs/nusmv.md, "The dispatch form").
 
     Depth bound (docs/semantics.md §5, "Depth-bounded LEBT"): a structured tree that would nest
     deeper than ``MAX_XML_LEVELS`` XML levels is not written; under ``auto`` the depth-bounded
@@ -102,16 +117,16 @@ def rules_fsm_to_bt(
     chosen, view = resolve_style(style, fsm, outcome_driven=outcome_driven, rules=rules)
     not_dispatch = ""
     checked_by_nusmv = bool(options.pop(NUSMV_CHECKED, False))
-    if chosen == DISPATCH and check_style(style) == AUTO and checked_by_nusmv:
-        not_dispatch = (
-            "NuSMV (--verify-engine nusmv|both) does not encode the dispatch form: the LEBT "
-            "was written, which both checkers prove (--verify-engine native gives the dispatch "
-            "form)"
-        )
-        chosen = "lebt"
-    elif chosen == DISPATCH and check_style(style) == AUTO:
+    if chosen == DISPATCH and check_style(style) == AUTO:
         try:
-            return fsm_to_dispatch(fsm, **options)
+            written = fsm_to_dispatch(fsm, **options)
+            refused = nusmv_refusal(written.model) if checked_by_nusmv else ""
+            if not refused:
+                return written
+            not_dispatch = (
+                f"NuSMV (--verify-engine nusmv|both) does not encode this dispatch tree "
+                f"({refused}): the LEBT was written, which both checkers prove"
+            )
         except InputError as exc:  # UnsupportedError too: an event a Switch cannot compare
             where = f" ({exc.element})" if exc.element else ""
             not_dispatch = (

@@ -17,9 +17,10 @@ from fsmbt.verify.nusmv.smv import Symbols
 from fsmbt.verify.report import PROPERTIES, PropertyResult, Report, TraceStep
 
 if TYPE_CHECKING:
+    from fsmbt.verify.nusmv.encode_dispatch import DispatchEncoder
     from fsmbt.verify.nusmv.encode_lebt import LebtEncoder
 
-Encoder: TypeAlias = "FSMEncoder | LeafBTEncoder | LebtEncoder"
+Encoder: TypeAlias = "FSMEncoder | LeafBTEncoder | LebtEncoder | DispatchEncoder"
 # What decoding needs: both encodings, both encoders, the input and output symbol tables, the
 # mode ("macro-step" or "leaf-execution") and the BDD variable order.
 Context: TypeAlias = tuple[Encoding, Encoding, Encoder, Encoder, Symbols, Symbols, str, str]
