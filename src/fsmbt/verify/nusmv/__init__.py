@@ -32,6 +32,7 @@ from fsmbt.verify.report import (
 
 if TYPE_CHECKING:
     from fsmbt.verify.nusmv.encode_lebt import LebtEncoder  # noqa: F401 - in Encoder
+    from fsmbt.verify.nusmv.encode_sv import SvEncoder  # noqa: F401 - in Encoder
 
 Encoders: TypeAlias = tuple[Encoder, Encoder, Symbols, Symbols, str]
 
@@ -64,7 +65,24 @@ def encode(source: FSM | BTDocument, result: FSM | BTDocument, *, loop: bool = F
         )
     if isinstance(source, FSM) and isinstance(result, BTDocument):
         from fsmbt.model.flatten import flatten
+        from fsmbt.semantics.execution import Flavour, flavour_of
         from fsmbt.verify.nusmv.encode_lebt import LebtEncoder
+
+        if flavour_of(result) is Flavour.STATE_VARIABLE:  # BSD, CHDS: Sv* leaves
+            from fsmbt.semantics.state_variable_runtime import StateVariableMachine
+            from fsmbt.verify.nusmv.encode_sv import SvEncoder
+
+            # the native pairing's alphabet (machines_for_state_variable): the FSM's events,
+            # then every event a leaf names
+            events = StateVariableMachine(result, ()).events()
+            alphabet = _union(flatten(source).events(), events)
+            return (
+                FSMEncoder(source, "source", inputs, outputs, alphabet=alphabet),
+                SvEncoder(result, "result", inputs, outputs, alphabet=alphabet),
+                inputs,
+                outputs,
+                MACRO_STEP,
+            )
 
         alphabet = _union(flatten(source).events(), lebt_guard_events(result))
         return (
