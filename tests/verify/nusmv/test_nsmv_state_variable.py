@@ -18,7 +18,7 @@ from fsmbt.convert.baselines.bsd import fsm_to_bsd
 from fsmbt.convert.baselines.chds import fsm_to_chds
 from fsmbt.convert.baselines.common import control, leaf_node, sv_node_models
 from fsmbt.generate.generator import random_fsm
-from fsmbt.model.bt import BTDocument
+from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.errors import InputError, UnsupportedError
 from fsmbt.model.fsm import FSM, State
 from fsmbt.semantics import state_variable_runtime as sv
@@ -76,7 +76,7 @@ def test_engine_both_agrees_on_a_mutant(nusmv_binary, monkeypatch) -> None:
     assert report.equivalent is verify(fsm, tree).equivalent
 
 
-def _state(name: str, *, initial: bool = False, action: str = "", then: str = "") -> object:
+def _state(name: str, *, initial: bool = False, action: str = "", then: str = "") -> BTNode:
     """A BSD-like subtree for ``name``: its test, its entry action, then an unguarded
     ``SvAssign`` to ``then`` (or the mode's controller when ``then`` is empty)."""
     last = (
@@ -95,11 +95,9 @@ def _state(name: str, *, initial: bool = False, action: str = "", then: str = ""
     )
 
 
-def _tree(*subtrees: object) -> BTDocument:
-    doc = BTDocument.single(control("ReactiveFallback", "Root", list(subtrees)))  # type: ignore[arg-type]
-    doc.node_models.update(
-        sv_node_models((sv.IS_STATE, sv.ENTRY_ACTION, sv.ASSIGN, sv.MODE))
-    )
+def _tree(*subtrees: BTNode) -> BTDocument:
+    doc = BTDocument.single(control("ReactiveFallback", "Root", list(subtrees)))
+    doc.node_models.update(sv_node_models((sv.IS_STATE, sv.ENTRY_ACTION, sv.ASSIGN, sv.MODE)))
     return doc
 
 
@@ -130,7 +128,12 @@ def test_more_actions_per_step_than_the_slots_is_refused(nusmv_binary, monkeypat
     # three actions in one macro step, one more than the encoding's slots
     chain = [f"a{i}" for i in range(MAX_ACTIONS + 1)]
     subtrees = [
-        _state(name, initial=i == 0, action=f"act_{name}", then=chain[i + 1] if i + 1 < len(chain) else "")
+        _state(
+            name,
+            initial=i == 0,
+            action=f"act_{name}",
+            then=chain[i + 1] if i + 1 < len(chain) else "",
+        )
         for i, name in enumerate(chain)
     ]
     tree = _tree(*subtrees)

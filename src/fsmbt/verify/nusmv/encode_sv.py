@@ -117,6 +117,9 @@ class SvEncoder:
             if leaf.type in (sv.ENTRY_ACTION, sv.MODE) and leaf.action is not None:
                 outputs.id(leaf.action)
         self.slots = MAX_ACTIONS
+        #: ticks one macro step may take in the encoding: the native bound, or 2 when the
+        #: static bound shows no step switches twice (``SvLeafFacts``): a smaller ``nt``
+        self.ticks = sv.MAX_TICKS_PER_STEP if self.facts.may_livelock else 2
 
     # -- the extra checks ----------------------------------------------------------------------
     def extra_specs(self) -> list[tuple[str, str]]:
@@ -197,7 +200,7 @@ class SvEncoder:
 
     def encode(self) -> Encoding:
         core, k = self.core, self.slots
-        ticks = sv.MAX_TICKS_PER_STEP
+        ticks = self.ticks
         core.declare(["TOP"], core.n(0))  # the start: the settle with no event
         out_enum = self.outputs.enum([NONE_OUT])
         extra_vars = {
@@ -285,5 +288,14 @@ class SvEncoder:
             list(self.alphabet),
             ident,
             decode_state=lambda values: names.get(values.get("bbs", ""), "?"),
-            var_order=list(core.var_types),
+            var_order=self._order(),
         )
+
+    def _order(self) -> list[str]:
+        """The BDD order of the module's variables: the blackboard first (every leaf answer
+        reads ``bbs``/``bbe``), then the tree's. Measured against the tree's variables first
+        (NuSMV CPU s, one random FSM's copy / one-transition mutant, docs/nusmv.md): BSD 20
+        states 20.9 -> 13.3 (copy), CHDS 10 states 2.4 -> 1.5 and 23.4 -> 17.8."""
+        names = list(self.core.var_types)
+        board = ["bbs", "bbe", "ent", "sw", "lres", "nt"]
+        return board + [v for v in names if v not in board]
