@@ -288,10 +288,10 @@ class SvEncoder:
             list(self.alphabet),
             ident,
             decode_state=lambda values: names.get(values.get("bbs", ""), "?"),
-            var_order=self._order(),
+            var_order=self.bdd_order(),
         )
 
-    def _order(self) -> list[str]:
+    def bdd_order(self) -> list[str]:
         """The BDD order of the module's variables: the blackboard first (every leaf answer
         reads ``bbs``/``bbe``), then the tree's. Measured against the tree's variables first
         (NuSMV CPU s, one random FSM's copy / one-transition mutant, docs/nusmv.md): BSD 20
