@@ -22,9 +22,10 @@ from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.errors import InputError, UnsupportedError
 from fsmbt.model.fsm import FSM, State
 from fsmbt.semantics import state_variable_runtime as sv
+from fsmbt.semantics.bt_interpreter import CompiledTree
 from fsmbt.verify import nusmv, verify
 from fsmbt.verify.mutations import mutants
-from fsmbt.verify.nusmv.encode_sv import MAX_ACTIONS
+from fsmbt.verify.nusmv.encode_sv import MAX_ACTIONS, SvLeafFacts
 
 STYLES = {"bsd": fsm_to_bsd, "chds": fsm_to_chds}
 SEEDS = (3, 11, 27)
@@ -142,3 +143,17 @@ def test_more_actions_per_step_than_the_slots_is_refused(nusmv_binary, monkeypat
     assert not native.equivalent
     with pytest.raises(UnsupportedError, match=f"at most {MAX_ACTIONS} actions per macro step"):
         nusmv.check(fsm, tree)
+
+
+def test_the_unguarded_cycle_check() -> None:
+    """CHDS's assigns sit behind an SvGuard in a reactive sequence: no livelock spec; an
+    assign behind only an SvIsState (the livelock tree above) keeps the native bound."""
+    fsm = random_fsm(3, n_states=5)
+    chds = fsm_to_chds(fsm).model
+    loop = _tree(_state("a", initial=True, action="x", then="b"), _state("b", then="a"))
+    assert not SvLeafFacts.of(CompiledTree(chds), _leaves(chds)).may_livelock
+    assert SvLeafFacts.of(CompiledTree(loop), _leaves(loop)).may_livelock
+
+
+def _leaves(doc: BTDocument) -> dict[int, sv.SvLeaf]:
+    return dict(sv.StateVariableMachine(doc, ()).leaves)

@@ -177,7 +177,8 @@ def check(
     ``timeout`` defaults to ``fsmbt.limits.current().nusmv_max_seconds`` (per NuSMV run); the
     memory cap is ``nusmv_max_memory_mb``. Raises ``UnsupportedError`` for BT node types the
     encoding does not model (docs/nusmv.md), ``NuSMVLimitError`` past a cap and
-    ``NuSMVNotFound`` when no binary is available.
+    ``NuSMVNotFound`` when no binary is available; for a state-variable (BSD/CHDS) tree whose
+    macro step never settles, the native checker's livelock ``InputError`` (``encode_sv``).
     """
     started = time.perf_counter()
     if split is None:

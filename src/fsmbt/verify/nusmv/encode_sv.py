@@ -27,9 +27,11 @@ last one sets ``lvl`` (the native machine's livelock ``InputError``); otherwise 
 the pending event is dropped. The start is the same settle with no event. ``final`` iff the last
 result is SUCCESS and ``bbs`` is not the start pseudo-state.
 
-Static bounds (``SvLeafFacts``): without an ``SvAssign`` leaf a macro step switches at most
-once (a switch needs a pending event and clears it), so at most two ticks and two actions run
-and neither livelock nor slot overflow can happen: no spec is added. With one, two invariants
+Static bounds (``SvLeafFacts``, the unguarded cycle check): without an *unguarded*
+``SvAssign`` leaf (one not behind an ``SvGuard`` in a reactive sequence, ``guarded``) a macro
+step switches at most once (every other switch needs a pending event and clears it), so at
+most two ticks and two actions run and neither livelock nor slot overflow can happen: no spec
+is added and ``nt`` is ``1..2`` (BSD and CHDS trees alike). With one, two invariants
 are checked on every state the result reaches (alone included): ``sv_livelock`` (``!lvl``; a
 failure is the native checker's livelock ``InputError``, word for word) and ``output_overflow``
 (at most ``MAX_ACTIONS`` actions per step, else ``UnsupportedError`` naming the limit).
@@ -46,7 +48,9 @@ from dataclasses import dataclass
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import Hint, InputError, UnsupportedError
 from fsmbt.semantics import state_variable_runtime as sv
+from fsmbt.semantics.bt_interpreter import CompiledTree
 from fsmbt.semantics.lebt.spec import NO_EVENT
+from fsmbt.semantics.nodes import node_semantics
 from fsmbt.verify.nusmv.encode_bt import BTCore, safe_text
 from fsmbt.verify.nusmv.encode_fsm import NONE_OUT, Encoding
 from fsmbt.verify.nusmv.smv import Symbols, case
@@ -61,16 +65,45 @@ OVERFLOW_SPEC = "output_overflow"
 
 @dataclass(frozen=True)
 class SvLeafFacts:
-    """What the static bounds read of the leaves: whether any switches without an event."""
+    """What the static bounds read of the leaves: whether any may switch without an event."""
 
-    assigns: bool
+    unguarded_assigns: bool
 
     @property
     def may_livelock(self) -> bool:
-        """A macro step can switch more than once only through ``SvAssign`` (an
-        ``SvTransition`` switch needs the pending event and clears it), so without one it has
-        at most two ticks (no livelock) and two actions (no overflow of ``MAX_ACTIONS``)."""
-        return self.assigns
+        """A macro step can switch more than once only through an unguarded ``SvAssign``: an
+        ``SvTransition`` switch needs the pending event and clears it, and so does an
+        ``SvAssign`` that a guard must pass first (``guarded``). Without an unguarded one a
+        step switches at most once: at most two ticks (no livelock) and two actions (an
+        action needs ``!ent``, which only a switch clears): no overflow of ``MAX_ACTIONS``."""
+        return self.unguarded_assigns
+
+    @staticmethod
+    def of(tree: CompiledTree, leaves: dict[int, sv.SvLeaf]) -> SvLeafFacts:
+        """The facts of ``tree`` (the unguarded cycle check, O(N))."""
+        return SvLeafFacts(
+            unguarded_assigns=any(
+                leaf.type == sv.ASSIGN and not guarded(tree, nid, leaves)
+                for nid, leaf in leaves.items()
+            )
+        )
+
+
+def guarded(tree: CompiledTree, nid: int, leaves: dict[int, sv.SvLeaf]) -> bool:
+    """Whether leaf ``nid`` is ticked only after an ``SvGuard`` returned SUCCESS in the same
+    tick: its parent is a reactive sequence (it ticks its children from the first on every
+    tick and goes on only past a SUCCESS; pre-conditions, which could skip the guard, are
+    rejected by the interpreter) and an earlier sibling is an ``SvGuard`` leaf, which succeeds
+    only on a pending event (CHDS's switching subtrees). O(children)."""
+    node = tree.nodes[nid]
+    if node.parent is None:
+        return False
+    parent = tree.nodes[node.parent]
+    spec = node_semantics(parent.type)
+    if spec is None or not spec.reactive or spec.is_fallback:
+        return False
+    before = parent.children[: node.index]
+    return any(c in leaves and leaves[c].type == sv.GUARD for c in before)
 
 
 class SvEncoder:
@@ -100,7 +133,7 @@ class SvEncoder:
         self.leaves: dict[int, sv.SvLeaf] = dict(machine.leaves)
         self.initial_state = machine.initial_state
         self.pseudo_start = machine.pseudo_start
-        self.facts = SvLeafFacts(assigns=any(x.type == sv.ASSIGN for x in self.leaves.values()))
+        self.facts = SvLeafFacts.of(self.core.tree, self.leaves)
         self.module = module
         self.inputs = inputs
         self.outputs = outputs
