@@ -1,7 +1,8 @@
 """NuSMV against the native checker on many generated FSM ~ FSM pairs (issue 27, item 2).
 
     .venv/bin/python benchmarks/bench_nusmv_agreement.py [--pairs 1000]
-        [--sizes 5,10,20,50,100,300,1000] [--timeout 60] [--seed 27] [--style fsm|dispatch]
+        [--sizes 5,10,20,50,100,300,1000] [--timeout 60] [--seed 27]
+        [--style fsm|dispatch|bsd|chds]
 
 Pairs: ``--pairs`` random FSMs (``fsmbt.generate.generator.random_fsm``, sizes cycling through
 ``--sizes``), each against its renamed copy (``bench_checker.renamed``: equivalent) or, every
@@ -15,6 +16,12 @@ A NuSMV run past ``--timeout`` wall seconds is counted as *gave up* (the native 
 as with ``--engine both``), never as agreement. Prints one line per size (pairs, agree,
 disagree, gave up, NuSMV CPU seconds total and largest) and the totals; exit 1 on any
 disagreement. CPU seconds come from ``RUSAGE_CHILDREN`` (independent of the machine's load).
+
+``--style bsd`` / ``--style chds`` (FSM ~ state-variable tree, ``fsmbt.verify.nusmv.encode_sv``):
+the source FSM against its conversion with that baseline (equivalent) or, every other pair,
+against the conversion of a one-transition mutant of it; ``--style fsm`` (default) is the FSM ~
+FSM benchmark above. The sizes then default to 5,10,20,30, and copy and mutant alternate
+per round of sizes as well, so every size gets both.
 """
 
 from __future__ import annotations
@@ -45,16 +52,31 @@ def child_cpu() -> float:
     return usage.ru_utime + usage.ru_stime
 
 
-def pair(index: int, size: int, rng: random.Random) -> tuple[FSM, FSM, str]:
-    """The ``index``-th pair: a copy for even indices, a one-transition mutant for odd."""
+def pair(
+    index: int, size: int, rng: random.Random, style: str = "fsm"
+) -> tuple[FSM, FSM | BTDocument, str]:
+    """The ``index``-th pair: a copy for even indices, a one-transition mutant for odd; with a
+    baseline ``style`` the result is that baseline's conversion of the copy or mutant."""
     source = random_fsm(rng.randrange(10**9), n_states=size)
     if index % 2 == 0 or not source.transitions:
-        return source, renamed(source), "copy"
+        return source, converted(renamed(source), style), "copy"
     mutant = copy.deepcopy(source)
     transition = mutant.transitions[rng.randrange(len(mutant.transitions))]
     others = [name for name in mutant.states if name != transition.target]
     transition.target = rng.choice(others)
-    return source, mutant, "mutant"
+    return source, converted(mutant, style), "mutant"
+
+
+def converted(fsm: FSM, style: str) -> FSM | BTDocument:
+    """``fsm`` itself (``fsm``) or its BSD/CHDS state-variable tree."""
+    if style == "fsm":
+        return fsm
+    from fsmbt.convert.baselines.bsd import fsm_to_bsd
+    from fsmbt.convert.baselines.chds import fsm_to_chds
+
+    model = {"bsd": fsm_to_bsd, "chds": fsm_to_chds}[style](fsm).model
+    assert isinstance(model, BTDocument)
+    return model
 
 
 def dispatch_pair(
@@ -75,11 +97,13 @@ def dispatch_pair(
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--pairs", type=int, default=1000)
-    parser.add_argument("--sizes", default="5,10,20,50,100,300,1000")
+    parser.add_argument("--sizes", default=None)
     parser.add_argument("--timeout", type=float, default=60.0)
     parser.add_argument("--seed", type=int, default=27)
-    parser.add_argument("--style", choices=("fsm", "dispatch"), default="fsm")
+    parser.add_argument("--style", choices=("fsm", "dispatch", "bsd", "chds"), default="fsm")
     args = parser.parse_args(argv)
+    if args.sizes is None:
+        args.sizes = "5,10,20,50,100,300,1000" if args.style == "fsm" else "5,10,20,30"
     limits.use(limits.current().with_changes(nusmv_max_seconds=args.timeout))
     sizes = [int(s) for s in args.sizes.split(",")]
     rng = random.Random(args.seed)
@@ -88,8 +112,13 @@ def main(argv: list[str] | None = None) -> int:
     started = time.perf_counter()
     for index in range(args.pairs):
         size = sizes[index % len(sizes)]
-        make = dispatch_pair if args.style == "dispatch" else pair
-        source, result, kind = make(index, size, rng)
+        if args.style == "dispatch":  # its measured sequence (docs/nusmv.md, "The dispatch form")
+            source, result, kind = dispatch_pair(index, size, rng)
+        else:
+            # FSM ~ FSM keeps its measured sequence; the baselines alternate copy/mutant per
+            # round too, so an even number of sizes still mixes both kinds at every size
+            slot = index if args.style == "fsm" else index + index // len(sizes)
+            source, result, kind = pair(slot, size, rng, args.style)
         native = verify(source, result)
         before = child_cpu()
         try:
@@ -126,7 +155,7 @@ def main(argv: list[str] | None = None) -> int:
             f"{equivalent:>6} {failing:>7} {sum(cpu[n]):>8.1f} {max(cpu[n], default=0):>7.2f}"
         )
     print(
-        f"total: {args.pairs} pairs, {total['agree']} agree, {total['disagree']} disagree, "
+        f"total ({args.style}): {args.pairs} pairs, {total['agree']} agree, {total['disagree']} disagree, "
         f"{total['gave up']} gave up (NuSMV past {args.timeout:g} s; native verdict only); "
         f"{time.perf_counter() - started:.0f} s wall"
     )

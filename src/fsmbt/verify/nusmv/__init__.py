@@ -33,6 +33,7 @@ from fsmbt.verify.report import (
 
 if TYPE_CHECKING:
     from fsmbt.verify.nusmv.encode_lebt import LebtEncoder  # noqa: F401 - in Encoder
+    from fsmbt.verify.nusmv.encode_sv import SvEncoder  # noqa: F401 - in Encoder
 
 Encoders: TypeAlias = tuple[Encoder, Encoder, Symbols, Symbols, str]
 
@@ -68,7 +69,24 @@ def encode(source: FSM | BTDocument, result: FSM | BTDocument, *, loop: bool = F
         return (*dispatch, inputs, outputs, MACRO_STEP)
     if isinstance(source, FSM) and isinstance(result, BTDocument):
         from fsmbt.model.flatten import flatten
+        from fsmbt.semantics.execution import Flavour, flavour_of
         from fsmbt.verify.nusmv.encode_lebt import LebtEncoder
+
+        if flavour_of(result) is Flavour.STATE_VARIABLE:  # BSD, CHDS: Sv* leaves
+            from fsmbt.semantics.state_variable_runtime import StateVariableMachine
+            from fsmbt.verify.nusmv.encode_sv import SvEncoder
+
+            # the native pairing's alphabet (machines_for_state_variable): the FSM's events,
+            # then every event a leaf names
+            events = StateVariableMachine(result, ()).events()
+            alphabet = _union(flatten(source).events(), events)
+            return (
+                FSMEncoder(source, "source", inputs, outputs, alphabet=alphabet),
+                SvEncoder(result, "result", inputs, outputs, alphabet=alphabet),
+                inputs,
+                outputs,
+                MACRO_STEP,
+            )
 
         alphabet = _union(flatten(source).events(), lebt_guard_events(result))
         return (
@@ -165,7 +183,8 @@ def check(
     ``timeout`` defaults to ``fsmbt.limits.current().nusmv_max_seconds`` (per NuSMV run); the
     memory cap is ``nusmv_max_memory_mb``. Raises ``UnsupportedError`` for BT node types the
     encoding does not model (docs/nusmv.md), ``NuSMVLimitError`` past a cap and
-    ``NuSMVNotFound`` when no binary is available.
+    ``NuSMVNotFound`` when no binary is available; for a state-variable (BSD/CHDS) tree whose
+    macro step never settles, the native checker's livelock ``InputError`` (``encode_sv``).
     """
     started = time.perf_counter()
     if split is None:

@@ -35,7 +35,13 @@ from fsmbt.verify.report import (
     TERMINATION_CONSISTENCY,
 )
 
-EXTRA_CHECKS = ("output_overflow",)
+EXTRA_CHECKS = ("output_overflow", "sv_livelock")
+#: Extra checks read on every state the product reaches, not only where ``ok`` holds: a
+#: state-variable tree's livelock (``encode_sv``) is an error wherever the result reaches it
+#: alone, as in the native checker, which explores each machine alone before the product (the
+#: detached ``ra`` mode reaches every state of the result from the start pair, where ``ok``
+#: holds, but a disagreeing step on the way clears ``ok``).
+UNGUARDED_CHECKS = frozenset({"sv_livelock"})
 
 
 @dataclass
@@ -159,7 +165,10 @@ def product(
         (TERMINATION_CONSISTENCY, "INVARSPEC", "((!det & ok & both) -> (s.final <-> r.final))")
     )
     extra_kind = "INVARSPEC" if part == WHOLE else "SPEC AG"
-    specs += [(name, extra_kind, f"(ok -> {formula})") for name, formula in (extra_specs or [])]
+    specs += [
+        (name, extra_kind, formula if name in UNGUARDED_CHECKS else f"(ok -> {formula})")
+        for name, formula in (extra_specs or [])
+    ]
     if part == INVARIANTS:
         specs = [spec for spec in specs if spec[1] == "INVARSPEC"]
     elif part == CTL:

@@ -19,8 +19,9 @@ from fsmbt.verify.report import PROPERTIES, PropertyResult, Report, TraceStep
 if TYPE_CHECKING:
     from fsmbt.verify.nusmv.encode_dispatch import DispatchEncoder
     from fsmbt.verify.nusmv.encode_lebt import LebtEncoder
+    from fsmbt.verify.nusmv.encode_sv import SvEncoder
 
-Encoder: TypeAlias = "FSMEncoder | LeafBTEncoder | LebtEncoder | DispatchEncoder"
+Encoder: TypeAlias = "FSMEncoder | LeafBTEncoder | LebtEncoder | DispatchEncoder | SvEncoder"
 # What decoding needs: both encodings, both encoders, the input and output symbol tables, the
 # mode ("macro-step" or "leaf-execution") and the BDD variable order.
 Context: TypeAlias = tuple[Encoding, Encoding, Encoder, Encoder, Symbols, Symbols, str, str]
@@ -112,10 +113,13 @@ def build_report(
         if name in PROPERTIES:
             continue
         if not result.holds:
-            from fsmbt.verify.nusmv.encode_lebt import LebtEncoder  # only LEBT adds specs
+            from fsmbt.verify.nusmv.encode_lebt import LebtEncoder  # LEBT and Sv add specs
+            from fsmbt.verify.nusmv.encode_sv import SvEncoder
 
             if isinstance(res_enc, LebtEncoder):
                 raise UnsupportedError(res_enc.extra_message(name), hints=(Hint.NATIVE_VERIFIER,))
+            if isinstance(res_enc, SvEncoder):  # the livelock: the native InputError, verbatim
+                raise res_enc.extra_failure(name)
             raise UnsupportedError(f"the NuSMV check {name!r} failed")
     for name, result in zip(names, results):
         if name not in PROPERTIES:
