@@ -33,6 +33,7 @@ would let the tick go on after a ``DispatchEntry`` wrote the index. Cost: O(node
 from __future__ import annotations
 
 from fsmbt.model.kinds import NodeKind
+from fsmbt.model.nodes import REACTIVE_CONTROLS, RESULT_MAP_DECORATORS
 from fsmbt.semantics.compiled import CompiledNode
 from fsmbt.semantics.dispatch_runtime import ENTRY
 from fsmbt.semantics.outcome_blackboard import SCRIPT, SWITCH, OutcomeTree
@@ -60,7 +61,8 @@ def _why(node: CompiledNode) -> str:
         return "it writes the blackboard outside a DispatchEntry's _onSuccess"
     if node.kind in (NodeKind.ACTION, NodeKind.CONDITION):
         return f"a dispatch tree's only leaves are {ENTRY}, AlwaysSuccess and AlwaysFailure"
-    if node.type in ("Inverter", "ForceSuccess", "ForceFailure", "ReactiveSequence"):
+    # status maps and reactive controls, as the node registry declares them (§9a)
+    if node.type in RESULT_MAP_DECORATORS or node.type in REACTIVE_CONTROLS:
         return (
             "a tick could go on after a DispatchEntry wrote the index (only "
             f"{KEEP_RUNNING} over it is encoded)"
