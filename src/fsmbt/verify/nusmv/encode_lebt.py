@@ -27,6 +27,7 @@ from fsmbt.semantics.lebt.leaves import LebtLeaves
 from fsmbt.semantics.lebt.spec import NO_EVENT
 from fsmbt.verify.nusmv.encode_bt import BTCore, safe_text
 from fsmbt.verify.nusmv.encode_fsm import NONE_OUT, Encoding
+from fsmbt.verify.nusmv.macro_frame import record_action, root_returned, start_step, step_defines
 from fsmbt.verify.nusmv.smv import Symbols, any_of, case, enum_type
 
 MAX_SLOTS = 6
@@ -126,19 +127,8 @@ class LebtEncoder:
         core.build()
         stable = "(cur = TOP & res = NONE)"
         # a macro step starts: set the event, tick the root
-        core.call("go", 0)
-        core.rule(
-            "bbe",
-            "go",
-            case(
-                [(f"inp = {self.inputs.id(e)}", self.events.id(e)) for e in self.alphabet],
-                "ev_none",
-            ),
-        )
+        start_step(core, self.inputs, self.events, self.alphabet, k)
         core.rule("tick2", "go", "FALSE")
-        core.rule("nact", "go", "0")
-        for j in range(1, k + 1):
-            core.rule(f"a{j}", "go", NONE_OUT)
         # guard leaves
         for nid, guard in self.leaves.guards.items():
             req = core.leaf_request(nid)
@@ -153,11 +143,7 @@ class LebtEncoder:
             req = core.leaf_request(nid)
             start = f"{req} & {core.st(nid)} = I"
             if spec.action is not None:
-                action = self.outputs.id(spec.action)
-                for j in range(1, k + 1):
-                    core.rule(f"a{j}", f"{start} & nact = {j - 1}", action)
-                core.rule("ovf", f"{start} & nact = {k}", "TRUE")
-                core.rule("nact", f"{start} & nact < {k}", "nact + 1")
+                record_action(core, start, self.outputs.id(spec.action), k)
             core.rule("bbs", start, self.states.id(spec.state))
             core.rule("bbe", start, "ev_none")
             core.ret(start, nid, "S" if spec.final else "R")
@@ -168,12 +154,7 @@ class LebtEncoder:
             core.rule("bbe", f"{running} & bbe != ev_none & !{exit_pending}", "ev_none")
             core.ret(running, nid, "R")
         # the root returned
-        top = "cur = TOP & res != NONE"
-        core.rule("wake", f"{top} & res = R & wake", "FALSE")
-        core.call(f"{top} & res = R & wake", 0)
-        ended = f"{top} & !(res = R & wake)"
-        core.rules.setdefault(core.st(0), []).append((f"{ended} & res != R", "I"))
-        core.rule("lres", ended, "case res = S : lr_S; res = F : lr_F; TRUE : lr_R; esac")
+        ended = root_returned(core)
         again = f"{ended} & res = S & bbe != ev_none & !tick2"
         core.rule("tick2", again, "TRUE")
         core.call(again, 0)
@@ -185,9 +166,7 @@ class LebtEncoder:
             ("stable", stable),
             ("final", f"(lres = lr_S & bbs != {self.states.id(self.leaves.start)})"),
         ]
-        defines += [(f"o{j}", f"a{j}") for j in range(1, k + 1)]
-        for symbol, sid in sorted(self.inputs.to_id.items()):
-            defines.append((f"offers_{sid}", "TRUE" if symbol in self.alphabet else "FALSE"))
+        defines += step_defines(self.inputs, self.alphabet, k)
         ident = [("bbs", extra_vars["bbs"]), ("lres", extra_vars["lres"])]
         runl = self._running_leaf()
         if runl is None:

@@ -53,7 +53,8 @@ from fsmbt.semantics.lebt.spec import NO_EVENT
 from fsmbt.semantics.nodes import node_semantics
 from fsmbt.verify.nusmv.encode_bt import BTCore, safe_text
 from fsmbt.verify.nusmv.encode_fsm import NONE_OUT, Encoding
-from fsmbt.verify.nusmv.smv import Symbols, case
+from fsmbt.verify.nusmv.macro_frame import record_action, root_returned, start_step, step_defines
+from fsmbt.verify.nusmv.smv import Symbols
 
 #: Actions one macro step may output in the encoding (slots ``a1..aK``): an entry action before
 #: and one after a switch, what every BSD/CHDS conversion needs (at most one switch per step).
@@ -208,11 +209,7 @@ class SvEncoder:
         elif leaf.type in (sv.ENTRY_ACTION, sv.MODE):
             enter = f"{req} & !ent"
             if leaf.action is not None:
-                action = self.outputs.id(leaf.action)
-                for j in range(1, k + 1):
-                    core.rule(f"a{j}", f"{enter} & nact = {j - 1}", action)
-                core.rule("ovf", f"{enter} & nact = {k}", "TRUE")
-                core.rule("nact", f"{enter} & nact < {k}", "nact + 1")
+                record_action(core, enter, self.outputs.id(leaf.action), k)
             core.rule("ent", enter, "TRUE")
             done = leaf.type == sv.ENTRY_ACTION or leaf.final
             core.ret(req, nid, "S" if done else "R")
@@ -266,29 +263,13 @@ class SvEncoder:
         core.build()
         stable = "(cur = TOP & res = NONE)"
         # a macro step starts: set the event, tick the root
-        core.call("go", 0)
-        core.rule(
-            "bbe",
-            "go",
-            case(
-                [(f"inp = {self.inputs.id(e)}", self.events.id(e)) for e in self.alphabet],
-                "ev_none",
-            ),
-        )
+        start_step(core, self.inputs, self.events, self.alphabet, k)
         core.rule("nt", "go", "1")
         core.rule("sw", "go", "FALSE")
-        core.rule("nact", "go", "0")
-        for j in range(1, k + 1):
-            core.rule(f"a{j}", "go", NONE_OUT)
         for nid, leaf in self.leaves.items():
             self._leaf(nid, leaf)
         # the root returned: a pending wake-up re-ticks at once (Tree::tickRoot)
-        top = "cur = TOP & res != NONE"
-        core.rule("wake", f"{top} & res = R & wake", "FALSE")
-        core.call(f"{top} & res = R & wake", 0)
-        ended = f"{top} & !(res = R & wake)"
-        core.rules.setdefault(core.st(0), []).append((f"{ended} & res != R", "I"))
-        core.rule("lres", ended, "case res = S : lr_S; res = F : lr_F; TRUE : lr_R; esac")
+        ended = root_returned(core)
         again = f"{ended} & sw & nt < {ticks}"  # a switch: the new state's subtree must run
         core.rule("sw", again, "FALSE")
         core.rule("nt", again, "nt + 1")
@@ -302,9 +283,7 @@ class SvEncoder:
         start = self.states.id(self.initial_state)
         final = "lres = lr_S" + (f" & bbs != {start}" if self.pseudo_start else "")
         defines = [("stable", stable), ("final", f"({final})")]
-        defines += [(f"o{j}", f"a{j}") for j in range(1, k + 1)]
-        for symbol, sid in sorted(self.inputs.to_id.items()):
-            defines.append((f"offers_{sid}", "TRUE" if symbol in self.alphabet else "FALSE"))
+        defines += step_defines(self.inputs, self.alphabet, k)
         # the native state: interpreter snapshot, state, entered, last result
         ident = [
             ("bbs", extra_vars["bbs"]),
