@@ -53,7 +53,13 @@ from fsmbt.semantics.lebt.spec import NO_EVENT
 from fsmbt.semantics.nodes import node_semantics
 from fsmbt.verify.nusmv.encode_bt import BTCore, safe_text
 from fsmbt.verify.nusmv.encode_fsm import NONE_OUT, Encoding
-from fsmbt.verify.nusmv.macro_frame import record_action, root_returned, start_step, step_defines
+from fsmbt.verify.nusmv.macro_frame import (
+    declare_frame,
+    record_action,
+    root_returned,
+    start_step,
+    step_defines,
+)
 from fsmbt.verify.nusmv.smv import Symbols
 
 #: Actions one macro step may output in the encoding (slots ``a1..aK``): an entry action before
@@ -255,12 +261,7 @@ class SvEncoder:
             "nact": "0",
             "ovf": "FALSE",
         }
-        for j in range(1, k + 1):
-            extra_vars[f"a{j}"] = out_enum
-            inits[f"a{j}"] = NONE_OUT
-        core.var_types.update(extra_vars)
-        core.init.update(inits)
-        core.build()
+        declare_frame(core, extra_vars, inits, k, out_enum)
         stable = "(cur = TOP & res = NONE)"
         # a macro step starts: set the event, tick the root
         start_step(core, self.inputs, self.events, self.alphabet, k)

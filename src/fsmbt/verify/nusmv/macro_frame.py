@@ -29,6 +29,20 @@ from fsmbt.verify.nusmv.encode_fsm import NONE_OUT
 from fsmbt.verify.nusmv.smv import Symbols, case
 
 
+def declare_frame(
+    core: BTCore, types: dict[str, str], inits: dict[str, str], slots: int, out_enum: str
+) -> None:
+    """Declare the encoder's variables ``types`` (with their ``inits``) and then the action
+    slots ``a1..aK`` (no action), in that order (it is the BDD order where the encoder keeps
+    the declaration order), and build the tree's tick rules."""
+    for j in range(1, slots + 1):
+        types[f"a{j}"] = out_enum
+        inits[f"a{j}"] = NONE_OUT
+    core.var_types.update(types)
+    core.init.update(inits)
+    core.build()
+
+
 def start_step(
     core: BTCore, inputs: Symbols, events: Symbols, alphabet: Sequence[str], slots: int
 ) -> None:
