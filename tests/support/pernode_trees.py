@@ -7,11 +7,14 @@ ParallelAll with random thresholds among them), bottom-up (no
 recursion), 40 % conditions, and each node wrapped in a random decorator with probability 0.25.
 ``family_tree`` of ``benchmarks/bench_reactive.py`` gives the bench families; this one covers
 the kinds those families lack (Async*, KeepRunningUntilFailure, counts 1, 3 and -1).
+``seeded_trees(count, seed)`` mixes the two: the sample the per-node and lift tests share.
 """
 
 from __future__ import annotations
 
 import random
+import sys
+from pathlib import Path
 
 from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.bt_nodes import NodeKind
@@ -88,3 +91,25 @@ def pernode_tree(leaves: int, seed: int) -> BTDocument:
     if root.is_leaf or root.kind is NodeKind.DECORATOR:
         root = BTNode(rng.choice(CONTROLS), NodeKind.CONTROL, children=[root])
     return BTDocument.single(root)
+
+
+#: The bench families of the sample, in the order that fixes which tree each index draws.
+SAMPLE_FAMILIES = ("memory", "mixed", "reactive-plain", "decorated")
+
+
+def seeded_trees(count: int, seed: int) -> list[BTDocument]:
+    """``count`` small trees (2-10 leaves): odd indices ``pernode_tree`` (at most 7 leaves: a
+    Parallel's product of completed sets grows fast), even ones the bench families in turn."""
+    sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))
+    from bench_reactive import family_tree
+
+    rng = random.Random(seed)
+    found = []
+    for index in range(count):
+        leaves = rng.randint(2, 10)
+        if index % 2:
+            found.append(pernode_tree(min(leaves, 7), seed * 10_000 + index))
+        else:
+            family = SAMPLE_FAMILIES[(index // 2) % len(SAMPLE_FAMILIES)]
+            found.append(family_tree(family, leaves, seed * 10_000 + index))
+    return found

@@ -20,9 +20,8 @@ from fsmbt.verify.compositional import compositional_report
 from fsmbt.verify.lazy_fsm import LazyDataMachine, Unsupported
 from fsmbt.verify.native import replay
 from fsmbt.verify.report import PER_NODE_LIFTED
-
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from test_ver_pernode import BOUND, mutate, pernode_machine, trees, whole  # noqa: E402
+from support.pernode_mutants import BOUND, mutate, pernode_machine, whole
+from support.pernode_trees import seeded_trees
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))
 from bench_reactive import family_tree  # noqa: E402
@@ -33,7 +32,7 @@ def test_the_lazy_machine_steps_as_the_expanded_one() -> None:
     random walks of small results and their mutants."""
     rng = random.Random(3)
     compared = 0
-    for doc in trees(40, seed=11):
+    for doc in seeded_trees(40, seed=11):
         model = bt_to_hfsm(doc, pernode=True).model
         for candidate in (model, mutate(model, rng) or model):
             try:
@@ -67,7 +66,7 @@ def _lifted_trace(report):  # type: ignore[no-untyped-def]
 def test_lifted_verdicts_agree_with_the_whole_product_on_small_trees() -> None:
     rng = random.Random(5)
     tally: Counter[str] = Counter()
-    for doc in trees(60, seed=4):
+    for doc in seeded_trees(60, seed=4):
         model = bt_to_hfsm(doc, pernode=True).model
         if pernode_machine(model) is None:
             continue

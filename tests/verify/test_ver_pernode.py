@@ -18,38 +18,22 @@ from pathlib import Path
 
 from fsmbt import limits
 from fsmbt.convert.bt_to_hfsm import bt_to_hfsm
-from fsmbt.model.bt import BTDocument
 from fsmbt.model.fsm_data import ASSIGN, parse_lines
 from fsmbt.verify import verify
 from fsmbt.verify.compositional import compositional_report
 from fsmbt.verify.report import PER_NODE
 from support.pernode_mutants import BOUND, mutate, pernode_machine, whole
-from support.pernode_trees import pernode_tree
+from support.pernode_trees import seeded_trees
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))
 from bench_reactive import family_tree  # noqa: E402
-
-FAMILIES = ("memory", "mixed", "reactive-plain", "decorated")
-
-
-def trees(count: int, seed: int) -> list[BTDocument]:
-    rng = random.Random(seed)
-    found = []
-    for index in range(count):
-        leaves = rng.randint(2, 10)
-        if index % 2:  # at most 7 leaves: a Parallel's product of completed sets grows fast
-            found.append(pernode_tree(min(leaves, 7), seed * 10_000 + index))
-        else:
-            family = FAMILIES[(index // 2) % len(FAMILIES)]
-            found.append(family_tree(family, leaves, seed * 10_000 + index))
-    return found
 
 
 def test_per_node_agrees_with_the_whole_product_on_mutants() -> None:
     """The unmutated pairs are in tests/convert/test_conv_bt_pernode.py (2 000 trees)."""
     rng = random.Random(27)
     tally: Counter[str] = Counter()
-    for doc in trees(300, seed=4):
+    for doc in seeded_trees(300, seed=4):
         model = bt_to_hfsm(doc, pernode=True).model
         if pernode_machine(model) is None:
             continue
@@ -83,7 +67,7 @@ def test_a_region_without_its_halt_resets_is_not_proven_per_node() -> None:
     """Dropping every halt reset of a reactive node's chain: the decomposition refuses (a
     partial halt) or the local check fails; never a proof."""
     refused = 0
-    for doc in trees(300, seed=8):
+    for doc in seeded_trees(300, seed=8):
         model = bt_to_hfsm(doc, pernode=True).model
         sub = pernode_machine(model)
         if sub is None:
@@ -117,7 +101,7 @@ def test_lying_tags_never_give_a_wrong_proof() -> None:
 
     rng = random.Random(11)
     tally: Counter[str] = Counter()
-    for doc in trees(160, seed=13):
+    for doc in seeded_trees(160, seed=13):
         model = bt_to_hfsm(doc, pernode=True).model
         if pernode_machine(model) is None:
             continue
