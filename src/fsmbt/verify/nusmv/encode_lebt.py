@@ -21,14 +21,15 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 from fsmbt.model.bt import BTDocument
-from fsmbt.model.errors import Hint, UnsupportedError
 from fsmbt.semantics.lebt.fast import strict_lebt_sels
 from fsmbt.semantics.lebt.leaves import LebtLeaves
 from fsmbt.semantics.lebt.spec import NO_EVENT
-from fsmbt.verify.nusmv.encode_bt import BTCore, safe_text
+from fsmbt.verify.nusmv.encode_bt import safe_text
 from fsmbt.verify.nusmv.encode_fsm import NONE_OUT, Encoding
 from fsmbt.verify.nusmv.macro_frame import (
     declare_frame,
+    frame_core,
+    frame_symbols,
     record_action,
     root_returned,
     start_step,
@@ -49,23 +50,13 @@ class LebtEncoder:
         *,
         alphabet: Sequence[str],
     ) -> None:
-        self.core = BTCore(doc, loop=False)
-        if self.core.may_skip[0]:  # the LEBT protocol reads SUCCESS/FAILURE/RUNNING only
-            raise UnsupportedError(
-                "the NuSMV encoding of an LEBT does not support a root that may return SKIPPED",
-                element=self.core.nodes[0].label,
-                hints=(Hint.NATIVE_VERIFIER,),
-            )
+        self.core = frame_core(doc, "an LEBT")
         self.leaves = LebtLeaves.of(self.core.tree)
         self.module = module
         self.inputs = inputs
         self.outputs = outputs
         self.alphabet = list(alphabet)
-        inputs.add_all(self.alphabet)
-        self.states = Symbols("bs")
-        self.states.id(self.leaves.start)
-        self.events = Symbols("ev")
-        self.events.add_all(self.alphabet)
+        self.states, self.events = frame_symbols(inputs, self.alphabet, self.leaves.start)
         for guard in self.leaves.guards.values():
             for source, _event in guard.pairs:
                 self.states.id(source)

@@ -51,10 +51,12 @@ from fsmbt.semantics import state_variable_runtime as sv
 from fsmbt.semantics.bt_interpreter import CompiledTree
 from fsmbt.semantics.lebt.spec import NO_EVENT
 from fsmbt.semantics.nodes import node_semantics
-from fsmbt.verify.nusmv.encode_bt import BTCore, safe_text
+from fsmbt.verify.nusmv.encode_bt import safe_text
 from fsmbt.verify.nusmv.encode_fsm import NONE_OUT, Encoding
 from fsmbt.verify.nusmv.macro_frame import (
     declare_frame,
+    frame_core,
+    frame_symbols,
     record_action,
     root_returned,
     start_step,
@@ -125,14 +127,7 @@ class SvEncoder:
         *,
         alphabet: Sequence[str],
     ) -> None:
-        self.core = BTCore(doc, loop=False)
-        if self.core.may_skip[0]:
-            raise UnsupportedError(
-                "the NuSMV encoding of a state-variable tree does not support a root that may "
-                "return SKIPPED",
-                element=self.core.nodes[0].label,
-                hints=(Hint.NATIVE_VERIFIER,),
-            )
+        self.core = frame_core(doc, "a state-variable tree")
         # the leaves' ports, the initial state and the start pseudo-state, parsed (and
         # validated) as the native machine does; its exploration is never used
         machine = sv.StateVariableMachine(doc, ())
@@ -145,11 +140,7 @@ class SvEncoder:
         self.inputs = inputs
         self.outputs = outputs
         self.alphabet = list(alphabet)
-        inputs.add_all(self.alphabet)
-        self.states = Symbols("bs")
-        self.states.id(self.initial_state)
-        self.events = Symbols("ev")
-        self.events.add_all(self.alphabet)
+        self.states, self.events = frame_symbols(inputs, self.alphabet, self.initial_state)
         for leaf in self.leaves.values():
             for name in (leaf.state, leaf.target, *(t for _e, t in leaf.transitions)):
                 if name:

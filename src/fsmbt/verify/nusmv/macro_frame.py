@@ -24,9 +24,36 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
+from fsmbt.model.bt import BTDocument
+from fsmbt.model.errors import Hint, UnsupportedError
 from fsmbt.verify.nusmv.encode_bt import BTCore
 from fsmbt.verify.nusmv.encode_fsm import NONE_OUT
 from fsmbt.verify.nusmv.smv import Symbols, case
+
+
+def frame_core(doc: BTDocument, what: str) -> BTCore:
+    """``doc``'s tick rules (``BTCore``, no ``loop``); a root that may return SKIPPED is refused
+    (the macro-step protocols read SUCCESS/FAILURE/RUNNING only). ``what``: the tree's kind,
+    for the message."""
+    core = BTCore(doc, loop=False)
+    if core.may_skip[0]:
+        raise UnsupportedError(
+            f"the NuSMV encoding of {what} does not support a root that may return SKIPPED",
+            element=core.nodes[0].label,
+            hints=(Hint.NATIVE_VERIFIER,),
+        )
+    return core
+
+
+def frame_symbols(inputs: Symbols, alphabet: Sequence[str], start: str) -> tuple[Symbols, Symbols]:
+    """The inputs get the ``alphabet``; returns the symbol tables of ``bbs`` (the states,
+    ``start`` first: its id is the initial value) and of ``bbe`` (the alphabet's events)."""
+    inputs.add_all(alphabet)
+    states = Symbols("bs")
+    states.id(start)
+    events = Symbols("ev")
+    events.add_all(alphabet)
+    return states, events
 
 
 def declare_frame(
