@@ -21,6 +21,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 from fsmbt.model.bt import BTDocument
+from fsmbt.model.errors import Hint, UnsupportedError
 from fsmbt.semantics.lebt.fast import strict_lebt_sels
 from fsmbt.semantics.lebt.leaves import LebtLeaves
 from fsmbt.semantics.lebt.spec import NO_EVENT
@@ -70,10 +71,12 @@ class LebtEncoder:
     def extra_specs(self) -> list[tuple[str, str]]:
         return [("output_overflow", "!r.ovf")]
 
-    def extra_message(self, name: str) -> str:
-        return (
+    def extra_failure(self, name: str) -> Exception:
+        """The error a failed extra check (the slot bound) stands for."""
+        return UnsupportedError(
             f"the NuSMV encoding bounds the actions of one macro step at {self.slots}; this "
-            "LEBT runs more in one step"
+            "LEBT runs more in one step",
+            hints=(Hint.NATIVE_VERIFIER,),
         )
 
     def _ev(self, event: str) -> str | None:

@@ -7,7 +7,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, TypeAlias
 
 from fsmbt.model.bt import BTDocument
-from fsmbt.model.errors import Hint, UnsupportedError
+from fsmbt.model.errors import UnsupportedError
 from fsmbt.model.fsm import FSM
 from fsmbt.semantics.status import MachineStatus
 from fsmbt.verify.nusmv.encode_bt import LeafBTEncoder
@@ -113,13 +113,10 @@ def build_report(
         if name in PROPERTIES:
             continue
         if not result.holds:
-            from fsmbt.verify.nusmv.encode_lebt import LebtEncoder  # LEBT and Sv add specs
-            from fsmbt.verify.nusmv.encode_sv import SvEncoder
-
-            if isinstance(res_enc, LebtEncoder):
-                raise UnsupportedError(res_enc.extra_message(name), hints=(Hint.NATIVE_VERIFIER,))
-            if isinstance(res_enc, SvEncoder):  # the livelock: the native InputError, verbatim
-                raise res_enc.extra_failure(name)
+            # an encoder that adds checks (``extra_specs``) says what each failure means
+            failure = getattr(res_enc, "extra_failure", None)
+            if failure is not None:
+                raise failure(name)
             raise UnsupportedError(f"the NuSMV check {name!r} failed")
     for name, result in zip(names, results):
         if name not in PROPERTIES:
