@@ -73,10 +73,12 @@ class DispatchEncoder:
         outputs: Symbols,
         *,
         alphabet: Sequence[str],
+        parsed: DispatchMachine | None = None,
     ) -> None:
         # the form's checks and tables (leaf type, post-conditions, entries, _onSuccess writes);
-        # no tick is taken
-        parsed = DispatchMachine(doc, ())
+        # no tick is taken (``parsed``: ``doc``'s, when the caller already built it)
+        if parsed is None:
+            parsed = DispatchMachine(doc, ())
         self.tree = parsed.tree
         refused = memory_refusal(self.tree)
         if refused is not None:
@@ -322,10 +324,10 @@ def encode_dispatch_pair(
         fsm, doc, fsm_side, tree_side = result, source, "result", "source"
     else:
         return None
-    events = DispatchMachine(doc, ()).events()
-    alphabet = list(dict.fromkeys([*FSMMachine(fsm).alphabet, *events]))
+    parsed = DispatchMachine(doc, ())  # parsed and checked once, for its events and tables
+    alphabet = list(dict.fromkeys([*FSMMachine(fsm).alphabet, *parsed.events()]))
     fsm_enc = FSMEncoder(fsm, fsm_side, inputs, outputs, alphabet=alphabet)
-    tree_enc = DispatchEncoder(doc, tree_side, inputs, outputs, alphabet=alphabet)
+    tree_enc = DispatchEncoder(doc, tree_side, inputs, outputs, alphabet=alphabet, parsed=parsed)
     return (fsm_enc, tree_enc) if fsm_side == "source" else (tree_enc, fsm_enc)
 
 
