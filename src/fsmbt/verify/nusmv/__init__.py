@@ -78,11 +78,11 @@ def encode(source: FSM | BTDocument, result: FSM | BTDocument, *, loop: bool = F
 
             # the native pairing's alphabet (machines_for_state_variable): the FSM's events,
             # then every event a leaf names
-            events = StateVariableMachine(result, ()).events()
-            alphabet = _union(flatten(source).events(), events)
+            machine = StateVariableMachine(result, ())  # parsed once, for both uses
+            alphabet = _union(flatten(source).events(), machine.events())
             return (
                 FSMEncoder(source, "source", inputs, outputs, alphabet=alphabet),
-                SvEncoder(result, "result", inputs, outputs, alphabet=alphabet),
+                SvEncoder(result, "result", inputs, outputs, alphabet=alphabet, machine=machine),
                 inputs,
                 outputs,
                 MACRO_STEP,

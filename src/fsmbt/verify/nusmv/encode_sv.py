@@ -126,11 +126,14 @@ class SvEncoder:
         outputs: Symbols,
         *,
         alphabet: Sequence[str],
+        machine: sv.StateVariableMachine | None = None,
     ) -> None:
         self.core = frame_core(doc, "a state-variable tree")
         # the leaves' ports, the initial state and the start pseudo-state, parsed (and
-        # validated) as the native machine does; its exploration is never used
-        machine = sv.StateVariableMachine(doc, ())
+        # validated) as the native machine does; its exploration is never used (``machine``:
+        # ``doc``'s, when the caller already built it)
+        if machine is None:
+            machine = sv.StateVariableMachine(doc, ())
         self.name = machine.name
         self.leaves: dict[int, sv.SvLeaf] = dict(machine.leaves)
         self.initial_state = machine.initial_state
