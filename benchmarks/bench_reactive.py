@@ -22,8 +22,10 @@ interpreter's leaf machine (``LeafMachine(generic=True)``), explored for trees u
 ``--faithful-up-to`` nodes (it is the cost this work removes; past the limit it is not run).
 Targets (issue 19): a 1 000-node reactive tree under 1 s, a 10 000-node one under 10 s.
 
-``--convert`` times the whole ``fsmbt convert`` of each tree (read, convert, verify, write; wall
-and CPU seconds) and prints the verdict's method. ``--compositional`` (issue 27) prints another table: per tree the conversion's seconds, the
+``--convert`` times the whole ``fsmbt convert`` of each tree (read, convert, verify, load check,
+write; wall and CPU seconds of this process - a load check in a child process is not in its CPU
+seconds), the proof's seconds (``verify s``), the wait for the load check past the proof (``load s``:
+it runs beside the proof, ``semantics.engines.load_beside``) and prints the verdict's method. ``--compositional`` (issue 27) prints another table: per tree the conversion's seconds, the
 compositional check's regions, largest region product, summed products and seconds (or why the
 pair falls back to the whole product), and the whole product's states and seconds beside it.
 """
@@ -261,7 +263,8 @@ def _convert_table(args: argparse.Namespace) -> int:
     from fsmbt import api
 
     header = (
-        f"{'family':<14} {'nodes':>6} {'convert s':>10} {'cpu s':>8} {'verdict':>15} {'method':>14}"
+        f"{'family':<14} {'nodes':>6} {'convert s':>10} {'cpu s':>8} {'verify s':>9} "
+        f"{'load s':>7} {'verdict':>15} {'method':>14}"
     )
     print(header)
     print("-" * len(header))
@@ -289,9 +292,11 @@ def _convert_table(args: argparse.Namespace) -> int:
                     continue
                 report = outcome.report
                 method = report.method if report is not None else "-"
+                verify_s = outcome.timings.get("verify", 0.0)
+                load_s = outcome.timings.get("load", 0.0)
                 print(
-                    f"{family:<14} {nodes:>6} {seconds:>10.3f} {cpu:>8.3f} "
-                    f"{api.verdict_word(report):>15} {method:>14}",
+                    f"{family:<14} {nodes:>6} {seconds:>10.3f} {cpu:>8.3f} {verify_s:>9.2f} "
+                    f"{load_s:>7.2f} {api.verdict_word(report):>15} {method:>14}",
                     flush=True,
                 )
     return 0

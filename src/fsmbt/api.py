@@ -20,7 +20,9 @@ The steps, each a thin public function over the package that owns it:
   BehaviorTree.CPP is loaded in BehaviorTree.CPP 4.8.2 before it is reported or written, an
   SCXML result in python-statemachine where it is installed (``scxml_load``); a result the
   engine refuses is a located ``TreeLoadError``, never a verdict (docs/semantics.md §5,
-  "Every written tree loads"). ``ConvertRequest.load_check=False`` skips it.
+  "Every written tree loads"). ``ConvertRequest.load_check=False`` skips it. The check runs
+  beside the proof (``semantics.engines.load_beside``: the two are independent), so a large
+  result costs the longer of the two, not their sum.
 - ``convert_file``: all of it for one input, returning one ``Outcome`` (both models, the
   conversion, the report, timings, warnings, where the result was written).
 
@@ -66,8 +68,8 @@ from fsmbt.model.fsm import FSM
 from fsmbt.model.validate import Issue
 from fsmbt.semantics.blockers import Blocker
 from fsmbt.semantics.blockers import conversion_blockers as blockers_of
-from fsmbt.semantics.engines.btcpp_load import LoadCheck, check_loads
-from fsmbt.semantics.engines.scxml_load import check_scxml_loads
+from fsmbt.semantics.engines.btcpp_load import LoadCheck
+from fsmbt.semantics.engines.load_beside import PendingLoad, start_load_check
 from fsmbt.semantics.outcome_rules import OutcomeRules
 from fsmbt.verify import Report, verify
 from fsmbt.verify.native import StateLimitError
@@ -832,25 +834,31 @@ def convert_loaded(
         conversion.warnings.append(data_loss)
     text = dumps(written_model, fmt)
     report: Report | None = None
-    if request.verify:
-        with _timed(timings, "verify", on_stage):
-            structured = conversion.stats.get("style") == "structured"
-            report = verify_models(
-                loaded.model,
-                conversion.model,
-                request.verify_engine,
-                loop=request.loop,
-                max_states=request.max_states,
-                outcomes=request.outcomes if structured else None,
-                outcome_driven=structured,
-            )
+    # the load check runs beside the proof (semantics.engines.load_beside): they are independent
+    pending: PendingLoad | None = None
+    if request.load_check and _load_checked(fmt, conversion.model):
+        pending = start_load_check(text, fmt)
+    try:
+        if request.verify:
+            with _timed(timings, "verify", on_stage):
+                structured = conversion.stats.get("style") == "structured"
+                report = verify_models(
+                    loaded.model,
+                    conversion.model,
+                    request.verify_engine,
+                    loop=request.loop,
+                    max_states=request.max_states,
+                    outcomes=request.outcomes if structured else None,
+                    outcome_driven=structured,
+                )
+    except BaseException:
+        if pending is not None:
+            pending.cancel()
+        raise
     load: LoadCheck | None = None
-    if request.load_check and fmt == "btcpp" and isinstance(conversion.model, BTDocument):
-        with _timed(timings, "load", on_stage):
-            load = check_loads(text)
-    elif request.load_check and fmt == "scxml" and isinstance(conversion.model, FSM):
-        with _timed(timings, "load", on_stage):
-            load = check_scxml_loads(text)  # None without python-statemachine
+    if pending is not None:
+        with _timed(timings, "load", on_stage):  # the wait past the proof
+            load = pending.result()  # None without the engine (python-statemachine)
     if load is not None:
         load.raise_if_refused(str(destination) if destination is not None else "<stdout>")
     outcome = Outcome(loaded, conversion, report, fmt, text, output=destination, load=load)
@@ -862,6 +870,14 @@ def convert_loaded(
         outcome.written = True
     outcome.timings = timings
     return outcome
+
+
+def _load_checked(fmt: str, model: FSM | BTDocument) -> bool:
+    """Whether a result written as ``fmt`` gets a load check (docs/semantics.md §5): a
+    behavior tree written for BehaviorTree.CPP, a state machine written as SCXML."""
+    if fmt == "btcpp":
+        return isinstance(model, BTDocument)
+    return fmt == "scxml" and isinstance(model, FSM)
 
 
 def verify_files(

@@ -15,7 +15,10 @@ Costs: the engine's parse and one start, O(document size).
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import io
+import json
+import sys
 
 from fsmbt.semantics.engines.btcpp_load import LoadCheck
 
@@ -46,3 +49,21 @@ def check_scxml_loads(text: str) -> LoadCheck | None:
         message = " ".join(f"{type(exc).__name__}: {exc}".split())[:600]
         return LoadCheck(engine, False, message)
     return LoadCheck(engine, True)
+
+
+def main() -> int:
+    """``python -m fsmbt.semantics.engines.scxml_load [FILE]``: the check of the SCXML text in
+    FILE (else on standard input), answered as one JSON line (the ``LoadCheck``'s fields;
+    ``null`` without python-statemachine). ``load_beside`` runs it beside a proof."""
+    if len(sys.argv) > 1:
+        with open(sys.argv[1], encoding="utf-8") as handle:
+            text = handle.read()
+    else:
+        text = sys.stdin.read()
+    answer = check_scxml_loads(text)
+    print(json.dumps(None if answer is None else dataclasses.asdict(answer)))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

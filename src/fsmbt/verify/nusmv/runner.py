@@ -13,24 +13,21 @@ UTF-8 with ``errors="replace"``: a stray byte never hides the verdicts.
 
 from __future__ import annotations
 
-import ctypes
-import math
 import os
 import re
 import signal
 import subprocess
-import sys
 import tempfile
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 from fsmbt import limits
+from fsmbt.child_process import bounded_child
 from fsmbt.limits import Limits
 from fsmbt.model.errors import FsmbtError, Hint
 from fsmbt.verify.nusmv.binary import require_nusmv
 
 DEFAULT_TIMEOUT_S = Limits.nusmv_max_seconds  # the default lives in fsmbt.limits
-_PR_SET_PDEATHSIG = 1  # <linux/prctl.h>
 #: Words NuSMV / CUDD / the C library print when an allocation fails under RLIMIT_AS.
 _MEMORY_WORDS = (
     "out of memory",
@@ -95,42 +92,6 @@ def count_variables(model: str) -> int:
         if in_vars and _DECLARATION.match(line):
             count += 1
     return count
-
-
-def _prctl() -> Callable[..., int] | None:
-    """Linux's ``prctl``, looked up in the parent (the child must not load libraries between
-    ``fork`` and ``exec``), or ``None`` elsewhere."""
-    if not sys.platform.startswith("linux"):
-        return None
-    try:
-        return ctypes.CDLL(None, use_errno=True).prctl
-    except (OSError, AttributeError):
-        return None
-
-
-def _child_caps(megabytes: int, seconds: float):  # type: ignore[no-untyped-def]
-    """A ``preexec_fn`` (it runs in the child, before ``exec``) that bounds the child for good:
-    its address space (``RLIMIT_AS``), its CPU time (``RLIMIT_CPU``, a little past the wall
-    cap: a backstop should the parent be unable to kill it) and its life - it is killed when
-    the process that started it dies (``PR_SET_PDEATHSIG``), so a batch worker or a CLI run
-    killed with SIGKILL leaves no NuSMV behind."""
-    import resource
-
-    prctl = _prctl()
-    parent = os.getpid()
-    cpu = max(1, int(seconds) + 5) if math.isfinite(seconds) else None
-
-    def apply() -> None:
-        cap = megabytes * 1024 * 1024
-        resource.setrlimit(resource.RLIMIT_AS, (cap, cap))
-        if cpu is not None:
-            resource.setrlimit(resource.RLIMIT_CPU, (cpu, cpu + 1))
-        if prctl is not None:
-            prctl(_PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
-            if os.getppid() != parent:  # the parent died before the request took effect
-                os._exit(1)
-
-    return apply
 
 
 def _out_of_memory(proc: subprocess.CompletedProcess[str]) -> bool:
@@ -216,7 +177,7 @@ def run_nusmv(
                 errors="replace",
                 timeout=timeout,
                 cwd=tmp,
-                preexec_fn=_child_caps(memory_mb, timeout),
+                preexec_fn=bounded_child(memory_mb, timeout),
             )
         except subprocess.TimeoutExpired:
             raise NuSMVLimitError(
@@ -224,7 +185,7 @@ def run_nusmv(
             ) from None
         elapsed = time.perf_counter() - started
     results = parse_output(proc.stdout)
-    if proc.returncode == -signal.SIGXCPU:  # the CPU backstop of _child_caps
+    if proc.returncode == -signal.SIGXCPU:  # the CPU backstop of bounded_child
         raise NuSMVLimitError("time", count_variables(model), "nusmv_max_seconds", timeout)
     if (proc.returncode != 0 or len(results) != expected_specs) and _out_of_memory(proc):
         raise NuSMVLimitError("memory", count_variables(model), "nusmv_max_memory_mb", memory_mb)
