@@ -201,6 +201,7 @@ class OutcomeBTEncoder(LeafBTEncoder):
     ) -> None:
         tree = OutcomeTree(doc)  # the blackboard model's parse and its soundness checks
         self.view = view
+        self.tree_name = doc.main.id
         self.outcome_keys = tree.outcome_keys
         values: dict[str, dict[str, None]] = {key: {} for key in sorted(tree.modelled)}
         for node in tree.nodes:
@@ -350,7 +351,7 @@ class OutcomeBTEncoder(LeafBTEncoder):
         return _refuse(
             "a tree that can tick forever without ticking a leaf (the native machine's "
             "LIVELOCK state)",
-            self.core.nodes[0].label,
+            f"tree '{self.tree_name}'",
         )
 
 
