@@ -4,7 +4,8 @@
 shortest counterexample when it fails. Two engines: ``native`` (explicit-state product, the
 default) and ``nusmv``; ``both`` runs the two and raises ``EngineDisagreement`` if any property
 verdict differs, since then one of them is wrong; when NuSMV reaches its time or memory cap, ``both``
-returns the native verdict with ``stats["nusmv_limit"]`` saying so. Every report names its
+returns the native verdict with ``stats["nusmv_limit"]`` saying so, and the same when the outcome
+pairing's encoding refuses a construct by name (docs/nusmv.md, "The outcome pairing"). Every report names its
 ``method``, ``engines`` and ``abstractions`` (``fsmbt.verify.method``); inside
 ``certificate.collecting()`` the native check's witness (or, for a compositional proof, each
 part's) is kept for a certificate.
