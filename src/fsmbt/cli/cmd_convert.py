@@ -217,6 +217,8 @@ def _print_summary(outcome: api.Outcome, *, to_stderr: bool, brief: bool = False
             f"  compositional check: {report.stats['compositional']}; the whole product decided",
             file=stream,
         )
+    if report.stats.get("nusmv_limit"):  # --verify-engine both: NuSMV did not confirm it
+        print(f"  NuSMV gave up (native verdict only): {report.stats['nusmv_limit']}", file=stream)
     counts = checked_counts(report.stats)
     if counts:
         print(f"  checked {counts}", file=stream)

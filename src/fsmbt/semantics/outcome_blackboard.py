@@ -240,9 +240,9 @@ class OutcomeLeafMachine(LeafMachine):
     (its label alone already differs from anything the source outputs).
     """
 
-    def __init__(self, doc: BTDocument, view: OutcomeView) -> None:
+    def __init__(self, doc: BTDocument, view: OutcomeView, *, generic: bool = False) -> None:
         tree = OutcomeTree(doc)
-        super().__init__(tree, generic=tree.uses_blackboard)
+        super().__init__(tree, generic=generic or tree.uses_blackboard)
         if tree.uses_blackboard:
             self.interp = OutcomeInterpreter(tree)
         self.outcome_tree = tree

@@ -4,7 +4,8 @@
 shortest counterexample when it fails. Two engines: ``native`` (explicit-state product, the
 default) and ``nusmv``; ``both`` runs the two and raises ``EngineDisagreement`` if any property
 verdict differs, since then one of them is wrong; when NuSMV reaches its time or memory cap, ``both``
-returns the native verdict with ``stats["nusmv_limit"]`` saying so. Every report names its
+returns the native verdict with ``stats["nusmv_limit"]`` saying so, and the same when the outcome
+pairing's encoding refuses a construct by name (docs/nusmv.md, "The outcome pairing"). Every report names its
 ``method``, ``engines`` and ``abstractions`` (``fsmbt.verify.method``); inside
 ``certificate.collecting()`` the native check's witness (or, for a compositional proof, each
 part's) is kept for a certificate.
@@ -94,17 +95,12 @@ def verify(
     """
     if engine not in ENGINES:
         raise InputError(f"unknown verification engine '{engine}' (known: {', '.join(ENGINES)})")
-    if (
-        engine != "native"
-        and isinstance(source, FSM)
+    pairing = (outcomes, outcome_driven)  # the outcome pairing's reading, for both engines
+    outcome_pair = (
+        isinstance(source, FSM)
         and isinstance(result, BTDocument)
         and is_outcome_pair(source, result, outcome_driven=outcome_driven)
-    ):
-        raise UnsupportedError(
-            "NuSMV does not encode the outcome pairing of a structured tree (its Switch and "
-            "Script blackboard model)",
-            hints=(Hint.NATIVE_VERIFIER,),
-        )
+    )
     if engine != "native" and dispatch_beside_bt(source, result):
         raise UnsupportedError(
             "NuSMV encodes the dispatch form (docs/semantics.md section 12) against a state "
@@ -112,7 +108,7 @@ def verify(
             hints=(Hint.NATIVE_VERIFIER,),
         )
     if engine == "nusmv":
-        report = _nusmv(source, result, loop, fallback=False)
+        report = _nusmv(source, result, loop, pairing, fallback=False)
         report.method = SYMBOLIC
         report.engines = nusmv_engine()
         return report
@@ -136,19 +132,32 @@ def verify(
     if engine == "native":
         return native
     try:
-        other = _nusmv(source, result, loop)
+        other = _nusmv(source, result, loop, pairing)
     except NuSMVGaveUp as exc:
         # NuSMV's time or memory cap: the native verdict stands, and the report says NuSMV
         # could not confirm it (docs/verification.md, "What a verdict says").
         native.engines.update(nusmv_engine())
         native.stats["nusmv_limit"] = str(exc)
         return native
+    except UnsupportedError as exc:
+        if not outcome_pair:
+            raise
+        # what the outcome pairing's encoding does not cover (docs/nusmv.md, "The outcome
+        # pairing"): the native verdict stands, the report names NuSMV's limit
+        native.engines.update(nusmv_engine())
+        native.stats["nusmv_limit"] = f"NuSMV does not encode this pair: {exc}"
+        return native
     if _reachability_only(native, other):
         # Reachability compares states: a leaf machine on reduced states (docs/semantics.md
         # §4a) may merge a state reached only outside the agreeing pairs with one reached in
         # them. The faithful machines decide the state-based property the way NuSMV does.
         source_machine, result_machine, mode = machines_for(
-            source, result, loop=loop, faithful=True
+            source,
+            result,
+            loop=loop,
+            faithful=True,
+            outcomes=outcomes,
+            outcome_driven=outcome_driven,
         )
         faithful = _native(source_machine, result_machine, max_states, mode, sink, loop, True)
         faithful.source, faithful.result = native.source, native.result
@@ -235,7 +244,12 @@ class NuSMVGaveUp(RuntimeError):
 
 
 def _nusmv(
-    source: FSM | BTDocument, result: FSM | BTDocument, loop: bool, *, fallback: bool = True
+    source: FSM | BTDocument,
+    result: FSM | BTDocument,
+    loop: bool,
+    pairing: tuple[OutcomeRules | None, bool] = (None, False),
+    *,
+    fallback: bool = True,
 ) -> Report:
     try:
         from fsmbt.verify import nusmv
@@ -250,7 +264,10 @@ def _nusmv(
             hints=(Hint.NATIVE_VERIFIER,),
         )
     try:
-        report: Report = checker(source, result, loop=loop)
+        outcomes, outcome_driven = pairing
+        report: Report = checker(
+            source, result, loop=loop, outcomes=outcomes, outcome_driven=outcome_driven
+        )
         return report
     except nusmv.NuSMVLimitError as exc:
         if fallback:

@@ -65,15 +65,17 @@ def _structured_signature(source: FSM, result: BTDocument) -> bool:
 
 
 def outcome_machines(
-    source: FSM, result: BTDocument, rules: OutcomeRules | None = None
+    source: FSM, result: BTDocument, rules: OutcomeRules | None = None, *, faithful: bool = False
 ) -> tuple[OutcomeFSMMachine, OutcomeLeafMachine, str]:
-    """The two machines of the outcome pairing and the mode's name.
+    """The two machines of the outcome pairing and the mode's name (``faithful``: the tree on
+    the faithful interpreter, as ``pairing.machines_for`` says).
 
     Raises:
         OutcomeError: the FSM is not outcome-driven (the state and the cause named).
     """
     view = read_structured_view(source, rules)
-    return OutcomeFSMMachine(view), OutcomeLeafMachine(result, view), OUTCOME_EXECUTION
+    leaves = OutcomeLeafMachine(result, view, generic=faithful)
+    return OutcomeFSMMachine(view), leaves, OUTCOME_EXECUTION
 
 
 def outcome_abstractions(view: OutcomeView) -> list[str]:

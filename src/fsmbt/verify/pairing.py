@@ -141,7 +141,7 @@ def machines_for(
         if is_dispatch_bt(result):  # the dispatch form (docs/semantics.md section 12)
             return (*machines_for_dispatch(source, result), MACRO_STEP)
         if is_outcome_pair(source, result, outcome_driven=outcome_driven):
-            return outcome_machines(source, result, outcomes)
+            return outcome_machines(source, result, outcomes, faithful=faithful)
 
         source_machine = FSMMachine(source)
         alphabet = _union(source_machine.alphabet, lebt_guard_events(result))

@@ -103,8 +103,9 @@ def test_the_blackboard_model_refuses_other_uses_of_a_modelled_entry() -> None:
         verify(fsm, doc, outcome_driven=True)
 
 
-def test_nusmv_is_refused_for_the_outcome_pairing() -> None:
+def test_both_engines_check_the_outcome_pairing(nusmv_binary: object) -> None:
     fsm = pipeline(2)
     doc = fsm_to_structured(fsm).model
-    with pytest.raises(UnsupportedError, match="outcome pairing"):
-        verify(fsm, doc, engine="both", outcome_driven=True)
+    report = verify(fsm, doc, engine="both", outcome_driven=True)
+    assert report.equivalent and report.engine == "native+nusmv"
+    assert "nusmv_limit" not in report.stats  # NuSMV decided it (tests/verify/nusmv/)

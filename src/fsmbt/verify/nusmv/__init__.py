@@ -16,10 +16,12 @@ from typing import TYPE_CHECKING, TypeAlias
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import InputError
 from fsmbt.model.fsm import FSM
+from fsmbt.semantics.outcome_rules import OutcomeRules
 from fsmbt.verify.nusmv.binary import NuSMVNotFound, find_nusmv, require_nusmv
 from fsmbt.verify.nusmv.encode_bt import LeafBTEncoder
 from fsmbt.verify.nusmv.encode_dispatch import encode_dispatch_pair, one_step_per_input
 from fsmbt.verify.nusmv.encode_fsm import FSMEncoder
+from fsmbt.verify.nusmv.encode_outcome import OutcomeBTEncoder
 from fsmbt.verify.nusmv.runner import NuSMVError, NuSMVLimitError, SpecResult, run_nusmv
 from fsmbt.verify.nusmv.smv import Symbols
 from fsmbt.verify.nusmv.specs import CTL, INVARIANTS, WHOLE, product
@@ -33,6 +35,7 @@ from fsmbt.verify.report import (
 
 if TYPE_CHECKING:
     from fsmbt.verify.nusmv.encode_lebt import LebtEncoder  # noqa: F401 - in Encoder
+    from fsmbt.verify.nusmv.encode_outcome import OutcomeFSMEncoder  # noqa: F401 - in Encoder
     from fsmbt.verify.nusmv.encode_sv import SvEncoder  # noqa: F401 - in Encoder
 
 Encoders: TypeAlias = tuple[Encoder, Encoder, Symbols, Symbols, str]
@@ -49,12 +52,31 @@ def _union(*groups: Iterable[str]) -> list[str]:
     return list(seen)
 
 
-def encode(source: FSM | BTDocument, result: FSM | BTDocument, *, loop: bool = False) -> Encoders:
+def encode(
+    source: FSM | BTDocument,
+    result: FSM | BTDocument,
+    *,
+    loop: bool = False,
+    outcomes: OutcomeRules | None = None,
+    outcome_driven: bool = False,
+) -> Encoders:
     """The two machine encoders, the shared symbol tables and the mode for a pair of models
-    (the same pairing as ``fsmbt.verify.pairing.machines_for``)."""
+    (the same pairing as ``fsmbt.verify.pairing.machines_for``; ``outcomes`` and
+    ``outcome_driven`` as there: an outcome-driven FSM and its structured tree are the outcome
+    pairing, ``encode_outcome``)."""
+    from fsmbt.verify.outcome_pairing import OUTCOME_EXECUTION, is_outcome_pair
     from fsmbt.verify.pairing import lebt_guard_events, sub_machine_events
 
     inputs, outputs = Symbols("in_"), Symbols("out_")
+    if (
+        isinstance(source, FSM)
+        and isinstance(result, BTDocument)
+        and is_outcome_pair(source, result, outcome_driven=outcome_driven)
+    ):
+        from fsmbt.verify.nusmv.encode_outcome import encode_outcome_pair
+
+        pair = encode_outcome_pair(source, result, inputs, outputs, outcomes)
+        return (*pair, inputs, outputs, OUTCOME_EXECUTION)
     if isinstance(source, FSM) and isinstance(result, FSM):
         alphabet = _union(source.events(), result.events(), *sub_machine_events(source, result))
         return (
@@ -121,13 +143,17 @@ def build_model(
     *,
     loop: bool = False,
     part: str = WHOLE,
+    outcomes: OutcomeRules | None = None,
+    outcome_driven: bool = False,
 ) -> tuple[str, list[str], Context]:
     """The SMV text of the product, the spec names and what is needed to decode traces.
 
     ``part`` (``specs.WHOLE``, ``INVARIANTS``, ``CTL``): which model - every spec on one
     product (the single model of earlier versions, kept for the benchmarks and
     ``scripts/smv_snapshot.py``) or one of the two that ``check`` runs."""
-    return build_models(source, result, loop=loop, parts=(part,))[0]
+    return build_models(
+        source, result, loop=loop, parts=(part,), outcomes=outcomes, outcome_driven=outcome_driven
+    )[0]
 
 
 def build_models(
@@ -136,9 +162,13 @@ def build_models(
     *,
     loop: bool = False,
     parts: tuple[str, ...] = (INVARIANTS, CTL),
+    outcomes: OutcomeRules | None = None,
+    outcome_driven: bool = False,
 ) -> list[tuple[str, list[str], Context]]:
     """``build_model`` for several parts, encoding the two machines once."""
-    src_enc, res_enc, inputs, outputs, mode = encode(source, result, loop=loop)
+    src_enc, res_enc, inputs, outputs, mode = encode(
+        source, result, loop=loop, outcomes=outcomes, outcome_driven=outcome_driven
+    )
     src, res = src_enc.encode(), res_enc.encode()
     extra: list[tuple[str, str]] = getattr(res_enc, "extra_specs", lambda: [])()
     models = []
@@ -159,8 +189,13 @@ def check(
     implied_reachability: bool = True,
     split: bool | None = None,
     mono: bool | None = None,
+    outcomes: OutcomeRules | None = None,
+    outcome_driven: bool = False,
 ) -> Report:
     """Verify ``result_model`` against ``source_model`` with NuSMV; see the module docstring.
+
+    ``outcomes``, ``outcome_driven``: an FSM and a structured tree are compared by the outcome
+    pairing (``encode_outcome``; ``fsmbt.verify.outcome_pairing``) under these rules.
 
     ``split`` (docs/nusmv.md, "Two runs"): the invariants run on the product without
     detaching (NuSMV's forward search then visits the faithful product only), the CTL specs on
@@ -191,7 +226,14 @@ def check(
         split = one_step_per_input(source_model, result_model)
     parts = (INVARIANTS, CTL) if split else (WHOLE,)
     mono = not split if mono is None else mono
-    models = build_models(source_model, result_model, loop=loop, parts=parts)
+    models = build_models(
+        source_model,
+        result_model,
+        loop=loop,
+        parts=parts,
+        outcomes=outcomes,
+        outcome_driven=outcome_driven,
+    )
     encoded = time.perf_counter()
     context = models[0][2]
     names: list[str] = []
@@ -219,6 +261,15 @@ def check(
         runs += 1
         nusmv_seconds += seconds
     report = build_report(names, results, context, source_model, result_model)
+    tree = context[3]
+    if isinstance(tree, OutcomeBTEncoder):  # the outcome pairing's livelock check, on its own
+        checked = tree.livelock_model(context[1])
+        if checked is not None:
+            found, seconds = run_nusmv(checked[0], 1, order=checked[1], timeout=timeout, mono=False)
+            runs += 1
+            nusmv_seconds += seconds
+            if not found[0].holds:
+                raise tree.livelock_failure()
     if deferred is not None:
         if all(p.holds for p in report.properties.values()):
             report.properties[REACHABILITY] = PropertyResult(REACHABILITY, True, IMPLIED_DETAIL)

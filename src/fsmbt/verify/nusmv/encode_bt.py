@@ -32,6 +32,7 @@ Size: O(N · d) SMV text for N nodes of depth d.
 from __future__ import annotations
 
 import re
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -74,7 +75,18 @@ class BTCore:
     adds its own rules (leaf answers, what happens when the root returns) and emits the module.
     """
 
-    def __init__(self, doc: BTDocument | CompiledTree, *, loop: bool) -> None:
+    def __init__(
+        self,
+        doc: BTDocument | CompiledTree,
+        *,
+        loop: bool,
+        own_rules: Mapping[str, NusmvRule] | None = None,
+        static_livelock: bool = True,
+    ) -> None:
+        """``own_rules``: rules by node type for compiled types the registry does not know
+        (the outcome pairing's blackboard Switch and Script, ``encode_outcome``); they have
+        the default ``RuleTraits``. ``static_livelock=False``: the caller checks livelock
+        itself (``encode_outcome``'s exact check), so the static refusal below is skipped."""
         self.tree = doc if isinstance(doc, CompiledTree) else CompiledTree(doc)
         self.nodes = self.tree.nodes
         self.loop = loop
@@ -82,6 +94,8 @@ class BTCore:
         # families' rules (``families.registry``: the built-in family modules and any rule
         # registered at run time), read once per encoder.
         self.dispatch: dict[str, NusmvRule] = dict(nusmv_rules())
+        own = dict(own_rules or {})
+        self.dispatch.update(own)
         self.info: list[NodeInfo] = []
         has_internal = False
         forever = False
@@ -92,6 +106,9 @@ class BTCore:
                     internal = SUCCESS if node.internal_status == NodeStatus.SUCCESS else FAILURE
                     has_internal = True
                 self.info.append(NodeInfo(node, internal is None, internal))
+                continue
+            if node.type in own:
+                self.info.append(NodeInfo(node, False, None, node.type))
                 continue
             spec = node_semantics(node.type)
             if spec is None or spec.nusmv is None or spec.nusmv not in self.dispatch:
@@ -111,7 +128,9 @@ class BTCore:
             has_internal |= alone is not None and alone(node, spec)
             self.info.append(NodeInfo(node, False, None, spec.nusmv, spec, traits))
         self.may_skip = self._may_skip()
-        if has_internal and (loop or forever) and not self._ticks_a_leaf()[0]:
+        #: some node may keep its child ticking without end (the livelock test's trigger)
+        self.ticks_forever = forever
+        if static_livelock and has_internal and (loop or forever) and not self._ticks_a_leaf()[0]:
             raise UnsupportedError(
                 "the NuSMV encoding does not model ticks that end without any leaf "
                 "(AlwaysSuccess/AlwaysFailure & co, a RunOnce or a zero-count Repeat/"
@@ -373,8 +392,10 @@ class LeafBTEncoder:
         outputs: Symbols,
         *,
         loop: bool,
+        own_rules: Mapping[str, NusmvRule] | None = None,
+        static_livelock: bool = True,
     ) -> None:
-        self.core = BTCore(doc, loop=loop)
+        self.core = BTCore(doc, loop=loop, own_rules=own_rules, static_livelock=static_livelock)
         self.module = module
         self.inputs = inputs
         self.outputs = outputs
@@ -395,6 +416,32 @@ class LeafBTEncoder:
 
         return ["cur"] if is_plain_tree(self.core.tree) else self.core.identity_vars()
 
+    # -- what a subclass may change (``encode_outcome``: outcomes as inputs, a blackboard) ----
+    def _declare_more(self) -> None:
+        """Declare variables of the subclass's own before the tick rules are built."""
+
+    def _answer(self, leaf: CompiledNode, req: str) -> None:
+        """The rules of the environment's answer to ``leaf``'s request ``req``: each leaf
+        outcome (``running`` for an action only) is the leaf's status."""
+        for outcome in LeafOutcome:
+            if outcome is LeafOutcome.RUNNING and leaf.kind is NodeKind.CONDITION:
+                continue
+            status = ST[outcome.status.name]
+            self.core.ret(f"go & {req} & inp = {self.inputs.id(outcome.value)}", leaf.id, status)
+
+    def _offers(self, symbol: str, requests: Sequence[str], condition_req: str) -> str:
+        """The condition that input ``symbol`` is offered (``requests``: each environment
+        leaf's request, ``condition_req`` any condition leaf's)."""
+        if symbol == LeafOutcome.RUNNING:
+            return f"(stable & !final & !{condition_req})"
+        if symbol in self._input_names():
+            return "(stable & !final)"
+        return "FALSE"
+
+    def _input_names(self) -> list[str]:
+        """The inputs the machine may be offered (``Encoding.inputs``)."""
+        return [o.value for o in LeafOutcome]
+
     def encode(self) -> Encoding:
         from fsmbt.verify.nusmv.encode_fsm import NONE_OUT, Encoding
 
@@ -404,17 +451,14 @@ class LeafBTEncoder:
         out_enum = self.outputs.enum([NONE_OUT])
         core.var_types["bres"] = out_enum
         core.init["bres"] = NONE_OUT
+        self._declare_more()
         core.build()
         ids = self.inputs
-        outcome = {o.value: ST[o.status.name] for o in LeafOutcome}
         requests = []
         for leaf in core.env_leaves():
             req = core.leaf_request(leaf.id)
             requests.append(req)
-            for name, status in outcome.items():
-                if name == LeafOutcome.RUNNING and leaf.kind is NodeKind.CONDITION:
-                    continue
-                core.ret(f"go & {req} & inp = {ids.id(name)}", leaf.id, status)
+            self._answer(leaf, req)
         stable = any_of(requests + [f"cur = {d}" for d in done])
         # the root returned: re-tick on a wake-up, else the tick is over
         top = "cur = TOP"
@@ -451,20 +495,14 @@ class LeafBTEncoder:
             r for r, leaf in zip(requests, core.env_leaves()) if leaf.kind is NodeKind.CONDITION
         )
         for symbol, sid in sorted(ids.to_id.items()):
-            if symbol == LeafOutcome.RUNNING:
-                value = f"(stable & !final & !{condition_req})"
-            elif symbol in outcome:
-                value = "(stable & !final)"
-            else:
-                value = "FALSE"
-            defines.append((f"offers_{sid}", value))
+            defines.append((f"offers_{sid}", self._offers(symbol, requests, condition_req)))
         text = core.emit(self.module, "go, inp", defines)
         ident = [(v, safe_text(core.var_types[v])) for v in self._identity()]
         return Encoding(
             self.module,
             text,
             ["o1", "o2"],
-            list(outcome),
+            self._input_names(),
             ident,
             decode_state=lambda values: describe_bt(core, values),
             var_order=list(core.var_types),
