@@ -219,10 +219,12 @@ def _per_node_nusmv(
 
     plan = CheckPlan()
     report, _why = _compositional(source, result, max_states, sink, plan)
-    if report is None or report.method not in (PER_NODE, PER_NODE_LIFTED):
+    unused = report is None or report.method not in (PER_NODE, PER_NODE_LIFTED)
+    if unused or (engine == "nusmv" and report is not None and report.method != PER_NODE):
+        if sink is not None:  # the whole check decides: its witness, not these parts
+            sink.witness, sink.parts = None, None
         return None
-    if engine == "nusmv" and report.method != PER_NODE:
-        return None
+    assert report is not None
     try:
         from fsmbt.verify.nusmv import NuSMVLimitError
         from fsmbt.verify.nusmv.pernode import check_plan

@@ -56,8 +56,11 @@ from fsmbt.verify.pernode import (
     exit_token,
 )
 
-#: Most configurations of one fragment's explicit table before the unit is refused.
-FRAGMENT_LIMIT = 20_000
+#: Most configurations of one fragment's explicit table before the unit is refused: NuSMV
+#: builds one BDD row per table step, and a 2 554-configuration table (a mutant's counter
+#: without its guard) took ~100 s; the units of unmutated trees have a few dozen
+#: (benchmarks/bench_nusmv_pernode.py counts the refusals).
+FRAGMENT_LIMIT = 500
 #: The shared input of every unit (``main``'s IVAR), by the local machines' input names:
 #: between ticks, then a child's status (``pernode.EVENTS``).
 INPUTS = {"tick": "tick", "halt": "halt", "success": "cS", "failure": "cF", "running": "cR"}

@@ -74,6 +74,7 @@ class LocalResult:
     verdicts: list[UnitVerdict] = field(default_factory=list)
     refused: list[tuple[LocalUnit, str]] = field(default_factory=list)
     runs: int = 0
+    cached: int = 0  # units whose module text was already decided (not run again)
     nusmv_seconds: float = 0.0
     encode_seconds: float = 0.0
     smv_lines: int = 0
@@ -88,6 +89,7 @@ class LocalResult:
             "units": len(self.verdicts),
             "units_held": sum(v.holds for v in self.verdicts),
             "units_refused": len(self.refused),
+            "units_cached": self.cached,
             "nusmv_runs": self.runs,
             "nusmv_seconds": round(self.nusmv_seconds, 6),
             "encode_seconds": round(self.encode_seconds, 6),
@@ -105,10 +107,21 @@ def batch_model(modules: list[UnitModule]) -> str:
     return "\n".join(lines) + "\n"
 
 
+#: NuSMV's verdicts by a unit module's text without its name (equal text, equal verdict):
+#: whether it holds, and the counterexample with the name of the module it was run as.
+Verdicts = dict[str, tuple[bool, list[TraceState], str]]
+
+
 def check_units(
-    units: list[LocalUnit], *, batch: int = BATCH, timeout: float | None = None
+    units: list[LocalUnit],
+    *,
+    batch: int = BATCH,
+    timeout: float | None = None,
+    cache: Verdicts | None = None,
 ) -> LocalResult:
-    """NuSMV's verdict on each unit (refused ones listed with why).
+    """NuSMV's verdict on each unit (refused ones listed with why). ``cache``: verdicts of
+    units already run, by module text (a unit whose SMV text, name aside, is in it is not run
+    again: the same text is the same model); updated with the new ones.
 
     Raises:
         NuSMVLimitError: a batch passed NuSMV's time or memory cap (``runner``).
@@ -123,23 +136,41 @@ def check_units(
         except UnitRefused as exc:
             result.refused.append((unit, str(exc)))
     result.encode_seconds = time.perf_counter() - started
-    for first in range(0, len(encoded), max(batch, 1)):
-        chunk = encoded[first : first + batch]
+    known: Verdicts = {} if cache is None else cache
+    to_run: list[tuple[LocalUnit, UnitModule]] = []
+    queued: set[str] = set()
+    for unit, module in encoded:
+        body = _body(module)
+        if body not in known and body not in queued:
+            queued.add(body)
+            to_run.append((unit, module))
+    for first in range(0, len(to_run), max(batch, 1)):
+        chunk = to_run[first : first + batch]
         text = batch_model([m for _u, m in chunk])
         result.smv_lines += text.count("\n")
         found, seconds = run_nusmv(text, len(chunk), timeout=timeout, options=["-coi"], mono=False)
         result.runs += 1
         result.nusmv_seconds += seconds
-        for (unit, module), spec in zip(chunk, found):
-            steps = [] if spec.holds else decode(unit, module, spec.trace or [])
-            result.verdicts.append(UnitVerdict(unit, spec.holds, steps))
+        for (_unit, module), spec in zip(chunk, found):
+            known[_body(module)] = (spec.holds, spec.trace or [], module.name)
+    for unit, module in encoded:
+        holds, trace, run_as = known[_body(module)]
+        steps = [] if holds else decode(unit, module, trace, run_as)
+        result.verdicts.append(UnitVerdict(unit, holds, steps))
+    result.cached = len(encoded) - len(to_run)
     return result
 
 
-def decode(unit: LocalUnit, module: UnitModule, trace: list[TraceState]) -> list[str]:
+def _body(module: UnitModule) -> str:
+    """The module's text without its first line (``MODULE <name>(inp)``)."""
+    return module.text.split("\n", 1)[1]
+
+
+def decode(unit: LocalUnit, module: UnitModule, trace: list[TraceState], run_as: str) -> list[str]:
     """A failing unit's counterexample in the user's words: each input at a stable point (one
-    line each), then what each side output on the last step."""
-    prefix = module.name + "."
+    line each), then what each side output on the last step. ``run_as``: the name of the
+    module NuSMV ran (a unit of equal text, ``check_units``' cache)."""
+    prefix = run_as + "."
     steps: list[str] = []
     before: dict[str, str] | None = None
     for state in trace:
@@ -234,11 +265,13 @@ def check_plan(
     wholes: list[tuple[str, BTDocument, FSM]],
     *,
     batch: int = BATCH,
+    cache: Verdicts | None = None,
 ) -> PlanResult:
     """NuSMV on what a compositional check decided (``compositional.CheckPlan``'s two lists):
     every distinct local check of the regions proven per node (``check_units``), and each
     part checked whole (a region, the skeleton) by the whole encoders when it has at most
-    ``WHOLE_LIMIT`` nodes; anything else is listed in ``limits``.
+    ``WHOLE_LIMIT`` nodes; anything else is listed in ``limits``. ``cache``: as for
+    ``check_units`` (shared by the regions).
 
     Raises:
         NuSMVLimitError: a run passed NuSMV's time or memory cap.
@@ -246,8 +279,9 @@ def check_plan(
     from fsmbt.verify.nusmv import check as whole_check
 
     result = PlanResult()
+    known: Verdicts = {} if cache is None else cache  # equal units across regions: run once
     for region, region_units in units:
-        found = check_units(region_units, batch=batch)
+        found = check_units(region_units, batch=batch, cache=known)
         _merge(result.local, found)
         result.regions += [region] * len(found.verdicts)
         result.limits += [
@@ -273,6 +307,7 @@ def _merge(total: LocalResult, part: LocalResult) -> None:
     total.verdicts += part.verdicts
     total.refused += part.refused
     total.runs += part.runs
+    total.cached += part.cached
     total.nusmv_seconds += part.nusmv_seconds
     total.encode_seconds += part.encode_seconds
     total.smv_lines += part.smv_lines
