@@ -25,7 +25,8 @@ converted by ``bt_to_hfsm(pernode=True)`` (regions written per node) and checked
 
 Each tree is capped at ``--cap`` seconds (SIGALRM; the row says ``stopped``). A disagreement
 prints the unit and both verdicts. ``--sweep`` times the unmutated tree's units at several
-batch sizes (one file per batch, ``-coi``) and prints the seconds per unit.
+batch sizes (one file per batch, with ``-coi``; and without it on the first ``4 x batch`` units
+for batches up to 8) and prints the seconds per unit.
 """
 
 from __future__ import annotations
@@ -43,14 +44,14 @@ HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 sys.path.insert(0, str(HERE.parent / "tests"))
 from bench_reactive import family_tree, leaves_for, node_count  # noqa: E402
-from support.pernode_mutants import mutate  # noqa: E402
 
 from fsmbt import limits  # noqa: E402
 from fsmbt.convert.bt_to_hfsm import bt_to_hfsm  # noqa: E402
 from fsmbt.model.errors import FsmbtError  # noqa: E402
 from fsmbt.verify.compositional import CheckPlan, NotDecomposable, decompose  # noqa: E402
 from fsmbt.verify.nusmv.pernode import PlanResult, Verdicts, check_plan, check_units  # noqa: E402
-
+from fsmbt.verify.nusmv.runner import NuSMVLimitError  # noqa: E402
+from support.pernode_mutants import mutate  # noqa: E402
 
 #: Seconds the native check of a region checked whole may take (a mutant outside the per-node
 #: check): the bench only counts pairs decided node by node.
@@ -199,15 +200,25 @@ def _count(total: Counter[str], found: PlanResult, agree: bool, nodes: int) -> N
 
 
 def _sweep(plan: CheckPlan, sizes: list[int]) -> None:
+    """The unmutated tree's units at each batch size, with ``-coi`` and, up to 8 units per
+    file, without it (capped by the runner's time limit)."""
     units = [u for _region, region_units in plan.units for u in region_units]
     for batch in sizes:
-        found = check_units(units, batch=batch)
-        per_unit = found.nusmv_seconds / max(len(found.verdicts), 1)
-        print(
-            f"  sweep: batch {batch}: {found.runs} runs, {found.nusmv_seconds:.2f} NuSMV s, "
-            f"{per_unit * 1000:.1f} ms per unit (load {os.getloadavg()[0]:.2f})",
-            flush=True,
-        )
+        for coi in (True, False) if batch <= 8 else (True,):
+            try:
+                found = check_units(
+                    units[: max(batch * 4, 8)] if not coi else units, batch=batch, coi=coi
+                )
+            except NuSMVLimitError as exc:
+                print(f"  sweep: batch {batch}, coi {coi}: {exc}", flush=True)
+                continue
+            per_unit = found.nusmv_seconds / max(len(found.verdicts), 1)
+            print(
+                f"  sweep: batch {batch}, {'-coi' if coi else 'no -coi'}: {len(found.verdicts)} "
+                f"units, {found.runs} runs, {found.nusmv_seconds:.2f} NuSMV s, "
+                f"{per_unit * 1000:.1f} ms per unit (load {os.getloadavg()[0]:.2f})",
+                flush=True,
+            )
 
 
 if __name__ == "__main__":

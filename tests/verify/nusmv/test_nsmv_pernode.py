@@ -161,3 +161,22 @@ def test_a_mutant_s_failing_unit_is_named_by_both_engines(nusmv_binary) -> None:
         assert stats["counterexample"][-2].startswith("then the tree:")
         return
     raise AssertionError("no mutant was refuted per node")
+
+
+def test_a_certificate_of_a_proof_both_engines_made_checks(nusmv_binary) -> None:
+    """The native parts of a ``compositional (per node)+symbolic (per node)`` proof are kept and
+    re-checked like those of the native proof (the method's first part names them)."""
+    import json
+
+    from fsmbt.verify import certificate
+    from support.pernode_certs import RESULT, SOURCE, family_pair, recheck
+
+    doc, model = family_pair("memory", 30, 4)
+    with certificate.collecting() as sink:
+        report = verify(doc, model, engine="both")
+    assert report.method == f"{PER_NODE}+{SYMBOLIC_PER_NODE}"
+    data = json.loads(
+        json.dumps(certificate.build(sink, report, source_digest=SOURCE, result_digest=RESULT))
+    )
+    checked = recheck(data, doc, model)
+    assert checked.equivalent and checked.method == report.method

@@ -118,10 +118,12 @@ def check_units(
     batch: int = BATCH,
     timeout: float | None = None,
     cache: Verdicts | None = None,
+    coi: bool = True,
 ) -> LocalResult:
     """NuSMV's verdict on each unit (refused ones listed with why). ``cache``: verdicts of
     units already run, by module text (a unit whose SMV text, name aside, is in it is not run
-    again: the same text is the same model); updated with the new ones.
+    again: the same text is the same model); updated with the new ones. ``coi``: NuSMV's
+    ``-coi`` (off only to measure it: the units' product is then one model).
 
     Raises:
         NuSMVLimitError: a batch passed NuSMV's time or memory cap (``runner``).
@@ -148,7 +150,9 @@ def check_units(
         chunk = to_run[first : first + batch]
         text = batch_model([m for _u, m in chunk])
         result.smv_lines += text.count("\n")
-        found, seconds = run_nusmv(text, len(chunk), timeout=timeout, options=["-coi"], mono=False)
+        found, seconds = run_nusmv(
+            text, len(chunk), timeout=timeout, options=["-coi"] if coi else [], mono=False
+        )
         result.runs += 1
         result.nusmv_seconds += seconds
         for (_unit, module), spec in zip(chunk, found):
