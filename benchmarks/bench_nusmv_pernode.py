@@ -1,16 +1,16 @@
 """NuSMV node by node on the bench_reactive families (issue 27 item 2; docs/nusmv.md, "Trees node
 by node"). Prints one table row per tree, then the agreement count.
 
-    .venv/bin/python benchmarks/bench_nusmv_pernode.py [--sizes 100,1000] [--trees 2]
+    .venv/bin/python benchmarks/bench_nusmv_pernode.py [--sizes 100,1000] [--trees 2] [--first-seed 1]
         [--mutants 10] [--families memory,mixed,reactive-plain,decorated] [--batch 2]
         [--cap 600] [--sweep 1,2,4,8]
 
-Per family and size, ``--trees`` random trees (``bench_reactive.family_tree``, seeds 1..) are
+Per family and size, ``--trees`` random trees (``bench_reactive.family_tree``, seeds from ``--first-seed``) are
 converted by ``bt_to_hfsm(pernode=True)`` (regions written per node) and checked:
 
 - ``native s``: the native compositional check (``compositional.decompose``; no lift), which
   also decides which local checks exist (the plan); a region it checks whole (a mutant the
-  per-node check refuses) gets ``NATIVE_BUDGET`` seconds;
+  per-node check refuses) gets ``NATIVE_BUDGET`` seconds and ``MUTANT_STATES`` states;
 - ``units``: distinct local checks NuSMV decided, ``runs``: NuSMV runs (``--batch`` units each,
   ``-coi``), ``NuSMV s``: NuSMV's wall seconds summed, ``enc s``: encoding seconds, and
   ``whole``: the parts checked whole by the whole encoders (the skeleton);
@@ -26,7 +26,7 @@ converted by ``bt_to_hfsm(pernode=True)`` (regions written per node) and checked
 Each tree is capped at ``--cap`` seconds (SIGALRM; the row says ``stopped``). A disagreement
 prints the unit and both verdicts. ``--sweep`` times the unmutated tree's units at several
 batch sizes (one file per batch, with ``-coi``; and without it on the first ``4 x batch`` units
-for batches up to 8) and prints the seconds per unit.
+for batches up to 8, each run capped at 30 s) and prints the seconds per distinct unit.
 """
 
 from __future__ import annotations
@@ -54,8 +54,11 @@ from fsmbt.verify.nusmv.runner import NuSMVLimitError  # noqa: E402
 from support.pernode_mutants import mutate  # noqa: E402
 
 #: Seconds the native check of a region checked whole may take (a mutant outside the per-node
-#: check): the bench only counts pairs decided node by node.
+#: check), and the data expansion's cap for a mutant (``conversion_max_states``): the bench only
+#: counts pairs decided node by node, and a 1 000-node region expanded to 20 000 states
+#: takes ~20 s before it stops.
 NATIVE_BUDGET = 5.0
+MUTANT_STATES = 1_000
 
 
 class _Stop(Exception):
@@ -72,7 +75,7 @@ def _decide(doc, model, batch: int, cache: Verdicts) -> tuple[CheckPlan, PlanRes
     plan = CheckPlan()
     started = time.perf_counter()
     try:  # a mutant outside the per-node check falls back to its region whole: capped
-        decompose(doc, model, plan=plan, max_states=20_000, max_seconds=NATIVE_BUDGET)
+        decompose(doc, model, plan=plan, max_states=MUTANT_STATES, max_seconds=NATIVE_BUDGET)
     except (NotDecomposable, FsmbtError):  # outside the scope, or a part past a limit
         pass
     native = time.perf_counter() - started
@@ -98,6 +101,7 @@ def main() -> int:
     parser = argparse.ArgumentParser()
     parser.add_argument("--sizes", default="100,1000")
     parser.add_argument("--trees", type=int, default=2)
+    parser.add_argument("--first-seed", type=int, default=1)
     parser.add_argument("--mutants", type=int, default=10)
     parser.add_argument("--families", default="memory,mixed,reactive-plain,decorated")
     parser.add_argument("--batch", type=int, default=2)
@@ -114,7 +118,7 @@ def main() -> int:
     total: Counter[str] = Counter()
     for size in [int(x) for x in args.sizes.split(",")]:
         for family in args.families.split(","):
-            for seed in range(1, args.trees + 1):
+            for seed in range(args.first_seed, args.first_seed + args.trees):
                 signal.alarm(args.cap)
                 try:
                     row = _tree(family, size, seed, args, total)
@@ -164,7 +168,7 @@ def _tree(family: str, size: int, seed: int, args: argparse.Namespace, total: Co
         mutant = mutate(model, rng)
         if mutant is None:
             break
-        with limits.changed(conversion_max_states=20_000):
+        with limits.changed(conversion_max_states=MUTANT_STATES):
             mplan, mfound, _native = _decide(doc, mutant, args.batch, cache)
         mut["pairs"] += 1
         if mfound is None:
@@ -206,17 +210,18 @@ def _sweep(plan: CheckPlan, sizes: list[int]) -> None:
     for batch in sizes:
         for coi in (True, False) if batch <= 8 else (True,):
             try:
-                found = check_units(
-                    units[: max(batch * 4, 8)] if not coi else units, batch=batch, coi=coi
-                )
+                chosen = units if coi else units[: max(batch * 4, 8)]
+                found = check_units(chosen, batch=batch, coi=coi, timeout=None if coi else 30)
             except NuSMVLimitError as exc:
                 print(f"  sweep: batch {batch}, coi {coi}: {exc}", flush=True)
                 continue
-            per_unit = found.nusmv_seconds / max(len(found.verdicts), 1)
+            run = len(found.verdicts) - found.cached  # distinct module texts, each run once
+            per_unit = found.nusmv_seconds / max(run, 1)
             print(
                 f"  sweep: batch {batch}, {'-coi' if coi else 'no -coi'}: {len(found.verdicts)} "
-                f"units, {found.runs} runs, {found.nusmv_seconds:.2f} NuSMV s, "
-                f"{per_unit * 1000:.1f} ms per unit (load {os.getloadavg()[0]:.2f})",
+                f"units ({run} distinct texts), {found.runs} runs, {found.nusmv_seconds:.2f} "
+                f"NuSMV s, {per_unit * 1000:.1f} ms per distinct unit "
+                f"(load {os.getloadavg()[0]:.2f})",
                 flush=True,
             )
 
