@@ -260,6 +260,12 @@ def _per_node_nusmv(
                 f"the local check of {found.first_failure()} (native holds, NuSMV fails: {steps})",
             )
         report.method = f"{PER_NODE}+{SYMBOLIC_PER_NODE}" if engine == "both" else SYMBOLIC_PER_NODE
+        confirmed = (
+            f"; NuSMV: every one of the {len(found.local.verdicts)} distinct local checks holds "
+            f"({found.local.runs} runs) and the {len(found.wholes)} part(s) checked whole"
+        )
+        for prop in report.properties.values():
+            prop.detail += confirmed
         report.engine = "native+nusmv" if engine == "both" else "nusmv"
     else:  # refuted per node and lifted: NuSMV must fail the same unit, and that one only
         native_failed = report.stats.get("per_node_failed", "")
