@@ -32,19 +32,29 @@ from fsmbt.verify.compositional import (
     attempt_seconds,
     compositional_report,
 )
-from fsmbt.verify.method import describe_method, nusmv_engine
+from fsmbt.verify.method import SYMBOLIC_PER_NODE_SENTENCE, describe_method, nusmv_engine
 from fsmbt.verify.native import DEFAULT_MAX_STATES, Replay, check, check_witnessed, replay
 from fsmbt.verify.outcome_pairing import is_outcome_pair, outcome_abstractions
 from fsmbt.verify.pairing import machines_for
-from fsmbt.verify.report import PROPERTIES, SYMBOLIC, PropertyResult, Report, TraceStep
+from fsmbt.verify.report import (
+    PER_NODE,
+    PER_NODE_LIFTED,
+    PROPERTIES,
+    SYMBOLIC,
+    SYMBOLIC_PER_NODE,
+    PropertyResult,
+    Report,
+    TraceStep,
+)
 
 ENGINES = ("native", "nusmv", "both")
 
 
 class EngineDisagreement(RuntimeError):
-    """The native checker and NuSMV disagree on a property: a bug in one of them (exit 3)."""
+    """The native checker and NuSMV disagree on a property, or on a local check of the
+    per-node decomposition (``detail`` says which): a bug in one of them (exit 3)."""
 
-    def __init__(self, native: Report, nusmv: Report) -> None:
+    def __init__(self, native: Report, nusmv: Report, detail: str | None = None) -> None:
         differing = [
             name for name in PROPERTIES if native.verdicts().get(name) != nusmv.verdicts().get(name)
         ]
@@ -53,7 +63,7 @@ class EngineDisagreement(RuntimeError):
             f"NuSMV {_word(nusmv.verdicts().get(name))})"
             for name in differing
         )
-        super().__init__(f"the engines disagree on {shown}")
+        super().__init__(f"the engines disagree on {detail or shown}")
         self.native = native
         self.nusmv = nusmv
         self.differing = differing
@@ -107,12 +117,16 @@ def verify(
             "machine only, by macro steps; not against another tree",
             hints=(Hint.NATIVE_VERIFIER,),
         )
+    sink = certificate.active_sink()
+    if engine != "native" and not loop:
+        decided = _per_node_nusmv(source, result, engine, max_states, sink)
+        if decided is not None:
+            return decided
     if engine == "nusmv":
         report = _nusmv(source, result, loop, pairing, fallback=False)
         report.method = SYMBOLIC
         report.engines = nusmv_engine()
         return report
-    sink = certificate.active_sink()
     fell_back = ""
     if engine == "native" and not loop:
         proved, fell_back = _compositional(source, result, max_states, sink)
@@ -191,11 +205,106 @@ def _native(
     return report
 
 
+def _per_node_nusmv(
+    source: FSM | BTDocument,
+    result: FSM | BTDocument,
+    engine: str,
+    max_states: int,
+    sink: certificate.WitnessSink | None,
+) -> Report | None:
+    """``both``/``nusmv`` on a pair the native checker decides node by node (docs/nusmv.md,
+    "Trees node by node"): NuSMV decides the same distinct local checks (its own encoding of
+    each node's tick rules) and the parts checked whole; ``None`` when the native verdict is
+    not per node (the whole encodings decide, as before; ``nusmv`` also when the native
+    per-node check refuted the pair). With ``both``, a NuSMV limit or a unit it does not
+    encode keeps the native verdict and says so (``stats["nusmv_limit"]``); any disagreement
+    on a unit raises ``EngineDisagreement``.
+
+    Raises:
+        NuSMVLimitError, UnsupportedError: with ``nusmv``, NuSMV past a cap or a unit it
+            does not encode.
+    """
+    from fsmbt.verify.compositional import CheckPlan
+
+    plan = CheckPlan()
+    report, _why = _compositional(source, result, max_states, sink, plan)
+    unused = report is None or report.method not in (PER_NODE, PER_NODE_LIFTED)
+    if unused or (engine == "nusmv" and report is not None and report.method != PER_NODE):
+        if sink is not None:  # the whole check decides: its witness, not these parts
+            sink.witness, sink.parts = None, None
+        return None
+    assert report is not None
+    try:
+        from fsmbt.verify.nusmv import NuSMVLimitError
+        from fsmbt.verify.nusmv.pernode import check_plan
+    except ImportError as exc:
+        raise InputError(
+            f"the NuSMV engine is not available ({exc})", hints=(Hint.NATIVE_VERIFIER,)
+        ) from None
+    try:
+        found = check_plan(plan.units, plan.wholes)
+    except NuSMVLimitError as exc:
+        if engine == "nusmv":
+            raise
+        report.engines.update(nusmv_engine())
+        report.stats["nusmv_limit"] = str(exc)
+        return report
+    if found.limits:
+        if engine == "nusmv":
+            raise UnsupportedError(
+                "NuSMV's per-node check does not encode " + "; ".join(found.limits[:3]),
+                hints=(Hint.NATIVE_VERIFIER,),
+            )
+        report.engines.update(nusmv_engine())
+        report.stats["nusmv_limit"] = "; ".join(found.limits[:3])
+        return report
+    stats = found.stats()
+    if report.method == PER_NODE:
+        if not found.holds:
+            failing = found.local.failed
+            steps = "; ".join(failing[0].steps) if failing else "a part checked whole differs"
+            raise EngineDisagreement(
+                report,
+                report,
+                f"the local check of {found.first_failure()} (native holds, NuSMV fails: {steps})",
+            )
+        report.method = f"{PER_NODE}+{SYMBOLIC_PER_NODE}" if engine == "both" else SYMBOLIC_PER_NODE
+        confirmed = (
+            f"; NuSMV: every one of the {len(found.local.verdicts)} distinct local checks holds "
+            f"({found.local.runs} runs) and the {len(found.wholes)} part(s) checked whole"
+        )
+        for prop in report.properties.values():
+            prop.detail += confirmed
+        report.engine = "native+nusmv" if engine == "both" else "nusmv"
+    else:  # refuted per node and lifted: NuSMV must fail the same unit, and that one only
+        native_failed = report.stats.get("per_node_failed", "")
+        verdicts = found.local.verdicts
+        same = (
+            bool(verdicts)
+            and all(v.holds for v in verdicts[:-1])
+            and not verdicts[-1].holds
+            and all(equivalent for _n, equivalent in found.wholes)
+        )
+        if not same:
+            raise EngineDisagreement(
+                report,
+                report,
+                f"the per-node check of {native_failed} (native fails there, NuSMV: "
+                f"{found.first_failure() or 'every local check holds'})",
+            )
+        report.engine = "native+nusmv"
+    report.abstractions.append(SYMBOLIC_PER_NODE_SENTENCE)
+    report.engines.update(nusmv_engine())
+    report.stats["nusmv"] = stats
+    return report
+
+
 def _compositional(
     source: FSM | BTDocument,
     result: FSM | BTDocument,
     max_states: int,
     sink: certificate.WitnessSink | None,
+    plan: Any = None,
 ) -> tuple[Report | None, str]:
     """The compositional proof of a BT against a hierarchical FSM (``fsmbt.verify.
     compositional``) when the pair decomposes into regions and every local check holds within
@@ -218,6 +327,7 @@ def _compositional(
             keep=parts,
             min_regions=2,
             max_seconds=attempt_seconds(),
+            plan=plan,
         )
     if report is None:
         # a part failed: the whole product decides and explains; the verdict says so

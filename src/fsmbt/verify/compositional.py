@@ -77,6 +77,7 @@ from fsmbt.verify.method import PER_NODE_SENTENCE
 from fsmbt.verify.native import DEFAULT_MAX_STATES, StateLimitError, check_witnessed
 from fsmbt.verify.pernode import (
     NODE_ATTR,
+    LocalUnit,
     LocalWitness,
     NotPerNode,
     PerNodeOutcome,
@@ -561,6 +562,18 @@ def skeleton_machines(
     it reaches (``results``: tree region -> results; an unpaired region may return either and
     keeps its own label, so the skeleton check fails if it is ever reached), the FSM's
     region-state labels renamed to their partners'."""
+    bt_skeleton, fsm_skeleton = skeleton_models(source, result, shape, tree_of_state, results)
+    return LeafMachine(bt_skeleton), FSMLeafMachine(fsm_skeleton)
+
+
+def skeleton_models(
+    source: BTDocument,
+    result: FSM,
+    shape: Structure,
+    tree_of_state: dict[int, int],
+    results: dict[int, frozenset[str]],
+) -> tuple[BTDocument, FSM]:
+    """The two models ``skeleton_machines`` runs (another engine checks them too)."""
     both = frozenset({SUCCESS, FAILURE})
     tree_results = [results.get(k, both) for k in range(len(shape.regions))]
     fsm_results = [
@@ -573,7 +586,7 @@ def skeleton_machines(
         fsm_skeleton,
         {_FSM_TOKEN.format(j): _BT_TOKEN.format(k) for j, k in tree_of_state.items()},
     )
-    return LeafMachine(bt_skeleton), FSMLeafMachine(fsm_skeleton)
+    return bt_skeleton, fsm_skeleton
 
 
 #: The kind of a certificate unit that is one distinct local check of a region proven per node.
@@ -608,6 +621,17 @@ class Parts:
     units: list[Part] = field(default_factory=list)
 
 
+@dataclass
+class CheckPlan:
+    """What a compositional check decided, for another engine to decide again (NuSMV,
+    ``fsmbt.verify.nusmv.pernode``): each region proven per node with its distinct local
+    checks (``LocalUnit``, the failing one last), and the parts checked whole - each region
+    that was not, and the skeleton - as (name, tree, machine) pairs of models."""
+
+    units: list[tuple[str, list[LocalUnit]]] = field(default_factory=list)
+    wholes: list[tuple[str, BTDocument, FSM]] = field(default_factory=list)
+
+
 def decompose(
     source: BTDocument,
     result: FSM,
@@ -616,9 +640,11 @@ def decompose(
     keep: Parts | None = None,
     min_regions: int = 1,
     max_seconds: float | None = None,
+    plan: CheckPlan | None = None,
 ) -> Decomposition:
     """Run the three parts of the compositional check (module docstring); with ``keep``, each
-    part's witness is appended to it (for a certificate: the parts' tables stay alive).
+    part's witness is appended to it (for a certificate: the parts' tables stay alive); with
+    ``plan``, what each part checked is recorded (``CheckPlan``; no extra check).
 
     The give-way (the attempt costs little when it cannot win): with fewer than
     ``min_regions`` paired regions no part is checked (one region *is* the whole product,
@@ -657,8 +683,11 @@ def decompose(
         if k is None:
             continue
         local: list[LocalWitness] | None = [] if keep is not None else None
-        per_node = _per_node(regions[k], region.machine, shape.declared, outcome, local)
+        units: list[LocalUnit] | None = [] if plan is not None else None
+        per_node = _per_node(regions[k], region.machine, shape.declared, outcome, local, units)
         if per_node is not None:  # proven (or refuted) node by node (verify/pernode.py)
+            if plan is not None and units is not None:
+                plan.units.append((f"{regions[k].label} (state {region.path})", units))
             if not per_node.equivalent:
                 outcome.equivalent = False
                 outcome.failed_region = (
@@ -676,6 +705,14 @@ def decompose(
                 )
             continue
         bt_region, fsm_region = region_machines(shape, k, j)
+        if plan is not None:
+            plan.wholes.append(
+                (
+                    f"region {regions[k].label} (state {region.path})",
+                    BTDocument.single(regions[k]),
+                    region_fsm(region, shape.declared, shape.mentioned[j]),
+                )
+            )
         try:
             report, witness = check_witnessed(
                 bt_region, fsm_region, max_states=max_states, max_seconds=budget.left()
@@ -696,7 +733,10 @@ def decompose(
         if keep is not None:
             keep.units.append(Part("region", witness, k, j))
     # 2. the skeleton with each region abstracted to its results
-    bt_skeleton, fsm_skeleton = skeleton_machines(source, result, shape, tree_of_state, results)
+    skeleton_bt, skeleton_fsm_model = skeleton_models(source, result, shape, tree_of_state, results)
+    if plan is not None:
+        plan.wholes.append(("the skeleton", skeleton_bt, skeleton_fsm_model))
+    bt_skeleton, fsm_skeleton = LeafMachine(skeleton_bt), FSMLeafMachine(skeleton_fsm_model)
     try:
         report, witness = check_witnessed(
             bt_skeleton, fsm_skeleton, max_states=max_states, max_seconds=budget.left()
@@ -740,14 +780,16 @@ def _per_node(
     declared: dict[str, str],
     outcome: Decomposition,
     keep: list[LocalWitness] | None = None,
+    units: list[LocalUnit] | None = None,
 ) -> PerNodeOutcome | None:
     """The per-node check of one region (``verify/pernode.py``) when its machine is tagged
     per node and decomposes; ``None``: check the region whole. With ``keep``, the distinct
-    local checks' witnesses are appended (for a certificate)."""
+    local checks' witnesses are appended (for a certificate); with ``units``, the distinct
+    local checks (for NuSMV)."""
     if not _tagged_per_node(machine):
         return None
     try:
-        found = check_region(region_root, machine, declared, keep)
+        found = check_region(region_root, machine, declared, keep, units)
     except NotPerNode as exc:
         outcome.stats.setdefault("per_node_refused", []).append(str(exc))
         return None
@@ -795,6 +837,7 @@ def compositional_report(
     keep: Parts | None = None,
     min_regions: int = 1,
     max_seconds: float | None = None,
+    plan: CheckPlan | None = None,
 ) -> tuple[Report | None, str]:
     """The compositional verdict when it proves the pair equivalent, else ``None`` and why
     (out of scope, past its budget, or a part failed: the caller runs the whole product for
@@ -810,6 +853,7 @@ def compositional_report(
             keep=keep,
             min_regions=min_regions,
             max_seconds=max_seconds,
+            plan=plan,
         )
     except NotDecomposable as exc:
         return None, str(exc)

@@ -30,6 +30,13 @@ PER_NODE_SENTENCE = (
     "local problems once; the results compose (docs/semantics.md §4d: equivalence is a "
     "congruence for the per-node wiring under the side conditions checked)"
 )
+SYMBOLIC_PER_NODE_SENTENCE = (
+    "symbolic (per node): NuSMV decides each distinct local check again, its tree side from "
+    "its own encoding of the node's tick rules over abstract children (encode_bt, families), "
+    "the fragment as an explicit table; the native walk only chooses which checks exist and "
+    "σ, the pairing of each node's statuses with its exits (docs/nusmv.md, 'Trees node by "
+    "node')"
+)
 ACTIVE_SENTENCE = (
     "inputs a machine declares silent in a state (active_inputs) are not stepped there: "
     "they are self-loops without output by the machine's own rules"

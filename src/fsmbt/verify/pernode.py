@@ -650,7 +650,9 @@ STATUS_OF = {name: status for status, name in EVENTS.items()}
 Sigma = dict[int, tuple[int, tuple[int, ...]]]
 
 
-def _exit_token(exit_: Any) -> str:
+def exit_token(exit_: Any) -> str:
+    """The output token of an exit (canonical target and assignment ids), as both local
+    machines print it (``fsmbt.verify.nusmv.encode_local`` maps σ through it too)."""
     target, assigns = exit_
     return "exit " + " ".join(str(x) for x in (target, *assigns))
 
@@ -691,7 +693,7 @@ class LocalTreeMachine:
         self.bt = _BtSide(_abstract_tree(problem.node, [RUNNING in a for a in problem.allowed]))
         self.halting = problem.local.halting
         self.never = problem.never
-        self.sigma = {s: _exit_token(e) for s, e in sigma.items()}
+        self.sigma = {s: exit_token(e) for s, e in sigma.items()}
         self.offered = _LocalInputs(problem.allowed, with_halt)
         self.exited: set[int] = set()
 
@@ -766,7 +768,7 @@ class LocalFragmentMachine:
                 running.add(position)
         fpos, (halted, (kind, what), touched) = self.fsm.resolve(hop, values, running)
         bad = FSM_UNPROVEN_HALT if touched & self.never else None
-        event = ("exit", _exit_token(what)) if kind == "exit" else ("tick", what)
+        event = ("exit", exit_token(what)) if kind == "exit" else ("tick", what)
         nxt = (fpos, tuple(sorted(values.items())), frozenset(running))
         return nxt, _local_outputs(halted, bad, event)
 
@@ -889,6 +891,22 @@ class NodeWalk:
 
 
 @dataclass
+class LocalUnit:
+    """One distinct local check as the walk decided it, for another engine to decide again
+    (``fsmbt.verify.nusmv.pernode``): the problem, σ (canonical; partial when the check
+    failed: the statuses paired before the failure), whether ``halt`` was offered, the
+    native verdict, the nodes it stands for (paths in the merged region) and the labels of
+    the node's children (how a counterexample names them)."""
+
+    problem: LocalProblem
+    sigma: Sigma
+    can_halt: bool
+    held: bool
+    nodes: list[str]
+    child_labels: list[str]
+
+
+@dataclass
 class LocalWitness:
     """One distinct local check kept for a certificate: the nodes it stands for (their paths
     in the merged region), σ (canonical), whether it held with ``halt`` offered, and the
@@ -906,12 +924,14 @@ def check_region(
     machine: FSM,
     declared: dict[str, str],
     keep: list[LocalWitness] | None = None,
+    units: list[LocalUnit] | None = None,
 ) -> PerNodeOutcome:
     """Check ``machine`` (a region state's sub-machine, tagged per node) against the region
     headed by ``region_root``, node by node (the module docstring). With ``keep``, each
     distinct local check that held is checked again by the native checker on
     ``local_machines`` and its witness appended (for a certificate: one small product more
-    per distinct check).
+    per distinct check). With ``units``, each distinct local check is appended as a
+    ``LocalUnit`` (what NuSMV checks again; no extra cost here), the failing one last.
 
     Raises:
         NotPerNode: the machine is not a valid per-node decomposition of this region.
@@ -919,6 +939,7 @@ def check_region(
     walk = NodeWalk(region_root, machine, declared)
     memo: dict[tuple[Any, ...], tuple[bool, dict[int, Any], int, list[Any], bool]] = {}
     kept: dict[tuple[Any, ...], LocalWitness] = {}
+    recorded: dict[tuple[Any, ...], LocalUnit] = {}
     outcome = PerNodeOutcome(equivalent=True, nodes=len(walk.tree.nodes))
     for problem in walk.problems():
         node = problem.node
@@ -937,6 +958,15 @@ def check_region(
                 kept[problem.key] = _witnessed(problem, found[1], found[4])
                 keep.append(kept[problem.key])
         equivalent, pairing, _states, local_trace, can_halt = found
+        if units is not None:
+            unit = recorded.get(problem.key)
+            if unit is None:
+                labels = [walk.tree.nodes[c].label for c in node.children]
+                sigma = sigma_exits(problem.local, pairing)
+                unit = LocalUnit(problem, sigma, can_halt, equivalent, [], labels)
+                recorded[problem.key] = unit
+                units.append(unit)
+            unit.nodes.append(node.path)
         if not equivalent:
             outcome.equivalent = False
             outcome.failed = f"{node.type} '{node.label}' at {node.path or 'the root'}"

@@ -37,7 +37,19 @@ PER_NODE = "compositional (per node)"
 #: a NOT EQUIVALENT verdict whose counterexample the per-node check found locally and
 #: ``fsmbt.verify.lift`` lifted to the whole tree and confirmed by replay (not always shortest)
 PER_NODE_LIFTED = "per node, lifted"
-METHODS = (WHOLE_PRODUCT, TABLE, CANONICAL, SYMBOLIC, COMPOSITIONAL, PER_NODE, PER_NODE_LIFTED)
+#: NuSMV deciding each distinct local check of the per-node decomposition (and the parts
+#: checked whole), the native walk choosing which (``fsmbt.verify.nusmv.pernode``)
+SYMBOLIC_PER_NODE = "symbolic (per node)"
+METHODS = (
+    WHOLE_PRODUCT,
+    TABLE,
+    CANONICAL,
+    SYMBOLIC,
+    COMPOSITIONAL,
+    PER_NODE,
+    PER_NODE_LIFTED,
+    SYMBOLIC_PER_NODE,
+)
 
 
 @dataclass

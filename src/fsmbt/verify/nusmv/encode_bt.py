@@ -298,9 +298,14 @@ class BTCore:
         if f"rk_{nid}" in self.var_types:  # the reactive frame's flag: canonical off the stack
             self.rule(f"rk_{nid}", cond, "1")
 
-    def build(self) -> None:
-        """Every node's tick rules, and the halt closure."""
+    def build(self, root_reset: str | None = None) -> None:
+        """Every node's tick rules, and the halt closure. ``root_reset``: a condition under
+        which the root's parent resets it from outside (``haltChild``: ``halt()`` when
+        RUNNING, the status reset otherwise; ``encode_local``'s external ``halt`` between
+        ticks), joined to ``clr_0`` like any parent's reset."""
         resets: Resets = {x.id: [] for x in self.nodes}  # child -> conditions
+        if root_reset is not None:
+            resets[0].append(root_reset)
         for info in self.info:
             x = info.node
             here = f"cur = {self.n(x.id)}"
