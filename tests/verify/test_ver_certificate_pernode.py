@@ -11,6 +11,7 @@ import copy
 import json
 import random
 from collections import Counter
+from typing import Any
 
 import pytest
 
@@ -74,9 +75,9 @@ def test_a_certificate_changes_no_verdict_on_seeded_small_trees() -> None:
     assert tally[PER_NODE] >= 90
 
 
-def _native_units(doc, model, data):  # type: ignore[no-untyped-def]
-    """Each pernode unit of ``data`` next to the native checker's witness on the
-    ``local_machines`` of the first node it covers (the walk re-derived as the checker does)."""
+def _walk_units(doc, model, data):  # type: ignore[no-untyped-def]
+    """The local checks of ``data``'s regions proven per node, re-derived as the checker does
+    (``pernode.NodeWalk``): per first node of each unit, the unit, its problem and its σ."""
     shape = structure(doc, model)
     units = _pernode_units(data)
     for k, j in sorted({(u["tree_region"], u["fsm_region"]) for u in units}):
@@ -92,11 +93,18 @@ def _native_units(doc, model, data):  # type: ignore[no-untyped-def]
             }
             if id(unit) not in done:
                 done.add(id(unit))
-                machines = local_machines(problem, sigma, bool(unit["halt"]))
-                report, witness = check_witnessed(*machines, max_states=LOCAL_LIMIT)
-                assert report.equivalent
-                yield unit, json.loads(json.dumps(witness.to_data()))
+                yield unit, problem, sigma
             walk.settle(problem, sigma, bool(unit["halt"]))
+
+
+def _native_units(doc, model, data):  # type: ignore[no-untyped-def]
+    """Each pernode unit of ``data`` next to the native checker's witness on the
+    ``local_machines`` of the first node it covers."""
+    for unit, problem, sigma in _walk_units(doc, model, data):
+        machines = local_machines(problem, sigma, bool(unit["halt"]))
+        report, witness = check_witnessed(*machines, max_states=LOCAL_LIMIT)
+        assert report.equivalent
+        yield unit, json.loads(json.dumps(witness.to_data()))
 
 
 def test_the_witness_from_the_proofs_own_steps_is_the_native_checkers() -> None:
@@ -248,6 +256,44 @@ def test_a_tampered_per_node_certificate_is_refused(proof, name: str) -> None:  
     edited = copy.deepcopy(data)
     TAMPERS[name](edited)
     assert edited != data
+    with pytest.raises(certificate.CertificateError):
+        recheck(edited, doc, model)
+
+
+def test_a_unit_repeating_an_earlier_regions_is_replayed_once_and_still_checked(
+    monkeypatch,  # type: ignore[no-untyped-def]
+) -> None:
+    """The checker replays a unit equal to one already replayed for the same local problem
+    only once; the repeat still counts, and the same repeat with one edited edge output or
+    relation pair is replayed and refused."""
+    doc, model = family_pair("mixed", 80, 3)  # regions proven per node, two repeated units
+    _report, data = certify(doc, model)
+    seen: set[Any] = set()
+    repeat = None
+    for unit, problem, _sigma in _walk_units(doc, model, data):
+        fingerprint = json.dumps([unit[k] for k in ("interface", "halt", "outputs", "machines")])
+        if (problem.key, fingerprint) in seen:
+            repeat = data["units"].index(unit)
+        seen.add((problem.key, fingerprint))
+    assert repeat is not None
+    replays: list[str] = []
+    original = certificate.check_unit
+
+    def counted(unit, source, result, name):  # type: ignore[no-untyped-def]
+        replays.append(name)
+        return original(unit, source, result, name)
+
+    monkeypatch.setattr(certificate, "check_unit", counted)
+    checked = recheck(data, doc, model)
+    assert checked.equivalent and checked.pairs == certificate.relation_pairs(data)
+    assert len(replays) < len(data["units"])  # the repeat was not replayed
+    edited = copy.deepcopy(data)
+    edge = edited["units"][repeat]["machines"]["source"]["edges"][0][0]
+    edge[2] = (edge[2] + 1) % len(edited["units"][repeat]["outputs"])
+    with pytest.raises(certificate.CertificateError, match="not as certified"):
+        recheck(edited, doc, model)
+    edited = copy.deepcopy(data)
+    edited["units"][repeat]["relation"].pop()
     with pytest.raises(certificate.CertificateError):
         recheck(edited, doc, model)
 
