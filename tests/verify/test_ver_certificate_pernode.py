@@ -23,10 +23,10 @@ from fsmbt.verify import certificate
 from fsmbt.verify.compositional import compositional_report, structure
 from fsmbt.verify.native import check_witnessed
 from fsmbt.verify.pernode import LOCAL_LIMIT, STATUS_OF, NodeWalk, local_machines
-from fsmbt.verify.report import PER_NODE, PER_NODE_LIFTED
+from fsmbt.verify.report import COMPOSITIONAL_LIFTED, LIFTED, PER_NODE
 from support.pernode_certs import FAMILIES, SOURCE, certify, family_pair, recheck
-from support.pernode_mutants import mutate, whole
-from support.pernode_trees import pernode_tree
+from support.pernode_mutants import mutate, pernode_machine, whole
+from support.pernode_trees import pernode_tree, seeded_trees
 
 PERNODE = certificate.PERNODE
 STATUSES = ("success", "failure", "running")
@@ -333,7 +333,7 @@ def test_a_lifted_not_equivalent_certificate_replays() -> None:
             report, data = certify(doc, mutant)
         except InputError:
             continue  # the whole product refuses this mutant (an eventless cycle)
-        if report.method != PER_NODE_LIFTED:
+        if report.method not in LIFTED:
             continue
         assert not data["equivalent"] and data["counterexamples"]
         checked = recheck(data, doc, mutant)
@@ -348,6 +348,31 @@ def test_a_lifted_not_equivalent_certificate_replays() -> None:
         if found == 2:
             break
     assert found >= 2
+
+
+def test_a_region_lifted_certificate_replays() -> None:
+    """A mutant whose region is checked whole (a broken per-node side condition) and fails is
+    refuted by the region's counterexample lifted to the whole tree (``compositional,
+    lifted``): its certificate replays on the mutant and is refused on the original."""
+    rng = random.Random(5)
+    for doc in seeded_trees(60, seed=4):
+        model = bt_to_hfsm(doc, pernode=True).model
+        if pernode_machine(model) is None:
+            continue
+        mutant = mutate(model, rng)
+        assert mutant is not None
+        try:
+            report, data = certify(doc, mutant)
+        except InputError:
+            continue
+        if report.method != COMPOSITIONAL_LIFTED:
+            continue
+        assert not data["equivalent"] and data["method"] == COMPOSITIONAL_LIFTED
+        assert not recheck(data, doc, mutant).equivalent
+        with pytest.raises(certificate.CertificateError):
+            recheck(data, doc, model)
+        return
+    raise AssertionError("no mutant of the sample was refuted by a lifted region")
 
 
 def test_the_cli_writes_and_checks_a_per_node_certificate(tmp_path, capsys) -> None:  # type: ignore[no-untyped-def]

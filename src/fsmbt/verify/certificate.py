@@ -93,7 +93,7 @@ from fsmbt.verify.pernode import (
     Sigma,
     local_machines,
 )
-from fsmbt.verify.report import COMPOSITIONAL, PER_NODE, PER_NODE_LIFTED, Report
+from fsmbt.verify.report import COMPOSITIONAL, LIFTED, PER_NODE, Report
 
 FORMAT = "fsmbt-certificate/2"
 #: The first format: one whole-product proof at the top level (read as one ``product`` unit).
@@ -304,7 +304,7 @@ def check(
     try:
         if by_parts is not None and checked.equivalent:
             by_parts(data, source, result, checked)
-        elif claimed == PER_NODE_LIFTED and not checked.equivalent:
+        elif claimed in LIFTED and not checked.equivalent:
             _check_lifted(data, source, result, checked)
         else:
             _check_whole(data, source, result, checked)

@@ -61,6 +61,7 @@ from fsmbt.verify.pairing import LEAF_EXECUTION
 from fsmbt.verify.pernode import PerNodeOutcome
 from fsmbt.verify.report import (
     COMPLETENESS,
+    COMPOSITIONAL_LIFTED,
     NO_ADDITIONAL_BEHAVIOR,
     PER_NODE_LIFTED,
     TERMINATION_CONSISTENCY,
@@ -74,6 +75,8 @@ SYMBOL = {
     FAILURE: LeafOutcome.FAILURE.value,
     RUNNING: LeafOutcome.RUNNING.value,
 }
+#: The status of each leaf machine input.
+STATUS = {symbol: status for status, symbol in SYMBOL.items()}
 #: Most states one abstract search settles.
 SEARCH_LIMIT = 3_000
 #: Most leaves one drive answers.
@@ -248,12 +251,20 @@ class Realizer:
 
 
 def drive(
-    tree: CompiledTree, target: int, local: Sequence[tuple[int | None, Any]], extra: int
+    tree: CompiledTree,
+    target: int,
+    local: Sequence[tuple[int | None, Any]],
+    extra: int,
+    region: Sequence[int] = (),
 ) -> list[str] | None:
     """Leaf outcomes from the root that tick ``target`` and then give its children the local
-    counterexample's outcomes, then ``extra`` more leaves (rule 2); ``None``: not liftable."""
+    counterexample's outcomes, then ``extra`` more leaves (rule 2); ``None``: not liftable.
+    With ``region`` (and no ``local``): once ``target`` is ticked, the leaves under it answer
+    these statuses in order (a region's own counterexample: its leaf outcomes from its fresh
+    tick, which the whole tree asks in the same order while the tick reaches it)."""
     if any(symbol == "halt" for _pos, symbol in local):
         return None
+    answers = deque(region)
     realizer = Realizer(tree)
     nodes = tree.nodes
     chain: list[int] = []
@@ -276,14 +287,22 @@ def drive(
             continue
         active = [frame[0] for frame in snap[2]]
         reached = reached or target in active
-        if reached and not events:  # the local counterexample is given: ``extra`` more
+        if reached and not events and not answers:  # the counterexample is given: ``extra``
             if left <= 0:
                 return inputs
             left -= 1
-        status = _from_queue(queues, active, event.node)
-        if status is None and goal is not None and goal[0] in active:
+        status = None
+        if answers and target in active:
+            status = answers.popleft()
+            if event.node.is_condition and status == RUNNING:
+                return None
+        else:
+            status = _from_queue(queues, active, event.node)
+        if status is not None:
+            pass
+        elif goal is not None and goal[0] in active:
             status = _propagate(realizer, active, active.index(goal[0]), goal[1])
-        elif status is None:
+        else:
             goal = None
             child, wanted = _plan(active, target, chain, events, realizer)
             if child is None:
@@ -416,6 +435,14 @@ LIFTED_SENTENCE = (
 )
 
 
+REGION_LIFTED_SENTENCE = (
+    "compositional, lifted: a region checked alone against its composite state fails; its "
+    "counterexample (leaf outcomes from the region's fresh tick) was lifted to leaf outcomes "
+    "from the root and replayed on the two whole machines, which it tells apart (a real "
+    "counterexample, not always a shortest one)"
+)
+
+
 def lift_machines(source: BTDocument, result: FSM) -> tuple[Machine[Any], LazyDataMachine]:
     """The two whole machines a lifted counterexample is confirmed on (and a certificate of it
     replayed on): the interpreter's leaf machine of ``source`` and ``result``'s data machine
@@ -438,17 +465,66 @@ def lifted_report(
         return None
     merged = tree.doc.main.root
     assert merged is not None
+    found = _target(source, region, merged, tree.nodes[target].source)
+    if found is None:
+        return None
+    whole, target_id = found
+    inputs = drive(whole, target_id, failed.trace, extra=4 * len(failed.trace) + 64)
+    if inputs is None:
+        return None
+    return _confirmed(
+        source, result, inputs, f"node {failed.failed}", PER_NODE_LIFTED, LIFTED_SENTENCE
+    )
+
+
+def lifted_region_report(
+    source: BTDocument, result: FSM, region: BTNode, failed: Report
+) -> Report | None:
+    """NOT EQUIVALENT with the counterexample of a region checked alone (``failed``: the
+    region's subtree run as a tree of its own against its composite state, docs/semantics.md
+    §4c) lifted to the whole tree: the drive ticks the region fresh, then its leaves answer
+    the region counterexample's outcomes in order (``drive``'s ``region``), confirmed by
+    replay as a per-node lift; ``None`` when the replay does not separate the machines."""
+    traces = [p.counterexample for p in failed.properties.values() if p.counterexample]
+    if not traces:
+        return None
+    shortest = min(traces, key=len)
+    answers = [STATUS[str(step.input)] for step in shortest[1:] if step.input in STATUS]
+    if len(answers) != len(shortest) - 1:
+        return None
+    found = _target(source, region, region, region)
+    if found is None:
+        return None
+    whole, target_id = found
+    inputs = drive(whole, target_id, [], extra=64, region=answers)
+    if inputs is None:
+        return None
+    where = f"region {region.label}"
+    return _confirmed(source, result, inputs, where, COMPOSITIONAL_LIFTED, REGION_LIFTED_SENTENCE)
+
+
+def _target(
+    source: BTDocument, region: BTNode, merged: BTNode, wanted: BTNode
+) -> tuple[CompiledTree, int] | None:
+    """The whole tree (``region`` replaced by ``merged``) and the id of the node ``wanted``."""
     try:
         whole = CompiledTree(whole_tree(source, region, merged))
     except FsmbtError:
         return None
-    wanted = tree.nodes[target].source
     ids = [n.id for n in whole.nodes if n.source is wanted]
-    if len(ids) != 1:
-        return None
-    inputs = drive(whole, ids[0], failed.trace, extra=4 * len(failed.trace) + 64)
-    if inputs is None:
-        return None
+    return (whole, ids[0]) if len(ids) == 1 else None
+
+
+def _confirmed(
+    source: BTDocument,
+    result: FSM,
+    inputs: list[str],
+    what: str,
+    method: str,
+    sentence: str,
+) -> Report | None:
+    """Rule 3 on the driven ``inputs`` and the report of what the replay shows (``what``: the
+    failing node or region, for the details)."""
     try:
         found = confirm(*lift_machines(source, result), inputs)
     except Unsupported:
@@ -459,7 +535,7 @@ def lifted_report(
     report = Report(engine="native", source="source", result="result", mode=LEAF_EXECUTION)
     step = next(s for s in shown.steps if s.note)
     trace = shown.steps[: step.step + 1]
-    where = f"after {len(best)} lifted leaf outcomes (node {failed.failed})"
+    where = f"after {len(best)} lifted leaf outcomes ({what})"
     if _SOURCE_REFUSES not in step.note and tuple(step.source_outputs) != tuple(
         step.result_outputs
     ):
@@ -484,8 +560,8 @@ def lifted_report(
         report.properties[COMPLETENESS] = PropertyResult(
             COMPLETENESS, False, f"{where}: {step.note}", trace
         )
-    report.method = PER_NODE_LIFTED
-    report.abstractions = [LIFTED_SENTENCE]
+    report.method = method
+    report.abstractions = [sentence]
     report.stats = {"lifted_steps": len(best), "drive_steps": len(inputs)}
     return report
 
