@@ -402,16 +402,26 @@ def separates(found: Replay) -> bool:
     return found.differs and _SOURCE_REFUSES not in found.differences[0]
 
 
+def separating_prefix(
+    source: Machine[Any], result: Machine[Any], inputs: list[str]
+) -> list[str] | None:
+    """The inputs cut at the first step where the replay separates the machines (``None``:
+    no prefix does). Cost: one replay."""
+    found = replay(source, result, inputs)
+    if not separates(found):
+        return None
+    return inputs[: next(step.step for step in found.steps if step.note)]
+
+
 def confirm(
     source: Machine[Any], result: Machine[Any], inputs: list[str]
 ) -> tuple[list[str], Replay] | None:
     """Rule 3: the inputs cut at the first separating step and shortened greedily, with
     their replay; ``None`` when no prefix separates the machines."""
-    found = replay(source, result, inputs)
-    if not separates(found):
+    cut = separating_prefix(source, result, inputs)
+    if cut is None:
         return None
-    first = next(step.step for step in found.steps if step.note)
-    best = inputs[:first]
+    best = cut
     runs = 0
     i = len(best) - 1
     deadline = time.perf_counter() + SHORTEN_SECONDS
@@ -420,8 +430,8 @@ def confirm(
         runs += 1
         attempt = replay(source, result, trial)
         if separates(attempt):
-            cut = next(step.step for step in attempt.steps if step.note)
-            best = trial[:cut]
+            first = next(step.step for step in attempt.steps if step.note)
+            best = trial[:first]
             i = min(i, len(best)) - 1
         else:
             i -= 1
@@ -459,22 +469,32 @@ def lifted_report(
 ) -> Report | None:
     """NOT EQUIVALENT with the lifted counterexample of ``failed`` (a per-node check that
     failed in ``region``), or ``None`` when the lift does not separate the whole machines
-    (the caller runs the whole product)."""
-    tree, target = failed.tree, failed.failed_id
-    if tree is None or target is None:
+    (the caller runs the whole product). Each failing node the check collected is driven and
+    replayed; the one whose replay separates the machines soonest is kept and shortened."""
+    tree = failed.tree
+    if tree is None or failed.failed_id is None or failed.failed is None:
         return None
     merged = tree.doc.main.root
     assert merged is not None
-    found = _target(source, region, merged, tree.nodes[target].source)
-    if found is None:
+    try:
+        machines = lift_machines(source, result)
+    except Unsupported:
         return None
-    whole, target_id = found
-    inputs = drive(whole, target_id, failed.trace, extra=4 * len(failed.trace) + 64)
-    if inputs is None:
+    best: tuple[list[str], str] | None = None
+    for what, node_id, trace in [(failed.failed, failed.failed_id, failed.trace), *failed.others]:
+        found = _target(source, region, merged, tree.nodes[node_id].source)
+        if found is None:
+            continue
+        inputs = drive(found[0], found[1], trace, extra=4 * len(trace) + 64)
+        try:
+            cut = None if inputs is None else separating_prefix(*machines, inputs)
+        except Unsupported:  # the result's run meets what the lazy runner refuses
+            continue
+        if cut is not None and (best is None or len(cut) < len(best[0])):
+            best = (cut, f"node {what}")
+    if best is None:
         return None
-    return _confirmed(
-        source, result, inputs, f"node {failed.failed}", PER_NODE_LIFTED, LIFTED_SENTENCE
-    )
+    return _confirmed(source, result, best[0], best[1], PER_NODE_LIFTED, LIFTED_SENTENCE)
 
 
 def lifted_region_report(

@@ -90,6 +90,8 @@ END_SUCCESS, END_FAILURE = "SUCCESS", "FAILURE"
 EVENTS = {SUCCESS: "success", FAILURE: "failure", RUNNING: "running"}
 #: Most pairs one local product may hold before the check refuses.
 LOCAL_LIMIT = 20_000
+#: Most failing nodes one region's check collects for the lift.
+MAX_FAILURES = 8
 #: Most eventless steps one resolution may take before the check refuses (a cycle).
 STEP_LIMIT = 10_000
 _IDENT = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
@@ -127,6 +129,13 @@ class PerNodeOutcome:
     failed_id: int | None = None
     trace: list[tuple[int | None, Any]] = field(default_factory=list)
     tree: CompiledTree | None = None
+    #: the other nodes whose local check failed, as (description, id, local counterexample):
+    #: the walk goes on past a failure (up to ``MAX_FAILURES``), a failed node settled with the
+    #: σ its check had paired when it failed (a guess, only used to find candidates: the lift
+    #: confirms each by replay), so the lift may try each - a mutant can break several local
+    #: checks (a wrong exit fails the parent's), and the first found is not always one the
+    #: whole tree reaches soonest, or at all
+    others: list[tuple[str, int, list[tuple[int | None, Any]]]] = field(default_factory=list)
 
 
 # -- expressions (fsmbt's subset: literals, names, ==, !=, <, <=, >, >=, and, or, x + 1) -------
@@ -938,27 +947,37 @@ def check_region(
     memo: dict[tuple[Any, ...], tuple[bool, dict[int, Any], int, list[Any], bool]] = {}
     kept: dict[tuple[Any, ...], LocalWitness] = {}
     outcome = PerNodeOutcome(equivalent=True, nodes=len(walk.tree.nodes))
-    for problem in walk.problems():
-        node = problem.node
-        found = memo.get(problem.key)
-        if found is None:
-            found, witness = _decide(problem, keep is not None)
-            memo[problem.key] = found
-            outcome.distinct += 1
-            outcome.local_states += found[2]
-            if witness is not None:
-                kept[problem.key] = witness
-                assert keep is not None
-                keep.append(witness)
-        equivalent, pairing, _states, local_trace, can_halt = found
-        if not equivalent:
-            outcome.equivalent = False
-            outcome.failed = f"{node.type} '{node.label}' at {node.path or 'the root'}"
-            outcome.failed_id, outcome.trace, outcome.tree = node.id, local_trace, walk.tree
-            return outcome
-        if keep is not None:
-            kept[problem.key].nodes.append(node.path)
-        walk.settle(problem, sigma_exits(problem.local, pairing), can_halt)
+    failures: list[tuple[str, int, list[tuple[int | None, Any]]]] = []
+    try:
+        for problem in walk.problems():
+            node = problem.node
+            found = memo.get(problem.key)
+            if found is None:
+                found, witness = _decide(problem, keep is not None and not failures)
+                memo[problem.key] = found
+                outcome.distinct += 1
+                outcome.local_states += found[2]
+                if witness is not None:
+                    kept[problem.key] = witness
+                    assert keep is not None
+                    keep.append(witness)
+            equivalent, pairing, _states, local_trace, can_halt = found
+            if not equivalent:
+                where = f"{node.type} '{node.label}' at {node.path or 'the root'}"
+                failures.append((where, node.id, local_trace))
+                if len(failures) >= MAX_FAILURES:
+                    break
+            if keep is not None and problem.key in kept:
+                kept[problem.key].nodes.append(node.path)
+            walk.settle(problem, sigma_exits(problem.local, pairing), can_halt)
+    except NotPerNode:
+        if not failures:  # past a failure, a node above it may not group: what was found stands
+            raise
+    if failures:
+        outcome.equivalent = False
+        outcome.failed, outcome.failed_id, outcome.trace = failures[0]
+        outcome.others, outcome.tree = failures[1:], walk.tree
+        return outcome
     outcome.results = walk.root_results()
     return outcome
 
