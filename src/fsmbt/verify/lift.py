@@ -469,8 +469,9 @@ def lifted_report(
 ) -> Report | None:
     """NOT EQUIVALENT with the lifted counterexample of ``failed`` (a per-node check that
     failed in ``region``), or ``None`` when the lift does not separate the whole machines
-    (the caller runs the whole product). Each failing node the check collected is driven and
-    replayed; the one whose replay separates the machines soonest is kept and shortened."""
+    (the caller runs the whole product). The failing nodes the check collected are driven and
+    replayed in the walk's order; the first whose replay separates the machines is kept and
+    shortened."""
     tree = failed.tree
     if tree is None or failed.failed_id is None or failed.failed is None:
         return None
@@ -480,8 +481,9 @@ def lifted_report(
         machines = lift_machines(source, result)
     except Unsupported:
         return None
-    best: tuple[list[str], str] | None = None
-    for what, node_id, trace in [(failed.failed, failed.failed_id, failed.trace), *failed.others]:
+    best: tuple[list[str], str] | None = None  # (separating inputs, the node)
+    first = (failed.failed, failed.failed_id, failed.trace)
+    for what, node_id, trace in itertools.chain([first], failed.more):
         found = _target(source, region, merged, tree.nodes[node_id].source)
         if found is None:
             continue
@@ -490,8 +492,9 @@ def lifted_report(
             cut = None if inputs is None else separating_prefix(*machines, inputs)
         except Unsupported:  # the result's run meets what the lazy runner refuses
             continue
-        if cut is not None and (best is None or len(cut) < len(best[0])):
+        if cut is not None:  # the first that separates (each try: a drive and a replay)
             best = (cut, f"node {what}")
+            break
     if best is None:
         return None
     return _confirmed(source, result, best[0], best[1], PER_NODE_LIFTED, LIFTED_SENTENCE)

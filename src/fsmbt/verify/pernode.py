@@ -55,12 +55,14 @@ For a certificate (``fsmbt.verify.certificate``, docs/verification.md §6) the p
 checker share two public pieces: ``NodeWalk`` (which local checks exist, children first, and
 the interfaces they settle) and ``local_machines`` (one local problem as two
 ``semantics.machine.Machine`` objects for the native checker, σ fixed). With ``keep``,
-``check_region`` checks each distinct local problem that held once more on those machines and
-keeps the witness (about doubling the per-node proof's time).
+``check_region`` keeps, per distinct local problem that held, the tables of those two machines
+and the relation, numbered from the lockstep product's own steps (``_witness_of``,
+``verify/table_witness.py``: no second search; the same tables the native checker would list).
 """
 
 from __future__ import annotations
 
+import itertools
 import re
 from collections import deque
 from collections.abc import Callable, Iterator
@@ -129,13 +131,13 @@ class PerNodeOutcome:
     failed_id: int | None = None
     trace: list[tuple[int | None, Any]] = field(default_factory=list)
     tree: CompiledTree | None = None
-    #: the other nodes whose local check failed, as (description, id, local counterexample):
-    #: the walk goes on past a failure (up to ``MAX_FAILURES``), a failed node settled with the
-    #: σ its check had paired when it failed (a guess, only used to find candidates: the lift
-    #: confirms each by replay), so the lift may try each - a mutant can break several local
-    #: checks (a wrong exit fails the parent's), and the first found is not always one the
-    #: whole tree reaches soonest, or at all
-    others: list[tuple[str, int, list[tuple[int | None, Any]]]] = field(default_factory=list)
+    #: the next nodes whose local check fails, as (description, id, local counterexample),
+    #: found only when asked (the walk resumed past the first failure, ``_failures``; at most
+    #: ``MAX_FAILURES`` in all): a mutant can break several local checks (a wrong exit fails
+    #: the parent's), and the first found is not always one the whole tree reaches
+    more: Iterator[tuple[str, int, list[tuple[int | None, Any]]]] = field(
+        default_factory=lambda: iter(())
+    )
 
 
 # -- expressions (fsmbt's subset: literals, names, ==, !=, <, <=, >, >=, and, or, x + 1) -------
@@ -944,16 +946,42 @@ def check_region(
         NotPerNode: the machine is not a valid per-node decomposition of this region.
     """
     walk = NodeWalk(region_root, machine, declared)
+    outcome = PerNodeOutcome(equivalent=True, nodes=len(walk.tree.nodes))
+    failures = _failures(walk, outcome, keep)
+    first = next(failures, None)
+    if first is not None:
+        outcome.equivalent = False
+        outcome.failed, outcome.failed_id, outcome.trace = first
+        outcome.tree, outcome.more = walk.tree, itertools.islice(failures, MAX_FAILURES - 1)
+        return outcome
+    outcome.results = walk.root_results()
+    return outcome
+
+
+Failure = tuple[str, int, list[tuple[int | None, Any]]]
+
+
+def _failures(
+    walk: NodeWalk, outcome: PerNodeOutcome, keep: list[LocalWitness] | None
+) -> Iterator[Failure]:
+    """Decide ``walk``'s local checks children first (equal problems once), counting them in
+    ``outcome``; yield each node whose check fails (description, id, local counterexample).
+    Resumed past a failure (only when the lift asks: ``PerNodeOutcome.more``), a failed node
+    is settled with the σ its check had paired when it failed - a guess that only finds more
+    candidates, each confirmed by replay - and a node above it that no longer groups ends the
+    walk. With ``keep``, the witnesses of the checks that held before any failure.
+
+    Raises:
+        NotPerNode: before any failure, the machine is not a valid per-node decomposition."""
     memo: dict[tuple[Any, ...], tuple[bool, dict[int, Any], int, list[Any], bool]] = {}
     kept: dict[tuple[Any, ...], LocalWitness] = {}
-    outcome = PerNodeOutcome(equivalent=True, nodes=len(walk.tree.nodes))
-    failures: list[tuple[str, int, list[tuple[int | None, Any]]]] = []
+    failed = False
     try:
         for problem in walk.problems():
             node = problem.node
             found = memo.get(problem.key)
             if found is None:
-                found, witness = _decide(problem, keep is not None and not failures)
+                found, witness = _decide(problem, keep is not None and not failed)
                 memo[problem.key] = found
                 outcome.distinct += 1
                 outcome.local_states += found[2]
@@ -963,23 +991,18 @@ def check_region(
                     keep.append(witness)
             equivalent, pairing, _states, local_trace, can_halt = found
             if not equivalent:
-                where = f"{node.type} '{node.label}' at {node.path or 'the root'}"
-                failures.append((where, node.id, local_trace))
-                if len(failures) >= MAX_FAILURES:
-                    break
+                failed = True
+                yield (
+                    f"{node.type} '{node.label}' at {node.path or 'the root'}",
+                    node.id,
+                    local_trace,
+                )
             if keep is not None and problem.key in kept:
                 kept[problem.key].nodes.append(node.path)
             walk.settle(problem, sigma_exits(problem.local, pairing), can_halt)
     except NotPerNode:
-        if not failures:  # past a failure, a node above it may not group: what was found stands
+        if not failed:
             raise
-    if failures:
-        outcome.equivalent = False
-        outcome.failed, outcome.failed_id, outcome.trace = failures[0]
-        outcome.others, outcome.tree = failures[1:], walk.tree
-        return outcome
-    outcome.results = walk.root_results()
-    return outcome
 
 
 def _decide(
