@@ -8,8 +8,7 @@ each proof (issue 27, item 3 "verdicts that say what was proven"). Prints a tabl
 ``--pernode SIZES``: only the per-node proofs (docs/semantics.md §4d), one row per
 ``bench_reactive`` family ``mixed``, ``memory``, ``reactive-plain``, ``decorated`` and size
 (nodes, seed = size): ``plain s`` is ``verify`` without a certificate, ``prove s`` with one
-(each distinct local check checked again by the native checker on ``pernode.local_machines``
-and its witness kept), ``units`` the certificate's ``pernode`` units (one per distinct local
+(each distinct local check's tables numbered from the proof's own steps and kept), ``units`` the certificate's ``pernode`` units (one per distinct local
 check) plus its ``region``/``skeleton`` units, ``check s`` the certificate's check, ``plain
 MiB``/``peak MiB`` each run's peak resident memory (forked children).
 

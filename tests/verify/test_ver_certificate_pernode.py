@@ -8,8 +8,10 @@ counterexample's certificate replays."""
 from __future__ import annotations
 
 import copy
+import json
 import random
 from collections import Counter
+from typing import Any
 
 import pytest
 
@@ -18,11 +20,13 @@ from fsmbt.cli import main
 from fsmbt.convert.bt_to_hfsm import bt_to_hfsm
 from fsmbt.model.errors import InputError
 from fsmbt.verify import certificate
-from fsmbt.verify.compositional import compositional_report
-from fsmbt.verify.report import PER_NODE, PER_NODE_LIFTED
+from fsmbt.verify.compositional import compositional_report, structure
+from fsmbt.verify.native import check_witnessed
+from fsmbt.verify.pernode import LOCAL_LIMIT, STATUS_OF, NodeWalk, local_machines
+from fsmbt.verify.report import COMPOSITIONAL_LIFTED, LIFTED, PER_NODE
 from support.pernode_certs import FAMILIES, SOURCE, certify, family_pair, recheck
-from support.pernode_mutants import mutate, whole
-from support.pernode_trees import pernode_tree
+from support.pernode_mutants import mutate, pernode_machine, whole
+from support.pernode_trees import pernode_tree, seeded_trees
 
 PERNODE = certificate.PERNODE
 STATUSES = ("success", "failure", "running")
@@ -51,9 +55,8 @@ def test_a_per_node_proof_gets_a_certificate_that_checks(family: str) -> None:
 
 def test_a_certificate_changes_no_verdict_on_seeded_small_trees() -> None:
     """The bench families and every kind ``convert/bt_pernode`` writes (Async*, Parallel,
-    ParallelAll, loops with -1): with a certificate the method is the one without, the local
-    machines never disagree with the proof's lockstep product (the guard that would refuse the
-    region), and every certificate checks."""
+    ParallelAll, loops with -1): with a certificate the method is the one without, and every
+    certificate checks."""
     rng = random.Random(5)
     tally: Counter[str] = Counter()
     for index in range(120):
@@ -64,13 +67,68 @@ def test_a_certificate_changes_no_verdict_on_seeded_small_trees() -> None:
             doc, model = family_pair(FAMILIES[index // 2 % 4], rng.randint(2, 12), 1000 + index)
         plain, _why = compositional_report(doc, model)
         report, data = certify(doc, model)
-        assert not [r for r in report.stats.get("per_node_refused", []) if "local machines" in r]
         if plain is not None:
             assert report.method == plain.method
         tally[report.method] += 1
         assert report.equivalent and recheck(data, doc, model).equivalent
     print(f"\n[certificates on small trees] {dict(tally)}")
     assert tally[PER_NODE] >= 90
+
+
+def _walk_units(doc, model, data):  # type: ignore[no-untyped-def]
+    """The local checks of ``data``'s regions proven per node, re-derived as the checker does
+    (``pernode.NodeWalk``): per first node of each unit, the unit, its problem and its σ."""
+    shape = structure(doc, model)
+    units = _pernode_units(data)
+    for k, j in sorted({(u["tree_region"], u["fsm_region"]) for u in units}):
+        mine = [u for u in units if (u["tree_region"], u["fsm_region"]) == (k, j)]
+        owner = {path: u for u in mine for path in u["nodes"]}
+        walk = NodeWalk(shape.regions[k], shape.machine_regions[j].machine, shape.declared)
+        done: set[int] = set()
+        for problem in walk.problems():
+            unit = owner[problem.node.path]
+            sigma = {
+                STATUS_OF[s]: (int(e[0]), tuple(int(a) for a in e[1]))
+                for s, e in unit["interface"].items()
+            }
+            if id(unit) not in done:
+                done.add(id(unit))
+                yield unit, problem, sigma
+            walk.settle(problem, sigma, bool(unit["halt"]))
+
+
+def _native_units(doc, model, data):  # type: ignore[no-untyped-def]
+    """Each pernode unit of ``data`` next to the native checker's witness on the
+    ``local_machines`` of the first node it covers."""
+    for unit, problem, sigma in _walk_units(doc, model, data):
+        machines = local_machines(problem, sigma, bool(unit["halt"]))
+        report, witness = check_witnessed(*machines, max_states=LOCAL_LIMIT)
+        assert report.equivalent
+        yield unit, json.loads(json.dumps(witness.to_data()))
+
+
+def test_the_witness_from_the_proofs_own_steps_is_the_native_checkers() -> None:
+    """A unit is numbered from the per-node check's own lockstep steps (``pernode._witness_of``,
+    no second search): on the bench families and every kind ``convert/bt_pernode`` writes, it
+    is exactly the native checker's witness on ``pernode.local_machines`` (same outputs, same
+    tables state for state and edge for edge, same relation as a set)."""
+    compared = 0
+    for index in range(24):
+        if index % 2:
+            doc = pernode_tree(3 + index % 5, 2000 + index)
+            model = bt_to_hfsm(doc, pernode=True).model
+        else:
+            doc, model = family_pair(FAMILIES[index // 2 % 4], 4 + index, 2000 + index)
+        report, data = certify(doc, model)
+        if report.method != PER_NODE:
+            continue
+        for unit, native in _native_units(doc, model, data):
+            assert unit["outputs"] == native["outputs"]
+            assert unit["machines"] == native["machines"]
+            assert sorted(map(tuple, unit["relation"])) == sorted(map(tuple, native["relation"]))
+            compared += 1
+    print(f"\n[units compared with the native witness] {compared}")
+    assert compared >= 60
 
 
 def test_a_certificate_does_not_make_a_large_proof_fall_back() -> None:
@@ -202,6 +260,44 @@ def test_a_tampered_per_node_certificate_is_refused(proof, name: str) -> None:  
         recheck(edited, doc, model)
 
 
+def test_a_unit_repeating_an_earlier_regions_is_replayed_once_and_still_checked(
+    monkeypatch,  # type: ignore[no-untyped-def]
+) -> None:
+    """The checker replays a unit equal to one already replayed for the same local problem
+    only once; the repeat still counts, and the same repeat with one edited edge output or
+    relation pair is replayed and refused."""
+    doc, model = family_pair("mixed", 80, 3)  # regions proven per node, two repeated units
+    _report, data = certify(doc, model)
+    seen: set[Any] = set()
+    repeat = None
+    for unit, problem, _sigma in _walk_units(doc, model, data):
+        fingerprint = json.dumps([unit[k] for k in ("interface", "halt", "outputs", "machines")])
+        if (problem.key, fingerprint) in seen:
+            repeat = data["units"].index(unit)
+        seen.add((problem.key, fingerprint))
+    assert repeat is not None
+    replays: list[str] = []
+    original = certificate.check_unit
+
+    def counted(unit, source, result, name):  # type: ignore[no-untyped-def]
+        replays.append(name)
+        return original(unit, source, result, name)
+
+    monkeypatch.setattr(certificate, "check_unit", counted)
+    checked = recheck(data, doc, model)
+    assert checked.equivalent and checked.pairs == certificate.relation_pairs(data)
+    assert len(replays) < len(data["units"])  # the repeat was not replayed
+    edited = copy.deepcopy(data)
+    edge = edited["units"][repeat]["machines"]["source"]["edges"][0][0]
+    edge[2] = (edge[2] + 1) % len(edited["units"][repeat]["outputs"])
+    with pytest.raises(certificate.CertificateError, match="not as certified"):
+        recheck(edited, doc, model)
+    edited = copy.deepcopy(data)
+    edited["units"][repeat]["relation"].pop()
+    with pytest.raises(certificate.CertificateError):
+        recheck(edited, doc, model)
+
+
 def test_other_files_digests_are_refused(proof) -> None:  # type: ignore[no-untyped-def]
     doc, model, data = proof
     with pytest.raises(certificate.CertificateError, match="other files"):
@@ -237,7 +333,7 @@ def test_a_lifted_not_equivalent_certificate_replays() -> None:
             report, data = certify(doc, mutant)
         except InputError:
             continue  # the whole product refuses this mutant (an eventless cycle)
-        if report.method != PER_NODE_LIFTED:
+        if report.method not in LIFTED:
             continue
         assert not data["equivalent"] and data["counterexamples"]
         checked = recheck(data, doc, mutant)
@@ -252,6 +348,31 @@ def test_a_lifted_not_equivalent_certificate_replays() -> None:
         if found == 2:
             break
     assert found >= 2
+
+
+def test_a_region_lifted_certificate_replays() -> None:
+    """A mutant whose region is checked whole (a broken per-node side condition) and fails is
+    refuted by the region's counterexample lifted to the whole tree (``compositional,
+    lifted``): its certificate replays on the mutant and is refused on the original."""
+    rng = random.Random(5)
+    for doc in seeded_trees(60, seed=4):
+        model = bt_to_hfsm(doc, pernode=True).model
+        if pernode_machine(model) is None:
+            continue
+        mutant = mutate(model, rng)
+        assert mutant is not None
+        try:
+            report, data = certify(doc, mutant)
+        except InputError:
+            continue
+        if report.method != COMPOSITIONAL_LIFTED:
+            continue
+        assert not data["equivalent"] and data["method"] == COMPOSITIONAL_LIFTED
+        assert not recheck(data, doc, mutant).equivalent
+        with pytest.raises(certificate.CertificateError):
+            recheck(data, doc, model)
+        return
+    raise AssertionError("no mutant of the sample was refuted by a lifted region")
 
 
 def test_the_cli_writes_and_checks_a_per_node_certificate(tmp_path, capsys) -> None:  # type: ignore[no-untyped-def]

@@ -7,7 +7,7 @@ from rich.console import Console, Group, RenderableType
 from rich.table import Table
 from rich.text import Text
 
-from fsmbt.verify.report import PER_NODE_LIFTED, PROPERTIES, PropertyResult, Report, TraceStep
+from fsmbt.verify.report import LIFTED, PROPERTIES, PropertyResult, Report, TraceStep
 
 _TITLES = {
     "reachability": "reachability",
@@ -73,7 +73,7 @@ def render(report: Report) -> RenderableType:
                 props[0],
                 [p.name for p in props],
                 leaf_execution=report.mode == "leaf-execution",
-                shortest=report.method != PER_NODE_LIFTED,
+                shortest=report.method not in LIFTED,
             )
         )
     stats = report.stats

@@ -61,6 +61,7 @@ from fsmbt.verify.pairing import LEAF_EXECUTION
 from fsmbt.verify.pernode import PerNodeOutcome
 from fsmbt.verify.report import (
     COMPLETENESS,
+    COMPOSITIONAL_LIFTED,
     NO_ADDITIONAL_BEHAVIOR,
     PER_NODE_LIFTED,
     TERMINATION_CONSISTENCY,
@@ -74,6 +75,8 @@ SYMBOL = {
     FAILURE: LeafOutcome.FAILURE.value,
     RUNNING: LeafOutcome.RUNNING.value,
 }
+#: The status of each leaf machine input.
+STATUS = {symbol: status for status, symbol in SYMBOL.items()}
 #: Most states one abstract search settles.
 SEARCH_LIMIT = 3_000
 #: Most leaves one drive answers.
@@ -248,12 +251,20 @@ class Realizer:
 
 
 def drive(
-    tree: CompiledTree, target: int, local: Sequence[tuple[int | None, Any]], extra: int
+    tree: CompiledTree,
+    target: int,
+    local: Sequence[tuple[int | None, Any]],
+    extra: int,
+    region: Sequence[int] = (),
 ) -> list[str] | None:
     """Leaf outcomes from the root that tick ``target`` and then give its children the local
-    counterexample's outcomes, then ``extra`` more leaves (rule 2); ``None``: not liftable."""
+    counterexample's outcomes, then ``extra`` more leaves (rule 2); ``None``: not liftable.
+    With ``region`` (and no ``local``): once ``target`` is ticked, the leaves under it answer
+    these statuses in order (a region's own counterexample: its leaf outcomes from its fresh
+    tick, which the whole tree asks in the same order while the tick reaches it)."""
     if any(symbol == "halt" for _pos, symbol in local):
         return None
+    answers = deque(region)
     realizer = Realizer(tree)
     nodes = tree.nodes
     chain: list[int] = []
@@ -276,14 +287,22 @@ def drive(
             continue
         active = [frame[0] for frame in snap[2]]
         reached = reached or target in active
-        if reached and not events:  # the local counterexample is given: ``extra`` more
+        if reached and not events and not answers:  # the counterexample is given: ``extra``
             if left <= 0:
                 return inputs
             left -= 1
-        status = _from_queue(queues, active, event.node)
-        if status is None and goal is not None and goal[0] in active:
+        status = None
+        if answers and target in active:
+            status = answers.popleft()
+            if event.node.is_condition and status == RUNNING:
+                return None
+        else:
+            status = _from_queue(queues, active, event.node)
+        if status is not None:
+            pass
+        elif goal is not None and goal[0] in active:
             status = _propagate(realizer, active, active.index(goal[0]), goal[1])
-        elif status is None:
+        else:
             goal = None
             child, wanted = _plan(active, target, chain, events, realizer)
             if child is None:
@@ -383,16 +402,26 @@ def separates(found: Replay) -> bool:
     return found.differs and _SOURCE_REFUSES not in found.differences[0]
 
 
+def separating_prefix(
+    source: Machine[Any], result: Machine[Any], inputs: list[str]
+) -> list[str] | None:
+    """The inputs cut at the first step where the replay separates the machines (``None``:
+    no prefix does). Cost: one replay."""
+    found = replay(source, result, inputs)
+    if not separates(found):
+        return None
+    return inputs[: next(step.step for step in found.steps if step.note)]
+
+
 def confirm(
     source: Machine[Any], result: Machine[Any], inputs: list[str]
 ) -> tuple[list[str], Replay] | None:
     """Rule 3: the inputs cut at the first separating step and shortened greedily, with
     their replay; ``None`` when no prefix separates the machines."""
-    found = replay(source, result, inputs)
-    if not separates(found):
+    cut = separating_prefix(source, result, inputs)
+    if cut is None:
         return None
-    first = next(step.step for step in found.steps if step.note)
-    best = inputs[:first]
+    best = cut
     runs = 0
     i = len(best) - 1
     deadline = time.perf_counter() + SHORTEN_SECONDS
@@ -401,8 +430,8 @@ def confirm(
         runs += 1
         attempt = replay(source, result, trial)
         if separates(attempt):
-            cut = next(step.step for step in attempt.steps if step.note)
-            best = trial[:cut]
+            first = next(step.step for step in attempt.steps if step.note)
+            best = trial[:first]
             i = min(i, len(best)) - 1
         else:
             i -= 1
@@ -413,6 +442,14 @@ LIFTED_SENTENCE = (
     "per node, lifted: the per-node check found a node whose local check fails; its local "
     "counterexample was lifted to leaf outcomes from the root and replayed on the two whole "
     "machines, which it tells apart (a real counterexample, not always a shortest one)"
+)
+
+
+REGION_LIFTED_SENTENCE = (
+    "compositional, lifted: a region checked alone against its composite state fails; its "
+    "counterexample (leaf outcomes from the region's fresh tick) was lifted to leaf outcomes "
+    "from the root and replayed on the two whole machines, which it tells apart (a real "
+    "counterexample, not always a shortest one)"
 )
 
 
@@ -432,23 +469,85 @@ def lifted_report(
 ) -> Report | None:
     """NOT EQUIVALENT with the lifted counterexample of ``failed`` (a per-node check that
     failed in ``region``), or ``None`` when the lift does not separate the whole machines
-    (the caller runs the whole product)."""
-    tree, target = failed.tree, failed.failed_id
-    if tree is None or target is None:
+    (the caller runs the whole product). The failing nodes the check collected are driven and
+    replayed in the walk's order; the first whose replay separates the machines is kept and
+    shortened."""
+    tree = failed.tree
+    if tree is None or failed.failed_id is None or failed.failed is None:
         return None
     merged = tree.doc.main.root
     assert merged is not None
     try:
+        machines = lift_machines(source, result)
+    except Unsupported:
+        return None
+    best: tuple[list[str], str] | None = None  # (separating inputs, the node)
+    first = (failed.failed, failed.failed_id, failed.trace)
+    for what, node_id, trace in itertools.chain([first], failed.more):
+        found = _target(source, region, merged, tree.nodes[node_id].source)
+        if found is None:
+            continue
+        inputs = drive(found[0], found[1], trace, extra=4 * len(trace) + 64)
+        try:
+            cut = None if inputs is None else separating_prefix(*machines, inputs)
+        except Unsupported:  # the result's run meets what the lazy runner refuses
+            continue
+        if cut is not None:  # the first that separates (each try: a drive and a replay)
+            best = (cut, f"node {what}")
+            break
+    if best is None:
+        return None
+    return _confirmed(source, result, best[0], best[1], PER_NODE_LIFTED, LIFTED_SENTENCE)
+
+
+def lifted_region_report(
+    source: BTDocument, result: FSM, region: BTNode, failed: Report
+) -> Report | None:
+    """NOT EQUIVALENT with the counterexample of a region checked alone (``failed``: the
+    region's subtree run as a tree of its own against its composite state, docs/semantics.md
+    §4c) lifted to the whole tree: the drive ticks the region fresh, then its leaves answer
+    the region counterexample's outcomes in order (``drive``'s ``region``), confirmed by
+    replay as a per-node lift; ``None`` when the replay does not separate the machines."""
+    traces = [p.counterexample for p in failed.properties.values() if p.counterexample]
+    if not traces:
+        return None
+    shortest = min(traces, key=len)
+    answers = [STATUS[str(step.input)] for step in shortest[1:] if step.input in STATUS]
+    if len(answers) != len(shortest) - 1:
+        return None
+    found = _target(source, region, region, region)
+    if found is None:
+        return None
+    whole, target_id = found
+    inputs = drive(whole, target_id, [], extra=64, region=answers)
+    if inputs is None:
+        return None
+    where = f"region {region.label}"
+    return _confirmed(source, result, inputs, where, COMPOSITIONAL_LIFTED, REGION_LIFTED_SENTENCE)
+
+
+def _target(
+    source: BTDocument, region: BTNode, merged: BTNode, wanted: BTNode
+) -> tuple[CompiledTree, int] | None:
+    """The whole tree (``region`` replaced by ``merged``) and the id of the node ``wanted``."""
+    try:
         whole = CompiledTree(whole_tree(source, region, merged))
     except FsmbtError:
         return None
-    wanted = tree.nodes[target].source
     ids = [n.id for n in whole.nodes if n.source is wanted]
-    if len(ids) != 1:
-        return None
-    inputs = drive(whole, ids[0], failed.trace, extra=4 * len(failed.trace) + 64)
-    if inputs is None:
-        return None
+    return (whole, ids[0]) if len(ids) == 1 else None
+
+
+def _confirmed(
+    source: BTDocument,
+    result: FSM,
+    inputs: list[str],
+    what: str,
+    method: str,
+    sentence: str,
+) -> Report | None:
+    """Rule 3 on the driven ``inputs`` and the report of what the replay shows (``what``: the
+    failing node or region, for the details)."""
     try:
         found = confirm(*lift_machines(source, result), inputs)
     except Unsupported:
@@ -459,7 +558,7 @@ def lifted_report(
     report = Report(engine="native", source="source", result="result", mode=LEAF_EXECUTION)
     step = next(s for s in shown.steps if s.note)
     trace = shown.steps[: step.step + 1]
-    where = f"after {len(best)} lifted leaf outcomes (node {failed.failed})"
+    where = f"after {len(best)} lifted leaf outcomes ({what})"
     if _SOURCE_REFUSES not in step.note and tuple(step.source_outputs) != tuple(
         step.result_outputs
     ):
@@ -484,8 +583,8 @@ def lifted_report(
         report.properties[COMPLETENESS] = PropertyResult(
             COMPLETENESS, False, f"{where}: {step.note}", trace
         )
-    report.method = PER_NODE_LIFTED
-    report.abstractions = [LIFTED_SENTENCE]
+    report.method = method
+    report.abstractions = [sentence]
     report.stats = {"lifted_steps": len(best), "drive_steps": len(inputs)}
     return report
 

@@ -55,12 +55,14 @@ For a certificate (``fsmbt.verify.certificate``, docs/verification.md §6) the p
 checker share two public pieces: ``NodeWalk`` (which local checks exist, children first, and
 the interfaces they settle) and ``local_machines`` (one local problem as two
 ``semantics.machine.Machine`` objects for the native checker, σ fixed). With ``keep``,
-``check_region`` checks each distinct local problem that held once more on those machines and
-keeps the witness (about doubling the per-node proof's time).
+``check_region`` keeps, per distinct local problem that held, the tables of those two machines
+and the relation, numbered from the lockstep product's own steps (``_witness_of``,
+``verify/table_witness.py``: no second search; the same tables the native checker would list).
 """
 
 from __future__ import annotations
 
+import itertools
 import re
 from collections import deque
 from collections.abc import Callable, Iterator
@@ -80,8 +82,8 @@ from fsmbt.semantics.bt_interpreter import (
     LeafRequest,
 )
 from fsmbt.semantics.compiled import FAILURE, RUNNING, SUCCESS, Work
-from fsmbt.verify.native import check_witnessed
 from fsmbt.verify.subset_expr import ForeignName, OutsideSubset, compile_subset
+from fsmbt.verify.table_witness import Rows, Side, witness_from_rows
 
 #: The tag the per-node conversion writes (``convert.bt_pernode.NODE_ATTR``; the SCXML
 #: writer's fsmbt namespace in Clark notation).
@@ -90,6 +92,8 @@ END_SUCCESS, END_FAILURE = "SUCCESS", "FAILURE"
 EVENTS = {SUCCESS: "success", FAILURE: "failure", RUNNING: "running"}
 #: Most pairs one local product may hold before the check refuses.
 LOCAL_LIMIT = 20_000
+#: Most failing nodes one region's check collects for the lift.
+MAX_FAILURES = 8
 #: Most eventless steps one resolution may take before the check refuses (a cycle).
 STEP_LIMIT = 10_000
 _IDENT = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
@@ -127,6 +131,13 @@ class PerNodeOutcome:
     failed_id: int | None = None
     trace: list[tuple[int | None, Any]] = field(default_factory=list)
     tree: CompiledTree | None = None
+    #: the next nodes whose local check fails, as (description, id, local counterexample),
+    #: found only when asked (the walk resumed past the first failure, ``_failures``; at most
+    #: ``MAX_FAILURES`` in all): a mutant can break several local checks (a wrong exit fails
+    #: the parent's), and the first found is not always one the whole tree reaches
+    more: Iterator[tuple[str, int, list[tuple[int | None, Any]]]] = field(
+        default_factory=lambda: iter(())
+    )
 
 
 # -- expressions (fsmbt's subset: literals, names, ==, !=, <, <=, >, >=, and, or, x + 1) -------
@@ -556,11 +567,16 @@ def _check_local(
     allowed: list[list[int]],
     haltable: frozenset[int],
     with_halt: bool,
-) -> tuple[bool, dict[int, Any], int, list[tuple[int | None, Any]]]:
+    rows: tuple[Rows, Rows] | None = None,
+) -> tuple[bool, dict[int, Any], int, list[tuple[int | None, Any]], list[Any]]:
     """The lockstep product of the two sides (module docstring). ``haltable``: the children
     whose own check held with ``halt`` offered (any halt of another child fails this one);
     ``with_halt``: offer ``halt`` between ticks. Returns (equivalent, σ: status -> canonical
-    exit, product states)."""
+    exit, product states, the local counterexample, the product's pairs).
+
+    With ``rows``, each side's steps are recorded there (state -> input -> (next state, raw
+    outputs), the input named as ``local_machines`` name it), once per side state: the
+    transitions a certificate lists (``_witness_of``), so no second search is needed."""
     bt = _BtSide(_abstract_tree(node, [RUNNING in a for a in allowed]))
     fsm = _FsmSide(local)
     never = frozenset(range(len(allowed))) - haltable
@@ -591,15 +607,20 @@ def _check_local(
         # two statuses may share an exit (a parent that treats them alike): σ is a function
         return bool(pairing.setdefault(b_what, f_what) == f_what)
 
+    bt_row: dict[str, Any] | None = None
+    fsm_row: dict[str, Any] | None = None
     while queue:
         current = queue.popleft()
         (snap, position), (fpos, fvalues, frunning) = current
         if position != fpos:
-            return False, pairing, len(seen), trace(current)
+            return False, pairing, len(seen), trace(current), []
         if position is None:
             inputs: list[Any] = ["tick", "halt"] if with_halt else ["tick"]
         else:
             inputs = allowed[position]
+        if rows is not None:  # each side state's row once, from the first pair holding it
+            bt_row = None if current[0] in rows[0] else rows[0].setdefault(current[0], {})
+            fsm_row = None if current[1] in rows[1] else rows[1].setdefault(current[1], {})
         for symbol in inputs:
             values = dict(fvalues)
             running = set(frunning)
@@ -609,11 +630,14 @@ def _check_local(
                 values.update(local.halt)
                 fsm_halts = frozenset(i for i in running if i in local.halting)
                 if halted & never or any(i in never for i in running):
-                    return False, pairing, len(seen), trace(current, (position, symbol))
+                    return False, pairing, len(seen), trace(current, (position, symbol)), []
                 running.clear()
-                if frozenset(i for i in halted if i in local.halting) != fsm_halts:
-                    return False, pairing, len(seen), trace(current, (position, symbol))
+                bt_halts = frozenset(i for i in halted if i in local.halting)
+                if bt_halts != fsm_halts:
+                    return False, pairing, len(seen), trace(current, (position, symbol)), []
                 fpos_next = None
+                bt_raw: Any = (bt_halts, ("none", None))
+                fsm_raw: Any = (fsm_halts, ("none", None))
             else:
                 if symbol == "tick":
                     bt_next, bt_out = bt.run(bt.interp.begin_tick(snap), None)
@@ -627,14 +651,19 @@ def _check_local(
                         running.add(position)
                 fpos_next, fsm_out = fsm.resolve(hop, values, running)
                 if not same(bt_out, fsm_out):
-                    return False, pairing, len(seen), trace(current, (position, symbol))
+                    return False, pairing, len(seen), trace(current, (position, symbol)), []
+                bt_raw, fsm_raw = (bt_out[0] & local.halting, bt_out[1]), fsm_out[:2]
             pair = (bt_next, (fpos_next, tuple(sorted(values.items())), frozenset(running)))
+            if bt_row is not None:
+                bt_row[symbol if isinstance(symbol, str) else EVENTS[symbol]] = (bt_next, bt_raw)
+            if fsm_row is not None:
+                fsm_row[symbol if isinstance(symbol, str) else EVENTS[symbol]] = (pair[1], fsm_raw)
             if pair not in seen:
                 if len(seen) >= LOCAL_LIMIT:
                     raise NotPerNode(f"the local problem of {node.label} passes {LOCAL_LIMIT}")
                 seen[pair] = (current, (position, symbol))
                 queue.append(pair)
-    return True, pairing, len(seen), []
+    return True, pairing, len(seen), [], list(seen) if rows is not None else []
 
 
 # -- the local machines (for a certificate: the same problem as ``_check_local``) ------------
@@ -928,65 +957,163 @@ def check_region(
 ) -> PerNodeOutcome:
     """Check ``machine`` (a region state's sub-machine, tagged per node) against the region
     headed by ``region_root``, node by node (the module docstring). With ``keep``, each
-    distinct local check that held is checked again by the native checker on
-    ``local_machines`` and its witness appended (for a certificate: one small product more
-    per distinct check). With ``units``, each distinct local check is appended as a
-    ``LocalUnit`` (what NuSMV checks again; no extra cost here), the failing one last.
+    distinct local check that held is kept with its witness: the tables of
+    ``local_machines`` and the relation, numbered from the steps the check itself made
+    (``_witness_of``; no second search). With ``units``, each distinct local check decided
+    up to the first failure is appended as a ``LocalUnit`` (what NuSMV checks again; no extra
+    cost here), the failing one last.
 
     Raises:
         NotPerNode: the machine is not a valid per-node decomposition of this region.
     """
     walk = NodeWalk(region_root, machine, declared)
-    memo: dict[tuple[Any, ...], tuple[bool, dict[int, Any], int, list[Any], bool]] = {}
-    kept: dict[tuple[Any, ...], LocalWitness] = {}
-    recorded: dict[tuple[Any, ...], LocalUnit] = {}
     outcome = PerNodeOutcome(equivalent=True, nodes=len(walk.tree.nodes))
-    for problem in walk.problems():
-        node = problem.node
-        found = memo.get(problem.key)
-        if found is None:
-            found = (*_check_local(problem.local, node, problem.allowed, problem.halts, True), True)
-            if not found[0]:  # proven for a node nobody halts, or not at all
-                found = (
-                    *_check_local(problem.local, node, problem.allowed, problem.halts, False),
-                    False,
-                )
-            memo[problem.key] = found
-            outcome.distinct += 1
-            outcome.local_states += found[2]
-            if keep is not None and found[0]:
-                kept[problem.key] = _witnessed(problem, found[1], found[4])
-                keep.append(kept[problem.key])
-        equivalent, pairing, _states, local_trace, can_halt = found
-        if units is not None:
-            unit = recorded.get(problem.key)
-            if unit is None:
-                labels = [walk.tree.nodes[c].label for c in node.children]
-                sigma = sigma_exits(problem.local, pairing)
-                unit = LocalUnit(problem, sigma, can_halt, equivalent, [], labels)
-                recorded[problem.key] = unit
-                units.append(unit)
-            unit.nodes.append(node.path)
-        if not equivalent:
-            outcome.equivalent = False
-            outcome.failed = f"{node.type} '{node.label}' at {node.path or 'the root'}"
-            outcome.failed_id, outcome.trace, outcome.tree = node.id, local_trace, walk.tree
-            return outcome
-        if keep is not None:
-            kept[problem.key].nodes.append(node.path)
-        walk.settle(problem, sigma_exits(problem.local, pairing), can_halt)
+    failures = _failures(walk, outcome, keep, units)
+    first = next(failures, None)
+    if first is not None:
+        outcome.equivalent = False
+        outcome.failed, outcome.failed_id, outcome.trace = first
+        outcome.tree, outcome.more = walk.tree, itertools.islice(failures, MAX_FAILURES - 1)
+        return outcome
     outcome.results = walk.root_results()
     return outcome
 
 
-def _witnessed(problem: LocalProblem, pairing: dict[int, Any], can_halt: bool) -> LocalWitness:
-    """The native checker's witness of a local check that held (the certificate's unit)."""
+Failure = tuple[str, int, list[tuple[int | None, Any]]]
+
+
+def _failures(
+    walk: NodeWalk,
+    outcome: PerNodeOutcome,
+    keep: list[LocalWitness] | None,
+    units: list[LocalUnit] | None = None,
+) -> Iterator[Failure]:
+    """Decide ``walk``'s local checks children first (equal problems once), counting them in
+    ``outcome``; yield each node whose check fails (description, id, local counterexample).
+    Resumed past a failure (only when the lift asks: ``PerNodeOutcome.more``), a failed node
+    is settled with the σ its check had paired when it failed - a guess that only finds more
+    candidates, each confirmed by replay - and a node above it that no longer groups ends the
+    walk. With ``keep``, the witnesses of the checks that held before any failure; with
+    ``units``, the distinct checks up to the first failure, the failing one last.
+
+    Raises:
+        NotPerNode: before any failure, the machine is not a valid per-node decomposition."""
+    memo: dict[tuple[Any, ...], tuple[bool, dict[int, Any], int, list[Any], bool]] = {}
+    kept: dict[tuple[Any, ...], LocalWitness] = {}
+    recorded: dict[tuple[Any, ...], LocalUnit] = {}
+    failed = False
+    try:
+        for problem in walk.problems():
+            node = problem.node
+            found = memo.get(problem.key)
+            if found is None:
+                found, witness = _decide(problem, keep is not None and not failed)
+                memo[problem.key] = found
+                outcome.distinct += 1
+                outcome.local_states += found[2]
+                if witness is not None:
+                    kept[problem.key] = witness
+                    assert keep is not None
+                    keep.append(witness)
+            equivalent, pairing, _states, local_trace, can_halt = found
+            if units is not None and not failed:
+                unit = recorded.get(problem.key)
+                if unit is None:
+                    labels = [walk.tree.nodes[c].label for c in node.children]
+                    sigma = sigma_exits(problem.local, pairing)
+                    unit = LocalUnit(problem, sigma, can_halt, equivalent, [], labels)
+                    recorded[problem.key] = unit
+                    units.append(unit)
+                unit.nodes.append(node.path)
+            if not equivalent:
+                failed = True
+                yield (
+                    f"{node.type} '{node.label}' at {node.path or 'the root'}",
+                    node.id,
+                    local_trace,
+                )
+            if keep is not None and problem.key in kept:
+                kept[problem.key].nodes.append(node.path)
+            walk.settle(problem, sigma_exits(problem.local, pairing), can_halt)
+    except NotPerNode:
+        if not failed:
+            raise
+
+
+def _decide(
+    problem: LocalProblem, keeping: bool
+) -> tuple[tuple[bool, dict[int, Any], int, list[Any], bool], LocalWitness | None]:
+    """One distinct local check: with ``halt`` offered, else (proven for a node nobody halts,
+    or not at all) without; (equivalent, σ, product states, local counterexample, with halt),
+    and, when ``keeping`` and it held, its witness built from the check's own steps."""
+    node, local = problem.node, problem.local
+    for with_halt in (True, False):
+        rows: tuple[Rows, Rows] | None = ({}, {}) if keeping else None
+        equivalent, pairing, states, trace, pairs = _check_local(
+            local, node, problem.allowed, problem.halts, with_halt, rows
+        )
+        if equivalent or not with_halt:
+            break
+    found = (equivalent, pairing, states, trace, with_halt)
+    if rows is None or not equivalent:
+        return found, None
+    return found, _witness_of(problem, pairing, with_halt, rows, pairs)
+
+
+def _witness_of(
+    problem: LocalProblem,
+    pairing: dict[int, Any],
+    can_halt: bool,
+    rows: tuple[Rows, Rows],
+    pairs: list[Any],
+) -> LocalWitness:
+    """A local check that held as a certificate unit: ``local_machines``'s two tables (their
+    outputs the tokens those machines give: halts of halting children, the child ticked, the
+    exit - a tree status named by σ's exit) and the product's pairs as the relation."""
     sigma = sigma_exits(problem.local, pairing)
-    tree_side, fragment = local_machines(problem, sigma, can_halt)
-    report, witness = check_witnessed(tree_side, fragment, max_states=LOCAL_LIMIT)
-    if not report.equivalent:  # the two formulations of one local check disagree: a bug
-        raise NotPerNode(f"the local machines of {problem.node.label} are not equivalent")
+    tokens: dict[Any, tuple[str, ...]] = {}
+
+    def named(raw: Any, tree_side: bool) -> tuple[str, ...]:
+        key = (tree_side, raw)
+        found = tokens.get(key)
+        if found is None:
+            halts, (kind, what) = raw
+            if kind == "exit":
+                what = exit_token(sigma[what] if tree_side else what)
+            found = tokens[key] = _local_outputs(halts, None, (kind, what))
+        return found
+
+    named_rows = tuple(
+        {
+            state: {symbol: (nxt, named(raw, side == 0)) for symbol, (nxt, raw) in row.items()}
+            for state, row in rows[side].items()
+        }
+        for side in (0, 1)
+    )
+    offered = _LocalInputs(problem.allowed, can_halt)
+    witness = witness_from_rows(
+        pairs[0],  # the product's start pair (its pairs in the order it met them)
+        (named_rows[0], named_rows[1]),
+        (
+            Side(_describe_at(1), _running, lambda state: offered.of(state[1])),
+            Side(_describe_at(0), _running, lambda state: offered.of(state[0])),
+        ),
+        pairs,
+    )
     return LocalWitness([], sigma, can_halt, witness)
+
+
+def _running(_state: Any) -> str:
+    return "running"
+
+
+def _describe_at(position: int) -> Callable[[Any], str]:
+    """``describe`` of a local machine whose position is item ``position`` of its state."""
+
+    def describe(state: Any) -> str:
+        return "between ticks" if state[position] is None else f"at child {state[position]}"
+
+    return describe
 
 
 def _real_exits(local: _Local, pairing: Sigma) -> Interface:

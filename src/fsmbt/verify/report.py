@@ -40,6 +40,12 @@ PER_NODE_LIFTED = "per node, lifted"
 #: NuSMV deciding each distinct local check of the per-node decomposition (and the parts
 #: checked whole), the native walk choosing which (``fsmbt.verify.nusmv.pernode``)
 SYMBOLIC_PER_NODE = "symbolic (per node)"
+#: a NOT EQUIVALENT verdict whose counterexample a region checked alone found (its own shortest,
+#: from the region's fresh tick) and ``fsmbt.verify.lift`` lifted to the whole tree and
+#: confirmed by replay
+COMPOSITIONAL_LIFTED = "compositional, lifted"
+#: the methods whose counterexample is lifted (real, confirmed by replay; not claimed shortest)
+LIFTED = (PER_NODE_LIFTED, COMPOSITIONAL_LIFTED)
 METHODS = (
     WHOLE_PRODUCT,
     TABLE,
@@ -49,6 +55,7 @@ METHODS = (
     PER_NODE,
     PER_NODE_LIFTED,
     SYMBOLIC_PER_NODE,
+    COMPOSITIONAL_LIFTED,
 )
 
 
