@@ -73,7 +73,7 @@ def test_unknown_engine_is_bad_input(files, capsys):
 
 
 def test_engine_disagreement_exits_3(files, monkeypatch, capsys):
-    def flipped_nusmv(source, result, loop):
+    def flipped_nusmv(source, result, loop, *_pairing, **_options):
         report = verify_module.verify(source, result)
         report.properties["deadlock_absence"].holds = False
         return report
@@ -85,7 +85,9 @@ def test_engine_disagreement_exits_3(files, monkeypatch, capsys):
 
 def test_engine_both_agreeing_exits_like_native(files, monkeypatch):
     monkeypatch.setattr(
-        verify_module, "_nusmv", lambda source, result, loop: verify_module.verify(source, result)
+        verify_module,
+        "_nusmv",
+        lambda source, result, loop, *_pairing, **_options: verify_module.verify(source, result),
     )
     assert main(["verify", files["source"], files["mutated"], "--engine", "both"]) == 1
 

@@ -61,7 +61,8 @@ def main() -> int:
     else:
         text = sys.stdin.read()
     answer = check_scxml_loads(text)
-    print(json.dumps(None if answer is None else dataclasses.asdict(answer)))
+    # the answer to the parent process (a protocol, not presentation: nobody reads it)
+    sys.stdout.write(json.dumps(None if answer is None else dataclasses.asdict(answer)) + "\n")
     return 0
 
 
