@@ -203,19 +203,20 @@ def check(
     names: list[str] = []
     results: list[SpecResult] = []
     runs, nusmv_seconds = 0, 0.0
-    deferred: tuple[str, list[str], list[str]] | None = None  # the reachability run, if needed
-    for part, (text, part_names, _context) in zip(parts, models):
+    # the reachability run, if needed: text, spec names, options, variable order
+    deferred: tuple[str, list[str], list[str], str] | None = None
+    for part, (text, part_names, part_context) in zip(parts, models):
         options = ["-df"] if part == CTL else []
         lean = without_spec(text, part_names, REACHABILITY) if implied_reachability else None
         if lean is not None:
-            deferred = (text, part_names, options)
+            deferred = (text, part_names, options, part_context[-1])
             text, part_names = lean
         if not part_names:
             continue
         found, seconds = run_nusmv(
             text,
             len(part_names),
-            order=context[-1],
+            order=part_context[-1],  # each part's own variables
             timeout=timeout,
             options=options,
             mono=mono,
@@ -236,12 +237,12 @@ def check(
             nusmv_seconds += seconds
             report.properties[REACHABILITY] = verdict
         else:  # a failing pair: reachability is decided by its own spec (its counterexample)
-            text, part_names, options = deferred
+            text, part_names, options, order = deferred
             only = _only_spec(text, part_names, REACHABILITY)
             if split:  # the closure over the frozen copies: forward-restricted, reordered
                 options = ["-dynamic"]  # (CPU s on a 100-state mutant: 17.6 -df, 6.2 here)
             found, seconds = run_nusmv(
-                only, 1, order=context[-1], timeout=timeout, options=options, mono=mono
+                only, 1, order=order, timeout=timeout, options=options, mono=mono
             )
             runs += 1
             nusmv_seconds += seconds

@@ -5,13 +5,15 @@ makes NuSMV's backward fixpoint a relation between every state and every frozen 
 transitive closure, past 60 s from ~300 states on. When each machine's state is one
 enumerated variable (an FSM's ``q``), reachability (docs/verification.md, section 2: every
 state a machine reaches on its own occurs in a pair of the faithful product ``F``) is instead
-decided from two invariants per state on the ``REACH`` model (``specs.state_reach_specs``),
-all checked on the reachable states of one forward search (``-dcx``: no traces); a
-state whose ``alone`` invariant fails (it is reached alone) and whose ``faithful`` invariant
-holds (no pair of ``F`` has it) is unmatched. A second run, only when some state is unmatched,
-asks for one invariant over all of them, whose counterexample NuSMV builds breadth first: a
-shortest path to an unmatched state in that machine alone; a third replays its inputs on both
-machines, which gives the native checker's kind of witness (``native._reachability``).
+decided by invariants per state on the ``REACH`` model (``specs.state_reach_specs``), each
+run checking them on the reachable states of one forward search (``-dcx``: no traces):
+first ``!(faithful & q = v)`` for every state ``v`` (it holds iff no pair of F has ``v``);
+then, only for those states, ``!(alone & q = v)`` (it fails iff the machine reaches ``v`` on
+its own: ``v`` is unmatched). States of F are always reached alone, so an equivalent pair's
+states, and a failing pair's whose reachability holds, need no second run. When some state is
+unmatched, one invariant over all of them has a counterexample NuSMV builds breadth first: a
+shortest path to an unmatched state in that machine alone; a last run replays its inputs on
+both machines, which gives the native checker's kind of witness (``native._reachability``).
 """
 
 from __future__ import annotations
@@ -45,19 +47,29 @@ def _text(
     return src.text + "\n" + res.text + "\n" + prod.text, prod.order
 
 
+def holding(specs: list[tuple[str, str]], results: list[SpecResult]) -> dict[str, list[str]]:
+    """Per side (``s``, ``r``), the states whose invariant in ``specs`` holds (for the
+    ``faithful`` ones: the states no pair of F has; for the ``alone`` ones: the states the
+    machine never reaches alone), in the order of the enumeration."""
+    found: dict[str, list[str]] = {}
+    for (name, _formula), result in zip(specs, results):
+        _kind, side, value = name.split(":", 2)
+        if result.holds:
+            found.setdefault(side, []).append(value)
+    return found
+
+
 def unmatched_states(
-    specs: list[tuple[str, str]], results: list[SpecResult]
+    candidates: dict[str, list[str]], specs: list[tuple[str, str]], results: list[SpecResult]
 ) -> dict[str, list[str]]:
-    """Per side (``s``, ``r``), the identity values reached alone and never in ``F``, in the
-    order of the enumeration (the order the encoder declared the states)."""
-    verdicts = {name: result.holds for (name, _f), result in zip(specs, results)}
+    """The ``candidates`` (states no pair of F has) that the ``alone`` invariants ``specs``
+    show reached alone: the unmatched states, per side, in the order of the enumeration."""
+    unreached = holding(specs, results)
     unmatched: dict[str, list[str]] = {}
-    for name, _formula in specs:
-        kind, side, value = name.split(":", 2)
-        if kind != "alone" or verdicts[name]:
-            continue  # not reached alone
-        if verdicts[f"faithful:{side}:{value}"]:
-            unmatched.setdefault(side, []).append(value)
+    for side, values in candidates.items():
+        missing = [v for v in values if v not in set(unreached.get(side, ()))]
+        if missing:
+            unmatched[side] = missing
     return unmatched
 
 
@@ -99,23 +111,35 @@ def _detail(context: Context, unmatched: dict[str, list[str]]) -> str:
 def check_reachability(
     context: Context, *, timeout: float | None
 ) -> tuple[PropertyResult, int, float]:
-    """Reachability's verdict (with its witness when it fails), the number of NuSMV runs (1
-    or 3) and their seconds. ``context`` must satisfy ``applies``. Cost: one forward search of
-    the ``REACH`` model (the faithful product plus each machine's run from the start) and
-    2 (S + R) set intersections; the witness: a forward search to the nearest unmatched state and
-    one replayed path."""
-    specs = state_reach_specs(context[0], context[1])
+    """Reachability's verdict (with its witness when it fails), the number of NuSMV runs and
+    their seconds. ``context`` must satisfy ``applies``. Runs: the ``faithful`` invariant of
+    every state (a forward search of the ``REACH`` model - F plus each machine's own states -
+    and S + R checks); when some states are not in F, their ``alone`` invariants (a second
+    run); when some of those are reached alone (reachability fails), the witness: a forward
+    search to the nearest one and its replayed path (two more runs)."""
+    src, res = context[0], context[1]
+    specs = state_reach_specs(src, res, "faithful")
     assert specs is not None
     text, order = _text(context, specs)
     results, seconds = run_nusmv(
         text, len(specs), order=order, timeout=timeout, options=["-dcx"], mono=False
     )
-    unmatched = unmatched_states(specs, results)
-    if not unmatched:
+    candidates = holding(specs, results)  # never in F: unmatched if reached alone
+    if not candidates:
         return PropertyResult(REACHABILITY, True, STATES_DETAIL), 1, seconds
+    specs = state_reach_specs(src, res, "alone", only=candidates)
+    assert specs is not None
+    text, order = _text(context, specs)
+    results, more = run_nusmv(
+        text, len(specs), order=order, timeout=timeout, options=["-dcx"], mono=False
+    )
+    seconds += more
+    unmatched = unmatched_states(candidates, specs, results)
+    if not unmatched:
+        return PropertyResult(REACHABILITY, True, STATES_DETAIL), 2, seconds
     trace, more = _witness(context, unmatched, timeout=timeout)
     result = PropertyResult(REACHABILITY, False, _detail(context, unmatched), trace or None)
-    return result, 3, seconds + more
+    return result, 4, seconds + more
 
 
 def _witness(
