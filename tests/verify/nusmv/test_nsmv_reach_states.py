@@ -110,10 +110,11 @@ def test_one_invariant_per_state_and_no_frozen_copy() -> None:
     src_enc, res_enc, inputs, _outputs, _mode = nusmv.encode(source, copy.deepcopy(source))
     src, res = src_enc.encode(), res_enc.encode()
     specs = state_reach_specs(src, res)
-    alone = state_reach_specs(src, res, "alone", only={"r": ["q1", "q2"]})
+    asked = res.id_values[1:3]
+    alone = state_reach_specs(src, res, "alone", only={"r": asked})
     assert specs is not None and alone is not None
     assert len(specs) == len(src_enc.states.to_id) + len(res_enc.states.to_id)
-    assert [name for name, _f in alone] == ["alone:r:q1", "alone:r:q2"]
+    assert [name for name, _f in alone] == [f"alone:r:{v}" for v in asked]
     prod = product(src, res, inputs, part=REACH, reach_specs=specs)
     assert re.search(r"\b(ts|tr)_\w+", prod.text) is None  # no frozen copy
     assert re.search(r"\b(EF|AG|EX)\b", prod.text) is None  # invariants only
@@ -130,3 +131,26 @@ def test_300_states_copy_and_mutant_are_decided_and_agree(nusmv_binary, monkeypa
         report = nusmv.check(source, result)
         assert report.verdicts() == native.verdicts()
     assert not native.equivalent  # the mutant's failing path ran
+
+
+def test_state_codes_round_trip_and_exclude_unused_words() -> None:
+    """Each FSM state is one ``unsigned word`` constant (its index) that decodes back to its
+    name; the width is the fewest bits that hold every state, and the codes past the last one
+    are excluded by an ``INVAR`` exactly when there are some."""
+    for size in (1, 2, 5, 8, 9):
+        fsm = FSM(name=f"n{size}")
+        for i in range(size):
+            fsm.add_state(State(f"S{i}", action=f"a{i}", final=i == size - 1))
+        fsm.initial = "S0"
+        for i in range(size - 1):
+            fsm.add_transition(f"S{i}", f"e{i}", f"S{i + 1}")
+        src_enc, _res_enc, _inputs, _outputs, _mode = nusmv.encode(fsm, copy.deepcopy(fsm))
+        enc = src_enc.encode()
+        bits = max(1, (size - 1).bit_length())
+        assert enc.id_vars == [("q", f"unsigned word[{bits}]")]
+        assert enc.id_values == [f"0ud{bits}_{i}" for i in range(size)]
+        assert [enc.decode_state({"q": code}) for code in enc.id_values] == list(fsm.states)
+        assert ("INVAR" in enc.text) == ((1 << bits) > size)
+        assert f"init(q) := {enc.id_values[0]};" in enc.text
+        statuses = [src_enc.status_of({"q": code}) for code in enc.id_values]
+        assert statuses == ["running"] * (size - 1) + ["final"]

@@ -212,15 +212,13 @@ def _order(src: Encoding, res: Encoding, *, copies: bool = True) -> str:
 
 
 def enumerated_identity(enc: Encoding) -> tuple[str, list[str]] | None:
-    """The identity variable and its values when a machine's state is one enumerated variable
-    (an FSM's ``q``), else ``None`` (a tree's identity spans many variables: its states are not
-    listed one by one; ``check`` keeps the frozen-copy reachability spec for it)."""
-    if len(enc.id_vars) != 1:
+    """The identity variable and its values when a machine's state is one variable whose
+    values the encoder lists (an FSM's ``q``: ``Encoding.id_values``), else ``None`` (a tree's
+    identity spans many variables: its states are not listed one by one; ``check`` keeps the
+    frozen-copy reachability spec for it)."""
+    if len(enc.id_vars) != 1 or not enc.id_values:
         return None
-    var, typ = enc.id_vars[0]
-    if not (typ.startswith("{") and typ.endswith("}")):
-        return None
-    return var, [v.strip() for v in typ[1:-1].split(",")]
+    return enc.id_vars[0][0], list(enc.id_values)
 
 
 def state_reach_specs(
