@@ -154,3 +154,17 @@ def test_state_codes_round_trip_and_exclude_unused_words() -> None:
         assert f"init(q) := {enc.id_values[0]};" in enc.text
         statuses = [src_enc.status_of({"q": code}) for code in enc.id_values]
         assert statuses == ["running"] * (size - 1) + ["final"]
+
+
+def test_one_state_machines_use_a_one_bit_word(nusmv_binary, monkeypatch) -> None:
+    """A one-state FSM is a ``word[1]`` with its unused code excluded; NuSMV decides both an
+    equal and a different one-state pair as the native checker does."""
+    monkeypatch.setenv("FSMBT_NUSMV", str(nusmv_binary))
+    a, b = FSM(name="a"), FSM(name="b")
+    a.add_state(State("X", action="x"))
+    b.add_state(State("Y", action="y"))
+    a.initial, b.initial = "X", "Y"
+    for result in (copy.deepcopy(a), b):
+        report = nusmv.check(a, result)
+        assert report.verdicts() == verify(a, result).verdicts()
+    assert _named(report.properties[REACHABILITY].detail) == (1, {"X"})
