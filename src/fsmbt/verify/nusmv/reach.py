@@ -33,7 +33,8 @@ _NAMES_SHOWN = 5
 
 def applies(context: Context) -> bool:
     """Whether the pair's reachability can be decided state by state (both identities, or the
-    source's for a result that follows the environment, are one enumerated variable)."""
+    source's for a result that follows the environment, are one variable whose values the
+    encoder lists: an FSM's ``q``)."""
     return state_reach_specs(context[0], context[1]) is not None
 
 
@@ -67,7 +68,8 @@ def unmatched_states(
     unreached = holding(specs, results)
     unmatched: dict[str, list[str]] = {}
     for side, values in candidates.items():
-        missing = [v for v in values if v not in set(unreached.get(side, ()))]
+        never = set(unreached.get(side, ()))
+        missing = [v for v in values if v not in never]
         if missing:
             unmatched[side] = missing
     return unmatched

@@ -246,7 +246,8 @@ def state_reach_specs(
             return None
         var, values = ident
         if only is not None:
-            values = [v for v in values if v in set(only.get(side, ()))]
+            asked = set(only.get(side, ()))
+            values = [v for v in values if v in asked]
         for value in values:
             if kind == "alone":
                 formula = f"!(mode = {mode} & {side}.stable & {side}.{var} = {value})"
