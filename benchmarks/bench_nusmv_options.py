@@ -1,11 +1,12 @@
 """NuSMV options and runs, measured (issue 27, item 2). Prints a table of NuSMV CPU seconds.
 
-    .venv/bin/python benchmarks/bench_nusmv_options.py [--sizes 10,30,100,300,1000]
-        [--timeout 60] [--columns whole,coi,dynamic,split-mono,after]
+    .venv/bin/python benchmarks/bench_nusmv_options.py [--sizes 100,300,1000]
+        [--timeout 60] [--columns whole,coi,dynamic,split-mono,frozen,after] [--random]
 
 Pairs: ``bench_checker.chain_fsm(n, n)`` against its renamed copy (``copy``: equivalent), and
 the same with one transition retargeted (``mutant``: not equivalent), FSM ~ FSM by macro
-steps. Each cell is NuSMV's CPU seconds (user + system of the NuSMV children, from
+steps; ``--random``: ``generate.random_fsm`` of n states instead (the agreement benchmark's
+FSMs; seed n), its mutant one random transition retargeted. Each cell is NuSMV's CPU seconds (user + system of the NuSMV children, from
 ``RUSAGE_CHILDREN``: independent of the load of this shared machine; wall seconds vary 2-10x
 with it), ``-`` past ``--timeout`` wall seconds in one run:
 
@@ -16,7 +17,10 @@ with it), ``-`` past ``--timeout`` wall seconds in one run:
   dynamic reordering;
 - ``split-mono``: ``check``'s two runs (invariants on the product without detaching; CTL
   specs with ``-df``) but each with ``-mono``;
-- ``after``: ``check``'s default: the two runs with NuSMV's partitioned relation.
+- ``frozen``: ``check``'s two runs, a failing pair's reachability by the frozen-copy spec
+  (``check(..., state_reach=False)``: the default before "Reachability state by state");
+- ``after``: ``check``'s default: the two runs with NuSMV's partitioned relation, a failing
+  pair's reachability decided state by state (``fsmbt.verify.nusmv.reach``).
 
 ``agree`` compares ``after``'s five verdicts with the native checker's; ``native`` is the
 native checker's CPU seconds.
@@ -26,6 +30,7 @@ from __future__ import annotations
 
 import argparse
 import copy
+import random
 import resource
 import sys
 import time
@@ -36,6 +41,7 @@ sys.path.insert(0, str(Path(__file__).parent))
 from bench_checker import chain_fsm, renamed  # noqa: E402
 
 from fsmbt import limits  # noqa: E402
+from fsmbt.generate.generator import random_fsm  # noqa: E402
 from fsmbt.model.fsm import FSM  # noqa: E402
 from fsmbt.verify import nusmv, verify  # noqa: E402
 from fsmbt.verify.nusmv.runner import NuSMVLimitError, run_nusmv  # noqa: E402
@@ -65,15 +71,17 @@ def _runs(
         "coi": lambda: run_nusmv(text, len(names), order=order, options=["-coi"]),
         "dynamic": lambda: run_nusmv(text, len(names), order=order, options=["-dynamic"]),
         "split-mono": lambda: nusmv.check(source, result, split=True, mono=True),
+        "frozen": lambda: nusmv.check(source, result, state_reach=False),
         "after": lambda: nusmv.check(source, result),
     }
 
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--sizes", default="10,30,100,300,1000")
+    parser.add_argument("--sizes", default="100,300,1000")
     parser.add_argument("--timeout", type=float, default=60.0)
-    parser.add_argument("--columns", default="whole,coi,dynamic,split-mono,after")
+    parser.add_argument("--columns", default="whole,coi,dynamic,split-mono,frozen,after")
+    parser.add_argument("--random", action="store_true", help="random_fsm pairs (seed = size)")
     args = parser.parse_args(argv)
     limits.use(limits.current().with_changes(nusmv_max_seconds=args.timeout))
     columns = args.columns.split(",")
@@ -82,10 +90,17 @@ def main(argv: list[str] | None = None) -> int:
     print("-" * (len(header) + 7))
     gave_up: set[str] = set()  # a column past the cap is not run on larger sizes
     for n in [int(x) for x in args.sizes.split(",")]:
-        source = chain_fsm(n, n)
-        same = renamed(chain_fsm(n, n))
-        mutant = copy.deepcopy(source)
-        mutant.transitions[0].target = mutant.transitions[-1].target
+        if args.random:
+            rng = random.Random(n)
+            source = random_fsm(rng.randrange(10**9), n_states=n)
+            mutant = copy.deepcopy(source)
+            moved = mutant.transitions[rng.randrange(len(mutant.transitions))]
+            moved.target = rng.choice([x for x in mutant.states if x != moved.target])
+        else:
+            source = chain_fsm(n, n)
+            mutant = copy.deepcopy(source)
+            mutant.transitions[0].target = mutant.transitions[-1].target
+        same = renamed(source)
         for label, result in (("copy", same), ("mutant", mutant)):
             started = time.process_time()
             native = verify(source, result)

@@ -26,7 +26,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from fsmbt.verify.nusmv.encode_fsm import NONE_OUT, Encoding
-from fsmbt.verify.nusmv.smv import Symbols, all_of, any_of, enum_type, subsequence
+from fsmbt.verify.nusmv.smv import Symbols, all_of, any_of, case, enum_type, subsequence
 from fsmbt.verify.report import (
     COMPLETENESS,
     DEADLOCK_ABSENCE,
@@ -52,8 +52,12 @@ class Product:
 
 
 #: The parts ``check`` runs (docs/nusmv.md, "Two runs"): the invariants on the attached product
-#: alone (forward reachability), the CTL specs on the product with detaching (``-df``).
-WHOLE, INVARIANTS, CTL = "whole", "invariants", "ctl"
+#: alone (forward reachability), the CTL specs on the product with detaching (``-df``);
+#: ``REACH`` the per-state reachability model (docs/nusmv.md, "Reachability state by state"):
+#: the mode is chosen once at the start, so the reachable states are the faithful product plus
+#: each machine's run from the start pair (the other replaying its inputs), never their cross
+#: product, and no frozen copy makes a fixpoint a transitive closure.
+WHOLE, INVARIANTS, CTL, REACH = "whole", "invariants", "ctl", "reach"
 
 
 def product(
@@ -63,15 +67,24 @@ def product(
     extra_specs: list[tuple[str, str]] | None = None,
     *,
     part: str = WHOLE,
+    reach_specs: list[tuple[str, str]] | None = None,
+    replay: tuple[str, list[str]] | None = None,
 ) -> Product:
     """The ``main`` module and the specs, in the order ``spec_names`` lists them.
 
     ``part``: ``WHOLE`` every spec on the product with detaching; ``INVARIANTS`` only the
     invariants (completeness, no additional behaviour, termination consistency) on the product
     without detaching - they read attached pairs only, and the detached states (each faithful
-    pair times everything one machine reaches alone) are most of a forward search's cost;
-    ``CTL`` the CTL specs (deadlock absence, reachability) and the extra invariants written
-    as ``AG``, for a run without the forward search (``-df``)."""
+    pair times everything one machine reaches alone) are most of a forward search's cost - and
+    without the deadlock helpers (``x_obs``, ``x_run``, ``x_st0``) and the frozen copies they
+    do not read (a 1 000-state mutant: the forward search 31 -> 9 s, docs/nusmv.md); ``CTL`` the CTL specs (deadlock absence, reachability) and the extra invariants written
+    as ``AG``, for a run without the forward search (``-df``); ``REACH`` the product whose
+    mode is frozen at the start (``att``: attached; ``sa``: the source runs alone on the
+    inputs it offers while the result stays at its start; ``ra``: the roles swapped) with the
+    ``INVARSPEC`` s ``reach_specs`` (name, formula) only (``state_reach_specs``); with
+    ``replay`` (mode, input ids) the one path that replays a witness (``_reach_product``)."""
+    if part == REACH:
+        return _reach_product(src, res, inputs, reach_specs or [], replay)
     detach = part != INVARIANTS
     in_ids = list(inputs.to_id.values())
     in_enum = enum_type(in_ids, "in_pad")  # never offered: no machine defines offers_in_pad
@@ -96,18 +109,14 @@ def product(
         "  s : " + src.module + "(go_s, inp_s);",
         "  r : " + res.module + "(go_r, inp_s);",
         "  mode : {att, sa, ra};",
-        "  s_obs : boolean;",
-        "  r_obs : boolean;",
-        "  s_run : boolean;",
-        "  r_run : boolean;",
-        "  s_st0 : boolean;",
-        "  r_st0 : boolean;",
         "  ok : boolean;",
-        "FROZENVAR",
     ]
-    for prefix, enc in (("ts", src), ("tr", res)):
-        for var, typ in enc.id_vars:
-            lines.append(f"  {prefix}_{var} : {typ};")
+    if detach:  # the deadlock helpers and the frozen copies: read by the CTL specs only
+        lines += [f"  {side}_{v} : boolean;" for v in ("obs", "run", "st0") for side in "sr"]
+        lines.append("FROZENVAR")
+        for prefix, enc in (("ts", src), ("tr", res)):
+            for var, typ in enc.id_vars:
+                lines.append(f"  {prefix}_{var} : {typ};")
     lines += [
         "DEFINE",
         "  det := mode != att;",
@@ -117,8 +126,13 @@ def product(
         f"  attached_go := !det & ok & both & ctl = step & {joint};",
         f"  go_s := attached_go | (mode = sa & s.stable & {alone_s});",
         f"  go_r := attached_go | (mode = ra & r.stable & {alone_r});",
-        "  s_out := " + any_of(f"{x} != {NONE_OUT}" for x in s_slots) + ";",
-        "  r_out := " + any_of(f"{x} != {NONE_OUT}" for x in r_slots) + ";",
+    ]
+    if detach:
+        lines += [
+            "  s_out := " + any_of(f"{x} != {NONE_OUT}" for x in s_slots) + ";",
+            "  r_out := " + any_of(f"{x} != {NONE_OUT}" for x in r_slots) + ";",
+        ]
+    lines += [
         "ASSIGN",
         "  init(mode) := att;",
         "  next(mode) := case !det & ok & both & ctl = alone_s : sa; "
@@ -128,7 +142,7 @@ def product(
         "  init(ok) := TRUE;",
         "  next(ok) := case !det & both : ok & agree; TRUE : ok; esac;",
     ]
-    for side in ("s", "r"):
+    for side in ("s", "r") if detach else ():
         lines += [
             f"  init({side}_obs) := FALSE;",
             f"  next({side}_obs) := case mode != {side}a : FALSE; "
@@ -175,19 +189,150 @@ def product(
         specs = [spec for spec in specs if spec[1] != "INVARSPEC"]
     for _name, kind, formula in specs:
         lines.append(f"{kind} {formula};")
-    order = _order(src, res)
+    order = _order(src, res, copies=detach)
     return Product("\n".join(lines) + "\n", [name for name, _, _ in specs], order)
 
 
-def _order(src: Encoding, res: Encoding) -> str:
+def _order(src: Encoding, res: Encoding, *, copies: bool = True) -> str:
     """A BDD variable order: each identity variable next to its frozen copy (the reachability
-    spec compares them), inputs first. Without it NuSMV is 20x slower on small models."""
-    order = ["ok", "ctl", "mode", "inp_s", "s_obs", "r_obs", "s_run", "r_run", "s_st0", "r_st0"]
+    spec compares them), inputs first. Without it NuSMV is 20x slower on small models.
+    ``copies=False``: the ``REACH`` model's (no frozen copies, no deadlock helpers)."""
+    order = ["ok", "ctl", "mode", "inp_s"]
+    if copies:
+        order += ["s_obs", "r_obs", "s_run", "r_run", "s_st0", "r_st0"]
     for side, copy, enc in (("s", "ts", src), ("r", "tr", res)):
         ids = {v for v, _ in enc.id_vars}
         for var in enc.var_order:
             order.append(f"{side}.{var}")
-            if var in ids:
+            if var in ids and copies:
                 order.append(f"{copy}_{var}")
-        order += [f"{copy}_{v}" for v, _ in enc.id_vars if v not in enc.var_order]  # DEFINEs
+        if copies:  # DEFINEs
+            order += [f"{copy}_{v}" for v, _ in enc.id_vars if v not in enc.var_order]
     return "\n".join(order) + "\n"
+
+
+def enumerated_identity(enc: Encoding) -> tuple[str, list[str]] | None:
+    """The identity variable and its values when a machine's state is one variable whose
+    values the encoder lists (an FSM's ``q``: ``Encoding.id_values``), else ``None`` (a tree's
+    identity spans many variables: its states are not listed one by one; ``check`` keeps the
+    frozen-copy reachability spec for it)."""
+    if len(enc.id_vars) != 1 or not enc.id_values:
+        return None
+    return enc.id_vars[0][0], list(enc.id_values)
+
+
+def state_reach_specs(
+    src: Encoding,
+    res: Encoding,
+    kind: str = "faithful",
+    only: dict[str, list[str]] | None = None,
+) -> list[tuple[str, str]] | None:
+    """The ``REACH`` model's invariants, one per state of each machine whose reachability
+    counts (the result's not when it follows the environment), named ``<kind>:<side>:<value>``:
+    ``kind="faithful"``: ``INVARSPEC !(faithful & s.q = v)``, false iff ``v`` occurs in a pair
+    of the faithful product F; ``kind="alone"``: ``INVARSPEC !(mode = sa & s.stable & s.q =
+    v)``, false iff the machine reaches ``v`` on its own. ``only`` (side -> values) restricts
+    them to those states. Reachability (docs/verification.md, section 2) holds iff every state
+    reached alone occurs in F; every state of F is reached alone (an attached step takes an input
+    both offer), so only the states not in F need their ``alone`` invariant (``reach``).
+    ``None`` when a side's state is not one enumerated variable. Size: one line per state;
+    NuSMV checks each on the reachable states of one forward search (~13 ms each at 1 000
+    states: most of the run, docs/nusmv.md)."""
+    sides = [("s", "sa", src)] + ([] if res.follows else [("r", "ra", res)])
+    specs: list[tuple[str, str]] = []
+    for side, mode, enc in sides:
+        ident = enumerated_identity(enc)
+        if ident is None:
+            return None
+        var, values = ident
+        if only is not None:
+            asked = set(only.get(side, ()))
+            values = [v for v in values if v in asked]
+        for value in values:
+            if kind == "alone":
+                formula = f"!(mode = {mode} & {side}.stable & {side}.{var} = {value})"
+            else:
+                formula = f"!(faithful & {side}.{var} = {value})"
+            specs.append((f"{kind}:{side}:{value}", formula))
+    return specs
+
+
+def _reach_product(
+    src: Encoding,
+    res: Encoding,
+    inputs: Symbols,
+    reach_specs: list[tuple[str, str]],
+    replay: tuple[str, list[str]] | None = None,
+) -> Product:
+    """The ``REACH`` model (see ``product``): the attached product of the other parts with
+    the mode frozen at the start instead of a detach step. In ``sa`` the source runs alone from
+    the start pair on the inputs it offers while the result stays at its start (``ra``: the
+    roles swapped), so the reachable states are F plus each machine's own states, never a
+    product of the two (the result replaying the source's inputs made NuSMV's forward search
+    go past 190 s on a 1 000-state mutant: after the retargeted step the two run apart).
+
+    ``replay`` (mode, input ids): the witness replay instead - the mode fixed, the inputs
+    dictated by a step counter ``k`` (``TRANS``), the other machine taking each input it offers
+    as the native checker replays its witness; one path, ``k = len(inputs)`` at its end."""
+    in_ids = list(inputs.to_id.values())
+    in_enum = enum_type(in_ids, "in_pad")
+    follows = res.follows
+    s_slots = [f"s.{x}" for x in src.slots]
+    r_slots = [f"r.{x}" for x in res.slots]
+    equal_outs = all_of(
+        [subsequence(s_slots, r_slots, NONE_OUT), subsequence(r_slots, s_slots, NONE_OUT)]
+    )
+    joint = any_of(
+        f"(inp_s = {i} & s.offers_{i}" + ("" if follows else f" & r.offers_{i}") + ")"
+        for i in in_ids
+    )
+    alone_s = any_of(f"(inp_s = {i} & s.offers_{i})" for i in in_ids)
+    alone_r = any_of(f"(inp_s = {i} & r.offers_{i})" for i in in_ids)
+    stable_s, stable_r = ("both", "both") if replay is not None else ("s.stable", "r.stable")
+    go_s = f"attached_go | (mode = sa & {stable_s} & {alone_s})"
+    go_r = f"attached_go | (mode = ra & {stable_r} & {alone_r})"
+    if replay is not None:  # the other machine replays the inputs it offers
+        go_s += f" | (mode = ra & both & {joint})"
+        go_r += f" | (mode = sa & both & {joint})"
+    lines = [
+        "MODULE main",
+        "IVAR",
+        f"  inp_s : {in_enum};",
+        "  ctl : {step, idle};",
+        "VAR",
+        "  s : " + src.module + "(go_s, inp_s);",
+        "  r : " + res.module + "(go_r, inp_s);",
+        "  ok : boolean;",
+    ]
+    if replay is not None:
+        lines.append(f"  k : 0..{max(1, len(replay[1]))};")  # one value: a constant
+    lines += [
+        "FROZENVAR",
+        "  mode : {att, sa, ra};",
+        "DEFINE",
+        "  det := mode != att;",
+        "  both := s.stable & r.stable;",
+        f"  agree := both & {equal_outs} & (s.final <-> r.final);",
+        "  faithful := !det & ok & agree;",
+        f"  attached_go := !det & ok & both & ctl = step & {joint};",
+        f"  go_s := {go_s};",
+        f"  go_r := {go_r};",
+        "ASSIGN",
+        "  init(ok) := TRUE;",
+        "  next(ok) := case !det & both : ok & agree; TRUE : ok; esac;",
+    ]
+    if replay is not None:
+        mode, word = replay
+        last = len(word)
+        lines += [
+            f"  init(mode) := {mode};",
+            "  init(k) := 0;",
+            f"  next(k) := case both & k < {last} : k + 1; TRUE : k; esac;",
+            "TRANS",
+            "  "
+            + case([(f"both & k = {j}", f"inp_s = {i}") for j, i in enumerate(word)], "TRUE")
+            + ";",
+        ]
+    lines += [f"INVARSPEC {formula};" for _name, formula in reach_specs]
+    order = _order(src, res, copies=False)
+    return Product("\n".join(lines) + "\n", [name for name, _ in reach_specs], order)

@@ -61,18 +61,33 @@ def _attached_go(before: dict[str, str], inputs: dict[str, str], follows: bool) 
     )
 
 
-def decode_trace(trace: list[TraceState], context: Context) -> list[TraceStep]:
+def alone_go(before: dict[str, str], inputs: dict[str, str]) -> bool:
+    """The ``REACH`` model's step in mode ``sa``/``ra`` (``specs._reach_product``): both
+    stable and the machine that runs alone offers the input (the other replays it)."""
+    symbol = inputs.get("inp_s")
+    driver = {"sa": "s", "ra": "r"}.get(before.get("mode", ""))
+    if driver is None or symbol is None or before.get("both") != "TRUE":
+        return False
+    return before.get(f"{driver}.offers_{symbol}") == "TRUE"
+
+
+def decode_trace(
+    trace: list[TraceState], context: Context, *, alone: bool = False
+) -> list[TraceStep]:
     """One step per attached input: a transition taken with ``attached_go`` starts it, the
-    next state where both machines are stable ends it (a BT module needs micro-steps)."""
+    next state where both machines are stable ends it (a BT module needs micro-steps).
+    ``alone``: a trace of the ``REACH`` model in mode ``sa``/``ra``, one step per input the
+    machine running alone takes (``alone_go``), the other's replay shown beside it."""
     src, res, _src_enc, _res_enc, inputs, outputs, _mode, _order = context
     steps: list[TraceStep] = []
     pending: str | None = None
     before: dict[str, str] = {}
     for state in trace:
-        if _attached_go(before, state.inputs, res.follows):
+        went = alone_go(before, state.inputs) if alone else None
+        if went or (not alone and _attached_go(before, state.inputs, res.follows)):
             pending = inputs.name(state.inputs["inp_s"]) or "?"
         v = before = state.values
-        if v.get("det") == "TRUE":
+        if v.get("det") == "TRUE" and not alone:
             break
         if v.get("both") != "TRUE" or (steps and pending is None):
             continue  # micro-steps, or an idle step: nothing happened

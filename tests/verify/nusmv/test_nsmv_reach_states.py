@@ -1,0 +1,170 @@
+"""Reachability decided state by state (docs/nusmv.md, "Reachability state by state";
+``fsmbt.verify.nusmv.reach``): on seeded FSM ~ FSM mutants it gives the verdict of the
+frozen-copy spec it replaces and of the native checker, names the same unmatched states as the
+native checker, and its witness is as short as the native one and replays (on the native
+machines) to a real difference; a 300-state mutant and copy are decided and agree."""
+
+from __future__ import annotations
+
+import copy
+import os
+import random
+import re
+
+from fsmbt.generate.generator import random_fsm
+from fsmbt.model.fsm import FSM, State
+from fsmbt.verify import nusmv, verify
+from fsmbt.verify.native import replay
+from fsmbt.verify.nusmv import reach
+from fsmbt.verify.nusmv.specs import REACH, product, state_reach_specs
+from fsmbt.verify.pairing import machines_for
+from fsmbt.verify.report import REACHABILITY
+
+SEED = int(os.environ.get("FSMBT_TEST_SEED", "27"))
+
+
+def _mutant(source: FSM, rng: random.Random) -> FSM:
+    """``source`` with one transition retargeted."""
+    mutant = copy.deepcopy(source)
+    transition = mutant.transitions[rng.randrange(len(mutant.transitions))]
+    transition.target = rng.choice([n for n in mutant.states if n != transition.target])
+    return mutant
+
+
+def _named(detail: str) -> tuple[int, set[str]]:
+    """The count and the names of ``N source state(s) never reached ...: A, B`` (source side)."""
+    head, _, names = detail.split(";")[0].partition(": ")
+    return int(head.split()[0]), {n.strip() for n in names.split(",") if n.strip() != "..."}
+
+
+def _check_witness(source: FSM, result: FSM, native_trace: list, trace: list) -> None:
+    assert trace and trace[0].input is None
+    assert len(trace) == len(native_trace)  # both shortest
+    inputs = [step.input for step in trace[1:]]
+    src, res, _mode = machines_for(source, result)
+    replayed = replay(src, res, inputs)
+    assert replayed.differs  # had every step agreed, the last state would be matched
+    for ours, theirs in zip(trace, replayed.steps):  # NuSMV's replay is the native one
+        assert (ours.source_state, ours.result_state) == (theirs.source_state, theirs.result_state)
+        assert (ours.source_outputs, ours.result_outputs) == (
+            theirs.source_outputs,
+            theirs.result_outputs,
+        )
+
+
+def test_state_by_state_agrees_with_frozen_copies_and_native(nusmv_binary, monkeypatch) -> None:
+    monkeypatch.setenv("FSMBT_NUSMV", str(nusmv_binary))
+    rng = random.Random(SEED)
+    unreached = compared = 0
+    while compared < 12:
+        source = random_fsm(rng.randrange(10**9), n_states=rng.randint(4, 12))
+        result = _mutant(source, rng)
+        native = verify(source, result)
+        if native.equivalent:
+            continue  # reachability is then implied; the state-by-state run is not made
+        compared += 1
+        new = nusmv.check(source, result)
+        old = nusmv.check(source, result, state_reach=False)
+        assert new.verdicts() == old.verdicts() == native.verdicts()
+        ours, theirs = new.properties[REACHABILITY], native.properties[REACHABILITY]
+        if ours.holds:
+            # the faithful invariants, and the alone ones when some state is not in F
+            assert ours.detail == reach.STATES_DETAIL and new.stats["nusmv_runs"] in (3, 4)
+            continue
+        unreached += 1
+        # two, the faithful and the alone invariants, the witness and its replay
+        assert new.stats["nusmv_runs"] == 6
+        count, names = _named(ours.detail)
+        native_count, native_names = _named(theirs.detail)
+        assert count == native_count
+        if count <= 5:
+            assert names == native_names
+        _check_witness(source, result, theirs.counterexample or [], ours.counterexample or [])
+    assert unreached >= 3  # the sample exercises the failing verdict and its witness
+
+
+def test_start_pair_disagreeing_gives_an_empty_witness(nusmv_binary, monkeypatch) -> None:
+    """The start outputs differ: F is empty, every state is unmatched, the witness is the start
+    alone (the replay model then has no input: its counter ``k`` must not be a constant)."""
+    monkeypatch.setenv("FSMBT_NUSMV", str(nusmv_binary))
+    source, result = FSM(name="a"), FSM(name="b")
+    for fsm, action in ((source, "hello"), (result, "bye")):
+        fsm.add_state(State("A", action=action))
+        fsm.add_state(State("B", action="x", final=True))
+        fsm.initial = "A"
+        fsm.add_transition("A", "go", "B")
+    native = verify(source, result)
+    report = nusmv.check(source, result)
+    assert report.verdicts() == native.verdicts()
+    assert not report.properties[REACHABILITY].holds
+    assert _named(report.properties[REACHABILITY].detail) == (2, {"A", "B"})
+    trace = report.properties[REACHABILITY].counterexample or []
+    assert [step.input for step in trace] == [None]
+    assert (trace[0].source_outputs, trace[0].result_outputs) == (["hello"], ["bye"])
+
+
+def test_one_invariant_per_state_and_no_frozen_copy() -> None:
+    """The REACH model lists every state of both machines once per kind (``only`` keeps the
+    states asked for) and keeps no frozen copy."""
+    source = random_fsm(3, n_states=6)
+    src_enc, res_enc, inputs, _outputs, _mode = nusmv.encode(source, copy.deepcopy(source))
+    src, res = src_enc.encode(), res_enc.encode()
+    specs = state_reach_specs(src, res)
+    asked = res.id_values[1:3]
+    alone = state_reach_specs(src, res, "alone", only={"r": asked})
+    assert specs is not None and alone is not None
+    assert len(specs) == len(src_enc.states.to_id) + len(res_enc.states.to_id)
+    assert [name for name, _f in alone] == [f"alone:r:{v}" for v in asked]
+    prod = product(src, res, inputs, part=REACH, reach_specs=specs)
+    assert re.search(r"\b(ts|tr)_\w+", prod.text) is None  # no frozen copy
+    assert re.search(r"\b(EF|AG|EX)\b", prod.text) is None  # invariants only
+    assert prod.text.count("INVARSPEC") == len(specs) == len(prod.spec_names)
+
+
+def test_300_states_copy_and_mutant_are_decided_and_agree(nusmv_binary, monkeypatch) -> None:
+    monkeypatch.setenv("FSMBT_NUSMV", str(nusmv_binary))
+    rng = random.Random(SEED + 300)
+    source = random_fsm(rng.randrange(10**9), n_states=300)
+    mutant = _mutant(source, rng)
+    for result in (copy.deepcopy(source), mutant):
+        native = verify(source, result)
+        report = nusmv.check(source, result)
+        assert report.verdicts() == native.verdicts()
+    assert not native.equivalent  # the mutant's failing path ran
+
+
+def test_state_codes_round_trip_and_exclude_unused_words() -> None:
+    """Each FSM state is one ``unsigned word`` constant (its index) that decodes back to its
+    name; the width is the fewest bits that hold every state, and the codes past the last one
+    are excluded by an ``INVAR`` exactly when there are some."""
+    for size in (1, 2, 5, 8, 9):
+        fsm = FSM(name=f"n{size}")
+        for i in range(size):
+            fsm.add_state(State(f"S{i}", action=f"a{i}", final=i == size - 1))
+        fsm.initial = "S0"
+        for i in range(size - 1):
+            fsm.add_transition(f"S{i}", f"e{i}", f"S{i + 1}")
+        src_enc, _res_enc, _inputs, _outputs, _mode = nusmv.encode(fsm, copy.deepcopy(fsm))
+        enc = src_enc.encode()
+        bits = max(1, (size - 1).bit_length())
+        assert enc.id_vars == [("q", f"unsigned word[{bits}]")]
+        assert enc.id_values == [f"0ud{bits}_{i}" for i in range(size)]
+        assert [enc.decode_state({"q": code}) for code in enc.id_values] == list(fsm.states)
+        assert ("INVAR" in enc.text) == ((1 << bits) > size)
+        assert f"init(q) := {enc.id_values[0]};" in enc.text
+        statuses = [src_enc.status_of({"q": code}) for code in enc.id_values]
+        assert statuses == ["running"] * (size - 1) + ["final"]
+
+
+def test_one_state_machines_use_a_one_bit_word(nusmv_binary, monkeypatch) -> None:
+    """A one-state FSM is a ``word[1]`` with its unused code excluded; NuSMV decides both an
+    equal and a different one-state pair as the native checker does."""
+    monkeypatch.setenv("FSMBT_NUSMV", str(nusmv_binary))
+    a, b = FSM(name="a"), FSM(name="b")
+    a.add_state(State("X", action="x"))
+    b.add_state(State("Y", action="y"))
+    a.initial, b.initial = "X", "Y"
+    for result in (copy.deepcopy(a), b):
+        report = nusmv.check(a, result)
+        assert report.verdicts() == verify(a, result).verdicts()
+    assert _named(report.properties[REACHABILITY].detail) == (1, {"X"})
