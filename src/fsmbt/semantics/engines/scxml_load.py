@@ -18,7 +18,9 @@ import contextlib
 import dataclasses
 import io
 import json
+import os
 import sys
+from typing import NoReturn
 
 from fsmbt.semantics.engines.btcpp_load import LoadCheck
 
@@ -51,7 +53,7 @@ def check_scxml_loads(text: str) -> LoadCheck | None:
     return LoadCheck(engine, True)
 
 
-def main() -> int:
+def main() -> NoReturn:
     """``python -m fsmbt.semantics.engines.scxml_load [FILE]``: the check of the SCXML text in
     FILE (else on standard input), answered as one JSON line (the ``LoadCheck``'s fields;
     ``null`` without python-statemachine). ``load_beside`` runs it beside a proof."""
@@ -61,10 +63,13 @@ def main() -> int:
     else:
         text = sys.stdin.read()
     answer = check_scxml_loads(text)
-    # the answer to the parent process (a protocol, not presentation: nobody reads it)
+    # the answer to the parent process (a protocol it reads, not presentation)
     sys.stdout.write(json.dumps(None if answer is None else dataclasses.asdict(answer)) + "\n")
-    return 0
+    sys.stdout.flush()
+    # the answer is out: skip the interpreter's teardown, which frees the engine's chart object
+    # by object (about 3.5 s for a 15 000-state chart, half as long as the check itself)
+    os._exit(0)
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    main()
