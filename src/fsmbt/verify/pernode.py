@@ -467,15 +467,18 @@ def _local(region: _Region, node: CompiledNode, interfaces: dict[int, Interface]
 
 
 # -- the local product ---------------------------------------------------------------------------
-def _abstract_tree(node: CompiledNode, kids_running: list[bool]) -> BTDocument:
+def abstract_tree(
+    node: CompiledNode, kids_running: list[bool], names: list[str] | None = None
+) -> BTDocument:
+    """The tree side's shape of a local problem (module docstring): N (its type, ports and
+    semantics) over abstract leaves, child i an action when it may return RUNNING (else a
+    condition), named ``names[i]`` (default ``⟪i⟫``). Only a shape: fsmbt's interpreter runs it
+    here, NuSMV's own tick rules in ``nusmv.encode_local``."""
     source = node.source
+    labels = names if names is not None else [f"⟪{i}⟫" for i in range(len(kids_running))]
     leaves = [
-        BTNode(
-            f"⟪{i}⟫",
-            NodeKind.ACTION if running else NodeKind.CONDITION,
-            name=f"⟪{i}⟫",
-        )
-        for i, running in enumerate(kids_running)
+        BTNode(label, NodeKind.ACTION if running else NodeKind.CONDITION, name=label)
+        for label, running in zip(labels, kids_running, strict=True)
     ]
     copy = BTNode(
         source.type,
@@ -577,7 +580,7 @@ def _check_local(
     With ``rows``, each side's steps are recorded there (state -> input -> (next state, raw
     outputs), the input named as ``local_machines`` name it), once per side state: the
     transitions a certificate lists (``_witness_of``), so no second search is needed."""
-    bt = _BtSide(_abstract_tree(node, [RUNNING in a for a in allowed]))
+    bt = _BtSide(abstract_tree(node, [RUNNING in a for a in allowed]))
     fsm = _FsmSide(local)
     never = frozenset(range(len(allowed))) - haltable
     pairing: dict[int, Any] = {}
@@ -719,7 +722,7 @@ class LocalTreeMachine:
 
     def __init__(self, problem: LocalProblem, sigma: Sigma, with_halt: bool) -> None:
         self.name = f"node {problem.node.label}"
-        self.bt = _BtSide(_abstract_tree(problem.node, [RUNNING in a for a in problem.allowed]))
+        self.bt = _BtSide(abstract_tree(problem.node, [RUNNING in a for a in problem.allowed]))
         self.halting = problem.local.halting
         self.never = problem.never
         self.sigma = {s: exit_token(e) for s, e in sigma.items()}

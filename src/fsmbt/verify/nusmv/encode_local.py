@@ -40,8 +40,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
-from fsmbt.model.bt import BTDocument, BTNode
-from fsmbt.model.bt_nodes import NodeKind
+from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import UnsupportedError
 from fsmbt.semantics.compiled import FAILURE, RUNNING, SUCCESS
 from fsmbt.verify.nusmv.encode_bt import BTCore
@@ -55,6 +54,7 @@ from fsmbt.verify.pernode import (
     NotPerNode,
     exit_token,
 )
+from fsmbt.verify.pernode import abstract_tree as pernode_shape
 
 #: Most configurations of one fragment's explicit table before the unit is refused: NuSMV
 #: builds one BDD row per table step, and a 2 554-configuration table (a mutant's counter
@@ -85,23 +85,10 @@ class UnitModule:
 
 def abstract_tree(unit: LocalUnit) -> BTDocument:
     """The node over abstract leaves ``c0..`` (an action when child i may return RUNNING)."""
-    source = unit.problem.node.source
-    leaves = [
-        BTNode(
-            f"c{i}",
-            NodeKind.ACTION if RUNNING in allowed else NodeKind.CONDITION,
-            name=f"c{i}",
-        )
-        for i, allowed in enumerate(unit.problem.allowed)
-    ]
-    copy = BTNode(
-        source.type,
-        source.kind,
-        attrs=dict(source.attrs),
-        children=leaves,
-        semantics=source.semantics,
+    allowed = unit.problem.allowed
+    return pernode_shape(
+        unit.problem.node, [RUNNING in a for a in allowed], [f"c{i}" for i in range(len(allowed))]
     )
-    return BTDocument.single(copy)
 
 
 def _fragment_table(

@@ -24,6 +24,7 @@ Properties (each one SPEC, all checked in one NuSMV run):
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import NamedTuple
 
 from fsmbt.verify.nusmv.encode_fsm import NONE_OUT, Encoding
 from fsmbt.verify.nusmv.smv import Symbols, all_of, any_of, case, enum_type, subsequence
@@ -60,6 +61,36 @@ class Product:
 WHOLE, INVARIANTS, CTL, REACH = "whole", "invariants", "ctl", "reach"
 
 
+class _Terms(NamedTuple):
+    """The input type and the agreement terms both product texts (``product``,
+    ``_reach_product``) are written with."""
+
+    in_enum: str  # the input type; ``in_pad`` is never offered (no ``offers_in_pad``)
+    s_slots: list[str]  # the source's output slots
+    r_slots: list[str]  # the result's output slots
+    equal_outs: str  # both machines output the same
+    joint: str  # the input is offered to the pair (the source alone when the result follows)
+    alone_s: str  # the input is offered to the source
+    alone_r: str  # the input is offered to the result
+
+
+def _terms(src: Encoding, res: Encoding, in_ids: list[str]) -> _Terms:
+    s_slots = [f"s.{x}" for x in src.slots]
+    r_slots = [f"r.{x}" for x in res.slots]
+    return _Terms(
+        enum_type(in_ids, "in_pad"),
+        s_slots,
+        r_slots,
+        all_of([subsequence(s_slots, r_slots, NONE_OUT), subsequence(r_slots, s_slots, NONE_OUT)]),
+        any_of(
+            f"(inp_s = {i} & s.offers_{i}" + ("" if res.follows else f" & r.offers_{i}") + ")"
+            for i in in_ids
+        ),
+        any_of(f"(inp_s = {i} & s.offers_{i})" for i in in_ids),
+        any_of(f"(inp_s = {i} & r.offers_{i})" for i in in_ids),
+    )
+
+
 def product(
     src: Encoding,
     res: Encoding,
@@ -87,19 +118,8 @@ def product(
         return _reach_product(src, res, inputs, reach_specs or [], replay)
     detach = part != INVARIANTS
     in_ids = list(inputs.to_id.values())
-    in_enum = enum_type(in_ids, "in_pad")  # never offered: no machine defines offers_in_pad
+    in_enum, s_slots, r_slots, equal_outs, joint, alone_s, alone_r = _terms(src, res, in_ids)
     follows = res.follows
-    s_slots = [f"s.{x}" for x in src.slots]
-    r_slots = [f"r.{x}" for x in res.slots]
-    equal_outs = all_of(
-        [subsequence(s_slots, r_slots, NONE_OUT), subsequence(r_slots, s_slots, NONE_OUT)]
-    )
-    joint = any_of(
-        f"(inp_s = {i} & s.offers_{i}" + ("" if follows else f" & r.offers_{i}") + ")"
-        for i in in_ids
-    )
-    alone_s = any_of(f"(inp_s = {i} & s.offers_{i})" for i in in_ids)
-    alone_r = any_of(f"(inp_s = {i} & r.offers_{i})" for i in in_ids)
     lines = [
         "MODULE main",
         "IVAR",
@@ -275,19 +295,7 @@ def _reach_product(
     dictated by a step counter ``k`` (``TRANS``), the other machine taking each input it offers
     as the native checker replays its witness; one path, ``k = len(inputs)`` at its end."""
     in_ids = list(inputs.to_id.values())
-    in_enum = enum_type(in_ids, "in_pad")
-    follows = res.follows
-    s_slots = [f"s.{x}" for x in src.slots]
-    r_slots = [f"r.{x}" for x in res.slots]
-    equal_outs = all_of(
-        [subsequence(s_slots, r_slots, NONE_OUT), subsequence(r_slots, s_slots, NONE_OUT)]
-    )
-    joint = any_of(
-        f"(inp_s = {i} & s.offers_{i}" + ("" if follows else f" & r.offers_{i}") + ")"
-        for i in in_ids
-    )
-    alone_s = any_of(f"(inp_s = {i} & s.offers_{i})" for i in in_ids)
-    alone_r = any_of(f"(inp_s = {i} & r.offers_{i})" for i in in_ids)
+    in_enum, _, _, equal_outs, joint, alone_s, alone_r = _terms(src, res, in_ids)
     stable_s, stable_r = ("both", "both") if replay is not None else ("s.stable", "r.stable")
     go_s = f"attached_go | (mode = sa & {stable_s} & {alone_s})"
     go_r = f"attached_go | (mode = ra & {stable_r} & {alone_r})"
