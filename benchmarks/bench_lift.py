@@ -41,8 +41,7 @@ from fsmbt.verify.lift import lift_machines  # noqa: E402
 from fsmbt.verify.native import check  # noqa: E402
 from fsmbt.verify.pairing import machines_for  # noqa: E402
 from fsmbt.verify.report import LIFTED, Report  # noqa: E402
-from support.pernode_mutants import mutate, pernode_machine  # noqa: E402
-from support.pernode_trees import seeded_trees  # noqa: E402
+from support.pernode_mutants import mutate, seeded_mutants  # noqa: E402
 
 
 def shortest(
@@ -124,16 +123,11 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--large-bound", type=int, default=200_000, help="states, large pairs")
     parser.add_argument("--limit", type=float, default=60.0, help="seconds per whole product")
     args = parser.parse_args(argv)
-    rng = random.Random(5)
-    small = []
-    for doc in seeded_trees(args.small, seed=4):
-        model = bt_to_hfsm(doc, pernode=True).model
-        if pernode_machine(model) is None:
-            continue
-        for _ in range(2):
-            mutant = mutate(model, rng)
-            assert mutant is not None
-            small.append((doc, mutant))
+    small = [
+        (doc, mutant)
+        for doc, _model, mutants in seeded_mutants(args.small, seed=4, rng_seed=5)
+        for mutant in mutants
+    ]
     print(f"small seeded trees ({len(small)} mutants, whole product <= {args.bound} states)")
     tally(small, args.bound, args.bound, args.limit)
     rng = random.Random(27)

@@ -4,20 +4,25 @@ product's verdict on small pairs: shared by the per-node, lift and certificate t
 ``mutate(model, rng)``: a copy of ``model`` with one transition of its first per-node
 sub-machine retargeted, its guard dropped, one assignment dropped or its value changed.
 ``whole(doc, model)``: the whole-product verdict, ``None`` past ``BOUND`` states.
+``seeded_mutants(...)``: the seeded trees written per node, each with its model and mutants -
+the one sample the per-node, lift and NuSMV per-node tests and ``bench_lift.py`` draw.
 """
 
 from __future__ import annotations
 
 import copy
 import random
+from collections.abc import Iterator
 
 from fsmbt import limits
+from fsmbt.convert.bt_to_hfsm import bt_to_hfsm
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import FsmbtError
 from fsmbt.model.fsm import FSM
 from fsmbt.model.fsm_data import ASSIGN, COND, parse_lines
 from fsmbt.verify.native import check
 from fsmbt.verify.pairing import machines_for
+from support.pernode_trees import seeded_trees
 
 #: Most states per machine or product here: a mutant may blow a machine up (seconds each).
 BOUND = 4_000
@@ -64,3 +69,19 @@ def whole(doc: BTDocument, model: FSM) -> bool | None:
             return check(source, result, max_states=BOUND).equivalent
     except FsmbtError:
         return None  # an eventless cycle without a leaf (not a machine), or past BOUND
+
+
+def seeded_mutants(
+    trees: int, *, seed: int, rng_seed: int, per_tree: int = 2
+) -> Iterator[tuple[BTDocument, FSM, list[FSM]]]:
+    """``seeded_trees(trees, seed=seed)`` converted per node, the trees without a per-node
+    sub-machine skipped, each with ``per_tree`` mutants drawn in order from one
+    ``random.Random(rng_seed)``: the same sample wherever it is drawn."""
+    rng = random.Random(rng_seed)
+    for doc in seeded_trees(trees, seed=seed):
+        model = bt_to_hfsm(doc, pernode=True).model
+        if pernode_machine(model) is None:
+            continue
+        mutants = [mutate(model, rng) for _ in range(per_tree)]
+        assert all(m is not None for m in mutants)
+        yield doc, model, [m for m in mutants if m is not None]

@@ -21,7 +21,7 @@ from fsmbt.verify.lazy_fsm import LazyDataMachine, Unsupported
 from fsmbt.verify.native import check, replay
 from fsmbt.verify.pairing import machines_for
 from fsmbt.verify.report import COMPOSITIONAL_LIFTED, LIFTED, PER_NODE_LIFTED
-from support.pernode_mutants import BOUND, mutate, pernode_machine, whole
+from support.pernode_mutants import BOUND, mutate, seeded_mutants
 from support.pernode_trees import seeded_trees
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))
@@ -64,33 +64,6 @@ def _lifted_trace(report):  # type: ignore[no-untyped-def]
     return traces[0]
 
 
-def test_lifted_verdicts_agree_with_the_whole_product_on_small_trees() -> None:
-    rng = random.Random(5)
-    tally: Counter[str] = Counter()
-    for doc in seeded_trees(60, seed=4):
-        model = bt_to_hfsm(doc, pernode=True).model
-        if pernode_machine(model) is None:
-            continue
-        for _ in range(2):
-            mutant = mutate(model, rng)
-            assert mutant is not None
-            verdict = whole(doc, mutant)
-            with limits.changed(conversion_max_states=BOUND):
-                report, _why = compositional_report(doc, mutant, max_states=BOUND)
-            if report is None or report.method not in LIFTED:
-                tally[f"whole {verdict}, not lifted"] += 1
-                continue
-            tally[f"whole {verdict}, lifted"] += 1
-            assert not report.equivalent
-            assert verdict is False, "a lifted counterexample on a pair the whole product proves"
-            trace = _lifted_trace(report)
-            inputs = [step.input for step in trace[1:]]
-            assert replay(leaf_machine(doc), LazyDataMachine(mutant), inputs).differs
-    print(f"\n[lifted vs whole product] {dict(tally)}")
-    assert tally["whole False, lifted"] >= 30
-    assert tally["whole True, lifted"] == 0
-
-
 def _whole_shortest(doc, model):  # type: ignore[no-untyped-def]
     """The whole product's shortest counterexample length (native breadth-first search),
     ``-1`` when it proves the pair, ``None`` past ``BOUND`` states."""
@@ -105,33 +78,32 @@ def _whole_shortest(doc, model):  # type: ignore[no-untyped-def]
     return min(len(p.counterexample) - 1 for p in report.properties.values() if p.counterexample)
 
 
-def test_the_lifted_counterexample_is_as_short_as_the_whole_products_shortest() -> None:
-    """On the seeded small mutants (the sample above) every lifted counterexample - a failing
-    node's local one (``per node, lifted``) or a failing region's own (``compositional,
-    lifted``) - has exactly as many leaf outcomes as the whole product's shortest
-    counterexample, wherever the whole product decides; and the lift refutes at least 70 of
-    the mutants the whole product refutes (49 before regions checked whole were lifted)."""
-    rng = random.Random(5)
+def test_lifted_counterexamples_are_real_and_as_short_as_the_whole_products() -> None:
+    """On the seeded small mutants every lifted counterexample - a failing node's local one
+    (``per node, lifted``) or a failing region's own (``compositional, lifted``) - is on a pair
+    the whole product refutes, replays to a difference of the two machines, and has exactly as
+    many leaf outcomes as the whole product's shortest counterexample; a pair the whole product
+    proves is never lifted; and the lift refutes at least 70 of the mutants (49 before regions
+    checked whole were lifted)."""
     tally: Counter[str] = Counter()
-    for doc in seeded_trees(60, seed=4):
-        model = bt_to_hfsm(doc, pernode=True).model
-        if pernode_machine(model) is None:
-            continue
-        for _ in range(2):
-            mutant = mutate(model, rng)
-            assert mutant is not None
+    for doc, _model, mutants in seeded_mutants(60, seed=4, rng_seed=5):
+        for mutant in mutants:
             best = _whole_shortest(doc, mutant)
             with limits.changed(conversion_max_states=BOUND):
                 report, _why = compositional_report(doc, mutant, max_states=BOUND)
+            lifted = report is not None and report.method in LIFTED
             if best == -1:  # the whole product proves it: never a lifted refutation
-                assert report is None or report.method not in LIFTED
+                assert not lifted, "a lifted counterexample on a pair the whole product proves"
             if best is None or best == -1:  # undecided past BOUND, or proven
                 continue
-            if report is None or report.method not in LIFTED:
+            if not lifted:
                 tally["refuted, not lifted"] += 1
                 continue
+            assert report is not None and not report.equivalent
             tally[report.method] += 1
             trace = _lifted_trace(report)
+            inputs = [step.input for step in trace[1:]]
+            assert replay(leaf_machine(doc), LazyDataMachine(mutant), inputs).differs
             assert len(trace) - 1 == best, f"lifted {len(trace) - 1}, shortest {best}"
     print(f"\n[lifted = shortest] {dict(tally)}")
     assert tally[PER_NODE_LIFTED] + tally[COMPOSITIONAL_LIFTED] >= 70

@@ -22,7 +22,7 @@ from fsmbt.model.fsm_data import ASSIGN, parse_lines
 from fsmbt.verify import verify
 from fsmbt.verify.compositional import compositional_report
 from fsmbt.verify.report import PER_NODE
-from support.pernode_mutants import BOUND, mutate, pernode_machine, whole
+from support.pernode_mutants import BOUND, pernode_machine, seeded_mutants, whole
 from support.pernode_trees import seeded_trees
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))
@@ -31,14 +31,9 @@ from bench_reactive import family_tree  # noqa: E402
 
 def test_per_node_agrees_with_the_whole_product_on_mutants() -> None:
     """The unmutated pairs are in tests/convert/test_conv_bt_pernode.py (2 000 trees)."""
-    rng = random.Random(27)
     tally: Counter[str] = Counter()
-    for doc in seeded_trees(300, seed=4):
-        model = bt_to_hfsm(doc, pernode=True).model
-        if pernode_machine(model) is None:
-            continue
-        for candidate in [mutate(model, rng) for _ in range(2)]:
-            assert candidate is not None
+    for doc, _model, mutants in seeded_mutants(300, seed=4, rng_seed=27):
+        for candidate in mutants:
             verdict = whole(doc, candidate)
             with limits.changed(conversion_max_states=BOUND):
                 report, _why = compositional_report(doc, candidate, max_states=BOUND)

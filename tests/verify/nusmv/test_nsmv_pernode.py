@@ -26,7 +26,7 @@ from fsmbt.verify.compositional import CheckPlan, compositional_report
 from fsmbt.verify.nusmv import check as whole_check
 from fsmbt.verify.nusmv.pernode import check_plan, check_units
 from fsmbt.verify.report import PER_NODE, PER_NODE_LIFTED, SYMBOLIC_PER_NODE
-from support.pernode_mutants import BOUND, mutate, pernode_machine
+from support.pernode_mutants import BOUND, mutate, pernode_machine, seeded_mutants
 from support.pernode_trees import seeded_trees
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[3] / "benchmarks"))
@@ -41,14 +41,9 @@ def _plan(doc, model) -> CheckPlan:  # type: ignore[no-untyped-def]
 
 
 def test_nusmv_decides_every_local_check_as_the_native_walk(nusmv_binary) -> None:
-    rng = random.Random(27)
     tally: Counter[str] = Counter()
-    for doc in seeded_trees(44, seed=4):
-        model = bt_to_hfsm(doc, pernode=True).model
-        if pernode_machine(model) is None:
-            continue
-        for candidate in [model, mutate(model, rng), mutate(model, rng)]:
-            assert candidate is not None
+    for doc, model, mutants in seeded_mutants(44, seed=4, rng_seed=27):
+        for candidate in [model, *mutants]:
             plan = _plan(doc, candidate)
             if not plan.units:
                 tally["not per node"] += 1
