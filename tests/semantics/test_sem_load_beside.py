@@ -95,3 +95,17 @@ def test_convert_checks_beside_the_proof_and_stops_the_check_when_the_proof_fail
     child = started[0]._child  # noqa: SLF001
     assert child is not None and child.poll() is not None
     assert not (tmp_path / "again.scxml").exists()
+
+
+@pytest.mark.usefixtures("every_scxml_in_a_child")
+def test_a_child_that_cannot_start_leaves_the_check_to_this_process(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    def no_process(*_args: object, **_kwargs: object) -> None:
+        raise OSError("no process for you")
+
+    monkeypatch.setattr(load_beside.subprocess, "Popen", no_process)
+    text = dumps(chain(5), "scxml")
+    pending = load_beside.start_load_check(text, "scxml")
+    assert not pending.in_child and pending._file is None  # noqa: SLF001 - its file removed
+    assert pending.result() == check_scxml_loads(text)

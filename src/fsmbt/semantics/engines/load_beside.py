@@ -20,7 +20,8 @@ killed: no process is left behind).
   and by ``load_max_seconds``; a smaller one is checked in this process when ``result()`` is
   called, as a child's start-up (about 0.2 s) would cost about as much as it saves (a
   300 kB document, a 600-node tree's HFSM, takes python-statemachine about 0.7 s). A child that cannot
-  answer (killed, out of memory, no JSON) is a refusal that says so, never a silent pass.
+  answer (killed, out of memory, no JSON) is a refusal that says so, never a silent pass; one
+  that cannot start (no temporary file, no process) leaves the check to this process.
 
 Costs: one thread, or one process start plus the engine's own O(document size) work.
 """
@@ -66,19 +67,26 @@ class PendingLoad:
             self._future = pool.submit(check_loads, text)
             pool.shutdown(wait=False)
         elif fmt == "scxml" and len(text) >= BESIDE_BYTES and engine_name() is not None:
-            handle, self._file = tempfile.mkstemp(prefix="fsmbt-load-", suffix=".scxml")
-            with os.fdopen(handle, "w", encoding="utf-8") as out:
-                out.write(text)
-            self._child = subprocess.Popen(
-                [sys.executable, *CHILD_COMMAND, self._file],
-                stdin=subprocess.DEVNULL,
-                stdout=subprocess.PIPE,
-                stderr=subprocess.PIPE,
-                text=True,
-                encoding="utf-8",
-                errors="replace",
-                preexec_fn=bounded_child(LOAD_MAX_MEMORY_MB, LOAD_MAX_SECONDS),
-            )
+            try:
+                self._child = self._start_child(text)
+            except OSError:  # no temporary file, no process: the check runs here, after
+                self._forget_file()
+                self._child = None
+
+    def _start_child(self, text: str) -> subprocess.Popen[str]:
+        handle, self._file = tempfile.mkstemp(prefix="fsmbt-load-", suffix=".scxml")
+        with os.fdopen(handle, "w", encoding="utf-8") as out:
+            out.write(text)
+        return subprocess.Popen(
+            [sys.executable, *CHILD_COMMAND, self._file],
+            stdin=subprocess.DEVNULL,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+            encoding="utf-8",
+            errors="replace",
+            preexec_fn=bounded_child(LOAD_MAX_MEMORY_MB, LOAD_MAX_SECONDS),
+        )
 
     @property
     def in_child(self) -> bool:
