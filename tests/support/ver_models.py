@@ -1,8 +1,11 @@
-"""Models shared by the checker's tests: the paper's A-J FSM and an equivalent renamed copy."""
+"""Models shared by the checker's tests: the paper's A-J FSM and an equivalent renamed copy; a
+small tree with two regions of memory (the compositional check's, docs/semantics.md §4c)."""
 
 from __future__ import annotations
 
 from fsmbt.model import FSM, State
+from fsmbt.model.bt import BTDocument, BTNode
+from fsmbt.model.bt_nodes import NodeKind
 
 PAPER_EDGES = ["AB", "AC", "AD", "AF", "BC", "BD", "CD", "DE", "EC", "ED", "EG", "GH", "FI", "IJ"]
 
@@ -28,3 +31,26 @@ def renamed_copy(fsm: FSM) -> FSM:
     for t in reversed(fsm.transitions):
         out.add_transition(f"r_{t.source}", t.event, f"r_{t.target}")
     return out
+
+
+def memory_regions_tree() -> BTDocument:
+    """Fallback(SequenceWithMemory(a1, a2), Sequence(c1, ReactiveSequence(c2, a3)), a4): two
+    regions, so the compositional check decides it by parts."""
+
+    def act(name: str) -> BTNode:
+        return BTNode("Act", NodeKind.ACTION, name=name)
+
+    def cond(name: str) -> BTNode:
+        return BTNode("Cond", NodeKind.CONDITION, name=name)
+
+    def ctrl(kind: str, *children: BTNode) -> BTNode:
+        return BTNode(kind, NodeKind.CONTROL, children=list(children))
+
+    return BTDocument.single(
+        ctrl(
+            "Fallback",
+            ctrl("SequenceWithMemory", act("a1"), act("a2")),
+            ctrl("Sequence", cond("c1"), ctrl("ReactiveSequence", cond("c2"), act("a3"))),
+            act("a4"),
+        )
+    )

@@ -44,6 +44,7 @@ from fsmbt.verify.pairing import machines_for
 from fsmbt.verify.report import COMPOSITIONAL, LIFTED
 from support.random_trees import random_tree
 from support.sampling import seed
+from support.ver_models import memory_regions_tree
 
 CONTROLS = (
     "Sequence",
@@ -131,35 +132,13 @@ def test_compositional_agrees_with_the_whole_product(batch: int) -> None:
     assert refuted >= pairs // 10  # and mutants that differ
 
 
-def _memory_tree() -> BTDocument:
-    """Fallback(SequenceWithMemory(a1, a2), Sequence(c1, ReactiveSequence(c2, a3)), a4)."""
-
-    def act(name: str) -> BTNode:
-        return BTNode("Act", NodeKind.ACTION, name=name)
-
-    def cond(name: str) -> BTNode:
-        return BTNode("Cond", NodeKind.CONDITION, name=name)
-
-    def ctrl(kind: str, *children: BTNode) -> BTNode:
-        return BTNode(kind, NodeKind.CONTROL, children=list(children))
-
-    return BTDocument.single(
-        ctrl(
-            "Fallback",
-            ctrl("SequenceWithMemory", act("a1"), act("a2")),
-            ctrl("Sequence", cond("c1"), ctrl("ReactiveSequence", cond("c2"), act("a3"))),
-            act("a4"),
-        )
-    )
-
-
 def test_regions_are_the_topmost_nodes_with_memory() -> None:
-    doc = _memory_tree()
+    doc = memory_regions_tree()
     assert [n.type for n in tree_regions(doc)] == ["SequenceWithMemory", "ReactiveSequence"]
 
 
 def test_verify_names_the_compositional_method() -> None:
-    doc = _memory_tree()
+    doc = memory_regions_tree()
     hfsm = bt_to_hfsm(doc).model
     report = verify(doc, hfsm)
     assert report.equivalent
@@ -169,7 +148,7 @@ def test_verify_names_the_compositional_method() -> None:
 
 
 def test_every_mutant_is_refuted_with_a_counterexample_that_replays() -> None:
-    doc = _memory_tree()
+    doc = memory_regions_tree()
     hfsm = bt_to_hfsm(doc).model
     found = said = 0
     for mutated in deep_mutants(hfsm, seed(), per_operator=None):
@@ -243,7 +222,7 @@ def test_regions_with_data_are_proved_and_a_shared_variable_is_refused() -> None
 
 
 def test_a_subtree_or_a_flat_machine_is_out_of_scope() -> None:
-    doc = _memory_tree()
+    doc = memory_regions_tree()
     sub = BTNode("SubTree", NodeKind.SUBTREE, attrs={"ID": "S"})
     with_subtree = BTDocument.single(
         BTNode("Sequence", NodeKind.CONTROL, children=[sub, BTNode("Act", NodeKind.ACTION)])
@@ -260,7 +239,7 @@ def test_the_cli_proves_compositionally_with_or_without_a_certificate(tmp_path, 
     """Through files (the HFSM written as SCXML and read back, its sub-machines renamed): the
     command names the compositional method; with ``--certificate`` too, whose units (one per
     region, one for the skeleton) ``check-certificate`` validates."""
-    doc = _memory_tree()
+    doc = memory_regions_tree()
     tree = api.write(doc, tmp_path / "tree.xml")
     machine = api.write(bt_to_hfsm(doc).model, tmp_path / "tree.scxml")
     assert main(["verify", str(tree), str(machine)]) == 0
@@ -287,7 +266,7 @@ def test_one_region_gives_way_before_any_part_is_checked() -> None:
     """A tree whose root is reactive is one region: the whole tree. ``verify``'s attempt gives
     way at once (``min_regions=2``: no region is explored, the reason says so) and the whole
     product decides; the same pair checked with ``min_regions=1`` explores the region."""
-    doc = _memory_tree()
+    doc = memory_regions_tree()
     assert doc.main.root is not None
     doc.main.root.type = "ReactiveFallback"
     hfsm = bt_to_hfsm(doc).model

@@ -28,6 +28,7 @@ from fsmbt.semantics.outcome_rules import OutcomeRules
 from fsmbt.verify import certificate
 from fsmbt.verify.compositional import (
     FAILED_PART,
+    CheckPlan,
     Parts,
     attempt_seconds,
     compositional_report,
@@ -37,6 +38,7 @@ from fsmbt.verify.native import DEFAULT_MAX_STATES, Replay, check, check_witness
 from fsmbt.verify.outcome_pairing import is_outcome_pair, outcome_abstractions
 from fsmbt.verify.pairing import machines_for
 from fsmbt.verify.report import (
+    LIFTED,
     PER_NODE,
     PER_NODE_LIFTED,
     PROPERTIES,
@@ -118,20 +120,28 @@ def verify(
             hints=(Hint.NATIVE_VERIFIER,),
         )
     sink = certificate.active_sink()
-    if engine != "native" and not loop:
-        decided = _per_node_nusmv(source, result, engine, max_states, sink)
-        if decided is not None:
-            return decided
+    fell_back = ""
+    if not loop:
+        # one compositional attempt serves every engine (docs/verification.md, "What a verdict
+        # says"): native keeps it; NuSMV decides its per-node checks again, or, with ``both``,
+        # the whole pair beside its verdict - the native verdict is never computed twice
+        plan = CheckPlan() if engine != "native" else None
+        proved, fell_back = _compositional(source, result, max_states, sink, plan)
+        if proved is not None and engine == "native":
+            return proved
+        if proved is not None and plan is not None:
+            decided = _per_node_nusmv(proved, plan, engine)
+            if decided is not None:
+                return decided
+            if engine == "both":
+                return _beside_nusmv(proved, source, result, pairing, outcome_pair)
+        if sink is not None and engine == "nusmv":  # NuSMV's whole encodings decide
+            sink.witness, sink.parts = None, None
     if engine == "nusmv":
         report = _nusmv(source, result, loop, pairing, fallback=False)
         report.method = SYMBOLIC
         report.engines = nusmv_engine()
         return report
-    fell_back = ""
-    if engine == "native" and not loop:
-        proved, fell_back = _compositional(source, result, max_states, sink)
-        if proved is not None:
-            return proved
     with gc_paused():  # a data machine's expansion allocates its flat machine (acyclic)
         source_machine, result_machine, mode = machines_for(
             source, result, loop=loop, outcomes=outcomes, outcome_driven=outcome_driven
@@ -147,20 +157,8 @@ def verify(
         return native
     try:
         other = _nusmv(source, result, loop, pairing)
-    except NuSMVGaveUp as exc:
-        # NuSMV's time or memory cap: the native verdict stands, and the report says NuSMV
-        # could not confirm it (docs/verification.md, "What a verdict says").
-        native.engines.update(nusmv_engine())
-        native.stats["nusmv_limit"] = str(exc)
-        return native
-    except UnsupportedError as exc:
-        if not outcome_pair:
-            raise
-        # what the outcome pairing's encoding does not cover (docs/nusmv.md, "The outcome
-        # pairing"): the native verdict stands, the report names NuSMV's limit
-        native.engines.update(nusmv_engine())
-        native.stats["nusmv_limit"] = f"NuSMV does not encode this pair: {exc}"
-        return native
+    except (NuSMVGaveUp, UnsupportedError) as exc:
+        return _nusmv_limited(native, exc, outcome_pair)
     if _reachability_only(native, other):
         # Reachability compares states: a leaf machine on reduced states (docs/semantics.md
         # §4a) may merge a state reached only outside the agreeing pairs with one reached in
@@ -178,6 +176,58 @@ def verify(
         native = faithful
     if native.verdicts() != other.verdicts():
         raise EngineDisagreement(native, other)
+    return _joined(native, other)
+
+
+def _beside_nusmv(
+    native: Report,
+    source: FSM | BTDocument,
+    result: FSM | BTDocument,
+    pairing: tuple[OutcomeRules | None, bool],
+    outcome_pair: bool,
+) -> Report:
+    """``both`` on a pair the compositional check decided but not node by node (a proof by
+    regions, or a region's counterexample lifted): NuSMV's whole encodings decide the pair
+    beside that verdict. A proof must meet NuSMV's on all five properties; a lifted
+    counterexample lists only the properties its replay shows failing (docs/verification.md
+    §3), and each of them must fail in NuSMV too, whose verdict must be NOT EQUIVALENT. A NuSMV
+    cap keeps the native verdict and says so, as for the whole product."""
+    try:
+        other = _nusmv(source, result, False, pairing)
+    except (NuSMVGaveUp, UnsupportedError) as exc:
+        return _nusmv_limited(native, exc, outcome_pair)
+    if native.method in LIFTED:
+        theirs = other.verdicts()
+        shown = [name for name, holds in native.verdicts().items() if not holds]
+        if other.equivalent or any(theirs.get(name) is not False for name in shown):
+            raise EngineDisagreement(
+                native,
+                other,
+                "the lifted counterexample's properties "
+                + ", ".join(f"{name} (NuSMV {_word(theirs.get(name))})" for name in shown),
+            )
+    elif native.verdicts() != other.verdicts():
+        raise EngineDisagreement(native, other)
+    return _joined(native, other)
+
+
+def _nusmv_limited(native: Report, exc: Exception, outcome_pair: bool) -> Report:
+    """The native verdict when NuSMV gave up (its time or memory cap) or, on an outcome pair,
+    refused a construct by name (docs/nusmv.md, "The outcome pairing"): the verdict stands and
+    the report says NuSMV could not confirm it (docs/verification.md, "What a verdict says").
+    Any other refusal is the user's answer and is raised again."""
+    if isinstance(exc, UnsupportedError):
+        if not outcome_pair:
+            raise exc
+        native.stats["nusmv_limit"] = f"NuSMV does not encode this pair: {exc}"
+    else:
+        native.stats["nusmv_limit"] = str(exc)
+    native.engines.update(nusmv_engine())
+    return native
+
+
+def _joined(native: Report, other: Report) -> Report:
+    """The native verdict confirmed by NuSMV's: both engines and methods named."""
     native.engine = "native+nusmv"
     native.method = f"{native.method}+{SYMBOLIC}"
     native.engines.update(nusmv_engine())
@@ -205,35 +255,23 @@ def _native(
     return report
 
 
-def _per_node_nusmv(
-    source: FSM | BTDocument,
-    result: FSM | BTDocument,
-    engine: str,
-    max_states: int,
-    sink: certificate.WitnessSink | None,
-) -> Report | None:
-    """``both``/``nusmv`` on a pair the native checker decides node by node (docs/nusmv.md,
-    "Trees node by node"): NuSMV decides the same distinct local checks (its own encoding of
-    each node's tick rules) and the parts checked whole; ``None`` when the native verdict is
-    not per node (the whole encodings decide, as before; ``nusmv`` also when the native
-    per-node check refuted the pair). With ``both``, a NuSMV limit or a unit it does not
-    encode keeps the native verdict and says so (``stats["nusmv_limit"]``); any disagreement
-    on a unit raises ``EngineDisagreement``.
+def _per_node_nusmv(report: Report, plan: CheckPlan, engine: str) -> Report | None:
+    """``both``/``nusmv`` on a pair the native checker decided node by node (``report``, with
+    the local checks it made in ``plan``; docs/nusmv.md, "Trees node by node"): NuSMV decides
+    the same distinct local checks (its own encoding of each node's tick rules) and the parts
+    checked whole; ``None`` when the native verdict is not per node (``nusmv`` also when the
+    native per-node check refuted the pair): the caller decides then. With ``both``, a NuSMV
+    limit or a unit it does not encode keeps the native verdict and says so
+    (``stats["nusmv_limit"]``); any disagreement on a unit raises ``EngineDisagreement``.
 
     Raises:
         NuSMVLimitError, UnsupportedError: with ``nusmv``, NuSMV past a cap or a unit it
             does not encode.
     """
-    from fsmbt.verify.compositional import CheckPlan
-
-    plan = CheckPlan()
-    report, _why = _compositional(source, result, max_states, sink, plan)
-    unused = report is None or report.method not in (PER_NODE, PER_NODE_LIFTED)
-    if unused or (engine == "nusmv" and report is not None and report.method != PER_NODE):
-        if sink is not None:  # the whole check decides: its witness, not these parts
-            sink.witness, sink.parts = None, None
+    if report.method not in (PER_NODE, PER_NODE_LIFTED):
         return None
-    assert report is not None
+    if engine == "nusmv" and report.method != PER_NODE:
+        return None
     try:
         from fsmbt.verify.nusmv import NuSMVLimitError
         from fsmbt.verify.nusmv.pernode import check_plan
@@ -304,7 +342,7 @@ def _compositional(
     result: FSM | BTDocument,
     max_states: int,
     sink: certificate.WitnessSink | None,
-    plan: Any = None,
+    plan: CheckPlan | None = None,
 ) -> tuple[Report | None, str]:
     """The compositional proof of a BT against a hierarchical FSM (``fsmbt.verify.
     compositional``) when the pair decomposes into regions and every local check holds within
