@@ -380,7 +380,8 @@ def _pernode_table(args: argparse.Namespace) -> int:
         signal.alarm(0)
         traces = [p.counterexample for p in report.properties.values() if p.counterexample]
         found = (
-            f"found ({report.method}), counterexample of {min(len(t) for t in traces)} steps"
+            f"found ({report.method}), counterexample of {min(len(t) for t in traces)} steps; "
+            + "; ".join(a for a in report.abstractions if "shortest" in a.split(":")[0])
             if not report.equivalent and traces
             else ("not equivalent" if not report.equivalent else "EQUIVALENT")
         )

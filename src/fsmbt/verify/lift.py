@@ -68,6 +68,7 @@ from fsmbt.verify.report import (
     PropertyResult,
     Report,
 )
+from fsmbt.verify.shortest import ShorterSearch, search_shorter
 
 #: The leaf machine's input for each status.
 SYMBOL = {
@@ -549,12 +550,19 @@ def _confirmed(
     """Rule 3 on the driven ``inputs`` and the report of what the replay shows (``what``: the
     failing node or region, for the details)."""
     try:
-        found = confirm(*lift_machines(source, result), inputs)
+        machines = lift_machines(source, result)
+        found = confirm(*machines, inputs)
     except Unsupported:
         return None
     if found is None:
         return None
     best, shown = found
+    try:  # is it the shortest? the whole machines' first levels say, within a budget
+        search = search_shorter(*machines, len(best))
+        if search.shorter is not None:
+            best, shown = search.shorter, replay(*machines, search.shorter)
+    except (Unsupported, FsmbtError):  # a state a machine cannot step: nothing is claimed
+        search = ShorterSearch(len(best), None, False, 0, 0)
     report = Report(engine="native", source="source", result="result", mode=LEAF_EXECUTION)
     step = next(s for s in shown.steps if s.note)
     trace = shown.steps[: step.step + 1]
@@ -584,8 +592,13 @@ def _confirmed(
             COMPLETENESS, False, f"{where}: {step.note}", trace
         )
     report.method = method
-    report.abstractions = [sentence]
-    report.stats = {"lifted_steps": len(best), "drive_steps": len(inputs)}
+    report.abstractions = [sentence, search.sentence()]
+    report.stats = {
+        "lifted_steps": len(best),
+        "drive_steps": len(inputs),
+        "shortest": search.exhausted,
+        "shortest_search_pairs": search.pairs,
+    }
     return report
 
 
