@@ -20,9 +20,9 @@ import sys
 from collections import Counter
 from pathlib import Path
 
-import fsmbt.convert.bt_pernode as pernode_module
 from fsmbt.convert.bt_pernode import NODE_ATTR, PERNODE_MIN_LOG2, pernode_estimate
 from fsmbt.convert.bt_to_hfsm import bt_to_hfsm
+from fsmbt.convert.pernode.writer import Writer
 from fsmbt.formats import dumps
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import FsmbtError
@@ -89,7 +89,7 @@ def test_pernode_regions_are_proven_on_2000_generated_trees() -> None:
 
 def test_a_converter_without_halt_resets_is_caught(monkeypatch) -> None:
     """Halting a child must reset its subtree's memory: without it, trees differ."""
-    monkeypatch.setattr(pernode_module._Writer, "_halt", lambda self, nid: [])
+    monkeypatch.setattr(Writer, "halt", lambda self, nid: [])
     differ = 0
     for _label, doc in generated(200, seed=5):
         try:
