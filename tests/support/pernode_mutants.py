@@ -3,7 +3,8 @@ product's verdict on small pairs: shared by the per-node, lift and certificate t
 
 ``mutate(model, rng)``: a copy of ``model`` with one transition of its first per-node
 sub-machine retargeted, its guard dropped, one assignment dropped or its value changed.
-``whole(doc, model)``: the whole-product verdict, ``None`` past ``BOUND`` states.
+``whole(doc, model)``: the whole-product verdict, ``None`` past ``BOUND`` states;
+``whole_shortest(doc, model)``: the length of its shortest counterexample.
 ``seeded_mutants(...)``: the seeded trees written per node, each with its model and mutants -
 the one sample the per-node, lift and NuSMV per-node tests and ``bench_lift.py`` draw.
 """
@@ -69,6 +70,20 @@ def whole(doc: BTDocument, model: FSM) -> bool | None:
             return check(source, result, max_states=BOUND).equivalent
     except FsmbtError:
         return None  # an eventless cycle without a leaf (not a machine), or past BOUND
+
+
+def whole_shortest(doc: BTDocument, model: FSM) -> int | None:
+    """The whole product's shortest counterexample length (inputs; native breadth-first
+    search), ``-1`` when it proves the pair, ``None`` past ``BOUND`` states."""
+    try:
+        with limits.changed(conversion_max_states=BOUND):
+            source, result, _mode = machines_for(doc, model)
+            report = check(source, result, max_states=BOUND)
+    except FsmbtError:
+        return None
+    if report.equivalent:
+        return -1
+    return min(len(p.counterexample) - 1 for p in report.properties.values() if p.counterexample)
 
 
 def seeded_mutants(

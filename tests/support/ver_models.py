@@ -33,19 +33,24 @@ def renamed_copy(fsm: FSM) -> FSM:
     return out
 
 
+def act(name: str) -> BTNode:
+    """An action leaf named ``name``."""
+    return BTNode("Act", NodeKind.ACTION, name=name)
+
+
+def cond(name: str) -> BTNode:
+    """A condition leaf named ``name``."""
+    return BTNode("Cond", NodeKind.CONDITION, name=name)
+
+
+def ctrl(kind: str, *children: BTNode) -> BTNode:
+    """A control node of type ``kind`` over ``children``."""
+    return BTNode(kind, NodeKind.CONTROL, children=list(children))
+
+
 def memory_regions_tree() -> BTDocument:
     """Fallback(SequenceWithMemory(a1, a2), Sequence(c1, ReactiveSequence(c2, a3)), a4): two
     regions, so the compositional check decides it by parts."""
-
-    def act(name: str) -> BTNode:
-        return BTNode("Act", NodeKind.ACTION, name=name)
-
-    def cond(name: str) -> BTNode:
-        return BTNode("Cond", NodeKind.CONDITION, name=name)
-
-    def ctrl(kind: str, *children: BTNode) -> BTNode:
-        return BTNode(kind, NodeKind.CONTROL, children=list(children))
-
     return BTDocument.single(
         ctrl(
             "Fallback",

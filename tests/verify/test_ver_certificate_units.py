@@ -15,8 +15,7 @@ from fsmbt import api
 from fsmbt.cli import main
 from fsmbt.convert.bt_to_hfsm import bt_to_hfsm
 from fsmbt.convert.lebt import fsm_to_lebt
-from fsmbt.model.bt import BTDocument, BTNode
-from fsmbt.model.bt_nodes import NodeKind
+from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import InputError
 from fsmbt.model.fsm import FSM
 from fsmbt.verify import certificate, verify
@@ -24,34 +23,22 @@ from fsmbt.verify.mutations import mutants
 from fsmbt.verify.report import COMPOSITIONAL
 from support.random_trees import random_tree
 from support.sampling import seed
-from support.ver_models import paper_fsm
-
-
-def _act(name: str) -> BTNode:
-    return BTNode("Act", NodeKind.ACTION, name=name)
-
-
-def _cond(name: str) -> BTNode:
-    return BTNode("Cond", NodeKind.CONDITION, name=name)
-
-
-def _ctrl(kind: str, *children: BTNode) -> BTNode:
-    return BTNode(kind, NodeKind.CONTROL, children=list(children))
+from support.ver_models import act, cond, ctrl, paper_fsm
 
 
 def memory_tree() -> BTDocument:
     """Four regions with memory under plain controls (three SequenceWithMemory, one reactive)."""
     return BTDocument.single(
-        _ctrl(
+        ctrl(
             "Sequence",
-            _ctrl(
+            ctrl(
                 "Fallback",
-                _ctrl("SequenceWithMemory", _act("a1"), _act("a2"), _act("a3")),
-                _cond("c1"),
+                ctrl("SequenceWithMemory", act("a1"), act("a2"), act("a3")),
+                cond("c1"),
             ),
-            _ctrl("SequenceWithMemory", _act("b1"), _cond("c2")),
-            _ctrl("Fallback", _cond("c3"), _ctrl("SequenceWithMemory", _act("d1"), _act("d2"))),
-            _ctrl("Sequence", _cond("c4"), _ctrl("ReactiveSequence", _cond("c5"), _act("e1"))),
+            ctrl("SequenceWithMemory", act("b1"), cond("c2")),
+            ctrl("Fallback", cond("c3"), ctrl("SequenceWithMemory", act("d1"), act("d2"))),
+            ctrl("Sequence", cond("c4"), ctrl("ReactiveSequence", cond("c5"), act("e1"))),
         )
     )
 

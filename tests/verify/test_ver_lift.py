@@ -18,10 +18,9 @@ from fsmbt.semantics.machine import FINAL, FSMLeafMachine
 from fsmbt.verify import verify
 from fsmbt.verify.compositional import compositional_report
 from fsmbt.verify.lazy_fsm import LazyDataMachine, Unsupported
-from fsmbt.verify.native import check, replay
-from fsmbt.verify.pairing import machines_for
+from fsmbt.verify.native import replay
 from fsmbt.verify.report import COMPOSITIONAL_LIFTED, LIFTED, PER_NODE_LIFTED
-from support.pernode_mutants import BOUND, mutate, seeded_mutants
+from support.pernode_mutants import BOUND, mutate, seeded_mutants, whole_shortest
 from support.pernode_trees import seeded_trees
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))
@@ -64,20 +63,6 @@ def _lifted_trace(report):  # type: ignore[no-untyped-def]
     return traces[0]
 
 
-def _whole_shortest(doc, model):  # type: ignore[no-untyped-def]
-    """The whole product's shortest counterexample length (native breadth-first search),
-    ``-1`` when it proves the pair, ``None`` past ``BOUND`` states."""
-    try:
-        with limits.changed(conversion_max_states=BOUND):
-            source, result, _mode = machines_for(doc, model)
-            report = check(source, result, max_states=BOUND)
-    except FsmbtError:
-        return None
-    if report.equivalent:
-        return -1
-    return min(len(p.counterexample) - 1 for p in report.properties.values() if p.counterexample)
-
-
 def test_lifted_counterexamples_are_real_and_as_short_as_the_whole_products() -> None:
     """On the seeded small mutants every lifted counterexample - a failing node's local one
     (``per node, lifted``) or a failing region's own (``compositional, lifted``) - is on a pair
@@ -88,7 +73,7 @@ def test_lifted_counterexamples_are_real_and_as_short_as_the_whole_products() ->
     tally: Counter[str] = Counter()
     for doc, _model, mutants in seeded_mutants(60, seed=4, rng_seed=5):
         for mutant in mutants:
-            best = _whole_shortest(doc, mutant)
+            best = whole_shortest(doc, mutant)
             with limits.changed(conversion_max_states=BOUND):
                 report, _why = compositional_report(doc, mutant, max_states=BOUND)
             lifted = report is not None and report.method in LIFTED

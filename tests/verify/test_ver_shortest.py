@@ -6,27 +6,12 @@ of the lift tests."""
 from __future__ import annotations
 
 from fsmbt import limits
-from fsmbt.model.errors import FsmbtError
 from fsmbt.verify.compositional import compositional_report
 from fsmbt.verify.lift import lift_machines, separates
-from fsmbt.verify.native import check, replay
-from fsmbt.verify.pairing import machines_for
+from fsmbt.verify.native import replay
 from fsmbt.verify.report import LIFTED
 from fsmbt.verify.shortest import search_shorter
-from support.pernode_mutants import BOUND, seeded_mutants
-
-
-def _whole_shortest(doc, model) -> int | None:  # type: ignore[no-untyped-def]
-    """The whole product's shortest counterexample (inputs); ``None``: proven or past BOUND."""
-    try:
-        with limits.changed(conversion_max_states=BOUND):
-            source, result, _mode = machines_for(doc, model)
-            report = check(source, result, max_states=BOUND)
-    except FsmbtError:
-        return None
-    if report.equivalent:
-        return None
-    return min(len(p.counterexample) - 1 for p in report.properties.values() if p.counterexample)
+from support.pernode_mutants import BOUND, seeded_mutants, whole_shortest
 
 
 def _lifted_pairs():  # type: ignore[no-untyped-def]
@@ -37,8 +22,8 @@ def _lifted_pairs():  # type: ignore[no-untyped-def]
                 report, _why = compositional_report(doc, mutant, max_states=BOUND)
             if report is None or report.method not in LIFTED:
                 continue
-            best = _whole_shortest(doc, mutant)
-            if best is not None:
+            best = whole_shortest(doc, mutant)
+            if best is not None and best >= 0:  # refuted by the whole product
                 yield doc, mutant, report, best
 
 
