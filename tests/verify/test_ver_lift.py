@@ -14,48 +14,16 @@ from fsmbt import limits
 from fsmbt.convert.bt_to_hfsm import bt_to_hfsm
 from fsmbt.model.errors import FsmbtError
 from fsmbt.semantics.execution import leaf_machine
-from fsmbt.semantics.machine import FINAL, FSMLeafMachine
 from fsmbt.verify import verify
 from fsmbt.verify.compositional import compositional_report
-from fsmbt.verify.lazy_fsm import LazyDataMachine, Unsupported
+from fsmbt.verify.lazy_fsm import LazyDataMachine
 from fsmbt.verify.native import check, replay
 from fsmbt.verify.pairing import machines_for
 from fsmbt.verify.report import COMPOSITIONAL_LIFTED, LIFTED, PER_NODE_LIFTED
 from support.pernode_mutants import BOUND, mutate, seeded_mutants
-from support.pernode_trees import seeded_trees
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))
 from bench_reactive import family_tree  # noqa: E402
-
-
-def test_the_lazy_machine_steps_as_the_expanded_one() -> None:
-    """The replay's result machine against ``FSMLeafMachine`` (the W3C expansion) on seeded
-    random walks of small results and their mutants."""
-    rng = random.Random(3)
-    compared = 0
-    for doc in seeded_trees(40, seed=11):
-        model = bt_to_hfsm(doc, pernode=True).model
-        for candidate in (model, mutate(model, rng) or model):
-            try:
-                lazy = LazyDataMachine(candidate)
-                with limits.changed(conversion_max_states=BOUND):
-                    reference = FSMLeafMachine(candidate)
-            except (Unsupported, FsmbtError):
-                continue
-            for _walk in range(10):
-                a, out_a = lazy.start()
-                b, out_b = reference.start()
-                assert out_a == out_b
-                for _step in range(25):
-                    if reference.status(b) == FINAL:
-                        break
-                    symbol = rng.choice(("success", "failure", "running"))
-                    a, out_a = lazy.step(a, symbol)
-                    b, out_b = reference.step(b, symbol)
-                    assert out_a == out_b
-                    assert lazy.status(a) == reference.status(b)
-            compared += 1
-    assert compared >= 50
 
 
 def _lifted_trace(report):  # type: ignore[no-untyped-def]
