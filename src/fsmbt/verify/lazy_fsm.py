@@ -87,12 +87,27 @@ def _expr(text: str) -> Evaluator:
 
 def _value(text: str, values: dict[str, Any]) -> Any:
     """``text`` evaluated over ``values`` (a failure is out of scope: W3C would raise
-    ``error.execution``, which this runner does not model)."""
+    ``error.execution``, which this runner does not model). The subset cannot assign, so the
+    values are read in place."""
     evaluate = _expr(text)
     try:
-        return evaluate(dict(values))
+        return evaluate(values)
     except Exception as exc:  # noqa: BLE001 - any evaluation failure of the user's text
         raise Unsupported(f"expression {text!r} fails ({type(exc).__name__})") from None
+
+
+_BLOCKS: dict[str, tuple[tuple[str, str], ...]] = {}
+
+
+def _assign(text: str, values: dict[str, Any]) -> None:
+    """Run the ``name=expr`` lines of ``text`` in order (parsed once per distinct text)."""
+    if not text:
+        return
+    block = _BLOCKS.get(text)
+    if block is None:
+        block = _BLOCKS[text] = tuple(parse_lines(text))
+    for var, expr in block:
+        values[var] = _value(expr, values)
 
 
 class LazyDataMachine:
@@ -296,8 +311,8 @@ class LazyDataMachine:
         run the assignments, enter the target."""
         t, level = move
         for depth in range(len(path), level, -1):
-            self._assign(self._state(path[:depth]).attrs.get(ONEXIT, ""), values)
-        self._assign(t.attrs.get(ASSIGN, ""), values)
+            _assign(self._state(path[:depth]).attrs.get(ONEXIT, ""), values)
+        _assign(t.attrs.get(ASSIGN, ""), values)
         return self._enter(path[:level], t.target, queue)
 
     def _enter(self, prefix: Path, name: str, queue: deque[Path]) -> Path:
@@ -324,8 +339,3 @@ class LazyDataMachine:
                 return path
             path = self._take(path, move, values, queue)
         raise Unsupported("eventless transitions or completions form a cycle")
-
-    @staticmethod
-    def _assign(text: str, values: dict[str, Any]) -> None:
-        for var, expr in parse_lines(text):
-            values[var] = _value(expr, values)
