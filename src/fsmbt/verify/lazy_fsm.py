@@ -63,6 +63,10 @@ State_ = tuple[Path, tuple[tuple[str, Any], ...]]  # (configuration, variable va
 Evaluator = Callable[[dict[str, Any]], Any]
 #: A transition selected and the level (index in the path) of its source state.
 Move = tuple[Transition, int]
+#: One level of a configuration: its state and the state's transitions by event.
+Level = tuple[State, dict[str | None, list[Transition]]]
+_NONE: dict[str | None, list[Transition]] = {}
+_EMPTY: list[Transition] = []
 #: The internal event entering a final sub-state of ``P`` raises (W3C ``done.state.P``).
 DONE = "done.state."
 
@@ -122,11 +126,12 @@ class LazyDataMachine:
         self.w3c = has_data(fsm)
         if fsm.initial is None or fsm.initial not in fsm.states:
             raise Unsupported("no initial state")
-        #: (id of a machine, source, event) -> transitions in document order (event None:
+        #: (id of a machine, source) -> event -> transitions in document order (event None:
         #: eventless, or a composite state's completions)
-        self.table: dict[tuple[int, str, str | None], list[Transition]] = {}
-        #: configuration prefix -> the machine its next state lives in (filled on demand)
-        self.machines: dict[Path, FSM] = {(): fsm}
+        self.table: dict[tuple[int, str], dict[str | None, list[Transition]]] = {}
+        #: configuration -> per level, its state and that state's transitions by event
+        #: (filled on demand: one lookup per configuration a step visits)
+        self.levels: dict[Path, tuple[Level, ...]] = {}
         stack = [(fsm, "the top machine")]
         while stack:  # every machine once, without recursion
             machine, where = stack.pop()
@@ -136,7 +141,8 @@ class LazyDataMachine:
                     stack.append((state.regions[0], f"the sub-machine of {state.name}"))
             for t in machine.transitions:
                 self._check_target(machine, t, where)
-                self.table.setdefault((id(machine), t.source, t.event), []).append(t)
+                arms = self.table.setdefault((id(machine), t.source), {})
+                arms.setdefault(t.event, []).append(t)
         values: dict[str, Any] = {}
         if self.w3c:
             for var, text in parse_lines(fsm.attrs.get(DATAMODEL, "")):
@@ -213,22 +219,26 @@ class LazyDataMachine:
         return (path, tuple(sorted(values.items()))), self._outputs(path)
 
     # -- both readings -----------------------------------------------------------------------
-    def _machine(self, prefix: Path) -> FSM:
-        """The machine the state after ``prefix`` lives in (cached per prefix)."""
-        found = self.machines.get(prefix)
+    def _levels(self, path: Path) -> tuple[Level, ...]:
+        """Per level of ``path``, its state and that state's transitions by event (cached)."""
+        found = self.levels.get(path)
         if found is None:
-            found = self._state(prefix).regions[0]
-            self.machines[prefix] = found
+            machine, built = self.fsm, []
+            for name in path:
+                state = machine.states[name]
+                built.append((state, self.table.get((id(machine), name), _NONE)))
+                if state.regions:
+                    machine = state.regions[0]
+            found = self.levels[path] = tuple(built)
         return found
 
     def _state(self, path: Path) -> State:
         """The state ``path`` ends in."""
-        return self._machine(path[:-1]).states[path[-1]]
+        return self._levels(path)[-1][0]
 
     def _arms(self, path: Path, level: int, event: str | None) -> list[Transition]:
         """The transitions of ``path[level]`` on ``event``, in document order."""
-        machine = self._machine(path[:level])
-        return self.table.get((id(machine), path[level], event), [])
+        return self._levels(path)[level][1].get(event, _EMPTY)
 
     def _outputs(self, path: Path) -> tuple[str, ...]:
         """The action of the configuration: its atomic state's."""
@@ -240,28 +250,28 @@ class LazyDataMachine:
     def _descend(self, prefix: Path, name: str) -> Path:
         """The configuration entering ``name`` (a state of ``prefix``'s machine) gives: down
         its initial sub-states to an atomic state."""
+        machine = self.fsm if not prefix else self._state(prefix).regions[0]
         path = prefix
         for _level in range(STEP_LIMIT):
-            machine = self._machine(path)
-            if name not in machine.states:
+            state = machine.states.get(name)
+            if state is None:
                 raise Unsupported(f"a transition to an unknown state {name}")
             path = (*path, name)
-            state = machine.states[name]
             if not state.regions:
                 return path
-            name = state.regions[0].initial or ""
+            machine = state.regions[0]
+            name = machine.initial or ""
         raise Unsupported("sub-machines nest deeper than the step limit")
 
     # -- without data: model/flatten.py ------------------------------------------------------
     def _flat_select(self, path: Path, event: str) -> Move | None:
         """The transition ``event`` fires: innermost first, a state marked final handling none
         (guards are not read)."""
+        levels = self._levels(path)
         for level in range(len(path) - 1, -1, -1):
-            if self._state(path[: level + 1]).final:
-                continue
-            arms = self._arms(path, level, event)
-            if arms:
-                return arms[0], level
+            state, arms = levels[level]
+            if not state.final and arms.get(event):
+                return arms[event][0], level
         return None
 
     def _settle(self, path: Path) -> Path:
@@ -310,8 +320,9 @@ class LazyDataMachine:
         """One micro step: exit the states from the source down (``onexit``, deepest first),
         run the assignments, enter the target."""
         t, level = move
-        for depth in range(len(path), level, -1):
-            _assign(self._state(path[:depth]).attrs.get(ONEXIT, ""), values)
+        levels = self._levels(path)
+        for depth in range(len(path) - 1, level - 1, -1):
+            _assign(levels[depth][0].attrs.get(ONEXIT, ""), values)
         _assign(t.attrs.get(ASSIGN, ""), values)
         return self._enter(path[:level], t.target, queue)
 
