@@ -2,8 +2,8 @@
 the shortest"): how often a one-transition mutant is refuted by a lifted counterexample, and
 whether it is as short as the whole product's shortest. Prints two tables.
 
-    .venv/bin/python benchmarks/bench_lift.py [--small 60] [--large 6] [--bound 4000]
-        [--large-bound 200000] [--limit 60]
+    .venv/bin/python benchmarks/bench_lift.py [--small 60] [--whole 150] [--large 6]
+        [--bound 4000] [--large-bound 200000] [--limit 60]
 
 ``small``: the sample ``tests/verify/test_ver_lift.py`` uses (``seeded_trees(N, seed=4)``, two
 mutants each of the first per-node sub-machine, ``random.Random(5)``): per whole-product
@@ -11,7 +11,11 @@ verdict (``None``: past ``--bound`` states) the method of the compositional verd
 (``per node, lifted``, ``compositional, lifted``, or ``none``: the whole product decides),
 and for each lifted one whether its length equals the whole product's shortest counterexample
 (native breadth-first search); the last line counts the lifted counterexamples the lift's own
-bounded search (``verify/shortest.py``) proved shortest. ``large``: six mutants each of ``bench_reactive``
+bounded search (``verify/shortest.py``) proved shortest. ``whole``: the same over results written
+whole (not per node: every region is checked whole),
+``support.whole_mutants.seeded_whole_mutants(N, seed=8)`` - the compositional test's random trees,
+two one-transition mutants each of a random machine, regions included. ``large``: six mutants
+each of ``bench_reactive``
 ``family_tree("mixed", 150, seed)`` for seeds 300.. (about 400 nodes, ``random.Random(27)``):
 the same, the whole product (the result run lazily, as the lift replays it) bounded by
 ``--large-bound`` states and ``--limit`` seconds per mutant (``unknown`` past either).
@@ -43,6 +47,7 @@ from fsmbt.verify.native import check  # noqa: E402
 from fsmbt.verify.pairing import machines_for  # noqa: E402
 from fsmbt.verify.report import LIFTED, Report  # noqa: E402
 from support.pernode_mutants import mutate, seeded_mutants  # noqa: E402
+from support.whole_mutants import seeded_whole_mutants  # noqa: E402
 
 
 def shortest(
@@ -124,6 +129,7 @@ def tally(
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--small", type=int, default=60, help="seeded small trees")
+    parser.add_argument("--whole", type=int, default=150, help="trees converted whole")
     parser.add_argument("--large", type=int, default=6, help="400-node mixed trees")
     parser.add_argument("--bound", type=int, default=4000, help="states, small pairs")
     parser.add_argument("--large-bound", type=int, default=200_000, help="states, large pairs")
@@ -136,6 +142,15 @@ def main(argv: list[str] | None = None) -> int:
     ]
     print(f"small seeded trees ({len(small)} mutants, whole product <= {args.bound} states)")
     tally(small, args.bound, args.bound, args.limit)
+    whole = [
+        (doc, mutant)
+        for doc, _model, mutants in seeded_whole_mutants(args.whole, seed=8)
+        for mutant in mutants
+    ]
+    print(
+        f"seeded trees written whole ({len(whole)} mutants, whole product <= {args.bound} states)"
+    )
+    tally(whole, args.bound, args.bound, args.limit)
     rng = random.Random(27)
     large = []
     for seed in range(300, 300 + args.large):

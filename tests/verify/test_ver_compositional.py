@@ -15,7 +15,6 @@ method not ``compositional``.
 
 from __future__ import annotations
 
-import copy
 import random
 import re
 
@@ -38,24 +37,14 @@ from fsmbt.verify.compositional import (
     fsm_regions,
     tree_regions,
 )
-from fsmbt.verify.mutations import mutants
 from fsmbt.verify.native import check
 from fsmbt.verify.pairing import machines_for
 from fsmbt.verify.report import COMPOSITIONAL, LIFTED
 from support.random_trees import random_tree
 from support.sampling import seed
 from support.ver_models import memory_regions_tree
+from support.whole_mutants import CONTROLS, DECORATORS, deep_mutants
 
-CONTROLS = (
-    "Sequence",
-    "Fallback",
-    "Sequence",
-    "Fallback",
-    "SequenceWithMemory",
-    "ReactiveSequence",
-    "ReactiveFallback",
-)
-DECORATORS = ("Inverter", "ForceSuccess", "ForceFailure", "Repeat", "RetryUntilSuccessful")
 #: Batches and trees per batch: 8 x 250 = 2 000 trees, each with its HFSM and one mutant.
 BATCHES, TREES = 8, 250
 
@@ -73,26 +62,6 @@ def _pairs(batch: int) -> list[tuple[BTDocument, FSM, bool]]:
         out.append((doc, hfsm, True))
         for mutant in deep_mutants(hfsm, rng.randrange(1 << 30), per_operator=1)[:1]:
             out.append((doc, mutant, False))
-    return out
-
-
-def deep_mutants(hfsm: FSM, seed_value: int, per_operator: int | None) -> list[FSM]:
-    """Single mutants of one machine of ``hfsm`` - the top machine or any sub-machine, so the
-    regions' own transitions are mutated too (``mutants`` mutates the machine it is given)."""
-    rng = random.Random(seed_value)
-    count = len(list(hfsm.machines()))
-    picks = range(count) if per_operator is None else [rng.randrange(count)]
-    out: list[FSM] = []
-    for index in picks:
-        inner = list(hfsm.machines())[index]
-        for mutant in mutants(inner, seed=seed_value, per_operator=per_operator):
-            assert isinstance(mutant.model, FSM)
-            whole = copy.deepcopy(hfsm)
-            target = list(whole.machines())[index]
-            target.states, target.transitions = mutant.model.states, mutant.model.transitions
-            target.initial = mutant.model.initial
-            out.append(whole)
-    rng.shuffle(out)
     return out
 
 
@@ -116,6 +85,12 @@ def test_compositional_agrees_with_the_whole_product(batch: int) -> None:
             assert not whole.equivalent, (
                 "a lifted counterexample on a pair the whole product proves"
             )
+            # and it tells the two flattened machines apart (not only the lazy runner)
+            trace = next(p.counterexample for p in proved.properties.values() if not p.holds)
+            assert trace is not None
+            source, result, _mode = machines_for(doc, fsm)
+            inputs = [step.input for step in trace[1:] if step.input is not None]
+            assert replay(source, result, inputs).differs
         elif proved is not None:
             decided += 1
             assert whole.equivalent, (

@@ -728,11 +728,10 @@ def decompose(
         if not report.equivalent:
             outcome.equivalent = False
             outcome.failed_region = f"{regions[k].label} (state {region.path})"
-            if _tagged_per_node(region.machine):
-                # lifted only where the lazy result runner is tested against the expanded
-                # machine (regions written per node and their mutants: tests/verify/
-                # test_ver_lift.py); on other regions' mutants it can disagree with it
-                outcome.region_failure = (regions[k], report)
+            # lifted by verify/lift.py, confirmed by replay on the two whole machines (the
+            # result run by verify/lazy_fsm.py, tested step for step against the flattened
+            # machine on regions written whole and per node and their mutants)
+            outcome.region_failure = (regions[k], report)
             return outcome
         possible = _results(witness)
         if not results_allowed(possible, shape, j):
