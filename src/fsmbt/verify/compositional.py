@@ -738,7 +738,6 @@ def decompose(
                     Part(PERNODE_UNIT, w.witness, k, j, w.nodes, w.sigma, w.can_halt) for w in local
                 )
             continue
-        bt_region, fsm_region = region_machines(shape, k, j)
         if plan is not None:
             plan.wholes.append(
                 (
@@ -747,7 +746,8 @@ def decompose(
                     region_fsm(region, shape.declared, shape.mentioned[j]),
                 )
             )
-        try:
+        try:  # building the machines may stop at a limit too (the data expansion)
+            bt_region, fsm_region = region_machines(shape, k, j)
             report, witness = check_witnessed(
                 bt_region, fsm_region, max_states=max_states, max_seconds=budget.left()
             )
@@ -757,6 +757,7 @@ def decompose(
             ):
                 if plan is not None and units is not None:
                     plan.wholes.pop()  # decided node by node after all
+                    plan.refused.pop()
                     plan.units.append((name, units))
                 return outcome
             if isinstance(exc, StateLimitError):
