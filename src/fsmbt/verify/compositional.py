@@ -101,6 +101,13 @@ COMPOSITIONAL_SENTENCE = (
 )
 
 
+#: A region written per node whose sub-machine has at most this many states, and that breaks
+#: the per-node check's entry condition, is checked whole first (a shortest counterexample; a
+#: few hundred states cost milliseconds to a second), its per-node candidate failure lifted only
+#: when that check stops at a limit; a larger one has the candidate lifted first (a tree of
+#: 1 000 nodes: seconds instead of a region check that stops). ``bench_pernode_outside.py``.
+WHOLE_FIRST = 250
+
 #: The mode of a compositional verdict (a BT's leaf-execution machine against an FSM's).
 LEAF_EXECUTION = "leaf-execution"
 
@@ -140,6 +147,9 @@ class Decomposition:
     #: the region checked whole whose check failed and its report (its counterexample, for
     #: ``verify/lift.py``)
     region_failure: tuple[BTNode, Report] | None = None
+    #: the lifted report of a per-node failure found past a broken entry condition
+    #: (``pernode.check_region``'s ``tolerate``), already confirmed by replay
+    lifted: Report | None = None
 
 
 # -- the tree side ---------------------------------------------------------------------------
@@ -629,10 +639,13 @@ class CheckPlan:
     """What a compositional check decided, for another engine to decide again (NuSMV,
     ``fsmbt.verify.nusmv.pernode``): each region proven per node with its distinct local
     checks (``LocalUnit``, the failing one last), and the parts checked whole - each region
-    that was not, and the skeleton - as (name, tree, machine) pairs of models."""
+    that was not, and the skeleton - as (name, tree, machine) pairs of models; ``refused``:
+    each region written per node that the per-node check refused, with the side condition it
+    named (``NotPerNode``'s message; what ``benchmarks/bench_pernode_outside.py`` classifies)."""
 
     units: list[tuple[str, list[LocalUnit]]] = field(default_factory=list)
     wholes: list[tuple[str, BTDocument, FSM]] = field(default_factory=list)
+    refused: list[tuple[str, str]] = field(default_factory=list)
 
 
 def decompose(
@@ -688,6 +701,24 @@ def decompose(
         local: list[LocalWitness] | None = [] if keep is not None else None
         units: list[LocalUnit] | None = [] if plan is not None else None
         per_node = _per_node(regions[k], region.machine, shape.declared, outcome, local, units)
+        name = f"{regions[k].label} (state {region.path})"
+        candidate: PerNodeOutcome | None = None
+        if per_node is not None and per_node.tolerated is not None:
+            # a failure past a broken entry condition (``check_region``'s ``tolerate``) is
+            # only a candidate, kept when the lift replays it on the two whole machines: on a
+            # small region after the region's whole check (its counterexample is a shortest
+            # one) could not decide, on a large one before it (docs/verification.md §5)
+            candidate, per_node = per_node, None
+            outcome.stats.setdefault("per_node_refused", []).append(candidate.tolerated)
+            if len(region.machine.states) > WHOLE_FIRST:
+                if _use_candidate(source, result, regions[k], candidate, outcome, name):
+                    if plan is not None and units is not None:
+                        plan.units.append((name, units))
+                    return outcome
+                candidate = None
+        if per_node is None and plan is not None and _tagged_per_node(region.machine):
+            reason = outcome.stats.get("per_node_refused", ["?"])[-1]
+            plan.refused.append((f"{regions[k].label} (state {region.path})", reason))
         if per_node is not None:  # proven (or refuted) node by node (verify/pernode.py)
             if plan is not None and units is not None:
                 plan.units.append((f"{regions[k].label} (state {region.path})", units))
@@ -707,7 +738,6 @@ def decompose(
                     Part(PERNODE_UNIT, w.witness, k, j, w.nodes, w.sigma, w.can_halt) for w in local
                 )
             continue
-        bt_region, fsm_region = region_machines(shape, k, j)
         if plan is not None:
             plan.wholes.append(
                 (
@@ -716,12 +746,23 @@ def decompose(
                     region_fsm(region, shape.declared, shape.mentioned[j]),
                 )
             )
-        try:
+        try:  # building the machines may stop at a limit too (the data expansion)
+            bt_region, fsm_region = region_machines(shape, k, j)
             report, witness = check_witnessed(
                 bt_region, fsm_region, max_states=max_states, max_seconds=budget.left()
             )
-        except StateLimitError as exc:
-            raise NotDecomposable(f"region {regions[k].label}: {exc}") from None
+        except FsmbtError as exc:
+            if candidate is not None and _use_candidate(
+                source, result, regions[k], candidate, outcome, name
+            ):
+                if plan is not None and units is not None:
+                    plan.wholes.pop()  # decided node by node after all
+                    plan.refused.pop()
+                    plan.units.append((name, units))
+                return outcome
+            if isinstance(exc, StateLimitError):
+                raise NotDecomposable(f"region {regions[k].label}: {exc}") from None
+            raise
         _add(outcome.stats, report.stats)
         outcome.region_states += report.stats["product_states"]
         outcome.largest_region = max(outcome.largest_region, report.stats["product_states"])
@@ -796,7 +837,7 @@ def _per_node(
     if not _tagged_per_node(machine):
         return None
     try:
-        found = check_region(region_root, machine, declared, keep, units)
+        found = check_region(region_root, machine, declared, keep, units, tolerate=True)
     except NotPerNode as exc:
         outcome.stats.setdefault("per_node_refused", []).append(str(exc))
         return None
@@ -809,13 +850,41 @@ def _per_node(
     return found
 
 
+def _use_candidate(
+    source: BTDocument,
+    result: FSM,
+    region: BTNode,
+    failed: PerNodeOutcome,
+    outcome: Decomposition,
+    name: str,
+) -> bool:
+    """Lift a per-node failure found past a broken entry condition; when its replay separates
+    the two whole machines, ``outcome`` is that NOT EQUIVALENT (``lifted``: the report) and
+    the answer is True; else (the lift does not separate them, or cannot run) False."""
+    started = time.perf_counter()
+    try:
+        report = lifted_report(source, result, region, failed)
+    except FsmbtError:
+        return False
+    if report is None:
+        return False
+    report.stats["lift_seconds"] = round(time.perf_counter() - started, 6)
+    outcome.lifted = report
+    outcome.equivalent = False
+    outcome.failed_region = f"{name}, node {failed.failed}"
+    outcome.per_node_failure = (region, failed)
+    return True
+
+
 def _lifted(source: BTDocument, result: FSM, found: Decomposition) -> Report | None:
     """NOT EQUIVALENT with the failing node's local counterexample, or the failing region's
     own, lifted to the whole tree and confirmed by replay (``verify/lift.py``), or ``None``:
     the whole product decides."""
     started = time.perf_counter()
     try:
-        if found.per_node_failure is not None:
+        if found.lifted is not None:
+            report: Report | None = found.lifted
+        elif found.per_node_failure is not None:
             report = lifted_report(source, result, *found.per_node_failure)
         else:
             assert found.region_failure is not None
@@ -832,10 +901,12 @@ def _lifted(source: BTDocument, result: FSM, found: Decomposition) -> Report | N
     if found.per_node_failure is not None:
         report.stats["per_node_failed"] = found.failed_region
         report.stats.setdefault("per_node_regions", 1)
+        if found.per_node_failure[1].tolerated is not None:
+            report.stats["per_node_broken"] = found.per_node_failure[1].tolerated
     else:
         report.stats["failed_region"] = found.failed_region
     report.stats["regions"] = found.regions
-    report.stats["lift_seconds"] = round(time.perf_counter() - started, 6)
+    report.stats.setdefault("lift_seconds", round(time.perf_counter() - started, 6))
     return report
 
 

@@ -138,6 +138,10 @@ class PerNodeOutcome:
     more: Iterator[tuple[str, int, list[tuple[int | None, Any]]]] = field(
         default_factory=lambda: iter(())
     )
+    #: the entry side condition the region broke when the check ran with ``tolerate`` and
+    #: failed (a stray jump into a subtree): the failure is then only a candidate, which
+    #: the caller must confirm by the lift's replay or check the region whole
+    tolerated: str | None = None
 
 
 # -- expressions (fsmbt's subset: literals, names, ==, !=, <, <=, >, >=, and, or, x + 1) -------
@@ -194,10 +198,20 @@ class _Hop:
 
 
 class _Region:
-    """The region's machine grouped by node (side conditions 1-3 of the module docstring)."""
+    """The region's machine grouped by node (side conditions 1-3 of the module docstring).
 
-    def __init__(self, tree: CompiledTree, machine: FSM, declared: dict[str, str]) -> None:
+    With ``tolerate``, a broken entry condition (2) is recorded in ``broken`` instead of
+    refused: each node's entry is the state most transitions from outside enter (the first met
+    on a tie), and a transition entering a subtree elsewhere is a *stray* jump that each
+    fragment reading it outputs as an exit no status pairs with (``_Local.strays``), so the
+    local check that reaches it fails; only a candidate (``check_region``)."""
+
+    def __init__(
+        self, tree: CompiledTree, machine: FSM, declared: dict[str, str], tolerate: bool = False
+    ) -> None:
         self.tree = tree
+        self.tolerate = tolerate
+        self.broken: list[str] = []
         self.nodes = tree.nodes
         self.machine = machine
         by_path = {node.path: node.id for node in self.nodes}
@@ -294,6 +308,7 @@ class _Region:
         if initial is None or initial not in self.tag:
             raise NotPerNode("the region's initial state is not a node's")
         self.entry[0] = initial
+        met: dict[int, dict[str, int]] = {}  # node -> state entered from outside -> times
         for transitions in self.out.values():
             for t in transitions:
                 if t.target not in self.tag:
@@ -302,9 +317,18 @@ class _Region:
                 while x is not None:  # every node whose subtree the transition enters
                     if self.inside(t.source, x):
                         break
-                    if self.entry.setdefault(x, t.target) != t.target:
-                        raise NotPerNode(f"node {self.nodes[x].label} is entered twice")
+                    counts = met.setdefault(x, {})
+                    counts[t.target] = counts.get(t.target, 0) + 1
                     x = self.nodes[x].parent
+        for x, counts in met.items():
+            entry = self.entry.get(x)  # only the region root's is fixed: the initial state
+            if entry is None:  # the most entered (``max`` keeps the first met on a tie)
+                entry = self.entry[x] = max(counts, key=counts.__getitem__)
+            if set(counts) != {entry}:
+                message = f"node {self.nodes[x].label} is entered twice"
+                if not self.tolerate:
+                    raise NotPerNode(message)
+                self.broken.append(message)
         # a node no transition enters is dead (its siblings before it never let the tick
         # through): nothing of it is checked, and its parent's check fails if the tree ticks it
 
@@ -351,6 +375,9 @@ class _Local:
     initial: tuple[tuple[str, Any], ...]
     halting: frozenset[int]  # children whose subtree has halt values
     exits: dict[int, Any]  # canonical id -> ("t", target) or ("a", (var, expr))
+    #: exits that are stray jumps into the node's subtree (``_Region``'s ``tolerate``): no
+    #: status pairs with one, so a local check reaching one fails
+    strays: frozenset[int] = frozenset()
 
 
 def _local(region: _Region, node: CompiledNode, interfaces: dict[int, Interface]) -> _Local:
@@ -385,7 +412,11 @@ def _local(region: _Region, node: CompiledNode, interfaces: dict[int, Interface]
                 order.append(name)
             return ("state", state_ids[name])
         if region.inside(name, node.id):
-            raise NotPerNode(f"a transition of {node.label} enters a child not at its entry")
+            message = f"a transition of {node.label} enters a child not at its entry"
+            if not region.tolerate:
+                raise NotPerNode(message)
+            region.broken.append(message)
+            return ("exit", outside_id(("stray", name)))
         return ("exit", outside_id(("t", name)))
 
     def hop(
@@ -451,6 +482,7 @@ def _local(region: _Region, node: CompiledNode, interfaces: dict[int, Interface]
     halt = tuple(sorted((names[v], region.halt_value[v]) for v in own if v in region.halt_value))
     initial = tuple(sorted((names[v], region.initial[v]) for v in own))
     halting = frozenset(i for i, values in enumerate(halts_of) if values)
+    strays = frozenset(cid for value, cid in outside_ids.items() if value[0] == "stray")
     key = (
         node.type,
         node.params,
@@ -461,9 +493,10 @@ def _local(region: _Region, node: CompiledNode, interfaces: dict[int, Interface]
         halt,
         initial,
         tuple(sorted(halting)),
+        tuple(sorted(strays)),
     )
     exits = {cid: value for value, cid in outside_ids.items()}
-    return _Local(key, entry, states, children, halt, initial, halting, exits)
+    return _Local(key, entry, states, children, halt, initial, halting, exits, strays)
 
 
 # -- the local product ---------------------------------------------------------------------------
@@ -607,6 +640,8 @@ def _check_local(
             return False
         if b_kind == "tick":
             return bool(b_what == f_what)
+        if f_what[0] in local.strays:
+            return False  # a stray jump into the subtree: no status of the node goes there
         # two statuses may share an exit (a parent that treats them alike): σ is a function
         return bool(pairing.setdefault(b_what, f_what) == f_what)
 
@@ -853,13 +888,17 @@ class NodeWalk:
     the next. Leaves and dead nodes (never entered) are settled from the machine alone.
     ``verify`` (``check_region``) and ``fsmbt.verify.certificate`` both walk it, so both
     decide the same local checks. Cost: O(states + transitions · depth) to group, plus the
-    canonicalization of each node's fragment.
+    canonicalization of each node's fragment. With ``tolerate`` (``check_region``'s, never a
+    certificate's) a broken entry condition is recorded in ``region.broken`` and its stray
+    jumps fail the local checks that reach them (``_Region``).
 
     Raises:
         NotPerNode: the machine is not a valid per-node decomposition of the region.
     """
 
-    def __init__(self, region_root: BTNode, machine: FSM, declared: dict[str, str]) -> None:
+    def __init__(
+        self, region_root: BTNode, machine: FSM, declared: dict[str, str], tolerate: bool = False
+    ) -> None:
         try:
             # the same-type merge of plain Sequence/Fallback children (docs/semantics.md §4d,
             # lemma M: it keeps the leaf-execution machine), so that the nodes are the machine's
@@ -867,7 +906,7 @@ class NodeWalk:
             self.tree = CompiledTree(BTDocument.single(merged))
         except FsmbtError as exc:
             raise NotPerNode(str(exc)) from None
-        self.region = _Region(self.tree, machine, declared)
+        self.region = _Region(self.tree, machine, declared, tolerate)
         self.interfaces: dict[int, Interface] = {}
         self.haltable: set[int] = set()
 
@@ -957,6 +996,7 @@ def check_region(
     declared: dict[str, str],
     keep: list[LocalWitness] | None = None,
     units: list[LocalUnit] | None = None,
+    tolerate: bool = False,
 ) -> PerNodeOutcome:
     """Check ``machine`` (a region state's sub-machine, tagged per node) against the region
     headed by ``region_root``, node by node (the module docstring). With ``keep``, each
@@ -966,10 +1006,20 @@ def check_region(
     up to the first failure is appended as a ``LocalUnit`` (what NuSMV checks again; no extra
     cost here), the failing one last.
 
+    With ``tolerate``, a region that breaks the entry condition (2) - a transition jumping
+    into a subtree elsewhere than its entry, as a retargeted transition does - is still walked:
+    each fragment reading a stray jump outputs it as an exit no status of the node pairs with,
+    so the local check that reaches it fails, and the outcome's ``tolerated`` names the broken
+    condition. Such a failure is only a candidate: the composition theorem (docs/semantics.md
+    §4d) needs the side conditions, so it says nothing about the region; the lift's replay on
+    the two whole machines decides (``verify/lift.py``), else the region is checked whole. A
+    region that breaks it and where no local check fails is refused (``NotPerNode``), as
+    without ``tolerate``: no equivalence is ever concluded from a broken decomposition.
+
     Raises:
         NotPerNode: the machine is not a valid per-node decomposition of this region.
     """
-    walk = NodeWalk(region_root, machine, declared)
+    walk = NodeWalk(region_root, machine, declared, tolerate)
     outcome = PerNodeOutcome(equivalent=True, nodes=len(walk.tree.nodes))
     failures = _failures(walk, outcome, keep, units)
     first = next(failures, None)
@@ -977,7 +1027,10 @@ def check_region(
         outcome.equivalent = False
         outcome.failed, outcome.failed_id, outcome.trace = first
         outcome.tree, outcome.more = walk.tree, itertools.islice(failures, MAX_FAILURES - 1)
+        outcome.tolerated = walk.region.broken[0] if walk.region.broken else None
         return outcome
+    if walk.region.broken:
+        raise NotPerNode(walk.region.broken[0])
     outcome.results = walk.root_results()
     return outcome
 
