@@ -215,11 +215,12 @@ def check(
     closure, the costliest spec) is left out at first; when the other four properties hold,
     reachability follows from them (docs/nusmv.md, "Reachability implied") and is reported as
     such; otherwise it is run too, so a failing pair gets reachability's own verdict and
-    counterexample. ``state_reach`` (default): on the split runs, when both machines' states
-    are one enumerated variable (FSM ~ FSM), that run is ``reach.check_reachability``'s
-    invariants per state instead of the frozen-copy spec (docs/nusmv.md, "Reachability state
-    by state": a 1 000-state mutant in seconds where the frozen copies gave up); ``False``:
-    the frozen-copy spec (kept for the benchmarks and the tests that compare the two).
+    counterexample. ``state_reach`` (default): on the split runs (FSM ~ FSM, FSM ~ dispatch
+    tree) that run is ``reach.check_reachability``'s listing of the reachable states instead
+    of the frozen-copy spec (docs/nusmv.md, "Reachability from the listed states": a
+    1 000-state mutant in one forward search where the frozen copies gave up at ~100
+    states); ``False``: the frozen-copy spec (kept for the benchmarks and the tests that
+    compare the two).
 
     ``timeout`` defaults to ``fsmbt.limits.current().nusmv_max_seconds`` (per NuSMV run); the
     memory cap is ``nusmv_max_memory_mb``. Raises ``UnsupportedError`` for BT node types the
@@ -282,7 +283,7 @@ def check(
             report.properties[REACHABILITY] = PropertyResult(REACHABILITY, True, IMPLIED_DETAIL)
         elif (
             split and state_reach and reach.applies(context)
-        ):  # a failing pair of FSMs: state by state
+        ):  # a failing split pair: from the listed reachable states
             verdict, more_runs, seconds = reach.check_reachability(context, timeout=timeout)
             runs += more_runs
             nusmv_seconds += seconds
