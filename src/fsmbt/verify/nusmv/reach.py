@@ -29,9 +29,9 @@ v)`` then ``!(alone & s.q = v)``, ~23 ms each on NuSMV's side - 2 000 of them we
 from __future__ import annotations
 
 from fsmbt.verify.nusmv.encode_fsm import Encoding
-from fsmbt.verify.nusmv.runner import list_reachable, run_nusmv
+from fsmbt.verify.nusmv.runner import SpecResult, check_and_list, list_reachable, run_nusmv
 from fsmbt.verify.nusmv.smv import all_of, any_of
-from fsmbt.verify.nusmv.specs import REACH, SEEN, product
+from fsmbt.verify.nusmv.specs import REACH, SEEN, invariant_specs, product
 from fsmbt.verify.nusmv.traces import Context, alone_go, decode_trace
 from fsmbt.verify.report import REACHABILITY, PropertyResult, TraceStep
 
@@ -136,16 +136,41 @@ def check_reachability(
 ) -> tuple[PropertyResult, int, float]:
     """Reachability's verdict (with its witness when it fails), the number of NuSMV runs and
     their seconds. ``context`` must satisfy ``applies``. Runs: the listing of the ``REACH``
-    model's reachable states (one forward search); when some state is unmatched, the witness:
-    a forward search to the nearest one and its replayed path (two more runs)."""
+    model's reachable states (one forward search), then ``verdict``'s."""
     text, order = _text(context, [], listing=True)
     states, seconds = list_reachable(text, order=order, timeout=timeout)
+    result, runs, more = verdict(context, states, timeout=timeout)
+    return result, runs + 1, seconds + more
+
+
+def invariants_and_listing(
+    context: Context, *, timeout: float | None
+) -> tuple[list[str], list[SpecResult], list[dict[str, str]], float]:
+    """One NuSMV run on the ``REACH`` model: the three invariants of ``specs.invariant_specs``
+    (their names, verdicts and counterexamples: shortest paths in the attached mode, which is
+    the ``INVARIANTS`` model's product) and the listing of its reachable states, from one
+    build and one forward search (``runner.check_and_list``); and NuSMV's seconds. It replaces
+    the separate invariants' run of ``check``'s split pairs: one build and one search fewer
+    (docs/nusmv.md, "Reachability from the listed states")."""
+    src, res, inputs = context[0], context[1], context[4]
+    specs = invariant_specs(src, res, list(inputs.to_id.values()))
+    text, order = _text(context, specs, listing=True)
+    results, states, seconds = check_and_list(text, len(specs), order=order, timeout=timeout)
+    return [name for name, _formula in specs], results, states, seconds
+
+
+def verdict(
+    context: Context, states: list[dict[str, str]], *, timeout: float | None
+) -> tuple[PropertyResult, int, float]:
+    """Reachability's verdict from the listed ``states``, the number of further NuSMV runs and
+    their seconds: none when every state reached alone is matched; else the witness, a forward
+    search to the nearest unmatched state and its replayed path (two runs)."""
     unmatched = unmatched_states(context, states)
     if not unmatched:
-        return PropertyResult(REACHABILITY, True, STATES_DETAIL), 1, seconds
-    trace, more = _witness(context, unmatched, timeout=timeout)
+        return PropertyResult(REACHABILITY, True, STATES_DETAIL), 0, 0.0
+    trace, seconds = _witness(context, unmatched, timeout=timeout)
     result = PropertyResult(REACHABILITY, False, _detail(context, unmatched), trace or None)
-    return result, 3, seconds + more
+    return result, 2, seconds
 
 
 def _witness(

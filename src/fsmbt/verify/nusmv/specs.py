@@ -178,8 +178,6 @@ def product(
         ]
     # CTL specs first, invariants after: NuSMV checks (and prints) them in that order.
     specs: list[tuple[str, str, str]] = []
-    offers_s_in_r = all_of(f"(s.offers_{i} -> r.offers_{i})" for i in in_ids)
-    offers_r_in_s = all_of(f"(r.offers_{i} -> s.offers_{i})" for i in in_ids)
     dead_s = "(!s.final & !(EX (mode = sa & EF s_obs)))"
     dead_r = "(!r.final & !(EX (mode = ra & EF r_obs)))"
     specs.append((DEADLOCK_ABSENCE, "SPEC", f"AG (faithful -> ({dead_s} <-> {dead_r}))"))
@@ -190,16 +188,7 @@ def product(
         reach += f" & ((EF (mode = ra & r.stable & {same_r})) -> (EF (faithful & {same_r})))"
     specs.append((REACHABILITY, "SPEC", reach))
     # invariants are checked by forward reachability: much cheaper than AG in CTL
-    compl = f"((!det & ok & both) -> {subsequence(s_slots, r_slots, NONE_OUT)})"
-    noadd = f"((!det & ok & both) -> {subsequence(r_slots, s_slots, NONE_OUT)})"
-    if not follows:
-        compl = f"{compl} & (faithful -> {offers_s_in_r})"
-        noadd = f"{noadd} & (faithful -> {offers_r_in_s})"
-    specs.append((COMPLETENESS, "INVARSPEC", compl))
-    specs.append((NO_ADDITIONAL_BEHAVIOR, "INVARSPEC", noadd))
-    specs.append(
-        (TERMINATION_CONSISTENCY, "INVARSPEC", "((!det & ok & both) -> (s.final <-> r.final))")
-    )
+    specs += [(name, "INVARSPEC", formula) for name, formula in invariant_specs(src, res, in_ids)]
     extra_kind = "INVARSPEC" if part == WHOLE else "SPEC AG"
     specs += [
         (name, extra_kind, formula if name in UNGUARDED_CHECKS else f"(ok -> {formula})")
@@ -213,6 +202,27 @@ def product(
         lines.append(f"{kind} {formula};")
     order = _order(src, res, copies=detach)
     return Product("\n".join(lines) + "\n", [name for name, _, _ in specs], order)
+
+
+def invariant_specs(src: Encoding, res: Encoding, in_ids: list[str]) -> list[tuple[str, str]]:
+    """Completeness, no additional behaviour and termination consistency as (name, invariant)
+    over the product's terms (``det``, ``ok``, ``both``, ``faithful``): true of every attached
+    pair (``!det``), so the same text holds on the ``INVARIANTS`` model and on the ``REACH``
+    model, whose alone modes are ``det``."""
+    s_slots = [f"s.{x}" for x in src.slots]
+    r_slots = [f"r.{x}" for x in res.slots]
+    compl = f"((!det & ok & both) -> {subsequence(s_slots, r_slots, NONE_OUT)})"
+    noadd = f"((!det & ok & both) -> {subsequence(r_slots, s_slots, NONE_OUT)})"
+    if not res.follows:
+        offers_s_in_r = all_of(f"(s.offers_{i} -> r.offers_{i})" for i in in_ids)
+        offers_r_in_s = all_of(f"(r.offers_{i} -> s.offers_{i})" for i in in_ids)
+        compl = f"{compl} & (faithful -> {offers_s_in_r})"
+        noadd = f"{noadd} & (faithful -> {offers_r_in_s})"
+    return [
+        (COMPLETENESS, compl),
+        (NO_ADDITIONAL_BEHAVIOR, noadd),
+        (TERMINATION_CONSISTENCY, "((!det & ok & both) -> (s.final <-> r.final))"),
+    ]
 
 
 def _order(src: Encoding, res: Encoding, *, copies: bool = True) -> str:
