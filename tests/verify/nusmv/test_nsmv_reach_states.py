@@ -1,9 +1,10 @@
-"""Reachability from NuSMV's listing of the reachable states (docs/nusmv.md, "Reachability
-from the listed states"; ``fsmbt.verify.nusmv.reach``): on seeded FSM ~ FSM mutants it gives
-the verdict of the frozen-copy spec it replaces and of the native checker, names the same
-unmatched states as the native checker, and its witness is as short as the native one and
-replays (on the native machines) to a real difference; a 300-state mutant and copy are decided
-and agree."""
+"""Reachability from NuSMV's listing of the reachable states (docs/nusmv.md, "Fifth round:
+reachability from the listed states"; ``fsmbt.verify.nusmv.reach``): on seeded FSM ~ FSM
+mutants it gives the verdict of the frozen-copy spec it replaces and of the native checker,
+names the same unmatched states as the native checker, and its witness is as short as the
+native one and replays (on the native machines) to a real difference; so do failing FSM ~
+dispatch pairs in both orders; the listing is the faithful product and the source's own
+states; a 300-state mutant and copy are decided and agree."""
 
 from __future__ import annotations
 

@@ -218,8 +218,8 @@ def check(
     such; otherwise it is run too, so a failing pair gets reachability's own verdict and
     counterexample. ``state_reach`` (default): on the split runs (FSM ~ FSM, FSM ~ dispatch
     tree) that run is ``reach.check_reachability``'s listing of the reachable states instead
-    of the frozen-copy spec (docs/nusmv.md, "Reachability from the listed states": a
-    1 000-state mutant in one forward search where the frozen copies gave up at ~100
+    of the frozen-copy spec (docs/nusmv.md, "Fifth round: reachability from the listed
+    states": a 1 000-state mutant in one forward search where the frozen copies gave up at ~100
     states); ``False``: the frozen-copy spec (kept for the benchmarks and the tests that
     compare the two). ``shared_search`` (default, with ``state_reach`` on the split runs):
     the invariants are checked on that listing's model in the same NuSMV run

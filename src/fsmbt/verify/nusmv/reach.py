@@ -1,5 +1,5 @@
-"""Reachability from one listing of the reachable states (docs/nusmv.md, "Reachability from
-the listed states").
+"""Reachability from one listing of the reachable states (docs/nusmv.md, "Fifth round:
+reachability from the listed states").
 
 The frozen-copy spec of ``specs.product`` (``EF(alone & s = ts) -> EF(faithful & s = ts)``)
 makes NuSMV's backward fixpoint a relation between every state and every frozen value: a
@@ -151,7 +151,7 @@ def invariants_and_listing(
     the ``INVARIANTS`` model's product) and the listing of its reachable states, from one
     build and one forward search (``runner.check_and_list``); and NuSMV's seconds. It replaces
     the separate invariants' run of ``check``'s split pairs: one build and one search fewer
-    (docs/nusmv.md, "Reachability from the listed states")."""
+    (docs/nusmv.md, "Fifth round: reachability from the listed states")."""
     src, res, inputs = context[0], context[1], context[4]
     specs = invariant_specs(src, res, list(inputs.to_id.values()))
     text, order = _text(context, specs, listing=True)
