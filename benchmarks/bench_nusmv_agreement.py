@@ -14,7 +14,8 @@ every other pair, against a mutant of the FSM (one transition retargeted); every
 puts the tree first (dispatch source, FSM result), so both orders are compared.
 A NuSMV run past ``--timeout`` wall seconds is counted as *gave up* (the native verdict stands,
 as with ``--engine both``), never as agreement. Prints one line per size (pairs, agree,
-disagree, gave up, NuSMV CPU seconds total and largest) and the totals; exit 1 on any
+disagree, gave up, NuSMV CPU seconds total and largest, and the largest wall seconds of one
+pair's ``check``, all its NuSMV runs, on the loaded machine) and the totals; exit 1 on any
 disagreement. CPU seconds come from ``RUSAGE_CHILDREN`` (independent of the machine's load).
 
 ``--style structured`` (the outcome pairing, docs/nusmv.md "The outcome pairing (structured
@@ -235,6 +236,7 @@ def main(argv: list[str] | None = None) -> int:
         return structured_main(args, sizes, rng)
     counts: dict[int, Counter[str]] = {n: Counter() for n in sizes}
     cpu: dict[int, list[float]] = {n: [] for n in sizes}
+    wall: dict[int, list[float]] = {n: [] for n in sizes}  # every NuSMV run of a pair, wall s
     started = time.perf_counter()
     for index in range(args.pairs):
         size = sizes[index % len(sizes)]
@@ -246,7 +248,7 @@ def main(argv: list[str] | None = None) -> int:
             slot = index if args.style == "fsm" else index + index // len(sizes)
             source, result, kind = pair(slot, size, rng, args.style)
         native = verify(source, result)
-        before = child_cpu()
+        before, begun = child_cpu(), time.perf_counter()
         try:
             report = nusmv.check(source, result)
         except NuSMVLimitError:
@@ -254,6 +256,7 @@ def main(argv: list[str] | None = None) -> int:
             continue
         finally:
             cpu[size].append(child_cpu() - before)
+            wall[size].append(time.perf_counter() - begun)
         same = report.verdicts() == native.verdicts()
         counts[size]["agree" if same else "disagree"] += 1
         counts[size][f"{kind} {'equivalent' if native.equivalent else 'failing'}"] += 1
@@ -265,7 +268,7 @@ def main(argv: list[str] | None = None) -> int:
             )
     header = (
         f"{'states':>6} {'pairs':>6} {'agree':>6} {'disagree':>8} {'gave up':>7} "
-        f"{'equiv.':>6} {'failing':>7} {'CPU s':>8} {'max s':>7}"
+        f"{'equiv.':>6} {'failing':>7} {'CPU s':>8} {'max s':>7} {'wall s':>7}"
     )
     print(header)
     print("-" * len(header))
@@ -278,7 +281,8 @@ def main(argv: list[str] | None = None) -> int:
         failing = c["copy failing"] + c["mutant failing"]
         print(
             f"{n:>6} {pairs:>6} {c['agree']:>6} {c['disagree']:>8} {c['gave up']:>7} "
-            f"{equivalent:>6} {failing:>7} {sum(cpu[n]):>8.1f} {max(cpu[n], default=0):>7.2f}"
+            f"{equivalent:>6} {failing:>7} {sum(cpu[n]):>8.1f} {max(cpu[n], default=0):>7.2f} "
+            f"{max(wall[n], default=0):>7.2f}"
         )
     print(
         f"total ({args.style}): {args.pairs} pairs, {total['agree']} agree, {total['disagree']} disagree, "

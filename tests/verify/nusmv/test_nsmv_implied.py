@@ -1,7 +1,9 @@
 """NuSMV's reachability implied by the other four properties (docs/nusmv.md, "Reachability
-implied") and the two runs (docs/nusmv.md, "Two runs"): on an equivalent pair the invariants' run
-and the CTL run without the reachability spec; a failing pair also gets the reachability spec's
-own run; every way gives the verdicts of one run of every spec and of the native checker."""
+implied") and the two runs (docs/nusmv.md, "Two runs"): on an equivalent pair without the
+shared search, the invariants' run and the CTL run without the reachability spec; with it (the
+default for FSM pairs), the invariants and the listing of the reachable states in one run and
+the CTL run; a failing pair also gets the listing (or the witness runs); every way gives the
+verdicts of one run of every spec and of the native checker."""
 
 from __future__ import annotations
 
@@ -10,6 +12,7 @@ from pathlib import Path
 
 from fsmbt import api
 from fsmbt.verify import nusmv, verify
+from fsmbt.verify.nusmv import reach
 from fsmbt.verify.report import REACHABILITY
 
 EXAMPLE = Path(__file__).resolve().parents[3] / "examples" / "guard_npc.csv"
@@ -18,12 +21,15 @@ EXAMPLE = Path(__file__).resolve().parents[3] / "examples" / "guard_npc.csv"
 def test_equivalent_pair_skips_the_reachability_spec(nusmv_binary, monkeypatch) -> None:
     monkeypatch.setenv("FSMBT_NUSMV", str(nusmv_binary))
     fsm = api.load(EXAMPLE).model
-    report = nusmv.check(fsm, copy.deepcopy(fsm))
+    report = nusmv.check(fsm, copy.deepcopy(fsm), shared_search=False)
     assert report.equivalent and report.stats["nusmv_runs"] == 2
     assert report.properties[REACHABILITY].detail == nusmv.IMPLIED_DETAIL
+    shared = nusmv.check(fsm, copy.deepcopy(fsm))  # reachability read off the listing
+    assert shared.equivalent and shared.stats["nusmv_runs"] == 2
+    assert shared.properties[REACHABILITY].detail == reach.STATES_DETAIL
     whole = nusmv.check(fsm, copy.deepcopy(fsm), implied_reachability=False, split=False)
     assert whole.stats["nusmv_runs"] == 1
-    assert whole.verdicts() == report.verdicts()
+    assert whole.verdicts() == report.verdicts() == shared.verdicts()
 
 
 def test_failing_pairs_get_every_spec_verdict(nusmv_binary, monkeypatch) -> None:
@@ -38,12 +44,15 @@ def test_failing_pairs_get_every_spec_verdict(nusmv_binary, monkeypatch) -> None
         native = verify(fsm, mutant)
         if native.equivalent:
             continue
-        report = nusmv.check(fsm, mutant)
-        # two runs, then reachability state by state: one or two runs when it holds, four
-        # when it fails (the two kinds of invariants, the witness, its replay; docs/nusmv.md)
+        report = nusmv.check(fsm, mutant, shared_search=False)
+        # two runs, then reachability from the listed states: one run when it holds, three
+        # when it fails (the listing, the witness, its replay; docs/nusmv.md)
         reached = report.properties[REACHABILITY].holds
-        assert report.stats["nusmv_runs"] in ((3, 4) if reached else (6,))
+        assert report.stats["nusmv_runs"] == (3 if reached else 5)
         assert report.verdicts() == native.verdicts()
+        shared = nusmv.check(fsm, mutant)  # the invariants and the listing in one run
+        assert shared.stats["nusmv_runs"] == (2 if reached else 4)
+        assert shared.verdicts() == native.verdicts()
         whole = nusmv.check(fsm, mutant, implied_reachability=False, split=False)
         assert report.verdicts() == whole.verdicts()
         compared += 1

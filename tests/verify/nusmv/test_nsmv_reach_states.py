@@ -1,8 +1,10 @@
-"""Reachability decided state by state (docs/nusmv.md, "Reachability state by state";
-``fsmbt.verify.nusmv.reach``): on seeded FSM ~ FSM mutants it gives the verdict of the
-frozen-copy spec it replaces and of the native checker, names the same unmatched states as the
-native checker, and its witness is as short as the native one and replays (on the native
-machines) to a real difference; a 300-state mutant and copy are decided and agree."""
+"""Reachability from NuSMV's listing of the reachable states (docs/nusmv.md, "Fifth round:
+reachability from the listed states"; ``fsmbt.verify.nusmv.reach``): on seeded FSM ~ FSM
+mutants it gives the verdict of the frozen-copy spec it replaces and of the native checker,
+names the same unmatched states as the native checker, and its witness is as short as the
+native one and replays (on the native machines) to a real difference; so do failing FSM ~
+dispatch pairs in both orders; the listing is the faithful product and the source's own
+states; a 300-state mutant and copy are decided and agree."""
 
 from __future__ import annotations
 
@@ -16,7 +18,8 @@ from fsmbt.model.fsm import FSM, State
 from fsmbt.verify import nusmv, verify
 from fsmbt.verify.native import replay
 from fsmbt.verify.nusmv import reach
-from fsmbt.verify.nusmv.specs import REACH, product, state_reach_specs
+from fsmbt.verify.nusmv.runner import list_reachable
+from fsmbt.verify.nusmv.specs import REACH, SEEN, product
 from fsmbt.verify.pairing import machines_for
 from fsmbt.verify.report import REACHABILITY
 
@@ -68,12 +71,12 @@ def test_state_by_state_agrees_with_frozen_copies_and_native(nusmv_binary, monke
         assert new.verdicts() == old.verdicts() == native.verdicts()
         ours, theirs = new.properties[REACHABILITY], native.properties[REACHABILITY]
         if ours.holds:
-            # the faithful invariants, and the alone ones when some state is not in F
-            assert ours.detail == reach.STATES_DETAIL and new.stats["nusmv_runs"] in (3, 4)
+            # the invariants with the listing of the reachable states, the CTL run
+            assert ours.detail == reach.STATES_DETAIL and new.stats["nusmv_runs"] == 2
             continue
         unreached += 1
-        # two, the faithful and the alone invariants, the witness and its replay
-        assert new.stats["nusmv_runs"] == 6
+        # the invariants with the listing, the CTL run, the witness and its replay
+        assert new.stats["nusmv_runs"] == 4
         count, names = _named(ours.detail)
         native_count, native_names = _named(theirs.detail)
         assert count == native_count
@@ -103,22 +106,52 @@ def test_start_pair_disagreeing_gives_an_empty_witness(nusmv_binary, monkeypatch
     assert (trace[0].source_outputs, trace[0].result_outputs) == (["hello"], ["bye"])
 
 
-def test_one_invariant_per_state_and_no_frozen_copy() -> None:
-    """The REACH model lists every state of both machines once per kind (``only`` keeps the
-    states asked for) and keeps no frozen copy."""
-    source = random_fsm(3, n_states=6)
-    src_enc, res_enc, inputs, _outputs, _mode = nusmv.encode(source, copy.deepcopy(source))
+def test_the_listing_is_every_reachable_state_classified_by_nusmv(nusmv_binary, monkeypatch):
+    """The ``REACH`` model keeps no frozen copy and no CTL; NuSMV lists its reachable states
+    with ``seen``: the listed ``fa`` states are exactly the faithful product's pairs and the
+    ``sa`` states exactly the source's own states, both found here by walking the two FSMs
+    (an explicit search independent of NuSMV and of the native checker's product)."""
+    monkeypatch.setenv("FSMBT_NUSMV", str(nusmv_binary))
+    rng = random.Random(SEED + 1)
+    source = random_fsm(rng.randrange(10**9), n_states=7)
+    mutant = _mutant(source, rng)
+    src_enc, res_enc, inputs, _outputs, _mode = nusmv.encode(source, mutant)
     src, res = src_enc.encode(), res_enc.encode()
-    specs = state_reach_specs(src, res)
-    asked = res.id_values[1:3]
-    alone = state_reach_specs(src, res, "alone", only={"r": asked})
-    assert specs is not None and alone is not None
-    assert len(specs) == len(src_enc.states.to_id) + len(res_enc.states.to_id)
-    assert [name for name, _f in alone] == [f"alone:r:{v}" for v in asked]
-    prod = product(src, res, inputs, part=REACH, reach_specs=specs)
+    prod = product(src, res, inputs, part=REACH, listing=True)
     assert re.search(r"\b(ts|tr)_\w+", prod.text) is None  # no frozen copy
-    assert re.search(r"\b(EF|AG|EX)\b", prod.text) is None  # invariants only
-    assert prod.text.count("INVARSPEC") == len(specs) == len(prod.spec_names)
+    assert re.search(r"\b(EF|AG|EX)\b", prod.text) is None and "INVARSPEC" not in prod.text
+    states, _seconds = list_reachable(src.text + "\n" + res.text + "\n" + prod.text)
+    code = {name: code for code, name in src_enc.codes.to_name.items()}
+    rcode = {name: code for code, name in res_enc.codes.to_name.items()}
+    faithful = {(st["s.q"], st["r.q"]) for st in states if st[SEEN] == "fa"}
+    alone = {st["s.q"] for st in states if st[SEEN] == "sa"}
+    # the faithful product and the source's own states by the interpreter's machines
+    s_m, r_m, _mode = machines_for(source, mutant)
+    (s0, s_out), (r0, r_out) = s_m.start(), r_m.start()
+
+    def agree(a: str, b: str, a_out: tuple, b_out: tuple) -> bool:
+        return a_out == b_out and s_m.status(a) == r_m.status(b)
+
+    pairs: set[tuple[str, str]] = set()
+    todo = [(s0, r0)] if agree(s0, r0, s_out, r_out) else []
+    while todo:
+        a, b = todo.pop()
+        if (a, b) in pairs:
+            continue
+        pairs.add((a, b))
+        for event in set(s_m.inputs(a)) & set(r_m.inputs(b)):
+            (u, u_out), (w, w_out) = s_m.step(a, event), r_m.step(b, event)
+            if agree(u, w, u_out, w_out):
+                todo.append((u, w))
+    assert len(pairs) > 1 and faithful == {(code[a], rcode[b]) for a, b in pairs}
+    own: set[str] = set()
+    todo_s = [s0]
+    while todo_s:
+        a = todo_s.pop()
+        if a not in own:
+            own.add(a)
+            todo_s += [s_m.step(a, event)[0] for event in s_m.inputs(a)]
+    assert len(own) > 1 and alone == {code[a] for a in own}
 
 
 def test_300_states_copy_and_mutant_are_decided_and_agree(nusmv_binary, monkeypatch) -> None:
@@ -168,3 +201,40 @@ def test_one_state_machines_use_a_one_bit_word(nusmv_binary, monkeypatch) -> Non
         report = nusmv.check(a, result)
         assert report.verdicts() == verify(a, result).verdicts()
     assert _named(report.properties[REACHABILITY].detail) == (1, {"X"})
+
+
+def test_dispatch_pairs_failing_reachability_get_a_replayed_witness(
+    nusmv_binary, monkeypatch
+) -> None:
+    """FSM ~ dispatch tree pairs (both orders) leave the frozen-copy spec too: a mutant of the
+    FSM against the original's tree whose reachability fails gets the native verdict from the
+    listing, a witness as short as the native one that replays on the native machines to a
+    real difference, and the FSM side's unmatched states named as the native checker names
+    them."""
+    from fsmbt.convert import convert
+
+    monkeypatch.setenv("FSMBT_NUSMV", str(nusmv_binary))
+    rng = random.Random(SEED + 2)
+    failing = {"fsm first": 0, "tree first": 0}
+    for _ in range(40):
+        source = random_fsm(rng.randrange(10**9), n_states=rng.randint(4, 12))
+        tree = convert(source, style="dispatch").model
+        mutant = _mutant(source, rng)
+        for a, b in ((mutant, tree), (tree, mutant)):
+            native = verify(a, b)
+            ours = nusmv.check(a, b)
+            assert ours.verdicts() == native.verdicts()
+            mine, theirs = ours.properties[REACHABILITY], native.properties[REACHABILITY]
+            if mine.holds:
+                continue
+            failing["fsm first" if a is mutant else "tree first"] += 1
+            assert ours.stats["nusmv_runs"] == 4  # listing with invariants, CTL, witness x2
+            if a is mutant:  # the FSM is the source: its unmatched states, by name
+                (count, names), (native_count, native_names) = map(
+                    _named, (mine.detail, theirs.detail)
+                )
+                assert count == native_count and (count > 5 or names == native_names)
+            _check_witness(a, b, theirs.counterexample or [], mine.counterexample or [])
+        if min(failing.values()) >= 2:
+            break
+    assert min(failing.values()) >= 2, failing  # the failing verdict, in both orders

@@ -193,6 +193,7 @@ def check(
     outcomes: OutcomeRules | None = None,
     outcome_driven: bool = False,
     state_reach: bool = True,
+    shared_search: bool = True,
 ) -> Report:
     """Verify ``result_model`` against ``source_model`` with NuSMV; see the module docstring.
 
@@ -215,11 +216,16 @@ def check(
     closure, the costliest spec) is left out at first; when the other four properties hold,
     reachability follows from them (docs/nusmv.md, "Reachability implied") and is reported as
     such; otherwise it is run too, so a failing pair gets reachability's own verdict and
-    counterexample. ``state_reach`` (default): on the split runs, when both machines' states
-    are one enumerated variable (FSM ~ FSM), that run is ``reach.check_reachability``'s
-    invariants per state instead of the frozen-copy spec (docs/nusmv.md, "Reachability state
-    by state": a 1 000-state mutant in seconds where the frozen copies gave up); ``False``:
-    the frozen-copy spec (kept for the benchmarks and the tests that compare the two).
+    counterexample. ``state_reach`` (default): on the split runs (FSM ~ FSM, FSM ~ dispatch
+    tree) that run is ``reach.check_reachability``'s listing of the reachable states instead
+    of the frozen-copy spec (docs/nusmv.md, "Fifth round: reachability from the listed
+    states": a 1 000-state mutant in one forward search where the frozen copies gave up at ~100
+    states); ``False``: the frozen-copy spec (kept for the benchmarks and the tests that
+    compare the two). ``shared_search`` (default, with ``state_reach`` on the split runs):
+    the invariants are checked on that listing's model in the same NuSMV run
+    (``reach.invariants_and_listing``: one build and one forward search for both, and
+    reachability decided directly rather than implied; docs/nusmv.md); ``False``: the
+    invariants' own run first, the listing only for a failing pair.
 
     ``timeout`` defaults to ``fsmbt.limits.current().nusmv_max_seconds`` (per NuSMV run); the
     memory cap is ``nusmv_max_memory_mb``. Raises ``UnsupportedError`` for BT node types the
@@ -247,9 +253,23 @@ def check(
     runs, nusmv_seconds = 0, 0.0
     # the reachability run, if needed: text, spec names, options, variable order
     deferred: tuple[str, list[str], list[str], str] | None = None
+    # the split pairs' invariants and reachability listing in one run (``reach``)
+    listed: list[dict[str, str]] | None = None
+    shared = split and state_reach and shared_search and reach.applies(context)
     for part, (text, part_names, part_context) in zip(parts, models):
+        if shared and part == INVARIANTS:
+            part_names, found, listed, seconds = reach.invariants_and_listing(
+                context, timeout=timeout
+            )
+            names += part_names
+            results += found
+            runs += 1
+            nusmv_seconds += seconds
+            continue
         options = ["-df"] if part == CTL else []
-        lean = without_spec(text, part_names, REACHABILITY) if implied_reachability else None
+        lean = (
+            without_spec(text, part_names, REACHABILITY) if implied_reachability or shared else None
+        )
         if lean is not None:
             deferred = (text, part_names, options, part_context[-1])
             text, part_names = lean
@@ -277,12 +297,18 @@ def check(
             nusmv_seconds += seconds
             if not found[0].holds:
                 raise tree.livelock_failure()
-    if deferred is not None:
+    if listed is not None:  # reachability from the shared run's listing
+        verdict, more_runs, seconds = reach.verdict(context, listed, timeout=timeout)
+        runs += more_runs
+        nusmv_seconds += seconds
+        report.properties[REACHABILITY] = verdict
+        report.properties = {n: report.properties[n] for n in PROPERTIES}
+    elif deferred is not None:
         if all(p.holds for p in report.properties.values()):
             report.properties[REACHABILITY] = PropertyResult(REACHABILITY, True, IMPLIED_DETAIL)
         elif (
             split and state_reach and reach.applies(context)
-        ):  # a failing pair of FSMs: state by state
+        ):  # a failing split pair: from the listed reachable states
             verdict, more_runs, seconds = reach.check_reachability(context, timeout=timeout)
             runs += more_runs
             nusmv_seconds += seconds

@@ -1,112 +1,133 @@
-"""Reachability decided state by state (docs/nusmv.md, "Reachability state by state").
+"""Reachability from one listing of the reachable states (docs/nusmv.md, "Fifth round:
+reachability from the listed states").
 
 The frozen-copy spec of ``specs.product`` (``EF(alone & s = ts) -> EF(faithful & s = ts)``)
 makes NuSMV's backward fixpoint a relation between every state and every frozen value: a
-transitive closure, past 60 s from ~300 states on. When each machine's state is one
-enumerated variable (an FSM's ``q``), reachability (docs/verification.md, section 2: every
-state a machine reaches on its own occurs in a pair of the faithful product ``F``) is instead
-decided by invariants per state on the ``REACH`` model (``specs.state_reach_specs``), each
-run checking them on the reachable states of one forward search (``-dcx``: no traces):
-first ``!(faithful & q = v)`` for every state ``v`` (it holds iff no pair of F has ``v``);
-then, only for those states, ``!(alone & q = v)`` (it fails iff the machine reaches ``v`` on
-its own: ``v`` is unmatched). States of F are always reached alone, so an equivalent pair's
-states, and a failing pair's whose reachability holds, need no second run. When some state is
-unmatched, one invariant over all of them has a counterexample NuSMV builds breadth first: a
-shortest path to an unmatched state in that machine alone; a last run replays its inputs on
-both machines, which gives the native checker's kind of witness (``native._reachability``).
+transitive closure, past 60 s from ~100 states on. For a pair whose machines take one step
+per input (FSM ~ FSM, FSM ~ dispatch tree: ``check``'s split runs), reachability
+(docs/verification.md, section 2: every state a machine reaches on its own occurs in a pair of
+the faithful product ``F``) is instead read off the ``REACH`` model (``specs.REACH``: the mode
+frozen at the start, so its reachable states are F plus each machine's own states, never their
+product): one NuSMV run lists every reachable state (``runner.list_reachable``) with the
+variable ``seen`` NuSMV assigns (``fa``: a pair of F; ``sa``/``ra``: that machine alone and
+stable). A machine's state is its identity variables' values (``Encoding.id_vars``: an FSM's
+``q``, a dispatch tree's written entries and ``fin``); a state listed alone and never in an
+``fa`` state is unmatched. Only set membership is computed here; which states are reached,
+and which pairs are faithful, is NuSMV's.
+
+When some state is unmatched, one invariant over all of them has a counterexample NuSMV builds
+breadth first: a shortest path to an unmatched state in that machine alone; a last run replays
+its inputs on both machines, which gives the native checker's kind of witness
+(``native._reachability``). So a pair whose reachability holds costs one run, a failing one
+three.
+
+(The version before listed nothing: one invariant per state and kind, ``!(faithful & s.q =
+v)`` then ``!(alone & s.q = v)``, ~23 ms each on NuSMV's side - 2 000 of them were most of a
+1 000-state mutant's 73 s - and only for an FSM's one enumerated ``q``.)
 """
 
 from __future__ import annotations
 
-from fsmbt.verify.nusmv.runner import SpecResult, run_nusmv
-from fsmbt.verify.nusmv.smv import any_of
-from fsmbt.verify.nusmv.specs import REACH, enumerated_identity, product, state_reach_specs
+from fsmbt.verify.nusmv.encode_fsm import Encoding
+from fsmbt.verify.nusmv.runner import SpecResult, check_and_list, list_reachable, run_nusmv
+from fsmbt.verify.nusmv.smv import all_of, any_of
+from fsmbt.verify.nusmv.specs import REACH, SEEN, invariant_specs, product
 from fsmbt.verify.nusmv.traces import Context, alone_go, decode_trace
 from fsmbt.verify.report import REACHABILITY, PropertyResult, TraceStep
 
-#: The detail of a holding verdict decided state by state.
+#: The detail of a holding verdict decided from the listing.
 STATES_DETAIL = (
-    "every state reachable alone is reached with matching behaviour (one NuSMV invariant per state)"
+    "every state reachable alone is reached with matching behaviour "
+    "(NuSMV's listing of the reachable states)"
 )
 _NAMES_SHOWN = 5
 
+#: A machine's state in the listing: its identity variables' values, in ``id_vars`` order.
+Key = tuple[str, ...]
+
 
 def applies(context: Context) -> bool:
-    """Whether the pair's reachability can be decided state by state (both identities, or the
-    source's for a result that follows the environment, are one variable whose values the
-    encoder lists: an FSM's ``q``)."""
-    return state_reach_specs(context[0], context[1]) is not None
+    """Whether both machines name their identity variables (every encoder does; ``check``
+    asks only for the split pairs, whose modules take one step per input)."""
+    return bool(context[0].id_vars) and bool(context[1].id_vars)
+
+
+def _sides(context: Context) -> list[tuple[str, str, Encoding]]:
+    """(prefix, alone mode, encoding) of each machine whose reachability counts: the
+    result's not when it follows the environment (its inputs are not the environment's)."""
+    src, res = context[0], context[1]
+    return [("s", "sa", src)] + ([] if res.follows else [("r", "ra", res)])
 
 
 def _text(
     context: Context,
     specs: list[tuple[str, str]],
     replay: tuple[str, list[str]] | None = None,
+    *,
+    listing: bool = False,
 ) -> tuple[str, str]:
     src, res, inputs = context[0], context[1], context[4]
-    prod = product(src, res, inputs, part=REACH, reach_specs=specs, replay=replay)
+    prod = product(src, res, inputs, part=REACH, reach_specs=specs, replay=replay, listing=listing)
     return src.text + "\n" + res.text + "\n" + prod.text, prod.order
 
 
-def holding(specs: list[tuple[str, str]], results: list[SpecResult]) -> dict[str, list[str]]:
-    """Per side (``s``, ``r``), the states whose invariant in ``specs`` holds (for the
-    ``faithful`` ones: the states no pair of F has; for the ``alone`` ones: the states the
-    machine never reaches alone), in the order of the enumeration."""
-    found: dict[str, list[str]] = {}
-    for (name, _formula), result in zip(specs, results):
-        _kind, side, value = name.split(":", 2)
-        if result.holds:
-            found.setdefault(side, []).append(value)
-    return found
+def _key(state: dict[str, str], side: str, enc: Encoding) -> Key:
+    return tuple(state.get(f"{side}.{var}", "?") for var, _typ in enc.id_vars)
 
 
-def unmatched_states(
-    candidates: dict[str, list[str]], specs: list[tuple[str, str]], results: list[SpecResult]
-) -> dict[str, list[str]]:
-    """The ``candidates`` (states no pair of F has) that the ``alone`` invariants ``specs``
-    show reached alone: the unmatched states, per side, in the order of the enumeration."""
-    unreached = holding(specs, results)
-    unmatched: dict[str, list[str]] = {}
-    for side, values in candidates.items():
-        never = set(unreached.get(side, ()))
-        missing = [v for v in values if v not in never]
+def unmatched_states(context: Context, states: list[dict[str, str]]) -> dict[str, list[Key]]:
+    """Per side (``s``, ``r``), the states listed alone (``seen`` = ``sa``/``ra``) that no
+    listed pair of F (``seen = fa``) has: the unmatched states. Order: an FSM's by its state
+    table (``Encoding.id_values``), any other's as NuSMV listed them. O(listed states)."""
+    unmatched: dict[str, list[Key]] = {}
+    for side, mode, enc in _sides(context):
+        matched = {_key(st, side, enc) for st in states if st.get(SEEN) == "fa"}
+        alone: dict[Key, None] = {}
+        for st in states:
+            if st.get(SEEN) == mode:
+                alone.setdefault(_key(st, side, enc), None)
+        missing = [key for key in alone if key not in matched]
+        if enc.id_values and len(enc.id_vars) == 1:
+            rank = {value: i for i, value in enumerate(enc.id_values)}
+            missing.sort(key=lambda key: rank.get(key[0], len(rank)))
         if missing:
             unmatched[side] = missing
     return unmatched
 
 
-def _target(context: Context, unmatched: dict[str, list[str]]) -> str:
+def _target(context: Context, unmatched: dict[str, list[Key]]) -> str:
     """``!(alone at an unmatched state)``: its counterexample is the witness."""
     parts = []
-    for side, mode, enc in (("s", "sa", context[0]), ("r", "ra", context[1])):
-        values = unmatched.get(side)
-        if not values:
+    for side, mode, enc in _sides(context):
+        keys = unmatched.get(side)
+        if not keys:
             continue
-        ident = enumerated_identity(enc)
-        assert ident is not None
-        var = ident[0]
-        states = any_of(f"{side}.{var} = {v}" for v in values)
+        names = [var for var, _typ in enc.id_vars]
+        states = any_of(
+            all_of(f"{side}.{var} = {value}" for var, value in zip(names, key)) for key in keys
+        )
         parts.append(f"(mode = {mode} & {side}.stable & {states})")
     return f"!{any_of(parts)}"
 
 
-def _detail(context: Context, unmatched: dict[str, list[str]]) -> str:
+def _detail(context: Context, unmatched: dict[str, list[Key]]) -> str:
     """The native checker's words (``native._reachability``), the states named in the
-    order of the encoding (the native checker names them in breadth-first order)."""
+    order of ``unmatched_states`` (the native checker names them in breadth-first order)."""
     parts = []
-    for side, words in (
-        ("s", "source state(s) never reached with matching behaviour"),
-        ("r", "result state(s) reachable only through behaviour the source does not have"),
-    ):
-        values = unmatched.get(side)
-        if not values:
+    words = {
+        "s": "source state(s) never reached with matching behaviour",
+        "r": "result state(s) reachable only through behaviour the source does not have",
+    }
+    for side, _mode, enc in _sides(context):
+        keys = unmatched.get(side)
+        if not keys:
             continue
-        enc = context[0] if side == "s" else context[1]
-        ident = enumerated_identity(enc)
-        assert ident is not None
-        names = [enc.decode_state({ident[0]: v}) for v in values]
-        shown = ", ".join(names[:_NAMES_SHOWN]) + (", ..." if len(names) > _NAMES_SHOWN else "")
-        parts.append(f"{len(values)} {words}: {shown}")
+        names: dict[str, None] = {}
+        for key in keys:
+            names.setdefault(enc.decode_state(dict(zip((v for v, _ in enc.id_vars), key))))
+        listed = list(names)
+        shown = ", ".join(listed[:_NAMES_SHOWN]) + (", ..." if len(listed) > _NAMES_SHOWN else "")
+        parts.append(f"{len(keys)} {words[side]}: {shown}")
     return "; ".join(parts)
 
 
@@ -114,38 +135,46 @@ def check_reachability(
     context: Context, *, timeout: float | None
 ) -> tuple[PropertyResult, int, float]:
     """Reachability's verdict (with its witness when it fails), the number of NuSMV runs and
-    their seconds. ``context`` must satisfy ``applies``. Runs: the ``faithful`` invariant of
-    every state (a forward search of the ``REACH`` model - F plus each machine's own states -
-    and S + R checks); when some states are not in F, their ``alone`` invariants (a second
-    run); when some of those are reached alone (reachability fails), the witness: a forward
-    search to the nearest one and its replayed path (two more runs)."""
-    src, res = context[0], context[1]
-    specs = state_reach_specs(src, res, "faithful")
-    assert specs is not None
-    text, order = _text(context, specs)
-    results, seconds = run_nusmv(
-        text, len(specs), order=order, timeout=timeout, options=["-dcx"], mono=False
-    )
-    candidates = holding(specs, results)  # never in F: unmatched if reached alone
-    if not candidates:
-        return PropertyResult(REACHABILITY, True, STATES_DETAIL), 1, seconds
-    specs = state_reach_specs(src, res, "alone", only=candidates)
-    assert specs is not None
-    text, order = _text(context, specs)
-    results, more = run_nusmv(
-        text, len(specs), order=order, timeout=timeout, options=["-dcx"], mono=False
-    )
-    seconds += more
-    unmatched = unmatched_states(candidates, specs, results)
+    their seconds. ``context`` must satisfy ``applies``. Runs: the listing of the ``REACH``
+    model's reachable states (one forward search), then ``verdict``'s."""
+    text, order = _text(context, [], listing=True)
+    states, seconds = list_reachable(text, order=order, timeout=timeout)
+    result, runs, more = verdict(context, states, timeout=timeout)
+    return result, runs + 1, seconds + more
+
+
+def invariants_and_listing(
+    context: Context, *, timeout: float | None
+) -> tuple[list[str], list[SpecResult], list[dict[str, str]], float]:
+    """One NuSMV run on the ``REACH`` model: the three invariants of ``specs.invariant_specs``
+    (their names, verdicts and counterexamples: shortest paths in the attached mode, which is
+    the ``INVARIANTS`` model's product) and the listing of its reachable states, from one
+    build and one forward search (``runner.check_and_list``); and NuSMV's seconds. It replaces
+    the separate invariants' run of ``check``'s split pairs: one build and one search fewer
+    (docs/nusmv.md, "Fifth round: reachability from the listed states")."""
+    src, res, inputs = context[0], context[1], context[4]
+    specs = invariant_specs(src, res, list(inputs.to_id.values()))
+    text, order = _text(context, specs, listing=True)
+    results, states, seconds = check_and_list(text, len(specs), order=order, timeout=timeout)
+    return [name for name, _formula in specs], results, states, seconds
+
+
+def verdict(
+    context: Context, states: list[dict[str, str]], *, timeout: float | None
+) -> tuple[PropertyResult, int, float]:
+    """Reachability's verdict from the listed ``states``, the number of further NuSMV runs and
+    their seconds: none when every state reached alone is matched; else the witness, a forward
+    search to the nearest unmatched state and its replayed path (two runs)."""
+    unmatched = unmatched_states(context, states)
     if not unmatched:
-        return PropertyResult(REACHABILITY, True, STATES_DETAIL), 2, seconds
-    trace, more = _witness(context, unmatched, timeout=timeout)
+        return PropertyResult(REACHABILITY, True, STATES_DETAIL), 0, 0.0
+    trace, seconds = _witness(context, unmatched, timeout=timeout)
     result = PropertyResult(REACHABILITY, False, _detail(context, unmatched), trace or None)
-    return result, 4, seconds + more
+    return result, 2, seconds
 
 
 def _witness(
-    context: Context, unmatched: dict[str, list[str]], *, timeout: float | None
+    context: Context, unmatched: dict[str, list[Key]], *, timeout: float | None
 ) -> tuple[list[TraceStep], float]:
     """The witness, in two runs: a shortest path to an unmatched state in the machine that
     reaches it alone (the other frozen at its start: NuSMV's breadth-first counterexample of

@@ -147,6 +147,34 @@ def run_nusmv(
         NuSMVLimitError: past the time or the memory cap.
         NuSMVError: NuSMV failed otherwise (a bug in the encoding).
     """
+    command = [*(["-mono"] if mono else []), *options]
+    proc, elapsed = _execute(model, command, order, timeout, memory_mb, keep=keep)
+    results = parse_output(proc.stdout)
+    if (proc.returncode != 0 or len(results) != expected_specs) and _out_of_memory(proc):
+        cap = limits.current().nusmv_max_memory_mb if memory_mb is None else memory_mb
+        raise NuSMVLimitError("memory", count_variables(model), "nusmv_max_memory_mb", cap)
+    if proc.returncode != 0 or len(results) != expected_specs:
+        tail = (proc.stderr or proc.stdout).strip().splitlines()[-8:]
+        raise NuSMVError(
+            f"NuSMV failed (exit {proc.returncode}, {len(results)} of "
+            f"{expected_specs} specs answered): " + " | ".join(tail)
+        )
+    return results, elapsed
+
+
+def _execute(
+    model: str,
+    options: Sequence[str],
+    order: str | None,
+    timeout: float | None,
+    memory_mb: int | None,
+    *,
+    keep: str | None = None,
+    script: str | None = None,
+) -> tuple[subprocess.CompletedProcess[str], float]:
+    """One NuSMV child on ``model`` under the caps (see ``run_nusmv``): its finished process
+    and wall seconds. ``script``: NuSMV commands run by ``-source`` instead of the batch mode
+    (the model is still NuSMV's input file; no standard input, so an aborted script ends)."""
     import time
 
     caps = limits.current()
@@ -160,18 +188,23 @@ def run_nusmv(
         if keep:
             with open(keep, "w", encoding="utf-8") as handle:
                 handle.write(model)
-        # -mono: one monolithic transition relation (see ``mono``)
-        command = [str(binary), *(["-mono"] if mono else []), *options]
+        command = [str(binary), *options]
         if order:
             order_path = os.path.join(tmp, "product.ord")
             with open(order_path, "w", encoding="utf-8") as handle:
                 handle.write(order)
             command += ["-i", order_path]
+        if script is not None:
+            script_path = os.path.join(tmp, "commands.txt")
+            with open(script_path, "w", encoding="utf-8") as handle:
+                handle.write(script)
+            command += ["-source", script_path]
         started = time.perf_counter()
         try:
             proc = subprocess.run(
                 command + [path],
                 capture_output=True,
+                stdin=subprocess.DEVNULL,
                 text=True,
                 encoding="utf-8",
                 errors="replace",
@@ -184,18 +217,95 @@ def run_nusmv(
                 "time", count_variables(model), "nusmv_max_seconds", timeout
             ) from None
         elapsed = time.perf_counter() - started
-    results = parse_output(proc.stdout)
     if proc.returncode == -signal.SIGXCPU:  # the CPU backstop of bounded_child
         raise NuSMVLimitError("time", count_variables(model), "nusmv_max_seconds", timeout)
-    if (proc.returncode != 0 or len(results) != expected_specs) and _out_of_memory(proc):
-        raise NuSMVLimitError("memory", count_variables(model), "nusmv_max_memory_mb", memory_mb)
-    if proc.returncode != 0 or len(results) != expected_specs:
-        tail = (proc.stderr or proc.stdout).strip().splitlines()[-8:]
+    return proc, elapsed
+
+
+#: ``check_and_list``'s commands: build the model, one forward search, the invariants on its
+#: layers, then every reachable state.
+_LIST_SCRIPT = (
+    "read_model\nflatten_hierarchy\nencode_variables\nbuild_model\ncompute_reachable\n"
+    "{check}print_reachable_states -v\nquit\n"
+)
+_LISTING = re.compile(r"^#{20,}$", re.MULTILINE)
+_STATE_HEAD = re.compile(r"^-+ State\s+\d+ -+$")
+_REACHABLE = re.compile(r"^reachable states: (\S+) ")
+
+
+def list_reachable(
+    model: str,
+    *,
+    order: str | None = None,
+    timeout: float | None = None,
+    memory_mb: int | None = None,
+) -> tuple[list[dict[str, str]], float]:
+    """``check_and_list`` of a model without invariants: its reachable states and seconds."""
+    _results, states, elapsed = check_and_list(
+        model, 0, order=order, timeout=timeout, memory_mb=memory_mb
+    )
+    return states, elapsed
+
+
+def check_and_list(
+    model: str,
+    expected_specs: int,
+    *,
+    order: str | None = None,
+    timeout: float | None = None,
+    memory_mb: int | None = None,
+) -> tuple[list[SpecResult], list[dict[str, str]], float]:
+    """The ``INVARSPEC`` s of ``model`` (verdicts and counterexamples, as ``run_nusmv``; there
+    must be ``expected_specs`` of them and no other spec), then every reachable state (its
+    state variables' values, as NuSMV prints them), from one build and one forward search
+    (``compute_reachable``, ``check_invar`` on its layers, ``print_reachable_states -v``), and
+    NuSMV's wall seconds.
+
+    Why: a question about the *set* of reachable states (``fsmbt.verify.nusmv.reach``: which
+    states occur in the faithful product, which a machine reaches alone) is one listing,
+    where invariants cost one check each over the search's layers (~23 ms per invariant on a
+    1 000-state pair's model: 46 s for its 2 000 states, against 2.2 s to list its 6 009
+    reachable states; docs/nusmv.md); and the invariants that read the same model share its
+    build and search instead of a run of their own. Cost: the forward search plus O(states x
+    variables) printed lines, so it is meant for models whose reachable states number in the
+    thousands, not millions (the time cap bounds it). The count NuSMV states is checked
+    against the list.
+
+    Raises:
+        NuSMVLimitError: past the time or the memory cap.
+        NuSMVError: NuSMV failed (the script aborted, a verdict is missing, or the list is not
+            the stated count).
+    """
+    script = _LIST_SCRIPT.format(check="check_invar\n" if expected_specs else "")
+    options = [] if expected_specs else ["-dcx"]
+    proc, elapsed = _execute(model, options, order, timeout, memory_mb, script=script)
+    cut = _LISTING.search(proc.stdout)
+    head, tail = (proc.stdout[: cut.start()], proc.stdout[cut.start() :]) if cut else ("", "")
+    results = parse_output(head)
+    states: list[dict[str, str]] = []
+    stated: float | None = None
+    for line in tail.splitlines():
+        if _STATE_HEAD.match(line):
+            states.append({})
+            continue
+        found = _REACHABLE.match(line)
+        if found:
+            stated = float(found.group(1))
+            continue
+        assign = _ASSIGN.match(line)
+        if assign and states:
+            states[-1][assign.group(1)] = assign.group(2)
+    if stated is None or stated != len(states) or len(results) != expected_specs:
+        if _out_of_memory(proc):
+            cap = limits.current().nusmv_max_memory_mb if memory_mb is None else memory_mb
+            raise NuSMVLimitError("memory", count_variables(model), "nusmv_max_memory_mb", cap)
+        tail_lines = (proc.stderr or proc.stdout).strip().splitlines()[-8:]
         raise NuSMVError(
-            f"NuSMV failed (exit {proc.returncode}, {len(results)} of "
-            f"{expected_specs} specs answered): " + " | ".join(tail)
+            f"NuSMV did not check and list ({len(results)} of {expected_specs} specs answered, "
+            f"{len(states)} states listed of {stated}; exit {proc.returncode}): "
+            + " | ".join(tail_lines)
         )
-    return results, elapsed
+    return results, states, elapsed
 
 
 def parse_output(text: str) -> list[SpecResult]:

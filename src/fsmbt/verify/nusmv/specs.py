@@ -100,6 +100,7 @@ def product(
     part: str = WHOLE,
     reach_specs: list[tuple[str, str]] | None = None,
     replay: tuple[str, list[str]] | None = None,
+    listing: bool = False,
 ) -> Product:
     """The ``main`` module and the specs, in the order ``spec_names`` lists them.
 
@@ -112,10 +113,11 @@ def product(
     as ``AG``, for a run without the forward search (``-df``); ``REACH`` the product whose
     mode is frozen at the start (``att``: attached; ``sa``: the source runs alone on the
     inputs it offers while the result stays at its start; ``ra``: the roles swapped) with the
-    ``INVARSPEC`` s ``reach_specs`` (name, formula) only (``state_reach_specs``); with
+    ``INVARSPEC`` s ``reach_specs`` (name, formula) only; ``listing``: with the variable
+    ``SEEN`` that classifies each state for ``reach``'s listing of the reachable states; with
     ``replay`` (mode, input ids) the one path that replays a witness (``_reach_product``)."""
     if part == REACH:
-        return _reach_product(src, res, inputs, reach_specs or [], replay)
+        return _reach_product(src, res, inputs, reach_specs or [], replay, listing=listing)
     detach = part != INVARIANTS
     in_ids = list(inputs.to_id.values())
     in_enum, s_slots, r_slots, equal_outs, joint, alone_s, alone_r = _terms(src, res, in_ids)
@@ -176,8 +178,6 @@ def product(
         ]
     # CTL specs first, invariants after: NuSMV checks (and prints) them in that order.
     specs: list[tuple[str, str, str]] = []
-    offers_s_in_r = all_of(f"(s.offers_{i} -> r.offers_{i})" for i in in_ids)
-    offers_r_in_s = all_of(f"(r.offers_{i} -> s.offers_{i})" for i in in_ids)
     dead_s = "(!s.final & !(EX (mode = sa & EF s_obs)))"
     dead_r = "(!r.final & !(EX (mode = ra & EF r_obs)))"
     specs.append((DEADLOCK_ABSENCE, "SPEC", f"AG (faithful -> ({dead_s} <-> {dead_r}))"))
@@ -188,16 +188,7 @@ def product(
         reach += f" & ((EF (mode = ra & r.stable & {same_r})) -> (EF (faithful & {same_r})))"
     specs.append((REACHABILITY, "SPEC", reach))
     # invariants are checked by forward reachability: much cheaper than AG in CTL
-    compl = f"((!det & ok & both) -> {subsequence(s_slots, r_slots, NONE_OUT)})"
-    noadd = f"((!det & ok & both) -> {subsequence(r_slots, s_slots, NONE_OUT)})"
-    if not follows:
-        compl = f"{compl} & (faithful -> {offers_s_in_r})"
-        noadd = f"{noadd} & (faithful -> {offers_r_in_s})"
-    specs.append((COMPLETENESS, "INVARSPEC", compl))
-    specs.append((NO_ADDITIONAL_BEHAVIOR, "INVARSPEC", noadd))
-    specs.append(
-        (TERMINATION_CONSISTENCY, "INVARSPEC", "((!det & ok & both) -> (s.final <-> r.final))")
-    )
+    specs += [(name, "INVARSPEC", formula) for name, formula in invariant_specs(src, res, in_ids)]
     extra_kind = "INVARSPEC" if part == WHOLE else "SPEC AG"
     specs += [
         (name, extra_kind, formula if name in UNGUARDED_CHECKS else f"(ok -> {formula})")
@@ -211,6 +202,27 @@ def product(
         lines.append(f"{kind} {formula};")
     order = _order(src, res, copies=detach)
     return Product("\n".join(lines) + "\n", [name for name, _, _ in specs], order)
+
+
+def invariant_specs(src: Encoding, res: Encoding, in_ids: list[str]) -> list[tuple[str, str]]:
+    """Completeness, no additional behaviour and termination consistency as (name, invariant)
+    over the product's terms (``det``, ``ok``, ``both``, ``faithful``): true of every attached
+    pair (``!det``), so the same text holds on the ``INVARIANTS`` model and on the ``REACH``
+    model, whose alone modes are ``det``."""
+    s_slots = [f"s.{x}" for x in src.slots]
+    r_slots = [f"r.{x}" for x in res.slots]
+    compl = f"((!det & ok & both) -> {subsequence(s_slots, r_slots, NONE_OUT)})"
+    noadd = f"((!det & ok & both) -> {subsequence(r_slots, s_slots, NONE_OUT)})"
+    if not res.follows:
+        offers_s_in_r = all_of(f"(s.offers_{i} -> r.offers_{i})" for i in in_ids)
+        offers_r_in_s = all_of(f"(r.offers_{i} -> s.offers_{i})" for i in in_ids)
+        compl = f"{compl} & (faithful -> {offers_s_in_r})"
+        noadd = f"{noadd} & (faithful -> {offers_r_in_s})"
+    return [
+        (COMPLETENESS, compl),
+        (NO_ADDITIONAL_BEHAVIOR, noadd),
+        (TERMINATION_CONSISTENCY, "((!det & ok & both) -> (s.final <-> r.final))"),
+    ]
 
 
 def _order(src: Encoding, res: Encoding, *, copies: bool = True) -> str:
@@ -231,50 +243,10 @@ def _order(src: Encoding, res: Encoding, *, copies: bool = True) -> str:
     return "\n".join(order) + "\n"
 
 
-def enumerated_identity(enc: Encoding) -> tuple[str, list[str]] | None:
-    """The identity variable and its values when a machine's state is one variable whose
-    values the encoder lists (an FSM's ``q``: ``Encoding.id_values``), else ``None`` (a tree's
-    identity spans many variables: its states are not listed one by one; ``check`` keeps the
-    frozen-copy reachability spec for it)."""
-    if len(enc.id_vars) != 1 or not enc.id_values:
-        return None
-    return enc.id_vars[0][0], list(enc.id_values)
-
-
-def state_reach_specs(
-    src: Encoding,
-    res: Encoding,
-    kind: str = "faithful",
-    only: dict[str, list[str]] | None = None,
-) -> list[tuple[str, str]] | None:
-    """The ``REACH`` model's invariants, one per state of each machine whose reachability
-    counts (the result's not when it follows the environment), named ``<kind>:<side>:<value>``:
-    ``kind="faithful"``: ``INVARSPEC !(faithful & s.q = v)``, false iff ``v`` occurs in a pair
-    of the faithful product F; ``kind="alone"``: ``INVARSPEC !(mode = sa & s.stable & s.q =
-    v)``, false iff the machine reaches ``v`` on its own. ``only`` (side -> values) restricts
-    them to those states. Reachability (docs/verification.md, section 2) holds iff every state
-    reached alone occurs in F; every state of F is reached alone (an attached step takes an input
-    both offer), so only the states not in F need their ``alone`` invariant (``reach``).
-    ``None`` when a side's state is not one enumerated variable. Size: one line per state;
-    NuSMV checks each on the reachable states of one forward search (~13 ms each at 1 000
-    states: most of the run, docs/nusmv.md)."""
-    sides = [("s", "sa", src)] + ([] if res.follows else [("r", "ra", res)])
-    specs: list[tuple[str, str]] = []
-    for side, mode, enc in sides:
-        ident = enumerated_identity(enc)
-        if ident is None:
-            return None
-        var, values = ident
-        if only is not None:
-            asked = set(only.get(side, ()))
-            values = [v for v in values if v in asked]
-        for value in values:
-            if kind == "alone":
-                formula = f"!(mode = {mode} & {side}.stable & {side}.{var} = {value})"
-            else:
-                formula = f"!(faithful & {side}.{var} = {value})"
-            specs.append((f"{kind}:{side}:{value}", formula))
-    return specs
+#: The ``REACH`` model's listing variable (``_reach_product(..., listing=True)``): per
+#: reachable state, ``fa`` a pair of the faithful product F, ``sa``/``ra`` the source / the
+#: result stable while running alone, ``no`` anything else (a disagreeing pair, a micro-step).
+SEEN = "seen"
 
 
 def _reach_product(
@@ -283,6 +255,8 @@ def _reach_product(
     inputs: Symbols,
     reach_specs: list[tuple[str, str]],
     replay: tuple[str, list[str]] | None = None,
+    *,
+    listing: bool = False,
 ) -> Product:
     """The ``REACH`` model (see ``product``): the attached product of the other parts with
     the mode frozen at the start instead of a detach step. In ``sa`` the source runs alone from
@@ -293,7 +267,12 @@ def _reach_product(
 
     ``replay`` (mode, input ids): the witness replay instead - the mode fixed, the inputs
     dictated by a step counter ``k`` (``TRANS``), the other machine taking each input it offers
-    as the native checker replays its witness; one path, ``k = len(inputs)`` at its end."""
+    as the native checker replays its witness; one path, ``k = len(inputs)`` at its end.
+
+    ``listing``: a state variable ``seen`` assigned from the others (``fa`` when ``faithful``,
+    ``sa``/``ra`` when that machine runs alone and is stable, else ``no``), so the listed
+    reachable states say themselves which set each belongs to: NuSMV evaluates ``faithful``,
+    the listing's reader does not (``reach.unmatched_states``)."""
     in_ids = list(inputs.to_id.values())
     in_enum, _, _, equal_outs, joint, alone_s, alone_r = _terms(src, res, in_ids)
     stable_s, stable_r = ("both", "both") if replay is not None else ("s.stable", "r.stable")
@@ -314,6 +293,8 @@ def _reach_product(
     ]
     if replay is not None:
         lines.append(f"  k : 0..{max(1, len(replay[1]))};")  # one value: a constant
+    if listing:
+        lines.append(f"  {SEEN} : {{fa, sa, ra, no}};")
     lines += [
         "FROZENVAR",
         "  mode : {att, sa, ra};",
@@ -329,6 +310,11 @@ def _reach_product(
         "  init(ok) := TRUE;",
         "  next(ok) := case !det & both : ok & agree; TRUE : ok; esac;",
     ]
+    if listing:
+        lines.append(
+            f"  {SEEN} := case faithful : fa; mode = sa & s.stable : sa; "
+            "mode = ra & r.stable : ra; TRUE : no; esac;"
+        )
     if replay is not None:
         mode, word = replay
         last = len(word)
@@ -342,5 +328,5 @@ def _reach_product(
             + ";",
         ]
     lines += [f"INVARSPEC {formula};" for _name, formula in reach_specs]
-    order = _order(src, res, copies=False)
+    order = _order(src, res, copies=False) + (f"{SEEN}\n" if listing else "")
     return Product("\n".join(lines) + "\n", [name for name, _ in reach_specs], order)
