@@ -49,6 +49,13 @@ class Encoding:
     var_order: list[str] = field(default_factory=list)  # the module's variables, for the BDD order
     # when the identity is one variable: every value it may take, in order (``specs.REACH``)
     id_values: list[str] = field(default_factory=list)
+    # the ``unsigned word`` position variable (name, bits), if the module has one
+    position: tuple[str, int] | None = None
+    # ask the product to interleave this module's position bits with the other module's
+    # (``specs._order``; docs/nusmv.md, "Trees by macro steps")
+    interleave: bool = False
+    # identity DEFINEs -> the variable their frozen copy is ordered next to (``specs._order``)
+    id_near: dict[str, str] = field(default_factory=dict)
 
 
 class _Codes:
@@ -203,6 +210,7 @@ class FSMEncoder:
             decode_state=decode,
             var_order=["q", *slots],
             id_values=list(q.to_name),
+            position=("q", q.bits),
         )
 
     def status_of(self, values: dict[str, str]) -> str:
