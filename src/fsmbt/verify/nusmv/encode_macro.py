@@ -51,7 +51,7 @@ from fsmbt.model.bt_nodes import NodeKind
 from fsmbt.model.errors import Hint, UnsupportedError
 from fsmbt.semantics.bt_interpreter import CompiledNode, CompiledTree
 from fsmbt.semantics.status import LeafOutcome, RootResult
-from fsmbt.verify.nusmv.encode_fsm import NONE_OUT, Encoding
+from fsmbt.verify.nusmv.encode_fsm import NONE_OUT, Encoding, enum_bits
 from fsmbt.verify.nusmv.smv import Symbols, any_of, case
 
 SEQUENCE, FALLBACK, MEMORY = "sequence", "fallback", "memory"
@@ -307,6 +307,7 @@ class MacroBTEncoder:
             # reachability runs (``reach``)
             id_values=[self.code(i) for i in range(count)] if len(identity) == 1 else [],
             position=("pos", self.bits),
+            output_words=[("bres", enum_bits(out_enum))],
             interleave=True,
             id_near={v: v[1:] for v, _ in identity if v.startswith("c")},
         )

@@ -225,7 +225,10 @@ def _order(src: Encoding, res: Encoding, *, copies: bool = True) -> str:
     for side, copy, enc in (("s", "ts", src), ("r", "tr", res)):
         ids = {v for v, _ in enc.id_vars}
         for var in enc.var_order:
-            if placed and enc.position is not None and var == enc.position[0]:
+            if placed and (
+                (enc.position is not None and var == enc.position[0])
+                or var in dict(enc.output_words)
+            ):
                 continue
             order.append(f"{side}.{var}")
             if var in ids and copies:
@@ -251,7 +254,7 @@ def _interleaved(src: Encoding, res: Encoding, copies: bool) -> list[str]:
     if not (src.interleave or res.interleave) or src.position is None or res.position is None:
         return []
     ids = {"s": {v for v, _ in src.id_vars}, "r": {v for v, _ in res.id_vars}}
-    words = (("s", "ts", *src.position), ("r", "tr", *res.position))
+    words = [("s", "ts", *src.position), ("r", "tr", *res.position)]
     order = []
     for bit in reversed(range(max(src.position[1], res.position[1]))):
         for side, copy, var, bits in words:
@@ -259,6 +262,10 @@ def _interleaved(src: Encoding, res: Encoding, copies: bool) -> list[str]:
                 order.append(f"{side}.{var}.{bit}")
                 if copies and var in ids[side]:
                     order.append(f"{copy}_{var}.{bit}")
+    # then the output variables, compared slot against slot by the agreement terms
+    outs = [("s", *w) for w in src.output_words] + [("r", *w) for w in res.output_words]
+    for bit in reversed(range(max((bits for _s, _v, bits in outs), default=0))):
+        order += [f"{side}.{var}.{bit}" for side, var, bits in outs if bit < bits]
     return order
 
 
