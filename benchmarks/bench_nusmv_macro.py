@@ -1,7 +1,7 @@
 """NuSMV on large trees by macro steps (``verify/nusmv/encode_macro.py``; issue 27 item 2).
 
     .venv/bin/python benchmarks/bench_nusmv_macro.py [--families plain,reactive,memory,mixed]
-        [--sizes 100,300,1000] [--cap 60] [--micro-up-to 0]
+        [--sizes 100,300,1000] [--cap 60] [--micro-up-to 0] [--both]
 
 For each family of ``bench_reactive.family_tree`` (seed 1, about ``size`` nodes) the tree is
 converted by ``bt_to_hfsm`` (not timed) and checked against its HFSM (``copy``) and against a
@@ -9,7 +9,8 @@ one-transition mutant of the flattened HFSM (``mutant``, seeded). Each row print
 checker's verdict and seconds, NuSMV's seconds (the ``nusmv_seconds`` of ``nusmv.check``: the
 NuSMV runs alone) and the whole ``nusmv.check`` wall seconds with the macro-step encoding,
 whether its five verdicts equal the native checker's, and - up to ``--micro-up-to`` nodes - the
-micro-step encoding's seconds. A NuSMV run past ``--cap`` seconds prints ``gave up``; a pair
+micro-step encoding's seconds; ``--both`` also times ``verify(doc, hfsm, engine="both")`` on
+each copy (the engines side by side, as ``fsmbt verify --engine both`` runs them). A NuSMV run past ``--cap`` seconds prints ``gave up``; a pair
 whose HFSM cannot be flattened (its data model expanded past the state limit) prints why.
 The machine's load (``os.getloadavg``) is printed before and after: the figures are wall
 seconds on a shared machine.
@@ -65,6 +66,7 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--sizes", default="100,300,1000")
     parser.add_argument("--cap", type=float, default=60.0)
     parser.add_argument("--micro-up-to", type=int, default=0)
+    parser.add_argument("--both", action="store_true", help="also time verify(engine='both')")
     args = parser.parse_args(argv)
     limits.use(limits.current().with_changes(nusmv_max_seconds=args.cap))
     print(f"# before: {load()} on {os.cpu_count()} cores; NuSMV cap {args.cap:.0f} s per run")
@@ -101,6 +103,15 @@ def main(argv: list[str]) -> int:
                     f"{macro} | {agree} | {micro}",
                     flush=True,
                 )
+                if args.both and pair == "copy":
+                    started = time.perf_counter()
+                    both = verify(doc, hfsm, engine="both")
+                    print(
+                        f"#   verify(doc, hfsm, engine='both'): equivalent={both.equivalent}, "
+                        f"{time.perf_counter() - started:.2f} s, NuSMV tree encoding: "
+                        f"{both.stats.get('nusmv', {}).get('nusmv_tree_encoding', '-')}",
+                        flush=True,
+                    )
                 if agree == "agree":
                     largest[f"{family} {pair}"] = max(largest.get(f"{family} {pair}", 0), nodes)
     for key, nodes in largest.items():

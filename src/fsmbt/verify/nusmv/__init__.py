@@ -247,8 +247,8 @@ def check(
     detaching (NuSMV's forward search then visits the faithful product only), the CTL specs on
     the product with detaching under ``-df`` (no forward search: the backward fixpoints of the
     specs alone). ``False``: one run of one model holding every spec. ``None`` (default): split
-    for an FSM ~ FSM pair and an FSM ~ dispatch tree pair (both modules take one step per
-    input; a 100-state equivalent dispatch pair: 0.6 s split, 11.6 s single) - there it wins by
+    for an FSM ~ FSM pair, an FSM ~ dispatch tree pair and a tree written by macro steps
+    beside an FSM (``tree_encoding``; both modules take one step per input; a 100-state equivalent dispatch pair: 0.6 s split, 11.6 s single) - there it wins by
     orders of magnitude, while on a BT's
     micro-step product the unrestricted backward fixpoints of ``-df`` cost far more than the
     forward search saves (measured: benchmarks/bench_nusmv_options.py, docs/nusmv.md). ``mono``: NuSMV's ``-mono`` (one monolithic transition relation); ``None``: only
@@ -264,6 +264,10 @@ def check(
     invariants per state instead of the frozen-copy spec (docs/nusmv.md, "Reachability state
     by state": a 1 000-state mutant in seconds where the frozen copies gave up); ``False``:
     the frozen-copy spec (kept for the benchmarks and the tests that compare the two).
+
+    ``tree_encoding`` (``AUTO``, ``MICRO``, ``MACRO``): how a BT ~ FSM pair's tree is written
+    (``uses_macro_steps``; docs/nusmv.md, "Trees by macro steps"); the report's
+    ``stats["nusmv_tree_encoding"]`` names the one used.
 
     ``timeout`` defaults to ``fsmbt.limits.current().nusmv_max_seconds`` (per NuSMV run); the
     memory cap is ``nusmv_max_memory_mb``. Raises ``UnsupportedError`` for BT node types the
