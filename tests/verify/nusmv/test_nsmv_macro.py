@@ -1,7 +1,7 @@
 """The macro-step tree encoding (``verify/nusmv/encode_macro.py``; docs/nusmv.md, "Trees by
 macro steps") against the native checker and the micro-step encoding, with real NuSMV.
 
-Seeded random trees of 5-40 leaves over Sequence, Fallback, ReactiveSequence, ReactiveFallback,
+24 seeded random trees of 5-40 leaves over Sequence, Fallback, ReactiveSequence, ReactiveFallback,
 SequenceWithMemory, Inverter, ForceSuccess, ForceFailure and SubTree, each against its HFSM
 (``bt_to_hfsm``) and against a one-transition mutant of the flattened HFSM: the macro
 encoding's five verdicts equal the native checker's; a failing invariant's counterexample is
@@ -93,7 +93,7 @@ def test_macro_agrees_with_native_and_micro(nusmv_binary, monkeypatch) -> None:
     rng = random.Random(SEED)
     failing = compared_micro = 0
     sizes = []
-    for doc in _trees(rng, 14):
+    for doc in _trees(rng, 24):
         leaves = leaf_count(doc)
         sizes.append(leaves)
         flat = flatten(bt_to_hfsm(doc).model)
@@ -179,3 +179,26 @@ def test_other_kinds_are_refused_by_name_and_left_to_the_micro_steps(
     report = nusmv.check(doc, flat)  # AUTO: the micro-step encoding
     assert report.stats["nusmv_tree_encoding"] == "micro-step tree (encode_bt)"
     assert report.equivalent
+
+
+def test_loop_agrees_with_native(nusmv_binary, monkeypatch) -> None:
+    """With ``loop`` (the root ticked again after its result, outputs ``(result, first
+    leaf)``): the HFSMs ``bt_to_hfsm(loop=True)`` writes and their one-transition mutants, the
+    five verdicts equal to the native checker's (trees the converter refuses with ``loop`` are
+    left out, counted)."""
+    monkeypatch.setenv("FSMBT_NUSMV", str(nusmv_binary))
+    rng = random.Random(SEED + 3)
+    checked = failing = 0
+    for doc in _trees(rng, 16):
+        try:
+            hfsm = bt_to_hfsm(doc, loop=True).model
+        except UnsupportedError:
+            continue
+        flat = flatten(hfsm)
+        for result in (flat, _mutant(flat, rng)):
+            native = verify(doc, result, loop=True)
+            macro = nusmv.check(doc, result, loop=True, tree_encoding=nusmv.MACRO)
+            assert macro.verdicts() == native.verdicts(), (leaf_count(doc), native.verdicts())
+            failing += not native.equivalent
+        checked += 1
+    assert checked >= 4 and failing >= 2, (checked, failing)
