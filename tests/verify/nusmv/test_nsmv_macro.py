@@ -10,9 +10,9 @@ encoding's verdicts equal the macro encoding's on the four properties other than
 reachability. Reachability is compared with the native checker only: the micro-step
 encoding's state identity is every variable of the interpreter's snapshot, finer than the
 native checker's canonical states (docs/semantics.md §4a), so a mutant can reach a "state"
-alone there that the native checker counts as reached (seen on 3 of 24 mutants of 5-10
-leaves); the macro encoding's identity is the canonical one, and it agrees with the native
-checker on every pair here. Mutants of trees with a WithMemory index keep their trees to 12
+alone there that the native checker counts as reached (seen on mutants of 5-10 leaves); the
+macro encoding's identity is the canonical one, and it agrees with the native checker on every
+pair here. Mutants of trees with a WithMemory index keep their trees to 12
 leaves: their reachability is the frozen-copy spec (a transitive closure, ~12 s at 20 leaves;
 docs/nusmv.md says the limit). ``FSMBT_TEST_SEED`` draws another sample.
 """
