@@ -246,11 +246,11 @@ def _order(src: Encoding, res: Encoding, *, copies: bool = True) -> str:
 
 def _interleaved(src: Encoding, res: Encoding, copies: bool) -> list[str]:
     """The two position words bit by bit, most significant first, each beside its frozen
-    copy, when one module asks for it (``Encoding.interleave``) and both have one; else
-    nothing. Why: in a faithful pair the tree's position and the machine's state determine
+    copy, then both modules' output variables (``Encoding.output_words``) bit by bit, when one
+    module asks for it (``Encoding.interleave``) and both have a position; else nothing. Why: in a faithful pair the tree's position and the machine's state determine
     each other, a relation whose BDD is small only with their bits side by side (a 320-node
-    tree against its HFSM: the invariants 11.2 -> 0.66 s, the deadlock spec past 60 s ->
-    0.9 s; docs/nusmv.md, "Trees by macro steps")."""
+    tree against its HFSM, by hand: the invariants 11.2 -> 0.66 s, the deadlock spec past
+    60 s -> 0.9 s; docs/nusmv.md, "Trees by macro steps")."""
     if not (src.interleave or res.interleave) or src.position is None or res.position is None:
         return []
     ids = {"s": {v for v, _ in src.id_vars}, "r": {v for v, _ in res.id_vars}}
