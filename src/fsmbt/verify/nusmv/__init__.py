@@ -17,7 +17,7 @@ from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import InputError
 from fsmbt.model.fsm import FSM
 from fsmbt.semantics.outcome_rules import OutcomeRules
-from fsmbt.verify.nusmv import reach
+from fsmbt.verify.nusmv import encode_macro, reach
 from fsmbt.verify.nusmv.binary import NuSMVNotFound, find_nusmv, require_nusmv
 from fsmbt.verify.nusmv.encode_bt import LeafBTEncoder
 from fsmbt.verify.nusmv.encode_dispatch import encode_dispatch_pair, one_step_per_input
@@ -44,6 +44,11 @@ Encoders: TypeAlias = tuple[Encoder, Encoder, Symbols, Symbols, str]
 MACRO_STEP = "macro-step"
 LEAF_EXECUTION = "leaf-execution"
 
+#: How a BT ~ FSM pair's tree is written (``check(tree_encoding=...)``): ``MICRO`` one
+#: micro-step per node visit (``encode_bt``), ``MACRO`` one step per leaf outcome
+#: (``encode_macro``, its node class only), ``AUTO`` the macro steps wherever they apply.
+AUTO, MICRO, MACRO = "auto", "micro", "macro"
+
 
 def _union(*groups: Iterable[str]) -> list[str]:
     seen: dict[str, None] = {}
@@ -60,11 +65,14 @@ def encode(
     loop: bool = False,
     outcomes: OutcomeRules | None = None,
     outcome_driven: bool = False,
+    tree_encoding: str = AUTO,
 ) -> Encoders:
     """The two machine encoders, the shared symbol tables and the mode for a pair of models
     (the same pairing as ``fsmbt.verify.pairing.machines_for``; ``outcomes`` and
     ``outcome_driven`` as there: an outcome-driven FSM and its structured tree are the outcome
-    pairing, ``encode_outcome``)."""
+    pairing, ``encode_outcome``). ``tree_encoding`` (``AUTO``/``MICRO``/``MACRO``): how the
+    tree of a BT ~ FSM pair is written; ``MACRO`` on a tree outside ``encode_macro``'s class
+    raises its ``UnsupportedError``."""
     from fsmbt.verify.outcome_pairing import OUTCOME_EXECUTION, is_outcome_pair
     from fsmbt.verify.pairing import lebt_guard_events, sub_machine_events
 
@@ -120,6 +128,14 @@ def encode(
             MACRO_STEP,
         )
     if isinstance(source, BTDocument) and isinstance(result, FSM):
+        if uses_macro_steps(source, result, tree_encoding):
+            return (
+                encode_macro.MacroBTEncoder(source, "source", inputs, outputs, loop=loop),
+                FSMEncoder(result, "result", inputs, outputs, alphabet=(), leaf=True, loop=loop),
+                inputs,
+                outputs,
+                LEAF_EXECUTION,
+            )
         return (
             LeafBTEncoder(source, "source", inputs, outputs, loop=loop),
             FSMEncoder(result, "result", inputs, outputs, alphabet=(), leaf=True, loop=loop),
@@ -138,6 +154,20 @@ def encode(
     raise InputError(f"cannot compare a {type(source).__name__} with a {type(result).__name__}")
 
 
+def uses_macro_steps(
+    source: FSM | BTDocument, result: FSM | BTDocument, tree_encoding: str = AUTO
+) -> bool:
+    """Whether ``encode`` writes the pair's tree by macro steps (``encode_macro``): a BT
+    source against an FSM, ``MACRO`` asked or ``AUTO`` and the tree in its class (measured:
+    it agrees with the micro-step encoding and is faster from 5 leaves on, docs/nusmv.md,
+    "Trees by macro steps"). The outcome and dispatch pairings have an FSM source."""
+    if not (isinstance(source, BTDocument) and isinstance(result, FSM)):
+        return False
+    if tree_encoding not in (AUTO, MICRO, MACRO):
+        raise InputError(f"unknown tree encoding {tree_encoding!r} (auto, micro or macro)")
+    return tree_encoding == MACRO or (tree_encoding == AUTO and encode_macro.applies(source))
+
+
 def build_model(
     source: FSM | BTDocument,
     result: FSM | BTDocument,
@@ -146,6 +176,7 @@ def build_model(
     part: str = WHOLE,
     outcomes: OutcomeRules | None = None,
     outcome_driven: bool = False,
+    tree_encoding: str = AUTO,
 ) -> tuple[str, list[str], Context]:
     """The SMV text of the product, the spec names and what is needed to decode traces.
 
@@ -153,7 +184,13 @@ def build_model(
     product (the single model of earlier versions, kept for the benchmarks and
     ``scripts/smv_snapshot.py``) or one of the two that ``check`` runs."""
     return build_models(
-        source, result, loop=loop, parts=(part,), outcomes=outcomes, outcome_driven=outcome_driven
+        source,
+        result,
+        loop=loop,
+        parts=(part,),
+        outcomes=outcomes,
+        outcome_driven=outcome_driven,
+        tree_encoding=tree_encoding,
     )[0]
 
 
@@ -165,10 +202,16 @@ def build_models(
     parts: tuple[str, ...] = (INVARIANTS, CTL),
     outcomes: OutcomeRules | None = None,
     outcome_driven: bool = False,
+    tree_encoding: str = AUTO,
 ) -> list[tuple[str, list[str], Context]]:
     """``build_model`` for several parts, encoding the two machines once."""
     src_enc, res_enc, inputs, outputs, mode = encode(
-        source, result, loop=loop, outcomes=outcomes, outcome_driven=outcome_driven
+        source,
+        result,
+        loop=loop,
+        outcomes=outcomes,
+        outcome_driven=outcome_driven,
+        tree_encoding=tree_encoding,
     )
     src, res = src_enc.encode(), res_enc.encode()
     extra: list[tuple[str, str]] = getattr(res_enc, "extra_specs", lambda: [])()
@@ -194,6 +237,7 @@ def check(
     outcome_driven: bool = False,
     state_reach: bool = True,
     shared_search: bool = True,
+    tree_encoding: str = AUTO,
 ) -> Report:
     """Verify ``result_model`` against ``source_model`` with NuSMV; see the module docstring.
 
@@ -204,8 +248,8 @@ def check(
     detaching (NuSMV's forward search then visits the faithful product only), the CTL specs on
     the product with detaching under ``-df`` (no forward search: the backward fixpoints of the
     specs alone). ``False``: one run of one model holding every spec. ``None`` (default): split
-    for an FSM ~ FSM pair and an FSM ~ dispatch tree pair (both modules take one step per
-    input; a 100-state equivalent dispatch pair: 0.6 s split, 11.6 s single) - there it wins by
+    for an FSM ~ FSM pair, an FSM ~ dispatch tree pair and a tree written by macro steps
+    beside an FSM (``tree_encoding``; both modules take one step per input; a 100-state equivalent dispatch pair: 0.6 s split, 11.6 s single) - there it wins by
     orders of magnitude, while on a BT's
     micro-step product the unrestricted backward fixpoints of ``-df`` cost far more than the
     forward search saves (measured: benchmarks/bench_nusmv_options.py, docs/nusmv.md). ``mono``: NuSMV's ``-mono`` (one monolithic transition relation); ``None``: only
@@ -227,6 +271,10 @@ def check(
     reachability decided directly rather than implied; docs/nusmv.md); ``False``: the
     invariants' own run first, the listing only for a failing pair.
 
+    ``tree_encoding`` (``AUTO``, ``MICRO``, ``MACRO``): how a BT ~ FSM pair's tree is written
+    (``uses_macro_steps``; docs/nusmv.md, "Trees by macro steps"); the report's
+    ``stats["nusmv_tree_encoding"]`` names the one used.
+
     ``timeout`` defaults to ``fsmbt.limits.current().nusmv_max_seconds`` (per NuSMV run); the
     memory cap is ``nusmv_max_memory_mb``. Raises ``UnsupportedError`` for BT node types the
     encoding does not model (docs/nusmv.md), ``NuSMVLimitError`` past a cap and
@@ -234,8 +282,9 @@ def check(
     macro step never settles, the native checker's livelock ``InputError`` (``encode_sv``).
     """
     started = time.perf_counter()
-    if split is None:
-        split = one_step_per_input(source_model, result_model)
+    macro = uses_macro_steps(source_model, result_model, tree_encoding)
+    if split is None:  # a tree by macro steps takes one step per input, like an FSM
+        split = macro or one_step_per_input(source_model, result_model)
     parts = (INVARIANTS, CTL) if split else (WHOLE,)
     mono = not split if mono is None else mono
     models = build_models(
@@ -245,6 +294,7 @@ def check(
         parts=parts,
         outcomes=outcomes,
         outcome_driven=outcome_driven,
+        tree_encoding=tree_encoding,
     )
     encoded = time.perf_counter()
     context = models[0][2]
@@ -336,6 +386,10 @@ def check(
             "seconds": round(time.perf_counter() - started, 6),
         }
     )
+    if isinstance(source_model, BTDocument) and isinstance(result_model, FSM):
+        report.stats["nusmv_tree_encoding"] = (
+            encode_macro.ENCODING_NAME if macro else "micro-step tree (encode_bt)"
+        )
     return report
 
 

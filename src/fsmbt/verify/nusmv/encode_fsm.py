@@ -49,6 +49,21 @@ class Encoding:
     var_order: list[str] = field(default_factory=list)  # the module's variables, for the BDD order
     # when the identity is one variable: every value it may take, in order (``specs.REACH``)
     id_values: list[str] = field(default_factory=list)
+    # the ``unsigned word`` position variable (name, bits), if the module has one
+    position: tuple[str, int] | None = None
+    # ask the product to interleave this module's position bits with the other module's
+    # (``specs._order``; docs/nusmv.md, "Trees by macro steps")
+    interleave: bool = False
+    # the variables holding outputs, with their bits, interleaved like ``position``
+    output_words: list[tuple[str, int]] = field(default_factory=list)
+    # identity DEFINEs -> the variable their frozen copy is ordered next to (``specs._order``)
+    id_near: dict[str, str] = field(default_factory=dict)
+
+
+def enum_bits(enum: str) -> int:
+    """The bits NuSMV's boolean encoding gives an enumeration written ``{a, b, ...}``."""
+    values = enum.count(",") + 1
+    return max(1, (values - 1).bit_length())
 
 
 class _Codes:
@@ -203,6 +218,8 @@ class FSMEncoder:
             decode_state=decode,
             var_order=["q", *slots],
             id_values=list(q.to_name),
+            position=("q", q.bits),
+            output_words=[(slot, enum_bits(out_enum)) for slot in slots],
         )
 
     def status_of(self, values: dict[str, str]) -> str:

@@ -47,9 +47,16 @@ Key = tuple[str, ...]
 
 
 def applies(context: Context) -> bool:
-    """Whether both machines name their identity variables (every encoder does; ``check``
-    asks only for the split pairs, whose modules take one step per input)."""
-    return bool(context[0].id_vars) and bool(context[1].id_vars)
+    """Whether both machines name their identity variables and each is a state variable of
+    its module (``Encoding.var_order``): NuSMV's listing prints state variables only, so an
+    identity read through a DEFINE (the canonical memory of a tree written by macro steps,
+    ``encode_macro``: ``cwr_n``, ``cix_n``) cannot be read off it - those pairs keep the
+    frozen-copy spec. ``check`` asks only for the split pairs, whose modules take one step per
+    input."""
+    return all(
+        enc.id_vars and all(var in enc.var_order for var, _typ in enc.id_vars)
+        for enc in (context[0], context[1])
+    )
 
 
 def _sides(context: Context) -> list[tuple[str, str, Encoding]]:

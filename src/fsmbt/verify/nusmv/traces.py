@@ -19,11 +19,13 @@ from fsmbt.verify.report import PROPERTIES, PropertyResult, Report, TraceStep
 if TYPE_CHECKING:
     from fsmbt.verify.nusmv.encode_dispatch import DispatchEncoder
     from fsmbt.verify.nusmv.encode_lebt import LebtEncoder
+    from fsmbt.verify.nusmv.encode_macro import MacroBTEncoder
     from fsmbt.verify.nusmv.encode_outcome import OutcomeFSMEncoder
     from fsmbt.verify.nusmv.encode_sv import SvEncoder
 
 Encoder: TypeAlias = (
     "FSMEncoder | LeafBTEncoder | LebtEncoder | DispatchEncoder | SvEncoder | OutcomeFSMEncoder"
+    " | MacroBTEncoder"
 )
 # What decoding needs: both encodings, both encoders, the input and output symbol tables, the
 # mode ("macro-step" or "leaf-execution") and the BDD variable order.
