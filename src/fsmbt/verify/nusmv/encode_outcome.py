@@ -44,6 +44,7 @@ O(entries x values) for the blackboard.
 
 from __future__ import annotations
 
+import re
 from collections.abc import Sequence
 
 from fsmbt.model.bt import BTDocument
@@ -478,6 +479,12 @@ class OutcomeBTEncoder(LeafBTEncoder):
     def _input_names(self) -> list[str]:
         return list(self.inputs.to_id)
 
+    def encode(self) -> Encoding:
+        """The tree's module, with its BDD order grouped by node (``node_order``)."""
+        encoding = super().encode()
+        encoding.var_order = node_order(encoding.var_order)
+        return encoding
+
     # -- the livelock check ----------------------------------------------------------------
     def livelock_model(self, encoding: Encoding) -> tuple[str, str] | None:
         """The model (SMV text, BDD order) of the livelock check, or ``None`` when no node
@@ -511,6 +518,36 @@ class OutcomeBTEncoder(LeafBTEncoder):
             "LIVELOCK state)",
             f"tree '{self.tree_name}'",
         )
+
+
+#: A node's own variable: ``<kind>_<node id>`` (``st_7``, ``ci_7``, ``sw_7``...).
+_NODE_VAR = re.compile(r"([a-z]+)_(\d+)")
+
+
+def node_order(order: Sequence[str]) -> list[str]:
+    """The BDD order with each node's memory variables (a Switch's ``sw_n``, an IfThenElse's
+    ``ci_n``, a loop's counter...) right after its status ``st_n`` instead of after every
+    node's status: the rules that read and write them test ``st_n`` and the node's call, and
+    NuSMV's relation over them blows up when they are far apart (a 20-state machine's
+    131-node tree: the monolithic relation past 120 s, 2.4 s grouped; docs/nusmv.md, "The
+    outcome pairing"). The blackboard entries (``bb_k``, ``k`` a key, not a node) and the
+    stack (``cur``, ``res``, ``lidx``) stay where they are."""
+    owned: dict[str, list[str]] = {}
+    for var in order:
+        found = _NODE_VAR.fullmatch(var)
+        if found and found.group(1) not in ("st", "bb"):
+            owned.setdefault(found.group(2), []).append(var)
+    placed = {v for group in owned.values() for v in group}
+    grouped: list[str] = []
+    for var in order:
+        if var in placed:
+            continue
+        grouped.append(var)
+        found = _NODE_VAR.fullmatch(var)
+        if found and found.group(1) == "st":
+            grouped += owned.pop(found.group(2), [])
+    grouped += [v for group in owned.values() for v in group]  # a node without a status
+    return grouped
 
 
 def _not(expr: str) -> str:
