@@ -171,6 +171,10 @@ def structured_main(args: argparse.Namespace, sizes: list[int], rng: random.Rand
         except FsmbtError:
             counts[label]["not read"] += 1  # a retargeted machine the outcome view refuses
             continue
+        except KeyError as exc:  # a native checker's bug, counted and shown, not hidden
+            counts[label]["native crashed"] += 1
+            print(f"NATIVE CRASHED ({label}, {kind}): KeyError {exc}", flush=True)
+            continue
         before = child_cpu()
         try:
             report = nusmv.check(source, tree, outcome_driven=True)
@@ -209,7 +213,8 @@ def structured_main(args: argparse.Namespace, sizes: list[int], rng: random.Rand
     print(
         f"total (structured): {total['agree']} agree, {total['disagree']} disagree, "
         f"{total['gave up']} gave up (NuSMV past {args.timeout:g} s), {total['refused']} refused "
-        f"{reasons}, {total['not read']} mutants not outcome-driven (skipped); "
+        f"{reasons}, {total['not read']} mutants not outcome-driven (skipped), "
+        f"{total['native crashed']} on which the native checker crashed (skipped); "
         f"{time.perf_counter() - started:.0f} s wall"
     )
     return 1 if total["disagree"] else 0

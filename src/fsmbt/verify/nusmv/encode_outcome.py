@@ -11,7 +11,10 @@ never from the native machines:
   down into every container it enters (its initial state), to the next atomic state or a
   top-level final state (``SUCCESS``/``FAILURE`` by the top-level exit's status); ``running``
   keeps the state. Output: the state's label, or the result. Offered: the state's outcomes
-  (``OutcomeView``: halting ``preempted`` ones removed) and ``running``.
+  (``OutcomeView``: halting ``preempted`` ones removed) and ``running``. A Concurrence read in
+  rounds (a ``Parallel``/``ParallelAll`` in the tree; docs/semantics.md §11) adds, per child,
+  its outcome so far and, per container child, where it is: ``encode_rounds`` (the round
+  reading, the turn and the outcome map's decision, written from the documented rules).
 - the tree side (``OutcomeBTEncoder``): BehaviorTree.CPP's tick rules (``encode_bt.BTCore`` and
   its families) over the tree the blackboard model parses (``outcome_blackboard.OutcomeTree``:
   it refuses every use of a modelled entry it does not cover), plus the three blackboard forms a
@@ -33,14 +36,15 @@ reaches micro-steps forever, and refuses the pair by name when one does (``--eng
 the native verdict). The same ``EG`` on the product cost 46 s (``-df``) and over 120 s (whole)
 on a 6-state machine whose tree alone takes 0.2 s.
 
-Refused by name (``UnsupportedError``, NuSMV's limits): a Concurrence read in rounds (the
-native machine's ``Round`` states; a Parallel in the tree), a child that may return SKIPPED
-under a Switch. Size: O(states x outcomes) for the FSM side; the tree's ``BTCore`` text plus
+Refused by name (``UnsupportedError``, NuSMV's limits): a child that may return SKIPPED under
+a Switch, a livelock (above). Size: O(states x outcomes) for the FSM side plus
+``encode_rounds``' rows per concurrence child outcome; the tree's ``BTCore`` text plus
 O(entries x values) for the blackboard.
 """
 
 from __future__ import annotations
 
+import re
 from collections.abc import Sequence
 
 from fsmbt.model.bt import BTDocument
@@ -50,16 +54,23 @@ from fsmbt.model.kinds import NodeKind
 from fsmbt.semantics.compiled import CompiledNode
 from fsmbt.semantics.outcome_blackboard import SCRIPT, SWITCH, OutcomeTree
 from fsmbt.semantics.outcome_rules import FAILURE, OutcomeError, OutcomeRules
-from fsmbt.semantics.outcome_view import RUNNING_INPUT, OutcomeView
+from fsmbt.semantics.outcome_view import RUNNING_INPUT, OutcomeView, Unit
 from fsmbt.semantics.status import LeafOutcome, RootResult
 from fsmbt.verify.nusmv.encode_bt import LeafBTEncoder
 from fsmbt.verify.nusmv.encode_fsm import NONE_OUT, Encoding
+from fsmbt.verify.nusmv.encode_rounds import RUNS, Child, RoundTable, Row, Target, negate
 from fsmbt.verify.nusmv.families.common import ST
 from fsmbt.verify.nusmv.families.contract import BTCore, Resets
 from fsmbt.verify.nusmv.smv import Symbols, all_of, any_of, case, enum_type
 
 #: The value of an entry nothing has written yet.
 UNSET = "bu"
+
+#: Where going to a state lands (``OutcomeFSMEncoder._enter``): an atomic state or a result,
+#: the start of a concurrence read in rounds, the end of a concurrence's container child.
+AT, ROUND, ENDED = "at", "round", "ended"
+#: (kind, value, whether a container child's loop went round on the way)
+Landing = tuple[str, str, bool]
 
 
 def _refuse(why: str, element: str) -> UnsupportedError:
@@ -76,13 +87,6 @@ class OutcomeFSMEncoder:
     follows = False
 
     def __init__(self, view: OutcomeView, module: str, inputs: Symbols, outputs: Symbols) -> None:
-        for path, region in view.regions.items():
-            if region.parallel:
-                raise _refuse(
-                    "a Concurrence read in rounds (a Parallel in the tree; the native checker "
-                    "decides it)",
-                    f"state '{path or view.fsm.name}'",
-                )
         self.view = view
         self.module = module
         self.inputs = inputs
@@ -91,6 +95,7 @@ class OutcomeFSMEncoder:
             u.path: u for r in view.regions.values() for u in r.units.values() if not u.container
         }
         self.region_of = {u.path: p for p, r in view.regions.items() for u in r.units.values()}
+        self.round_trips = frozenset(t for r in view.regions.values() for t in r.round_trips)
         self.states = Symbols("q")
         for path in self.units:
             self.states.id(path)
@@ -98,42 +103,168 @@ class OutcomeFSMEncoder:
             inputs.add_all(unit.outcomes)
             outputs.id(unit.label)
         inputs.id(RUNNING_INPUT)
-        self.start = self._enter("", view.top.initial)
-        #: (state path, outcome) -> the state (path or result word) it leads to
-        self.moves = {
-            (path, o): self._enter(self.region_of[path], unit.targets[o])
-            for path, unit in self.units.items()
-            for o in unit.outcomes
-        }
-        self.results = sorted(
-            {s for s in (self.start, *self.moves.values()) if s not in self.units}
-        )
+        #: the outcomes a concurrence's child ended with (the ``dn`` variables' values)
+        self.done_ids = Symbols("dv")
+        #: region path -> its concurrence read in rounds (``encode_rounds``)
+        self.rounds: dict[str, RoundTable] = {}
+        for path, region in view.regions.items():
+            if region.parallel:
+                self.rounds[path] = self._round_table(len(self.rounds), path)
+        self.start = self._landing_target(self._start())
+        self.rows: list[Row] = []
+        for path, unit in self.units.items():
+            self.rows += self._moves(path, unit)
+        targets = [self.start, *(row.target for row in self.rows)]
+        self.results = sorted({t.path for t in targets if t.path and t.path not in self.units})
         for word in self.results:
             self.states.id(word)
             outputs.id(word)
 
-    def _enter(self, region_path: str, target: str) -> str:
-        """The atomic state (its path) or the root's result reached by going to ``target`` in
-        a region (the module docstring). O(nesting depth) steps; a cycle of containers that
-        enter and leave each other without running a state is an ``OutcomeError``."""
+    # -- reading the machine ---------------------------------------------------------------
+    def _round_table(self, key: int, path: str) -> RoundTable:
+        region = self.view.regions[path]
+        concurrence = region.concurrence
+        assert concurrence is not None
+        children: list[Child] = []
+        for index, label in enumerate(concurrence.labels):
+            unit = region.units[label]
+            if not unit.container:
+                children.append(Child(index, unit.path, False, unit.path))
+                continue
+            kind, entry, _trip = self._enter(unit.path, self.view.regions[unit.path].initial)
+            assert kind == AT and entry in self.units, "a container child runs a state first"
+            inside = [p for p in self.units if p.startswith(unit.path + "/")]
+            children.append(Child(index, unit.path, True, entry, inside))
+        for outcomes in concurrence.outcomes:
+            self.done_ids.add_all(outcomes)
+        return RoundTable(key, path, concurrence, children)
+
+    def _start(self) -> Landing:
+        if self.view.top.parallel:
+            return ROUND, "", False
+        return self._enter("", self.view.top.initial)
+
+    def _enter(self, region_path: str, target: str) -> Landing:
+        """Where going to ``target`` in a region lands (the module docstring): an atomic
+        state or the root's result (``AT``), the start of a concurrence read in rounds
+        (``ROUND``, its region), or the end of a concurrence's container child (``ENDED``, its
+        outcome); and whether it went round a loop of such a child (``Region.round_trips``).
+        O(nesting depth) steps; a cycle of containers that enter and leave each other without
+        running a state is an ``OutcomeError``."""
         seen: set[tuple[str, str]] = set()
+        round_trip = False
+        regions = self.view.regions
         while (region_path, target) not in seen:
             seen.add((region_path, target))
-            region = self.view.regions[region_path]
+            region = regions[region_path]
             if region.machine.states[target].final:
                 owner = region.owner
                 if owner is None:
-                    return self.view.root_result(target)
-                region_path, target = self.region_of[owner.path], owner.targets[target]
+                    return AT, self.view.root_result(target), round_trip
+                region_path = self.region_of[owner.path]
+                if regions[region_path].parallel:
+                    return ENDED, target, round_trip
+                round_trip = round_trip or (owner.path, target) in self.round_trips
+                target = owner.targets[target]
                 continue
             unit = region.units[target]
+            if unit.container and regions[unit.path].parallel:
+                return ROUND, unit.path, round_trip
             if not unit.container:
-                return unit.path
-            region_path, target = unit.path, self.view.regions[unit.path].initial
+                return AT, unit.path, round_trip
+            region_path, target = unit.path, regions[unit.path].initial
         raise OutcomeError(
             "containers enter and leave each other forever without running a state",
             element=f"state '{target}'",
         )
+
+    def _landing_target(self, landing: Landing) -> Target:
+        kind, value, _trip = landing
+        if kind == ROUND:
+            return self.rounds[value].entry_target()
+        assert kind == AT, "a container child ends inside its concurrence only"
+        return Target(value)
+
+    def _context(self, path: str) -> tuple[RoundTable, int] | None:
+        """The concurrence read in rounds whose child runs the atomic state ``path``, and the
+        child's index; ``None`` outside every one (a SMACH ``outcome_cb`` state included)."""
+        unit, region_path = self.units[path], self.region_of[path]
+        table = self.rounds.get(region_path)
+        if table is not None and unit.name in table.concurrence.labels:
+            return table, table.concurrence.labels.index(unit.name)
+        while True:
+            owner = self.view.regions[region_path].owner
+            if owner is None:
+                return None
+            region_path = self.region_of[owner.path]
+            table = self.rounds.get(region_path)
+            if table is not None:
+                return table, table.concurrence.labels.index(owner.name)
+
+    # -- the moves -------------------------------------------------------------------------
+    def _moves(self, path: str, unit: Unit) -> list[Row]:
+        """Every guarded move out of the atomic state ``path`` (disjoint guards)."""
+        here = Target(path)
+        running = f"go & q = {self.states.id(path)} & inp = {self.inputs.id(RUNNING_INPUT)}"
+        context = self._context(path)
+        rows: list[Row] = []
+        if context is None:
+            rows.append(Row(running, here))
+            for o in unit.outcomes:
+                guard = f"go & q = {self.states.id(path)} & inp = {self.inputs.id(o)}"
+                landing = self._enter(self.region_of[path], unit.targets[o])
+                rows.append(Row(guard, self._landing_target(landing)))
+            return rows
+        table, index = context
+        child = table.children[index]
+        rows += table.next_child_rows(running, index, here, {})
+        for o in unit.outcomes:
+            guard = f"go & q = {self.states.id(path)} & inp = {self.inputs.id(o)}"
+            if not child.container:
+                rows += self._ended(table, index, o, guard)
+                continue
+            kind, value, trip = self._enter(self.region_of[path], unit.targets[o])
+            trip = trip or (path, o) in self.round_trips  # a loop back to its head
+            if kind == ENDED:
+                rows += self._ended(table, index, value, guard)
+                continue
+            assert kind == AT and value in child.positions, "a container child stays inside"
+            sets = {table.pos_var(index): self.states.id(value)} if child.tracked else {}
+            if trip:  # its loop went round: its tree returned RUNNING, the next child's turn
+                rows += table.next_child_rows(guard, index, Target(value), sets)
+            else:
+                rows.append(Row(guard, Target(value), sets))
+        return rows
+
+    def _ended(self, table: RoundTable, index: int, outcome: str, guard: str) -> list[Row]:
+        """Child ``index`` ended with ``outcome``: the source decision leaves the concurrence
+        (through its ``outcome_cb`` state when it has one), else the next child's turn."""
+        rows: list[Row] = []
+        decided: list[str] = []
+        reset = table.reset()
+        reset = {var: self._value(var, v) for var, v in reset.items()}
+        callback = table.concurrence.callback_state
+        owner = self.view.regions[table.region].owner
+        for cond, container_outcome in table.decision_rows(index, outcome, self.done_ids):
+            target = callback if callback is not None else container_outcome
+            if owner is None or callback is not None or target in owner.targets:
+                landing = self._enter(table.region, target)
+                rows.append(
+                    Row(all_of([guard, *decided, cond]), self._landing_target(landing), reset)
+                )
+            # else an outcome the concurrence never gives (its product never reaches that
+            # final state, so the container has no transition for it): no combination the
+            # rounds reach makes ``cond`` hold here, and no row is written
+            decided.append(negate(cond))
+        sets = {table.done_var(index): self.done_ids.id(outcome)}
+        if table.children[index].tracked:
+            sets[table.pos_var(index)] = self.states.id(table.children[index].entry)
+        rows += table.next_child_rows(all_of([guard, *decided]), index, None, sets)
+        return rows
+
+    def _value(self, var: str, value: str) -> str:
+        """An SMV value for a round variable: ``dnr`` as is, a position as its ``q`` id."""
+        return value if var.startswith("dn") else self.states.id(value)
 
     def _out(self, state: str) -> str:
         unit = self.units.get(state)
@@ -143,19 +274,43 @@ class OutcomeFSMEncoder:
         q, ids = self.states, self.inputs
         next_q: list[tuple[str, str]] = []
         next_o1: list[tuple[str, str]] = []
-        for (path, outcome), lands in self.moves.items():
-            guard = f"go & q = {q.id(path)} & inp = {ids.id(outcome)}"
-            next_q.append((guard, q.id(lands)))
-            next_o1.append((guard, self._out(lands)))
-        for path in self.units:  # running: the state goes on, its label output again
-            guard = f"go & q = {q.id(path)} & inp = {ids.id(RUNNING_INPUT)}"
-            next_o1.append((guard, self._out(path)))
+        assigned: dict[str, list[tuple[str, str]]] = {}
+        for row in self.rows:
+            if row.target.var:
+                next_q.append((row.guard, row.target.var))
+                child = next(
+                    c for t in self.rounds.values() for c in t.children
+                    if t.pos_var(c.index) == row.target.var
+                )  # fmt: skip
+                for p in child.positions:
+                    cond = all_of([row.guard, f"{row.target.var} = {q.id(p)}"])
+                    next_o1.append((cond, self._out(p)))
+            else:
+                next_q.append((row.guard, q.id(row.target.path)))
+                next_o1.append((row.guard, self._out(row.target.path)))
+            for var, value in row.sets.items():
+                assigned.setdefault(var, []).append((row.guard, value))
         final = any_of(f"q = {q.id(r)}" for r in self.results)
         lines = [
             f"MODULE {self.module}(go, inp)",
             "VAR",
             f"  q : {q.enum()};",
             f"  o1 : {self.outputs.enum([NONE_OUT])};",
+        ]
+        round_vars: list[tuple[str, str]] = []
+        inits: list[str] = []
+        for table in self.rounds.values():
+            for c in table.children:
+                outs = [self.done_ids.id(o) for o in table.concurrence.outcomes[c.index]]
+                round_vars.append((table.done_var(c.index), enum_type([RUNS, *outs], "dvpad")))
+                inits.append(f"  init({table.done_var(c.index)}) := {RUNS};")
+            for c in table.children:
+                if c.tracked:
+                    values = [q.id(p) for p in c.positions]
+                    round_vars.append((table.pos_var(c.index), enum_type(values, "qpad")))
+                    inits.append(f"  init({table.pos_var(c.index)}) := {q.id(c.entry)};")
+        lines += [f"  {var} : {typ};" for var, typ in round_vars]
+        lines += [
             "DEFINE",
             "  stable := TRUE;",
             f"  final := {final};",
@@ -168,13 +323,17 @@ class OutcomeFSMEncoder:
                     f"q = {q.id(p)}" for p, u in self.units.items() if symbol in u.outcomes
                 )
             lines.append(f"  offers_{sid} := {offered};")
+        start = self.start.path
         lines += [
             "ASSIGN",
-            f"  init(q) := {q.id(self.start)};",
+            f"  init(q) := {q.id(start)};",
             f"  next(q) := {case(next_q, 'q')};",
-            f"  init(o1) := {self._out(self.start)};",
+            f"  init(o1) := {self._out(start)};",
             f"  next(o1) := {case(next_o1 + [('go', NONE_OUT)], 'o1')};",
+            *inits,
         ]
+        for var, _typ in round_vars:
+            lines.append(f"  next({var}) := {case(assigned.get(var, []), var)};")
 
         def describe(values: dict[str, str]) -> str:
             name = q.name(values.get("q", "")) or "?"
@@ -186,9 +345,9 @@ class OutcomeFSMEncoder:
             "\n".join(lines) + "\n",
             ["o1"],
             [*dict.fromkeys(o for u in self.units.values() for o in u.outcomes), RUNNING_INPUT],
-            [("q", q.enum())],
+            [("q", q.enum()), *round_vars],
             decode_state=describe,
-            var_order=["q", "o1"],
+            var_order=["q", *(var for var, _t in round_vars), "o1"],
         )
 
 
@@ -320,6 +479,12 @@ class OutcomeBTEncoder(LeafBTEncoder):
     def _input_names(self) -> list[str]:
         return list(self.inputs.to_id)
 
+    def encode(self) -> Encoding:
+        """The tree's module, with its BDD order grouped by node (``node_order``)."""
+        encoding = super().encode()
+        encoding.var_order = node_order(encoding.var_order)
+        return encoding
+
     # -- the livelock check ----------------------------------------------------------------
     def livelock_model(self, encoding: Encoding) -> tuple[str, str] | None:
         """The model (SMV text, BDD order) of the livelock check, or ``None`` when no node
@@ -353,6 +518,36 @@ class OutcomeBTEncoder(LeafBTEncoder):
             "LIVELOCK state)",
             f"tree '{self.tree_name}'",
         )
+
+
+#: A node's own variable: ``<kind>_<node id>`` (``st_7``, ``ci_7``, ``sw_7``...).
+_NODE_VAR = re.compile(r"([a-z]+)_(\d+)")
+
+
+def node_order(order: Sequence[str]) -> list[str]:
+    """The BDD order with each node's memory variables (a Switch's ``sw_n``, an IfThenElse's
+    ``ci_n``, a loop's counter...) right after its status ``st_n`` instead of after every
+    node's status: the rules that read and write them test ``st_n`` and the node's call, and
+    NuSMV's relation over them blows up when they are far apart (a 20-state machine's
+    131-node tree: the monolithic relation past 120 s, 2.4 s grouped; docs/nusmv.md, "The
+    outcome pairing"). The blackboard entries (``bb_k``, ``k`` a key, not a node) and the
+    stack (``cur``, ``res``, ``lidx``) stay where they are."""
+    owned: dict[str, list[str]] = {}
+    for var in order:
+        found = _NODE_VAR.fullmatch(var)
+        if found and found.group(1) not in ("st", "bb"):
+            owned.setdefault(found.group(2), []).append(var)
+    placed = {v for group in owned.values() for v in group}
+    grouped: list[str] = []
+    for var in order:
+        if var in placed:
+            continue
+        grouped.append(var)
+        found = _NODE_VAR.fullmatch(var)
+        if found and found.group(1) == "st":
+            grouped += owned.pop(found.group(2), [])
+    grouped += [v for group in owned.values() for v in group]  # a node without a status
+    return grouped
 
 
 def _not(expr: str) -> str:
