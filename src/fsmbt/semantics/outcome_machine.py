@@ -198,7 +198,14 @@ class OutcomeFSMMachine:
                     return _Ended(target)
                 if (owner.path, target) in self.round_trips:
                     self._went_round = True
-                target = owner.targets[target]
+                onward = owner.targets.get(target)
+                if onward is None:  # SMACH raises on an outcome its container does not map
+                    raise OutcomeError(
+                        f"the container ends with outcome '{target}', which its parent "
+                        "state machine does not map to a transition",
+                        element=f"state '{owner.path}'",
+                    )
+                target = onward
                 continue
             unit = region.units[target]
             if unit.container and self.view.regions[unit.path].parallel:
