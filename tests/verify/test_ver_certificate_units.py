@@ -24,6 +24,7 @@ from fsmbt.verify.report import COMPOSITIONAL
 from support.random_trees import random_tree
 from support.sampling import seed
 from support.ver_models import act, cond, ctrl, paper_fsm
+from support.whole_mutants import DECORATORS
 
 
 def memory_tree() -> BTDocument:
@@ -222,7 +223,6 @@ CONTROLS = (
     "SequenceWithMemory",
     "ReactiveSequence",
 )
-DECORATORS = ("Inverter", "ForceSuccess", "ForceFailure", "Repeat", "RetryUntilSuccessful")
 
 
 def test_random_compositional_certificates_check_and_tree_mutants_are_refused():

@@ -18,8 +18,8 @@ from collections import Counter
 from fsmbt import limits
 from fsmbt.verify import compositional
 from fsmbt.verify.compositional import CheckPlan, compositional_report
-from fsmbt.verify.nusmv.pernode import check_plan
 from support.pernode_mutants import BOUND, seeded_mutants
+from support.pernode_units import units_agree
 
 
 def test_nusmv_fails_the_unit_the_stray_jump_fails(nusmv_binary, monkeypatch) -> None:
@@ -32,16 +32,7 @@ def test_nusmv_fails_the_unit_the_stray_jump_fails(nusmv_binary, monkeypatch) ->
                 report, _why = compositional_report(doc, mutant, max_states=BOUND, plan=plan)
             if report is None or "per_node_broken" not in report.stats:
                 continue
-            found = check_plan(plan.units, [])
-            units = [u for _region, region_units in plan.units for u in region_units]
-            refused = {id(u) for u, _why in found.local.refused}
-            checked = [u for u in units if id(u) not in refused]
-            assert len(checked) == len(found.local.verdicts)
-            for unit, verdict in zip(checked, found.local.verdicts, strict=True):
-                assert unit.held == verdict.holds, (
-                    f"{verdict.node}: native {'holds' if unit.held else 'fails'}, "
-                    f"NuSMV {'holds' if verdict.holds else 'fails'}: {verdict.steps}"
-                )
+            units, checked, refused = units_agree(plan)
             tally["pairs"] += 1
             tally["units agree"] += len(checked)
             tally["units refused by NuSMV"] += len(refused)
