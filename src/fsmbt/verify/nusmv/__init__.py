@@ -287,6 +287,7 @@ def check(
         split = macro or one_step_per_input(source_model, result_model)
     parts = (INVARIANTS, CTL) if split else (WHOLE,)
     mono = not split if mono is None else mono
+    # the encoding decided once above: ``encode`` does not compile and scan the tree again
     models = build_models(
         source_model,
         result_model,
@@ -294,7 +295,7 @@ def check(
         parts=parts,
         outcomes=outcomes,
         outcome_driven=outcome_driven,
-        tree_encoding=tree_encoding,
+        tree_encoding=MACRO if macro else MICRO,
     )
     encoded = time.perf_counter()
     context = models[0][2]
