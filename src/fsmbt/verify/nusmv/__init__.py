@@ -306,7 +306,7 @@ def check(
     deferred: tuple[str, list[str], list[str], str] | None = None
     # the split pairs' invariants and reachability listing in one run (``reach``)
     listed: list[dict[str, str]] | None = None
-    shared = split and state_reach and shared_search and reach.applies(context)
+    shared = split and state_reach and shared_search and reach.lists_cheaply(context)
     for part, (text, part_names, part_context) in zip(parts, models):
         if shared and part == INVARIANTS:
             part_names, found, listed, seconds = reach.invariants_and_listing(
