@@ -12,6 +12,7 @@ import pytest
 from fsmbt import api
 from fsmbt.formats import dumps
 from fsmbt.semantics.engines import load_beside
+from fsmbt.semantics.engines.btcpp_load import LoadCheck
 from fsmbt.semantics.engines.scxml_load import check_scxml_loads
 from support.chains import chain
 
@@ -109,3 +110,35 @@ def test_a_child_that_cannot_start_leaves_the_check_to_this_process(
     pending = load_beside.start_load_check(text, "scxml")
     assert not pending.in_child and pending._file is None  # noqa: SLF001 - its file removed
     assert pending.result() == check_scxml_loads(text)
+
+
+def test_the_child_answers_one_json_line_with_the_collector_off(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``scxml_load.main`` (what the child runs) turns Python's cyclic collector off before the
+    load (the engine's objects all live until the process ends; the collector's passes cost
+    more than the load: ``benchmarks/bench_load_check.py``) and answers as the check does."""
+    import gc
+    import json
+
+    from fsmbt.semantics.engines import scxml_load
+
+    text = dumps(chain(8), "scxml")
+    (tmp_path / "c.scxml").write_text(text, encoding="utf-8")
+    monkeypatch.setattr(scxml_load.sys, "argv", ["scxml_load", str(tmp_path / "c.scxml")])
+
+    def exit_here(status: int) -> None:
+        raise SystemExit(status)
+
+    monkeypatch.setattr(scxml_load.os, "_exit", exit_here)
+    assert gc.isenabled()
+    try:
+        with pytest.raises(SystemExit) as ended:
+            scxml_load.main()
+        assert not gc.isenabled()
+    finally:
+        gc.enable()
+    assert ended.value.code == 0
+    answer = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
+    assert check_scxml_loads(text) == LoadCheck(**answer)
+    assert answer["loaded"] is True

@@ -67,17 +67,31 @@ TICK_MARK = "fsmbt:tick-end"
 
 @dataclass
 class Namer:
-    """Unique, readable variable names across every region of one conversion."""
+    """Unique, readable variable names across every region of one conversion.
+
+    Rule: ``name(base)`` is ``base`` when free, else ``base_n`` for the smallest free n >= 2.
+    ``taken`` only grows, so a suffix found taken stays taken: the search for a base resumes
+    where its last one stopped (``_next``) and gives the same name as a search from 2. Cost:
+    O(1) amortised per name (a search from 2 each time made k names of one base cost O(k^2):
+    1.2 s of the 1.8 s conversion of the 15 560-node ``memory`` tree, whose variables are
+    nearly all ``SequenceWithMemory_idx_<n>``).
+    """
 
     taken: set[str] = field(default_factory=set)
+    _next: dict[str, int] = field(default_factory=dict, repr=False)
 
     def name(self, base: str) -> str:
         base = _NOT_NAME.sub("_", base).strip("_") or "v"
         if not (base[0].isalpha() or base[0] == "_"):
             base = "n_" + base
-        unique, n = base, 2
-        while unique in self.taken:
-            unique, n = f"{base}_{n}", n + 1
+        unique = base
+        if unique in self.taken:
+            n = self._next.get(base, 2)
+            unique = f"{base}_{n}"
+            while unique in self.taken:
+                n += 1
+                unique = f"{base}_{n}"
+            self._next[base] = n + 1
         self.taken.add(unique)
         return unique
 

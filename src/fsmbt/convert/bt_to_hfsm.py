@@ -158,15 +158,24 @@ class _Builder:
     explored_cache: dict[int, tuple[LeafMachine, ExploredMachine[Any]]] = field(
         default_factory=dict
     )
+    #: per machine (by id, the machine held): the next ``#n`` suffix to try per state name
+    _suffixes: dict[int, tuple[FSM, dict[str, int]]] = field(default_factory=dict, repr=False)
 
     # -- naming ----------------------------------------------------------------------------
-    @staticmethod
-    def _unique(fsm: FSM, base: str) -> str:
+    def _unique(self, fsm: FSM, base: str) -> str:
+        """``base`` when no state of ``fsm`` has that name, else ``base#n`` for the smallest
+        n >= 2 free. The builder only adds states, so a suffix found taken stays taken: the
+        search resumes where the last one for (``fsm``, ``base``) stopped (``_suffixes``;
+        ``fsm`` is kept alive there, so its id is not reused). Cost: O(1) amortised per name
+        (a search from 2 each time was O(k^2) for k states of one name: 0.7 s of the 15 560-node
+        ``mixed`` tree's conversion, under cProfile)."""
         if base not in fsm.states:
             return base
-        n = 2
-        while f"{base}#{n}" in fsm.states:
+        held, next_of = self._suffixes.setdefault(id(fsm), (fsm, {}))
+        n = next_of.get(base, 2)
+        while f"{base}#{n}" in held.states:
             n += 1
+        next_of[base] = n
         return f"{base}#{n}"
 
     def _new_machine(self, name: str, top: bool) -> FSM:
