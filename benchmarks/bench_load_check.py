@@ -33,7 +33,7 @@ import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).parent))
-from bench_reactive import family_tree, leaves_for, node_count  # noqa: E402
+from bench_reactive import node_count, written_trees  # noqa: E402
 
 from fsmbt import api  # noqa: E402
 from fsmbt.formats import dumps  # noqa: E402
@@ -142,38 +142,33 @@ def main() -> int:
         f"{'verify s':>8} | {'child s':>7} {'cpu s':>6} {'RSS MB':>6} | {'gc on s':>7} "
         f"{'cpu s':>6} {'RSS MB':>6}  answer"
     )
-    print(header)
-    print("-" * len(header))
     with tempfile.TemporaryDirectory() as folder:
-        for family in args.families.split(","):
-            for size in (int(s) for s in args.sizes.split(",")):
-                doc = family_tree(family, leaves_for(size), size)
-                tree = api.write(doc, Path(folder) / f"{family}{size}.xml")
-                started = time.perf_counter()
-                loaded = api.load(tree)
-                read = time.perf_counter() - started
-                started = time.perf_counter()
-                conversion = api.convert_model(loaded.model, "rules")
-                converted = time.perf_counter() - started
-                started = time.perf_counter()
-                text = dumps(conversion.model, "scxml")
-                dumped = time.perf_counter() - started
-                started = time.perf_counter()
-                api.verify_models(loaded.model, conversion.model, "native")
-                verified = time.perf_counter() - started
-                scxml = Path(folder) / f"{family}{size}.scxml"
-                scxml.write_text(text, encoding="utf-8")
-                now = _child(CHILD_COMMAND, str(scxml), args.limit)
-                before = _child(GC_ON, str(scxml), args.limit)
-                print(
-                    f"{family:<8} {node_count(doc):>6} {read:>7.2f} {converted:>7.2f} "
-                    f"{dumped:>8.2f} {len(text) / 1e6:>5.1f} {verified:>8.2f} | {now[0]:>7.2f} "
-                    f"{now[1]:>6.2f} {now[2]:>6} | {before[0]:>7.2f} {before[1]:>6.2f} "
-                    f"{before[2]:>6}  loaded {now[3]} / {before[3]}",
-                    flush=True,
-                )
-                if args.profile:
-                    print(f"  profile ({family} {node_count(doc)}): {_profile(text)}", flush=True)
+        for family, size, doc, tree in written_trees(args, header, Path(folder)):
+            started = time.perf_counter()
+            loaded = api.load(tree)
+            read = time.perf_counter() - started
+            started = time.perf_counter()
+            conversion = api.convert_model(loaded.model, "rules")
+            converted = time.perf_counter() - started
+            started = time.perf_counter()
+            text = dumps(conversion.model, "scxml")
+            dumped = time.perf_counter() - started
+            started = time.perf_counter()
+            api.verify_models(loaded.model, conversion.model, "native")
+            verified = time.perf_counter() - started
+            scxml = Path(folder) / f"{family}{size}.scxml"
+            scxml.write_text(text, encoding="utf-8")
+            now = _child(CHILD_COMMAND, str(scxml), args.limit)
+            before = _child(GC_ON, str(scxml), args.limit)
+            print(
+                f"{family:<8} {node_count(doc):>6} {read:>7.2f} {converted:>7.2f} "
+                f"{dumped:>8.2f} {len(text) / 1e6:>5.1f} {verified:>8.2f} | {now[0]:>7.2f} "
+                f"{now[1]:>6.2f} {now[2]:>6} | {before[0]:>7.2f} {before[1]:>6.2f} "
+                f"{before[2]:>6}  loaded {now[3]} / {before[3]}",
+                flush=True,
+            )
+            if args.profile:
+                print(f"  profile ({family} {node_count(doc)}): {_profile(text)}", flush=True)
     print(_load_average())
     return 0
 

@@ -38,6 +38,7 @@ import signal
 import sys
 import tempfile
 import time
+from collections.abc import Iterator
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).parent))
@@ -255,6 +256,22 @@ def main(argv: list[str] | None = None) -> int:
     return 0
 
 
+def written_trees(
+    args: argparse.Namespace, header: str, folder: Path
+) -> Iterator[tuple[str, int, BTDocument, Path]]:
+    """Print ``header`` and its rule, then, for each family and size of ``args``, the family's
+    tree (seeded by its size) written as BT.CPP XML into ``folder``: (family, size, tree, its
+    file) - the rows the ``--convert`` table and ``bench_load_check.py`` time."""
+    from fsmbt import api
+
+    print(header)
+    print("-" * len(header))
+    for family in args.families.split(","):
+        for size in (int(s) for s in args.sizes.split(",")):
+            doc = family_tree(family, leaves_for(size), size)
+            yield family, size, doc, api.write(doc, folder / f"{family}{size}.xml")
+
+
 def _convert_table(args: argparse.Namespace) -> int:
     """One row per tree: the whole ``convert`` (``fsmbt.api.convert_file``) in seconds (wall, and
     the process's CPU time: on a shared machine the wall time grows with the load, the CPU time
@@ -266,39 +283,34 @@ def _convert_table(args: argparse.Namespace) -> int:
         f"{'family':<14} {'nodes':>6} {'convert s':>10} {'cpu s':>8} {'verify s':>9} "
         f"{'load s':>7} {'verdict':>15} {'method':>14}"
     )
-    print(header)
-    print("-" * len(header))
     with tempfile.TemporaryDirectory() as folder:
-        for family in args.families.split(","):
-            for size in (int(s) for s in args.sizes.split(",")):
-                doc = family_tree(family, leaves_for(size), size)
-                nodes = node_count(doc)
-                tree = api.write(doc, Path(folder) / f"{family}{size}.xml")
-                signal.alarm(args.limit)
-                try:
-                    started, cpu = time.perf_counter(), time.process_time()
-                    outcome = api.convert_file(
-                        tree, Path(folder) / f"{family}{size}.scxml", overwrite=True
-                    )
-                    seconds = time.perf_counter() - started
-                    cpu = time.process_time() - cpu
-                    signal.alarm(0)
-                except Exception as exc:  # the time limit, or what fsmbt refused and why
-                    signal.alarm(0)
-                    why = f"over {args.limit} s" if isinstance(exc, _Timeout) else str(exc)
-                    if "_Timeout" in why:  # the limit met inside a step that wraps errors
-                        why = f"over {args.limit} s"
-                    print(f"{family:<14} {nodes:>6}  stopped: {why[:90]}", flush=True)
-                    continue
-                report = outcome.report
-                method = report.method if report is not None else "-"
-                verify_s = outcome.timings.get("verify", 0.0)
-                load_s = outcome.timings.get("load", 0.0)
-                print(
-                    f"{family:<14} {nodes:>6} {seconds:>10.3f} {cpu:>8.3f} {verify_s:>9.2f} "
-                    f"{load_s:>7.2f} {api.verdict_word(report):>15} {method:>14}",
-                    flush=True,
+        for family, size, doc, tree in written_trees(args, header, Path(folder)):
+            nodes = node_count(doc)
+            signal.alarm(args.limit)
+            try:
+                started, cpu = time.perf_counter(), time.process_time()
+                outcome = api.convert_file(
+                    tree, Path(folder) / f"{family}{size}.scxml", overwrite=True
                 )
+                seconds = time.perf_counter() - started
+                cpu = time.process_time() - cpu
+                signal.alarm(0)
+            except Exception as exc:  # the time limit, or what fsmbt refused and why
+                signal.alarm(0)
+                why = f"over {args.limit} s" if isinstance(exc, _Timeout) else str(exc)
+                if "_Timeout" in why:  # the limit met inside a step that wraps errors
+                    why = f"over {args.limit} s"
+                print(f"{family:<14} {nodes:>6}  stopped: {why[:90]}", flush=True)
+                continue
+            report = outcome.report
+            method = report.method if report is not None else "-"
+            verify_s = outcome.timings.get("verify", 0.0)
+            load_s = outcome.timings.get("load", 0.0)
+            print(
+                f"{family:<14} {nodes:>6} {seconds:>10.3f} {cpu:>8.3f} {verify_s:>9.2f} "
+                f"{load_s:>7.2f} {api.verdict_word(report):>15} {method:>14}",
+                flush=True,
+            )
     return 0
 
 
