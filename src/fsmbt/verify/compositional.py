@@ -62,6 +62,7 @@ from fsmbt.model.bt_nodes import NodeKind
 from fsmbt.model.errors import FsmbtError
 from fsmbt.model.fsm import FSM, State, Transition
 from fsmbt.model.fsm_data import DATAMODEL, ONEXIT, join_lines, parse_lines
+from fsmbt.semantics.bt_interpreter import CompiledTree
 from fsmbt.semantics.leaf_machine import LeafMachine
 from fsmbt.semantics.machine import FSMLeafMachine
 from fsmbt.semantics.nodes import (
@@ -72,9 +73,10 @@ from fsmbt.semantics.nodes import (
     canonical_type,
 )
 from fsmbt.semantics.status import LeafOutcome, RootResult
-from fsmbt.verify.lift import lifted_region_report, lifted_report
+from fsmbt.verify.lift import lifted_region_report, lifted_report, whole_tree
+from fsmbt.verify.lower_bound import LowerBound, lower_bound
 from fsmbt.verify.method import PER_NODE_SENTENCE
-from fsmbt.verify.native import DEFAULT_MAX_STATES, StateLimitError, check_witnessed
+from fsmbt.verify.native import DEFAULT_MAX_STATES, StateLimitError, check, check_witnessed
 from fsmbt.verify.pernode import (
     NODE_ATTR,
     LocalUnit,
@@ -82,6 +84,7 @@ from fsmbt.verify.pernode import (
     NotPerNode,
     PerNodeOutcome,
     check_region,
+    complete_walk,
 )
 from fsmbt.verify.report import COMPOSITIONAL, PER_NODE, PROPERTIES, PropertyResult, Report
 
@@ -907,7 +910,66 @@ def _lifted(source: BTDocument, result: FSM, found: Decomposition) -> Report | N
         report.stats["failed_region"] = found.failed_region
     report.stats["regions"] = found.regions
     report.stats.setdefault("lift_seconds", round(time.perf_counter() - started, 6))
+    if found.per_node_failure is not None and not report.stats.get("shortest"):
+        started = time.perf_counter()
+        bound = per_node_lower_bound(source, result, *found.per_node_failure)
+        report.stats["lower_bound_seconds"] = round(time.perf_counter() - started, 6)
+        _claim_by_bound(report, bound)
     return report
+
+
+def per_node_lower_bound(
+    source: BTDocument, result: FSM, region: BTNode, failed: PerNodeOutcome
+) -> LowerBound | None:
+    """The lower bound of ``verify/lower_bound.py`` on any counterexample of the pair, when
+    its conditions hold (docs/semantics.md §4d, "A lower bound from the per-node proof"):
+    the per-node failure broke no entry condition, the tree has this one region and the
+    machine one region state (the skeleton around it is checked here, the region abstracted
+    to the results its root's interface gives, §4c), and the complete walk decides every local
+    check; ``None`` otherwise (nothing is claimed)."""
+    if failed.tolerated is not None:
+        return None
+    try:
+        shape = structure(source, result)
+        if len(shape.regions) != 1 or len(shape.machine_regions) != 1:
+            return None
+        if shape.regions[0] is not region:
+            return None
+        walk = complete_walk(region, shape.machine_regions[0].machine, shape.declared)
+        bt_skeleton, fsm_skeleton = skeleton_models(
+            source, result, shape, {0: 0}, {0: walk.results}
+        )
+        if not check(LeafMachine(bt_skeleton), FSMLeafMachine(fsm_skeleton)).equivalent:
+            return None
+        merged = walk.walk.tree.doc.main.root
+        assert merged is not None
+        whole = CompiledTree(whole_tree(source, region, merged))
+        return lower_bound(whole, walk)
+    except (NotDecomposable, NotPerNode, FsmbtError):
+        return None
+
+
+def _claim_by_bound(report: Report, bound: LowerBound | None) -> None:
+    """Record the bound; when it meets the counterexample's length, the verdict says the
+    counterexample is shortest and names the method."""
+    length = report.stats.get("lifted_steps")
+    if bound is None or not isinstance(length, int):
+        return
+    report.stats["shortest_lower_bound"] = bound.bound
+    if bound.bound != length:
+        return  # (a bound above the length would contradict the replay: never claimed)
+    report.stats["shortest"] = True
+    report.stats["shortest_method"] = "lower bound"
+    said = (
+        f"shortest: no counterexample can be shorter than {length} inputs (a lower bound from "
+        f"the per-node proof, docs/semantics.md §4d: every local check decided, {bound.failing} "
+        f"failing; a difference needs a failing node's local pair to differ, at least "
+        f"{bound.before} leaf outcomes before node {bound.node} is first ticked and "
+        f"{bound.inside} under it)"
+    )
+    report.abstractions = [
+        said if a.startswith("not known to be shortest") else a for a in report.abstractions
+    ]
 
 
 def _add(total: dict[str, Any], part: dict[str, Any]) -> None:

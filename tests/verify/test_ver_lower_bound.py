@@ -1,0 +1,169 @@
+"""The lower bound on any counterexample's length (``verify/lower_bound.py``; docs/semantics.md
+§4d, "A lower bound from the per-node proof"; docs/verification.md §3): its soundness against
+the interpreter (the leaves before a node's first tick, the leaves of a first tick) and against
+the whole product's shortest counterexample on seeded one-transition mutants, and the verdict
+that claims "shortest" by it."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from typing import Any
+
+import pytest
+
+from fsmbt import limits
+from fsmbt.model.bt import BTDocument
+from fsmbt.model.bt_nodes import NodeKind
+from fsmbt.model.errors import FsmbtError
+from fsmbt.model.fsm import FSM
+from fsmbt.semantics.bt_interpreter import BTInterpreter, CompiledTree, LeafRequest
+from fsmbt.semantics.compiled import FAILURE, RUNNING, SUCCESS
+from fsmbt.verify import lift
+from fsmbt.verify.compositional import (
+    NotDecomposable,
+    compositional_report,
+    decompose,
+    per_node_lower_bound,
+)
+from fsmbt.verify.lower_bound import LowerBound, TickCosts
+from fsmbt.verify.report import LIFTED
+from support.pernode_mutants import BOUND, seeded_mutants, whole_shortest
+from support.pernode_trees import seeded_trees
+
+#: Leaves the interpreter's breadth-first search answers, and the states it may hold.
+DEPTH, STATES = 9, 30_000
+
+
+def _first_ticks(doc: BTDocument) -> tuple[CompiledTree, dict[int, int], dict[int, int]]:
+    """Breadth-first over the interpreter's leaf outcomes (``DEPTH`` leaves at most): the fewest
+    leaves answered before each node is seen ticking (on the path to a requested leaf), and
+    before the root's first tick returns each status (``exactly_once``: a RUNNING with a
+    wake-up ends the tick, as a parent sees its child's tick)."""
+    interp = BTInterpreter(doc, exactly_once=True)
+    seen: dict[int, int] = {}
+    root_first: dict[int, int] = {}
+    start, event = interp.advance(interp.begin_tick(interp.initial()), None)
+    level: list[tuple[Any, Any, bool]] = [(start, event, True)]
+    visited = {start}
+    for depth in range(DEPTH + 1):
+        following: list[tuple[Any, Any, bool]] = []
+        for snap, event, first in level:
+            while not isinstance(event, LeafRequest):
+                if first:
+                    root_first.setdefault(event.status, depth)
+                if event.status != RUNNING:
+                    break
+                first = False
+                snap = (snap[0], snap[1], snap[2], False)
+                snap, event = interp.advance(interp.begin_tick(snap), None)
+            if not isinstance(event, LeafRequest):
+                continue
+            for frame in snap[2]:
+                seen.setdefault(frame[0], depth)
+            node = event.node
+            outcomes = (
+                (SUCCESS, FAILURE)
+                if node.kind is NodeKind.CONDITION
+                else (SUCCESS, FAILURE, RUNNING)
+            )
+            for status in outcomes:
+                nxt, ev = interp.advance(snap, status)
+                if nxt not in visited and len(visited) < STATES:
+                    visited.add(nxt)
+                    following.append((nxt, ev, first))
+        level = following
+    return interp.tree, seen, root_first
+
+
+def test_the_costs_never_exceed_what_the_interpreter_does() -> None:
+    """P(U) <= the fewest leaves before U is seen ticking; the root's ``first`` <= the fewest
+    leaves of its first tick returning that status (both from the interpreter's own runs)."""
+    checked = tight = 0
+    for doc in seeded_trees(60, seed=31):
+        tree, seen, root_first = _first_ticks(doc)
+        costs = TickCosts(tree)
+        for nid, depth in seen.items():
+            before = costs.before(nid)
+            assert before is not None and before <= depth, (tree.nodes[nid].path, before, depth)
+            checked += 1
+            tight += before == depth
+        for status, depth in root_first.items():
+            assert costs.costs[0].first[status] <= depth
+            assert costs.costs[0].any[status] <= costs.costs[0].first[status]
+    assert checked >= 500
+    assert tight >= checked // 2  # the bound is not trivially low
+
+
+def _bounded_pairs(
+    trees: int, seed: int, rng_seed: int, per_tree: int
+) -> Iterator[tuple[BTDocument, FSM, LowerBound]]:
+    """The seeded mutants whose per-node check fails and the bound's conditions hold."""
+    for doc, _model, mutants in seeded_mutants(
+        trees, seed=seed, rng_seed=rng_seed, per_tree=per_tree
+    ):
+        for mutant in mutants:
+            try:
+                with limits.changed(conversion_max_states=BOUND):
+                    found = decompose(doc, mutant, max_states=BOUND)
+            except (NotDecomposable, FsmbtError):
+                continue
+            if found.per_node_failure is None:
+                continue
+            bound = per_node_lower_bound(doc, mutant, *found.per_node_failure)
+            if bound is not None:
+                yield doc, mutant, bound
+
+
+@pytest.mark.parametrize(
+    ("trees", "seed", "rng_seed", "per_tree", "least"),
+    [(60, 4, 5, 2, 25), (120, 41, 42, 3, 60)],
+)
+def test_the_bound_never_exceeds_the_whole_products_shortest(
+    trees: int, seed: int, rng_seed: int, per_tree: int, least: int
+) -> None:
+    """On every seeded mutant the whole product decides: bound <= its shortest counterexample;
+    and the bound meets it often (a bound one too high fails here)."""
+    decided = equal = 0
+    for doc, mutant, bound in _bounded_pairs(trees, seed, rng_seed, per_tree):
+        best = whole_shortest(doc, mutant)
+        if best is None or best < 0:
+            continue  # undecided, or equivalent (nothing to bound)
+        assert bound.bound <= best, (bound, best)
+        assert bound.failing >= 1 and bound.before + bound.inside == bound.bound
+        decided += 1
+        equal += bound.bound == best
+    assert decided >= least
+    assert equal >= least // 2
+
+
+def test_a_verdict_claims_shortest_by_the_bound_only_when_it_is(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """With the breadth-first search given no time (as on a large tree), the verdict falls to
+    the bound: when it says "shortest" by the bound, the whole product's shortest is its
+    length; otherwise it says "not known to be shortest"."""
+    search = lift.search_shorter
+    monkeypatch.setattr(
+        lift, "search_shorter", lambda s, r, n, **kw: search(s, r, n, max_seconds=0.0)
+    )
+    claimed = unclaimed = 0
+    for doc, _model, mutants in seeded_mutants(60, seed=4, rng_seed=5):
+        for mutant in mutants:
+            with limits.changed(conversion_max_states=BOUND):
+                report, _why = compositional_report(doc, mutant, max_states=BOUND)
+            if report is None or report.method not in LIFTED:
+                continue
+            length = report.stats["lifted_steps"]
+            said = " ".join(report.abstractions)
+            if report.stats.get("shortest_method") == "lower bound":
+                assert report.stats["shortest"] is True
+                assert report.stats["shortest_lower_bound"] == length
+                assert "shortest: no counterexample can be shorter than" in said
+                assert whole_shortest(doc, mutant) == length
+                claimed += 1
+            elif length >= 2:  # (a budget of 0 s still finishes the first level)
+                assert report.stats["shortest"] is False
+                assert "not known to be shortest" in said
+                unclaimed += 1
+    assert claimed >= 15
+    assert unclaimed >= 1
