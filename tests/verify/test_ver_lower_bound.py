@@ -6,73 +6,16 @@ that claims "shortest" by it."""
 
 from __future__ import annotations
 
-from collections.abc import Iterator
-from typing import Any
-
 import pytest
 
 from fsmbt import limits
-from fsmbt.model.bt import BTDocument
-from fsmbt.model.bt_nodes import NodeKind
-from fsmbt.model.errors import FsmbtError
-from fsmbt.model.fsm import FSM
-from fsmbt.semantics.bt_interpreter import BTInterpreter, CompiledTree, LeafRequest
-from fsmbt.semantics.compiled import FAILURE, RUNNING, SUCCESS
 from fsmbt.verify import lift
-from fsmbt.verify.compositional import (
-    NotDecomposable,
-    compositional_report,
-    decompose,
-    per_node_lower_bound,
-)
-from fsmbt.verify.lower_bound import LowerBound, TickCosts
+from fsmbt.verify.compositional import compositional_report
+from fsmbt.verify.lower_bound import TickCosts
 from fsmbt.verify.report import LIFTED
+from support.lower_bound_samples import bounded_pairs, first_ticks
 from support.pernode_mutants import BOUND, seeded_mutants, whole_shortest
 from support.pernode_trees import seeded_trees
-
-#: Leaves the interpreter's breadth-first search answers, and the states it may hold.
-DEPTH, STATES = 9, 30_000
-
-
-def _first_ticks(doc: BTDocument) -> tuple[CompiledTree, dict[int, int], dict[int, int]]:
-    """Breadth-first over the interpreter's leaf outcomes (``DEPTH`` leaves at most): the fewest
-    leaves answered before each node is seen ticking (on the path to a requested leaf), and
-    before the root's first tick returns each status (``exactly_once``: a RUNNING with a
-    wake-up ends the tick, as a parent sees its child's tick)."""
-    interp = BTInterpreter(doc, exactly_once=True)
-    seen: dict[int, int] = {}
-    root_first: dict[int, int] = {}
-    start, event = interp.advance(interp.begin_tick(interp.initial()), None)
-    level: list[tuple[Any, Any, bool]] = [(start, event, True)]
-    visited = {start}
-    for depth in range(DEPTH + 1):
-        following: list[tuple[Any, Any, bool]] = []
-        for snap, event, first in level:
-            while not isinstance(event, LeafRequest):
-                if first:
-                    root_first.setdefault(event.status, depth)
-                if event.status != RUNNING:
-                    break
-                first = False
-                snap = (snap[0], snap[1], snap[2], False)
-                snap, event = interp.advance(interp.begin_tick(snap), None)
-            if not isinstance(event, LeafRequest):
-                continue
-            for frame in snap[2]:
-                seen.setdefault(frame[0], depth)
-            node = event.node
-            outcomes = (
-                (SUCCESS, FAILURE)
-                if node.kind is NodeKind.CONDITION
-                else (SUCCESS, FAILURE, RUNNING)
-            )
-            for status in outcomes:
-                nxt, ev = interp.advance(snap, status)
-                if nxt not in visited and len(visited) < STATES:
-                    visited.add(nxt)
-                    following.append((nxt, ev, first))
-        level = following
-    return interp.tree, seen, root_first
 
 
 def test_the_costs_never_exceed_what_the_interpreter_does() -> None:
@@ -80,7 +23,7 @@ def test_the_costs_never_exceed_what_the_interpreter_does() -> None:
     leaves of its first tick returning that status (both from the interpreter's own runs)."""
     checked = tight = 0
     for doc in seeded_trees(60, seed=31):
-        tree, seen, root_first = _first_ticks(doc)
+        tree, seen, root_first = first_ticks(doc)
         costs = TickCosts(tree)
         for nid, depth in seen.items():
             before = costs.before(nid)
@@ -94,26 +37,6 @@ def test_the_costs_never_exceed_what_the_interpreter_does() -> None:
     assert tight >= checked // 2  # the bound is not trivially low
 
 
-def _bounded_pairs(
-    trees: int, seed: int, rng_seed: int, per_tree: int
-) -> Iterator[tuple[BTDocument, FSM, LowerBound]]:
-    """The seeded mutants whose per-node check fails and the bound's conditions hold."""
-    for doc, _model, mutants in seeded_mutants(
-        trees, seed=seed, rng_seed=rng_seed, per_tree=per_tree
-    ):
-        for mutant in mutants:
-            try:
-                with limits.changed(conversion_max_states=BOUND):
-                    found = decompose(doc, mutant, max_states=BOUND)
-            except (NotDecomposable, FsmbtError):
-                continue
-            if found.per_node_failure is None:
-                continue
-            bound = per_node_lower_bound(doc, mutant, *found.per_node_failure)
-            if bound is not None:
-                yield doc, mutant, bound
-
-
 @pytest.mark.parametrize(
     ("trees", "seed", "rng_seed", "per_tree", "least"),
     [(60, 4, 5, 2, 25), (120, 41, 42, 3, 60)],
@@ -124,7 +47,7 @@ def test_the_bound_never_exceeds_the_whole_products_shortest(
     """On every seeded mutant the whole product decides: bound <= its shortest counterexample;
     and the bound meets it often (a bound one too high fails here)."""
     decided = equal = 0
-    for doc, mutant, bound in _bounded_pairs(trees, seed, rng_seed, per_tree):
+    for doc, mutant, bound in bounded_pairs(trees, seed, rng_seed, per_tree):
         best = whole_shortest(doc, mutant)
         if best is None or best < 0:
             continue  # undecided, or equivalent (nothing to bound)
