@@ -1,5 +1,5 @@
 """The lower bound on any counterexample's length (``verify/lower_bound.py``; docs/semantics.md
-§4d, "A lower bound from the per-node proof"; docs/verification.md §3): its soundness against
+§4d, "A lower bound on any counterexample"; docs/verification.md §3): its soundness against
 the interpreter (the leaves before a node's first tick, the leaves of a first tick) and against
 the whole product's shortest counterexample on seeded one-transition mutants, and the verdict
 that claims "shortest" by it."""

@@ -1,6 +1,6 @@
 """A lower bound on the length of *any* counterexample of a pair whose per-node check failed
-(docs/semantics.md §4d, "A lower bound from the per-node proof"; docs/verification.md §3,
-"Lifted counterexamples"; issue 27 item 1).
+(docs/semantics.md §4d, "A lower bound on any counterexample, from the per-node proof";
+docs/verification.md §3, "A lower bound from the per-node proof"; issue 27 item 1).
 
 Why: a lifted counterexample of ``L`` inputs is shortest when nothing shorter separates the two
 whole machines. The breadth-first search of ``verify/shortest.py`` settles that only while the
@@ -11,23 +11,26 @@ closes the gap when ``B == L``.
 The argument (the full text is docs/semantics.md §4d):
 
 1. when the complete walk (``pernode.complete_walk``: every live node checked, no stray jump,
-   no early stop) fails at the set ``F`` of nodes, the composition of §4d, read step by step,
-   says the two machines agree on every input sequence until some node ``U`` of ``F`` has its
-   local pair (tree side with σ_U as settled, fragment side) output differently; every other
-   node's pair is related at every step before that (its local check held with the σ its
-   children were settled with);
+   no early stop; a node failing with and without ``halt`` settled haltable) fails at the set
+   ``F`` of nodes (the caller has checked the skeleton around the one region, §4c), the
+   composition of §4d, read step by step, says the two machines agree on every input sequence
+   until some node ``U`` of ``F`` has its local pair (tree side with σ_U as settled, fragment
+   side) output differently; every other node's pair is related at every step before that
+   (its local check held with the σ its children were settled with);
 2. before ``U``'s first tick its local pair is at rest on both sides, so a difference needs
    (a) the leaves consumed before ``U`` is first ticked - at least ``P(U)``, the sum over
    ``U``'s ancestors ``A`` of ``reach(A, i)``: the cheapest way, from ``A``'s rest, to have
-   ``A`` tick its child ``i`` towards ``U`` for the first time, each tick of another child
-   ``j`` returning ``s`` costing ``tick(j, s)`` - and (b) the leaves under ``U`` until its pair
-   differs - at least ``k(U)``, the cheapest path of ``U``'s local product to a step whose
-   outputs differ, child ``i``'s outcome ``s`` costing ``tick(child i, s)``;
-3. ``tick(x, s)``: a lower bound on the leaves *one* tick of ``x`` consumes to return ``s``,
-   from *any* state ``x`` can reach (fresh, resumed, halted, done): the least cost over every
-   reachable state of ``x`` over abstract children, each child event costing its own
-   ``tick``; an environment leaf costs 1, a leaf with a fixed status 0. The leaves under
-   different children are different leaves, so the costs add.
+   ``A`` tick its child ``i`` towards ``U`` for the first time - and (b) the leaves under ``U``
+   until its pair differs - at least ``k(U)``, the cheapest path of ``U``'s local product from
+   rest to a step whose outputs differ (``U``'s children are at rest at its first tick). In
+   both searches a child ``j`` returning ``s`` costs ``first_j(s)`` the first time and
+   ``any_j(s)`` later (the search state records which children were touched);
+3. ``any_x(s)``: a lower bound on the leaves *one* tick of ``x`` consumes to return ``s``, from
+   *any* state ``x`` can reach (fresh, resumed, halted, done): the least cost over every
+   reachable state of ``x`` over abstract children, each child event costing its own ``any``;
+   ``first_x(s)``: the same for ``x``'s first tick from rest (children's first events costing
+   their ``first``). An environment leaf costs 1, a leaf with a fixed status 0. The leaves
+   under different children are different leaves, so the costs add.
 
 So every counterexample has at least ``B = min over U in F of P(U) + k(U)`` inputs. Node
 behaviour is the interpreter's (``BTInterpreter`` on the node over abstract leaves, ``tick`` and
