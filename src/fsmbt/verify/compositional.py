@@ -922,24 +922,45 @@ def per_node_lower_bound(
     source: BTDocument, result: FSM, region: BTNode, failed: PerNodeOutcome
 ) -> LowerBound | None:
     """The lower bound of ``verify/lower_bound.py`` on any counterexample of the pair, when
-    its conditions hold (docs/semantics.md §4d, "A lower bound on any counterexample"):
-    the per-node failure broke no entry condition, the tree has this one region and the
-    machine one region state (the skeleton around it is checked here, the region abstracted
-    to the completions its state has, §4c), and the complete walk decides every local check;
-    ``None`` otherwise (nothing is claimed). Cost: the per-node walk again, the skeleton's
-    product, and ``lower_bound``'s searches (2.7 s on the 15 560-node mutant)."""
+    its conditions hold (docs/semantics.md §4d, "A lower bound on any counterexample"): the
+    per-node failure broke no entry condition; the complete walk of its region decides every
+    local check; every other paired region is proven (per node, else whole) with results its
+    state completes on; and the skeleton is equivalent with each proven region abstracted to
+    its results and the failing one to the results its root's settled interface pairs (else to
+    every completion its state has) - §4c, read prefix by prefix. ``None`` otherwise (nothing
+    is claimed). Cost: the regions' checks and the per-node walk again, the skeleton's
+    product, and ``lower_bound``'s searches (about 3 s on the 15 560-node mutant)."""
     if failed.tolerated is not None:
         return None
     try:
         shape = structure(source, result)
-        if len(shape.regions) != 1 or len(shape.machine_regions) != 1:
-            return None
-        if shape.regions[0] is not region:
-            return None
-        walk = complete_walk(region, shape.machine_regions[0].machine, shape.declared)
-        bt_skeleton, fsm_skeleton = skeleton_models(
-            source, result, shape, {0: 0}, {0: walk.results}
+        both = frozenset({SUCCESS, FAILURE})
+        regions, machine_regions = shape.regions, shape.machine_regions
+        pairs = pair_regions(
+            LeafMachine(skeleton_tree(source, regions, [both] * len(regions))),
+            FSMLeafMachine(skeleton_fsm(result, machine_regions, None)),
+            DEFAULT_MAX_STATES,
         )
+        tree_of_state = {
+            int(fsm_token[len("⟪state ") : -1]): int(tree_token[len("⟪unit ") : -1])
+            for fsm_token, tree_token in pairs.items()
+        }
+        results: dict[int, frozenset[str]] = {}
+        walk = None
+        for j, k in tree_of_state.items():
+            machine = machine_regions[j].machine
+            if regions[k] is region:
+                walk = complete_walk(region, machine, shape.declared)
+                if results_allowed(walk.results, shape, j):
+                    results[k] = walk.results
+                continue
+            possible = _proven_results(shape, k, j)
+            if possible is None or not results_allowed(possible, shape, j):
+                return None
+            results[k] = possible
+        if walk is None:
+            return None
+        bt_skeleton, fsm_skeleton = skeleton_models(source, result, shape, tree_of_state, results)
         if not check(LeafMachine(bt_skeleton), FSMLeafMachine(fsm_skeleton)).equivalent:
             return None
         merged = walk.walk.tree.doc.main.root
@@ -948,6 +969,22 @@ def per_node_lower_bound(
         return lower_bound(whole, walk)
     except (NotDecomposable, NotPerNode, FsmbtError):
         return None
+
+
+def _proven_results(shape: Structure, k: int, j: int) -> frozenset[str] | None:
+    """The results of tree region ``k`` when it is proven equivalent to region state ``j``
+    (per node when written so, else its whole product), else ``None``."""
+    machine = shape.machine_regions[j].machine
+    if _tagged_per_node(machine):
+        try:
+            found = check_region(shape.regions[k], machine, shape.declared)
+        except NotPerNode:
+            found = None
+        if found is not None:
+            return found.results if found.equivalent else None
+    bt_region, fsm_region = region_machines(shape, k, j)
+    report, witness = check_witnessed(bt_region, fsm_region)
+    return _results(witness) if report.equivalent else None
 
 
 def _claim_by_bound(report: Report, bound: LowerBound | None) -> None:
