@@ -40,7 +40,12 @@ from fsmbt.convert.bt_to_hfsm import bt_to_hfsm  # noqa: E402
 from fsmbt.model.bt import BTDocument  # noqa: E402
 from fsmbt.model.errors import FsmbtError  # noqa: E402
 from fsmbt.model.fsm import FSM  # noqa: E402
-from fsmbt.verify.compositional import compositional_report  # noqa: E402
+from fsmbt.verify.compositional import (  # noqa: E402
+    NotDecomposable,
+    compositional_report,
+    decompose,
+    per_node_lower_bound,
+)
 from fsmbt.verify.lazy_fsm import Unsupported  # noqa: E402
 from fsmbt.verify.lift import lift_machines  # noqa: E402
 from fsmbt.verify.native import check  # noqa: E402
@@ -75,6 +80,21 @@ def shortest(
     )
 
 
+def lower_bound_of(doc: BTDocument, mutant: FSM, bound: int) -> int | None:
+    """The lower bound on any counterexample's length (``verify/lower_bound.py``) when the
+    per-node check failed and its conditions hold, else ``None`` (computed for every lifted
+    verdict, whether or not the bounded search already proved it shortest)."""
+    try:
+        with limits.changed(conversion_max_states=bound):
+            found = decompose(doc, mutant, max_states=bound)
+    except (NotDecomposable, FsmbtError):
+        return None
+    if found.per_node_failure is None:
+        return None
+    lower = per_node_lower_bound(doc, mutant, *found.per_node_failure)
+    return None if lower is None else lower.bound
+
+
 def lifted_length(report: Report) -> int:
     return min(len(p.counterexample) - 1 for p in report.properties.values() if p.counterexample)
 
@@ -90,6 +110,10 @@ def tally(
     rows: Counter[tuple[str, str, str]] = Counter()
     spent = 0.0
     proven = 0  # lifted verdicts whose bounded search proved them shortest (verify/shortest.py)
+    by_bound = 0  # ... whose lower bound (verify/lower_bound.py) meets their length
+    bounded = 0  # lifted per-node verdicts the lower bound applies to
+    above = 0  # a bound above the whole product's shortest (unsound: must stay 0)
+    bound_seconds = 0.0
     for doc, mutant in pairs:
         started = time.perf_counter()
         with limits.changed(conversion_max_states=bound):
@@ -102,6 +126,13 @@ def tally(
         if report is not None and report.method in LIFTED:
             mine = lifted_length(report)
             proven += bool(report.stats.get("shortest"))
+            started = time.perf_counter()
+            lower = lower_bound_of(doc, mutant, bound)
+            bound_seconds += time.perf_counter() - started
+            if lower is not None:
+                bounded += 1
+                by_bound += lower == mine
+                above += best is not None and best >= 0 and lower > best
             if best is None:
                 length = "whole product undecided"
             elif best == -1:
@@ -121,7 +152,10 @@ def tally(
         f"lifted {lifted} of {differ} mutants the whole product refutes; {equal} of them as "
         f"short as its shortest; compositional check + lift {spent:.1f} s in all\n"
         f"proven shortest by the lift's own bounded search: {proven} of the {every} lifted "
-        "counterexamples\n",
+        "counterexamples\n"
+        f"lower bound (verify/lower_bound.py) computed for {bounded} of them, equal to the "
+        f"lifted length for {by_bound} (proven shortest by the bound alone), above the whole "
+        f"product's shortest for {above} (must be 0); {bound_seconds:.1f} s in all\n",
         flush=True,
     )
 

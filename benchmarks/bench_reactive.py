@@ -397,7 +397,9 @@ def _pernode_table(args: argparse.Namespace) -> int:
             if not report.equivalent and traces
             else ("not equivalent" if not report.equivalent else "EQUIVALENT")
         )
-        print(f"verify: {found} in {time.perf_counter() - started:.2f} s")
+        spent = report.stats.get("lower_bound_seconds")
+        bound = "" if spent is None else f" (of which the lower bound {spent:.2f} s)"
+        print(f"verify: {found} in {time.perf_counter() - started:.2f} s{bound}")
     except _Timeout:
         print(f"verify: not found within {args.limit} s")
     except InputError as exc:

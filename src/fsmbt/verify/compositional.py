@@ -62,6 +62,7 @@ from fsmbt.model.bt_nodes import NodeKind
 from fsmbt.model.errors import FsmbtError
 from fsmbt.model.fsm import FSM, State, Transition
 from fsmbt.model.fsm_data import DATAMODEL, ONEXIT, join_lines, parse_lines
+from fsmbt.semantics.bt_interpreter import CompiledTree
 from fsmbt.semantics.leaf_machine import LeafMachine
 from fsmbt.semantics.machine import FSMLeafMachine
 from fsmbt.semantics.nodes import (
@@ -72,9 +73,10 @@ from fsmbt.semantics.nodes import (
     canonical_type,
 )
 from fsmbt.semantics.status import LeafOutcome, RootResult
-from fsmbt.verify.lift import lifted_region_report, lifted_report
+from fsmbt.verify.lift import lifted_region_report, lifted_report, whole_tree
+from fsmbt.verify.lower_bound import LowerBound, lower_bound
 from fsmbt.verify.method import PER_NODE_SENTENCE
-from fsmbt.verify.native import DEFAULT_MAX_STATES, StateLimitError, check_witnessed
+from fsmbt.verify.native import DEFAULT_MAX_STATES, StateLimitError, check, check_witnessed
 from fsmbt.verify.pernode import (
     NODE_ATTR,
     LocalUnit,
@@ -82,6 +84,7 @@ from fsmbt.verify.pernode import (
     NotPerNode,
     PerNodeOutcome,
     check_region,
+    complete_walk,
 )
 from fsmbt.verify.report import COMPOSITIONAL, PER_NODE, PROPERTIES, PropertyResult, Report
 
@@ -907,7 +910,112 @@ def _lifted(source: BTDocument, result: FSM, found: Decomposition) -> Report | N
         report.stats["failed_region"] = found.failed_region
     report.stats["regions"] = found.regions
     report.stats.setdefault("lift_seconds", round(time.perf_counter() - started, 6))
+    if found.per_node_failure is not None and not report.stats.get("shortest"):
+        started = time.perf_counter()
+        bound = per_node_lower_bound(source, result, *found.per_node_failure)
+        report.stats["lower_bound_seconds"] = round(time.perf_counter() - started, 6)
+        _claim_by_bound(report, bound)
     return report
+
+
+def per_node_lower_bound(
+    source: BTDocument, result: FSM, region: BTNode, failed: PerNodeOutcome
+) -> LowerBound | None:
+    """The lower bound of ``verify/lower_bound.py`` on any counterexample of the pair, when
+    its conditions hold (docs/semantics.md §4d, "A lower bound on any counterexample"): the
+    per-node failure broke no entry condition; the complete walk of its region decides every
+    local check; every other paired region is proven (per node, else whole) with results its
+    state completes on; and the skeleton is equivalent with each proven region abstracted to
+    its results and the failing one to the results its root's settled interface pairs (else to
+    every completion its state has) - §4c, read prefix by prefix. ``None`` otherwise (nothing
+    is claimed). Cost: the regions' checks and the per-node walk again, the skeleton's
+    product, and ``lower_bound``'s searches (about 3 s on the 15 560-node mutant)."""
+    if failed.tolerated is not None:
+        return None
+    try:
+        shape = structure(source, result)
+        both = frozenset({SUCCESS, FAILURE})
+        regions, machine_regions = shape.regions, shape.machine_regions
+        pairs = pair_regions(
+            LeafMachine(skeleton_tree(source, regions, [both] * len(regions))),
+            FSMLeafMachine(skeleton_fsm(result, machine_regions, None)),
+            DEFAULT_MAX_STATES,
+        )
+        tree_of_state = {
+            int(fsm_token[len("⟪state ") : -1]): int(tree_token[len("⟪unit ") : -1])
+            for fsm_token, tree_token in pairs.items()
+        }
+        results: dict[int, frozenset[str]] = {}
+        walk = None
+        for j, k in tree_of_state.items():
+            machine = machine_regions[j].machine
+            if regions[k] is region:
+                walk = complete_walk(region, machine, shape.declared)
+                if results_allowed(walk.results, shape, j):
+                    results[k] = walk.results
+                continue
+            possible = _proven_results(shape, k, j)
+            if possible is None or not results_allowed(possible, shape, j):
+                return None
+            results[k] = possible
+        if walk is None:
+            return None
+        bt_skeleton, fsm_skeleton = skeleton_models(source, result, shape, tree_of_state, results)
+        if not check(LeafMachine(bt_skeleton), FSMLeafMachine(fsm_skeleton)).equivalent:
+            return None
+        merged = walk.walk.tree.doc.main.root
+        assert merged is not None
+        whole = CompiledTree(whole_tree(source, region, merged))
+        return lower_bound(whole, walk)
+    except (NotDecomposable, NotPerNode, FsmbtError):
+        return None
+
+
+def _proven_results(shape: Structure, k: int, j: int) -> frozenset[str] | None:
+    """The results of tree region ``k`` when it is proven equivalent to region state ``j``
+    (per node when written so, else its whole product), else ``None``."""
+    machine = shape.machine_regions[j].machine
+    if _tagged_per_node(machine):
+        try:
+            found = check_region(shape.regions[k], machine, shape.declared)
+        except NotPerNode:
+            found = None
+        if found is not None:
+            return found.results if found.equivalent else None
+    bt_region, fsm_region = region_machines(shape, k, j)
+    report, witness = check_witnessed(bt_region, fsm_region)
+    return _results(witness) if report.equivalent else None
+
+
+def _claim_by_bound(report: Report, bound: LowerBound | None) -> None:
+    """Record the bound; when it meets the counterexample's length, the verdict says the
+    counterexample is shortest and names the method."""
+    length = report.stats.get("lifted_steps")
+    if bound is None or not isinstance(length, int):
+        return
+    report.stats["shortest_lower_bound"] = bound.bound
+    if bound.bound < length:
+        report.abstractions.append(
+            f"not known to be shortest by the lower bound either: no counterexample can be "
+            f"shorter than {bound.bound} inputs (the per-node proof, docs/semantics.md §4d: "
+            f"{bound.before} leaf outcomes before node {bound.node} is first ticked, "
+            f"{bound.inside} under it), {length - bound.bound} short of this one"
+        )
+        return
+    if bound.bound > length:
+        return  # it would contradict the replay: never claimed (the tests assert it is not)
+    report.stats["shortest"] = True
+    report.stats["shortest_method"] = "lower bound"
+    said = (
+        f"shortest: no counterexample can be shorter than {length} inputs (a lower bound from "
+        f"the per-node proof, docs/semantics.md §4d: every local check decided, {bound.failing} "
+        f"failing; a difference needs a failing node's local pair to differ, at least "
+        f"{bound.before} leaf outcomes before node {bound.node} is first ticked and "
+        f"{bound.inside} under it)"
+    )
+    report.abstractions = [
+        said if a.startswith("not known to be shortest") else a for a in report.abstractions
+    ]
 
 
 def _add(total: dict[str, Any], part: dict[str, Any]) -> None:

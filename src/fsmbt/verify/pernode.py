@@ -1096,6 +1096,64 @@ def _failures(
             raise
 
 
+@dataclass
+class FailedUnit:
+    """A node whose local check failed, as the complete walk settled it: the problem, σ
+    (canonical; the statuses its check paired before failing) and whether ``halt`` was
+    offered when it was settled (what ``local_machines`` needs to run it again)."""
+
+    problem: LocalProblem
+    sigma: Sigma
+    can_halt: bool
+
+
+@dataclass
+class CompleteWalk:
+    """Every live node's local check decided, none skipped: the walk (its merged tree) and the
+    failing nodes, children first. ``verify/lower_bound.py`` reads it."""
+
+    walk: NodeWalk
+    failed: list[FailedUnit]
+    results: frozenset[str]
+
+
+def complete_walk(region_root: BTNode, machine: FSM, declared: dict[str, str]) -> CompleteWalk:
+    """Decide every local check of the region (equal problems once) as ``check_region`` does
+    - with ``halt`` offered, else without (then the node is not haltable) - but go past
+    failures, and never tolerate a broken side condition: the failing set is then *complete*
+    (no early stop, no cap on failures, no stray jump). A failing node is settled haltable,
+    with the σ its check paired with ``halt`` offered: its local pair is the one run with
+    ``halt`` (``FailedUnit.can_halt``), so its parent's check does not fail merely because it
+    halts it (a failure would otherwise climb to the root). Cost: the walk of
+    ``check_region`` to its end, failing problems checked twice.
+
+    Raises:
+        NotPerNode: a side condition fails anywhere (also past a failure), a local problem
+            passes ``LOCAL_LIMIT``, or the root's interface is not the finals': the failing
+            set is not known complete, so the caller claims nothing from it.
+    """
+    walk = NodeWalk(region_root, machine, declared)
+    memo: dict[tuple[Any, ...], tuple[bool, dict[int, Any], bool]] = {}
+    failed: list[FailedUnit] = []
+    for problem in walk.problems():
+        found = memo.get(problem.key)
+        if found is None:
+            args = (problem.local, problem.node, problem.allowed, problem.halts)
+            held, pairing, _states, _trace, _pairs = _check_local(*args, True)
+            found = (held, pairing, True)
+            if not held:
+                alone = _check_local(*args, False)
+                if alone[0]:  # proven for a node nobody halts
+                    found = (True, alone[1], False)
+            memo[problem.key] = found
+        held, pairing, can_halt = found
+        sigma = sigma_exits(problem.local, pairing)
+        if not held:
+            failed.append(FailedUnit(problem, sigma, can_halt))
+        walk.settle(problem, sigma, can_halt)
+    return CompleteWalk(walk, failed, walk.root_results())
+
+
 def _decide(
     problem: LocalProblem, keeping: bool
 ) -> tuple[tuple[bool, dict[int, Any], int, list[Any], bool], LocalWitness | None]:
