@@ -1,7 +1,8 @@
 """NuSMV options and runs, measured (issue 27, item 2). Prints a table of NuSMV CPU seconds.
 
     .venv/bin/python benchmarks/bench_nusmv_options.py [--sizes 100,300,1000]
-        [--timeout 60] [--columns whole,coi,dynamic,split-mono,frozen,unshared,after] [--random]
+        [--timeout 60] [--columns whole,coi,dynamic,split-mono,frozen,unshared,after,beside]
+        [--random] [--wall]
 
 Pairs: ``bench_checker.chain_fsm(n, n)`` against its renamed copy (``copy``: equivalent), and
 the same with one transition retargeted (``mutant``: not equivalent), FSM ~ FSM by macro
@@ -21,10 +22,16 @@ with it), ``-`` past ``--timeout`` wall seconds in one run:
   (``check(..., state_reach=False)``: the default before "Reachability state by state");
 - ``unshared``: ``check(..., shared_search=False)``: the invariants' own run, the CTL run,
   and for a failing pair the listing of the reachable states (``fsmbt.verify.nusmv.reach``);
-- ``after``: ``check``'s default: the invariants and the listing in one run (one build, one
-  forward search), the CTL run, the witness's two runs when reachability fails.
+- ``after``: ``check(..., beside=False)`` (the fifth round's default): the invariants and the
+  listing in one run (one build, one forward search), the CTL run, the witness's two runs when
+  reachability fails;
+- ``beside``: ``check``'s default: the same runs, the CTL run in a second process beside the
+  shared run (docs/nusmv.md, "Sixth round").
 
-``agree`` compares ``after``'s five verdicts with the native checker's; ``native`` is the
+``--wall``: each cell is ``CPU/wall`` seconds (the wall of the whole ``check``, on the loaded
+machine).
+
+``agree`` compares ``after``'s (and ``beside``'s) five verdicts with the native checker's; ``native`` is the
 native checker's CPU seconds.
 """
 
@@ -54,14 +61,16 @@ def child_cpu() -> float:
     return usage.ru_utime + usage.ru_stime
 
 
-def cpu_of(run: Callable[[], object]) -> tuple[str, object]:
-    """NuSMV CPU seconds of ``run()`` (``-`` past the cap) and its value."""
-    before = child_cpu()
+def cpu_of(run: Callable[[], object], wall: bool = False) -> tuple[str, object]:
+    """NuSMV CPU seconds of ``run()`` (``-`` past the cap) and its value; with ``wall``,
+    ``CPU/wall`` (the wall seconds of the whole call: two runs side by side share it)."""
+    before, begun = child_cpu(), time.perf_counter()
     try:
         value = run()
     except NuSMVLimitError:
         return "-", None
-    return f"{child_cpu() - before:.2f}", value
+    cell = f"{child_cpu() - before:.2f}"
+    return (f"{cell}/{time.perf_counter() - begun:.1f}" if wall else cell), value
 
 
 def _runs(
@@ -75,7 +84,8 @@ def _runs(
         "split-mono": lambda: nusmv.check(source, result, split=True, mono=True),
         "frozen": lambda: nusmv.check(source, result, state_reach=False),
         "unshared": lambda: nusmv.check(source, result, shared_search=False),
-        "after": lambda: nusmv.check(source, result),
+        "after": lambda: nusmv.check(source, result, beside=False),
+        "beside": lambda: nusmv.check(source, result),
     }
 
 
@@ -85,6 +95,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--timeout", type=float, default=60.0)
     parser.add_argument("--columns", default="whole,coi,dynamic,split-mono,frozen,after")
     parser.add_argument("--random", action="store_true", help="random_fsm pairs (seed = size)")
+    parser.add_argument("--wall", action="store_true", help="cells CPU/wall seconds")
     args = parser.parse_args(argv)
     limits.use(limits.current().with_changes(nusmv_max_seconds=args.timeout))
     columns = args.columns.split(",")
@@ -117,11 +128,11 @@ def main(argv: list[str] | None = None) -> int:
                 if key in gave_up:
                     cells.append("-")
                     continue
-                cell, value = cpu_of(runs[column])
+                cell, value = cpu_of(runs[column], args.wall)
                 if cell == "-":
                     gave_up.add(key)
                 cells.append(cell)
-                if column == "after" and value is not None:
+                if column in ("after", "beside") and value is not None:
                     same_verdicts = value.verdicts() == native.verdicts()  # type: ignore[attr-defined]
                     agree = "yes" if same_verdicts else "NO"
             print(
