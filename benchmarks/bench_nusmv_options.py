@@ -1,7 +1,8 @@
 """NuSMV options and runs, measured (issue 27, item 2). Prints a table of NuSMV CPU seconds.
 
     .venv/bin/python benchmarks/bench_nusmv_options.py [--sizes 100,300,1000]
-        [--timeout 60] [--columns whole,coi,dynamic,split-mono,frozen,unshared,after,beside]
+        [--timeout 60] [--columns whole,coi,dynamic,split-mono,frozen,unshared,after,beside,
+        input-first]
         [--random] [--wall]
 
 Pairs: ``bench_checker.chain_fsm(n, n)`` against its renamed copy (``copy``: equivalent), and
@@ -22,17 +23,18 @@ with it), ``-`` past ``--timeout`` wall seconds in one run:
   (``check(..., state_reach=False)``: the default before "Reachability state by state");
 - ``unshared``: ``check(..., shared_search=False)``: the invariants' own run, the CTL run,
   and for a failing pair the listing of the reachable states (``fsmbt.verify.nusmv.reach``);
-- ``after``: ``check(..., beside=False)`` (the fifth round's default): the invariants and the
-  listing in one run (one build, one forward search), the CTL run, the witness's two runs when
-  reachability fails;
-- ``beside``: ``check``'s default: the same runs, the CTL run in a second process beside the
-  shared run (docs/nusmv.md, "Sixth round").
+- ``after``: ``check``'s default: the invariants and the listing in one run (one build, one
+  forward search), the CTL run, the witness's two runs when reachability fails;
+- ``beside``: ``check(..., beside=True)``: the same runs, the CTL run in a second process
+  beside the shared run (docs/nusmv.md, "Sixth round");
+- ``input-first``: ``after`` with the input ``inp_s`` first in the BDD order of an FSM ~ FSM
+  pair (the order before the sixth round; ``after`` puts it after the source's variables).
 
 ``--wall``: each cell is ``CPU/wall`` seconds (the wall of the whole ``check``, on the loaded
 machine).
 
-``agree`` compares ``after``'s (and ``beside``'s) five verdicts with the native checker's; ``native`` is the
-native checker's CPU seconds.
+``agree`` compares the five verdicts of ``after``, ``beside`` and ``input-first`` (each run)
+with the native checker's; ``native`` is the native checker's CPU seconds.
 """
 
 from __future__ import annotations
@@ -53,6 +55,7 @@ from fsmbt import limits  # noqa: E402
 from fsmbt.generate.generator import random_fsm  # noqa: E402
 from fsmbt.model.fsm import FSM  # noqa: E402
 from fsmbt.verify import nusmv, verify  # noqa: E402
+from fsmbt.verify.nusmv.encode_fsm import Encoding, FSMEncoder  # noqa: E402
 from fsmbt.verify.nusmv.runner import NuSMVLimitError, run_nusmv  # noqa: E402
 
 
@@ -84,9 +87,27 @@ def _runs(
         "split-mono": lambda: nusmv.check(source, result, split=True, mono=True),
         "frozen": lambda: nusmv.check(source, result, state_reach=False),
         "unshared": lambda: nusmv.check(source, result, shared_search=False),
-        "after": lambda: nusmv.check(source, result, beside=False),
-        "beside": lambda: nusmv.check(source, result),
+        "after": lambda: nusmv.check(source, result),
+        "beside": lambda: nusmv.check(source, result, beside=True),
+        "input-first": lambda: _input_first(lambda: nusmv.check(source, result)),
     }
+
+
+def _input_first(run: Callable[[], object]) -> object:
+    """``run()`` with every FSM module's ``Encoding.input_after_source`` off: the input
+    ``inp_s`` first in the BDD order, as before the sixth round (docs/nusmv.md)."""
+    original = FSMEncoder.encode
+
+    def encode(self: FSMEncoder) -> Encoding:
+        encoding = original(self)
+        encoding.input_after_source = False
+        return encoding
+
+    FSMEncoder.encode = encode  # type: ignore[method-assign]
+    try:
+        return run()
+    finally:
+        FSMEncoder.encode = original  # type: ignore[method-assign]
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -132,9 +153,9 @@ def main(argv: list[str] | None = None) -> int:
                 if cell == "-":
                     gave_up.add(key)
                 cells.append(cell)
-                if column in ("after", "beside") and value is not None:
+                if column in ("after", "beside", "input-first") and value is not None:
                     same_verdicts = value.verdicts() == native.verdicts()  # type: ignore[attr-defined]
-                    agree = "yes" if same_verdicts else "NO"
+                    agree = "NO" if agree == "NO" or not same_verdicts else "yes"
             print(
                 f"{label:<7} {n:>6} {native_s:>7.3f} "
                 + " ".join(f"{c:>10}" for c in cells)

@@ -63,7 +63,7 @@ HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 sys.path.insert(0, str(HERE.parent / "tests"))
 from bench_nusmv_agreement import dispatch_pair, pair, structured_pairs  # noqa: E402
-from bench_nusmv_macro import mutant_of  # noqa: E402
+from bench_nusmv_macro import load, mutant_of  # noqa: E402
 from bench_reactive import family_tree, leaves_for, node_count  # noqa: E402
 
 from fsmbt import limits  # noqa: E402
@@ -204,7 +204,8 @@ def pernode_pairs(args: argparse.Namespace) -> Iterator[Pair]:
                 candidates.append(("mutant", mutant))
         for which, result in candidates:
             plan = CheckPlan()
-            with limits.changed(conversion_max_states=MUTANT_STATES):
+            capped = MUTANT_STATES if which == "mutant" else limits.current().conversion_max_states
+            with limits.changed(conversion_max_states=capped):
                 try:  # a mutant outside the per-node check falls back to its region whole
                     decompose(
                         doc, result, plan=plan, max_states=MUTANT_STATES, max_seconds=NATIVE_BUDGET
@@ -287,18 +288,21 @@ def sample(args: argparse.Namespace) -> Iterator[Pair]:
     yield from structured(args, rng)
 
 
-def load() -> str:
-    return "{:.2f} {:.2f} {:.2f}".format(*os.getloadavg())
+#: The table's columns: (title, width); the first left-aligned.
+COLUMNS = (
+    ("kind", 10), ("pairs", 6), ("agree", 6), ("disagree", 8), ("gave up", 7), ("refused", 7),
+    ("not asked", 9), ("error", 5), ("max CPU s", 9), ("max wall s", 10),
+    ("decided <= budget", 17),
+)  # fmt: skip
 
 
 def table(rows: list[Row], budget: float) -> int:
     """One line per kind and the total; the number of disagreements and errors."""
-    header = (
-        f"{'kind':<10} {'pairs':>6} {'agree':>6} {'disagree':>8} {'gave up':>7} {'refused':>7} "
-        f"{'not asked':>9} {'error':>5} {'max CPU s':>9} {'max wall s':>10} {'decided <= budget':>17}"
+    header = " ".join(
+        title.ljust(width) if i == 0 else title.rjust(width)
+        for i, (title, width) in enumerate(COLUMNS)
     )
-    print(header)
-    print("-" * len(header))
+    print(f"{header}\n{'-' * len(header)}")
     groups = [(k, [r for r in rows if r.pair.kind == k]) for k in KINDS] + [("total", rows)]
     for kind, group in groups:
         if not group:
@@ -345,7 +349,7 @@ def main(argv: list[str] | None = None) -> int:
     # one NuSMV run may not pass the pair's budget either
     limits.use(limits.current().with_changes(nusmv_max_seconds=args.budget))
     started = time.perf_counter()
-    print(f"# load at start: {load()} (1, 5, 15 min) on {os.cpu_count()} cores", flush=True)
+    print(f"# at start: {load()} (1, 5, 15 min) on {os.cpu_count()} cores", flush=True)
     print("# kind | label | pair | native | outcome | NuSMV CPU s | pair wall s | detail")
     rows: list[Row] = []
     for item in sample(args):
@@ -360,7 +364,7 @@ def main(argv: list[str] | None = None) -> int:
     bad = table(rows, args.budget)
     print(
         f"# {len(rows)} pairs in {time.perf_counter() - started:.0f} s wall; "
-        f"budget {args.budget:g} s wall per pair; load at end: {load()}",
+        f"budget {args.budget:g} s wall per pair; at end: {load()}",
         flush=True,
     )
     return 1 if bad else 0

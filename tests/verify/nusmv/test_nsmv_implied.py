@@ -64,8 +64,8 @@ def test_failing_pairs_get_every_spec_verdict(nusmv_binary, monkeypatch) -> None
 
 
 def test_the_ctl_run_beside_the_shared_run_gives_the_same_report(nusmv_binary, monkeypatch) -> None:
-    """``check(beside=True)`` (the default: the CTL run in a second process beside the shared
-    run; docs/nusmv.md, "Sixth round") against ``beside=False`` (one after the other): the same
+    """``check(beside=True)`` (the CTL run in a second process beside the shared run;
+    docs/nusmv.md, "Sixth round") against the default ``beside=False`` (one after the other): the same
     runs, verdicts, details and counterexamples, on seeded random pairs, copies and mutants."""
     monkeypatch.setenv("FSMBT_NUSMV", str(nusmv_binary))
     rng = random.Random(SEED)
@@ -77,8 +77,8 @@ def test_the_ctl_run_beside_the_shared_run_gives_the_same_report(nusmv_binary, m
         transition.target = rng.choice([s for s in mutant.states if s != transition.target])
         for result in (copy.deepcopy(source), mutant):
             native = verify(source, result)
-            beside = nusmv.check(source, result)
-            alone = nusmv.check(source, result, beside=False)
+            beside = nusmv.check(source, result, beside=True)
+            alone = nusmv.check(source, result)
             assert beside.verdicts() == alone.verdicts() == native.verdicts()
             assert beside.stats["nusmv_runs"] == alone.stats["nusmv_runs"]
             for name, found in beside.properties.items():

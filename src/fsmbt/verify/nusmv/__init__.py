@@ -238,7 +238,7 @@ def check(
     outcome_driven: bool = False,
     state_reach: bool = True,
     shared_search: bool = True,
-    beside: bool = True,
+    beside: bool = False,
     tree_encoding: str = AUTO,
 ) -> Report:
     """Verify ``result_model`` against ``source_model`` with NuSMV; see the module docstring.
@@ -271,12 +271,13 @@ def check(
     the invariants are checked on that listing's model in the same NuSMV run
     (``reach.invariants_and_listing``: one build and one forward search for both, and
     reachability decided directly rather than implied; docs/nusmv.md); ``False``: the
-    invariants' own run first, the listing only for a failing pair. ``beside`` (default, with
-    the shared run): the CTL run is started in a second NuSMV process beside it (a thread
-    waits on it), since neither reads the other's result - the pair's wall time is then the
-    longer run's, not their sum, on a machine with a core to spare or shared fairly among
-    processes (docs/nusmv.md, "Sixth round"); the CPU seconds are the same, the memory two
-    processes' (each under ``nusmv_max_memory_mb``). ``False``: one after the other.
+    invariants' own run first, the listing only for a failing pair. ``beside`` (with the shared
+    run): the CTL run is started in a second NuSMV process beside it (a thread waits on it),
+    since neither reads the other's result - the same runs and report, the wall time the
+    longer run's rather than their sum when a core is free, at the cost of two processes'
+    memory (each under ``nusmv_max_memory_mb``). Not the default: on the random 1 000-state
+    pair at load 4.4-4.9 it gained no wall time (copy 50.1 -> 52.9 s, mutant 61.5 -> 57.7 s;
+    docs/nusmv.md, "Sixth round"). ``False``: one after the other.
 
     ``tree_encoding`` (``AUTO``, ``MICRO``, ``MACRO``): how a BT ~ FSM pair's tree is written
     (``uses_macro_steps``; docs/nusmv.md, "Trees by macro steps"); the report's
