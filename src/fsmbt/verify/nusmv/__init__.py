@@ -276,7 +276,8 @@ def check(
     since neither reads the other's result - the same runs and report, the wall time the
     longer run's rather than their sum when a core is free, at the cost of two processes'
     memory (each under ``nusmv_max_memory_mb``). Not the default: on the random 1 000-state
-    pair at load 4.4-4.9 it gained no wall time (copy 50.1 -> 52.9 s, mutant 61.5 -> 57.7 s;
+    pair, four measured runs at load 1.3-4.9 gave 9 % less wall in total but a loss in three of
+    eight pairs (copy 23.3 -> 13.4 s at load 1.9, 27.7 -> 32.4 s at load 1.3-2.2;
     docs/nusmv.md, "Sixth round"). ``False``: one after the other.
 
     ``tree_encoding`` (``AUTO``, ``MICRO``, ``MACRO``): how a BT ~ FSM pair's tree is written
