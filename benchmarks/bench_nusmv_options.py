@@ -1,7 +1,9 @@
 """NuSMV options and runs, measured (issue 27, item 2). Prints a table of NuSMV CPU seconds.
 
     .venv/bin/python benchmarks/bench_nusmv_options.py [--sizes 100,300,1000]
-        [--timeout 60] [--columns whole,coi,dynamic,split-mono,frozen,unshared,after] [--random]
+        [--timeout 60] [--columns whole,coi,dynamic,split-mono,frozen,unshared,after,beside,
+        input-first]
+        [--random] [--wall]
 
 Pairs: ``bench_checker.chain_fsm(n, n)`` against its renamed copy (``copy``: equivalent), and
 the same with one transition retargeted (``mutant``: not equivalent), FSM ~ FSM by macro
@@ -22,10 +24,17 @@ with it), ``-`` past ``--timeout`` wall seconds in one run:
 - ``unshared``: ``check(..., shared_search=False)``: the invariants' own run, the CTL run,
   and for a failing pair the listing of the reachable states (``fsmbt.verify.nusmv.reach``);
 - ``after``: ``check``'s default: the invariants and the listing in one run (one build, one
-  forward search), the CTL run, the witness's two runs when reachability fails.
+  forward search), the CTL run, the witness's two runs when reachability fails;
+- ``beside``: ``check(..., beside=True)``: the same runs, the CTL run in a second process
+  beside the shared run (docs/nusmv.md, "Sixth round");
+- ``input-first``: ``after`` with the input ``inp_s`` first in the BDD order of an FSM ~ FSM
+  pair (the order before the sixth round; ``after`` puts it after the source's variables).
 
-``agree`` compares ``after``'s five verdicts with the native checker's; ``native`` is the
-native checker's CPU seconds.
+``--wall``: each cell is ``CPU/wall`` seconds (the wall of the whole ``check``, on the loaded
+machine).
+
+``agree`` compares the five verdicts of ``after``, ``beside`` and ``input-first`` (each run)
+with the native checker's; ``native`` is the native checker's CPU seconds.
 """
 
 from __future__ import annotations
@@ -46,6 +55,7 @@ from fsmbt import limits  # noqa: E402
 from fsmbt.generate.generator import random_fsm  # noqa: E402
 from fsmbt.model.fsm import FSM  # noqa: E402
 from fsmbt.verify import nusmv, verify  # noqa: E402
+from fsmbt.verify.nusmv.encode_fsm import Encoding, FSMEncoder  # noqa: E402
 from fsmbt.verify.nusmv.runner import NuSMVLimitError, run_nusmv  # noqa: E402
 
 
@@ -54,14 +64,16 @@ def child_cpu() -> float:
     return usage.ru_utime + usage.ru_stime
 
 
-def cpu_of(run: Callable[[], object]) -> tuple[str, object]:
-    """NuSMV CPU seconds of ``run()`` (``-`` past the cap) and its value."""
-    before = child_cpu()
+def cpu_of(run: Callable[[], object], wall: bool = False) -> tuple[str, object]:
+    """NuSMV CPU seconds of ``run()`` (``-`` past the cap) and its value; with ``wall``,
+    ``CPU/wall`` (the wall seconds of the whole call: two runs side by side share it)."""
+    before, begun = child_cpu(), time.perf_counter()
     try:
         value = run()
     except NuSMVLimitError:
         return "-", None
-    return f"{child_cpu() - before:.2f}", value
+    cell = f"{child_cpu() - before:.2f}"
+    return (f"{cell}/{time.perf_counter() - begun:.1f}" if wall else cell), value
 
 
 def _runs(
@@ -76,7 +88,26 @@ def _runs(
         "frozen": lambda: nusmv.check(source, result, state_reach=False),
         "unshared": lambda: nusmv.check(source, result, shared_search=False),
         "after": lambda: nusmv.check(source, result),
+        "beside": lambda: nusmv.check(source, result, beside=True),
+        "input-first": lambda: _input_first(lambda: nusmv.check(source, result)),
     }
+
+
+def _input_first(run: Callable[[], object]) -> object:
+    """``run()`` with every FSM module's ``Encoding.input_after_source`` off: the input
+    ``inp_s`` first in the BDD order, as before the sixth round (docs/nusmv.md)."""
+    original = FSMEncoder.encode
+
+    def encode(self: FSMEncoder) -> Encoding:
+        encoding = original(self)
+        encoding.input_after_source = False
+        return encoding
+
+    FSMEncoder.encode = encode  # type: ignore[method-assign]
+    try:
+        return run()
+    finally:
+        FSMEncoder.encode = original  # type: ignore[method-assign]
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -85,6 +116,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--timeout", type=float, default=60.0)
     parser.add_argument("--columns", default="whole,coi,dynamic,split-mono,frozen,after")
     parser.add_argument("--random", action="store_true", help="random_fsm pairs (seed = size)")
+    parser.add_argument("--wall", action="store_true", help="cells CPU/wall seconds")
     args = parser.parse_args(argv)
     limits.use(limits.current().with_changes(nusmv_max_seconds=args.timeout))
     columns = args.columns.split(",")
@@ -117,13 +149,13 @@ def main(argv: list[str] | None = None) -> int:
                 if key in gave_up:
                     cells.append("-")
                     continue
-                cell, value = cpu_of(runs[column])
+                cell, value = cpu_of(runs[column], args.wall)
                 if cell == "-":
                     gave_up.add(key)
                 cells.append(cell)
-                if column == "after" and value is not None:
+                if column in ("after", "beside", "input-first") and value is not None:
                     same_verdicts = value.verdicts() == native.verdicts()  # type: ignore[attr-defined]
-                    agree = "yes" if same_verdicts else "NO"
+                    agree = "NO" if agree == "NO" or not same_verdicts else "yes"
             print(
                 f"{label:<7} {n:>6} {native_s:>7.3f} "
                 + " ".join(f"{c:>10}" for c in cells)

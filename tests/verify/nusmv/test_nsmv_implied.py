@@ -8,14 +8,18 @@ verdicts of one run of every spec and of the native checker."""
 from __future__ import annotations
 
 import copy
+import os
+import random
 from pathlib import Path
 
 from fsmbt import api
+from fsmbt.generate.generator import random_fsm
 from fsmbt.verify import nusmv, verify
 from fsmbt.verify.nusmv import reach
 from fsmbt.verify.report import REACHABILITY
 
 EXAMPLE = Path(__file__).resolve().parents[3] / "examples" / "guard_npc.csv"
+SEED = int(os.environ.get("FSMBT_TEST_SEED", "27"))
 
 
 def test_equivalent_pair_skips_the_reachability_spec(nusmv_binary, monkeypatch) -> None:
@@ -57,3 +61,28 @@ def test_failing_pairs_get_every_spec_verdict(nusmv_binary, monkeypatch) -> None
         assert report.verdicts() == whole.verdicts()
         compared += 1
     assert compared >= 1
+
+
+def test_the_ctl_run_beside_the_shared_run_gives_the_same_report(nusmv_binary, monkeypatch) -> None:
+    """``check(beside=True)`` (the CTL run in a second process beside the shared run;
+    docs/nusmv.md, "Sixth round") against the default ``beside=False`` (one after the other): the same
+    runs, verdicts, details and counterexamples, on seeded random pairs, copies and mutants."""
+    monkeypatch.setenv("FSMBT_NUSMV", str(nusmv_binary))
+    rng = random.Random(SEED)
+    failing = 0
+    for size in (5, 12, 30, 60):
+        source = random_fsm(rng.randrange(10**9), n_states=size)
+        mutant = copy.deepcopy(source)
+        transition = mutant.transitions[rng.randrange(len(mutant.transitions))]
+        transition.target = rng.choice([s for s in mutant.states if s != transition.target])
+        for result in (copy.deepcopy(source), mutant):
+            native = verify(source, result)
+            beside = nusmv.check(source, result, beside=True)
+            alone = nusmv.check(source, result)
+            assert beside.verdicts() == alone.verdicts() == native.verdicts()
+            assert beside.stats["nusmv_runs"] == alone.stats["nusmv_runs"]
+            for name, found in beside.properties.items():
+                other = alone.properties[name]
+                assert (found.detail, found.counterexample) == (other.detail, other.counterexample)
+            failing += not native.equivalent
+    assert failing >= 1  # failing pairs (counterexamples) were compared too

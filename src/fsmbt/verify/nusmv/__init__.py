@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Iterable
+from concurrent.futures import Future, ThreadPoolExecutor
 from typing import TYPE_CHECKING, TypeAlias
 
 from fsmbt.model.bt import BTDocument
@@ -237,6 +238,7 @@ def check(
     outcome_driven: bool = False,
     state_reach: bool = True,
     shared_search: bool = True,
+    beside: bool = False,
     tree_encoding: str = AUTO,
 ) -> Report:
     """Verify ``result_model`` against ``source_model`` with NuSMV; see the module docstring.
@@ -269,7 +271,14 @@ def check(
     the invariants are checked on that listing's model in the same NuSMV run
     (``reach.invariants_and_listing``: one build and one forward search for both, and
     reachability decided directly rather than implied; docs/nusmv.md); ``False``: the
-    invariants' own run first, the listing only for a failing pair.
+    invariants' own run first, the listing only for a failing pair. ``beside`` (with the shared
+    run): the CTL run is started in a second NuSMV process beside it (a thread waits on it),
+    since neither reads the other's result - the same runs and report, the wall time the
+    longer run's rather than their sum when a core is free, at the cost of two processes'
+    memory (each under ``nusmv_max_memory_mb``). Not the default: on the random 1 000-state
+    pair, four measured runs at load 1.3-4.9 gave 9 % less wall in total but a loss in three of
+    eight pairs (copy 23.3 -> 13.4 s at load 1.9, 27.7 -> 32.4 s at load 1.3-2.2;
+    docs/nusmv.md, "Sixth round"). ``False``: one after the other.
 
     ``tree_encoding`` (``AUTO``, ``MICRO``, ``MACRO``): how a BT ~ FSM pair's tree is written
     (``uses_macro_steps``; docs/nusmv.md, "Trees by macro steps"); the report's
@@ -307,37 +316,53 @@ def check(
     # the split pairs' invariants and reachability listing in one run (``reach``)
     listed: list[dict[str, str]] | None = None
     shared = split and state_reach and shared_search and reach.lists_cheaply(context)
-    for part, (text, part_names, part_context) in zip(parts, models):
-        if shared and part == INVARIANTS:
-            part_names, found, listed, seconds = reach.invariants_and_listing(
-                context, timeout=timeout
-            )
+    drop_reach = implied_reachability or shared
+    pool = ThreadPoolExecutor(max_workers=1) if shared and beside and CTL in parts else None
+    ctl_run: Future[tuple[list[SpecResult], float]] | None = None
+    try:
+        for part, (text, part_names, part_context) in zip(parts, models):
+            if shared and part == INVARIANTS:
+                if pool is not None:  # the CTL run does not read this one's result: beside it
+                    ctl_text, ctl_names, ctl_context = models[parts.index(CTL)]
+                    ctl_text, ctl_names, ctl_options, _kept = _lean_part(
+                        CTL, ctl_text, ctl_names, ctl_context[-1], drop_reach
+                    )
+                    if ctl_names:
+                        ctl_run = pool.submit(
+                            run_nusmv,
+                            ctl_text,
+                            len(ctl_names),
+                            order=ctl_context[-1],
+                            timeout=timeout,
+                            options=ctl_options,
+                            mono=mono,
+                        )
+                part_names, found, listed, seconds = reach.invariants_and_listing(
+                    context, timeout=timeout
+                )
+                names += part_names
+                results += found
+                runs += 1
+                nusmv_seconds += seconds
+                continue
+            order = part_context[-1]  # each part's own variables
+            text, part_names, options, lean = _lean_part(part, text, part_names, order, drop_reach)
+            deferred = lean or deferred
+            if not part_names:
+                continue
+            if part == CTL and ctl_run is not None:
+                found, seconds = ctl_run.result()  # started beside the shared run
+            else:
+                found, seconds = run_nusmv(
+                    text, len(part_names), order=order, timeout=timeout, options=options, mono=mono
+                )
             names += part_names
             results += found
             runs += 1
             nusmv_seconds += seconds
-            continue
-        options = ["-df"] if part == CTL else []
-        lean = (
-            without_spec(text, part_names, REACHABILITY) if implied_reachability or shared else None
-        )
-        if lean is not None:
-            deferred = (text, part_names, options, part_context[-1])
-            text, part_names = lean
-        if not part_names:
-            continue
-        found, seconds = run_nusmv(
-            text,
-            len(part_names),
-            order=part_context[-1],  # each part's own variables
-            timeout=timeout,
-            options=options,
-            mono=mono,
-        )
-        names += part_names
-        results += found
-        runs += 1
-        nusmv_seconds += seconds
+    finally:  # a run past its cap raised: the other process ends by its own cap, waited for
+        if pool is not None:
+            pool.shutdown(wait=True)
     report = build_report(names, results, context, source_model, result_model)
     tree = context[3]
     if isinstance(tree, OutcomeBTEncoder):  # the outcome pairing's livelock check, on its own
@@ -392,6 +417,19 @@ def check(
             encode_macro.ENCODING_NAME if macro else "micro-step tree (encode_bt)"
         )
     return report
+
+
+def _lean_part(
+    part: str, text: str, names: list[str], order: str, drop_reach: bool
+) -> tuple[str, list[str], list[str], tuple[str, list[str], list[str], str] | None]:
+    """One part's run as ``check`` makes it: (text, spec names, NuSMV options, the run kept
+    for reachability or ``None``). ``-df`` for the CTL part; with ``drop_reach`` the
+    reachability spec is left out, and the whole part is kept to run it later if needed."""
+    options = ["-df"] if part == CTL else []
+    lean = without_spec(text, names, REACHABILITY) if drop_reach else None
+    if lean is None:
+        return text, names, options, None
+    return lean[0], lean[1], options, (text, names, options, order)
 
 
 def _only_spec(text: str, names: list[str], kept: str) -> str:

@@ -58,6 +58,9 @@ class Encoding:
     output_words: list[tuple[str, int]] = field(default_factory=list)
     # identity DEFINEs -> the variable their frozen copy is ordered next to (``specs._order``)
     id_near: dict[str, str] = field(default_factory=dict)
+    # the input ``inp_s`` ordered after the source's variables when both modules ask for it
+    # (an FSM read by events; ``specs._order``; docs/nusmv.md, "Sixth round")
+    input_after_source: bool = False
 
 
 def enum_bits(enum: str) -> int:
@@ -220,6 +223,7 @@ class FSMEncoder:
             id_values=list(q.to_name),
             position=("q", q.bits),
             output_words=[(slot, enum_bits(out_enum)) for slot in slots],
+            input_after_source=not self.leaf,
         )
 
     def status_of(self, values: dict[str, str]) -> str:
