@@ -192,7 +192,7 @@ def _words(equivalent: bool) -> str:
 
 def pernode_pairs(args: argparse.Namespace) -> Iterator[Pair]:
     """Per family one tree and ``--tree-mutants`` mutants, decided node by node."""
-    for family in args.pernode_families.split(","):
+    for family in filter(None, args.pernode_families.split(",")):
         doc = family_tree(family, leaves_for(args.tree_size), 1)
         label = f"{family} {node_count(doc)} nodes"
         model = bt_to_hfsm(doc, pernode=True).model
@@ -251,7 +251,7 @@ def _units(count: int) -> str:
 
 def macro_pairs(args: argparse.Namespace, rng: random.Random) -> Iterator[Pair]:
     """Per family a tree against its flattened HFSM and a one-transition mutant of it."""
-    for family in args.macro_families.split(","):
+    for family in filter(None, args.macro_families.split(",")):
         doc = family_tree(family, leaves_for(args.tree_size), 1)
         label = f"{family} {node_count(doc)} nodes"
         flat = flatten(bt_to_hfsm(doc).model)

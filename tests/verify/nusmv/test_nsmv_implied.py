@@ -16,7 +16,7 @@ from fsmbt import api
 from fsmbt.generate.generator import random_fsm
 from fsmbt.verify import nusmv, verify
 from fsmbt.verify.nusmv import reach
-from fsmbt.verify.report import REACHABILITY
+from fsmbt.verify.report import DEADLOCK_ABSENCE, REACHABILITY
 
 EXAMPLE = Path(__file__).resolve().parents[3] / "examples" / "guard_npc.csv"
 SEED = int(os.environ.get("FSMBT_TEST_SEED", "27"))
@@ -28,9 +28,14 @@ def test_equivalent_pair_skips_the_reachability_spec(nusmv_binary, monkeypatch) 
     report = nusmv.check(fsm, copy.deepcopy(fsm), shared_search=False)
     assert report.equivalent and report.stats["nusmv_runs"] == 2
     assert report.properties[REACHABILITY].detail == nusmv.IMPLIED_DETAIL
-    shared = nusmv.check(fsm, copy.deepcopy(fsm))  # reachability read off the listing
+    shared = nusmv.check(fsm, copy.deepcopy(fsm), implied_deadlock=False)  # off the listing
     assert shared.equivalent and shared.stats["nusmv_runs"] == 2
     assert shared.properties[REACHABILITY].detail == reach.STATES_DETAIL
+    # the default: deadlock absence follows from the shared run, no CTL run
+    lean = nusmv.check(fsm, copy.deepcopy(fsm))
+    assert lean.equivalent and lean.stats["nusmv_runs"] == 1
+    assert lean.properties[DEADLOCK_ABSENCE].detail == nusmv.DEADLOCK_IMPLIED_DETAIL
+    assert lean.verdicts() == shared.verdicts()
     whole = nusmv.check(fsm, copy.deepcopy(fsm), implied_reachability=False, split=False)
     assert whole.stats["nusmv_runs"] == 1
     assert whole.verdicts() == report.verdicts() == shared.verdicts()
@@ -78,7 +83,7 @@ def test_the_ctl_run_beside_the_shared_run_gives_the_same_report(nusmv_binary, m
         for result in (copy.deepcopy(source), mutant):
             native = verify(source, result)
             beside = nusmv.check(source, result, beside=True)
-            alone = nusmv.check(source, result)
+            alone = nusmv.check(source, result, implied_deadlock=False)
             assert beside.verdicts() == alone.verdicts() == native.verdicts()
             assert beside.stats["nusmv_runs"] == alone.stats["nusmv_runs"]
             for name, found in beside.properties.items():
@@ -86,3 +91,30 @@ def test_the_ctl_run_beside_the_shared_run_gives_the_same_report(nusmv_binary, m
                 assert (found.detail, found.counterexample) == (other.detail, other.counterexample)
             failing += not native.equivalent
     assert failing >= 1  # failing pairs (counterexamples) were compared too
+
+
+def test_deadlock_is_implied_only_when_the_rest_holds(nusmv_binary, monkeypatch) -> None:
+    """Deadlock absence implied by the shared run (``nusmv.deadlock_implied``): on seeded
+    random FSM ~ FSM copies and one-transition mutants, the default gives the verdicts of the
+    run that decides deadlock absence with its own CTL spec and of the native checker; the
+    implication is used on every equivalent pair (one NuSMV run) and on no failing one (its
+    deadlock verdict, holding or not, is NuSMV's own, with the CTL run)."""
+    monkeypatch.setenv("FSMBT_NUSMV", str(nusmv_binary))
+    rng = random.Random(SEED + 1)
+    implied = failing = 0
+    for size in (4, 8, 15, 25, 40, 70):
+        source = random_fsm(rng.randrange(10**9), n_states=size)
+        mutant = copy.deepcopy(source)
+        transition = mutant.transitions[rng.randrange(len(mutant.transitions))]
+        transition.target = rng.choice([s for s in mutant.states if s != transition.target])
+        for result in (copy.deepcopy(source), mutant):
+            native = verify(source, result)
+            lean = nusmv.check(source, result)
+            full = nusmv.check(source, result, implied_deadlock=False)
+            assert lean.verdicts() == full.verdicts() == native.verdicts()
+            said = lean.properties[DEADLOCK_ABSENCE].detail == nusmv.DEADLOCK_IMPLIED_DETAIL
+            assert said == native.equivalent
+            assert lean.stats["nusmv_runs"] == full.stats["nusmv_runs"] - said
+            implied += said
+            failing += not native.equivalent
+    assert implied >= 6 and failing >= 3

@@ -29,6 +29,7 @@ from fsmbt.verify.nusmv.smv import Symbols
 from fsmbt.verify.nusmv.specs import CTL, INVARIANTS, WHOLE, product
 from fsmbt.verify.nusmv.traces import Context, Encoder, build_report
 from fsmbt.verify.report import (
+    DEADLOCK_ABSENCE,
     PROPERTIES,
     REACHABILITY,
     PropertyResult,
@@ -240,6 +241,7 @@ def check(
     shared_search: bool = True,
     beside: bool = False,
     tree_encoding: str = AUTO,
+    implied_deadlock: bool = True,
 ) -> Report:
     """Verify ``result_model`` against ``source_model`` with NuSMV; see the module docstring.
 
@@ -280,6 +282,10 @@ def check(
     eight pairs (copy 23.3 -> 13.4 s at load 1.9, 27.7 -> 32.4 s at load 1.3-2.2;
     docs/nusmv.md, "Sixth round"). ``False``: one after the other.
 
+    ``implied_deadlock`` (default): on the shared run's split pairs, when the three invariants
+    hold and the listing leaves no state unmatched (reachability holds), deadlock absence is
+    implied (``deadlock_implied``) and the CTL run is not made; ``False``: it always runs.
+
     ``tree_encoding`` (``AUTO``, ``MICRO``, ``MACRO``): how a BT ~ FSM pair's tree is written
     (``uses_macro_steps``; docs/nusmv.md, "Trees by macro steps"); the report's
     ``stats["nusmv_tree_encoding"]`` names the one used.
@@ -319,6 +325,9 @@ def check(
     drop_reach = implied_reachability or shared
     pool = ThreadPoolExecutor(max_workers=1) if shared and beside and CTL in parts else None
     ctl_run: Future[tuple[list[SpecResult], float]] | None = None
+    # reachability's verdict from the listing when decided beside the CTL run
+    reach_found: tuple[PropertyResult, int, float] | None = None
+    deadlock_follows = False  # deadlock absence implied, its spec not run (``deadlock_implied``)
     try:
         for part, (text, part_names, part_context) in zip(parts, models):
             if shared and part == INVARIANTS:
@@ -348,10 +357,38 @@ def check(
             order = part_context[-1]  # each part's own variables
             text, part_names, options, lean = _lean_part(part, text, part_names, order, drop_reach)
             deferred = lean or deferred
+            if (
+                part == CTL
+                and ctl_run is None
+                and implied_deadlock
+                and listed is not None
+                and deadlock_implied(context, results, listed)
+            ):
+                dropped = without_spec(text, part_names, DEADLOCK_ABSENCE)
+                if dropped is not None:
+                    text, part_names = dropped
+                    deadlock_follows = True
             if not part_names:
                 continue
             if part == CTL and ctl_run is not None:
                 found, seconds = ctl_run.result()  # started beside the shared run
+            elif part == CTL and listed is not None and reach.unmatched_states(context, listed):
+                # reachability fails: its witness runs go beside the CTL run (neither reads
+                # the other's result), so the pair's wall is the longer of the two
+                with ThreadPoolExecutor(max_workers=1) as beside_pool:
+                    ctl_future = beside_pool.submit(
+                        run_nusmv,
+                        text,
+                        len(part_names),
+                        order=order,
+                        timeout=timeout,
+                        options=options,
+                        mono=mono,
+                    )
+                    try:
+                        reach_found = reach.verdict(context, listed, timeout=timeout)
+                    finally:  # past its cap: the CTL run ends by its own cap, waited for
+                        found, seconds = ctl_future.result()
             else:
                 found, seconds = run_nusmv(
                     text, len(part_names), order=order, timeout=timeout, options=options, mono=mono
@@ -373,8 +410,12 @@ def check(
             nusmv_seconds += seconds
             if not found[0].holds:
                 raise tree.livelock_failure()
+    if deadlock_follows:
+        report.properties[DEADLOCK_ABSENCE] = PropertyResult(
+            DEADLOCK_ABSENCE, True, DEADLOCK_IMPLIED_DETAIL
+        )
     if listed is not None:  # reachability from the shared run's listing
-        verdict, more_runs, seconds = reach.verdict(context, listed, timeout=timeout)
+        verdict, more_runs, seconds = reach_found or reach.verdict(context, listed, timeout=timeout)
         runs += more_runs
         nusmv_seconds += seconds
         report.properties[REACHABILITY] = verdict
@@ -447,6 +488,36 @@ IMPLIED_DETAIL = (
     "implied by the other four (every faithful pair steps on every input the source offers "
     "to an agreeing pair, so every state either side reaches is reached faithfully)"
 )
+
+#: The deadlock verdict when the three invariants and reachability hold (``deadlock_implied``).
+DEADLOCK_IMPLIED_DETAIL = (
+    "implied by the other four (neither machine follows the environment, so in every faithful "
+    "pair both offer the same inputs and every common step agrees: what one side can still "
+    "do observably the other can, docs/verification.md §2)"
+)
+
+
+def deadlock_implied(
+    context: Context, invariants: list[SpecResult], listed: list[dict[str, str]]
+) -> bool:
+    """Whether deadlock absence follows from the shared run (docs/nusmv.md, "Deadlock
+    implied"): its three invariants hold (completeness, no additional behaviour, termination
+    consistency: from a faithful pair the two machines offer the same inputs - neither follows
+    the environment, so neither exception of docs/verification.md §2 applies - and each common
+    step has equal outputs and statuses, so it leads to a faithful pair) and reachability holds
+    on its listing. Then from any pair of F every input sequence one side offers the other offers
+    too, with the same outputs and statuses, so an observable step one side can still reach the
+    other reaches: a side is dead exactly when the other is. (A result that follows the
+    environment may offer inputs the source refuses: not implied there.) Cost: O(listed)."""
+    src, res = context[0], context[1]
+    return (
+        not src.follows
+        and not res.follows
+        and bool(invariants)
+        and all(found.holds for found in invariants)
+        and not reach.unmatched_states(context, listed)
+    )
+
 
 _SPEC_PREFIXES = ("SPEC ", "INVARSPEC ", "LTLSPEC ")
 
