@@ -21,8 +21,10 @@ from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import FsmbtError
 from fsmbt.model.fsm import FSM
 from fsmbt.model.fsm_data import ASSIGN, COND, parse_lines
+from fsmbt.verify.compositional import compositional_report
 from fsmbt.verify.native import check
 from fsmbt.verify.pairing import machines_for
+from fsmbt.verify.report import LIFTED, Report
 from support.pernode_trees import seeded_trees
 
 #: Most states per machine or product here: a mutant may blow a machine up (seconds each).
@@ -100,3 +102,15 @@ def seeded_mutants(
         mutants = [mutate(model, rng) for _ in range(per_tree)]
         assert all(m is not None for m in mutants)
         yield doc, model, [m for m in mutants if m is not None]
+
+
+def lifted_reports(count: int) -> Iterator[tuple[BTDocument, FSM, Report]]:
+    """(tree, mutant, report) for the mutants of ``seeded_mutants(count, seed=4, rng_seed=5)``
+    that the compositional check refutes by a lifted counterexample (``report.method`` in
+    ``LIFTED``): the sample the shortest-counterexample tests read."""
+    for doc, _model, mutants in seeded_mutants(count, seed=4, rng_seed=5):
+        for mutant in mutants:
+            with limits.changed(conversion_max_states=BOUND):
+                report, _why = compositional_report(doc, mutant, max_states=BOUND)
+            if report is not None and report.method in LIFTED:
+                yield doc, mutant, report

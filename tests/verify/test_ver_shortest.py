@@ -5,26 +5,18 @@ of the lift tests."""
 
 from __future__ import annotations
 
-from fsmbt import limits
-from fsmbt.verify.compositional import compositional_report
 from fsmbt.verify.lift import lift_machines, separates
 from fsmbt.verify.native import replay
-from fsmbt.verify.report import LIFTED
 from fsmbt.verify.shortest import search_shorter
-from support.pernode_mutants import BOUND, seeded_mutants, whole_shortest
+from support.pernode_mutants import lifted_reports, whole_shortest
 
 
 def _lifted_pairs():  # type: ignore[no-untyped-def]
     """(tree, mutant, lifted report, whole product's shortest) for the sample's lifted ones."""
-    for doc, _model, mutants in seeded_mutants(40, seed=4, rng_seed=5):
-        for mutant in mutants:
-            with limits.changed(conversion_max_states=BOUND):
-                report, _why = compositional_report(doc, mutant, max_states=BOUND)
-            if report is None or report.method not in LIFTED:
-                continue
-            best = whole_shortest(doc, mutant)
-            if best is not None and best >= 0:  # refuted by the whole product
-                yield doc, mutant, report, best
+    for doc, mutant, report in lifted_reports(40):
+        best = whole_shortest(doc, mutant)
+        if best is not None and best >= 0:  # refuted by the whole product
+            yield doc, mutant, report, best
 
 
 def test_every_lifted_verdict_says_it_is_proven_shortest_and_is() -> None:

@@ -22,6 +22,18 @@ EXAMPLE = Path(__file__).resolve().parents[3] / "examples" / "guard_npc.csv"
 SEED = int(os.environ.get("FSMBT_TEST_SEED", "27"))
 
 
+def _copies_and_mutants(rng: random.Random, sizes: tuple[int, ...]):  # type: ignore[no-untyped-def]
+    """For each size, a seeded random FSM with its copy, then with a one-transition mutant:
+    (source, result) pairs."""
+    for size in sizes:
+        source = random_fsm(rng.randrange(10**9), n_states=size)
+        mutant = copy.deepcopy(source)
+        transition = mutant.transitions[rng.randrange(len(mutant.transitions))]
+        transition.target = rng.choice([s for s in mutant.states if s != transition.target])
+        yield source, copy.deepcopy(source)
+        yield source, mutant
+
+
 def test_equivalent_pair_skips_the_reachability_spec(nusmv_binary, monkeypatch) -> None:
     monkeypatch.setenv("FSMBT_NUSMV", str(nusmv_binary))
     fsm = api.load(EXAMPLE).model
@@ -75,21 +87,16 @@ def test_the_ctl_run_beside_the_shared_run_gives_the_same_report(nusmv_binary, m
     monkeypatch.setenv("FSMBT_NUSMV", str(nusmv_binary))
     rng = random.Random(SEED)
     failing = 0
-    for size in (5, 12, 30, 60):
-        source = random_fsm(rng.randrange(10**9), n_states=size)
-        mutant = copy.deepcopy(source)
-        transition = mutant.transitions[rng.randrange(len(mutant.transitions))]
-        transition.target = rng.choice([s for s in mutant.states if s != transition.target])
-        for result in (copy.deepcopy(source), mutant):
-            native = verify(source, result)
-            beside = nusmv.check(source, result, beside=True)
-            alone = nusmv.check(source, result, implied_deadlock=False)
-            assert beside.verdicts() == alone.verdicts() == native.verdicts()
-            assert beside.stats["nusmv_runs"] == alone.stats["nusmv_runs"]
-            for name, found in beside.properties.items():
-                other = alone.properties[name]
-                assert (found.detail, found.counterexample) == (other.detail, other.counterexample)
-            failing += not native.equivalent
+    for source, result in _copies_and_mutants(rng, (5, 12, 30, 60)):
+        native = verify(source, result)
+        beside = nusmv.check(source, result, beside=True)
+        alone = nusmv.check(source, result, implied_deadlock=False)
+        assert beside.verdicts() == alone.verdicts() == native.verdicts()
+        assert beside.stats["nusmv_runs"] == alone.stats["nusmv_runs"]
+        for name, found in beside.properties.items():
+            other = alone.properties[name]
+            assert (found.detail, found.counterexample) == (other.detail, other.counterexample)
+        failing += not native.equivalent
     assert failing >= 1  # failing pairs (counterexamples) were compared too
 
 
@@ -102,19 +109,14 @@ def test_deadlock_is_implied_only_when_the_rest_holds(nusmv_binary, monkeypatch)
     monkeypatch.setenv("FSMBT_NUSMV", str(nusmv_binary))
     rng = random.Random(SEED + 1)
     implied = failing = 0
-    for size in (4, 8, 15, 25, 40, 70):
-        source = random_fsm(rng.randrange(10**9), n_states=size)
-        mutant = copy.deepcopy(source)
-        transition = mutant.transitions[rng.randrange(len(mutant.transitions))]
-        transition.target = rng.choice([s for s in mutant.states if s != transition.target])
-        for result in (copy.deepcopy(source), mutant):
-            native = verify(source, result)
-            lean = nusmv.check(source, result)
-            full = nusmv.check(source, result, implied_deadlock=False)
-            assert lean.verdicts() == full.verdicts() == native.verdicts()
-            said = lean.properties[DEADLOCK_ABSENCE].detail == nusmv.DEADLOCK_IMPLIED_DETAIL
-            assert said == native.equivalent
-            assert lean.stats["nusmv_runs"] == full.stats["nusmv_runs"] - said
-            implied += said
-            failing += not native.equivalent
+    for source, result in _copies_and_mutants(rng, (4, 8, 15, 25, 40, 70)):
+        native = verify(source, result)
+        lean = nusmv.check(source, result)
+        full = nusmv.check(source, result, implied_deadlock=False)
+        assert lean.verdicts() == full.verdicts() == native.verdicts()
+        said = lean.properties[DEADLOCK_ABSENCE].detail == nusmv.DEADLOCK_IMPLIED_DETAIL
+        assert said == native.equivalent
+        assert lean.stats["nusmv_runs"] == full.stats["nusmv_runs"] - said
+        implied += said
+        failing += not native.equivalent
     assert implied >= 6 and failing >= 3
