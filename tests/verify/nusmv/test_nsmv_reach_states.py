@@ -238,3 +238,58 @@ def test_dispatch_pairs_failing_reachability_get_a_replayed_witness(
         if min(failing.values()) >= 2:
             break
     assert min(failing.values()) >= 2, failing  # the failing verdict, in both orders
+
+
+def _counts(detail: str) -> dict[str, int]:
+    """``{"source": N, "result": M}`` from a failing reachability detail (either side)."""
+    return {side: int(n) for n, side in re.findall(r"(\d+) (source|result) state", detail)}
+
+
+def _region_mutant(machine: FSM, rng: random.Random) -> FSM:
+    """``machine`` (hierarchical, outcome-driven) with one transition of one of its regions
+    retargeted to another state of that region."""
+    mutant = copy.deepcopy(machine)
+    regions = [m for _p, m, _s in mutant.walk() if m.transitions]
+    regions += [r for _p, _m, s in mutant.walk() for r in s.regions if r.transitions]
+    region = rng.choice(regions or [mutant])
+    transition = region.transitions[rng.randrange(len(region.transitions))]
+    transition.target = rng.choice([n for n in region.states if n != transition.target])
+    return mutant
+
+
+def _micro_step_pairs(rng: random.Random):  # type: ignore[no-untyped-def]
+    """Failing pairs whose tree takes micro-steps (``check`` does not split them): an
+    outcome-driven machine with one transition retargeted against its structured tree."""
+    from fsmbt.convert.structured import fsm_to_structured
+    from fsmbt.generate.outcome_machines import random_outcome_fsm
+
+    for size in (4, 5, 6, 7, 8, 5, 6, 7, 8, 10):
+        machine = random_outcome_fsm(rng.randrange(10**9), states=size, containers=0.2)
+        tree = fsm_to_structured(machine).model
+        yield _region_mutant(machine, rng), tree, nusmv.AUTO
+
+
+def test_micro_step_pairs_read_reachability_off_the_listing(nusmv_binary, monkeypatch) -> None:
+    """A failing structured pair (not split: the tree takes micro-steps) gets reachability from
+    the listing too, not the frozen-copy spec (a transitive closure: a 10-state structured mutant passed 120 s there, the listing
+    decides it): the same verdicts as that spec and the native checker, the same number of
+    unmatched states per side, a witness as short as the native one."""
+    monkeypatch.setenv("FSMBT_NUSMV", str(nusmv_binary))
+    rng = random.Random(SEED)
+    listed = unreached = 0
+    for source, result, encoding in _micro_step_pairs(rng):
+        native = verify(source, result)
+        if native.equivalent:
+            continue
+        new = nusmv.check(source, result, tree_encoding=encoding)
+        old = nusmv.check(source, result, tree_encoding=encoding, state_reach=False)
+        assert new.verdicts() == old.verdicts() == native.verdicts()
+        ours, theirs = new.properties[REACHABILITY], native.properties[REACHABILITY]
+        if ours.detail == reach.STATES_DETAIL:
+            listed += 1
+        elif not ours.holds:
+            unreached += 1
+            assert _counts(ours.detail) == _counts(theirs.detail)
+            assert len(ours.counterexample or []) == len(theirs.counterexample or [])
+            assert ours.counterexample and ours.counterexample[0].input is None
+    assert listed + unreached >= 4 and unreached >= 2, (listed, unreached)

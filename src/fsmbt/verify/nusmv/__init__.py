@@ -424,8 +424,10 @@ def check(
         if all(p.holds for p in report.properties.values()):
             report.properties[REACHABILITY] = PropertyResult(REACHABILITY, True, IMPLIED_DETAIL)
         elif (
-            split and state_reach and reach.applies(context)
-        ):  # a failing split pair: from the listed reachable states
+            state_reach
+            and reach.applies(context)
+            and (split or isinstance(context[3], OutcomeBTEncoder))
+        ):  # a failing split or structured pair: from the listed reachable states
             verdict, more_runs, seconds = reach.check_reachability(context, timeout=timeout)
             runs += more_runs
             nusmv_seconds += seconds

@@ -210,7 +210,9 @@ def _witness(
         for before, state in zip(path, path[1:])
         if alone_go(before.values, state.inputs)
     ]
-    end = f"k = {len(word)}"
+    # the last input taken and both machines stable again: a machine by micro-steps (a
+    # structured tree, a tree ``check`` does not split) has finished that input's step
+    end = f"k = {len(word)} & both"
     text, order = _text(context, [("replay", f"!({end})")], replay=(mode, word))
     found, more = run_nusmv(text, 1, order=order, timeout=timeout, mono=False)
     return decode_trace(found[0].trace or [], context, alone=True), seconds + more
