@@ -321,6 +321,8 @@ def check(
     deferred: tuple[str, list[str], list[str], str] | None = None
     # the split pairs' invariants and reachability listing in one run (``reach``)
     listed: list[dict[str, str]] | None = None
+    # the listing's unmatched states per side (``reach.unmatched_states``), read once
+    unmatched: dict[str, list[reach.Key]] = {}
     shared = split and state_reach and shared_search and reach.lists_cheaply(context)
     drop_reach = implied_reachability or shared
     pool = ThreadPoolExecutor(max_workers=1) if shared and beside and CTL in parts else None
@@ -349,6 +351,7 @@ def check(
                 part_names, found, listed, seconds = reach.invariants_and_listing(
                     context, timeout=timeout
                 )
+                unmatched = reach.unmatched_states(context, listed)
                 names += part_names
                 results += found
                 runs += 1
@@ -362,7 +365,7 @@ def check(
                 and ctl_run is None
                 and implied_deadlock
                 and listed is not None
-                and deadlock_implied(context, results, listed)
+                and deadlock_implied(context, results, unmatched)
             ):
                 dropped = without_spec(text, part_names, DEADLOCK_ABSENCE)
                 if dropped is not None:
@@ -372,7 +375,7 @@ def check(
                 continue
             if part == CTL and ctl_run is not None:
                 found, seconds = ctl_run.result()  # started beside the shared run
-            elif part == CTL and listed is not None and reach.unmatched_states(context, listed):
+            elif part == CTL and unmatched:
                 # reachability fails: its witness runs go beside the CTL run (neither reads
                 # the other's result), so the pair's wall is the longer of the two
                 with ThreadPoolExecutor(max_workers=1) as beside_pool:
@@ -386,7 +389,7 @@ def check(
                         mono=mono,
                     )
                     try:
-                        reach_found = reach.verdict(context, listed, timeout=timeout)
+                        reach_found = reach.judged(context, unmatched, timeout=timeout)
                     finally:  # past its cap: the CTL run ends by its own cap, waited for
                         found, seconds = ctl_future.result()
             else:
@@ -415,7 +418,9 @@ def check(
             DEADLOCK_ABSENCE, True, DEADLOCK_IMPLIED_DETAIL
         )
     if listed is not None:  # reachability from the shared run's listing
-        verdict, more_runs, seconds = reach_found or reach.verdict(context, listed, timeout=timeout)
+        verdict, more_runs, seconds = reach_found or reach.judged(
+            context, unmatched, timeout=timeout
+        )
         runs += more_runs
         nusmv_seconds += seconds
         report.properties[REACHABILITY] = verdict
@@ -500,7 +505,7 @@ DEADLOCK_IMPLIED_DETAIL = (
 
 
 def deadlock_implied(
-    context: Context, invariants: list[SpecResult], listed: list[dict[str, str]]
+    context: Context, invariants: list[SpecResult], unmatched: dict[str, list[reach.Key]]
 ) -> bool:
     """Whether deadlock absence follows from the shared run (docs/nusmv.md, "Deadlock
     implied"): its three invariants hold (completeness, no additional behaviour, termination
@@ -510,14 +515,15 @@ def deadlock_implied(
     on its listing. Then from any pair of F every input sequence one side offers the other offers
     too, with the same outputs and statuses, so an observable step one side can still reach the
     other reaches: a side is dead exactly when the other is. (A result that follows the
-    environment may offer inputs the source refuses: not implied there.) Cost: O(listed)."""
+    environment may offer inputs the source refuses: not implied there.) ``unmatched``: the
+    listing's unmatched states (``reach.unmatched_states``). Cost: O(1)."""
     src, res = context[0], context[1]
     return (
         not src.follows
         and not res.follows
         and bool(invariants)
         and all(found.holds for found in invariants)
-        and not reach.unmatched_states(context, listed)
+        and not unmatched
     )
 
 

@@ -50,8 +50,9 @@ def applies(context: Context) -> bool:
     """Whether both machines name their identity variables. NuSMV's listing prints state
     variables only; an identity read through a DEFINE (the canonical memory of a tree written
     by macro steps, ``encode_macro``: ``cwr_n``, ``cix_n``) is listed through the ``REACH``
-    model's copy of it (``specs.listing_mirrors``). ``check`` asks only for the split pairs,
-    whose modules take one step per input."""
+    model's copy of it (``specs.listing_mirrors``). ``check`` asks for the split pairs, whose
+    modules take one step per input, and for failing structured pairs (their tree takes
+    micro-steps; ``_witness`` ends the replay when both machines are stable again)."""
     return all(enc.id_vars for enc in (context[0], context[1]))
 
 
@@ -186,7 +187,14 @@ def verdict(
     """Reachability's verdict from the listed ``states``, the number of further NuSMV runs and
     their seconds: none when every state reached alone is matched; else the witness, a forward
     search to the nearest unmatched state and its replayed path (two runs)."""
-    unmatched = unmatched_states(context, states)
+    return judged(context, unmatched_states(context, states), timeout=timeout)
+
+
+def judged(
+    context: Context, unmatched: dict[str, list[Key]], *, timeout: float | None
+) -> tuple[PropertyResult, int, float]:
+    """``verdict`` from the listing's ``unmatched_states`` already computed (``check`` reads
+    them once for deadlock absence, the witness and the verdict)."""
     if not unmatched:
         return PropertyResult(REACHABILITY, True, STATES_DETAIL), 0, 0.0
     trace, seconds = _witness(context, unmatched, timeout=timeout)
