@@ -20,7 +20,9 @@ The argument (the full text is docs/semantics.md §4d):
 2. before ``U``'s first tick its local pair is at rest on both sides, so a difference needs
    (a) the leaves consumed before ``U`` is first ticked - at least ``P(U)``, the sum over
    ``U``'s ancestors ``A`` of ``reach(A, i)``: the cheapest way, from ``A``'s rest, to have
-   ``A`` tick its child ``i`` towards ``U`` for the first time - and (b) the leaves under ``U``
+   ``A`` tick its child ``i`` towards ``U`` for the first time, or, when larger, the sum of
+   ``A``'s stages' standalone distances (``verify/approach.py``: each earlier child of a
+   sequence or fallback ancestor must pass once before, run alone exactly) - and (b) the leaves under ``U``
    until its pair differs - at least ``k(U)``, the cheapest path of ``U``'s local product from
    rest to a step whose outputs differ (``U``'s children are at rest at its first tick). In
    both searches a child ``j`` returning ``s`` costs ``first_j(s)`` the first time and
@@ -61,6 +63,7 @@ from fsmbt.semantics.bt_interpreter import (
     LeafRequest,
 )
 from fsmbt.semantics.compiled import FAILURE, RUNNING, SUCCESS, Work
+from fsmbt.verify.approach import StageBounds
 from fsmbt.verify.pernode import (
     LOCAL_LIMIT,
     STATUS_OF,
@@ -240,6 +243,7 @@ class TickCosts:
 
     def __init__(self, tree: CompiledTree) -> None:
         self.tree = tree
+        self.stages = StageBounds(tree)
         self.costs: dict[int, NodeCosts] = {}
         self.reach: dict[int, dict[int, int]] = {}
         memo: dict[Hashable, _Shape] = {}
@@ -258,16 +262,20 @@ class TickCosts:
             self.reach[node.id] = shape.reach
 
     def before(self, nid: int) -> int | None:
-        """``P``: least leaves consumed before ``nid`` is first ticked (``None``: never)."""
+        """``P``: least leaves consumed before ``nid`` is first ticked (``None``: never). Per
+        ancestor, the larger of its ``reach`` and its stages' standalone distances
+        (``verify/approach.py``): both bound the leaves under its other children before the
+        path child's first tick, and ancestors' other children are disjoint subtrees."""
         total = 0
         nodes = self.tree.nodes
+        staged = self.stages.per_ancestor(nid)
         child = nid
         parent = nodes[nid].parent
         while parent is not None:
             step = self.reach[parent].get(nodes[child].index)
             if step is None:
                 return None  # the interpreter never ticks that child: neither is the node
-            total += step
+            total += max(step, staged.get(parent, 0))
             child, parent = parent, nodes[parent].parent
         return total
 
