@@ -55,6 +55,7 @@ from fsmbt.semantics.compiled import FAILURE, RUNNING, SUCCESS
 from fsmbt.semantics.execution import leaf_machine
 from fsmbt.semantics.machine import Machine
 from fsmbt.semantics.status import LeafOutcome
+from fsmbt.verify.approach import approach
 from fsmbt.verify.lazy_fsm import LazyDataMachine, Unsupported
 from fsmbt.verify.native import Replay, replay
 from fsmbt.verify.pairing import LEAF_EXECUTION
@@ -257,15 +258,19 @@ def drive(
     local: Sequence[tuple[int | None, Any]],
     extra: int,
     region: Sequence[int] = (),
+    prefix: Sequence[int] = (),
 ) -> list[str] | None:
     """Leaf outcomes from the root that tick ``target`` and then give its children the local
     counterexample's outcomes, then ``extra`` more leaves (rule 2); ``None``: not liftable.
     With ``region`` (and no ``local``): once ``target`` is ticked, the leaves under it answer
     these statuses in order (a region's own counterexample: its leaf outcomes from its fresh
-    tick, which the whole tree asks in the same order while the tick reaches it)."""
+    tick, which the whole tree asks in the same order while the tick reaches it). With
+    ``prefix`` (``approach.approach``: a run to ``target``'s first tick), the leaves answer it
+    until ``target`` is ticked, instead of each off-path child's realization from rest."""
     if any(symbol == "halt" for _pos, symbol in local):
         return None
     answers = deque(region)
+    approaching = deque(prefix)
     realizer = Realizer(tree)
     nodes = tree.nodes
     chain: list[int] = []
@@ -293,7 +298,9 @@ def drive(
                 return inputs
             left -= 1
         status = None
-        if answers and target in active:
+        if approaching and not reached:
+            status = approaching.popleft()
+        elif answers and target in active:
             status = answers.popleft()
             if event.node.is_condition and status == RUNNING:
                 return None
@@ -488,13 +495,16 @@ def lifted_report(
         found = _target(source, region, merged, tree.nodes[node_id].source)
         if found is None:
             continue
-        inputs = drive(found[0], found[1], trace, extra=4 * len(trace) + 64)
-        try:
-            cut = None if inputs is None else separating_prefix(*machines, inputs)
-        except Unsupported:  # the result's run meets what the lazy runner refuses
-            continue
-        if cut is not None:  # the first that separates (each try: a drive and a replay)
-            best = (cut, f"node {what}")
+        for prefix in _approaches(*found):
+            inputs = drive(found[0], found[1], trace, extra=4 * len(trace) + 64, prefix=prefix)
+            try:
+                cut = None if inputs is None else separating_prefix(*machines, inputs)
+            except Unsupported:  # the result's run meets what the lazy runner refuses
+                continue
+            if cut is not None:  # the first that separates (each try: a drive and a replay)
+                best = (cut, f"node {what}")
+                break
+        if best is not None:
             break
     if best is None:
         return None
@@ -520,11 +530,25 @@ def lifted_region_report(
     if found is None:
         return None
     whole, target_id = found
-    inputs = drive(whole, target_id, [], extra=64, region=answers)
-    if inputs is None:
-        return None
     where = f"region {region.label}"
-    return _confirmed(source, result, inputs, where, COMPOSITIONAL_LIFTED, REGION_LIFTED_SENTENCE)
+    for prefix in _approaches(whole, target_id):
+        inputs = drive(whole, target_id, [], extra=64, region=answers, prefix=prefix)
+        if inputs is None:
+            continue
+        report = _confirmed(
+            source, result, inputs, where, COMPOSITIONAL_LIFTED, REGION_LIFTED_SENTENCE
+        )
+        if report is not None:
+            return report
+    return None
+
+
+def _approaches(tree: CompiledTree, target: int) -> list[Sequence[int]]:
+    """The prefixes ``drive`` tries, in order: the stages' approach to ``target``'s first tick
+    (``verify/approach.py``, rule 3; usually far shorter on large trees with memory), then none
+    (each off-path child's realization from rest)."""
+    found = approach(tree, target)
+    return [found, ()] if found else [()]
 
 
 def _target(
