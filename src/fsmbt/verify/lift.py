@@ -19,7 +19,10 @@ Rules (every step judged by fsmbt's interpreter, never by the converter's rules)
    ``N`` answers what its off-path ancestor child must return for the tick to reach ``N``; a
    leaf under ``N``'s child ``i`` answers the realization of the local counterexample's next
    outcome of child ``i``. A halt in the local counterexample is not lifted (the check's
-   failing run offers none);
+   failing run offers none). The drive first tries the stages' approach to ``N``'s first tick
+   (``verify/approach.py``: each earlier sibling on the way follows a shortest plan from its
+   current state, far shorter on large trees with memory than each sibling's realization from
+   rest), then, when that run's replay does not separate the machines, the drive from rest;
 3. *replay*: the leaf outcomes run on both whole machines (``native.replay``); accepted only
    when a step differs that is not the source refusing its input. The sequence is cut at the
    first difference and shortened greedily (a step dropped while the replay still separates).
