@@ -33,8 +33,9 @@ Rules (node behaviour is fsmbt's interpreter's, ``BTInterpreter``, never the con
    stages are planned one at a time, while a later stage's ticks make every earlier stage pass
    again in each of them.
 
-Cost: one standalone search per stage (at most ``STAGE_LIMIT`` states), memoized by node; the
-approach replans once per stage per tick it passes in, each a search of the same size.
+Cost: one standalone search per stage (at most ``STAGE_LIMIT`` states; ``BOUND_BUDGET`` for
+all of one tree's), memoized by node; the approach replans once per stage per tick it passes
+in, each search at most ``PLAN_LIMIT`` states and ``APPROACH_BUDGET`` for all of them.
 """
 
 from __future__ import annotations
@@ -68,6 +69,8 @@ BOUND_BUDGET = 500_000
 #: Most states one plan's search settles (past it the approach gives up: ``drive`` then costs
 #: each off-path child from rest, as before).
 PLAN_LIMIT = 20_000
+#: Most states all the plans of one approach settle together (past it the approach gives up).
+APPROACH_BUDGET = 200_000
 #: Most leaves the approach answers before it gives up (a run that never reaches ``U``).
 APPROACH_LIMIT = 20_000
 _STANDALONE_ID = "__fsmbt_stage__"
@@ -253,7 +256,8 @@ def approach(
     """Rule 3: leaf outcomes from the root up to ``target``'s first tick (the last outcome given
     is the one after which ``target`` is ticked), or ``None`` when the run does not get there
     (a leaf outside every stage, a stage without a plan, the root returning SUCCESS or FAILURE
-    - the leaf machine stops there, docs/semantics.md §4 - or ``APPROACH_LIMIT`` leaves)."""
+    - the leaf machine stops there, docs/semantics.md §4 -, ``APPROACH_LIMIT`` leaves or
+    ``APPROACH_BUDGET`` states settled by its plans)."""
     bounds = bounds or StageBounds(tree)
     found = stages(tree, target)
     owner: list[tuple[int, int, frozenset[int]]] = []
@@ -272,6 +276,7 @@ def approach(
     # pass again, so it costs about their sum (earlier stages are planned first: a tick meets
     # them first)
     spent = [0] * len(owner)
+    settled = 0  # states the plans settled (``APPROACH_BUDGET``)
     outcomes: list[int] = []
     try:
         snap, event = interp.advance(interp.begin_tick(interp.initial()), None)
@@ -295,7 +300,8 @@ def approach(
             plan = plans.get(stage)
             if not plan or plan[0][0] != here[:3]:  # spent, or the run left it (a halt)
                 _cost, steps = alone.search(here, passing, False, sum(spent[:stage]), PLAN_LIMIT)
-                if not steps:
+                settled += alone.last_settled
+                if not steps or settled > APPROACH_BUDGET:
                     return None
                 plan = plans[stage] = deque(steps)
                 spent[stage] = len(steps)
