@@ -22,8 +22,8 @@ The argument (the full text is docs/semantics.md §4d):
    ``U``'s ancestors ``A`` of ``reach(A, i)``: the cheapest way, from ``A``'s rest, to have
    ``A`` tick its child ``i`` towards ``U`` for the first time, or, when larger, the sum of
    ``A``'s stages' standalone distances (``verify/approach.py``: each earlier child of a
-   sequence or fallback ancestor must pass once before, run alone exactly) - and (b) the leaves under ``U``
-   until its pair differs - at least ``k(U)``, the cheapest path of ``U``'s local product from
+   sequence or fallback ancestor must pass once before, run alone exactly) - and (b) the
+   leaves under ``U`` until its pair differs - at least ``k(U)``, the cheapest path of ``U``'s local product from
    rest to a step whose outputs differ (``U``'s children are at rest at its first tick). In
    both searches a child ``j`` returning ``s`` costs ``first_j(s)`` the first time and
    ``any_j(s)`` later (the search state records which children were touched);
