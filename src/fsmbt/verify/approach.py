@@ -121,8 +121,11 @@ class Standalone:
         self.offset = nid
         self.last = nid + len(self.interp.nodes) - 1
         self.last_settled = 0  # states the last search settled
-        if self.last >= len(tree.nodes) or any(
-            a.type != b.type
+        last = node  # the subtree's last node in pre-order: down the last children
+        while last.children:
+            last = tree.nodes[last.children[-1]]
+        if last.id != self.last or any(
+            a.type != b.type or len(a.children) != len(b.children)
             for a, b in zip(self.interp.nodes, tree.nodes[nid : self.last + 1], strict=True)
         ):
             raise FsmbtError(f"the subtree at {node.path or 'the root'} does not compile alone")
