@@ -27,7 +27,7 @@ from bench_reactive import family_tree, leaves_for
 
 from fsmbt.semantics.bt_interpreter import BTInterpreter, CompiledTree, LeafRequest
 from fsmbt.semantics.compiled import FAILURE, RUNNING, SUCCESS
-from fsmbt.verify.approach import StageBounds, approach, stages
+from fsmbt.verify.approach import StageBounds, approach, last_descendant, stages
 from fsmbt.verify.lower_bound import TickCosts
 
 
@@ -43,10 +43,7 @@ def _astar(tree: CompiledTree, target: int, seconds: float) -> tuple[int, bool, 
     alone = [bounds.standalone(nid) for nid, _p in found]
     assert all(a is not None for a in alone)
     memo: dict[tuple[int, object], int] = {}
-    nodes = tree.nodes
-    last = target
-    while nodes[last].children:
-        last = nodes[last].children[-1]
+    last = last_descendant(tree, target)
 
     def h(snap: object) -> int:
         total = 0

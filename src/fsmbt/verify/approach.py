@@ -105,6 +105,15 @@ def stages(tree: CompiledTree, target: int) -> list[tuple[int, frozenset[int]]]:
     return found
 
 
+def last_descendant(tree: CompiledTree, nid: int) -> int:
+    """The id of the last node of ``nid``'s subtree in pre-order (ids are pre-order, so the
+    subtree is ``nid ..`` that id): down the last children."""
+    nodes = tree.nodes
+    while nodes[nid].children:
+        nid = nodes[nid].children[-1]
+    return nid
+
+
 class Standalone:
     """A stage's subtree compiled alone (rule 2): its ids are the tree's shifted by
     ``offset``, so a slice of a whole-tree snapshot is a snapshot of it."""
@@ -121,10 +130,7 @@ class Standalone:
         self.offset = nid
         self.last = nid + len(self.interp.nodes) - 1
         self.last_settled = 0  # states the last search settled
-        last = node  # the subtree's last node in pre-order: down the last children
-        while last.children:
-            last = tree.nodes[last.children[-1]]
-        if last.id != self.last or any(
+        if last_descendant(tree, nid) != self.last or any(
             a.type != b.type or len(a.children) != len(b.children)
             for a, b in zip(self.interp.nodes, tree.nodes[nid : self.last + 1], strict=True)
         ):
@@ -238,18 +244,13 @@ class StageBounds:
         return self._distance[nid]
 
     def per_ancestor(self, target: int) -> dict[int, int]:
-        """ancestor id -> the sum of ``d_j`` over its stages towards ``target``."""
-        nodes = self.tree.nodes
+        """ancestor id -> the sum of ``d_j`` over its stages towards ``target`` (ancestors
+        without stages absent)."""
         out: dict[int, int] = {}
-        child = nodes[target]
-        while child.parent is not None:
-            parent = nodes[child.parent]
-            passing = pass_statuses(parent)
-            if passing is not None:
-                out[parent.id] = sum(
-                    self.distance(j, passing) for j in parent.children[: child.index]
-                )
-            child = parent
+        for nid, passing in stages(self.tree, target):
+            parent = self.tree.nodes[nid].parent
+            assert parent is not None
+            out[parent] = out.get(parent, 0) + self.distance(nid, passing)
         return out
 
 
@@ -262,17 +263,13 @@ def approach(
     - the leaf machine stops there, docs/semantics.md §4 -, ``APPROACH_LIMIT`` leaves or
     ``APPROACH_BUDGET`` states settled by its plans)."""
     bounds = bounds or StageBounds(tree)
-    found = stages(tree, target)
-    owner: list[tuple[int, int, frozenset[int]]] = []
-    for nid, passing in found:
+    owner: list[tuple[Standalone, frozenset[int]]] = []
+    for nid, passing in stages(tree, target):
         alone = bounds.standalone(nid)
         if alone is None:
             return None
-        owner.append((alone.offset, alone.last, passing))
-    nodes = tree.nodes
-    last = target
-    while nodes[last].children:
-        last = nodes[last].children[-1]
+        owner.append((alone, passing))
+    last = last_descendant(tree, target)
     interp = BTInterpreter(tree)
     plans: dict[int, deque[tuple[Any, int]]] = {}
     # the leaves each stage's last plan took: a tick begun by stage k makes every earlier stage
@@ -292,13 +289,16 @@ def approach(
             if target <= event.node.id <= last:
                 return outcomes
             stage = next(
-                (k for k, (lo, hi, _p) in enumerate(owner) if lo <= event.node.id <= hi), None
+                (
+                    k
+                    for k, (alone, _p) in enumerate(owner)
+                    if alone.offset <= event.node.id <= alone.last
+                ),
+                None,
             )
             if stage is None:
                 return None
-            lo, _hi, passing = owner[stage]
-            alone = bounds.standalone(lo)
-            assert alone is not None
+            alone, passing = owner[stage]
             here = alone.slice(snap)
             plan = plans.get(stage)
             if not plan or plan[0][0] != here[:3]:  # spent, or the run left it (a halt)

@@ -23,10 +23,10 @@ The argument (the full text is docs/semantics.md §4d):
    ``A`` tick its child ``i`` towards ``U`` for the first time, or, when larger, the sum of
    ``A``'s stages' standalone distances (``verify/approach.py``: each earlier child of a
    sequence or fallback ancestor must pass once before, run alone exactly) - and (b) the
-   leaves under ``U`` until its pair differs - at least ``k(U)``, the cheapest path of ``U``'s local product from
-   rest to a step whose outputs differ (``U``'s children are at rest at its first tick). In
-   both searches a child ``j`` returning ``s`` costs ``first_j(s)`` the first time and
-   ``any_j(s)`` later (the search state records which children were touched);
+   leaves under ``U`` until its pair differs - at least ``k(U)``, the cheapest path of ``U``'s
+   local product from rest to a step whose outputs differ (``U``'s children are at rest at
+   its first tick). In both searches a child ``j`` returning ``s`` costs ``first_j(s)`` the
+   first time and ``any_j(s)`` later (the search state records which children were touched);
 3. ``any_x(s)``: a lower bound on the leaves *one* tick of ``x`` consumes to return ``s``, from
    *any* state ``x`` can reach (fresh, resumed, halted, done): the least cost over every
    reachable state of ``x`` over abstract children, each child event costing its own ``any``;
