@@ -180,6 +180,8 @@ def structured_main(args: argparse.Namespace, sizes: list[int], rng: random.Rand
             report = nusmv.check(source, tree, outcome_driven=True)
         except NuSMVLimitError:
             counts[label]["gave up"] += 1
+            nodes = sum(1 for _ in tree.nodes())
+            print(f"GAVE UP ({label}, {kind}): tree '{tree.main.id}', {nodes} nodes", flush=True)
             continue
         except UnsupportedError as exc:
             counts[label]["refused"] += 1

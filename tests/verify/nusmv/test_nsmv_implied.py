@@ -16,6 +16,7 @@ from fsmbt import api
 from fsmbt.generate.generator import random_fsm
 from fsmbt.verify import nusmv, verify
 from fsmbt.verify.nusmv import reach
+from fsmbt.verify.nusmv.runner import run_nusmv
 from fsmbt.verify.report import DEADLOCK_ABSENCE, REACHABILITY
 
 EXAMPLE = Path(__file__).resolve().parents[3] / "examples" / "guard_npc.csv"
@@ -120,3 +121,61 @@ def test_deadlock_is_implied_only_when_the_rest_holds(nusmv_binary, monkeypatch)
         implied += said
         failing += not native.equivalent
     assert implied >= 6 and failing >= 3
+
+
+def _structured_mutant() -> tuple[str, list[str], str]:
+    """A failing structured pair's product (every spec) and its variable order: a seeded
+    outcome-driven machine with one transition retargeted against its structured tree (the
+    first retargeting the native checker refutes)."""
+    from fsmbt.convert.structured import fsm_to_structured
+    from fsmbt.generate.outcome_machines import random_outcome_fsm
+    from fsmbt.model.errors import FsmbtError
+
+    source = random_outcome_fsm(SEED, states=6, containers=0.2)
+    tree = fsm_to_structured(source).model
+    rng = random.Random(SEED)
+    for _attempt in range(50):
+        mutant = copy.deepcopy(source)
+        moved = rng.choice(mutant.transitions)
+        moved.target = rng.choice([s for s in mutant.states if s != moved.target])
+        try:
+            refuted = not verify(mutant, tree, outcome_driven=True).equivalent
+        except FsmbtError:  # a retargeting the outcome view refuses: not a pair
+            continue
+        if refuted:
+            text, names, context = nusmv.build_model(mutant, tree, outcome_driven=True)
+            return text, names, context[-1]
+    raise AssertionError("no refuted retargeting in 50 draws")
+
+
+def test_the_lean_run_drops_the_frozen_copies_only_reachability_read() -> None:
+    text, names, order = _structured_mutant()
+    # with the reachability spec every copy is read: nothing is dropped
+    assert nusmv.without_unread_copies(text, order) == (text, order)
+    lean = nusmv.without_spec(text, names, REACHABILITY)
+    assert lean is not None
+    lean_text, lean_order = nusmv.without_unread_copies(lean[0], order)
+    declared = {line.split(" : ")[0].strip() for line in lean[0].split("\n") if " : " in line}
+    kept = {line.split(" : ")[0].strip() for line in lean_text.split("\n") if " : " in line}
+    dropped = declared - kept
+    assert dropped and all(name.startswith(("ts_", "tr_")) for name in dropped)
+    assert "FROZENVAR" not in lean_text.split("MODULE main")[1]  # the emptied section too
+    assert not any(entry.split(".")[0] in dropped for entry in lean_order.split("\n"))
+    assert set(order.split("\n")) - set(lean_order.split("\n")) == dropped
+
+
+def test_without_the_copies_nusmv_gives_the_same_verdicts_and_trace_lengths(
+    nusmv_binary, monkeypatch
+) -> None:
+    """The copies are free variables once reachability is left out: dropping them changes no
+    verdict and no counterexample's length (NuSMV's traces are shortest), only its cost."""
+    monkeypatch.setenv("FSMBT_NUSMV", str(nusmv_binary))
+    text, names, order = _structured_mutant()
+    lean = nusmv.without_spec(text, names, REACHABILITY)
+    assert lean is not None
+    runs = [(lean[0], order), nusmv.without_unread_copies(lean[0], order)]
+    answers = [run_nusmv(model, len(lean[1]), order=model_order)[0] for model, model_order in runs]
+    assert [r.holds for r in answers[0]] == [r.holds for r in answers[1]]
+    assert not all(r.holds for r in answers[0])  # the mutant fails: there are traces
+    lengths = [[len(r.trace or ()) for r in found] for found in answers]
+    assert lengths[0] == lengths[1]

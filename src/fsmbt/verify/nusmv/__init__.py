@@ -9,6 +9,7 @@ then the CTL specs; docs/nusmv.md, "Two runs") and returns the same
 
 from __future__ import annotations
 
+import re
 import time
 from collections.abc import Iterable
 from concurrent.futures import Future, ThreadPoolExecutor
@@ -335,7 +336,7 @@ def check(
             if shared and part == INVARIANTS:
                 if pool is not None:  # the CTL run does not read this one's result: beside it
                     ctl_text, ctl_names, ctl_context = models[parts.index(CTL)]
-                    ctl_text, ctl_names, ctl_options, _kept = _lean_part(
+                    ctl_text, ctl_names, ctl_options, ctl_order, _kept = _lean_part(
                         CTL, ctl_text, ctl_names, ctl_context[-1], drop_reach
                     )
                     if ctl_names:
@@ -343,7 +344,7 @@ def check(
                             run_nusmv,
                             ctl_text,
                             len(ctl_names),
-                            order=ctl_context[-1],
+                            order=ctl_order,
                             timeout=timeout,
                             options=ctl_options,
                             mono=mono,
@@ -357,8 +358,9 @@ def check(
                 runs += 1
                 nusmv_seconds += seconds
                 continue
-            order = part_context[-1]  # each part's own variables
-            text, part_names, options, lean = _lean_part(part, text, part_names, order, drop_reach)
+            text, part_names, options, order, lean = _lean_part(
+                part, text, part_names, part_context[-1], drop_reach
+            )
             deferred = lean or deferred
             if (
                 part == CTL
@@ -408,7 +410,9 @@ def check(
     if isinstance(tree, OutcomeBTEncoder):  # the outcome pairing's livelock check, on its own
         checked = tree.livelock_model(context[1])
         if checked is not None:
-            found, seconds = run_nusmv(checked[0], 1, order=checked[1], timeout=timeout, mono=False)
+            # one monolithic relation: the partitioned one passed 200 s on the 125-node tree
+            # of a corpus FlexBE machine, -mono takes 1.4 s (docs/nusmv.md, "Eighth round")
+            found, seconds = run_nusmv(checked[0], 1, order=checked[1], timeout=timeout, mono=True)
             runs += 1
             nusmv_seconds += seconds
             if not found[0].holds:
@@ -469,15 +473,68 @@ def check(
 
 def _lean_part(
     part: str, text: str, names: list[str], order: str, drop_reach: bool
-) -> tuple[str, list[str], list[str], tuple[str, list[str], list[str], str] | None]:
-    """One part's run as ``check`` makes it: (text, spec names, NuSMV options, the run kept
-    for reachability or ``None``). ``-df`` for the CTL part; with ``drop_reach`` the
-    reachability spec is left out, and the whole part is kept to run it later if needed."""
+) -> tuple[str, list[str], list[str], str, tuple[str, list[str], list[str], str] | None]:
+    """One part's run as ``check`` makes it: (text, spec names, NuSMV options, variable
+    order, the run kept for reachability or ``None``). ``-df`` for the CTL part; with
+    ``drop_reach`` the reachability spec is left out, with the frozen copies only it read
+    (``without_unread_copies``), and the whole part is kept to run it later if needed."""
     options = ["-df"] if part == CTL else []
     lean = without_spec(text, names, REACHABILITY) if drop_reach else None
     if lean is None:
-        return text, names, options, None
-    return lean[0], lean[1], options, (text, names, options, order)
+        return text, names, options, order, None
+    lean_text, lean_order = without_unread_copies(lean[0], order)
+    return lean_text, lean[1], options, lean_order, (text, names, options, order)
+
+
+#: A declaration line of ``MODULE main`` (``  name : type;``).
+_DECLARED = re.compile(r"^  ([A-Za-z_][A-Za-z0-9_]*) : ")
+_IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_.]*")
+
+
+def without_unread_copies(text: str, order: str) -> tuple[str, str]:
+    """``text`` without the ``FROZENVAR`` declarations of ``MODULE main`` that no other line
+    reads, and ``order`` without them (a name or one of its bits, ``name.k``).
+
+    Why: the frozen copies of the identity variables (``ts_*``, ``tr_*``; ``specs.product``) are read
+    by the reachability spec alone; once ``without_spec`` has left it out they are free
+    variables that change no verdict but make every counterexample costly, NuSMV picking and
+    printing a value of each at every step: on a 125-node structured tree's mutant (a corpus
+    FlexBE machine) the two failing invariants' traces took 49 s with the copies and 5 s
+    without (docs/nusmv.md, "The outcome pairing", "Eighth round"). O(size of the text)."""
+    lines = text.split("\n")
+    try:
+        main = lines.index("MODULE main")
+    except ValueError:
+        return text, order
+    frozen: dict[str, int] = {}  # name -> its declaration's line
+    heads: dict[int, list[int]] = {}  # a FROZENVAR header's line -> its declarations' lines
+    head = None
+    for i in range(main + 1, len(lines)):
+        line = lines[i]
+        if line and not line.startswith(" "):
+            head = i if line.strip() == "FROZENVAR" else None
+            if head is not None:
+                heads[head] = []
+            continue
+        found = _DECLARED.match(line)
+        if head is not None and found:
+            frozen[found.group(1)] = i
+            heads[head].append(i)
+    if not frozen:
+        return text, order
+    declared_at = set(frozen.values())
+    read: set[str] = set()
+    for i, line in enumerate(lines):
+        if i not in declared_at:
+            read.update(name.split(".")[0] for name in _IDENTIFIER.findall(line))
+    unread = {name for name in frozen if name not in read}
+    if not unread:
+        return text, order
+    drop = {frozen[name] for name in unread}
+    drop.update(h for h, declared in heads.items() if drop.issuperset(declared))  # now empty
+    kept_lines = [line for i, line in enumerate(lines) if i not in drop]
+    kept_order = [entry for entry in order.split("\n") if entry.split(".")[0] not in unread]
+    return "\n".join(kept_lines), "\n".join(kept_order)
 
 
 def _only_spec(text: str, names: list[str], kept: str) -> str:
