@@ -179,3 +179,33 @@ def test_without_the_copies_nusmv_gives_the_same_verdicts_and_trace_lengths(
     assert not all(r.holds for r in answers[0])  # the mutant fails: there are traces
     lengths = [[len(r.trace or ()) for r in found] for found in answers]
     assert lengths[0] == lengths[1]
+
+
+def test_a_copy_that_alone_declares_a_symbol_is_kept(nusmv_binary, monkeypatch) -> None:
+    """A DEFINE may evaluate to a symbol only a frozen copy's type declares (an LEBT's
+    ``runl`` to ``rl_4``, declared by ``tr_runl`` alone): that copy stays, the others go, and
+    NuSMV reads the lean text."""
+    monkeypatch.setenv("FSMBT_NUSMV", str(nusmv_binary))
+    text = "\n".join(
+        [
+            "MODULE m",
+            "VAR",
+            "  x : boolean;",
+            "DEFINE",
+            "  d := case x : a1; TRUE : a0; esac;",
+            "MODULE main",
+            "VAR",
+            "  r : m;",
+            "FROZENVAR",
+            "  tr_d : {a0, a1};",
+            "  tr_x : boolean;",
+            "INVARSPEC (r.d = a0 | r.d = a1);",
+            "",
+        ]
+    )
+    order = "r.x\ntr_x\ntr_d\n"
+    lean, lean_order = nusmv.without_unread_copies(text, order)
+    assert "  tr_d : {a0, a1};" in lean and "tr_x" not in lean
+    assert lean_order.split() == ["r.x", "tr_d"]
+    results, _seconds = run_nusmv(lean, 1, order=lean_order)
+    assert results[0].holds

@@ -493,14 +493,17 @@ _IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_.]*")
 
 def without_unread_copies(text: str, order: str) -> tuple[str, str]:
     """``text`` without the ``FROZENVAR`` declarations of ``MODULE main`` that no other line
-    reads, and ``order`` without them (a name or one of its bits, ``name.k``).
+    reads, and ``order`` without them (a name or one of its bits, ``name.k``). A copy whose
+    enumerated type is the only declaration of one of its symbols is kept (a DEFINE may
+    evaluate to that symbol: a tree's ``runl`` to ``rl_4``, declared by ``tr_runl`` alone).
 
-    Why: the frozen copies of the identity variables (``ts_*``, ``tr_*``; ``specs.product``) are read
-    by the reachability spec alone; once ``without_spec`` has left it out they are free
-    variables that change no verdict but make every counterexample costly, NuSMV picking and
-    printing a value of each at every step: on a 125-node structured tree's mutant (a corpus
-    FlexBE machine) the two failing invariants' traces took 49 s with the copies and 5 s
-    without (docs/nusmv.md, "The outcome pairing", "Eighth round"). O(size of the text)."""
+    Why: the frozen copies of the identity variables (``ts_*``, ``tr_*``; ``specs.product``)
+    are read by the reachability spec alone; once ``without_spec`` has left it out they are
+    free variables that change no verdict but make every counterexample costly, NuSMV picking
+    and printing a value of each at every step: on a 125-node structured tree's mutant (a
+    corpus FlexBE machine) the two failing invariants' traces took 49.4 s with the copies and
+    6.4 s without (docs/nusmv.md, "The outcome pairing", "Eighth round"). O(size of the
+    text)."""
     lines = text.split("\n")
     try:
         main = lines.index("MODULE main")
@@ -511,6 +514,8 @@ def without_unread_copies(text: str, order: str) -> tuple[str, str]:
     head = None
     for i in range(main + 1, len(lines)):
         line = lines[i]
+        if line.startswith("MODULE "):
+            break  # main's sections end at the next module
         if line and not line.startswith(" "):
             head = i if line.strip() == "FROZENVAR" else None
             if head is not None:
@@ -520,21 +525,49 @@ def without_unread_copies(text: str, order: str) -> tuple[str, str]:
         if head is not None and found:
             frozen[found.group(1)] = i
             heads[head].append(i)
-    if not frozen:
-        return text, order
     declared_at = set(frozen.values())
     read: set[str] = set()
     for i, line in enumerate(lines):
         if i not in declared_at:
             read.update(name.split(".")[0] for name in _IDENTIFIER.findall(line))
-    unread = {name for name in frozen if name not in read}
-    if not unread:
+    unread = [name for name in frozen if name not in read]
+    # the enumerated symbols declared by the declarations that stay (symbols are global)
+    candidates = {frozen[name] for name in unread}
+    symbols = {
+        symbol
+        for i, line in enumerate(lines)
+        if i not in candidates and _ENUM_DECLARED.match(line)
+        for symbol in _symbols(line)
+    }
+    dropped: set[str] = set()
+    for name in unread:
+        own = _symbols(lines[frozen[name]])
+        if own <= symbols:
+            dropped.add(name)
+        else:  # the only declaration of a symbol: kept
+            symbols |= own
+    if not dropped:
         return text, order
-    drop = {frozen[name] for name in unread}
+    drop = {frozen[name] for name in dropped}
     drop.update(h for h, declared in heads.items() if drop.issuperset(declared))  # now empty
     kept_lines = [line for i, line in enumerate(lines) if i not in drop]
-    kept_order = [entry for entry in order.split("\n") if entry.split(".")[0] not in unread]
+    kept_order = [entry for entry in order.split("\n") if entry.split(".")[0] not in dropped]
     return "\n".join(kept_lines), "\n".join(kept_order)
+
+
+_ENUMERATION = re.compile(r"\{([^}]*)\}")
+#: A declaration of an enumerated type, in any module.
+_ENUM_DECLARED = re.compile(r"^\s+[A-Za-z_][A-Za-z0-9_.]*\s*:\s*\{")
+
+
+def _symbols(line: str) -> set[str]:
+    """The symbols of the enumerated types written on ``line`` (``x : {a, b};`` -> a, b)."""
+    return {
+        symbol.strip()
+        for found in _ENUMERATION.findall(line)
+        for symbol in found.split(",")
+        if symbol.strip()
+    }
 
 
 def _only_spec(text: str, names: list[str], kept: str) -> str:

@@ -539,10 +539,10 @@ def node_order(order: Sequence[str]) -> list[str]:
     - the blackboard entries (``bb_k``, ``k`` a key, not a node) right after the call stack
       (``cur``, ``res``, ``lidx``), not after every node: every Switch's call and every
       Script's write tests ``cur`` beside the entry, so with the entries last each such rule
-      spans the whole order. Measured on the relation's build and the forward search of eight
-      20-state machines (``bench_nusmv_structured_phases.py --seeds 1..8 --sizes 20``): past
-      40 s -> 2.6 + 46 s and 26.8 s on the two with loops, 4-26 s -> 1.8-9.5 s on the others
-      (docs/nusmv.md, "The outcome pairing", "Eighth round").
+      spans the whole order. Measured on eight 20-state machines' pairs
+      (``bench_nusmv_structured_phases.py --seeds 1,...,8 --sizes 20``, the copies, variant
+      ``before`` against now): two past 60 s -> 54 s and 30 s wall, the six others
+      3.8-27.6 s -> 1.8-9.7 s (docs/nusmv.md, "The outcome pairing", "Eighth round").
 
     Every other variable keeps its place."""
     owned: dict[str, list[str]] = {}
