@@ -125,27 +125,26 @@ def test_deadlock_is_implied_only_when_the_rest_holds(nusmv_binary, monkeypatch)
 
 def _structured_mutant() -> tuple[str, list[str], str]:
     """A failing structured pair's product (every spec) and its variable order: a seeded
-    outcome-driven machine with one transition retargeted against its structured tree (the
-    first retargeting the native checker refutes)."""
+    outcome-driven machine with one transition retargeted (``fsmbt.verify.mutations``)
+    against its structured tree - the first such mutant the native checker refutes."""
     from fsmbt.convert.structured import fsm_to_structured
     from fsmbt.generate.outcome_machines import random_outcome_fsm
     from fsmbt.model.errors import FsmbtError
+    from fsmbt.verify.mutations import mutants
 
     source = random_outcome_fsm(SEED, states=6, containers=0.2)
     tree = fsm_to_structured(source).model
-    rng = random.Random(SEED)
-    for _attempt in range(50):
-        mutant = copy.deepcopy(source)
-        moved = rng.choice(mutant.transitions)
-        moved.target = rng.choice([s for s in mutant.states if s != moved.target])
+    for mutant in mutants(source, seed=SEED, per_operator=None):
+        if mutant.operator != "retarget_transition":
+            continue
         try:
-            refuted = not verify(mutant, tree, outcome_driven=True).equivalent
+            refuted = not verify(mutant.model, tree, outcome_driven=True).equivalent
         except FsmbtError:  # a retargeting the outcome view refuses: not a pair
             continue
         if refuted:
-            text, names, context = nusmv.build_model(mutant, tree, outcome_driven=True)
+            text, names, context = nusmv.build_model(mutant.model, tree, outcome_driven=True)
             return text, names, context[-1]
-    raise AssertionError("no refuted retargeting in 50 draws")
+    raise AssertionError("no retargeted transition is refuted")
 
 
 def test_the_lean_run_drops_the_frozen_copies_only_reachability_read() -> None:
