@@ -4,7 +4,10 @@ docs/verification.md §3, "Stages: a sharper bound and a shorter approach").
 For the node the 15 000-node `mixed` mutant's per-node check fails at (``bench_reactive.py
 --pernode``: the first per-node region's first guarded transition loses its guard), prints:
 
-- the per-node bound's ``P(U)`` before the stages (``reach`` alone) and with them;
+- the per-node bound's ``P(U)`` before the stages (``reach`` alone), with them (each stage's
+  standalone distance) and with the stages coupled (``verify/coupling.py``: the passes a later
+  stage's calls force on the earlier ones), the last at the verdict's default limit and, with
+  ``--labels N``, at ``shortest_max_labels`` = N (``FSMBT_MAX_SHORTEST_LABELS``);
 - the approach's length (a real run to the node's first tick) and its seconds;
 - with ``--astar SECONDS``: an A* search over the source tree's interpreter alone to the
   node's first tick, its heuristic the sum over the stages of each stage's standalone distance
@@ -13,7 +16,7 @@ For the node the 15 000-node `mixed` mutant's per-node check fails at (``bench_r
   the node's first tick, so the gap the verdict leaves is narrowed further, at a cost no
   verdict can pay (minutes).
 
-Run: ``PYTHONPATH=src .venv/bin/python benchmarks/bench_approach.py [--astar 120]``.
+Run: ``PYTHONPATH=src .venv/bin/python benchmarks/bench_approach.py [--astar 120] [--labels 400000]``.
 """
 
 from __future__ import annotations
@@ -25,6 +28,7 @@ import time
 
 from bench_reactive import family_tree, leaves_for
 
+from fsmbt import limits
 from fsmbt.semantics.bt_interpreter import BTInterpreter, CompiledTree, LeafRequest
 from fsmbt.semantics.compiled import FAILURE, RUNNING, SUCCESS
 from fsmbt.verify.approach import StageBounds, approach, last_descendant, stages
@@ -101,6 +105,9 @@ def main() -> int:
     parser.add_argument("--size", type=int, default=15000)
     parser.add_argument("--node", default="3/4", help="the failing node's path (bench_reactive)")
     parser.add_argument("--astar", type=float, default=0.0, help="seconds for the A* (0: none)")
+    parser.add_argument(
+        "--labels", type=int, default=0, help="the coupled bound again at this label limit"
+    )
     args = parser.parse_args()
     doc = family_tree(args.family, leaves_for(args.size), args.size)
     tree = CompiledTree(doc)
@@ -117,7 +124,17 @@ def main() -> int:
     print(
         f"{args.family} {len(tree.nodes)} nodes, node {args.node}: {len(stages(tree, target))} stages"
     )
-    print(f"P(U) by reach alone {reach_only}; with the stages {combined} ({spent:.2f} s)")
+    print(
+        f"P(U) by reach alone {reach_only}; with the stages {costs.before(target, coupled=False)}; "
+        f"coupled {combined} ({spent:.2f} s, shortest_max_labels "
+        f"{limits.current().shortest_max_labels})"
+    )
+    if args.labels:
+        started = time.perf_counter()
+        with limits.changed(shortest_max_labels=args.labels):
+            larger = TickCosts(tree).before(target)
+        spent = time.perf_counter() - started
+        print(f"coupled {larger} ({spent:.2f} s, shortest_max_labels {args.labels})")
     started = time.perf_counter()
     found = approach(tree, target)
     spent = time.perf_counter() - started

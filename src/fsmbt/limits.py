@@ -57,6 +57,11 @@ class Limits:
         nusmv_max_seconds: wall seconds one NuSMV run may take. ``FSMBT_MAX_NUSMV_SECONDS``.
         nusmv_max_memory_mb: address space of the NuSMV process (``RLIMIT_AS``), MiB.
             ``FSMBT_MAX_NUSMV_MEMORY_MB``.
+        shortest_max_labels: most (state, passes) labels one stage's pass-count search
+            settles for the coupled lower bound on a counterexample's length
+            (``verify/coupling.py``; fifty times as many for one tree's searches together):
+            past it the bound is weaker, never wrong, and the verdict may say "not known to be
+            shortest". ``FSMBT_MAX_SHORTEST_LABELS``.
         llm_max_response_bytes: largest HTTP response body accepted from an LLM endpoint; the
             download stops at this size and the attempt fails. ``FSMBT_MAX_LLM_RESPONSE_BYTES``.
     """
@@ -75,6 +80,7 @@ class Limits:
     checker_max_seconds: float = 600.0
     nusmv_max_seconds: float = 300.0
     nusmv_max_memory_mb: int = 4096
+    shortest_max_labels: int = 40_000
     llm_max_response_bytes: int = 4 * 1024 * 1024
 
     def with_changes(self, **changes: int | float) -> Limits:

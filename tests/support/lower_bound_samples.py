@@ -23,8 +23,10 @@ from support.pernode_mutants import BOUND, seeded_mutants
 DEPTH, STATES = 9, 30_000
 
 
-def first_ticks(doc: BTDocument) -> tuple[CompiledTree, dict[int, int], dict[int, int]]:
-    """Breadth-first over the interpreter's leaf outcomes (``DEPTH`` leaves at most): the fewest
+def first_ticks(
+    doc: BTDocument, depth: int = DEPTH, states: int = STATES
+) -> tuple[CompiledTree, dict[int, int], dict[int, int]]:
+    """Breadth-first over the interpreter's leaf outcomes (``depth`` leaves at most): the fewest
     leaves answered before each node is seen ticking (on the path to a requested leaf), and
     before the root's first tick returns each status (``exactly_once``: a RUNNING with a
     wake-up ends the tick, as a parent sees its child's tick)."""
@@ -34,12 +36,12 @@ def first_ticks(doc: BTDocument) -> tuple[CompiledTree, dict[int, int], dict[int
     start, event = interp.advance(interp.begin_tick(interp.initial()), None)
     level: list[tuple[Any, Any, bool]] = [(start, event, True)]
     visited = {start}
-    for depth in range(DEPTH + 1):
+    for level_depth in range(depth + 1):
         following: list[tuple[Any, Any, bool]] = []
         for snap, event, first in level:
             while not isinstance(event, LeafRequest):
                 if first:
-                    root_first.setdefault(event.status, depth)
+                    root_first.setdefault(event.status, level_depth)
                 if event.status != RUNNING:
                     break
                 first = False
@@ -48,7 +50,7 @@ def first_ticks(doc: BTDocument) -> tuple[CompiledTree, dict[int, int], dict[int
             if not isinstance(event, LeafRequest):
                 continue
             for frame in snap[2]:
-                seen.setdefault(frame[0], depth)
+                seen.setdefault(frame[0], level_depth)
             node = event.node
             outcomes = (
                 (SUCCESS, FAILURE)
@@ -57,7 +59,7 @@ def first_ticks(doc: BTDocument) -> tuple[CompiledTree, dict[int, int], dict[int
             )
             for status in outcomes:
                 nxt, ev = interp.advance(snap, status)
-                if nxt not in visited and len(visited) < STATES:
+                if nxt not in visited and len(visited) < states:
                     visited.add(nxt)
                     following.append((nxt, ev, first))
         level = following

@@ -26,16 +26,21 @@ Rules (node behaviour is fsmbt's interpreter's, ``BTInterpreter``, never the con
    leaves before its first pass, ``d_j``, bounds the leaves under it before ``U``'s first tick;
    stages are disjoint subtrees, so the bounds add: ``P(U) >= sum of d_j`` (a 0-1 breadth-first
    search per stage; past ``STAGE_LIMIT`` states, the depth it exhausted, still a bound);
-3. *approach*: the whole tree is run by the interpreter; a leaf inside stage ``j`` answers the
+3. *coupled*: under a parent of the ``reactive`` family, every call that reaches a later stage
+   makes the earlier ones pass again; ``verify/coupling.py`` bounds what the stages cost
+   together (docs/semantics.md §4d, "Coupled stages");
+4. *approach*: the whole tree is run by the interpreter; a leaf inside stage ``j`` answers the
    next outcome of ``j``'s current plan, a shortest way (no halts: the parent decides those)
-   from ``j``'s state at that moment to its next pass, searched again when the plan is spent or
-   the run left it. The result is a real run to ``U``'s first tick, not a shortest one: the
-   stages are planned one at a time, while a later stage's ticks make every earlier stage pass
-   again in each of them.
+   from ``j``'s state at that moment to its next pass, each tick it begins weighed by what the
+   earlier coupled stages need to pass once more from where they are (their *refail* cost,
+   measured on the run), searched again when the plan is spent or the run
+   left it. The result is a real run to ``U``'s first tick, not a shortest one: it is
+   shortest when its length meets the bound.
 
 Cost: one standalone search per stage (at most ``STAGE_LIMIT`` states; ``BOUND_BUDGET`` for
-all of one tree's), memoized by node; the approach replans once per stage per tick it passes
-in, each search at most ``PLAN_LIMIT`` states and ``APPROACH_BUDGET`` for all of them.
+all of one tree's), memoized by node; the approach replans once per stage per tick
+it passes in, each search at most ``PLAN_LIMIT`` states and ``APPROACH_BUDGET`` for all of
+them, refail costs memoized by the stage's state.
 """
 
 from __future__ import annotations
@@ -59,6 +64,7 @@ from fsmbt.semantics.bt_interpreter import (
     Snapshot,
 )
 from fsmbt.semantics.compiled import FAILURE, RUNNING, SUCCESS
+from fsmbt.semantics.leaf_canonical import Canonicalizer, is_canonical_class
 from fsmbt.semantics.nodes import runtime_tables
 
 #: Most states one stage's standalone search settles (past it: the least cost not settled).
@@ -73,6 +79,10 @@ PLAN_LIMIT = 20_000
 APPROACH_BUDGET = 200_000
 #: Most leaves the approach answers before it gives up (a run that never reaches ``U``).
 APPROACH_LIMIT = 20_000
+#: The weight of a tick in a refail search: far above any plan's leaves, so the search finds
+#: the fewest ticks first (one, when the stage can pass again in one tick), then the fewest
+#: leaves.
+_ONE_TICK = 1_000_000
 _STANDALONE_ID = "__fsmbt_stage__"
 
 
@@ -88,6 +98,13 @@ def pass_statuses(parent: CompiledNode) -> frozenset[int] | None:
     else:
         return None
     return frozenset((FAILURE if fallback else SUCCESS, SKIPPED))
+
+
+def coupled(parent: CompiledNode) -> bool:
+    """Whether ``parent`` calls its children again from child 0 on every call (the
+    ``reactive`` family, rule 3): its earlier children then pass again in every call that
+    reaches a later one."""
+    return runtime_tables().handlers.get(parent.type) == "reactive"
 
 
 def stages(tree: CompiledTree, target: int) -> list[tuple[int, frozenset[int]]]:
@@ -130,6 +147,7 @@ class Standalone:
         self.offset = nid
         self.last = nid + len(self.interp.nodes) - 1
         self.last_settled = 0  # states the last search settled
+        self._canonical: tuple[Canonicalizer, ...] | None = None
         if last_descendant(tree, nid) != self.last or any(
             a.type != b.type or len(a.children) != len(b.children)
             for a, b in zip(self.interp.nodes, tree.nodes[nid : self.last + 1], strict=True)
@@ -146,9 +164,38 @@ class Standalone:
             False,
         )
 
-    def _moves(self, snap: Snapshot, halts: bool) -> Iterable[tuple[str, Any, Snapshot, Any]]:
+    def canonical(self) -> Canonicalizer | None:
+        """The stage's ``leaf_canonical.Canonicalizer`` when its subtree is of the canonical
+        class (docs/semantics.md §4a: statuses and frame locals reset before they are read are
+        erased, so snapshots with the same future - under leaf outcomes, ticks and halts of the
+        root alike - are one), else ``None``; built once."""
+        if self._canonical is None:
+            tree = self.interp.tree
+            self._canonical = (Canonicalizer(tree),) if is_canonical_class(tree) else ()
+        return self._canonical[0] if self._canonical else None
+
+    def start(self, canonical: bool = False) -> Snapshot:
+        """The stage at rest (canonical when asked and the class allows)."""
+        snap = self.interp.initial()
+        erase = self.canonical() if canonical else None
+        return erase.canonical(snap) if erase is not None else snap
+
+    def moves(
+        self, snap: Snapshot, halts: bool, canonical: bool = False
+    ) -> Iterable[tuple[str, Any, Snapshot, Any]]:
         """(``halt``, ``tick`` or ``leaf``; the outcome given or None; the next snapshot; the
-        status the stage returned or None)."""
+        status the stage returned or None); with ``canonical``, each next snapshot canonical
+        (``Standalone.canonical``): the same costs over fewer states, for the searches that
+        need no faithful snapshot (``verify/coupling.py``; a plan is matched against the
+        whole tree's faithful run, so the approach's searches keep them)."""
+        erase = self.canonical() if canonical else None
+        if erase is None:
+            yield from self._moves(snap, halts)
+            return
+        for kind, outcome, after, status in self._moves(snap, halts):
+            yield kind, outcome, erase.canonical(after), status
+
+    def _moves(self, snap: Snapshot, halts: bool) -> Iterable[tuple[str, Any, Snapshot, Any]]:
         it = self.interp
         if not snap[2]:  # between ticks: tick it (and, for the bound, halt it)
             if halts:
@@ -170,12 +217,14 @@ class Standalone:
         halts: bool,
         tick_cost: int = 0,
         limit: int = STAGE_LIMIT,
+        canonical: bool = False,
     ) -> tuple[int, list[tuple[Any, int]] | None]:
         """Dijkstra from ``start`` to the first tick returning a pass status, a leaf costing 1
         and each tick begun ``tick_cost``: (least cost, the outcomes - each with the stage's
         statuses, memories and frames before it - or ``None``). Past ``limit`` states, or
         when no pass is reachable: (the least cost not yet settled, ``None``) - with
-        ``tick_cost`` 0, a lower bound on the leaves either way."""
+        ``tick_cost`` 0, a lower bound on the leaves either way. ``canonical``: see
+        ``moves`` (the plan's snapshots are then canonical too)."""
         counter = itertools.count()
         self.last_settled = 0
         heap: list[tuple[int, int, Any, Any]] = [(0, next(counter), start, None)]
@@ -192,7 +241,7 @@ class Standalone:
                     return cost, None
                 settled.add(snap)
                 self.last_settled = len(settled)
-                for kind, outcome, after, status in self._moves(snap, halts):
+                for kind, outcome, after, status in self.moves(snap, halts, canonical):
                     step = link if outcome is None else ((snap[:3], outcome), link)
                     extra = 1 if kind == "leaf" else tick_cost if kind == "tick" else 0
                     if status in passing:
@@ -264,19 +313,35 @@ def approach(
     ``APPROACH_BUDGET`` states settled by its plans)."""
     bounds = bounds or StageBounds(tree)
     owner: list[tuple[Standalone, frozenset[int]]] = []
-    for nid, passing in stages(tree, target):
+    # the coupled stages (rule 3): each tick a later stage begins makes them pass again
+    again: list[int] = []
+    for k, (nid, passing) in enumerate(stages(tree, target)):
         alone = bounds.standalone(nid)
         if alone is None:
             return None
         owner.append((alone, passing))
+        parent = tree.nodes[nid].parent
+        if parent is not None and coupled(tree.nodes[parent]):
+            again.append(k)
     last = last_descendant(tree, target)
     interp = BTInterpreter(tree)
     plans: dict[int, deque[tuple[Any, int]]] = {}
-    # the leaves each stage's last plan took: a tick begun by stage k makes every earlier stage
-    # pass again, so it costs about their sum (earlier stages are planned first: a tick meets
-    # them first)
-    spent = [0] * len(owner)
+    refails: dict[tuple[int, Snapshot], int] = {}
     settled = 0  # states the plans settled (``APPROACH_BUDGET``)
+
+    def refail(k: int, snap: Snapshot) -> int:
+        """The leaves stage ``k`` needs to pass once more, in one tick when it can, from its
+        state in ``snap`` with its parent's reset of its status at the tick's end."""
+        nonlocal settled
+        alone, passing = owner[k]
+        piece = alone.slice(snap)
+        piece = (tuple(e for e in piece[0] if e[0] != 0), piece[1], (), False)
+        if (k, piece) not in refails:
+            _cost, steps = alone.search(piece, passing, False, _ONE_TICK, PLAN_LIMIT)
+            settled += alone.last_settled
+            refails[k, piece] = len(steps) if steps is not None else 0
+        return refails[k, piece]
+
     outcomes: list[int] = []
     try:
         snap, event = interp.advance(interp.begin_tick(interp.initial()), None)
@@ -302,12 +367,12 @@ def approach(
             here = alone.slice(snap)
             plan = plans.get(stage)
             if not plan or plan[0][0] != here[:3]:  # spent, or the run left it (a halt)
-                _cost, steps = alone.search(here, passing, False, sum(spent[:stage]), PLAN_LIMIT)
+                weight = sum(refail(k, snap) for k in again if k < stage)
+                _cost, steps = alone.search(here, passing, False, weight, PLAN_LIMIT)
                 settled += alone.last_settled
                 if not steps or settled > APPROACH_BUDGET:
                     return None
                 plan = plans[stage] = deque(steps)
-                spent[stage] = len(steps)
             outcome = plan.popleft()[1]
             if event.node.is_condition and outcome == RUNNING:
                 return None

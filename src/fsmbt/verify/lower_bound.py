@@ -22,7 +22,9 @@ The argument (the full text is docs/semantics.md §4d):
    ``U``'s ancestors ``A`` of ``reach(A, i)``: the cheapest way, from ``A``'s rest, to have
    ``A`` tick its child ``i`` towards ``U`` for the first time, or, when larger, the sum of
    ``A``'s stages' standalone distances (``verify/approach.py``: each earlier child of a
-   sequence or fallback ancestor must pass once before, run alone exactly) - and (b) the
+   sequence or fallback ancestor must pass once before, run alone exactly), or the stages'
+   coupled bound (``verify/coupling.py``: under a reactive parent, each call a later stage
+   makes forces the earlier ones to pass again) plus the other ancestors' ``reach`` - and (b) the
    leaves under ``U`` until its pair differs - at least ``k(U)``, the cheapest path of ``U``'s
    local product from rest to a step whose outputs differ (``U``'s children are at rest at
    its first tick). In both searches a child ``j`` returning ``s`` costs ``first_j(s)`` the
@@ -63,7 +65,8 @@ from fsmbt.semantics.bt_interpreter import (
     LeafRequest,
 )
 from fsmbt.semantics.compiled import FAILURE, RUNNING, SUCCESS, Work
-from fsmbt.verify.approach import StageBounds
+from fsmbt.verify.approach import StageBounds, stages
+from fsmbt.verify.coupling import CoupledBound
 from fsmbt.verify.pernode import (
     LOCAL_LIMIT,
     STATUS_OF,
@@ -244,6 +247,7 @@ class TickCosts:
     def __init__(self, tree: CompiledTree) -> None:
         self.tree = tree
         self.stages = StageBounds(tree)
+        self.coupling = CoupledBound(tree, self.stages)
         self.costs: dict[int, NodeCosts] = {}
         self.reach: dict[int, dict[int, int]] = {}
         memo: dict[Hashable, _Shape] = {}
@@ -261,12 +265,16 @@ class TickCosts:
             self.costs[node.id] = shape.costs
             self.reach[node.id] = shape.reach
 
-    def before(self, nid: int) -> int | None:
+    def before(self, nid: int, coupled: bool = True) -> int | None:
         """``P``: least leaves consumed before ``nid`` is first ticked (``None``: never). Per
         ancestor, the larger of its ``reach`` and its stages' standalone distances
         (``verify/approach.py``): both bound the leaves under its other children before the
-        path child's first tick, and ancestors' other children are disjoint subtrees."""
+        path child's first tick, and ancestors' other children are disjoint subtrees. Or,
+        when larger, the coupled stages' bound (``verify/coupling.py``) plus the ``reach`` of the
+        ancestors without stages (disjoint from every stage); ``coupled`` False leaves that
+        bound out (for the benchmarks and tests that compare the two)."""
         total = 0
+        unstaged = 0  # the ancestors without stages: their ``reach`` alone
         nodes = self.tree.nodes
         staged = self.stages.per_ancestor(nid)
         child = nid
@@ -276,8 +284,18 @@ class TickCosts:
             if step is None:
                 return None  # the interpreter never ticks that child: neither is the node
             total += max(step, staged.get(parent, 0))
+            if parent not in staged:
+                unstaged += step
             child, parent = parent, nodes[parent].parent
-        return total
+        if not staged or not coupled:
+            return total
+        # the stages coupled through reactive parents (``verify/coupling.py``): a bound on
+        # the leaves under all of them together, beside the other ancestors' reach
+        refail = {
+            j: min((self.costs[j].any[s] for s in passing if s in self.costs[j].any), default=0)
+            for j, passing in stages(self.tree, nid)
+        }
+        return max(total, unstaged + self.coupling.before(nid, refail))
 
 
 def _leaf_costs(node: CompiledNode) -> dict[int, int]:
