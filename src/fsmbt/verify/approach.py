@@ -33,14 +33,14 @@ Rules (node behaviour is fsmbt's interpreter's, ``BTInterpreter``, never the con
    next outcome of ``j``'s current plan, a shortest way (no halts: the parent decides those)
    from ``j``'s state at that moment to its next pass, each tick it begins weighed by what the
    earlier coupled stages need to pass once more from where they are (their *refail* cost,
-   measured on the run), searched again when the plan is spent or the run
-   left it. The result is a real run to ``U``'s first tick, not a shortest one: it is
-   shortest when its length meets the bound.
+   measured on the run), searched again when the plan is spent or the run left it. The result
+   is a real run to ``U``'s first tick, not a shortest one: it is shortest when its length
+   meets the bound.
 
 Cost: one standalone search per stage (at most ``STAGE_LIMIT`` states; ``BOUND_BUDGET`` for
-all of one tree's), memoized by node; the approach replans once per stage per tick
-it passes in, each search at most ``PLAN_LIMIT`` states and ``APPROACH_BUDGET`` for all of
-them, refail costs memoized by the stage's state.
+all of one tree's), memoized by node; the approach replans once per stage per tick it passes
+in, each search at most ``PLAN_LIMIT`` states and ``APPROACH_BUDGET`` for all of them, refail
+costs memoized by the stage's state.
 """
 
 from __future__ import annotations

@@ -36,7 +36,9 @@ alone, ``approach.Standalone``, under *any* interleaving of calls and halts):
    first tick number at least ``min over (t_j) of sum over i of G_i(t_i, M_i)``: a dynamic
    programme over the stages from the last, its state the running sum ``S`` of ``t_j - 1``
    (capped at ``SUM_CAP``: ``G`` grows with ``M``, so a smaller ``S`` only lowers the bound).
-   A search stopped at its cap answers with its frontier's least cost (a bound still).
+   A search stopped at its cap answers with its frontier's least cost (a bound still). The
+   searches run over canonical snapshots (``Standalone.moves``, docs/semantics.md §4a: the
+   same future under calls, halts and leaf outcomes, so the same costs over fewer states).
 
 Cost: per stage, a profile search, one weighted search per ``WEIGHTS`` entry and a pass-count
 search, at most ``PROFILE_LIMIT``, ``approach.STAGE_LIMIT`` and ``shortest_max_labels``
@@ -79,9 +81,8 @@ _NEVER = 10**9
 @dataclass(frozen=True)
 class StageCosts:
     """One stage's rule-4 costs: ``profile[t - 1] = D(t)`` for ``t`` in ``1..TICK_CAP - 1``
-    and ``d_j`` last,
-    ``passes[m] = H(m)`` for ``m`` in ``0..EXTRA_PASSES``, ``refail = r``, and whether its
-    parent is reactive (rule 3)."""
+    and ``d_j`` last, ``passes[m] = H(m)`` for ``m`` in ``0..EXTRA_PASSES``, ``refail = r``,
+    and whether its parent is reactive (rule 3)."""
 
     profile: tuple[int, ...]
     passes: tuple[int, ...]
