@@ -6,8 +6,11 @@ that claims "shortest" by it."""
 
 from __future__ import annotations
 
+import contextlib
+
 import pytest
 
+from fsmbt import limits
 from fsmbt.verify import lift
 from fsmbt.verify.lower_bound import TickCosts
 from support.lower_bound_samples import bounded_pairs, first_ticks
@@ -82,3 +85,25 @@ def test_a_verdict_claims_shortest_by_the_bound_only_when_it_is(
             unclaimed += 1
     assert claimed >= 15
     assert unclaimed >= 1
+
+
+def test_the_verdict_names_the_label_limit_only_when_a_search_stopped_there(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A bound that falls short says to raise ``FSMBT_MAX_SHORTEST_LABELS`` only when one of
+    its coupled-stage searches stopped at that limit (``verify/coupling.py``): never on the
+    small sample at the default limit (its searches finish), and on some of it at a limit of
+    one label."""
+    search = lift.search_shorter
+    monkeypatch.setattr(
+        lift, "search_shorter", lambda s, r, n, **kw: search(s, r, n, max_seconds=0.0)
+    )
+    named: dict[bool, int] = {}
+    for tight in (False, True):
+        with limits.changed(shortest_max_labels=1) if tight else contextlib.nullcontext():
+            for _doc, _mutant, report in lifted_reports(60):
+                said = " ".join(report.abstractions)
+                if "not known to be shortest by the lower bound either" in said:
+                    named[tight] = named.get(tight, 0) + ("FSMBT_MAX_SHORTEST_LABELS" in said)
+    assert named.get(False) == 0
+    assert named.get(True, 0) >= 1

@@ -999,9 +999,14 @@ def _claim_by_bound(report: Report, bound: LowerBound | None) -> None:
             f"not known to be shortest by the lower bound either: no counterexample can be "
             f"shorter than {bound.bound} inputs (the per-node proof, docs/semantics.md §4d: "
             f"{bound.before} leaf outcomes before node {bound.node} is first ticked, "
-            f"{bound.inside} under it), {length - bound.bound} short of this one (a deeper "
-            f"search of the stages before that node: raise {limits.env_name('shortest_max_labels')}"
-            f", now {limits.current().shortest_max_labels})"
+            f"{bound.inside} under it), {length - bound.bound} short of this one"
+            + (
+                f" (its search of the stages before that node stopped at its limit: raise "
+                f"{limits.env_name('shortest_max_labels')}, now "
+                f"{limits.current().shortest_max_labels})"
+                if bound.cut
+                else ""
+            )
         )
         return
     if bound.bound > length:

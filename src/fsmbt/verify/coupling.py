@@ -41,7 +41,7 @@ alone, ``approach.Standalone``, under *any* interleaving of calls and halts):
    same future under calls, halts and leaf outcomes, so the same costs over fewer states).
 
 Cost: per stage, a profile search, one weighted search per ``WEIGHTS`` entry and a pass-count
-search, at most ``PROFILE_LIMIT``, ``approach.STAGE_LIMIT`` and ``shortest_max_labels``
+search, at most ``PROFILE_LIMIT``, ``WEIGHT_LIMIT`` and ``shortest_max_labels``
 (``fsmbt.limits``, ``FSMBT_MAX_SHORTEST_LABELS``) settled labels, ``BUDGET_PER_LABEL`` times
 the last for a tree's (past it, a stage's costs fall back to ``d_j``); the programme is
 ``O(stages * SUM_CAP * TICK_CAP)``. At the default limit the 15 560-node mutant's bound costs
@@ -68,6 +68,8 @@ PROFILE_LIMIT = 5_000
 #: leaves plus ``w`` per call before the first pass (weak duality; cheap where the first search
 #: is cut, since a heavy weight keeps the search on runs with few calls).
 WEIGHTS = (2, 6, 16, 32)
+#: Most labels one weighted search settles (past it: its frontier's least cost).
+WEIGHT_LIMIT = 10_000
 #: Passes after the first that ``pass_counts`` searches for (later ones: ``r_i`` each).
 EXTRA_PASSES = 8
 #: Labels all of one tree's coupling searches settle, per label one pass-count search may
@@ -197,6 +199,7 @@ class CoupledBound:
         self.bounds = bounds
         self._costs: dict[int, StageCosts] = {}
         self.settled = 0  # labels the searches settled (``BUDGET_PER_LABEL``)
+        self.cut = False  # a pass-count search stopped at its limit, or the budget was spent
 
     def stage_costs(self, nid: int, passing: frozenset[int], refail: int) -> StageCosts:
         """A stage's rule-4 costs (``d_j`` everywhere when it does not compile alone or the
@@ -209,15 +212,19 @@ class CoupledBound:
             floor = self.bounds.distance(nid, passing)
             labels = limits.current().shortest_max_labels
             if alone is None or self.settled >= BUDGET_PER_LABEL * labels:
+                self.cut = self.cut or alone is not None
                 costs = StageCosts((floor,) * TICK_CAP, (floor,), 0, is_coupled)
             else:
                 profile, used = tick_profile(alone, passing, PROFILE_LIMIT)
                 for weight in WEIGHTS:
                     start = alone.start(canonical=True)
-                    least = alone.search(start, passing, True, weight, canonical=True)[0]
+                    least = alone.search(
+                        start, passing, True, weight, WEIGHT_LIMIT, canonical=True
+                    )[0]
                     used += alone.last_settled
                     profile = [max(p, least - weight * t) for t, p in enumerate(profile, 1)]
                 counts, more = pass_counts(alone, passing, labels)
+                self.cut = self.cut or more >= labels
                 self.settled += used + more
                 # the last entry stands for every count of calls from ``TICK_CAP`` on: ``d_j``
                 profile[-1] = floor

@@ -49,6 +49,7 @@ distinct failing problem of at most ``pernode.LOCAL_LIMIT`` pairs.
 
 from __future__ import annotations
 
+import dataclasses
 import heapq
 import itertools
 from collections.abc import Hashable
@@ -348,13 +349,16 @@ def local_distance(unit: FailedUnit, kids: list[NodeCosts]) -> int:
 @dataclass(frozen=True)
 class LowerBound:
     """``bound``: no counterexample has fewer inputs; ``node``: the failing node that gives it
-    (its path), with ``before`` (P) and ``inside`` (k); ``failing``: the size of ``F``."""
+    (its path), with ``before`` (P) and ``inside`` (k); ``failing``: the size of ``F``;
+    ``cut``: some coupled-stage search stopped at ``shortest_max_labels`` (a larger limit may
+    raise the bound; ``verify/coupling.py``)."""
 
     bound: int
     node: str
     before: int
     inside: int
     failing: int
+    cut: bool = False
 
 
 def lower_bound(whole: CompiledTree, found: CompleteWalk) -> LowerBound | None:
@@ -386,4 +390,6 @@ def lower_bound(whole: CompiledTree, found: CompleteWalk) -> LowerBound | None:
         if best is None or before + inside < best.bound:
             path = unit.problem.node.path or "the root"
             best = LowerBound(before + inside, path, before, inside, len(found.failed))
+    if best is not None and costs.coupling.cut:
+        best = dataclasses.replace(best, cut=True)
     return best
