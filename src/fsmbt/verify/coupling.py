@@ -30,10 +30,11 @@ alone, ``approach.Standalone``, under *any* interleaving of calls and halts):
    (a search over (state, calls), ``tick_profile``), ``H_i(m)`` the least leaves for ``1 + m``
    passes (a search over (state, passes), ``pass_counts``) and ``r_i`` a bound on one pass from
    any state (``lower_bound.TickCosts``' ``any``), stage ``i`` consumes at least
-   ``G_i(t_i, M_i) = max(D_i(t_i) + M_i * r_i, H_i(M_i))`` leaves (``H_i(m)`` past the searched
-   ``m`` grows by ``r_i`` per pass; ``D_i(t)`` is also at least ``L_i(w) - w * t`` for the
-   least cost ``L_i(w)`` of a first pass when each call costs ``w`` more, ``WEIGHTS``). Stages are disjoint subtrees, so the leaves before ``U``'s
-   first tick number at least ``min over (t_j) of sum over i of G_i(t_i, M_i)``: a dynamic
+   ``G_i(t_i, M_i) = max(D_i(t_i) + M_i * r_i, max over m <= M_i of H_i(m) + (M_i - m) * r_i)``
+   leaves (every pass after the ``m``-th costs at least ``r_i``; ``D_i(t)`` is also at least
+   ``L_i(w) - w * t`` for the least cost ``L_i(w)`` of a first pass when each call costs ``w``
+   more, ``WEIGHTS``). Stages are disjoint subtrees, so the leaves before ``U``'s first tick
+   number at least ``min over (t_j) of sum over i of G_i(t_i, M_i)``: a dynamic
    programme over the stages from the last, its state the running sum ``S`` of ``t_j - 1``
    (capped at ``SUM_CAP``: ``G`` grows with ``M``, so a smaller ``S`` only lowers the bound).
    A search stopped at its cap answers with its frontier's least cost (a bound still). The
@@ -44,9 +45,9 @@ Cost: per stage, a profile search, one weighted search per ``WEIGHTS`` entry and
 search, at most ``PROFILE_LIMIT``, ``WEIGHT_LIMIT`` and ``shortest_max_labels``
 (``fsmbt.limits``, ``FSMBT_MAX_SHORTEST_LABELS``) settled labels, ``BUDGET_PER_LABEL`` times
 the last for a tree's (past it, a stage's costs fall back to ``d_j``); the programme is
-``O(stages * SUM_CAP * TICK_CAP)``. At the default limit the 15 560-node mutant's bound costs
-about 7 s and falls 11 inputs short; at 400 000 labels, about 140 s and it meets the
-counterexample (docs/verification.md §3, "Coupled stages").
+``O(stages * SUM_CAP * TICK_CAP)``. On the 15 560-node mutant the coupling costs about 8 s at
+the default limit and its bound meets the counterexample (106); at 20 000 labels, 5 s and 103
+(docs/verification.md §3, "Coupled stages").
 """
 
 from __future__ import annotations
