@@ -177,8 +177,12 @@ class Standalone:
     def start(self, canonical: bool = False) -> Snapshot:
         """The stage at rest (canonical when asked and the class allows)."""
         snap = self.interp.initial()
-        erase = self.canonical() if canonical else None
-        return erase.canonical(snap) if erase is not None else snap
+        return self.erase(snap) if canonical else snap
+
+    def erase(self, snap: Snapshot) -> Snapshot:
+        """``snap`` canonical when the class allows (``canonical``), else itself."""
+        canonical = self.canonical()
+        return canonical.canonical(snap) if canonical is not None else snap
 
     def moves(
         self, snap: Snapshot, halts: bool, canonical: bool = False
@@ -186,8 +190,8 @@ class Standalone:
         """(``halt``, ``tick`` or ``leaf``; the outcome given or None; the next snapshot; the
         status the stage returned or None); with ``canonical``, each next snapshot canonical
         (``Standalone.canonical``): the same costs over fewer states, for the searches that
-        need no faithful snapshot (``verify/coupling.py``; a plan is matched against the
-        whole tree's faithful run, so the approach's searches keep them)."""
+        need no faithful snapshot (``verify/coupling.py``; the approach, whose plan steps are
+        matched against the run's snapshots made canonical the same way, ``erase``)."""
         erase = self.canonical() if canonical else None
         if erase is None:
             yield from self._moves(snap, halts)
@@ -335,9 +339,11 @@ def approach(
         nonlocal settled
         alone, passing = owner[k]
         piece = alone.slice(snap)
-        piece = (tuple(e for e in piece[0] if e[0] != 0), piece[1], (), False)
+        piece = alone.erase((tuple(e for e in piece[0] if e[0] != 0), piece[1], (), False))
         if (k, piece) not in refails:
-            _cost, steps = alone.search(piece, passing, False, _ONE_TICK, PLAN_LIMIT)
+            _cost, steps = alone.search(
+                piece, passing, False, _ONE_TICK, PLAN_LIMIT, canonical=True
+            )
             settled += alone.last_settled
             refails[k, piece] = len(steps) if steps is not None else 0
         return refails[k, piece]
@@ -364,11 +370,15 @@ def approach(
             if stage is None:
                 return None
             alone, passing = owner[stage]
-            here = alone.slice(snap)
+            # plans run over canonical snapshots (fewer states, the same costs; a plan step
+            # is matched against the run's snapshot made canonical the same way)
+            here = alone.erase(alone.slice(snap))
             plan = plans.get(stage)
             if not plan or plan[0][0] != here[:3]:  # spent, or the run left it (a halt)
                 weight = sum(refail(k, snap) for k in again if k < stage)
-                _cost, steps = alone.search(here, passing, False, weight, PLAN_LIMIT)
+                _cost, steps = alone.search(
+                    here, passing, False, weight, PLAN_LIMIT, canonical=True
+                )
                 settled += alone.last_settled
                 if not steps or settled > APPROACH_BUDGET:
                     return None
