@@ -987,6 +987,12 @@ def _proven_results(shape: Structure, k: int, j: int) -> frozenset[str] | None:
     return _results(witness) if report.equivalent else None
 
 
+def _named(path: str) -> str:
+    """A failing node as a verdict names it: its path in its region, or the region's root
+    (``lower_bound`` names that one "the root")."""
+    return "its region's root" if path == "the root" else f"node {path}"
+
+
 def _claim_by_bound(report: Report, bound: LowerBound | None) -> None:
     """Record the bound; when it meets the counterexample's length, the verdict says the
     counterexample is shortest and names the method."""
@@ -998,10 +1004,10 @@ def _claim_by_bound(report: Report, bound: LowerBound | None) -> None:
         report.abstractions.append(
             f"not known to be shortest by the lower bound either: no counterexample can be "
             f"shorter than {bound.bound} inputs (the per-node proof, docs/semantics.md §4d: "
-            f"{bound.before} leaf outcomes before node {bound.node} is first ticked, "
+            f"{bound.before} leaf outcomes before {_named(bound.node)} is first ticked, "
             f"{bound.inside} under it), {length - bound.bound} short of this one"
             + (
-                f" (its search of the stages before that node stopped at its limit: raise "
+                f" (a search of the coupled stages stopped at its limit: raise "
                 f"{limits.env_name('shortest_max_labels')}, now "
                 f"{limits.current().shortest_max_labels})"
                 if bound.cut
@@ -1017,7 +1023,7 @@ def _claim_by_bound(report: Report, bound: LowerBound | None) -> None:
         f"shortest: no counterexample can be shorter than {length} inputs (a lower bound from "
         f"the per-node proof, docs/semantics.md §4d: every local check decided, {bound.failing} "
         f"failing; a difference needs a failing node's local pair to differ, at least "
-        f"{bound.before} leaf outcomes before node {bound.node} is first ticked and "
+        f"{bound.before} leaf outcomes before {_named(bound.node)} is first ticked and "
         f"{bound.inside} under it)"
     )
     report.abstractions = [
