@@ -217,8 +217,8 @@ class CoupledBound:
                 costs = StageCosts((floor,) * TICK_CAP, (floor,), 0, is_coupled)
             else:
                 profile, used = tick_profile(alone, passing, PROFILE_LIMIT)
+                start = alone.start(canonical=True)
                 for weight in WEIGHTS:
-                    start = alone.start(canonical=True)
                     least = alone.search(
                         start, passing, True, weight, WEIGHT_LIMIT, canonical=True
                     )[0]
