@@ -129,6 +129,7 @@ def _only_comment_dashes(path: Path) -> bool:
     return False
 
 
+@pytest.mark.skipif(not CORPUS.is_dir(), reason=f"corpus not found at {CORPUS} (set FSMBT_CORPUS)")
 def test_the_corpus_malformed_files_are_rows_not_a_crash(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -106,7 +106,7 @@ def test_corpus_and_generated_trees_within_the_bound_and_proven() -> None:
         docs.append(
             (f"gen{index}", random_bt(seed=2400 + index, depth=3, breadth=3, extended=True))
         )
-    proven = 0
+    proven = {"corpus": 0, "generated": 0}
     for label, doc in docs:
         try:
             result = bt_to_hfsm(doc, max_states=4000)
@@ -115,8 +115,10 @@ def test_corpus_and_generated_trees_within_the_bound_and_proven() -> None:
         assert elements(result.model) <= 4 * nodes(doc) + 10, label
         report = check(doc, result.model)
         assert report.equivalent, (label, report.to_dict())
-        proven += 1
-    assert proven >= 35
+        proven["generated" if label.startswith("gen") else "corpus"] += 1
+    # without the corpus beside the checkout (a bare clone) only the generated part counts
+    assert proven["generated"] >= 25, proven
+    assert not folder.exists() or proven["corpus"] >= 15, proven
 
 
 def test_plain_trees_are_the_papers_hfsm_unchanged() -> None:
