@@ -54,6 +54,7 @@ from fsmbt.semantics.leaf_machine import LeafMachine, StateLimitError, explore  
 from fsmbt.verify.compositional import compositional_report  # noqa: E402
 from fsmbt.verify.native import check  # noqa: E402
 from fsmbt.verify.pairing import machines_for  # noqa: E402
+from fsmbt.verify.pernode import NODE_ATTR  # noqa: E402
 
 FAMILIES: dict[str, dict[str, tuple[str, ...]]] = {
     "plain": {"Sequence": ("Sequence",), "Fallback": ("Fallback",)},
@@ -314,6 +315,24 @@ def _convert_table(args: argparse.Namespace) -> int:
     return 0
 
 
+def _never_ticked(doc: BTDocument, path: str) -> bool:
+    """Whether the node at ``path`` (a per-node tag: the path in its region after the
+    same-type merge) is one the tree never ticks in every region that has such a path."""
+    from fsmbt.convert.compress import inline_and_compress
+    from fsmbt.semantics.bt_interpreter import CompiledTree
+    from fsmbt.verify.compositional import tree_regions
+    from fsmbt.verify.tickable import never_ticked
+
+    verdicts = []
+    for root in tree_regions(doc):
+        merged = inline_and_compress(BTDocument.single(root)).compression.root
+        tree = CompiledTree(BTDocument.single(merged))
+        ids = [n.id for n in tree.nodes if n.path == path]
+        if ids:
+            verdicts.append(ids[0] in never_ticked(tree))
+    return bool(verdicts) and all(verdicts)
+
+
 def _pernode_table(args: argparse.Namespace) -> int:
     """One row per tree: nodes, conversion seconds, result states (every state at any level),
     per-node regions, nodes checked, distinct local checks and their product states, proof
@@ -372,13 +391,21 @@ def _pernode_table(args: argparse.Namespace) -> int:
     )
     changed = next(t for t in region.transitions if COND in t.attrs)
     del changed.attrs[COND]
+    changed_path = region.states[changed.source].attrs.get(NODE_ATTR, "")
     started = time.perf_counter()
     proved, why = compositional_report(doc, mutant)
     seconds = time.perf_counter() - started
     if proved is None:
         said = "not proven: " + why[:110]
     elif proved.equivalent:
-        said = "PROVED (wrong)"
+        # a mutant is not always different: a change inside a node the tree never ticks is
+        # none (docs/semantics.md §4d, "Dead nodes"); said so only when the tree says it
+        said = (
+            f"proved EQUIVALENT: the changed transition is in node {changed_path!r}, which the "
+            f"tree never ticks ({proved.stats.get('per_node_unticked', 0)} such nodes skipped)"
+            if _never_ticked(doc, changed_path)
+            else "PROVED (wrong)"
+        )
     else:
         said = f"NOT EQUIVALENT ({proved.method}: {proved.stats.get('per_node_failed')})"
     print(

@@ -850,6 +850,7 @@ def _per_node(
     outcome.stats["per_node_local_states"] = (
         outcome.stats.get("per_node_local_states", 0) + found.local_states
     )
+    outcome.stats["per_node_unticked"] = outcome.stats.get("per_node_unticked", 0) + found.unticked
     return found
 
 
@@ -1092,7 +1093,13 @@ def compositional_report(
         detail += (
             f"; {found.stats['per_node_regions']} of them node by node "
             f"({found.stats['per_node_nodes']} nodes, {found.stats['per_node_distinct']} "
-            "distinct local checks)"
+            "distinct local checks"
+            + (
+                f", {found.stats['per_node_unticked']} nodes the tree never ticks skipped"
+                if found.stats.get("per_node_unticked")
+                else ""
+            )
+            + ")"
         )
         for name in PROPERTIES:
             report.properties[name] = PropertyResult(name, True, detail)

@@ -59,13 +59,12 @@ from typing import Any
 from fsmbt.model.bt_nodes import NodeKind
 from fsmbt.model.errors import FsmbtError
 from fsmbt.semantics.bt_interpreter import (
-    BTInterpreter,
     BTLivelock,
     CompiledNode,
     CompiledTree,
-    LeafRequest,
 )
-from fsmbt.semantics.compiled import FAILURE, RUNNING, SUCCESS, Work
+from fsmbt.semantics.compiled import FAILURE, RUNNING, SUCCESS
+from fsmbt.verify.abstract_node import AbstractRun, Edge, State
 from fsmbt.verify.approach import StageBounds, stages
 from fsmbt.verify.coupling import CoupledBound
 from fsmbt.verify.pernode import (
@@ -73,7 +72,6 @@ from fsmbt.verify.pernode import (
     STATUS_OF,
     CompleteWalk,
     FailedUnit,
-    abstract_tree,
     local_machines,
 )
 
@@ -82,40 +80,6 @@ ABSTRACT_LIMIT = 5_000
 ALL = (SUCCESS, FAILURE, RUNNING)
 
 Costs = dict[int, int]  # status -> least leaves one tick returning it consumes
-State = tuple[Any, int | None]  # (interpreter snapshot, child position or None between ticks)
-Edge = tuple[Any, int, State, tuple[str, Any]]  # (input: "tick", "halt" or a child's status,
-# cost, next state, event)
-
-
-class _Abstract:
-    """A node over abstract children run by fsmbt's interpreter, one tick at a time
-    (``exactly_once``: a RUNNING is returned to the parent), ``halt`` between ticks."""
-
-    def __init__(self, node: CompiledNode, kids: list[Costs]) -> None:
-        self.interp = BTInterpreter(
-            abstract_tree(node, [RUNNING in k for k in kids]), exactly_once=True
-        )
-        self.index = {n.id: int(n.label[1:-1]) for n in self.interp.tree.nodes if n.is_env_leaf}
-        self.kids = kids
-
-    def _run(self, snap: Any, outcome: int | None) -> tuple[State, tuple[str, Any]]:
-        snap, event = self.interp.advance(snap, outcome)
-        if isinstance(event, LeafRequest):
-            i = self.index[event.node.id]
-            return (snap, i), ("tick", i)
-        return ((snap[0], snap[1], snap[2], False), None), ("exit", event.status)
-
-    def edges(self, state: State) -> list[Edge]:
-        snap, position = state
-        if position is None:
-            tick = self._run(self.interp.begin_tick(snap), None)
-            w = Work(snap)
-            self.interp.reset_child(w, 0, None)
-            return [("tick", 0, *tick), ("halt", 0, (w.snapshot(), None), ("none", None))]
-        return [
-            (status, cost, *self._run(snap, status))
-            for status, cost in sorted(self.kids[position].items())
-        ]
 
 
 @dataclass(frozen=True)
@@ -151,8 +115,8 @@ def _explore(node: CompiledNode, kids: list[NodeCosts]) -> _Shape:
     free = {s: 0 for s in ALL}
     zero = _Shape(NodeCosts(free, free), {i: 0 for i in range(len(kids))})
     try:
-        machine = _Abstract(node, [k.any for k in kids])
-        start: State = (machine.interp.initial(), None)
+        machine = AbstractRun(node, [k.any for k in kids])
+        start: State = machine.start()
         graph: dict[State, list[Edge]] = {}
         todo = [start]
         while todo:

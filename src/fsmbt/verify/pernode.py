@@ -82,8 +82,10 @@ from fsmbt.semantics.bt_interpreter import (
     LeafRequest,
 )
 from fsmbt.semantics.compiled import FAILURE, RUNNING, SUCCESS, Work
+from fsmbt.verify.abstract_node import abstract_tree
 from fsmbt.verify.subset_expr import ForeignName, OutsideSubset, compile_subset
 from fsmbt.verify.table_witness import Rows, Side, witness_from_rows
+from fsmbt.verify.tickable import never_ticked
 
 #: The tag the per-node conversion writes (``convert.bt_pernode.NODE_ATTR``; the SCXML
 #: writer's fsmbt namespace in Clark notation).
@@ -113,7 +115,8 @@ class PerNodeOutcome:
         equivalent: every local check held and the root's interface is the finals'.
         results: the results the region may return (``SUCCESS``/``FAILURE``).
         nodes: nodes checked; ``distinct``: local problems actually explored (the rest
-            memoized); ``local_states``: their product states summed.
+            memoized); ``local_states``: their product states summed; ``unticked``: nodes the
+            machine enters but the tree never ticks, skipped (docs/semantics.md §4d).
         failed: the node whose local check failed (its path and type), else ``None``.
     """
 
@@ -122,6 +125,8 @@ class PerNodeOutcome:
     nodes: int = 0
     distinct: int = 0
     local_states: int = 0
+    #: live nodes of the machine the tree never ticks (``tickable.never_ticked``): not checked
+    unticked: int = 0
     failed: str | None = None
     stats: dict[str, Any] = field(default_factory=dict)
     #: the failing node's id in ``tree`` (the region after the same-type merge), and the local
@@ -500,29 +505,6 @@ def _local(region: _Region, node: CompiledNode, interfaces: dict[int, Interface]
 
 
 # -- the local product ---------------------------------------------------------------------------
-def abstract_tree(
-    node: CompiledNode, kids_running: list[bool], names: list[str] | None = None
-) -> BTDocument:
-    """The tree side's shape of a local problem (module docstring): N (its type, ports and
-    semantics) over abstract leaves, child i an action when it may return RUNNING (else a
-    condition), named ``names[i]`` (default ``⟪i⟫``). Only a shape: fsmbt's interpreter runs it
-    here, NuSMV's own tick rules in ``nusmv.encode_local``."""
-    source = node.source
-    labels = names if names is not None else [f"⟪{i}⟫" for i in range(len(kids_running))]
-    leaves = [
-        BTNode(label, NodeKind.ACTION if running else NodeKind.CONDITION, name=label)
-        for label, running in zip(labels, kids_running, strict=True)
-    ]
-    copy = BTNode(
-        source.type,
-        source.kind,
-        attrs=dict(source.attrs),
-        children=leaves,
-        semantics=source.semantics,
-    )
-    return BTDocument.single(copy)
-
-
 class _FsmSide:
     """The fragment as a machine: configuration = (position, own values, children that
     returned RUNNING last); position ``None`` between ticks, ``i`` at child i."""
@@ -656,6 +638,8 @@ def _check_local(
             inputs: list[Any] = ["tick", "halt"] if with_halt else ["tick"]
         else:
             inputs = allowed[position]
+            if not inputs:  # a dead child ticked on both sides: not what was proven dead
+                raise NotPerNode(f"{node.label} ticks child {position}, proven never ticked")
         if rows is not None:  # each side state's row once, from the first pair holding it
             bt_row = None if current[0] in rows[0] else rows[0].setdefault(current[0], {})
             fsm_row = None if current[1] in rows[1] else rows[1].setdefault(current[1], {})
@@ -909,11 +893,16 @@ class NodeWalk:
         self.region = _Region(self.tree, machine, declared, tolerate)
         self.interfaces: dict[int, Interface] = {}
         self.haltable: set[int] = set()
+        #: the nodes no run of the tree ticks (``tickable.never_ticked``: from the tree alone)
+        self.unticked = never_ticked(self.tree)
 
     def problems(self) -> Iterator[LocalProblem]:
         region, interfaces = self.region, self.interfaces
         for node in reversed(self.tree.nodes):
-            if node.id not in region.entry:  # dead: never ticked by the machine
+            # dead: never ticked by the machine (no entry) or by the tree (docs/semantics.md
+            # §4d, "Dead nodes": its parent's check, which holds or fails on its own, then
+            # proves the machine never enters it either)
+            if node.id not in region.entry or node.id in self.unticked:
                 interfaces[node.id] = {}
                 self.haltable.add(node.id)
                 continue
@@ -1021,6 +1010,7 @@ def check_region(
     """
     walk = NodeWalk(region_root, machine, declared, tolerate)
     outcome = PerNodeOutcome(equivalent=True, nodes=len(walk.tree.nodes))
+    outcome.unticked = sum(1 for n in walk.unticked if n in walk.region.entry)
     failures = _failures(walk, outcome, keep, units)
     first = next(failures, None)
     if first is not None:

@@ -43,6 +43,7 @@ from typing import Any
 from fsmbt.model.bt import BTDocument
 from fsmbt.model.errors import UnsupportedError
 from fsmbt.semantics.compiled import FAILURE, RUNNING, SUCCESS
+from fsmbt.verify.abstract_node import abstract_tree as pernode_shape
 from fsmbt.verify.nusmv.encode_bt import BTCore
 from fsmbt.verify.nusmv.families.common import ST
 from fsmbt.verify.nusmv.smv import Symbols, all_of, any_of, case, enum_type
@@ -54,7 +55,6 @@ from fsmbt.verify.pernode import (
     NotPerNode,
     exit_token,
 )
-from fsmbt.verify.pernode import abstract_tree as pernode_shape
 
 #: Most configurations of one fragment's explicit table before the unit is refused: NuSMV
 #: builds one BDD row per table step, and a 2 554-configuration table (a mutant's counter
