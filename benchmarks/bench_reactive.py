@@ -401,8 +401,12 @@ def _pernode_table(args: argparse.Namespace) -> int:
         # a mutant is not always different: a change inside a node the tree never ticks is
         # none (docs/semantics.md §4d, "Dead nodes"); said so only when the tree says it
         said = (
-            f"proved EQUIVALENT: the changed transition is in node {changed_path!r}, which the "
-            f"tree never ticks ({proved.stats.get('per_node_unticked', 0)} such nodes skipped)"
+            "proved EQUIVALENT: the changed region is never ticked ("
+            + "; ".join(proved.stats["never_ticked_by"])
+            + ")"
+            if proved.stats.get("never_ticked_by")
+            else f"proved EQUIVALENT: the changed transition is in node {changed_path!r}, which "
+            f"the tree never ticks ({proved.stats.get('per_node_unticked', 0)} such nodes skipped)"
             if _never_ticked(doc, changed_path)
             else "PROVED (wrong)"
         )

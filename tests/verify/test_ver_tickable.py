@@ -6,7 +6,9 @@ Two claims, each against something the analysis does not use:
 - *what it buys*: a one-transition mutant of the per-node machine inside a dead node's
   fragment is proven equivalent per node exactly when the whole product proves it, and a
   mutant that lets the parent enter a dead child is never proven (the whole product refutes
-  it). Counts are printed (``pytest -s``).
+  it); a failing region that an earlier region never lets through (``NeverReturns``: the
+  subtree run alone, exhaustively) is set aside only where the whole product proves the
+  pair. Counts are printed (``pytest -s``).
 """
 
 from __future__ import annotations
@@ -17,17 +19,22 @@ import sys
 from collections import Counter
 from pathlib import Path
 
+import pytest
+
 from fsmbt import limits
 from fsmbt.convert.bt_to_hfsm import bt_to_hfsm
 from fsmbt.convert.compress import inline_and_compress
-from fsmbt.model.bt import BTDocument
+from fsmbt.model.bt import BTDocument, BTNode
+from fsmbt.model.bt_nodes import NodeKind
 from fsmbt.model.errors import FsmbtError
+from fsmbt.model.fsm import FSM
 from fsmbt.semantics.bt_interpreter import BTInterpreter, CompiledTree, LeafRequest
 from fsmbt.semantics.compiled import FAILURE, RUNNING, SUCCESS
+from fsmbt.verify import compositional
 from fsmbt.verify.compositional import compositional_report, tree_regions
 from fsmbt.verify.pernode import NODE_ATTR
 from fsmbt.verify.report import PER_NODE
-from fsmbt.verify.tickable import never_ticked
+from fsmbt.verify.tickable import NeverReturns, never_ticked, stage_never_passes
 from support.pernode_mutants import BOUND, pernode_machine, whole
 from support.pernode_trees import pernode_tree
 
@@ -89,6 +96,8 @@ def sample(count: int, seed: int) -> list[BTDocument]:
 
 
 def test_no_dead_node_is_ever_ticked_by_the_interpreter() -> None:
+    """Both proofs: the set abstraction (``never_ticked``) and a stage that never goes on
+    (``stage_never_passes``, the subtree run alone)."""
     tally: Counter[str] = Counter()
     for doc in sample(160, seed=31):
         tree = merged(doc)
@@ -98,6 +107,11 @@ def test_no_dead_node_is_ever_ticked_by_the_interpreter() -> None:
             continue
         dead = never_ticked(tree)
         assert not dead & ticked, [tree.nodes[d].path for d in dead & ticked]
+        searches = NeverReturns(tree)
+        for node in tree.nodes:
+            if stage_never_passes(tree, node.id, searches) is not None:
+                assert node.id not in ticked, node.path
+                tally["never ticked by a stage"] += 1
         tally["trees"] += 1
         tally["nodes"] += len(tree.nodes)
         tally["dead"] += len(dead)
@@ -105,6 +119,7 @@ def test_no_dead_node_is_ever_ticked_by_the_interpreter() -> None:
     print(f"\n[tickable] {dict(tally)}")
     assert tally["trees"] >= 120
     assert tally["dead"] >= 60  # the sample has dead code to find
+    assert tally["never ticked by a stage"] >= 60
     # what the over-approximation misses (concretely dead, called live) stays small
     assert tally["dead"] >= 0.8 * tally["never ticked"], dict(tally)
 
@@ -177,3 +192,139 @@ def test_mutants_inside_dead_fragments_are_proven_and_entering_one_is_not() -> N
     print(f"\n[dead fragments] {dict(tally)}")
     assert tally["inside: whole True, per node proved"] >= 20
     assert sum(v for k, v in tally.items() if k.startswith("into: whole False")) >= 10
+
+
+def _pernode_machines(model: FSM) -> list[FSM]:
+    """Every sub-machine the converter wrote per node, in the model's walk order."""
+    return [
+        state.regions[0]
+        for _path, _machine, state in model.walk()
+        if state.regions and state.regions[0].name.startswith("pernode_")
+    ]
+
+
+def _writes(machine: FSM, region: BTNode) -> bool:
+    """Whether ``machine`` is the per-node machine of ``region``: each state of a control node
+    is named after the type of the node its tag names (``Type.role#n``)."""
+    types = {n.path: n.type for n in merged(BTDocument.single(region)).nodes}
+    controls = [
+        (state.attrs.get(NODE_ATTR), name.split(".")[0])
+        for name, state in machine.states.items()
+        if "." in name and state.attrs.get(NODE_ATTR) is not None
+    ]
+    return bool(controls) and all(types.get(path) == kind for path, kind in controls)
+
+
+def _node(kind: str, *children: BTNode, **attrs: str) -> BTNode:
+    if not children:
+        leaf = NodeKind.CONDITION if kind == "Check" else NodeKind.ACTION
+        return BTNode(kind, leaf)
+    family = NodeKind.DECORATOR if len(children) == 1 and kind != "Sequence" else NodeKind.CONTROL
+    return BTNode(kind, family, attrs=dict(attrs), children=list(children))
+
+
+def never_failing_in_one_tick() -> BTNode:
+    """A ``ReactiveFallback`` whose two children can each fail, but never in the same tick
+    (met in the 11 727-node ``decorated`` tree of ``bench_reactive.py``): the set abstraction
+    of ``never_ticked`` says it may fail, the subtree run alone says it never does."""
+    one = {"success_count": "1", "failure_count": "1"}
+    two = {"num_attempts": "2"}
+    do, check = _node("Do"), _node("Check")
+    return _node(
+        "ReactiveFallback",
+        _node(
+            "Parallel",
+            _node("Fallback", _node("Do"), _node("Do"), _node("Do")),
+            _node(
+                "SequenceWithMemory",
+                _node("Check"),
+                _node("ForceSuccess", _node("Do")),
+                _node("Check"),
+                _node("Do"),
+            ),
+            _node("Parallel", _node("Check"), check, **one),
+            **one,
+        ),
+        _node(
+            "ReactiveFallback",
+            _node(
+                "ReactiveFallback",
+                _node("RetryUntilSuccessful", _node("Do"), **two),
+                _node("RetryUntilSuccessful", _node("Do"), **two),
+                _node("Do"),
+            ),
+            _node("ReactiveSequence", _node("Do"), _node("Do"), _node("Do"), _node("Check")),
+            _node(
+                "SequenceWithMemory",
+                _node("Do"),
+                _node("ForceFailure", _node("Do")),
+                _node("Do"),
+                _node("Check"),
+            ),
+            _node("Fallback", do, _node("Do")),
+        ),
+    )
+
+
+def _two_regions(seed: int) -> BTDocument:
+    """A plain ``Fallback`` or ``Sequence`` over two regions: the first decides whether the
+    second is ever ticked - ``never_failing_in_one_tick`` under a Fallback half the time
+    (the second region then never ticked, though the converter writes it), else a random
+    ``mixed`` region - the second a random region with memory."""
+    rng = random.Random(seed)
+    second = family_tree(rng.choice(("memory", "mixed")), rng.randint(3, 5), seed + 1).main.root
+    if rng.random() < 0.5:
+        first, kind = never_failing_in_one_tick(), "Fallback"
+    else:
+        first = family_tree("mixed", rng.randint(3, 6), seed).main.root
+        kind = rng.choice(("Sequence", "Fallback"))
+    return BTDocument.single(BTNode(kind, NodeKind.CONTROL, children=[first, second]))
+
+
+def test_a_region_never_ticked_is_set_aside_only_when_the_whole_product_agrees(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Mutants of the *second* region's per-node machine (found by its node types): the
+    compositional check sets the region aside (``regions_never_ticked``) only when the whole
+    product proves the pair, and a mutant of a region that is ticked is never proven. The
+    lift is switched off, so that every failing region - real differences included - reaches
+    the never-ticked rule (with it, a real difference is refuted before the rule is asked)."""
+    monkeypatch.setattr(compositional, "_lifted", lambda *_args: None)
+    rng = random.Random(11)
+    tally: Counter[str] = Counter()
+    for index in range(400):
+        doc = _two_regions(4100 + 7 * index)
+        try:
+            with limits.changed(conversion_max_states=BOUND):
+                model = bt_to_hfsm(doc, pernode=True, max_states=BOUND).model
+        except FsmbtError:
+            continue
+        machines = _pernode_machines(model)
+        if len(machines) < 2:
+            continue
+        mutant = copy.deepcopy(model)
+        subs = [m for m in _pernode_machines(mutant) if _writes(m, doc.main.root.children[1])]
+        if len(subs) != 1:
+            continue
+        sub = subs[0]
+        t = rng.choice(sub.transitions)
+        tag = sub.states[t.source].attrs.get(NODE_ATTR)
+        same = [n for n, st in sub.states.items() if st.attrs.get(NODE_ATTR) == tag]
+        if len(same) < 2:
+            continue
+        t.target = rng.choice([n for n in same if n != t.target])
+        verdict = whole(doc, mutant)
+        if verdict is None:
+            continue
+        with limits.changed(conversion_max_states=BOUND):
+            report, _why = compositional_report(doc, mutant, max_states=BOUND)
+        aside = report is not None and bool(report.stats.get("regions_never_ticked"))
+        proved = report is not None and report.equivalent
+        tally[f"whole {verdict}, {'set aside' if aside else 'proved' if proved else 'not'}"] += 1
+        if proved:
+            assert verdict is True, (index, report.stats.get("never_ticked_by"))
+        if aside:
+            assert any("never returns" in p for p in report.stats["never_ticked_by"])
+    print(f"\n[regions never ticked] {dict(tally)}")
+    assert tally["whole True, set aside"] >= 10
+    assert sum(v for k, v in tally.items() if k.startswith("whole False")) >= 8

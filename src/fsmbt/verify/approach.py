@@ -147,6 +147,9 @@ class Standalone:
         self.offset = nid
         self.last = nid + len(self.interp.nodes) - 1
         self.last_settled = 0  # states the last search settled
+        #: whether the last search that found no pass settled every reachable state (a proof
+        #: that none is reachable: neither a limit nor a refused construct stopped it)
+        self.last_exhausted = False
         self._canonical: tuple[Canonicalizer, ...] | None = None
         if last_descendant(tree, nid) != self.last or any(
             a.type != b.type or len(a.children) != len(b.children)
@@ -231,6 +234,7 @@ class Standalone:
         ``moves`` (the plan's snapshots are then canonical too)."""
         counter = itertools.count()
         self.last_settled = 0
+        self.last_exhausted = False
         heap: list[tuple[int, int, Any, Any]] = [(0, next(counter), start, None)]
         settled: set[Snapshot] = set()
         cost = 0
@@ -254,6 +258,7 @@ class Standalone:
                         heapq.heappush(heap, (cost + extra, next(counter), after, step))
         except (FsmbtError, ValueError, BTLivelock):
             return cost, None  # a construct the standalone run refuses: what was settled
+        self.last_exhausted = True
         return cost, None
 
 

@@ -72,7 +72,7 @@ from fsmbt.semantics.nodes import (
     SUBTREE_TYPE,
     canonical_type,
 )
-from fsmbt.semantics.status import LeafOutcome, RootResult
+from fsmbt.semantics.status import LeafOutcome, NodeStatus, RootResult
 from fsmbt.verify.lift import lifted_region_report, lifted_report, whole_tree
 from fsmbt.verify.lower_bound import LowerBound, lower_bound
 from fsmbt.verify.method import PER_NODE_SENTENCE
@@ -87,6 +87,7 @@ from fsmbt.verify.pernode import (
     complete_walk,
 )
 from fsmbt.verify.report import COMPOSITIONAL, PER_NODE, PROPERTIES, PropertyResult, Report
+from fsmbt.verify.tickable import NeverReturns, stage_never_passes
 
 SUCCESS, FAILURE = RootResult.SUCCESS.value, RootResult.FAILURE.value
 EV_SUCCESS, EV_FAILURE = LeafOutcome.SUCCESS.value, LeafOutcome.FAILURE.value
@@ -153,6 +154,8 @@ class Decomposition:
     #: the lifted report of a per-node failure found past a broken entry condition
     #: (``pernode.check_region``'s ``tolerate``), already confirmed by replay
     lifted: Report | None = None
+    #: the index (in ``Structure.regions``) of the tree region whose check failed
+    failed_index: int | None = None
 
 
 # -- the tree side ---------------------------------------------------------------------------
@@ -660,10 +663,16 @@ def decompose(
     min_regions: int = 1,
     max_seconds: float | None = None,
     plan: CheckPlan | None = None,
+    unticked: frozenset[int] = frozenset(),
 ) -> Decomposition:
     """Run the three parts of the compositional check (module docstring); with ``keep``, each
     part's witness is appended to it (for a certificate: the parts' tables stay alive); with
     ``plan``, what each part checked is recorded (``CheckPlan``; no extra check).
+
+    ``unticked``: tree regions (indices of ``Structure.regions``) proven never ticked in the
+    whole tree (``tickable.stage_never_passes``): not checked, each standing in the skeleton
+    for an action that may return any result its region state has (docs/semantics.md §4c,
+    "Regions never ticked").
 
     The give-way (the attempt costs little when it cannot win): with fewer than
     ``min_regions`` paired regions no part is checked (one region *is* the whole product,
@@ -701,10 +710,17 @@ def decompose(
         k = tree_of_state.get(j)
         if k is None:
             continue
+        name = f"{regions[k].label} (state {region.path})"
+        if k in unticked:
+            possible = frozenset(region.exits) & both
+            if not possible:
+                raise NotDecomposable(f"region {regions[k].label} has no completion")
+            results[k] = possible
+            outcome.stats.setdefault("regions_never_ticked", []).append(name)
+            continue
         local: list[LocalWitness] | None = [] if keep is not None else None
         units: list[LocalUnit] | None = [] if plan is not None else None
         per_node = _per_node(regions[k], region.machine, shape.declared, outcome, local, units)
-        name = f"{regions[k].label} (state {region.path})"
         candidate: PerNodeOutcome | None = None
         if per_node is not None and per_node.tolerated is not None:
             # a failure past a broken entry condition (``check_region``'s ``tolerate``) is
@@ -731,6 +747,7 @@ def decompose(
                     f"{regions[k].label} (state {region.path}), node {per_node.failed}"
                 )
                 outcome.per_node_failure = (regions[k], per_node)
+                outcome.failed_index = k
                 return outcome
             possible = per_node.results
             if not results_allowed(possible, shape, j):
@@ -776,6 +793,7 @@ def decompose(
             # result run by verify/lazy_fsm.py, tested step for step against the flattened
             # machine on regions written whole and per node and their mutants)
             outcome.region_failure = (regions[k], report)
+            outcome.failed_index = k
             return outcome
         possible = _results(witness)
         if not results_allowed(possible, shape, j):
@@ -1038,6 +1056,46 @@ def _add(total: dict[str, Any], part: dict[str, Any]) -> None:
         total[key] = total.get(key, 0) + part.get(key, 0)
 
 
+#: What a verdict says when a region was set aside as never ticked.
+NEVER_TICKED_SENTENCE = (
+    "regions never ticked: a region whose check failed is set aside when an earlier sibling "
+    "of one of its ancestors, run alone under any ticks and halts, never returns what its "
+    "parent goes on with (docs/semantics.md §4c, 'Regions never ticked'); the skeleton check "
+    "then proves the machine never enters its state either"
+)
+#: Most failing regions one compositional check sets aside as never ticked (each costs one
+#: more pass of ``decompose``).
+MAX_UNTICKED = 8
+
+
+class _NeverTicked:
+    """Proofs that a failing region is never ticked in the whole tree
+    (``tickable.stage_never_passes``), the searches shared between regions."""
+
+    def __init__(self, source: BTDocument) -> None:
+        self.tree = CompiledTree(source)
+        self.searches = NeverReturns(self.tree)
+        #: per region set aside: its label and the stage that never goes on (its path)
+        self.proofs: list[str] = []
+
+    def region(self, found: Decomposition) -> bool:
+        failure = found.per_node_failure or found.region_failure
+        if failure is None:
+            return False
+        ids = [n.id for n in self.tree.nodes if n.source is failure[0]]
+        if len(ids) != 1:
+            return False
+        proof = stage_never_passes(self.tree, ids[0], self.searches)
+        if proof is None:
+            return False
+        stage = self.tree.nodes[proof[0]]
+        self.proofs.append(
+            f"{failure[0].label}: its earlier {stage.type} at {stage.path or 'the root'} "
+            f"never returns {' or '.join(sorted(NodeStatus(s).name for s in proof[1]))}"
+        )
+        return True
+
+
 def compositional_report(
     source: BTDocument,
     result: FSM,
@@ -1054,27 +1112,41 @@ def compositional_report(
     certificate); ``min_regions`` and ``max_seconds``: the give-way of ``decompose``.
     Cost: see the module docstring."""
     started = time.perf_counter()
-    try:
-        found = decompose(
-            source,
-            result,
-            max_states=max_states,
-            keep=keep,
-            min_regions=min_regions,
-            max_seconds=max_seconds,
-            plan=plan,
-        )
-    except NotDecomposable as exc:
-        return None, str(exc)
-    except FsmbtError as exc:
-        # a part the machines refuse (a limit, a construct): the whole product decides and
-        # gives the error or verdict it gave before
-        return None, f"a part cannot be checked ({type(exc).__name__})"
-    if not found.equivalent:
+    unticked: set[int] = set()
+    never: _NeverTicked | None = None
+    while True:
+        try:
+            found = decompose(
+                source,
+                result,
+                max_states=max_states,
+                keep=keep,
+                min_regions=min_regions,
+                max_seconds=max_seconds,
+                plan=plan,
+                unticked=frozenset(unticked),
+            )
+        except NotDecomposable as exc:
+            return None, str(exc)
+        except FsmbtError as exc:
+            # a part the machines refuse (a limit, a construct): the whole product decides and
+            # gives the error or verdict it gave before
+            return None, f"a part cannot be checked ({type(exc).__name__})"
+        if found.equivalent:
+            break
         if found.per_node_failure is not None or found.region_failure is not None:
             lifted = _lifted(source, result, found)
             if lifted is not None:
                 return lifted, ""
+        # no run found to the failure: a region the whole tree never ticks is no difference
+        # (docs/semantics.md §4c, "Regions never ticked"); not for a certificate or a plan,
+        # which list what was checked
+        k = found.failed_index
+        if keep is None and plan is None and k is not None and k not in unticked:
+            never = never or _NeverTicked(source)
+            if len(unticked) < MAX_UNTICKED and never.region(found):
+                unticked.add(k)
+                continue
         return None, f"{FAILED_PART} {found.failed_region} fails"
     seconds = time.perf_counter() - started
     report = Report(engine="native", source="source", result="result", mode=LEAF_EXECUTION)
@@ -1103,7 +1175,14 @@ def compositional_report(
         )
         for name in PROPERTIES:
             report.properties[name] = PropertyResult(name, True, detail)
+    if never is not None and found.stats.get("regions_never_ticked"):
+        report.stats["never_ticked_by"] = never.proofs
+        detail += "; not checked, never ticked by the tree: " + "; ".join(never.proofs)
+        report.abstractions.append(NEVER_TICKED_SENTENCE)
+        for name in PROPERTIES:
+            report.properties[name] = PropertyResult(name, True, detail)
     report.stats = {
+        **report.stats,
         **found.stats,
         "regions": found.regions,
         "region_product_states": found.region_states,
