@@ -296,7 +296,9 @@ class StageBounds:
             if alone is None:
                 self._distance[nid] = 0
             else:
-                found = alone.search(alone.interp.initial(), passing, True)
+                # over canonical snapshots (docs/semantics.md §4a: the same costs, fewer
+                # states, so the same limit reaches deeper)
+                found = alone.search(alone.start(canonical=True), passing, True, canonical=True)
                 self._distance[nid] = found[0]
                 self.settled += alone.last_settled
         return self._distance[nid]
