@@ -31,11 +31,11 @@ from fsmbt.model.fsm import FSM
 from fsmbt.semantics.bt_interpreter import BTInterpreter, CompiledTree, LeafRequest
 from fsmbt.semantics.compiled import FAILURE, RUNNING, SUCCESS
 from fsmbt.verify import compositional
-from fsmbt.verify.compositional import compositional_report, tree_regions
-from fsmbt.verify.pernode import NODE_ATTR
+from fsmbt.verify.compositional import compositional_report, structure, tree_regions
+from fsmbt.verify.pernode import NODE_ATTR, NotPerNode, complete_walk
 from fsmbt.verify.report import PER_NODE
 from fsmbt.verify.tickable import NeverReturns, never_ticked, stage_never_passes
-from support.pernode_mutants import BOUND, pernode_machine, whole
+from support.pernode_mutants import BOUND, pernode_machine, seeded_mutants, whole
 from support.pernode_trees import pernode_tree
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))
@@ -328,3 +328,32 @@ def test_a_region_never_ticked_is_set_aside_only_when_the_whole_product_agrees(
     print(f"\n[regions never ticked] {dict(tally)}")
     assert tally["whole True, set aside"] >= 10
     assert sum(v for k, v in tally.items() if k.startswith("whole False")) >= 8
+
+
+def test_the_complete_walk_never_takes_a_failing_child_for_a_dead_one() -> None:
+    """A failing node settled with an empty interface (its check failed before any status
+    paired) is ticked by its parent's tree side like any live child; only the children the
+    tree never ticks refuse when ticked. (Mistaking one for the other made the complete walk
+    refuse, and the lower bound vanish, on the 15 560-node mutant of ``bench_reactive.py``.)"""
+    tally: Counter[str] = Counter()
+    for doc, _model, mutants in seeded_mutants(160, seed=4, rng_seed=27):
+        for mutant in mutants:
+            try:
+                shape = structure(doc, mutant)
+            except FsmbtError:
+                continue
+            for k, region in enumerate(shape.machine_regions):
+                if not region.machine.name.startswith("pernode_") or k >= len(shape.regions):
+                    continue
+                try:
+                    walk = complete_walk(shape.regions[k], region.machine, shape.declared)
+                except NotPerNode as exc:
+                    assert "proven never ticked" not in str(exc)
+                    tally["refused"] += 1
+                    continue
+                tally["walked"] += 1
+                empty = [f for f in walk.failed if not f.sigma]
+                tally["failing with an empty interface"] += len(empty)
+    print(f"\n[complete walk] {dict(tally)}")
+    assert tally["walked"] >= 50
+    assert tally["failing with an empty interface"] >= 5

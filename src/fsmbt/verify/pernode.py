@@ -586,6 +586,7 @@ def _check_local(
     haltable: frozenset[int],
     with_halt: bool,
     rows: tuple[Rows, Rows] | None = None,
+    dead: frozenset[int] = frozenset(),
 ) -> tuple[bool, dict[int, Any], int, list[tuple[int | None, Any]], list[Any]]:
     """The lockstep product of the two sides (module docstring). ``haltable``: the children
     whose own check held with ``halt`` offered (any halt of another child fails this one);
@@ -638,7 +639,7 @@ def _check_local(
             inputs: list[Any] = ["tick", "halt"] if with_halt else ["tick"]
         else:
             inputs = allowed[position]
-            if not inputs:  # a dead child ticked on both sides: not what was proven dead
+            if position in dead:  # ticked on both sides: not what was proven
                 raise NotPerNode(f"{node.label} ticks child {position}, proven never ticked")
         if rows is not None:  # each side state's row once, from the first pair holding it
             bt_row = None if current[0] in rows[0] else rows[0].setdefault(current[0], {})
@@ -858,6 +859,8 @@ class LocalProblem:
     allowed: list[list[int]]
     halts: frozenset[int]
     key: tuple[Any, ...]
+    #: the children the tree never ticks (``NodeWalk.unticked``): ticking one refuses
+    dead: frozenset[int] = frozenset()
 
     @property
     def never(self) -> frozenset[int]:
@@ -918,8 +921,14 @@ class NodeWalk:
             local = _local(region, node, interfaces)
             allowed = [sorted(interfaces[c]) for c in node.children]
             halts = frozenset(i for i, c in enumerate(node.children) if c in self.haltable)
-            key = (local.key, tuple(tuple(a) for a in allowed), tuple(sorted(halts)))
-            yield LocalProblem(node, local, allowed, halts, key)
+            dead = frozenset(i for i, c in enumerate(node.children) if c in self.unticked)
+            key = (
+                local.key,
+                tuple(tuple(a) for a in allowed),
+                tuple(sorted(halts)),
+                tuple(sorted(dead)),
+            )
+            yield LocalProblem(node, local, allowed, halts, key, dead)
             if node.id not in interfaces:
                 raise NotPerNode(f"the local check of {node.label} was not settled")
 
@@ -1129,10 +1138,10 @@ def complete_walk(region_root: BTNode, machine: FSM, declared: dict[str, str]) -
         found = memo.get(problem.key)
         if found is None:
             args = (problem.local, problem.node, problem.allowed, problem.halts)
-            held, pairing, _states, _trace, _pairs = _check_local(*args, True)
+            held, pairing, _states, _trace, _pairs = _check_local(*args, True, dead=problem.dead)
             found = (held, pairing, True)
             if not held:
-                alone = _check_local(*args, False)
+                alone = _check_local(*args, False, dead=problem.dead)
                 if alone[0]:  # proven for a node nobody halts
                     found = (True, alone[1], False)
             memo[problem.key] = found
@@ -1154,7 +1163,7 @@ def _decide(
     for with_halt in (True, False):
         rows: tuple[Rows, Rows] | None = ({}, {}) if keeping else None
         equivalent, pairing, states, trace, pairs = _check_local(
-            local, node, problem.allowed, problem.halts, with_halt, rows
+            local, node, problem.allowed, problem.halts, with_halt, rows, problem.dead
         )
         if equivalent or not with_halt:
             break
