@@ -84,6 +84,16 @@ def ticked_nodes(tree: CompiledTree) -> set[int] | None:
     return ticked
 
 
+def pernode_model(doc: BTDocument) -> FSM | None:
+    """``doc`` converted with its regions written per node, within ``BOUND`` states (``None``:
+    the converter refuses it)."""
+    try:
+        with limits.changed(conversion_max_states=BOUND):
+            return bt_to_hfsm(doc, pernode=True, max_states=BOUND).model
+    except FsmbtError:
+        return None
+
+
 def sample(count: int, seed: int) -> list[BTDocument]:
     rng = random.Random(seed)
     docs = []
@@ -146,13 +156,9 @@ def test_mutants_inside_dead_fragments_are_proven_and_entering_one_is_not() -> N
         if not paths or not paths[0]:
             continue
         dead, parents = paths
-        try:
-            with limits.changed(conversion_max_states=BOUND):
-                model = bt_to_hfsm(doc, pernode=True, max_states=BOUND).model
-        except FsmbtError:
-            continue
-        sub = pernode_machine(model)
-        if sub is None:
+        model = pernode_model(doc)
+        sub = None if model is None else pernode_machine(model)
+        if model is None or sub is None:
             continue
         inside = [t for t in sub.transitions if sub.states[t.source].attrs.get(NODE_ATTR) in dead]
         entries = {
@@ -294,13 +300,8 @@ def test_a_region_never_ticked_is_set_aside_only_when_the_whole_product_agrees(
     tally: Counter[str] = Counter()
     for index in range(400):
         doc = _two_regions(4100 + 7 * index)
-        try:
-            with limits.changed(conversion_max_states=BOUND):
-                model = bt_to_hfsm(doc, pernode=True, max_states=BOUND).model
-        except FsmbtError:
-            continue
-        machines = _pernode_machines(model)
-        if len(machines) < 2:
+        model = pernode_model(doc)
+        if model is None or len(_pernode_machines(model)) < 2:
             continue
         mutant = copy.deepcopy(model)
         subs = [m for m in _pernode_machines(mutant) if _writes(m, doc.main.root.children[1])]
@@ -357,3 +358,32 @@ def test_the_complete_walk_never_takes_a_failing_child_for_a_dead_one() -> None:
     print(f"\n[complete walk] {dict(tally)}")
     assert tally["walked"] >= 50
     assert tally["failing with an empty interface"] >= 5
+
+
+def test_behaviortree_cpp_never_gets_past_the_never_failing_fallback() -> None:
+    """The real engine agrees on the example the rule is built for: BehaviorTree.CPP 4.8 runs
+    ``Fallback(never_failing_in_one_tick(), Sentinel)`` under 400 seeded scripts (12 ticks
+    each, ``tickExactlyOnce``) and never ticks ``Sentinel`` (nor does the root fail), while the
+    last leaf each child of the ``ReactiveFallback`` asks fails in hundreds of ticks (the
+    scripts do drive both towards failing)."""
+    from fsmbt.semantics.engines.btcpp_engine import BTCppRunner
+    from support.random_trees import OutcomeScript
+
+    sentinel = BTNode("Sentinel", NodeKind.ACTION, name="Sentinel")
+    root = BTNode("Fallback", NodeKind.CONTROL, children=[never_failing_in_one_tick(), sentinel])
+    doc = BTDocument.single(root)
+    tree = merged(doc)
+    assert stage_never_passes(tree, tree.nodes[0].children[1], NeverReturns(tree)) is not None
+    failed: Counter[str] = Counter()
+    for seed in range(400):
+        engine = BTCppRunner(doc, OutcomeScript(seed), exactly_once=True)
+        for _ in range(12):
+            record = engine.tick_once()
+            assert all(not path.startswith("1") for _label, path, _o in record.leaves), seed
+            assert record.result != "FAILURE", seed
+            last = {path.split("/")[1]: outcome for _label, path, outcome in record.leaves}
+            for child, outcome in last.items():
+                failed[f"last leaf under child {child}: {outcome}"] += 1
+    print(f"\n[BehaviorTree.CPP] {dict(failed)}")
+    assert failed["last leaf under child 0: failure"] > 100
+    assert failed["last leaf under child 1: failure"] > 100
