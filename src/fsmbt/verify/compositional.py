@@ -1079,13 +1079,18 @@ class _NeverTicked:
         self.proofs: list[str] = []
 
     def region(self, found: Decomposition) -> bool:
+        """Whether the region that failed in ``found`` is proven never ticked (its proof
+        recorded); ``False`` when not proven, or when the searches refuse the tree."""
         failure = found.per_node_failure or found.region_failure
         if failure is None:
             return False
         ids = [n.id for n in self.tree.nodes if n.source is failure[0]]
         if len(ids) != 1:
             return False
-        proof = stage_never_passes(self.tree, ids[0], self.searches)
+        try:
+            proof = stage_never_passes(self.tree, ids[0], self.searches)
+        except FsmbtError:
+            return False
         if proof is None:
             return False
         stage = self.tree.nodes[proof[0]]
@@ -1143,7 +1148,10 @@ def compositional_report(
         # which list what was checked
         k = found.failed_index
         if keep is None and plan is None and k is not None and k not in unticked:
-            never = never or _NeverTicked(source)
+            try:
+                never = never or _NeverTicked(source)
+            except FsmbtError:  # the whole tree does not compile: nothing is set aside
+                return None, f"{FAILED_PART} {found.failed_region} fails"
             if len(unticked) < MAX_UNTICKED and never.region(found):
                 unticked.add(k)
                 continue
