@@ -2,10 +2,11 @@
 every local argument about a tree node shares (docs/semantics.md §4d).
 
 Why a module of its own: the per-node check (``verify/pernode.py``), the lower bound on a
-counterexample (``verify/lower_bound.py``), the tickable-node analysis (``verify/tickable.py``)
-and NuSMV's local encoding (``verify/nusmv/encode_local.py``) all read a node ``N`` as ``N``
-itself (its type, ports and semantics) over abstract leaves ``⟪i⟫`` whose outcomes an
-environment chooses. Node behaviour is the interpreter's, never the converter's.
+counterexample (``verify/lower_bound.py``), the tickable-node analysis
+(``verify/tickable.py``), the lift's shortest realizations (``verify/lift.py``) and NuSMV's
+local encoding (``verify/nusmv/encode_local.py``) all read a node ``N`` as ``N`` itself (its
+type, ports and semantics) over abstract leaves ``⟪i⟫`` whose outcomes an environment
+chooses. Node behaviour is the interpreter's, never the converter's.
 """
 
 from __future__ import annotations

@@ -58,6 +58,7 @@ from fsmbt.semantics.compiled import FAILURE, RUNNING, SUCCESS
 from fsmbt.semantics.execution import leaf_machine
 from fsmbt.semantics.machine import Machine
 from fsmbt.semantics.status import LeafOutcome
+from fsmbt.verify.abstract_node import abstract_tree
 from fsmbt.verify.approach import approach
 from fsmbt.verify.lazy_fsm import LazyDataMachine, Unsupported
 from fsmbt.verify.native import Replay, replay
@@ -115,32 +116,10 @@ def whole_tree(source: BTDocument, region: BTNode, merged: BTNode) -> BTDocument
     return BTDocument.single(top)
 
 
-def _abstract(node: CompiledNode, costs: list[Costs]) -> BTDocument:
-    """``node`` over abstract leaves ``⟪i⟫`` (an action when child i may run)."""
-    leaves = [
-        BTNode(
-            f"⟪{i}⟫",
-            NodeKind.ACTION if RUNNING in c else NodeKind.CONDITION,
-            name=f"⟪{i}⟫",
-        )
-        for i, c in enumerate(costs)
-    ]
-    source = node.source
-    return BTDocument.single(
-        BTNode(
-            source.type,
-            source.kind,
-            attrs=dict(source.attrs),
-            children=leaves,
-            semantics=source.semantics,
-        )
-    )
-
-
 def _search(node: CompiledNode, costs: list[Costs]) -> tuple[dict[int, Path], dict[int, Path]]:
     """Dijkstra over ``node``'s abstract problem from a fresh tick: for each status its
     shortest path to be returned, for each child index its shortest path to be ticked."""
-    interp = BTInterpreter(_abstract(node, costs), exactly_once=True)
+    interp = BTInterpreter(abstract_tree(node, [RUNNING in c for c in costs]), exactly_once=True)
     index = {n.id: int(n.label[1:-1]) for n in interp.tree.nodes if n.is_env_leaf}
     counter = itertools.count()
     heap: list[Any] = []
