@@ -4,7 +4,8 @@ Two claims, each against something the analysis does not use:
 - *sound*: no node it calls dead is ever ticked by fsmbt's interpreter running the whole
   tree (every reachable snapshot explored, every leaf outcome offered at every request);
 - *what it buys*: a one-transition mutant of the per-node machine inside a dead node's
-  fragment is proven equivalent per node exactly when the whole product proves it, and a
+  fragment, or leaving one for anywhere in the region (a stray jump from a state the machine
+  never enters), is proven equivalent per node exactly when the whole product proves it, and a
   mutant that lets the parent enter a dead child is never proven (the whole product refutes
   it); a failing region that an earlier region never lets through (``NeverReturns``: the
   subtree run alone, exhaustively) is set aside only where the whole product proves the
@@ -149,7 +150,7 @@ def _dead_paths(doc: BTDocument) -> tuple[set[str], set[str]] | None:
 
 
 def test_mutants_inside_dead_fragments_are_proven_and_entering_one_is_not() -> None:
-    rng = random.Random(5)
+    rng, stray = random.Random(5), random.Random(6)
     tally: Counter[str] = Counter()
     for doc in sample(240, seed=37):
         paths = _dead_paths(doc)
@@ -174,6 +175,11 @@ def test_mutants_inside_dead_fragments_are_proven_and_entering_one_is_not() -> N
             tag = sub.states[t.source].attrs.get(NODE_ATTR)
             same = [n for n, st in sub.states.items() if st.attrs.get(NODE_ATTR) == tag]
             cases.append(("inside", sub.transitions.index(t), rng.choice(same)))
+        if inside:  # retargeted anywhere else: a stray jump, but from a state never entered
+            t = inside[stray.randrange(len(inside))]
+            tag = sub.states[t.source].attrs.get(NODE_ATTR)
+            other = [n for n, st in sub.states.items() if st.attrs.get(NODE_ATTR) != tag]
+            cases.append(("out of", sub.transitions.index(t), stray.choice(other)))
         if into and entries:
             t = rng.randrange(len(into))
             cases.append(("into", sub.transitions.index(into[t]), rng.choice(sorted(entries))))
@@ -193,10 +199,11 @@ def test_mutants_inside_dead_fragments_are_proven_and_entering_one_is_not() -> N
             tally[f"{kind}: whole {verdict}, per node {'proved' if proved else 'not'}"] += 1
             if proved:
                 assert verdict is True, f"per node proved a {kind} mutant the whole product refutes"
-            if kind == "inside" and verdict is True:
+            if kind in ("inside", "out of") and verdict is True:
                 assert proved, f"a mutant inside a dead fragment left to the whole product: {_why}"
     print(f"\n[dead fragments] {dict(tally)}")
     assert tally["inside: whole True, per node proved"] >= 20
+    assert tally["out of: whole True, per node proved"] >= 20
     assert sum(v for k, v in tally.items() if k.startswith("into: whole False")) >= 10
 
 

@@ -27,6 +27,10 @@ the check refuses (``NotPerNode``), so the caller checks the region whole as bef
    fragment only on the way out of it (an exit), never on a path that ticks one of its children.
    Variables no guard reads cannot change a decision: ignored.
 
+Conditions 2 and 3 are asked of *live* transitions only: a transition leaving a state of a node
+the tree never ticks (``tickable.never_ticked``) never fires, since the live checks prove that
+the machine never enters such a state (docs/semantics.md §4d, "Transitions out of dead states").
+
 The local problem of a node ``N`` with children ``c1..cn`` (docs/semantics.md §4d):
 
 - *tree side*: ``N`` itself (type and ports) over abstract leaves ``⟪i⟫`` (an action when child
@@ -73,7 +77,7 @@ from fsmbt.convert.compress import inline_and_compress
 from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.bt_nodes import NodeKind
 from fsmbt.model.errors import FsmbtError
-from fsmbt.model.fsm import FSM
+from fsmbt.model.fsm import FSM, Transition
 from fsmbt.model.fsm_data import ASSIGN, COND, parse_lines
 from fsmbt.semantics.bt_interpreter import (
     BTInterpreter,
@@ -209,13 +213,25 @@ class _Region:
     refused: each node's entry is the state most transitions from outside enter (the first met
     on a tie), and a transition entering a subtree elsewhere is a *stray* jump that each
     fragment reading it outputs as an exit no status pairs with (``_Local.strays``), so the
-    local check that reaches it fails; only a candidate (``check_region``)."""
+    local check that reaches it fails; only a candidate (``check_region``).
+
+    ``unticked``: the nodes the tree never ticks (``tickable.never_ticked``). A transition
+    whose source is a state of one is *dead*: conditions 2 and 3 are not asked of it (the live
+    checks prove that the machine never enters such a state, docs/semantics.md §4d, "Dead
+    nodes", so a dead transition never fires; a one-transition change there, even a jump into
+    the middle of another subtree, is no difference)."""
 
     def __init__(
-        self, tree: CompiledTree, machine: FSM, declared: dict[str, str], tolerate: bool = False
+        self,
+        tree: CompiledTree,
+        machine: FSM,
+        declared: dict[str, str],
+        tolerate: bool = False,
+        unticked: frozenset[int] = frozenset(),
     ) -> None:
         self.tree = tree
         self.tolerate = tolerate
+        self.unticked = unticked
         self.broken: list[str] = []
         self.nodes = tree.nodes
         self.machine = machine
@@ -240,6 +256,10 @@ class _Region:
         self._leaf_states()
         self._variables(declared)
         self._entries()
+
+    def dead(self, t: Transition) -> bool:
+        """Whether ``t`` leaves a state of a node the tree never ticks (the class docstring)."""
+        return self.tag.get(t.source) in self.unticked
 
     def inside(self, state: str, nid: int) -> bool:
         x = self.tag.get(state)
@@ -274,6 +294,8 @@ class _Region:
         self.owner: dict[str, int] = {}
         for name, transitions in self.out.items():
             for t in transitions:
+                if self.dead(t):
+                    continue
                 for word in _IDENT.findall(t.attrs.get(COND, "")):
                     if word in ("and", "or", "not", "True", "False"):
                         continue
@@ -299,6 +321,8 @@ class _Region:
                 if len({v for v, _e in live}) != len(live):
                     raise NotPerNode(f"a transition of {t.source} assigns a variable twice")
                 self.assigns[id(t)] = live
+                if self.dead(t):
+                    continue
                 for var, expr in live:
                     value = _literal(expr)
                     if value is None and expr.replace(" ", "") != f"{var}+1":
@@ -316,7 +340,7 @@ class _Region:
         met: dict[int, dict[str, int]] = {}  # node -> state entered from outside -> times
         for transitions in self.out.values():
             for t in transitions:
-                if t.target not in self.tag:
+                if t.target not in self.tag or self.dead(t):
                     continue
                 x: int | None = self.tag[t.target]
                 while x is not None:  # every node whose subtree the transition enters
@@ -893,11 +917,11 @@ class NodeWalk:
             self.tree = CompiledTree(BTDocument.single(merged))
         except FsmbtError as exc:
             raise NotPerNode(str(exc)) from None
-        self.region = _Region(self.tree, machine, declared, tolerate)
-        self.interfaces: dict[int, Interface] = {}
-        self.haltable: set[int] = set()
         #: the nodes no run of the tree ticks (``tickable.never_ticked``: from the tree alone)
         self.unticked = never_ticked(self.tree)
+        self.region = _Region(self.tree, machine, declared, tolerate, self.unticked)
+        self.interfaces: dict[int, Interface] = {}
+        self.haltable: set[int] = set()
 
     def problems(self) -> Iterator[LocalProblem]:
         region, interfaces = self.region, self.interfaces
