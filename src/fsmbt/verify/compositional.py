@@ -297,14 +297,19 @@ def _mentions(fsm: FSM, names: set[str]) -> set[str]:
 def _is_region_state(name: str, state: State, labels: frozenset[str]) -> bool:
     """A composite state made of a region: a flat sub-machine named ``compact_...`` or
     ``explored_...`` (``bt_to_hfsm``), or, once the names are lost (an SCXML file read back), a
-    state named after a region of the tree and after no plain control of it. Recognition only:
-    the checks decide."""
+    state named after a region of the tree and after no plain control of it; or a Parallel
+    heading its region as a ``<parallel>`` (``convert/bt_parallel.py``: a sub-machine whose
+    top holds one parallel state, named ``parallel_...`` or after a region of the tree).
+    Recognition only: the checks decide (the region is checked whole, its W3C meaning)."""
     if len(state.regions) != 1:
         return False
     sub = state.regions[0]
+    named = name.split("#")[0] in labels
     if sub.is_hierarchical:
-        return False
-    return sub.name.startswith(("compact_", "explored_")) or name.split("#")[0] in labels
+        return (sub.name.startswith("parallel_") or named) and any(
+            inner.is_parallel for inner in sub.states.values()
+        )
+    return sub.name.startswith(("compact_", "explored_")) or named
 
 
 @dataclass
