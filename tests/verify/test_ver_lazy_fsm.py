@@ -8,8 +8,10 @@ reachable pair, which proves them equal on every input sequence) over (a) result
 whole (``bt_to_hfsm`` without per node) of the compositional test's random trees, (b) their
 one-transition mutants (one per operator of ``verify/mutations.py`` in every machine, regions
 included), (c) per-node results and their mutants (``support.pernode_mutants``) and (d) the
-bench families. The runner refuses a machine only when it has a parallel state or when the
-flattening refuses it too, and never fails in the middle of a run the flattening explores.
+bench families, and (e) results holding a Parallel written as ``<parallel>`` (run as a block,
+``verify/lazy_block.py``) with their mutants. The runner refuses a machine only when it has a
+parallel state it cannot run as a block or when the flattening refuses it too, and never fails
+in the middle of a run the flattening explores.
 Then the rules the comparison found, one machine each, against the flattened machine.
 """
 
@@ -24,14 +26,16 @@ import pytest
 
 from fsmbt import limits
 from fsmbt.convert.bt_to_hfsm import bt_to_hfsm
-from fsmbt.model.errors import FsmbtError
+from fsmbt.model.errors import FsmbtError, InputError, UnsupportedError
 from fsmbt.model.fsm import FSM, State
 from fsmbt.model.fsm_data import ASSIGN, COND, DATAMODEL, ONEXIT
 from fsmbt.semantics.machine import FINAL, LEAF_OUTCOMES, FSMLeafMachine
+from fsmbt.verify.lazy_block import holds_parallel
 from fsmbt.verify.lazy_fsm import LazyDataMachine, Unsupported
 from fsmbt.verify.native import StateLimitError, check
 from support.pernode_mutants import BOUND, mutate, seeded_mutants
-from support.whole_mutants import deep_mutants, seeded_whole_mutants
+from support.random_trees import random_tree
+from support.whole_mutants import DECORATORS, deep_mutants, seeded_whole_mutants
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))
 from bench_reactive import family_tree  # noqa: E402
@@ -113,6 +117,40 @@ def test_per_node_results_their_mutants_and_the_bench_families() -> None:
                     tally[_compare(candidate, rng, walks=4, steps=40)] += 1
     print(f"\n[per-node results, mutants, bench families] {dict(tally)}")
     assert tally["same"] >= 300
+
+
+#: Controls of (e): a Parallel or ParallelAll heading regions, with and without memory.
+PARALLEL_CONTROLS = (
+    "Sequence",
+    "Fallback",
+    "Parallel",
+    "ParallelAll",
+    "SequenceWithMemory",
+    "ReactiveSequence",
+)
+
+
+def test_parallel_blocks_run_as_the_flattened_machine() -> None:
+    """(e): a composite state holding a ``<parallel>`` is a block: its sub-machine flattened
+    alone and stepped inside the run, the same steps as the whole machine flattened."""
+    tally: Counter[str] = Counter()
+    rng = random.Random(47)
+    trees = 0
+    while trees < 60:
+        doc = random_tree(rng, controls=PARALLEL_CONTROLS, decorators=DECORATORS, max_nodes=14)
+        try:
+            model = bt_to_hfsm(doc).model
+        except (InputError, UnsupportedError):
+            continue
+        if not any(holds_parallel(state) for _path, _machine, state in model.walk()):
+            continue
+        trees += 1
+        tally[_compare(model, rng)] += 1
+        for mutant in deep_mutants(model, rng.randrange(1 << 30), 1, every_machine=True)[:5]:
+            tally[f"mutant {_compare(mutant, rng)}"] += 1
+    print(f"\n[parallel blocks] {dict(tally)}")
+    assert tally["same"] == trees  # every converted result runs, and runs the same
+    assert tally["mutant same"] >= 150
 
 
 # -- the rules, one machine each ---------------------------------------------------------------

@@ -11,8 +11,11 @@ converted trees, written whole and per node, and their one-transition mutants:
 
 Scope (anything else raises ``Unsupported`` naming the shape; the caller then does not lift):
 atomic states and composite states (one sub-machine each, nested to any depth) - every shape
-``bt_to_hfsm`` writes but a parallel state. A configuration is the path of active states from
-the top machine down to an atomic state.
+``bt_to_hfsm`` writes. A configuration is the path of active states from the top machine down
+to an atomic state, or down to a composite state holding a parallel state (a *block*,
+``verify/lazy_block.py``: a Parallel written as ``<parallel>``; its sub-machine, whose data
+no one else reads, is flattened alone and stepped inside the run; the block's own state is
+part of the configuration). A parallel state anywhere else is refused.
 
 ``FSMLeafMachine`` reads a machine by one of two readings (docs/semantics.md §6 and §6a), and
 this runner follows the one it uses:
@@ -53,13 +56,15 @@ from fsmbt.formats.scxml.structural import EXIT_MARK
 from fsmbt.model.fsm import FSM, State, Transition
 from fsmbt.model.fsm_data import ASSIGN, COND, DATAMODEL, ONEXIT, has_data, parse_lines
 from fsmbt.semantics.machine import FINAL, LEAF_OUTCOMES, RUNNING
+from fsmbt.verify.lazy_block import BlockUnsupported, ParallelBlock, holds_parallel
 from fsmbt.verify.subset_expr import OutsideSubset, compile_subset
 
 #: Most transitions one input may take (a cycle of eventless transitions is refused).
 STEP_LIMIT = 10_000
 
 Path = tuple[str, ...]  # the active states, top machine first, down to an atomic state
-State_ = tuple[Path, tuple[tuple[str, Any], ...]]  # (configuration, variable values)
+#: (configuration, variable values, the block's own state when the path ends at a block)
+State_ = tuple[Path, tuple[tuple[str, Any], ...], Any]
 Evaluator = Callable[[dict[str, Any]], Any]
 #: A transition selected and the level (index in the path) of its source state.
 Move = tuple[Transition, int]
@@ -132,10 +137,19 @@ class LazyDataMachine:
         #: configuration -> per level, its state and that state's transitions by event
         #: (filled on demand: one lookup per configuration a step visits)
         self.levels: dict[Path, tuple[Level, ...]] = {}
+        #: (id of a machine, state) -> the block that state is (``verify/lazy_block.py``)
+        self.blocks: dict[tuple[int, str], ParallelBlock] = {}
+        self.block_at: dict[Path, ParallelBlock | None] = {}
+        #: the block entered during the current start or step: (its state, its outputs)
+        self._inside: tuple[Any, tuple[str, ...]] | None = None
+        declared = {var for var, _text in parse_lines(fsm.attrs.get(DATAMODEL, ""))}
         stack = [(fsm, "the top machine")]
         while stack:  # every machine once, without recursion
             machine, where = stack.pop()
             for state in machine.states.values():
+                if self.w3c and holds_parallel(state):
+                    self._add_block(machine, state, declared, where)
+                    continue
                 self._check_state(machine, state, where)
                 if state.regions:
                     stack.append((state.regions[0], f"the sub-machine of {state.name}"))
@@ -148,6 +162,25 @@ class LazyDataMachine:
             for var, text in parse_lines(fsm.attrs.get(DATAMODEL, "")):
                 values[var] = _value(text, values)
         self.initial_values = tuple(sorted(values.items()))
+
+    def _add_block(self, machine: FSM, state: State, declared: set[str], where: str) -> None:
+        """``state`` (holding a parallel state) as a block, or ``Unsupported``."""
+        what = f"state {state.name} in {where} holds a parallel state"
+        if any(t.event is not None for t in machine.outgoing(state.name)):
+            raise Unsupported(f"{what} and is left by an event")
+        try:
+            self.blocks[(id(machine), state.name)] = ParallelBlock(self.fsm, state, declared)
+        except BlockUnsupported as exc:
+            raise Unsupported(f"{what}, not run as a block: {exc}") from None
+
+    def _block(self, path: Path) -> ParallelBlock | None:
+        """The block ``path`` ends at, if it ends at one (cached)."""
+        if path not in self.block_at:
+            machine = self.fsm
+            for name in path[:-1]:
+                machine = machine.states[name].regions[0]
+            self.block_at[path] = self.blocks.get((id(machine), path[-1]))
+        return self.block_at[path]
 
     def _check_state(self, machine: FSM, state: State, where: str) -> None:
         """Refuse a shape this runner does not read as ``FSMLeafMachine`` does."""
@@ -183,40 +216,75 @@ class LazyDataMachine:
     def start(self) -> tuple[State_, tuple[str, ...]]:
         assert self.fsm.initial is not None
         values = dict(self.initial_values)
+        self._inside = None
         if self.w3c:
             queue: deque[Path] = deque()
-            path = self._enter((), self.fsm.initial, queue)
+            path = self._enter((), self.fsm.initial, queue, values)
             path = self._stabilise(path, values, queue)
         else:
             path = self._settle(self._descend((), self.fsm.initial))
-        return (path, tuple(sorted(values.items()))), self._outputs(path)
+        return self._result(path, values)
+
+    def _result(self, path: Path, values: dict[str, Any]) -> tuple[State_, tuple[str, ...]]:
+        """The state reached and its outputs (a block's own when the run stopped in one)."""
+        inside, self._inside = self._inside, None
+        if inside is not None:
+            return (path, tuple(sorted(values.items())), inside[0]), inside[1]
+        return (path, tuple(sorted(values.items())), None), self._outputs(path)
 
     def inputs(self, state: State_) -> Sequence[str]:
         return () if self.status(state) == FINAL else LEAF_OUTCOMES
 
     def status(self, state: State_) -> str:
         path = state[0]
+        if state[2] is not None:  # in a block: a state holding sub-states, never the end
+            return RUNNING
         return FINAL if len(path) == 1 and self.fsm.states[path[0]].final else RUNNING
 
     def describe(self, state: State_) -> str:
-        return "/".join(state[0])
+        inner = state[2]
+        return "/".join(state[0]) + ("" if inner is None else f"[{inner[1]}]")
 
     def step(self, state: State_, symbol: str) -> tuple[State_, tuple[str, ...]]:
         if self.status(state) == FINAL:
             return state, ()
-        path, frozen = state
+        path, frozen, inner = state
         values = dict(frozen)
+        self._inside = None
         if self.w3c:
             queue: deque[Path] = deque()
-            move = self._select(path, symbol, values)
-            if move is not None:
-                path = self._take(path, move, values, queue)
+            if inner is not None:
+                path = self._block_step(path, inner, symbol, queue)
+                if self._inside is not None:  # still in the block: nothing else moves
+                    return self._result(path, values)
+            else:
+                move = self._select(path, symbol, values)
+                if move is not None:
+                    path = self._take(path, move, values, queue)
             path = self._stabilise(path, values, queue)
         else:
             move = self._flat_select(path, symbol)
             if move is not None:
                 path = self._settle(self._descend(path[: move[1]], move[0].target))
-        return (path, tuple(sorted(values.items()))), self._outputs(path)
+        return self._result(path, values)
+
+    def _block_step(self, path: Path, inner: Any, symbol: str, queue: deque[Path]) -> Path:
+        """``symbol`` inside the block ``path`` ends at: still in it (``_inside`` set), or at
+        the final sub-state it reached with ``done.state`` queued."""
+        block = self._block(path)
+        assert block is not None
+        if any(self._arms(path, level, symbol) for level in range(len(path))):
+            # W3C would offer the event to these states too (a region taking none)
+            raise Unsupported(f"a state around parallel state block {path[-1]} takes {symbol!r}")
+        try:
+            at, outputs, final = block.step(inner, symbol)
+        except BlockUnsupported as exc:
+            raise Unsupported(f"parallel state block {path[-1]}: {exc}") from None
+        if final is None:
+            self._inside = (at, outputs)
+            return path
+        queue.append(path)
+        return (*path, final)
 
     # -- both readings -----------------------------------------------------------------------
     def _levels(self, path: Path) -> tuple[Level, ...]:
@@ -249,7 +317,7 @@ class LazyDataMachine:
 
     def _descend(self, prefix: Path, name: str) -> Path:
         """The configuration entering ``name`` (a state of ``prefix``'s machine) gives: down
-        its initial sub-states to an atomic state."""
+        its initial sub-states to an atomic state or a block."""
         machine = self.fsm if not prefix else self._state(prefix).regions[0]
         path = prefix
         for _level in range(STEP_LIMIT):
@@ -257,8 +325,8 @@ class LazyDataMachine:
             if state is None:
                 raise Unsupported(f"a transition to an unknown state {name}")
             path = (*path, name)
-            if not state.regions:
-                return path
+            if not state.regions or (id(machine), name) in self.blocks:
+                return path  # an atomic state, or a block (its own flattening goes on)
             machine = state.regions[0]
             name = machine.initial or ""
         raise Unsupported("sub-machines nest deeper than the step limit")
@@ -324,12 +392,23 @@ class LazyDataMachine:
         for depth in range(len(path) - 1, level - 1, -1):
             _assign(levels[depth][0].attrs.get(ONEXIT, ""), values)
         _assign(t.attrs.get(ASSIGN, ""), values)
-        return self._enter(path[:level], t.target, queue)
+        return self._enter(path[:level], t.target, queue, values)
 
-    def _enter(self, prefix: Path, name: str, queue: deque[Path]) -> Path:
+    def _enter(self, prefix: Path, name: str, queue: deque[Path], values: dict[str, Any]) -> Path:
         """Enter ``name`` and its initial sub-states; a final sub-state queues its parent's
-        ``done.state``."""
+        ``done.state``. A block is started with ``values`` (``_inside`` set while it runs)."""
         path = self._descend(prefix, name)
+        block = self._block(path) if self.blocks else None
+        if block is not None:
+            try:
+                at, outputs, final = block.start(values)
+            except BlockUnsupported as exc:
+                raise Unsupported(f"parallel state block {path[-1]}: {exc}") from None
+            if final is None:
+                self._inside = (at, outputs)
+                return path
+            queue.append(path)
+            return (*path, final)
         if len(path) > 1 and self._state(path).final:
             queue.append(path[:-1])
         return path
@@ -338,6 +417,8 @@ class LazyDataMachine:
         for _step in range(STEP_LIMIT):
             if len(path) == 1 and self.fsm.states[path[0]].final:
                 return path  # the run is over (W3C: a top-level final)
+            if self._inside is not None:
+                return path  # in a block: its own eventless steps ran in its flattening
             move = None
             for t in self._arms(path, len(path) - 1, None):  # the atomic state's eventless
                 cond = t.attrs.get(COND)
