@@ -5,7 +5,8 @@ sub-machines of seeded small trees (the bench families and every kind ``convert/
 writes; the 2 000 unmutated pairs are in tests/convert/test_conv_bt_pernode.py) (a retargeted transition, a dropped guard, a dropped or changed
 assignment) - the per-node check never proves a pair the whole product finds different, and
 it proves most of the equivalent ones on its own (the rest fall back to the whole product, as
-the verdict says). Counts are printed (``pytest -s``).
+the verdict says). A failure no run is lifted to, in a small region, has that region checked
+whole (``compositional_report``), whose verdict must be the whole product's. Counts are printed (``pytest -s``).
 """
 
 from __future__ import annotations
@@ -42,10 +43,16 @@ def test_per_node_agrees_with_the_whole_product_on_mutants() -> None:
             tally[f"whole {verdict}, per node {'proved' if proved else 'fell back'}"] += 1
             if proved:
                 assert verdict is True, "the per-node check proved a pair that differs"
+            if report is not None and report.stats.get("regions_checked_whole"):
+                # a per-node failure no run was lifted to: its region checked whole decided
+                tally[f"whole {verdict}, region checked whole: {report.equivalent}"] += 1
+                assert report.equivalent is verdict
     print(f"\n[per-node vs whole product] {dict(tally)}")
     assert tally["pairs"] >= 450
     assert tally["whole True, per node proved"] >= 40  # harmless mutants proven per node
     assert tally["whole False, per node fell back"] >= 200  # mutants do differ
+    # per-node failures with no run to them, proven by their small region's whole check
+    assert tally["whole True, region checked whole: True"] >= 30
 
 
 def test_verify_names_the_per_node_method_on_a_1000_node_tree() -> None:

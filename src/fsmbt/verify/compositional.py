@@ -156,6 +156,9 @@ class Decomposition:
     lifted: Report | None = None
     #: the index (in ``Structure.regions``) of the tree region whose check failed
     failed_index: int | None = None
+    #: a per-node failure in a region of at most ``WHOLE_FIRST`` states: when the lift finds
+    #: no run to it, ``compositional_report`` checks that region whole instead
+    failed_small: bool = False
 
 
 # -- the tree side ---------------------------------------------------------------------------
@@ -669,10 +672,15 @@ def decompose(
     max_seconds: float | None = None,
     plan: CheckPlan | None = None,
     unticked: frozenset[int] = frozenset(),
+    whole: frozenset[int] = frozenset(),
 ) -> Decomposition:
     """Run the three parts of the compositional check (module docstring); with ``keep``, each
     part's witness is appended to it (for a certificate: the parts' tables stay alive); with
     ``plan``, what each part checked is recorded (``CheckPlan``; no extra check).
+
+    ``whole``: tree regions (indices of ``Structure.regions``) checked whole even when written
+    per node (their per-node check failed and no run to the failure was lifted: a small
+    region's whole check decides, and proves it where the per-node abstraction cannot).
 
     ``unticked``: tree regions (indices of ``Structure.regions``) proven never ticked in the
     whole tree (``tickable.stage_never_passes``): not checked, each standing in the skeleton
@@ -725,7 +733,13 @@ def decompose(
             continue
         local: list[LocalWitness] | None = [] if keep is not None else None
         units: list[LocalUnit] | None = [] if plan is not None else None
-        per_node = _per_node(regions[k], region.machine, shape.declared, outcome, local, units)
+        if k in whole:
+            per_node = None
+            outcome.stats.setdefault("per_node_refused", []).append(
+                f"{name}: checked whole, its per-node check fails and no run was lifted"
+            )
+        else:
+            per_node = _per_node(regions[k], region.machine, shape.declared, outcome, local, units)
         candidate: PerNodeOutcome | None = None
         if per_node is not None and per_node.tolerated is not None:
             # a failure past a broken entry condition (``check_region``'s ``tolerate``) is
@@ -753,6 +767,7 @@ def decompose(
                 )
                 outcome.per_node_failure = (regions[k], per_node)
                 outcome.failed_index = k
+                outcome.failed_small = len(region.machine.states) <= WHOLE_FIRST
                 return outcome
             possible = per_node.results
             if not results_allowed(possible, shape, j):
@@ -1123,6 +1138,7 @@ def compositional_report(
     Cost: see the module docstring."""
     started = time.perf_counter()
     unticked: set[int] = set()
+    whole: set[int] = set()
     never: _NeverTicked | None = None
     while True:
         try:
@@ -1135,6 +1151,7 @@ def compositional_report(
                 max_seconds=max_seconds,
                 plan=plan,
                 unticked=frozenset(unticked),
+                whole=frozenset(whole),
             )
         except NotDecomposable as exc:
             return None, str(exc)
@@ -1148,10 +1165,17 @@ def compositional_report(
             lifted = _lifted(source, result, found)
             if lifted is not None:
                 return lifted, ""
+        k = found.failed_index
+        if found.per_node_failure is not None and found.failed_small and k not in whole:
+            # no run found to a per-node failure in a small region: the region's whole check
+            # (part 1) decides - it proves the region where the per-node abstraction is too
+            # coarse, or gives a counterexample from the region's fresh tick to lift
+            assert k is not None
+            whole.add(k)
+            continue
         # no run found to the failure: a region the whole tree never ticks is no difference
         # (docs/semantics.md §4c, "Regions never ticked"); not for a certificate or a plan,
         # which list what was checked
-        k = found.failed_index
         if keep is None and plan is None and k is not None and k not in unticked:
             try:
                 never = never or _NeverTicked(source)
@@ -1185,6 +1209,14 @@ def compositional_report(
                 else ""
             )
             + ")"
+        )
+        for name in PROPERTIES:
+            report.properties[name] = PropertyResult(name, True, detail)
+    if whole:
+        report.stats["regions_checked_whole"] = len(whole)
+        detail += (
+            f"; {len(whole)} region(s) written per node checked whole (their per-node check "
+            "failed and no run to the failure was lifted)"
         )
         for name in PROPERTIES:
             report.properties[name] = PropertyResult(name, True, detail)
