@@ -302,6 +302,8 @@ def test_a_parallel_written_as_parallel_regions_is_a_region() -> None:
             decided += 1
             assert whole.equivalent, "compositional proved a pair the whole product refutes"
         refuted += not whole.equivalent
-    print(f"\n[parallel regions] {pairs} pairs, {decided} proven compositionally, {refuted} refuted")
+    print(
+        f"\n[parallel regions] {pairs} pairs, {decided} proven compositionally, {refuted} refuted"
+    )
     assert decided >= 20
     assert refuted >= 12
