@@ -56,8 +56,9 @@ def holds_parallel(state: State) -> bool:
     return len(state.regions) == 1 and any(s.is_parallel for s in state.regions[0].states.values())
 
 
-def _texts(machine: FSM) -> Iterator[str]:
-    """Every guard, assignment and ``onexit`` text of ``machine`` and its sub-machines."""
+def _texts(machine: FSM, skip: State | None = None) -> Iterator[str]:
+    """Every guard, assignment and ``onexit`` text of ``machine`` and its sub-machines but
+    those of ``skip`` (its ``onexit`` and everything below it)."""
     stack = [machine]
     while stack:
         current = stack.pop()
@@ -65,6 +66,8 @@ def _texts(machine: FSM) -> Iterator[str]:
             yield t.attrs.get(COND, "")
             yield t.attrs.get(ASSIGN, "")
         for state in current.states.values():
+            if state is skip:
+                continue
             yield state.attrs.get(ONEXIT, "")
             stack.extend(state.regions)
 
@@ -94,7 +97,7 @@ class ParallelBlock:
         for text in _texts(self.sub):
             inside.update(w for w in _IDENT.findall(text) if w in declared)
         outside: set[str] = set()
-        for text in self._outside_texts(fsm):
+        for text in _texts(fsm, skip=state):
             outside.update(w for w in _IDENT.findall(text) if w in declared)
         shared = inside & outside
         if shared:
@@ -114,20 +117,6 @@ class ParallelBlock:
                 raise BlockUnsupported(f"state {state.name}: its final {name} does something")
         self.private = sorted(inside)
         self.machines: dict[tuple[tuple[str, Any], ...], FSMLeafMachine] = {}
-
-    def _outside_texts(self, fsm: FSM) -> Iterator[str]:
-        """The texts of ``fsm`` but the block's sub-machine and ``S``'s own ``onexit``."""
-        stack = [fsm]
-        while stack:
-            current = stack.pop()
-            for t in current.transitions:
-                yield t.attrs.get(COND, "")
-                yield t.attrs.get(ASSIGN, "")
-            for state in current.states.values():
-                if state is self.state:
-                    continue
-                yield state.attrs.get(ONEXIT, "")
-                stack.extend(state.regions)
 
     def key(self, values: dict[str, Any]) -> tuple[tuple[str, Any], ...]:
         """The entry valuation of the block's private variables."""

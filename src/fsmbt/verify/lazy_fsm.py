@@ -276,8 +276,19 @@ class LazyDataMachine:
         if any(self._arms(path, level, symbol) for level in range(len(path))):
             # W3C would offer the event to these states too (a region taking none)
             raise Unsupported(f"a state around parallel state block {path[-1]} takes {symbol!r}")
+        return self._in_block(path, queue, lambda: block.step(inner, symbol))
+
+    def _in_block(
+        self,
+        path: Path,
+        queue: deque[Path],
+        run: Callable[[], tuple[Any, tuple[str, ...], str | None]],
+    ) -> Path:
+        """``run`` (a block's start or step) at the block ``path`` ends at: still in it
+        (``_inside`` set, ``path``), or at the final sub-state it reached, ``done.state``
+        queued."""
         try:
-            at, outputs, final = block.step(inner, symbol)
+            at, outputs, final = run()
         except BlockUnsupported as exc:
             raise Unsupported(f"parallel state block {path[-1]}: {exc}") from None
         if final is None:
@@ -400,15 +411,7 @@ class LazyDataMachine:
         path = self._descend(prefix, name)
         block = self._block(path) if self.blocks else None
         if block is not None:
-            try:
-                at, outputs, final = block.start(values)
-            except BlockUnsupported as exc:
-                raise Unsupported(f"parallel state block {path[-1]}: {exc}") from None
-            if final is None:
-                self._inside = (at, outputs)
-                return path
-            queue.append(path)
-            return (*path, final)
+            return self._in_block(path, queue, lambda: block.start(values))
         if len(path) > 1 and self._state(path).final:
             queue.append(path[:-1])
         return path
