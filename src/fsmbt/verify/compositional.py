@@ -112,6 +112,11 @@ COMPOSITIONAL_SENTENCE = (
 #: 1 000 nodes: seconds instead of a region check that stops). ``bench_pernode_outside.py``.
 WHOLE_FIRST = 250
 
+#: Most configurations and data values the region's machine may expand to when a region
+#: written per node is checked whole after its per-node check failed (``compositional_report``):
+#: a few seconds of the W3C expansion at most; past it, the whole product decides as before.
+WHOLE_AFTER_FAILURE_STATES = 20_000
+
 #: The mode of a compositional verdict (a BT's leaf-execution machine against an FSM's).
 LEAF_EXECUTION = "leaf-execution"
 
@@ -787,7 +792,11 @@ def decompose(
                 )
             )
         try:  # building the machines may stop at a limit too (the data expansion)
-            bt_region, fsm_region = region_machines(shape, k, j)
+            if k in whole:  # a second try after a per-node failure: a small expansion only
+                with limits.changed(conversion_max_states=WHOLE_AFTER_FAILURE_STATES):
+                    bt_region, fsm_region = region_machines(shape, k, j)
+            else:
+                bt_region, fsm_region = region_machines(shape, k, j)
             report, witness = check_witnessed(
                 bt_region, fsm_region, max_states=max_states, max_seconds=budget.left()
             )
