@@ -1175,7 +1175,8 @@ def compositional_report(
             if lifted is not None:
                 return lifted, ""
         k = found.failed_index
-        if found.per_node_failure is not None and found.failed_small and k not in whole:
+        retry = keep is None and plan is None  # a second pass would list their parts twice
+        if retry and found.per_node_failure is not None and found.failed_small and k not in whole:
             # no run found to a per-node failure in a small region: the region's whole check
             # (part 1) decides - it proves the region where the per-node abstraction is too
             # coarse, or gives a counterexample from the region's fresh tick to lift
@@ -1185,7 +1186,7 @@ def compositional_report(
         # no run found to the failure: a region the whole tree never ticks is no difference
         # (docs/semantics.md §4c, "Regions never ticked"); not for a certificate or a plan,
         # which list what was checked
-        if keep is None and plan is None and k is not None and k not in unticked:
+        if retry and k is not None and k not in unticked:
             try:
                 never = never or _NeverTicked(source)
             except FsmbtError:  # the whole tree does not compile: nothing is set aside
