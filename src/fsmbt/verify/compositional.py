@@ -1148,6 +1148,10 @@ def compositional_report(
     started = time.perf_counter()
     unticked: set[int] = set()
     whole: set[int] = set()
+    tried: set[int] = set()
+    #: the region just put in ``whole`` and the failure that sent it there: if its whole
+    #: check gives up (a limit), the rules below go on from that failure
+    pending: tuple[int, Decomposition] | None = None
     never: _NeverTicked | None = None
     while True:
         try:
@@ -1162,26 +1166,33 @@ def compositional_report(
                 unticked=frozenset(unticked),
                 whole=frozenset(whole),
             )
-        except NotDecomposable as exc:
-            return None, str(exc)
-        except FsmbtError as exc:
-            # a part the machines refuse (a limit, a construct): the whole product decides and
-            # gives the error or verdict it gave before
-            return None, f"a part cannot be checked ({type(exc).__name__})"
-        if found.equivalent:
-            break
-        if found.per_node_failure is not None or found.region_failure is not None:
-            lifted = _lifted(source, result, found)
-            if lifted is not None:
-                return lifted, ""
+        except (NotDecomposable, FsmbtError) as exc:
+            if pending is None:
+                if isinstance(exc, NotDecomposable):
+                    return None, str(exc)
+                # a part the machines refuse (a limit, a construct): the whole product
+                # decides and gives the error or verdict it gave before
+                return None, f"a part cannot be checked ({type(exc).__name__})"
+            whole.discard(pending[0])
+            found, pending = pending[1], None
+        else:
+            pending = None
+            if found.equivalent:
+                break
+            if found.per_node_failure is not None or found.region_failure is not None:
+                lifted = _lifted(source, result, found)
+                if lifted is not None:
+                    return lifted, ""
         k = found.failed_index
         retry = keep is None and plan is None  # a second pass would list their parts twice
-        if retry and found.per_node_failure is not None and found.failed_small and k not in whole:
+        if retry and found.per_node_failure is not None and found.failed_small and k not in tried:
             # no run found to a per-node failure in a small region: the region's whole check
             # (part 1) decides - it proves the region where the per-node abstraction is too
             # coarse, or gives a counterexample from the region's fresh tick to lift
             assert k is not None
             whole.add(k)
+            tried.add(k)
+            pending = (k, found)
             continue
         # no run found to the failure: a region the whole tree never ticks is no difference
         # (docs/semantics.md §4c, "Regions never ticked"); not for a certificate or a plan,
