@@ -1130,6 +1130,25 @@ class _NeverTicked:
         return True
 
 
+def _marks(keep: Parts | None, plan: CheckPlan | None) -> tuple[int, ...]:
+    """How much ``keep`` and ``plan`` hold before a pass (``_rewind`` drops the rest)."""
+    held = [len(keep.units)] if keep is not None else [0]
+    if plan is not None:
+        held += [len(plan.units), len(plan.wholes), len(plan.refused)]
+    return tuple(held)
+
+
+def _rewind(keep: Parts | None, plan: CheckPlan | None, marks: tuple[int, ...]) -> None:
+    """Drop what a failed pass added to ``keep`` and to ``plan``'s parts checked whole (the
+    next pass lists them again). ``plan``'s local checks stay: each was decided, and NuSMV
+    decides each again, the failing one included (docs/nusmv.md, "Trees node by node")."""
+    if keep is not None:
+        del keep.units[marks[0] :]
+    if plan is not None:
+        del plan.wholes[marks[2] :]
+        del plan.refused[marks[3] :]
+
+
 def compositional_report(
     source: BTDocument,
     result: FSM,
@@ -1154,6 +1173,7 @@ def compositional_report(
     pending: tuple[int, Decomposition] | None = None
     never: _NeverTicked | None = None
     while True:
+        marks = _marks(keep, plan)
         try:
             found = decompose(
                 source,
@@ -1173,6 +1193,7 @@ def compositional_report(
                 # a part the machines refuse (a limit, a construct): the whole product
                 # decides and gives the error or verdict it gave before
                 return None, f"a part cannot be checked ({type(exc).__name__})"
+            _rewind(keep, plan, marks)
             whole.discard(pending[0])
             found, pending = pending[1], None
         else:
@@ -1184,12 +1205,13 @@ def compositional_report(
                 if lifted is not None:
                     return lifted, ""
         k = found.failed_index
-        retry = keep is None and plan is None  # a second pass would list their parts twice
-        if retry and found.per_node_failure is not None and found.failed_small and k not in tried:
+        if found.per_node_failure is not None and found.failed_small and k not in tried:
             # no run found to a per-node failure in a small region: the region's whole check
             # (part 1) decides - it proves the region where the per-node abstraction is too
-            # coarse, or gives a counterexample from the region's fresh tick to lift
+            # coarse, or gives a counterexample from the region's fresh tick to lift; what the
+            # failed pass kept for a certificate or a plan is dropped (listed once)
             assert k is not None
+            _rewind(keep, plan, marks)
             whole.add(k)
             tried.add(k)
             pending = (k, found)
@@ -1197,7 +1219,7 @@ def compositional_report(
         # no run found to the failure: a region the whole tree never ticks is no difference
         # (docs/semantics.md §4c, "Regions never ticked"); not for a certificate or a plan,
         # which list what was checked
-        if retry and k is not None and k not in unticked:
+        if keep is None and plan is None and k is not None and k not in unticked:
             try:
                 never = never or _NeverTicked(source)
             except FsmbtError:  # the whole tree does not compile: nothing is set aside
