@@ -32,7 +32,7 @@ import re
 from collections.abc import Callable
 
 from fsmbt.model.errors import UnsupportedError
-from fsmbt.model.fsm import FSM
+from fsmbt.model.fsm import FSM, State
 
 #: Keys in ``attrs`` (they contain no character an XML attribute name may hold alone).
 DATAMODEL = "fsmbt:datamodel"
@@ -70,6 +70,8 @@ SUBSET_NODES: tuple[type[ast.AST], ...] = (
 )
 
 _expander: Callable[[FSM], FSM] | None = None
+#: A word of an expression: what ``mentioned_names`` looks for.
+_IDENT = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 
 
 def has_data(fsm: FSM) -> bool:
@@ -90,6 +92,32 @@ def parse_lines(text: str) -> list[tuple[str, str]]:
 def join_lines(pairs: list[tuple[str, str]]) -> str:
     """The inverse of ``parse_lines``."""
     return "\n".join(f"{name}={expr}" for name, expr in pairs)
+
+
+def mentioned_names(fsm: FSM, names: set[str], skip: State | None = None) -> set[str]:
+    """The ``names`` (declared variables) that ``fsm`` and the machines nested in it mention in
+    any attribute of a transition or a state (its ``name`` aside): guards, assignments,
+    ``onexit``, anything a format kept. ``skip``: a state whose attributes and sub-machines are
+    left out. Why one function: the compositional check asks which region uses a variable, the
+    lazy runner whether a block's variables are read outside it; both must read the same
+    places. O(the attributes' text)."""
+    found: set[str] = set()
+    stack = [fsm]
+    while stack:
+        machine = stack.pop()
+        texts = [_attribute_text(t.attrs) for t in machine.transitions]
+        for state in machine.states.values():
+            if state is skip:
+                continue
+            texts.append(_attribute_text(state.attrs))
+            stack.extend(state.regions)
+        for text in texts:
+            found.update(word for word in _IDENT.findall(text) if word in names)
+    return found
+
+
+def _attribute_text(attrs: dict[str, str]) -> str:
+    return " ".join(value for key, value in attrs.items() if key != "name")
 
 
 def data_places(fsm: FSM, limit: int = 4) -> str:

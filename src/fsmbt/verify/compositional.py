@@ -48,6 +48,7 @@ m states costs O(k · m) instead of the product of the regions' memories.
 
 from __future__ import annotations
 
+import contextlib
 import copy
 import re
 import time
@@ -61,7 +62,7 @@ from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.bt_nodes import NodeKind
 from fsmbt.model.errors import FsmbtError
 from fsmbt.model.fsm import FSM, State, Transition
-from fsmbt.model.fsm_data import DATAMODEL, ONEXIT, join_lines, parse_lines
+from fsmbt.model.fsm_data import DATAMODEL, ONEXIT, join_lines, mentioned_names, parse_lines
 from fsmbt.semantics.bt_interpreter import CompiledTree
 from fsmbt.semantics.leaf_machine import LeafMachine
 from fsmbt.semantics.machine import FSMLeafMachine
@@ -281,25 +282,6 @@ def skeleton_tree(
 # -- the state machine side ------------------------------------------------------------------
 def _declared(fsm: FSM) -> dict[str, str]:
     return dict(parse_lines(fsm.attrs.get(DATAMODEL, "")))
-
-
-def _data_text(attrs: dict[str, str]) -> str:
-    return " ".join(value for key, value in attrs.items() if key != "name")
-
-
-def _mentions(fsm: FSM, names: set[str]) -> set[str]:
-    """The declared variables that a machine (and the machines nested in it) names anywhere."""
-    found: set[str] = set()
-    stack = [fsm]
-    while stack:
-        machine = stack.pop()
-        texts = [_data_text(t.attrs) for t in machine.transitions]
-        for state in machine.states.values():
-            texts.append(_data_text(state.attrs))
-            stack.extend(state.regions)
-        for text in texts:
-            found.update(word for word in _IDENT.findall(text) if word in names)
-    return found
 
 
 def _is_region_state(name: str, state: State, labels: frozenset[str]) -> bool:
@@ -555,7 +537,7 @@ def structure(source: BTDocument, result: FSM) -> Structure:
     owner: dict[str, int] = {}
     mentioned: list[set[str]] = []
     for j, region in enumerate(machine_regions):
-        used = _mentions(region.machine, names) | {
+        used = mentioned_names(region.machine, names) | {
             w for w in _IDENT.findall(region.state.attrs.get(ONEXIT, "")) if w in names
         }
         for name in used:
@@ -792,10 +774,12 @@ def decompose(
                 )
             )
         try:  # building the machines may stop at a limit too (the data expansion)
-            if k in whole:  # a second try after a per-node failure: a small expansion only
-                with limits.changed(conversion_max_states=WHOLE_AFTER_FAILURE_STATES):
-                    bt_region, fsm_region = region_machines(shape, k, j)
-            else:
+            # a second try after a per-node failure: a small expansion only
+            with (
+                limits.changed(conversion_max_states=WHOLE_AFTER_FAILURE_STATES)
+                if k in whole
+                else contextlib.nullcontext()
+            ):
                 bt_region, fsm_region = region_machines(shape, k, j)
             report, witness = check_witnessed(
                 bt_region, fsm_region, max_states=max_states, max_seconds=budget.left()
@@ -1134,7 +1118,7 @@ def _marks(keep: Parts | None, plan: CheckPlan | None) -> tuple[int, ...]:
     """How much ``keep`` and ``plan`` hold before a pass (``_rewind`` drops the rest)."""
     held = [len(keep.units)] if keep is not None else [0]
     if plan is not None:
-        held += [len(plan.units), len(plan.wholes), len(plan.refused)]
+        held += [len(plan.wholes), len(plan.refused)]
     return tuple(held)
 
 
@@ -1145,8 +1129,8 @@ def _rewind(keep: Parts | None, plan: CheckPlan | None, marks: tuple[int, ...]) 
     if keep is not None:
         del keep.units[marks[0] :]
     if plan is not None:
-        del plan.wholes[marks[2] :]
-        del plan.refused[marks[3] :]
+        del plan.wholes[marks[1] :]
+        del plan.refused[marks[2] :]
 
 
 def compositional_report(

@@ -33,12 +33,18 @@ from __future__ import annotations
 
 import copy
 import re
-from collections.abc import Iterator
 from typing import Any
 
 from fsmbt.model.errors import FsmbtError
 from fsmbt.model.fsm import FSM, State
-from fsmbt.model.fsm_data import ASSIGN, COND, DATAMODEL, ONEXIT, join_lines, parse_lines
+from fsmbt.model.fsm_data import (
+    ASSIGN,
+    DATAMODEL,
+    ONEXIT,
+    join_lines,
+    mentioned_names,
+    parse_lines,
+)
 from fsmbt.semantics.machine import FINAL, FSMLeafMachine
 
 _IDENT = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
@@ -54,22 +60,6 @@ class BlockUnsupported(Exception):
 def holds_parallel(state: State) -> bool:
     """Whether ``state`` is composite and its sub-machine holds a parallel state."""
     return len(state.regions) == 1 and any(s.is_parallel for s in state.regions[0].states.values())
-
-
-def _texts(machine: FSM, skip: State | None = None) -> Iterator[str]:
-    """Every guard, assignment and ``onexit`` text of ``machine`` and its sub-machines but
-    those of ``skip`` (its ``onexit`` and everything below it)."""
-    stack = [machine]
-    while stack:
-        current = stack.pop()
-        for t in current.transitions:
-            yield t.attrs.get(COND, "")
-            yield t.attrs.get(ASSIGN, "")
-        for state in current.states.values():
-            if state is skip:
-                continue
-            yield state.attrs.get(ONEXIT, "")
-            stack.extend(state.regions)
 
 
 def _written(machine: FSM) -> set[str]:
@@ -93,13 +83,8 @@ class ParallelBlock:
     def __init__(self, fsm: FSM, state: State, declared: set[str]) -> None:
         self.state = state
         self.sub = state.regions[0]
-        inside: set[str] = set()
-        for text in _texts(self.sub):
-            inside.update(w for w in _IDENT.findall(text) if w in declared)
-        outside: set[str] = set()
-        for text in _texts(fsm, skip=state):
-            outside.update(w for w in _IDENT.findall(text) if w in declared)
-        shared = inside & outside
+        inside = mentioned_names(self.sub, declared)
+        shared = inside & mentioned_names(fsm, declared, skip=state)
         if shared:
             raise BlockUnsupported(
                 f"state {state.name}: variable {sorted(shared)[0]} is read or written outside it"
