@@ -9,8 +9,9 @@ under a decorator, a tenth of the controls Parallel), converted per node; each m
 ``tests/support/pernode_mutants.mutate`` (one transition of the first per-node sub-machine
 retargeted, its guard dropped, or one assignment dropped or changed), drawn from
 ``random.Random(seed)``. Each is given to ``verify`` with ``--limit`` seconds (SIGALRM):
-the verdict, its method, and whether a proof of equivalence set dead code aside (nodes the
-tree never ticks skipped per node, or a region never ticked). ``undecided`` counts the
+the verdict, its method, and the rules past the plain check that decided it (``_kind``: dead
+code set aside - nodes the tree never ticks skipped per node, or a region never ticked -,
+transitions no local check follows, stages that never go on; random runs for a refutation). ``undecided`` counts the
 mutants past the limit or stopped by a state limit. Why: the single mutant row of
 ``bench_reactive.py --pernode`` showed one pair; this counts a sample, so a change to what
 the checker decides shows as numbers, before and after.
@@ -47,11 +48,20 @@ def _alarm(_signum, _frame):  # type: ignore[no-untyped-def]
 
 
 def _kind(report) -> str:  # type: ignore[no-untyped-def]
-    """The verdict, its method and, for a proof, whether dead code was set aside."""
+    """The verdict, its method and the rules past the plain check that decided it: for a
+    proof, dead code set aside, transitions no local check follows, stages that never go on;
+    for a refutation, random runs."""
     if not report.equivalent:
-        return f"NOT EQUIVALENT ({report.method})"
-    dead = report.stats.get("regions_never_ticked") or report.stats.get("per_node_unticked")
-    return f"EQUIVALENT ({report.method}{', dead code set aside' if dead else ''})"
+        walked = any("random runs" in a for a in report.abstractions)
+        return f"NOT EQUIVALENT ({report.method}{', random runs' if walked else ''})"
+    rules = []
+    if report.stats.get("regions_never_ticked") or report.stats.get("per_node_unticked"):
+        rules.append("dead code set aside")
+    if report.stats.get("per_node_unfired"):
+        rules.append("unfired")
+    if report.stats.get("never_go_on"):
+        rules.append("stages")
+    return f"EQUIVALENT ({', '.join([report.method, *rules])})"
 
 
 def main() -> int:

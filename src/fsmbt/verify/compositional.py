@@ -53,7 +53,7 @@ import copy
 import re
 import time
 from collections import deque
-from collections.abc import Hashable, Iterable, Sequence
+from collections.abc import Hashable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -74,9 +74,10 @@ from fsmbt.semantics.nodes import (
     canonical_type,
 )
 from fsmbt.semantics.status import LeafOutcome, NodeStatus, RootResult
-from fsmbt.verify.lift import lifted_region_report, lifted_report, whole_tree
+from fsmbt.verify.lift import lifted_region_report, lifted_report, walked_report, whole_tree
 from fsmbt.verify.lower_bound import LowerBound, lower_bound
 from fsmbt.verify.method import PER_NODE_SENTENCE
+from fsmbt.verify.narrow import StagesNeverGoingOn
 from fsmbt.verify.native import DEFAULT_MAX_STATES, StateLimitError, check, check_witnessed
 from fsmbt.verify.pernode import (
     NODE_ATTR,
@@ -660,6 +661,7 @@ def decompose(
     plan: CheckPlan | None = None,
     unticked: frozenset[int] = frozenset(),
     whole: frozenset[int] = frozenset(),
+    stages: dict[int, StagesNeverGoingOn] | None = None,
 ) -> Decomposition:
     """Run the three parts of the compositional check (module docstring); with ``keep``, each
     part's witness is appended to it (for a certificate: the parts' tables stay alive); with
@@ -668,6 +670,11 @@ def decompose(
     ``whole``: tree regions (indices of ``Structure.regions``) checked whole even when written
     per node (their per-node check failed and no run to the failure was lifted: a small
     region's whole check decides, and proves it where the per-node abstraction cannot).
+
+    ``stages``: per tree region, the stages proven never to go on inside it
+    (``verify/narrow.py``), which its per-node check is told, and where a failure past a broken
+    entry condition that the lift does not reach adds more (``_past_stages``); ``None``: not
+    used (a certificate or a plan, which list what was checked).
 
     ``unticked``: tree regions (indices of ``Structure.regions``) proven never ticked in the
     whole tree (``tickable.stage_never_passes``): not checked, each standing in the skeleton
@@ -726,7 +733,10 @@ def decompose(
                 f"{name}: checked whole, its per-node check fails and no run was lifted"
             )
         else:
-            per_node = _per_node(regions[k], region.machine, shape.declared, outcome, local, units)
+            told = None if stages is None or k not in stages else stages[k].never
+            per_node = _per_node(
+                regions[k], region.machine, shape.declared, outcome, local, units, told
+            )
         candidate: PerNodeOutcome | None = None
         if per_node is not None and per_node.tolerated is not None:
             # a failure past a broken entry condition (``check_region``'s ``tolerate``) is
@@ -737,6 +747,26 @@ def decompose(
             outcome.stats.setdefault("per_node_refused", []).append(candidate.tolerated)
             if len(region.machine.states) > WHOLE_FIRST:
                 if _use_candidate(source, result, regions[k], candidate, outcome, name):
+                    if plan is not None and units is not None:
+                        plan.units.append((name, units))
+                    return outcome
+                if stages is not None and candidate.tree is not None:
+                    known = stages.setdefault(k, StagesNeverGoingOn(candidate.tree))
+                    per_node, lifted = _past_stages(
+                        (source, result),
+                        regions[k],
+                        region.machine,
+                        shape.declared,
+                        candidate,
+                        outcome,
+                        known,
+                        name,
+                    )
+                    if lifted:
+                        return outcome
+                if per_node is None and _use_walk(
+                    source, result, regions[k], candidate, outcome, name
+                ):
                     if plan is not None and units is not None:
                         plan.units.append((name, units))
                     return outcome
@@ -863,26 +893,86 @@ def _per_node(
     outcome: Decomposition,
     keep: list[LocalWitness] | None = None,
     units: list[LocalUnit] | None = None,
+    never: Mapping[int, frozenset[int]] | None = None,
 ) -> PerNodeOutcome | None:
     """The per-node check of one region (``verify/pernode.py``) when its machine is tagged
     per node and decomposes; ``None``: check the region whole. With ``keep``, the distinct
     local checks' witnesses are appended (for a certificate); with ``units``, the distinct
-    local checks (for NuSMV)."""
+    local checks (for NuSMV); ``never``: statuses stages are proven never to return
+    (``verify/narrow.py``)."""
     if not _tagged_per_node(machine):
         return None
     try:
-        found = check_region(region_root, machine, declared, keep, units, tolerate=True)
+        found = check_region(
+            region_root, machine, declared, keep, units, tolerate=True, never=never
+        )
     except NotPerNode as exc:
         outcome.stats.setdefault("per_node_refused", []).append(str(exc))
         return None
-    outcome.stats["per_node_regions"] = outcome.stats.get("per_node_regions", 0) + 1
-    outcome.stats["per_node_nodes"] = outcome.stats.get("per_node_nodes", 0) + found.nodes
-    outcome.stats["per_node_distinct"] = outcome.stats.get("per_node_distinct", 0) + found.distinct
-    outcome.stats["per_node_local_states"] = (
-        outcome.stats.get("per_node_local_states", 0) + found.local_states
-    )
-    outcome.stats["per_node_unticked"] = outcome.stats.get("per_node_unticked", 0) + found.unticked
+    _tally(outcome.stats, found, 1)
     return found
+
+
+def _tally(stats: dict[str, Any], found: PerNodeOutcome, sign: int) -> None:
+    """Count (``sign`` 1) or take back (-1) one region's per-node check in ``stats``."""
+    for key, value in (
+        ("per_node_regions", 1),
+        ("per_node_nodes", found.nodes),
+        ("per_node_distinct", found.distinct),
+        ("per_node_local_states", found.local_states),
+        ("per_node_unticked", found.unticked),
+        ("per_node_unfired", found.unfired),
+    ):
+        stats[key] = stats.get(key, 0) + sign * value
+
+
+#: Most rounds of stage proofs one region's per-node check takes (``_past_stages``).
+STAGE_ROUNDS = 3
+#: Most stages one region may have proven never to go on (each proof costs a search and a
+#: pass of ``decompose``).
+MAX_STAGES = 8
+#: What a verdict says when a stage's proof made nodes dead.
+NEVER_GO_ON_SENTENCE = (
+    "stages that never go on: a node whose local check failed and that no lifted run reached "
+    "is skipped when an earlier sibling on its path, run alone exhaustively, never returns "
+    "what its parent goes on with; the parent is then offered only what that sibling can "
+    "return (docs/semantics.md §4d, 'Children that never go on')"
+)
+
+
+def _past_stages(
+    pair: tuple[BTDocument, FSM],
+    region_root: BTNode,
+    machine: FSM,
+    declared: dict[str, str],
+    failed: PerNodeOutcome,
+    outcome: Decomposition,
+    stages: StagesNeverGoingOn,
+    name: str,
+) -> tuple[PerNodeOutcome | None, bool]:
+    """A per-node failure no run reaches (the lift found none): prove stages on the failing
+    nodes' paths never go on (``verify/narrow.py``; docs/semantics.md §4d, "Children that
+    never go on") and check the region again knowing it, up to ``STAGE_ROUNDS`` rounds. The
+    answer: the last check (proven, or failing with its side conditions intact: the caller's
+    rules go on from it; a failure past a broken entry condition is lifted first, and when
+    it is, the second item is True and ``outcome`` is that NOT EQUIVALENT), or ``None``: no
+    stage proven, or the check refused; the region is then checked whole as before."""
+    for _round in range(STAGE_ROUNDS):
+        if len(stages.never) >= MAX_STAGES or not stages.add_for(failed.seen):
+            return None, False
+        _tally(outcome.stats, failed, -1)  # counted again as the new check
+        try:
+            found = check_region(region_root, machine, declared, tolerate=True, never=stages.never)
+        except NotPerNode as exc:
+            outcome.stats.setdefault("per_node_refused", []).append(str(exc))
+            return None, False
+        _tally(outcome.stats, found, 1)
+        if found.tolerated is None:
+            return found, False
+        if _use_candidate(*pair, region_root, found, outcome, name):
+            return None, True
+        failed = found
+    return None, False
 
 
 def _use_candidate(
@@ -901,6 +991,29 @@ def _use_candidate(
         report = lifted_report(source, result, region, failed)
     except FsmbtError:
         return False
+    if report is None:
+        return False
+    report.stats["lift_seconds"] = round(time.perf_counter() - started, 6)
+    outcome.lifted = report
+    outcome.equivalent = False
+    outcome.failed_region = f"{name}, node {failed.failed}"
+    outcome.per_node_failure = (region, failed)
+    return True
+
+
+def _use_walk(
+    source: BTDocument,
+    result: FSM,
+    region: BTNode,
+    failed: PerNodeOutcome,
+    outcome: Decomposition,
+    name: str,
+) -> bool:
+    """Seeded random runs when no planned drive reached ``failed`` (``lift.walked_report``):
+    when one separates the two whole machines, ``outcome`` is that NOT EQUIVALENT and the
+    answer is True; else False (nothing claimed)."""
+    started = time.perf_counter()
+    report = walked_report(source, result, f"node {failed.failed}")
     if report is None:
         return False
     report.stats["lift_seconds"] = round(time.perf_counter() - started, 6)
@@ -1156,6 +1269,9 @@ def compositional_report(
     #: check gives up (a limit), the rules below go on from that failure
     pending: tuple[int, Decomposition] | None = None
     never: _NeverTicked | None = None
+    # stages proven never to go on, per region (verify/narrow.py); not for a certificate or
+    # a plan, which list what was checked
+    stages: dict[int, StagesNeverGoingOn] | None = {} if keep is None and plan is None else None
     while True:
         marks = _marks(keep, plan)
         try:
@@ -1169,6 +1285,7 @@ def compositional_report(
                 plan=plan,
                 unticked=frozenset(unticked),
                 whole=frozenset(whole),
+                stages=stages,
             )
         except (NotDecomposable, FsmbtError) as exc:
             if pending is None:
@@ -1200,6 +1317,15 @@ def compositional_report(
             tried.add(k)
             pending = (k, found)
             continue
+        # no run found to a per-node failure: a stage on its path that never goes on makes it
+        # dead; the check runs again knowing it (docs/semantics.md §4d, "Children that never
+        # go on")
+        if stages is not None and k is not None and found.per_node_failure is not None:
+            failed = found.per_node_failure[1]
+            if failed.tree is not None:
+                known = stages.setdefault(k, StagesNeverGoingOn(failed.tree))
+                if len(known.never) < MAX_STAGES and known.add_for(failed.seen):
+                    continue
         # no run found to the failure: a region the whole tree never ticks is no difference
         # (docs/semantics.md §4c, "Regions never ticked"); not for a certificate or a plan,
         # which list what was checked
@@ -1211,6 +1337,13 @@ def compositional_report(
             if len(unticked) < MAX_UNTICKED and never.region(found):
                 unticked.add(k)
                 continue
+        # no rule sets the failure aside and no planned drive reached it: seeded random runs
+        # may still (a real counterexample when one separates the machines); in a large region
+        # only - a small one's whole product is cheap and gives a shortest counterexample
+        if found.per_node_failure is not None and not found.failed_small:
+            walked = walked_report(source, result, found.failed_region or "a region")
+            if walked is not None:
+                return walked, ""
         return None, f"{FAILED_PART} {found.failed_region} fails"
     seconds = time.perf_counter() - started
     report = Report(engine="native", source="source", result="result", mode=LEAF_EXECUTION)
@@ -1235,6 +1368,12 @@ def compositional_report(
                 if found.stats.get("per_node_unticked")
                 else ""
             )
+            + (
+                f", {found.stats['per_node_unfired']} transitions no local check follows left "
+                "out of the entry condition"
+                if found.stats.get("per_node_unfired")
+                else ""
+            )
             + ")"
         )
         for name in PROPERTIES:
@@ -1245,6 +1384,13 @@ def compositional_report(
             f"; {len(whole)} region(s) written per node checked whole (their per-node check "
             "failed and no run to the failure was lifted)"
         )
+        for name in PROPERTIES:
+            report.properties[name] = PropertyResult(name, True, detail)
+    proofs = [proof for known in (stages or {}).values() for proof in known.proofs]
+    if proofs:
+        report.stats["never_go_on"] = proofs
+        detail += "; nodes behind a stage that never goes on skipped: " + "; ".join(proofs)
+        report.abstractions.append(NEVER_GO_ON_SENTENCE)
         for name in PROPERTIES:
             report.properties[name] = PropertyResult(name, True, detail)
     if never is not None and found.stats.get("regions_never_ticked"):

@@ -38,6 +38,7 @@ from __future__ import annotations
 import copy
 import heapq
 import itertools
+import random
 import time
 from collections import deque
 from collections.abc import Sequence
@@ -64,6 +65,7 @@ from fsmbt.verify.lazy_fsm import LazyDataMachine, Unsupported
 from fsmbt.verify.native import Replay, replay
 from fsmbt.verify.pairing import LEAF_EXECUTION
 from fsmbt.verify.pernode import PerNodeOutcome
+from fsmbt.verify.random_walk import SEED, WALK_BUDGET, WALK_LEAVES, walk_inputs
 from fsmbt.verify.report import (
     COMPLETENESS,
     COMPOSITIONAL_LIFTED,
@@ -491,6 +493,37 @@ def lifted_report(
     if best is None:
         return None
     return _confirmed(source, result, best[0], best[1], PER_NODE_LIFTED, LIFTED_SENTENCE)
+
+
+WALKED_SENTENCE = (
+    "per node, random runs: a part of the compositional check failed (a node's local check "
+    "or a region's) and no planned drive reached the failure; "
+    "seeded random leaf outcomes from the root were replayed on the two whole machines until "
+    "one run told them apart (verify/random_walk.py; a real counterexample, cut at the first "
+    "difference and shortened, not always a shortest one)"
+)
+
+
+def walked_report(source: BTDocument, result: FSM, what: str) -> Report | None:
+    """NOT EQUIVALENT with the first seeded random run that separates the two whole machines
+    (``verify/random_walk.py``), confirmed and shortened as a lifted counterexample, or
+    ``None``: no run does (nothing is claimed). ``what``: the failing node, for the details."""
+    try:
+        machines = lift_machines(source, result)
+    except Unsupported:
+        return None
+    rng = random.Random(SEED)
+    spent = 0
+    while spent < WALK_BUDGET:
+        try:
+            inputs = walk_inputs(machines[0], rng, WALK_LEAVES)
+            cut = separating_prefix(*machines, inputs)
+        except (Unsupported, FsmbtError):
+            return None
+        if cut is not None:
+            return _confirmed(source, result, cut, what, PER_NODE_LIFTED, WALKED_SENTENCE)
+        spent += max(len(inputs), 1)
+    return None
 
 
 def lifted_region_report(

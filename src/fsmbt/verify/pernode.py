@@ -69,7 +69,7 @@ from __future__ import annotations
 import itertools
 import re
 from collections import deque
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -131,6 +131,9 @@ class PerNodeOutcome:
     local_states: int = 0
     #: live nodes of the machine the tree never ticks (``tickable.never_ticked``): not checked
     unticked: int = 0
+    #: live transitions no local check follows, left out of the entry condition
+    #: (``_past_unfired``; 0: the rule was not needed)
+    unfired: int = 0
     failed: str | None = None
     stats: dict[str, Any] = field(default_factory=dict)
     #: the failing node's id in ``tree`` (the region after the same-type merge), and the local
@@ -147,6 +150,8 @@ class PerNodeOutcome:
     more: Iterator[tuple[str, int, list[tuple[int | None, Any]]]] = field(
         default_factory=lambda: iter(())
     )
+    #: the failures met so far: the first, then each ``more`` gave
+    seen: list[tuple[str, int, list[tuple[int | None, Any]]]] = field(default_factory=list)
     #: the entry side condition the region broke when the check ran with ``tolerate`` and
     #: failed (a stray jump into a subtree): the failure is then only a candidate, which
     #: the caller must confirm by the lift's replay or check the region whole
@@ -219,7 +224,12 @@ class _Region:
     whose source is a state of one is *dead*: conditions 2 and 3 are not asked of it (the live
     checks prove that the machine never enters such a state, docs/semantics.md §4d, "Dead
     nodes", so a dead transition never fires; a one-transition change there, even a jump into
-    the middle of another subtree, is no difference)."""
+    the middle of another subtree, is no difference).
+
+    ``unfired``: transitions (``id``) that no local check of an earlier walk followed
+    (``check_region``'s second walk, docs/semantics.md §4d, "Transitions no local check
+    fires"): condition 2 is not asked of them, and a stray jump of one is not recorded as
+    broken (the walk checks again that none of them is followed)."""
 
     def __init__(
         self,
@@ -228,10 +238,12 @@ class _Region:
         declared: dict[str, str],
         tolerate: bool = False,
         unticked: frozenset[int] = frozenset(),
+        unfired: frozenset[int] = frozenset(),
     ) -> None:
         self.tree = tree
         self.tolerate = tolerate
         self.unticked = unticked
+        self.unfired = unfired
         self.broken: list[str] = []
         self.nodes = tree.nodes
         self.machine = machine
@@ -340,7 +352,7 @@ class _Region:
         met: dict[int, dict[str, int]] = {}  # node -> state entered from outside -> times
         for transitions in self.out.values():
             for t in transitions:
-                if t.target not in self.tag or self.dead(t):
+                if t.target not in self.tag or self.dead(t) or id(t) in self.unfired:
                     continue
                 x: int | None = self.tag[t.target]
                 while x is not None:  # every node whose subtree the transition enters
@@ -407,6 +419,9 @@ class _Local:
     #: exits that are stray jumps into the node's subtree (``_Region``'s ``tolerate``): no
     #: status pairs with one, so a local check reaching one fails
     strays: frozenset[int] = frozenset()
+    #: the machine's name of each state of ``states`` (not in the key: equal problems of two
+    #: nodes differ only in names), to map a followed arm back to its transition
+    state_names: tuple[str, ...] = ()
 
 
 def _local(region: _Region, node: CompiledNode, interfaces: dict[int, Interface]) -> _Local:
@@ -430,7 +445,7 @@ def _local(region: _Region, node: CompiledNode, interfaces: dict[int, Interface]
     def outside_id(value: Any) -> int:
         return outside_ids.setdefault(value, len(outside_ids))
 
-    def target_of(name: str, entering: bool = False) -> tuple[str, int]:
+    def target_of(name: str, entering: bool = False, unfired: bool = False) -> tuple[str, int]:
         if name == root_entry and not entering:
             return ("exit", outside_id(("t", name)))  # the root's RUNNING: the next tick
         if name in child_of_entry:
@@ -441,6 +456,8 @@ def _local(region: _Region, node: CompiledNode, interfaces: dict[int, Interface]
                 order.append(name)
             return ("state", state_ids[name])
         if region.inside(name, node.id):
+            if unfired:  # proven not followed by the walk itself (``_Region.unfired``)
+                return ("exit", outside_id(("stray", name)))
             message = f"a transition of {node.label} enters a child not at its entry"
             if not region.tolerate:
                 raise NotPerNode(message)
@@ -449,7 +466,11 @@ def _local(region: _Region, node: CompiledNode, interfaces: dict[int, Interface]
         return ("exit", outside_id(("t", name)))
 
     def hop(
-        cond_text: str, pairs: list[tuple[str, str]], target: str, entering: bool = False
+        cond_text: str,
+        pairs: list[tuple[str, str]],
+        target: str,
+        entering: bool = False,
+        unfired: bool = False,
     ) -> _Hop:
         for word in _IDENT.findall(cond_text):
             if word in own:
@@ -485,7 +506,7 @@ def _local(region: _Region, node: CompiledNode, interfaces: dict[int, Interface]
             tuple(fns),
             frozenset(halted),
             (outside_id(("a", tuple(outside))),) if outside else (),
-            target_of(target, entering),
+            target_of(target, entering, unfired),
         )
 
     def shape(h: _Hop) -> tuple[Any, ...]:
@@ -504,7 +525,15 @@ def _local(region: _Region, node: CompiledNode, interfaces: dict[int, Interface]
     while len(states) < len(order):
         name = order[len(states)]
         states.append(
-            [hop(t.attrs.get(COND, ""), region.assigns[id(t)], t.target) for t in region.out[name]]
+            [
+                hop(
+                    t.attrs.get(COND, ""),
+                    region.assigns[id(t)],
+                    t.target,
+                    unfired=id(t) in region.unfired,
+                )
+                for t in region.out[name]
+            ]
         )
     for var in sorted(own):  # read by a guard, so named above; kept total for safety
         names.setdefault(var, f"v{len(names)}")
@@ -525,16 +554,19 @@ def _local(region: _Region, node: CompiledNode, interfaces: dict[int, Interface]
         tuple(sorted(strays)),
     )
     exits = {cid: value for value, cid in outside_ids.items()}
-    return _Local(key, entry, states, children, halt, initial, halting, exits, strays)
+    return _Local(key, entry, states, children, halt, initial, halting, exits, strays, tuple(order))
 
 
 # -- the local product ---------------------------------------------------------------------------
 class _FsmSide:
     """The fragment as a machine: configuration = (position, own values, children that
-    returned RUNNING last); position ``None`` between ticks, ``i`` at child i."""
+    returned RUNNING last); position ``None`` between ticks, ``i`` at child i. With ``fired``,
+    each arm followed is added to it as ``("state", state index, arm index)`` (what
+    ``check_region``'s second walk maps back to transitions)."""
 
-    def __init__(self, local: _Local) -> None:
+    def __init__(self, local: _Local, fired: set[tuple[Any, ...]] | None = None) -> None:
         self.local = local
+        self.fired = fired
 
     def resolve(self, hop: _Hop, values: dict[str, Any], running: set[int]) -> tuple[Any, Any]:
         """Follow ``hop`` and the eventless hops after it (updating ``values`` and
@@ -561,9 +593,11 @@ class _FsmSide:
                 exit_ = ("exit", (where, tuple(outside)))
                 return None, (frozenset(halted), exit_, frozenset(touched))
             env = dict(values)
-            for arm in self.local.states[where]:
+            for index, arm in enumerate(self.local.states[where]):
                 if arm.cond is None or arm.cond(env):
                     hop = arm
+                    if self.fired is not None:
+                        self.fired.add(("state", where, index))
                     break
             else:  # the last arm is unguarded (checked when grouping)
                 raise NotPerNode("a transient state has no enabled transition")
@@ -611,6 +645,7 @@ def _check_local(
     with_halt: bool,
     rows: tuple[Rows, Rows] | None = None,
     dead: frozenset[int] = frozenset(),
+    fired: set[tuple[Any, ...]] | None = None,
 ) -> tuple[bool, dict[int, Any], int, list[tuple[int | None, Any]], list[Any]]:
     """The lockstep product of the two sides (module docstring). ``haltable``: the children
     whose own check held with ``halt`` offered (any halt of another child fails this one);
@@ -619,9 +654,12 @@ def _check_local(
 
     With ``rows``, each side's steps are recorded there (state -> input -> (next state, raw
     outputs), the input named as ``local_machines`` name it), once per side state: the
-    transitions a certificate lists (``_witness_of``), so no second search is needed."""
+    transitions a certificate lists (``_witness_of``), so no second search is needed.
+
+    With ``fired``, every hop the fragment follows is added to it: ``("state", s, a)`` for
+    arm ``a`` of state ``s``, ``("child", i, status)`` for child i's interface hop."""
     bt = _BtSide(abstract_tree(node, [RUNNING in a for a in allowed]))
-    fsm = _FsmSide(local)
+    fsm = _FsmSide(local, fired)
     never = frozenset(range(len(allowed))) - haltable
     pairing: dict[int, Any] = {}
     start: tuple[Any, Any] = ((bt.interp.initial(), None), (None, local.initial, frozenset()))
@@ -693,6 +731,8 @@ def _check_local(
                     bt_next, bt_out = bt.run(snap, symbol)
                     assert position is not None
                     hop = local.children[position][symbol]
+                    if fired is not None:
+                        fired.add(("child", position, symbol))
                     running.discard(position)
                     if symbol == RUNNING:
                         running.add(position)
@@ -908,7 +948,13 @@ class NodeWalk:
     """
 
     def __init__(
-        self, region_root: BTNode, machine: FSM, declared: dict[str, str], tolerate: bool = False
+        self,
+        region_root: BTNode,
+        machine: FSM,
+        declared: dict[str, str],
+        tolerate: bool = False,
+        unfired: frozenset[int] = frozenset(),
+        never: Mapping[int, frozenset[int]] | None = None,
     ) -> None:
         try:
             # the same-type merge of plain Sequence/Fallback children (docs/semantics.md §4d,
@@ -917,11 +963,30 @@ class NodeWalk:
             self.tree = CompiledTree(BTDocument.single(merged))
         except FsmbtError as exc:
             raise NotPerNode(str(exc)) from None
+        #: statuses nodes of ``tree`` (ids) are proven never to return (``narrow.py``): their
+        #: parents' checks are offered only the others, and what those never tick is dead
+        self.never: Mapping[int, frozenset[int]] = never or {}
         #: the nodes no run of the tree ticks (``tickable.never_ticked``: from the tree alone)
-        self.unticked = never_ticked(self.tree)
-        self.region = _Region(self.tree, machine, declared, tolerate, self.unticked)
+        self.unticked = never_ticked(self.tree, self.never)
+        self.region = _Region(self.tree, machine, declared, tolerate, self.unticked, unfired)
         self.interfaces: dict[int, Interface] = {}
         self.haltable: set[int] = set()
+        #: the transitions (``id``) a local check decided so far followed (``followed``)
+        self.fired: set[int] = set()
+
+    def followed(self, problem: LocalProblem, hops: set[tuple[Any, ...]]) -> None:
+        """Record the transitions ``problem``'s check followed, from its canonical hops
+        (``_check_local``'s ``fired``; equal problems share them): an arm of one of the
+        node's states, or a leaf child's transition on the status it returned (a control
+        child's interface is its own fragment's, recorded by its own check)."""
+        region, node = self.region, problem.node
+        for kind, at, which in hops:
+            if kind == "state":
+                self.fired.add(id(region.out[problem.local.state_names[at]][which]))
+                continue
+            leaf = region.leaf_state.get(node.children[at])
+            if leaf is not None:
+                self.fired.update(id(t) for t in region.out[leaf] if t.event == EVENTS[which])
 
     def problems(self) -> Iterator[LocalProblem]:
         region, interfaces = self.region, self.interfaces
@@ -943,7 +1008,10 @@ class NodeWalk:
                 self.haltable.add(node.id)  # a leaf's halt is its halt hook: nothing is kept
                 continue
             local = _local(region, node, interfaces)
-            allowed = [sorted(interfaces[c]) for c in node.children]
+            allowed = [
+                sorted(s for s in interfaces[c] if s not in self.never.get(c, ()))
+                for c in node.children
+            ]
             halts = frozenset(i for i, c in enumerate(node.children) if c in self.haltable)
             dead = frozenset(i for i, c in enumerate(node.children) if c in self.unticked)
             key = (
@@ -1019,6 +1087,7 @@ def check_region(
     keep: list[LocalWitness] | None = None,
     units: list[LocalUnit] | None = None,
     tolerate: bool = False,
+    never: Mapping[int, frozenset[int]] | None = None,
 ) -> PerNodeOutcome:
     """Check ``machine`` (a region state's sub-machine, tagged per node) against the region
     headed by ``region_root``, node by node (the module docstring). With ``keep``, each
@@ -1041,7 +1110,7 @@ def check_region(
     Raises:
         NotPerNode: the machine is not a valid per-node decomposition of this region.
     """
-    walk = NodeWalk(region_root, machine, declared, tolerate)
+    walk = NodeWalk(region_root, machine, declared, tolerate, never=never)
     outcome = PerNodeOutcome(equivalent=True, nodes=len(walk.tree.nodes))
     outcome.unticked = sum(1 for n in walk.unticked if n in walk.region.entry)
     failures = _failures(walk, outcome, keep, units)
@@ -1049,16 +1118,70 @@ def check_region(
     if first is not None:
         outcome.equivalent = False
         outcome.failed, outcome.failed_id, outcome.trace = first
-        outcome.tree, outcome.more = walk.tree, itertools.islice(failures, MAX_FAILURES - 1)
+        outcome.seen = [first]
+        outcome.tree = walk.tree
+        outcome.more = _remembered(itertools.islice(failures, MAX_FAILURES - 1), outcome.seen)
         outcome.tolerated = walk.region.broken[0] if walk.region.broken else None
         return outcome
     if walk.region.broken:
-        raise NotPerNode(walk.region.broken[0])
+        if keep is not None or units is not None:  # a certificate or a plan: not this rule
+            raise NotPerNode(walk.region.broken[0])
+        walk = _past_unfired(region_root, machine, declared, walk, outcome)
     outcome.results = walk.root_results()
     return outcome
 
 
+#: Most walks ``_past_unfired`` makes before it refuses (each one grows the followed set).
+UNFIRED_WALKS = 4
+
+
+def _past_unfired(
+    region_root: BTNode,
+    machine: FSM,
+    declared: dict[str, str],
+    walk: NodeWalk,
+    outcome: PerNodeOutcome,
+) -> NodeWalk:
+    """A region that broke the entry condition (2) while no local check failed: walk again
+    with condition 2 not asked of the live transitions no local check followed
+    (``_Region.unfired``), until the walk follows none of them; that walk, its local checks
+    all held, is the proof (docs/semantics.md §4d, "Transitions no local check fires"). A
+    one-transition change guarded by a value its node never reaches, or out of a state its
+    node's fragment never reaches, jumps nowhere. Each walk may pick other entries, so it is
+    checked again whole; the followed set only grows, so the walks end. Cost: one walk
+    (``check_region``'s) per round, at most ``UNFIRED_WALKS``.
+
+    Raises:
+        NotPerNode: a walk fails a local check, breaks condition 2 with a followed
+            transition, or follows a transition it was told no check follows.
+    """
+    first = walk.region.broken[0]
+    followed = set(walk.fired)
+    live = {id(t) for t in machine.transitions if not walk.region.dead(t)}
+    for _round in range(UNFIRED_WALKS):
+        unfired = frozenset(live - followed)
+        again = NodeWalk(region_root, machine, declared, unfired=unfired, never=walk.never)
+        tally = PerNodeOutcome(equivalent=True)
+        if next(_failures(again, tally, None), None) is not None:
+            raise NotPerNode(f"{first}; walked again past what no check follows, a check fails")
+        if again.fired <= followed:
+            outcome.unfired = len(unfired)
+            outcome.distinct += tally.distinct
+            outcome.local_states += tally.local_states
+            return again
+        followed |= again.fired
+    raise NotPerNode(f"{first}; what no check follows did not settle in {UNFIRED_WALKS} walks")
+
+
 Failure = tuple[str, int, list[tuple[int | None, Any]]]
+
+
+def _remembered(items: Iterator[Failure], into: list[Failure]) -> Iterator[Failure]:
+    """``items``, each also appended to ``into`` as it is met (what a rule after the lift
+    reads: the failures the lift already asked for)."""
+    for item in items:
+        into.append(item)
+        yield item
 
 
 def _failures(
@@ -1080,13 +1203,15 @@ def _failures(
     memo: dict[tuple[Any, ...], tuple[bool, dict[int, Any], int, list[Any], bool]] = {}
     kept: dict[tuple[Any, ...], LocalWitness] = {}
     recorded: dict[tuple[Any, ...], LocalUnit] = {}
+    followed: dict[tuple[Any, ...], set[tuple[Any, ...]]] = {}
     failed = False
     try:
         for problem in walk.problems():
             node = problem.node
             found = memo.get(problem.key)
             if found is None:
-                found, witness = _decide(problem, keep is not None and not failed)
+                hops = followed[problem.key] = set()
+                found, witness = _decide(problem, keep is not None and not failed, hops)
                 memo[problem.key] = found
                 outcome.distinct += 1
                 outcome.local_states += found[2]
@@ -1113,6 +1238,7 @@ def _failures(
                 )
             if keep is not None and problem.key in kept:
                 kept[problem.key].nodes.append(node.path)
+            walk.followed(problem, followed[problem.key])
             walk.settle(problem, sigma_exits(problem.local, pairing), can_halt)
     except NotPerNode:
         if not failed:
@@ -1178,19 +1304,23 @@ def complete_walk(region_root: BTNode, machine: FSM, declared: dict[str, str]) -
 
 
 def _decide(
-    problem: LocalProblem, keeping: bool
+    problem: LocalProblem, keeping: bool, fired: set[tuple[Any, ...]] | None = None
 ) -> tuple[tuple[bool, dict[int, Any], int, list[Any], bool], LocalWitness | None]:
     """One distinct local check: with ``halt`` offered, else (proven for a node nobody halts,
     or not at all) without; (equivalent, σ, product states, local counterexample, with halt),
-    and, when ``keeping`` and it held, its witness built from the check's own steps."""
+    and, when ``keeping`` and it held, its witness built from the check's own steps. With
+    ``fired``, the hops the deciding run followed are added to it (``_check_local``)."""
     node, local = problem.node, problem.local
     for with_halt in (True, False):
         rows: tuple[Rows, Rows] | None = ({}, {}) if keeping else None
+        hops: set[tuple[Any, ...]] | None = set() if fired is not None else None
         equivalent, pairing, states, trace, pairs = _check_local(
-            local, node, problem.allowed, problem.halts, with_halt, rows, problem.dead
+            local, node, problem.allowed, problem.halts, with_halt, rows, problem.dead, hops
         )
         if equivalent or not with_halt:
             break
+    if fired is not None and hops is not None:
+        fired.update(hops)
     found = (equivalent, pairing, states, trace, with_halt)
     if rows is None or not equivalent:
         return found, None

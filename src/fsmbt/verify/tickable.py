@@ -41,6 +41,7 @@ those), so one child that never does is a proof too (searched the same way, recu
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from typing import Any
 
 from fsmbt.model.bt_nodes import NodeKind
@@ -100,22 +101,28 @@ def _shape(node: CompiledNode, kids: list[frozenset[int]]) -> tuple[Any, ...]:
     )
 
 
-def never_ticked(tree: CompiledTree) -> frozenset[int]:
+def never_ticked(
+    tree: CompiledTree, never: Mapping[int, frozenset[int]] | None = None
+) -> frozenset[int]:
     """The ids of ``tree``'s nodes no run of the tree ever ticks (the module docstring).
-    Iterative: children before parents (reverse pre-order), then parents before children."""
+    ``never``: statuses some nodes are proven never to return (``NeverReturns``, by their
+    standalone search), taken out of what the set abstraction says they may return, so their
+    parents' abstract runs see only what they can return. Iterative: children before parents
+    (reverse pre-order), then parents before children."""
+    never = never or {}
     returns: dict[int, frozenset[int]] = {}
     ticks: dict[int, frozenset[int]] = {}
     memo: dict[tuple[Any, ...], tuple[frozenset[int], frozenset[int]]] = {}
     for node in reversed(tree.nodes):
         if node.is_env_leaf and not node.children:
-            returns[node.id] = _leaf_returns(node)
+            returns[node.id] = _leaf_returns(node) - never.get(node.id, frozenset())
             continue
         kids = [returns[c] for c in node.children]
         key = _shape(node, kids)
         found = memo.get(key)
         if found is None:
             found = memo[key] = _run(node, kids)
-        returns[node.id] = found[0]
+        returns[node.id] = found[0] - never.get(node.id, frozenset())
         ticks[node.id] = frozenset(node.children[i] for i in found[1])
     dead: set[int] = set()
     for node in tree.nodes:  # pre-order: a parent before its children
