@@ -97,10 +97,10 @@ def main() -> int:
                 tally[kind] += 1
                 seconds.setdefault(kind, []).append(time.perf_counter() - started)
     total = sum(tally.values())
-    print(f"{'verdict':<62} {'mutants':>7} {'max s':>7}")
-    print("-" * 78)
+    print(f"{'verdict':<80} {'mutants':>7} {'max s':>7}")
+    print("-" * 96)
     for kind, count in tally.most_common():
-        print(f"{kind:<62} {count:>7} {max(seconds[kind]):>7.2f}")
+        print(f"{kind:<80} {count:>7} {max(seconds[kind]):>7.2f}")
     undecided = sum(c for k, c in tally.items() if k.startswith("undecided"))
     print(f"total: {total} mutants, {total - undecided} decided, {undecided} undecided")
     return 0

@@ -35,6 +35,7 @@ step (O(n·d) per micro step for n states of nesting depth d). Everything is ite
 
 from __future__ import annotations
 
+import operator
 import re
 from collections import deque
 from collections.abc import Sequence
@@ -917,6 +918,9 @@ class _Interpreter:
         #: once: a guard is asked again in every configuration with the same data)
         self.pure: dict[int, tuple[str, ...] | None] = {}
         self.memo: dict[tuple[int, tuple[object, ...], tuple[type, ...]], object] = {}
+        #: the value of each pure expression that reads no variable (a literal reset, the most
+        #: common assignment of a converted tree's halts), once it evaluated without error
+        self.constant: dict[int, object] = {}
         # the document's shape does not change while it runs: atomic/compound once per state
         self.is_atomic: list[bool] = [
             not any(self.s[c].kind != "history" for c in node.children) for node in self.s
@@ -986,9 +990,15 @@ class _Interpreter:
         return value is not _FAILED and scxml_expr.truthy(value)  # type: ignore[arg-type]
 
     def value(self, expr: scxml_expr.Expr, run: _Run, line: int | None) -> object:
-        """``expr``'s value in ``run``; ``_FAILED`` after raising ``error.execution``."""
-        reads = self.pure.get(id(expr), ())
-        if reads == ():
+        """``expr``'s value in ``run``; ``_FAILED`` after raising ``error.execution``. Pure
+        expressions are memoized by the values they read (a constant once), so the data
+        expansion evaluates each distinct case once."""
+        hit = self.constant.get(id(expr), _UNKNOWN)
+        if hit is not _UNKNOWN:
+            return hit
+        if id(expr) in self.pure:
+            reads = self.pure[id(expr)]
+        else:
             pure = scxml_expr.EVENT_NAME not in expr.names and all(
                 kind != "call" for kind, _item in expr.postfix
             )
@@ -1020,7 +1030,9 @@ class _Interpreter:
                 f"unsupported: '{expr.text}': {exc}, line {line}",
                 location=self.doc.ctx.location(line),
             ) from None
-        if key is not None:
+        if reads == ():
+            self.constant[id(expr)] = value
+        elif key is not None:
             self.memo[key] = value
         return value
 
@@ -1530,9 +1542,17 @@ def read_scxml_w3c(text: str, ctx: ReadContext) -> FSM:
         tuple[object, ...],  # invoked sessions (scxml_invoke.sessions_key)
     ]
 
+    varying = tuple(doc.plan.varying)
+    # the varying values of a run, in ``varying``'s order (one C-level call: a converted
+    # tree's region can have hundreds of variables, read once per configuration reached)
+    values_of = operator.itemgetter(*varying) if len(varying) > 1 else None
+
     def key_of(run: _Run) -> Key:
         hist = tuple(sorted(run.history.items())) if has_history else ()
-        data = tuple((n, run.data[n]) for n in doc.plan.varying)
+        if values_of is not None:
+            data = tuple(zip(varying, values_of(run.data), strict=True))
+        else:
+            data = tuple((n, run.data[n]) for n in varying)
         return (frozenset(run.config), hist, run.running, data, scxml_invoke.sessions_key(run))
 
     names: dict[Key, str] = {}
