@@ -208,7 +208,12 @@ def test_random_runs_refute_only_what_the_whole_product_refutes(
     random runs: a pair they refute is refuted by the whole product, and their counterexample
     separates the two whole machines when replayed."""
     monkeypatch.setattr(compositional, "WHOLE_FIRST", 0)
-    monkeypatch.setattr(compositional, "_use_candidate", lambda *_args: False)
+    planned_or_walked = compositional._use_candidate  # only the walk is left on
+    monkeypatch.setattr(
+        compositional,
+        "_use_candidate",
+        lambda *args, walk=False: walk and planned_or_walked(*args, walk=True),
+    )
     monkeypatch.setattr(compositional, "_lifted", lambda *_args: None)
     monkeypatch.setattr(compositional, "StagesNeverGoingOn", _NoStages)
     rng = random.Random(17)

@@ -764,8 +764,8 @@ def decompose(
                     )
                     if lifted:
                         return outcome
-                if per_node is None and _use_walk(
-                    source, result, regions[k], candidate, outcome, name
+                if per_node is None and _use_candidate(
+                    source, result, regions[k], candidate, outcome, name, walk=True
                 ):
                     if plan is not None and units is not None:
                         plan.units.append((name, units))
@@ -982,38 +982,21 @@ def _use_candidate(
     failed: PerNodeOutcome,
     outcome: Decomposition,
     name: str,
+    walk: bool = False,
 ) -> bool:
-    """Lift a per-node failure found past a broken entry condition; when its replay separates
-    the two whole machines, ``outcome`` is that NOT EQUIVALENT (``lifted``: the report) and
-    the answer is True; else (the lift does not separate them, or cannot run) False."""
+    """Lift a per-node failure found past a broken entry condition - by the planned drive
+    (``lift.lifted_report``), or with ``walk`` by seeded random runs when no drive reached it
+    (``lift.walked_report``); when the replay separates the two whole machines, ``outcome`` is
+    that NOT EQUIVALENT (``lifted``: the report) and the answer is True; else (no separation,
+    or the lift cannot run: nothing claimed) False."""
     started = time.perf_counter()
     try:
-        report = lifted_report(source, result, region, failed)
+        if walk:
+            report = walked_report(source, result, f"node {failed.failed}")
+        else:
+            report = lifted_report(source, result, region, failed)
     except FsmbtError:
         return False
-    if report is None:
-        return False
-    report.stats["lift_seconds"] = round(time.perf_counter() - started, 6)
-    outcome.lifted = report
-    outcome.equivalent = False
-    outcome.failed_region = f"{name}, node {failed.failed}"
-    outcome.per_node_failure = (region, failed)
-    return True
-
-
-def _use_walk(
-    source: BTDocument,
-    result: FSM,
-    region: BTNode,
-    failed: PerNodeOutcome,
-    outcome: Decomposition,
-    name: str,
-) -> bool:
-    """Seeded random runs when no planned drive reached ``failed`` (``lift.walked_report``):
-    when one separates the two whole machines, ``outcome`` is that NOT EQUIVALENT and the
-    answer is True; else False (nothing claimed)."""
-    started = time.perf_counter()
-    report = walked_report(source, result, f"node {failed.failed}")
     if report is None:
         return False
     report.stats["lift_seconds"] = round(time.perf_counter() - started, 6)
