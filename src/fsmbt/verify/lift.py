@@ -65,7 +65,7 @@ from fsmbt.verify.lazy_fsm import LazyDataMachine, Unsupported
 from fsmbt.verify.native import Replay, replay
 from fsmbt.verify.pairing import LEAF_EXECUTION
 from fsmbt.verify.pernode import PerNodeOutcome
-from fsmbt.verify.random_walk import SEED, WALK_BUDGET, WALK_LEAVES, walk_inputs
+from fsmbt.verify.random_walk import SEED, WALK_LEAVES, budget, walk_inputs
 from fsmbt.verify.report import (
     COMPLETENESS,
     COMPOSITIONAL_LIFTED,
@@ -513,8 +513,8 @@ def walked_report(source: BTDocument, result: FSM, what: str) -> Report | None:
     except Unsupported:
         return None
     rng = random.Random(SEED)
-    spent = 0
-    while spent < WALK_BUDGET:
+    spent, allowed = 0, budget(sum(1 for _ in source.nodes()))
+    while spent < allowed:
         try:
             inputs = walk_inputs(machines[0], rng, WALK_LEAVES)
             cut = separating_prefix(*machines, inputs)

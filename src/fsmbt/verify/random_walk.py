@@ -12,8 +12,9 @@ such a run. What they find is a real counterexample (the replay shows the two ma
 not find proves nothing, and the caller goes on as before.
 
 The walks are deterministic (``random.Random(SEED)``), so a verdict does not depend on the
-machine's load. Cost: at most ``WALK_BUDGET`` leaf outcomes in walks of at most ``WALK_LEAVES``,
-each stepped on the tree and replayed on both machines.
+machine's load. Cost: at most ``budget(nodes)`` leaf outcomes (``WALK_BUDGET``, less on trees past
+1 000 nodes) in walks of at most ``WALK_LEAVES``, each stepped on the tree and replayed on both
+machines.
 """
 
 from __future__ import annotations
@@ -28,6 +29,15 @@ from fsmbt.semantics.machine import Machine
 WALK_BUDGET = 20_000
 WALK_LEAVES = 200
 SEED = 27
+#: A step's cost grows with the tree (the interpreter's call stack, the result's active path):
+#: the budget shrinks past this many leaf outcomes x nodes (about 2 s here: 20 000 leaves of
+#: a 1 000-node tree; a 10 000-node tree gets 2 000), never below ``WALK_LEAVES`` x 5.
+WALK_WORK = 20_000_000
+
+
+def budget(nodes: int) -> int:
+    """The leaf outcomes one search gives a tree of ``nodes`` nodes."""
+    return max(5 * WALK_LEAVES, min(WALK_BUDGET, WALK_WORK // max(nodes, 1)))
 
 
 def walk_inputs(source: Machine[Any], rng: random.Random, length: int) -> list[str]:
