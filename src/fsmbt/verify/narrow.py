@@ -3,7 +3,8 @@
 
 Why: the per-node check offers each child every status its own local check pairs, so a node
 after a stage that can never go on (a ``ReactiveFallback`` whose two children can each fail but
-never in the same tick, under a ``Sequence``) is still checked, and a one-transition change
+never in the same tick, under a ``Fallback``: it never fails, so the next child is never
+ticked) is still checked, and a one-transition change
 there fails its local check although no run of the tree ever ticks it: the lift finds no run
 and the region was left to its whole product, which stops on large trees with memory. Here,
 for each failing node, the stages on its path (``approach.stages``: earlier siblings under a
