@@ -27,11 +27,9 @@ from pathlib import Path
 import pytest
 
 from fsmbt import limits
-from fsmbt.convert.bt_to_hfsm import bt_to_hfsm
 from fsmbt.convert.compress import inline_and_compress
 from fsmbt.model.bt import BTDocument, BTNode
 from fsmbt.model.bt_nodes import NodeKind
-from fsmbt.model.errors import FsmbtError
 from fsmbt.model.fsm import FSM
 from fsmbt.semantics.bt_interpreter import CompiledTree
 from fsmbt.verify import compositional, pernode
@@ -43,27 +41,23 @@ from fsmbt.verify.pernode import NODE_ATTR
 from fsmbt.verify.report import PER_NODE
 from fsmbt.verify.tickable import NeverReturns, never_ticked, stage_never_passes
 from support.pernode_mutants import BOUND, pernode_machine, whole
-from support.pernode_trees import pernode_tree
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))
 from bench_reactive import family_tree  # noqa: E402
-from test_ver_tickable import never_failing_in_one_tick, ticked_nodes  # noqa: E402
+from test_ver_tickable import (  # noqa: E402
+    never_failing_in_one_tick,
+    pernode_model,
+    sample,
+    ticked_nodes,
+)
 
 
 def _sample(count: int, seed: int) -> Iterator[tuple[BTDocument, FSM]]:
-    """Small trees (the per-node family and ``decorated``) written per node."""
-    rng = random.Random(seed)
-    for index in range(count):
-        if index % 2:
-            doc = pernode_tree(rng.randint(3, 8), seed * 1000 + index)
-        else:
-            doc = family_tree("decorated", rng.randint(4, 12), seed * 1000 + index)
-        try:
-            with limits.changed(conversion_max_states=BOUND):
-                model = bt_to_hfsm(doc, pernode=True, max_states=BOUND).model
-        except FsmbtError:
-            continue
-        if pernode_machine(model) is not None:
+    """``test_ver_tickable``'s small trees (the per-node family and ``decorated``) written per
+    node, those without a per-node sub-machine left out."""
+    for doc in sample(count, seed):
+        model = pernode_model(doc)
+        if model is not None and pernode_machine(model) is not None:
             yield doc, model
 
 
@@ -154,10 +148,8 @@ def test_a_stage_that_never_goes_on_sets_aside_only_what_the_whole_product_does(
     tally: Counter[str] = Counter()
     for index in range(45):
         doc = _behind_a_stage(5200 + 7 * index)
-        try:
-            with limits.changed(conversion_max_states=BOUND):
-                model = bt_to_hfsm(doc, pernode=True, max_states=BOUND).model
-        except FsmbtError:
+        model = pernode_model(doc)
+        if model is None:
             continue
         for mutant in _second_child_mutants(doc, model, rng):
             verdict = whole(doc, mutant)
